@@ -1,0 +1,42 @@
+# uvnav — set-up, main job, tests, benchmarks.  Every target creates .venv when missing.
+PYTHON ?= python3.11
+VENV   ?= .venv
+PY     := $(VENV)/bin/python
+# Extras installed by `make run` / `make test`; later chapters add theirs here (see docs/design-notes.md).
+RUN_EXTRAS  ?= prediction
+TEST_EXTRAS ?= prediction,test
+STAMP_RUN  := $(VENV)/.installed-run
+STAMP_TEST := $(VENV)/.installed-test
+
+.PHONY: run test bench lint clean venv
+
+$(PY):
+	$(PYTHON) -m venv $(VENV) || python3 -m venv $(VENV)
+	$(PY) -m pip install --quiet --upgrade pip setuptools wheel
+
+$(STAMP_RUN): pyproject.toml | $(PY)
+	$(PY) -m pip install --quiet -e ".[$(RUN_EXTRAS)]"
+	touch $@
+
+$(STAMP_TEST): pyproject.toml | $(PY)
+	$(PY) -m pip install --quiet -e ".[$(TEST_EXTRAS)]"
+	touch $@
+
+venv: $(STAMP_TEST)
+
+run: $(STAMP_RUN)
+	$(VENV)/bin/uvnav run
+
+test: $(STAMP_TEST)
+	$(PY) -m pytest -n 2 -q
+
+lint: $(STAMP_TEST)
+	$(VENV)/bin/ruff check src tests benchmarks
+	$(VENV)/bin/mypy
+	$(VENV)/bin/lint-imports
+
+bench: $(STAMP_RUN)
+	$(PY) benchmarks/run_benchmarks.py --out benchmarks/results
+
+clean:
+	rm -rf $(VENV) results report .pytest_cache .mypy_cache .ruff_cache

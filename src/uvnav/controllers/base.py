@@ -1,0 +1,158 @@
+"""Controller contract and registry (DESIGN §2).
+
+A controller is reset with the vehicle's limits, the goal and a generator, then asked for a command
+at every decision time with nothing but its :class:`~uvnav.sensors.Observation`.  Controllers are
+registered by versioned name (``zhang2019-v1``) with :func:`register`; third-party packages register
+theirs through the ``uvnav.controllers`` entry-point group (the entry point must resolve to a
+:class:`ControllerInfo` or to a controller class with a ``name`` attribute).
+
+Parameters are a frozen dataclass (``Params``) whose field docs carry units; ``make_controller`` builds
+it from keyword arguments and rejects unknown names with a clear message.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from collections.abc import Callable
+from dataclasses import dataclass
+from importlib.metadata import entry_points
+from typing import Any, ClassVar, Protocol, runtime_checkable
+
+import numpy as np
+
+from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
+from uvnav.sensors.observation import Observation
+
+
+@runtime_checkable
+class Controller(Protocol):
+    """A navigation law for the unicycle (the 2D contract; 3D vehicles add their own commands)."""
+
+    name: ClassVar[str]
+    #: True when the law reads ground truth it could not sense (DESIGN §2 "oracle").
+    oracle: bool
+
+    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None: ...
+
+    def act(self, obs: Observation) -> UnicycleCommand: ...
+
+    @property
+    def mode(self) -> str:
+        """Name of the current mode (``"M1"``, ``"M2"``, ...) for the mode-switch metric."""
+        ...
+
+
+@dataclass(frozen=True)
+class ControllerInfo:
+    """Registry entry: versioned name, factory, parameter dataclass and a one-line summary."""
+
+    name: str
+    factory: Callable[..., Controller]
+    params_type: type | None
+    summary: str
+    reference: str = ""
+    #: obstacles must be slower than the robot for the law's guarantees (thesis (2.6)).
+    requires_slower_obstacles: bool = False
+
+
+_REGISTRY: dict[str, ControllerInfo] = {}
+_ENTRY_POINTS_LOADED = False
+
+
+class UnknownControllerError(KeyError):
+    """Raised for a name that is not registered."""
+
+
+class ControllerParamsError(ValueError):
+    """Raised for unknown or invalid controller parameters."""
+
+
+def register(info: ControllerInfo) -> ControllerInfo:
+    """Add ``info`` to the registry (a later registration of the same name replaces it)."""
+    _REGISTRY[info.name] = info
+    return info
+
+
+def _load_entry_points() -> None:
+    global _ENTRY_POINTS_LOADED
+    if _ENTRY_POINTS_LOADED:
+        return
+    _ENTRY_POINTS_LOADED = True
+    for ep in entry_points(group="uvnav.controllers"):
+        obj = ep.load()
+        if isinstance(obj, ControllerInfo):
+            register(obj)
+        else:
+            register(ControllerInfo(name=ep.name, factory=obj, params_type=getattr(obj, "Params", None), summary=""))
+
+
+def available_controllers() -> dict[str, ControllerInfo]:
+    """All registered controllers by name (built-ins and entry points)."""
+    # import the built-in modules for their registration side effect
+    from uvnav.controllers import savkin_wang2013, straight, zhang2019  # noqa: F401
+
+    _load_entry_points()
+    return dict(sorted(_REGISTRY.items()))
+
+
+def controller_info(name: str) -> ControllerInfo:
+    ctrls = available_controllers()
+    if name not in ctrls:
+        raise UnknownControllerError(f"unknown controller {name!r}; known: {', '.join(ctrls)}")
+    return ctrls[name]
+
+
+def build_params(params_type: type | None, params: dict[str, Any]) -> Any:
+    """Instantiate the frozen parameter dataclass, with a one-line error for unknown/invalid fields."""
+    if params_type is None:
+        if params:
+            raise ControllerParamsError(f"takes no parameters, got {', '.join(params)}")
+        return None
+    fields = {f.name for f in dataclasses.fields(params_type)}
+    unknown = sorted(set(params) - fields)
+    if unknown:
+        raise ControllerParamsError(f"unknown parameter(s) {', '.join(unknown)}; known: {', '.join(sorted(fields))}")
+    try:
+        return params_type(**params)
+    except (TypeError, ValueError) as exc:
+        raise ControllerParamsError(str(exc)) from exc
+
+
+def make_controller(name: str, *, oracle: bool = False, **params: Any) -> Controller:
+    """Build a registered controller by name with keyword parameters.
+
+    Args:
+        name: versioned registry name, e.g. ``"zhang2019-v1"``.
+        oracle: let the controller read true obstacle velocities (the simulator then gives it
+            ground-truth rates even when sensing is configured as estimated).
+        **params: fields of the controller's ``Params`` dataclass.
+    """
+    info = controller_info(name)
+    p = build_params(info.params_type, params)
+    ctrl = info.factory(p) if info.params_type is not None else info.factory()
+    ctrl.oracle = oracle
+    return ctrl
+
+
+def params_dict(params: Any) -> dict[str, Any]:
+    """A parameter dataclass as a plain dict (for hashing and storage)."""
+    return dataclasses.asdict(params) if params is not None and dataclasses.is_dataclass(params) else {}
+
+
+def saturate(value: float, limit: float) -> float:
+    """Clip ``value`` to [-limit, limit]; NaN maps to 0."""
+    if not np.isfinite(value):
+        return 0.0
+    return float(min(max(value, -limit), limit))
+
+
+def heading_rate_toward(angle_error: float, u_max: float, period: float) -> float:
+    """Sliding-mode heading law with a boundary layer: ``u = U_max * sat(err / (U_max * period))``.
+
+    Outside the layer this is the thesis's bang-bang ``U_max * sign(err)`` (eq. (2.15)); inside it the
+    turn that cancels ``angle_error`` [rad] in one decision ``period`` [s], which removes the
+    chattering a sampled sign function produces (docs/thesis-notes.md).
+    """
+    if period <= 0:
+        return float(u_max * np.sign(angle_error))
+    return saturate(angle_error / period, u_max)

@@ -1,0 +1,76 @@
+"""Unicycle robot, thesis Ch. 2 eqs. (2.1)-(2.4).
+
+    x' = V_R cos(theta),  y' = V_R sin(theta),  theta' = u_R,
+    V_R in [0, V_max],  u_R in [-U_max, U_max].
+
+Eq. (2.3) of the thesis reads ``theta' = u_R cos(theta)``; the ``cos(theta)`` is a typo (it would make
+the robot unable to turn when heading along +-y, contradicting the rest of the chapter), so the
+standard unicycle is used (docs/thesis-notes.md).  Integration is exact for piecewise-constant
+commands (motion along a circular arc), not Euler.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from uvnav.geometry.angles import FloatArray, wrap_scalar
+
+_STRAIGHT = 1e-9  # |u| dt below which the arc is integrated as a straight line [rad]
+
+
+@dataclass(frozen=True)
+class UnicycleSpec:
+    """Limits and size of a unicycle robot.
+
+    Attributes:
+        v_max: maximum speed V_max [m/s] (> 0).
+        u_max: maximum turn rate U_max [rad/s] (> 0).
+        radius: radius of the robot's disc body [m] (>= 0).
+    """
+
+    v_max: float
+    u_max: float
+    radius: float = 0.1
+
+
+@dataclass(frozen=True)
+class UnicycleCommand:
+    """Speed ``v`` [m/s] and angular velocity ``u`` [rad/s] of a unicycle."""
+
+    v: float
+    u: float
+
+    def violates(self, spec: UnicycleSpec, *, tol: float = 1e-9) -> bool:
+        """True when the command is outside the limits (2.4) of ``spec``."""
+        return bool(self.v < -tol or self.v > spec.v_max + tol or abs(self.u) > spec.u_max + tol)
+
+    def clipped(self, spec: UnicycleSpec) -> UnicycleCommand:
+        """The command saturated to the limits (2.4); NaN components become 0."""
+        v = 0.0 if not np.isfinite(self.v) else float(np.clip(self.v, 0.0, spec.v_max))
+        u = 0.0 if not np.isfinite(self.u) else float(np.clip(self.u, -spec.u_max, spec.u_max))
+        return UnicycleCommand(v, u)
+
+
+def unicycle_step(state: FloatArray, v: float, u: float, dt: float) -> FloatArray:
+    """Exact unicycle motion for ``dt`` [s] under constant ``v`` [m/s], ``u`` [rad/s].
+
+    Args:
+        state: ``[x, y, theta]`` ([m], [m], [rad]).
+
+    Returns:
+        The new ``[x, y, theta]`` with theta wrapped to (-pi, pi].
+    """
+    x, y, th = float(state[0]), float(state[1]), float(state[2])
+    dth = u * dt
+    if abs(dth) < _STRAIGHT:
+        # second-order expansion of the arc keeps the straight-line limit exact to O(dth^2)
+        c, s = np.cos(th + 0.5 * dth), np.sin(th + 0.5 * dth)
+        x += v * dt * c
+        y += v * dt * s
+    else:
+        r = v / u
+        x += r * (np.sin(th + dth) - np.sin(th))
+        y -= r * (np.cos(th + dth) - np.cos(th))
+    return np.array([x, y, wrap_scalar(th + dth)])

@@ -1,0 +1,93 @@
+"""What a controller is given: :class:`Observation` and per-obstacle :class:`ObstacleReading`.
+
+These are the only inputs of ``Controller.act`` (DESIGN §2).  The thesis's Ch. 2 sensing model
+(§2.2) is: for every obstacle within sensing range, the distance d_i (2.5) and nearest boundary
+point r_min, the obstacle's shape and mass centre, and its velocity v_i and angular velocity u_i.
+Whether v_i, u_i are the true values ("known") or finite-difference estimates is decided by the
+simulator's sensing configuration and written in :attr:`ObstacleReading.velocity_source`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from uvnav.geometry.angles import FloatArray
+
+
+@dataclass(frozen=True)
+class ObstacleReading:
+    """One obstacle as sensed from the robot's current position.
+
+    Attributes:
+        obstacle_id: stable index of the obstacle in the world (lets controllers track it).
+        distance: distance d_i from the robot centre to the obstacle set [m] (0 when inside).
+        nearest_point: r_min, the closest boundary point [m], shape (2,).
+        centre: mass centre [m], shape (2,).
+        velocity: v_i [m/s], shape (2,) (true or estimated, see ``velocity_source``).
+        angular_velocity: u_i [rad/s].
+        outline: boundary vertices in the world frame [m], (n, 2); empty for a disc.
+        radius: disc radius [m]; 0 for a polygon.
+        bounding_radius: radius of the centroid-centred disc containing the body [m].
+        velocity_source: ``"known"`` (ground truth) or ``"estimated"``.
+    """
+
+    obstacle_id: int
+    distance: float
+    nearest_point: FloatArray
+    centre: FloatArray
+    velocity: FloatArray
+    angular_velocity: float
+    outline: FloatArray
+    radius: float
+    bounding_radius: float
+    velocity_source: str = "known"
+
+    @property
+    def is_disc(self) -> bool:
+        return self.radius > 0.0
+
+    @property
+    def speed(self) -> float:
+        """||v_i|| [m/s]."""
+        return float(np.hypot(self.velocity[0], self.velocity[1]))
+
+
+@dataclass(frozen=True)
+class LidarScan:
+    """Ranges [m] along ``angles`` [rad, world frame]; ``max_range`` where nothing is seen, NaN on dropout."""
+
+    angles: FloatArray
+    ranges: FloatArray
+    max_range: float
+
+
+@dataclass(frozen=True)
+class Observation:
+    """Everything a controller may use at one decision time.
+
+    Attributes:
+        time: simulation time [s].
+        pose: the robot's own ``[x, y, theta]`` ([m], [m], [rad]).
+        speed: the robot's current speed V_R [m/s] (its last applied command).
+        goal: target point T [m], shape (2,).
+        obstacles: readings of the obstacles within sensing range, nearest first.
+        lidar: optional range scan.
+    """
+
+    time: float
+    pose: FloatArray
+    speed: float
+    goal: FloatArray
+    obstacles: tuple[ObstacleReading, ...] = ()
+    lidar: LidarScan | None = None
+    extras: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def position(self) -> FloatArray:
+        return self.pose[:2]
+
+    @property
+    def heading(self) -> float:
+        return float(self.pose[2])

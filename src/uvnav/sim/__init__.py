@@ -1,0 +1,16 @@
+"""Layer 4: the world, the step loop, collision checks, termination, recorder and metrics."""
+
+from uvnav.sim.episode import EpisodeResult, EpisodeSetup, LidarConfig, SensingConfig, run_episode
+from uvnav.sim.metrics import METRIC_NAMES, EpisodeMetrics
+from uvnav.sim.recorder import Trajectory
+
+__all__ = [
+    "METRIC_NAMES",
+    "EpisodeMetrics",
+    "EpisodeResult",
+    "EpisodeSetup",
+    "LidarConfig",
+    "SensingConfig",
+    "Trajectory",
+    "run_episode",
+]

@@ -1,0 +1,62 @@
+"""Episode metrics, identical for every controller (DESIGN §4).
+
+Names are the snake_case column names used in JSON, the results database and the report.  Metrics
+that do not exist for an episode (time to goal of a failed run) are ``None``, never NaN.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+METRIC_NAMES: tuple[str, ...] = (
+    "success",
+    "collision",
+    "min_clearance",
+    "path_length",
+    "detour_ratio",
+    "time_to_goal",
+    "time_ratio",
+    "control_effort",
+    "limit_violations",
+    "mode_switches",
+    "decision_us_median",
+    "decision_us_p99",
+)
+
+
+@dataclass(frozen=True)
+class EpisodeMetrics:
+    """Outcome of one episode.
+
+    Attributes:
+        success: reached the goal tolerance before ``t_max`` without collision.
+        collision: the robot's disc overlapped an obstacle at some integration step.
+        min_clearance: smallest gap between the robot's disc and any obstacle [m] (negative on overlap).
+        path_length: distance travelled by the robot centre [m].
+        detour_ratio: path length / straight start-goal distance (1.0 is the physical limit); for a
+            failed episode, path length / distance covered toward the goal is meaningless, so ``None``.
+        time_to_goal: time of arrival [s], ``None`` if the goal was not reached.
+        time_ratio: ``time_to_goal / (straight distance / V_max)``, ``None`` if not reached.
+        control_effort: integral of u_R^2 dt [rad^2/s] plus integral of (dV_R/dt)^2 dt [m^2/s^3].
+        limit_violations: number of decisions whose command was outside the vehicle limits.
+        mode_switches: number of changes of the controller's reported mode.
+        decision_us_median: median controller compute time per decision [µs].
+        decision_us_p99: 99th percentile of the same [µs].
+    """
+
+    success: bool
+    collision: bool
+    min_clearance: float
+    path_length: float
+    detour_ratio: float | None
+    time_to_goal: float | None
+    time_ratio: float | None
+    control_effort: float
+    limit_violations: int
+    mode_switches: int
+    decision_us_median: float
+    decision_us_p99: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
