@@ -6,19 +6,19 @@
 Eq. (2.3) of the thesis reads ``theta' = u_R cos(theta)``; the ``cos(theta)`` is a typo (it would make
 the robot unable to turn when heading along +-y, contradicting the rest of the chapter), so the
 standard unicycle is used (docs/thesis-notes.md).  Integration is exact for piecewise-constant
-commands (motion along a circular arc), not Euler.
+commands (motion along a circular arc, written as the arc's chord so that it stays exact as
+u -> 0), not Euler.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
+import math
+
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-
-_STRAIGHT = 1e-9  # |u| dt below which the arc is integrated as a straight line [rad]
-
 
 @dataclass(frozen=True)
 class UnicycleSpec:
@@ -63,14 +63,10 @@ def unicycle_step(state: FloatArray, v: float, u: float, dt: float) -> FloatArra
         The new ``[x, y, theta]`` with theta wrapped to (-pi, pi].
     """
     x, y, th = float(state[0]), float(state[1]), float(state[2])
-    dth = u * dt
-    if abs(dth) < _STRAIGHT:
-        # second-order expansion of the arc keeps the straight-line limit exact to O(dth^2)
-        c, s = np.cos(th + 0.5 * dth), np.sin(th + 0.5 * dth)
-        x += v * dt * c
-        y += v * dt * s
-    else:
-        r = v / u
-        x += r * (np.sin(th + dth) - np.sin(th))
-        y -= r * (np.cos(th + dth) - np.cos(th))
-    return np.array([x, y, wrap_scalar(th + dth)])
+    half = 0.5 * u * dt
+    # chord of the arc, v dt sin(half)/half, along the mid-arc heading: exact for every turn rate,
+    # with no cancellation near u = 0 (np.sinc(x) = sin(pi x) / (pi x))
+    chord = v * dt * float(np.sinc(half / math.pi))
+    x += chord * math.cos(th + half)
+    y += chord * math.sin(th + half)
+    return np.array([x, y, wrap_scalar(th + 2.0 * half)])

@@ -7,6 +7,8 @@ assigns beta = pi to the positive branch).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
@@ -17,12 +19,17 @@ def wrap_to_pi(angle: ArrayLike) -> FloatArray:
     """Wrap ``angle`` [rad] to (-pi, pi]; vectorised, NaN-free for finite input."""
     a = np.asarray(angle, dtype=float)
     wrapped = np.pi - np.mod(np.pi - a, 2.0 * np.pi)
-    return wrapped
+    wrapped = np.where(wrapped <= -np.pi, np.pi, wrapped)
+    return np.asarray(np.where((a > -np.pi) & (a <= np.pi), a, wrapped))
 
 
 def wrap_scalar(angle: float) -> float:
     """Scalar :func:`wrap_to_pi` returning a Python float [rad]."""
-    return float(np.pi - (np.pi - angle) % (2.0 * np.pi))
+    a = float(angle)
+    if -math.pi < a <= math.pi:
+        return a
+    w = math.pi - (math.pi - a) % (2.0 * math.pi)
+    return w if w > -math.pi else math.pi
 
 
 def heading_vector(theta: ArrayLike) -> FloatArray:

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+import shapely
 
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.polygons import polygon_area, polygon_centroid, rays_segments_hit, polygon_edges
@@ -52,6 +53,8 @@ class PolygonBody:
             raise ValueError("a polygon needs at least 3 vertices given as [x, y] pairs")
         if abs(polygon_area(v)) < 1e-12:
             raise ValueError("polygon has zero area")
+        if not shapely.is_valid(shapely.polygons(v)):
+            raise ValueError("polygon is not simple (its edges cross)")
         c = polygon_centroid(v)
         local = v - c
         if polygon_area(local) < 0:

@@ -3,6 +3,7 @@
 from uvnav.sim.episode import EpisodeResult, EpisodeSetup, LidarConfig, SensingConfig, run_episode
 from uvnav.sim.metrics import METRIC_NAMES, EpisodeMetrics
 from uvnav.sim.recorder import Trajectory
+from uvnav.sim.seeding import run_rng, world_rng
 
 __all__ = [
     "METRIC_NAMES",
@@ -13,4 +14,6 @@ __all__ = [
     "SensingConfig",
     "Trajectory",
     "run_episode",
+    "run_rng",
+    "world_rng",
 ]

@@ -130,8 +130,9 @@ def run_episode(
     def clearance_of(fld: ObstacleField, pos: FloatArray) -> tuple[float, int]:
         if len(fld) == 0:
             return np.inf, -1
-        d, _, inside = fld.nearest(pos)
-        gaps = np.where(inside, -spec.radius, d - spec.radius)
+        d, near, inside = fld.nearest(pos)
+        depth = np.hypot(near[:, 0] - pos[0], near[:, 1] - pos[1])
+        gaps = np.where(inside, -depth, d) - spec.radius
         j = int(np.argmin(gaps))
         return float(gaps[j]), j
 
@@ -205,13 +206,14 @@ def run_episode(
                      field_now.centres, field_now.headings, field_now.velocities, field_now.angular_velocities)
     dec = np.asarray(decision_us) if decision_us else np.zeros(1)
     success = status == "success"
-    straight_time = start_dist / spec.v_max if spec.v_max > 0 else 0.0
+    shortest = max(start_dist - setup.goal_tolerance, 0.0)  # to the edge of the goal disc
+    straight_time = shortest / spec.v_max if spec.v_max > 0 else 0.0
     metrics = EpisodeMetrics(
         success=success,
         collision=status == "collision",
         min_clearance=float(min_clear) if np.isfinite(min_clear) else 1e9,
         path_length=path,
-        detour_ratio=(path / start_dist) if success and start_dist > 0 else None,
+        detour_ratio=(path / shortest) if success and shortest > 0 else None,
         time_to_goal=reached_at,
         time_ratio=(reached_at / straight_time) if (reached_at is not None and straight_time > 0) else None,
         control_effort=float(effort),

@@ -34,10 +34,10 @@ class EpisodeMetrics:
         collision: the robot's disc overlapped an obstacle at some integration step.
         min_clearance: smallest gap between the robot's disc and any obstacle [m] (negative on overlap).
         path_length: distance travelled by the robot centre [m].
-        detour_ratio: path length / straight start-goal distance (1.0 is the physical limit); for a
-            failed episode, path length / distance covered toward the goal is meaningless, so ``None``.
+        detour_ratio: path length / straight distance from the start to the edge of the goal
+            tolerance disc (1.0 is the physical limit); ``None`` for a failed episode.
         time_to_goal: time of arrival [s], ``None`` if the goal was not reached.
-        time_ratio: ``time_to_goal / (straight distance / V_max)``, ``None`` if not reached.
+        time_ratio: ``time_to_goal / (that straight distance / V_max)``, ``None`` if not reached.
         control_effort: integral of u_R^2 dt [rad^2/s] plus integral of (dV_R/dt)^2 dt [m^2/s^3].
         limit_violations: number of decisions whose command was outside the vehicle limits.
         mode_switches: number of changes of the controller's reported mode.

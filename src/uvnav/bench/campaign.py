@@ -1,0 +1,479 @@
+"""Campaigns: scenarios × controllers × seeds on a local process pool, streamed into the store.
+
+A campaign is a list of :class:`Job` s — small picklable *descriptions* (scenario name, generator
+seed or a module-level setup factory; controller name and parameters; seed).  The episode is built
+inside the worker (``build_episode(load_scenario(name), seed)`` or
+``build_episode(random_ch2_scenario(g), seed)``), so nothing heavy or stateful crosses process
+boundaries and the same job replays bit for bit anywhere (DESIGN §2, randomness).
+
+:func:`run_campaign` writes each episode to the :class:`~uvnav.bench.store.ResultsStore` in its own
+transaction the moment it arrives, so an interrupted campaign (Ctrl-C, a killed machine) loses only
+the episodes in flight; run it again with the same name and it skips every key already stored
+(resume) and never duplicates.  A job whose code raises is stored with status ``"error"`` and the
+message; it does not stop the campaign.
+
+Workers are a :class:`concurrent.futures.ProcessPoolExecutor` started with the ``forkserver`` method
+on POSIX (``spawn`` elsewhere): forking a parent that runs a progress-bar thread and holds an open
+SQLite connection is unsafe, and the fork server preloads uvnav once so workers start quickly.  At
+most ``2 × workers`` jobs are submitted ahead, which bounds memory for large campaigns.  With
+``workers=1`` everything runs in-process (no pool; easiest to debug and profile).  As with any
+``spawn``/``forkserver`` pool, a *script* that starts a campaign with ``workers > 1`` must do so
+under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already do), and a
+``setup_factory`` must be importable (defined at module level, not in a notebook cell); pass
+``mp_context=multiprocessing.get_context("fork")`` to lift both restrictions at fork's usual risks.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import signal
+import sys
+import time
+import traceback
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from uvnav.bench.store import STATUS_ERROR, EpisodeKey, ResultsStore, params_hash
+from uvnav.sim import EpisodeSetup, Trajectory, run_episode, run_rng
+
+#: Scenario generators a :class:`Job` may name, by label → function name in :mod:`uvnav.scenarios`.
+GENERATORS: dict[str, str] = {"random-ch2": "random_ch2_scenario"}
+
+SetupFactory = Callable[[int], EpisodeSetup]
+
+
+def _freeze(
+    params: Mapping[str, Any] | Iterable[tuple[str, Any]] | None,
+) -> tuple[tuple[str, Any], ...]:
+    items = params.items() if isinstance(params, Mapping) else (params or ())
+    return tuple(sorted((str(k), v) for k, v in items))
+
+
+@dataclass(frozen=True)
+class Job:
+    """One episode to run: where the scene comes from, which controller, which seed.
+
+    Exactly one scene source must be given: ``scenario``, ``generator_seed`` or ``setup_factory``.
+
+    Attributes:
+        controller: registry name, e.g. ``"zhang2019-v1"``.
+        seed: episode seed (``build_episode(..., seed)`` and ``run_episode``'s generator).
+        scenario: built-in scenario name or path to a YAML file.
+        generator_seed: seed of the scenario generator named by ``generator``.
+        generator: generator label, a key of :data:`GENERATORS` (default ``"random-ch2"``).
+        setup_factory: a *module-level* (picklable) function ``seed -> EpisodeSetup``; needs
+            ``label``.
+        label: scenario label stored in the database (defaults from the source).
+        family: scenario family reports group by (defaults: scenario name, or generator label).
+        params: controller parameters (a mapping is accepted and frozen to sorted pairs).  When the
+            scenario names the same controller, these override the scenario's own parameters.
+        use_scenario_params: start from the scenario's ``controller.params`` when the scenario names
+            this controller (default ``True``).
+        record: keep the trajectory and store it (for figures; costs memory and disk).
+    """
+
+    controller: str
+    seed: int
+    scenario: str | None = None
+    generator_seed: int | None = None
+    generator: str = "random-ch2"
+    setup_factory: SetupFactory | None = None
+    label: str | None = None
+    family: str | None = None
+    params: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
+    use_scenario_params: bool = True
+    record: bool = False
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "params", _freeze(self.params))
+        sources = sum(
+            x is not None for x in (self.scenario, self.generator_seed, self.setup_factory)
+        )
+        if sources != 1:
+            raise ValueError("a Job needs exactly one of scenario, generator_seed, setup_factory")
+        if self.setup_factory is not None and self.label is None:
+            raise ValueError("a Job with a setup_factory needs a label")
+        if self.generator_seed is not None and self.generator not in GENERATORS:
+            raise ValueError(
+                f"unknown generator {self.generator!r}; known: {', '.join(GENERATORS)}"
+            )
+
+    @property
+    def params_dict(self) -> dict[str, Any]:
+        """The controller parameters as a dict."""
+        return dict(self.params)
+
+    @property
+    def scenario_label(self) -> str:
+        """What the ``scenario`` column stores: the name/path, ``generator/NNNN`` or the label."""
+        if self.label is not None:
+            return self.label
+        if self.scenario is not None:
+            return self.scenario
+        return f"{self.generator}/{self.generator_seed:04d}"
+
+    @property
+    def family_label(self) -> str:
+        """Scenario family for reports."""
+        if self.family is not None:
+            return self.family
+        if self.generator_seed is not None:
+            return self.generator
+        return self.scenario_label
+
+    @property
+    def key(self) -> EpisodeKey:
+        """Resume key ``(scenario, controller, params_hash, seed)``."""
+        return (self.scenario_label, self.controller, params_hash(self.params_dict), int(self.seed))
+
+
+@dataclass
+class JobOutcome:
+    """What a worker sends back for one job.
+
+    Attributes:
+        job: the job.
+        status: ``success``, ``collision``, ``timeout`` or ``error``.
+        metrics: metric name → value (``None`` for an error).
+        error: ``"ExceptionType: message"`` for an error, else ``None``.
+        wall_time: time spent in the worker, building included [s].
+        trajectory: recorded trajectory when ``job.record``.
+        effective_params: parameters the controller was built with.
+    """
+
+    job: Job
+    status: str
+    metrics: dict[str, Any] | None
+    error: str | None
+    wall_time: float
+    trajectory: Trajectory | None = None
+    effective_params: dict[str, Any] = field(default_factory=dict)
+
+
+def _plain(params: Any) -> dict[str, Any]:
+    if params is None:
+        return {}
+    if hasattr(params, "model_dump"):
+        return dict(params.model_dump())
+    return dict(params)
+
+
+def build_job(job: Job) -> tuple[EpisodeSetup, dict[str, Any]]:
+    """Instantiate the job's episode and the controller parameters to use (runs in the worker)."""
+    if job.setup_factory is not None:
+        return job.setup_factory(int(job.seed)), job.params_dict
+    import uvnav.scenarios as scenarios  # layer 5; imported lazily so bench works without it
+
+    if job.scenario is not None:
+        scenario = scenarios.load_scenario(job.scenario)
+    else:
+        scenario = getattr(scenarios, GENERATORS[job.generator])(int(job.generator_seed or 0))
+    params = job.params_dict
+    ctrl = getattr(scenario, "controller", None)
+    if (
+        job.use_scenario_params
+        and ctrl is not None
+        and getattr(ctrl, "name", None) == job.controller
+    ):
+        params = {**_plain(getattr(ctrl, "params", None)), **params}
+    return scenarios.build_episode(scenario, int(job.seed)), params
+
+
+def run_job(job: Job) -> JobOutcome:
+    """Build and run one job; any exception becomes an ``error`` outcome (never raises it)."""
+    from uvnav.controllers import make_controller
+
+    tic = time.perf_counter()
+    params: dict[str, Any] = job.params_dict
+    try:
+        setup, params = build_job(job)
+        controller = make_controller(job.controller, **params)
+        result = run_episode(
+            setup, controller, run_rng(int(job.seed)), record=job.record
+        )
+    except Exception as exc:  # a failing job is data, not a crash of the campaign
+        tb = traceback.extract_tb(exc.__traceback__)
+        where = f" (at {tb[-1].filename}:{tb[-1].lineno})" if tb else ""
+        return JobOutcome(
+            job,
+            STATUS_ERROR,
+            None,
+            f"{type(exc).__name__}: {exc}{where}",
+            time.perf_counter() - tic,
+            None,
+            params,
+        )
+    return JobOutcome(
+        job=job,
+        status=result.status,
+        metrics=result.metrics.to_dict(),
+        error=None,
+        wall_time=time.perf_counter() - tic,
+        trajectory=result.trajectory if job.record else None,
+        effective_params=params,
+    )
+
+
+@dataclass
+class CampaignRun:
+    """Summary of one :func:`run_campaign` call.
+
+    Attributes:
+        campaign_id: id in the store.
+        total: distinct jobs asked for.
+        skipped: jobs already stored (resume).
+        ran: jobs run and stored by this call.
+        errors: of those, how many ended with status ``error``.
+        statuses: status → count over the jobs run by this call.
+        episode_ids: resume key → episode id, for the jobs run by this call.
+        wall_time: elapsed time of the call [s].
+    """
+
+    campaign_id: int
+    total: int
+    skipped: int
+    ran: int = 0
+    errors: int = 0
+    statuses: dict[str, int] = field(default_factory=dict)
+    episode_ids: dict[EpisodeKey, int] = field(default_factory=dict)
+    wall_time: float = 0.0
+
+
+def _store_outcome(store: ResultsStore, campaign_id: int, out: JobOutcome) -> int:
+    job = out.job
+    return store.add_episode(
+        campaign_id,
+        scenario=job.scenario_label,
+        family=job.family_label,
+        controller=job.controller,
+        params=job.params_dict,
+        effective_params=out.effective_params,
+        seed=job.seed,
+        status=out.status,
+        metrics=out.metrics,
+        error=out.error,
+        wall_time=out.wall_time,
+        trajectory=out.trajectory,
+    )
+
+
+def default_mp_context() -> mp.context.BaseContext:
+    """``forkserver`` (uvnav preloaded) on POSIX, ``spawn`` elsewhere; see the module docstring."""
+    if sys.platform != "win32" and "forkserver" in mp.get_all_start_methods():
+        ctx = mp.get_context("forkserver")
+        ctx.set_forkserver_preload(["uvnav.bench.campaign", "uvnav.scenarios", "uvnav.controllers"])
+        return ctx
+    return mp.get_context("spawn")
+
+
+def run_campaign(
+    store: ResultsStore,
+    name: str,
+    jobs: Sequence[Job],
+    *,
+    config: Mapping[str, Any] | None = None,
+    workers: int = 1,
+    progress: bool = False,
+    retry_errors: bool = False,
+    mp_context: mp.context.BaseContext | None = None,
+    on_outcome: Callable[[JobOutcome, int], None] | None = None,
+) -> CampaignRun:
+    """Run ``jobs`` under campaign ``name``, storing each episode as it finishes; resume-safe.
+
+    Args:
+        store: the results store (written only from this process).
+        name: campaign name; an existing campaign of that name is resumed.
+        jobs: job descriptions; duplicates (same resume key) run once.
+        config: JSON-able description stored with a new campaign.
+        workers: worker processes; ``1`` runs in-process.
+        progress: show a rich progress bar on stderr.
+        retry_errors: run again the jobs stored with status ``error`` (replacing those rows).
+        mp_context: multiprocessing context for the pool (default :func:`default_mp_context`).
+        on_outcome: called in this process with each outcome and its episode id, after storing.
+
+    Returns:
+        What was skipped, run and stored.
+
+    Raises:
+        KeyboardInterrupt: re-raised after cancelling queued jobs; stored episodes stay stored.
+        concurrent.futures.process.BrokenProcessPool: a worker died (not a Python exception).
+    """
+    tic = time.perf_counter()
+    cfg = dict(config) if config is not None else {"n_jobs": len(jobs)}
+    campaign_id = store.campaign(name, cfg)
+    done = store.done_keys(campaign_id, include_errors=not retry_errors)
+    todo: list[Job] = []
+    seen: set[EpisodeKey] = set()
+    for job in jobs:
+        k = job.key
+        if k in seen:
+            continue
+        seen.add(k)
+        if k not in done:
+            todo.append(job)
+    run = CampaignRun(campaign_id=campaign_id, total=len(seen), skipped=len(seen) - len(todo))
+
+    bar = _ProgressBar(name, len(todo), run.skipped) if progress and todo else None
+
+    def handle(out: JobOutcome) -> None:
+        episode_id = _store_outcome(store, campaign_id, out)
+        run.ran += 1
+        run.errors += out.status == STATUS_ERROR
+        run.statuses[out.status] = run.statuses.get(out.status, 0) + 1
+        run.episode_ids[out.job.key] = episode_id
+        if bar is not None:
+            bar.advance(run.statuses)
+        if on_outcome is not None:
+            on_outcome(out, episode_id)
+
+    try:
+        if bar is not None:
+            bar.start()
+        if workers <= 1:
+            for job in todo:
+                handle(run_job(job))
+        elif todo:
+            _run_pool(todo, handle, workers, mp_context or default_mp_context())
+    finally:
+        if bar is not None:
+            bar.stop()
+        run.wall_time = time.perf_counter() - tic
+    return run
+
+
+def _ignore_sigint() -> None:
+    """Worker initializer: Ctrl-C is handled by the main process alone (see :func:`_run_pool`)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+
+
+def _stop_workers(executor: ProcessPoolExecutor) -> None:
+    """Cancel queued jobs and end the workers now: their episodes are lost anyway on interrupt."""
+    terminate = getattr(executor, "terminate_workers", None)  # Python >= 3.14
+    if callable(terminate):
+        terminate()
+        return
+    # best effort before 3.14: the executor keeps its processes in a private mapping
+    procs = list((getattr(executor, "_processes", None) or {}).values())
+    executor.shutdown(wait=False, cancel_futures=True)
+    for proc in procs:
+        if proc.is_alive():
+            proc.terminate()
+
+
+def _run_pool(
+    todo: Sequence[Job],
+    handle: Callable[[JobOutcome], None],
+    workers: int,
+    ctx: mp.context.BaseContext,
+) -> None:
+    """Run ``todo`` on a process pool, handing each outcome to ``handle`` as it finishes.
+
+    Workers ignore SIGINT, so a Ctrl-C (sent by the terminal to the whole process group) reaches
+    only this process: it stops the workers at once — without waiting for the episodes in flight,
+    whose results would be discarded — and re-raises :class:`KeyboardInterrupt`.
+    """
+    executor = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_ignore_sigint)
+    queue = iter(todo)
+    pending: set[Future[JobOutcome]] = set()
+    window = 2 * workers
+    try:
+        while True:
+            while len(pending) < window:
+                job = next(queue, None)
+                if job is None:
+                    break
+                pending.add(executor.submit(run_job, job))
+            if not pending:
+                break
+            finished, pending = wait(pending, return_when=FIRST_COMPLETED)
+            for fut in finished:
+                handle(fut.result())
+    except BaseException:
+        _stop_workers(executor)
+        raise
+    executor.shutdown(wait=True)
+
+
+class _ProgressBar:
+    """A rich progress bar on stderr showing done/total, rate, ETA and status counts."""
+
+    def __init__(self, name: str, total: int, skipped: int) -> None:
+        from rich.console import Console
+        from rich.progress import (
+            BarColumn,
+            MofNCompleteColumn,
+            Progress,
+            TextColumn,
+            TimeElapsedColumn,
+            TimeRemainingColumn,
+        )
+
+        self._progress = Progress(
+            TextColumn("[bold]{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            TimeRemainingColumn(),
+            TextColumn("{task.fields[counts]}"),
+            console=Console(stderr=True),
+        )
+        note = f" ({skipped} already done)" if skipped else ""
+        self._task = self._progress.add_task(f"{name}{note}", total=total, counts="")
+
+    def start(self) -> None:
+        self._progress.start()
+
+    def stop(self) -> None:
+        self._progress.stop()
+
+    def advance(self, statuses: Mapping[str, int]) -> None:
+        counts = " ".join(f"{k}={v}" for k, v in sorted(statuses.items()))
+        self._progress.update(self._task, advance=1, counts=counts)
+
+
+def grid_jobs(
+    controllers: Sequence[str | tuple[str, Mapping[str, Any]]],
+    seeds: Iterable[int],
+    *,
+    scenarios: Sequence[str] = (),
+    generator_seeds: Iterable[int] | None = None,
+    generator: str = "random-ch2",
+    record: bool = False,
+) -> list[Job]:
+    """The cartesian product scenarios × controllers × seeds as jobs.
+
+    Args:
+        controllers: names, or ``(name, params)`` pairs.
+        seeds: episode seeds.
+        scenarios: built-in names or YAML paths.
+        generator_seeds: if given, also one generated scenario per generator seed, run with
+            episode seed equal to the generator seed (``seeds`` is not crossed with these).
+        generator: generator label (key of :data:`GENERATORS`).
+        record: record trajectories.
+    """
+    ctrls = [(c, {}) if isinstance(c, str) else (c[0], dict(c[1])) for c in controllers]
+    seed_list = [int(s) for s in seeds]
+    jobs = [
+        Job(controller=c, params=p, seed=s, scenario=sc, record=record)
+        for sc in scenarios
+        for c, p in ctrls
+        for s in seed_list
+    ]
+    if generator_seeds is not None:
+        jobs += [
+            Job(
+                controller=c,
+                params=p,
+                seed=int(g),
+                generator_seed=int(g),
+                generator=generator,
+                record=record,
+            )
+            for g in generator_seeds
+            for c, p in ctrls
+        ]
+    return jobs

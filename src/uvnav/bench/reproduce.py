@@ -1,0 +1,500 @@
+"""Thesis Chapter 2 reproduction: the job behind ``uvnav run`` (DESIGN §6).
+
+:func:`reproduce` runs
+
+1. every built-in ``thesis-ch2-*`` scene (Figs. 2.7–2.10) with both ``zhang2019-v1`` (the thesis's
+   law, Ch. 2 §2.3) and ``savkin-wang2013-v1`` (the baseline of thesis ref. [3.14]), seed 0, with
+   trajectories recorded — campaign ``ch2-thesis-scenes``;
+2. a random campaign on ``random_ch2_scenario(seed)`` for seeds ``0..199`` (``1000`` with
+   ``full=True``) with both laws — campaign ``ch2-random``;
+
+stores everything in ``results_dir/uvnav.sqlite``, and builds the table "thesis reported vs uvnav
+measured" whose *measured* column is read back from the stored episodes (never typed in).  Figures
+and the HTML report are then made by a *renderer*
+(:func:`uvnav.viz.reproduction.render_reproduction` by default).
+
+Layering (DESIGN §1): ``bench`` (layer 6) sits below ``viz`` (layer 7) and must not import it, so
+the default renderer is looked up at run time by its dotted name (:data:`DEFAULT_RENDERER`) rather
+than imported; pass ``render=`` to use another one (the CLI may pass
+``uvnav.viz.reproduction.render_reproduction`` explicitly).  ``matplotlib`` is never imported here.
+
+Resume and staleness: both campaigns carry a fingerprint of the code and scenario files that decide
+episode outcomes (:func:`code_fingerprint`).  Re-running with unchanged code resumes (an interrupted
+run only finishes what is missing; a finished one costs nothing).  If the code changed since a
+campaign was stored, that campaign is deleted and run again, so the table never mixes results of
+different code.  ``fresh=True`` always reruns.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import importlib
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from uvnav.bench.campaign import Job, run_campaign
+from uvnav.bench.store import STATUS_ERROR, ResultsStore
+
+CONTROLLERS: tuple[str, ...] = ("zhang2019-v1", "savkin-wang2013-v1")
+THESIS_PREFIX = "thesis-ch2-"
+COMPARISON_SCENE = "thesis-ch2-fig2-10-comparison"
+SCENES_CAMPAIGN = "ch2-thesis-scenes"
+RANDOM_CAMPAIGN = "ch2-random"
+RANDOM_FAMILY = "random-ch2"
+QUICK_SEEDS = 200
+FULL_SEEDS = 1000
+DB_NAME = "uvnav.sqlite"
+#: ``module:function`` of the default renderer (the module docstring says why it is not imported).
+DEFAULT_RENDERER = "uvnav.viz.reproduction:render_reproduction"
+
+#: Thesis Fig. 2.10 (Ch. 2 §2.4): path lengths [m] reported for the two laws on that scene.
+THESIS_PATH_LENGTH = {"zhang2019-v1": 14.9, "savkin-wang2013-v1": 15.7}
+#: Straight-line distance from I = (0, 0) to T = (10, 10) [m] (thesis Ch. 2 §2.4).
+THESIS_STRAIGHT_LINE = float(np.hypot(10.0, 10.0))
+
+_NOT_RUN = ("not reported (law not run on this scene in the thesis)", "not reported")
+#: What the thesis says about each scene and law: (outcome, minimum distance).
+THESIS_CLAIMS: dict[str, dict[str, tuple[str, str]]] = {
+    "thesis-ch2-one-obstacle": {
+        "zhang2019-v1": (
+            "success, no collision (Fig. 2.7)",
+            '> 0 ("never reaches 0", Fig. 2.7(b))',
+        ),
+        "savkin-wang2013-v1": _NOT_RUN,
+    },
+    "thesis-ch2-six-obstacles": {
+        "zhang2019-v1": ("success, no collision (Fig. 2.8)", "> 0 (no collision, Fig. 2.8(b))"),
+        "savkin-wang2013-v1": _NOT_RUN,
+    },
+    COMPARISON_SCENE: {
+        "zhang2019-v1": ("success, no collision (Fig. 2.10(b))", "> 0 (no collision)"),
+        "savkin-wang2013-v1": ("success, no collision (Fig. 2.10(a))", "> 0 (no collision)"),
+    },
+    "thesis-ch2-fig2-9-changing-direction": {
+        "zhang2019-v1": (
+            "not shown; the thesis claims the law handles such scenes",
+            "not reported",
+        ),
+        "savkin-wang2013-v1": (
+            "path shown (Fig. 2.9), outcome not stated: a scene outside the law's assumptions",
+            "not reported",
+        ),
+    },
+}
+
+
+@dataclass(frozen=True)
+class SceneEpisode:
+    """One stored thesis-scene episode: scene name, controller, seed, episode id and status."""
+
+    scene: str
+    controller: str
+    seed: int
+    episode_id: int
+    status: str
+
+
+@dataclass
+class RenderRequest:
+    """Everything a renderer needs to draw the figures and write the report.
+
+    Attributes:
+        db_path: the results database.
+        report_dir: where ``index.html`` and the figures go.
+        scene_episodes: the recorded thesis-scene episodes (one figure each).
+        comparison_scene: scene drawn as the Fig. 2.10 comparison of all controllers (or ``None``).
+        random_campaign: name of the random campaign (summary figure).
+        table: the "thesis reported vs uvnav measured" rows.
+    """
+
+    db_path: Path
+    report_dir: Path
+    scene_episodes: list[SceneEpisode]
+    comparison_scene: str | None
+    random_campaign: str
+    table: list[dict[str, str]]
+
+
+@dataclass
+class RenderResult:
+    """What a renderer produced: the report page and the figure files."""
+
+    report_path: Path
+    figures: list[Path] = field(default_factory=list)
+
+
+Renderer = Callable[[RenderRequest], RenderResult]
+
+
+@dataclass
+class ReproductionSummary:
+    """Outcome of :func:`reproduce`.
+
+    Attributes:
+        table: rows ``{"quantity", "thesis", "measured", "note"}`` (strings), measured from the
+            runs.
+        db_path: the results database.
+        report_path: ``index.html`` of the report (``None`` when rendering was skipped).
+        failures: ``(controller, seed, status)`` of every random-campaign episode that did not
+            succeed (status ``collision``, ``timeout`` or ``error``).
+        figures: figure files written.
+        campaigns: per campaign: ``ran``, ``skipped``, ``errors``, ``wall_time`` [s],
+            ``rerun_stale``.
+        wall_time: total elapsed time [s].
+    """
+
+    table: list[dict[str, str]]
+    db_path: Path
+    report_path: Path | None
+    failures: list[tuple[str, int, str]]
+    figures: list[Path] = field(default_factory=list)
+    campaigns: dict[str, dict[str, Any]] = field(default_factory=dict)
+    wall_time: float = 0.0
+
+
+#: Package parts whose code decides Ch. 2 episode outcomes (hashed by :func:`code_fingerprint`).
+FINGERPRINT_PARTS: tuple[str, ...] = (
+    "geometry",
+    "dynamics",
+    "obstacles",
+    "sensors",
+    "prediction",
+    "controllers",
+    "sim",
+    "scenarios",
+    "bench/campaign.py",
+)
+
+
+def code_fingerprint() -> str:
+    """Hash of the code and data that decide Chapter 2 episode outcomes.
+
+    Covers the sources and scenario files under :data:`FINGERPRINT_PARTS` and the numpy version
+    (results are bitwise only for one numpy); not ``viz``, ``cli`` or other chapters' packages, so
+    editing those does not invalidate stored results.
+
+    Returns:
+        16 hex digits.
+    """
+    import uvnav
+
+    root = Path(uvnav.__file__).parent
+    h = hashlib.sha256(f"{getattr(uvnav, '__version__', '')}|numpy {np.__version__}".encode())
+    for part in FINGERPRINT_PARTS:
+        base = root / part
+        paths = [base] if base.is_file() else sorted(base.rglob("*")) if base.is_dir() else []
+        for p in paths:
+            if not p.is_file() or p.suffix not in {".py", ".yaml", ".yml", ".json"}:
+                continue
+            if "__pycache__" in p.parts:
+                continue
+            h.update(str(p.relative_to(root)).encode())
+            h.update(p.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def _load_renderer(spec: str) -> Renderer:
+    module, _, name = spec.partition(":")
+    fn: Renderer = getattr(importlib.import_module(module), name)
+    return fn
+
+
+def _prepare_campaign(store: ResultsStore, name: str, config: dict[str, Any], fresh: bool) -> bool:
+    """Delete campaign ``name`` if ``fresh`` or its fingerprint differs; True if it was deleted."""
+    for c in store.campaigns():
+        if c["name"] != name:
+            continue
+        stale = c["config"].get("fingerprint") != config["fingerprint"]
+        if fresh or stale:
+            store.delete_campaign(name)
+            return True
+    return False
+
+
+def _fmt_m(x: Any, digits: int = 2) -> str:
+    if x is None or not np.isfinite(float(x)):
+        return "n/a"
+    if float(x) >= 1e8:  # run_episode's "no obstacle" clearance
+        return "no obstacle"
+    return f"{float(x):.{digits}f} m"
+
+
+def _outcome(row: dict[str, Any] | None) -> str:
+    if row is None:
+        return "not run"
+    if row["status"] == STATUS_ERROR:
+        # the stored message ends with " (at file:line)"; the table keeps only type and message
+        return f"error: {str(row['error']).split(' (at ')[0]}"
+    return "success, no collision" if row["status"] == "success" else str(row["status"])
+
+
+def _pct(measured: float, reference: float) -> str:
+    return f"{100.0 * (measured - reference) / reference:+.1f}% vs thesis"
+
+
+def build_table(
+    store: ResultsStore,
+    scenes: Sequence[str],
+    controllers: Sequence[str],
+    *,
+    straight_line: float | None,
+    scene_campaign: str = SCENES_CAMPAIGN,
+    random_campaign: str = RANDOM_CAMPAIGN,
+    seed: int = 0,
+    max_listed_failures: int = 40,
+) -> tuple[list[dict[str, str]], list[tuple[str, int, str]]]:
+    """The "thesis reported vs uvnav measured" rows, measured values read from the store.
+
+    Args:
+        store: results store holding both campaigns.
+        scenes: thesis scenes run.
+        controllers: controllers run.
+        straight_line: measured I–T distance of the comparison scene [m] (``None`` if not built).
+        scene_campaign: campaign of the thesis scenes.
+        random_campaign: campaign of the random scenes.
+        seed: episode seed of the thesis scenes.
+        max_listed_failures: failed seeds listed per law in the table (the failures list has
+            all of them).
+
+    Returns:
+        ``(rows, failures)``; failures are ``(controller, seed, status)`` of the random campaign.
+    """
+
+    def row_of(scene: str, ctrl: str) -> dict[str, Any] | None:
+        eid = store.find_episode(scene_campaign, scenario=scene, controller=ctrl, seed=seed)
+        return None if eid is None else store.episode_row(eid)
+
+    rows: list[dict[str, str]] = []
+    # -- Fig. 2.10 path lengths
+    measured_len: dict[str, float] = {}
+    for ctrl in controllers:
+        thesis = THESIS_PATH_LENGTH.get(ctrl)
+        r = row_of(COMPARISON_SCENE, ctrl) if COMPARISON_SCENE in scenes else None
+        if r is None or r["path_length"] is None:
+            measured, note = "not run", _outcome(r) if r is not None else "scene not available"
+        else:
+            measured_len[ctrl] = float(r["path_length"])
+            measured = _fmt_m(r["path_length"])
+            note = f"status {r['status']}"
+            if thesis is not None:
+                note = f"{_pct(measured_len[ctrl], thesis)}; {note}"
+        rows.append(
+            {
+                "quantity": f"Fig. 2.10 path length, {ctrl}",
+                "thesis": f"{thesis} m" if thesis is not None else "not reported",
+                "measured": measured,
+                "note": note,
+            }
+        )
+    if {"zhang2019-v1", "savkin-wang2013-v1"} <= set(measured_len):
+        ratio = measured_len["savkin-wang2013-v1"] / measured_len["zhang2019-v1"]
+        thesis_ratio = THESIS_PATH_LENGTH["savkin-wang2013-v1"] / THESIS_PATH_LENGTH["zhang2019-v1"]
+        rows.append(
+            {
+                "quantity": "Fig. 2.10 path length ratio savkin-wang2013-v1 / zhang2019-v1",
+                "thesis": f"{thesis_ratio:.3f} (15.7 / 14.9)",
+                "measured": f"{ratio:.3f}",
+                "note": "thesis: zhang2019 about 5% shorter",
+            }
+        )
+    rows.append(
+        {
+            "quantity": "Fig. 2.10 straight-line distance I–T",
+            "thesis": f"{THESIS_STRAIGHT_LINE:.2f} m",
+            "measured": _fmt_m(straight_line)
+            if straight_line is not None
+            else "scene not available",
+            "note": "lower bound of every path length",
+        }
+    )
+    # -- per thesis scene and law ------------------------------------------------------------------
+    for scene in scenes:
+        for ctrl in controllers:
+            claims = THESIS_CLAIMS.get(scene, {}).get(ctrl, ("not reported", "not reported"))
+            r = row_of(scene, ctrl)
+            rows.append(
+                {
+                    "quantity": f"outcome, {scene}, {ctrl}",
+                    "thesis": claims[0],
+                    "measured": _outcome(r),
+                    "note": ""
+                    if r is None or r["time_to_goal"] is None
+                    else f"time to goal {float(r['time_to_goal']):.1f} s, "
+                    f"path {float(r['path_length']):.2f} m",
+                }
+            )
+            rows.append(
+                {
+                    "quantity": f"min clearance, {scene}, {ctrl}",
+                    "thesis": claims[1],
+                    "measured": "n/a" if r is None else _fmt_m(r["min_clearance"], 3),
+                    "note": "gap between robot disc and obstacle; < 0 is a collision",
+                }
+            )
+    # -- random campaign
+    df = store.episodes_frame(random_campaign)
+    failures: list[tuple[str, int, str]] = []
+    for ctrl in controllers:
+        pairs = sorted(
+            (int(s), str(st))
+            for c, s, st in zip(df["controller"], df["seed"], df["status"], strict=True)
+            if c == ctrl
+        )
+        n = len(pairs)
+        n_ok = sum(st == "success" for _, st in pairs)
+        counts = {
+            k: sum(st == k for _, st in pairs) for k in ("collision", "timeout", STATUS_ERROR)
+        }
+        rows.append(
+            {
+                "quantity": f"random campaign success rate, {ctrl}",
+                "thesis": "not reported (no random campaign in the thesis)",
+                "measured": f"{n_ok / n:.1%} ({n_ok}/{n})" if n else "not run",
+                "note": ", ".join(f"{k}: {v}" for k, v in counts.items()) if n else "",
+            }
+        )
+        ctrl_fail = [(ctrl, s, st) for s, st in pairs if st != "success"]
+        failures += ctrl_fail
+        listed = ", ".join(f"{s} ({st})" for _, s, st in ctrl_fail[:max_listed_failures])
+        if len(ctrl_fail) > max_listed_failures:
+            listed += f", … (+{len(ctrl_fail) - max_listed_failures} more)"
+        rows.append(
+            {
+                "quantity": f"random campaign failed seeds, {ctrl}",
+                "thesis": "not reported",
+                "measured": (listed or "none") if n else "not run",
+                "note": f"{len(ctrl_fail)} of {n} episodes",
+            }
+        )
+    return rows, failures
+
+
+def reproduce(
+    results_dir: Path,
+    report_dir: Path,
+    *,
+    full: bool = False,
+    workers: int = 2,
+    progress: bool = True,
+    fresh: bool = False,
+    n_random: int | None = None,
+    controllers: Sequence[str] = CONTROLLERS,
+    render: Renderer | str | None = DEFAULT_RENDERER,
+) -> ReproductionSummary:
+    """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
+
+    Args:
+        results_dir: folder of the results database ``uvnav.sqlite`` (created).
+        report_dir: folder of ``index.html`` and the figures (created).
+        full: thesis-size random campaign (1000 seeds instead of 200).
+        workers: worker processes (1 = in-process).
+        progress: show rich progress bars on stderr.
+        fresh: delete and rerun both campaigns even when the stored ones are current.
+        n_random: override the number of random seeds (tests, quick looks).
+        controllers: laws to run (default both Ch. 2 laws).
+        render: renderer callable or ``"module:function"``; ``None`` skips figures and report.
+
+    Returns:
+        The summary: table, database and report paths, random-campaign failures.
+
+    Raises:
+        ImportError: :mod:`uvnav.scenarios` is not available.
+    """
+    import uvnav.scenarios as scenarios
+
+    tic = time.perf_counter()
+    results_dir = Path(results_dir)
+    report_dir = Path(report_dir)
+    results_dir.mkdir(parents=True, exist_ok=True)
+    db_path = results_dir / DB_NAME
+    n_seeds = n_random if n_random is not None else (FULL_SEEDS if full else QUICK_SEEDS)
+    scenes = sorted(n for n in scenarios.list_builtin() if n.startswith(THESIS_PREFIX))
+    fp = code_fingerprint()
+    ctrls = list(controllers)
+    summary_campaigns: dict[str, dict[str, Any]] = {}
+
+    with ResultsStore(db_path) as store:
+        scene_cfg = {
+            "chapter": 2,
+            "scenes": scenes,
+            "controllers": ctrls,
+            "seed": 0,
+            "fingerprint": fp,
+        }
+        random_cfg = {
+            "chapter": 2,
+            "generator": RANDOM_FAMILY,
+            "controllers": ctrls,
+            "fingerprint": fp,
+        }
+        plans = [
+            (
+                SCENES_CAMPAIGN,
+                scene_cfg,
+                [Job(controller=c, seed=0, scenario=s, record=True) for s in scenes for c in ctrls],
+            ),
+            (
+                RANDOM_CAMPAIGN,
+                random_cfg,
+                [
+                    Job(controller=c, seed=g, generator_seed=g)
+                    for g in range(n_seeds)
+                    for c in ctrls
+                ],
+            ),
+        ]
+        for name, cfg, jobs in plans:
+            stale = _prepare_campaign(store, name, cfg, fresh)
+            run = run_campaign(store, name, jobs, config=cfg, workers=workers, progress=progress)
+            summary_campaigns[name] = {
+                "jobs": run.total,
+                "ran": run.ran,
+                "skipped": run.skipped,
+                "errors": run.errors,
+                "statuses": dict(run.statuses),
+                "wall_time": round(run.wall_time, 2),
+                "rerun_stale": stale,
+            }
+
+        straight: float | None = None
+        if COMPARISON_SCENE in scenes:
+            setup = scenarios.build_episode(scenarios.load_scenario(COMPARISON_SCENE), 0)
+            straight = float(np.hypot(*(np.asarray(setup.goal) - np.asarray(setup.start)[:2])))
+        table, failures = build_table(store, scenes, ctrls, straight_line=straight)
+        scene_episodes = []
+        for s in scenes:
+            for c in ctrls:
+                eid = store.find_episode(SCENES_CAMPAIGN, scenario=s, controller=c, seed=0)
+                if eid is not None:
+                    status = str(store.episode_row(eid)["status"])
+                    scene_episodes.append(SceneEpisode(s, c, 0, eid, status))
+
+    report_path: Path | None = None
+    figures: list[Path] = []
+    if render is not None:
+        renderer = _load_renderer(render) if isinstance(render, str) else render
+        out = renderer(
+            RenderRequest(
+                db_path=db_path,
+                report_dir=report_dir,
+                scene_episodes=scene_episodes,
+                comparison_scene=COMPARISON_SCENE if COMPARISON_SCENE in scenes else None,
+                random_campaign=RANDOM_CAMPAIGN,
+                table=table,
+            )
+        )
+        report_path, figures = out.report_path, list(out.figures)
+    return ReproductionSummary(
+        table=table,
+        db_path=db_path,
+        report_path=report_path,
+        failures=failures,
+        figures=figures,
+        campaigns=summary_campaigns,
+        wall_time=time.perf_counter() - tic,
+    )

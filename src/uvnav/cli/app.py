@@ -1,0 +1,613 @@
+"""The ``uvnav`` command line (DESIGN §6, layer 8): thin Typer commands over the library.
+
+Commands parse their arguments, call the library and print with rich (or plain JSON/YAML where the
+output is meant for machines).  User errors — a bad scenario file, an unknown controller or
+parameter, a missing file, a malformed ``--param`` — are turned into ONE line
+``error: <message>`` on stderr and exit status 2 in a single place, :class:`UvnavGroup`; a
+traceback means a bug.
+
+Heavy or optional parts (the reproduction job, figures, the report) are imported inside the
+command that needs them, so ``uvnav scenarios list`` stays fast and works without them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import importlib
+import inspect
+import json
+import re
+from pathlib import Path
+from typing import Annotated, Any
+
+import numpy as np
+import typer
+import yaml
+from typer.core import TyperGroup
+
+from uvnav.controllers import (
+    ControllerInfo,
+    ControllerParamsError,
+    UnknownControllerError,
+    available_controllers,
+    controller_info,
+    make_controller,
+)
+from uvnav.scenarios import (
+    Scenario,
+    ScenarioError,
+    build_episode,
+    check_constraints,
+    list_builtin,
+    load_scenario,
+    scenario_text,
+    scenario_to_yaml,
+    validate_for_controller,
+)
+from uvnav.sim import METRIC_NAMES, run_episode, run_rng
+
+# ---------------------------------------------------------------------------------- error handling
+
+
+class CliError(Exception):
+    """A user-facing error: printed as ``error: <message>``, exit status ``code``."""
+
+    def __init__(self, message: str, code: int = 2) -> None:
+        super().__init__(message)
+        self.message = message
+        self.code = code
+
+
+def _is_usage_error(exc: BaseException) -> bool:
+    # Typer vendors click in recent versions; match click's classes by name, not by import path.
+    names = {cls.__name__ for cls in type(exc).__mro__}
+    return "UsageError" in names and "NoArgsIsHelpError" not in names
+
+
+def user_error(exc: BaseException) -> tuple[str, int] | None:
+    """``(one-line message, exit status)`` for an exception caused by the user, else ``None``."""
+    if isinstance(exc, CliError):
+        return exc.message, exc.code
+    if isinstance(exc, ScenarioError):
+        return str(exc), 2
+    if isinstance(exc, UnknownControllerError):
+        return str(exc.args[0]) if exc.args else "unknown controller", 2
+    if isinstance(exc, ControllerParamsError):
+        return str(exc), 2
+    if isinstance(
+        exc, FileNotFoundError | IsADirectoryError | NotADirectoryError | PermissionError
+    ):
+        name = f": {exc.filename}" if exc.filename else ""
+        return f"{exc.strerror or exc}{name}", 2
+    if _is_usage_error(exc):
+        ctx = getattr(exc, "ctx", None)
+        hint = f" (see '{ctx.command_path} --help')" if ctx is not None else ""
+        return f"{exc.format_message()}{hint}", int(getattr(exc, "exit_code", 2))  # type: ignore[attr-defined]
+    return None
+
+
+class UvnavGroup(TyperGroup):
+    """Typer group that turns user errors into one ``error:`` line and exit status 2 (DESIGN §3)."""
+
+    def invoke(self, ctx: Any) -> Any:
+        try:
+            return super().invoke(ctx)
+        except typer.Exit:
+            raise
+        except Exception as exc:
+            handled = user_error(exc)
+            if handled is None:
+                raise
+            message, code = handled
+            typer.echo(f"error: {_one_line(message)}", err=True)
+            raise typer.Exit(code) from None
+
+
+def _one_line(text: str) -> str:
+    return re.sub(r"\s+", " ", text).strip()
+
+
+def _first_sentence(text: str) -> str:
+    """Up to the first full stop that ends a sentence (not the one in "Fig. 2.7")."""
+    return re.split(r"(?<=[a-z0-9)\]])\.\s+(?=[A-Z])", text, maxsplit=1)[0].rstrip(".") + "."
+
+
+app = typer.Typer(
+    cls=UvnavGroup,
+    name="uvnav",
+    help="Real-time navigation of unmanned vehicles: simulate, benchmark and report.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_show_locals=False,
+)
+scenarios_app = typer.Typer(
+    cls=UvnavGroup, no_args_is_help=True, help="Built-in and user scenarios."
+)
+controllers_app = typer.Typer(
+    cls=UvnavGroup, no_args_is_help=True, help="Registered navigation laws."
+)
+app.add_typer(scenarios_app, name="scenarios")
+app.add_typer(controllers_app, name="controllers")
+
+
+def _version(value: bool) -> None:
+    if value:
+        from uvnav import __version__
+
+        typer.echo(f"uvnav {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool,
+        typer.Option(
+            "--version", callback=_version, is_eager=True, help="Print the version and exit."
+        ),
+    ] = False,
+) -> None:
+    """Real-time navigation of unmanned vehicles: simulate, benchmark and report."""
+
+
+# ----------------------------------------------------------------------------------------- helpers
+
+
+def _console(stderr: bool = False) -> Any:
+    from rich.console import Console
+
+    return Console(stderr=stderr, highlight=False)
+
+
+def _text(value: Any) -> Any:
+    from rich.text import Text
+
+    return Text(str(value))
+
+
+def _fmt(value: Any) -> str:
+    if value is None:
+        return "-"
+    if isinstance(value, bool | np.bool_):
+        return "yes" if value else "no"
+    if isinstance(value, int | np.integer):
+        return str(int(value))
+    if isinstance(value, float | np.floating):
+        return f"{float(value):.4g}"
+    return str(value)
+
+
+def _jsonable(value: Any) -> Any:
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, np.ndarray):
+        return value.tolist()
+    if isinstance(value, Path):
+        return str(value)
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+def _dumps(data: Any, *, indent: int | None = None) -> str:
+    return json.dumps(data, default=_jsonable, indent=indent, allow_nan=False)
+
+
+def _optional(module: str, attr: str, what: str) -> Any:
+    """``module.attr`` imported on demand; a missing part is a one-line error (status 1)."""
+    try:
+        mod = importlib.import_module(module)
+    except ImportError as exc:
+        raise CliError(f"{what} is not available: cannot import {module} ({exc})", code=1) from None
+    obj = getattr(mod, attr, None)
+    if obj is None:
+        raise CliError(f"{what} is not available: {module} has no {attr!r}", code=1)
+    return obj
+
+
+_PARAM_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+
+
+def parse_params(items: list[str] | None) -> dict[str, Any]:
+    """``["alpha0=0.1", "mode=fast"]`` -> ``{"alpha0": 0.1, "mode": "fast"}`` (values read as YAML).
+
+    Raises:
+        CliError: an item is not ``KEY=VALUE`` with an identifier key, or its value is not YAML.
+    """
+    params: dict[str, Any] = {}
+    for item in items or []:
+        key, sep, raw = item.partition("=")
+        key = key.strip()
+        if not sep or not _PARAM_KEY.match(key):
+            raise CliError(
+                f"--param {item!r}: expected KEY=VALUE with an identifier KEY (e.g. alpha0=0.1)"
+            )
+        try:
+            value = yaml.safe_load(raw) if raw.strip() else ""
+        except yaml.YAMLError:
+            raise CliError(f"--param {item!r}: value is not a valid YAML scalar or list") from None
+        params[key] = value
+    return params
+
+
+_METRIC_UNITS = {
+    "min_clearance": "m",
+    "path_length": "m",
+    "time_to_goal": "s",
+    "control_effort": "rad²/s + m²/s³",
+    "decision_us_median": "µs",
+    "decision_us_p99": "µs",
+}
+
+
+def _make_controller(name: str, params: dict[str, Any]) -> Any:
+    try:
+        return make_controller(name, **params)
+    except ControllerParamsError as exc:
+        raise ControllerParamsError(f"controller {name}: {exc}") from None
+
+
+# ---------------------------------------------------------------------------------------- simulate
+
+
+@app.command()
+def simulate(
+    scenario: Annotated[
+        str, typer.Argument(help="Built-in name, YAML file, or random-ch2:<seed>.")
+    ],
+    controller: Annotated[
+        str | None,
+        typer.Option("--controller", "-c", help="Controller name (default: the scenario's)."),
+    ] = None,
+    param: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--param", "-p", help="Controller parameter KEY=VALUE (repeatable; value read as YAML)."
+        ),
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Episode seed (obstacle motion, sensing noise).")] = 0,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object instead of a table.")
+    ] = False,
+    plot: Annotated[
+        Path | None, typer.Option(help="Also draw the episode into this image file.")
+    ] = None,
+) -> None:
+    """Run one episode of SCENARIO and print the metrics (DESIGN §4).
+
+    The scenario's controller parameters are used when the controller is the scenario's own;
+    ``--param`` values override them.  With another ``--controller`` only ``--param`` values apply.
+    """
+    sc = load_scenario(scenario)
+    name = controller or sc.controller.name
+    params = dict(sc.controller.params) if name == sc.controller.name else {}
+    params.update(parse_params(param))
+    validate_for_controller(sc, name)
+    ctrl = _make_controller(name, params)
+    plot_episode = (
+        _optional("uvnav.viz.figures", "plot_episode", "plotting (--plot)") if plot else None
+    )
+    setup = build_episode(sc, seed)
+    result = run_episode(setup, ctrl, run_rng(seed), record=plot is not None)
+    metrics = result.metrics.to_dict()
+    record: dict[str, Any] = {
+        "scenario": sc.name,
+        "controller": name,
+        "params": params,
+        "seed": seed,
+        "status": result.status,
+        **{k: metrics[k] for k in METRIC_NAMES},
+    }
+    if plot_episode is not None and plot is not None:
+        plot_episode(result, setup, plot)
+    if json_out:
+        typer.echo(_dumps(record))
+        if plot is not None:
+            typer.echo(f"wrote {plot}", err=True)
+        return
+    from rich.table import Table
+
+    table = Table(title=f"{sc.name} | {name} | seed {seed} | {result.status}")
+    table.add_column("metric")
+    table.add_column("value", justify="right")
+    table.add_column("unit")
+    for key in METRIC_NAMES:
+        table.add_row(key, _fmt(metrics[key]), _METRIC_UNITS.get(key, ""))
+    con = _console()
+    con.print(table)
+    if plot is not None:
+        typer.echo(f"wrote {plot}")
+
+
+# --------------------------------------------------------------------------------------- scenarios
+
+
+@scenarios_app.command("list")
+def scenarios_list(
+    json_out: Annotated[bool, typer.Option("--json", help="Print a JSON list.")] = False,
+) -> None:
+    """List the built-in scenarios (thesis experiments first)."""
+    rows: list[dict[str, Any]] = []
+    for name in list_builtin():
+        sc = load_scenario(name)
+        rows.append(
+            {
+                "name": name,
+                "description": _one_line(sc.description),
+                "obstacles": len(sc.obstacles),
+                "controller": sc.controller.name,
+            }
+        )
+    if json_out:
+        typer.echo(_dumps(rows))
+        return
+    from rich.table import Table
+
+    table = Table(
+        title="built-in scenarios", caption="also: random-ch2:<seed> (random Chapter-2 scene)"
+    )
+    table.add_column("name", no_wrap=True)
+    table.add_column("obstacles", justify="right")
+    table.add_column("description (first sentence; `uvnav scenarios show NAME` for all)")
+    for row in rows:
+        table.add_row(
+            _text(row["name"]), str(row["obstacles"]), _text(_first_sentence(row["description"]))
+        )
+    _console().print(table)
+
+
+@scenarios_app.command("show")
+def scenarios_show(
+    name: Annotated[str, typer.Argument(help="Built-in name, YAML file, or random-ch2:<seed>.")],
+    resolved: Annotated[
+        bool,
+        typer.Option(
+            "--resolved", help="Print the validated scenario with every default filled in."
+        ),
+    ] = False,
+) -> None:
+    """Print a scenario as YAML (the file as written, or --resolved)."""
+    sc = load_scenario(name)
+    if resolved or name.startswith("random-ch2:"):
+        typer.echo(scenario_to_yaml(sc), nl=False)
+        return
+    _, text = scenario_text(name)
+    typer.echo(text, nl=not text.endswith("\n"))
+
+
+@scenarios_app.command("schema")
+def scenarios_schema() -> None:
+    """Print the JSON Schema of a scenario file."""
+    typer.echo(_dumps(Scenario.model_json_schema(), indent=2))
+
+
+@scenarios_app.command("validate")
+def scenarios_validate(
+    files: Annotated[list[str], typer.Argument(help="Scenario files (or built-in names).")],
+) -> None:
+    """Check scenario files: OK, or one error line each, plus (2.6)-(2.8) constraint warnings.
+
+    Exit status 2 when any file is invalid.
+    """
+    invalid = 0
+    for item in files:
+        try:
+            sc = load_scenario(item)
+        except ScenarioError as exc:
+            typer.echo(f"error: {exc}", err=True)
+            invalid += 1
+            continue
+        warnings = [f"{item}: {w}" for w in check_constraints(sc)]
+        try:
+            validate_for_controller(sc, sc.controller.name)
+        except ScenarioError as exc:
+            typer.echo(f"error: {item}: {exc.path}: {exc.problem}", err=True)
+            invalid += 1
+            continue
+        except UnknownControllerError:
+            warnings.append(
+                f"{item}: controller.name: {sc.controller.name!r} is not a registered controller"
+            )
+        suffix = (
+            f" ({len(warnings)} warning{'s' if len(warnings) != 1 else ''})" if warnings else ""
+        )
+        typer.echo(f"OK {item}{suffix}")
+        for w in warnings:
+            typer.echo(f"  warning: {w}")
+    if invalid:
+        raise typer.Exit(2)
+
+
+# ------------------------------------------------------------------------------------- controllers
+
+
+def attribute_docs(cls: type) -> dict[str, str]:
+    """Field descriptions from the ``Attributes:`` section of a Google-style class docstring."""
+    doc = inspect.getdoc(cls) or ""
+    out: dict[str, str] = {}
+    in_section = False
+    indent: int | None = None
+    current: str | None = None
+    for line in doc.splitlines():
+        stripped = line.strip()
+        if stripped in ("Attributes:", "Args:", "Parameters:"):
+            in_section, indent, current = True, None, None
+            continue
+        if not in_section:
+            continue
+        if not stripped:
+            current = None
+            continue
+        level = len(line) - len(line.lstrip())
+        if level == 0:
+            in_section = False
+            continue
+        match = re.match(r"^(\w+)(?:\s*\([^)]*\))?:\s*(.*)$", stripped)
+        if match and (indent is None or level == indent):
+            indent = level
+            current = match.group(1)
+            out[current] = match.group(2)
+        elif current is not None:
+            out[current] = f"{out[current]} {stripped}".strip()
+    return out
+
+
+def _param_rows(info: ControllerInfo) -> list[dict[str, Any]]:
+    ptype = info.params_type
+    if ptype is None or not dataclasses.is_dataclass(ptype):
+        return []
+    docs = attribute_docs(ptype)
+    rows = []
+    for f in dataclasses.fields(ptype):
+        if f.default is not dataclasses.MISSING:
+            default: Any = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            default = f.default_factory()
+        else:
+            default = None
+        type_name = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
+        rows.append(
+            {"name": f.name, "type": type_name, "default": default, "doc": docs.get(f.name, "")}
+        )
+    return rows
+
+
+@controllers_app.command("list")
+def controllers_list(
+    json_out: Annotated[bool, typer.Option("--json", help="Print a JSON list.")] = False,
+) -> None:
+    """List the registered controllers."""
+    infos = available_controllers()
+    rows = [
+        {
+            "name": name,
+            "summary": info.summary,
+            "reference": info.reference,
+            "requires_slower_obstacles": info.requires_slower_obstacles,
+        }
+        for name, info in infos.items()
+    ]
+    if json_out:
+        typer.echo(_dumps(rows))
+        return
+    from rich.table import Table
+
+    table = Table(title="controllers")
+    table.add_column("name", no_wrap=True)
+    table.add_column("summary")
+    table.add_column("slower obstacles")
+    for row in rows:
+        table.add_row(
+            _text(row["name"]),
+            _text(row["summary"]),
+            "required" if row["requires_slower_obstacles"] else "",
+        )
+    _console().print(table)
+
+
+@controllers_app.command("show")
+def controllers_show(
+    name: Annotated[str, typer.Argument(help="Registered controller name, e.g. zhang2019-v1.")],
+    json_out: Annotated[bool, typer.Option("--json", help="Print a JSON object.")] = False,
+) -> None:
+    """Show a controller: summary, reference and parameters with defaults and units."""
+    info = controller_info(name)
+    rows = _param_rows(info)
+    if json_out:
+        typer.echo(
+            _dumps(
+                {
+                    "name": info.name,
+                    "summary": info.summary,
+                    "reference": info.reference,
+                    "requires_slower_obstacles": info.requires_slower_obstacles,
+                    "params": rows,
+                }
+            )
+        )
+        return
+    from rich.table import Table
+
+    con = _console()
+    con.print(_text(f"{info.name}: {info.summary}"))
+    if info.reference:
+        con.print(_text(f"reference: {info.reference}"))
+    if info.requires_slower_obstacles:
+        con.print(_text("requires obstacles slower than the robot (thesis (2.6))"))
+    if not rows:
+        con.print(_text("no parameters"))
+        return
+    table = Table(title="parameters")
+    table.add_column("name", no_wrap=True)
+    table.add_column("type")
+    table.add_column("default", justify="right")
+    table.add_column("description")
+    for row in rows:
+        table.add_row(
+            _text(row["name"]), _text(row["type"]), _text(_fmt(row["default"])), _text(row["doc"])
+        )
+    con.print(table)
+
+
+# ------------------------------------------------------------------------------------- run / report
+
+
+@app.command()
+def run(
+    full: Annotated[
+        bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
+    ] = False,
+    workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 2,
+    results: Annotated[Path, typer.Option(help="Directory of the results database.")] = Path(
+        "results"
+    ),
+    report: Annotated[Path, typer.Option(help="Directory of the HTML report.")] = Path("report"),
+) -> None:
+    """Reproduce the thesis's experiments: results database, report, and the comparison table."""
+    reproduce = _optional("uvnav.bench.reproduce", "reproduce", "the reproduction job (uvnav run)")
+    summary = reproduce(results, report, full=full, workers=workers, progress=True)
+    from rich.table import Table
+
+    table = Table(title="thesis reported vs uvnav measured")
+    for col in ("quantity", "thesis", "measured", "note"):
+        table.add_column(col, justify="right" if col in ("thesis", "measured") else "left")
+    for row in getattr(summary, "table", []) or []:
+        table.add_row(
+            *(_text(_fmt(row.get(col))) for col in ("quantity", "thesis", "measured", "note"))
+        )
+    con = _console()
+    con.print(table)
+    written: list[Path] = []
+    for attr in ("db_path", "report_path"):
+        value = getattr(summary, attr, None)
+        if isinstance(value, Path):
+            written.append(value)
+    for default in (results / "uvnav.sqlite", report / "index.html"):
+        if default.exists() and default not in written:
+            written.append(default)
+    for path in written:
+        typer.echo(f"wrote {path}")
+    figures = [f for f in getattr(summary, "figures", None) or [] if isinstance(f, Path)]
+    if figures:
+        folders = sorted({str(f.parent) for f in figures})
+        typer.echo(f"wrote {len(figures)} figure file(s) in {', '.join(folders)}")
+
+
+@app.command("report")
+def report_cmd(
+    db: Annotated[
+        Path, typer.Argument(help="Results database (SQLite) written by uvnav run / bench.")
+    ],
+    out: Annotated[Path, typer.Option("--out", help="Output directory.")] = Path("report"),
+) -> None:
+    """Turn a results database into the HTML report."""
+    if not db.exists():
+        raise CliError(f"{db}: no such database file")
+    if not db.is_file():
+        raise CliError(f"{db}: not a file")
+    write_report = _optional("uvnav.viz.report", "write_report", "the report (uvnav report)")
+    path = write_report(db, out)
+    typer.echo(f"wrote {path}")
+
+
+def main() -> None:
+    """Console-script entry point (``uvnav``)."""
+    app(prog_name="uvnav")

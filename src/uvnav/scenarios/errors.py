@@ -1,0 +1,180 @@
+"""One-line scenario errors (DESIGN §3: one clear line naming the file, the field and the problem).
+
+Every problem found while reading a scenario — malformed YAML, an unknown or mistyped field, a
+value out of range, an inconsistent scene — is raised as :class:`ScenarioError`, whose ``str()``
+is a single line ``<file>: <field path>: <problem>``, e.g.
+``thesis.yaml: robot.v_max: must be > 0 (got -1)``.
+Pydantic's structured errors are translated here, so that the command line can print them verbatim
+and exit with status 2 instead of showing a traceback.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from typing import Any
+
+from pydantic import ValidationError
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot be loaded or does not make sense.
+
+    Attributes:
+        source: the file (or ``"<dict>"``, or a built-in name) the scenario came from.
+        path: dotted field path (``obstacles.0.motion.speed``), ``"line N"`` for YAML syntax
+            errors, or ``""`` for a problem with the whole file.
+        problem: what is wrong, in one line.
+    """
+
+    def __init__(self, source: str, path: str, problem: str) -> None:
+        self.source = str(source)
+        self.path = str(path)
+        self.problem = _one_line(problem)
+        super().__init__(str(self))
+
+    def __str__(self) -> str:
+        parts = [p for p in (self.source, self.path, self.problem) if p]
+        return ": ".join(parts)
+
+
+class FieldError(ValueError):
+    """Raised inside model validators to point at a sub-field (``path`` relative to the model)."""
+
+    def __init__(self, path: str, problem: str) -> None:
+        self.path = path
+        self.problem = problem
+        super().__init__(problem)
+
+
+def _one_line(text: str) -> str:
+    return re.sub(r"\s+", " ", str(text)).strip()
+
+
+def _show(value: Any, limit: int = 40) -> str:
+    """Compact rendering of an offending input value (``0.0`` as ``0``, strings quoted)."""
+    if isinstance(value, float) and value.is_integer():
+        text = str(int(value))
+    elif isinstance(value, str):
+        text = repr(value)
+    elif isinstance(value, dict):
+        text = "{" + ", ".join(str(k) for k in value) + "}"
+    else:
+        text = repr(value)
+    text = _one_line(text)
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+#: pydantic error types about the kind of value, and the noun we expect instead
+_TYPE_NOUNS = {
+    "float_type": "a number",
+    "float_parsing": "a number",
+    "int_type": "an integer",
+    "int_parsing": "an integer",
+    "int_from_float": "an integer",
+    "bool_type": "true or false",
+    "bool_parsing": "true or false",
+    "string_type": "a string",
+    "dict_type": "a mapping",
+    "model_type": "a mapping",
+    "model_attributes_type": "a mapping",
+    "list_type": "a list",
+    "tuple_type": "a list",
+    "finite_number": "a finite number",
+}
+
+
+def _describe(err: Any, allowed: Sequence[str] | None) -> str:
+    """Translate one pydantic error dict into a short problem statement."""
+    kind = err.get("type", "")
+    ctx = err.get("ctx") or {}
+    value = err.get("input")
+    if kind == "value_error" and isinstance(ctx.get("error"), Exception):
+        return str(ctx["error"])
+    bounds = {
+        "greater_than": ">",
+        "greater_than_equal": ">=",
+        "less_than": "<",
+        "less_than_equal": "<=",
+    }
+    if kind in bounds:
+        key = {
+            "greater_than": "gt",
+            "greater_than_equal": "ge",
+            "less_than": "lt",
+            "less_than_equal": "le",
+        }[kind]
+        return f"must be {bounds[kind]} {_show(ctx.get(key))} (got {_show(value)})"
+    if kind == "missing":
+        return "required field is missing"
+    if kind == "extra_forbidden":
+        hint = f" (allowed: {', '.join(allowed)})" if allowed else ""
+        return f"unknown field{hint}"
+    if kind in _TYPE_NOUNS:
+        return f"expected {_TYPE_NOUNS[kind]} (got {_show(value)})"
+    if kind == "literal_error":
+        return f"must be {ctx.get('expected')} (got {_show(value)})"
+    if kind in ("too_short", "too_long"):
+        n = ctx.get("actual_length")
+        limit = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
+        word = "at least" if kind == "too_short" else "at most"
+        return f"needs {word} {limit} item(s) (got {n})"
+    if kind == "union_tag_invalid":
+        what = ctx.get("discriminator", "tag")
+        expected = ctx.get("expected_tags")
+        return f"unknown {what} {_show(ctx.get('tag'))} (expected one of: {expected})"
+    if kind == "union_tag_not_found":
+        return f"missing {ctx.get('discriminator', 'tag')} (one of the motion types)"
+    msg = str(err.get("msg", "invalid value"))
+    return (
+        f"{msg} (got {_show(value)})" if value is not None and not isinstance(value, dict) else msg
+    )
+
+
+def format_loc(loc: Sequence[str | int], tags: Sequence[str] = ()) -> str:
+    """Dotted field path of a pydantic ``loc``, without discriminated-union tag segments."""
+    parts: list[str] = []
+    for i, part in enumerate(loc):
+        if isinstance(part, str) and part in tags and i > 0 and loc[i - 1] == "motion":
+            continue
+        parts.append(str(part))
+    return ".".join(parts)
+
+
+def from_validation_error(
+    exc: ValidationError,
+    source: str,
+    *,
+    tags: Sequence[str] = (),
+    allowed_fields: Any = None,
+) -> ScenarioError:
+    """The first error of ``exc`` as a :class:`ScenarioError` (with a count of the others).
+
+    Args:
+        exc: pydantic's error.
+        source: the file name to report.
+        tags: discriminator values that pydantic inserts into ``loc`` and we hide.
+        allowed_fields: optional callable ``loc -> list[str] | None`` naming the fields allowed at
+            the location of an ``extra_forbidden`` error.
+    """
+    errors = exc.errors(include_url=False)
+    if not errors:  # pragma: no cover - pydantic always reports at least one
+        return ScenarioError(source, "", str(exc))
+    # an unknown field is usually the cause of the other errors (a misspelt required field)
+    errors = sorted(errors, key=lambda e: e.get("type") != "extra_forbidden")
+    first = errors[0]
+    loc = tuple(first.get("loc", ()))
+    ctx = first.get("ctx") or {}
+    extra_path = ""
+    if first.get("type") == "value_error" and isinstance(ctx.get("error"), FieldError):
+        extra_path = ctx["error"].path
+    path = format_loc(loc, tags)
+    if extra_path:
+        path = f"{path}.{extra_path}" if path else extra_path
+    allowed = None
+    if first.get("type") == "extra_forbidden" and allowed_fields is not None:
+        allowed = allowed_fields(loc[:-1])
+    problem = _describe(first, allowed)
+    if len(errors) > 1:
+        problem += f" (and {len(errors) - 1} more error{'s' if len(errors) > 2 else ''})"
+    return ScenarioError(source, path or "<root>", problem)

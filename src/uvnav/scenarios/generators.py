@@ -1,0 +1,213 @@
+"""Seeded generators of random scenarios.
+
+:func:`random_ch2_scenario` draws scenes of the kind the thesis's Chapter 2 experiments use
+(Figs. 2.7-2.8): the robot goes from I = [0, 0] to T = [10, 10] with V_max = 0.707 m/s and
+U_max = 1.414 rad/s among randomly wandering non-convex obstacles that lie in its way and obey the
+motion constraints (2.6)-(2.8).  Shapes and motions are drawn by rejection: a candidate is redrawn
+until it is a valid, star-shaped, non-convex polygon and satisfies
+:func:`uvnav.scenarios.build.check_constraints`; a position is redrawn until it keeps the required
+clearances.  Everything is drawn from ``np.random.default_rng(seed)``, so a seed always gives the
+same scene.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from uvnav.geometry.polygons import polygon_area, polygon_centroid
+from uvnav.scenarios.build import obstacle_bounds
+from uvnav.scenarios.loader import scenario_from_dict
+from uvnav.scenarios.schema import ObstacleSpec, Scenario
+
+CH2_START = (0.0, 0.0)
+CH2_GOAL = (10.0, 10.0)
+CH2_V_MAX = 0.707  # [m/s]
+CH2_U_MAX = 1.414  # [rad/s]
+CH2_ARENA = (-3.0, -3.0, 13.0, 13.0)  # [m]
+
+_RADIUS_RANGE = (0.3, 0.9)  # vertex distance from the centroid [m]
+_VERTEX_COUNT = (5, 9)
+_ALONG_TRACK = (2.0, 12.0)  # [m] from I along I->T
+_LATERAL = 2.0  # [m] either side of the I->T line
+_END_CLEARANCE = 1.5  # [m] from start and goal to the obstacle's bounding disc
+_GAP = 0.3  # [m] between bounding discs of two obstacles
+_MAX_TRIES = 500
+
+
+def is_convex(vertices: np.ndarray) -> bool:
+    """True when the simple polygon ``vertices`` (n, 2) has no reflex vertex."""
+    v = np.asarray(vertices, dtype=float)
+    if polygon_area(v) < 0:
+        v = v[::-1]
+    e_in = v - np.roll(v, 1, axis=0)
+    e_out = np.roll(v, -1, axis=0) - v
+    cross = e_in[:, 0] * e_out[:, 1] - e_in[:, 1] * e_out[:, 0]
+    return bool(np.all(cross >= -1e-12))
+
+
+def is_star_about(vertices: np.ndarray, point: np.ndarray) -> bool:
+    """True when every edge of the CCW polygon ``vertices`` is seen from ``point`` turning CCW.
+
+    For vertices listed in angular order about ``point``, this is the condition for the polygon to
+    be star-shaped with respect to ``point`` (every ray from it crosses the boundary once).
+    """
+    rel = np.asarray(vertices, dtype=float) - point
+    nxt = np.roll(rel, -1, axis=0)
+    return bool(np.all(rel[:, 0] * nxt[:, 1] - rel[:, 1] * nxt[:, 0] > 1e-9))
+
+
+def random_star_polygon(
+    rng: np.random.Generator,
+    *,
+    n_vertices: tuple[int, int] = _VERTEX_COUNT,
+    radii: tuple[float, float] = _RADIUS_RANGE,
+) -> np.ndarray:
+    """A random non-convex polygon, star-shaped about its own centroid, centred on it.
+
+    Args:
+        rng: generator.
+        n_vertices: inclusive range of the vertex count.
+        radii: range of vertex distances from the centroid [m].
+
+    Returns:
+        (n, 2) counter-clockwise vertices [m], centroid at the origin (to 1e-4 m).
+    """
+    from shapely.geometry import Polygon
+
+    for _ in range(_MAX_TRIES):
+        k = int(rng.integers(n_vertices[0], n_vertices[1] + 1))
+        step = 2.0 * math.pi / k
+        angles = (
+            step * np.arange(k) + rng.uniform(0.0, 2.0 * math.pi) + rng.uniform(-0.3, 0.3, k) * step
+        )
+        r = rng.uniform(radii[0], radii[1], k)
+        verts = np.stack([r * np.cos(angles), r * np.sin(angles)], axis=-1)
+        verts = np.round(verts - polygon_centroid(verts), 4)
+        c = polygon_centroid(verts)
+        dist = np.hypot(*(verts - c).T)
+        if dist.min() < radii[0] or dist.max() > radii[1]:
+            continue
+        if is_convex(verts) or not is_star_about(verts, c) or not Polygon(verts).is_valid:
+            continue
+        return verts
+    raise RuntimeError("could not draw a star-shaped non-convex polygon")  # pragma: no cover
+
+
+def _random_motion(rng: np.random.Generator) -> dict[str, Any]:
+    lo = float(rng.uniform(0.05, 0.2))
+    hi = float(rng.uniform(lo, 0.5 * CH2_V_MAX))
+    w = float(rng.uniform(0.05, 0.3))
+    return {
+        "type": "random_turn",
+        "speed": [round(lo, 4), round(hi, 4)],
+        "turn_rate": [round(-w, 4), round(w, 4)],
+        "change_period": round(float(rng.uniform(1.0, 3.0)), 3),
+        "arena": list(CH2_ARENA),
+    }
+
+
+def random_ch2_scenario(
+    seed: int,
+    *,
+    n_obstacles: int | None = None,
+    controller: str = "zhang2019-v1",
+    controller_params: dict[str, Any] | None = None,
+    dt: float = 0.1,
+    t_max: float = 120.0,
+) -> Scenario:
+    """A random Chapter-2 scene, deterministic in ``seed``.
+
+    Robot: I = [0, 0], T = [10, 10], heading toward T, V_max 0.707 m/s, U_max 1.414 rad/s, radius
+    0.1 m.  Obstacles: non-convex star-shaped polygons (5-9 vertices at 0.3-0.9 m from the
+    centroid) centred near the I->T line (2-12 m along it, up to +-2 m across), clear of each other
+    (0.3 m between bounding discs) and of the start and goal (1.5 m from the bounding disc), moving
+    with ``random_turn`` (speeds within [0.05, 0.5 V_max] m/s, turn rates within +-0.3 rad/s, arena
+    [-3, -3, 13, 13] m) and obeying the thesis's (2.6)-(2.8).
+
+    Args:
+        seed: the only source of randomness.
+        n_obstacles: number of obstacles; drawn in 1..6 when ``None``.
+        controller: default controller of the scene.
+        controller_params: its parameters (controller defaults when ``None``).
+        dt: integration and decision step [s].
+        t_max: time limit [s].
+    """
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 7)) if n_obstacles is None else int(n_obstacles)
+    if n < 0:
+        raise ValueError(f"n_obstacles must be >= 0 (got {n})")
+    start = np.asarray(CH2_START)
+    goal = np.asarray(CH2_GOAL)
+    along = (goal - start) / np.hypot(*(goal - start))
+    across = np.array([-along[1], along[0]])
+
+    obstacles: list[dict[str, Any]] = []
+    placed: list[tuple[np.ndarray, float]] = []  # (centre, bounding radius)
+    for j in range(n):
+        for _ in range(_MAX_TRIES):
+            verts = random_star_polygon(rng)
+            spec: dict[str, Any] = {
+                "name": f"polygon-{j}",
+                "body": {"polygon": verts.tolist()},
+                "start": {"position": [0.0, 0.0], "heading": 0.0},
+                "motion": _random_motion(rng),
+            }
+            speed, turn, growth = obstacle_bounds(ObstacleSpec.model_validate(spec))
+            if not (speed < CH2_V_MAX and turn < CH2_U_MAX and growth < CH2_V_MAX - speed):
+                continue
+            bound = float(np.max(np.hypot(*(verts - polygon_centroid(verts)).T)))
+            centre = None
+            for _ in range(_MAX_TRIES):
+                c = (
+                    start
+                    + rng.uniform(*_ALONG_TRACK) * along
+                    + rng.uniform(-_LATERAL, _LATERAL) * across
+                )
+                c = np.round(c, 3)
+                if np.hypot(*(c - start)) - bound < _END_CLEARANCE:
+                    continue
+                if np.hypot(*(c - goal)) - bound < _END_CLEARANCE:
+                    continue
+                if any(np.hypot(*(c - pc)) < bound + pb + _GAP for pc, pb in placed):
+                    continue
+                centre = c
+                break
+            if centre is None:
+                continue
+            heading = round(float(rng.uniform(-math.pi, math.pi)), 4)
+            spec["start"] = {"position": centre.tolist(), "heading": heading}
+            placed.append((centre, bound))
+            obstacles.append(spec)
+            break
+        else:  # pragma: no cover - the strip has room for far more than 6 obstacles
+            raise RuntimeError(f"could not place obstacle {j} of {n} (seed {seed})")
+
+    heading = float(np.arctan2(along[1], along[0]))
+    data: dict[str, Any] = {
+        "name": f"random-ch2-{seed}",
+        "description": (
+            f"Random Chapter-2 scene (seed {seed}): {n} randomly turning non-convex obstacle(s) "
+            "near the straight path I->T, all obeying (2.6)-(2.8)."
+        ),
+        "dim": 2,
+        "dt": dt,
+        "control_period": dt,
+        "t_max": t_max,
+        "goal_tolerance": 0.1,
+        "robot": {
+            "model": "unicycle",
+            "start": list(CH2_START),
+            "heading": heading,
+            "goal": list(CH2_GOAL),
+            "v_max": CH2_V_MAX,
+            "u_max": CH2_U_MAX,
+            "radius": 0.1,
+        },
+        "sensing": {"range": 5.0, "velocities": "known", "position_noise": 0.0},
+        "obstacles": obstacles,
+        "controller": {"name": controller, "params": dict(controller_params or {})},
+    }
+    return scenario_from_dict(data, source=f"random-ch2:{seed}")

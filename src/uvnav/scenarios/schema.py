@@ -1,0 +1,492 @@
+"""Pydantic v2 schema of a scenario file (DESIGN §3).
+
+Every model forbids unknown fields (``extra="forbid"``) and non-finite numbers, so a typo in a YAML
+file is an error, not a silently ignored key.  Units are SI and written in each field's
+description (they show up in ``uvnav scenarios schema``).
+
+Besides the per-field checks (positive limits, valid polygons, ordered ranges), the model checks the
+scene as a whole at t = 0: the decision period is a positive multiple of the integration step, the
+goal is not inside an obstacle, and the robot's disc does not overlap one.  Each spec knows how to
+instantiate the library object it describes (:meth:`BodySpec.to_body`,
+:meth:`ObstacleSpec.to_obstacle`, ...); :func:`uvnav.scenarios.build.build_episode` assembles them.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Annotated, Any, Literal
+
+import numpy as np
+from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, field_validator, model_validator
+
+from uvnav.dynamics.unicycle import UnicycleSpec
+from uvnav.obstacles import (
+    Body,
+    ConstantVelocity,
+    DiscBody,
+    MotionModel,
+    Obstacle,
+    ObstacleField,
+    ObstacleState,
+    PolygonBody,
+    RandomTurn,
+    Replay,
+    Waypoints,
+)
+from uvnav.scenarios.errors import FieldError
+from uvnav.sim import LidarConfig, SensingConfig
+
+Point2 = Annotated[tuple[float, float], Field(description="[x, y] [m]")]
+"""A planar point ``[x, y]`` [m]."""
+
+
+class _Model(BaseModel):
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+
+def _heading_of(vector: np.ndarray, default: float) -> float:
+    """Direction [rad] of ``vector``, or ``default`` for a (near) zero vector."""
+    if float(np.hypot(vector[0], vector[1])) <= 1e-12:
+        return default
+    return float(np.arctan2(vector[1], vector[0]))
+
+
+# ------------------------------------------------------------------------------------------- robot
+
+
+class RobotSpec(_Model):
+    """The controlled vehicle, thesis Ch. 2 eqs. (2.1)-(2.4)."""
+
+    model: Literal["unicycle"] = Field(
+        "unicycle", description="vehicle model (only 'unicycle' in 2D)"
+    )
+    start: Point2 = Field(description="initial point I, [x, y] [m]")
+    heading: float | None = Field(
+        None, description="initial heading theta_0 [rad]; omitted = facing the goal"
+    )
+    goal: Point2 = Field(description="target point T, [x, y] [m]")
+    v_max: float = Field(gt=0, description="maximum speed V_max [m/s]")
+    u_max: float = Field(gt=0, description="maximum angular velocity U_max [rad/s]")
+    radius: float = Field(0.1, ge=0, description="radius of the robot's disc body [m]")
+
+    def initial_heading(self) -> float:
+        """``heading`` or, when omitted, the direction from start to goal [rad]."""
+        if self.heading is not None:
+            return float(self.heading)
+        gap = np.asarray(self.goal, dtype=float) - np.asarray(self.start, dtype=float)
+        return _heading_of(gap, 0.0)
+
+    def to_spec(self) -> UnicycleSpec:
+        """The simulator's :class:`~uvnav.dynamics.UnicycleSpec`."""
+        return UnicycleSpec(v_max=self.v_max, u_max=self.u_max, radius=self.radius)
+
+
+# ----------------------------------------------------------------------------------------- sensing
+
+
+class LidarSpec(_Model):
+    """An optional range scanner on the robot."""
+
+    n_rays: int = Field(72, ge=1, description="number of beams")
+    max_range: float = Field(5.0, gt=0, description="maximum range [m]")
+    fov: float = Field(2.0 * math.pi, gt=0, le=2.0 * math.pi, description="field of view [rad]")
+    noise_std: float = Field(0.0, ge=0, description="std of additive range noise [m]")
+    dropout: float = Field(0.0, ge=0, le=1, description="probability that a beam returns nothing")
+
+    def to_config(self) -> LidarConfig:
+        """The simulator's :class:`~uvnav.sim.LidarConfig`."""
+        return LidarConfig(
+            n_rays=self.n_rays,
+            max_range=self.max_range,
+            fov=self.fov,
+            noise_std=self.noise_std,
+            dropout=self.dropout,
+        )
+
+
+class SensingSpec(_Model):
+    """What the robot can know about obstacles (thesis §2.2 sensing model)."""
+
+    range: float = Field(5.0, gt=0, description="obstacles farther than this are not seen [m]")
+    velocities: Literal["known", "estimated"] = Field(
+        "known",
+        description="'known': true v_i, u_i (thesis assumption); 'estimated': finite differences",
+    )
+    position_noise: float = Field(
+        0.0, ge=0, description="std of the noise on sensed centres when estimating [m]"
+    )
+    lidar: LidarSpec | None = Field(None, description="optional range scanner")
+
+    def to_config(self) -> SensingConfig:
+        """The simulator's :class:`~uvnav.sim.SensingConfig`."""
+        return SensingConfig(
+            sensing_range=self.range,
+            velocities=self.velocities,
+            position_noise=self.position_noise,
+            lidar=self.lidar.to_config() if self.lidar is not None else None,
+        )
+
+
+# ------------------------------------------------------------------------------------------ bodies
+
+
+class BodySpec(_Model):
+    """An obstacle body: exactly one of ``polygon`` or ``disc``.
+
+    The polygon is given in the body frame; it is re-centred on its area centroid (the mass centre
+    the thesis's rotation u_i refers to), so ``start.position`` is where the centroid goes.
+    """
+
+    polygon: list[Point2] | None = Field(
+        None, description="simple polygon (non-convex allowed), vertices [[x, y], ...] [m]"
+    )
+    disc: float | None = Field(None, gt=0, description="disc radius [m]")
+
+    @field_validator("polygon")
+    @classmethod
+    def _simple_polygon(
+        cls, value: list[tuple[float, float]] | None
+    ) -> list[tuple[float, float]] | None:
+        if value is None:
+            return value
+        if len(value) < 3:
+            raise ValueError(f"a polygon needs at least 3 vertices (got {len(value)})")
+        from shapely.geometry import Polygon
+        from shapely.validation import explain_validity
+
+        poly = Polygon(value)
+        if not poly.is_valid:
+            raise ValueError(f"polygon is not simple: {explain_validity(poly)}")
+        if poly.area <= 1e-12:
+            raise ValueError("polygon has zero area")
+        return value
+
+    @model_validator(mode="after")
+    def _exactly_one(self) -> BodySpec:
+        if (self.polygon is None) == (self.disc is None):
+            raise ValueError("give exactly one of 'polygon' (vertices [m]) or 'disc' (radius [m])")
+        return self
+
+    def to_body(self) -> Body:
+        """A :class:`~uvnav.obstacles.PolygonBody` (centred on its centroid) or a disc."""
+        if self.polygon is not None:
+            return PolygonBody.from_vertices(np.asarray(self.polygon, dtype=float))
+        assert self.disc is not None
+        return DiscBody(float(self.disc))
+
+
+class ObstacleStart(_Model):
+    """Initial pose of an obstacle."""
+
+    position: Point2 = Field(description="mass-centre position at t = 0 [m]")
+    heading: float = Field(0.0, description="rotation of the body frame at t = 0 [rad]")
+
+
+# ----------------------------------------------------------------------------------------- motions
+
+
+class ConstantMotion(_Model):
+    """Straight line at constant velocity, constant spin (Savkin–Wang's obstacle model)."""
+
+    type: Literal["constant"]
+    velocity: Point2 = Field(description="velocity v_i [m/s], [vx, vy]")
+    angular_velocity: float = Field(0.0, description="spin u_i about the mass centre [rad/s]")
+
+    def to_model(self, rng: np.random.Generator) -> ConstantVelocity:
+        """The motion model (``rng`` unused: the motion is deterministic)."""
+        return ConstantVelocity(
+            np.asarray(self.velocity, dtype=float), float(self.angular_velocity)
+        )
+
+
+class RandomTurnMotion(_Model):
+    """Random wandering with bounded speed and turn rate (thesis Figs. 2.7-2.8)."""
+
+    type: Literal["random_turn"]
+    speed: tuple[Annotated[float, Field(ge=0)], Annotated[float, Field(ge=0)]] = Field(
+        description="(min, max) speed ||v_i|| [m/s]"
+    )
+    turn_rate: tuple[float, float] = Field(description="(min, max) course turn rate [rad/s]")
+    change_period: float = Field(
+        1.0, gt=0, description="a new speed and turn rate are drawn this often [s]"
+    )
+    spin: float = Field(0.0, description="extra constant rotation of the body [rad/s]")
+    arena: tuple[float, float, float, float] | None = Field(
+        None, description="[xmin, ymin, xmax, ymax] [m]; outside it the course turns back"
+    )
+
+    @field_validator("speed", "turn_rate")
+    @classmethod
+    def _ordered(cls, value: tuple[float, float]) -> tuple[float, float]:
+        if value[0] > value[1]:
+            raise ValueError(f"min {value[0]} > max {value[1]}")
+        return value
+
+    @field_validator("arena")
+    @classmethod
+    def _box(
+        cls, value: tuple[float, float, float, float] | None
+    ) -> tuple[float, float, float, float] | None:
+        if value is not None and not (value[0] < value[2] and value[1] < value[3]):
+            raise ValueError(f"need xmin < xmax and ymin < ymax (got {list(value)})")
+        return value
+
+    def to_model(self, rng: np.random.Generator) -> RandomTurn:
+        """The motion model, drawing from ``rng`` (the obstacle's own child generator)."""
+        return RandomTurn(
+            speed=(float(self.speed[0]), float(self.speed[1])),
+            turn_rate=(float(self.turn_rate[0]), float(self.turn_rate[1])),
+            rng=rng,
+            change_period=float(self.change_period),
+            spin=float(self.spin),
+            arena=self.arena,
+        )
+
+
+class WaypointsMotion(_Model):
+    """Scripted path through waypoints at constant speed (sharp turns at the waypoints)."""
+
+    type: Literal["waypoints"]
+    points: list[Point2] = Field(min_length=1, description="waypoints [[x, y], ...] [m]")
+    speed: float = Field(gt=0, description="travel speed [m/s]")
+    loop: bool = Field(False, description="restart at the first waypoint after the last")
+    turn_with_course: bool = Field(
+        True, description="the body turns to face the course (instantaneous turns: unbounded u_i)"
+    )
+
+    def to_model(self, rng: np.random.Generator) -> Waypoints:
+        """The motion model (``rng`` unused)."""
+        return Waypoints(
+            np.asarray(self.points, dtype=float),
+            float(self.speed),
+            self.loop,
+            self.turn_with_course,
+        )
+
+
+class ReplayMotion(_Model):
+    """A recorded trajectory, linearly interpolated (e.g. pedestrians)."""
+
+    type: Literal["replay"]
+    times: list[float] = Field(min_length=1, description="sample times, strictly increasing [s]")
+    positions: list[Point2] = Field(
+        min_length=1, description="mass-centre positions [[x, y], ...] [m]"
+    )
+
+    @field_validator("times")
+    @classmethod
+    def _increasing(cls, value: list[float]) -> list[float]:
+        if any(b <= a for a, b in itertools.pairwise(value)):
+            raise ValueError("times must be strictly increasing")
+        return value
+
+    @model_validator(mode="after")
+    def _same_length(self) -> ReplayMotion:
+        if len(self.times) != len(self.positions):
+            raise FieldError(
+                "positions",
+                f"needs one position per time ({len(self.positions)} != {len(self.times)})",
+            )
+        return self
+
+    def to_model(self, rng: np.random.Generator) -> Replay:
+        """The motion model (``rng`` unused)."""
+        return Replay(np.asarray(self.times, dtype=float), np.asarray(self.positions, dtype=float))
+
+
+MotionSpec = Annotated[
+    ConstantMotion | RandomTurnMotion | WaypointsMotion | ReplayMotion,
+    Field(discriminator="type"),
+]
+"""One of the motion specs, chosen by its ``type`` field."""
+
+MOTION_TYPES: dict[str, type[_Model]] = {
+    "constant": ConstantMotion,
+    "random_turn": RandomTurnMotion,
+    "waypoints": WaypointsMotion,
+    "replay": ReplayMotion,
+}
+
+
+# ---------------------------------------------------------------------------------------- obstacle
+
+
+class ObstacleSpec(_Model):
+    """One moving obstacle: body, initial pose and motion."""
+
+    name: str = Field("", description="optional label (plots, messages)")
+    body: BodySpec
+    start: ObstacleStart | None = Field(
+        None,
+        description="initial pose; optional for waypoints (first point) and replay (first sample)",
+    )
+    motion: MotionSpec
+
+    @model_validator(mode="after")
+    def _start_given(self) -> ObstacleSpec:
+        m = self.motion
+        if self.start is None and not isinstance(m, WaypointsMotion | ReplayMotion):
+            raise FieldError("start", f"required for motion type {m.type!r}")
+        if self.start is not None and isinstance(m, ReplayMotion):
+            at0 = m.to_model(np.random.default_rng(0)).position_at(0.0)
+            if float(np.hypot(*(np.asarray(self.start.position) - at0))) > 1e-6:
+                raise FieldError(
+                    "start.position",
+                    f"must match the replayed position at t=0, {at0.round(6).tolist()}, "
+                    "or be omitted",
+                )
+        return self
+
+    def initial_state(self, dt: float) -> ObstacleState:
+        """State at t = 0: pose from ``start`` (or the path), velocity along the initial course.
+
+        For ``random_turn`` the course starts along ``start.heading`` at the middle of the speed
+        range (the first step draws the actual speed); for ``waypoints`` it points at the first
+        waypoint; for ``replay`` it is the first interpolated displacement over ``dt`` [s].
+        """
+        m = self.motion
+        heading = self.start.heading if self.start is not None else 0.0
+        if isinstance(m, ReplayMotion):
+            replay = m.to_model(np.random.default_rng(0))
+            pos = replay.position_at(0.0)
+            vel = (replay.position_at(dt) - pos) / dt
+            if self.start is None:
+                heading = _heading_of(vel, 0.0)
+            return ObstacleState(position=pos, heading=heading, velocity=vel, angular_velocity=0.0)
+        if isinstance(m, WaypointsMotion):
+            pts = np.asarray(m.points, dtype=float)
+            pos = (
+                np.asarray(self.start.position, dtype=float)
+                if self.start is not None
+                else pts[0].copy()
+            )
+            target = (
+                pts[0] if float(np.hypot(*(pts[0] - pos))) > 1e-12 else pts[min(1, len(pts) - 1)]
+            )
+            gap = target - pos
+            dist = float(np.hypot(*gap))
+            vel = gap / dist * m.speed if dist > 1e-12 else np.zeros(2)
+            if self.start is None:
+                heading = _heading_of(gap, 0.0)
+            return ObstacleState(position=pos, heading=heading, velocity=vel, angular_velocity=0.0)
+        assert self.start is not None
+        pos = np.asarray(self.start.position, dtype=float)
+        if isinstance(m, ConstantMotion):
+            return ObstacleState(
+                position=pos,
+                heading=heading,
+                velocity=np.asarray(m.velocity, dtype=float),
+                angular_velocity=float(m.angular_velocity),
+            )
+        speed = 0.5 * (m.speed[0] + m.speed[1])
+        vel = speed * np.array([np.cos(heading), np.sin(heading)])
+        return ObstacleState(
+            position=pos, heading=heading, velocity=vel, angular_velocity=float(m.spin)
+        )
+
+    def to_obstacle(self, rng: np.random.Generator, dt: float, index: int = 0) -> Obstacle:
+        """A fresh :class:`~uvnav.obstacles.Obstacle` for one episode.
+
+        Args:
+            rng: this obstacle's own generator (only ``random_turn`` draws from it).
+            dt: the episode's integration step [s] (initial velocity of a replay).
+            index: position in the scenario, used for the default name.
+        """
+        state = self.initial_state(dt)
+        motion: MotionModel = self.motion.to_model(rng)
+        if isinstance(motion, RandomTurn):
+            motion.course = float(state.heading)
+        return Obstacle(
+            body=self.body.to_body(),
+            state=state,
+            motion=motion,
+            name=self.name or f"obstacle-{index}",
+        )
+
+
+class ControllerSpec(_Model):
+    """The navigation law a scenario runs with by default."""
+
+    name: str = Field(
+        "zhang2019-v1", min_length=1, description="registered controller name, e.g. zhang2019-v1"
+    )
+    params: dict[str, Any] = Field(
+        default_factory=dict,
+        description="fields of the controller's Params (units: `uvnav controllers show NAME`)",
+    )
+
+
+# ---------------------------------------------------------------------------------------- scenario
+
+
+class Scenario(_Model):
+    """A complete scenario (DESIGN §3): robot, sensing, obstacles, timing and default controller."""
+
+    name: str = Field(min_length=1, description="scenario name, e.g. thesis-ch2-one-obstacle")
+    description: str = Field("", description="what the scene is and where it comes from")
+    dim: Literal[2] = Field(2, description="dimension of the world (2 for Ch. 2 scenes)")
+    dt: float = Field(0.1, gt=0, description="integration step [s]")
+    control_period: float = Field(
+        0.1, gt=0, description="decision period [s], a positive multiple of dt (defaults to dt)"
+    )
+    t_max: float = Field(60.0, gt=0, description="time limit of an episode [s]")
+    goal_tolerance: float = Field(
+        0.1, gt=0, description="the goal counts as reached within this distance [m]"
+    )
+    robot: RobotSpec
+    sensing: SensingSpec = Field(default_factory=lambda: SensingSpec.model_validate({}))
+    obstacles: list[ObstacleSpec] = Field(default_factory=list)
+    controller: ControllerSpec = Field(default_factory=lambda: ControllerSpec.model_validate({}))
+
+    _source: str = PrivateAttr(default="<dict>")
+
+    @property
+    def source(self) -> str:
+        """The file (or ``"<dict>"``) this scenario was read from, for error messages."""
+        return self._source
+
+    def __eq__(self, other: object) -> bool:
+        """Equal when every field is equal; where the scenario was read from does not count."""
+        if not isinstance(other, Scenario):
+            return NotImplemented
+        return self.__dict__ == other.__dict__
+
+    __hash__ = None  # type: ignore[assignment]  # lists inside: not hashable
+
+    @model_validator(mode="before")
+    @classmethod
+    def _default_control_period(cls, data: Any) -> Any:
+        dt = data.get("dt") if isinstance(data, dict) else None
+        numeric = isinstance(dt, int | float) and not isinstance(dt, bool)
+        if numeric and "control_period" not in data:
+            data = {**data, "control_period": data["dt"]}
+        return data
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Scenario:
+        ratio = self.control_period / self.dt
+        if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
+            raise FieldError(
+                "control_period",
+                f"must be a positive multiple of dt={self.dt:g} s (got {self.control_period:g})",
+            )
+        if not self.obstacles:
+            return self
+        rng = np.random.default_rng(0)
+        obstacles = [o.to_obstacle(rng, self.dt, j) for j, o in enumerate(self.obstacles)]
+        field = ObstacleField.from_obstacles(obstacles)
+        _, _, inside = field.nearest(np.asarray(self.robot.goal, dtype=float))
+        if inside.any():
+            j = int(np.argmax(inside))
+            raise FieldError("robot.goal", f"lies inside obstacle {j} ({obstacles[j].name}) at t=0")
+        dist, _, inside = field.nearest(np.asarray(self.robot.start, dtype=float))
+        gaps = np.where(inside, -np.inf, dist - self.robot.radius)
+        j = int(np.argmin(gaps))
+        if gaps[j] < 0:
+            raise FieldError(
+                "robot.start",
+                f"robot disc (radius {self.robot.radius:g} m) overlaps obstacle {j} "
+                f"({obstacles[j].name}) at t=0",
+            )
+        return self

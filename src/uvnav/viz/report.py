@@ -1,0 +1,240 @@
+"""The HTML report of a results database (DESIGN §5–6: ``uvnav report DB`` and ``uvnav run``).
+
+:func:`write_report` renders ``out_dir/index.html`` from the Jinja2 template
+``uvnav/viz/templates/report.html`` with
+
+* the table "thesis reported vs uvnav measured" (rows given by the caller, e.g.
+  :func:`uvnav.bench.reproduce.reproduce`, whose measured values come from the runs),
+* a metric summary per scenario family and controller computed from the ``episodes`` table
+  (episodes, success/collision/timeout rates, errors, mean / median of the distance metrics),
+* the figures, copied next to ``index.html`` and linked relatively,
+* the episodes that raised errors, and the campaigns with their configs,
+* a note that the Chapter 2 obstacles are simulated.
+
+The page is self-contained: inline CSS, no scripts, no external URL — it opens offline and can be
+zipped or published as is.
+"""
+
+from __future__ import annotations
+
+import shutil
+import sys
+from collections.abc import Mapping, Sequence
+from datetime import UTC, datetime
+from importlib.resources import files
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+if TYPE_CHECKING:
+    import pandas as pd
+
+SIMULATION_NOTE = (
+    "In this chapter (thesis Ch. 2) the obstacles are simulated: their shapes and motions come "
+    "from the scenario definitions (random turns, constant velocities), and the robot senses them "
+    "exactly (distance, nearest boundary point, velocity and rotation rate). No recorded sensor "
+    "data is used."
+)
+
+_TABLE_ORDER = ("quantity", "thesis", "measured", "note")
+_TEXT_COLUMNS = ("family", "controller")
+_MAX_ERRORS = 50
+#: ``run_episode`` reports ``min_clearance = 1e9`` [m] for scenes without obstacles.
+_NO_OBSTACLE_CLEARANCE = 1e8
+
+FigureSpec = Path | str | tuple[Path | str, str]
+
+
+def _fmt(x: float | None, digits: int = 3) -> str:
+    if x is None or not np.isfinite(x):
+        return "–"
+    return f"{x:.{digits}f}"
+
+
+def _mean_median(values: pd.Series, digits: int = 3) -> str:
+    v = values.to_numpy(dtype=float, na_value=np.nan)
+    v = v[np.isfinite(v) & (np.abs(v) < _NO_OBSTACLE_CLEARANCE)]
+    if not len(v):
+        return "–"
+    return f"{_fmt(float(np.mean(v)), digits)} / {_fmt(float(np.median(v)), digits)}"
+
+
+def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
+    """Per (family, controller) summary rows of an episodes frame, formatted for display.
+
+    Args:
+        df: from :meth:`uvnav.bench.store.ResultsStore.episodes_frame` or ``pandas.read_sql``.
+
+    Returns:
+        One dict per group, keys in display order: ``family``, ``controller``, ``episodes``,
+        ``success rate``, ``collision rate``, ``timeout rate``, ``errors``, and "mean / median"
+        strings of ``min_clearance [m]``, ``path_length [m]``, ``detour_ratio``, ``time_ratio``,
+        ``control_effort`` and ``decision_us_median [µs]``.
+    """
+    if df.empty:
+        return []
+    frame = df.copy()
+    if "family" not in frame.columns:
+        frame["family"] = frame["scenario"]
+    rows: list[dict[str, Any]] = []
+    for (family, controller), g in frame.groupby(["family", "controller"], sort=True):
+        n = len(g)
+        status = g["status"].astype(str)
+        ok = status == "success"
+        rows.append(
+            {
+                "family": family,
+                "controller": controller,
+                "episodes": n,
+                "success rate": f"{ok.mean():.1%}",
+                "collision rate": f"{(status == 'collision').mean():.1%}",
+                "timeout rate": f"{(status == 'timeout').mean():.1%}",
+                "errors": int((status == "error").sum()),
+                "min_clearance [m]": _mean_median(g["min_clearance"]),
+                "path_length [m]": _mean_median(g["path_length"], 2),
+                "detour_ratio": _mean_median(g.loc[ok, "detour_ratio"]),
+                "time_ratio": _mean_median(g.loc[ok, "time_ratio"]),
+                "control_effort": _mean_median(g["control_effort"], 2),
+                "decision_us_median [µs]": _mean_median(g["decision_us_median"], 1),
+            }
+        )
+    return rows
+
+
+def _copy_figures(figures: Sequence[FigureSpec], out_dir: Path) -> list[dict[str, str]]:
+    out: list[dict[str, str]] = []
+    used: set[str] = set()
+    for i, spec in enumerate(figures):
+        src, caption = (Path(spec[0]), spec[1]) if isinstance(spec, tuple) else (Path(spec), "")
+        if not src.is_file():
+            raise FileNotFoundError(f"figure {src} does not exist")
+        name = src.name
+        if name in used:
+            name = f"{i:02d}-{name}"
+        used.add(name)
+        dest = out_dir / name
+        if src.resolve() != dest.resolve():
+            shutil.copyfile(src, dest)
+        out.append(
+            {"src": name, "caption": caption or src.stem.replace("-", " ").replace("_", " ")}
+        )
+    return out
+
+
+def write_report(
+    db_path: Path,
+    out_dir: Path,
+    *,
+    figures: Sequence[FigureSpec] | None = None,
+    table: Sequence[Mapping[str, Any]] | None = None,
+    title: str = "uvnav results",
+    summary_figure: bool = True,
+) -> Path:
+    """Render the HTML report of a results database.
+
+    Args:
+        db_path: SQLite results database (must exist).
+        out_dir: output folder (created); receives ``index.html`` and the PNG figures.
+        figures: PNG files to include, optionally as ``(path, caption)`` pairs; they are copied into
+            ``out_dir`` (a file already there is used in place).
+        table: rows of the "thesis reported vs uvnav measured" table, dicts with keys ``quantity``,
+            ``thesis``, ``measured``, ``note`` (further keys become further columns).
+        title: page title.
+        summary_figure: add a campaign summary figure (outcomes, clearance and detour distributions)
+            of all episodes, written as ``out_dir/campaign-summary.png``.
+
+    Returns:
+        The path of ``index.html``.
+
+    Raises:
+        FileNotFoundError: ``db_path`` or a figure does not exist.
+    """
+    import jinja2
+
+    from uvnav import __version__
+    from uvnav.bench.store import ResultsStore
+
+    db_path = Path(db_path)
+    if not db_path.is_file():
+        raise FileNotFoundError(f"results database {db_path} does not exist")
+    for spec in figures or []:
+        src = Path(spec[0] if isinstance(spec, tuple) else spec)
+        if not src.is_file():
+            raise FileNotFoundError(f"figure {src} does not exist")
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    with ResultsStore(db_path) as store:
+        df = store.episodes_frame()
+        campaigns = store.campaigns()
+    counts = df["campaign_id"].value_counts().to_dict() if not df.empty else {}
+    campaign_rows = [
+        {**c, "n": int(counts.get(c["id"], 0)), "config": _short_json(c["config"])}
+        for c in campaigns
+    ]
+
+    figure_specs: list[FigureSpec] = list(figures or [])
+    if summary_figure and not df.empty:
+        from uvnav.viz.figures import plot_campaign_summary
+
+        summary_png = plot_campaign_summary(
+            df, out_dir / "campaign-summary.png", title="All episodes in the database"
+        )
+        figure_specs.append(
+            (
+                summary_png,
+                "Outcomes, minimum clearance and detour ratio per "
+                "controller over all episodes in the database.",
+            )
+        )
+    figure_rows = _copy_figures(figure_specs, out_dir)
+
+    table_rows = [dict(r) for r in (table or [])]
+    table_columns = list(_TABLE_ORDER) if table_rows else []
+    for r in table_rows:
+        table_columns += [k for k in r if k not in table_columns]
+
+    summary = summary_table(df)
+    errors_df = df[df["status"] == "error"] if not df.empty else df
+    errors = [
+        {
+            "campaign": r.campaign,
+            "scenario": r.scenario,
+            "controller": r.controller,
+            "seed": r.seed,
+            "error": r.error,
+        }
+        for r in errors_df.head(_MAX_ERRORS).itertuples()
+    ]
+
+    template_text = files("uvnav.viz").joinpath("templates/report.html").read_text(encoding="utf-8")
+    env = jinja2.Environment(
+        autoescape=True, undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True
+    )
+    html = env.from_string(template_text).render(
+        title=title,
+        generated=datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
+        version=f"{__version__} (Python {sys.version.split()[0]})",
+        db_name=db_path.name,
+        n_episodes=len(df),
+        campaigns=campaign_rows,
+        simulation_note=SIMULATION_NOTE,
+        table=table_rows,
+        table_columns=table_columns,
+        summary=summary,
+        summary_columns=list(summary[0]) if summary else [],
+        text_columns=_TEXT_COLUMNS,
+        figures=figure_rows,
+        errors=errors,
+        errors_truncated=max(0, len(errors_df) - _MAX_ERRORS),
+    )
+    index = out_dir / "index.html"
+    index.write_text(html, encoding="utf-8")
+    return index
+
+
+def _short_json(config: Any, limit: int = 300) -> str:
+    import json
+
+    text = json.dumps(config, sort_keys=True)
+    return text if len(text) <= limit else text[: limit - 1] + "…"

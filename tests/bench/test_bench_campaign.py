@@ -1,0 +1,175 @@
+"""Campaigns: resume without duplicates, interruption, errors as data, pool == in-process."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from uvnav.bench.campaign import Job, JobOutcome, grid_jobs, run_campaign, run_job
+from uvnav.bench.store import ResultsStore
+from uvnav.dynamics import UnicycleSpec
+from uvnav.obstacles import ConstantVelocity, DiscBody, Obstacle, ObstacleState
+from uvnav.sim import METRIC_NAMES, EpisodeSetup
+
+# metrics that do not depend on timing (decision_us_* are wall-clock measurements)
+DETERMINISTIC = [m for m in METRIC_NAMES if not m.startswith("decision_us")]
+
+
+def tiny_setup(seed: int) -> EpisodeSetup:
+    """Robot (0, 0) -> (2, 0) past one disc; the disc blocks the path for seed % 3 == 0."""
+    rng = np.random.default_rng(seed)
+    y = 0.0 if seed % 3 == 0 else float(rng.uniform(0.8, 1.5))
+    disc = Obstacle(
+        DiscBody(0.25),
+        ObstacleState(np.array([1.0, y])),
+        ConstantVelocity(np.array([0.0, float(rng.uniform(0.0, 0.1))])),
+    )
+    return EpisodeSetup(
+        spec=UnicycleSpec(1.0, 1.0, 0.1),
+        start=np.array([0.0, 0.0, 0.0]),
+        goal=np.array([2.0, 0.0]),
+        obstacles=[disc],
+        t_max=8.0,
+    )
+
+
+def broken_setup(seed: int) -> EpisodeSetup:
+    raise RuntimeError(f"cannot build seed {seed}")
+
+
+def tiny_jobs(seeds: range) -> list[Job]:
+    params = [{}, {"slow_radius": 0.5}]
+    return [
+        Job(controller="straight-v1", seed=s, setup_factory=tiny_setup, label="tiny", params=p)
+        for s in seeds
+        for p in params
+    ]
+
+
+def test_job_validation_and_key() -> None:
+    with pytest.raises(ValueError, match="exactly one"):
+        Job(controller="straight-v1", seed=0)
+    with pytest.raises(ValueError, match="exactly one"):
+        Job(controller="straight-v1", seed=0, scenario="a", generator_seed=1)
+    with pytest.raises(ValueError, match="label"):
+        Job(controller="straight-v1", seed=0, setup_factory=tiny_setup)
+    a = Job(controller="c", seed=3, scenario="s", params={"b": 1, "a": 2})
+    b = Job(controller="c", seed=3, scenario="s", params={"a": 2, "b": 1})
+    assert a == b and a.key == b.key and hash(a) == hash(b)
+    g = Job(controller="c", seed=7, generator_seed=7)
+    assert g.scenario_label == "random-ch2/0007" and g.family_label == "random-ch2"
+
+
+def test_grid_jobs() -> None:
+    jobs = grid_jobs(
+        ["a", ("b", {"x": 1})], range(3), scenarios=["s1", "s2"], generator_seeds=range(4)
+    )
+    assert len(jobs) == 2 * 2 * 3 + 4 * 2
+    assert len({j.key for j in jobs}) == len(jobs)
+
+
+def test_run_job_error_is_an_outcome() -> None:
+    out = run_job(Job(controller="straight-v1", seed=1, setup_factory=broken_setup, label="broken"))
+    assert out.status == "error" and out.metrics is None
+    assert out.error is not None and "RuntimeError: cannot build seed 1" in out.error
+    unknown = run_job(Job(controller="no-such-law-v9", seed=1, setup_factory=tiny_setup, label="t"))
+    assert unknown.status == "error" and "no-such-law-v9" in (unknown.error or "")
+
+
+def test_resume_after_partial_run_has_no_duplicates(tmp_path: Path) -> None:
+    jobs = tiny_jobs(range(6))
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        first = run_campaign(store, "tiny", jobs[:5])  # "interrupted" after 5 of 12
+        assert (first.ran, first.skipped) == (5, 0)
+        second = run_campaign(store, "tiny", jobs)
+        assert (second.total, second.ran, second.skipped) == (12, 7, 5)
+        third = run_campaign(store, "tiny", jobs + jobs)  # duplicates in the list run once
+        assert (third.total, third.ran, third.skipped) == (12, 0, 12)
+        df = store.episodes_frame("tiny")
+    assert len(df) == 12
+    keys = set(zip(df["scenario"], df["controller"], df["params_hash"], df["seed"], strict=True))
+    assert keys == {j.key for j in jobs}
+    assert set(df["status"]) == {"success", "collision"}
+    # resumed results equal an uninterrupted run, bit for bit
+    with ResultsStore(tmp_path / "straight.sqlite") as other:
+        run_campaign(other, "tiny", jobs)
+        ref = other.episodes_frame("tiny")
+    a = df.sort_values(["seed", "params_hash"]).reset_index(drop=True)
+    b = ref.sort_values(["seed", "params_hash"]).reset_index(drop=True)
+    assert a[DETERMINISTIC].equals(b[DETERMINISTIC])
+
+
+def test_ctrl_c_keeps_finished_episodes_and_resume_completes(tmp_path: Path) -> None:
+    jobs = tiny_jobs(range(4))
+    seen: list[int] = []
+
+    def interrupt_after_three(out: JobOutcome, episode_id: int) -> None:
+        seen.append(episode_id)
+        if len(seen) == 3:
+            raise KeyboardInterrupt
+
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        with pytest.raises(KeyboardInterrupt):
+            run_campaign(store, "tiny", jobs, on_outcome=interrupt_after_three)
+        assert store.count("tiny") == 3
+        rest = run_campaign(store, "tiny", jobs)
+        assert (rest.ran, rest.skipped) == (5, 3)
+        assert store.count("tiny") == 8
+
+
+def test_failing_job_is_stored_and_campaign_continues(tmp_path: Path) -> None:
+    jobs = [
+        *tiny_jobs(range(2)),
+        Job(controller="straight-v1", seed=5, setup_factory=broken_setup, label="broken"),
+    ]
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        run = run_campaign(store, "mixed", jobs)
+        assert (run.ran, run.errors) == (5, 1)
+        df = store.episodes_frame("mixed")
+        err = df[df["status"] == "error"].iloc[0]
+        assert "cannot build seed 5" in err["error"]
+        assert err[DETERMINISTIC].isna().all()
+        # errors count as done unless retried
+        assert run_campaign(store, "mixed", jobs).ran == 0
+        assert run_campaign(store, "mixed", jobs, retry_errors=True).ran == 1
+        assert store.count("mixed") == 5
+
+
+def test_process_pool_matches_in_process(tmp_path: Path) -> None:
+    jobs = tiny_jobs(range(3))
+    with ResultsStore(tmp_path / "pool.sqlite") as store:
+        run = run_campaign(store, "tiny", jobs, workers=2, progress=True)
+        assert run.ran == 6
+        pooled = store.episodes_frame("tiny").sort_values(["seed", "params_hash"])
+    with ResultsStore(tmp_path / "one.sqlite") as store:
+        run_campaign(store, "tiny", jobs, workers=1)
+        serial = store.episodes_frame("tiny").sort_values(["seed", "params_hash"])
+    assert (
+        pooled[DETERMINISTIC]
+        .reset_index(drop=True)
+        .equals(serial[DETERMINISTIC].reset_index(drop=True))
+    )
+
+
+def test_recorded_job_stores_trajectory(tmp_path: Path) -> None:
+    job = Job(controller="straight-v1", seed=1, setup_factory=tiny_setup, label="tiny", record=True)
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        run = run_campaign(store, "rec", [job])
+        traj = store.load_trajectory(run.episode_ids[job.key])
+    assert traj is not None and len(traj.times) > 10
+
+
+def test_scenario_and_generator_jobs() -> None:
+    scenarios = pytest.importorskip("uvnav.scenarios")
+    name = next(n for n in scenarios.list_builtin() if n.startswith("thesis-ch2-"))
+    out = run_job(Job(controller="straight-v1", seed=0, scenario=name))
+    assert out.status in {"success", "collision", "timeout"}, out.error
+    gen = run_job(Job(controller="straight-v1", seed=3, generator_seed=3))
+    assert gen.status in {"success", "collision", "timeout"}, gen.error
+    again = run_job(Job(controller="straight-v1", seed=3, generator_seed=3))
+    assert gen.metrics is not None and again.metrics is not None
+    assert {k: gen.metrics[k] for k in DETERMINISTIC} == {
+        k: again.metrics[k] for k in DETERMINISTIC
+    }

@@ -1,0 +1,189 @@
+"""Chapter 2 reproduction: the table is read from the store; end-to-end run, resume, staleness."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from uvnav.bench import reproduce as rp
+from uvnav.bench.store import ResultsStore
+
+SCENES = ["thesis-ch2-fig2-10-comparison", "thesis-ch2-one-obstacle"]
+LAWS = ["zhang2019-v1", "savkin-wang2013-v1"]
+
+
+def fake_metrics(path_length: float, *, success: bool = True, clearance: float = 0.25) -> dict:
+    return {
+        "success": success,
+        "collision": not success,
+        "min_clearance": clearance,
+        "path_length": path_length,
+        "detour_ratio": path_length / 14.142 if success else None,
+        "time_to_goal": 22.0 if success else None,
+        "time_ratio": 1.1 if success else None,
+        "control_effort": 1.0,
+        "limit_violations": 0,
+        "mode_switches": 2,
+        "decision_us_median": 10.0,
+        "decision_us_p99": 20.0,
+    }
+
+
+def test_build_table_reads_measured_values_from_the_store(tmp_path: Path) -> None:
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        scenes = store.campaign(rp.SCENES_CAMPAIGN)
+        lengths = {"zhang2019-v1": 15.02, "savkin-wang2013-v1": 16.31}
+        for law in LAWS:
+            store.add_episode(
+                scenes,
+                scenario=SCENES[0],
+                controller=law,
+                seed=0,
+                status="success",
+                metrics=fake_metrics(lengths[law]),
+            )
+        store.add_episode(
+            scenes,
+            scenario=SCENES[1],
+            controller="zhang2019-v1",
+            seed=0,
+            status="collision",
+            metrics=fake_metrics(7.5, success=False, clearance=-0.01),
+        )
+        store.add_episode(
+            scenes,
+            scenario=SCENES[1],
+            controller="savkin-wang2013-v1",
+            seed=0,
+            status="error",
+            error="ValueError: discs only",
+        )
+        rand = store.campaign(rp.RANDOM_CAMPAIGN)
+        outcomes = {0: "success", 1: "timeout", 2: "success", 3: "collision"}
+        for law in LAWS:
+            for seed, status in outcomes.items():
+                ok = status == "success"
+                store.add_episode(
+                    rand,
+                    scenario=f"random-ch2/{seed:04d}",
+                    family="random-ch2",
+                    controller=law,
+                    seed=seed,
+                    status=status,
+                    metrics=fake_metrics(15.0, success=ok),
+                )
+        rows, failures = rp.build_table(store, SCENES, LAWS, straight_line=14.1421356)
+    table = {r["quantity"]: r for r in rows}
+    assert all(set(r) == {"quantity", "thesis", "measured", "note"} for r in rows)
+    z = table["Fig. 2.10 path length, zhang2019-v1"]
+    assert (z["thesis"], z["measured"]) == ("14.9 m", "15.02 m")
+    assert "+0.8% vs thesis" in z["note"]
+    s = table["Fig. 2.10 path length, savkin-wang2013-v1"]
+    assert (s["thesis"], s["measured"]) == ("15.7 m", "16.31 m")
+    assert table["Fig. 2.10 straight-line distance I–T"]["measured"] == "14.14 m"
+    assert table["Fig. 2.10 straight-line distance I–T"]["thesis"] == "14.14 m"
+    ratio = table["Fig. 2.10 path length ratio savkin-wang2013-v1 / zhang2019-v1"]
+    assert ratio["measured"] == f"{16.31 / 15.02:.3f}"
+    assert table[f"outcome, {SCENES[0]}, zhang2019-v1"]["measured"] == "success, no collision"
+    assert table[f"outcome, {SCENES[1]}, zhang2019-v1"]["measured"] == "collision"
+    assert table[f"outcome, {SCENES[1]}, zhang2019-v1"]["thesis"].startswith(
+        "success, no collision"
+    )
+    assert (
+        table[f"outcome, {SCENES[1]}, savkin-wang2013-v1"]["measured"]
+        == "error: ValueError: discs only"
+    )
+    assert table[f"min clearance, {SCENES[1]}, zhang2019-v1"]["measured"] == "-0.010 m"
+    assert table[f"min clearance, {SCENES[0]}, savkin-wang2013-v1"]["measured"] == "0.250 m"
+    for law in LAWS:
+        assert table[f"random campaign success rate, {law}"]["measured"] == "50.0% (2/4)"
+        assert (
+            table[f"random campaign failed seeds, {law}"]["measured"]
+            == "1 (timeout), 3 (collision)"
+        )
+    assert failures == [
+        (law, seed, st) for law in LAWS for seed, st in ((1, "timeout"), (3, "collision"))
+    ]
+
+
+def test_table_when_nothing_was_run(tmp_path: Path) -> None:
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        rows, failures = rp.build_table(store, [], LAWS, straight_line=None)
+    table = {r["quantity"]: r for r in rows}
+    assert table["Fig. 2.10 path length, zhang2019-v1"]["measured"] == "not run"
+    assert table["random campaign success rate, zhang2019-v1"]["measured"] == "not run"
+    assert failures == []
+
+
+def test_code_fingerprint_covers_simulation_code_only(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import uvnav
+
+    fake = tmp_path / "uvnav"
+    (fake / "sim").mkdir(parents=True)
+    (fake / "viz").mkdir()
+    (fake / "__init__.py").write_text("")
+    (fake / "sim" / "loop.py").write_text("x = 1\n")
+    (fake / "viz" / "plot.py").write_text("y = 1\n")
+    monkeypatch.setattr(uvnav, "__file__", str(fake / "__init__.py"))
+    first = rp.code_fingerprint()
+    assert len(first) == 16 and rp.code_fingerprint() == first
+    (fake / "viz" / "plot.py").write_text("y = 2\n")
+    assert rp.code_fingerprint() == first
+    (fake / "sim" / "loop.py").write_text("x = 2\n")
+    assert rp.code_fingerprint() != first
+
+
+def test_reproduce_end_to_end_resume_and_staleness(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    scenarios = pytest.importorskip("uvnav.scenarios")
+    n_scenes = sum(n.startswith(rp.THESIS_PREFIX) for n in scenarios.list_builtin())
+    assert n_scenes >= 1
+    kw: dict[str, Any] = dict(n_random=3, controllers=("straight-v1",), workers=1, progress=False)
+    # pin the fingerprint: concurrent edits of the tree must not look like stale results
+    monkeypatch.setattr(rp, "code_fingerprint", lambda: "a" * 16)
+    summary = rp.reproduce(tmp_path / "results", tmp_path / "report", **kw)
+    assert summary.db_path == tmp_path / "results" / "uvnav.sqlite" and summary.db_path.is_file()
+    assert summary.report_path == tmp_path / "report" / "index.html"
+    html = summary.report_path.read_text(encoding="utf-8")
+    assert "Thesis reported vs uvnav measured" in html
+    for fig in summary.figures:
+        assert fig.is_file() and fig.parent == tmp_path / "report"
+        assert f'src="{fig.name}"' in html
+    assert len(summary.figures) == n_scenes + 1  # one per scene (one law) + random summary
+    assert summary.campaigns[rp.SCENES_CAMPAIGN]["ran"] == n_scenes
+    assert summary.campaigns[rp.RANDOM_CAMPAIGN]["ran"] == 3
+    with ResultsStore(summary.db_path) as store:
+        df = store.episodes_frame(rp.RANDOM_CAMPAIGN)
+    expected = sorted(
+        ("straight-v1", int(s), st)
+        for s, st in zip(df["seed"], df["status"], strict=True)
+        if st != "success"
+    )
+    assert sorted(summary.failures) == expected
+    rows = {r["quantity"]: r["measured"] for r in summary.table}
+    n_ok = int((df["status"] == "success").sum())
+    assert rows["random campaign success rate, straight-v1"] == f"{n_ok / 3:.1%} ({n_ok}/3)"
+
+    # unchanged code: everything is resumed, nothing runs again
+    again = rp.reproduce(tmp_path / "results", tmp_path / "report", render=None, **kw)
+    assert again.campaigns[rp.SCENES_CAMPAIGN]["ran"] == 0
+    assert again.campaigns[rp.RANDOM_CAMPAIGN]["skipped"] == 3
+    assert again.table == summary.table and again.report_path is None
+
+    # changed code: stale campaigns are replaced, never mixed
+    monkeypatch.setattr(rp, "code_fingerprint", lambda: "b" * 16)
+    stale = rp.reproduce(tmp_path / "results", tmp_path / "report", render=None, **kw)
+    assert stale.campaigns[rp.RANDOM_CAMPAIGN] | {"wall_time": 0} == {
+        **stale.campaigns[rp.RANDOM_CAMPAIGN],
+        "ran": 3,
+        "skipped": 0,
+        "rerun_stale": True,
+        "wall_time": 0,
+    }
+    with ResultsStore(summary.db_path) as store:
+        assert store.count(rp.RANDOM_CAMPAIGN) == 3

@@ -1,0 +1,376 @@
+"""Behaviour of the 2D step loop: goal reaching, collisions, determinism, decision rate, metrics.
+
+Every episode is built by hand from :mod:`uvnav.obstacles` and :mod:`uvnav.sim` and run with the
+registered ``straight-v1`` law (or a probe that wraps it).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import fields
+from typing import Any, ClassVar
+
+import numpy as np
+import pytest
+
+from uvnav.controllers import make_controller
+from uvnav.dynamics import UnicycleCommand, UnicycleSpec
+from uvnav.obstacles import (
+    ConstantVelocity,
+    DiscBody,
+    Obstacle,
+    ObstacleState,
+    PolygonBody,
+    RandomTurn,
+    Waypoints,
+)
+from uvnav.sensors import Observation
+from uvnav.sim import (
+    METRIC_NAMES,
+    EpisodeResult,
+    EpisodeSetup,
+    LidarConfig,
+    SensingConfig,
+    Trajectory,
+    run_episode,
+)
+
+SPEC = UnicycleSpec(v_max=0.707, u_max=1.414, radius=0.1)
+START = np.array([0.0, 0.0, math.pi / 4])
+GOAL = np.array([10.0, 10.0])
+ARROW = np.array([[-0.6, -0.4], [0.7, -0.5], [0.2, 0.1], [0.6, 0.6], [-0.5, 0.5]])
+
+
+def _static(body: DiscBody | PolygonBody, x: float, y: float, heading: float = 0.0) -> Obstacle:
+    return Obstacle(
+        body,
+        ObstacleState(position=np.array([x, y]), heading=heading),
+        ConstantVelocity(np.zeros(2)),
+    )
+
+
+def _setup(obstacles: list[Obstacle], **kw: Any) -> EpisodeSetup:
+    args: dict[str, Any] = {
+        "spec": SPEC,
+        "start": START.copy(),
+        "goal": GOAL.copy(),
+        "obstacles": obstacles,
+    }
+    args.update(kw)
+    return EpisodeSetup(**args)
+
+
+def _metrics_are_clean(res: EpisodeResult) -> None:
+    d = res.metrics.to_dict()
+    assert tuple(d) == METRIC_NAMES
+    for name, value in d.items():
+        assert value is None or isinstance(value, bool | int) or math.isfinite(value), (
+            f"{name} = {value!r}"
+        )
+    assert res.status in {"success", "collision", "timeout"}
+    assert res.metrics.success == (res.status == "success")
+    assert res.metrics.collision == (res.status == "collision")
+
+
+class Probe:
+    """Wraps a controller: records every observation, optionally scales speed / cycles modes."""
+
+    name: ClassVar[str] = "probe"
+
+    def __init__(
+        self, inner: Any, *, v_scale: float = 1.0, modes: tuple[str, ...] = ("M1",)
+    ) -> None:
+        self.inner = inner
+        self.v_scale = v_scale
+        self.modes = modes
+        self.seen: list[Observation] = []
+
+    @property
+    def oracle(self) -> bool:
+        return bool(self.inner.oracle)
+
+    @oracle.setter
+    def oracle(self, value: bool) -> None:
+        self.inner.oracle = value
+
+    @property
+    def mode(self) -> str:
+        return self.modes[(len(self.seen) - 1) % len(self.modes)]
+
+    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
+        self.seen.clear()
+        self.inner.reset(spec, goal, rng)
+
+    def act(self, obs: Observation) -> UnicycleCommand:
+        self.seen.append(obs)
+        cmd = self.inner.act(obs)
+        return UnicycleCommand(cmd.v * self.v_scale, cmd.u)
+
+
+class ConstantCommand:
+    name: ClassVar[str] = "constant"
+    oracle = False
+    mode = "M1"
+
+    def __init__(self, v: float, u: float) -> None:
+        self.cmd = UnicycleCommand(v, u)
+
+    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
+        pass
+
+    def act(self, obs: Observation) -> UnicycleCommand:
+        return self.cmd
+
+
+def test_empty_world_straight_line_reaches_goal() -> None:
+    res = run_episode(_setup([]), make_controller("straight-v1"), np.random.default_rng(0))
+    _metrics_are_clean(res)
+    m = res.metrics
+    dist = float(np.hypot(*GOAL))
+    assert res.status == "success" and m.success and not m.collision
+    # straight at V_max: it stops on entering the tolerance disc, within one step of its rim
+    step = SPEC.v_max * 0.1
+    assert dist - 0.2 - 1e-9 <= m.path_length <= dist - 0.2 + step
+    assert m.time_to_goal == pytest.approx((dist - 0.2) / SPEC.v_max, abs=0.1 + 1e-9)
+    assert m.detour_ratio is not None and m.detour_ratio > 0.98  # exact value: see next test
+    assert m.limit_violations == 0 and m.mode_switches == 0
+    assert m.min_clearance > 1e6  # no obstacle: finite sentinel, never inf/NaN
+    traj = res.trajectory
+    assert traj is not None
+    assert np.hypot(*(traj.robot[-1, :2] - GOAL)) <= 0.2
+    # every sample lies on the start-goal diagonal
+    assert np.allclose(traj.robot[:, 0], traj.robot[:, 1], atol=1e-9)
+
+
+def test_detour_ratio_respects_physical_limit() -> None:
+    """DESIGN §4: 'detour ratio ... 1.0 is the physical limit'; the straight law must not beat it.
+
+    The robot stops within ``goal_tolerance`` of T, so the shortest possible path is
+    ``|T - I| - goal_tolerance``; dividing by ``|T - I|`` reports 0.986 for a perfect straight run.
+    """
+    res = run_episode(
+        _setup([], goal_tolerance=0.5), make_controller("straight-v1"), np.random.default_rng(0)
+    )
+    assert res.status == "success"
+    assert res.metrics.detour_ratio is not None
+    assert 1.0 - 1e-9 <= res.metrics.detour_ratio <= 1.0 + 0.1 / 14.0
+    assert res.metrics.time_ratio is not None and res.metrics.time_ratio >= 1.0 - 1e-9
+
+
+def test_static_disc_on_the_line_causes_collision() -> None:
+    disc = _static(DiscBody(0.5), 5.0, 5.0)
+    res = run_episode(_setup([disc]), make_controller("straight-v1"), np.random.default_rng(0))
+    _metrics_are_clean(res)
+    assert res.status == "collision" and res.metrics.collision and not res.metrics.success
+    assert res.metrics.min_clearance < 0
+    assert res.metrics.detour_ratio is None and res.metrics.time_to_goal is None
+    traj = res.trajectory
+    assert traj is not None
+    # it stops at the first step whose disc overlaps: within one step of first contact
+    hit_at = math.hypot(5, 5) - 0.5 - SPEC.radius
+    assert hit_at <= res.metrics.path_length <= hit_at + SPEC.v_max * 0.1
+    assert traj.clearance[-1] < 0 <= traj.clearance[-2]
+    assert traj.nearest_id[-1] == 0
+
+
+def test_static_polygon_on_the_line_causes_collision() -> None:
+    poly = _static(PolygonBody.from_vertices(ARROW), 5.0, 5.0, heading=0.4)
+    res = run_episode(_setup([poly]), make_controller("straight-v1"), np.random.default_rng(0))
+    assert res.status == "collision" and res.metrics.min_clearance < 0
+
+
+@pytest.mark.parametrize(
+    "body", [DiscBody(0.5), PolygonBody.from_vertices(ARROW)], ids=["disc", "polygon"]
+)
+def test_point_robot_entering_an_obstacle_collides(body: DiscBody | PolygonBody) -> None:
+    """A robot of radius 0 that drives through an obstacle must collide (-0.0 is not a gap)."""
+    spec = UnicycleSpec(v_max=0.707, u_max=1.414, radius=0.0)
+    res = run_episode(
+        _setup([_static(body, 5.0, 5.0)], spec=spec),
+        make_controller("straight-v1"),
+        np.random.default_rng(0),
+    )
+    assert res.status == "collision"
+    assert res.metrics.min_clearance < 0
+
+
+def test_disc_beside_the_line_is_passed_with_analytic_clearance() -> None:
+    # centre 1 m off the diagonal: clearance = 1 - 0.5 - 0.1 = 0.4 m
+    c = np.array([5.0, 5.0]) + np.array([1.0, -1.0]) / math.sqrt(2.0)
+    res = run_episode(
+        _setup([_static(DiscBody(0.5), *c)]),
+        make_controller("straight-v1"),
+        np.random.default_rng(0),
+    )
+    _metrics_are_clean(res)
+    assert res.status == "success"
+    assert res.metrics.min_clearance == pytest.approx(0.4, abs=1e-3)
+
+
+def test_starting_in_collision_and_at_goal() -> None:
+    res = run_episode(
+        _setup([_static(DiscBody(1.0), 0.5, 0.0)]),
+        make_controller("straight-v1"),
+        np.random.default_rng(0),
+    )
+    assert res.status == "collision" and res.metrics.path_length == 0.0
+    res = run_episode(
+        _setup([], goal=np.array([0.05, 0.05])),
+        make_controller("straight-v1"),
+        np.random.default_rng(0),
+    )
+    assert res.status == "success" and res.metrics.time_to_goal == 0.0
+    _metrics_are_clean(res)
+
+
+def _moving_world(seed: int) -> EpisodeSetup:
+    """Chapter-2 like scene; the obstacles' generators derive from the episode seed."""
+    rng = np.random.default_rng(seed)
+    obstacles = []
+    for j in range(4):
+        body: DiscBody | PolygonBody = DiscBody(0.4) if j % 2 else PolygonBody.from_vertices(ARROW)
+        pos = np.array([2.0 + 2.0 * j, 3.0 + 1.5 * j])
+        motion = RandomTurn(speed=(0.1, 0.4), turn_rate=(-0.3, 0.3), rng=rng.spawn(1)[0], spin=0.1)
+        obstacles.append(Obstacle(body, ObstacleState(position=pos, heading=0.3 * j), motion))
+    sensing = SensingConfig(
+        sensing_range=4.0,
+        velocities="estimated",
+        position_noise=0.01,
+        lidar=LidarConfig(n_rays=36, noise_std=0.02, dropout=0.1),
+    )
+    return _setup(obstacles, t_max=25.0, sensing=sensing)
+
+
+def test_same_seed_same_trajectory_bit_for_bit() -> None:
+    def once(seed: int) -> tuple[EpisodeResult, list[Observation]]:
+        probe = Probe(make_controller("straight-v1"))
+        return run_episode(_moving_world(seed), probe, np.random.default_rng(seed)), probe.seen
+
+    (a, seen_a), (b, seen_b), (c, _) = once(3), once(3), once(4)
+    ta, tb, tc = a.trajectory, b.trajectory, c.trajectory
+    assert ta is not None and tb is not None and tc is not None
+    for f in fields(Trajectory):
+        va, vb = getattr(ta, f.name), getattr(tb, f.name)
+        if isinstance(va, np.ndarray):
+            assert va.dtype == vb.dtype and np.array_equal(va, vb), f.name
+        elif f.name == "obstacle_shapes":
+            assert all(np.array_equal(x, y) for x, y in zip(va, vb, strict=True))
+        else:
+            assert va == vb, f.name
+    da, db = a.metrics.to_dict(), b.metrics.to_dict()
+    for name in METRIC_NAMES:
+        if not name.startswith("decision_us"):
+            assert da[name] == db[name], name
+    # sensing noise and lidar dropout are part of what must replay
+    assert len(seen_a) == len(seen_b)
+    for oa, ob in zip(seen_a, seen_b, strict=True):
+        assert oa.lidar is not None and ob.lidar is not None
+        assert np.array_equal(oa.lidar.ranges, ob.lidar.ranges, equal_nan=True)
+        assert [r.velocity.tolist() for r in oa.obstacles] == [
+            r.velocity.tolist() for r in ob.obstacles
+        ]
+    assert any(np.isnan(o.lidar.ranges).any() for o in seen_a if o.lidar is not None)
+    # a different seed gives a different world
+    assert not np.array_equal(
+        ta.obstacle_centres[: len(tc.times)], tc.obstacle_centres[: len(ta.times)]
+    )
+
+
+@pytest.mark.parametrize(("control_period", "expected_calls"), [(0.1, 100), (0.5, 20), (1.0, 10)])
+def test_controller_called_every_control_period(control_period: float, expected_calls: int) -> None:
+    setup = _setup(
+        [], goal=np.array([1000.0, 1000.0]), t_max=10.0, dt=0.1, control_period=control_period
+    )
+    probe = Probe(make_controller("straight-v1"))
+    res = run_episode(setup, probe, np.random.default_rng(0))
+    assert res.status == "timeout"
+    assert len(probe.seen) == expected_calls == len(res.decision_us)
+    times = np.array([o.time for o in probe.seen])
+    assert times == pytest.approx(np.arange(expected_calls) * control_period)
+    # the integration still runs at dt
+    assert res.trajectory is not None
+    assert len(res.trajectory.times) == 101
+    assert np.diff(res.trajectory.times) == pytest.approx(np.full(100, 0.1))
+    _metrics_are_clean(res)
+
+
+def test_limit_violations_are_counted_and_the_command_saturated() -> None:
+    setup = _setup([], goal=np.array([1000.0, 1000.0]), t_max=5.0, control_period=0.5)
+    res = run_episode(
+        setup, Probe(make_controller("straight-v1"), v_scale=2.0), np.random.default_rng(0)
+    )
+    assert res.metrics.limit_violations == 10
+    assert res.trajectory is not None
+    assert np.all(res.trajectory.commands[:, 0] <= SPEC.v_max)
+    assert res.metrics.path_length == pytest.approx(SPEC.v_max * 5.0)
+    res_ok = run_episode(setup, Probe(make_controller("straight-v1")), np.random.default_rng(0))
+    assert res_ok.metrics.limit_violations == 0
+
+
+def test_control_effort_and_mode_switches() -> None:
+    setup = _setup([], goal=np.array([1000.0, 0.0]), t_max=4.0, start=np.zeros(3))
+    res = run_episode(setup, ConstantCommand(0.5, 0.2), np.random.default_rng(0))
+    # integral of u^2 dt over 4 s; the speed is constant after the first decision
+    assert res.metrics.control_effort == pytest.approx(0.2**2 * 4.0)
+    probe = Probe(make_controller("straight-v1"), modes=("M1", "M1", "M2"))
+    res = run_episode(setup, probe, np.random.default_rng(0))
+    # modes M1 M1 M2 M1 M1 M2 ...: two switches per period of three decisions
+    n = len(probe.seen)
+    modes = [("M1", "M1", "M2")[i % 3] for i in range(n)]
+    assert res.metrics.mode_switches == sum(a != b for a, b in itertools.pairwise(modes))
+
+
+def test_velocities_known_estimated_and_oracle() -> None:
+    def first_reading_sources(velocities: str, oracle: bool) -> set[str]:
+        ob = Obstacle(
+            DiscBody(0.3),
+            ObstacleState(position=np.array([3.0, 0.0]), velocity=np.array([0.0, 0.2])),
+            ConstantVelocity(np.array([0.0, 0.2])),
+        )
+        setup = _setup(
+            [ob],
+            start=np.array([0.0, -3.0, 0.0]),
+            t_max=1.0,
+            sensing=SensingConfig(velocities=velocities),
+        )  # type: ignore[arg-type]
+        probe = Probe(make_controller("straight-v1", oracle=oracle))
+        run_episode(setup, probe, np.random.default_rng(0))
+        return {r.velocity_source for o in probe.seen for r in o.obstacles}
+
+    assert first_reading_sources("known", False) == {"known"}
+    assert first_reading_sources("estimated", False) == {"estimated"}
+    assert first_reading_sources("estimated", True) == {"known"}
+
+
+def test_collision_checked_at_every_integration_step() -> None:
+    """An obstacle sweeping across the robot between two decisions is still caught."""
+    sweeper = Obstacle(
+        DiscBody(0.3),
+        ObstacleState(position=np.array([1.5, -3.0])),  # crosses y = 0 at t = 1 s
+        Waypoints(points=np.array([[1.5, 3.0]]), speed=3.0),
+    )
+    setup = _setup(
+        [sweeper],
+        start=np.array([1.0, 0.0, 0.0]),
+        goal=np.array([20.0, 0.0]),
+        control_period=5.0,
+        t_max=10.0,
+    )
+    res = run_episode(setup, ConstantCommand(0.3, 0.0), np.random.default_rng(0))
+    assert res.status == "collision"
+    assert res.trajectory is not None and res.trajectory.times[-1] < 5.0
+
+
+def test_record_off_gives_same_metrics() -> None:
+    a = run_episode(
+        _moving_world(1), make_controller("straight-v1"), np.random.default_rng(1), record=True
+    )
+    b = run_episode(
+        _moving_world(1), make_controller("straight-v1"), np.random.default_rng(1), record=False
+    )
+    assert b.trajectory is None
+    for name in METRIC_NAMES:
+        if not name.startswith("decision_us"):
+            assert a.metrics.to_dict()[name] == b.metrics.to_dict()[name]
+    _metrics_are_clean(a)

@@ -1,0 +1,134 @@
+"""Figures: valid non-empty PNGs, no pyplot state, robustness to odd episodes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib.image as mpimg
+import numpy as np
+import pytest
+
+from uvnav.bench.campaign import Job, run_campaign
+from uvnav.bench.store import ResultsStore
+from uvnav.controllers import make_controller
+from uvnav.dynamics import UnicycleSpec
+from uvnav.obstacles import (
+    ConstantVelocity,
+    DiscBody,
+    Obstacle,
+    ObstacleState,
+    PolygonBody,
+    RandomTurn,
+)
+from uvnav.sim import EpisodeResult, EpisodeSetup, run_episode
+from uvnav.viz.figures import (
+    path_length_over_time,
+    plot_campaign_summary,
+    plot_comparison,
+    plot_episode,
+    snapshot_indices,
+)
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def scene(seed: int, *, with_obstacles: bool = True) -> EpisodeSetup:
+    rng = np.random.default_rng(seed)
+    obstacles = []
+    if with_obstacles:
+        poly = PolygonBody.from_vertices(
+            np.array([[-0.6, -0.4], [0.7, -0.5], [0.2, 0.1], [0.6, 0.6], [-0.5, 0.5]]) * 0.5
+        )
+        obstacles = [
+            Obstacle(
+                poly, ObstacleState(np.array([2.0, 2.8])), RandomTurn((0.1, 0.3), (-0.3, 0.3), rng)
+            ),
+            Obstacle(
+                DiscBody(0.3),
+                ObstacleState(np.array([3.0, 0.5])),
+                ConstantVelocity(np.array([-0.1, 0.1])),
+            ),
+        ]
+    return EpisodeSetup(
+        spec=UnicycleSpec(0.707, 1.414, 0.1),
+        start=np.array([0.0, 0.0, 0.785]),
+        goal=np.array([4.0, 4.0]),
+        obstacles=obstacles,
+        t_max=15.0,
+    )
+
+
+def episode(seed: int, **kw: bool) -> tuple[EpisodeResult, EpisodeSetup]:
+    setup = scene(seed, **kw)
+    result = run_episode(setup, make_controller("straight-v1"), np.random.default_rng(seed))
+    return result, setup
+
+
+def assert_png(path: Path, min_bytes: int = 10_000) -> None:
+    data = path.read_bytes()
+    assert data[:8] == PNG_MAGIC
+    assert len(data) > min_bytes
+    img = mpimg.imread(path)
+    assert img.ndim == 3 and img.shape[0] > 200 and img.shape[1] > 200
+    # not a blank canvas
+    assert float(img[..., :3].std()) > 0.01
+
+
+def test_plot_episode_writes_valid_png(tmp_path: Path) -> None:
+    import matplotlib.pyplot as plt
+
+    before = plt.get_fignums()
+    result, setup = episode(1)
+    out = plot_episode(result, setup, tmp_path / "sub" / "ep.png", title="tiny scene")
+    assert out == tmp_path / "sub" / "ep.png"
+    assert_png(out)
+    assert plt.get_fignums() == before  # no pyplot figure leaked
+
+
+def test_plot_episode_without_obstacles_and_without_trajectory(tmp_path: Path) -> None:
+    result, setup = episode(2, with_obstacles=False)
+    assert result.status == "success"
+    assert_png(plot_episode(result, setup, tmp_path / "empty.png"))
+    unrecorded = EpisodeResult(result.metrics, result.status, None, result.decision_us)
+    with pytest.raises(ValueError, match="record"):
+        plot_episode(unrecorded, setup, tmp_path / "none.png")
+
+
+def test_plot_comparison(tmp_path: Path) -> None:
+    runs = {"law A": episode(1), "law B": episode(3)}
+    assert_png(plot_comparison(runs, tmp_path / "cmp.png", title="two laws"))
+    with pytest.raises(ValueError):
+        plot_comparison({}, tmp_path / "none.png")
+
+
+def _tiny(seed: int) -> EpisodeSetup:
+    return scene(seed)
+
+
+def _broken(seed: int) -> EpisodeSetup:
+    raise RuntimeError("no scene")
+
+
+def test_plot_campaign_summary_handles_errors_and_nulls(tmp_path: Path) -> None:
+    jobs = [
+        Job(controller="straight-v1", seed=s, setup_factory=_tiny, label="tiny", params=p)
+        for s in range(4)
+        for p in ({}, {"slow_radius": 1.0})
+    ]
+    jobs.append(Job(controller="straight-v1", seed=9, setup_factory=_broken, label="broken"))
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        run_campaign(store, "c", jobs)
+        df = store.episodes_frame()
+    assert (df["status"] == "error").sum() == 1
+    assert_png(plot_campaign_summary(df, tmp_path / "summary.png"))
+    assert_png(plot_campaign_summary(df.iloc[0:0], tmp_path / "empty.png"), min_bytes=2_000)
+
+
+def test_helpers() -> None:
+    assert list(snapshot_indices(11, 3)) == [0, 5, 10]
+    assert list(snapshot_indices(2, 10)) == [0, 1]
+    assert len(snapshot_indices(0, 5)) == 0
+    result, _ = episode(1)
+    length = path_length_over_time(result.trajectory)  # type: ignore[arg-type]
+    assert length[0] == 0.0 and np.all(np.diff(length) >= 0)
+    assert length[-1] == pytest.approx(result.metrics.path_length)

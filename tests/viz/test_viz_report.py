@@ -1,0 +1,122 @@
+"""HTML report: renders, self-contained, tables and figures present and linked relatively."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from uvnav.bench.campaign import Job, run_campaign
+from uvnav.bench.store import ResultsStore
+from uvnav.dynamics import UnicycleSpec
+from uvnav.obstacles import ConstantVelocity, DiscBody, Obstacle, ObstacleState
+from uvnav.sim import EpisodeSetup
+from uvnav.viz.report import SIMULATION_NOTE, summary_table, write_report
+
+
+def small_setup(seed: int) -> EpisodeSetup:
+    y = 0.0 if seed % 2 == 0 else 1.0  # even seeds: a disc blocks the straight path
+    disc = Obstacle(DiscBody(0.3), ObstacleState(np.array([1.5, y])), ConstantVelocity(np.zeros(2)))
+    return EpisodeSetup(
+        spec=UnicycleSpec(1.0, 1.0, 0.1),
+        start=np.array([0.0, 0.0, 0.0]),
+        goal=np.array([3.0, 0.0]),
+        obstacles=[disc],
+        t_max=8.0,
+    )
+
+
+def broken_setup(seed: int) -> EpisodeSetup:
+    raise ValueError("bad <scene>")
+
+
+@pytest.fixture
+def db(tmp_path: Path) -> Path:
+    path = tmp_path / "results" / "uvnav.sqlite"
+    jobs = [
+        Job(
+            controller="straight-v1",
+            seed=s,
+            setup_factory=small_setup,
+            label="small",
+            family="small-family",
+            params=p,
+        )
+        for s in range(4)
+        for p in ({}, {"slow_radius": 0.5})
+    ]
+    jobs.append(Job(controller="straight-v1", seed=7, setup_factory=broken_setup, label="broken"))
+    with ResultsStore(path) as store:
+        run_campaign(store, "demo", jobs, config={"purpose": "test"})
+    return path
+
+
+def test_report_renders_tables_and_figures(db: Path, tmp_path: Path) -> None:
+    fig_dir = tmp_path / "elsewhere"
+    fig_dir.mkdir()
+    fig = fig_dir / "extra.png"
+    fig.write_bytes(b"\x89PNG\r\n\x1a\n" + b"0" * 100)
+    table = [
+        {
+            "quantity": "Fig. 2.10 path length, zhang2019-v1",
+            "thesis": "14.9 m",
+            "measured": "15.02 m",
+            "note": "<script>alert(1)</script>",
+        },
+        {"quantity": "straight line", "thesis": "14.14 m", "measured": "14.14 m", "note": ""},
+    ]
+    out = tmp_path / "report"
+    index = write_report(db, out, figures=[fig, (fig, "the same, captioned")], table=table)
+    assert index == out / "index.html" and index.is_file()
+    html = index.read_text(encoding="utf-8")
+    assert "Thesis reported vs uvnav measured" in html
+    assert "Fig. 2.10 path length, zhang2019-v1" in html and "15.02 m" in html
+    assert "<script>" not in html and "&lt;script&gt;" in html  # escaped
+    assert SIMULATION_NOTE.split(":")[0] in html
+    # the summary table: family and controller, success rate of 2 of 4 per parameter set
+    assert "small-family" in html and "straight-v1" in html and "50.0%" in html
+    # errors are listed with their message
+    assert "bad &lt;scene&gt;" in html
+    # every image exists next to index.html and is linked relatively
+    srcs = re.findall(r'<img src="([^"]+)"', html)
+    assert len(srcs) == 3  # two given (same file twice) + the campaign summary
+    for src in srcs:
+        assert "/" not in src and (out / src).is_file()
+    assert "the same, captioned" in html
+    # self-contained: no external resources
+    assert not re.search(r"(src|href)=\"(https?:)?//", html)
+    assert "http://" not in html and "https://" not in html
+
+
+def test_report_without_table_or_figures(db: Path, tmp_path: Path) -> None:
+    index = write_report(db, tmp_path / "r", summary_figure=False)
+    html = index.read_text(encoding="utf-8")
+    assert "No reproduction table" in html
+    assert "<img" not in html
+
+
+def test_report_of_empty_database(tmp_path: Path) -> None:
+    path = tmp_path / "empty.sqlite"
+    ResultsStore(path).close()
+    html = write_report(path, tmp_path / "r").read_text(encoding="utf-8")
+    assert "holds no episodes" in html
+
+
+def test_missing_inputs_raise(db: Path, tmp_path: Path) -> None:
+    with pytest.raises(FileNotFoundError):
+        write_report(tmp_path / "nope.sqlite", tmp_path / "r")
+    with pytest.raises(FileNotFoundError):
+        write_report(db, tmp_path / "r", figures=[tmp_path / "missing.png"])
+
+
+def test_summary_table_values(db: Path) -> None:
+    with ResultsStore(db) as store:
+        rows = summary_table(store.episodes_frame())
+    by_family = {r["family"]: r for r in rows}
+    assert by_family["small-family"]["episodes"] == 8
+    assert by_family["small-family"]["success rate"] == "50.0%"
+    assert by_family["small-family"]["collision rate"] == "50.0%"
+    assert by_family["broken"]["errors"] == 1
+    assert by_family["broken"]["min_clearance [m]"] == "–"
