@@ -83,7 +83,11 @@ def _load_entry_points() -> None:
         if isinstance(obj, ControllerInfo):
             register(obj)
         else:
-            register(ControllerInfo(name=ep.name, factory=obj, params_type=getattr(obj, "Params", None), summary=""))
+            register(
+                ControllerInfo(
+                    name=ep.name, factory=obj, params_type=getattr(obj, "Params", None), summary=""
+                )
+            )
 
 
 def available_controllers() -> dict[str, ControllerInfo]:
@@ -111,7 +115,9 @@ def build_params(params_type: type | None, params: dict[str, Any]) -> Any:
     fields = {f.name for f in dataclasses.fields(params_type)}
     unknown = sorted(set(params) - fields)
     if unknown:
-        raise ControllerParamsError(f"unknown parameter(s) {', '.join(unknown)}; known: {', '.join(sorted(fields))}")
+        raise ControllerParamsError(
+            f"unknown parameter(s) {', '.join(unknown)}; known: {', '.join(sorted(fields))}"
+        )
     try:
         return params_type(**params)
     except (TypeError, ValueError) as exc:
@@ -136,7 +142,11 @@ def make_controller(name: str, *, oracle: bool = False, **params: Any) -> Contro
 
 def params_dict(params: Any) -> dict[str, Any]:
     """A parameter dataclass as a plain dict (for hashing and storage)."""
-    return dataclasses.asdict(params) if params is not None and dataclasses.is_dataclass(params) else {}
+    return (
+        dataclasses.asdict(params)
+        if params is not None and dataclasses.is_dataclass(params)
+        else {}
+    )
 
 
 def saturate(value: float, limit: float) -> float:

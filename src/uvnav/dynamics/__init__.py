@@ -1,5 +1,5 @@
-"""Layer 1: vehicle models as pure ``step(state, command, dt) -> state`` functions and their limits."""
+"""Layer 1: vehicle models as pure ``step(state, command, dt) -> state`` functions, and limits."""
 
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_step
+from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance, unicycle_step
 
-__all__ = ["UnicycleCommand", "UnicycleSpec", "unicycle_step"]
+__all__ = ["UnicycleCommand", "UnicycleSpec", "unicycle_advance", "unicycle_step"]

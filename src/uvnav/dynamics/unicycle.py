@@ -3,24 +3,26 @@
     x' = V_R cos(theta),  y' = V_R sin(theta),  theta' = u_R,
     V_R in [0, V_max],  u_R in [-U_max, U_max].
 
-Eq. (2.3) of the thesis reads ``theta' = u_R cos(theta)``; the ``cos(theta)`` is a typo (it would make
-the robot unable to turn when heading along +-y, contradicting the rest of the chapter), so the
-standard unicycle is used (docs/thesis-notes.md).  Integration is exact for piecewise-constant
+Eq. (2.3) of the thesis reads ``theta' = u_R cos(theta)``; the ``cos(theta)`` is a typo (it would
+make the robot unable to turn when heading along +-y, contradicting the rest of the chapter), so
+the standard unicycle is used (docs/thesis-notes.md).  Integration is exact for piecewise-constant
 commands (motion along a circular arc, written as the arc's chord so that it stays exact as
 u -> 0), not Euler.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 
-@dataclass(frozen=True)
+_EPS = float(np.finfo(float).eps)
+
+
+@dataclass(frozen=True, slots=True)
 class UnicycleSpec:
     """Limits and size of a unicycle robot.
 
@@ -35,7 +37,7 @@ class UnicycleSpec:
     radius: float = 0.1
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class UnicycleCommand:
     """Speed ``v`` [m/s] and angular velocity ``u`` [rad/s] of a unicycle."""
 
@@ -47,10 +49,31 @@ class UnicycleCommand:
         return bool(self.v < -tol or self.v > spec.v_max + tol or abs(self.u) > spec.u_max + tol)
 
     def clipped(self, spec: UnicycleSpec) -> UnicycleCommand:
-        """The command saturated to the limits (2.4); NaN components become 0."""
-        v = 0.0 if not np.isfinite(self.v) else float(np.clip(self.v, 0.0, spec.v_max))
-        u = 0.0 if not np.isfinite(self.u) else float(np.clip(self.u, -spec.u_max, spec.u_max))
+        """The command saturated to the limits (2.4); NaN and infinite components become 0."""
+        v = float(self.v)
+        u = float(self.u)
+        v = min(max(v, 0.0), float(spec.v_max)) if math.isfinite(v) else 0.0
+        u = min(max(u, -float(spec.u_max)), float(spec.u_max)) if math.isfinite(u) else 0.0
         return UnicycleCommand(v, u)
+
+
+def unicycle_advance(
+    x: float, y: float, theta: float, v: float, u: float, dt: float
+) -> tuple[float, float, float]:
+    """:func:`unicycle_step` on plain floats: the new ``(x, y, theta)``, bit for bit the same."""
+    half = 0.5 * u * dt
+    # chord of the arc, v dt sin(half)/half, along the mid-arc heading: exact for every turn rate,
+    # with no cancellation near u = 0; written as numpy's sinc(half / pi) = sin(y) / y with
+    # y = pi * (half / pi) (machine epsilon at 0), as numpy computes it, to keep its numbers
+    s = math.pi * (half / math.pi)
+    if s == 0.0:
+        s = _EPS
+    chord = v * dt * (math.sin(s) / s)
+    return (
+        x + chord * math.cos(theta + half),
+        y + chord * math.sin(theta + half),
+        wrap_scalar(theta + 2.0 * half),
+    )
 
 
 def unicycle_step(state: FloatArray, v: float, u: float, dt: float) -> FloatArray:
@@ -62,11 +85,6 @@ def unicycle_step(state: FloatArray, v: float, u: float, dt: float) -> FloatArra
     Returns:
         The new ``[x, y, theta]`` with theta wrapped to (-pi, pi].
     """
-    x, y, th = float(state[0]), float(state[1]), float(state[2])
-    half = 0.5 * u * dt
-    # chord of the arc, v dt sin(half)/half, along the mid-arc heading: exact for every turn rate,
-    # with no cancellation near u = 0 (np.sinc(x) = sin(pi x) / (pi x))
-    chord = v * dt * float(np.sinc(half / math.pi))
-    x += chord * math.cos(th + half)
-    y += chord * math.sin(th + half)
-    return np.array([x, y, wrap_scalar(th + 2.0 * half)])
+    return np.array(
+        unicycle_advance(float(state[0]), float(state[1]), float(state[2]), v, u, dt)
+    )

@@ -1,6 +1,12 @@
 """Layer 0: pure math on numpy arrays (angles, tangents, polygon and disc kernels)."""
 
-from uvnav.geometry.angles import heading_vector, signed_angle, vector_angle, wrap_scalar, wrap_to_pi
+from uvnav.geometry.angles import (
+    heading_vector,
+    signed_angle,
+    vector_angle,
+    wrap_scalar,
+    wrap_to_pi,
+)
 from uvnav.geometry.polygons import (
     angular_extent,
     edge_soup,

@@ -61,7 +61,9 @@ def polygon_centroid(vertices: FloatArray) -> FloatArray:
     return np.array([cx, cy])
 
 
-def segment_nearest(point: FloatArray, starts: FloatArray, ends: FloatArray) -> tuple[FloatArray, FloatArray]:
+def segment_nearest(
+    point: FloatArray, starts: FloatArray, ends: FloatArray
+) -> tuple[FloatArray, FloatArray]:
     """Distance [m] and nearest point from ``point`` to every segment; shapes (E,), (E, 2)."""
     p = np.asarray(point, dtype=float)
     d = ends - starts
@@ -88,19 +90,23 @@ def nearest_on_polygons(
 ) -> tuple[FloatArray, FloatArray, np.ndarray]:
     """Nearest boundary point of each polygon of an edge soup.
 
+    For repeated queries against the same polygons, pack them once with :func:`closed_rings`
+    and use :func:`rings_nearest`, which needs no per-call grouping.
+
     Returns:
-        ``(distance (k,), nearest (k, 2), inside (k,) bool)``; ``distance`` is to the boundary, so a
-        point inside a polygon has ``inside`` True and a positive boundary distance.
+        ``(distance (k,), nearest (k, 2), inside (k,) bool)``; ``distance`` is to the boundary,
+        so a point inside a polygon has ``inside`` True and a positive boundary distance.
     """
     k = len(offsets) - 1
     if k == 0:
         return np.zeros(0), np.zeros((0, 2)), np.zeros(0, dtype=bool)
     dists, nearest = segment_nearest(point, starts, ends)
     first = offsets[:-1]
+    mins = np.minimum.reduceat(dists, first)
     owner = np.repeat(np.arange(k), np.diff(offsets))
-    # groups are contiguous, so after sorting by (owner, distance) group j starts at offsets[j]
-    idx = np.lexsort((dists, owner))[first]
-    mins = dists[idx]
+    # first edge of each group attaining the group's minimum (same tie-break as a stable sort)
+    hit = np.flatnonzero(dists == mins[owner])
+    idx = hit[np.searchsorted(owner[hit], np.arange(k))]
     crossings = np.add.reduceat(crossing_parity(point, starts, ends), first)
     return mins, nearest[idx], (crossings % 2) == 1
 
@@ -112,7 +118,9 @@ def polygon_nearest(point: FloatArray, vertices: FloatArray) -> tuple[float, Flo
     return float(d[0]), n[0], bool(inside[0])
 
 
-def rays_segments_hit(origin: FloatArray, directions: FloatArray, starts: FloatArray, ends: FloatArray) -> FloatArray:
+def rays_segments_hit(
+    origin: FloatArray, directions: FloatArray, starts: FloatArray, ends: FloatArray
+) -> FloatArray:
     """Ray parameter t [m along unit directions] at which each ray meets each segment.
 
     Args:
@@ -135,7 +143,9 @@ def rays_segments_hit(origin: FloatArray, directions: FloatArray, starts: FloatA
     return np.where(ok, t, np.inf)
 
 
-def rays_circles_hit(origin: FloatArray, directions: FloatArray, centres: FloatArray, radii: FloatArray) -> FloatArray:
+def rays_circles_hit(
+    origin: FloatArray, directions: FloatArray, centres: FloatArray, radii: FloatArray
+) -> FloatArray:
     """(R, C) distance [m] along each unit ray to the first boundary crossing of each circle.
 
     A ray starting inside a circle hits its boundary on the way out; misses are ``inf``.
@@ -153,7 +163,9 @@ def rays_circles_hit(origin: FloatArray, directions: FloatArray, centres: FloatA
     return np.where((disc >= 0.0) & (t >= 0.0), t, np.inf)
 
 
-def ray_polygon_hit(origin: FloatArray, angle: float, vertices: FloatArray) -> tuple[float, FloatArray | None]:
+def ray_polygon_hit(
+    origin: FloatArray, angle: float, vertices: FloatArray
+) -> tuple[float, FloatArray | None]:
     """First hit of the ray from ``origin`` at ``angle`` [rad] with a polygon's boundary.
 
     Returns ``(distance [m], hit point)``; ``(inf, None)`` when the ray misses.
@@ -167,7 +179,9 @@ def ray_polygon_hit(origin: FloatArray, angle: float, vertices: FloatArray) -> t
     return tmin, np.asarray(origin, dtype=float) + tmin * direction[0]
 
 
-def angular_extent(point: FloatArray, vertices: FloatArray, reference_angle: float) -> tuple[float, float]:
+def angular_extent(
+    point: FloatArray, vertices: FloatArray, reference_angle: float
+) -> tuple[float, float]:
     """Silhouette of a polygon seen from an outside ``point``.
 
     Returns the (min, max) angle [rad] of the polygon's vertices measured from ``reference_angle``
@@ -191,7 +205,9 @@ def transform_points(local: FloatArray, position: FloatArray, heading: float) ->
     return out
 
 
-def segment_intersects_polygon(a: FloatArray, b: FloatArray, vertices: FloatArray, *, margin: float = 0.0) -> bool:
+def segment_intersects_polygon(
+    a: FloatArray, b: FloatArray, vertices: FloatArray, *, margin: float = 0.0
+) -> bool:
     """True when segment ``a``-``b`` comes within ``margin`` [m] of (or crosses) the polygon."""
     s, e = polygon_edges(vertices)
     if segments_min_distance(a, b, s, e) <= margin:
@@ -200,7 +216,9 @@ def segment_intersects_polygon(a: FloatArray, b: FloatArray, vertices: FloatArra
     return inside
 
 
-def segments_min_distance(a: FloatArray, b: FloatArray, starts: FloatArray, ends: FloatArray) -> float:
+def segments_min_distance(
+    a: FloatArray, b: FloatArray, starts: FloatArray, ends: FloatArray
+) -> float:
     """Minimum distance [m] between segment ``a``-``b`` and a set of segments (0 if they cross)."""
     a = np.asarray(a, dtype=float)
     b = np.asarray(b, dtype=float)
@@ -234,5 +252,114 @@ def _points_to_segment(points: FloatArray, starts: FloatArray, ends: FloatArray)
 
 def point_segment_distance(point: FloatArray, a: FloatArray, b: FloatArray) -> float:
     """Distance [m] from ``point`` to the segment ``a``-``b``."""
-    dist, _ = segment_nearest(point, np.asarray(a, dtype=float)[None], np.asarray(b, dtype=float)[None])
+    dist, _ = segment_nearest(
+        point, np.asarray(a, dtype=float)[None], np.asarray(b, dtype=float)[None]
+    )
     return float(dist[0])
+
+
+# --------------------------------------------------------------------------------------------
+# padded closed rings: many polygons as two (m, n_max + 1) arrays, no per-call grouping
+
+
+def closed_rings(polygons: Sequence[FloatArray]) -> tuple[FloatArray, FloatArray, np.ndarray]:
+    """Pack polygons into padded closed rings for the ``rings_*`` kernels.
+
+    Row ``i`` of ``xs``/``ys`` holds the ``n_i`` vertices of polygon ``i`` followed by its first
+    vertex, repeated up to ``n_max + 1`` columns.  The edges ``(xs[:, :-1], ys[:, :-1])`` ->
+    ``(xs[:, 1:], ys[:, 1:])`` are then the polygon's own edges followed by zero-length edges at
+    its first vertex, which are never strictly nearer than the real edge starting there, never
+    straddle a horizontal line and never meet a ray: every kernel is exact on the padded rows.
+
+    Returns:
+        ``(xs, ys, counts)``: two (m, n_max + 1) arrays [m] and the (m,) vertex counts.
+    """
+    m = len(polygons)
+    counts = np.array([len(p) for p in polygons], dtype=np.intp)
+    width = int(counts.max()) + 1 if m else 1
+    xs = np.empty((m, width))
+    ys = np.empty((m, width))
+    for i, poly in enumerate(polygons):
+        v = np.asarray(poly, dtype=float)
+        n = len(v)
+        xs[i, :n] = v[:, 0]
+        ys[i, :n] = v[:, 1]
+        xs[i, n:] = v[0, 0]
+        ys[i, n:] = v[0, 1]
+    return xs, ys, counts
+
+
+def rings_nearest(
+    point: FloatArray | tuple[float, float],
+    xs: FloatArray, ys: FloatArray, *, parity: bool = True
+) -> tuple[FloatArray, FloatArray, FloatArray, np.ndarray | None]:
+    """Nearest boundary point of each polygon of a :func:`closed_rings` pack.
+
+    Args:
+        point: (2,) query point [m].
+        xs, ys: (m, w) closed rings.
+        parity: also run the even-odd containment test; pass False when ``point`` is known to be
+            outside every polygon (e.g. outside their bounding discs) to skip it.
+
+    Returns:
+        ``(distance (m,), nearest_x (m,), nearest_y (m,), inside (m,) bool or None)``;
+        ``distance`` is to the boundary (positive inside too); ``inside`` is None without
+        ``parity``.  Ties between edges go to the first edge, as in :func:`nearest_on_polygons`,
+        and the numbers are the same as its.
+    """
+    px = float(point[0])
+    py = float(point[1])
+    sx = xs[:, :-1]
+    sy = ys[:, :-1]
+    ex = xs[:, 1:] - sx
+    ey = ys[:, 1:] - sy
+    wx = px - sx
+    wy = py - sy
+    t = (wx * ex + wy * ey) / np.maximum(ex * ex + ey * ey, _EPS)
+    t = np.minimum(np.maximum(t, 0.0), 1.0, out=t)
+    qx = sx + t * ex
+    qy = sy + t * ey
+    dx = qx - px
+    dy = qy - py
+    d = np.sqrt(dx * dx + dy * dy)
+    flat = d.argmin(axis=1)
+    flat += np.arange(0, d.size, d.shape[1])
+    dist = d.ravel().take(flat)
+    nx = qx.ravel().take(flat)
+    ny = qy.ravel().take(flat)
+    if not parity:
+        return dist, nx, ny, None
+    y1 = ys[:, 1:]
+    straddles = (sy > py) != (y1 > py)
+    x_cross = sx + (py - sy) * ex / np.where(straddles, ey, 1.0)
+    crossings = np.count_nonzero(straddles & (x_cross > px), axis=1)
+    return dist, nx, ny, (crossings % 2) == 1
+
+
+def rays_rings_hit(
+    origin: FloatArray | tuple[float, float],
+    directions: FloatArray, xs: FloatArray, ys: FloatArray
+) -> FloatArray:
+    """(R, m) distance [m] along each unit ray to the first boundary crossing of each ring.
+
+    The same test as :func:`rays_segments_hit` (zero-length padding edges never hit); ``inf``
+    where a ray misses.
+    """
+    ox = float(origin[0])
+    oy = float(origin[1])
+    dirs = np.asarray(directions, dtype=float)
+    dx = dirs[:, 0, None, None]  # (R,1,1)
+    dy = dirs[:, 1, None, None]
+    sx = xs[:, :-1]
+    sy = ys[:, :-1]
+    ex = xs[:, 1:] - sx
+    ey = ys[:, 1:] - sy
+    wx = sx - ox
+    wy = sy - oy
+    denom = dx * ey - dy * ex  # (R,m,n)
+    bad = np.abs(denom) < _EPS
+    safe = np.where(bad, 1.0, denom)
+    t = (wx * ey - wy * ex) / safe
+    s = (wx * dy - wy * dx) / safe
+    ok = ~bad & (t >= 0.0) & (s >= 0.0) & (s <= 1.0)
+    return np.where(ok, t, np.inf).min(axis=2, initial=np.inf)

@@ -64,7 +64,9 @@ def circle_tangents(point: FloatArray, centre: FloatArray, radius: float) -> Cir
     return CircleTangents(points=points, angles=angles, length=length, gamma=gamma, inside=inside)
 
 
-def disc_silhouette_angles(point: FloatArray, centre: FloatArray, radius: float) -> tuple[float, float]:
+def disc_silhouette_angles(
+    point: FloatArray, centre: FloatArray, radius: float
+) -> tuple[float, float]:
     """Directions [rad] of the two rays from ``point`` grazing a disc: (clockwise, counter-clockwise).
 
     These are the boundary rays of the obstacle's vision cone used by Savkin & Wang (2013).  A point

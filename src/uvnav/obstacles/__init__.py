@@ -1,6 +1,12 @@
 """Layer 1: obstacle bodies (discs, non-convex polygons) and their motion models."""
 
-from uvnav.obstacles.bodies import Body, DiscBody, PolygonBody, radial_profile, rotation_boundary_growth
+from uvnav.obstacles.bodies import (
+    Body,
+    DiscBody,
+    PolygonBody,
+    radial_profile,
+    rotation_boundary_growth,
+)
 from uvnav.obstacles.motion import (
     ConstantVelocity,
     MotionModel,
@@ -9,7 +15,8 @@ from uvnav.obstacles.motion import (
     Replay,
     Waypoints,
 )
-from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
+from uvnav.obstacles.batch import ObstacleBatch
+from uvnav.obstacles.obstacle import FieldTemplate, NearestQuery, Obstacle, ObstacleField
 
 __all__ = [
     "Body",
@@ -17,7 +24,9 @@ __all__ = [
     "DiscBody",
     "FieldTemplate",
     "MotionModel",
+    "NearestQuery",
     "Obstacle",
+    "ObstacleBatch",
     "ObstacleField",
     "ObstacleState",
     "PolygonBody",

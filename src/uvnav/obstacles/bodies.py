@@ -14,7 +14,7 @@ import numpy as np
 import shapely
 
 from uvnav.geometry.angles import FloatArray
-from uvnav.geometry.polygons import polygon_area, polygon_centroid, rays_segments_hit, polygon_edges
+from uvnav.geometry.polygons import polygon_area, polygon_centroid, polygon_edges, rays_segments_hit
 
 
 @dataclass(frozen=True)
@@ -65,7 +65,7 @@ class PolygonBody:
     def bounding_radius(self) -> float:
         return float(np.max(np.hypot(self.vertices[:, 0], self.vertices[:, 1])))
 
-    def outline(self, n: int = 0) -> FloatArray:  # noqa: ARG002 - same signature as DiscBody
+    def outline(self, n: int = 0) -> FloatArray:
         return self.vertices
 
 
@@ -101,5 +101,7 @@ def rotation_boundary_growth(body: Body, rotation: float, n_directions: int = 36
     shifts = int(np.ceil(abs(rotation) / step))
     growth = 0.0
     for k in range(1, shifts + 1):
-        growth = max(growth, float(np.max(np.roll(rho, k) - rho)), float(np.max(np.roll(rho, -k) - rho)))
+        growth = max(
+            growth, float(np.max(np.roll(rho, k) - rho)), float(np.max(np.roll(rho, -k) - rho))
+        )
     return growth

@@ -1,10 +1,14 @@
-"""Obstacle motion models (thesis Ch. 2 §2.2: translation with v_i(t), rotation about the mass centre
-with u_i(t), bounded as in (2.6)-(2.8)).
+"""Obstacle motion models (thesis Ch. 2 §2.2: translation with v_i(t), rotation about the mass
+centre with u_i(t), bounded as in (2.6)-(2.8)).
 
 Each model is a small stateful object built fresh for every episode; the only randomness comes from
 the ``numpy.random.Generator`` handed to it, so the same seed replays the same motion bit for bit.
 ``step(state, t, dt)`` returns the state after ``dt`` [s] and sets ``velocity`` [m/s] and
 ``angular_velocity`` [rad/s] to the values used over that step.
+
+``step`` is the reference definition of each model.  The simulator advances all obstacles of an
+episode at once with :class:`uvnav.obstacles.batch.ObstacleBatch`, which reproduces it bit for bit
+(vectorised for :class:`ConstantVelocity` and :class:`RandomTurn`, by calling ``step`` otherwise).
 """
 
 from __future__ import annotations
@@ -17,7 +21,7 @@ import numpy as np
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True)
 class ObstacleState:
     """Pose and rates of a rigid obstacle.
 
@@ -59,7 +63,8 @@ def _advance(state: ObstacleState, velocity: FloatArray, omega: float, dt: float
 
 @dataclass
 class ConstantVelocity:
-    """Straight-line motion at constant ``velocity`` [m/s] with constant spin ``angular_velocity`` [rad/s]."""
+    """Straight-line motion at constant ``velocity`` [m/s], constant spin ``angular_velocity``
+    [rad/s]."""
 
     velocity: FloatArray
     angular_velocity: float = 0.0
@@ -167,7 +172,9 @@ class Waypoints:
         if self.turn_with_course and np.hypot(*velocity) > 1e-9:
             heading = float(np.arctan2(velocity[1], velocity[0]))
         omega = wrap_scalar(heading - state.heading) / dt
-        return ObstacleState(position=pos, heading=heading, velocity=velocity, angular_velocity=omega)
+        return ObstacleState(
+            position=pos, heading=heading, velocity=velocity, angular_velocity=omega
+        )
 
     def speed_bound(self) -> float:
         return float(self.speed)
@@ -199,7 +206,9 @@ class Replay:
         if np.hypot(*velocity) > 1e-9:
             heading = float(np.arctan2(velocity[1], velocity[0]))
         omega = wrap_scalar(heading - state.heading) / dt
-        return ObstacleState(position=new, heading=heading, velocity=velocity, angular_velocity=omega)
+        return ObstacleState(
+            position=new, heading=heading, velocity=velocity, angular_velocity=omega
+        )
 
     def speed_bound(self) -> float:
         tt = np.asarray(self.times, dtype=float)

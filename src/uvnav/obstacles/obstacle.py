@@ -1,13 +1,21 @@
 """A moving rigid obstacle and a vectorised snapshot of many of them.
 
-:class:`ObstacleField` is what the simulator steps and what sensors query: it holds every obstacle's
-world-frame geometry as arrays (discs as centres + radii, polygons as one edge soup), rebuilt once per
-integration step, so nearest-point, containment and ray queries over all obstacles are single numpy
-passes (see :mod:`uvnav.geometry.polygons`).
+:class:`ObstacleField` is what the simulator steps and what sensors query: every obstacle's pose
+and rates as arrays, over a :class:`FieldTemplate` that holds the bodies' geometry packed once per
+episode (discs as radii, polygons as padded closed rings, see
+:func:`uvnav.geometry.polygons.closed_rings`).  Building a field is a handful of references; the
+world-frame outlines are transformed only when something asks for them.
+
+Queries go through :meth:`ObstacleField.query`, which culls with bounding discs and then runs the
+exact kernels on the obstacles that can matter.  The cull is conservative (a margin of 1e-9
+relative plus 1e-9 m absolute covers the rounding of the bound), so what it returns is bit for bit
+what the unculled computation gives for those obstacles, and the obstacles it leaves out are
+provably farther than everything it reports.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -15,14 +23,20 @@ import numpy as np
 
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.polygons import (
+    closed_rings,
     edge_soup,
-    nearest_on_polygons,
     rays_circles_hit,
-    rays_segments_hit,
+    rays_rings_hit,
+    rings_nearest,
     transform_points,
 )
 from uvnav.obstacles.bodies import Body, DiscBody, PolygonBody
 from uvnav.obstacles.motion import MotionModel, ObstacleState
+
+#: relative and absolute [m] slack of the bounding-disc cull (far above the rounding it covers)
+_CULL_REL = 1e-9
+_CULL_ABS = 1e-9
+_X_AXIS = np.array([1.0, 0.0])
 
 
 @dataclass
@@ -39,7 +53,52 @@ class Obstacle:
         return transform_points(self.body.outline(), self.state.position, self.state.heading)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, slots=True, eq=False)
+class NearestQuery:
+    """Exact nearest-point answers from one point for the obstacles that can matter.
+
+    Made by :meth:`ObstacleField.query`; ``ids`` is a superset of (a) every obstacle whose set
+    lies within ``radius`` of ``point`` and (b) every obstacle nearest to ``point`` (smallest
+    ``signed``).  Every obstacle not in ``ids`` is strictly farther than ``radius`` and than the
+    nearest one.  The entries are those :meth:`ObstacleField.nearest` gives for the same ids.
+
+    Attributes:
+        point: the query point ``(x, y)`` [m].
+        radius: the radius [m] the query was made for.
+        ids: (m,) obstacle indices, increasing.
+        distance: (m,) distance to the obstacle *set* [m] (0 inside).
+        nearest: (m, 2) nearest boundary point [m].
+        inside: (m,) the point is inside the obstacle.
+        signed: (m,) ``distance`` outside, minus the distance to the boundary inside [m].
+    """
+
+    point: tuple[float, float]
+    radius: float
+    ids: np.ndarray
+    distance: FloatArray
+    nearest: FloatArray
+    inside: np.ndarray
+    signed: FloatArray
+    _field: ObstacleField
+    _ring_of: np.ndarray
+    _wx: FloatArray
+    _wy: FloatArray
+
+    def outline(self, i: int) -> FloatArray | None:
+        """World vertices (n, 2) [m] of obstacle ``ids[i]`` (``None`` for a disc).
+
+        Equal to ``field.polygons[ids[i]]``, taken from the rings this query already transformed.
+        """
+        r = int(self._ring_of[i])
+        if r < 0:
+            return None
+        n = int(self._field.template.counts[self._field.template.poly_row[self.ids[i]]])
+        out = np.empty((n, 2))
+        out[:, 0] = self._wx[r, :n]
+        out[:, 1] = self._wy[r, :n]
+        return out
+
+
 class ObstacleField:
     """World-frame geometry of all obstacles at one instant.
 
@@ -50,25 +109,54 @@ class ObstacleField:
         headings: (k,) body rotations [rad].
         radii: (k,) disc radius [m], 0 for polygons.
         bounding_radii: (k,) radius of the centroid-centred disc containing each body [m].
-        polygons: tuple of (n_j, 2) world vertices for every obstacle (``None`` for discs).
+        polygons: tuple of (n_j, 2) world vertices for every obstacle (``None`` for discs),
+            built on first access.
+        template: the packed body geometry.
+
+    A field is a snapshot: it never changes its arrays, and callers must not either.
     """
 
-    centres: FloatArray
-    velocities: FloatArray
-    angular_velocities: FloatArray
-    headings: FloatArray
-    radii: FloatArray
-    bounding_radii: FloatArray
-    polygons: tuple[FloatArray | None, ...]
-    _poly_ids: np.ndarray
-    _starts: FloatArray
-    _ends: FloatArray
-    _offsets: np.ndarray
+    __slots__ = (
+        "_last",
+        "_polygons",
+        "_world",
+        "angular_velocities",
+        "centres",
+        "headings",
+        "template",
+        "velocities",
+    )
+
+    def __init__(
+        self,
+        template: FieldTemplate,
+        centres: FloatArray,
+        headings: FloatArray,
+        velocities: FloatArray,
+        angular_velocities: FloatArray,
+    ) -> None:
+        self.template = template
+        self.centres = centres
+        self.headings = headings
+        self.velocities = velocities
+        self.angular_velocities = angular_velocities
+        self._polygons: tuple[FloatArray | None, ...] | None = None
+        self._world: tuple[FloatArray, FloatArray] | None = None
+        self._last: NearestQuery | None = None
 
     @classmethod
-    def from_obstacles(cls, obstacles: Sequence[Obstacle], template: FieldTemplate | None = None) -> ObstacleField:
-        """Snapshot of ``obstacles``; pass the episode's :class:`FieldTemplate` to skip re-stacking bodies."""
-        tpl = template if template is not None else FieldTemplate.from_bodies([o.body for o in obstacles])
+    def from_obstacles(
+        cls, obstacles: Sequence[Obstacle], template: FieldTemplate | None = None
+    ) -> ObstacleField:
+        """Snapshot of ``obstacles``.
+
+        Pass the episode's :class:`FieldTemplate` to skip re-packing the bodies.
+        """
+        tpl = (
+            template
+            if template is not None
+            else FieldTemplate.from_bodies([o.body for o in obstacles])
+        )
         k = len(obstacles)
         centres = np.empty((k, 2))
         velocities = np.empty((k, 2))
@@ -85,55 +173,211 @@ class ObstacleField:
     def __len__(self) -> int:
         return len(self.centres)
 
+    def __repr__(self) -> str:
+        return f"ObstacleField(k={len(self)})"
+
+    @property
+    def radii(self) -> FloatArray:
+        return self.template.radii
+
+    @property
+    def bounding_radii(self) -> FloatArray:
+        return self.template.bounding_radii
+
     @property
     def is_disc(self) -> np.ndarray:
         """(k,) True for disc obstacles."""
-        return self.radii > 0
+        return self.template.radii > 0
+
+    # ---------------------------------------------------------------- world-frame outlines
+
+    def _transform(self, ids: np.ndarray | None) -> tuple[FloatArray, FloatArray]:
+        """World rings (rows of ``template.ring_x``) of polygon obstacles ``ids`` (all if None)."""
+        tpl = self.template
+        if ids is None:
+            ids = tpl.poly_ids
+            lx, ly = tpl.ring_x, tpl.ring_y
+        else:
+            rows = tpl.poly_row.take(ids)
+            lx, ly = tpl.ring_x.take(rows, axis=0), tpl.ring_y.take(rows, axis=0)
+        h = self.headings.take(ids)
+        c = np.cos(h)[:, None]
+        s = np.sin(h)[:, None]
+        cx = self.centres[:, 0].take(ids)[:, None]
+        cy = self.centres[:, 1].take(ids)[:, None]
+        return c * lx - s * ly + cx, s * lx + c * ly + cy
+
+    def _world_rings(self) -> tuple[FloatArray, FloatArray]:
+        if self._world is None:
+            self._world = self._transform(None)
+        return self._world
+
+    @property
+    def polygons(self) -> tuple[FloatArray | None, ...]:
+        if self._polygons is None:
+            tpl = self.template
+            out: list[FloatArray | None] = [None] * len(self)
+            if len(tpl.poly_ids):
+                wx, wy = self._world_rings()
+                for r, j in enumerate(tpl.poly_ids.tolist()):
+                    n = int(tpl.counts[r])
+                    v = np.empty((n, 2))
+                    v[:, 0] = wx[r, :n]
+                    v[:, 1] = wy[r, :n]
+                    out[j] = v
+            self._polygons = tuple(out)
+        return self._polygons
+
+    # ---------------------------------------------------------------- queries
+
+    def query(self, point: FloatArray | tuple[float, float], radius: float = 0.0) -> NearestQuery:
+        """Exact nearest boundary points of the obstacles within ``radius`` [m] of ``point``.
+
+        Obstacles whose bounding disc is farther than both ``radius`` and the nearest obstacle's
+        upper bound are culled; see :class:`NearestQuery` for the guarantee.  The last answer is
+        kept, so asking again from the same point with the same or a smaller radius (the
+        simulator's collision check, then the sensors) costs nothing.
+        """
+        px = float(point[0])
+        py = float(point[1])
+        last = self._last
+        if last is not None and last.point == (px, py) and last.radius >= radius:
+            return last
+        q = self._query(px, py, float(radius))
+        self._last = q
+        return q
+
+    def _query(self, px: float, py: float, radius: float) -> NearestQuery:
+        tpl = self.template
+        k = len(self.centres)
+        if k == 0:
+            e = np.zeros(0)
+            return NearestQuery(
+                (px, py), radius, np.zeros(0, np.intp), e, np.zeros((0, 2)),
+                np.zeros(0, bool), e, self, np.zeros(0, np.intp), np.zeros((0, 1)),
+                np.zeros((0, 1)),
+            )  # fmt: skip
+        cx = self.centres[:, 0]
+        cy = self.centres[:, 1]
+        dc = np.hypot(cx - px, cy - py)
+        slack = _CULL_ABS * (1.0 + abs(px) + abs(py))
+        lower = dc - tpl.bounding_radii
+        upper = dc + tpl.bounding_radii
+        best = float(upper[upper.argmin()]) * (1.0 + _CULL_REL) + slack
+        limit = max(best, radius * (1.0 + _CULL_REL) + slack)
+        if math.isinf(limit):
+            ids = tpl.all_ids
+        else:
+            ids = (lower <= limit).nonzero()[0]
+        # containment is possible only inside an obstacle's bounding disc
+        maybe_inside = lower.take(ids) <= 2.0 * slack
+        any_inside = bool(maybe_inside[maybe_inside.argmax()]) if len(ids) else False
+        m = len(ids)
+        if tpl.n_discs == 0:
+            # polygons only (the common case): one ring per id, in order
+            wx, wy = self._transform(ids) if m < k or self._world is None else self._world
+            if m == k and self._world is None:
+                self._world = (wx, wy)
+            dist, nx, ny, ins = rings_nearest((px, py), wx, wy, parity=any_inside)
+            if ins is None:
+                inside = np.zeros(m, dtype=bool)
+            else:
+                inside = ins
+                dist = np.where(inside, 0.0, dist)
+            near = np.empty((m, 2))
+            near[:, 0] = nx
+            near[:, 1] = ny
+            ring_of = tpl.all_ids[:m]
+        else:
+            dist = np.empty(m)
+            near = np.empty((m, 2))
+            inside = np.zeros(m, dtype=bool)
+            ring_of = np.full(m, -1, dtype=np.intp)
+            is_disc = tpl.radii.take(ids) > 0
+            d_at = is_disc.nonzero()[0]
+            p_at = (~is_disc).nonzero()[0]
+            wx = wy = np.zeros((0, 1))
+            if len(d_at):
+                dids = ids.take(d_at)
+                rad = tpl.radii.take(dids)
+                cen = self.centres.take(dids, axis=0)
+                off = np.array([px, py]) - cen
+                r = np.hypot(off[:, 0], off[:, 1])
+                safe = np.where(r > 0, r, 1.0)
+                unit = np.where((r > 0)[:, None], off / safe[:, None], _X_AXIS)
+                near[d_at] = cen + unit * rad[:, None]
+                dist[d_at] = np.maximum(r - rad, 0.0)
+                inside[d_at] = r < rad
+            if len(p_at):
+                pids = ids.take(p_at)
+                wx, wy = self._transform(pids)
+                parity = bool(maybe_inside.take(p_at).any())
+                d, nx, ny, ins = rings_nearest((px, py), wx, wy, parity=parity)
+                if ins is not None:
+                    inside[p_at] = ins
+                    d = np.where(ins, 0.0, d)
+                dist[p_at] = d
+                near[p_at, 0] = nx
+                near[p_at, 1] = ny
+                ring_of[p_at] = np.arange(len(p_at))
+        signed = dist
+        if any_inside and bool(inside.any()):
+            depth = np.hypot(near[:, 0] - px, near[:, 1] - py)
+            signed = np.where(inside, -depth, dist)
+        return NearestQuery(
+            (px, py), radius, ids, dist, near, inside, signed, self, ring_of, wx, wy
+        )
 
     def nearest(self, point: FloatArray) -> tuple[FloatArray, FloatArray, np.ndarray]:
-        """Distance from ``point`` to each obstacle *set* [m], its nearest boundary point, and containment.
+        """Distance from ``point`` to each obstacle *set* [m], its nearest boundary point, and
+        containment.
 
-        Returns ``(distance (k,), nearest (k, 2), inside (k,))``.  ``distance`` is 0 for a point inside
-        an obstacle (the thesis's d_i of eq. (2.5) is a distance to the set), while ``nearest`` is
-        still the closest boundary point.
+        Returns ``(distance (k,), nearest (k, 2), inside (k,))``.  ``distance`` is 0 for a point
+        inside an obstacle (the thesis's d_i of eq. (2.5) is a distance to the set), while
+        ``nearest`` is still the closest boundary point.  Use :meth:`query` when only the
+        obstacles within some radius (or the nearest one) are needed.
         """
-        p = np.asarray(point, dtype=float)
-        k = len(self)
-        dist = np.zeros(k)
-        near = np.zeros((k, 2))
-        inside = np.zeros(k, dtype=bool)
-        discs = np.nonzero(self.is_disc)[0]
-        if discs.size:
-            off = p - self.centres[discs]
-            r = np.hypot(off[:, 0], off[:, 1])
-            safe = np.where(r > 0, r, 1.0)
-            unit = np.where((r > 0)[:, None], off / safe[:, None], np.array([1.0, 0.0]))
-            near[discs] = self.centres[discs] + unit * self.radii[discs, None]
-            dist[discs] = np.maximum(r - self.radii[discs], 0.0)
-            inside[discs] = r < self.radii[discs]
-        if self._poly_ids.size:
-            d, n, ins = nearest_on_polygons(p, self._starts, self._ends, self._offsets)
-            dist[self._poly_ids] = np.where(ins, 0.0, d)
-            near[self._poly_ids] = n
-            inside[self._poly_ids] = ins
-        return dist, near, inside
+        q = self.query(point, math.inf)
+        return q.distance.copy(), q.nearest.copy(), q.inside.copy()
 
-    def ray_hits(self, origin: FloatArray, directions: FloatArray) -> FloatArray:
-        """(R, k) distance [m] along each unit ray to each obstacle's boundary, ``inf`` on a miss."""
-        R = len(directions)
-        out = np.full((R, len(self)), np.inf)
-        discs = np.nonzero(self.is_disc)[0]
-        if discs.size:
-            out[:, discs] = rays_circles_hit(origin, directions, self.centres[discs], self.radii[discs])
-        if self._poly_ids.size:
-            t = rays_segments_hit(origin, directions, self._starts, self._ends)
-            out[:, self._poly_ids] = np.minimum.reduceat(t, self._offsets[:-1], axis=1)
+    def ray_hits(
+        self, origin: FloatArray, directions: FloatArray, *, max_range: float = math.inf
+    ) -> FloatArray:
+        """(R, k) distance [m] along each unit ray to each obstacle's boundary, ``inf`` on a miss.
+
+        With a finite ``max_range`` [m], obstacles whose bounding disc lies entirely beyond it are
+        not ray-cast and read ``inf`` (their hits, if any, are farther than ``max_range``).
+        """
+        tpl = self.template
+        ox = float(origin[0])
+        oy = float(origin[1])
+        dirs = np.asarray(directions, dtype=float)
+        out = np.full((len(dirs), len(self)), np.inf)
+        if len(self) == 0:
+            return out
+        if math.isinf(max_range):
+            ids = tpl.all_ids
+        else:
+            dc = np.hypot(self.centres[:, 0] - ox, self.centres[:, 1] - oy)
+            slack = _CULL_ABS * (1.0 + abs(ox) + abs(oy))
+            limit = max_range * (1.0 + _CULL_REL) + slack
+            ids = (dc - tpl.bounding_radii <= limit).nonzero()[0]
+        is_disc = tpl.radii.take(ids) > 0
+        dids = ids[is_disc]
+        pids = ids[~is_disc]
+        if len(dids):
+            out[:, dids] = rays_circles_hit(
+                np.array([ox, oy]), dirs, self.centres.take(dids, axis=0), tpl.radii.take(dids)
+            )
+        if len(pids):
+            wx, wy = self._transform(pids)
+            out[:, pids] = rays_rings_hit((ox, oy), dirs, wx, wy)
         return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class FieldTemplate:
-    """Body geometry of an episode's obstacles, stacked once so each step is a few array operations.
+    """Body geometry of an episode's obstacles, packed once so each step is a few array operations.
 
     Attributes:
         radii: (k,) disc radius [m], 0 for polygons.
@@ -143,6 +387,12 @@ class FieldTemplate:
         owner: (E,) obstacle index of each vertex.
         next_vertex: (E,) index of the following vertex of the same polygon (closes each ring).
         offsets: (p + 1,) start of each polygon's vertices in ``local``.
+        ring_x, ring_y: (p, n_max + 1) the polygons as padded closed rings in their body frames
+            (:func:`uvnav.geometry.polygons.closed_rings`), row ``i`` for ``poly_ids[i]``.
+        counts: (p,) vertices per polygon.
+        poly_row: (k,) row of each obstacle in ``ring_x`` (-1 for discs).
+        all_ids: ``arange(k)``.
+        n_discs: number of disc obstacles.
     """
 
     radii: FloatArray
@@ -152,44 +402,56 @@ class FieldTemplate:
     owner: np.ndarray
     next_vertex: np.ndarray
     offsets: np.ndarray
+    ring_x: FloatArray
+    ring_y: FloatArray
+    counts: np.ndarray
+    poly_row: np.ndarray
+    all_ids: np.ndarray
+    n_discs: int
 
     @classmethod
     def from_bodies(cls, bodies: Sequence[Body]) -> FieldTemplate:
-        radii = np.array([b.radius if isinstance(b, DiscBody) else 0.0 for b in bodies], dtype=float)
+        radii = np.array(
+            [b.radius if isinstance(b, DiscBody) else 0.0 for b in bodies], dtype=float
+        )
         bounds = np.array([b.bounding_radius for b in bodies], dtype=float)
-        poly_ids = np.array([j for j, b in enumerate(bodies) if isinstance(b, PolygonBody)], dtype=np.intp)
-        verts = [bodies[j].vertices for j in poly_ids]  # type: ignore[union-attr]
+        polys = [(j, b) for j, b in enumerate(bodies) if isinstance(b, PolygonBody)]
+        poly_ids = np.array([j for j, _ in polys], dtype=np.intp)
+        verts = [b.vertices for _, b in polys]
         _, _, offsets = edge_soup(verts)
         local = np.concatenate(verts, axis=0) if verts else np.zeros((0, 2))
         owner = np.repeat(poly_ids, np.diff(offsets)) if verts else np.zeros(0, dtype=np.intp)
         nxt = np.arange(len(local)) + 1
         if verts:
             nxt[offsets[1:] - 1] = offsets[:-1]
-        return cls(radii, bounds, poly_ids, local, owner, nxt, offsets)
+        ring_x, ring_y, counts = closed_rings(verts)
+        poly_row = np.full(len(bodies), -1, dtype=np.intp)
+        poly_row[poly_ids] = np.arange(len(poly_ids))
+        return cls(
+            radii=radii,
+            bounding_radii=bounds,
+            poly_ids=poly_ids,
+            local=local,
+            owner=owner,
+            next_vertex=nxt,
+            offsets=offsets,
+            ring_x=ring_x,
+            ring_y=ring_y,
+            counts=counts,
+            poly_row=poly_row,
+            all_ids=np.arange(len(bodies), dtype=np.intp),
+            n_discs=int(np.count_nonzero(radii > 0)),
+        )
 
     def field(
         self, centres: FloatArray, headings: FloatArray, velocities: FloatArray, omegas: FloatArray
     ) -> ObstacleField:
-        """The :class:`ObstacleField` for obstacles at ``centres`` (k, 2) [m] and ``headings`` (k,) [rad]."""
-        c = np.cos(headings[self.owner])
-        s = np.sin(headings[self.owner])
-        lx, ly = self.local[:, 0], self.local[:, 1]
-        world = np.empty_like(self.local)
-        world[:, 0] = c * lx - s * ly + centres[self.owner, 0]
-        world[:, 1] = s * lx + c * ly + centres[self.owner, 1]
-        polygons: list[FloatArray | None] = [None] * len(centres)
-        for i, j in enumerate(self.poly_ids):
-            polygons[j] = world[self.offsets[i] : self.offsets[i + 1]]
-        return ObstacleField(
-            centres=centres,
-            velocities=velocities,
-            angular_velocities=omegas,
-            headings=headings,
-            radii=self.radii,
-            bounding_radii=self.bounding_radii,
-            polygons=tuple(polygons),
-            _poly_ids=self.poly_ids,
-            _starts=world,
-            _ends=world[self.next_vertex],
-            _offsets=self.offsets,
-        )
+        """The :class:`ObstacleField` for obstacles at ``centres`` (k, 2) [m], ``headings`` (k,)
+        [rad], moving at ``velocities`` (k, 2) [m/s] and ``omegas`` (k,) [rad/s].
+
+        The arrays are kept, not copied: do not change them afterwards.
+        """
+        return ObstacleField(self, centres, headings, velocities, omegas)
+
+    def __len__(self) -> int:
+        return len(self.radii)

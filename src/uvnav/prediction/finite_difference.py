@@ -31,10 +31,16 @@ class FiniteDifferenceEstimator:
     position_noise: float = 0.0
     _last: dict[int, tuple[float, FloatArray, FloatArray]] = field(default_factory=dict)
 
-    def update(self, time: float, readings: tuple[ObstacleReading, ...]) -> tuple[ObstacleReading, ...]:
+    def update(
+        self, time: float, readings: tuple[ObstacleReading, ...]
+    ) -> tuple[ObstacleReading, ...]:
         out = []
         for rd in readings:
-            noise = self.rng.normal(0.0, self.position_noise, 2) if self.position_noise > 0 else np.zeros(2)
+            noise = (
+                self.rng.normal(0.0, self.position_noise, 2)
+                if self.position_noise > 0
+                else np.zeros(2)
+            )
             centre = rd.centre + noise
             shape = rd.outline - rd.centre if len(rd.outline) else np.zeros((0, 2))
             velocity = np.zeros(2)

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.angles import FloatArray, wrap_to_pi
 from uvnav.obstacles.obstacle import ObstacleField
 from uvnav.sensors.observation import LidarScan, ObstacleReading
 
@@ -25,21 +25,30 @@ def sense_obstacles(
 
     Velocities and angular velocities are the true ones (``velocity_source="known"``); the
     simulator swaps in estimates when configured to (see :mod:`uvnav.prediction.finite_difference`).
+
+    The distances come from :meth:`ObstacleField.query`, which culls far obstacles exactly and
+    remembers its last answer: the simulator makes that query for its collision check at every
+    integration step (with ``sensing_range`` before a decision), so sensing reuses it.  Ties in
+    distance keep obstacle order.
     """
     if len(field) == 0:
         return ()
-    dist, near, _ = field.nearest(position)
-    order = np.argsort(dist, kind="stable")
+    q = field.query(position, sensing_range)
+    dist = q.distance
+    ids = q.ids
+    order = np.argsort(dist, kind="stable").tolist() if len(dist) > 1 else [0]
     out = []
-    for j in order:
-        if dist[j] > sensing_range:
+    for i in order:
+        d = float(dist[i])
+        if d > sensing_range:
             break
-        poly = field.polygons[j]
+        j = int(ids[i])
+        poly = q.outline(i)
         out.append(
             ObstacleReading(
-                obstacle_id=int(j),
-                distance=float(dist[j]),
-                nearest_point=near[j].copy(),
+                obstacle_id=j,
+                distance=d,
+                nearest_point=q.nearest[i].copy(),
                 centre=field.centres[j].copy(),
                 velocity=field.velocities[j].copy(),
                 angular_velocity=float(field.angular_velocities[j]),
@@ -64,6 +73,9 @@ def lidar_scan(
 ) -> LidarScan:
     """A planar range scan centred on the robot's heading.
 
+    Beam angles are in the world frame, wrapped to (-pi, pi].  Obstacles whose bounding disc lies
+    beyond ``max_range`` are not ray-cast (they cannot change a range).
+
     Args:
         pose: ``[x, y, theta]``.
         n_rays: number of beams, evenly spread over ``fov`` [rad].
@@ -76,17 +88,19 @@ def lidar_scan(
         rel = np.linspace(-np.pi, np.pi, n_rays, endpoint=False)
     else:
         rel = np.linspace(-0.5 * fov, 0.5 * fov, n_rays)
-    angles = th + rel
+    angles = wrap_to_pi(th + rel)
     dirs = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
     ranges = np.full(n_rays, max_range)
     if len(field):
-        hits = field.ray_hits(np.array([x, y]), dirs).min(axis=1)
+        hits = field.ray_hits(np.array([x, y]), dirs, max_range=max_range).min(axis=1)
         ranges = np.minimum(hits, max_range)
     if (noise_std > 0 or dropout > 0) and rng is None:
         raise ValueError("lidar noise or dropout needs a numpy.random.Generator")
     if noise_std > 0 and rng is not None:
         hit = ranges < max_range
-        ranges = np.where(hit, np.clip(ranges + rng.normal(0.0, noise_std, n_rays), 0.0, max_range), ranges)
+        ranges = np.where(
+            hit, np.clip(ranges + rng.normal(0.0, noise_std, n_rays), 0.0, max_range), ranges
+        )
     if dropout > 0 and rng is not None:
         ranges = np.where(rng.random(n_rays) < dropout, np.nan, ranges)
     return LidarScan(angles=angles, ranges=ranges, max_range=max_range)

@@ -56,7 +56,8 @@ class ObstacleReading:
 
 @dataclass(frozen=True)
 class LidarScan:
-    """Ranges [m] along ``angles`` [rad, world frame]; ``max_range`` where nothing is seen, NaN on dropout."""
+    """Ranges [m] along ``angles`` [rad, world frame, in (-pi, pi]]; ``max_range`` where nothing
+    is seen, NaN on dropout."""
 
     angles: FloatArray
     ranges: FloatArray

@@ -164,10 +164,23 @@ def run_episode(
             if sensing.lidar is not None:
                 lc = sensing.lidar
                 scan = lidar_scan(
-                    robot, field_now, sense_rng, n_rays=lc.n_rays, max_range=lc.max_range,
-                    fov=lc.fov, noise_std=lc.noise_std, dropout=lc.dropout,
+                    robot,
+                    field_now,
+                    sense_rng,
+                    n_rays=lc.n_rays,
+                    max_range=lc.max_range,
+                    fov=lc.fov,
+                    noise_std=lc.noise_std,
+                    dropout=lc.dropout,
                 )
-            obs = Observation(time=t, pose=robot.copy(), speed=applied.v, goal=goal, obstacles=readings, lidar=scan)
+            obs = Observation(
+                time=t,
+                pose=robot.copy(),
+                speed=applied.v,
+                goal=goal,
+                obstacles=readings,
+                lidar=scan,
+            )
             tic = _time.perf_counter_ns()
             cmd = controller.act(obs)
             decision_us.append((_time.perf_counter_ns() - tic) / 1000.0)
@@ -181,8 +194,18 @@ def run_episode(
                 switches += 1
             last_mode = mode
         if recorder is not None:
-            recorder.add(t, robot.copy(), (applied.v, applied.u), last_mode or "", clearance, nearest,
-                         field_now.centres, field_now.headings, field_now.velocities, field_now.angular_velocities)
+            recorder.add(
+                t,
+                robot.copy(),
+                (applied.v, applied.u),
+                last_mode or "",
+                clearance,
+                nearest,
+                field_now.centres,
+                field_now.headings,
+                field_now.velocities,
+                field_now.angular_velocities,
+            )
         effort += applied.u**2 * dt
         new_robot = unicycle_step(robot, applied.v, applied.u, dt)
         path += float(np.hypot(*(new_robot[:2] - robot[:2])))
@@ -202,8 +225,18 @@ def run_episode(
             break
 
     if recorder is not None:
-        recorder.add(t, robot.copy(), (applied.v, applied.u), last_mode or "", clearance, nearest,
-                     field_now.centres, field_now.headings, field_now.velocities, field_now.angular_velocities)
+        recorder.add(
+            t,
+            robot.copy(),
+            (applied.v, applied.u),
+            last_mode or "",
+            clearance,
+            nearest,
+            field_now.centres,
+            field_now.headings,
+            field_now.velocities,
+            field_now.angular_velocities,
+        )
     dec = np.asarray(decision_us) if decision_us else np.zeros(1)
     success = status == "success"
     shortest = max(start_dist - setup.goal_tolerance, 0.0)  # to the edge of the goal disc
@@ -215,7 +248,9 @@ def run_episode(
         path_length=path,
         detour_ratio=(path / shortest) if success and shortest > 0 else None,
         time_to_goal=reached_at,
-        time_ratio=(reached_at / straight_time) if (reached_at is not None and straight_time > 0) else None,
+        time_ratio=(reached_at / straight_time)
+        if (reached_at is not None and straight_time > 0)
+        else None,
         control_effort=float(effort),
         limit_violations=violations,
         mode_switches=switches,

@@ -169,7 +169,7 @@ def _draw_scene(
     ]
     if status == "collision":
         handles.append(Line2D([], [], marker="X", color="k", ls="", label="collision"))
-    ax.legend(handles=handles, loc="upper left", fontsize="small", framealpha=0.8)
+    ax.legend(handles=handles, loc="lower right", fontsize="small", framealpha=0.8)
     if colorbar_fig is not None and k:
         colorbar_fig.colorbar(
             ScalarMappable(norm=norm, cmap=cmap),
