@@ -86,17 +86,25 @@ def test_build_table_reads_measured_values_from_the_store(tmp_path: Path) -> Non
     assert table["Fig. 2.10 straight-line distance I–T"]["thesis"] == "14.14 m"
     ratio = table["Fig. 2.10 path length ratio savkin-wang2013-v1 / zhang2019-v1"]
     assert ratio["measured"] == f"{16.31 / 15.02:.3f}"
-    assert table[f"outcome, {SCENES[0]}, zhang2019-v1"]["measured"] == "success, no collision"
-    assert table[f"outcome, {SCENES[1]}, zhang2019-v1"]["measured"] == "collision"
-    assert table[f"outcome, {SCENES[1]}, zhang2019-v1"]["thesis"].startswith(
+    assert (
+        table[f"outcome, {rp.scene_label(SCENES[0])}, zhang2019-v1"]["measured"]
+        == "success, no collision"
+    )
+    assert table[f"outcome, {rp.scene_label(SCENES[1])}, zhang2019-v1"]["measured"] == "collision"
+    assert table[f"outcome, {rp.scene_label(SCENES[1])}, zhang2019-v1"]["thesis"].startswith(
         "success, no collision"
     )
     assert (
-        table[f"outcome, {SCENES[1]}, savkin-wang2013-v1"]["measured"]
+        table[f"outcome, {rp.scene_label(SCENES[1])}, savkin-wang2013-v1"]["measured"]
         == "error: ValueError: discs only"
     )
-    assert table[f"min clearance, {SCENES[1]}, zhang2019-v1"]["measured"] == "-0.010 m"
-    assert table[f"min clearance, {SCENES[0]}, savkin-wang2013-v1"]["measured"] == "0.250 m"
+    assert (
+        table[f"min clearance, {rp.scene_label(SCENES[1])}, zhang2019-v1"]["measured"] == "-0.010 m"
+    )
+    assert (
+        table[f"min clearance, {rp.scene_label(SCENES[0])}, savkin-wang2013-v1"]["measured"]
+        == "0.250 m"
+    )
     for law in LAWS:
         assert table[f"random campaign success rate, {law}"]["measured"] == "50.0% (2/4)"
         assert (

@@ -126,11 +126,14 @@ def test_lidar_ranges_agree_with_ray_casts(fov: float) -> None:
     pose = np.array([0.1, 0.2, 0.7])
     scan = lidar_scan(pose, fld, n_rays=90, max_range=6.0, fov=fov)
     assert scan.angles.shape == scan.ranges.shape == (90,)
-    rel = scan.angles - pose[2]
+    # world-frame beam angles, wrapped to (-pi, pi]
+    assert np.all((scan.angles > -math.pi) & (scan.angles <= math.pi))
+    rel = np.remainder(scan.angles - pose[2] + math.pi, 2 * math.pi) - math.pi  # about the heading
     if fov >= 2 * math.pi:
-        assert np.allclose(np.diff(rel), 2 * math.pi / 90)
+        assert np.allclose(np.remainder(np.diff(rel), 2 * math.pi), 2 * math.pi / 90)
     else:
         assert rel[0] == pytest.approx(-fov / 2) and rel[-1] == pytest.approx(fov / 2)
+        assert np.allclose(np.diff(rel), fov / 89)
     ref = _shapely_scan(fld, pose, scan.angles, 6.0)
     assert scan.ranges == pytest.approx(ref, abs=1e-9)
     assert np.any(scan.ranges < 6.0)

@@ -135,7 +135,7 @@ def test_empty_world_straight_line_reaches_goal() -> None:
     assert m.time_to_goal == pytest.approx((dist - 0.2) / SPEC.v_max, abs=0.1 + 1e-9)
     assert m.detour_ratio is not None and m.detour_ratio > 0.98  # exact value: see next test
     assert m.limit_violations == 0 and m.mode_switches == 0
-    assert m.min_clearance > 1e6  # no obstacle: finite sentinel, never inf/NaN
+    assert m.min_clearance is None  # no obstacle: no clearance (None, never inf/NaN/sentinel)
     traj = res.trajectory
     assert traj is not None
     assert np.hypot(*(traj.robot[-1, :2] - GOAL)) <= 0.2

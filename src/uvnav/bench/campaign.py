@@ -35,8 +35,6 @@ from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wai
 from dataclasses import dataclass, field
 from typing import Any
 
-import numpy as np
-
 from uvnav.bench.store import STATUS_ERROR, EpisodeKey, ResultsStore, params_hash
 from uvnav.sim import EpisodeSetup, Trajectory, run_episode, run_rng
 
@@ -192,9 +190,7 @@ def run_job(job: Job) -> JobOutcome:
     try:
         setup, params = build_job(job)
         controller = make_controller(job.controller, **params)
-        result = run_episode(
-            setup, controller, run_rng(int(job.seed)), record=job.record
-        )
+        result = run_episode(setup, controller, run_rng(int(job.seed)), record=job.record)
     except Exception as exc:  # a failing job is data, not a crash of the campaign
         tb = traceback.extract_tb(exc.__traceback__)
         where = f" (at {tb[-1].filename}:{tb[-1].lineno})" if tb else ""

@@ -88,6 +88,20 @@ THESIS_CLAIMS: dict[str, dict[str, tuple[str, str]]] = {
 }
 
 
+#: Short table labels of the thesis scenes (figure number and what the scene is).
+SCENE_LABELS: dict[str, str] = {
+    "thesis-ch2-one-obstacle": "Fig. 2.7 one obstacle",
+    "thesis-ch2-six-obstacles": "Fig. 2.8 six obstacles",
+    "thesis-ch2-fig2-9-changing-direction": "Fig. 2.9 changing direction",
+    COMPARISON_SCENE: "Fig. 2.10 comparison",
+}
+
+
+def scene_label(scene: str) -> str:
+    """Table label of a scene: its thesis figure if known, else the scene name."""
+    return SCENE_LABELS.get(scene, scene)
+
+
 @dataclass(frozen=True)
 class SceneEpisode:
     """One stored thesis-scene episode: scene name, controller, seed, episode id and status."""
@@ -319,7 +333,7 @@ def build_table(
             r = row_of(scene, ctrl)
             rows.append(
                 {
-                    "quantity": f"outcome, {scene}, {ctrl}",
+                    "quantity": f"outcome, {scene_label(scene)}, {ctrl}",
                     "thesis": claims[0],
                     "measured": _outcome(r),
                     "note": ""
@@ -330,10 +344,10 @@ def build_table(
             )
             rows.append(
                 {
-                    "quantity": f"min clearance, {scene}, {ctrl}",
+                    "quantity": f"min clearance, {scene_label(scene)}, {ctrl}",
                     "thesis": claims[1],
                     "measured": "n/a" if r is None else _fmt_m(r["min_clearance"], 3),
-                    "note": "gap between robot disc and obstacle; < 0 is a collision",
+                    "note": "robot disc to obstacle gap; < 0 is a collision",
                 }
             )
     # -- random campaign

@@ -363,24 +363,41 @@ class Zhang2019Controller:
         head_run = position + (v_max * heading - reading.velocity) * ahead
         return run_clearance(reading, position, head_run, margin) <= margin
 
-    def passing_points(self, position: FloatArray, group: ObstacleGroup, tag: int) -> FloatArray:
-        """Centres of the forecast circles the robot must pass outside (note 3): r*_min, r_min and
-        the group's boundary points within D on the passing side in front of r_min."""
+    def passing_points(
+        self, position: FloatArray, group: ObstacleGroup, tag: int
+    ) -> tuple[FloatArray, FloatArray]:
+        """Forecast circles the robot must pass outside (note 3): ``(centres (m, 2), grow (m,))``.
+
+        The circles are centred at r*_min, r_min and the group's polygon vertices within D on the
+        passing side in front of r_min, and at the centre of every disc member in front of r_min;
+        each has radius ``rho + grow`` (``grow`` is the disc's radius for disc centres, else 0), so
+        discs are handled exactly.
+        """
         near = group.nearest
         to_near = _reference_direction(position, near)
-        boundary = group.samples()
-        offsets = boundary - position
-        rel = signed_angle(to_near, offsets) * tag
-        dist = np.hypot(offsets[:, 0], offsets[:, 1])
-        keep = (rel <= 0.0) & (rel >= -0.5 * np.pi) & (dist <= self.params.switch_distance)
-        head = np.array([self.forecast_centre(position, group, tag), near.nearest_point])
-        return np.concatenate([head, boundary[keep]])
+        centres = [self.forecast_centre(position, group, tag), near.nearest_point]
+        grow = [0.0, 0.0]
+        polys = [m for m in group.members if not m.is_disc]
+        if polys:
+            boundary = np.concatenate([m.outline for m in polys])
+            offsets = boundary - position
+            rel = signed_angle(to_near, offsets) * tag
+            dist = np.hypot(offsets[:, 0], offsets[:, 1])
+            keep = (rel <= 0.0) & (rel >= -0.5 * np.pi) & (dist <= self.params.switch_distance)
+            centres.extend(boundary[keep])
+            grow.extend([0.0] * int(keep.sum()))
+        for m in group.members:
+            if m.is_disc and m.distance <= self.params.switch_distance:
+                if abs(float(signed_angle(to_near, m.centre - position))) <= 0.5 * np.pi:
+                    centres.append(m.centre)
+                    grow.append(m.radius)
+        return np.asarray(centres, dtype=float), np.asarray(grow, dtype=float)
 
     def steering_angle(self, obs: Observation, group: ObstacleGroup) -> float:
         """Direction [rad] of l_J: the outermost passing-side tangent over the forecast circles."""
         pos = obs.position
-        rho = self.forecast_radius(group)
-        centres = self.passing_points(pos, group, self._tag)
+        centres, grow = self.passing_points(pos, group, self._tag)
+        rho = self.forecast_radius(group) + grow
         offsets = centres - pos
         dist = np.hypot(offsets[:, 0], offsets[:, 1])
         base = np.arctan2(offsets[:, 1], offsets[:, 0])
@@ -394,7 +411,7 @@ class Zhang2019Controller:
             err_ccw = np.abs(wrap_to_pi(ccw - obs.heading))
             err_cw = np.abs(wrap_to_pi(cw - obs.heading))
             angles = np.where(err_ccw <= err_cw, ccw, cw)
-        tilt = np.minimum(0.25 * np.pi, 0.5 * np.pi * (rho - dist) / max(rho, 1e-9))
+        tilt = np.minimum(0.25 * np.pi, 0.5 * np.pi * (rho - dist) / np.maximum(rho, 1e-9))
         angles = np.where(inside, base - tag * (0.5 * np.pi + tilt), angles)
         ref = _reference_direction(pos, group.nearest)
         dirs = np.stack([np.cos(angles), np.sin(angles)], axis=-1)

@@ -1,16 +1,25 @@
-"""The 2D step loop: sensing, decisions, exact integration, collision checks, metrics (DESIGN §2, §4).
+"""The 2D step loop: sensing, decisions, exact integration, collision checks, metrics (DESIGN §2,
+§4).
 
 Decision rate and integration rate are separate: the controller is asked every ``control_period``
-[s]; robot and obstacles are integrated every ``dt`` [s] with the last command held.  Collisions are
-checked at *every* integration step, exactly (robot disc against disc or polygon sets, see
-:meth:`uvnav.obstacles.ObstacleField.nearest`; the kernel is property-tested against shapely).
+[s] (a whole multiple of ``dt``, else :func:`run_episode` raises ``ValueError``); robot and
+obstacles are integrated every ``dt`` [s] with the last command held.  Collisions are checked at
+*every* integration step, exactly (robot disc against disc or polygon sets, see
+:meth:`uvnav.obstacles.ObstacleField.query`; the kernel is property-tested against shapely).
 
 The simulator clips nothing silently: a command outside the limits (2.4) is saturated to what the
 vehicle can physically do *and* counted in ``limit_violations``.
+
+Speed (``benchmarks/``): the obstacles are advanced together by
+:class:`uvnav.obstacles.ObstacleBatch` (bit for bit their models' own ``step``), each step's
+:class:`~uvnav.obstacles.ObstacleField` is a few array references, and one nearest-point query per
+step, culled by bounding discs, serves both the collision check and, before a decision, the
+sensors (:func:`uvnav.sensors.sense_obstacles` finds it cached on the field).
 """
 
 from __future__ import annotations
 
+import math
 import time as _time
 from dataclasses import dataclass, field
 from typing import Literal
@@ -18,8 +27,9 @@ from typing import Literal
 import numpy as np
 
 from uvnav.controllers.base import Controller
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_step
+from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
 from uvnav.geometry.angles import FloatArray
+from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
 from uvnav.sensors.exact import lidar_scan, sense_obstacles
@@ -30,7 +40,7 @@ from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
 
 @dataclass(frozen=True)
 class LidarConfig:
-    """Lidar attached to the robot: ``n_rays`` beams over ``fov`` [rad], ``max_range`` [m], noise [m]."""
+    """Lidar on the robot: ``n_rays`` beams over ``fov`` [rad], ``max_range`` [m], noise [m]."""
 
     n_rays: int = 72
     max_range: float = 5.0
@@ -45,8 +55,9 @@ class SensingConfig:
 
     Attributes:
         sensing_range: obstacles farther than this [m] are not reported.
-        velocities: ``"known"`` gives true v_i, u_i (the thesis's assumption); ``"estimated"`` gives
-            finite differences of the sensed centre and outline (:class:`FiniteDifferenceEstimator`).
+        velocities: ``"known"`` gives true v_i, u_i (the thesis's assumption); ``"estimated"``
+            gives finite differences of the sensed centre and outline
+            (:class:`FiniteDifferenceEstimator`).
         position_noise: std [m] of the noise on the observed centre when estimating.
         lidar: optional range scanner.
     """
@@ -67,7 +78,7 @@ class EpisodeSetup:
         goal: target T [m].
         obstacles: obstacles with their episode-specific motion models.
         dt: integration step [s].
-        control_period: decision period [s] (a multiple of ``dt``).
+        control_period: decision period [s], a whole multiple of ``dt`` (within 1e-9 relative).
         t_max: time limit [s].
         goal_tolerance: the goal is reached within this distance [m].
         sensing: sensing configuration.
@@ -94,6 +105,24 @@ class EpisodeResult:
     decision_us: FloatArray
 
 
+def decision_ratio(control_period: float, dt: float) -> int:
+    """Integration steps per decision: ``control_period / dt`` as a whole number >= 1.
+
+    Raises:
+        ValueError: ``control_period`` is not a positive whole multiple of ``dt`` within 1e-9
+            relative (the same rule as the scenario schema).
+    """
+    if not (dt > 0 and math.isfinite(dt)):
+        raise ValueError(f"dt must be a positive number of seconds (got {dt!r})")
+    ratio = control_period / dt
+    n = round(ratio) if math.isfinite(ratio) else 0
+    if n < 1 or abs(ratio - n) > 1e-9 * max(1.0, ratio):
+        raise ValueError(
+            f"control_period must be a positive multiple of dt={dt:g} s (got {control_period:g})"
+        )
+    return int(n)
+
+
 def run_episode(
     setup: EpisodeSetup,
     controller: Controller,
@@ -104,41 +133,53 @@ def run_episode(
     """Run one episode to success, collision or ``t_max``.
 
     Args:
-        setup: the instantiated scenario (obstacles are advanced in place).
+        setup: the instantiated scenario; its obstacles' states (and their motion models' internal
+            state) are left as they are at the end of the episode.
         controller: a fresh or reusable controller; it is reset here.
         rng: the episode generator; independent children feed the controller and the sensors.
         record: keep the full trajectory (needed for figures; off for large campaigns).
+
+    Raises:
+        ValueError: ``setup.control_period`` is not a whole multiple of ``setup.dt``.
     """
     ctrl_rng, sense_rng = rng.spawn(2)
     spec = setup.spec
     dt = float(setup.dt)
-    ratio = max(1, round(setup.control_period / dt))
+    ratio = decision_ratio(float(setup.control_period), dt)
     n_steps = round(setup.t_max / dt)
     goal = np.asarray(setup.goal, dtype=float)
-    robot = np.asarray(setup.start, dtype=float).copy()
+    gx, gy = float(goal[0]), float(goal[1])
+    start = np.asarray(setup.start, dtype=float)
+    x, y, th = float(start[0]), float(start[1]), float(start[2])
     obstacles = setup.obstacles
     template = FieldTemplate.from_bodies([o.body for o in obstacles])
-    field_now = ObstacleField.from_obstacles(obstacles, template)
+    batch = ObstacleBatch(obstacles)
+    field_now = batch.field(template)
     sensing = setup.sensing
+    sensing_range = float(sensing.sensing_range)
+    robot_radius = float(spec.radius)
+    goal_tolerance = float(setup.goal_tolerance)
     estimator = None
     if sensing.velocities == "estimated" and not getattr(controller, "oracle", False):
         estimator = FiniteDifferenceEstimator(sense_rng, sensing.position_noise)
 
     controller.reset(spec, goal, ctrl_rng)
     recorder = TrajectoryRecorder([o.body.outline() for o in obstacles]) if record else None
+    has_obstacles = len(obstacles) > 0
 
-    def clearance_of(fld: ObstacleField, pos: FloatArray) -> tuple[float, int]:
-        if len(fld) == 0:
-            return np.inf, -1
-        d, near, inside = fld.nearest(pos)
-        depth = np.hypot(near[:, 0] - pos[0], near[:, 1] - pos[1])
-        gaps = np.where(inside, -depth, d) - spec.radius
-        j = int(np.argmin(gaps))
-        return float(gaps[j]), j
+    def clearance_of(fld: ObstacleField, px: float, py: float, radius: float) -> tuple[float, int]:
+        """Gap [m] between the robot's disc and the nearest obstacle (negative on overlap), and
+        that obstacle; the query also covers ``radius`` for the sensors."""
+        if not has_obstacles:
+            return math.inf, -1
+        q = fld.query((px, py), radius)
+        gaps = q.signed - robot_radius
+        j = int(gaps.argmin())
+        return float(gaps[j]), int(q.ids[j])
 
-    clearance, nearest = clearance_of(field_now, robot[:2])
+    clearance, nearest = clearance_of(field_now, x, y, sensing_range)
     min_clear = clearance
-    start_dist = float(np.hypot(*(goal - robot[:2])))
+    start_dist = math.hypot(gx - x, gy - y)
     path = 0.0
     effort = 0.0
     violations = 0
@@ -152,82 +193,87 @@ def run_episode(
     if clearance < 0:
         status = "collision"
         n_steps = 0
-    elif start_dist <= setup.goal_tolerance:
+    elif start_dist <= goal_tolerance:
         status, reached_at, n_steps = "success", 0.0, 0
 
-    for i in range(n_steps):
-        if i % ratio == 0:
-            readings = sense_obstacles(robot[:2], field_now, sensing_range=sensing.sensing_range)
-            if estimator is not None:
-                readings = estimator.update(t, readings)
-            scan = None
-            if sensing.lidar is not None:
-                lc = sensing.lidar
-                scan = lidar_scan(
-                    robot,
-                    field_now,
-                    sense_rng,
-                    n_rays=lc.n_rays,
-                    max_range=lc.max_range,
-                    fov=lc.fov,
-                    noise_std=lc.noise_std,
-                    dropout=lc.dropout,
+    perf_ns = _time.perf_counter_ns
+    try:
+        for i in range(n_steps):
+            if i % ratio == 0:
+                robot = np.array((x, y, th))
+                readings = sense_obstacles(robot[:2], field_now, sensing_range=sensing_range)
+                if estimator is not None:
+                    readings = estimator.update(t, readings)
+                scan = None
+                if sensing.lidar is not None:
+                    lc = sensing.lidar
+                    scan = lidar_scan(
+                        robot,
+                        field_now,
+                        sense_rng,
+                        n_rays=lc.n_rays,
+                        max_range=lc.max_range,
+                        fov=lc.fov,
+                        noise_std=lc.noise_std,
+                        dropout=lc.dropout,
+                    )
+                obs = Observation(
+                    time=t,
+                    pose=robot,
+                    speed=applied.v,
+                    goal=goal,
+                    obstacles=readings,
+                    lidar=scan,
                 )
-            obs = Observation(
-                time=t,
-                pose=robot.copy(),
-                speed=applied.v,
-                goal=goal,
-                obstacles=readings,
-                lidar=scan,
-            )
-            tic = _time.perf_counter_ns()
-            cmd = controller.act(obs)
-            decision_us.append((_time.perf_counter_ns() - tic) / 1000.0)
-            if cmd.violates(spec):
-                violations += 1
-            new = cmd.clipped(spec)
-            effort += ((new.v - applied.v) ** 2) / (ratio * dt) if i > 0 else 0.0
-            applied = new
-            mode = controller.mode
-            if last_mode is not None and mode != last_mode:
-                switches += 1
-            last_mode = mode
-        if recorder is not None:
-            recorder.add(
-                t,
-                robot.copy(),
-                (applied.v, applied.u),
-                last_mode or "",
-                clearance,
-                nearest,
-                field_now.centres,
-                field_now.headings,
-                field_now.velocities,
-                field_now.angular_velocities,
-            )
-        effort += applied.u**2 * dt
-        new_robot = unicycle_step(robot, applied.v, applied.u, dt)
-        path += float(np.hypot(*(new_robot[:2] - robot[:2])))
-        robot = new_robot
-        for ob in obstacles:
-            ob.state = ob.motion.step(ob.state, t, dt)
-        t = (i + 1) * dt
-        field_now = ObstacleField.from_obstacles(obstacles, template)
-        clearance, nearest = clearance_of(field_now, robot[:2])
-        min_clear = min(min_clear, clearance)
-        if clearance < 0:
-            status = "collision"
-            break
-        if float(np.hypot(*(goal - robot[:2]))) <= setup.goal_tolerance:
-            status = "success"
-            reached_at = t
-            break
+                tic = perf_ns()
+                cmd = controller.act(obs)
+                decision_us.append((perf_ns() - tic) / 1000.0)
+                if cmd.violates(spec):
+                    violations += 1
+                new = cmd.clipped(spec)
+                effort += ((new.v - applied.v) ** 2) / (ratio * dt) if i > 0 else 0.0
+                applied = new
+                mode = controller.mode
+                if last_mode is not None and mode != last_mode:
+                    switches += 1
+                last_mode = mode
+            if recorder is not None:
+                recorder.add(
+                    t,
+                    np.array((x, y, th)),
+                    (applied.v, applied.u),
+                    last_mode or "",
+                    clearance,
+                    nearest,
+                    field_now.centres,
+                    field_now.headings,
+                    field_now.velocities,
+                    field_now.angular_velocities,
+                )
+            effort += applied.u**2 * dt
+            nx, ny, th = unicycle_advance(x, y, th, applied.v, applied.u, dt)
+            path += math.hypot(nx - x, ny - y)
+            x, y = nx, ny
+            batch.step(t, dt)
+            t = (i + 1) * dt
+            field_now = batch.field(template)
+            radius = sensing_range if (i + 1) % ratio == 0 else 0.0
+            clearance, nearest = clearance_of(field_now, x, y, radius)
+            min_clear = min(min_clear, clearance)
+            if clearance < 0:
+                status = "collision"
+                break
+            if math.hypot(gx - x, gy - y) <= goal_tolerance:
+                status = "success"
+                reached_at = t
+                break
+    finally:
+        batch.write_back()
 
     if recorder is not None:
         recorder.add(
             t,
-            robot.copy(),
+            np.array((x, y, th)),
             (applied.v, applied.u),
             last_mode or "",
             clearance,
@@ -239,12 +285,12 @@ def run_episode(
         )
     dec = np.asarray(decision_us) if decision_us else np.zeros(1)
     success = status == "success"
-    shortest = max(start_dist - setup.goal_tolerance, 0.0)  # to the edge of the goal disc
+    shortest = max(start_dist - goal_tolerance, 0.0)  # to the edge of the goal disc
     straight_time = shortest / spec.v_max if spec.v_max > 0 else 0.0
     metrics = EpisodeMetrics(
         success=success,
         collision=status == "collision",
-        min_clearance=float(min_clear) if np.isfinite(min_clear) else 1e9,
+        min_clearance=float(min_clear) if has_obstacles else None,
         path_length=path,
         detour_ratio=(path / shortest) if success and shortest > 0 else None,
         time_to_goal=reached_at,

@@ -1,7 +1,8 @@
 """Episode metrics, identical for every controller (DESIGN §4).
 
 Names are the snake_case column names used in JSON, the results database and the report.  Metrics
-that do not exist for an episode (time to goal of a failed run) are ``None``, never NaN.
+that do not exist for an episode (time to goal of a failed run, minimum clearance in a world
+without obstacles) are ``None``, never NaN or infinite.
 """
 
 from __future__ import annotations
@@ -32,7 +33,8 @@ class EpisodeMetrics:
     Attributes:
         success: reached the goal tolerance before ``t_max`` without collision.
         collision: the robot's disc overlapped an obstacle at some integration step.
-        min_clearance: smallest gap between the robot's disc and any obstacle [m] (negative on overlap).
+        min_clearance: smallest gap between the robot's disc and any obstacle over the episode's
+            integration steps [m] (negative on overlap); ``None`` when the world has no obstacle.
         path_length: distance travelled by the robot centre [m].
         detour_ratio: path length / straight distance from the start to the edge of the goal
             tolerance disc (1.0 is the physical limit); ``None`` for a failed episode.
@@ -47,7 +49,7 @@ class EpisodeMetrics:
 
     success: bool
     collision: bool
-    min_clearance: float
+    min_clearance: float | None
     path_length: float
     detour_ratio: float | None
     time_to_goal: float | None

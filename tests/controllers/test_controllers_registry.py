@@ -1,0 +1,44 @@
+"""Controller registry and ``make_controller`` (DESIGN §2)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from uvnav.controllers import (
+    ControllerParamsError,
+    UnknownControllerError,
+    available_controllers,
+    controller_info,
+    make_controller,
+)
+from uvnav.dynamics import UnicycleSpec
+from uvnav.sensors import Observation
+
+
+def test_builtin_laws_are_registered_with_versioned_names() -> None:
+    names = set(available_controllers())
+    assert {"zhang2019-v1", "savkin-wang2013-v1", "straight-v1"} <= names
+    assert all(name.rsplit("-", 1)[-1].startswith("v") for name in names)
+    assert controller_info("zhang2019-v1").requires_slower_obstacles
+
+
+def test_unknown_name_lists_the_known_ones() -> None:
+    with pytest.raises(UnknownControllerError, match="zhang2019-v1"):
+        make_controller("no-such-law-v1")
+
+
+def test_unknown_parameter_is_rejected() -> None:
+    with pytest.raises(ControllerParamsError, match="unknown parameter"):
+        make_controller("savkin-wang2013-v1", gain=3.0)
+
+
+@pytest.mark.parametrize("name", ["zhang2019-v1", "savkin-wang2013-v1", "straight-v1"])
+def test_every_law_drives_toward_a_free_goal(name: str) -> None:
+    ctrl = make_controller(name)
+    spec = UnicycleSpec(0.707, 1.414, 0.1)
+    ctrl.reset(spec, np.array([5.0, 0.0]), np.random.default_rng(0))
+    cmd = ctrl.act(Observation(time=0.0, pose=np.zeros(3), speed=0.0, goal=np.array([5.0, 0.0])))
+    assert cmd.v == pytest.approx(spec.v_max) and cmd.u == pytest.approx(0.0)
+    assert ctrl.oracle is False
+    assert make_controller(name, oracle=True).oracle is True
