@@ -179,10 +179,8 @@ def test_commands_are_finite_and_within_limits_for_degenerate_geometry(
 ) -> None:
     """Robot on the boundary or inside, zero-size or zero-speed obstacles, ||v_i|| >= d: no NaN."""
     centre = np.array([rx, ry])
-    if on_boundary:  # place the robot exactly on the disc's boundary (or on its centre for r = 0)
-        pose = [rx + radius, ry, th]
-    else:
-        pose = [0.0, 0.0, th]
+    # on_boundary: the robot exactly on the disc's boundary (or on its centre for r = 0)
+    pose = [rx + radius, ry, th] if on_boundary else [0.0, 0.0, th]
     obstacles = [
         disc(rx, ry, r=max(radius, 1e-6), v=(vx, vy)),
         disc(rx, ry, r=max(radius, 1e-6), v=(0.0, 0.0)),

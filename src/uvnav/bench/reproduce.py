@@ -427,7 +427,11 @@ def reproduce(
     results_dir.mkdir(parents=True, exist_ok=True)
     db_path = results_dir / DB_NAME
     n_seeds = n_random if n_random is not None else (FULL_SEEDS if full else QUICK_SEEDS)
-    scenes = sorted(n for n in scenarios.list_builtin() if n.startswith(THESIS_PREFIX))
+    order = list(SCENE_LABELS)
+    scenes = sorted(
+        (n for n in scenarios.list_builtin() if n.startswith(THESIS_PREFIX)),
+        key=lambda n: (order.index(n) if n in order else len(order), n),
+    )
     fp = code_fingerprint()
     ctrls = list(controllers)
     summary_campaigns: dict[str, dict[str, Any]] = {}

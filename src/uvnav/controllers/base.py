@@ -6,7 +6,8 @@ registered by versioned name (``zhang2019-v1``) with :func:`register`; third-par
 theirs through the ``uvnav.controllers`` entry-point group (the entry point must resolve to a
 :class:`ControllerInfo` or to a controller class with a ``name`` attribute).
 
-Parameters are a frozen dataclass (``Params``) whose field docs carry units; ``make_controller`` builds
+Parameters are a frozen dataclass (``Params``) whose field docs carry units;
+``make_controller`` builds
 it from keyword arguments and rejects unknown names with a clear message.
 """
 
@@ -107,7 +108,7 @@ def controller_info(name: str) -> ControllerInfo:
 
 
 def build_params(params_type: type | None, params: dict[str, Any]) -> Any:
-    """Instantiate the frozen parameter dataclass, with a one-line error for unknown/invalid fields."""
+    """Instantiate the frozen parameter dataclass; one-line error for unknown/invalid fields."""
     if params_type is None:
         if params:
             raise ControllerParamsError(f"takes no parameters, got {', '.join(params)}")
@@ -144,7 +145,7 @@ def params_dict(params: Any) -> dict[str, Any]:
     """A parameter dataclass as a plain dict (for hashing and storage)."""
     return (
         dataclasses.asdict(params)
-        if params is not None and dataclasses.is_dataclass(params)
+        if params is not None and dataclasses.is_dataclass(params) and not isinstance(params, type)
         else {}
     )
 
@@ -159,7 +160,8 @@ def saturate(value: float, limit: float) -> float:
 def heading_rate_toward(angle_error: float, u_max: float, period: float) -> float:
     """Sliding-mode heading law with a boundary layer: ``u = U_max * sat(err / (U_max * period))``.
 
-    Outside the layer this is the thesis's bang-bang ``U_max * sign(err)`` (eq. (2.15)); inside it the
+    Outside the layer this is the thesis's bang-bang ``U_max * sign(err)`` (eq. (2.15)); inside
+    it the
     turn that cancels ``angle_error`` [rad] in one decision ``period`` [s], which removes the
     chattering a sampled sign function produces (docs/thesis-notes.md).
     """

@@ -85,7 +85,8 @@ def widened_cone(
 ) -> tuple[float, float]:
     """Angles (beta_1, beta_2) [rad] of the widened vision cone of a disc seen from ``position``.
 
-    ``beta_1 = alpha_1 - alpha_0`` (clockwise boundary), ``beta_2 = alpha_2 + alpha_0``.  From inside
+    ``beta_1 = alpha_1 - alpha_0`` (clockwise boundary), ``beta_2 = alpha_2 + alpha_0``.  From
+    inside
     the disc the cone is the half-plane facing it (half-angle pi/2).
     """
     off = centre - position
@@ -142,7 +143,7 @@ class SavkinWang2013Controller:
     def collision_course(
         self, position: FloatArray, reading: ObstacleReading
     ) -> tuple[bool, float, float]:
-        """Whether heading to the target at V_max points into the widened cone; also (beta_1, beta_2)."""
+        """Whether heading to T at V_max points into the widened cone; also (beta_1, beta_2)."""
         centre, radius = disc_of(reading)
         b1, b2 = widened_cone(position, centre, radius, self.alpha0(radius))
         to_goal = self._goal - position

@@ -1,6 +1,7 @@
 """``straight-v1``: drive at the target at V_max, ignoring obstacles (the floor for every metric).
 
-It turns toward the goal with the bounded heading law of :func:`uvnav.controllers.base.heading_rate_toward`.
+It turns toward the goal with the bounded heading law of
+:func:`uvnav.controllers.base.heading_rate_toward`.
 """
 
 from __future__ import annotations
@@ -21,7 +22,8 @@ class StraightParams:
     """Parameters of ``straight-v1``.
 
     Attributes:
-        slow_radius: distance to the goal [m] inside which speed falls linearly to 0 (0 = never slow).
+        slow_radius: distance to the goal [m] inside which speed falls linearly to 0
+            (0 = never slow).
     """
 
     slow_radius: float = 0.0

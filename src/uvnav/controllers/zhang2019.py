@@ -13,7 +13,8 @@ The law switches between two modes:
   (a) direction tag from alpha(t0), the angle of L_M (robot -> mass centre) measured from L_T
   (robot -> target) when avoidance of that obstacle starts (eq. (2.9)): '+' for alpha >= 0, '-'
   otherwise; (b) the nearest boundary point r_min, then r*_min, the first boundary point hit by the
-  ray from the robot rotated by alpha0 from the direction of r_min toward the passing side (Fig. 2.5);
+  ray from the robot rotated by alpha0 from the direction of r_min toward the passing side
+  (Fig. 2.5);
   (c) the forecast circle (2.11) centred at r*_min, its two tangent lines from the robot, the
   forecast vectors l^1, l^2 (2.12)-(2.13), the angles beta^1, beta^2 from the robot's velocity, the
   index J, and the law  u_R = U_max f(l_J, v_R),  V_R = ||l_J|| / T_f  (capped at V_max).
@@ -101,7 +102,8 @@ class Zhang2019Params:
         tangent_rule: ``"side"`` (tangent on the passing side) or ``"min_beta"`` (|beta| rule).
         threat_horizon: how far ahead [s] the "in the robot's way" test looks along L_T.
         min_speed: floor [m/s] of V_R in M2.
-        speed_law: ``"max"`` (V_R = V_max) or ``"tangent"`` (the literal V_R = ||l_J|| / T_f); note 7.
+        speed_law: ``"max"`` (V_R = V_max) or ``"tangent"`` (the literal V_R = ||l_J|| / T_f);
+            note 7.
         turn_slowdown: scale V_R by cos(beta_J) (not below the speed floor) while turning; note 7.
     """
 
@@ -269,8 +271,7 @@ def group_around(
     frontier = [0]
     while frontier:
         c = frontier.pop()
-        for j in np.nonzero(coarse[c])[0]:
-            j = int(j)
+        for j in (int(i) for i in np.nonzero(coarse[c])[0]):
             if not in_group[j] and body_gap(allr[c], allr[j]) < limit[c, j]:
                 in_group[j] = True
                 frontier.append(j)
@@ -318,7 +319,7 @@ class Zhang2019Controller:
     # -- the pieces of §2.3 -------------------------------------------------------------------
 
     def direction_tag(self, position: FloatArray, centre: FloatArray) -> int:
-        """Eq. (2.9): +1 when alpha(t0) = angle(L_T -> L_M) >= 0, else -1 (L_M toward ``centre``)."""
+        """Eq. (2.9): +1 when alpha(t0) = angle(L_T -> L_M) >= 0, else -1 (L_M to ``centre``)."""
         alpha = float(signed_angle(self._goal - position, centre - position))
         return 1 if alpha >= 0.0 else -1
 
@@ -387,10 +388,10 @@ class Zhang2019Controller:
             centres.extend(boundary[keep])
             grow.extend([0.0] * int(keep.sum()))
         for m in group.members:
-            if m.is_disc and m.distance <= self.params.switch_distance:
-                if abs(float(signed_angle(to_near, m.centre - position))) <= 0.5 * np.pi:
-                    centres.append(m.centre)
-                    grow.append(m.radius)
+            in_front = abs(float(signed_angle(to_near, m.centre - position))) <= 0.5 * np.pi
+            if m.is_disc and m.distance <= self.params.switch_distance and in_front:
+                centres.append(m.centre)
+                grow.append(m.radius)
         return np.asarray(centres, dtype=float), np.asarray(grow, dtype=float)
 
     def steering_angle(self, obs: Observation, group: ObstacleGroup) -> float:
@@ -419,7 +420,7 @@ class Zhang2019Controller:
         return wrap_scalar(float(angles[int(np.argmax(score))]))
 
     def forecast_speed(self, group: ObstacleGroup) -> float:
-        """V_R = ||l_J|| / T_f with ||l_J||^2 = d_min^2 - (||v_i|| T_f)^2 (eqs. (2.12)-(2.15); note 7)
+        """V_R = ||l_J|| / T_f, ||l_J||^2 = d_min^2 - (||v_i|| T_f)^2 (eqs. (2.12)-(2.15); note 7)
         [m/s]."""
         p = self.params
         if p.speed_law == "max":
@@ -445,7 +446,8 @@ class Zhang2019Controller:
         """M1 (2.16): V_max toward T, turning toward it when not facing it (note 10).
 
         Where T lies inside the robot's minimum turning circle (radius V_max / U_max) the speed is
-        lowered to the largest one whose turning circle passes through T, ``U_max d / (2 sin|beta|)``.
+        lowered to the largest one whose turning circle passes through T,
+        ``U_max d / (2 sin|beta|)``.
         """
         to_goal = self._goal - obs.position
         dist = float(np.hypot(*to_goal))

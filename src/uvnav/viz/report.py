@@ -33,8 +33,8 @@ if TYPE_CHECKING:
 SIMULATION_NOTE = (
     "In this chapter (thesis Ch. 2) the obstacles are simulated: their shapes and motions come "
     "from the scenario definitions (random turns, constant velocities), and the robot senses them "
-    "exactly (distance, nearest boundary point, velocity and rotation rate). No recorded sensor "
-    "data is used."
+    "as each scenario's sensing block says (in the thesis scenes: exact distance, nearest boundary "
+    "point, velocity and rotation rate). No recorded sensor data is used."
 )
 
 _TABLE_ORDER = ("quantity", "thesis", "measured", "note")

@@ -66,8 +66,16 @@ def render_reproduction(req: RenderRequest) -> RenderResult:
             path,
             title="Fig. 2.10: comparison of the two laws (one disc at constant velocity)",
         )
+        first = next(
+            (
+                i
+                for i, (p, _) in enumerate(figures)
+                if p.name.startswith(f"{req.comparison_scene}--")
+            ),
+            len(figures),
+        )
         figures.insert(
-            0,
+            first,
             (
                 path,
                 "Fig. 2.10 reproduced: paths of both laws on the comparison scene "
