@@ -145,13 +145,25 @@ def test_code_fingerprint_covers_simulation_code_only(
     assert rp.code_fingerprint() != first
 
 
+TWIN = "straight-twin-test-v1"
+
+
 def test_reproduce_end_to_end_resume_and_staleness(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     scenarios = pytest.importorskip("uvnav.scenarios")
-    n_scenes = sum(n.startswith(rp.THESIS_PREFIX) for n in scenarios.list_builtin())
-    assert n_scenes >= 1
-    kw: dict[str, Any] = dict(n_random=3, controllers=("straight-v1",), workers=1, progress=False)
+    from uvnav.controllers import base
+    from uvnav.controllers.straight import StraightController, StraightParams
+
+    # a second "law" (straight-v1 under another name) so the comparison figure is drawn without
+    # depending on the Ch. 2 controllers; in-process only (workers=1), removed after the test
+    twin = base.ControllerInfo(TWIN, StraightController, StraightParams, "test twin")
+    base.available_controllers()
+    monkeypatch.setitem(base._REGISTRY, TWIN, twin)
+    thesis = [n for n in scenarios.list_builtin() if n.startswith(rp.THESIS_PREFIX)]
+    assert rp.COMPARISON_SCENE in thesis
+    laws = ("straight-v1", TWIN)
+    kw: dict[str, Any] = dict(n_random=3, controllers=laws, workers=1, progress=False)
     # pin the fingerprint: concurrent edits of the tree must not look like stale results
     monkeypatch.setattr(rp, "code_fingerprint", lambda: "a" * 16)
     summary = rp.reproduce(tmp_path / "results", tmp_path / "report", **kw)
@@ -162,36 +174,38 @@ def test_reproduce_end_to_end_resume_and_staleness(
     for fig in summary.figures:
         assert fig.is_file() and fig.parent == tmp_path / "report"
         assert f'src="{fig.name}"' in html
-    assert len(summary.figures) == n_scenes + 1  # one per scene (one law) + random summary
-    assert summary.campaigns[rp.SCENES_CAMPAIGN]["ran"] == n_scenes
-    assert summary.campaigns[rp.RANDOM_CAMPAIGN]["ran"] == 3
+    names = [f.name for f in summary.figures]
+    # one per scene and law, the Fig. 2.10 comparison, the random-campaign summary
+    assert len(names) == 2 * len(thesis) + 2
+    assert f"{rp.COMPARISON_SCENE}--comparison.png" in names
+    assert names[-1] == f"{rp.RANDOM_CAMPAIGN}-summary.png"
+    assert summary.campaigns[rp.SCENES_CAMPAIGN]["ran"] == 2 * len(thesis)
+    assert summary.campaigns[rp.RANDOM_CAMPAIGN]["ran"] == 6
     with ResultsStore(summary.db_path) as store:
         df = store.episodes_frame(rp.RANDOM_CAMPAIGN)
     expected = sorted(
-        ("straight-v1", int(s), st)
-        for s, st in zip(df["seed"], df["status"], strict=True)
+        (str(c), int(s), str(st))
+        for c, s, st in zip(df["controller"], df["seed"], df["status"], strict=True)
         if st != "success"
     )
     assert sorted(summary.failures) == expected
     rows = {r["quantity"]: r["measured"] for r in summary.table}
-    n_ok = int((df["status"] == "success").sum())
-    assert rows["random campaign success rate, straight-v1"] == f"{n_ok / 3:.1%} ({n_ok}/3)"
+    for law in laws:
+        n_ok = int(((df["status"] == "success") & (df["controller"] == law)).sum())
+        assert rows[f"random campaign success rate, {law}"] == f"{n_ok / 3:.1%} ({n_ok}/3)"
+    # the same law under two names gives the same Fig. 2.10 path length
+    assert rows["Fig. 2.10 path length, straight-v1"] == rows[f"Fig. 2.10 path length, {TWIN}"]
 
     # unchanged code: everything is resumed, nothing runs again
     again = rp.reproduce(tmp_path / "results", tmp_path / "report", render=None, **kw)
     assert again.campaigns[rp.SCENES_CAMPAIGN]["ran"] == 0
-    assert again.campaigns[rp.RANDOM_CAMPAIGN]["skipped"] == 3
+    assert again.campaigns[rp.RANDOM_CAMPAIGN]["skipped"] == 6
     assert again.table == summary.table and again.report_path is None
 
     # changed code: stale campaigns are replaced, never mixed
     monkeypatch.setattr(rp, "code_fingerprint", lambda: "b" * 16)
     stale = rp.reproduce(tmp_path / "results", tmp_path / "report", render=None, **kw)
-    assert stale.campaigns[rp.RANDOM_CAMPAIGN] | {"wall_time": 0} == {
-        **stale.campaigns[rp.RANDOM_CAMPAIGN],
-        "ran": 3,
-        "skipped": 0,
-        "rerun_stale": True,
-        "wall_time": 0,
-    }
+    c = stale.campaigns[rp.RANDOM_CAMPAIGN]
+    assert (c["ran"], c["skipped"], c["rerun_stale"]) == (6, 0, True)
     with ResultsStore(summary.db_path) as store:
-        assert store.count(rp.RANDOM_CAMPAIGN) == 3
+        assert store.count(rp.RANDOM_CAMPAIGN) == 6
