@@ -166,7 +166,9 @@ def test_reproduce_end_to_end_resume_and_staleness(
     kw: dict[str, Any] = dict(n_random=3, controllers=laws, workers=1, progress=False)
     # pin the fingerprint: concurrent edits of the tree must not look like stale results
     monkeypatch.setattr(rp, "code_fingerprint", lambda: "a" * 16)
-    summary = rp.reproduce(tmp_path / "results", tmp_path / "report", **kw)
+    from uvnav.viz.reproduction import render_reproduction
+
+    summary = rp.reproduce(tmp_path / "results", tmp_path / "report", render=render_reproduction, **kw)
     assert summary.db_path == tmp_path / "results" / "uvnav.sqlite" and summary.db_path.is_file()
     assert summary.report_path == tmp_path / "report" / "index.html"
     html = summary.report_path.read_text(encoding="utf-8")

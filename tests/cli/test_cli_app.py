@@ -348,6 +348,8 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
             figures=[report_dir / "a.png", report_dir / "b.png"],
         )
 
+    from uvnav.viz.reproduction import render_reproduction
+
     fake = types.ModuleType("uvnav.bench.reproduce")
     fake.reproduce = reproduce  # type: ignore[attr-defined]
     monkeypatch.setitem(sys.modules, "uvnav.bench.reproduce", fake)
@@ -359,7 +361,14 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
     )
     assert result.exit_code == 0, result.output
     assert calls == [
-        {"results": res_dir, "report": rep_dir, "full": False, "workers": 3, "progress": True}
+        {
+            "results": res_dir,
+            "report": rep_dir,
+            "full": False,
+            "workers": 3,
+            "progress": True,
+            "render": render_reproduction,
+        }
     ]
     assert "thesis reported vs uvnav measured" in result.stdout
     assert "14.9 m" in result.stdout and "15.2 m" in result.stdout

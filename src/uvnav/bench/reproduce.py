@@ -10,13 +10,13 @@
 
 stores everything in ``results_dir/uvnav.sqlite``, and builds the table "thesis reported vs uvnav
 measured" whose *measured* column is read back from the stored episodes (never typed in).  Figures
-and the HTML report are then made by a *renderer*
-(:func:`uvnav.viz.reproduction.render_reproduction` by default).
+and the HTML report are then made by a *renderer* passed in by the caller
+(the CLI passes :func:`uvnav.viz.reproduction.render_reproduction`).
 
 Layering (DESIGN §1): ``bench`` (layer 6) sits below ``viz`` (layer 7) and must not import it, so
-the default renderer is looked up at run time by its dotted name (:data:`DEFAULT_RENDERER`) rather
-than imported; pass ``render=`` to use another one (the CLI may pass
-``uvnav.viz.reproduction.render_reproduction`` explicitly).  ``matplotlib`` is never imported here.
+``uvnav.viz`` sits above ``uvnav.bench`` in the layers (DESIGN §1), so this module never imports
+it: the renderer is injected (``render=``), which keeps the layer contract enforceable.
+``matplotlib`` is never imported here.
 
 Resume and staleness: both campaigns carry a fingerprint of the code and scenario files that decide
 episode outcomes (:func:`code_fingerprint`).  Re-running with unchanged code resumes (an interrupted
@@ -28,7 +28,6 @@ different code.  ``fresh=True`` always reruns.
 from __future__ import annotations
 
 import hashlib
-import importlib
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -49,8 +48,6 @@ RANDOM_FAMILY = "random-ch2"
 QUICK_SEEDS = 200
 FULL_SEEDS = 1000
 DB_NAME = "uvnav.sqlite"
-#: ``module:function`` of the default renderer (the module docstring says why it is not imported).
-DEFAULT_RENDERER = "uvnav.viz.reproduction:render_reproduction"
 
 #: Thesis Fig. 2.10 (Ch. 2 §2.4): path lengths [m] reported for the two laws on that scene.
 THESIS_PATH_LENGTH = {"zhang2019-v1": 14.9, "savkin-wang2013-v1": 15.7}
@@ -210,12 +207,6 @@ def code_fingerprint() -> str:
             h.update(str(p.relative_to(root)).encode())
             h.update(p.read_bytes())
     return h.hexdigest()[:16]
-
-
-def _load_renderer(spec: str) -> Renderer:
-    module, _, name = spec.partition(":")
-    fn: Renderer = getattr(importlib.import_module(module), name)
-    return fn
 
 
 def _prepare_campaign(store: ResultsStore, name: str, config: dict[str, Any], fresh: bool) -> bool:
@@ -398,7 +389,7 @@ def reproduce(
     fresh: bool = False,
     n_random: int | None = None,
     controllers: Sequence[str] = CONTROLLERS,
-    render: Renderer | str | None = DEFAULT_RENDERER,
+    render: Renderer | None = None,
 ) -> ReproductionSummary:
     """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
 
@@ -411,7 +402,8 @@ def reproduce(
         fresh: delete and rerun both campaigns even when the stored ones are current.
         n_random: override the number of random seeds (tests, quick looks).
         controllers: laws to run (default both Ch. 2 laws).
-        render: renderer callable or ``"module:function"``; ``None`` skips figures and report.
+        render: renderer callable (e.g. ``uvnav.viz.reproduction.render_reproduction``);
+            ``None`` skips figures and report.
 
     Returns:
         The summary: table, database and report paths, random-campaign failures.
@@ -495,7 +487,7 @@ def reproduce(
     report_path: Path | None = None
     figures: list[Path] = []
     if render is not None:
-        renderer = _load_renderer(render) if isinstance(render, str) else render
+        renderer = render
         out = renderer(
             RenderRequest(
                 db_path=db_path,

@@ -563,7 +563,8 @@ def run(
 ) -> None:
     """Reproduce the thesis's experiments: results database, report, and the comparison table."""
     reproduce = _optional("uvnav.bench.reproduce", "reproduce", "the reproduction job (uvnav run)")
-    summary = reproduce(results, report, full=full, workers=workers, progress=True)
+    render = _optional("uvnav.viz.reproduction", "render_reproduction", "the report renderer")
+    summary = reproduce(results, report, full=full, workers=workers, progress=True, render=render)
     from rich.table import Table
 
     table = Table(title="thesis reported vs uvnav measured")
