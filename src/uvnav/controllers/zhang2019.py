@@ -82,9 +82,15 @@ import numpy as np
 
 from uvnav.controllers.base import ControllerInfo, heading_rate_toward, register
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
-from uvnav.geometry.angles import FloatArray, signed_angle, wrap_scalar, wrap_to_pi
-from uvnav.geometry.polygons import rays_circles_hit, rays_segments_hit
-from uvnav.geometry.segments import points_to_segments, segment_to_polygon_distance
+from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.geometry.segments import points_to_segments
+from uvnav.geometry.small import (
+    point_segment_distance,
+    ray_circle_distance,
+    ray_polygon_distance,
+    segment_polygon_distance,
+    wrap,
+)
 from uvnav.sensors.observation import Observation, ObstacleReading
 
 _DISC_SAMPLES = 24
@@ -149,14 +155,6 @@ def _ring_edges(reading: ObstacleReading) -> tuple[FloatArray, FloatArray]:
     return pts, np.concatenate([pts[1:], pts[:1]])
 
 
-def _point_segment_distance(px: float, py: float, a: FloatArray, b: FloatArray) -> float:
-    ax, ay = float(a[0]), float(a[1])
-    rx, ry = float(b[0]) - ax, float(b[1]) - ay
-    len2 = rx * rx + ry * ry
-    t = 0.0 if len2 < 1e-24 else min(max(((px - ax) * rx + (py - ay) * ry) / len2, 0.0), 1.0)
-    return math.hypot(ax + t * rx - px, ay + t * ry - py)
-
-
 def run_clearance(reading: ObstacleReading, a: FloatArray, b: FloatArray, margin: float) -> float:
     """Distance [m] from the segment ``a``-``b`` to the obstacle's body, exact up to ``margin``.
 
@@ -164,15 +162,16 @@ def run_clearance(reading: ObstacleReading, a: FloatArray, b: FloatArray, margin
     (underestimated) disc distance is returned without touching the edges.
     """
     c = reading.centre
-    dc = _point_segment_distance(float(c[0]), float(c[1]), a, b)
+    dc = point_segment_distance(
+        float(c[0]), float(c[1]), float(a[0]), float(a[1]), float(b[0]), float(b[1])
+    )
     if reading.is_disc:
         return max(dc - reading.radius, 0.0)
     if dc - reading.bounding_radius > margin:
         return dc - reading.bounding_radius
     if reading.distance == 0.0:  # the robot is inside this body
         return 0.0
-    s, e = _ring_edges(reading)
-    return segment_to_polygon_distance(a, b, s, e)
+    return segment_polygon_distance(a, b, reading.outline.tolist())
 
 
 def body_gap(a: ObstacleReading, b: ObstacleReading) -> float:
@@ -215,6 +214,8 @@ class ObstacleGroup:
     @property
     def centre(self) -> FloatArray:
         """Mass centre of the group [m] (members weighted by their bounding-disc areas)."""
+        if len(self.members) == 1:
+            return np.asarray(self.members[0].centre, dtype=float)
         w = np.array([max(m.bounding_radius, 1e-6) ** 2 for m in self.members])
         c = np.array([m.centre for m in self.members])
         return np.asarray((w[:, None] * c).sum(axis=0) / w.sum(), dtype=float)
@@ -235,16 +236,19 @@ class ObstacleGroup:
 
     def ray_hit(self, origin: FloatArray, angle: float) -> FloatArray | None:
         """First boundary point of any member on the ray from ``origin`` at ``angle`` [rad]."""
-        direction = np.array([[math.cos(angle), math.sin(angle)]])
-        best = np.inf
+        ox, oy = float(origin[0]), float(origin[1])
+        best = math.inf
         for m in self.members:
             if m.is_disc:
-                t = rays_circles_hit(origin, direction, m.centre[None, :], np.array([m.radius]))
+                t = ray_circle_distance(
+                    ox, oy, angle, float(m.centre[0]), float(m.centre[1]), m.radius
+                )
             else:
-                s, e = _ring_edges(m)
-                t = rays_segments_hit(origin, direction, s, e)
-            best = min(best, float(t.min()))
-        return None if not np.isfinite(best) else origin + best * direction[0]
+                t = ray_polygon_distance(ox, oy, angle, m.outline.tolist())
+            best = min(best, t)
+        if not math.isfinite(best):
+            return None
+        return np.array([ox + best * math.cos(angle), oy + best * math.sin(angle)])
 
 
 def group_around(
@@ -253,29 +257,26 @@ def group_around(
     """Single-linkage group of ``first`` with the readings whose bodies are closer than ``gap`` [m]
     plus how much the pair can close in ``horizon`` [s] at their current speeds (note 9).
 
-    A vectorised bounding-circle test prunes the pairs; only the survivors get the exact
-    boundary distance of :func:`body_gap`.
+    A bounding-circle test prunes the pairs; only the survivors get the exact boundary distance of
+    :func:`body_gap`.
     """
-    allr = [first, *(rd for rd in readings if rd.obstacle_id != first.obstacle_id)]
-    k = len(allr)
-    if k == 1:
-        return ObstacleGroup((first,))
-    centres = np.array([rd.centre for rd in allr])
-    bound = np.array([rd.bounding_radius for rd in allr])
-    speeds = np.hypot(*np.array([rd.velocity for rd in allr]).T)
-    limit = gap + (speeds[:, None] + speeds[None, :]) * horizon
-    spread = centres[:, None, :] - centres[None, :, :]
-    coarse = np.hypot(spread[..., 0], spread[..., 1]) - bound[:, None] - bound[None, :] < limit
-    in_group = [False] * k
-    in_group[0] = True
-    frontier = [0]
-    while frontier:
-        c = frontier.pop()
-        for j in (int(i) for i in np.nonzero(coarse[c])[0]):
-            if not in_group[j] and body_gap(allr[c], allr[j]) < limit[c, j]:
-                in_group[j] = True
-                frontier.append(j)
-    members = sorted((allr[j] for j in range(k) if in_group[j]), key=lambda m: m.distance)
+    pool = [rd for rd in readings if rd.obstacle_id != first.obstacle_id]
+    members = [first]
+    frontier = [first]
+    while frontier and pool:
+        cur = frontier.pop()
+        cx, cy = float(cur.centre[0]), float(cur.centre[1])
+        linked = []
+        for rd in pool:
+            limit = gap + (cur.speed + rd.speed) * horizon
+            far = math.hypot(cx - float(rd.centre[0]), cy - float(rd.centre[1]))
+            if far - cur.bounding_radius - rd.bounding_radius < limit and body_gap(cur, rd) < limit:
+                linked.append(rd)
+        for rd in linked:
+            pool.remove(rd)
+        members.extend(linked)
+        frontier.extend(linked)
+    members.sort(key=lambda m: m.distance)
     return ObstacleGroup(tuple(members))
 
 
@@ -320,20 +321,26 @@ class Zhang2019Controller:
 
     def direction_tag(self, position: FloatArray, centre: FloatArray) -> int:
         """Eq. (2.9): +1 when alpha(t0) = angle(L_T -> L_M) >= 0, else -1 (L_M to ``centre``)."""
-        alpha = float(signed_angle(self._goal - position, centre - position))
+        to_t = self._goal - position
+        to_m = centre - position
+        alpha = wrap(math.atan2(to_m[1], to_m[0]) - math.atan2(to_t[1], to_t[0]))
         return 1 if alpha >= 0.0 else -1
 
     def forecast_centre(self, position: FloatArray, group: ObstacleGroup, tag: int) -> FloatArray:
         """r*_min (Fig. 2.5): first hit of the ray rotated by alpha0 from r_min toward the passing
         side; where the ray misses every body, the silhouette point on the passing side."""
-        to_near = _reference_direction(position, group.nearest)
-        ray = float(np.arctan2(to_near[1], to_near[0])) - tag * self.params.alpha0
-        hit = group.ray_hit(position, ray)
+        ref = _reference_angle(position, group.nearest)
+        hit = group.ray_hit(position, ref - tag * self.params.alpha0)
         if hit is not None:
             return hit
-        pts = group.samples()
-        rel = signed_angle(to_near, pts - position)
-        return np.asarray(pts[int(np.argmin(rel)) if tag > 0 else int(np.argmax(rel))], dtype=float)
+        px, py = float(position[0]), float(position[1])
+        best, best_rel = None, -math.inf
+        for x, y in group.samples().tolist():
+            rel = -tag * wrap(math.atan2(y - py, x - px) - ref)  # outermost on the passing side
+            if rel > best_rel:
+                best, best_rel = (x, y), rel
+        assert best is not None
+        return np.array(best)
 
     def forecast_radius(self, group: ObstacleGroup) -> float:
         """rho = (||v_i|| + |u_i| R_i) T_f + r_robot + margin [m] (thesis: ||v_i||; note 2)."""
@@ -366,58 +373,63 @@ class Zhang2019Controller:
 
     def passing_points(
         self, position: FloatArray, group: ObstacleGroup, tag: int
-    ) -> tuple[FloatArray, FloatArray]:
-        """Forecast circles the robot must pass outside (note 3): ``(centres (m, 2), grow (m,))``.
+    ) -> list[tuple[float, float, float]]:
+        """Forecast circles the robot must pass outside (note 3), as ``(x, y, grow)`` [m].
 
         The circles are centred at r*_min, r_min and the group's polygon vertices within D on the
         passing side in front of r_min, and at the centre of every disc member in front of r_min;
         each has radius ``rho + grow`` (``grow`` is the disc's radius for disc centres, else 0), so
         discs are handled exactly.
         """
+        px, py = float(position[0]), float(position[1])
         near = group.nearest
-        to_near = _reference_direction(position, near)
-        centres = [self.forecast_centre(position, group, tag), near.nearest_point]
-        grow = [0.0, 0.0]
-        polys = [m for m in group.members if not m.is_disc]
-        if polys:
-            boundary = np.concatenate([m.outline for m in polys])
-            offsets = boundary - position
-            rel = signed_angle(to_near, offsets) * tag
-            dist = np.hypot(offsets[:, 0], offsets[:, 1])
-            keep = (rel <= 0.0) & (rel >= -0.5 * np.pi) & (dist <= self.params.switch_distance)
-            centres.extend(boundary[keep])
-            grow.extend([0.0] * int(keep.sum()))
+        ref = _reference_angle(position, near)
+        reach = self.params.switch_distance
+        r_star = self.forecast_centre(position, group, tag)
+        circles = [
+            (float(r_star[0]), float(r_star[1]), 0.0),
+            (float(near.nearest_point[0]), float(near.nearest_point[1]), 0.0),
+        ]
         for m in group.members:
-            in_front = abs(float(signed_angle(to_near, m.centre - position))) <= 0.5 * np.pi
-            if m.is_disc and m.distance <= self.params.switch_distance and in_front:
-                centres.append(m.centre)
-                grow.append(m.radius)
-        return np.asarray(centres, dtype=float), np.asarray(grow, dtype=float)
+            if m.is_disc:
+                cx, cy = float(m.centre[0]), float(m.centre[1])
+                in_front = abs(wrap(math.atan2(cy - py, cx - px) - ref)) <= 0.5 * math.pi
+                if m.distance <= reach and in_front:
+                    circles.append((cx, cy, m.radius))
+                continue
+            for x, y in m.outline.tolist():
+                rel = tag * wrap(math.atan2(y - py, x - px) - ref)
+                if -0.5 * math.pi <= rel <= 0.0 and math.hypot(x - px, y - py) <= reach:
+                    circles.append((x, y, 0.0))
+        return circles
 
     def steering_angle(self, obs: Observation, group: ObstacleGroup) -> float:
         """Direction [rad] of l_J: the outermost passing-side tangent over the forecast circles."""
         pos = obs.position
-        centres, grow = self.passing_points(pos, group, self._tag)
-        rho = self.forecast_radius(group) + grow
-        offsets = centres - pos
-        dist = np.hypot(offsets[:, 0], offsets[:, 1])
-        base = np.arctan2(offsets[:, 1], offsets[:, 0])
-        inside = dist <= rho
-        gamma = np.arcsin(np.clip(rho / np.maximum(dist, 1e-12), 0.0, 1.0))
+        px, py = float(pos[0]), float(pos[1])
         tag = self._tag
-        if self.params.tangent_rule == "side":
-            angles = base - tag * gamma
-        else:  # thesis's literal rule: of the two tangents, the one nearer the current heading
-            ccw, cw = base + gamma, base - gamma
-            err_ccw = np.abs(wrap_to_pi(ccw - obs.heading))
-            err_cw = np.abs(wrap_to_pi(cw - obs.heading))
-            angles = np.where(err_ccw <= err_cw, ccw, cw)
-        tilt = np.minimum(0.25 * np.pi, 0.5 * np.pi * (rho - dist) / np.maximum(rho, 1e-9))
-        angles = np.where(inside, base - tag * (0.5 * np.pi + tilt), angles)
-        ref = _reference_direction(pos, group.nearest)
-        dirs = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
-        score = -tag * signed_angle(ref, dirs)  # most clockwise of r_min for '+', CCW for '-'
-        return wrap_scalar(float(angles[int(np.argmax(score))]))
+        rho0 = self.forecast_radius(group)
+        ref = _reference_angle(pos, group.nearest)
+        literal = self.params.tangent_rule == "min_beta"
+        best_angle, best_score = ref, -math.inf
+        for cx, cy, grow in self.passing_points(pos, group, tag):
+            rho = rho0 + grow
+            dist = math.hypot(cx - px, cy - py)
+            base = math.atan2(cy - py, cx - px)
+            if dist <= rho:  # inside the circle: the limiting direction, tilted outward (note 6)
+                tilt = min(0.25 * math.pi, 0.5 * math.pi * (rho - dist) / max(rho, 1e-9))
+                angle = base - tag * (0.5 * math.pi + tilt)
+            else:
+                gamma = math.asin(rho / dist)
+                angle = base - tag * gamma
+                if literal:  # thesis's |beta| rule: of the two tangents, the one nearer the heading
+                    other = base + tag * gamma
+                    if abs(wrap(other - obs.heading)) < abs(wrap(angle - obs.heading)):
+                        angle = other
+            score = -tag * wrap(angle - ref)  # most clockwise of r_min for '+', CCW for '-'
+            if score > best_score:
+                best_angle, best_score = angle, score
+        return wrap(best_angle)
 
     def forecast_speed(self, group: ObstacleGroup) -> float:
         """V_R = ||l_J|| / T_f, ||l_J||^2 = d_min^2 - (||v_i|| T_f)^2 (eqs. (2.12)-(2.15); note 7)
@@ -487,12 +499,15 @@ class Zhang2019Controller:
         return self.avoidance_command(obs, group, period)
 
 
-def _reference_direction(position: FloatArray, reading: ObstacleReading) -> FloatArray:
-    """Direction of r_min from the robot (of the mass centre when the robot is on the boundary)."""
-    to_near = reading.nearest_point - position
-    if float(np.hypot(*to_near)) < 1e-9:
-        to_near = reading.centre - position
-    return np.asarray(to_near, dtype=float)
+def _reference_angle(position: FloatArray, reading: ObstacleReading) -> float:
+    """Direction [rad] of r_min from the robot (of the mass centre when the robot is on the
+    boundary)."""
+    dx = float(reading.nearest_point[0] - position[0])
+    dy = float(reading.nearest_point[1] - position[1])
+    if math.hypot(dx, dy) < 1e-9:
+        dx = float(reading.centre[0] - position[0])
+        dy = float(reading.centre[1] - position[1])
+    return math.atan2(dy, dx)
 
 
 register(

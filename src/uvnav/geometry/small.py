@@ -1,0 +1,101 @@
+"""Pure-Python kernels for a handful of points.
+
+A controller decides on one obstacle outline of 5-20 vertices at a time; there numpy's per-call
+overhead (a few microseconds per operation on the machines we target) costs more than the
+arithmetic, so these loops over Python floats are several times faster than the vectorised
+kernels of :mod:`uvnav.geometry.polygons`, which remain the choice for large batches (the
+simulator's edge soup of every obstacle).  Results are identical up to floating-point rounding;
+the property tests compare the two.  Points are ``(x, y)`` tuples or length-2 sequences,
+lengths in [m], angles in [rad].
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+Point = Sequence[float]
+
+
+def wrap(angle: float) -> float:
+    """``angle`` [rad] wrapped to (-pi, pi]."""
+    if -math.pi < angle <= math.pi:
+        return angle
+    w = math.pi - (math.pi - angle) % (2.0 * math.pi)
+    return w if w > -math.pi else math.pi
+
+
+def point_segment_distance(
+    px: float, py: float, ax: float, ay: float, bx: float, by: float
+) -> float:
+    """Distance [m] from point p to segment a-b."""
+    rx, ry = bx - ax, by - ay
+    len2 = rx * rx + ry * ry
+    t = 0.0 if len2 < 1e-24 else min(max(((px - ax) * rx + (py - ay) * ry) / len2, 0.0), 1.0)
+    return math.hypot(ax + t * rx - px, ay + t * ry - py)
+
+
+def segment_polygon_distance(a: Point, b: Point, ring: Sequence[Point]) -> float:
+    """Distance [m] from segment a-b to the closed polygon boundary ``ring`` (0 if they cross)."""
+    ax, ay, bx, by = float(a[0]), float(a[1]), float(b[0]), float(b[1])
+    rx, ry = bx - ax, by - ay
+    best = math.inf
+    n = len(ring)
+    for i in range(n):
+        sx, sy = ring[i][0], ring[i][1]
+        ex, ey = ring[(i + 1) % n][0], ring[(i + 1) % n][1]
+        qx, qy = ex - sx, ey - sy
+        denom = rx * qy - ry * qx
+        if denom != 0.0:
+            wx, wy = sx - ax, sy - ay
+            t = (wx * qy - wy * qx) / denom
+            u = (wx * ry - wy * rx) / denom
+            if 0.0 <= t <= 1.0 and 0.0 <= u <= 1.0:
+                return 0.0
+        best = min(
+            best,
+            point_segment_distance(ax, ay, sx, sy, ex, ey),
+            point_segment_distance(bx, by, sx, sy, ex, ey),
+            point_segment_distance(sx, sy, ax, ay, bx, by),
+        )
+    return best
+
+
+def ray_polygon_distance(ox: float, oy: float, angle: float, ring: Sequence[Point]) -> float:
+    """Distance [m] along the ray from o at ``angle`` to its first crossing of ``ring``.
+
+    ``inf`` when the ray misses.
+    """
+    dx, dy = math.cos(angle), math.sin(angle)
+    best = math.inf
+    n = len(ring)
+    for i in range(n):
+        sx, sy = ring[i][0], ring[i][1]
+        qx, qy = ring[(i + 1) % n][0] - sx, ring[(i + 1) % n][1] - sy
+        denom = dx * qy - dy * qx
+        if abs(denom) < 1e-12:
+            continue
+        wx, wy = sx - ox, sy - oy
+        t = (wx * qy - wy * qx) / denom
+        s = (wx * dy - wy * dx) / denom
+        if t >= 0.0 and 0.0 <= s <= 1.0 and t < best:
+            best = t
+    return best
+
+
+def ray_circle_distance(
+    ox: float, oy: float, angle: float, cx: float, cy: float, r: float
+) -> float:
+    """Distance [m] along the ray from o at ``angle`` to its first crossing of a circle.
+
+    ``inf`` when the ray misses; a ray starting inside meets the circle on the way out.
+    """
+    dx, dy = math.cos(angle), math.sin(angle)
+    mx, my = cx - ox, cy - oy
+    b = dx * mx + dy * my
+    disc = b * b - (mx * mx + my * my - r * r)
+    if disc < 0.0:
+        return math.inf
+    sq = math.sqrt(disc)
+    t = b - sq if b - sq >= 0.0 else b + sq
+    return t if t >= 0.0 else math.inf
