@@ -19,7 +19,11 @@ Benchmarks:
   T = [10, 10], V_max = 0.707 m/s, U_max = 1.414 rad/s, one random-turn polygon) per controller.
 
 ``--quick`` runs a few hundred samples of each for a smoke test (numbers are then indicative only);
-``--profile`` also writes a cProfile summary of the world step (``world_step_profile.json``).
+``--profile`` also writes a cProfile summary of the world step (``world_step_profile.json``);
+``--against DIR`` also times ``world_steps`` side by side against another uvnav source tree
+(``world_steps_ab.json``: the same scenes, run alternately in two worker processes, one importing
+``DIR``'s ``uvnav``, the other this checkout's), which is how a speed-up is measured on a noisy
+machine.
 """
 
 from __future__ import annotations
@@ -32,6 +36,7 @@ import math
 import os
 import platform
 import pstats
+import subprocess
 import sys
 import time
 import traceback
@@ -357,7 +362,7 @@ def _time_episode(
 
 def bench_world(quick: bool) -> dict[str, Any]:
     n_steps = 300 if quick else 3000
-    repeats = 1 if quick else 3
+    repeats = 1 if quick else 5
     results: dict[str, Any] = {}
     for n in WORLD_COUNTS:
         row: dict[str, Any] = {}
@@ -449,14 +454,18 @@ def bench_episodes(quick: bool) -> dict[str, Any]:
 
 def world_step_components(n_obstacles: int, quick: bool) -> dict[str, float]:
     """Direct timing (best of 5, no profiler overhead) of each part of one run_episode step [µs]."""
+    from uvnav.obstacles import ObstacleBatch  # here: --worker runs against older trees too
+
     setup = world_setup(n_obstacles, 100, seed=0)
     obstacles = setup.obstacles
     template = FieldTemplate.from_bodies([o.body for o in obstacles])
-    fld = ObstacleField.from_obstacles(obstacles, template)
+    batch = ObstacleBatch(obstacles)
+    fld = batch.field(template)
     robot = np.array([0.0, 0.0, 0.0])
     ctrl = make_controller("straight-v1")
     ctrl.reset(setup.spec, setup.goal, np.random.default_rng(0))
-    readings = sense_obstacles(robot[:2], fld, sensing_range=setup.sensing.sensing_range)
+    sensing_range = setup.sensing.sensing_range
+    readings = sense_obstacles(robot[:2], fld, sensing_range=sensing_range)
     obs = Observation(time=0.0, pose=robot, speed=0.7, goal=setup.goal, obstacles=readings)
     reps = 20 if quick else 200
 
@@ -469,24 +478,33 @@ def world_step_components(n_obstacles: int, quick: bool) -> dict[str, float]:
             best = min(best, (time.perf_counter() - tic) / reps)
         return 1e6 * best
 
-    def advance_all() -> None:
+    clock = [0.0]
+
+    def advance_batch() -> None:
+        batch.step(clock[0], 0.1)
+        clock[0] += 0.1
+
+    def advance_each() -> None:  # the per-obstacle reference path the batch reproduces
         for ob in obstacles:
             ob.state = ob.motion.step(ob.state, 0.0, 0.1)
 
+    def fresh_query(radius: float) -> Callable[[], object]:
+        def run() -> object:
+            fld._last = None  # defeat the one-answer cache
+            return fld.query(robot[:2], radius, nearest=True)
+
+        return run
+
     return {
         "robot unicycle_step": best_us(lambda: unicycle_step(robot, 0.7, 0.1, 0.1)),
-        "obstacle motion (all)": best_us(advance_all),
-        "ObstacleField.from_obstacles": best_us(
-            lambda: ObstacleField.from_obstacles(obstacles, template)
-        ),
-        "  of which FieldTemplate.field": best_us(
-            lambda: template.field(
-                fld.centres, fld.headings, fld.velocities, fld.angular_velocities
-            )
-        ),
-        "ObstacleField.nearest (clearance)": best_us(lambda: fld.nearest(robot[:2])),
-        "sense_obstacles (decision steps)": best_us(
-            lambda: sense_obstacles(robot[:2], fld, sensing_range=setup.sensing.sensing_range)
+        "ObstacleBatch.step (all obstacles)": best_us(advance_batch),
+        "  reference: motion.step per obstacle": best_us(advance_each),
+        "ObstacleBatch.field": best_us(lambda: batch.field(template)),
+        "ObstacleField.query (collision check)": best_us(fresh_query(0.0)),
+        "ObstacleField.query (+ sensing range)": best_us(fresh_query(sensing_range)),
+        "ObstacleField.nearest (all obstacles)": best_us(fresh_query(math.inf)),
+        "sense_obstacles (query cached)": best_us(
+            lambda: sense_obstacles(robot[:2], fld, sensing_range=sensing_range)
         ),
         "straight-v1 act": best_us(lambda: ctrl.act(obs)),
         "readings in range": float(len(readings)),
@@ -536,6 +554,144 @@ def profile_world(quick: bool, top: int = 25) -> dict[str, Any]:
 
 
 # --------------------------------------------------------------------------------------------
+# side by side against another source tree (--against)
+
+
+def _world_job(job: dict[str, Any]) -> dict[str, Any]:
+    wall, res = _time_episode(
+        lambda: world_setup(int(job["n"]), int(job["steps"]), seed=int(job["seed"])),
+        "straight-v1",
+        int(job["seed"]),
+        bool(job.get("record", False)),
+    )
+    return {"wall": wall, "status": res.status}
+
+
+def worker_main() -> int:
+    """``--worker``: run the world jobs read from stdin (one JSON object a line) with whichever
+    ``uvnav`` this interpreter imports; answer one JSON line each."""
+    import uvnav
+
+    print(json.dumps({"uvnav": str(Path(uvnav.__file__).parent)}), flush=True)
+    for line in sys.stdin:
+        job = json.loads(line)
+        try:
+            out = _world_job(job)
+        except Exception as exc:
+            out = {"error": f"{type(exc).__name__}: {exc}"}
+        print(json.dumps(out), flush=True)
+    return 0
+
+
+class _Worker:
+    """A ``--worker`` subprocess importing ``uvnav`` from ``src``."""
+
+    def __init__(self, src: Path) -> None:
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join(
+            [str(src), *([env["PYTHONPATH"]] if env.get("PYTHONPATH") else [])]
+        )
+        self.proc = subprocess.Popen(
+            [sys.executable, str(Path(__file__).resolve()), "--worker"],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+            env=env,
+        )
+        self.uvnav = str(self._read().get("uvnav"))
+
+    def _read(self) -> dict[str, Any]:
+        assert self.proc.stdout is not None
+        line = self.proc.stdout.readline()
+        if not line:
+            raise RuntimeError("benchmark worker exited (see its stderr above)")
+        out: dict[str, Any] = json.loads(line)
+        return out
+
+    def run(self, job: dict[str, Any]) -> dict[str, Any]:
+        assert self.proc.stdin is not None
+        self.proc.stdin.write(json.dumps(job) + "\n")
+        self.proc.stdin.flush()
+        return self._read()
+
+    def close(self) -> None:
+        if self.proc.stdin is not None:
+            self.proc.stdin.close()
+        self.proc.wait(timeout=60)
+
+
+def _source_dir(path: Path) -> Path:
+    """``path`` itself if it holds ``uvnav/``, else ``path/src``."""
+    path = path.resolve()
+    if (path / "uvnav" / "__init__.py").exists():
+        return path
+    if (path / "src" / "uvnav" / "__init__.py").exists():
+        return path / "src"
+    raise SystemExit(f"--against {path}: no uvnav/ or src/uvnav/ there")
+
+
+def bench_world_ab(quick: bool, against: Path) -> dict[str, Any]:
+    """``world_steps`` (record off) for ``against`` and this checkout, alternately, same seeds.
+
+    Each round runs one episode per side (the order alternates between rounds); the ratio of the
+    two best times and the median of the per-round ratios are the speed-up, both insensitive to
+    the machine slowing down or speeding up between rounds.
+    """
+    rounds = 1 if quick else 5
+    steps = {10: 300 if quick else 3000, 100: 100 if quick else 1000}
+    sides = {
+        "baseline": _Worker(_source_dir(against)),
+        "current": _Worker(Path(__file__).resolve().parents[1] / "src"),
+    }
+    results: dict[str, Any] = {}
+    try:
+        for n in WORLD_COUNTS:
+            n_steps = steps.get(n, 1000)
+            walls: dict[str, list[float]] = {name: [] for name in sides}
+            statuses: dict[str, set[str]] = {name: set() for name in sides}
+            errors: dict[str, str] = {}
+            for r in range(rounds):
+                order = list(sides) if r % 2 == 0 else list(reversed(sides))
+                for name in order:
+                    out = sides[name].run({"n": n, "steps": n_steps, "seed": r})
+                    if "error" in out:
+                        errors[name] = out["error"]
+                        continue
+                    walls[name].append(out["wall"])
+                    statuses[name].add(out["status"])
+            row: dict[str, Any] = {"steps": n_steps, "rounds": rounds}
+            for name, w in walls.items():
+                if w:
+                    row[name] = {
+                        "best_steps_per_s": n_steps / min(w),
+                        "median_steps_per_s": n_steps / float(np.median(w)),
+                        "us_per_step_best": 1e6 * min(w) / n_steps,
+                        "statuses": sorted(statuses[name]),
+                    }
+            if errors:
+                row["errors"] = errors
+            b, c = walls["baseline"], walls["current"]
+            if b and c:
+                row["speedup_best"] = min(b) / min(c)
+                if len(b) == len(c):
+                    row["speedup_median_of_rounds"] = float(
+                        np.median([x / y for x, y in zip(b, c, strict=True)])
+                    )
+            results[str(n)] = row
+    finally:
+        for w in sides.values():
+            w.close()
+    return {
+        "benchmark": "world_steps_ab",
+        "description": "run_episode(straight-v1) steps/s, baseline tree vs this checkout, "
+        "alternating rounds, same scenes and seeds (record off)",
+        "params": {"obstacle_counts": WORLD_COUNTS, "steps": steps, "rounds": rounds},
+        "sources": {name: w.uvnav for name, w in sides.items()},
+        "results": results,
+    }
+
+
+# --------------------------------------------------------------------------------------------
 # report
 
 
@@ -578,6 +734,27 @@ def print_tables(reports: dict[str, dict[str, Any]]) -> None:
                 f"{a.get('us_per_step', float('nan')):.1f}",
                 f"{b.get('steps_per_s', float('nan')):,.0f}",
                 str(a.get("status", a.get("error", "?"))),
+            )
+        console.print(t)
+    if "world_steps_ab" in reports:
+        ab = reports["world_steps_ab"]
+        t = Table(title="world steps per second, side by side (best / median of rounds)")
+        for col in ("obstacles", "baseline", "current", "speed-up (best)", "speed-up (median)"):
+            t.add_column(col, justify="right")
+        for n in WORLD_COUNTS:
+            row = ab["results"].get(str(n), {})
+            cells = []
+            for side in ("baseline", "current"):
+                r = row.get(side, {})
+                cells.append(
+                    f"{r.get('best_steps_per_s', float('nan')):,.0f} / "
+                    f"{r.get('median_steps_per_s', float('nan')):,.0f}"
+                )
+            t.add_row(
+                str(n),
+                *cells,
+                f"{row.get('speedup_best', float('nan')):.2f}x",
+                f"{row.get('speedup_median_of_rounds', float('nan')):.2f}x",
             )
         console.print(t)
     if "episodes" in reports:
@@ -649,7 +826,17 @@ def main(argv: list[str] | None = None) -> int:
         help="run a subset (default: all)",
     )
     parser.add_argument("--profile", action="store_true", help="also cProfile the world step")
+    parser.add_argument(
+        "--against",
+        type=Path,
+        metavar="DIR",
+        help="also time the world steps side by side against the uvnav in DIR (a source tree, "
+        "e.g. from `git archive <commit> src | tar -x -C DIR`)",
+    )
+    parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
+    if args.worker:
+        return worker_main()
 
     chosen = set(args.only or ["decision", "world", "episodes"])
     info = machine_info()
@@ -661,6 +848,9 @@ def main(argv: list[str] | None = None) -> int:
     ]
     if args.profile:
         runners.append(("world", "world_step_profile", profile_world))
+    if args.against is not None:
+        against = args.against
+        runners.append(("world", "world_steps_ab", lambda quick: bench_world_ab(quick, against)))
     for key, name, fn in runners:
         if key not in chosen:
             continue

@@ -168,7 +168,8 @@ def test_reproduce_end_to_end_resume_and_staleness(
     monkeypatch.setattr(rp, "code_fingerprint", lambda: "a" * 16)
     from uvnav.viz.reproduction import render_reproduction
 
-    summary = rp.reproduce(tmp_path / "results", tmp_path / "report", render=render_reproduction, **kw)
+    report_dir = tmp_path / "report"
+    summary = rp.reproduce(tmp_path / "results", report_dir, render=render_reproduction, **kw)
     assert summary.db_path == tmp_path / "results" / "uvnav.sqlite" and summary.db_path.is_file()
     assert summary.report_path == tmp_path / "report" / "index.html"
     html = summary.report_path.read_text(encoding="utf-8")

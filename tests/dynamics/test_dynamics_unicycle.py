@@ -9,7 +9,12 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_step
+from uvnav.dynamics.unicycle import (
+    UnicycleCommand,
+    UnicycleSpec,
+    unicycle_advance,
+    unicycle_step,
+)
 
 speed = st.floats(min_value=0.0, max_value=3.0)
 rate = st.floats(min_value=-3.0, max_value=3.0)
@@ -135,3 +140,31 @@ def test_command_limits(v: float, u: float) -> None:
 def test_clipped_nan_is_zero() -> None:
     c = UnicycleCommand(math.nan, math.inf).clipped(UnicycleSpec(1.0, 1.0))
     assert (c.v, c.u) == (0.0, 0.0)
+
+
+@settings(max_examples=300, deadline=None)
+@given(pose, speed, rate | st.just(0.0) | st.floats(-1e-12, 1e-12), step)
+def test_float_path_equals_array_path_and_numpy_sinc(
+    p: tuple[float, float, float], v: float, u: float, dt: float
+) -> None:
+    """``unicycle_advance`` (the simulator's float path) is ``unicycle_step`` bit for bit, and
+    both keep numpy's ``sinc`` numbers."""
+    out = unicycle_advance(*p, v, u, dt)
+    assert np.array_equal(np.array(out), unicycle_step(np.array(p), v, u, dt))
+    half = 0.5 * u * dt
+    chord = v * dt * float(np.sinc(half / math.pi))
+    assert out[0] == p[0] + chord * math.cos(p[2] + half)
+    assert out[1] == p[1] + chord * math.sin(p[2] + half)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.floats(allow_nan=True, allow_infinity=True), st.floats(allow_nan=True, allow_infinity=True)
+)
+def test_clipped_equals_numpy_clip(v: float, u: float) -> None:
+    spec = UnicycleSpec(0.7, 1.4)
+    c = UnicycleCommand(v, u).clipped(spec)
+    ev = 0.0 if not np.isfinite(v) else float(np.clip(v, 0.0, spec.v_max))
+    eu = 0.0 if not np.isfinite(u) else float(np.clip(u, -spec.u_max, spec.u_max))
+    assert (c.v, c.u) == (ev, eu)
+    assert isinstance(c.v, float) and isinstance(c.u, float)

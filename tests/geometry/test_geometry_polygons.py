@@ -13,6 +13,7 @@ from shapely.geometry import LineString, Point, Polygon
 
 from uvnav.geometry.polygons import (
     angular_extent,
+    closed_rings,
     edge_soup,
     nearest_on_polygons,
     polygon_area,
@@ -20,10 +21,14 @@ from uvnav.geometry.polygons import (
     polygon_nearest,
     ray_polygon_hit,
     rays_circles_hit,
+    rays_rings_hit,
     rays_segments_hit,
+    ring_perp,
+    rings_nearest,
     segment_intersects_polygon,
     segments_min_distance,
     transform_points,
+    transform_rings,
 )
 
 small = st.floats(min_value=-4.0, max_value=4.0, allow_nan=False, allow_infinity=False)
@@ -173,6 +178,8 @@ def test_rays_circles_hit_analytic(
     dist_line = abs(u[0] * (c - o)[1] - u[1] * (c - o)[0])
     if abs(dist_line - r) < 1e-6:  # grazing: hit or miss are both acceptable within rounding
         return
+    if abs(float(np.hypot(*m)) - r) < 1e-9:  # starting on the rim: 0 or the far side, both fine
+        return
     if not real:
         assert t == math.inf
         return
@@ -250,3 +257,54 @@ def test_transform_points_is_rigid_rotation_then_translation(
         shapely.affinity.rotate(Polygon(verts), th, origin=(0, 0), use_radians=True), x, y
     )
     assert np.allclose(out, np.asarray(ref.exterior.coords)[:-1], atol=1e-12)
+
+
+# ------------------------------------------------------------------ padded closed rings
+
+
+@SETTINGS
+@given(st.lists(star_polygons(max_n=9), min_size=1, max_size=5), small, small, heading)
+def test_ring_kernels_equal_edge_soup_kernels_bit_for_bit(
+    polys: list[np.ndarray], x: float, y: float, angle: float
+) -> None:
+    """Packing polygons into padded rings changes no number: nearest points, containment and ray
+    hits are those of the edge-soup kernels (themselves checked against shapely above)."""
+    p = np.array([x, y])
+    rings, counts = closed_rings(polys)
+    assert rings.shape == (2, len(polys), max(len(v) for v in polys) + 1)
+    assert counts.tolist() == [len(v) for v in polys]
+    starts, ends, offsets = edge_soup(polys)
+    d0, n0, in0 = nearest_on_polygons(p, starts, ends, offsets)
+    d1, n1, in1 = rings_nearest(p, rings)
+    assert np.array_equal(d0, d1) and np.array_equal(n0, n1.T) and np.array_equal(in0, in1)
+    d2, n2, in2 = rings_nearest((x, y), rings, parity=False)
+    assert np.array_equal(d1, d2) and np.array_equal(n1, n2) and in2 is None
+    dirs = np.array([[math.cos(angle + a), math.sin(angle + a)] for a in (0.0, 1.0, 2.5, -2.0)])
+    soup_hits = np.minimum.reduceat(rays_segments_hit(p, dirs, starts, ends), offsets[:-1], axis=1)
+    assert np.array_equal(soup_hits, rays_rings_hit(p, dirs, rings))
+
+
+@SETTINGS
+@given(
+    st.lists(star_polygons(max_n=9), min_size=1, max_size=4),
+    st.lists(st.tuples(small, small, heading), min_size=4, max_size=4),
+)
+def test_transform_rings_equals_transform_points(
+    polys: list[np.ndarray], poses: list[tuple[float, float, float]]
+) -> None:
+    rings, counts = closed_rings(polys)
+    poses = poses[: len(polys)]
+    centres = np.array([[px, py] for px, py, _ in poses])
+    headings = np.array([h for _, _, h in poses])
+    world = transform_rings(rings, centres, headings)
+    assert np.array_equal(world, transform_rings(rings, centres, headings, perp=ring_perp(rings)))
+    for i, (v, n) in enumerate(zip(polys, counts.tolist(), strict=True)):
+        expect = transform_points(v, centres[i], float(headings[i]))
+        assert np.array_equal(world[:, i, :n].T, expect)
+        # the padding repeats the first vertex
+        assert np.array_equal(world[:, i, n:], np.repeat(expect[0][:, None], world.shape[2] - n, 1))
+
+
+def test_closed_rings_empty() -> None:
+    rings, counts = closed_rings([])
+    assert rings.shape == (2, 0, 1) and counts.shape == (0,)

@@ -198,3 +198,97 @@ def test_field_follows_obstacle_motion() -> None:
     expect = transform_points(body.vertices, np.array([1.0, 0.0]), 0.5)
     assert fld.polygons[0] == pytest.approx(expect, abs=1e-12)
     assert Polygon(fld.polygons[0]).area == pytest.approx(Polygon(body.vertices).area)
+
+
+def _polygon_world(seed: int, k: int) -> list[Obstacle]:
+    """Polygons only (the query's fast path)."""
+    rng = np.random.default_rng(seed)
+    return [
+        Obstacle(
+            PolygonBody.from_vertices(_star(rng, int(rng.integers(3, 10)))),
+            ObstacleState(position=rng.uniform(-12, 12, 2), heading=float(rng.uniform(-4, 4))),
+            ConstantVelocity(np.zeros(2)),
+        )
+        for _ in range(k)
+    ]
+
+
+@settings(max_examples=80, deadline=None)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.integers(1, 30),
+    st.booleans(),
+    st.floats(-14, 14),
+    st.floats(-14, 14),
+    st.sampled_from([0.0, 0.5, 2.0, 5.0, math.inf]),
+    st.booleans(),
+)
+def test_culled_query_equals_unculled(
+    seed: int, k: int, polygons_only: bool, x: float, y: float, radius: float, with_nearest: bool
+) -> None:
+    """The bounding-disc cull changes nothing: same numbers for what it keeps, and what it drops
+    is farther than the radius (and than the nearest obstacle)."""
+    obstacles = _polygon_world(seed, k) if polygons_only else _world(seed, k)
+    fld = ObstacleField.from_obstacles(obstacles)
+    p = np.array([x, y])
+    dist, near, inside = ObstacleField.from_obstacles(obstacles).nearest(p)  # unculled
+    q = fld.query(p, radius, nearest=with_nearest)
+    ids = q.ids
+    assert np.all(np.diff(ids) > 0)
+    assert np.array_equal(q.distance, dist[ids])
+    assert np.array_equal(q.nearest, near[ids])
+    assert np.array_equal(q.inside, inside[ids])
+    dropped = np.setdiff1d(np.arange(k), ids)
+    assert np.all(dist[dropped] > radius)
+    # the signed distance orders obstacles like the simulator's clearance
+    depth = np.hypot(near[:, 0] - x, near[:, 1] - y)
+    signed = np.where(inside, -depth, dist)
+    assert np.array_equal(q.signed, signed[ids])
+    if with_nearest:
+        assert len(ids) >= 1
+        assert int(ids[np.argmin(q.signed)]) == int(np.argmin(signed))
+        assert np.all(signed[dropped] > signed.min())
+    for i, j in enumerate(ids.tolist()):
+        outline = q.outline(i)
+        if fld.polygons[j] is None:
+            assert outline is None
+        else:
+            assert outline is not None and np.array_equal(outline, fld.polygons[j])
+
+
+def test_query_keeps_its_last_answer() -> None:
+    fld = ObstacleField.from_obstacles(_world(3, 6))
+    p = np.array([0.5, -0.25])
+    q = fld.query(p, 3.0, nearest=True)
+    assert fld.query(p, 2.0, nearest=False) is q  # no more than asked before: cached
+    assert fld.query((0.5, -0.25), 3.0) is q
+    assert fld.query(p, 4.0) is not q  # a larger radius is a new question
+    assert fld.query(p + 1e-9, 1.0) is not fld.query(p, 1.0)
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 12), st.floats(0.5, 6.0))
+def test_ray_hits_cull_keeps_every_hit_within_range(seed: int, k: int, max_range: float) -> None:
+    obstacles = _world(seed, k)
+    fld = ObstacleField.from_obstacles(obstacles)
+    o = np.array([0.3, -0.2])
+    ang = np.linspace(-math.pi, math.pi, 36, endpoint=False)
+    dirs = np.stack([np.cos(ang), np.sin(ang)], axis=-1)
+    full = fld.ray_hits(o, dirs)
+    culled = fld.ray_hits(o, dirs, max_range=max_range)
+    assert np.array_equal(np.minimum(full, max_range), np.minimum(culled, max_range))
+    assert np.all((culled == full) | np.isinf(culled))
+
+
+def test_polygons_are_built_lazily_and_match_the_bodies() -> None:
+    obstacles = _world(4, 9)
+    fld = ObstacleField.from_obstacles(obstacles)
+    polys = fld.polygons
+    assert fld.polygons is polys  # built once
+    for o, poly in zip(obstacles, polys, strict=True):
+        if isinstance(o.body, DiscBody):
+            assert poly is None
+        else:
+            assert poly is not None and poly.flags.c_contiguous
+            expect = transform_points(o.body.vertices, o.state.position, o.state.heading)
+            assert np.array_equal(poly, expect)

@@ -10,7 +10,14 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from uvnav.obstacles.motion import ConstantVelocity, ObstacleState, RandomTurn, Replay, Waypoints
+from uvnav.obstacles.motion import (
+    ConstantVelocity,
+    ObstacleState,
+    RandomTurn,
+    Replay,
+    Waypoints,
+    uniform_draw,
+)
 
 
 def _run(model: object, state: ObstacleState, n: int, dt: float) -> list[ObstacleState]:
@@ -156,3 +163,24 @@ def test_replay_interpolates_and_holds() -> None:
     assert states[20].heading == pytest.approx(math.pi / 2)
     assert states[40].velocity == pytest.approx([0.0, 0.0], abs=1e-12)  # held after the last sample
     assert m.speed_bound() == pytest.approx(2.0)
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.tuples(st.floats(-5.0, 5.0), st.floats(-5.0, 5.0)),
+)
+def test_uniform_draw_is_generator_uniform(seed: int, bounds: tuple[float, float]) -> None:
+    """RandomTurn draws with ``lo + (hi - lo) * random()``: numpy's own formula for
+    ``Generator.uniform``, so the numbers and the stream are those of ``rng.uniform(lo, hi)``."""
+    a = np.random.default_rng(seed)
+    b = np.random.default_rng(seed)
+    if bounds[1] < bounds[0]:
+        with pytest.raises(ValueError):
+            b.uniform(*bounds)
+        with pytest.raises(ValueError):
+            uniform_draw(a, bounds)
+        return
+    for _ in range(20):
+        assert uniform_draw(a, bounds) == float(b.uniform(*bounds))
+    assert a.random() == b.random()  # same stream position afterwards

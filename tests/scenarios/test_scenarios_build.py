@@ -7,7 +7,6 @@ from typing import Any
 import numpy as np
 import pytest
 
-from uvnav.sim import world_rng
 from uvnav.controllers import ControllerInfo, make_controller
 from uvnav.controllers import base as controllers_base
 from uvnav.geometry.polygons import polygon_centroid
@@ -20,7 +19,7 @@ from uvnav.scenarios import (
     scenario_from_dict,
     validate_for_controller,
 )
-from uvnav.sim import run_episode
+from uvnav.sim import run_episode, world_rng
 
 POLYGON = [[-0.6, -0.4], [0.7, -0.5], [0.2, 0.1], [0.6, 0.6], [-0.5, 0.5]]
 

@@ -185,3 +185,20 @@ def test_noisy_scan_is_deterministic_given_seed() -> None:
     a = lidar_scan(np.zeros(3), fld, np.random.default_rng(9), noise_std=0.1, dropout=0.1)
     b = lidar_scan(np.zeros(3), fld, np.random.default_rng(9), noise_std=0.1, dropout=0.1)
     assert np.array_equal(a.ranges, b.ranges, equal_nan=True)
+
+
+@pytest.mark.parametrize("sensing_range", [0.5, 2.0, 4.5, math.inf])
+def test_sensing_reuses_a_wider_query_without_changing_readings(sensing_range: float) -> None:
+    """The simulator queries the field once per step (collision check, covering the sensing
+    range); sensing then reads that cached answer, with the same result as a fresh field."""
+    p = np.array([0.2, -0.1])
+    fresh = sense_obstacles(p, _ring_world(), sensing_range=sensing_range)
+    fld = _ring_world()
+    q = fld.query(p, sensing_range + 1.0, nearest=True)
+    cached = sense_obstacles(p, fld, sensing_range=sensing_range)
+    assert fld.query(p, sensing_range, nearest=False) is q
+    assert len(cached) == len(fresh)
+    for a, b in zip(cached, fresh, strict=True):
+        assert a.obstacle_id == b.obstacle_id and a.distance == b.distance
+        for name in ("nearest_point", "centre", "velocity", "outline"):
+            assert np.array_equal(getattr(a, name), getattr(b, name))

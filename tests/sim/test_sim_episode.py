@@ -20,12 +20,13 @@ from uvnav.obstacles import (
     ConstantVelocity,
     DiscBody,
     Obstacle,
+    ObstacleField,
     ObstacleState,
     PolygonBody,
     RandomTurn,
     Waypoints,
 )
-from uvnav.sensors import Observation
+from uvnav.sensors import Observation, sense_obstacles
 from uvnav.sim import (
     METRIC_NAMES,
     EpisodeResult,
@@ -374,3 +375,122 @@ def test_record_off_gives_same_metrics() -> None:
         if not name.startswith("decision_us"):
             assert a.metrics.to_dict()[name] == b.metrics.to_dict()[name]
     _metrics_are_clean(a)
+
+
+@pytest.mark.parametrize(
+    ("dt", "control_period"), [(0.1, 0.15), (0.1, 0.05), (0.1, 0.0), (0.1, 0.1000001), (0.0, 0.1)]
+)
+def test_control_period_must_be_a_multiple_of_dt(dt: float, control_period: float) -> None:
+    setup = _setup([], dt=dt, control_period=control_period)
+    with pytest.raises(ValueError, match=r"multiple of dt|dt must be"):
+        run_episode(setup, make_controller("straight-v1"), np.random.default_rng(0))
+
+
+def test_control_period_multiple_within_rounding_is_accepted() -> None:
+    setup = _setup([], dt=0.1, control_period=0.30000000000000004, t_max=3.0)
+    probe = Probe(make_controller("straight-v1"))
+    run_episode(setup, probe, np.random.default_rng(0))
+    assert len(probe.seen) == 10
+
+
+def _crowd(seed: int, k: int = 30) -> EpisodeSetup:
+    """Many wandering polygons and discs across the robot's path (culling, sensing, collisions)."""
+    rng = np.random.default_rng(seed)
+    obstacles = []
+    for j in range(k):
+        body: DiscBody | PolygonBody = (
+            DiscBody(0.25) if j % 4 == 0 else PolygonBody.from_vertices(0.5 * ARROW)
+        )
+        pos = rng.uniform(1.0, 11.0, 2)
+        motion = RandomTurn(
+            speed=(0.05, 0.3),
+            turn_rate=(-0.4, 0.4),
+            rng=rng.spawn(1)[0],
+            spin=0.1,
+            arena=(0.0, 0.0, 12.0, 12.0),
+        )
+        obstacles.append(Obstacle(body, ObstacleState(position=pos, heading=0.7 * j), motion))
+    return _setup(obstacles, t_max=30.0, sensing=SensingConfig(sensing_range=3.0))
+
+
+@pytest.mark.parametrize(("seed", "k"), [(s, k) for s in range(6) for k in (6, 30)])
+def test_record_off_gives_same_metrics_and_observations_in_a_crowd(seed: int, k: int) -> None:
+    """Unrecorded runs skip the clearance of steps that cannot lower its minimum: nothing a
+    caller can see may change (collisions and successes both occur over these seeds)."""
+    runs = []
+    for record in (True, False):
+        probe = Probe(make_controller("straight-v1"))
+        res = run_episode(_crowd(seed, k), probe, np.random.default_rng(seed), record=record)
+        runs.append((res, probe.seen))
+    (a, seen_a), (b, seen_b) = runs
+    assert a.status == b.status
+    for name in METRIC_NAMES:
+        if not name.startswith("decision_us"):
+            assert a.metrics.to_dict()[name] == b.metrics.to_dict()[name], name
+    assert a.trajectory is not None
+    assert a.metrics.min_clearance == float(np.min(a.trajectory.clearance))
+    assert len(seen_a) == len(seen_b)
+    for oa, ob in zip(seen_a, seen_b, strict=True):
+        assert [r.obstacle_id for r in oa.obstacles] == [r.obstacle_id for r in ob.obstacles]
+        for ra, rb in zip(oa.obstacles, ob.obstacles, strict=True):
+            assert ra.distance == rb.distance
+            assert np.array_equal(ra.nearest_point, rb.nearest_point)
+            assert np.array_equal(ra.outline, rb.outline)
+
+
+def test_crowd_observations_equal_fresh_unculled_sensing() -> None:
+    """What the controller is given equals sensing a freshly built field from the recorded poses
+    (no cull, no cache), reading for reading."""
+    setup = _crowd(3)
+    bodies = [o.body for o in setup.obstacles]
+    probe = Probe(make_controller("straight-v1"))
+    res = run_episode(setup, probe, np.random.default_rng(3))
+    traj = res.trajectory
+    assert traj is not None and len(probe.seen) > 10
+    seen_any = False
+    for i, obs in enumerate(probe.seen):
+        assert traj.times[i] == obs.time
+        world = [
+            Obstacle(
+                body,
+                ObstacleState(
+                    position=traj.obstacle_centres[i, j],
+                    heading=float(traj.obstacle_headings[i, j]),
+                    velocity=traj.obstacle_velocities[i, j],
+                    angular_velocity=float(traj.obstacle_omegas[i, j]),
+                ),
+                ConstantVelocity(np.zeros(2)),
+            )
+            for j, body in enumerate(bodies)
+        ]
+        expect = sense_obstacles(
+            obs.position, ObstacleField.from_obstacles(world), sensing_range=3.0
+        )
+        assert len(expect) == len(obs.obstacles)
+        for r, e in zip(obs.obstacles, expect, strict=True):
+            seen_any = True
+            assert r.obstacle_id == e.obstacle_id and r.distance == e.distance
+            for name in ("nearest_point", "centre", "velocity", "outline"):
+                assert np.array_equal(getattr(r, name), getattr(e, name)), name
+            assert r.angular_velocity == e.angular_velocity and r.radius == e.radius
+    assert seen_any
+
+
+def test_final_obstacle_states_are_left_on_the_setup() -> None:
+    """run_episode advances the obstacles in place, as the per-obstacle loop did."""
+    setup = _crowd(1)
+    reference = _crowd(1)
+    res = run_episode(setup, make_controller("straight-v1"), np.random.default_rng(1))
+    assert res.trajectory is not None
+    n_steps = len(res.trajectory.times) - 1
+    for i in range(n_steps):
+        for ob in reference.obstacles:
+            ob.state = ob.motion.step(ob.state, i * setup.dt, setup.dt)
+    for ob, ref in zip(setup.obstacles, reference.obstacles, strict=True):
+        assert np.array_equal(ob.state.position, ref.state.position)
+        assert ob.state.heading == ref.state.heading
+        assert np.array_equal(ob.state.velocity, ref.state.velocity)
+        assert ob.state.angular_velocity == ref.state.angular_velocity
+        assert ob.motion.course == ref.motion.course  # type: ignore[attr-defined]
+    j = int(res.trajectory.nearest_id[-1])
+    assert np.array_equal(res.trajectory.obstacle_centres[-1, j], setup.obstacles[j].state.position)

@@ -171,7 +171,8 @@ def run_clearance(reading: ObstacleReading, a: FloatArray, b: FloatArray, margin
         return dc - reading.bounding_radius
     if reading.distance == 0.0:  # the robot is inside this body
         return 0.0
-    return segment_polygon_distance(a, b, reading.outline.tolist())
+    ends = ((float(a[0]), float(a[1])), (float(b[0]), float(b[1])))
+    return segment_polygon_distance(*ends, reading.outline.tolist())
 
 
 def body_gap(a: ObstacleReading, b: ObstacleReading) -> float:

@@ -85,6 +85,4 @@ def unicycle_step(state: FloatArray, v: float, u: float, dt: float) -> FloatArra
     Returns:
         The new ``[x, y, theta]`` with theta wrapped to (-pi, pi].
     """
-    return np.array(
-        unicycle_advance(float(state[0]), float(state[1]), float(state[2]), v, u, dt)
-    )
+    return np.array(unicycle_advance(float(state[0]), float(state[1]), float(state[2]), v, u, dt))

@@ -45,7 +45,8 @@ def vector_angle(vec: ArrayLike) -> FloatArray:
 
 
 def signed_angle(from_vec: ArrayLike, to_vec: ArrayLike) -> FloatArray:
-    """Angle [rad] that rotates ``from_vec`` onto ``to_vec``, counter-clockwise positive, in (-pi, pi].
+    """Angle [rad] that rotates ``from_vec`` onto ``to_vec``, counter-clockwise positive, in
+    (-pi, pi].
 
     Zero-length vectors give 0 (never NaN).
     """

@@ -148,13 +148,15 @@ def rays_circles_hit(
 ) -> FloatArray:
     """(R, C) distance [m] along each unit ray to the first boundary crossing of each circle.
 
-    A ray starting inside a circle hits its boundary on the way out; misses are ``inf``.
+    A ray starting inside a circle hits its boundary on the way out; misses are ``inf``.  Every
+    entry is computed on its own (elementwise products, no matrix product), so it does not depend
+    on which other rays or circles are in the call.
     """
     o = np.asarray(origin, dtype=float)
     dvec = np.asarray(directions, dtype=float)
     m = np.asarray(centres, dtype=float) - o  # (C,2)
-    b = dvec @ m.T  # (R,C) projection of centre on ray
-    c = np.einsum("ij,ij->i", m, m) - np.asarray(radii, dtype=float) ** 2  # (C,)
+    b = dvec[:, 0, None] * m[:, 0] + dvec[:, 1, None] * m[:, 1]  # (R,C) projection on the ray
+    c = (m[:, 0] * m[:, 0] + m[:, 1] * m[:, 1]) - np.asarray(radii, dtype=float) ** 2  # (C,)
     disc = b * b - c[None, :]
     sq = np.sqrt(np.maximum(disc, 0.0))
     t_near = b - sq
@@ -259,101 +261,121 @@ def point_segment_distance(point: FloatArray, a: FloatArray, b: FloatArray) -> f
 
 
 # --------------------------------------------------------------------------------------------
-# padded closed rings: many polygons as two (m, n_max + 1) arrays, no per-call grouping
+# padded closed rings: many polygons as one (2, m, n_max + 1) array, no per-call grouping
 
 
-def closed_rings(polygons: Sequence[FloatArray]) -> tuple[FloatArray, FloatArray, np.ndarray]:
+def closed_rings(polygons: Sequence[FloatArray]) -> tuple[FloatArray, np.ndarray]:
     """Pack polygons into padded closed rings for the ``rings_*`` kernels.
 
-    Row ``i`` of ``xs``/``ys`` holds the ``n_i`` vertices of polygon ``i`` followed by its first
-    vertex, repeated up to ``n_max + 1`` columns.  The edges ``(xs[:, :-1], ys[:, :-1])`` ->
-    ``(xs[:, 1:], ys[:, 1:])`` are then the polygon's own edges followed by zero-length edges at
-    its first vertex, which are never strictly nearer than the real edge starting there, never
-    straddle a horizontal line and never meet a ray: every kernel is exact on the padded rows.
+    ``rings[0]`` holds x and ``rings[1]`` y coordinates; row ``i`` holds the ``n_i`` vertices of
+    polygon ``i`` followed by its first vertex, repeated up to ``n_max + 1`` columns.  The edges
+    ``rings[:, :, :-1]`` -> ``rings[:, :, 1:]`` are then the polygon's own edges followed by
+    zero-length edges at its first vertex, which are never strictly nearer than the real edge
+    starting there, never straddle a horizontal line and never meet a ray: every kernel is exact
+    on the padded rows, and per-polygon results need no grouping (one row, one polygon).
 
     Returns:
-        ``(xs, ys, counts)``: two (m, n_max + 1) arrays [m] and the (m,) vertex counts.
+        ``(rings, counts)``: the (2, m, n_max + 1) array [m] and the (m,) vertex counts.
     """
     m = len(polygons)
     counts = np.array([len(p) for p in polygons], dtype=np.intp)
     width = int(counts.max()) + 1 if m else 1
-    xs = np.empty((m, width))
-    ys = np.empty((m, width))
+    rings = np.empty((2, m, width))
     for i, poly in enumerate(polygons):
         v = np.asarray(poly, dtype=float)
         n = len(v)
-        xs[i, :n] = v[:, 0]
-        ys[i, :n] = v[:, 1]
-        xs[i, n:] = v[0, 0]
-        ys[i, n:] = v[0, 1]
-    return xs, ys, counts
+        rings[:, i, :n] = v.T
+        rings[:, i, n:] = v[0, :, None]
+    return rings, counts
+
+
+def transform_rings(
+    rings: FloatArray,
+    centres: FloatArray,
+    headings: FloatArray,
+    *,
+    perp: FloatArray | None = None,
+) -> FloatArray:
+    """Rigid transforms of packed rings: ring ``i`` rotated by ``headings[i]`` [rad] about the
+    origin, then moved by ``centres[i]`` (m, 2) [m].
+
+    The same numbers as :func:`transform_points` (``c x - s y + cx``, ``s x + c y + cy``).  Pass
+    ``perp = ring_perp(rings)`` when transforming the same rings repeatedly.
+    """
+    h = np.asarray(headings, dtype=float)[None, :, None]
+    if perp is None:
+        perp = ring_perp(rings)
+    # c * x + s * (-y) is bit for bit c * x - s * y
+    return np.cos(h) * rings + np.sin(h) * perp + np.asarray(centres, dtype=float).T[:, :, None]
+
+
+def ring_perp(rings: FloatArray) -> FloatArray:
+    """``(-y, x)`` of packed rings (every point turned by +90 degrees), for
+    :func:`transform_rings`."""
+    return np.stack((-rings[1], rings[0]))
 
 
 def rings_nearest(
-    point: FloatArray | tuple[float, float],
-    xs: FloatArray, ys: FloatArray, *, parity: bool = True
-) -> tuple[FloatArray, FloatArray, FloatArray, np.ndarray | None]:
+    point: FloatArray | tuple[float, float], rings: FloatArray, *, parity: bool = True
+) -> tuple[FloatArray, FloatArray, np.ndarray | None]:
     """Nearest boundary point of each polygon of a :func:`closed_rings` pack.
 
     Args:
         point: (2,) query point [m].
-        xs, ys: (m, w) closed rings.
+        rings: (2, m, w) closed rings.
         parity: also run the even-odd containment test; pass False when ``point`` is known to be
             outside every polygon (e.g. outside their bounding discs) to skip it.
 
     Returns:
-        ``(distance (m,), nearest_x (m,), nearest_y (m,), inside (m,) bool or None)``;
-        ``distance`` is to the boundary (positive inside too); ``inside`` is None without
-        ``parity``.  Ties between edges go to the first edge, as in :func:`nearest_on_polygons`,
-        and the numbers are the same as its.
+        ``(distance (m,), nearest (2, m), inside (m,) bool or None)``: ``distance`` is to the
+        boundary (positive inside too), ``nearest`` holds x and y of the nearest points, and
+        ``inside`` is None without ``parity``.  Ties between edges go to the first edge, and the
+        numbers are those of :func:`nearest_on_polygons`.
     """
     px = float(point[0])
     py = float(point[1])
-    sx = xs[:, :-1]
-    sy = ys[:, :-1]
-    ex = xs[:, 1:] - sx
-    ey = ys[:, 1:] - sy
-    wx = px - sx
-    wy = py - sy
-    t = (wx * ex + wy * ey) / np.maximum(ex * ex + ey * ey, _EPS)
-    t = np.minimum(np.maximum(t, 0.0), 1.0, out=t)
-    qx = sx + t * ex
-    qy = sy + t * ey
-    dx = qx - px
-    dy = qy - py
-    d = np.sqrt(dx * dx + dy * dy)
+    p = np.array((px, py)).reshape(2, 1, 1)
+    starts = rings[:, :, :-1]
+    e = rings[:, :, 1:] - starts
+    we = (p - starts) * e
+    ee = e * e
+    t = (we[0] + we[1]) / np.maximum(ee[0] + ee[1], _EPS)
+    t = np.minimum(np.maximum(t, 0.0, out=t), 1.0, out=t)
+    q = starts + t * e
+    dq = q - p
+    dq *= dq
+    d = np.sqrt(dq[0] + dq[1])
+    m, n = d.shape
     flat = d.argmin(axis=1)
-    flat += np.arange(0, d.size, d.shape[1])
+    flat += np.arange(0, m * n, n)
     dist = d.ravel().take(flat)
-    nx = qx.ravel().take(flat)
-    ny = qy.ravel().take(flat)
+    nearest = q.reshape(2, m * n).take(flat, axis=1)
     if not parity:
-        return dist, nx, ny, None
-    y1 = ys[:, 1:]
-    straddles = (sy > py) != (y1 > py)
-    x_cross = sx + (py - sy) * ex / np.where(straddles, ey, 1.0)
+        return dist, nearest, None
+    sy = starts[1]
+    straddles = (sy > py) != (rings[1, :, 1:] > py)
+    x_cross = starts[0] + (py - sy) * e[0] / np.where(straddles, e[1], 1.0)
     crossings = np.count_nonzero(straddles & (x_cross > px), axis=1)
-    return dist, nx, ny, (crossings % 2) == 1
+    return dist, nearest, (crossings % 2) == 1
 
 
 def rays_rings_hit(
-    origin: FloatArray | tuple[float, float],
-    directions: FloatArray, xs: FloatArray, ys: FloatArray
+    origin: FloatArray | tuple[float, float], directions: FloatArray, rings: FloatArray
 ) -> FloatArray:
     """(R, m) distance [m] along each unit ray to the first boundary crossing of each ring.
 
-    The same test as :func:`rays_segments_hit` (zero-length padding edges never hit); ``inf``
-    where a ray misses.
+    The same test and numbers as :func:`rays_segments_hit` (zero-length padding edges never hit);
+    ``inf`` where a ray misses.
     """
     ox = float(origin[0])
     oy = float(origin[1])
     dirs = np.asarray(directions, dtype=float)
     dx = dirs[:, 0, None, None]  # (R,1,1)
     dy = dirs[:, 1, None, None]
-    sx = xs[:, :-1]
-    sy = ys[:, :-1]
-    ex = xs[:, 1:] - sx
-    ey = ys[:, 1:] - sy
+    sx = rings[0, :, :-1]
+    sy = rings[1, :, :-1]
+    ex = rings[0, :, 1:] - sx
+    ey = rings[1, :, 1:] - sy
     wx = sx - ox
     wy = sy - oy
     denom = dx * ey - dy * ex  # (R,m,n)

@@ -67,7 +67,8 @@ def circle_tangents(point: FloatArray, centre: FloatArray, radius: float) -> Cir
 def disc_silhouette_angles(
     point: FloatArray, centre: FloatArray, radius: float
 ) -> tuple[float, float]:
-    """Directions [rad] of the two rays from ``point`` grazing a disc: (clockwise, counter-clockwise).
+    """Directions [rad] of the two rays from ``point`` grazing a disc: (clockwise,
+    counter-clockwise).
 
     These are the boundary rays of the obstacle's vision cone used by Savkin & Wang (2013).  A point
     inside the disc gives the perpendicular limit (half-angle pi/2).

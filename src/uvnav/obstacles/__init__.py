@@ -1,5 +1,6 @@
 """Layer 1: obstacle bodies (discs, non-convex polygons) and their motion models."""
 
+from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.bodies import (
     Body,
     DiscBody,
@@ -15,7 +16,6 @@ from uvnav.obstacles.motion import (
     Replay,
     Waypoints,
 )
-from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.obstacle import FieldTemplate, NearestQuery, Obstacle, ObstacleField
 
 __all__ = [

@@ -1,7 +1,7 @@
 """Many obstacles advanced together as arrays: the simulator's hot path for obstacle motion.
 
-:class:`ObstacleBatch` holds the positions, headings and rates of an episode's obstacles as
-(k, 2) / (k,) arrays and advances the common motion models in vectorised form:
+:class:`ObstacleBatch` holds the positions, headings and rates of an episode's obstacles as arrays
+and advances the common motion models in vectorised form:
 
 * :class:`~uvnav.obstacles.motion.ConstantVelocity`: fixed rates, one array update;
 * :class:`~uvnav.obstacles.motion.RandomTurn`: speeds and turn rates drawn from each obstacle's
@@ -28,55 +28,51 @@ from collections.abc import Sequence
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-from uvnav.obstacles.motion import ConstantVelocity, ObstacleState, RandomTurn
+from uvnav.obstacles.motion import ConstantVelocity, ObstacleState, RandomTurn, uniform_draw
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
 
 _Rows = slice | np.ndarray
+#: at most this many obstacles outside their arena are steered one by one, more in array form
+_FEW = 4
 
 
 def wrap_array_inplace(a: FloatArray) -> FloatArray:
-    """Wrap every element of ``a`` to (-pi, pi] in place, exactly as :func:`wrap_scalar` does.
+    """Wrap every element of the C-contiguous array ``a`` to (-pi, pi] in place, exactly as
+    :func:`wrap_scalar` does.
 
     Elements already inside are untouched; the few outside go through :func:`wrap_scalar` itself,
     so both paths agree bit for bit (NaN included).
     """
     ok = np.abs(a) < math.pi
-    if len(ok) and not ok[ok.argmin()]:
-        for i in (~ok).nonzero()[0].tolist():
-            a[i] = wrap_scalar(float(a[i]))
+    if ok.size and not ok.flat[ok.argmin()]:
+        flat = a.reshape(-1)
+        for i in (~ok).reshape(-1).nonzero()[0].tolist():
+            flat[i] = wrap_scalar(float(flat[i]))
     return a
+
+
+def wrap_array(a: FloatArray) -> FloatArray:
+    """:func:`wrap_scalar` on every element of ``a`` in array operations (a new array).
+
+    The same operations as :func:`wrap_scalar` (numpy's ``mod`` is Python's ``%`` on floats),
+    hence bit for bit its results, NaN included.
+    """
+    w = math.pi - np.mod(math.pi - a, 2.0 * math.pi)
+    w = np.where(w > -math.pi, w, math.pi)
+    return np.where((a > -math.pi) & (a <= math.pi), a, w)
 
 
 def _rows(idx: list[int], k: int) -> _Rows:
     return slice(None) if len(idx) == k else np.array(idx, dtype=np.intp)
 
 
-class _ConstantGroup:
-    """Obstacles moved by :class:`ConstantVelocity`."""
-
-    def __init__(self, rows: _Rows, models: list[ConstantVelocity]) -> None:
-        self.rows = rows
-        self.velocity = np.array([np.asarray(m.velocity, dtype=float) for m in models]).reshape(
-            -1, 2
-        )
-        self.omega = np.array([float(m.angular_velocity) for m in models])
-
-
 class _RandomTurnGroup:
-    """Obstacles moved by :class:`RandomTurn`, their draws and course as arrays."""
+    """The :class:`RandomTurn` obstacles: their parameters, draws and arena boxes as arrays."""
 
-    def __init__(self, rows: _Rows, models: list[RandomTurn], states: list[ObstacleState]) -> None:
+    def __init__(self, rows: _Rows, models: list[RandomTurn]) -> None:
         self.rows = rows
         self.models = models
         m = len(models)
-        course = np.empty(m)
-        for i, (mod, st) in enumerate(zip(models, states, strict=True)):
-            if mod.course is None:  # as RandomTurn.step does on its first call
-                v = st.velocity
-                course[i] = float(np.arctan2(v[1], v[0])) if np.hypot(*v) > 0 else st.heading
-            else:
-                course[i] = mod.course
-        self.course = course
         self.speed = np.array([mod._speed for mod in models], dtype=float)
         self.turn = np.array([mod._turn for mod in models], dtype=float)
         self.next_change = np.array([mod._next_change for mod in models], dtype=float)
@@ -84,57 +80,93 @@ class _RandomTurnGroup:
         self.due_at = float(self.threshold.min())
         self.period = [float(mod.change_period) for mod in models]
         self.spin = np.array([mod.spin for mod in models], dtype=float)
-        self.arena = [i for i, mod in enumerate(models) if mod.arena is not None]
-        lo = np.full((m, 2), -np.inf)
-        hi = np.full((m, 2), np.inf)
-        for i in self.arena:
-            x0, y0, x1, y1 = models[i].arena  # type: ignore[misc]
-            lo[i] = (x0, y0)
-            hi[i] = (x1, y1)
+        self.has_arena = np.array([mod.arena is not None for mod in models], dtype=bool)
+        self.any_arena = bool(self.has_arena.any())
+        lo = np.full((2, m), -np.inf)
+        hi = np.full((2, m), np.inf)
+        mid = np.zeros((2, m))
+        for i, mod in enumerate(models):
+            if mod.arena is not None:
+                x0, y0, x1, y1 = mod.arena
+                lo[:, i] = (x0, y0)
+                hi[:, i] = (x1, y1)
+                mid[:, i] = (0.5 * (x0 + x1), 0.5 * (y0 + y1))
         self.lo = lo
         self.hi = hi
+        self.mid = mid
+        self.limit = np.array(
+            [max(abs(mod.turn_rate[0]), abs(mod.turn_rate[1])) for mod in models], dtype=float
+        )
+        # per obstacle as Python floats, for the one-by-one steering
+        self.steer_consts = [
+            (float(mid[0, i]), float(mid[1, i]), float(self.limit[i]), float(self.spin[i]))
+            for i in range(m)
+        ]
+        self.half = np.zeros(m)  # 0.5 * turn * dt, refreshed with the batch's increments
 
-    def advance(
-        self, t: float, dt: float, positions: FloatArray
-    ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """New course; returns the step's velocity components and rotation rates."""
-        if t >= self.due_at:
-            due = (t >= self.threshold).nonzero()[0].tolist()
-            for i in due:
-                mod = self.models[i]
-                self.speed[i] = float(mod.rng.uniform(*mod.speed))
-                self.turn[i] = float(mod.rng.uniform(*mod.turn_rate))
-                nc = t + self.period[i]
-                self.next_change[i] = nc
-                self.threshold[i] = nc - 1e-12
-            self.due_at = float(self.threshold.min())
-        turn = self.turn
-        if self.arena:
-            ok = (self.lo <= positions) & (positions <= self.hi)
-            if not ok.flat[ok.argmin()]:
-                turn = turn.copy()
-                inside = ok[:, 0] & ok[:, 1]
-                for i in (~inside).nonzero()[0].tolist():
-                    mod = self.models[i]
-                    if mod.arena is None:
-                        continue
-                    x0, y0, x1, y1 = mod.arena
-                    p = positions[i]
-                    to_centre = np.arctan2(0.5 * (y0 + y1) - p[1], 0.5 * (x0 + x1) - p[0])
-                    err = wrap_scalar(float(to_centre) - float(self.course[i]))
-                    limit = max(abs(mod.turn_rate[0]), abs(mod.turn_rate[1]))
-                    turn[i] = float(np.clip(err / dt, -limit, limit))
-        course = wrap_array_inplace(self.course + turn * dt)
-        self.course = course
-        mid = course - 0.5 * turn * dt
-        return self.speed * np.cos(mid), self.speed * np.sin(mid), turn + self.spin
+    def draw(self, t: float) -> None:
+        """New speeds and turn rates for the obstacles whose change period is over at ``t``."""
+        for i in (t >= self.threshold).nonzero()[0].tolist():
+            mod = self.models[i]
+            self.speed[i] = uniform_draw(mod.rng, mod.speed)
+            self.turn[i] = uniform_draw(mod.rng, mod.turn_rate)
+            nc = t + self.period[i]
+            self.next_change[i] = nc
+            self.threshold[i] = nc - 1e-12
+        self.due_at = float(self.threshold.min())
 
-    def write_back(self) -> None:
-        for i, mod in enumerate(self.models):
-            mod.course = float(self.course[i])
-            mod._speed = float(self.speed[i])
-            mod._turn = float(self.turn[i])
-            mod._next_change = float(self.next_change[i])
+    def steer(
+        self, x: FloatArray, dt: float, inc: FloatArray, omega: FloatArray
+    ) -> tuple[FloatArray, FloatArray, FloatArray] | None:
+        """Arena steering (``RandomTurn.step``): this step's ``(inc, omega, half)`` with the
+        steered obstacles' turn rates, or None when every obstacle is inside its arena.
+
+        ``x`` is the batch's (4, k) state (x, y, heading, course); ``inc`` (2, k) the heading and
+        course increments and ``omega`` (k,) the rotation rates for the drawn turn rates, and
+        ``half`` is ``0.5 * turn * dt`` (group order).  A few obstacles outside are steered one by
+        one with the very calls of ``RandomTurn.step``; many, in array operations that are the
+        same element by element.
+        """
+        rows = self.rows
+        p = x[0:2, rows]
+        ok = (self.lo <= p) & (p <= self.hi)
+        if ok.flat[ok.argmin()]:
+            return None
+        m = len(self.models)
+        flat = (~ok).reshape(-1).nonzero()[0].tolist()
+        out = sorted({i % m for i in flat if self.has_arena[i % m]})
+        if not out:
+            return None
+        course = x[3, rows]
+        inc = inc.copy()
+        omega = omega.copy()
+        if len(out) <= _FEW:
+            half = self.half.copy()
+            consts = self.steer_consts
+            for i in out:
+                mid_x, mid_y, lim, spin = consts[i]
+                # the operations of RandomTurn.step, on the same values
+                to_c = np.arctan2(mid_y - p[1, i], mid_x - p[0, i])
+                e = wrap_scalar(float(to_c) - float(course[i]))
+                tr = min(max(e / dt, -lim), lim)  # np.clip(e / dt, -lim, lim)
+                om_i = tr + spin
+                j = i if isinstance(rows, slice) else int(rows[i])
+                omega[j] = om_i
+                inc[0, j] = om_i * dt
+                inc[1, j] = tr * dt
+                half[i] = 0.5 * tr * dt
+            return inc, omega, half
+        to_centre = np.arctan2(self.mid[1] - p[1], self.mid[0] - p[0])
+        err = wrap_array(to_centre - course)
+        steer = np.minimum(np.maximum(err / dt, -self.limit), self.limit)
+        outside = np.zeros(m, dtype=bool)
+        outside[out] = True
+        turn = np.where(outside, steer, self.turn)
+        om = turn + self.spin
+        omega[rows] = om
+        inc[0, rows] = om * dt
+        inc[1, rows] = turn * dt
+        return inc, omega, 0.5 * turn * dt
 
 
 class ObstacleBatch:
@@ -146,58 +178,75 @@ class ObstacleBatch:
         headings: (k,) body rotations [rad].
         velocities: (k, 2) [m/s] and angular_velocities (k,) [rad/s] used over the last step.
 
-    The arrays are replaced, never modified, by :meth:`step`.
+    The arrays are views of storage that :meth:`step` replaces, never modifies.
     """
 
     __slots__ = (
         "_const",
+        "_dt",
+        "_inc",
+        "_omega",
+        "_omega_base",
         "_other",
         "_random",
         "_states",
         "_stepped",
-        "angular_velocities",
-        "headings",
+        "_v",
+        "_x",
         "obstacles",
-        "positions",
-        "velocities",
     )
 
     def __init__(self, obstacles: Sequence[Obstacle]) -> None:
         self.obstacles = list(obstacles)
         k = len(self.obstacles)
-        self.positions = np.empty((k, 2))
-        self.velocities = np.empty((k, 2))
-        self.headings = np.empty(k)
-        self.angular_velocities = np.empty(k)
+        # rows: x, y, heading, course (random-turn obstacles only, else 0)
+        x = np.zeros((4, k))
+        v = np.zeros((2, k))
+        omega = np.zeros(k)
         cv: list[int] = []
         rt: list[int] = []
         other: list[int] = []
         for j, ob in enumerate(self.obstacles):
             st = ob.state
-            self.positions[j] = st.position
-            self.velocities[j] = st.velocity
-            self.headings[j] = st.heading
-            self.angular_velocities[j] = st.angular_velocity
+            x[0:2, j] = st.position
+            x[2, j] = st.heading
+            v[:, j] = st.velocity
+            omega[j] = st.angular_velocity
             kind = type(ob.motion)
-            (cv if kind is ConstantVelocity else rt if kind is RandomTurn else other).append(j)
+            if kind is RandomTurn:
+                mod: RandomTurn = ob.motion  # type: ignore[assignment]
+                if mod.course is None:  # as RandomTurn.step does on its first call
+                    vel = st.velocity
+                    course = float(np.arctan2(vel[1], vel[0])) if np.hypot(*vel) > 0 else st.heading
+                else:
+                    course = mod.course
+                x[3, j] = course
+                rt.append(j)
+            elif kind is ConstantVelocity:
+                cv.append(j)
+            else:
+                other.append(j)
+        self._x = x
+        self._v = v
+        self._omega = omega
         obs = self.obstacles
-        self._const = (
-            _ConstantGroup(_rows(cv, k), [obs[j].motion for j in cv])  # type: ignore[misc]
-            if cv
-            else None
-        )
+        self._const: tuple[_Rows, FloatArray, FloatArray] | None = None
+        if cv:
+            models: list[ConstantVelocity] = [obs[j].motion for j in cv]  # type: ignore[misc]
+            vel = np.array([np.asarray(m.velocity, dtype=float) for m in models]).reshape(-1, 2)
+            om = np.array([float(m.angular_velocity) for m in models])
+            self._const = (_rows(cv, k), vel.T.copy(), om)
         self._random = (
-            _RandomTurnGroup(
-                _rows(rt, k),
-                [obs[j].motion for j in rt],  # type: ignore[misc]
-                [obs[j].state for j in rt],
-            )
+            _RandomTurnGroup(_rows(rt, k), [obs[j].motion for j in rt])  # type: ignore[misc]
             if rt
             else None
         )
         self._other = other
         self._states = {j: obs[j].state for j in other}
         self._stepped = False
+        self._dt = math.nan
+        self._inc = np.zeros((2, k))
+        self._omega_base = np.zeros(k)
 
     @classmethod
     def from_obstacles(cls, obstacles: Sequence[Obstacle]) -> ObstacleBatch:
@@ -206,42 +255,92 @@ class ObstacleBatch:
     def __len__(self) -> int:
         return len(self.obstacles)
 
+    @property
+    def positions(self) -> FloatArray:
+        return self._x[0:2].T
+
+    @property
+    def headings(self) -> FloatArray:
+        return self._x[2]
+
+    @property
+    def velocities(self) -> FloatArray:
+        return self._v.T
+
+    @property
+    def angular_velocities(self) -> FloatArray:
+        return self._omega
+
+    def _refresh(self, dt: float) -> None:
+        """Per-step increments of heading and course, and rotation rates, for the current draws."""
+        k = len(self.obstacles)
+        omega = np.zeros(k)
+        inc = np.zeros((2, k))
+        if self._const is not None:
+            rows, _, om = self._const
+            omega[rows] = om
+        rnd = self._random
+        if rnd is not None:
+            omega[rnd.rows] = rnd.turn + rnd.spin
+            inc[1, rnd.rows] = rnd.turn * dt
+            rnd.half = 0.5 * rnd.turn * dt
+        inc[0] = omega * dt
+        self._dt = dt
+        self._inc = inc
+        self._omega_base = omega
+
     def step(self, t: float, dt: float) -> None:
         """Advance every obstacle from time ``t`` [s] by ``dt`` [s]."""
         k = len(self.obstacles)
         if k == 0:
             return
         self._stepped = True
-        vel = np.empty((k, 2)) if not self._other else np.zeros((k, 2))
-        omega = np.empty(k) if not self._other else np.zeros(k)
-        if self._const is not None:
-            vel[self._const.rows] = self._const.velocity
-            omega[self._const.rows] = self._const.omega
         rnd = self._random
+        refresh = dt != self._dt
+        if rnd is not None and t >= rnd.due_at:
+            rnd.draw(t)
+            refresh = True
+        if refresh:
+            self._refresh(dt)
+        x = self._x
+        inc = self._inc
+        omega = self._omega_base
+        half = rnd.half if rnd is not None else None
+        if rnd is not None and rnd.any_arena:
+            steered = rnd.steer(x, dt, inc, omega)
+            if steered is not None:
+                inc, omega, half = steered
+        xn = np.empty((4, k))
+        np.add(x[2:4], inc, out=xn[2:4])
+        wrap_array_inplace(xn[2:4])
+        v = np.empty((2, k)) if not self._other else np.zeros((2, k))
+        if self._const is not None:
+            rows, vel, _ = self._const
+            v[:, rows] = vel
         if rnd is not None:
             rows = rnd.rows
-            vx, vy, om = rnd.advance(t, dt, self.positions[rows])
             if isinstance(rows, slice):
-                vel[:, 0] = vx
-                vel[:, 1] = vy
-                omega[:] = om
+                mid = xn[3] - half
+                np.cos(mid, out=v[0])
+                np.sin(mid, out=v[1])
+                v *= rnd.speed
             else:
-                vel[rows, 0] = vx
-                vel[rows, 1] = vy
-                omega[rows] = om
-        pos = self.positions + vel * dt
-        heading = wrap_array_inplace(self.headings + omega * dt)
-        for j in self._other:
-            st = self.obstacles[j].motion.step(self._states[j], t, dt)
-            self._states[j] = st
-            pos[j] = st.position
-            heading[j] = st.heading
-            vel[j] = st.velocity
-            omega[j] = st.angular_velocity
-        self.positions = pos
-        self.headings = heading
-        self.velocities = vel
-        self.angular_velocities = omega
+                mid = xn[3, rows] - half
+                v[0, rows] = rnd.speed * np.cos(mid)
+                v[1, rows] = rnd.speed * np.sin(mid)
+        np.add(x[0:2], v * dt, out=xn[0:2])
+        if self._other:
+            omega = omega.copy()
+            for j in self._other:
+                st = self.obstacles[j].motion.step(self._states[j], t, dt)
+                self._states[j] = st
+                xn[0:2, j] = st.position
+                xn[2, j] = st.heading
+                v[:, j] = st.velocity
+                omega[j] = st.angular_velocity
+        self._x = xn
+        self._v = v
+        self._omega = omega
 
     def field(self, template: FieldTemplate | None = None) -> ObstacleField:
         """The :class:`ObstacleField` of the current state (shares this step's arrays)."""
@@ -257,10 +356,10 @@ class ObstacleBatch:
         if j in self._states:
             return self._states[j]
         return ObstacleState(
-            position=self.positions[j].copy(),
-            heading=float(self.headings[j]),
-            velocity=self.velocities[j].copy(),
-            angular_velocity=float(self.angular_velocities[j]),
+            position=self._x[0:2, j].copy(),
+            heading=float(self._x[2, j]),
+            velocity=self._v[:, j].copy(),
+            angular_velocity=float(self._omega[j]),
         )
 
     def write_back(self) -> None:
@@ -270,5 +369,11 @@ class ObstacleBatch:
             return
         for j, ob in enumerate(self.obstacles):
             ob.state = self.state(j)
-        if self._random is not None:
-            self._random.write_back()
+        rnd = self._random
+        if rnd is not None:
+            course = self._x[3, rnd.rows]
+            for i, mod in enumerate(rnd.models):
+                mod.course = float(course[i])
+                mod._speed = float(rnd.speed[i])
+                mod._turn = float(rnd.turn[i])
+                mod._next_change = float(rnd.next_change[i])

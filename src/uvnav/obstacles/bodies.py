@@ -88,15 +88,17 @@ def radial_profile(body: Body, n_directions: int = 360) -> tuple[FloatArray, Flo
 
 
 def rotation_boundary_growth(body: Body, rotation: float, n_directions: int = 360) -> float:
-    """The thesis's Delta-distance (Fig. 2.2, constraint (2.8)) for a rotation of ``rotation`` [rad].
+    """The thesis's Delta-distance (Fig. 2.2, constraint (2.8)) for a rotation of ``rotation``
+    [rad].
 
     Along a fixed ray from the mass centre, the boundary moves outward while the body turns; the
     thesis calls the largest outward excursion ``B_max - B_initial``.  This returns its maximum over
-    all ray directions and over rotations of up to ``|rotation|`` in either sense [m].  Zero for a disc.
+    all ray directions and over rotations of up to ``|rotation|`` in either sense [m].  Zero for a
+    disc.
     """
     if isinstance(body, DiscBody) or rotation == 0.0:
         return 0.0
-    angles, rho = radial_profile(body, n_directions)
+    _, rho = radial_profile(body, n_directions)
     step = 2.0 * np.pi / n_directions
     shifts = int(np.ceil(abs(rotation) / step))
     growth = 0.0

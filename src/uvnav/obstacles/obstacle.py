@@ -27,8 +27,10 @@ from uvnav.geometry.polygons import (
     edge_soup,
     rays_circles_hit,
     rays_rings_hit,
+    ring_perp,
     rings_nearest,
     transform_points,
+    transform_rings,
 )
 from uvnav.obstacles.bodies import Body, DiscBody, PolygonBody
 from uvnav.obstacles.motion import MotionModel, ObstacleState
@@ -37,6 +39,7 @@ from uvnav.obstacles.motion import MotionModel, ObstacleState
 _CULL_REL = 1e-9
 _CULL_ABS = 1e-9
 _X_AXIS = np.array([1.0, 0.0])
+_NO_RINGS = np.zeros((2, 0, 1))
 
 
 @dataclass
@@ -53,18 +56,22 @@ class Obstacle:
         return transform_points(self.body.outline(), self.state.position, self.state.heading)
 
 
-@dataclass(frozen=True, slots=True, eq=False)
 class NearestQuery:
     """Exact nearest-point answers from one point for the obstacles that can matter.
 
     Made by :meth:`ObstacleField.query`; ``ids`` is a superset of (a) every obstacle whose set
-    lies within ``radius`` of ``point`` and (b) every obstacle nearest to ``point`` (smallest
-    ``signed``).  Every obstacle not in ``ids`` is strictly farther than ``radius`` and than the
-    nearest one.  The entries are those :meth:`ObstacleField.nearest` gives for the same ids.
+    lies within ``radius`` of ``point`` and, if ``with_nearest``, (b) every obstacle nearest to
+    ``point`` (smallest ``signed``).  Every obstacle not in ``ids`` is strictly farther than
+    ``radius`` (and, if ``with_nearest``, than the nearest one); without ``with_nearest``, ``ids``
+    may be empty.  The entries are bit for bit those :meth:`ObstacleField.nearest` gives for the
+    same ids.  Read-only: the arrays may be shared with the field.
 
     Attributes:
         point: the query point ``(x, y)`` [m].
         radius: the radius [m] the query was made for.
+        with_nearest: whether the nearest obstacle is guaranteed to be included.
+        bounds: ``(low, high)`` [m], guaranteed bounds of the distance from ``point`` to the
+            nearest obstacle set, from the bounding discs (``(inf, inf)`` with no obstacle).
         ids: (m,) obstacle indices, increasing.
         distance: (m,) distance to the obstacle *set* [m] (0 inside).
         nearest: (m, 2) nearest boundary point [m].
@@ -72,31 +79,63 @@ class NearestQuery:
         signed: (m,) ``distance`` outside, minus the distance to the boundary inside [m].
     """
 
-    point: tuple[float, float]
-    radius: float
-    ids: np.ndarray
-    distance: FloatArray
-    nearest: FloatArray
-    inside: np.ndarray
-    signed: FloatArray
-    _field: ObstacleField
-    _ring_of: np.ndarray
-    _wx: FloatArray
-    _wy: FloatArray
+    __slots__ = (
+        "_field",
+        "_ring_of",
+        "_rings",
+        "bounds",
+        "distance",
+        "ids",
+        "inside",
+        "nearest",
+        "point",
+        "radius",
+        "signed",
+        "with_nearest",
+    )
+
+    def __init__(
+        self,
+        field: ObstacleField,
+        point: tuple[float, float],
+        radius: float,
+        with_nearest: bool,
+        ids: np.ndarray,
+        distance: FloatArray,
+        nearest: FloatArray,
+        inside: np.ndarray,
+        signed: FloatArray,
+        rings: FloatArray,
+        ring_of: np.ndarray | None,
+        bounds: tuple[float, float],
+    ) -> None:
+        self._field = field
+        self.point = point
+        self.radius = radius
+        self.with_nearest = with_nearest
+        self.ids = ids
+        self.distance = distance
+        self.nearest = nearest
+        self.inside = inside
+        self.signed = signed
+        self._rings = rings
+        self._ring_of = ring_of
+        self.bounds = bounds
+
+    def __len__(self) -> int:
+        return len(self.ids)
 
     def outline(self, i: int) -> FloatArray | None:
         """World vertices (n, 2) [m] of obstacle ``ids[i]`` (``None`` for a disc).
 
-        Equal to ``field.polygons[ids[i]]``, taken from the rings this query already transformed.
+        Equal to ``field.polygons[ids[i]]``, taken from the rings this query transformed.
         """
-        r = int(self._ring_of[i])
+        r = i if self._ring_of is None else int(self._ring_of[i])
         if r < 0:
             return None
-        n = int(self._field.template.counts[self._field.template.poly_row[self.ids[i]]])
-        out = np.empty((n, 2))
-        out[:, 0] = self._wx[r, :n]
-        out[:, 1] = self._wy[r, :n]
-        return out
+        tpl = self._field.template
+        n = int(tpl.counts[tpl.poly_row[self.ids[i]]])
+        return self._rings[:, r, :n].T.copy()
 
 
 class ObstacleField:
@@ -141,7 +180,7 @@ class ObstacleField:
         self.velocities = velocities
         self.angular_velocities = angular_velocities
         self._polygons: tuple[FloatArray | None, ...] | None = None
-        self._world: tuple[FloatArray, FloatArray] | None = None
+        self._world: FloatArray | None = None
         self._last: NearestQuery | None = None
 
     @classmethod
@@ -191,25 +230,25 @@ class ObstacleField:
 
     # ---------------------------------------------------------------- world-frame outlines
 
-    def _transform(self, ids: np.ndarray | None) -> tuple[FloatArray, FloatArray]:
-        """World rings (rows of ``template.ring_x``) of polygon obstacles ``ids`` (all if None)."""
+    def _transform(self, ids: np.ndarray) -> FloatArray:
+        """(2, m, w) world rings of the polygon obstacles ``ids``."""
         tpl = self.template
-        if ids is None:
-            ids = tpl.poly_ids
-            lx, ly = tpl.ring_x, tpl.ring_y
-        else:
-            rows = tpl.poly_row.take(ids)
-            lx, ly = tpl.ring_x.take(rows, axis=0), tpl.ring_y.take(rows, axis=0)
-        h = self.headings.take(ids)
-        c = np.cos(h)[:, None]
-        s = np.sin(h)[:, None]
-        cx = self.centres[:, 0].take(ids)[:, None]
-        cy = self.centres[:, 1].take(ids)[:, None]
-        return c * lx - s * ly + cx, s * lx + c * ly + cy
+        rows = ids if tpl.n_discs == 0 else tpl.poly_row.take(ids)
+        r4 = tpl.rings4.take(rows, axis=1)
+        return transform_rings(
+            r4[:2], self.centres.take(ids, axis=0), self.headings.take(ids), perp=r4[2:]
+        )
 
-    def _world_rings(self) -> tuple[FloatArray, FloatArray]:
+    def _world_rings(self) -> FloatArray:
+        """(2, p, w) world rings of all polygons (rows of ``template.poly_ids``), cached."""
         if self._world is None:
-            self._world = self._transform(None)
+            tpl = self.template
+            if tpl.n_discs == 0:
+                c, h = self.centres, self.headings
+            else:
+                c = self.centres.take(tpl.poly_ids, axis=0)
+                h = self.headings.take(tpl.poly_ids)
+            self._world = transform_rings(tpl.rings4[:2], c, h, perp=tpl.rings4[2:])
         return self._world
 
     @property
@@ -218,114 +257,139 @@ class ObstacleField:
             tpl = self.template
             out: list[FloatArray | None] = [None] * len(self)
             if len(tpl.poly_ids):
-                wx, wy = self._world_rings()
-                for r, j in enumerate(tpl.poly_ids.tolist()):
-                    n = int(tpl.counts[r])
-                    v = np.empty((n, 2))
-                    v[:, 0] = wx[r, :n]
-                    v[:, 1] = wy[r, :n]
-                    out[j] = v
+                w = self._world_rings()
+                pairs = zip(tpl.poly_ids.tolist(), tpl.counts.tolist(), strict=True)
+                for r, (j, n) in enumerate(pairs):
+                    out[j] = w[:, r, :n].T.copy()
             self._polygons = tuple(out)
         return self._polygons
 
     # ---------------------------------------------------------------- queries
 
-    def query(self, point: FloatArray | tuple[float, float], radius: float = 0.0) -> NearestQuery:
-        """Exact nearest boundary points of the obstacles within ``radius`` [m] of ``point``.
+    def query(
+        self,
+        point: FloatArray | tuple[float, float],
+        radius: float = 0.0,
+        *,
+        nearest: bool = True,
+    ) -> NearestQuery:
+        """Exact nearest boundary points of the obstacles within ``radius`` [m] of ``point`` and,
+        with ``nearest``, of the nearest obstacle wherever it is.
 
-        Obstacles whose bounding disc is farther than both ``radius`` and the nearest obstacle's
-        upper bound are culled; see :class:`NearestQuery` for the guarantee.  The last answer is
-        kept, so asking again from the same point with the same or a smaller radius (the
-        simulator's collision check, then the sensors) costs nothing.
+        Obstacles whose bounding disc is farther than ``radius`` (and, with ``nearest``, than an
+        upper bound of the nearest obstacle's distance) are culled before the exact kernels run;
+        see :class:`NearestQuery` for the guarantee.  The last answer is kept, so asking again
+        from the same point for no more (the simulator's collision check, then the sensors)
+        costs nothing.
         """
         px = float(point[0])
         py = float(point[1])
         last = self._last
-        if last is not None and last.point == (px, py) and last.radius >= radius:
+        if (
+            last is not None
+            and last.point == (px, py)
+            and last.radius >= radius
+            and (last.with_nearest or not nearest)
+        ):
             return last
-        q = self._query(px, py, float(radius))
+        q = self._query(px, py, float(radius), nearest)
         self._last = q
         return q
 
-    def _query(self, px: float, py: float, radius: float) -> NearestQuery:
+    def _query(self, px: float, py: float, radius: float, with_nearest: bool) -> NearestQuery:
         tpl = self.template
         k = len(self.centres)
-        if k == 0:
+        cen = self.centres
+        ids: np.ndarray | None = None
+        maybe_inside = False
+        bounds = (math.inf, math.inf)
+        if k:
+            dc = np.hypot(cen[:, 0] - px, cen[:, 1] - py)
+            lower = dc - tpl.bounding_radii
+            j0 = int(lower.argmin())
+            slack = _CULL_ABS * (1.0 + abs(px) + abs(py))
+            # containment is possible only inside an obstacle's bounding disc
+            maybe_inside = bool(lower[j0] <= 2.0 * slack)
+            dc0 = float(dc[j0])
+            r0 = float(tpl.bounding_radii[j0])
+            # nearest distance: at least the smallest lower bound, at most j0's upper bound
+            bounds = (
+                float(lower[j0]) - _CULL_REL * dc0 - 2.0 * slack,
+                (dc0 + r0) * (1.0 + _CULL_REL) + 2.0 * slack,
+            )
+            limit = radius * (1.0 + _CULL_REL) + slack
+            if with_nearest:
+                limit = max(limit, bounds[1])
+            if not math.isinf(limit):
+                ids = (lower <= limit).nonzero()[0]
+                if len(ids) == k:
+                    ids = None
+        if ids is None:
+            ids = tpl.all_ids
+        m = len(ids)
+        if m == 0:
             e = np.zeros(0)
             return NearestQuery(
-                (px, py), radius, np.zeros(0, np.intp), e, np.zeros((0, 2)),
-                np.zeros(0, bool), e, self, np.zeros(0, np.intp), np.zeros((0, 1)),
-                np.zeros((0, 1)),
+                self, (px, py), radius, with_nearest, ids, e, np.zeros((0, 2)),
+                np.zeros(0, bool), e, _NO_RINGS, None, bounds,
             )  # fmt: skip
-        cx = self.centres[:, 0]
-        cy = self.centres[:, 1]
-        dc = np.hypot(cx - px, cy - py)
-        slack = _CULL_ABS * (1.0 + abs(px) + abs(py))
-        lower = dc - tpl.bounding_radii
-        upper = dc + tpl.bounding_radii
-        best = float(upper[upper.argmin()]) * (1.0 + _CULL_REL) + slack
-        limit = max(best, radius * (1.0 + _CULL_REL) + slack)
-        if math.isinf(limit):
-            ids = tpl.all_ids
-        else:
-            ids = (lower <= limit).nonzero()[0]
-        # containment is possible only inside an obstacle's bounding disc
-        maybe_inside = lower.take(ids) <= 2.0 * slack
-        any_inside = bool(maybe_inside[maybe_inside.argmax()]) if len(ids) else False
-        m = len(ids)
         if tpl.n_discs == 0:
-            # polygons only (the common case): one ring per id, in order
-            wx, wy = self._transform(ids) if m < k or self._world is None else self._world
-            if m == k and self._world is None:
-                self._world = (wx, wy)
-            dist, nx, ny, ins = rings_nearest((px, py), wx, wy, parity=any_inside)
+            # polygons only (the common case): ring r is obstacle ids[r]
+            rings = self._world_rings() if m == k else self._transform(ids)
+            dist, near2, ins = rings_nearest((px, py), rings, parity=maybe_inside)
             if ins is None:
                 inside = np.zeros(m, dtype=bool)
             else:
                 inside = ins
-                dist = np.where(inside, 0.0, dist)
-            near = np.empty((m, 2))
-            near[:, 0] = nx
-            near[:, 1] = ny
-            ring_of = tpl.all_ids[:m]
+                dist = np.where(ins, 0.0, dist)
+            near = near2.T
+            ring_of = None
         else:
             dist = np.empty(m)
             near = np.empty((m, 2))
             inside = np.zeros(m, dtype=bool)
             ring_of = np.full(m, -1, dtype=np.intp)
-            is_disc = tpl.radii.take(ids) > 0
+            is_disc = tpl.poly_row.take(ids) < 0
             d_at = is_disc.nonzero()[0]
             p_at = (~is_disc).nonzero()[0]
-            wx = wy = np.zeros((0, 1))
+            rings = _NO_RINGS
             if len(d_at):
                 dids = ids.take(d_at)
                 rad = tpl.radii.take(dids)
-                cen = self.centres.take(dids, axis=0)
-                off = np.array([px, py]) - cen
+                c = cen.take(dids, axis=0)
+                off = np.array([px, py]) - c
                 r = np.hypot(off[:, 0], off[:, 1])
                 safe = np.where(r > 0, r, 1.0)
                 unit = np.where((r > 0)[:, None], off / safe[:, None], _X_AXIS)
-                near[d_at] = cen + unit * rad[:, None]
+                near[d_at] = c + unit * rad[:, None]
                 dist[d_at] = np.maximum(r - rad, 0.0)
                 inside[d_at] = r < rad
             if len(p_at):
-                pids = ids.take(p_at)
-                wx, wy = self._transform(pids)
-                parity = bool(maybe_inside.take(p_at).any())
-                d, nx, ny, ins = rings_nearest((px, py), wx, wy, parity=parity)
+                rings = self._transform(ids.take(p_at))
+                d, near2, ins = rings_nearest((px, py), rings, parity=maybe_inside)
                 if ins is not None:
                     inside[p_at] = ins
                     d = np.where(ins, 0.0, d)
                 dist[p_at] = d
-                near[p_at, 0] = nx
-                near[p_at, 1] = ny
+                near[p_at] = near2.T
                 ring_of[p_at] = np.arange(len(p_at))
         signed = dist
-        if any_inside and bool(inside.any()):
+        if maybe_inside and inside[inside.argmax()]:
             depth = np.hypot(near[:, 0] - px, near[:, 1] - py)
             signed = np.where(inside, -depth, dist)
         return NearestQuery(
-            (px, py), radius, ids, dist, near, inside, signed, self, ring_of, wx, wy
+            self,
+            (px, py),
+            radius,
+            with_nearest,
+            ids,
+            dist,
+            near,
+            inside,
+            signed,
+            rings,
+            ring_of,
+            bounds,
         )
 
     def nearest(self, point: FloatArray) -> tuple[FloatArray, FloatArray, np.ndarray]:
@@ -355,14 +419,13 @@ class ObstacleField:
         out = np.full((len(dirs), len(self)), np.inf)
         if len(self) == 0:
             return out
-        if math.isinf(max_range):
-            ids = tpl.all_ids
-        else:
+        ids = tpl.all_ids
+        if not math.isinf(max_range):
             dc = np.hypot(self.centres[:, 0] - ox, self.centres[:, 1] - oy)
             slack = _CULL_ABS * (1.0 + abs(ox) + abs(oy))
             limit = max_range * (1.0 + _CULL_REL) + slack
             ids = (dc - tpl.bounding_radii <= limit).nonzero()[0]
-        is_disc = tpl.radii.take(ids) > 0
+        is_disc = tpl.poly_row.take(ids) < 0
         dids = ids[is_disc]
         pids = ids[~is_disc]
         if len(dids):
@@ -370,8 +433,7 @@ class ObstacleField:
                 np.array([ox, oy]), dirs, self.centres.take(dids, axis=0), tpl.radii.take(dids)
             )
         if len(pids):
-            wx, wy = self._transform(pids)
-            out[:, pids] = rays_rings_hit((ox, oy), dirs, wx, wy)
+            out[:, pids] = rays_rings_hit((ox, oy), dirs, self._transform(pids))
         return out
 
 
@@ -387,10 +449,12 @@ class FieldTemplate:
         owner: (E,) obstacle index of each vertex.
         next_vertex: (E,) index of the following vertex of the same polygon (closes each ring).
         offsets: (p + 1,) start of each polygon's vertices in ``local``.
-        ring_x, ring_y: (p, n_max + 1) the polygons as padded closed rings in their body frames
+        rings: (2, p, n_max + 1) the polygons as padded closed rings in their body frames
             (:func:`uvnav.geometry.polygons.closed_rings`), row ``i`` for ``poly_ids[i]``.
+        rings4: (4, p, n_max + 1) ``rings`` and ``ring_perp(rings)`` stacked (one gather for
+            :func:`uvnav.geometry.polygons.transform_rings`).
         counts: (p,) vertices per polygon.
-        poly_row: (k,) row of each obstacle in ``ring_x`` (-1 for discs).
+        poly_row: (k,) row of each obstacle in ``rings`` (-1 for discs).
         all_ids: ``arange(k)``.
         n_discs: number of disc obstacles.
     """
@@ -402,8 +466,8 @@ class FieldTemplate:
     owner: np.ndarray
     next_vertex: np.ndarray
     offsets: np.ndarray
-    ring_x: FloatArray
-    ring_y: FloatArray
+    rings: FloatArray
+    rings4: FloatArray
     counts: np.ndarray
     poly_row: np.ndarray
     all_ids: np.ndarray
@@ -424,7 +488,7 @@ class FieldTemplate:
         nxt = np.arange(len(local)) + 1
         if verts:
             nxt[offsets[1:] - 1] = offsets[:-1]
-        ring_x, ring_y, counts = closed_rings(verts)
+        rings, counts = closed_rings(verts)
         poly_row = np.full(len(bodies), -1, dtype=np.intp)
         poly_row[poly_ids] = np.arange(len(poly_ids))
         return cls(
@@ -435,12 +499,12 @@ class FieldTemplate:
             owner=owner,
             next_vertex=nxt,
             offsets=offsets,
-            ring_x=ring_x,
-            ring_y=ring_y,
+            rings=rings,
+            rings4=np.concatenate((rings, ring_perp(rings))),
             counts=counts,
             poly_row=poly_row,
             all_ids=np.arange(len(bodies), dtype=np.intp),
-            n_discs=int(np.count_nonzero(radii > 0)),
+            n_discs=len(bodies) - len(polys),
         )
 
     def field(

@@ -28,14 +28,16 @@ def sense_obstacles(
 
     The distances come from :meth:`ObstacleField.query`, which culls far obstacles exactly and
     remembers its last answer: the simulator makes that query for its collision check at every
-    integration step (with ``sensing_range`` before a decision), so sensing reuses it.  Ties in
-    distance keep obstacle order.
+    integration step (covering ``sensing_range`` before a decision), so sensing reuses it.  Ties
+    in distance keep obstacle order.
     """
     if len(field) == 0:
         return ()
-    q = field.query(position, sensing_range)
+    q = field.query(position, sensing_range, nearest=False)
     dist = q.distance
     ids = q.ids
+    if len(dist) == 0:
+        return ()
     order = np.argsort(dist, kind="stable").tolist() if len(dist) > 1 else [0]
     out = []
     for i in order:

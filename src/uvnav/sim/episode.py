@@ -14,7 +14,11 @@ Speed (``benchmarks/``): the obstacles are advanced together by
 :class:`uvnav.obstacles.ObstacleBatch` (bit for bit their models' own ``step``), each step's
 :class:`~uvnav.obstacles.ObstacleField` is a few array references, and one nearest-point query per
 step, culled by bounding discs, serves both the collision check and, before a decision, the
-sensors (:func:`uvnav.sensors.sense_obstacles` finds it cached on the field).
+sensors (:func:`uvnav.sensors.sense_obstacles` finds it cached on the field).  Unrecorded, the
+exact clearance of a step that can neither collide nor hold the episode's minimum is never
+computed (:class:`_MinClearance`); recorded, every step's is.  Either way the metrics, the
+observations and the trajectory are bit for bit those of the straightforward loop (every obstacle
+stepped by its own model, exact nearest points of every obstacle at every step).
 """
 
 from __future__ import annotations
@@ -105,6 +109,75 @@ class EpisodeResult:
     decision_us: FloatArray
 
 
+class _MinClearance:
+    """Exact minimum clearance over an unrecorded episode, without the exact kernel every step.
+
+    A step's clearance (gap between the robot's disc and the nearest obstacle set [m]) matters to
+    an unrecorded run only through the episode minimum and the collision test (gap < 0).  Each
+    step the field's query bounds it by bounding discs (``NearestQuery.bounds``, the same pass
+    that culls for the sensors), and:
+
+    * a step that may overlap (lower bound <= 0) gets its exact clearance now;
+    * a step whose sensor query already contains the nearest obstacle gives it exactly for free;
+    * any other step is kept (its field and robot position: a few references) only while its
+      lower bound is below the best upper bound of the minimum seen so far, and the kept steps
+      are evaluated exactly in batches and at the end, in increasing lower-bound order.
+
+    The result is the minimum of the exact clearances of all steps, bit for bit what evaluating
+    every step gives: a step that is dropped has a lower bound above the exact clearance of some
+    other step.
+    """
+
+    __slots__ = ("_best", "_kept", "_radius")
+
+    #: evaluate the kept steps once there are this many (bounds memory and work)
+    BATCH = 64
+
+    def __init__(self, robot_radius: float, initial: float) -> None:
+        self._radius = robot_radius
+        self._best = initial  # exact minimum so far
+        self._kept: list[tuple[float, ObstacleField, float, float]] = []
+
+    def _exact(self, fld: ObstacleField, px: float, py: float, radius: float = 0.0) -> float:
+        q = fld.query((px, py), radius, nearest=True)
+        return float((q.signed - self._radius).min())
+
+    def step(self, fld: ObstacleField, px: float, py: float, radius: float) -> float:
+        """Account for the robot at ``(px, py)`` in ``fld``; the query also covers ``radius`` [m]
+        for the sensors.  Returns the step's exact clearance, or a lower bound of it that is
+        >= 0 (no collision) when it was deferred or not needed."""
+        q = fld.query((px, py), radius, nearest=False)
+        low = q.bounds[0] - self._radius
+        if low <= 0.0:  # possible overlap: the collision test needs the exact value now
+            gap = self._exact(fld, px, py, radius)
+        elif len(q.ids) and float(q.distance.min()) <= radius:
+            # the nearest obstacle is within the sensors' radius, hence in the query
+            gap = float((q.signed - self._radius).min())
+        else:
+            if low < self._best:
+                self._kept.append((low, fld, px, py))
+                if len(self._kept) >= self.BATCH:
+                    self._flush()
+            return max(low, 0.0)
+        if gap < self._best:
+            self._best = gap
+        return gap
+
+    def _flush(self) -> None:
+        for low, fld, px, py in sorted(self._kept, key=lambda e: e[0]):
+            if low >= self._best:
+                break
+            gap = self._exact(fld, px, py)
+            if gap < self._best:
+                self._best = gap
+        self._kept.clear()
+
+    def finish(self) -> float:
+        """The exact minimum clearance of the episode [m]."""
+        self._flush()
+        return self._best
+
+
 def decision_ratio(control_period: float, dt: float) -> int:
     """Integration steps per decision: ``control_period / dt`` as a whole number >= 1.
 
@@ -167,18 +240,25 @@ def run_episode(
     recorder = TrajectoryRecorder([o.body.outline() for o in obstacles]) if record else None
     has_obstacles = len(obstacles) > 0
 
-    def clearance_of(fld: ObstacleField, px: float, py: float, radius: float) -> tuple[float, int]:
+    def clearance_of(
+        fld: ObstacleField, px: float, py: float, radius: float, with_nearest: bool
+    ) -> tuple[float, int]:
         """Gap [m] between the robot's disc and the nearest obstacle (negative on overlap), and
-        that obstacle; the query also covers ``radius`` for the sensors."""
+        that obstacle; the query also covers ``radius`` [m] for the sensors.  Without
+        ``with_nearest`` only obstacles within ``radius`` are examined: ``(inf, -1)`` if none."""
         if not has_obstacles:
             return math.inf, -1
-        q = fld.query((px, py), radius)
+        q = fld.query((px, py), radius, nearest=with_nearest)
+        if len(q.ids) == 0:
+            return math.inf, -1
         gaps = q.signed - robot_radius
         j = int(gaps.argmin())
         return float(gaps[j]), int(q.ids[j])
 
-    clearance, nearest = clearance_of(field_now, x, y, sensing_range)
+    clearance, nearest = clearance_of(field_now, x, y, sensing_range, True)
     min_clear = clearance
+    # unrecorded, only the minimum clearance and collisions are visible: defer what can wait
+    tracker = _MinClearance(robot_radius, clearance) if has_obstacles and not record else None
     start_dist = math.hypot(gx - x, gy - y)
     path = 0.0
     effort = 0.0
@@ -258,8 +338,11 @@ def run_episode(
             t = (i + 1) * dt
             field_now = batch.field(template)
             radius = sensing_range if (i + 1) % ratio == 0 else 0.0
-            clearance, nearest = clearance_of(field_now, x, y, radius)
-            min_clear = min(min_clear, clearance)
+            if recorder is not None or tracker is None:
+                clearance, nearest = clearance_of(field_now, x, y, radius, True)
+                min_clear = min(min_clear, clearance)
+            else:
+                clearance = tracker.step(field_now, x, y, radius)
             if clearance < 0:
                 status = "collision"
                 break
@@ -269,6 +352,8 @@ def run_episode(
                 break
     finally:
         batch.write_back()
+    if tracker is not None:
+        min_clear = tracker.finish()
 
     if recorder is not None:
         recorder.add(
