@@ -16,6 +16,7 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
+from importlib import import_module
 from importlib.metadata import entry_points
 from typing import Any, ClassVar, Protocol, runtime_checkable
 
@@ -57,6 +58,8 @@ class ControllerInfo:
 
 
 _REGISTRY: dict[str, ControllerInfo] = {}
+#: Modules of ``uvnav.controllers`` that register built-in laws when imported.
+BUILTIN_MODULES: tuple[str, ...] = ("zhang2019", "savkin_wang2013", "straight")
 _ENTRY_POINTS_LOADED = False
 
 
@@ -94,7 +97,8 @@ def _load_entry_points() -> None:
 def available_controllers() -> dict[str, ControllerInfo]:
     """All registered controllers by name (built-ins and entry points)."""
     # import the built-in modules for their registration side effect
-    from uvnav.controllers import savkin_wang2013, straight, zhang2019  # noqa: F401
+    for module in BUILTIN_MODULES:
+        import_module(f"uvnav.controllers.{module}")
 
     _load_entry_points()
     return dict(sorted(_REGISTRY.items()))

@@ -17,7 +17,7 @@ from uvnav.scenarios.build import (
     validate_for_controller,
 )
 from uvnav.scenarios.errors import ScenarioError
-from uvnav.scenarios.generators import random_ch2_scenario
+from uvnav.scenarios.generators import GENERATORS, generate, random_ch2_scenario
 from uvnav.scenarios.loader import (
     builtin_text,
     list_builtin,
@@ -44,6 +44,7 @@ from uvnav.scenarios.schema import (
 )
 
 __all__ = [
+    "GENERATORS",
     "BodySpec",
     "ConstantMotion",
     "ControllerSpec",
@@ -60,6 +61,7 @@ __all__ = [
     "build_episode",
     "builtin_text",
     "check_constraints",
+    "generate",
     "list_builtin",
     "load_scenario",
     "obstacle_bounds",

@@ -13,6 +13,7 @@ same scene.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -211,3 +212,17 @@ def random_ch2_scenario(
         "controller": {"name": controller, "params": dict(controller_params or {})},
     }
     return scenario_from_dict(data, source=f"random-ch2:{seed}")
+
+
+#: Seeded scenario generators by name: ``GENERATORS[name](seed, **params) -> Scenario``.
+#: ``load_scenario("<name>:<seed>")`` and campaign files refer to them by these names.
+GENERATORS: dict[str, Callable[..., Scenario]] = {"random-ch2": random_ch2_scenario}
+
+
+def generate(name: str, seed: int, **params: Any) -> Scenario:
+    """Scenario number ``seed`` of the generator ``name`` (a key of :data:`GENERATORS`)."""
+    if name not in GENERATORS:
+        raise KeyError(
+            f"unknown scenario generator {name!r}; known: {', '.join(sorted(GENERATORS))}"
+        )
+    return GENERATORS[name](seed, **params)

@@ -27,7 +27,12 @@ from uvnav.scenarios.schema import MOTION_TYPES, Scenario
 
 BUILTIN_PACKAGE = "uvnav.scenarios"
 BUILTIN_DIR = "builtin"
-GENERATOR_PREFIX = "random-ch2:"
+
+
+def _generator_names() -> list[str]:
+    from uvnav.scenarios.generators import GENERATORS
+
+    return list(GENERATORS)
 
 
 class _UniqueKeyLoader(yaml.SafeLoader):
@@ -205,7 +210,8 @@ def scenario_text(name_or_path: str | Path) -> tuple[str, str]:
                 name_or_path,
                 "",
                 "no such file or built-in scenario "
-                f"(built-ins: {', '.join(list_builtin())}; generator: {GENERATOR_PREFIX}<seed>)",
+                f"(built-ins: {', '.join(list_builtin())}; generators: <name>:<seed> with name in "
+                f"{', '.join(sorted(_generator_names()))})",
             )
     path = Path(name_or_path)
     source = str(name_or_path)
@@ -220,20 +226,21 @@ def scenario_text(name_or_path: str | Path) -> tuple[str, str]:
 
 
 def load_scenario(name_or_path: str | Path) -> Scenario:
-    """Load a scenario by built-in name, ``random-ch2:<seed>``, or YAML path.
+    """Load a scenario by built-in name, ``<generator>:<seed>`` (``random-ch2:7``), or YAML path.
 
     Raises:
         ScenarioError: the file is missing, malformed, or describes an invalid scene.
     """
-    if isinstance(name_or_path, str) and name_or_path.startswith(GENERATOR_PREFIX):
-        seed_text = name_or_path[len(GENERATOR_PREFIX) :]
-        if not seed_text.isdigit():
-            raise ScenarioError(
-                name_or_path, "", f"expected {GENERATOR_PREFIX}<non-negative integer seed>"
-            )
-        from uvnav.scenarios.generators import random_ch2_scenario
+    if isinstance(name_or_path, str) and ":" in name_or_path and not Path(name_or_path).exists():
+        from uvnav.scenarios.generators import GENERATORS
 
-        return random_ch2_scenario(int(seed_text))
+        name, _, seed_text = name_or_path.partition(":")
+        if name in GENERATORS:
+            if not seed_text.isdigit():
+                raise ScenarioError(
+                    name_or_path, "", f"expected {name}:<non-negative integer seed>"
+                )
+            return GENERATORS[name](int(seed_text))
     source, text = scenario_text(name_or_path)
     return scenario_from_dict(parse_yaml(text, source), source)
 
