@@ -3,12 +3,14 @@ PYTHON ?= python3.11
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 # Extras installed by `make run` / `make test`; later chapters add theirs here (see docs/design-notes.md).
-RUN_EXTRAS  ?= prediction
-TEST_EXTRAS ?= prediction,test
+RUN_EXTRAS  ?= prediction,report
+TEST_EXTRAS ?= prediction,report,test
 STAMP_RUN  := $(VENV)/.installed-run
 STAMP_TEST := $(VENV)/.installed-test
+# Debian's Chromium for the report's browser test (playwright drives it; no browser download)
+CHROMIUM   ?= chromium
 
-.PHONY: run test bench lint clean venv
+.PHONY: run test bench lint clean venv browser
 
 $(PY):
 	$(PYTHON) -m venv $(VENV) || python3 -m venv $(VENV)
@@ -24,10 +26,15 @@ $(STAMP_TEST): pyproject.toml | $(PY)
 
 venv: $(STAMP_TEST)
 
+browser:
+	@command -v $(CHROMIUM) >/dev/null 2>&1 || { \
+	  if [ "$$(id -u)" = 0 ]; then apt-get update -qq && apt-get install -y -qq $(CHROMIUM) >/dev/null; \
+	  else echo "note: install Debian's '$(CHROMIUM)' package for the browser test"; fi; }
+
 run: $(STAMP_RUN)
 	$(VENV)/bin/uvnav run
 
-test: $(STAMP_TEST)
+test: $(STAMP_TEST) browser
 	$(PY) -m pytest -n 2 -q
 
 lint: $(STAMP_TEST)

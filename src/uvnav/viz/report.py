@@ -130,6 +130,7 @@ def write_report(
     table: Sequence[Mapping[str, Any]] | None = None,
     title: str = "uvnav results",
     summary_figure: bool = True,
+    animations: int = 12,
 ) -> Path:
     """Render the HTML report of a results database.
 
@@ -143,6 +144,8 @@ def write_report(
         title: page title.
         summary_figure: add a campaign summary figure (outcomes, clearance and detour distributions)
             of all episodes, written as ``out_dir/campaign-summary.png``.
+        animations: at most this many animated trajectory views (plotly, one per recorded
+            episode; ``plotly.min.js`` is written next to ``index.html``); 0 for none.
 
     Returns:
         The path of ``index.html``.
@@ -207,6 +210,16 @@ def write_report(
         for r in errors_df.head(_MAX_ERRORS).itertuples()
     ]
 
+    anim_sections: list[dict[str, str]] = []
+    if animations > 0:
+        from uvnav.viz.interactive import PLOTLY_JS, animation_sections, write_plotly_js
+
+        anim_sections = animation_sections(db_path, limit=animations)
+        if anim_sections:
+            write_plotly_js(out_dir)
+    else:
+        PLOTLY_JS = ""
+
     template_text = files("uvnav.viz").joinpath("templates/report.html").read_text(encoding="utf-8")
     env = jinja2.Environment(
         autoescape=True, undefined=jinja2.StrictUndefined, trim_blocks=True, lstrip_blocks=True
@@ -226,6 +239,8 @@ def write_report(
         text_columns=_TEXT_COLUMNS,
         figures=figure_rows,
         errors=errors,
+        animations=anim_sections,
+        plotly_js=PLOTLY_JS,
         errors_truncated=max(0, len(errors_df) - _MAX_ERRORS),
     )
     index = out_dir / "index.html"

@@ -1,0 +1,92 @@
+"""The HTML report in a real browser: headless Chromium (Debian's package) driven by playwright.
+
+Checks that the page renders with no console error, that its tables hold the numbers in the
+database, and that an animated trajectory view advances when played.  ``make test`` installs the
+browser; outside CI the test is skipped when no Chromium is on the PATH, in CI it fails.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import sqlite3
+from pathlib import Path
+
+import pytest
+
+from uvnav.bench.campaign import Job, run_campaign
+from uvnav.bench.store import ResultsStore
+from uvnav.viz.report import write_report
+
+playwright_api = pytest.importorskip("playwright.sync_api")
+
+SCENE = "thesis-ch2-fig2-10-comparison"
+
+
+def chromium_path() -> str:
+    path = shutil.which("chromium") or shutil.which("chromium-browser")
+    if path is None:
+        if os.environ.get("CI"):
+            pytest.fail("Debian's chromium is not installed (make test installs it)")
+        pytest.skip("no chromium on PATH (make test installs Debian's chromium)")
+    return path
+
+
+@pytest.fixture(scope="module")
+def report(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    out = tmp_path_factory.mktemp("browser")
+    db = out / "uvnav.sqlite"
+    jobs = [
+        Job(controller=c, seed=0, scenario=SCENE, record=True)
+        for c in ("straight-v1", "savkin-wang2013-v1")
+    ]
+    with ResultsStore(db) as store:
+        run_campaign(store, "browser-test", jobs, workers=1)
+    index = write_report(db, out / "report", summary_figure=False)
+    return db, index
+
+
+def test_report_renders_tables_and_animates(report: tuple[Path, Path]) -> None:
+    db, index = report
+    with sqlite3.connect(db) as conn:
+        rows = conn.execute("SELECT controller, status, path_length FROM episodes").fetchall()
+    assert {r[0] for r in rows} == {"straight-v1", "savkin-wang2013-v1"}
+    with playwright_api.sync_playwright() as p:
+        browser = p.chromium.launch(
+            executable_path=chromium_path(),
+            args=[
+                "--no-sandbox",
+                "--disable-gpu",
+                "--disable-background-networking",
+                "--disable-component-update",
+                "--disable-sync",
+            ],
+        )
+        try:
+            page = browser.new_page(viewport={"width": 1200, "height": 900})
+            errors: list[str] = []
+            page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
+            page.on("pageerror", lambda e: errors.append(str(e)))
+            page.goto(index.as_uri())
+            page.wait_for_selector(".js-plotly-plot")
+            text = page.inner_text("body")
+            # the summary table holds the database's numbers
+            for controller, status, path_length in rows:
+                assert controller in text
+                if status == "success":
+                    assert f"{path_length:.2f}" in text
+            assert "collision" in text  # straight-v1 drives into the crossing disc
+            plots = page.locator(".js-plotly-plot")
+            assert plots.count() == len(rows)
+            start = page.evaluate(
+                "() => document.querySelector('.js-plotly-plot')._fullLayout.sliders[0].active"
+            )
+            page.locator(".updatemenu-button").first.click()  # Play
+            page.wait_for_timeout(1500)
+            later = page.evaluate(
+                "() => document.querySelector('.js-plotly-plot')._fullLayout.sliders[0].active"
+            )
+            assert later > start
+            assert errors == []
+        finally:
+            browser.close()
