@@ -116,7 +116,17 @@ def test_summary_table_values(db: Path) -> None:
         rows = summary_table(store.episodes_frame())
     by_family = {r["family"]: r for r in rows}
     assert by_family["small-family"]["episodes"] == 8
-    assert by_family["small-family"]["success rate"] == "50.0%"
-    assert by_family["small-family"]["collision rate"] == "50.0%"
+    # 4 of 8, with the 95 % Wilson interval [21.5 %, 78.5 %]
+    assert by_family["small-family"]["success rate"] == "50.0% [21.5%, 78.5%]"
+    assert by_family["small-family"]["collision rate"] == "50.0% [21.5%, 78.5%]"
     assert by_family["broken"]["errors"] == 1
     assert by_family["broken"]["min_clearance [m]"] == "–"
+
+
+def test_wilson_interval_matches_the_closed_form() -> None:
+    from uvnav.viz.report import wilson_interval
+
+    lo, hi = wilson_interval(0, 10)
+    assert lo == 0.0 and abs(hi - 0.2775) < 1e-4  # the rule-of-three-like upper bound at 0/10
+    lo, hi = wilson_interval(198, 200)
+    assert lo < 0.99 < hi and hi <= 1.0

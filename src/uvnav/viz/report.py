@@ -53,11 +53,36 @@ def _fmt(x: float | None, digits: int = 3) -> str:
 
 
 def _mean_median(values: pd.Series, digits: int = 3) -> str:
+    """``"mean [95 % CI] / median"`` of the finite values (Student-t interval of the mean)."""
     v = values.to_numpy(dtype=float, na_value=np.nan)
     v = v[np.isfinite(v) & (np.abs(v) < _NO_OBSTACLE_CLEARANCE)]
     if not len(v):
         return "–"
-    return f"{_fmt(float(np.mean(v)), digits)} / {_fmt(float(np.median(v)), digits)}"
+    mean, median = float(np.mean(v)), float(np.median(v))
+    if len(v) < 2:
+        return f"{_fmt(mean, digits)} / {_fmt(median, digits)}"
+    from scipy import stats
+
+    half = float(stats.t.ppf(0.975, len(v) - 1) * np.std(v, ddof=1) / np.sqrt(len(v)))
+    ci = f"[{_fmt(mean - half, digits)}, {_fmt(mean + half, digits)}]"
+    return f"{_fmt(mean, digits)} {ci} / {_fmt(median, digits)}"
+
+
+def wilson_interval(successes: int, n: int, z: float = 1.959963984540054) -> tuple[float, float]:
+    """95 % Wilson score interval of a proportion (well-behaved at 0 % and 100 %)."""
+    if n == 0:
+        return 0.0, 1.0
+    p = successes / n
+    denom = 1.0 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def _rate(hits: pd.Series) -> str:
+    k, n = int(hits.sum()), len(hits)
+    lo, hi = wilson_interval(k, n)
+    return f"{k / n:.1%} [{lo:.1%}, {hi:.1%}]" if n else "–"
 
 
 def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
@@ -68,9 +93,10 @@ def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
 
     Returns:
         One dict per group, keys in display order: ``family``, ``controller``, ``episodes``,
-        ``success rate``, ``collision rate``, ``timeout rate``, ``errors``, and "mean / median"
-        strings of ``min_clearance [m]``, ``path_length [m]``, ``detour_ratio``, ``time_ratio``,
-        ``control_effort`` and ``decision_us_median [µs]``.
+        ``success rate`` and ``collision rate`` (with 95 % Wilson intervals), ``timeout rate``,
+        ``errors``, and "mean [95 % CI] / median" strings of ``min_clearance [m]``,
+        ``path_length [m]``, ``detour_ratio``, ``time_ratio``, ``control_effort``,
+        ``decision_us_median [µs]`` and ``decision_us_p99 [µs]``.
     """
     if df.empty:
         return []
@@ -87,8 +113,8 @@ def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
                 "family": family,
                 "controller": controller,
                 "episodes": n,
-                "success rate": f"{ok.mean():.1%}",
-                "collision rate": f"{(status == 'collision').mean():.1%}",
+                "success rate": _rate(ok),
+                "collision rate": _rate(status == "collision"),
                 "timeout rate": f"{(status == 'timeout').mean():.1%}",
                 "errors": int((status == "error").sum()),
                 "min_clearance [m]": _mean_median(g["min_clearance"]),
@@ -97,6 +123,7 @@ def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
                 "time_ratio": _mean_median(g.loc[ok, "time_ratio"]),
                 "control_effort": _mean_median(g["control_effort"], 2),
                 "decision_us_median [µs]": _mean_median(g["decision_us_median"], 1),
+                "decision_us_p99 [µs]": _mean_median(g["decision_us_p99"], 1),
             }
         )
     return rows
