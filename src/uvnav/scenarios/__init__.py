@@ -8,6 +8,7 @@ Public API::
     check_constraints(scenario) -> list[str]          # thesis (2.6)-(2.8)
     validate_for_controller(scenario, controller_name)
     random_ch2_scenario(seed, n_obstacles=None, ...)
+    crowd_crossing_scenario(seed, dataset='eth', v_max=1.2, ...)   # real pedestrians (ETH)
 """
 
 from uvnav.scenarios.build import (
@@ -17,7 +18,12 @@ from uvnav.scenarios.build import (
     validate_for_controller,
 )
 from uvnav.scenarios.errors import ScenarioError
-from uvnav.scenarios.generators import GENERATORS, generate, random_ch2_scenario
+from uvnav.scenarios.generators import (
+    GENERATORS,
+    crowd_crossing_scenario,
+    generate,
+    random_ch2_scenario,
+)
 from uvnav.scenarios.loader import (
     builtin_text,
     list_builtin,
@@ -32,6 +38,7 @@ from uvnav.scenarios.schema import (
     BodySpec,
     ConstantMotion,
     ControllerSpec,
+    CrowdSpec,
     LidarSpec,
     ObstacleSpec,
     ObstacleStart,
@@ -48,6 +55,7 @@ __all__ = [
     "BodySpec",
     "ConstantMotion",
     "ControllerSpec",
+    "CrowdSpec",
     "LidarSpec",
     "ObstacleSpec",
     "ObstacleStart",
@@ -61,6 +69,7 @@ __all__ = [
     "build_episode",
     "builtin_text",
     "check_constraints",
+    "crowd_crossing_scenario",
     "generate",
     "list_builtin",
     "load_scenario",

@@ -30,6 +30,7 @@ import numpy as np
 from uvnav.controllers.base import controller_info
 from uvnav.obstacles import MotionModel, rotation_boundary_growth
 from uvnav.scenarios.errors import ScenarioError
+from uvnav.scenarios.pedestrians import crowd_speed_stats
 from uvnav.scenarios.schema import ObstacleSpec, Scenario
 from uvnav.sim import EpisodeSetup, world_rng
 
@@ -42,7 +43,9 @@ def build_episode(scenario: Scenario, seed: int) -> EpisodeSetup:
 
     Args:
         scenario: a validated scenario.
-        seed: episode seed; obstacle ``i`` draws from ``world_rng(seed).spawn(n)[i]``.
+        seed: episode seed; obstacle ``i`` draws from ``world_rng(seed).spawn(n)[i]``.  The
+            pedestrians of ``scenario.crowd`` (deterministic replays) come after the ``n``
+            obstacles, in the order of :func:`uvnav.scenarios.pedestrians.episode_tracks`.
 
     Returns:
         A fresh :class:`~uvnav.sim.EpisodeSetup` (its obstacles are advanced in place by
@@ -54,6 +57,8 @@ def build_episode(scenario: Scenario, seed: int) -> EpisodeSetup:
         spec.to_obstacle(child, scenario.dt, j)
         for j, (spec, child) in enumerate(zip(scenario.obstacles, children, strict=True))
     ]
+    if scenario.crowd is not None:
+        obstacles += scenario.crowd.to_obstacles(scenario.t_max)
     robot = scenario.robot
     start = np.array([robot.start[0], robot.start[1], robot.initial_heading()], dtype=float)
     return EpisodeSetup(
@@ -114,6 +119,49 @@ def check_constraints(scenario: Scenario) -> list[str]:
                 f"(1 s of rotation at {turn:.3g} rad/s) "
                 f"is not < V_max - ||v_i|| = {v_max - speed:.3g} m/s"
             )
+    if scenario.crowd is not None:
+        lines.extend(crowd_warnings(scenario))
+    return lines
+
+
+def crowd_speeds(scenario: Scenario) -> tuple[int, float, float]:
+    """``(pedestrians, typical speed, max speed)`` of the scene's crowd in its window [m/s].
+
+    See :func:`uvnav.scenarios.pedestrians.crowd_speed_stats`; all zero without a crowd.
+    """
+    crowd = scenario.crowd
+    if crowd is None:
+        return 0, 0.0, 0.0
+    pieces = crowd.pieces(scenario.t_max)
+    typical, top = crowd_speed_stats(pieces, crowd.window(scenario.t_max))
+    return len(pieces), typical, top
+
+
+def crowd_warnings(scenario: Scenario) -> list[str]:
+    """Warnings (never errors) about a crowd's pedestrians and the thesis's (2.6)-(2.8).
+
+    Replayed pedestrians are not bound by (2.6)-(2.8): they walk at 1.0-1.4 m/s (often faster than
+    a slow robot) and turn at will, and that is the point of these scenes.  One summary line for
+    (2.6) when some pedestrian is not slower than V_max, and one for (2.7)-(2.8) (their turn rate is
+    not bounded by the replay).
+    """
+    crowd = scenario.crowd
+    if crowd is None:
+        return []
+    v_max = scenario.robot.v_max
+    n, typical, top = crowd_speeds(scenario)
+    if n == 0:
+        return []
+    pieces = crowd.pieces(scenario.t_max)
+    faster = sum(bool(np.max(p.speeds()) >= v_max) for p in pieces)
+    label = f"crowd ({crowd.dataset}, {n} pedestrians)"
+    lines: list[str] = []
+    if faster:
+        lines.append(
+            f"{label}: (2.6) {faster} pedestrian(s) reach >= V_max {v_max:.3g} m/s "
+            f"(typical {typical:.3g}, max {top:.3g} m/s); real pedestrians, warning only"
+        )
+    lines.append(f"{label}: (2.7)-(2.8) replayed pedestrians turn at unbounded rate; warning only")
     return lines
 
 
@@ -124,6 +172,13 @@ def validate_for_controller(scenario: Scenario, controller_name: str) -> None:
         ScenarioError: the controller requires obstacles slower than the robot (thesis (2.6)) and an
             obstacle's speed bound is ``>= V_max``.
         uvnav.controllers.UnknownControllerError: no such controller.
+
+    A crowd of real pedestrians is judged as a whole, not per pedestrian: it is rejected only when
+    the robot is not faster than the crowd's *typical* walking speed (time-weighted mean speed of
+    the pedestrians in the episode window, standing ones included), i.e. when the law's
+    assumption fails for most of the obstacles it meets.  Individual pedestrians faster than
+    V_max (some jog, most are faster for a moment) are a documented departure, reported by
+    :func:`check_constraints` as warnings.
     """
     info = controller_info(controller_name)
     if not info.requires_slower_obstacles:
@@ -137,4 +192,14 @@ def validate_for_controller(scenario: Scenario, controller_name: str) -> None:
                 f"obstacles.{j}.motion",
                 f"speed bound {speed:.3g} m/s >= V_max {v_max:.3g} m/s, but {controller_name} "
                 "requires obstacles slower than the robot (thesis (2.6))",
+            )
+    if scenario.crowd is not None:
+        n, typical, _ = crowd_speeds(scenario)
+        if n and typical >= v_max:
+            raise ScenarioError(
+                scenario.source,
+                "crowd",
+                f"typical pedestrian speed {typical:.3g} m/s >= V_max {v_max:.3g} m/s, but "
+                f"{controller_name} requires obstacles slower than the robot (thesis (2.6)); "
+                "raise robot.v_max",
             )

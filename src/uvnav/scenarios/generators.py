@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -214,9 +215,149 @@ def random_ch2_scenario(
     return scenario_from_dict(data, source=f"random-ch2:{seed}")
 
 
+# ----------------------------------------------------------------------------------- crowd crossing
+
+CROWD_V_MAX = 1.2  # [m/s]
+CROWD_U_MAX = 2.0  # [rad/s]
+CROWD_ROBOT_RADIUS = 0.3  # [m]
+CROWD_T_MAX = 40.0  # [s]
+_CROSSING_LENGTH = (8.0, 12.0)  # start-goal distance [m]
+_NEAR_CROSSING = 1.5  # [m] from the start-goal segment: a pedestrian "near the crossing"
+_MIN_NEAR = 4  # pedestrians near the crossing while the robot could be crossing
+_CLEAR_MARGIN = 0.5  # [m] free space between the robot disc and any pedestrian disc at t = 0
+
+
+def _segment_distance(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    ab = b - a
+    s = np.clip(((points - a) @ ab) / float(ab @ ab), 0.0, 1.0)
+    return np.hypot(*(points - (a + s[:, None] * ab)).T)
+
+
+def crowd_crossing_scenario(
+    seed: int,
+    *,
+    dataset: str = "eth",
+    v_max: float = CROWD_V_MAX,
+    u_max: float = CROWD_U_MAX,
+    radius: float = 0.3,
+    robot_radius: float = CROWD_ROBOT_RADIUS,
+    t_max: float = CROWD_T_MAX,
+    dt: float = 0.1,
+    t_start: float | None = None,
+    controller: str = "zhang2019-v1",
+    controller_params: dict[str, Any] | None = None,
+) -> Scenario:
+    """A robot crossing a walkway of real pedestrians (ETH ``eth`` or ``hotel``), seeded.
+
+    The walkway's main direction is the principal axis of all annotated positions
+    (:func:`uvnav.scenarios.pedestrians.walkway_axes`).  Drawn from ``default_rng(seed)``: the
+    recording time that becomes t = 0 (unless ``t_start`` is given), the crossing point along the
+    walkway (within one standard deviation of the positions along it), the crossing length (8-12 m,
+    centred on the walkway's axis) and the side the robot starts on.  A draw is kept when at t = 0
+    no pedestrian is within ``robot_radius + radius + 0.5`` m of the start or the goal, and at
+    least 4 pedestrians pass within 1.5 m of the start-goal segment during the time the robot
+    needs to cross twice at V_max (so the crossing is busy).  Pedestrians do not react to the robot.
+
+    Args:
+        seed: the only source of randomness.
+        dataset: ``"eth"`` or ``"hotel"``.
+        v_max: robot V_max [m/s] (eth pedestrians walk 1.4 m/s on average, hotel 1.0 m/s).
+        u_max: robot U_max [rad/s].
+        radius: pedestrian disc radius [m].
+        robot_radius: robot disc radius [m].
+        t_max: time limit, also the replayed window [s].
+        dt: integration and decision step [s].
+        t_start: recording time of t = 0 [s]; drawn when ``None``.
+        controller: default controller of the scene.
+        controller_params: its parameters.
+    """
+    from uvnav.scenarios import pedestrians
+
+    rng = np.random.default_rng(seed)
+    tracks = pedestrians.load_dataset(dataset)
+    centre, along, across = pedestrians.walkway_axes(tracks)
+    pts = pedestrians.all_positions(tracks)
+    spread = float(np.std((pts - centre) @ along))
+    t_first = min(float(t.times[0]) for t in tracks.values())
+    t_last = max(float(t.times[-1]) for t in tracks.values())
+    clear = robot_radius + radius + _CLEAR_MARGIN
+    for _ in range(_MAX_TRIES):
+        t0 = (
+            round(float(rng.uniform(t_first, t_last - t_max)), 1)
+            if t_start is None
+            else float(t_start)
+        )
+        offset = float(rng.uniform(-spread, spread))
+        length = float(rng.uniform(*_CROSSING_LENGTH))
+        side = 1.0 if rng.random() < 0.5 else -1.0
+        mid = centre + offset * along
+        start = np.round(mid - side * 0.5 * length * across, 3)
+        goal = np.round(mid + side * 0.5 * length * across, 3)
+        pieces = pedestrians.episode_tracks(tracks, t_start=t0, duration=t_max)
+        now = [p for p in pieces if p.times[0] <= 1e-9 <= p.times[-1] + 1e-9]
+        at0 = np.array(
+            [
+                [
+                    np.interp(0.0, p.times, p.positions[:, 0]),
+                    np.interp(0.0, p.times, p.positions[:, 1]),
+                ]
+                for p in now
+            ]
+        ).reshape(-1, 2)
+        if len(at0) and (
+            np.min(np.hypot(*(at0 - start).T)) < clear or np.min(np.hypot(*(at0 - goal).T)) < clear
+        ):
+            continue
+        horizon = min(t_max, 2.0 * length / v_max)
+        near = 0
+        for p in pieces:
+            inside = (p.times >= 0.0) & (p.times <= horizon)
+            if inside.any() and _segment_distance(p.positions[inside], start, goal).min() < (
+                _NEAR_CROSSING
+            ):
+                near += 1
+        if near < _MIN_NEAR:
+            continue
+        break
+    else:
+        raise RuntimeError(f"no busy, clear crossing found in {dataset} (seed {seed})")
+
+    data: dict[str, Any] = {
+        "name": f"crowd-{dataset}-seed{seed}",
+        "description": (
+            f"Crossing the {dataset} walkway (ETH pedestrian recordings, Pellegrini et al. ICCV "
+            f"2009; seed {seed}): {near} real pedestrians pass near the {length:.1f} m crossing "
+            f"in its first {horizon:.0f} s. Pedestrians do not react to the robot (replayed "
+            f"recording). V_max {v_max:g} m/s; pedestrians may be faster, so the thesis's "
+            "(2.6)-(2.8) do not hold for all of them."
+        ),
+        "dim": 2,
+        "dt": dt,
+        "control_period": dt,
+        "t_max": t_max,
+        "goal_tolerance": 0.2,
+        "robot": {
+            "model": "unicycle",
+            "start": start.tolist(),
+            "goal": goal.tolist(),
+            "v_max": v_max,
+            "u_max": u_max,
+            "radius": robot_radius,
+        },
+        "sensing": {"range": 5.0, "velocities": "known", "position_noise": 0.0},
+        "crowd": {"dataset": dataset, "t_start": t0, "radius": radius},
+        "controller": {"name": controller, "params": dict(controller_params or {})},
+    }
+    return scenario_from_dict(data, source=f"crowd-{dataset}:{seed}")
+
+
 #: Seeded scenario generators by name: ``GENERATORS[name](seed, **params) -> Scenario``.
 #: ``load_scenario("<name>:<seed>")`` and campaign files refer to them by these names.
-GENERATORS: dict[str, Callable[..., Scenario]] = {"random-ch2": random_ch2_scenario}
+GENERATORS: dict[str, Callable[..., Scenario]] = {
+    "random-ch2": random_ch2_scenario,
+    "crowd-eth": partial(crowd_crossing_scenario, dataset="eth"),
+    "crowd-hotel": partial(crowd_crossing_scenario, dataset="hotel"),
+}
 
 
 def generate(name: str, seed: int, **params: Any) -> Scenario:

@@ -129,7 +129,8 @@ def scenario_from_dict(data: dict[str, Any], source: str = "<dict>") -> Scenario
 
     Args:
         data: the parsed YAML (or any mapping of scenario fields).
-        source: what to call the origin in error messages (a file name).
+        source: what to call the origin in error messages (a file name); when it is an existing
+            file, relative ``crowd.dataset`` paths are taken from its folder.
 
     Raises:
         ScenarioError: one line naming ``source``, the field path and the problem.
@@ -138,8 +139,9 @@ def scenario_from_dict(data: dict[str, Any], source: str = "<dict>") -> Scenario
         raise ScenarioError(
             source, "<root>", f"expected a mapping of scenario fields (got {type(data).__name__})"
         )
+    base = Path(source).parent if Path(source).is_file() else None
     try:
-        scenario = Scenario.model_validate(data)
+        scenario = Scenario.model_validate(data, context={"base_dir": base})
     except ValidationError as exc:
         raise from_validation_error(
             exc, source, tags=tuple(MOTION_TYPES), allowed_fields=allowed_fields

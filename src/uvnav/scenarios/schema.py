@@ -15,10 +15,19 @@ from __future__ import annotations
 
 import itertools
 import math
+from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, field_validator, model_validator
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationInfo,
+    field_validator,
+    model_validator,
+)
 
 from uvnav.dynamics.unicycle import UnicycleSpec
 from uvnav.obstacles import (
@@ -34,7 +43,8 @@ from uvnav.obstacles import (
     Replay,
     Waypoints,
 )
-from uvnav.scenarios.errors import FieldError
+from uvnav.scenarios import pedestrians
+from uvnav.scenarios.errors import FieldError, ScenarioError
 from uvnav.sim import LidarConfig, SensingConfig
 
 Point2 = Annotated[tuple[float, float], Field(description="[x, y] [m]")]
@@ -405,6 +415,94 @@ class ObstacleSpec(_Model):
         )
 
 
+# ------------------------------------------------------------------------------------------- crowd
+
+
+class CrowdSpec(_Model):
+    """Real pedestrians replayed from a recording (:mod:`uvnav.scenarios.pedestrians`).
+
+    At build time every pedestrian whose track overlaps the episode window becomes a disc obstacle
+    of ``radius`` replaying its annotations (linear interpolation between them, times shifted so
+    that ``t_start`` of the recording is t = 0).  Outside its track a pedestrian is parked 1 km
+    away (absent: not sensed, cannot collide).  Pedestrians do not react to the robot.  They are
+    not bound by the thesis's (2.6)-(2.8): :func:`~uvnav.scenarios.check_constraints` reports them
+    as warnings only.
+    """
+
+    dataset: str = Field(
+        min_length=1,
+        description="shipped sequence 'eth' or 'hotel', or a path to a track file "
+        "(relative paths are taken from the scenario file's folder)",
+    )
+    format: Literal["obsmat", "xy4"] = Field(
+        "obsmat",
+        description="file format: ETH 'obsmat' (frame id x z y vx vz vy) or 'xy4' (frame id x y); "
+        "ignored for the shipped sequences",
+    )
+    t_start: float = Field(0.0, description="recording time that becomes t = 0 [s]")
+    duration: float | None = Field(
+        None, gt=0, description="length of the replayed window [s]; omitted = the scene's t_max"
+    )
+    radius: float = Field(pedestrians.DEFAULT_RADIUS, gt=0, description="pedestrian disc [m]")
+    frame_rate: float | None = Field(
+        None,
+        gt=0,
+        description="frames per second of the file [1/s]; omitted = the sequence's own (eth 15, "
+        "hotel 25) or, for a file, inferred from a 0.4 s annotation period",
+    )
+    region: tuple[float, float, float, float] | None = Field(
+        None, description="optional crop [xmin, ymin, xmax, ymax] [m]: samples outside are absent"
+    )
+
+    @field_validator("dataset")
+    @classmethod
+    def _resolve(cls, value: str, info: ValidationInfo) -> str:
+        if value in pedestrians.DATASETS:
+            return value
+        base = (info.context or {}).get("base_dir") if info.context else None
+        path = Path(value).expanduser()
+        if not path.is_absolute() and base is not None:
+            path = Path(base) / path
+        return str(path)
+
+    @field_validator("region")
+    @classmethod
+    def _box(
+        cls, value: tuple[float, float, float, float] | None
+    ) -> tuple[float, float, float, float] | None:
+        if value is not None and not (value[0] < value[2] and value[1] < value[3]):
+            raise ValueError(f"need xmin < xmax and ymin < ymax (got {list(value)})")
+        return value
+
+    @model_validator(mode="after")
+    def _readable(self) -> CrowdSpec:
+        try:
+            self.tracks()
+        except ScenarioError as exc:
+            raise FieldError("dataset", str(exc)) from None
+        return self
+
+    def tracks(self) -> dict[int, pedestrians.Track]:
+        """All tracks of the recording (recording times) [s], [m]."""
+        return pedestrians.load_tracks(self.dataset, self.format, frame_rate=self.frame_rate)
+
+    def window(self, t_max: float) -> float:
+        """Length of the replayed window [s]: ``duration`` or the scene's ``t_max``."""
+        return float(self.duration) if self.duration is not None else float(t_max)
+
+    def pieces(self, t_max: float) -> list[pedestrians.Track]:
+        """Episode-time track pieces, :func:`uvnav.scenarios.pedestrians.episode_tracks`."""
+        return pedestrians.episode_tracks(
+            self.tracks(), t_start=self.t_start, duration=self.window(t_max), region=self.region
+        )
+
+    def to_obstacles(self, t_max: float) -> list[Obstacle]:
+        """Fresh replayed disc obstacles for one episode of a scene with time limit ``t_max``."""
+        tracks = self.tracks()
+        centre = pedestrians.all_positions(tracks).mean(axis=0)
+        return pedestrians.crowd_obstacles(self.pieces(t_max), radius=self.radius, centre=centre)
+
+
 class ControllerSpec(_Model):
     """The navigation law a scenario runs with by default."""
 
@@ -437,6 +535,9 @@ class Scenario(_Model):
     robot: RobotSpec
     sensing: SensingSpec = Field(default_factory=lambda: SensingSpec.model_validate({}))
     obstacles: list[ObstacleSpec] = Field(default_factory=list)
+    crowd: CrowdSpec | None = Field(
+        None, description="real pedestrians replayed as moving discs (appended after obstacles)"
+    )
     controller: ControllerSpec = Field(default_factory=lambda: ControllerSpec.model_validate({}))
 
     _source: str = PrivateAttr(default="<dict>")
@@ -471,15 +572,22 @@ class Scenario(_Model):
                 "control_period",
                 f"must be a positive multiple of dt={self.dt:g} s (got {self.control_period:g})",
             )
-        if not self.obstacles:
-            return self
         rng = np.random.default_rng(0)
         obstacles = [o.to_obstacle(rng, self.dt, j) for j, o in enumerate(self.obstacles)]
+        if obstacles:
+            field = ObstacleField.from_obstacles(obstacles)
+            _, _, inside = field.nearest(np.asarray(self.robot.goal, dtype=float))
+            if inside.any():
+                j = int(np.argmax(inside))
+                raise FieldError(
+                    "robot.goal", f"lies inside obstacle {j} ({obstacles[j].name}) at t=0"
+                )
+        # pedestrians walk on: one crossing the goal at t = 0 is no error, one on the start is
+        if self.crowd is not None:
+            obstacles += self.crowd.to_obstacles(self.t_max)
+        if not obstacles:
+            return self
         field = ObstacleField.from_obstacles(obstacles)
-        _, _, inside = field.nearest(np.asarray(self.robot.goal, dtype=float))
-        if inside.any():
-            j = int(np.argmax(inside))
-            raise FieldError("robot.goal", f"lies inside obstacle {j} ({obstacles[j].name}) at t=0")
         dist, _, inside = field.nearest(np.asarray(self.robot.start, dtype=float))
         gaps = np.where(inside, -np.inf, dist - self.robot.radius)
         j = int(np.argmin(gaps))

@@ -1,0 +1,476 @@
+"""Real pedestrians as moving obstacles: the ETH walking-pedestrian recordings (EWAP).
+
+Data: S. Pellegrini, A. Ess, K. Schindler, L. van Gool, "You'll never walk alone: modeling social
+behavior for multi-target tracking", ICCV 2009; sequences ``seq_eth`` and ``seq_hotel`` as
+redistributed in OpenTraj, shipped as package data under ``uvnav/scenarios/data/pedestrians/``
+(see the ``README.md`` there for attribution and checksums).  Research use; cite the paper.
+
+Two text formats are read, both one row per (frame, person), whitespace (or comma) separated:
+
+* ``obsmat`` (the ETH files): ``frame id pos_x pos_z pos_y v_x v_z v_y`` in [m] and [m/s], world
+  frame; ``pos_z``/``v_z`` are the (always zero) vertical axis.  Only the planar positions
+  ``(pos_x, pos_y)`` are used: velocities are re-derived from the positions so that the replayed
+  motion and its reported velocity agree.
+* ``xy4`` (the common ``frame id x y`` files of Social-LSTM/Social-GAN/TrajNet): positions [m].
+
+Times are ``frame / frame_rate`` [s].  When ``frame_rate`` is not given it is inferred from the
+most common frame step between consecutive annotations of one person, assuming the ETH/UCY
+annotation period of :data:`ANNOTATION_PERIOD` = 0.4 s (2.5 Hz): seq_eth steps by 6 frames
+(15 frames/s), seq_hotel by 10 (25 frames/s).
+
+Replay (:class:`PedestrianReplay`): a pedestrian is present from its first to its last annotation
+and its position is interpolated linearly in between (piecewise-constant velocity).  Outside that
+interval it is *absent*: parked at a distant point (:data:`ABSENT_DISTANCE` = 1 km from the
+recording's centre, each pedestrian at its own spot) with zero velocity, so it neither collides
+with nor is sensed by the robot (sensing ranges are metres), and no phantom obstacle blocks the
+scene.  It appears and disappears instantaneously; the step on which it appears reports the
+velocity of its first track segment, not the jump from the parking spot (simulation collision
+checks are made at integration steps, so the jump itself cannot collide).  Pedestrians do not
+react to the robot: the recording is replayed as it was.
+"""
+
+from __future__ import annotations
+
+import bisect
+import gzip
+import itertools
+import math
+from collections import Counter
+from dataclasses import dataclass, field
+from functools import cache
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+
+from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.obstacles import DiscBody, Obstacle, ObstacleState, Replay
+from uvnav.scenarios.errors import ScenarioError
+
+#: time between two annotations of the ETH/UCY recordings [s] (2.5 Hz)
+ANNOTATION_PERIOD = 0.4
+#: frame rates [frames/s] of the shipped sequences (frame steps 6 and 10 per 0.4 s annotation)
+DATASETS: dict[str, float] = {"eth": 15.0, "hotel": 25.0}
+#: default pedestrian disc radius [m]
+DEFAULT_RADIUS = 0.3
+#: absent pedestrians are parked this far from the recording's centre [m]
+ABSENT_DISTANCE = 1000.0
+#: tolerance on the presence interval [s] (simulation times are sums of dt)
+_TIME_EPS = 1e-9
+
+FORMATS = ("obsmat", "xy4")
+_COLUMNS = {"obsmat": 8, "xy4": 4}
+
+_DATA_PACKAGE = "uvnav.scenarios"
+_DATA_DIR = "data/pedestrians"
+
+
+@dataclass(frozen=True)
+class Track:
+    """One pedestrian's annotated path.
+
+    Attributes:
+        ped_id: the person id of the file.
+        times: (n,) strictly increasing sample times [s].
+        positions: (n, 2) positions [x, y] [m] at those times.
+    """
+
+    ped_id: int
+    times: FloatArray
+    positions: FloatArray
+
+    def speeds(self) -> FloatArray:
+        """(n - 1,) speed over each segment between annotations [m/s]."""
+        if len(self.times) < 2:
+            return np.zeros(0)
+        return np.hypot(*np.diff(self.positions, axis=0).T) / np.diff(self.times)
+
+    def mean_speed(self) -> float:
+        """Path length over duration [m/s] (0 for a single sample)."""
+        if len(self.times) < 2:
+            return 0.0
+        length = float(np.sum(np.hypot(*np.diff(self.positions, axis=0).T)))
+        return length / float(self.times[-1] - self.times[0])
+
+
+# ------------------------------------------------------------------------------------------ parsing
+
+
+def _parse(text: str, source: str, fmt: str, frame_rate: float | None) -> dict[int, Track]:
+    if fmt not in _COLUMNS:
+        raise ScenarioError(source, "", f"unknown track format {fmt!r} (one of: obsmat, xy4)")
+    if frame_rate is not None and not (math.isfinite(frame_rate) and frame_rate > 0):
+        raise ScenarioError(source, "", f"frame_rate must be > 0 (got {frame_rate})")
+    ncol = _COLUMNS[fmt]
+    rows: dict[int, list[tuple[float, float, float, int]]] = {}
+    seen: set[tuple[float, int]] = set()
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split("#", 1)[0].replace(",", " ").strip()
+        if not line:
+            continue
+        parts = line.split()
+        where = f"line {lineno}"
+        if len(parts) != ncol:
+            raise ScenarioError(
+                source, where, f"expected {ncol} columns for {fmt} (got {len(parts)})"
+            )
+        try:
+            values = [float(p) for p in parts]
+        except ValueError:
+            bad = next(p for p in parts if not _is_float(p))
+            raise ScenarioError(source, where, f"not a number: {bad!r}") from None
+        if not all(math.isfinite(v) for v in values):
+            raise ScenarioError(source, where, "non-finite number")
+        frame, pid = values[0], values[1]
+        if not pid.is_integer():
+            raise ScenarioError(source, where, f"person id must be an integer (got {parts[1]})")
+        x, y = (values[2], values[4]) if fmt == "obsmat" else (values[2], values[3])
+        key = (frame, int(pid))
+        if key in seen:
+            raise ScenarioError(
+                source, where, f"person {int(pid)} annotated twice in frame {parts[0]}"
+            )
+        seen.add(key)
+        rows.setdefault(int(pid), []).append((frame, x, y, lineno))
+    if not rows:
+        raise ScenarioError(source, "", "no annotations")
+    for r in rows.values():
+        r.sort()
+    rate = frame_rate if frame_rate is not None else _infer_frame_rate(rows, source)
+    return {
+        pid: Track(
+            ped_id=pid,
+            times=np.array([f / rate for f, _, _, _ in r]),
+            positions=np.array([(x, y) for _, x, y, _ in r], dtype=float).reshape(-1, 2),
+        )
+        for pid, r in sorted(rows.items())
+    }
+
+
+def _is_float(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _infer_frame_rate(rows: dict[int, list[tuple[float, float, float, int]]], source: str) -> float:
+    steps: Counter[float] = Counter()
+    for r in rows.values():
+        steps.update(round(b[0] - a[0], 6) for a, b in itertools.pairwise(r))
+    if not steps:
+        raise ScenarioError(
+            source, "", "cannot infer frame_rate: no person has two annotations; give frame_rate"
+        )
+    step = steps.most_common(1)[0][0]
+    return step / ANNOTATION_PERIOD
+
+
+def parse_obsmat(
+    text: str, source: str = "<text>", *, frame_rate: float | None = None
+) -> dict[int, Track]:
+    """Tracks of an ETH ``obsmat.txt``: ``frame id pos_x pos_z pos_y v_x v_z v_y`` per row.
+
+    Args:
+        text: the file's contents.
+        source: file name for error messages.
+        frame_rate: frames per second [1/s]; inferred (0.4 s annotation period) when ``None``.
+
+    Returns:
+        ``{person id: Track}`` with times ``frame / frame_rate`` [s] and positions ``(pos_x,
+        pos_y)`` [m], sorted by time.
+
+    Raises:
+        ScenarioError: one line naming ``source``, the line and the problem.
+    """
+    return _parse(text, source, "obsmat", frame_rate)
+
+
+def parse_xy4(
+    text: str, source: str = "<text>", *, frame_rate: float | None = None
+) -> dict[int, Track]:
+    """Tracks of a ``frame id x y`` file (Social-GAN/TrajNet style); see :func:`parse_obsmat`."""
+    return _parse(text, source, "xy4", frame_rate)
+
+
+def read_tracks(
+    path: str | Path, fmt: str = "obsmat", *, frame_rate: float | None = None
+) -> dict[int, Track]:
+    """Tracks of a file in format ``fmt`` (``obsmat`` or ``xy4``); ``.gz`` files are decompressed.
+
+    Raises:
+        ScenarioError: missing/unreadable file or bad contents (one line).
+    """
+    p = Path(path)
+    source = str(path)
+    try:
+        data = p.read_bytes()
+    except FileNotFoundError:
+        raise ScenarioError(source, "", "no such file") from None
+    except OSError as exc:
+        raise ScenarioError(source, "", f"cannot read: {exc}") from None
+    return _parse(_decode(data, source, p.name), source, fmt, frame_rate)
+
+
+def _decode(data: bytes, source: str, name: str) -> str:
+    try:
+        if name.endswith(".gz"):
+            data = gzip.decompress(data)
+        return data.decode("utf-8")
+    except (OSError, EOFError, UnicodeDecodeError) as exc:
+        raise ScenarioError(source, "", f"cannot decode: {exc}") from None
+
+
+@cache
+def load_dataset(name: str) -> dict[int, Track]:
+    """Tracks of a shipped sequence, ``"eth"`` or ``"hotel"`` (cached; do not mutate).
+
+    Raises:
+        ScenarioError: unknown name.
+    """
+    if name not in DATASETS:
+        raise ScenarioError(name, "", f"unknown pedestrian dataset (known: {', '.join(DATASETS)})")
+    entry = resources.files(_DATA_PACKAGE).joinpath(_DATA_DIR, name, "obsmat.txt.gz")
+    source = f"{_DATA_DIR}/{name}/obsmat.txt.gz"
+    return _parse(_decode(entry.read_bytes(), source, entry.name), source, "obsmat", DATASETS[name])
+
+
+@cache
+def _cached_file(
+    path: str, fmt: str, frame_rate: float | None, stamp: tuple[int, int]
+) -> dict[int, Track]:
+    return read_tracks(path, fmt, frame_rate=frame_rate)
+
+
+def load_tracks(
+    dataset: str, fmt: str = "obsmat", *, frame_rate: float | None = None
+) -> dict[int, Track]:
+    """Tracks of a shipped dataset name (``eth``, ``hotel``) or of a file path (cached by path,
+    modification time and size).  A shipped name ignores ``fmt``; ``frame_rate`` overrides its
+    rate when given."""
+    if dataset in DATASETS:
+        if frame_rate is None or frame_rate == DATASETS[dataset]:
+            return load_dataset(dataset)
+        base = load_dataset(dataset)
+        scale = DATASETS[dataset] / frame_rate
+        return {k: Track(k, t.times * scale, t.positions) for k, t in base.items()}
+    p = Path(dataset)
+    try:
+        st = p.stat()
+    except OSError:
+        raise ScenarioError(
+            dataset, "", f"no such file or shipped dataset ({', '.join(DATASETS)})"
+        ) from None
+    return _cached_file(str(p.resolve()), fmt, frame_rate, (st.st_mtime_ns, st.st_size))
+
+
+# ---------------------------------------------------------------------------------------- geometry
+
+
+def all_positions(tracks: dict[int, Track]) -> FloatArray:
+    """(N, 2) every annotated position [m]."""
+    return np.concatenate([t.positions for t in tracks.values()])
+
+
+def walkway_axes(tracks: dict[int, Track]) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """``(centre, along, across)``: the mean position [m] and unit vectors of the principal axis of
+    all annotated positions (the walkway's main direction) and of the perpendicular axis."""
+    pts = all_positions(tracks)
+    centre = pts.mean(axis=0)
+    _, vecs = np.linalg.eigh(np.cov((pts - centre).T))
+    along = vecs[:, 1] * (1.0 if vecs[0, 1] + vecs[1, 1] >= 0 else -1.0)
+    across = np.array([-along[1], along[0]])
+    return centre, along, across
+
+
+# ------------------------------------------------------------------------------------------ replay
+
+
+@dataclass
+class PedestrianReplay(Replay):
+    """A pedestrian's recorded path, present only between its first and last sample.
+
+    Inside ``[times[0], times[-1]]`` [s] positions are interpolated linearly (velocity piecewise
+    constant, heading along the course), exactly as :class:`~uvnav.obstacles.Replay`; outside it
+    the pedestrian is parked at ``absent`` [m] with zero velocity (see the module docstring).
+
+    Attributes:
+        times: (m,) strictly increasing sample times [s], m >= 2.
+        positions: (m, 2) positions [m].
+        absent: (2,) parking position while absent [m].
+    """
+
+    absent: FloatArray = field(default_factory=lambda: np.full(2, ABSENT_DISTANCE))
+    _t: list[float] = field(default_factory=list, init=False, repr=False)
+    _x: list[float] = field(default_factory=list, init=False, repr=False)
+    _y: list[float] = field(default_factory=list, init=False, repr=False)
+
+    def __post_init__(self) -> None:
+        self.times = np.asarray(self.times, dtype=float)
+        self.positions = np.asarray(self.positions, dtype=float).reshape(-1, 2)
+        self.absent = np.asarray(self.absent, dtype=float)
+        if len(self.times) < 2 or len(self.times) != len(self.positions):
+            raise ValueError("need >= 2 samples, one position per time")
+        if np.any(np.diff(self.times) <= 0):
+            raise ValueError("times must be strictly increasing")
+        self._t = self.times.tolist()
+        self._x = self.positions[:, 0].tolist()
+        self._y = self.positions[:, 1].tolist()
+
+    def present(self, t: float) -> bool:
+        """Whether the pedestrian is on the scene at time ``t`` [s]."""
+        return self._t[0] - _TIME_EPS <= t <= self._t[-1] + _TIME_EPS
+
+    def _segment(self, t: float) -> int:
+        return min(max(bisect.bisect_right(self._t, t) - 1, 0), len(self._t) - 2)
+
+    def position_at(self, t: float) -> FloatArray:
+        """Position [m] at ``t`` [s]: interpolated while present, ``absent`` otherwise."""
+        if not self.present(t):
+            return self.absent.copy()
+        k = self._segment(t)
+        t0, t1 = self._t[k], self._t[k + 1]
+        s = min(max((t - t0) / (t1 - t0), 0.0), 1.0)
+        if s == 0.0:
+            return np.array([self._x[k], self._y[k]])
+        if s == 1.0:
+            return np.array([self._x[k + 1], self._y[k + 1]])
+        return np.array(
+            [
+                self._x[k] + s * (self._x[k + 1] - self._x[k]),
+                self._y[k] + s * (self._y[k + 1] - self._y[k]),
+            ]
+        )
+
+    def velocity_at(self, t: float) -> FloatArray:
+        """Velocity [m/s] of the track segment containing ``t`` [s] (zero while absent)."""
+        if not self.present(t):
+            return np.zeros(2)
+        k = self._segment(t)
+        dt = self._t[k + 1] - self._t[k]
+        return np.array([(self._x[k + 1] - self._x[k]) / dt, (self._y[k + 1] - self._y[k]) / dt])
+
+    def initial_state(self, t: float = 0.0) -> ObstacleState:
+        """State at ``t`` [s]: position, segment velocity, heading along it."""
+        vel = self.velocity_at(t)
+        heading = float(math.atan2(vel[1], vel[0])) if math.hypot(*vel) > 1e-9 else 0.0
+        return ObstacleState(position=self.position_at(t), heading=heading, velocity=vel)
+
+    def step(self, state: ObstacleState, t: float, dt: float) -> ObstacleState:
+        t1 = t + dt
+        if not self.present(t1):
+            return ObstacleState(
+                position=self.absent.copy(), heading=state.heading, velocity=np.zeros(2)
+            )
+        new = self.position_at(t1)
+        # appearing: report the track's velocity, not the jump from the parking spot
+        velocity = (new - state.position) / dt if self.present(t) else self.velocity_at(t1)
+        heading = state.heading
+        if math.hypot(velocity[0], velocity[1]) > 1e-9:
+            heading = float(math.atan2(velocity[1], velocity[0]))
+        omega = wrap_scalar(heading - state.heading) / dt if self.present(t) else 0.0
+        return ObstacleState(
+            position=new, heading=heading, velocity=velocity, angular_velocity=omega
+        )
+
+    def speed_bound(self) -> float:
+        """Largest segment speed of the track [m/s] (the parking jumps do not count)."""
+        return float(np.max(np.hypot(*np.diff(self.positions, axis=0).T) / np.diff(self.times)))
+
+
+# ------------------------------------------------------------------------------------- episodes
+
+
+def episode_tracks(
+    tracks: dict[int, Track],
+    *,
+    t_start: float,
+    duration: float,
+    region: tuple[float, float, float, float] | None = None,
+) -> list[Track]:
+    """The pieces of ``tracks`` seen in the episode window, times shifted so ``t_start`` is 0.
+
+    With ``region = [xmin, ymin, xmax, ymax]`` [m] only samples inside it are kept, and a track that
+    leaves and re-enters gives one piece per visit.  Pieces with fewer than two samples are dropped
+    (a pedestrian seen once has no motion to replay).  A piece is kept when its time span overlaps
+    ``[0, duration]``; samples outside the window are kept too, so the interpolation at the window
+    edges uses the real neighbouring annotations.
+    """
+    out: list[Track] = []
+    for pid, tr in tracks.items():
+        times = tr.times - t_start
+        pos = tr.positions
+        if times[-1] < -_TIME_EPS or times[0] > duration + _TIME_EPS:
+            continue
+        if region is None:
+            runs = [np.arange(len(times))]
+        else:
+            x0, y0, x1, y1 = region
+            inside = (pos[:, 0] >= x0) & (pos[:, 0] <= x1) & (pos[:, 1] >= y0) & (pos[:, 1] <= y1)
+            idx = np.flatnonzero(inside)
+            runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []
+        for run in runs:
+            if len(run) < 2:
+                continue
+            tt = times[run]
+            if tt[-1] < -_TIME_EPS or tt[0] > duration + _TIME_EPS:
+                continue
+            out.append(Track(ped_id=pid, times=tt, positions=pos[run]))
+    return out
+
+
+def crowd_obstacles(
+    pieces: list[Track], *, radius: float = DEFAULT_RADIUS, centre: FloatArray | None = None
+) -> list[Obstacle]:
+    """Disc obstacles replaying ``pieces`` (from :func:`episode_tracks`), named ``ped-<id>``.
+
+    Args:
+        pieces: episode-time tracks.
+        radius: pedestrian disc radius [m].
+        centre: centre of the recording [m]; absent pedestrians are parked
+            :data:`ABSENT_DISTANCE` m from it, one metre apart from each other.
+    """
+    c = np.zeros(2) if centre is None else np.asarray(centre, dtype=float)
+    names: Counter[int] = Counter()
+    out: list[Obstacle] = []
+    for j, tr in enumerate(pieces):
+        parked = c + np.array([ABSENT_DISTANCE + float(j), 0.0])
+        motion = PedestrianReplay(tr.times, tr.positions, absent=parked)
+        k = names[tr.ped_id]
+        names[tr.ped_id] += 1
+        name = f"ped-{tr.ped_id}" + (f".{k}" if k else "")
+        out.append(
+            Obstacle(
+                body=DiscBody(float(radius)),
+                state=motion.initial_state(0.0),
+                motion=motion,
+                name=name,
+            )
+        )
+    return out
+
+
+def crowd_speed_stats(pieces: list[Track], duration: float) -> tuple[float, float]:
+    """``(typical, max)`` walking speed [m/s] of the pedestrians in the window ``[0, duration]``.
+
+    ``typical`` is the time-weighted mean speed (every pedestrian-second in the window counts the
+    same, standing people included: the dataset README's "mean walking speed"), ``max`` the largest
+    segment speed.  Both zero without pieces.
+    """
+    lengths = 0.0
+    total = 0.0
+    top = 0.0
+    for tr in pieces:
+        lo = np.clip(tr.times[:-1], 0.0, duration)
+        hi = np.clip(tr.times[1:], 0.0, duration)
+        w = hi - lo
+        if not np.any(w > 0):
+            continue
+        sp = tr.speeds()
+        lengths += float(np.sum(sp * w))
+        total += float(np.sum(w))
+        top = max(top, float(np.max(sp[w > 0])))
+    if total <= 0.0:
+        return 0.0, 0.0
+    return lengths / total, top
