@@ -118,8 +118,12 @@ def _draw_scene(
     ring_colours: list[Any] = []
     for j in range(k):
         c = traj.obstacle_centres[:, j, :]
+        away = far_from_path(c, traj.robot[:, :2])
+        c = np.where(away[:, None], np.nan, c)  # absent (parked) obstacles: no line to them
         ax.plot(c[:, 0], c[:, 1], color="tab:blue", lw=0.8, alpha=0.6, ls="-")
         for i in idx:
+            if away[i]:
+                continue
             outline = traj.obstacle_outline(j, int(i))
             rings.append(np.vstack([outline, outline[:1]]))
             ring_colours.append(shade(float(times[i])))
@@ -377,6 +381,16 @@ def plot_comparison(
     return _save(fig, path)
 
 
+def far_from_path(points: np.ndarray, path: np.ndarray, limit: float = 50.0) -> np.ndarray:
+    """(n,) True for points more than ``limit`` [m] outside the robot path's bounding box.
+
+    Replayed pedestrians are parked far away while absent from the recording
+    (:mod:`uvnav.scenarios.pedestrians`); figures leave those positions out.
+    """
+    lo, hi = path.min(axis=0) - limit, path.max(axis=0) + limit
+    return np.asarray(np.any((points < lo) | (points > hi), axis=1))
+
+
 def _common_limits(
     runs: Sequence[tuple[Trajectory, EpisodeSetup]], margin: float = 0.5
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -392,6 +406,7 @@ def _common_limits(
                 default=0.0,
             )
             c = traj.obstacle_centres.reshape(-1, 2)
+            c = c[~far_from_path(c, traj.robot[:, :2])]
             pts += [c - reach, c + reach]
     allp = np.concatenate(pts, axis=0)
     return allp.min(axis=0) - margin, allp.max(axis=0) + margin

@@ -145,7 +145,10 @@ def trajectory_animation(
         )
         for i in idx
     ]
-    pts = [path, traj.obstacle_centres.reshape(-1, 2), np.asarray([goal])]
+    from uvnav.viz.figures import far_from_path
+
+    centres = traj.obstacle_centres.reshape(-1, 2)
+    pts = [path, centres[~far_from_path(centres, path)], np.asarray([goal])]
     allp = np.concatenate([p for p in pts if len(p)])
     pad = 1.5 + (
         sensing_range if sensing_range is not None and math.isfinite(sensing_range) else 0.0
