@@ -59,7 +59,14 @@ class ControllerInfo:
 
 _REGISTRY: dict[str, ControllerInfo] = {}
 #: Modules of ``uvnav.controllers`` that register built-in laws when imported.
-BUILTIN_MODULES: tuple[str, ...] = ("zhang2019", "savkin_wang2013", "straight", "orca")
+BUILTIN_MODULES: tuple[str, ...] = (
+    "zhang2019",
+    "savkin_wang2013",
+    "straight",
+    "orca",
+    "dwa",
+    "apf",
+)
 _ENTRY_POINTS_LOADED = False
 
 

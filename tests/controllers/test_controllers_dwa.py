@@ -1,0 +1,186 @@
+"""Behaviour of the Dynamic Window Approach baseline (``dwa-v1``)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import uvnav.controllers.dwa  # noqa: F401  (registers dwa-v1)
+from uvnav.controllers import ControllerParamsError, make_controller
+from uvnav.controllers.dwa import (
+    DwaController,
+    predicted_clearance,
+    rollout_poses,
+    rollout_times,
+)
+from uvnav.dynamics import UnicycleSpec
+from uvnav.dynamics.unicycle import unicycle_step
+from uvnav.obstacles import (
+    ConstantVelocity,
+    DiscBody,
+    Obstacle,
+    ObstacleField,
+    ObstacleState,
+    PolygonBody,
+)
+from uvnav.scenarios import build_episode, load_scenario
+from uvnav.sensors import Observation, sense_obstacles
+from uvnav.sim import EpisodeSetup, run_episode, run_rng
+
+SPEC = UnicycleSpec(v_max=0.707, u_max=1.414, radius=0.1)
+GOAL = np.array([10.0, 0.0])
+
+
+def disc(x: float, y: float, r: float, v: tuple[float, float] = (0.0, 0.0)) -> Obstacle:
+    vel = np.asarray(v, dtype=float)
+    return Obstacle(
+        DiscBody(r), ObstacleState(np.array([x, y]), velocity=vel), ConstantVelocity(vel)
+    )
+
+
+def observe(
+    pose: list[float], obstacles: list[Obstacle], *, speed: float = SPEC.v_max
+) -> Observation:
+    p = np.asarray(pose, dtype=float)
+    fld = ObstacleField.from_obstacles(obstacles)
+    return Observation(
+        time=0.0, pose=p, speed=speed, goal=GOAL, obstacles=sense_obstacles(p[:2], fld)
+    )
+
+
+def fresh(**params: Any) -> DwaController:
+    ctrl = make_controller("dwa-v1", **params)
+    assert isinstance(ctrl, DwaController)
+    ctrl.reset(SPEC, GOAL, np.random.default_rng(0))
+    return ctrl
+
+
+def test_rollouts_are_the_exact_unicycle_arcs() -> None:
+    pose = np.array([1.0, -2.0, 0.3])
+    v, u = np.array([0.5, 0.7, 0.0]), np.array([1.2, 0.0, -1.0])
+    times = rollout_times(3.0, 0.2)
+    xs, ys, ths = rollout_poses(pose, v, u, times)
+    for i in range(3):
+        end = unicycle_step(pose, float(v[i]), float(u[i]), float(times[-1]))
+        assert xs[i, -1] == pytest.approx(end[0], abs=1e-12)
+        assert ys[i, -1] == pytest.approx(end[1], abs=1e-12)
+        assert math.remainder(ths[i, -1] - end[2], 2 * math.pi) == pytest.approx(0, abs=1e-12)
+
+
+def test_polygon_clearance_is_signed_and_follows_the_prediction() -> None:
+    square = PolygonBody.from_vertices(np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float))
+    ob = Obstacle(
+        square,
+        ObstacleState(square.offset.copy(), velocity=np.array([1.0, 0.0])),
+        ConstantVelocity(np.array([1.0, 0.0])),
+    )
+    readings = sense_obstacles(np.array([3.0, 0.5]), ObstacleField.from_obstacles([ob]))
+    times = np.array([0.0, 1.0, 2.0])
+    px = np.array([[2.5, 2.5, 2.5], [0.5, 0.5, 0.5]])
+    py = np.full((2, 3), 0.5)
+    moving = predicted_clearance(px, py, times, readings, inflate=0.0)
+    assert moving[0] == pytest.approx([1.5, 0.5, -0.5])  # the square comes to the point
+    assert moving[1] == pytest.approx([-0.5, 0.5, 1.5])  # inside, then left behind
+    static = predicted_clearance(px, py, times, readings, inflate=0.1, predict_motion=False)
+    assert static[0] == pytest.approx([1.4, 1.4, 1.4])
+
+
+@pytest.mark.parametrize("scene", ["thesis-ch2-one-obstacle"])
+def test_reaches_target_without_collision_on_the_thesis_scene(scene: str) -> None:
+    setup = build_episode(load_scenario(scene), 0)
+    res = run_episode(setup, make_controller("dwa-v1"), run_rng(0), record=False)
+    assert res.status == "success"
+    assert (res.metrics.min_clearance or -1.0) > 0.0
+    assert res.metrics.limit_violations == 0
+
+
+def test_static_disc_head_on_is_avoided() -> None:
+    setup = EpisodeSetup(spec=SPEC, start=np.zeros(3), goal=GOAL, obstacles=[disc(5.0, 0.0, 0.8)])
+    res = run_episode(setup, make_controller("dwa-v1"), run_rng(2), record=False)
+    assert res.status == "success"
+    assert (res.metrics.min_clearance or -1.0) > 0.1
+    assert res.metrics.limit_violations == 0
+
+
+def test_prediction_avoids_a_crossing_obstacle_that_a_static_window_would_hit() -> None:
+    """A disc crossing the robot's path: frozen, it is 1 m off the path; predicted, it arrives
+    on the path when the robot does.  The chosen rollout is checked against the true motion.  The
+    window is opened to all of V_s (large accelerations) so that only the prediction differs."""
+    crossing = [disc(1.2, -1.0, 0.3, (0.0, 0.6))]
+    obs = observe([0.0, 0.0, 0.0], crossing)
+    times = rollout_times(3.0, 0.05)
+
+    def true_gap(cmd_v: float, cmd_u: float) -> float:
+        xs, ys, _ = rollout_poses(obs.pose, np.array([cmd_v]), np.array([cmd_u]), times)
+        return float(predicted_clearance(xs, ys, times, obs.obstacles, inflate=SPEC.radius).min())
+
+    wide = {"max_accel": 10.0, "max_ang_accel": 30.0}
+    static = fresh(predict_motion=False, **wide).act(obs)
+    predicting = fresh(**wide).act(obs)
+    assert true_gap(static.v, static.u) < 0.0  # the frozen world lets it drive into the disc
+    assert true_gap(predicting.v, predicting.u) > 0.0
+
+
+@pytest.mark.parametrize(
+    ("bad", "message"),
+    [
+        ({"v_samples": 1}, "v_samples"),
+        ({"horizon": -1.0}, "horizon"),
+        ({"rollout_dt": 5.0}, "rollout_dt"),
+        ({"clearance_weight": float("nan")}, "clearance_weight"),
+        ({"nope": 1}, "unknown"),
+    ],
+)
+def test_bad_parameters_are_rejected_with_the_field_name(bad: dict[str, Any], message: str) -> None:
+    with pytest.raises(ControllerParamsError, match=message):
+        make_controller("dwa-v1", **bad)
+
+
+coords = st.floats(-2.0, 2.0, allow_nan=False)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    rx=coords,
+    ry=coords,
+    th=st.floats(-math.pi, math.pi),
+    vx=st.floats(-1.0, 1.0),
+    vy=st.floats(-1.0, 1.0),
+    radius=st.floats(0.0, 1.0),
+    where=st.sampled_from(["boundary", "centre", "origin"]),
+    speed=st.floats(0.0, 0.707),
+)
+def test_commands_are_finite_and_within_limits_for_degenerate_geometry(
+    rx: float,
+    ry: float,
+    th: float,
+    vx: float,
+    vy: float,
+    radius: float,
+    where: str,
+    speed: float,
+) -> None:
+    r = max(radius, 1e-6)
+    pose = {"boundary": [rx + r, ry, th], "centre": [rx, ry, th], "origin": [0.0, 0.0, th]}[where]
+    square = PolygonBody.from_vertices(
+        np.array([[0, 0], [1, 0], [1, 0], [1, 1], [0, 1]], dtype=float) * max(radius, 0.01)
+    )
+    obstacles = [
+        disc(rx, ry, r, (vx, vy)),
+        disc(rx, ry, r),
+        Obstacle(square, ObstacleState(np.array([rx, ry])), ConstantVelocity(np.zeros(2))),
+    ]
+    ctrl = fresh()
+    for k in range(3):
+        obs = observe(pose, obstacles, speed=speed)
+        obs = Observation(
+            time=0.1 * k, pose=obs.pose, speed=speed, goal=GOAL, obstacles=obs.obstacles
+        )
+        cmd = ctrl.act(obs)
+        assert math.isfinite(cmd.v) and math.isfinite(cmd.u)
+        assert not cmd.violates(SPEC)
