@@ -1,22 +1,39 @@
 """Layer 6: benchmark campaigns — scenarios × controllers × seeds → a SQLite results store.
 
 * :mod:`uvnav.bench.store` — the results database (DESIGN §5).
-* :mod:`uvnav.bench.campaign` — picklable jobs run on a local process pool, resumable.
+* :mod:`uvnav.bench.campaign` — picklable jobs run on a local process pool (or Ray), resumable.
+* :mod:`uvnav.bench.spec` — campaign YAML files (scenarios × controllers × seeds) → jobs.
+* :mod:`uvnav.bench.ray_engine` — the jobs as Ray tasks (extra ``uvnav[bench]``, imported lazily).
+* :mod:`uvnav.bench.summary` — the per-controller table ``uvnav bench`` prints.
 * :mod:`uvnav.bench.reproduce` — the thesis Chapter 2 reproduction behind ``uvnav run``
   (``from uvnav.bench.reproduce import reproduce``; the function is not re-exported here so that it
   does not shadow its module).
 """
 
 from uvnav.bench.campaign import CampaignRun, Job, JobOutcome, grid_jobs, run_campaign, run_job
+from uvnav.bench.spec import (
+    CampaignError,
+    CampaignSpec,
+    campaign_from_dict,
+    load_campaign,
+    run_campaign_spec,
+)
 from uvnav.bench.store import ResultsStore, params_hash
+from uvnav.bench.summary import controller_summary
 
 __all__ = [
+    "CampaignError",
     "CampaignRun",
+    "CampaignSpec",
     "Job",
     "JobOutcome",
     "ResultsStore",
+    "campaign_from_dict",
+    "controller_summary",
     "grid_jobs",
+    "load_campaign",
     "params_hash",
     "run_campaign",
+    "run_campaign_spec",
     "run_job",
 ]

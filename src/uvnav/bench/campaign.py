@@ -1,10 +1,12 @@
 """Campaigns: scenarios × controllers × seeds on a local process pool, streamed into the store.
 
 A campaign is a list of :class:`Job` s — small picklable *descriptions* (scenario name, generator
-seed or a module-level setup factory; controller name and parameters; seed).  The episode is built
-inside the worker (``build_episode(load_scenario(name), seed)`` or
-``build_episode(random_ch2_scenario(g), seed)``), so nothing heavy or stateful crosses process
-boundaries and the same job replays bit for bit anywhere (DESIGN §2, randomness).
+name, parameters and seed, or a module-level setup factory; controller name and parameters; seed).
+The episode is built inside the worker (``build_episode(load_scenario(name), seed)`` or
+``build_episode(generate(generator, g, **params), seed)``), so nothing heavy or stateful crosses
+process boundaries and the same job replays bit for bit anywhere (DESIGN §2, randomness): the
+stored metrics do not depend on the engine or the number of workers.  Campaign files (YAML) are
+expanded into jobs by :mod:`uvnav.bench.spec`.
 
 :func:`run_campaign` writes each episode to the :class:`~uvnav.bench.store.ResultsStore` in its own
 transaction the moment it arrives, so an interrupted campaign (Ctrl-C, a killed machine) loses only
@@ -16,7 +18,9 @@ Workers are a :class:`concurrent.futures.ProcessPoolExecutor` started with the `
 on POSIX (``spawn`` elsewhere): forking a parent that runs a progress-bar thread and holds an open
 SQLite connection is unsafe, and the fork server preloads uvnav once so workers start quickly.  At
 most ``2 × workers`` jobs are submitted ahead, which bounds memory for large campaigns.  With
-``workers=1`` everything runs in-process (no pool; easiest to debug and profile).  As with any
+``workers=1`` everything runs in-process (no pool; easiest to debug and profile).  ``engine="ray"``
+runs the same jobs as Ray tasks instead (:mod:`uvnav.bench.ray_engine`); results still come back to
+this process, which alone writes the store.  As with any
 ``spawn``/``forkserver`` pool, a *script* that starts a campaign with ``workers > 1`` must do so
 under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already do), and a
 ``setup_factory`` must be importable (defined at module level, not in a notebook cell); pass
@@ -35,11 +39,10 @@ from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wai
 from dataclasses import dataclass, field
 from typing import Any
 
-from uvnav.bench.store import STATUS_ERROR, EpisodeKey, ResultsStore, params_hash
+from uvnav.bench.store import STATUS_ERROR, EpisodeKey, ResultsStore, canonical_json, params_hash
 from uvnav.sim import EpisodeSetup, Trajectory, run_episode, run_rng
 
-#: Scenario generators a :class:`Job` may name, by label → function name in :mod:`uvnav.scenarios`.
-GENERATORS: dict[str, str] = {"random-ch2": "random_ch2_scenario"}
+ENGINES = ("local", "ray")
 
 SetupFactory = Callable[[int], EpisodeSetup]
 
@@ -62,13 +65,18 @@ class Job:
         seed: episode seed (``build_episode(..., seed)`` and ``run_episode``'s generator).
         scenario: built-in scenario name or path to a YAML file.
         generator_seed: seed of the scenario generator named by ``generator``.
-        generator: generator label, a key of :data:`GENERATORS` (default ``"random-ch2"``).
+        generator: generator name, a key of :data:`uvnav.scenarios.GENERATORS` (default
+            ``"random-ch2"``).
+        generator_params: keyword arguments of the generator (a mapping is accepted and frozen to
+            sorted pairs); they become part of the scenario label, hence of the resume key.
         setup_factory: a *module-level* (picklable) function ``seed -> EpisodeSetup``; needs
             ``label``.
         label: scenario label stored in the database (defaults from the source).
         family: scenario family reports group by (defaults: scenario name, or generator label).
         params: controller parameters (a mapping is accepted and frozen to sorted pairs).  When the
             scenario names the same controller, these override the scenario's own parameters.
+            ``oracle=True`` among them is passed to ``make_controller`` (ground-truth obstacle
+            velocities, DESIGN §2) and, being a parameter, keeps oracle runs apart in the store.
         use_scenario_params: start from the scenario's ``controller.params`` when the scenario names
             this controller (default ``True``).
         record: keep the trajectory and store it (for figures; costs memory and disk).
@@ -79,6 +87,7 @@ class Job:
     scenario: str | None = None
     generator_seed: int | None = None
     generator: str = "random-ch2"
+    generator_params: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
     setup_factory: SetupFactory | None = None
     label: str | None = None
     family: str | None = None
@@ -88,6 +97,7 @@ class Job:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", _freeze(self.params))
+        object.__setattr__(self, "generator_params", _freeze(self.generator_params))
         sources = sum(
             x is not None for x in (self.scenario, self.generator_seed, self.setup_factory)
         )
@@ -95,10 +105,15 @@ class Job:
             raise ValueError("a Job needs exactly one of scenario, generator_seed, setup_factory")
         if self.setup_factory is not None and self.label is None:
             raise ValueError("a Job with a setup_factory needs a label")
-        if self.generator_seed is not None and self.generator not in GENERATORS:
-            raise ValueError(
-                f"unknown generator {self.generator!r}; known: {', '.join(GENERATORS)}"
-            )
+        if self.generator_seed is not None:
+            from uvnav.scenarios.generators import GENERATORS  # layer 5, imported when needed
+
+            if self.generator not in GENERATORS:
+                raise ValueError(
+                    f"unknown generator {self.generator!r}; known: {', '.join(sorted(GENERATORS))}"
+                )
+        elif self.generator_params:
+            raise ValueError("generator_params need a generator_seed")
 
     @property
     def params_dict(self) -> dict[str, Any]:
@@ -106,21 +121,34 @@ class Job:
         return dict(self.params)
 
     @property
+    def generator_label(self) -> str:
+        """``generator`` or, with parameters, ``generator[k=v,...]`` (values as canonical JSON)."""
+        if not self.generator_params:
+            return self.generator
+        items = dict(self.generator_params).items()
+        args = ",".join(f"{k}={canonical_json(v)}" for k, v in items)
+        return f"{self.generator}[{args}]"
+
+    @property
     def scenario_label(self) -> str:
-        """What the ``scenario`` column stores: the name/path, ``generator/NNNN`` or the label."""
+        """What the ``scenario`` column stores: the name/path, ``generator/NNNN`` or the label.
+
+        A generator with parameters stores ``generator[k=v,...]/NNNN`` (see
+        :attr:`generator_label`).
+        """
         if self.label is not None:
             return self.label
         if self.scenario is not None:
             return self.scenario
-        return f"{self.generator}/{self.generator_seed:04d}"
+        return f"{self.generator_label}/{self.generator_seed:04d}"
 
     @property
     def family_label(self) -> str:
-        """Scenario family for reports."""
+        """Scenario family for reports (the generator label for generated scenes)."""
         if self.family is not None:
             return self.family
         if self.generator_seed is not None:
-            return self.generator
+            return self.generator_label
         return self.scenario_label
 
     @property
@@ -169,7 +197,9 @@ def build_job(job: Job) -> tuple[EpisodeSetup, dict[str, Any]]:
     if job.scenario is not None:
         scenario = scenarios.load_scenario(job.scenario)
     else:
-        scenario = getattr(scenarios, GENERATORS[job.generator])(int(job.generator_seed or 0))
+        scenario = scenarios.generate(
+            job.generator, int(job.generator_seed or 0), **dict(job.generator_params)
+        )
     params = job.params_dict
     ctrl = getattr(scenario, "controller", None)
     if (
@@ -277,6 +307,8 @@ def run_campaign(
     retry_errors: bool = False,
     mp_context: mp.context.BaseContext | None = None,
     on_outcome: Callable[[JobOutcome, int], None] | None = None,
+    engine: str = "local",
+    address: str | None = None,
 ) -> CampaignRun:
     """Run ``jobs`` under campaign ``name``, storing each episode as it finishes; resume-safe.
 
@@ -285,11 +317,15 @@ def run_campaign(
         name: campaign name; an existing campaign of that name is resumed.
         jobs: job descriptions; duplicates (same resume key) run once.
         config: JSON-able description stored with a new campaign.
-        workers: worker processes; ``1`` runs in-process.
+        workers: worker processes (``engine="local"``; ``1`` runs in-process) or Ray CPUs
+            (``engine="ray"``).
         progress: show a rich progress bar on stderr.
         retry_errors: run again the jobs stored with status ``error`` (replacing those rows).
         mp_context: multiprocessing context for the pool (default :func:`default_mp_context`).
         on_outcome: called in this process with each outcome and its episode id, after storing.
+        engine: ``"local"`` (process pool) or ``"ray"`` (Ray tasks, see
+            :func:`uvnav.bench.ray_engine.run_ray`); the stored metrics are the same.
+        address: Ray cluster address (``engine="ray"`` only; default: a local Ray instance).
 
     Returns:
         What was skipped, run and stored.
@@ -297,7 +333,15 @@ def run_campaign(
     Raises:
         KeyboardInterrupt: re-raised after cancelling queued jobs; stored episodes stay stored.
         concurrent.futures.process.BrokenProcessPool: a worker died (not a Python exception).
+        ValueError: unknown ``engine``.
+        uvnav.bench.ray_engine.EngineUnavailableError: ``engine="ray"`` without Ray installed.
     """
+    if engine not in ENGINES:
+        raise ValueError(f"unknown engine {engine!r}; known: {', '.join(ENGINES)}")
+    if engine == "ray":
+        from uvnav.bench.ray_engine import import_ray
+
+        import_ray()  # fail before touching the store when Ray is missing
     tic = time.perf_counter()
     cfg = dict(config) if config is not None else {"n_jobs": len(jobs)}
     campaign_id = store.campaign(name, cfg)
@@ -329,7 +373,12 @@ def run_campaign(
     try:
         if bar is not None:
             bar.start()
-        if workers <= 1:
+        if engine == "ray":
+            if todo:
+                from uvnav.bench.ray_engine import run_ray
+
+                run_ray(todo, handle, workers=workers, address=address)
+        elif workers <= 1:
             for job in todo:
                 handle(run_job(job))
         elif todo:

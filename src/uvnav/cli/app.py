@@ -609,6 +609,162 @@ def report_cmd(
     typer.echo(f"wrote {path}")
 
 
+# ------------------------------------------------------------------------------------------ bench
+
+_SUMMARY_HEADERS = {
+    "episodes": "n",
+    "errors": "err",
+    "success_rate": "success",
+    "collision_rate": "collide",
+    "min_clearance": "min\nclear.\n[m]",
+    "detour_ratio": "detour\nratio",
+    "time_ratio": "time\nratio",
+    "decision_us_median": "decide\nµs\nmedian",
+    "decision_us_p99": "decide\nµs\np99",
+}
+
+
+def _summary_cell(col: str, value: Any) -> str:
+    if value is None:
+        return "-"
+    if col.endswith("_rate"):
+        return f"{100.0 * float(value):.1f}%"
+    if col in ("min_clearance", "detour_ratio", "time_ratio"):
+        return f"{float(value):.3f}"
+    if col.startswith("decision_us"):
+        return f"{float(value):.0f}"
+    return _fmt(value)
+
+
+@app.command()
+def bench(
+    campaign: Annotated[Path, typer.Argument(help="Campaign YAML file (scenarios × controllers).")],
+    engine: Annotated[
+        str, typer.Option(help="local (process pool) or ray (Ray tasks; extra uvnav[bench]).")
+    ] = "local",
+    workers: Annotated[
+        int | None, typer.Option(min=1, help="Worker processes / Ray CPUs (default: all CPUs).")
+    ] = None,
+    db: Annotated[Path, typer.Option(help="Results database (SQLite).")] = Path(
+        "results/bench.sqlite"
+    ),
+    resume: Annotated[
+        bool, typer.Option("--resume", help="Continue a campaign of the same name in --db.")
+    ] = False,
+    address: Annotated[
+        str | None, typer.Option(help="Ray cluster address (--engine ray; default: local Ray).")
+    ] = None,
+    retry_errors: Annotated[
+        bool, typer.Option("--retry-errors", help="With --resume: run 'error' episodes again.")
+    ] = False,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print the run and the summary as one JSON object.")
+    ] = False,
+) -> None:
+    """Run a benchmark campaign into a results database, then print a per-controller summary.
+
+    Each finished episode is stored at once (one transaction), so an interrupted campaign resumes
+    with --resume and never duplicates an episode.
+    """
+    import os
+    import time
+
+    from uvnav.bench.campaign import ENGINES
+    from uvnav.bench.ray_engine import EngineUnavailableError, import_ray
+    from uvnav.bench.spec import load_campaign, run_campaign_spec
+    from uvnav.bench.store import ResultsStore
+    from uvnav.bench.summary import SUMMARY_COLUMNS, controller_summary
+
+    if engine not in ENGINES:
+        raise CliError(f"--engine {engine!r}: expected one of {', '.join(ENGINES)}")
+    if address is not None and engine != "ray":
+        raise CliError("--address needs --engine ray")
+    spec = load_campaign(campaign)
+    if engine == "ray":
+        try:
+            import_ray()  # before the database is created
+        except EngineUnavailableError as exc:
+            raise CliError(str(exc), code=1) from None
+    n_workers = workers or os.cpu_count() or 1
+    with ResultsStore(db) as store:
+        if resume:
+            before = next((c for c in store.campaigns() if c["name"] == spec.name), None)
+            if before is not None and before["config"] != spec.config():
+                typer.echo(
+                    f"warning: {campaign} changed since campaign {spec.name!r} was created; "
+                    "stored episodes are kept, new keys are run",
+                    err=True,
+                )
+        tic = time.perf_counter()
+        try:
+            result = run_campaign_spec(
+                store,
+                spec,
+                resume=resume,
+                engine=engine,
+                workers=n_workers,
+                address=address,
+                progress=not json_out,
+                retry_errors=retry_errors,
+            )
+        except EngineUnavailableError as exc:
+            raise CliError(str(exc), code=1) from None
+        except KeyboardInterrupt:
+            typer.echo(
+                f"interrupted: {store.count(spec.name)} episode(s) of {spec.name!r} are stored in "
+                f"{db}; run again with --resume to finish",
+                err=True,
+            )
+            raise typer.Exit(130) from None
+        elapsed = time.perf_counter() - tic
+        rows = controller_summary(store, spec.name)
+    rate = result.ran / elapsed if result.ran and elapsed > 0 else None
+    if json_out:
+        record = {
+            "campaign": spec.name,
+            "db": str(db),
+            "engine": engine,
+            "workers": n_workers,
+            "total": result.total,
+            "ran": result.ran,
+            "skipped": result.skipped,
+            "errors": result.errors,
+            "wall_time": elapsed,
+            "episodes_per_s": rate,
+            "controllers": rows,
+        }
+        typer.echo(_dumps(record))
+        return
+    from rich import box
+    from rich.table import Table
+
+    table = Table(
+        title=f"campaign {spec.name} ({result.total} episodes)",
+        box=box.SIMPLE_HEAD,
+        pad_edge=False,
+        collapse_padding=True,
+    )
+    numeric = [c for c in SUMMARY_COLUMNS if c in _SUMMARY_HEADERS]
+    table.add_column("controller\nparams", overflow="fold", ratio=1, min_width=12)
+    cells = [[_summary_cell(col, row[col]) for col in numeric] for row in rows]
+    for i, col in enumerate(numeric):
+        widest = max(len(r[i]) for r in cells) if cells else 1
+        head = _SUMMARY_HEADERS[col]
+        width = max(widest, *(len(w) for w in head.split("\n")))
+        table.add_column(head, justify="right", no_wrap=True, min_width=width)
+    for row, r in zip(rows, cells, strict=True):
+        label = (
+            row["controller"] if row["params"] == "-" else f"{row['controller']}\n{row['params']}"
+        )
+        table.add_row(_text(label), *(_text(c) for c in r))
+    _console().print(table)
+    speed = f", {rate:.2f} episodes/s" if rate is not None else ""
+    typer.echo(
+        f"ran {result.ran} episode(s) ({result.errors} error(s)), skipped {result.skipped} already "
+        f"stored, in {elapsed:.1f} s{speed} on {engine} × {n_workers}; results in {db}"
+    )
+
+
 def main() -> None:
     """Console-script entry point (``uvnav``)."""
     app(prog_name="uvnav")

@@ -1,0 +1,420 @@
+"""Campaign files: a YAML description of scenarios × controllers × seeds, expanded into jobs.
+
+Example (``uvnav bench ch2.yaml``)::
+
+    name: ch2-baselines            # campaign name in the results database (the resume identity)
+    description: optional text
+    scenarios:
+      - generator: random-ch2      # a key of uvnav.scenarios.GENERATORS
+        seeds: [0, 200]            # two integers: the range [start, stop)
+        params: {n_obstacles: 3}   # optional generator keyword arguments
+      - builtin: thesis-ch2-one-obstacle
+        seeds: {values: [0, 7]}    # explicit seeds (any list that is not two integers is too)
+      - file: scenes/corridor.yaml # a scenario YAML file, relative to this file
+        seeds: [0, 5]
+    controllers:
+      - name: zhang2019-v1
+        params: {alpha0: 0.1}                 # fixed parameters
+        grid: {switch_distance: [1.0, 1.5]}   # cartesian product of parameter values
+        oracle: false                         # true: ground-truth obstacle velocities
+      - name: savkin-wang2013-v1
+    record: false                  # store trajectories (figures; costs disk)
+
+Expansion (:meth:`CampaignSpec.jobs`): every scenario entry × every controller entry × every grid
+point × every seed is one :class:`~uvnav.bench.campaign.Job`; the episode seed is the scenario seed
+(for a generator, the same number draws the scene and seeds the episode).  Controller parameters are
+checked against the controller's ``Params`` when the file is loaded, so a typo stops the campaign
+before it starts rather than filling the database with ``error`` rows.
+
+The schema is pydantic v2 with ``extra="forbid"`` (DESIGN §3); :func:`load_campaign` turns every
+problem into one :class:`CampaignError` line ``FILE: FIELD: PROBLEM``.
+"""
+
+from __future__ import annotations
+
+import inspect
+import itertools
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import (
+    BaseModel,
+    ConfigDict,
+    Field,
+    PrivateAttr,
+    ValidationError,
+    ValidationInfo,
+    model_validator,
+)
+
+from uvnav.bench.campaign import CampaignRun, Job, run_campaign
+from uvnav.bench.store import ResultsStore
+from uvnav.controllers import ControllerParamsError, available_controllers, make_controller
+from uvnav.scenarios import GENERATORS, ScenarioError, list_builtin, load_scenario
+from uvnav.scenarios.errors import FieldError, from_validation_error
+
+
+class CampaignError(ScenarioError):
+    """A campaign file that cannot be loaded or run: ``source: field: problem`` on one line.
+
+    A subclass of :class:`~uvnav.scenarios.ScenarioError` (same attributes ``source``, ``path``,
+    ``problem``), so callers that report scenario errors report these the same way.
+    """
+
+
+class _Strict(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class SeedValues(_Strict):
+    """Explicit seeds, for when two seeds must not read as a range: ``{values: [3, 7]}``."""
+
+    values: list[int] = Field(min_length=1)
+
+
+def _seed_list(seeds: list[int] | SeedValues) -> list[int]:
+    """The seeds a ``seeds`` field means (raises :class:`FieldError` for a bad one)."""
+    if isinstance(seeds, SeedValues):
+        values = list(seeds.values)
+    elif len(seeds) == 2:
+        start, stop = seeds
+        if start >= stop:
+            raise FieldError(
+                "seeds",
+                f"[{start}, {stop}] is read as the range [start, stop) and needs start < stop "
+                "(write {values: [a, b]} for two explicit seeds)",
+            )
+        values = list(range(start, stop))
+    elif not seeds:
+        raise FieldError("seeds", "needs [start, stop) or a list of seeds (got an empty list)")
+    else:
+        values = list(seeds)
+    if min(values) < 0:
+        raise FieldError("seeds", f"seeds must be >= 0 (got {min(values)})")
+    if len(set(values)) != len(values):
+        dup = sorted({s for s in values if values.count(s) > 1})
+        raise FieldError("seeds", f"duplicate seed(s) {dup}")
+    return values
+
+
+class ScenarioEntry(_Strict):
+    """Where episodes come from: exactly one of ``generator``, ``builtin``, ``file``; and seeds.
+
+    Attributes:
+        generator: scenario generator name (a key of :data:`uvnav.scenarios.GENERATORS`).
+        builtin: built-in scenario name (``uvnav scenarios list``).
+        file: scenario YAML file, relative to the campaign file.
+        seeds: ``[start, stop]`` (a range), or any other list of seeds, or ``{values: [...]}``.
+        params: generator keyword arguments (generator entries only).
+    """
+
+    generator: str | None = None
+    builtin: str | None = None
+    file: str | None = None
+    seeds: list[int] | SeedValues
+    params: dict[str, Any] = Field(default_factory=dict)
+
+    _path: Path | None = PrivateAttr(default=None)
+
+    @model_validator(mode="after")
+    def _check(self, info: ValidationInfo) -> ScenarioEntry:
+        given = [k for k in ("generator", "builtin", "file") if getattr(self, k) is not None]
+        if len(given) != 1:
+            got = ", ".join(given) if given else "none"
+            raise FieldError("", f"needs exactly one of generator, builtin, file (got {got})")
+        _seed_list(self.seeds)
+        if self.generator is not None:
+            if self.generator not in GENERATORS:
+                known = ", ".join(sorted(GENERATORS))
+                raise FieldError(
+                    "generator", f"unknown generator {self.generator!r} (known: {known})"
+                )
+            try:
+                inspect.signature(GENERATORS[self.generator]).bind(0, **self.params)
+            except TypeError as exc:
+                raise FieldError("params", f"{self.generator}: {exc}") from None
+            return self
+        if self.params:
+            raise FieldError("params", "only generator entries take params")
+        if self.builtin is not None and self.builtin not in list_builtin():
+            raise FieldError(
+                "builtin",
+                f"unknown built-in scenario {self.builtin!r} (known: {', '.join(list_builtin())}; "
+                "for a YAML file use file:)",
+            )
+        if self.file is not None:
+            base = (info.context or {}).get("base_dir") or Path.cwd()
+            path = Path(self.file).expanduser()
+            self._path = path if path.is_absolute() else Path(base) / path
+            if not self._path.is_file():
+                raise FieldError("file", f"no such scenario file {str(self._path)!r}")
+        return self
+
+    def seed_list(self) -> list[int]:
+        """The seeds of this entry, in order."""
+        return _seed_list(self.seeds)
+
+    def job(self, controller: str, params: Mapping[str, Any], seed: int, record: bool) -> Job:
+        """The job of one controller parameter set and one seed on this scenario entry."""
+        if self.generator is not None:
+            return Job(
+                controller=controller,
+                params=params,
+                seed=seed,
+                generator_seed=seed,
+                generator=self.generator,
+                generator_params=self.params,
+                record=record,
+            )
+        if self.builtin is not None:
+            return Job(
+                controller=controller,
+                params=params,
+                seed=seed,
+                scenario=self.builtin,
+                record=record,
+            )
+        assert self.file is not None and self._path is not None
+        return Job(
+            controller=controller,
+            params=params,
+            seed=seed,
+            scenario=str(self._path),
+            label=self.file,  # the key keeps the path as written, so a moved tree still resumes
+            record=record,
+        )
+
+
+class ControllerEntry(_Strict):
+    """A controller with fixed parameters and an optional parameter grid.
+
+    Attributes:
+        name: registered controller name (``uvnav controllers list``).
+        params: fixed parameters (fields of the controller's ``Params``).
+        grid: parameter → list of values; the campaign runs the cartesian product (in the order
+            written), each point merged over ``params``.
+        oracle: give the controller ground-truth obstacle velocities (DESIGN §2); stored as the
+            parameter ``oracle: true``, so oracle and sensing runs of one law stay apart.
+    """
+
+    name: str
+    params: dict[str, Any] = Field(default_factory=dict)
+    grid: dict[str, list[Any]] = Field(default_factory=dict)
+    oracle: bool = False
+
+    @model_validator(mode="after")
+    def _check(self) -> ControllerEntry:
+        known = available_controllers()
+        if self.name not in known:
+            raise FieldError(
+                "name", f"unknown controller {self.name!r} (known: {', '.join(sorted(known))})"
+            )
+        if "oracle" in self.params or "oracle" in self.grid:
+            raise FieldError("params", "set oracle with the entry's own oracle: field")
+        for key, values in self.grid.items():
+            if not values:
+                raise FieldError(f"grid.{key}", "needs at least one value")
+            if key in self.params:
+                raise FieldError(f"grid.{key}", "is also in params (give it in one place)")
+        for point in self.param_sets():
+            try:
+                make_controller(self.name, **point)
+            except ControllerParamsError as exc:
+                where = "grid" if set(point) & set(self.grid) else "params"
+                raise FieldError(where, f"{self.name}: {exc}") from None
+        return self
+
+    def param_sets(self) -> list[dict[str, Any]]:
+        """Every parameter set of this entry (the grid's cartesian product over ``params``)."""
+        keys = list(self.grid)
+        sets = []
+        for values in itertools.product(*(self.grid[k] for k in keys)):
+            point = {**self.params, **dict(zip(keys, values, strict=True))}
+            if self.oracle:
+                point["oracle"] = True
+            sets.append(point)
+        return sets
+
+
+class CampaignSpec(_Strict):
+    """A campaign file (see the module docstring).
+
+    Attributes:
+        name: campaign name in the results database; running the file again resumes it.
+        description: free text.
+        scenarios: scenario entries.
+        controllers: controller entries.
+        record: store every episode's trajectory.
+    """
+
+    name: str = Field(min_length=1, pattern=r"^\S(.*\S)?$")
+    description: str = ""
+    scenarios: list[ScenarioEntry] = Field(min_length=1)
+    controllers: list[ControllerEntry] = Field(min_length=1)
+    record: bool = False
+
+    def jobs(self) -> list[Job]:
+        """The campaign's jobs: scenario entries × controller entries × grid points × seeds."""
+        return [
+            sc.job(ctrl.name, params, seed, self.record)
+            for sc in self.scenarios
+            for ctrl in self.controllers
+            for params in ctrl.param_sets()
+            for seed in sc.seed_list()
+        ]
+
+    def config(self) -> dict[str, Any]:
+        """What the store keeps with the campaign: the file's content, defaults filled in."""
+        return self.model_dump(mode="json")
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """SafeLoader that rejects duplicate mapping keys (a silently lost grid is a wrong result)."""
+
+
+def _unique_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode, deep: bool = False) -> Any:
+    seen: set[Any] = set()
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=deep)
+        if key in seen:
+            raise yaml.constructor.ConstructorError(
+                None, None, f"duplicate key {key!r}", key_node.start_mark
+            )
+        seen.add(key)
+    return loader.construct_mapping(node, deep=deep)
+
+
+_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _unique_mapping)
+
+
+def _allowed_fields(loc: tuple[str | int, ...]) -> list[str] | None:
+    model: Any = CampaignSpec
+    for part in loc:
+        if isinstance(part, int):
+            continue
+        if model is CampaignSpec and part == "scenarios":
+            model = ScenarioEntry
+        elif model is CampaignSpec and part == "controllers":
+            model = ControllerEntry
+        elif model is ScenarioEntry and part == "seeds":
+            model = SeedValues
+        elif part == "SeedValues":
+            continue
+        else:
+            return None
+    return list(model.model_fields)
+
+
+def campaign_from_dict(
+    data: Any, source: str = "<dict>", *, base_dir: str | Path | None = None
+) -> CampaignSpec:
+    """Validate a mapping as a :class:`CampaignSpec`.
+
+    Args:
+        data: the parsed YAML.
+        source: what to call the origin in error messages.
+        base_dir: directory that ``file:`` entries are relative to (default: the working directory).
+
+    Raises:
+        CampaignError: one line naming ``source``, the field and the problem.
+    """
+    if not isinstance(data, dict):
+        raise CampaignError(
+            source, "<root>", f"expected a mapping of campaign fields (got {type(data).__name__})"
+        )
+    try:
+        return CampaignSpec.model_validate(data, context={"base_dir": base_dir})
+    except ValidationError as exc:
+        err = from_validation_error(exc, source, allowed_fields=_allowed_fields)
+        raise CampaignError(source, _drop_union_tags(err.path), err.problem) from None
+
+
+def _drop_union_tags(path: str) -> str:
+    # ``seeds`` is ``list[int] | SeedValues``: pydantic names the failing branch in the location
+    parts = [p for p in path.split(".") if p not in ("list[int]", "SeedValues")]
+    return ".".join(parts)
+
+
+def load_campaign(path: str | Path) -> CampaignSpec:
+    """Read and validate a campaign file; ``file:`` scenarios are checked to load.
+
+    Raises:
+        CampaignError: missing file, malformed YAML, a schema violation, or a bad scenario file.
+    """
+    path = Path(path)
+    source = str(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise CampaignError(source, "", "no such campaign file") from None
+    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+        raise CampaignError(source, "", f"cannot read: {exc}") from None
+    try:
+        data = yaml.load(text, Loader=_UniqueKeyLoader)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        where = f"line {mark.line + 1}" if mark is not None else ""
+        what = exc.problem or exc.context or "cannot parse"
+        raise CampaignError(source, where, f"malformed YAML: {what}") from None
+    except yaml.YAMLError as exc:
+        raise CampaignError(source, "", f"malformed YAML: {exc}") from None
+    if data is None:
+        raise CampaignError(source, "", "empty file (expected a campaign mapping)")
+    spec = campaign_from_dict(data, source, base_dir=path.parent)
+    for i, entry in enumerate(spec.scenarios):
+        if entry.file is not None:
+            try:
+                load_scenario(str(entry._path))
+            except ScenarioError as exc:
+                raise CampaignError(source, f"scenarios.{i}.file", str(exc)) from None
+    return spec
+
+
+def run_campaign_spec(
+    store: ResultsStore,
+    spec: CampaignSpec,
+    *,
+    resume: bool = False,
+    engine: str = "local",
+    workers: int = 1,
+    address: str | None = None,
+    progress: bool = False,
+    retry_errors: bool = False,
+) -> CampaignRun:
+    """Run a campaign file's jobs into ``store`` (see :func:`~uvnav.bench.campaign.run_campaign`).
+
+    Args:
+        store: results store.
+        spec: the campaign.
+        resume: continue a campaign of the same name already in the store (skipping stored keys);
+            without it such a campaign is an error, so two different campaigns that share a name
+            never mix in one database.
+        engine: ``"local"`` or ``"ray"``.
+        workers: worker processes / Ray CPUs.
+        address: Ray cluster address.
+        progress: rich progress bar on stderr.
+        retry_errors: run again the episodes stored with status ``error``.
+
+    Raises:
+        CampaignError: the campaign exists and ``resume`` is false.
+    """
+    if not resume and store.campaign_id(spec.name) is not None:
+        raise CampaignError(
+            str(store.path),
+            "",
+            f"campaign {spec.name!r} is already in this database: pass --resume to continue it, "
+            "or --db for another database",
+        )
+    return run_campaign(
+        store,
+        spec.name,
+        spec.jobs(),
+        config=spec.config(),
+        workers=workers,
+        progress=progress,
+        retry_errors=retry_errors,
+        engine=engine,
+        address=address,
+    )

@@ -1,0 +1,98 @@
+"""Per-controller summary of a campaign: the table ``uvnav bench`` prints at the end.
+
+One row per (controller, parameter set), over every stored episode of the campaign:
+
+``episodes``, ``errors``
+    counts (``error`` rows are excluded from every rate and statistic below).
+``success_rate``, ``collision_rate``
+    fractions of the non-error episodes.
+``min_clearance`` [m]
+    the smallest ``min_clearance`` of any episode — the worst case, the safety number.
+``detour_ratio``, ``time_ratio``
+    means over the successful episodes (path length / straight distance; time / (distance/V_max)).
+``decision_us_median``, ``decision_us_p99`` [µs]
+    medians over episodes of each episode's median and p99 decision time (wall-clock: the only
+    columns that differ between two runs of the same campaign).
+
+The rows are computed from the episodes sorted by their resume key, so the same stored episodes give
+bit-identical numbers whatever order the engine finished them in.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+from uvnav.bench.store import STATUS_ERROR, ResultsStore
+
+#: Columns of a summary row, in display order.
+SUMMARY_COLUMNS = (
+    "controller",
+    "params",
+    "episodes",
+    "errors",
+    "success_rate",
+    "collision_rate",
+    "min_clearance",
+    "detour_ratio",
+    "time_ratio",
+    "decision_us_median",
+    "decision_us_p99",
+)
+
+#: Columns that are wall-clock measurements (not reproducible from run to run).
+TIMING_COLUMNS = ("decision_us_median", "decision_us_p99")
+
+
+def _num(value: Any) -> float | None:
+    """A pandas scalar as a float, ``None`` for missing."""
+    if value is None:
+        return None
+    v = float(value)
+    return v if math.isfinite(v) else None
+
+
+def params_text(params_json: str) -> str:
+    """``{"a":1,"b":2}`` → ``a=1 b=2`` (``-`` for no parameters)."""
+    params = json.loads(params_json) if params_json else {}
+    if not params:
+        return "-"
+    return " ".join(f"{k}={json.dumps(v)}" for k, v in sorted(params.items()))
+
+
+def controller_summary(store: ResultsStore, campaign: int | str) -> list[dict[str, Any]]:
+    """Summary rows (see the module docstring) of one campaign, sorted by controller and params.
+
+    Returns:
+        One dict per (controller, parameter set) with the keys of :data:`SUMMARY_COLUMNS`;
+        ``params`` is ``k=v`` text.  Statistics without data (no success, all errors) are ``None``.
+    """
+    df = store.episodes_frame(campaign)
+    if df.empty:
+        return []
+    df = df.sort_values(["controller", "params_hash", "scenario", "seed"], kind="mergesort")
+    rows: list[dict[str, Any]] = []
+    for (controller, _), group in df.groupby(["controller", "params_hash"], sort=True):
+        ok = group[group["status"] != STATUS_ERROR]
+        success = ok["success"].fillna(False).astype(bool)
+        collision = ok["collision"].fillna(False).astype(bool)
+        wins = ok[success]
+        n = len(ok)
+        rows.append(
+            {
+                "controller": str(controller),
+                "params": params_text(str(group["params"].iloc[0])),
+                "episodes": len(group),
+                "errors": len(group) - n,
+                "success_rate": _num(success.mean()) if n else None,
+                "collision_rate": _num(collision.mean()) if n else None,
+                "min_clearance": _num(ok["min_clearance"].min()) if n else None,
+                "detour_ratio": _num(wins["detour_ratio"].mean()) if len(wins) else None,
+                "time_ratio": _num(wins["time_ratio"].mean()) if len(wins) else None,
+                "decision_us_median": _num(ok["decision_us_median"].median()) if n else None,
+                "decision_us_p99": _num(ok["decision_us_p99"].median()) if n else None,
+            }
+        )
+    rows.sort(key=lambda r: (r["controller"], r["params"]))
+    return rows

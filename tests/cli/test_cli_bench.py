@@ -1,0 +1,162 @@
+"""``uvnav bench``: table, JSON, resume rules, one-line errors, and resume after a SIGKILL."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+from typer.testing import CliRunner
+
+from uvnav.bench.summary import TIMING_COLUMNS
+from uvnav.cli.app import app
+
+runner = CliRunner()
+
+CAMPAIGN = """\
+name: cli-small
+scenarios:
+  - generator: random-ch2
+    seeds: [0, 2]
+controllers:
+  - name: straight-v1
+  - name: zhang2019-v1
+    grid: {switch_distance: [1.0, 1.5]}
+"""
+
+# 30 episodes, long enough (~0.1-0.2 s each) to be killed in the middle
+KILLED = """\
+name: kill-me
+scenarios:
+  - generator: random-ch2
+    seeds: [0, 15]
+controllers:
+  - name: zhang2019-v1
+  - name: savkin-wang2013-v1
+"""
+
+
+def invoke(*args: str) -> Any:
+    return runner.invoke(app, list(args))
+
+
+def deterministic(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    return [{k: v for k, v in r.items() if k not in TIMING_COLUMNS} for r in rows]
+
+
+@pytest.fixture
+def campaign(tmp_path: Path) -> Path:
+    path = tmp_path / "campaign.yaml"
+    path.write_text(CAMPAIGN)
+    return path
+
+
+def test_bench_prints_the_per_controller_table(campaign: Path, tmp_path: Path) -> None:
+    db = tmp_path / "r.sqlite"
+    args = ["bench", str(campaign), "--db", str(db), "--workers", "1"]
+    result = runner.invoke(app, args, env={"COLUMNS": "160"})
+    assert result.exit_code == 0, result.output
+    out = result.stdout
+    assert "campaign cli-small (6 episodes)" in out
+    for text in ("straight-v1", "switch_distance=1.0", "switch_distance=1.5", "success", "µs"):
+        assert text in out
+    assert "ran 6 episode(s)" in out and str(db) in out
+
+    again = invoke("bench", str(campaign), "--db", str(db))
+    line = assert_one_line_error(again, 2)
+    assert "campaign 'cli-small' is already in this database" in line
+    assert "--resume" in line and "--db" in line
+
+    resumed = invoke("bench", str(campaign), "--db", str(db), "--resume", "--json")
+    assert resumed.exit_code == 0, resumed.output
+    record = json.loads(resumed.stdout)
+    assert (record["total"], record["ran"], record["skipped"]) == (6, 0, 6)
+    rows = record["controllers"]
+    assert [(r["controller"], r["params"], r["episodes"]) for r in rows] == [
+        ("straight-v1", "-", 2),
+        ("zhang2019-v1", "switch_distance=1.0", 2),
+        ("zhang2019-v1", "switch_distance=1.5", 2),
+    ]
+    assert rows[1]["success_rate"] == 1.0 and rows[1]["collision_rate"] == 0.0
+    assert rows[1]["detour_ratio"] >= 1.0 and rows[1]["decision_us_median"] > 0
+
+
+def assert_one_line_error(result: Any, code: int, *fragments: str) -> str:
+    assert result.exit_code == code, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1, result.stderr
+    assert lines[0].startswith("error: ") and "Traceback" not in result.output
+    for fragment in fragments:
+        assert fragment in lines[0]
+    return lines[0]
+
+
+def test_bench_errors_are_one_line(
+    campaign: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(CAMPAIGN.replace("switch_distance", "switch_distanse"))
+    assert_one_line_error(
+        invoke("bench", str(bad)), 2, str(bad), "controllers.1.grid", "switch_distanse"
+    )
+    assert_one_line_error(invoke("bench", str(tmp_path / "none.yaml")), 2, "no such campaign file")
+    assert_one_line_error(invoke("bench", str(campaign), "--engine", "dask"), 2, "--engine")
+    assert_one_line_error(invoke("bench", str(campaign), "--address", "auto"), 2, "--engine ray")
+    monkeypatch.setitem(sys.modules, "ray", None)  # as if Ray were not installed
+    db = tmp_path / "r.sqlite"
+    assert_one_line_error(
+        invoke("bench", str(campaign), "--engine", "ray", "--db", str(db)), 1, "uvnav[bench]"
+    )
+    assert not db.exists()  # nothing was started
+
+
+def stored(db: Path) -> int:
+    try:
+        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=1.0) as conn:
+            return int(conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0])
+    except sqlite3.OperationalError:  # not created yet
+        return 0
+
+
+def test_sigkill_then_resume_equals_an_uninterrupted_run(tmp_path: Path) -> None:
+    path = tmp_path / "kill.yaml"
+    path.write_text(KILLED)
+    db = tmp_path / "killed.sqlite"
+    cmd = [sys.executable, "-m", "uvnav.cli", "bench", str(path), "--db", str(db), "--workers", "2"]
+    # own session, so the kill reaches the fork server and the workers too (a machine going down)
+    proc = subprocess.Popen(
+        cmd, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True
+    )
+    try:
+        deadline = time.monotonic() + 60
+        while stored(db) < 5 and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.02)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    at_kill = stored(db)
+    assert 5 <= at_kill < 30, f"killed with {at_kill} of 30 episodes stored"
+
+    resumed = invoke("bench", str(path), "--db", str(db), "--resume", "--workers", "2", "--json")
+    assert resumed.exit_code == 0, resumed.output
+    record = json.loads(resumed.stdout)
+    assert record["skipped"] == at_kill and record["ran"] == 30 - at_kill
+
+    fresh = invoke("bench", str(path), "--db", str(tmp_path / "fresh.sqlite"), "--json")
+    assert fresh.exit_code == 0, fresh.output
+    assert deterministic(record["controllers"]) == deterministic(
+        json.loads(fresh.stdout)["controllers"]
+    )
+    with sqlite3.connect(db) as conn:
+        n, keys = conn.execute(
+            "SELECT COUNT(*), COUNT(DISTINCT scenario || controller || params_hash || seed) "
+            "FROM episodes"
+        ).fetchone()
+    assert n == keys == 30
