@@ -163,7 +163,15 @@ def test_reproduce_end_to_end_resume_and_staleness(
     thesis = [n for n in scenarios.list_builtin() if n.startswith(rp.THESIS_PREFIX)]
     assert rp.COMPARISON_SCENE in thesis
     laws = ("straight-v1", TWIN)
-    kw: dict[str, Any] = dict(n_random=3, controllers=laws, workers=1, progress=False)
+    kw: dict[str, Any] = dict(
+        n_random=3,
+        controllers=laws,
+        workers=1,
+        progress=False,
+        baselines=("apf-v1",),
+        n_baseline_seeds=2,
+        n_crowd_seeds=1,
+    )
     # pin the fingerprint: concurrent edits of the tree must not look like stale results
     monkeypatch.setattr(rp, "code_fingerprint", lambda: "a" * 16)
     from uvnav.viz.reproduction import render_reproduction
@@ -212,3 +220,25 @@ def test_reproduce_end_to_end_resume_and_staleness(
     assert (c["ran"], c["skipped"], c["rerun_stale"]) == (6, 0, True)
     with ResultsStore(summary.db_path) as store:
         assert store.count(rp.RANDOM_CAMPAIGN) == 6
+
+
+def test_baseline_and_crowd_rows_come_from_the_store(tmp_path: Path) -> None:
+    """The beyond-the-thesis rows count the stored baseline and crowd episodes."""
+    summary = rp.reproduce(
+        tmp_path / "results",
+        tmp_path / "report",
+        render=None,
+        n_random=1,
+        controllers=("straight-v1",),
+        baselines=("apf-v1",),
+        n_baseline_seeds=2,
+        n_crowd_seeds=1,
+        workers=1,
+        progress=False,
+    )
+    rows = {r["quantity"]: r for r in summary.table}
+    assert rows["success rate, random-ch2, apf-v1"]["measured"].endswith("/2)")
+    crowd = [q for q in rows if q.startswith("success rate, crowd-")]
+    assert {q.split(", ")[1].split("[")[0] for q in crowd} == {"crowd-eth", "crowd-hotel"}
+    assert all(rows[q]["measured"].endswith("/1)") for q in crowd)
+    assert "do not react" in rows[crowd[0]]["note"]
