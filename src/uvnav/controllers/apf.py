@@ -45,7 +45,12 @@ from typing import ClassVar
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, heading_rate_toward, register
+from uvnav.controllers.base import (
+    ControllerInfo,
+    check_params,
+    heading_rate_toward,
+    register,
+)
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.small import wrap
@@ -87,42 +92,31 @@ class ApfParams:
     escape_timeout: float = 40.0
 
     def __post_init__(self) -> None:
-        for name in (
-            "attract_gain",
-            "attract_switch",
-            "influence",
-            "min_distance",
-            "stall_window",
-            "follow_distance",
-            "escape_timeout",
-        ):
-            value = getattr(self, name)
-            if not _is_number(value) or value <= 0:
-                raise ValueError(f"{name} must be a number > 0 (got {value!r})")
-        for name in (
-            "repulse_gain",
-            "stall_progress",
-            "stall_force",
-            "follow_gain",
-            "leave_margin",
-        ):
-            value = getattr(self, name)
-            if not _is_number(value) or value < 0:
-                raise ValueError(f"{name} must be a number >= 0 (got {value!r})")
+        check_params(
+            self,
+            positive=(
+                "attract_gain",
+                "attract_switch",
+                "influence",
+                "min_distance",
+                "stall_window",
+                "follow_distance",
+                "escape_timeout",
+            ),
+            non_negative=(
+                "repulse_gain",
+                "stall_progress",
+                "stall_force",
+                "follow_gain",
+                "leave_margin",
+            ),
+        )
         if self.min_distance >= self.influence:
             raise ValueError(
                 f"min_distance must be < influence (got {self.min_distance} >= {self.influence})"
             )
         if not isinstance(self.escape, bool):
             raise ValueError(f"escape must be a bool (got {self.escape!r})")
-
-
-def _is_number(value: object) -> bool:
-    return (
-        isinstance(value, int | float)
-        and not isinstance(value, bool)
-        and math.isfinite(float(value))
-    )
 
 
 def attractive_force(

@@ -14,7 +14,7 @@ it from keyword arguments and rejects unknown names with a clear message.
 from __future__ import annotations
 
 import dataclasses
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from importlib import import_module
 from importlib.metadata import entry_points
@@ -159,6 +159,32 @@ def params_dict(params: Any) -> dict[str, Any]:
         if params is not None and dataclasses.is_dataclass(params) and not isinstance(params, type)
         else {}
     )
+
+
+def is_number(value: object) -> bool:
+    """True for a finite int or float (``bool`` excluded)."""
+    return (
+        isinstance(value, int | float) and not isinstance(value, bool) and np.isfinite(float(value))
+    )
+
+
+def check_params(
+    params: Any, *, positive: Sequence[str] = (), non_negative: Sequence[str] = ()
+) -> None:
+    """Validate numeric fields of a parameter dataclass in ``__post_init__``.
+
+    Raises:
+        ValueError: naming the first field that is not a finite number > 0 (``positive``) or
+            >= 0 (``non_negative``).
+    """
+    for name in positive:
+        value = getattr(params, name)
+        if not is_number(value) or value <= 0:
+            raise ValueError(f"{name} must be a number > 0 (got {value!r})")
+    for name in non_negative:
+        value = getattr(params, name)
+        if not is_number(value) or value < 0:
+            raise ValueError(f"{name} must be a number >= 0 (got {value!r})")
 
 
 def saturate(value: float, limit: float) -> float:

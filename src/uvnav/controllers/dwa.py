@@ -74,7 +74,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, register
+from uvnav.controllers.base import ControllerInfo, check_params, register
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.geometry.angles import FloatArray
 from uvnav.sensors.observation import Observation, ObstacleReading
@@ -124,27 +124,24 @@ class DwaParams:
             value = getattr(self, name)
             if not isinstance(value, int) or isinstance(value, bool) or value < 2:
                 raise ValueError(f"{name} must be an integer >= 2 (got {value!r})")
-        for name in (
-            "horizon",
-            "rollout_dt",
-            "max_accel",
-            "max_ang_accel",
-            "brake_accel",
-            "clearance_cap",
-        ):
-            value = getattr(self, name)
-            if not _is_number(value) or value <= 0:
-                raise ValueError(f"{name} must be a number > 0 (got {value!r})")
-        for name in (
-            "heading_weight",
-            "clearance_weight",
-            "velocity_weight",
-            "heading_time",
-            "safety_margin",
-        ):
-            value = getattr(self, name)
-            if not _is_number(value) or value < 0:
-                raise ValueError(f"{name} must be a number >= 0 (got {value!r})")
+        check_params(
+            self,
+            positive=(
+                "horizon",
+                "rollout_dt",
+                "max_accel",
+                "max_ang_accel",
+                "brake_accel",
+                "clearance_cap",
+            ),
+            non_negative=(
+                "heading_weight",
+                "clearance_weight",
+                "velocity_weight",
+                "heading_time",
+                "safety_margin",
+            ),
+        )
         if self.rollout_dt > self.horizon:
             raise ValueError(
                 f"rollout_dt must be <= horizon (got {self.rollout_dt} > {self.horizon})"
@@ -153,14 +150,6 @@ class DwaParams:
             raise ValueError("horizon / rollout_dt must be <= 200 rollout steps")
         if not isinstance(self.predict_motion, bool):
             raise ValueError(f"predict_motion must be a bool (got {self.predict_motion!r})")
-
-
-def _is_number(value: object) -> bool:
-    return (
-        isinstance(value, int | float)
-        and not isinstance(value, bool)
-        and math.isfinite(float(value))
-    )
 
 
 def rollout_times(horizon: float, step: float) -> FloatArray:

@@ -81,7 +81,13 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, heading_rate_toward, register
+from uvnav.controllers.base import (
+    ControllerInfo,
+    check_params,
+    heading_rate_toward,
+    is_number,
+    register,
+)
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.sensors.observation import Observation, ObstacleReading
@@ -135,28 +141,28 @@ class OrcaParams:
     static_speed: float = 0.01
 
     def __post_init__(self) -> None:
-        for name in ("time_horizon", "time_horizon_obst", "neighbor_dist"):
-            value = getattr(self, name)
-            if not _is_number(value) or value <= 0:
-                raise ValueError(f"{name} must be a number > 0 (got {value!r})")
-        for name in ("safety_margin", "static_speed"):
-            value = getattr(self, name)
-            if not _is_number(value) or value < 0:
-                raise ValueError(f"{name} must be a number >= 0 (got {value!r})")
+        check_params(
+            self,
+            positive=(
+                "time_horizon",
+                "time_horizon_obst",
+                "neighbor_dist",
+            ),
+            non_negative=(
+                "safety_margin",
+                "static_speed",
+            ),
+        )
         if (
             not isinstance(self.max_neighbors, int)
             or isinstance(self.max_neighbors, bool)
             or self.max_neighbors < 1
         ):
             raise ValueError(f"max_neighbors must be an integer >= 1 (got {self.max_neighbors!r})")
-        if not _is_number(self.responsibility) or not 0.0 < self.responsibility <= 1.0:
+        if not is_number(self.responsibility) or not 0.0 < self.responsibility <= 1.0:
             raise ValueError(f"responsibility must be in (0, 1] (got {self.responsibility!r})")
         if not isinstance(self.static_polygons, bool):
             raise ValueError(f"static_polygons must be a bool (got {self.static_polygons!r})")
-
-
-def _is_number(value: object) -> bool:
-    return isinstance(value, int | float) and not isinstance(value, bool) and math.isfinite(value)
 
 
 # -- RVO2's linear programs, in float64 (port of Agent.cc linearProgram1-3) -------------------

@@ -43,7 +43,7 @@ from typing import ClassVar
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, heading_rate_toward, register
+from uvnav.controllers.base import ControllerInfo, check_params, heading_rate_toward, register
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.sensors.observation import Observation, ObstacleReading
@@ -65,12 +65,9 @@ class SavkinWang2013Params:
     alpha0_min: float = 0.0
 
     def __post_init__(self) -> None:
-        for name in ("switch_distance", "safe_distance", "alpha0_min"):
-            value = getattr(self, name)
-            if not isinstance(value, int | float) or not math.isfinite(value) or value < 0:
-                raise ValueError(f"{name} must be a number >= 0 (got {value!r})")
-        if self.switch_distance <= 0:
-            raise ValueError(f"switch_distance must be > 0 (got {self.switch_distance})")
+        check_params(
+            self, positive=("switch_distance",), non_negative=("safe_distance", "alpha0_min")
+        )
         if self.alpha0_min >= 0.5 * math.pi:
             raise ValueError(f"alpha0_min must be < pi/2 rad (got {self.alpha0_min})")
 

@@ -80,7 +80,7 @@ from typing import ClassVar, Literal
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, heading_rate_toward, register
+from uvnav.controllers.base import ControllerInfo, check_params, heading_rate_toward, register
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.segments import points_to_segments
@@ -124,16 +124,15 @@ class Zhang2019Params:
     turn_slowdown: bool = True
 
     def __post_init__(self) -> None:
-        for name in ("alpha0", "switch_distance", "forecast_horizon", "threat_horizon"):
-            value = getattr(self, name)
-            if not isinstance(value, int | float) or not np.isfinite(value) or value <= 0:
-                raise ValueError(f"{name} must be a number > 0 (got {value!r})")
+        check_params(
+            self,
+            positive=("alpha0", "switch_distance", "forecast_horizon", "threat_horizon"),
+            non_negative=("safety_margin", "min_speed"),
+        )
         if self.alpha0 >= 0.5 * np.pi:
             raise ValueError(f"alpha0 must be < pi/2 rad (got {self.alpha0})")
-        for name in ("safety_margin", "min_speed"):
-            value = getattr(self, name)
-            if not isinstance(value, int | float) or not np.isfinite(value) or value < 0:
-                raise ValueError(f"{name} must be a number >= 0 (got {value!r})")
+        if not isinstance(self.turn_slowdown, bool):
+            raise ValueError(f"turn_slowdown must be a bool (got {self.turn_slowdown!r})")
         if self.tangent_rule not in ("side", "min_beta"):
             raise ValueError(
                 f"tangent_rule must be 'side' or 'min_beta' (got {self.tangent_rule!r})"
