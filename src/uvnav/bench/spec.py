@@ -38,7 +38,6 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-import yaml
 from pydantic import (
     BaseModel,
     ConfigDict,
@@ -54,6 +53,7 @@ from uvnav.bench.store import ResultsStore
 from uvnav.controllers import ControllerParamsError, available_controllers, make_controller
 from uvnav.scenarios import GENERATORS, ScenarioError, list_builtin, load_scenario
 from uvnav.scenarios.errors import FieldError, from_validation_error
+from uvnav.scenarios.loader import parse_yaml
 
 
 class CampaignError(ScenarioError):
@@ -270,25 +270,6 @@ class CampaignSpec(_Strict):
         return self.model_dump(mode="json")
 
 
-class _UniqueKeyLoader(yaml.SafeLoader):
-    """SafeLoader that rejects duplicate mapping keys (a silently lost grid is a wrong result)."""
-
-
-def _unique_mapping(loader: yaml.SafeLoader, node: yaml.MappingNode, deep: bool = False) -> Any:
-    seen: set[Any] = set()
-    for key_node, _ in node.value:
-        key = loader.construct_object(key_node, deep=deep)
-        if key in seen:
-            raise yaml.constructor.ConstructorError(
-                None, None, f"duplicate key {key!r}", key_node.start_mark
-            )
-        seen.add(key)
-    return loader.construct_mapping(node, deep=deep)
-
-
-_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _unique_mapping)
-
-
 def _allowed_fields(loc: tuple[str | int, ...]) -> list[str] | None:
     model: Any = CampaignSpec
     for part in loc:
@@ -351,17 +332,7 @@ def load_campaign(path: str | Path) -> CampaignSpec:
         raise CampaignError(source, "", "no such campaign file") from None
     except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
         raise CampaignError(source, "", f"cannot read: {exc}") from None
-    try:
-        data = yaml.load(text, Loader=_UniqueKeyLoader)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        where = f"line {mark.line + 1}" if mark is not None else ""
-        what = exc.problem or exc.context or "cannot parse"
-        raise CampaignError(source, where, f"malformed YAML: {what}") from None
-    except yaml.YAMLError as exc:
-        raise CampaignError(source, "", f"malformed YAML: {exc}") from None
-    if data is None:
-        raise CampaignError(source, "", "empty file (expected a campaign mapping)")
+    data = parse_yaml(text, source, kind="campaign", error=CampaignError)
     spec = campaign_from_dict(data, source, base_dir=path.parent)
     for i, entry in enumerate(spec.scenarios):
         if entry.file is not None:

@@ -58,8 +58,20 @@ _UniqueKeyLoader.add_constructor(
 )
 
 
-def parse_yaml(text: str, source: str) -> dict[str, Any]:
-    """Parse scenario YAML text into a mapping.
+def parse_yaml(
+    text: str,
+    source: str,
+    *,
+    kind: str = "scenario",
+    error: type[ScenarioError] = ScenarioError,
+) -> dict[str, Any]:
+    """Parse YAML text (duplicate keys rejected) into a mapping.
+
+    Args:
+        text: the YAML document.
+        source: file name for messages.
+        kind: what the document describes, for messages ("scenario", "campaign").
+        error: the :class:`ScenarioError` subclass to raise.
 
     Raises:
         ScenarioError: malformed YAML (with its line number) or a top level that is not a mapping.
@@ -70,14 +82,14 @@ def parse_yaml(text: str, source: str) -> dict[str, Any]:
         mark = exc.problem_mark or exc.context_mark
         where = f"line {mark.line + 1}" if mark is not None else ""
         what = exc.problem or exc.context or "cannot parse"
-        raise ScenarioError(source, where, f"malformed YAML: {what}") from None
+        raise error(source, where, f"malformed YAML: {what}") from None
     except yaml.YAMLError as exc:
-        raise ScenarioError(source, "", f"malformed YAML: {exc}") from None
+        raise error(source, "", f"malformed YAML: {exc}") from None
     if data is None:
-        raise ScenarioError(source, "", "empty file (expected a scenario mapping)")
+        raise error(source, "", f"empty file (expected a {kind} mapping)")
     if not isinstance(data, dict):
-        raise ScenarioError(
-            source, "<root>", f"expected a mapping of scenario fields (got {type(data).__name__})"
+        raise error(
+            source, "<root>", f"expected a mapping of {kind} fields (got {type(data).__name__})"
         )
     return data
 
