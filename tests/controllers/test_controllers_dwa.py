@@ -22,7 +22,6 @@ from uvnav.dynamics import UnicycleSpec
 from uvnav.dynamics.unicycle import unicycle_step
 from uvnav.obstacles import (
     ConstantVelocity,
-    DiscBody,
     Obstacle,
     ObstacleField,
     ObstacleState,
@@ -37,10 +36,7 @@ GOAL = np.array([10.0, 0.0])
 
 
 def disc(x: float, y: float, r: float, v: tuple[float, float] = (0.0, 0.0)) -> Obstacle:
-    vel = np.asarray(v, dtype=float)
-    return Obstacle(
-        DiscBody(r), ObstacleState(np.array([x, y]), velocity=vel), ConstantVelocity(vel)
-    )
+    return Obstacle.moving_disc((x, y), r, v)
 
 
 def observe(

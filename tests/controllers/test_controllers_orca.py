@@ -24,7 +24,6 @@ from uvnav.controllers.orca import (
 from uvnav.dynamics import UnicycleSpec
 from uvnav.obstacles import (
     ConstantVelocity,
-    DiscBody,
     Obstacle,
     ObstacleField,
     ObstacleState,
@@ -39,10 +38,7 @@ GOAL = np.array([10.0, 0.0])
 
 
 def disc(x: float, y: float, r: float, v: tuple[float, float] = (0.0, 0.0)) -> Obstacle:
-    vel = np.asarray(v, dtype=float)
-    return Obstacle(
-        DiscBody(r), ObstacleState(np.array([x, y]), velocity=vel), ConstantVelocity(vel)
-    )
+    return Obstacle.moving_disc((x, y), r, v)
 
 
 def polygon(vertices: list[tuple[float, float]], v: tuple[float, float] = (0.0, 0.0)) -> Obstacle:

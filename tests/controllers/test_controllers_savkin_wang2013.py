@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from uvnav.controllers import make_controller
 from uvnav.controllers.savkin_wang2013 import SavkinWang2013Controller, in_cone, widened_cone
 from uvnav.dynamics import UnicycleSpec
-from uvnav.obstacles import ConstantVelocity, DiscBody, Obstacle, ObstacleField, ObstacleState
+from uvnav.obstacles import Obstacle, ObstacleField
 from uvnav.scenarios import build_episode, load_scenario
 from uvnav.sensors import Observation, sense_obstacles
 from uvnav.sim import EpisodeSetup, run_episode, run_rng
@@ -22,10 +22,7 @@ GOAL = np.array([10.0, 0.0])
 
 
 def disc(x: float, y: float, r: float, v: tuple[float, float] = (0.0, 0.0)) -> Obstacle:
-    vel = np.asarray(v, dtype=float)
-    return Obstacle(
-        DiscBody(r), ObstacleState(np.array([x, y]), velocity=vel), ConstantVelocity(vel)
-    )
+    return Obstacle.moving_disc((x, y), r, v)
 
 
 def test_widened_cone_contains_the_disc_with_margin() -> None:

@@ -14,7 +14,6 @@ from uvnav.controllers.zhang2019 import Zhang2019Controller, group_around
 from uvnav.dynamics import UnicycleSpec
 from uvnav.obstacles import (
     ConstantVelocity,
-    DiscBody,
     Obstacle,
     ObstacleField,
     ObstacleState,
@@ -38,10 +37,7 @@ def observe(pose: list[float], obstacles: list[Obstacle], *, time: float = 0.0) 
 
 
 def disc(x: float, y: float, r: float = 0.5, v: tuple[float, float] = (0.0, 0.0)) -> Obstacle:
-    vel = np.asarray(v, dtype=float)
-    return Obstacle(
-        DiscBody(r), ObstacleState(np.array([x, y]), velocity=vel), ConstantVelocity(vel)
-    )
+    return Obstacle.moving_disc((x, y), r, v)
 
 
 def fresh() -> Zhang2019Controller:

@@ -33,7 +33,7 @@ from uvnav.geometry.polygons import (
     transform_rings,
 )
 from uvnav.obstacles.bodies import Body, DiscBody, PolygonBody
-from uvnav.obstacles.motion import MotionModel, ObstacleState
+from uvnav.obstacles.motion import ConstantVelocity, MotionModel, ObstacleState
 
 #: relative and absolute [m] slack of the bounding-disc cull (far above the rounding it covers)
 _CULL_REL = 1e-9
@@ -50,6 +50,20 @@ class Obstacle:
     state: ObstacleState
     motion: MotionModel
     name: str = ""
+
+    @classmethod
+    def moving_disc(
+        cls,
+        position: tuple[float, float] | FloatArray,
+        radius: float,
+        velocity: tuple[float, float] | FloatArray = (0.0, 0.0),
+        *,
+        name: str = "",
+    ) -> Obstacle:
+        """A disc of ``radius`` [m] at ``position`` [m] moving at constant ``velocity`` [m/s]."""
+        vel = np.asarray(velocity, dtype=float)
+        state = ObstacleState(np.asarray(position, dtype=float), velocity=vel)
+        return cls(DiscBody(float(radius)), state, ConstantVelocity(vel), name)
 
     def world_outline(self) -> FloatArray:
         """Boundary vertices in the world frame [m] (a fine polygon for discs; for plots)."""
