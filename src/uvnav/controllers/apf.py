@@ -47,11 +47,12 @@ import numpy as np
 
 from uvnav.controllers.base import (
     ControllerInfo,
+    UnicycleController,
     check_params,
     heading_rate_toward,
     register,
 )
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
+from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.small import wrap
 from uvnav.sensors.observation import Observation, ObstacleReading
@@ -171,19 +172,15 @@ def firas_force(
     return total
 
 
-class ApfController:
+class ApfController(UnicycleController):
     """Khatib's artificial potential field with a wall-following escape (module docstring)."""
 
     name: ClassVar[str] = "apf-v1"
 
     def __init__(self, params: ApfParams | None = None) -> None:
+        super().__init__()
         self.params = params or ApfParams()
-        self.oracle = False
-        self._spec = UnicycleSpec(1.0, 1.0)
-        self._goal = np.zeros(2)
         self._rng = np.random.default_rng(0)
-        self._mode = "M1"
-        self._last_t: float | None = None
         self._history: deque[tuple[float, float]] = deque()
         self._side = 1
         self._stall_distance = math.inf
@@ -191,16 +188,8 @@ class ApfController:
         #: number of stalls detected in the episode (for inspection and tests)
         self.stalls = 0
 
-    @property
-    def mode(self) -> str:
-        return self._mode
-
-    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
-        self._spec = spec
-        self._goal = np.asarray(goal, dtype=float)
+    def _reset_law(self, rng: np.random.Generator) -> None:
         self._rng = rng
-        self._mode = "M1"
-        self._last_t = None
         self._history.clear()
         self._side = 1
         self._stall_distance = math.inf
@@ -263,8 +252,7 @@ class ApfController:
     def act(self, obs: Observation) -> UnicycleCommand:
         spec = self._spec
         t = float(obs.time) if math.isfinite(obs.time) else 0.0
-        period = 0.1 if self._last_t is None else max(t - self._last_t, 1e-3)
-        self._last_t = t
+        period = self.decision_period(t)
         pos = np.asarray(obs.position, dtype=float)
         d_goal = float(np.hypot(*(self._goal - pos)))
         net = self.force(obs)

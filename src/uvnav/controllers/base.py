@@ -14,6 +14,7 @@ it from keyword arguments and rejects unknown names with a clear message.
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from importlib import import_module
@@ -159,6 +160,49 @@ def params_dict(params: Any) -> dict[str, Any]:
         if params is not None and dataclasses.is_dataclass(params) and not isinstance(params, type)
         else {}
     )
+
+
+class UnicycleController:
+    """State every unicycle law keeps: limits, goal, mode and the decision clock.
+
+    Subclasses call ``super().__init__()``, put their own per-episode state in
+    :meth:`_reset_law`, and get the decision period from :meth:`decision_period`.
+    """
+
+    name: ClassVar[str]
+    #: period [s] assumed at the first decision of an episode
+    FIRST_PERIOD: ClassVar[float] = 0.1
+
+    def __init__(self) -> None:
+        self.oracle = False
+        self._spec = UnicycleSpec(1.0, 1.0)
+        self._goal = np.zeros(2)
+        self._mode = "M1"
+        self._last_t: float | None = None
+
+    @property
+    def mode(self) -> str:
+        """Name of the current mode (for the mode-switch metric)."""
+        return self._mode
+
+    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
+        self._spec = spec
+        self._goal = np.asarray(goal, dtype=float)
+        self._mode = "M1"
+        self._last_t = None
+        self._reset_law(rng)
+
+    def _reset_law(self, rng: np.random.Generator) -> None:
+        """Reset the law's own per-episode state (none by default)."""
+
+    def decision_period(self, time: float) -> float:
+        """Time [s] since the previous decision (``FIRST_PERIOD`` at the first, at least 1 ms, and
+        ``FIRST_PERIOD`` for a non-finite time); advances the decision clock to ``time``."""
+        if not math.isfinite(time):
+            return self.FIRST_PERIOD
+        period = self.FIRST_PERIOD if self._last_t is None else max(time - self._last_t, 1e-3)
+        self._last_t = time
+        return period
 
 
 def is_number(value: object) -> bool:

@@ -74,8 +74,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, check_params, register
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
+from uvnav.controllers.base import ControllerInfo, UnicycleController, check_params, register
+from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray
 from uvnav.sensors.observation import Observation, ObstacleReading
 
@@ -286,32 +286,20 @@ def _polygon_gaps(
     return out
 
 
-class DwaController:
+class DwaController(UnicycleController):
     """Dynamic Window Approach (Fox, Burgard & Thrun 1997), see the module docstring."""
 
     name: ClassVar[str] = "dwa-v1"
 
     def __init__(self, params: DwaParams | None = None) -> None:
+        super().__init__()
         self.params = params or DwaParams()
-        self.oracle = False
-        self._spec = UnicycleSpec(1.0, 1.0)
-        self._goal = np.zeros(2)
-        self._mode = "M1"
-        self._last_t: float | None = None
         self._last_u = 0.0
         self._times = rollout_times(self.params.horizon, self.params.rollout_dt)
         #: the last decision's samples and scores (for inspection and tests)
         self.last_samples: tuple[FloatArray, FloatArray] | None = None
 
-    @property
-    def mode(self) -> str:
-        return self._mode
-
-    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
-        self._spec = spec
-        self._goal = np.asarray(goal, dtype=float)
-        self._mode = "M1"
-        self._last_t = None
+    def _reset_law(self, rng: np.random.Generator) -> None:
         self._last_u = 0.0
         self.last_samples = None
 
@@ -333,9 +321,7 @@ class DwaController:
 
     def act(self, obs: Observation) -> UnicycleCommand:
         p, spec = self.params, self._spec
-        period = 0.1 if self._last_t is None else max(obs.time - self._last_t, 1e-3)
-        period = min(period, 1.0) if math.isfinite(period) else 0.1
-        self._last_t = obs.time
+        period = min(self.decision_period(obs.time), 1.0)
         pose = np.asarray(obs.pose, dtype=float)
         v, u = self.window(float(obs.speed), period)
         times = self._times

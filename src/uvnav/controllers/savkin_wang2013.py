@@ -43,8 +43,14 @@ from typing import ClassVar
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, check_params, heading_rate_toward, register
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
+from uvnav.controllers.base import (
+    ControllerInfo,
+    UnicycleController,
+    check_params,
+    heading_rate_toward,
+    register,
+)
+from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.sensors.observation import Observation, ObstacleReading
 
@@ -103,32 +109,20 @@ def in_cone(direction: FloatArray, beta1: float, beta2: float) -> bool:
     return 0.0 < (ang - beta1) % (2.0 * math.pi) < width
 
 
-class SavkinWang2013Controller:
+class SavkinWang2013Controller(UnicycleController):
     """Savkin & Wang (2013), with the reconstruction described in the module docstring."""
 
     name: ClassVar[str] = "savkin-wang2013-v1"
 
     def __init__(self, params: SavkinWang2013Params | None = None) -> None:
+        super().__init__()
         self.params = params or SavkinWang2013Params()
-        self.oracle = False
-        self._spec = UnicycleSpec(1.0, 1.0)
-        self._goal = np.zeros(2)
-        self._mode = "M1"
         self._target_id: int | None = None
         self._side = 0
-        self._last_t: float | None = None
 
-    @property
-    def mode(self) -> str:
-        return self._mode
-
-    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
-        self._spec = spec
-        self._goal = np.asarray(goal, dtype=float)
-        self._mode = "M1"
+    def _reset_law(self, rng: np.random.Generator) -> None:
         self._target_id = None
         self._side = 0
-        self._last_t = None
 
     def alpha0(self, radius: float) -> float:
         """Cone widening alpha_0 = max(alpha0_min, arccos(R / (R + r_robot + d_safe))) [rad]."""
@@ -157,8 +151,7 @@ class SavkinWang2013Controller:
         return np.asarray(reading.velocity + rel, dtype=float)
 
     def act(self, obs: Observation) -> UnicycleCommand:
-        period = 0.1 if self._last_t is None else max(obs.time - self._last_t, 1e-6)
-        self._last_t = obs.time
+        period = self.decision_period(obs.time)
         pos = obs.position
         heading = obs.heading
         reading = obs.obstacles[0] if obs.obstacles else None

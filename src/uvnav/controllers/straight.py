@@ -11,8 +11,8 @@ from typing import ClassVar
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, heading_rate_toward, register
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
+from uvnav.controllers.base import ControllerInfo, UnicycleController, heading_rate_toward, register
+from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import wrap_scalar
 from uvnav.sensors.observation import Observation
 
@@ -29,28 +29,15 @@ class StraightParams:
     slow_radius: float = 0.0
 
 
-class StraightController:
+class StraightController(UnicycleController):
     name: ClassVar[str] = "straight-v1"
 
     def __init__(self, params: StraightParams | None = None) -> None:
+        super().__init__()
         self.params = params or StraightParams()
-        self.oracle = False
-        self._spec = UnicycleSpec(1.0, 1.0)
-        self._goal = np.zeros(2)
-        self._last_t: float | None = None
-
-    @property
-    def mode(self) -> str:
-        return "M1"
-
-    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
-        self._spec = spec
-        self._goal = np.asarray(goal, dtype=float)
-        self._last_t = None
 
     def act(self, obs: Observation) -> UnicycleCommand:
-        period = 0.1 if self._last_t is None else max(obs.time - self._last_t, 1e-6)
-        self._last_t = obs.time
+        period = self.decision_period(obs.time)
         to_goal = self._goal - obs.position
         err = wrap_scalar(float(np.arctan2(to_goal[1], to_goal[0])) - obs.heading)
         v = self._spec.v_max

@@ -80,8 +80,14 @@ from typing import ClassVar, Literal
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, check_params, heading_rate_toward, register
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
+from uvnav.controllers.base import (
+    ControllerInfo,
+    UnicycleController,
+    check_params,
+    heading_rate_toward,
+    register,
+)
+from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.segments import points_to_segments
 from uvnav.geometry.small import (
@@ -280,24 +286,16 @@ def group_around(
     return ObstacleGroup(tuple(members))
 
 
-class Zhang2019Controller:
+class Zhang2019Controller(UnicycleController):
     """Thesis Ch. 2 law; see the module docstring for the equations and interpretation choices."""
 
     name: ClassVar[str] = "zhang2019-v1"
 
     def __init__(self, params: Zhang2019Params | None = None) -> None:
+        super().__init__()
         self.params = params or Zhang2019Params()
-        self.oracle = False
-        self._spec = UnicycleSpec(1.0, 1.0)
-        self._goal = np.zeros(2)
-        self._mode = "M1"
         self._group_ids: frozenset[int] = frozenset()
         self._tag = 1
-        self._last_t: float | None = None
-
-    @property
-    def mode(self) -> str:
-        return self._mode
 
     @property
     def target_ids(self) -> frozenset[int]:
@@ -309,13 +307,9 @@ class Zhang2019Controller:
         """Current direction tag: +1 ('+', counter-clockwise round the obstacle) or -1."""
         return self._tag
 
-    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
-        self._spec = spec
-        self._goal = np.asarray(goal, dtype=float)
-        self._mode = "M1"
+    def _reset_law(self, rng: np.random.Generator) -> None:
         self._group_ids = frozenset()
         self._tag = 1
-        self._last_t = None
 
     # -- the pieces of §2.3 -------------------------------------------------------------------
 
@@ -475,8 +469,7 @@ class Zhang2019Controller:
     # -- the switching law ---------------------------------------------------------------------
 
     def act(self, obs: Observation) -> UnicycleCommand:
-        period = 0.1 if self._last_t is None else max(obs.time - self._last_t, 1e-6)
-        self._last_t = obs.time
+        period = self.decision_period(obs.time)
         p = self.params
         margin = self._spec.radius + p.safety_margin
         threat = None

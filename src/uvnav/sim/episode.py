@@ -325,10 +325,7 @@ def run_episode(
                     last_mode or "",
                     clearance,
                     nearest,
-                    field_now.centres,
-                    field_now.headings,
-                    field_now.velocities,
-                    field_now.angular_velocities,
+                    field_now,
                 )
             effort += applied.u**2 * dt
             nx, ny, th = unicycle_advance(x, y, th, applied.v, applied.u, dt)
@@ -363,10 +360,7 @@ def run_episode(
             last_mode or "",
             clearance,
             nearest,
-            field_now.centres,
-            field_now.headings,
-            field_now.velocities,
-            field_now.angular_velocities,
+            field_now,
         )
     dec = np.asarray(decision_us) if decision_us else np.zeros(1)
     success = status == "success"

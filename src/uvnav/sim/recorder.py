@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
+from uvnav.obstacles.obstacle import ObstacleField
 
 
 @dataclass
@@ -69,21 +70,20 @@ class TrajectoryRecorder:
         mode: str,
         clearance: float,
         nearest: int,
-        centres: FloatArray,
-        headings: FloatArray,
-        velocities: FloatArray,
-        omegas: FloatArray,
+        field: ObstacleField,
     ) -> None:
+        """One sample: time [s], robot pose, applied command, mode, clearance [m], nearest
+        obstacle index and the obstacles' state (``field``)."""
         self._t.append(t)
         self._robot.append(robot)
         self._cmd.append(command)
         self._mode.append(mode)
         self._clear.append(clearance)
         self._near.append(nearest)
-        self._oc.append(centres)
-        self._oh.append(headings)
-        self._ov.append(velocities)
-        self._ow.append(omegas)
+        self._oc.append(field.centres)
+        self._oh.append(field.headings)
+        self._ov.append(field.velocities)
+        self._ow.append(field.angular_velocities)
 
     def finish(self) -> Trajectory:
         k = len(self.shapes)
