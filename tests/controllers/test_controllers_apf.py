@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 import uvnav.controllers.apf  # noqa: F401  (registers apf-v1)
 from uvnav.controllers import ControllerParamsError, make_controller
@@ -17,12 +14,10 @@ from uvnav.dynamics import UnicycleSpec
 from uvnav.obstacles import (
     ConstantVelocity,
     Obstacle,
-    ObstacleField,
     ObstacleState,
     PolygonBody,
 )
 from uvnav.scenarios import build_episode, load_scenario
-from uvnav.sensors import Observation, sense_obstacles
 from uvnav.sim import EpisodeSetup, run_episode, run_rng
 
 SPEC = UnicycleSpec(v_max=0.707, u_max=1.414, radius=0.1)
@@ -103,38 +98,3 @@ def test_escape_is_deterministic_per_seed() -> None:
 def test_bad_parameters_are_rejected_with_the_field_name(bad: dict[str, Any], message: str) -> None:
     with pytest.raises(ControllerParamsError, match=message):
         make_controller("apf-v1", **bad)
-
-
-coords = st.floats(-2.0, 2.0, allow_nan=False)
-
-
-@settings(max_examples=60, deadline=None)
-@given(
-    rx=coords,
-    ry=coords,
-    th=st.floats(-math.pi, math.pi),
-    vx=st.floats(-1.0, 1.0),
-    vy=st.floats(-1.0, 1.0),
-    radius=st.floats(0.0, 1.0),
-    where=st.sampled_from(["boundary", "centre", "origin", "goal"]),
-)
-def test_commands_are_finite_and_within_limits_for_degenerate_geometry(
-    rx: float, ry: float, th: float, vx: float, vy: float, radius: float, where: str
-) -> None:
-    r = max(radius, 1e-6)
-    pose = {
-        "boundary": [rx + r, ry, th],
-        "centre": [rx, ry, th],
-        "origin": [0.0, 0.0, th],
-        "goal": [GOAL[0], GOAL[1], th],
-    }[where]
-    obstacles = [disc(rx, ry, r, (vx, vy)), disc(rx, ry, r)]
-    fld = ObstacleField.from_obstacles(obstacles)
-    p = np.asarray(pose, dtype=float)
-    readings = sense_obstacles(p[:2], fld)
-    ctrl = make_controller("apf-v1", stall_window=0.1)
-    ctrl.reset(SPEC, GOAL, np.random.default_rng(0))
-    for k in range(4):
-        cmd = ctrl.act(Observation(time=0.1 * k, pose=p, speed=0.0, goal=GOAL, obstacles=readings))
-        assert math.isfinite(cmd.v) and math.isfinite(cmd.u)
-        assert not cmd.violates(SPEC)

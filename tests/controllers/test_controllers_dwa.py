@@ -7,8 +7,6 @@ from typing import Any
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 import uvnav.controllers.dwa  # noqa: F401  (registers dwa-v1)
 from uvnav.controllers import ControllerParamsError, make_controller
@@ -135,48 +133,3 @@ def test_prediction_avoids_a_crossing_obstacle_that_a_static_window_would_hit() 
 def test_bad_parameters_are_rejected_with_the_field_name(bad: dict[str, Any], message: str) -> None:
     with pytest.raises(ControllerParamsError, match=message):
         make_controller("dwa-v1", **bad)
-
-
-coords = st.floats(-2.0, 2.0, allow_nan=False)
-
-
-@settings(max_examples=30, deadline=None)
-@given(
-    rx=coords,
-    ry=coords,
-    th=st.floats(-math.pi, math.pi),
-    vx=st.floats(-1.0, 1.0),
-    vy=st.floats(-1.0, 1.0),
-    radius=st.floats(0.0, 1.0),
-    where=st.sampled_from(["boundary", "centre", "origin"]),
-    speed=st.floats(0.0, 0.707),
-)
-def test_commands_are_finite_and_within_limits_for_degenerate_geometry(
-    rx: float,
-    ry: float,
-    th: float,
-    vx: float,
-    vy: float,
-    radius: float,
-    where: str,
-    speed: float,
-) -> None:
-    r = max(radius, 1e-6)
-    pose = {"boundary": [rx + r, ry, th], "centre": [rx, ry, th], "origin": [0.0, 0.0, th]}[where]
-    square = PolygonBody.from_vertices(
-        np.array([[0, 0], [1, 0], [1, 0], [1, 1], [0, 1]], dtype=float) * max(radius, 0.01)
-    )
-    obstacles = [
-        disc(rx, ry, r, (vx, vy)),
-        disc(rx, ry, r),
-        Obstacle(square, ObstacleState(np.array([rx, ry])), ConstantVelocity(np.zeros(2))),
-    ]
-    ctrl = fresh()
-    for k in range(3):
-        obs = observe(pose, obstacles, speed=speed)
-        obs = Observation(
-            time=0.1 * k, pose=obs.pose, speed=speed, goal=GOAL, obstacles=obs.obstacles
-        )
-        cmd = ctrl.act(obs)
-        assert math.isfinite(cmd.v) and math.isfinite(cmd.u)
-        assert not cmd.violates(SPEC)

@@ -6,8 +6,6 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
-from hypothesis import strategies as st
 
 from uvnav.controllers import ControllerParamsError, make_controller
 from uvnav.controllers.zhang2019 import Zhang2019Controller, group_around
@@ -155,39 +153,6 @@ def test_bad_parameters_are_rejected_with_the_field_name(
 ) -> None:
     with pytest.raises(ControllerParamsError, match=message):
         make_controller("zhang2019-v1", **bad)
-
-
-coords = st.floats(-3.0, 3.0, allow_nan=False)
-
-
-@settings(max_examples=60, deadline=None)
-@given(
-    rx=coords,
-    ry=coords,
-    th=st.floats(-math.pi, math.pi),
-    vx=st.floats(-2.0, 2.0),
-    vy=st.floats(-2.0, 2.0),
-    radius=st.floats(0.0, 1.0),
-    on_boundary=st.booleans(),
-)
-def test_commands_are_finite_and_within_limits_for_degenerate_geometry(
-    rx: float, ry: float, th: float, vx: float, vy: float, radius: float, on_boundary: bool
-) -> None:
-    """Robot on the boundary or inside, zero-size or zero-speed obstacles, ||v_i|| >= d: no NaN."""
-    centre = np.array([rx, ry])
-    # on_boundary: the robot exactly on the disc's boundary (or on its centre for r = 0)
-    pose = [rx + radius, ry, th] if on_boundary else [0.0, 0.0, th]
-    obstacles = [
-        disc(rx, ry, r=max(radius, 1e-6), v=(vx, vy)),
-        disc(rx, ry, r=max(radius, 1e-6), v=(0.0, 0.0)),
-    ]
-    ctrl = fresh()
-    for k in range(3):
-        cmd = ctrl.act(observe(pose, obstacles, time=0.1 * k))
-        assert math.isfinite(cmd.v) and math.isfinite(cmd.u)
-        assert 0.0 <= cmd.v <= SPEC.v_max + 1e-12
-        assert abs(cmd.u) <= SPEC.u_max + 1e-12
-    _ = centre
 
 
 def test_coincident_polygon_points_do_not_break_the_law() -> None:

@@ -234,8 +234,6 @@ def _prepare_campaign(store: ResultsStore, name: str, config: dict[str, Any], fr
 def _fmt_m(x: Any, digits: int = 2) -> str:
     if x is None or not np.isfinite(float(x)):
         return "n/a"
-    if float(x) >= 1e8:  # run_episode's "no obstacle" clearance
-        return "no obstacle"
     return f"{float(x):.{digits}f} m"
 
 

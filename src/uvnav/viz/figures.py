@@ -78,13 +78,9 @@ def snapshot_indices(n_samples: int, snapshots: int) -> np.ndarray:
     return np.unique(np.linspace(0, n_samples - 1, max(1, snapshots)).round().astype(int))
 
 
-#: ``run_episode`` reports ``min_clearance = 1e9`` [m] for a scene without obstacles: missing.
-NO_OBSTACLE_CLEARANCE = 1e8
-
-
 def _finite(a: np.ndarray) -> np.ndarray:
     out = np.asarray(a, dtype=float).copy()
-    out[~np.isfinite(out) | (out >= NO_OBSTACLE_CLEARANCE)] = np.nan
+    out[~np.isfinite(out)] = np.nan
     return out
 
 
@@ -269,11 +265,7 @@ def _draw_path_length(
 
 def _summary_line(result: EpisodeResult) -> str:
     m = result.metrics
-    clear = (
-        "n/a"
-        if m.min_clearance is None or m.min_clearance >= NO_OBSTACLE_CLEARANCE
-        else f"{m.min_clearance:.3f} m"
-    )
+    clear = "n/a" if m.min_clearance is None else f"{m.min_clearance:.3f} m"
     return f"status: {result.status}, path length {m.path_length:.2f} m, min clearance {clear}"
 
 
@@ -421,7 +413,7 @@ def _box(
     ref: float | None = None,
     ref_label: str = "",
 ) -> None:
-    data = [(name, v[np.isfinite(v) & (v < NO_OBSTACLE_CLEARANCE)]) for name, v in groups]
+    data = [(name, v[np.isfinite(v)]) for name, v in groups]
     data = [(name, v) for name, v in data if len(v)]
     if not data:
         ax.text(0.5, 0.5, "no data", ha="center", va="center", transform=ax.transAxes)

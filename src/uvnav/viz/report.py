@@ -40,8 +40,6 @@ SIMULATION_NOTE = (
 _TABLE_ORDER = ("quantity", "thesis", "measured", "note")
 _TEXT_COLUMNS = ("family", "controller")
 _MAX_ERRORS = 50
-#: ``run_episode`` reports ``min_clearance = 1e9`` [m] for scenes without obstacles.
-_NO_OBSTACLE_CLEARANCE = 1e8
 
 FigureSpec = Path | str | tuple[Path | str, str]
 
@@ -55,7 +53,7 @@ def _fmt(x: float | None, digits: int = 3) -> str:
 def _mean_median(values: pd.Series, digits: int = 3) -> str:
     """``"mean [95 % CI] / median"`` of the finite values (Student-t interval of the mean)."""
     v = values.to_numpy(dtype=float, na_value=np.nan)
-    v = v[np.isfinite(v) & (np.abs(v) < _NO_OBSTACLE_CLEARANCE)]
+    v = v[np.isfinite(v)]
     if not len(v):
         return "–"
     mean, median = float(np.mean(v)), float(np.median(v))
