@@ -89,7 +89,7 @@ from uvnav.controllers.base import (
 )
 from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-from uvnav.geometry.segments import points_to_segments
+from uvnav.geometry.polygons import points_to_segments
 from uvnav.geometry.small import (
     point_segment_distance,
     ray_circle_distance,

@@ -55,9 +55,3 @@ def signed_angle(from_vec: ArrayLike, to_vec: ArrayLike) -> FloatArray:
     cross = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
     dot = a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1]
     return wrap_to_pi(np.arctan2(cross, dot))
-
-
-def rotation_matrix(theta: float) -> FloatArray:
-    """2x2 rotation matrix for a counter-clockwise rotation by ``theta`` [rad]."""
-    c, s = np.cos(theta), np.sin(theta)
-    return np.array([[c, -s], [s, c]])

@@ -239,25 +239,19 @@ def segments_min_distance(
     # endpoints of the other segments against a-b
     ab_s = np.broadcast_to(a, starts.shape)
     ab_e = np.broadcast_to(b, starts.shape)
-    d3 = _points_to_segment(starts, ab_s, ab_e)
-    d4 = _points_to_segment(ends, ab_s, ab_e)
+    d3 = points_to_segments(starts, ab_s, ab_e)
+    d4 = points_to_segments(ends, ab_s, ab_e)
     return float(min(d1.min(), d2.min(), d3.min(), d4.min())) if len(starts) else np.inf
 
 
-def _points_to_segment(points: FloatArray, starts: FloatArray, ends: FloatArray) -> FloatArray:
+def points_to_segments(points: FloatArray, starts: FloatArray, ends: FloatArray) -> FloatArray:
+    """Distance [m] from each point to the matching segment ``starts[i]``-``ends[i]``;
+    (N, 2) arrays -> (N,)."""
     d = ends - starts
     len2 = np.maximum(np.einsum("ij,ij->i", d, d), _EPS)
     t = np.clip(np.einsum("ij,ij->i", points - starts, d) / len2, 0.0, 1.0)
     diff = starts + t[:, None] * d - points
     return np.sqrt(np.einsum("ij,ij->i", diff, diff))
-
-
-def point_segment_distance(point: FloatArray, a: FloatArray, b: FloatArray) -> float:
-    """Distance [m] from ``point`` to the segment ``a``-``b``."""
-    dist, _ = segment_nearest(
-        point, np.asarray(a, dtype=float)[None], np.asarray(b, dtype=float)[None]
-    )
-    return float(dist[0])
 
 
 # --------------------------------------------------------------------------------------------

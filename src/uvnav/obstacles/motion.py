@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Protocol
 
 import numpy as np
@@ -235,8 +235,3 @@ class Replay:
 
     def turn_bound(self) -> float:
         return np.inf
-
-
-def with_velocity(state: ObstacleState, velocity: FloatArray) -> ObstacleState:
-    """Copy of ``state`` with ``velocity`` replaced (for initial conditions)."""
-    return replace(state, velocity=np.asarray(velocity, dtype=float))

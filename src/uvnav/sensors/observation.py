@@ -9,7 +9,7 @@ simulator's sensing configuration and written in :attr:`ObstacleReading.velocity
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -83,7 +83,6 @@ class Observation:
     goal: FloatArray
     obstacles: tuple[ObstacleReading, ...] = ()
     lidar: LidarScan | None = None
-    extras: dict[str, float] = field(default_factory=dict)
 
     @property
     def position(self) -> FloatArray:
