@@ -38,7 +38,7 @@ def test_segment_polygon_distance_matches_shapely(
     ring: np.ndarray, ax: float, ay: float, bx: float, by: float
 ) -> None:
     poly = shapely.Polygon(ring)
-    if not poly.is_valid or poly.area < 1e-6:
+    if not poly.is_valid or poly.area < 1e-3:
         return
     seg = (
         shapely.LineString([(ax, ay), (bx, by)]) if (ax, ay) != (bx, by) else shapely.Point(ax, ay)
