@@ -8,7 +8,10 @@ and advances the common motion models in vectorised form:
   own generator with exactly the calls, in exactly the order, that ``RandomTurn.step`` makes
   (obstacles in index order), and the course, arena steering and pose updates done with the same
   floating-point operations, element by element;
-* any other model (``Waypoints``, ``Replay``, subclasses, third-party models): its own
+* a model class with a ``batch_group(models)`` classmethod (for instance the pedestrian replays
+  of :mod:`uvnav.scenarios.pedestrians`): one :class:`~uvnav.obstacles.motion.MotionGroup` call
+  per class and step;
+* any other model (``Waypoints``, ``Replay``, third-party models): its own
   ``step(state, t, dt)``, called per obstacle.
 
 The result is bit for bit what calling ``obstacle.motion.step`` on every obstacle gives (the test
@@ -28,7 +31,13 @@ from collections.abc import Sequence
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-from uvnav.obstacles.motion import ConstantVelocity, ObstacleState, RandomTurn, uniform_draw
+from uvnav.obstacles.motion import (
+    ConstantVelocity,
+    MotionGroup,
+    ObstacleState,
+    RandomTurn,
+    uniform_draw,
+)
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
 
 _Rows = slice | np.ndarray
@@ -184,6 +193,7 @@ class ObstacleBatch:
     __slots__ = (
         "_const",
         "_dt",
+        "_groups",
         "_inc",
         "_omega",
         "_omega_base",
@@ -206,6 +216,7 @@ class ObstacleBatch:
         cv: list[int] = []
         rt: list[int] = []
         other: list[int] = []
+        grouped: dict[type, list[int]] = {}
         for j, ob in enumerate(self.obstacles):
             st = ob.state
             x[0:2, j] = st.position
@@ -224,6 +235,8 @@ class ObstacleBatch:
                 rt.append(j)
             elif kind is ConstantVelocity:
                 cv.append(j)
+            elif callable(getattr(kind, "batch_group", None)):
+                grouped.setdefault(kind, []).append(j)
             else:
                 other.append(j)
         self._x = x
@@ -243,6 +256,10 @@ class ObstacleBatch:
         )
         self._other = other
         self._states = {j: obs[j].state for j in other}
+        self._groups: list[tuple[np.ndarray, MotionGroup]] = [
+            (np.array(idx, dtype=np.intp), kind.batch_group([obs[j].motion for j in idx]))  # type: ignore[attr-defined]
+            for kind, idx in grouped.items()
+        ]
         self._stepped = False
         self._dt = math.nan
         self._inc = np.zeros((2, k))
@@ -313,7 +330,7 @@ class ObstacleBatch:
         xn = np.empty((4, k))
         np.add(x[2:4], inc, out=xn[2:4])
         wrap_array_inplace(xn[2:4])
-        v = np.empty((2, k)) if not self._other else np.zeros((2, k))
+        v = np.empty((2, k)) if not (self._other or self._groups) else np.zeros((2, k))
         if self._const is not None:
             rows, vel, _ = self._const
             v[:, rows] = vel
@@ -329,8 +346,14 @@ class ObstacleBatch:
                 v[0, rows] = rnd.speed * np.cos(mid)
                 v[1, rows] = rnd.speed * np.sin(mid)
         np.add(x[0:2], v * dt, out=xn[0:2])
-        if self._other:
+        if self._other or self._groups:
             omega = omega.copy()
+            for idx, group in self._groups:
+                p, h, vel, om = group.step(x[0:2, idx], x[2, idx], t, dt)
+                xn[0:2, idx] = p
+                xn[2, idx] = h
+                v[:, idx] = vel
+                omega[idx] = om
             for j in self._other:
                 st = self.obstacles[j].motion.step(self._states[j], t, dt)
                 self._states[j] = st

@@ -54,6 +54,31 @@ class MotionModel(Protocol):
         ...
 
 
+class MotionGroup(Protocol):
+    """Several obstacles with the same motion model, advanced together as arrays.
+
+    A model class opts in by defining a classmethod ``batch_group(models) -> MotionGroup``;
+    :class:`~uvnav.obstacles.ObstacleBatch` then advances all obstacles of that class with one
+    :meth:`step` call instead of one ``model.step`` each.  The group must give, bit for bit, what
+    the models' own ``step`` gives (the state it needs beyond position and heading it keeps itself).
+    """
+
+    def step(
+        self, position: FloatArray, heading: FloatArray, t: float, dt: float
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """Advance from time ``t`` [s] by ``dt`` [s].
+
+        Args:
+            position: (2, m) mass centres at ``t`` [m], in the order the group was made.
+            heading: (m,) headings at ``t`` [rad].
+
+        Returns:
+            ``(position (2, m) [m], heading (m,) [rad], velocity (2, m) [m/s],
+            angular_velocity (m,) [rad/s])`` at ``t + dt`` (rates used over the step).
+        """
+        ...
+
+
 def uniform_draw(rng: np.random.Generator, bounds: Sequence[float]) -> float:
     """``float(rng.uniform(lo, hi))`` for ``bounds = (lo, hi)``: the same draw from the stream and
     the same number (numpy computes ``lo + (hi - lo) * random()``), several times faster for one

@@ -36,6 +36,7 @@ import gzip
 import itertools
 import math
 from collections import Counter
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from functools import cache
 from importlib import resources
@@ -45,6 +46,7 @@ import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.obstacles import DiscBody, Obstacle, ObstacleState, Replay
+from uvnav.obstacles.batch import wrap_array
 from uvnav.scenarios.errors import ScenarioError
 
 #: time between two annotations of the ETH/UCY recordings [s] (2.5 Hz)
@@ -374,6 +376,12 @@ class PedestrianReplay(Replay):
             position=new, heading=heading, velocity=velocity, angular_velocity=omega
         )
 
+    @classmethod
+    def batch_group(cls, models: Sequence[PedestrianReplay]) -> PedestrianReplayGroup:
+        """All of an episode's pedestrians advanced together (see
+        :class:`~uvnav.obstacles.motion.MotionGroup`)."""
+        return PedestrianReplayGroup(models)
+
     def speed_bound(self) -> float:
         """Largest segment speed of the track [m/s] (the parking jumps do not count)."""
         return float(np.max(np.hypot(*np.diff(self.positions, axis=0).T) / np.diff(self.times)))
@@ -474,3 +482,70 @@ def crowd_speed_stats(pieces: list[Track], duration: float) -> tuple[float, floa
     if total <= 0.0:
         return 0.0, 0.0
     return lengths / total, top
+
+
+class PedestrianReplayGroup:
+    """:meth:`PedestrianReplay.step` for many pedestrians at once, as arrays.
+
+    The tracks are packed into (m, L) arrays padded with +inf times, so a step costs a few array
+    operations whatever the number of pedestrians (a crowd scene has 50–100).  Every number is
+    computed with the scalar method's operations in the same order, so the results are bit for bit
+    those of calling ``step`` on each pedestrian (the test suite checks it).
+    """
+
+    def __init__(self, models: Sequence[PedestrianReplay]) -> None:
+        m = len(models)
+        width = max((len(r.times) for r in models), default=2)
+        self._t = np.full((m, width), np.inf)
+        self._x = np.zeros((m, width))
+        self._y = np.zeros((m, width))
+        self._last_seg = np.empty(m, dtype=np.intp)
+        for i, r in enumerate(models):
+            n = len(r.times)
+            self._t[i, :n] = r.times
+            self._x[i, :n] = r.positions[:, 0]
+            self._y[i, :n] = r.positions[:, 1]
+            self._last_seg[i] = n - 2
+        self._first = self._t[:, 0] - _TIME_EPS
+        self._end = self._t[np.arange(m), self._last_seg + 1] + _TIME_EPS
+        self._absent = np.array([r.absent for r in models], dtype=float).reshape(m, 2).T
+        self._rows = np.arange(m)
+
+    def _present(self, t: float) -> np.ndarray:
+        return (self._first <= t) & (t <= self._end)
+
+    def step(
+        self, position: FloatArray, heading: FloatArray, t: float, dt: float
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        """See :meth:`uvnav.obstacles.motion.MotionGroup.step`."""
+        t1 = t + dt
+        was = self._present(t)
+        now = self._present(t1)
+        seg = np.count_nonzero(self._t <= t1, axis=1) - 1
+        seg = np.minimum(np.maximum(seg, 0), self._last_seg)
+        rows = self._rows
+        ta = self._t[rows, seg]
+        tb = self._t[rows, seg + 1]
+        xa, xb = self._x[rows, seg], self._x[rows, seg + 1]
+        ya, yb = self._y[rows, seg], self._y[rows, seg + 1]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            s = np.minimum(np.maximum((t1 - ta) / (tb - ta), 0.0), 1.0)
+            new = np.stack(
+                (
+                    np.where(s == 1.0, xb, xa + s * (xb - xa)),
+                    np.where(s == 1.0, yb, ya + s * (yb - ya)),
+                )
+            )
+            span = tb - ta
+            track_v = np.stack(((xb - xa) / span, (yb - ya) / span))
+        new = np.where(now, new, self._absent)
+        vel = np.where(was, (new - position) / dt, track_v)
+        vel = np.where(now, vel, 0.0)
+        moving = (np.hypot(vel[0], vel[1]) > 1e-9).nonzero()[0]
+        new_heading = np.array(heading, dtype=float)
+        # math.atan2, as the scalar step: numpy's vectorised arctan2 may differ in the last bit
+        vx, vy = vel[0, moving].tolist(), vel[1, moving].tolist()
+        new_heading[moving] = [math.atan2(b, a) for a, b in zip(vx, vy, strict=True)]
+        diff = new_heading - heading
+        omega = np.where(was & now, wrap_array(diff) / dt, 0.0)
+        return new, new_heading, vel, omega
