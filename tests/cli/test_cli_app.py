@@ -386,8 +386,10 @@ def test_report_calls_write_report(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     db.write_bytes(b"")
     seen: list[tuple[Path, Path]] = []
 
-    def write_report(db_path: Path, out_dir: Path) -> Path:
+    def write_report(db_path: Path, out_dir: Path, bench_dir: Path | None = None) -> Path:
         seen.append((db_path, out_dir))
+        if bench_dir is not None and not (bench_dir / "summary.json").exists():
+            raise ValueError(f"{bench_dir}: benchmark file without the expected field 'targets'")
         return out_dir / "index.html"
 
     fake = types.ModuleType("uvnav.viz.report")
@@ -398,6 +400,11 @@ def test_report_calls_write_report(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     assert result.exit_code == 0, result.output
     assert seen == [(db, out)]
     assert "index.html" in result.stdout
+    missing = invoke("report", str(db), "--bench", str(tmp_path / "nope"))
+    assert missing.exit_code == 2 and "--bench must be a folder" in missing.output
+    broken = invoke("report", str(db), "--bench", str(tmp_path))
+    assert broken.exit_code == 2 and "expected field 'targets'" in broken.output
+    assert "Traceback" not in broken.output
 
 
 # ---------------------------------------------------------------------------- console script

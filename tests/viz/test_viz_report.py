@@ -130,3 +130,81 @@ def test_wilson_interval_matches_the_closed_form() -> None:
     assert lo == 0.0 and abs(hi - 0.2775) < 1e-4  # the rule-of-three-like upper bound at 0/10
     lo, hi = wilson_interval(198, 200)
     assert lo < 0.99 < hi and hi <= 1.0
+
+
+def test_one_summary_table_per_campaign(tmp_path: Path) -> None:
+    """Two campaigns over the same scene and law get separate tables with their own numbers."""
+    from uvnav.bench.campaign import Job, run_campaign
+
+    db = tmp_path / "two.sqlite"
+    with ResultsStore(db) as store:
+        run_campaign(store, "first", [Job(controller="straight-v1", seed=0, generator_seed=0)])
+        run_campaign(
+            store,
+            "second",
+            [Job(controller="straight-v1", seed=s, generator_seed=s) for s in range(3)],
+        )
+        df = store.episodes_frame()
+    from uvnav.viz.report import campaign_summaries
+
+    tables = {t["campaign"]: t for t in campaign_summaries(df)}
+    assert set(tables) == {"first", "second"}
+    assert [r["episodes"] for r in tables["first"]["rows"]] == [1]
+    assert [r["episodes"] for r in tables["second"]["rows"]] == [3]
+    html = write_report(db, tmp_path / "r", summary_figure=False, animations=0).read_text()
+    assert "Campaign <code>first</code>" in html and "Campaign <code>second</code>" in html
+    assert html.count('class="summary-table"') == 2
+
+
+def test_benchmark_section_reads_the_json_files(tmp_path: Path) -> None:
+    import json
+
+    bench = tmp_path / "bench"
+    bench.mkdir()
+    machine = {"timestamp": "t", "cpu_count": 2, "load_average_1m": 0.5, "python": "3.11"}
+    (bench / "summary.json").write_text(
+        json.dumps(
+            {
+                "machine": machine,
+                "targets": {
+                    "x": {
+                        "what": "steps/s",
+                        "limit": 10.0,
+                        "direction": ">=",
+                        "measured": 12345.6,
+                        "pass": True,
+                    },
+                },
+            }
+        )
+    )
+    (bench / "peers.json").write_text(
+        json.dumps(
+            {
+                "machine": machine,
+                "results": {
+                    "100": {
+                        "irsim": {"steps_per_s": 31.0},
+                        "uvnav": {"steps_per_s": 2234.0},
+                        "ratio_uvnav_over_irsim": 72.06,
+                    },
+                },
+            }
+        )
+    )
+    from uvnav.viz.report import benchmark_tables
+
+    tables = benchmark_tables(bench)
+    assert [t["title"] for t in tables] == [
+        "Targets (make bench)",
+        "World stepping: uvnav vs ir-sim",
+    ]
+    assert tables[0]["rows"][0]["measured"] == "12,345.6"
+    assert tables[1]["rows"][0]["uvnav / ir-sim"] == "72.1×"
+    db = tmp_path / "e.sqlite"
+    ResultsStore(db).close()
+    html = write_report(db, tmp_path / "r", bench_dir=bench).read_text(encoding="utf-8")
+    assert "uvnav vs ir-sim" in html and "2,234.0" in html
+    (bench / "peers.json").write_text(json.dumps({"machine": machine}))
+    with pytest.raises(ValueError, match="expected field 'results'"):
+        benchmark_tables(bench)

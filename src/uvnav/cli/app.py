@@ -598,14 +598,26 @@ def report_cmd(
         Path, typer.Argument(help="Results database (SQLite) written by uvnav run / bench.")
     ],
     out: Annotated[Path, typer.Option("--out", help="Output directory.")] = Path("report"),
+    bench: Annotated[
+        Path | None,
+        typer.Option(
+            "--bench",
+            help="Folder of benchmark JSON (make bench, benchmarks/peers/) to add as a section.",
+        ),
+    ] = None,
 ) -> None:
     """Turn a results database into the HTML report."""
     if not db.exists():
         raise CliError(f"{db}: no such database file")
     if not db.is_file():
         raise CliError(f"{db}: not a file")
+    if bench is not None and not bench.is_dir():
+        raise CliError(f"{bench}: --bench must be a folder of benchmark JSON files")
     write_report = _optional("uvnav.viz.report", "write_report", "the report (uvnav report)")
-    path = write_report(db, out)
+    try:
+        path = write_report(db, out, bench_dir=bench)
+    except ValueError as exc:
+        raise CliError(str(exc)) from None
     typer.echo(f"wrote {path}")
 
 

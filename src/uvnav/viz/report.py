@@ -17,6 +17,7 @@ zipped or published as is.
 
 from __future__ import annotations
 
+import math
 import shutil
 import sys
 from collections.abc import Mapping, Sequence
@@ -127,6 +128,123 @@ def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
     return rows
 
 
+def campaign_summaries(df: pd.DataFrame) -> list[dict[str, Any]]:
+    """One :func:`summary_table` per campaign, in campaign order.
+
+    Returns:
+        ``[{"id": int, "campaign": name, "rows": [...], "columns": [...]}, ...]``; campaigns
+        without episodes are left out.
+    """
+    if df.empty:
+        return []
+    out: list[dict[str, Any]] = []
+    for _, g in df.groupby("campaign_id", sort=True):
+        rows = summary_table(g)
+        name = str(g["campaign"].iloc[0]) if "campaign" in g.columns else ""
+        cid_int = int(g["campaign_id"].iloc[0])
+        out.append({"id": cid_int, "campaign": name, "rows": rows, "columns": list(rows[0])})
+    return out
+
+
+def _num(x: Any, digits: int = 1) -> str:
+    return f"{x:,.{digits}f}" if isinstance(x, int | float) and math.isfinite(x) else "–"
+
+
+def benchmark_tables(bench_dir: Path) -> list[dict[str, Any]]:
+    """Tables of the benchmark JSON files found in ``bench_dir`` (missing files are skipped).
+
+    * ``summary.json`` (``make bench``): each target, its limit and the measured value;
+    * ``peers.json`` (``benchmarks/peers/irsim_steps.py``): world steps/s, uvnav vs ir-sim;
+    * ``peers_navground.json`` (``benchmarks/peers/navground_crowd.py``): µs per step and decision
+      cost on crowd crossings, uvnav vs navground, with each run's outcome.
+
+    Raises:
+        ValueError: a file is not the JSON its writer makes (names the file and the key).
+    """
+    import json
+
+    bench_dir = Path(bench_dir)
+    tables: list[dict[str, Any]] = []
+
+    def load(name: str) -> dict[str, Any] | None:
+        path = bench_dir / name
+        if not path.is_file():
+            return None
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+        except json.JSONDecodeError as exc:
+            raise ValueError(f"{path}: not JSON ({exc.msg}, line {exc.lineno})") from None
+        if not isinstance(data, dict):
+            raise ValueError(f"{path}: expected a JSON object")
+        return data
+
+    def machine(data: dict[str, Any]) -> str:
+        m = data.get("machine", {})
+        return (
+            f"measured {m.get('timestamp', '?')} on {m.get('cpu_count', '?')} CPUs "
+            f"(1-min load {_num(m.get('load_average_1m'), 2)}), Python {m.get('python', '?')}"
+        )
+
+    try:
+        if (data := load("summary.json")) is not None:
+            rows = [
+                {
+                    "target": key,
+                    "what": t["what"],
+                    "limit": f"{t['direction']} {_num(t['limit'])}",
+                    "measured": _num(t["measured"]),
+                    "met": "yes" if t["pass"] else "NO",
+                }
+                for key, t in data["targets"].items()
+            ]
+            tables.append({"title": "Targets (make bench)", "note": machine(data), "rows": rows})
+        if (data := load("peers.json")) is not None:
+            rows = []
+            for n, r in data["results"].items():
+                ir, uv = r["irsim"], r["uvnav"]
+                rows.append(
+                    {
+                        "obstacles": n,
+                        "ir-sim steps/s": _num(ir.get("steps_per_s")),
+                        "uvnav steps/s": _num(uv.get("steps_per_s")),
+                        "uvnav / ir-sim": _num(r.get("ratio_uvnav_over_irsim")) + "×",
+                    }
+                )
+            tables.append(
+                {"title": "World stepping: uvnav vs ir-sim", "note": machine(data), "rows": rows}
+            )
+        if (data := load("peers_navground.json")) is not None:
+            rows = []
+            for scene, r in data["scenes"].items():
+                for run, v in r["runs"].items():
+                    dec = v.get("decision_us_median", v.get("decision_us_estimate"))
+                    outcome = v.get("status") or ("reached" if v.get("reached_goal") else "no")
+                    gap = v.get("min_clearance_m", v.get("min_gap_m"))
+                    rows.append(
+                        {
+                            "scene": scene,
+                            "simulator:law": run,
+                            "steps": v["steps"],
+                            "µs/step": _num(v["us_per_step"]),
+                            "decision µs": _num(dec),
+                            "outcome": f"{outcome}, min gap {_num(gap, 2)} m",
+                        }
+                    )
+            tables.append(
+                {
+                    "title": "Crowd crossings: uvnav vs navground",
+                    "note": machine(data) + "; navground's decision cost is estimated as µs/step "
+                    "with the behaviour minus µs/step with Dummy, uvnav's is its own median",
+                    "rows": rows,
+                }
+            )
+    except (KeyError, TypeError) as exc:
+        raise ValueError(f"{bench_dir}: benchmark file without the expected field {exc}") from None
+    for t in tables:
+        t["columns"] = list(t["rows"][0]) if t["rows"] else []
+    return tables
+
+
 def _copy_figures(figures: Sequence[FigureSpec], out_dir: Path) -> list[dict[str, str]]:
     out: list[dict[str, str]] = []
     used: set[str] = set()
@@ -156,6 +274,7 @@ def write_report(
     title: str = "uvnav results",
     summary_figure: bool = True,
     animations: int = 12,
+    bench_dir: Path | None = None,
 ) -> Path:
     """Render the HTML report of a results database.
 
@@ -171,6 +290,8 @@ def write_report(
             of all episodes, written as ``out_dir/campaign-summary.png``.
         animations: at most this many animated trajectory views (plotly, one per recorded
             episode; ``plotly.min.js`` is written next to ``index.html``); 0 for none.
+        bench_dir: a folder of benchmark JSON files (``make bench`` and ``benchmarks/peers/``
+            write ``benchmarks/results/``); their targets and peer comparisons become a section.
 
     Returns:
         The path of ``index.html``.
@@ -222,7 +343,7 @@ def write_report(
     for r in table_rows:
         table_columns += [k for k in r if k not in table_columns]
 
-    summary = summary_table(df)
+    summaries = campaign_summaries(df)
     errors_df = df[df["status"] == "error"] if not df.empty else df
     errors = [
         {
@@ -259,8 +380,8 @@ def write_report(
         simulation_note=SIMULATION_NOTE,
         table=table_rows,
         table_columns=table_columns,
-        summary=summary,
-        summary_columns=list(summary[0]) if summary else [],
+        summaries=summaries,
+        benchmarks=benchmark_tables(Path(bench_dir)) if bench_dir is not None else [],
         text_columns=_TEXT_COLUMNS,
         figures=figure_rows,
         errors=errors,
