@@ -29,6 +29,7 @@ under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already 
 
 from __future__ import annotations
 
+import functools
 import multiprocessing as mp
 import signal
 import sys
@@ -188,6 +189,16 @@ def _plain(params: Any) -> dict[str, Any]:
     return dict(params)
 
 
+@functools.lru_cache(maxsize=256)
+def _generated(name: str, seed: int, params: tuple[tuple[str, Any], ...]) -> Any:
+    """A generated scenario, kept for the next jobs on the same scene (other controllers or
+    parameter sets): generators are pure functions of their seed and parameters, and
+    ``build_episode`` never modifies the scenario it instantiates."""
+    import uvnav.scenarios as scenarios
+
+    return scenarios.generate(name, seed, **dict(params))
+
+
 def build_job(job: Job) -> tuple[EpisodeSetup, dict[str, Any]]:
     """Instantiate the job's episode and the controller parameters to use (runs in the worker)."""
     if job.setup_factory is not None:
@@ -197,9 +208,7 @@ def build_job(job: Job) -> tuple[EpisodeSetup, dict[str, Any]]:
     if job.scenario is not None:
         scenario = scenarios.load_scenario(job.scenario)
     else:
-        scenario = scenarios.generate(
-            job.generator, int(job.generator_seed or 0), **dict(job.generator_params)
-        )
+        scenario = _generated(job.generator, int(job.generator_seed or 0), job.generator_params)
     params = job.params_dict
     ctrl = getattr(scenario, "controller", None)
     if (

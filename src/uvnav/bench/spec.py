@@ -256,13 +256,18 @@ class CampaignSpec(_Strict):
     record: bool = False
 
     def jobs(self) -> list[Job]:
-        """The campaign's jobs: scenario entries × controller entries × grid points × seeds."""
+        """The campaign's jobs: scenario entries × seeds × controller entries × grid points.
+
+        Seeds come before controllers so that the jobs of one generated scene run close together
+        and a worker generates the scene once for all of them (see
+        :func:`uvnav.bench.campaign.build_job`).
+        """
+        sets = [(ctrl.name, params) for ctrl in self.controllers for params in ctrl.param_sets()]
         return [
-            sc.job(ctrl.name, params, seed, self.record)
+            sc.job(name, params, seed, self.record)
             for sc in self.scenarios
-            for ctrl in self.controllers
-            for params in ctrl.param_sets()
             for seed in sc.seed_list()
+            for name, params in sets
         ]
 
     def config(self) -> dict[str, Any]:

@@ -101,9 +101,10 @@ def rotation_boundary_growth(body: Body, rotation: float, n_directions: int = 36
     _, rho = radial_profile(body, n_directions)
     step = 2.0 * np.pi / n_directions
     shifts = int(np.ceil(abs(rotation) / step))
-    growth = 0.0
-    for k in range(1, shifts + 1):
-        growth = max(
-            growth, float(np.max(np.roll(rho, k) - rho)), float(np.max(np.roll(rho, -k) - rho))
-        )
-    return growth
+    # every turn of k = 1..shifts samples in both senses at once: rho[i -+ k] - rho[i]
+    n = len(rho)
+    k = np.arange(1, min(shifts, n) + 1)[:, None]
+    i = np.arange(n)[None, :]
+    back = rho[(i - k) % n] - rho
+    ahead = rho[(i + k) % n] - rho
+    return max(0.0, float(back.max()), float(ahead.max()))
