@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 from uvnav.planners import DStarLite, astar, path_cost
 
 
-@settings(max_examples=120, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(
     st.integers(3, 14),
     st.integers(3, 14),
