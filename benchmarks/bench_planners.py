@@ -33,7 +33,9 @@ from uvnav.planners import DStarLite, astar
 TARGET_RATIO = 10.0
 
 
-def run(size: int, n_changes: int, seed: int = 0, advance: int = 25, ahead: int = 8) -> dict[str, Any]:
+def run(
+    size: int, n_changes: int, seed: int = 0, advance: int = 25, ahead: int = 8
+) -> dict[str, Any]:
     rng = np.random.default_rng(seed)
     occ = rng.random((size, size)) < 0.2
     start, goal = (5, 5), (size - 6, size - 20)
@@ -93,8 +95,11 @@ def run(size: int, n_changes: int, seed: int = 0, advance: int = 25, ahead: int 
         "changes": changes,
         "median_ratio_time": ratio,
         "median_ratio_expanded": statistics.median(ch["ratio_expanded"] for ch in changes),
-        "target": {"what": "A* from scratch time / D* Lite replan time", "limit": TARGET_RATIO,
-                   "direction": ">="},
+        "target": {
+            "what": "A* from scratch time / D* Lite replan time",
+            "limit": TARGET_RATIO,
+            "direction": ">=",
+        },
         "pass": ratio >= TARGET_RATIO,
     }
 

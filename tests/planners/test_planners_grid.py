@@ -13,12 +13,21 @@ from uvnav.planners import empty_grid, occupancy_grid, safe_inflation
 
 @settings(max_examples=25, deadline=None)
 @given(
-    st.floats(1.0, 4.0), st.floats(1.0, 4.0), st.floats(0.2, 1.5), st.floats(0.0, 0.6),
+    st.floats(1.0, 4.0),
+    st.floats(1.0, 4.0),
+    st.floats(0.2, 1.5),
+    st.floats(0.0, 0.6),
     st.floats(0.05, 0.3),
 )
 def test_occupied_iff_centre_within_inflation(cx, cy, half, inflate, res) -> None:
-    square = np.array([[cx - half, cy - half], [cx + half, cy - half],
-                       [cx + half, cy + half], [cx - half, cy + half]])
+    square = np.array(
+        [
+            [cx - half, cy - half],
+            [cx + half, cy - half],
+            [cx + half, cy + half],
+            [cx - half, cy + half],
+        ]
+    )
     grid = occupancy_grid((0, 0, 6, 6), res, [square], inflate=inflate)
     gx, gy = grid.cell_centres()
     d = shapely.distance(shapely.Polygon(square), shapely.points(gx, gy))

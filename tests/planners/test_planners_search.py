@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 
 import numpy as np
@@ -29,7 +30,7 @@ def grids(draw: st.DrawFn) -> tuple[np.ndarray, tuple[int, int], tuple[int, int]
 
 
 def _valid_moves(occ: np.ndarray, cells: np.ndarray) -> bool:
-    for (r0, c0), (r1, c1) in zip(cells[:-1], cells[1:], strict=True):
+    for (r0, c0), (r1, c1) in itertools.pairwise(cells):
         dr, dc = int(r1 - r0), int(c1 - c0)
         if (dr, dc) not in MOVES or occ[r1, c1]:
             return False

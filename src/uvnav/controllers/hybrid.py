@@ -82,8 +82,11 @@ class HybridParams:
     lookahead: float = 3.0
 
     def __post_init__(self) -> None:
-        check_params(self, positive=("resolution", "margin", "lookahead"),
-                     non_negative=("inflation", "static_speed"))
+        check_params(
+            self,
+            positive=("resolution", "margin", "lookahead"),
+            non_negative=("inflation", "static_speed"),
+        )
         if self.law.startswith("hybrid"):
             raise ValueError("law must be a reactive law, not another hybrid")
         if self.bounds and len(self.bounds) != 4:
@@ -91,7 +94,9 @@ class HybridParams:
         make_controller(self.law, **dict(self.law_params))  # fail early on a bad law or params
 
 
-def _reading_geometry(rd: ObstacleReading) -> tuple[list[FloatArray], list[tuple[float, float, float]]]:
+def _reading_geometry(
+    rd: ObstacleReading,
+) -> tuple[list[FloatArray], list[tuple[float, float, float]]]:
     if rd.is_disc:
         return [], [(float(rd.centre[0]), float(rd.centre[1]), float(rd.radius))]
     return [np.asarray(rd.outline, dtype=float)], []
@@ -101,7 +106,7 @@ def line_of_sight(grid_occ: np.ndarray, grid: OccupancyGrid, a: FloatArray, b: F
     """True when no occupied cell lies on the segment ``a``-``b`` [m] (sampled at a quarter
     cell; vectorised)."""
     length = float(np.hypot(*(b - a)))
-    n = max(2, int(math.ceil(length / (0.25 * grid.resolution))) + 1)
+    n = max(2, math.ceil(length / (0.25 * grid.resolution)) + 1)
     t = np.linspace(0.0, 1.0, n)
     pts = a[None, :] + t[:, None] * (b - a)[None, :]
     cols = np.floor((pts[:, 0] - grid.origin[0]) / grid.resolution).astype(int)

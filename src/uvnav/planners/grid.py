@@ -67,8 +67,8 @@ class OccupancyGrid:
     def to_cell(self, point: FloatArray | Sequence[float]) -> tuple[int, int]:
         """The (row, col) of the cell containing ``point`` [m], clipped to the grid."""
         p = np.asarray(point, dtype=float)
-        c = int(math.floor((p[0] - self.origin[0]) / self.resolution))
-        r = int(math.floor((p[1] - self.origin[1]) / self.resolution))
+        c = math.floor((p[0] - self.origin[0]) / self.resolution)
+        r = math.floor((p[1] - self.origin[1]) / self.resolution)
         rows, cols = self.shape
         return (min(max(r, 0), rows - 1), min(max(c, 0), cols - 1))
 

@@ -76,7 +76,9 @@ def heuristic_fn(kind: Heuristic, resolution: float) -> Callable[[int, int, int,
     raise ValueError(f"unknown heuristic {kind!r}; known: euclidean, octile, zero")
 
 
-def grid_edges(occupied: np.ndarray, resolution: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def grid_edges(
+    occupied: np.ndarray, resolution: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """All directed edges of the grid graph as (source, target, cost [m]) flat-index arrays.
 
     Vectorised: one boolean shift per move, no Python loop over cells.
@@ -111,9 +113,7 @@ def _check_cells(occupied: np.ndarray, *cells: Cell) -> None:
             raise ValueError(f"cell {(r, c)} is outside the {rows}x{cols} grid")
 
 
-def dijkstra(
-    occupied: np.ndarray, start: Cell, goal: Cell, *, resolution: float = 1.0
-) -> GridPath:
+def dijkstra(occupied: np.ndarray, start: Cell, goal: Cell, *, resolution: float = 1.0) -> GridPath:
     """Shortest 8-connected path from ``start`` to ``goal`` (row, col) by scipy's Dijkstra.
 
     ``expanded`` is the number of vertices with a finite distance (scipy searches them all when
