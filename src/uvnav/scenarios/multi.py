@@ -201,7 +201,9 @@ def crossing_scenario(n: int, *, controller: str = "zhang2019-v1") -> MultiScena
         r, c = divmod(k, cols)
         lane = (r - (rows - 1) / 2) * 1.0
         back = c * 1.2
-        robots.append(_robot(np.array([-8.0 - back, lane]), np.array([8.0 - back, lane]), f"east-{k}"))
+        robots.append(
+            _robot(np.array([-8.0 - back, lane]), np.array([8.0 - back, lane]), f"east-{k}")
+        )
         robots.append(
             _robot(np.array([lane, -8.0 - back - 0.6]), np.array([lane, 8.0 - back]), f"north-{k}")
         )
@@ -285,18 +287,17 @@ def load_multi_scenario(name: str | Path) -> MultiScenario:
         try:
             n = int(arg)
         except ValueError:
-            raise ScenarioError(text, "<generator>", f"N must be an integer (got {arg!r})") from None
+            raise ScenarioError(
+                text, "<generator>", f"N must be an integer (got {arg!r})"
+            ) from None
         try:
             return MULTI_GENERATORS[gen](n)
         except ValueError as exc:
             raise ScenarioError(text, "<generator>", str(exc)) from None
     path = Path(text)
     if not path.is_file():
-        raise ScenarioError(
-            text,
-            "<name>",
-            f"not a file nor a generator; generators: {', '.join(f'{g}:N' for g in MULTI_GENERATORS)}",
-        )
+        known = ", ".join(f"{g}:N" for g in MULTI_GENERATORS)
+        raise ScenarioError(text, "<name>", f"not a file nor a generator; generators: {known}")
     try:
         data = yaml.safe_load(path.read_text())
     except yaml.YAMLError as exc:

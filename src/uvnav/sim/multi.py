@@ -146,9 +146,7 @@ def _robot_velocity(v: float, th: float) -> tuple[float, float]:
     return v * math.cos(th), v * math.sin(th)
 
 
-def run_multi(
-    setup: MultiSetup, rng: np.random.Generator, *, record: bool = True
-) -> MultiResult:
+def run_multi(setup: MultiSetup, rng: np.random.Generator, *, record: bool = True) -> MultiResult:
     """Run one multi-robot episode (see the module docstring).
 
     Args:
@@ -346,7 +344,9 @@ def run_multi(
     stuck = sum(
         1
         for i in range(n)
-        if status[i] == "timeout" and t >= setup.deadlock_window and moved[i] < setup.deadlock_distance
+        if status[i] == "timeout"
+        and t >= setup.deadlock_window
+        and moved[i] < setup.deadlock_distance
     )
     group = GroupMetrics(
         all_arrived=all_arrived,
@@ -376,7 +376,9 @@ def summarize(results: Sequence[MultiResult]) -> dict[str, float | None]:
     makespans = [r.group.makespan for r in results if r.group.makespan is not None]
     return {
         "episodes": float(len(results)),
-        "arrival_rate": float(np.mean([r.group.arrived / m for r, m in zip(results, n, strict=True)])),
+        "arrival_rate": float(
+            np.mean([r.group.arrived / m for r, m in zip(results, n, strict=True)])
+        ),
         "all_arrived_rate": float(np.mean([r.group.all_arrived for r in results])),
         "robot_collisions": float(np.mean([r.group.robot_collisions for r in results])),
         "obstacle_collisions": float(np.mean([r.group.obstacle_collisions for r in results])),
