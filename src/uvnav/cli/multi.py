@@ -44,15 +44,11 @@ def run(
         params = {**sc.controller.params, **params}
     setup = build_multi(sc, seed, controller=controller, params=params)
     res = run_multi(setup, run_rng(seed), record=False)
-    data = {
-        "scenario": sc.name,
-        "seed": seed,
-        "group": res.group.to_dict(),
-        "robots": [
-            {"name": r.name, "status": s, **m.to_dict()}
-            for r, s, m in zip(setup.robots, res.statuses, res.robots, strict=True)
-        ],
-    }
+    robots = [
+        {"name": r.name, "status": s, **m.to_dict()}
+        for r, s, m in zip(setup.robots, res.statuses, res.robots, strict=True)
+    ]
+    data = {"scenario": sc.name, "seed": seed, "group": res.group.to_dict(), "robots": robots}
     if json_out:
         typer.echo(json.dumps(data))
         return
@@ -62,7 +58,7 @@ def run(
         f"collisions, {g.obstacle_collisions} obstacle collisions, {g.deadlocks} deadlocked, "
         f"makespan {g.makespan if g.makespan is not None else 'n/a'} s"
     )
-    for row in data["robots"]:
+    for row in robots:
         t = row["time_to_goal"]
         typer.echo(
             f"  {row['name']:>12}  {row['status']:<9}  path {row['path_length']:.2f} m"
