@@ -39,13 +39,13 @@ def test_office_reactive_law_fails_hybrid_with_the_same_law_arrives() -> None:
     assert traj.robot[k, 0] < 1.4
 
 
-def test_office_hybrid_zhang2019_arrives_with_a_shorter_path_than_the_reactive_law() -> None:
+def test_office_hybrid_zhang2019_arrives_by_the_door() -> None:
+    # zhang2019-v1 alone also escapes (it follows room A's walls round: 25.3 m, 37.1 s, measured
+    # in the issue-9 note); the hybrid takes the door directly (23.5 m)
     hybrid, _ = _run("office-floor", "hybrid-v1", law="zhang2019-v1")
-    reactive, _ = _run("office-floor", "zhang2019-v1")
     assert hybrid.status == "success"
     assert hybrid.metrics.min_clearance is not None and hybrid.metrics.min_clearance > 0.0
-    if reactive.status == "success":
-        assert hybrid.metrics.path_length < reactive.metrics.path_length
+    assert hybrid.metrics.path_length < 24.5
 
 
 def test_map_is_learned_from_sensed_static_obstacles_only() -> None:

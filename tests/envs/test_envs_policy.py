@@ -37,8 +37,8 @@ def test_zhang2019_as_policy_reaches_the_goal_like_in_the_simulator() -> None:
 
 
 def test_policy_resets_between_episodes_and_actions_are_in_the_box() -> None:
-    env = Nav2DEnv("corridor")
-    pol = as_policy(make_controller("hybrid-v1", law="zhang2019-v1"))
+    env = Nav2DEnv("open-field")
+    pol = as_policy(make_controller("straight-v1"))
     obs, info = env.reset(seed=0)
     a = pol(obs, info)
     assert env.action_space.contains(a)

@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 from uvnav.planners import empty_grid, occupancy_grid, safe_inflation
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=15, deadline=None)
 @given(
     st.floats(1.0, 4.0),
     st.floats(1.0, 4.0),

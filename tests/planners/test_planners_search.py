@@ -39,7 +39,7 @@ def _valid_moves(occ: np.ndarray, cells: np.ndarray) -> bool:
     return True
 
 
-@settings(max_examples=70, deadline=None)
+@settings(max_examples=50, deadline=None)
 @given(grids(), st.sampled_from(["octile", "euclidean", "zero"]), st.floats(0.05, 2.0))
 def test_astar_cost_equals_dijkstra(case, heuristic, res) -> None:
     occ, start, goal = case

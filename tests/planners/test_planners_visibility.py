@@ -33,7 +33,7 @@ def test_free_is_straight_and_blocked_is_none() -> None:
     assert not visibility_path((0, -1.7), (5, 5), ring).found  # start inside
 
 
-@settings(max_examples=15, deadline=None)
+@settings(max_examples=10, deadline=None)
 @given(st.integers(0, 2**31 - 1), st.integers(1, 5), st.floats(0.0, 0.3))
 def test_path_clear_and_not_longer_than_grid(seed, k, inflate) -> None:
     rng = np.random.default_rng(seed)

@@ -130,6 +130,8 @@ class HybridController(UnicycleController):
         self._mapped: set[int] = set()
         self._waypoint: FloatArray | None = None
         self._path: FloatArray = np.zeros((0, 2))
+        self._cells = np.zeros((0, 2), dtype=int)
+        self._dirty = True
         self.replans = 0
 
     @property
@@ -155,6 +157,8 @@ class HybridController(UnicycleController):
         self._mapped = set()
         self._waypoint = None
         self._path = np.zeros((0, 2))
+        self._cells = np.zeros((0, 2), dtype=int)
+        self._dirty = True
         self.replans = 0
 
     def _grow(self) -> float:
@@ -224,11 +228,24 @@ class HybridController(UnicycleController):
             return self._goal
         start = self._free_cell(grid.to_cell(position), occ)
         self._planner.move_start(start)
-        cost = self._planner.compute()
-        if not math.isfinite(cost):
-            self._path = np.zeros((0, 2))
-            return None
-        cells = self._planner.path().cells
+        cells = self._cells
+        hit = (
+            np.flatnonzero((cells[:, 0] == start[0]) & (cells[:, 1] == start[1]))
+            if not self._dirty and len(cells)
+            else np.zeros(0, dtype=int)
+        )
+        if len(hit):
+            # same map, robot still on its path: a suffix of a shortest path is a shortest path
+            cells = cells[int(hit[0]) :]
+        else:
+            cost = self._planner.compute()
+            if not math.isfinite(cost):
+                self._path = np.zeros((0, 2))
+                self._cells = np.zeros((0, 2), dtype=int)
+                return None
+            cells = self._planner.path().cells
+            self._dirty = False
+        self._cells = cells
         pts = grid.to_world(cells)
         pts[-1] = self._goal
         self._path = pts
@@ -248,6 +265,7 @@ class HybridController(UnicycleController):
             self._build(position)
         if self._map_static(obs):
             self.replans += 1
+            self._dirty = True
         waypoint = self._choose_waypoint(position)
         target = self._goal if waypoint is None else waypoint
         self._waypoint = waypoint

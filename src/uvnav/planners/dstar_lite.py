@@ -76,6 +76,8 @@ class DStarLite:
         self._open: dict[int, tuple[float, float]] = {}
         self._heap: list[tuple[float, float, int]] = []
         self.expanded = 0
+        # neighbour lists, cached; a change of cell c invalidates those of its 3x3 neighbourhood
+        self._nbr: dict[int, list[tuple[int, float]]] = {}
         self._eps = 1e-9 * self.resolution
         self._rhs[self._goal] = 0.0 if self._free[self._goal] else INF
         if self._free[self._goal]:
@@ -111,7 +113,11 @@ class DStarLite:
         return INF, INF, -1
 
     def _succ(self, u: int) -> list[tuple[int, float]]:
-        return neighbours(self._free, self.rows, self.cols, u, self.resolution)
+        nb = self._nbr.get(u)
+        if nb is None:
+            nb = neighbours(self._free, self.rows, self.cols, u, self.resolution)
+            self._nbr[u] = nb
+        return nb
 
     def _update_vertex(self, u: int) -> None:
         if u != self._goal:
@@ -216,6 +222,8 @@ class DStarLite:
                     nr, nc = r + dr, c + dc
                     if 0 <= nr < self.rows and 0 <= nc < self.cols:
                         affected.add(nr * self.cols + nc)
+        for u in affected:
+            self._nbr.pop(u, None)
         for u in affected:
             if u == self._goal:
                 self._rhs[u] = 0.0 if self._free[u] else INF
