@@ -59,3 +59,20 @@ def test_swap_and_trajectory_figures(tmp_path) -> None:
     )
     with pytest.raises(ValueError, match="not recorded"):
         plot_swap(unrecorded, goals)
+
+
+def test_ch9_figures_are_written(tmp_path) -> None:
+    from uvnav.viz.figures_ch9 import ch9_figures
+
+    files = ch9_figures(
+        tmp_path,
+        office_law="savkin-wang2013-v1",
+        swap="antipodal:4",
+        swap_laws=(("straight-v1", {}),),
+    )
+    assert [f.name for f in files] == [
+        "ch9-paths.png",
+        "ch9-office.png",
+        "ch9-swap-straight-v1.png",
+    ]
+    assert all(f.stat().st_size > 5_000 for f in files)
