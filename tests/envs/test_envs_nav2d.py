@@ -77,3 +77,12 @@ def test_render_draws_robot_and_obstacles() -> None:
     assert Nav2DEnv("office-floor").render() is None
     with pytest.raises(ValueError, match="render_mode"):
         Nav2DEnv(render_mode="human")
+
+
+def test_gymnasium_entry_point_resolves_to_the_registration() -> None:
+    from importlib.metadata import entry_points
+
+    (ep,) = [e for e in entry_points(group="gymnasium.envs") if e.name == "uvnav"]
+    assert ep.load() is uvnav.envs.register_envs
+    uvnav.envs.register_envs()  # idempotent
+    assert gym.spec("uvnav/Nav2D-v0").entry_point == "uvnav.envs.nav2d:Nav2DEnv"
