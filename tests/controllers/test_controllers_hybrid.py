@@ -95,3 +95,42 @@ def test_a_priori_map_is_configuration() -> None:
 def test_bad_params(params: dict, match: str) -> None:
     with pytest.raises((ControllerParamsError, KeyError), match=match):
         make_controller("hybrid-v1", **params)
+
+
+def test_estimated_velocity_needs_a_second_look_before_mapping() -> None:
+    from uvnav.dynamics import UnicycleSpec
+    from uvnav.sensors import Observation
+    from uvnav.sensors.observation import ObstacleReading
+
+    ctrl = make_controller("hybrid-v1", law="straight-v1", bounds=[-1, -3, 9, 3])
+    assert isinstance(ctrl, HybridController)
+    ctrl.reset(UnicycleSpec(1.0, 1.0, 0.2), np.array([8.0, 0.0]), np.random.default_rng(0))
+    disc = ObstacleReading(
+        obstacle_id=0,
+        distance=2.5,
+        nearest_point=np.array([2.5, 0.0]),
+        centre=np.array([3.0, 0.0]),
+        velocity=np.zeros(2),
+        angular_velocity=0.0,
+        outline=np.zeros((0, 2)),
+        radius=0.5,
+        bounding_radius=0.5,
+        velocity_source="estimated",
+    )
+
+    def see(t: float) -> None:
+        ctrl.act(
+            Observation(
+                time=t,
+                pose=np.array([0.0, 0.0, 0.0]),
+                speed=0.0,
+                goal=np.array([8.0, 0.0]),
+                obstacles=(disc,),
+            )
+        )
+
+    see(0.0)
+    grid = ctrl.grid
+    assert grid is not None and not grid.occupied[grid.to_cell((3.0, 0.0))]
+    see(0.1)
+    assert grid.occupied[grid.to_cell((3.0, 0.0))]

@@ -19,6 +19,8 @@ What the controller knows (DESIGN §2, a controller sees only its Observation):
   ``static_speed`` [m/s] and that does not rotate is taken to be static: its outline (the Ch. 2
   sensing model reports the body's shape) grown by the robot radius plus ``inflation`` is marked
   on the grid once, and D* Lite repairs the plan.  Anything moving is left to the reactive law.
+  With estimated velocities (finite differences, zero at first sight) an obstacle must look
+  static on two decisions before it is mapped.
 
 Each decision: move D* Lite's start to the robot's cell, repair the plan, pick as waypoint the
 farthest point of the path within ``lookahead`` [m] that is in line of sight on the grid (the
@@ -128,6 +130,7 @@ class HybridController(UnicycleController):
         self._grid: OccupancyGrid | None = None
         self._planner: DStarLite | None = None
         self._mapped: set[int] = set()
+        self._seen: set[int] = set()
         self._waypoint: FloatArray | None = None
         self._path: FloatArray = np.zeros((0, 2))
         self._cells = np.zeros((0, 2), dtype=int)
@@ -155,6 +158,7 @@ class HybridController(UnicycleController):
         self._grid = None
         self._planner = None
         self._mapped = set()
+        self._seen = set()
         self._waypoint = None
         self._path = np.zeros((0, 2))
         self._cells = np.zeros((0, 2), dtype=int)
@@ -204,6 +208,10 @@ class HybridController(UnicycleController):
             if rd.obstacle_id in self._mapped:
                 continue
             if rd.speed > self.params.static_speed or abs(rd.angular_velocity) > 1e-3:
+                continue
+            if rd.velocity_source == "estimated" and rd.obstacle_id not in self._seen:
+                # a finite-difference estimate is 0 at first sight: wait for a second look
+                self._seen.add(rd.obstacle_id)
                 continue
             self._mapped.add(rd.obstacle_id)
             polys, discs = _reading_geometry(rd)
