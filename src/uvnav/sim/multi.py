@@ -15,8 +15,8 @@ Integration, collision checks and the per-robot metrics follow :func:`uvnav.sim.
 (same names, :data:`uvnav.sim.metrics.METRIC_NAMES`): the robot's clearance is the gap to the
 nearest obstacle *or other robot*.  A robot that reaches its goal stops there and stays in the
 world as a parked disc (it is physically there); a robot that collides stops where it is (a
-wreck, also still there).  The episode ends when every robot has arrived or collided, or at
-``t_max``.
+wreck, also still there); its own metrics stop there, as a single-robot episode's do.  The
+episode ends when every robot has arrived or collided, or at ``t_max``.
 
 Group metrics (:class:`GroupMetrics`): ``all_arrived``, ``robot_collisions`` (pairs of robots
 whose discs ever overlapped), ``obstacle_collisions`` (robots that hit a world obstacle),
@@ -218,6 +218,8 @@ def run_multi(setup: MultiSetup, rng: np.random.Generator, *, record: bool = Tru
         """Clearances, collisions and arrivals after a step (or at t = 0)."""
         nonlocal obstacle_hits
         for i in range(n):
+            if not active[i]:
+                continue  # an arrived or wrecked robot's episode is over (as in run_episode)
             # the own disc is always nearest: ask for everything within the sensing range instead
             # (clearances beyond it are not tracked: min_clearance is exact when below it)
             q = fld.query(state[i, :2], reach[i], nearest=False)
@@ -229,8 +231,6 @@ def run_multi(setup: MultiSetup, rng: np.random.Generator, *, record: bool = Tru
             if len(gaps) == 0:
                 continue
             min_clear[i] = min(min_clear[i], float(gaps.min()))
-            if not active[i]:
-                continue
             hit = gaps < 0
             if hit.any():
                 for j in ids[hit]:
