@@ -25,6 +25,7 @@ DESIGN_LAYERS = [
     {"uvnav.scenarios"},
     {"uvnav.sim"},
     {"uvnav.controllers", "uvnav.recon"},
+    {"uvnav.planners"},  # issue 9: below the controllers (hybrid-v1 plans with them)
     {"uvnav.sensors", "uvnav.prediction"},
     {"uvnav.dynamics", "uvnav.obstacles"},
     {"uvnav.geometry"},
@@ -97,6 +98,7 @@ LOW_LAYERS = [
     "uvnav.obstacles",
     "uvnav.sensors",
     "uvnav.prediction",
+    "uvnav.planners",
     "uvnav.sim",
 ]
 

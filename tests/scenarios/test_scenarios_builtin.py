@@ -43,6 +43,10 @@ def straight_status(sc: Scenario, seed: int) -> str:
     ).status
 
 
+#: static walls and rooms (issue 9), checked in tests/controllers/test_controllers_hybrid.py
+WALLED = ("corridor", "office-floor")
+
+
 def test_thesis_experiments_come_first() -> None:
     names = list_builtin()
     assert set(THESIS) <= set(names)
@@ -65,6 +69,8 @@ def test_every_builtin_loads_builds_and_obeys_the_constraints(name: str) -> None
         return
     assert check_constraints(sc) == []
     assert len(setup.obstacles) == len(sc.obstacles)
+    if name in WALLED:  # issue 9's walled scenes: their own start and goal
+        return
     r = sc.robot
     assert (r.start, r.goal, r.v_max, r.u_max) == ((0.0, 0.0), (10.0, 10.0), 0.707, 1.414)
     assert builtin_text(name).lstrip().startswith("#")  # a commented file, not a dump

@@ -583,6 +583,10 @@ def reproduce(
         table, failures = build_table(store, scenes, ctrls, straight_line=straight)
         if baselines:
             table += comparison_rows(store)
+        if baselines and n_random is None:  # issue 9 rows (a real run, not a quick look)
+            from uvnav.bench.reproduce_ch9 import reproduce_ch9
+
+            table += reproduce_ch9(full=full)
         scene_episodes = []
         for s in scenes:
             for c in ctrls:

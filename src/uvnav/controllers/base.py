@@ -67,6 +67,7 @@ BUILTIN_MODULES: tuple[str, ...] = (
     "orca",
     "dwa",
     "apf",
+    "hybrid",
 )
 _ENTRY_POINTS_LOADED = False
 

@@ -1,0 +1,159 @@
+"""``uvnav/Nav2D-v0``: a Gymnasium environment on the 2D world of the thesis's Ch. 2.
+
+One robot (unicycle, (2.1)-(2.4)) among a scenario's obstacles; one env step is one decision
+(``control_period``), integrated with the scenario's ``dt`` and checked for collisions at every
+integration step (:mod:`uvnav.envs.core`).
+
+* **Observation** ``Box(4 + n_rays,)`` float32: goal distance / ``goal_scale`` in [0, 1], cos and
+  sin of the goal bearing in the robot frame, speed / V_max, then ``n_rays`` lidar ranges /
+  ``max_range`` in [0, 1] (first beam straight behind, counter-clockwise).
+* **Action** ``Box([-1, -1], [1, 1])`` float32: ``v = (a0 + 1) / 2 V_max``, ``u = a1 U_max``.
+* **Reward**: :class:`uvnav.envs.core.RewardConfig` (progress, time, clearance, success,
+  collision), configurable with ``reward={...}``.
+* **Termination**: arrival (``info["status"] == "success"``) or collision; **truncation** at the
+  scenario's ``t_max``.
+* ``info``: ``status``, ``distance`` [m], ``clearance`` [m], ``time`` [s], and — so that any uvnav
+  controller can drive the env (:func:`uvnav.envs.as_policy`) — ``uvnav``, a
+  :class:`~uvnav.envs.core.ControllerView` holding the :class:`~uvnav.sensors.Observation` the
+  simulator would give the controller and the vehicle limits.
+* ``render_mode="rgb_array"``: 256 x 256 RGB frames.
+
+Each ``reset(seed=...)`` draws an episode seed from the env's generator and builds the scenario
+for it (:func:`uvnav.scenarios.build.build_episode`), so random obstacles differ per episode and
+the same seed gives the same episode.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
+from uvnav.envs.core import NavWorld, RewardConfig, WorldRobot, render_frame, scene_bounds
+from uvnav.scenarios.build import build_episode
+from uvnav.scenarios.loader import load_scenario
+from uvnav.scenarios.schema import Scenario
+
+try:
+    import gymnasium as gym
+    from gymnasium import spaces
+except ImportError as exc:  # pragma: no cover - exercised only without the extra
+    raise ImportError("uvnav.envs needs gymnasium: pip install 'uvnav[envs]'") from exc
+
+
+def reward_config(reward: RewardConfig | dict[str, float] | None) -> RewardConfig:
+    """A :class:`RewardConfig` from a config, a dict of its fields, or ``None`` (defaults)."""
+    if reward is None:
+        return RewardConfig()
+    if isinstance(reward, RewardConfig):
+        return reward
+    return replace(RewardConfig(), **reward)
+
+
+def obs_space(n_rays: int) -> spaces.Box:
+    low = np.zeros(4 + n_rays, dtype=np.float32)
+    low[1:3] = -1.0
+    return spaces.Box(low=low, high=np.ones(4 + n_rays, dtype=np.float32), dtype=np.float32)
+
+
+def act_space() -> spaces.Box:
+    return spaces.Box(low=-1.0, high=1.0, shape=(2,), dtype=np.float32)
+
+
+class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
+    """``uvnav/Nav2D-v0`` (module docstring).
+
+    Args:
+        scenario: built-in name, YAML path or generator (``random-ch2:3``), or a
+            :class:`~uvnav.scenarios.Scenario`.
+        render_mode: ``None`` or ``"rgb_array"``.
+        n_rays: lidar beams in the observation.
+        max_range: lidar range [m].
+        goal_scale: distance [m] mapped to 1 (default: the scenario's start-goal distance x 1.5).
+        reward: reward weights (:class:`RewardConfig` or a dict of its fields).
+    """
+
+    metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 10}  # noqa: RUF012 - gymnasium declares it an instance variable
+
+    def __init__(
+        self,
+        scenario: str | Scenario = "thesis-ch2-one-obstacle",
+        *,
+        render_mode: str | None = None,
+        n_rays: int = 32,
+        max_range: float = 5.0,
+        goal_scale: float | None = None,
+        reward: RewardConfig | dict[str, float] | None = None,
+    ) -> None:
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
+        self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+        self.render_mode = render_mode
+        self.n_rays = int(n_rays)
+        self.max_range = float(max_range)
+        r = self.scenario.robot
+        dist = float(np.hypot(r.goal[0] - r.start[0], r.goal[1] - r.start[1]))
+        self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
+        self.reward_config = reward_config(reward)
+        self.observation_space = obs_space(self.n_rays)
+        self.action_space = act_space()
+        self._world: NavWorld | None = None
+        self._bounds = (0.0, 0.0, 1.0, 1.0)
+        self._t_max = float(self.scenario.t_max)
+
+    def _info(self) -> dict[str, Any]:
+        w = self._world
+        assert w is not None
+        return {
+            "status": w.status[0],
+            "distance": w.distance(0),
+            "clearance": float(w.clearance[0]),
+            "time": w.t,
+            "uvnav": w.view(0),
+        }
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        if self._world is not None:
+            self._world.close()
+        episode_seed = int(self.np_random.integers(2**31 - 1))
+        setup = build_episode(self.scenario, episode_seed)
+        robot = WorldRobot(setup.spec, setup.start, setup.goal, setup.sensing)
+        self._world = NavWorld(
+            [robot],
+            setup.obstacles,
+            dt=setup.dt,
+            control_period=setup.control_period,
+            goal_tolerance=setup.goal_tolerance,
+            n_rays=self.n_rays,
+            max_range=self.max_range,
+            goal_scale=self.goal_scale,
+            reward=self.reward_config,
+        )
+        self._bounds = scene_bounds(self._world)
+        return self._world.vector(0), self._info()
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        w = self._world
+        if w is None:
+            raise RuntimeError("call reset() before step()")
+        reward = float(w.step({0: np.asarray(action)})[0])
+        terminated = w.status[0] in ("success", "collision")
+        truncated = not terminated and w.t >= self._t_max - 1e-9
+        info = self._info()
+        if truncated:
+            info["status"] = "timeout"
+        return w.vector(0), reward, terminated, truncated, info
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode != "rgb_array" or self._world is None:
+            return None
+        return render_frame(self._world, self._bounds)
+
+    def close(self) -> None:
+        if self._world is not None:
+            self._world.close()
+            self._world = None

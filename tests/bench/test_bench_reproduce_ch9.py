@@ -1,0 +1,23 @@
+"""Issue-9 rows of `uvnav run`: measured from real runs, one row per configuration."""
+
+from __future__ import annotations
+
+from uvnav.bench.reproduce_ch9 import BEYOND, office_rows, swap_rows
+
+
+def test_office_rows_measure_law_alone_and_hybrid() -> None:
+    (row,) = office_rows(["apf-v1"], scenario="corridor")
+    assert row["thesis"] == BEYOND
+    assert "corridor" in row["quantity"] and "apf-v1" in row["quantity"]
+    alone, hybrid = row["measured"].split("; ")
+    assert alone.startswith("alone: success") and hybrid.startswith("hybrid: success")
+
+
+def test_swap_rows_count_arrivals() -> None:
+    tuned = {"switch_distance": 2.5, "forecast_horizon": 2.0, "safety_margin": 0.3}
+    rows = swap_rows("antipodal:4", [("zhang2019-v1", tuned), ("straight-v1", {})])
+    assert len(rows) == 2
+    assert rows[0]["measured"].startswith("4/4 arrived, 0 robot-robot collisions")
+    assert "switch_distance=2.5" in rows[0]["quantity"]
+    # straight lines through the centre: everyone collides
+    assert rows[1]["measured"].startswith("0/4 arrived")
