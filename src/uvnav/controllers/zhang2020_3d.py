@@ -31,9 +31,12 @@ Where the thesis is ambiguous this implementation chooses as follows (docs/thesi
 2. *Sign of alpha and meaning of '+'.* alpha is measured counter-clockwise from Y' (seen from +Z');
    '+' (alpha >= 0, the centre on the -X' side) passes on the +X' side — the shorter way round,
    the reading that makes the tag useful.  The tag is fixed when avoidance of an obstacle starts.
-3. *Forecast sphere radius.* ||v_i*|| T_s as in (3.17), plus the distance a boundary point moves in
-   T_s by rotation (||u_i*|| R_i), plus the robot's radius and ``safety_margin`` (a zero radius
-   would steer the robot onto the surface of a static obstacle).
+3. *Forecast sphere radius.* ||v_i*|| T_s as in (3.17), plus the robot's radius and
+   ``safety_margin`` (a zero radius would steer the robot onto the surface of a static obstacle);
+   the horizon is shortened near the body (the motion term is at most half the free distance) so
+   that the robot never sits inside the spheres, where no tangent exists.  The predicted rotation
+   u_i* enters through the boundary points rotated by u_i* T_s about the mass centre, taken
+   together with the current ones.
 4. *Which circles (non-convex bodies).* The tangent on the tagged side is taken over the forecast
    circles of *all* projected boundary points (the silhouette), rotated out by alpha0: for a convex
    body this is the tangent to the circle at r*_min, for a non-convex one it never grazes a spike
@@ -207,23 +210,24 @@ class Zhang2020Law(Vehicle3DController):
         return v, u
 
     # ------------------------------------------------------------------------------- geometry
-    def forecast_radius(self, rd: ObstacleReading3D, v: FloatArray, u: FloatArray) -> float:
-        ts = self.p.sample_period
-        return float(
-            (np.linalg.norm(v) + np.linalg.norm(u) * rd.bounding_radius) * ts
-            + self._spec.radius
-            + self.p.safety_margin
-        )
+    def forecast_radius(self, rd: ObstacleReading3D, v: FloatArray) -> float:
+        """Radius [m] of the forecast sphere (3.17): ||v_i*|| T_s plus the robot's radius and the
+        margin, with the horizon shortened near the body so that the robot stays outside the
+        spheres (item 3 of the module docstring)."""
+        base = self._spec.radius + self.p.safety_margin
+        move = float(np.linalg.norm(v)) * self.p.sample_period
+        room = max(rd.distance - base, 0.0)
+        return base + min(move, 0.5 * room)
 
-    def _points(self, rd: ObstacleReading3D, v: FloatArray, u: FloatArray) -> FloatArray:
-        """Boundary points now and as predicted one period ahead (translated and rotated)."""
+    def _points(self, rd: ObstacleReading3D, u: FloatArray) -> FloatArray:
+        """Boundary points now and rotated as predicted one period ahead (the translation is
+        covered by the forecast sphere)."""
         ts = self.p.sample_period
-        if float(np.linalg.norm(u)) > 1e-9:
+        if float(np.linalg.norm(u)) * ts * rd.bounding_radius > 1e-3:
             rot = rotation_from_vector(u * ts)
-            ahead = (rd.outline - rd.centre) @ rot.T + rd.centre + v * ts
-        else:
-            ahead = rd.outline + v * ts
-        return np.concatenate([rd.outline, ahead])
+            ahead = (rd.outline - rd.centre) @ rot.T + rd.centre
+            return np.concatenate([rd.outline, ahead])
+        return rd.outline
 
     def shadows(
         self, frame: OnlineFrame, obs: Observation3D
@@ -236,9 +240,9 @@ class Zhang2020Law(Vehicle3DController):
             v, u = rd.velocity, rd.rotation_rate
             if rd.obstacle_id == self._target:
                 v, u = self.predict(rd)
-            rho = self.forecast_radius(rd, v, u)
+            rho = self.forecast_radius(rd, v)
             out[rd.obstacle_id] = (
-                shadow_of(frame, self._points(rd, v, u), rd.centre, rho), rd, v, u,
+                shadow_of(frame, self._points(rd, u), rd.centre, rho), rd, v, u,
             )  # fmt: skip
         return out
 
