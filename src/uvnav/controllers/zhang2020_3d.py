@@ -186,7 +186,8 @@ class Zhang2020Law(Vehicle3DController):
         if i not in store:
             store[i] = ARPredictor(
                 dim=3, period=self.p.sample_period, max_lag=self.p.ar_max_lag, ic=self.p.ar_ic,
-                min_samples=max(12, self.p.ar_max_lag + 3), window=40, refit_every=8,
+                min_samples=max(12, self.p.ar_max_lag + 3), window=40, refit_every=1,
+                reselect_every=10,
             )  # fmt: skip
         return store[i]
 

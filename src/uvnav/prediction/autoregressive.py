@@ -22,8 +22,9 @@ How the thesis was read (docs/thesis-notes.md):
   at ``lb_lags`` lags; a model whose residuals are not white (p < ``alpha``) is rejected.
 * While the history is shorter than ``min_samples``, when the fit fails or is rejected, or when
   the series is constant, the prediction falls back to *constant velocity* (the last sample).
-* Order and coefficients are re-estimated every ``refit_every`` new samples (fits are the costly
-  part; between refits the fixed model predicts from the newest samples).
+* The order is re-selected every ``reselect_every`` new samples (statsmodels, the costly part)
+  and the coefficients re-estimated by OLS at that order every ``refit_every`` samples
+  (:func:`refit_ols`, the same estimates as ``AutoReg``; tested against it).
 
 k-step predictions iterate (3.13); their error std is sigma * sqrt(sum_{j<k} psi_j^2) with psi the
 MA(inf) weights of the fitted model (for the fallback: the std of the sample-to-sample changes
@@ -112,6 +113,43 @@ def fit_ar(
     return ARFit(order, const, phi, sigma, p_value, accepted)
 
 
+def ljung_box_pvalue(resid: FloatArray, lags: int, model_df: int = 0) -> float:
+    """Ljung–Box p-value: Q = n (n + 2) sum_{k<=h} rho_k^2 / (n - k) against chi^2(h - model_df)
+    (the statistic of statsmodels' ``acorr_ljungbox``, computed directly for the refits)."""
+    from scipy.stats import chi2
+
+    r = np.asarray(resid, dtype=float)
+    n = len(r)
+    r = r - r.mean()
+    denom = float(r @ r)
+    if n <= lags + 1 or denom <= 0.0:
+        return float("nan")
+    rho = np.array([float(r[k:] @ r[:-k]) / denom for k in range(1, lags + 1)])
+    q = n * (n + 2) * float(np.sum(rho**2 / (n - np.arange(1, lags + 1))))
+    df = max(lags - model_df, 1)
+    return float(chi2.sf(q, df))
+
+
+def refit_ols(series: FloatArray, order: int, *, alpha: float = 0.05) -> ARFit:
+    """OLS fit of (3.13) with a constant at a *given* order (the estimates of statsmodels'
+    ``AutoReg(series, order, trend="c").fit()``), with the Ljung–Box check of
+    :func:`ljung_box_pvalue`; used between order selections."""
+    y = np.asarray(series, dtype=float)
+    n = len(y)
+    if n < order + 3:
+        raise ValueError(f"series of {n} samples is too short for order {order}")
+    cols = [np.ones(n - order)] + [y[order - i : n - i] for i in range(1, order + 1)]
+    x = np.stack(cols, axis=1)
+    target = y[order:]
+    beta, *_ = np.linalg.lstsq(x, target, rcond=None)
+    resid = target - x @ beta
+    sigma = float(np.sqrt(float(resid @ resid) / len(resid)))
+    n_lb = max(1, min(10, len(resid) // 5))
+    p_value = ljung_box_pvalue(resid, n_lb, order) if float(np.std(resid)) > 1e-12 else float("nan")
+    accepted = bool(not np.isfinite(p_value) or p_value >= alpha)
+    return ARFit(order, float(beta[0]), beta[1:].copy(), sigma, p_value, accepted)
+
+
 def psi_weights(phi: FloatArray, k: int) -> FloatArray:
     """First ``k`` MA(inf) weights psi_0 = 1, psi_j = sum_i phi_i psi_{j-i}."""
     psi = np.zeros(max(k, 1))
@@ -169,7 +207,10 @@ class ARPredictor:
         ic: order criterion ("bic" default, "aic", "hqic").
         min_samples: samples needed before AR is tried (constant-velocity fallback before).
         window: newest samples used for fitting.
-        refit_every: refit after this many new samples.
+        refit_every: refit the coefficients (OLS at the current orders) after this many new
+            samples.
+        reselect_every: re-select the orders (statsmodels ``ar_select_order``) after this many
+            new samples.
         alpha: significance of the Ljung–Box whiteness check.
     """
 
@@ -179,12 +220,14 @@ class ARPredictor:
     ic: Criterion = "bic"
     min_samples: int = 12
     window: int = 60
-    refit_every: int = 5
+    refit_every: int = 1
+    reselect_every: int = 10
     alpha: float = 0.05
     _times: list[float] = field(default_factory=list)
     _values: list[FloatArray] = field(default_factory=list)
     _fits: list[ARFit | None] = field(default_factory=list)
     _since_fit: int = 0
+    _since_select: int = 0
 
     def __post_init__(self) -> None:
         if self.min_samples < self.max_lag + 3:
@@ -211,24 +254,30 @@ class ARPredictor:
         if len(self._values) > self.window:
             del self._values[0], self._times[0]
         self._since_fit += 1
+        self._since_select += 1
         return True
 
     def _refit(self) -> None:
         y = self.history
+        select = not self._fits or self._since_select >= self.reselect_every
         fits: list[ARFit | None] = []
         for j in range(self.dim):
             col = y[:, j]
             if float(np.ptp(col)) < 1e-9:
                 fits.append(None)
                 continue
+            prev = self._fits[j] if j < len(self._fits) else None
             try:
-                fits.append(
-                    fit_ar(col, max_lag=self.max_lag, ic=self.ic, alpha=self.alpha)
-                )
+                if select or prev is None:
+                    fits.append(fit_ar(col, max_lag=self.max_lag, ic=self.ic, alpha=self.alpha))
+                else:
+                    fits.append(refit_ols(col, prev.order, alpha=self.alpha))
             except (ValueError, np.linalg.LinAlgError):
                 fits.append(None)
         self._fits = fits
         self._since_fit = 0
+        if select:
+            self._since_select = 0
 
     def predict(self, k: int = 1) -> VectorPrediction:
         """Predictions for the next ``k`` periods (AR, or the constant-velocity fallback)."""
