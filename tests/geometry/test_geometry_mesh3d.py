@@ -12,6 +12,8 @@ from uvnav.geometry.mesh3d import (
     PseudoNormals,
     Triangles,
     box_mesh,
+    closest_barycentric,
+    closest_barycentric_scalar,
     closest_points_on_triangles,
     contains_points,
     icosphere,
@@ -50,6 +52,10 @@ def test_nearest_point_lies_on_the_triangle_and_is_optimal(
     xs = w[:, :1] * a + w[:, 1:2] * b + w[:, 2:] * c
     assert np.all((xs - q) @ (p - q) <= 1e-7 * (1 + np.abs(p).max() ** 2))
     assert np.sqrt(d2[0]) <= np.linalg.norm(xs - p, axis=1).min() + 1e-9
+    # the scalar form of the kernel gives the same weights
+    v, w = closest_barycentric(p, tri)
+    vs, ws = closest_barycentric_scalar(tuple(p), tuple(a), tuple(b - a), tuple(c - a))
+    assert (vs, ws) == pytest.approx((float(v[0]), float(w[0])), abs=1e-9)
 
 
 def _box_signed(p: np.ndarray, h: np.ndarray) -> float:

@@ -29,6 +29,8 @@ import numpy as np
 from uvnav.geometry.angles import FloatArray
 
 IntArray = np.ndarray
+#: at most this many candidate triangles are evaluated with plain floats instead of numpy
+SCALAR_CANDIDATES = 24
 
 
 @dataclass(frozen=True)
@@ -137,6 +139,50 @@ def closest_barycentric(point: FloatArray, tri: Triangles) -> tuple[FloatArray, 
     return v, w
 
 
+def closest_barycentric_scalar(
+    p: tuple[float, float, float],
+    a: tuple[float, float, float],
+    ab: tuple[float, float, float],
+    ac: tuple[float, float, float],
+) -> tuple[float, float]:
+    """:func:`closest_barycentric` for one triangle on plain floats (the same region tests in
+    the same order; faster than numpy for the handful of candidate triangles a query keeps)."""
+    apx, apy, apz = p[0] - a[0], p[1] - a[1], p[2] - a[2]
+    abx, aby, abz = ab
+    acx, acy, acz = ac
+    d1 = abx * apx + aby * apy + abz * apz
+    d2 = acx * apx + acy * apy + acz * apz
+    if d1 <= 0.0 and d2 <= 0.0:
+        return 0.0, 0.0
+    bpx, bpy, bpz = apx - abx, apy - aby, apz - abz
+    d3 = abx * bpx + aby * bpy + abz * bpz
+    d4 = acx * bpx + acy * bpy + acz * bpz
+    if d3 >= 0.0 and d4 <= d3:
+        return 1.0, 0.0
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        e = d1 - d3
+        return (d1 / e if e != 0.0 else 0.0), 0.0
+    cpx, cpy, cpz = apx - acx, apy - acy, apz - acz
+    d5 = abx * cpx + aby * cpy + abz * cpz
+    d6 = acx * cpx + acy * cpy + acz * cpz
+    if d6 >= 0.0 and d5 <= d6:
+        return 0.0, 1.0
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        e = d2 - d6
+        return 0.0, (d2 / e if e != 0.0 else 0.0)
+    va = d3 * d6 - d5 * d4
+    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+        e = (d4 - d3) + (d5 - d6)
+        w = (d4 - d3) / e if e != 0.0 else 0.0
+        return 1.0 - w, w
+    denom = va + vb + vc
+    if denom == 0.0:
+        return 0.0, 0.0
+    return vb / denom, vc / denom
+
+
 def closest_points_on_triangles(point: FloatArray, tri: Triangles) -> tuple[FloatArray, FloatArray]:
     """Nearest point of every triangle to ``point`` (Ericson §5.1.5, vectorised).
 
@@ -225,6 +271,26 @@ def signed_nearest(
     the sign from the angle-weighted pseudo-normals (exact for a closed, outward mesh)."""
     p = np.asarray(point, dtype=float)
     idx = tri.candidates(p)
+    if len(idx) <= SCALAR_CANDIDATES:
+        pt = (float(p[0]), float(p[1]), float(p[2]))
+        best = (math.inf, 0, 0.0, 0.0, (0.0, 0.0, 0.0))
+        a_l, ab_l, ac_l = tri.a[idx].tolist(), tri.ab[idx].tolist(), tri.ac[idx].tolist()
+        for k in range(len(idx)):
+            a, ab, ac = a_l[k], ab_l[k], ac_l[k]
+            vk, wk = closest_barycentric_scalar(pt, a, ab, ac)
+            qx = a[0] + ab[0] * vk + ac[0] * wk
+            qy = a[1] + ab[1] * vk + ac[1] * wk
+            qz = a[2] + ab[2] * vk + ac[2] * wk
+            dd = (pt[0] - qx) ** 2 + (pt[1] - qy) ** 2 + (pt[2] - qz) ** 2
+            if dd < best[0]:
+                best = (dd, k, vk, wk, (qx, qy, qz))
+        d2k, k, vk, wk, q = best
+        j = int(idx[k])
+        qa = np.array(q)
+        d = math.sqrt(d2k)
+        if d > 0.0 and float((p - qa) @ normals.normal_at(j, vk, wk)) < 0.0:
+            d = -d
+        return qa, d, j
     sub = tri.subset(idx)
     v, w = closest_barycentric(p, sub)
     closest = sub.a + sub.ab * v[:, None] + sub.ac * w[:, None]
@@ -296,7 +362,8 @@ def ray_triangles(
         tri: the triangles.
         eps: |det| below which a ray is taken as parallel to a triangle's plane.
         bary_tol: slack on the barycentric tests, so that a ray through a shared edge or vertex
-            hits (at least) one of the triangles sharing it.
+            hits (at least) one of the triangles sharing it, and on t >= 0 (an origin on the
+            triangle hits at t = 0).
 
     Returns:
         (r, m) ray parameters t >= 0 of the hits (inf where the ray misses), so that the hit point
@@ -315,8 +382,8 @@ def ray_triangles(
     qvec = np.cross(tvec, e1)
     v = _rowdot(d, qvec) * inv
     t = _rowdot(e2, qvec) * inv
-    hit = ok & (u >= -bary_tol) & (v >= -bary_tol) & (u + v <= 1.0 + bary_tol) & (t >= 0.0)
-    return np.where(hit, t, np.inf)
+    hit = ok & (u >= -bary_tol) & (v >= -bary_tol) & (u + v <= 1.0 + bary_tol) & (t >= -bary_tol)
+    return np.where(hit, np.maximum(t, 0.0), np.inf)
 
 
 def ray_cast(
