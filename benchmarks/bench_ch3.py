@@ -124,7 +124,7 @@ def main() -> None:
     sps = world["unrecorded"]["steps_per_s"]
     data = {
         "machine": {"platform": platform.platform(), "python": platform.python_version(),
-                    "cpus": os.cpu_count(), "load": os.getloadavg()},  # fmt: skip
+                    "cpus": os.cpu_count(), "load": os.getloadavg()},
         "when": datetime.now(UTC).isoformat(),
         "decision_time": dec,
         "world_steps": world,
@@ -133,7 +133,7 @@ def main() -> None:
                                       "pass": med <= TARGETS["decision_us_median_10"]},
             "world_steps_per_s_10": {"limit": TARGETS["world_steps_per_s_10"], "value": sps,
                                      "pass": sps >= TARGETS["world_steps_per_s_10"]},
-        },  # fmt: skip
+        },
     }
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "ch3.json").write_text(json.dumps(data, indent=1), encoding="utf-8")

@@ -89,8 +89,8 @@ def test_3d_commands_are_finite_within_limits_and_orthogonal(
     centre = np.array([x, y + 3.0, z])
     world = [Obstacle3D(SphereBody(0.8), ConstantMotion3D(np.array([vx, vy, 0.0])),
                         ObstacleState3D(centre, velocity=np.array([vx, vy, 0.0])))]  # fmt: skip
-    pos = {"boundary": centre + [0.8, 0, 0], "centre": centre, "goal": GOAL,
-           "near": centre + [0, -1.0, 0]}[where]  # fmt: skip
+    pos = {"boundary": centre + np.array([0.8, 0, 0]), "centre": centre, "goal": GOAL,
+           "near": centre + np.array([0, -1.0, 0])}[where]  # fmt: skip
     heading = np.array([math.cos(th), math.sin(th), 0.0])
     c = make_controller3d(name, oracle=True)
     c.reset(SPEC, GOAL, np.random.default_rng(0))

@@ -32,7 +32,7 @@ def test_sphere_body_is_exact(p: np.ndarray) -> None:
 @settings(max_examples=150, deadline=None)
 @given(p=point)
 def test_star_mesh_sign_agrees_with_winding_and_distance_with_brute_force(p: np.ndarray) -> None:
-    q, d = STAR_MESH.nearest_body(p)
+    _, d = STAR_MESH.nearest_body(p)
     inside = bool(STAR_MESH.contains_body(p[None])[0])
     assert (d < 0) == inside or abs(d) < 1e-9
     # brute force over every triangle

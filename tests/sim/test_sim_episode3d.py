@@ -7,8 +7,8 @@ import pytest
 
 from uvnav.controllers.base3d import make_controller3d
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
-from uvnav.obstacles.bodies3d import MeshBody, SphereBody
 from uvnav.geometry.mesh3d import box_mesh
+from uvnav.obstacles.bodies3d import MeshBody, SphereBody
 from uvnav.obstacles.motion3d import ConstantMotion3D, Obstacle3D, ObstacleState3D
 from uvnav.scenarios import load_scenario
 from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, run_episode3d

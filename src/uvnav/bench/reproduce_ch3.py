@@ -207,9 +207,11 @@ def reproduce_ch3(
             "measured": f"{100 * rate:.1f}% of {len(grp)}",
             "note": f"collisions {int(grp['collision'].astype(float).sum())}",
         })  # fmt: skip
-        for _, r in grp[~grp["success"].astype(bool)].iterrows():
-            failures.append({"scene": r["scenario"], "controller": ctrl, "params": params,
-                             "status": r["status"], "min_clearance": r["min_clearance"]})  # fmt: skip
+        for _, fr in grp[~grp["success"].astype(bool)].iterrows():
+            failures.append({
+                "scene": fr["scenario"], "controller": ctrl, "params": params,
+                "status": fr["status"], "min_clearance": fr["min_clearance"],
+            })  # fmt: skip
     table.append({
         "quantity": "one-step velocity prediction RMS error [m/s]",
         "thesis": "AR model (3.13)-(3.14), no numbers",

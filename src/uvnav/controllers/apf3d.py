@@ -13,9 +13,9 @@ only the sensed nearest points (no velocities).
 
 from __future__ import annotations
 
-import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
@@ -87,7 +87,7 @@ class APF3D(Vehicle3DController):
 register3d(
     ControllerInfo(
         name=APF3D.name,
-        factory=APF3D,
+        factory=cast("Callable[..., Any]", APF3D),  # a 3D law (base3d registry)
         params_type=APF3DParams,
         summary="3D artificial potential field with tangential sliding (baseline)",
         reference="Khatib, IJRR 1986",

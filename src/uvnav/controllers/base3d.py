@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import math
 from importlib import import_module
-from typing import Any, ClassVar, Protocol, runtime_checkable
+from typing import Any, ClassVar, Protocol, cast, runtime_checkable
 
 import numpy as np
 
@@ -70,7 +70,7 @@ def make_controller3d(name: str, *, oracle: bool = False, **params: Any) -> Cont
     p = build_params(info.params_type, params)
     ctrl = info.factory(p) if info.params_type is not None else info.factory()
     ctrl.oracle = oracle
-    return ctrl  # type: ignore[no-any-return]
+    return cast(Controller3D, ctrl)
 
 
 class Vehicle3DController:

@@ -18,8 +18,9 @@ bodies (their bounding spheres are used).
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import ClassVar
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
@@ -136,7 +137,7 @@ class VO3D(Vehicle3DController):
 register3d(
     ControllerInfo(
         name=VO3D.name,
-        factory=VO3D,
+        factory=cast("Callable[..., Any]", VO3D),  # a 3D law (base3d registry)
         params_type=VO3DParams,
         summary="3D velocity obstacles by sampling, bounding spheres (baseline)",
         reference="Fiorini & Shiller, IJRR 1998",

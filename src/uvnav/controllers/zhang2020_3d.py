@@ -60,8 +60,9 @@ Where the thesis is ambiguous this implementation chooses as follows (docs/thesi
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import ClassVar, Literal
+from typing import Any, ClassVar, Literal, cast
 
 import numpy as np
 
@@ -343,7 +344,7 @@ class Zhang2020Law(Vehicle3DController):
 register3d(
     ControllerInfo(
         name=Zhang2020Law.name,
-        factory=Zhang2020Law,
+        factory=cast("Callable[..., Any]", Zhang2020Law),  # a 3D law (base3d registry)
         params_type=Zhang2020Params,
         summary="Thesis Ch. 3: sliding-mode law in the on-line frame with AR prediction (3D)",
         reference="Zhang, thesis Ch. 3 §3.3, eqs. (3.11)-(3.22); ICCAR 2020",

@@ -9,8 +9,9 @@ Vehicles*, UNSW, Chapter 3 §3.2 (ICCAR 2020).  Chapter 5's underwater vehicle h
 Integration is exact for a command held over a step: the heading moves along a great circle of the
 unit sphere (rotation of a_R about the fixed axis a_R x u_R by ||u_R|| dt) and the position
 integrates V_R a_R(t) along it in closed form (:func:`uvnav.geometry.frames3d.rotate_on_sphere`,
-:func:`~uvnav.geometry.frames3d.arc_displacement`).  During the hold, u_R(t) rotates with a_R so that
-(a_R, u_R) = 0 and ||u_R|| stay exact — the held command is the angular velocity a_R x u_R.  The
+:func:`~uvnav.geometry.frames3d.arc_displacement`).  During the hold, u_R(t) rotates with a_R so
+that (a_R, u_R) = 0 and ||u_R|| stay exact — the held command is the angular velocity
+a_R x u_R.  The
 heading is renormalised every step (a projection the exact flow leaves unchanged), so ||a_R|| = 1
 to rounding over any number of steps (tested over 10^5 steps to 1e-12).
 """

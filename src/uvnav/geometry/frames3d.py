@@ -69,7 +69,9 @@ def check_unit(a: FloatArray, *, name: str = "heading", tol: float = 1e-9) -> Fl
         raise ValueError(f"{name} must be a finite 3-vector (got {np.asarray(a).tolist()!r})")
     norm = math.sqrt(float(v @ v))
     if abs(norm - 1.0) > tol:
-        raise ValueError(f"{name} must be a unit vector (||{name}|| = {norm:.12g}, tolerance {tol:g})")
+        raise ValueError(
+            f"{name} must be a unit vector (||{name}|| = {norm:.12g}, tolerance {tol:g})"
+        )
     return v
 
 
@@ -153,7 +155,7 @@ class OnlineFrame:
         return np.stack([self.x_axis, self.y_axis, self.z_axis])
 
     def to_plane(self, points: FloatArray) -> FloatArray:
-        """World points (..., 3) [m] -> their (X', Y') coordinates (..., 2) (projection along Z')."""
+        """World points (..., 3) [m] -> (X', Y') coordinates (..., 2) (projection along Z')."""
         rel = np.asarray(points, dtype=float) - self.origin
         return np.stack([rel @ self.x_axis, rel @ self.y_axis], axis=-1)
 
@@ -184,8 +186,8 @@ def online_frame(
 
 
 def sphere_tangent_half_angle(distance: float, radius: float) -> float:
-    """Half-angle [rad] of the cone of tangents from a point at ``distance`` [m] from the centre of a
-    sphere of ``radius`` [m] (pi/2 when the point is inside or on the sphere)."""
+    """Half-angle [rad] of the cone of tangents from a point at ``distance`` [m] from the centre
+    of a sphere of ``radius`` [m] (pi/2 when the point is inside or on the sphere)."""
     if distance <= radius:
         return 0.5 * math.pi
     return math.asin(radius / distance)

@@ -439,9 +439,8 @@ def validate_mesh(
     f_in = np.asarray(faces)
     if f_in.ndim != 2 or f_in.shape[1] != 3 or f_in.shape[0] < 4:
         raise MeshError(f"faces must be an (m >= 4, 3) array of vertex indices (got {f_in.shape})")
-    if not np.issubdtype(f_in.dtype, np.integer):
-        if not np.all(np.equal(np.mod(f_in, 1), 0)):
-            raise MeshError("faces must hold integer vertex indices")
+    if not np.issubdtype(f_in.dtype, np.integer) and not np.all(np.equal(np.mod(f_in, 1), 0)):
+        raise MeshError("faces must hold integer vertex indices")
     f = f_in.astype(np.int64)
     if f.min() < 0 or f.max() >= v.shape[0]:
         raise MeshError(f"face index out of range 0..{v.shape[0] - 1}")

@@ -96,7 +96,7 @@ class MeshBody:
         return contains_points(points, self.tri)
 
     def ray_body(self, origins: FloatArray, directions: FloatArray) -> FloatArray:
-        """(r,) distance along each body-frame ray (unit directions) to the first hit (inf: miss)."""
+        """(r,) distance along each body-frame ray (unit direction) to its first hit (inf: none)."""
         t = ray_triangles(origins, directions, self.tri)
         return t.min(axis=1) if t.shape[1] else np.full(t.shape[0], np.inf)
 

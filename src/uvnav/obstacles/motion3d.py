@@ -116,7 +116,7 @@ class ARMotion3D:
         return np.asarray(x + sigma * self.rng.standard_normal(3))
 
     def rates(self, t: float, state: ObstacleState3D) -> tuple[FloatArray, FloatArray]:
-        k = int(math.floor(t / self.period + 1e-9))
+        k = math.floor(t / self.period + 1e-9)
         while self._k < k:
             self._k += 1
             vm = np.asarray(self.v_mean, float)

@@ -313,10 +313,7 @@ class ARPredictor:
         return VectorPrediction(mean, std, model, tuple(orders))
 
     def _constant(self, y: FloatArray, k: int) -> VectorPrediction:
-        if len(y) >= 3:
-            step_std = np.std(np.diff(y, axis=0), axis=0)
-        else:
-            step_std = np.zeros(self.dim)
+        step_std = np.std(np.diff(y, axis=0), axis=0) if len(y) >= 3 else np.zeros(self.dim)
         std = step_std[None] * np.sqrt(np.arange(1, k + 1))[:, None]
         return VectorPrediction(np.repeat(y[-1][None], k, axis=0), std, "constant",
                                 (-1,) * self.dim)  # fmt: skip

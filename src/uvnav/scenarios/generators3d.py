@@ -68,7 +68,7 @@ def random_ch3_scenario(
     side /= np.linalg.norm(side)
     up = np.cross(side, axis)
     placed: list[tuple[np.ndarray, float]] = []
-    obstacles = []
+    obstacles: list[dict[str, Any]] = []
     tries = 0
     while len(obstacles) < n and tries < 400:
         tries += 1

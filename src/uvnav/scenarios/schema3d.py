@@ -142,7 +142,7 @@ class Body3DSpec(_Model):
         if self.sphere is not None:
             return SphereBody(self.sphere)
         if self.box is not None:
-            return MeshBody.from_mesh(*box_mesh(self.box))
+            return MeshBody.from_mesh(*box_mesh(np.array(self.box, float)))
         if self.star is not None:
             s = self.star
             star = StarBody(
@@ -239,7 +239,9 @@ class Obstacle3DSpec(_Model):
     body: Body3DSpec
     start: Start3DSpec
     motion: Motion3DSpec = Field(
-        default_factory=lambda: ConstantMotion3DSpec(type="constant", velocity=(0.0, 0.0, 0.0))
+        default_factory=lambda: ConstantMotion3DSpec(
+            type="constant", velocity=(0.0, 0.0, 0.0), rotation_rate=(0.0, 0.0, 0.0)
+        )
     )
 
     def to_obstacle(self, rng: np.random.Generator) -> Obstacle3D:
