@@ -69,11 +69,17 @@ class Triangles:
 
     def candidates(self, point: FloatArray) -> IntArray:
         """Indices of the triangles that may hold the nearest point to ``point``: those whose
-        bounding sphere comes within the nearest centroid's distance (a lower bound against an
-        upper bound, so the nearest triangle is always among them)."""
+        bounding sphere comes within the exact distance to the triangle of the nearest centroid
+        (a lower bound against an upper bound, so the nearest triangle is always among them)."""
         gap = self.centre - point
         dc = np.sqrt((gap * gap).sum(axis=1))
-        return np.flatnonzero(dc - self.radius <= dc.min())
+        k = int(np.argmin(dc))
+        # the exact distance to the triangle with the nearest centroid is a tighter upper bound
+        p = (float(point[0]), float(point[1]), float(point[2]))
+        a, ab, ac = self.a[k].tolist(), self.ab[k].tolist(), self.ac[k].tolist()
+        v, w = closest_barycentric_scalar(p, a, ab, ac)
+        ub = math.sqrt(sum((p[i] - (a[i] + ab[i] * v + ac[i] * w)) ** 2 for i in range(3)))
+        return np.flatnonzero(dc - self.radius <= ub * (1.0 + 1e-12) + 1e-12)
 
     def subset(self, idx: IntArray) -> Triangles:
         return Triangles(
