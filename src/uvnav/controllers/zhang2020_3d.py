@@ -266,6 +266,7 @@ class Zhang2020Law(Vehicle3DController):
     # ------------------------------------------------------------------------------------ act
     def act(self, obs: Observation3D) -> Vehicle3DCommand:
         period = self.decision_period(obs.time)
+        self.predictions = {}  # only this decision's predictions are visible to probes
         self.observe(obs)
         frame = online_frame(obs.position, self._goal, self._x_prev)
         self._x_prev = frame.x_axis

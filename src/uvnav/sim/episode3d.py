@@ -262,7 +262,6 @@ def run_episode3d(
     estimator = None if known else FiniteDifference3D(sense_rng, sensing.position_noise)
     controller.reset(spec, goal, ctrl_rng)
     rec = _Recorder(obstacles) if record else None
-    predicted = getattr(controller, "predictions", None)
 
     # obstacle rates of the first step (so that the first sensing sees them)
     for ob in obstacles:
@@ -316,7 +315,7 @@ def run_episode3d(
         if rec is not None:
             rec.add(
                 t, pos, a, applied.v, u_held, last_mode or "", clearance, nearest, obstacles,
-                dict(predicted) if predicted else {},
+                dict(getattr(controller, "predictions", None) or {}),
             )  # fmt: skip
         effort += float(u_held @ u_held) * dt
         new_pos, a, u_held = vehicle3d_advance(pos, a, applied.v, u_held, dt)
@@ -341,7 +340,7 @@ def run_episode3d(
     if rec is not None:
         rec.add(
             t, pos, a, applied.v, u_held, last_mode or "", clearance, nearest, obstacles,
-            dict(predicted) if predicted else {},
+            dict(getattr(controller, "predictions", None) or {}),
         )  # fmt: skip
     dec = np.asarray(decision_us) if decision_us else np.zeros(1)
     success = status == "success"
