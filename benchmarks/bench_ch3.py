@@ -43,7 +43,7 @@ def _obstacles(n: int, seed: int, centre: np.ndarray, spread: float) -> list[Obs
         d = rng.normal(size=(3, 3))
         star = StarBody(float(rng.uniform(0.6, 1.0)), d, rng.uniform(-0.3, 0.5, 3),
                         rng.uniform(3, 6, 3))  # fmt: skip
-        body = star.to_mesh(2)[0]
+        body = star.to_mesh(2)
         pos = centre + rng.uniform(-spread, spread, 3)
         pos[0] = centre[0] + (i - n / 2) * 2.5
         motion = ARMotion3D(rng=rng.spawn(1)[0], v_mean=rng.normal(size=3) * 0.1,

@@ -38,7 +38,7 @@ def test_m1_goes_straight_at_vmax_without_turning() -> None:
 
 def test_fig_3_5_single_cycle_avoids_on_the_tagged_side_with_a_valid_command() -> None:
     """Fig. 3.5: the predicted obstacle motion in the on-line frame is v* = [0.5, 0.5], u* = 0."""
-    body, _ = StarBody(1.0).to_mesh(1)
+    body = StarBody(1.0).to_mesh(1)
     world = [Obstacle3D(body, ConstantMotion3D(np.array([0.5, 0.5, 0.0])),
                         ObstacleState3D(np.array([-0.8, 2.2, 0.0]),
                                         velocity=np.array([0.5, 0.5, 0.0])))]  # fmt: skip

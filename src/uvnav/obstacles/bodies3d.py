@@ -16,8 +16,8 @@ rotation)`` with ``world = centre + rotation @ body``.  Queries are made in the 
 * :class:`StarBody` — an analytic star-shaped body r(d) = R0 (1 + sum_j h_j exp(k_j (d . n_j - 1)))
   (bumps h_j > 0 and dents h_j < 0 around unit directions n_j); its inside test is analytic and its
   distance queries go through :meth:`StarBody.to_mesh` (a tessellation on an icosphere whose
-  vertices lie *on* the analytic surface; the largest radial gap between the two is reported as
-  ``tessellation_error``).
+  vertices lie *on* the analytic surface; :meth:`StarBody.tessellation_error` measures the largest
+  radial gap between the two).
 
 Bad input (degenerate or open meshes, non-positive radii, a star function that is not positive)
 raises ``ValueError`` with one line naming the problem.
@@ -202,28 +202,26 @@ class StarBody:
         safe = np.where(n[:, None] > 0, p / np.where(n > 0, n, 1.0)[:, None], [1.0, 0.0, 0.0])
         return np.asarray(n < self.radius(safe))
 
-    def to_mesh(self, subdivisions: int = 2) -> tuple[MeshBody, float]:
-        """Tessellation with vertices on the surface: ``(body, tessellation_error)``.
+    def to_mesh(self, subdivisions: int = 2) -> MeshBody:
+        """Tessellation on an icosphere of level ``subdivisions`` with its vertices on the
+        analytic surface (re-centred on the tessellation's volume centroid by :class:`MeshBody`)."""
+        dirs, faces = icosphere(subdivisions)
+        return MeshBody.from_mesh(dirs * self.radius(dirs)[:, None], faces)
 
-        The error is the largest radial gap [m] between the analytic surface and the mesh, measured
-        at the face centres and edge midpoints of a 4x finer sampling."""
+    def tessellation_error(self, subdivisions: int = 2) -> float:
+        """Largest radial gap [m] between the analytic surface and :meth:`to_mesh`'s, sampled along
+        the directions of an icosphere two levels finer (a costly check, not done on building)."""
         dirs, faces = icosphere(subdivisions)
         verts = dirs * self.radius(dirs)[:, None]
-        # the mass centre of the tessellation is used (MeshBody re-centres); keep the offset small
-        body = MeshBody.from_mesh(verts, faces)
         fine, _ = icosphere(subdivisions + 2)
-        r_true = self.radius(fine)
-        t, _ = _radial_hits(body, fine, verts, faces)
-        return body, float(np.abs(t - r_true).max())
+        t = _radial_hits(fine, verts, faces)
+        return float(np.abs(t - self.radius(fine)).max())
 
 
-def _radial_hits(
-    body: MeshBody, dirs: FloatArray, verts: FloatArray, faces: np.ndarray
-) -> tuple[FloatArray, FloatArray]:
-    """Distance from the *original* origin along ``dirs`` to the mesh (before re-centring)."""
+def _radial_hits(dirs: FloatArray, verts: FloatArray, faces: np.ndarray) -> FloatArray:
+    """Distance from the origin along each unit direction to the mesh (first hit)."""
     tri = Triangles.from_mesh(verts, faces)
-    t = ray_triangles(np.zeros((len(dirs), 3)), dirs, tri)
-    return t.min(axis=1), dirs
+    return np.asarray(ray_triangles(np.zeros((len(dirs), 3)), dirs, tri).min(axis=1))
 
 
 Body3D = MeshBody | SphereBody
@@ -232,4 +230,4 @@ Body3D = MeshBody | SphereBody
 
 def body_from_star(star: StarBody, subdivisions: int = 2) -> MeshBody:
     """The mesh of an analytic star-shaped body (see :meth:`StarBody.to_mesh`)."""
-    return star.to_mesh(subdivisions)[0]
+    return star.to_mesh(subdivisions)

@@ -151,7 +151,7 @@ class Body3DSpec(_Model):
                 np.array([b.height for b in s.bumps], float),
                 np.array([b.sharpness for b in s.bumps], float),
             )
-            return star.to_mesh(s.subdivisions)[0]
+            return star.to_mesh(s.subdivisions)
         assert self.mesh is not None
         return MeshBody.from_mesh(np.array(self.mesh.vertices, float), np.array(self.mesh.faces))
 
