@@ -41,7 +41,10 @@ Where the thesis is ambiguous this implementation chooses as follows (docs/thesi
    circles of *all* projected boundary points (the silhouette), rotated out by alpha0: for a convex
    body this is the tangent to the circle at r*_min, for a non-convex one it never grazes a spike
    beyond r*_min.  Other obstacles within D whose inflated silhouettes contain that direction push
-   it further out on the same side (the robot avoids the nearest obstacle "and its neighbours").
+   it further out on the same side (the robot avoids the nearest obstacle "and its neighbours");
+   neighbours count up to 2 D.  When the nearest blocking obstacle changes during M2 the new one
+   inherits the passing side (the robot goes round a group instead of turning back between its
+   bodies); the alpha rule (3.15) sets the side when M2 starts.
 5. *J.* The thesis compares |l^1| and |l^2|, which are equal (both are ||v*|| / tan gamma); the
    tangent on the tagged side is used, which is what the tag is for.
 6. *f and the sign of u.* u_R* = -U_max f would turn the robot away from l_J with beta measured
@@ -49,8 +52,8 @@ Where the thesis is ambiguous this implementation chooses as follows (docs/thesi
    layer (the rate that closes the angle in one decision period) against chattering.
 7. *Speed.* (3.21) V_R* = ||l_J|| (tangent length per T_s) with ``speed_law="tangent"``, floored
    at 1.5 ||v_i*|| ((3.9) needs the robot faster than the obstacle) and capped at V_max; the
-   default ``"max"`` keeps V_max, scaled by cos(beta) while turning (never below the floor) as the
-   Chapter 2 law does.
+   default ``"max"`` keeps V_max, scaled by cos(beta) while turning (never below the floor, nor
+   below V_max / 2) as the Chapter 2 law does.
 8. *Switching distance D, written twice.* The second sentence of §3.3 repeats "shorter than D" for
    leaving M2; it is read as "longer than D".  M2 is entered when an obstacle is within D and in
    the robot's way (its inflated silhouette contains the direction to E or the robot's velocity
@@ -237,7 +240,7 @@ class Zhang2020Law(Vehicle3DController):
         """Inflated shadows of the obstacles within D (using the sensed rates)."""
         out = {}
         for rd in obs.obstacles:
-            if rd.distance > self.p.switch_distance:
+            if rd.distance > 2.0 * self.p.switch_distance:  # neighbours count up to 2 D
                 continue
             v, u = rd.velocity, rd.rotation_rate
             if rd.obstacle_id == self._target:
@@ -275,22 +278,28 @@ class Zhang2020Law(Vehicle3DController):
         blocking = [
             (rd.distance, i)
             for i, (sh, rd, v, _) in shadows.items()
-            if self.in_the_way(frame, sh, v, obs, pad if i == self._target else 0.0)
+            if rd.distance <= self.p.switch_distance
+            and self.in_the_way(frame, sh, v, obs, pad if i == self._target else 0.0)
         ]
         if not blocking:
             self._mode = "M1"
             self._target = None
             return self.approach(obs, period)
         _, target = min(blocking)
+        previous = self._target
         if target != self._target:
             self._target = target
             shadows = self.shadows(frame, obs)  # the target's rates are now the predicted ones
         self._mode = "M2"
         sh, rd, v, _u = shadows[target]
         if target not in self._tag:
-            # (3.15): alpha = angle of L_center from Y', counter-clockwise
-            alpha = sh.centre_angle
-            self._tag[target] = 1 if alpha >= 0.0 else -1
+            if previous is not None and previous in self._tag:
+                # handing over from one obstacle to the next during M2: keep the passing side,
+                # so the robot goes round the group instead of turning back between bodies
+                self._tag[target] = self._tag[previous]
+            else:
+                # (3.15): alpha = angle of L_center from Y', counter-clockwise
+                self._tag[target] = 1 if sh.centre_angle >= 0.0 else -1
         tag = self._tag[target]
         for other in list(self._tag):
             if other not in shadows:
@@ -330,7 +339,7 @@ class Zhang2020Law(Vehicle3DController):
     ) -> float:
         """(3.21) or V_max (``speed_law``), floored at 1.5 ||v_i*|| ((3.9))."""
         vmax = self._spec.v_max
-        floor = min(vmax, 1.5 * float(np.linalg.norm(v)) + 0.05 * vmax)
+        floor = min(vmax, max(1.5 * float(np.linalg.norm(v)) + 0.05 * vmax, 0.5 * vmax))
         if self.p.speed_law == "tangent":
             # ||l_J|| = ||v*|| / tan(gamma) = sqrt(d*^2 - r^2): the tangent length to the
             # forecast sphere at r*_min, covered in T_s

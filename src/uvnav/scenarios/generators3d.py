@@ -2,7 +2,8 @@
 
 The robot (V_max = 1 m/s, U_max = 1 rad/s, radius 0.1 m) flies from S = [0, 0, 5] to an end point E
 20-26 m away in a random horizontal direction and 0-6 m higher or lower.  ``n_obstacles`` (2-4 by
-default) non-convex star-shaped bodies (base radius 0.8-1.5 m, 2-4 bumps and dents) are placed so
+default) non-convex star-shaped bodies (base radius 0.8-1.5 m, 2-4 bumps and dents, the dents'
+relative depths summing to at most 0.5) are placed so
 that, moving with their *mean* velocity, they would sit near the straight path S-E when the robot
 gets there (lateral and vertical offsets within +-1.2 m): they are in the way.  Their motion is
 :class:`~uvnav.obstacles.motion3d.ARMotion3D` — slowly varying AR(2) velocity and rotation — with
@@ -28,10 +29,16 @@ def _star(rng: np.random.Generator) -> tuple[dict[str, Any], float]:
     r0 = float(rng.uniform(0.8, 1.5))
     bumps = []
     bound = 1.0
+    dents = 0.0
     for _ in range(int(rng.integers(2, 5))):
         d = rng.normal(size=3)
         d /= np.linalg.norm(d)
         h = float(rng.uniform(0.2, 0.6)) * (1 if rng.random() < 0.6 else -0.5)
+        if h < 0:
+            if dents + h < -0.5:  # keep the body solid: dents sum to at most -0.5
+                h = -h
+            else:
+                dents += h
         bumps.append(
             {"direction": [float(x) for x in d], "height": round(h, 3),
              "sharpness": round(float(rng.uniform(3.0, 6.0)), 3)}
