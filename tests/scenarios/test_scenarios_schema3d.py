@@ -64,3 +64,12 @@ def test_random_ch3_is_registered_seeded_and_valid() -> None:
     assert 2 <= len(a.obstacles) <= 4
     for ob in a.obstacles:
         assert ob.motion.bounds()[0] < a.robot.v_max and ob.motion.bounds()[1] < a.robot.u_max
+
+
+def test_2d_entry_points_refuse_or_skip_3d_scenes_clearly() -> None:
+    from uvnav.scenarios import build_episode, check_constraints
+
+    sc = load_scenario("thesis-ch3-fig3-5-single-cycle")
+    assert check_constraints(sc) == []  # (3.9)-(3.10) were checked on loading
+    with pytest.raises(ScenarioError, match="3D simulator"):
+        build_episode(sc, 0)  # type: ignore[arg-type]
