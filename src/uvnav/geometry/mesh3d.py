@@ -30,7 +30,7 @@ from uvnav.geometry.angles import FloatArray
 
 IntArray = np.ndarray
 #: at most this many candidate triangles are evaluated with plain floats instead of numpy
-SCALAR_CANDIDATES = 24
+SCALAR_CANDIDATES = 64
 
 
 @dataclass(frozen=True)
