@@ -280,6 +280,14 @@ class Scenario3D(_Model):
     def source(self) -> str:
         return self._source
 
+    def __eq__(self, other: object) -> bool:
+        """Equal when every field is equal; where the scenario was read from does not count."""
+        if not isinstance(other, Scenario3D):
+            return NotImplemented
+        return self.__dict__ == other.__dict__
+
+    __hash__ = None  # type: ignore[assignment]  # lists inside: not hashable
+
     @model_validator(mode="after")
     def _consistent(self) -> Scenario3D:
         ratio = self.control_period / self.dt
