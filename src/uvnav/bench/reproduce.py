@@ -595,6 +595,10 @@ def reproduce(
                     status = str(store.episode_row(eid)["status"])
                     scene_episodes.append(SceneEpisode(s, c, 0, eid, status))
 
+    if n_random is None:  # thesis Ch. 3 (3D): scenes + random campaign rows (bench/reproduce_ch3)
+        from uvnav.bench.reproduce_ch3 import reproduce_ch3
+
+        table += reproduce_ch3(results_dir, report_dir, full=full, workers=workers).table
     report_path: Path | None = None
     figures: list[Path] = []
     if render is not None:

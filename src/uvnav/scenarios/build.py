@@ -50,7 +50,16 @@ def build_episode(scenario: Scenario, seed: int) -> EpisodeSetup:
     Returns:
         A fresh :class:`~uvnav.sim.EpisodeSetup` (its obstacles are advanced in place by
         :func:`~uvnav.sim.run_episode`, so build one per run).
+
+    Raises:
+        ScenarioError: a 3D scene (``dim: 3``; built by ``Scenario3D.build``).
     """
+    if getattr(scenario, "dim", 2) == 3:
+        raise ScenarioError(
+            getattr(scenario, "source", "<dict>"), "dim",
+            "a 3D scene runs in the 3D simulator (Scenario3D.build + uvnav.sim.episode3d), "
+            "not in the 2D one",
+        )  # fmt: skip
     rng = world_rng(seed)
     children = rng.spawn(len(scenario.obstacles))
     obstacles = [
@@ -99,6 +108,8 @@ def check_constraints(scenario: Scenario) -> list[str]:
     Returns:
         An empty list when every obstacle obeys (2.6)-(2.8) for the robot's V_max and U_max.
     """
+    if getattr(scenario, "dim", 2) == 3:  # 3D: (3.9)-(3.10) are enforced by schema3d on loading
+        return []
     v_max = scenario.robot.v_max
     u_max = scenario.robot.u_max
     lines: list[str] = []

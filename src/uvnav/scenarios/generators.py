@@ -351,12 +351,20 @@ def crowd_crossing_scenario(
     return scenario_from_dict(data, source=f"crowd-{dataset}:{seed}")
 
 
+def _random_ch3(seed: int, **params: Any) -> Any:
+    """3D scenes of thesis Ch. 3 (:func:`uvnav.scenarios.generators3d.random_ch3_scenario`)."""
+    from uvnav.scenarios.generators3d import random_ch3_scenario
+
+    return random_ch3_scenario(seed, **params)
+
+
 #: Seeded scenario generators by name: ``GENERATORS[name](seed, **params) -> Scenario``.
 #: ``load_scenario("<name>:<seed>")`` and campaign files refer to them by these names.
 GENERATORS: dict[str, Callable[..., Scenario]] = {
     "random-ch2": random_ch2_scenario,
     "crowd-eth": partial(crowd_crossing_scenario, dataset="eth"),
     "crowd-hotel": partial(crowd_crossing_scenario, dataset="hotel"),
+    "random-ch3": _random_ch3,
 }
 
 

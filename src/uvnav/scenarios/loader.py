@@ -151,6 +151,10 @@ def scenario_from_dict(data: dict[str, Any], source: str = "<dict>") -> Scenario
         raise ScenarioError(
             source, "<root>", f"expected a mapping of scenario fields (got {type(data).__name__})"
         )
+    if data.get("dim") == 3:  # 3D scenes (thesis Ch. 3): their own schema
+        from uvnav.scenarios.schema3d import scenario3d_from_dict
+
+        return scenario3d_from_dict(data, source)  # type: ignore[return-value]
     base = Path(source).parent if Path(source).is_file() else None
     try:
         scenario = Scenario.model_validate(data, context={"base_dir": base})

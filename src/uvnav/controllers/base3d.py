@@ -1,0 +1,136 @@
+"""Controller contract and registry for the 3D vehicle (DESIGN §2; thesis Chapters 3 and 5).
+
+A 3D law is reset with the vehicle's limits (:class:`~uvnav.dynamics.vehicle3d.Vehicle3DSpec`),
+the goal and a generator, and asked for a :class:`~uvnav.dynamics.vehicle3d.Vehicle3DCommand`
+``(V_R, u_R)`` with nothing but an :class:`~uvnav.sensors.sensing3d.Observation3D`.
+
+3D laws have their own registry (``available_controllers3d`` / ``make_controller3d``), built on the
+same :class:`~uvnav.controllers.base.ControllerInfo` and parameter checking as the 2D one: the
+2D registry's contract test feeds every law 2D observations, which a 3D law cannot take.
+"""
+
+from __future__ import annotations
+
+import math
+from importlib import import_module
+from typing import Any, ClassVar, Protocol, cast, runtime_checkable
+
+import numpy as np
+
+from uvnav.controllers.base import (
+    ControllerInfo,
+    UnknownControllerError,
+    build_params,
+)
+from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
+from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.frames3d import turn_toward
+from uvnav.sensors.sensing3d import Observation3D
+
+
+@runtime_checkable
+class Controller3D(Protocol):
+    """A navigation law for the 3D vehicle."""
+
+    name: ClassVar[str]
+    oracle: bool
+
+    def reset(self, spec: Vehicle3DSpec, goal: np.ndarray, rng: np.random.Generator) -> None: ...
+
+    def act(self, obs: Observation3D) -> Vehicle3DCommand: ...
+
+    @property
+    def mode(self) -> str: ...
+
+
+_REGISTRY3D: dict[str, ControllerInfo] = {}
+#: Modules of ``uvnav.controllers`` that register built-in 3D laws when imported.
+BUILTIN_MODULES_3D: tuple[str, ...] = ("zhang2020_3d", "apf3d", "vo3d")
+
+
+def register3d(info: ControllerInfo) -> ControllerInfo:
+    """Add a 3D law to the 3D registry."""
+    _REGISTRY3D[info.name] = info
+    return info
+
+
+def available_controllers3d() -> dict[str, ControllerInfo]:
+    """All registered 3D laws by name."""
+    for module in BUILTIN_MODULES_3D:
+        import_module(f"uvnav.controllers.{module}")
+    return dict(sorted(_REGISTRY3D.items()))
+
+
+def make_controller3d(name: str, *, oracle: bool = False, **params: Any) -> Controller3D:
+    """Build a registered 3D law by name with keyword parameters (see ``make_controller``)."""
+    ctrls = available_controllers3d()
+    if name not in ctrls:
+        raise UnknownControllerError(f"unknown 3D controller {name!r}; known: {', '.join(ctrls)}")
+    info = ctrls[name]
+    p = build_params(info.params_type, params)
+    ctrl = info.factory(p) if info.params_type is not None else info.factory()
+    ctrl.oracle = oracle
+    return cast(Controller3D, ctrl)
+
+
+class Vehicle3DController:
+    """State every 3D law keeps: limits, goal, mode, decision clock; and the M1 approach law."""
+
+    name: ClassVar[str]
+    FIRST_PERIOD: ClassVar[float] = 0.1
+
+    def __init__(self) -> None:
+        self.oracle = False
+        self._spec = Vehicle3DSpec(1.0, 1.0)
+        self._goal = np.zeros(3)
+        self._mode = "M1"
+        self._last_t: float | None = None
+
+    @property
+    def mode(self) -> str:
+        return self._mode
+
+    def reset(self, spec: Vehicle3DSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
+        self._spec = spec
+        self._goal = np.asarray(goal, dtype=float)
+        self._mode = "M1"
+        self._last_t = None
+        self._reset_law(rng)
+
+    def _reset_law(self, rng: np.random.Generator) -> None:
+        """Per-episode state of the law (none by default)."""
+
+    def decision_period(self, time: float) -> float:
+        """Seconds since the previous decision (``FIRST_PERIOD`` at the first, >= 1 ms)."""
+        if not math.isfinite(time):
+            return self.FIRST_PERIOD
+        period = self.FIRST_PERIOD if self._last_t is None else max(time - self._last_t, 1e-3)
+        self._last_t = time
+        return period
+
+    def steer(
+        self, obs: Observation3D, direction: FloatArray, speed: float, period: float
+    ) -> Vehicle3DCommand:
+        """Command turning the heading toward ``direction`` at the bounded rate (orthogonal to
+        a_R by construction) with speed ``speed`` clipped to [0, V_max]."""
+        a = np.asarray(obs.heading, dtype=float)
+        u = turn_toward(a, direction, self._spec.u_max, period)
+        v = min(max(float(speed), 0.0), self._spec.v_max) if math.isfinite(speed) else 0.0
+        return Vehicle3DCommand(v, u)
+
+    def approach(self, obs: Observation3D, period: float) -> Vehicle3DCommand:
+        """M1 (3.11)-(3.12): V_max straight to E; when not facing E the heading turns toward it
+        at the bounded rate, slowing where E lies inside the minimum turning circle."""
+        gap = self._goal - obs.position
+        dist = float(np.linalg.norm(gap))
+        if dist < 1e-9:
+            return Vehicle3DCommand(0.0, np.zeros(3))
+        cos_e = float(np.clip(gap @ obs.heading / dist, -1.0, 1.0))
+        err = math.acos(cos_e)
+        v = self._spec.v_max
+        # keep E outside the turning circle of radius V / U (a circle through the robot tangent
+        # to a_R contains E when dist < 2 R sin(err)); slow down so that it does not
+        if err > 1e-6:
+            v_fit = self._spec.u_max * dist / (2.0 * math.sin(err)) if err < math.pi / 2 else 0.0
+            v = min(v, max(v_fit, 0.2 * self._spec.v_max))
+        return self.steer(obs, gap, v, period)

@@ -1,0 +1,216 @@
+"""3D frames and rotations: exact rotation on the sphere of headings, SO(3) exp/log, the thesis's
+on-line frame, and the tangent cone to a sphere.
+
+Reference: Y. Zhang, *Algorithms of Real-Time Navigation and Control of Autonomous Unmanned
+Vehicles*, UNSW — Chapter 3 ("Collision-free Navigation of Flying Robots in Outdoor Environments
+with Dynamic Obstacles", ICCAR 2020), eqs. (3.1)-(3.7) (unit heading a_R, turn vector u_R with
+(a_R, u_R) = 0), §3.3.2 (the on-line coordinate (X', Y')), eq. (3.17) (forecast sphere).
+
+Rotations are written here (Rodrigues' formula and its inverse) rather than taken from
+``scipy.spatial.transform.Rotation`` because they run once per integration step per obstacle and
+the scipy object costs about 10x more per call; the test suite checks them against scipy.
+
+On-line frame (§3.3.2): origin at the robot, Y' toward the end point E, X' *horizontal* and
+perpendicular to Y'.  The thesis leaves X' undefined when E is straight above or below the robot
+(Y' vertical); then X' is taken as the previous X' projected off Y' (continuity), or world +x when
+there is none (docs/thesis-notes.md).  X' = Y' x z / ||Y' x z|| (points to the right of Y' seen
+from above, so that (X', Y', Z') with Z' = X' x Y' is right-handed and Z' points up).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from uvnav.geometry.angles import FloatArray
+
+_Z = np.array([0.0, 0.0, 1.0])
+
+
+def skew(w: FloatArray) -> FloatArray:
+    """The matrix [w]x with [w]x v = w x v."""
+    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+
+
+def rotation_from_vector(rotvec: FloatArray) -> FloatArray:
+    """exp([r]x): rotation by ||r|| [rad] about r / ||r|| (Rodrigues); identity for r = 0."""
+    r = np.asarray(rotvec, dtype=float)
+    theta = math.sqrt(float(r @ r))
+    if theta < 1e-12:
+        return np.eye(3) + skew(r)
+    k = skew(r / theta)
+    return np.eye(3) + math.sin(theta) * k + (1.0 - math.cos(theta)) * (k @ k)
+
+
+def rotation_to_vector(rot: FloatArray) -> FloatArray:
+    """log of a rotation matrix as a rotation vector [rad] (angle in [0, pi])."""
+    m = np.asarray(rot, dtype=float)
+    cos_t = min(max((float(np.trace(m)) - 1.0) * 0.5, -1.0), 1.0)
+    theta = math.acos(cos_t)
+    w = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
+    if theta < 1e-6:
+        return 0.5 * w  # first order; exact to O(theta^3)
+    if math.pi - theta < 1e-6:
+        # axis from the symmetric part: R = I + 2 k k^T - 2 I at theta = pi
+        b = (m + np.eye(3)) * 0.5
+        i = int(np.argmax(np.diag(b)))
+        axis = b[:, i] / math.sqrt(max(b[i, i], 1e-300))
+        axis /= np.linalg.norm(axis)
+        return theta * axis
+    return theta / (2.0 * math.sin(theta)) * w
+
+
+def check_unit(a: FloatArray, *, name: str = "heading", tol: float = 1e-9) -> FloatArray:
+    """``a`` as a float (3,) array, or ``ValueError`` naming ``name`` if it is not a unit vector."""
+    v = np.asarray(a, dtype=float)
+    if v.shape != (3,) or not np.all(np.isfinite(v)):
+        raise ValueError(f"{name} must be a finite 3-vector (got {np.asarray(a).tolist()!r})")
+    norm = math.sqrt(float(v @ v))
+    if abs(norm - 1.0) > tol:
+        raise ValueError(
+            f"{name} must be a unit vector (||{name}|| = {norm:.12g}, tolerance {tol:g})"
+        )
+    return v
+
+
+def rotate_on_sphere(a: FloatArray, u: FloatArray, dt: float) -> tuple[FloatArray, FloatArray]:
+    """Exact solution of a' = u(t), (a, u) = 0, with the turn held about the fixed axis a x u.
+
+    Over ``dt`` [s] the heading moves along the great circle through ``a`` toward ``u``:
+    ``a(dt) = a cos(w dt) + (u / w) sin(w dt)`` with ``w = ||u||`` [rad/s], and the turn vector
+    becomes ``u(dt) = -w a sin(w dt) + u cos(w dt)`` (still orthogonal to ``a(dt)``, same norm).
+
+    Returns:
+        ``(a(dt), u(dt))``; ``a(dt)`` is renormalised (a projection onto the sphere, which the exact
+        flow preserves), so its norm is 1 to rounding however many steps are taken.
+    """
+    w = math.sqrt(float(u @ u))
+    theta = w * dt
+    if w == 0.0:
+        return a.copy(), u.copy()
+    c, s = math.cos(theta), math.sin(theta)
+    a_new = a * c + u * (s / w)
+    u_new = u * c - a * (w * s)
+    a_new = a_new / math.sqrt(float(a_new @ a_new))
+    u_new = u_new - float(u_new @ a_new) * a_new  # keep (a, u) = 0 to rounding
+    return a_new, u_new
+
+
+def arc_displacement(a: FloatArray, u: FloatArray, v: float, dt: float) -> FloatArray:
+    """Exact displacement [m] of c' = v a(t) while a turns as in :func:`rotate_on_sphere`.
+
+    ``∫ a(s) ds = a sin(w dt)/w + (u/w) (1 - cos(w dt))/w``, written with sinc so that it stays
+    exact as w -> 0 (it tends to ``a dt``).
+    """
+    w = math.sqrt(float(u @ u))
+    half = 0.5 * w * dt
+    sinc_half = math.sin(half) / half if half > 1e-12 else 1.0 - half * half / 6.0
+    full = w * dt
+    sinc_full = math.sin(full) / full if full > 1e-12 else 1.0 - full * full / 6.0
+    # (1 - cos(w dt)) / w^2 = dt^2 / 2 * sinc(half)^2
+    return v * (a * (dt * sinc_full) + u * (0.5 * dt * dt * sinc_half * sinc_half))
+
+
+def horizontal_perpendicular(y_axis: FloatArray, previous: FloatArray | None = None) -> FloatArray:
+    """X' of the on-line frame: horizontal, perpendicular to ``y_axis`` (a unit vector).
+
+    ``X' = Y' x z / ||Y' x z||``.  When Y' is (nearly) vertical the previous X' projected off Y' is
+    used (or world +x when there is none) — a choice the thesis leaves open.
+    """
+    x = np.cross(y_axis, _Z)
+    n = math.sqrt(float(x @ x))
+    if n > 1e-6:
+        return x / n
+    ref = np.array([1.0, 0.0, 0.0]) if previous is None else np.asarray(previous, dtype=float)
+    x = ref - float(ref @ y_axis) * y_axis
+    n = math.sqrt(float(x @ x))
+    if n < 1e-9:
+        ref = np.array([0.0, 1.0, 0.0])
+        x = ref - float(ref @ y_axis) * y_axis
+        n = math.sqrt(float(x @ x))
+    return x / n
+
+
+@dataclass(frozen=True)
+class OnlineFrame:
+    """The thesis's on-line frame (§3.3.2) at one decision time.
+
+    Attributes:
+        origin: robot position c_R [m], (3,).
+        x_axis: X', horizontal, perpendicular to Y'.
+        y_axis: Y', unit vector from the robot toward E.
+        z_axis: Z' = X' x Y' (normal of the on-line plane).
+    """
+
+    origin: FloatArray
+    x_axis: FloatArray
+    y_axis: FloatArray
+    z_axis: FloatArray
+
+    @property
+    def basis(self) -> FloatArray:
+        """(3, 3) matrix whose rows are X', Y', Z'."""
+        return np.stack([self.x_axis, self.y_axis, self.z_axis])
+
+    def to_plane(self, points: FloatArray) -> FloatArray:
+        """World points (..., 3) [m] -> (X', Y') coordinates (..., 2) (projection along Z')."""
+        rel = np.asarray(points, dtype=float) - self.origin
+        return np.stack([rel @ self.x_axis, rel @ self.y_axis], axis=-1)
+
+    def vector_to_plane(self, vectors: FloatArray) -> FloatArray:
+        """World vectors (..., 3) -> their (X', Y') components (..., 2)."""
+        v = np.asarray(vectors, dtype=float)
+        return np.stack([v @ self.x_axis, v @ self.y_axis], axis=-1)
+
+    def plane_to_world(self, vectors2: FloatArray) -> FloatArray:
+        """(X', Y') vectors (..., 2) -> world vectors (..., 3) in the on-line plane."""
+        v = np.asarray(vectors2, dtype=float)
+        return v[..., :1] * self.x_axis + v[..., 1:2] * self.y_axis
+
+
+def online_frame(
+    position: FloatArray, goal: FloatArray, previous_x: FloatArray | None = None
+) -> OnlineFrame:
+    """The on-line frame at ``position`` toward ``goal`` [m] (see the module docstring).
+
+    A robot exactly at the goal gets Y' = world +y (the frame is then irrelevant)."""
+    p = np.asarray(position, dtype=float)
+    gap = np.asarray(goal, dtype=float) - p
+    n = math.sqrt(float(gap @ gap))
+    y = gap / n if n > 1e-12 else np.array([0.0, 1.0, 0.0])
+    x = horizontal_perpendicular(y, previous_x)
+    z = np.cross(x, y)
+    return OnlineFrame(origin=p, x_axis=x, y_axis=y, z_axis=z)
+
+
+def sphere_tangent_half_angle(distance: float, radius: float) -> float:
+    """Half-angle [rad] of the cone of tangents from a point at ``distance`` [m] from the centre
+    of a sphere of ``radius`` [m] (pi/2 when the point is inside or on the sphere)."""
+    if distance <= radius:
+        return 0.5 * math.pi
+    return math.asin(radius / distance)
+
+
+def turn_toward(a: FloatArray, direction: FloatArray, u_max: float, period: float) -> FloatArray:
+    """Turn vector u (orthogonal to the unit heading ``a``, ||u|| <= ``u_max``) turning ``a`` toward
+    ``direction`` along the great circle: rate ``u_max`` outside a boundary layer, and the rate that
+    closes the angle in one ``period`` [s] inside it (the 3D form of the sliding-mode law with a
+    boundary layer used in Ch. 2).  Zero for a zero direction or one already aligned."""
+    d = np.asarray(direction, dtype=float)
+    nd = math.sqrt(float(d @ d))
+    if nd < 1e-12:
+        return np.zeros(3)
+    d = d / nd
+    perp = d - float(d @ a) * a
+    n_perp = math.sqrt(float(perp @ perp))
+    angle = math.atan2(n_perp, float(d @ a))
+    if n_perp < 1e-12:
+        if angle < 0.5 * math.pi:
+            return np.zeros(3)
+        # exactly opposite: turn about any axis, horizontal first
+        perp = horizontal_perpendicular(a)
+        n_perp = 1.0
+    rate = min(u_max, angle / period) if period > 0 else u_max
+    return perp * (rate / n_perp)

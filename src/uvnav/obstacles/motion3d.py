@@ -1,0 +1,206 @@
+"""Moving, rotating 3D obstacles and their motion models.
+
+Thesis Chapter 3 §3.2 (Y. Zhang, ICCAR 2020): obstacle i moves with velocity v_i(t) = V_i(t) a_i(t)
+and rotates about its mass centre with rotation vector u_i(t), subject to (3.9)
+0 < ||v_i|| < ||v_R|| < V_max and (3.10) ||u_i|| < ||u_R|| < U_max.  §3.3.1 assumes the motion
+"changes slowly" so that an AR model predicts it; the models here are:
+
+* :class:`ConstantMotion3D` — fixed v_i, u_i;
+* :class:`ARMotion3D` — v_i and u_i are AR(p) processes sampled every ``period`` T_s [s] (1 s in
+  the thesis) around a mean, held constant within a period, with their norms kept in the bounds
+  of (3.9)-(3.10) (a draw outside is scaled back to the bound): the "slowly varying" motion the
+  AR predictor of :mod:`uvnav.prediction.autoregressive` is built for;
+* :class:`Waypoints3D` — a scripted path through points at a fixed speed, with a fixed spin.
+
+Integration of one step ``dt`` with (v, u) held is exact: ``c += v dt``,
+``R = exp([u]x dt) R``.  Randomness only from the ``numpy.random.Generator`` a model is built with.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.frames3d import rotation_from_vector
+from uvnav.obstacles.bodies3d import Body3D
+
+
+@dataclass
+class ObstacleState3D:
+    """Pose and rates of a 3D obstacle.
+
+    Attributes:
+        centre: mass centre [m], (3,).
+        rotation: body-to-world rotation matrix (3, 3).
+        velocity: v_i [m/s], (3,), held over the current step.
+        rotation_rate: u_i [rad/s], (3,), world frame, held over the current step.
+    """
+
+    centre: FloatArray
+    rotation: FloatArray = field(default_factory=lambda: np.eye(3))
+    velocity: FloatArray = field(default_factory=lambda: np.zeros(3))
+    rotation_rate: FloatArray = field(default_factory=lambda: np.zeros(3))
+
+
+class MotionModel3D(Protocol):
+    """Sets the obstacle's (v_i, u_i) for the step starting at ``t`` [s]."""
+
+    def rates(self, t: float, state: ObstacleState3D) -> tuple[FloatArray, FloatArray]: ...
+
+
+def _clip_norm(x: FloatArray, lo: float, hi: float) -> FloatArray:
+    n = float(np.linalg.norm(x))
+    if n > hi:
+        return x * (hi / n)
+    if n < lo:
+        if n < 1e-12:
+            return np.array([lo, 0.0, 0.0])
+        return x * (lo / n)
+    return x
+
+
+@dataclass
+class ConstantMotion3D:
+    """Constant velocity ``velocity`` [m/s] and rotation ``rotation_rate`` [rad/s] (world frame)."""
+
+    velocity: FloatArray
+    rotation_rate: FloatArray = field(default_factory=lambda: np.zeros(3))
+
+    def rates(self, t: float, state: ObstacleState3D) -> tuple[FloatArray, FloatArray]:
+        return np.asarray(self.velocity, float), np.asarray(self.rotation_rate, float)
+
+
+@dataclass
+class ARMotion3D:
+    """Slowly varying random motion: per component, an AR(p) process sampled every ``period``.
+
+    ``x_k = mean + sum_j phi_j (x_{k-j} - mean) + sigma e_k`` (e_k standard normal), for the
+    velocity (``v_*``) and the rotation vector (``u_*``); each new sample is scaled into
+    ``[v_min, v_max]`` / ``[0, u_max]`` by norm.
+
+    Attributes:
+        rng: the generator of the noise.
+        v_mean: mean velocity [m/s], (3,).
+        phi: AR coefficients (p,) shared by both processes (stationary choices only).
+        v_sigma: noise std of the velocity [m/s].
+        v_min, v_max: bounds on ||v_i|| [m/s] ((3.9) with v_max < the robot's speed).
+        u_mean: mean rotation vector [rad/s], (3,).
+        u_sigma: noise std of the rotation vector [rad/s].
+        u_max: bound on ||u_i|| [rad/s] ((3.10)).
+        period: sampling period T_s [s] (thesis: 1 s).
+    """
+
+    rng: np.random.Generator
+    v_mean: FloatArray
+    phi: FloatArray = field(default_factory=lambda: np.array([0.6, 0.2]))
+    v_sigma: float = 0.05
+    v_min: float = 0.05
+    v_max: float = 0.5
+    u_mean: FloatArray = field(default_factory=lambda: np.zeros(3))
+    u_sigma: float = 0.02
+    u_max: float = 0.3
+    period: float = 1.0
+    _k: int = field(default=-1, init=False)
+    _v_hist: list[FloatArray] = field(default_factory=list, init=False)
+    _u_hist: list[FloatArray] = field(default_factory=list, init=False)
+
+    def _next(self, hist: list[FloatArray], mean: FloatArray, sigma: float) -> FloatArray:
+        x = mean.copy()
+        for j, ph in enumerate(np.asarray(self.phi, float)):
+            prev = hist[-1 - j] if j < len(hist) else mean
+            x = x + ph * (prev - mean)
+        return np.asarray(x + sigma * self.rng.standard_normal(3))
+
+    def rates(self, t: float, state: ObstacleState3D) -> tuple[FloatArray, FloatArray]:
+        k = math.floor(t / self.period + 1e-9)
+        while self._k < k:
+            self._k += 1
+            vm = np.asarray(self.v_mean, float)
+            um = np.asarray(self.u_mean, float)
+            if not self._v_hist:
+                v = _clip_norm(vm.copy(), self.v_min, self.v_max)
+                u = _clip_norm(um.copy(), 0.0, self.u_max)
+            else:
+                v = _clip_norm(self._next(self._v_hist, vm, self.v_sigma), self.v_min, self.v_max)
+                u = _clip_norm(self._next(self._u_hist, um, self.u_sigma), 0.0, self.u_max)
+            self._v_hist.append(v)
+            self._u_hist.append(u)
+            if len(self._v_hist) > 16:
+                del self._v_hist[0], self._u_hist[0]
+        return self._v_hist[-1], self._u_hist[-1]
+
+
+@dataclass
+class Waypoints3D:
+    """Scripted path: straight at ``speed`` [m/s] through ``points`` (k, 3) [m], then back along
+    them when ``loop`` (ping-pong), else stop at the last; spins with ``rotation_rate``."""
+
+    points: FloatArray
+    speed: float
+    rotation_rate: FloatArray = field(default_factory=lambda: np.zeros(3))
+    loop: bool = True
+    _i: int = field(default=0, init=False)
+    _step: int = field(default=1, init=False)
+
+    def rates(self, t: float, state: ObstacleState3D) -> tuple[FloatArray, FloatArray]:
+        pts = np.asarray(self.points, float)
+        u = np.asarray(self.rotation_rate, float)
+        for _ in range(2 * len(pts) + 1):
+            gap = pts[self._i] - state.centre
+            dist = float(np.linalg.norm(gap))
+            if dist > 1e-9:
+                return gap / dist * self.speed, u
+            nxt = self._i + self._step
+            if not 0 <= nxt < len(pts):
+                if not self.loop or len(pts) < 2:
+                    return np.zeros(3), u
+                self._step = -self._step
+                nxt = self._i + self._step
+            self._i = nxt
+        return np.zeros(3), u
+
+
+@dataclass
+class Obstacle3D:
+    """A body, its motion model and its current state."""
+
+    body: Body3D
+    motion: MotionModel3D
+    state: ObstacleState3D
+
+    def step(self, t: float, dt: float) -> None:
+        """Advance by ``dt`` [s] from time ``t`` [s] with the rates the model gives for the step
+        (stored in the state as the rates held over it)."""
+        v, u = self.motion.rates(t, self.state)
+        self.state.velocity = v
+        self.state.rotation_rate = u
+        self.state.centre = self.state.centre + v * dt
+        if float(u @ u) > 0.0:
+            self.state.rotation = rotation_from_vector(u * dt) @ self.state.rotation
+
+    def to_body(self, point: FloatArray) -> FloatArray:
+        """World point -> body frame."""
+        return np.asarray(self.state.rotation.T @ (np.asarray(point, float) - self.state.centre))
+
+    def to_world(self, points: FloatArray) -> FloatArray:
+        """Body-frame points (n, 3) -> world."""
+        return np.asarray(points) @ self.state.rotation.T + self.state.centre
+
+    def nearest(self, point: FloatArray) -> tuple[FloatArray, float]:
+        """Nearest surface point (world) to ``point`` and the signed distance [m] (3.8)."""
+        q, d = self.body.nearest_body(self.to_body(point))
+        return self.state.rotation @ q + self.state.centre, d
+
+    def ray_cast(self, origins: FloatArray, directions: FloatArray) -> FloatArray:
+        """Distance [m] along each world ray (unit directions) to the body (inf: miss)."""
+        o = (np.atleast_2d(origins) - self.state.centre) @ self.state.rotation
+        d = np.atleast_2d(directions) @ self.state.rotation
+        return self.body.ray_body(o, d)
+
+    def world_outline(self) -> FloatArray:
+        """The body's spanning points in the world frame (n, 3) [m]."""
+        return self.to_world(self.body.outline_points())
