@@ -3,8 +3,8 @@ PYTHON ?= python3.11
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 # Extras installed by `make run` / `make test`; later chapters add theirs here (see docs/design-notes.md).
-RUN_EXTRAS  ?= prediction,report,bench
-TEST_EXTRAS ?= prediction,report,bench,test
+RUN_EXTRAS  ?= prediction,report,bench,recon
+TEST_EXTRAS ?= prediction,report,bench,recon,test
 STAMP_RUN  := $(VENV)/.installed-run
 STAMP_TEST := $(VENV)/.installed-test
 # Debian's Chromium for the report's browser test (playwright drives it; no browser download)
