@@ -15,10 +15,11 @@ Three sources (all pure except the explicit loaders at the bottom, which the CLI
   (``matplotlib.cbook.get_sample_data("jacksboro_fault_dem.npz")``: 3 arc-second cells,
   elevations in metres).  Lat/lon are turned into metres with a local equirectangular projection
   (1 arc-second of latitude = 30.87 m; longitude scaled by cos(latitude)).  Its native cells are
-  ~92 m x ~75 m, far coarser than the chapter's 300 m / 600 m areas, so the documented default
-  (:data:`JACKSBORO_DEFAULT`) crops a 48 x 48-cell window and scales it *horizontally* by 1/6 and
-  *vertically* by 1/3 (slopes x2): a real relief shape at the scale of the experiments.  The
-  scale factors are parameters and are recorded on the returned :class:`Terrain`.
+  ~93 m x ~75 m, far coarser than the chapter's 300 m / 600 m areas, so the documented default
+  (:data:`JACKSBORO_DEFAULT`) crops a 64 x 64-cell window (rows 140:204 from the south, columns
+  170:234) and scales it by 1/6 both horizontally and vertically — a geometrically similar model
+  (slopes and occlusions preserved) about 795 m x 990 m with ~12.4 m x 15.4 m cells.  The crop
+  and scale factors are parameters and are recorded in the returned terrain's ``source``.
 
 Heights outside the grid are clamped to the edge values (the lattice can put a waypoint up to R
 outside D; D itself must lie inside the DEM, which :func:`check_area_inside` enforces).
@@ -218,11 +219,11 @@ class JacksboroCrop:
         vertical_scale: Factor applied to the heights above the crop minimum.
     """
 
-    row0: int = 100
-    col0: int = 100
-    n: int = 48
+    row0: int = 140
+    col0: int = 170
+    n: int = 64
     horizontal_scale: float = 1.0 / 6.0
-    vertical_scale: float = 1.0 / 3.0
+    vertical_scale: float = 1.0 / 6.0
 
 
 JACKSBORO_DEFAULT = JacksboroCrop()
@@ -231,15 +232,16 @@ JACKSBORO_DEFAULT = JacksboroCrop()
 def jacksboro_terrain(data: dict[str, Any], crop: JacksboroCrop = JACKSBORO_DEFAULT) -> Terrain:
     """Terrain from the arrays of matplotlib's ``jacksboro_fault_dem.npz`` (pure; see loader).
 
-    ``data`` holds ``elevation`` (rows north to south), ``dx``/``dy`` (cell size [arc-second]) and
-    ``ymin`` (south latitude [deg]).  Rows are flipped to south-up, lat/lon converted to metres at
+    ``data`` holds ``elevation`` (rows north to south), ``dx``/``dy`` (cell size [deg], 3 arc-seconds)
+    and ``ymin``/``ymax`` (latitude range [deg]).  Rows are flipped to south-up, lat/lon converted to metres at
     the crop's mean latitude, then cropped and scaled by ``crop``; the origin is the crop's
     south-west node at (0, 0).
     """
     elev = np.asarray(data["elevation"], dtype=float)[::-1]
-    dlat = float(data["dy"]) if "dy" in data else 3.0
-    dlon = float(data["dx"]) if "dx" in data else 3.0
-    lat0 = float(data["ymin"]) + (crop.row0 + crop.n / 2) * dlat / 3600.0 if "ymin" in data else 36.0
+    dlat = 3600.0 * float(data.get("dy", 3.0 / 3600.0))  # [arc-second]
+    dlon = 3600.0 * float(data.get("dx", 3.0 / 3600.0))
+    # the file's ymin/ymax are swapped (36.73 / 36.45); only their mean is used
+    lat0 = 0.5 * (float(data.get("ymin", 36.6)) + float(data.get("ymax", 36.6)))
     if crop.row0 + crop.n > elev.shape[0] or crop.col0 + crop.n > elev.shape[1]:
         raise ValueError(f"jacksboro crop {crop} exceeds the DEM shape {elev.shape}")
     z = elev[crop.row0 : crop.row0 + crop.n, crop.col0 : crop.col0 + crop.n]

@@ -86,16 +86,19 @@ def line_of_sight(
         p = pts[s : s + chunk]
         c = cams[s : s + chunk]
         L = np.hypot(p[:, 0] - c[:, 0], p[:, 1] - c[:, 1])
-        n = int(math.ceil(float(L.max(initial=0.0)) / step)) if len(L) else 0
+        # per-ray sample count, so a ray's verdict never depends on the batch it is in
+        n_i = np.ceil(L / step).astype(np.intp)
+        n = int(n_i.max(initial=0))
         if n < 1:
             continue
-        t = (np.arange(1, n + 1) / (n + 1))[None, :]  # strictly between the ends
-        # samples placed by horizontal distance so their spacing is <= step for every ray
+        k = np.arange(1, n + 1)[None, :]
+        t = k / (n_i[:, None] + 1.0)  # strictly between the ends, spacing <= step
+        valid = k <= n_i[:, None]
         x = c[:, 0, None] + (p[:, 0] - c[:, 0])[:, None] * t
         y = c[:, 1, None] + (p[:, 1] - c[:, 1])[:, None] * t
         zl = c[:, 2, None] + (p[:, 2] - c[:, 2])[:, None] * t
         zt = terrain.height(x, y)
-        out[s : s + chunk] = ~np.any(zt > zl + eps, axis=1)
+        out[s : s + chunk] = ~np.any(valid & (zt > zl + eps), axis=1)
     return out
 
 
@@ -135,9 +138,13 @@ def lowest_altitude(
 
     if not sees(z_hi):
         raise ValueError(f"lowest_altitude: targets not all visible from z_hi = {z_hi:.2f} m")
-    if sees(z_lo):
-        return float(z_lo)
-    lo, hi = float(z_lo), float(z_hi)
+    # the cone alone needs z >= z_g + d / tan(θ/2) for every target: an exact lower bound
+    d = np.hypot(targets[:, 0] - xy[0], targets[:, 1] - xy[1])
+    z_cone = float(np.max(targets[:, 2] + d / math.tan(theta / 2.0)))
+    lo = min(max(float(z_lo), z_cone), float(z_hi))
+    if sees(lo):
+        return lo
+    hi = float(z_hi)
     while hi - lo > tol:
         mid = 0.5 * (lo + hi)
         if sees(mid):
