@@ -27,6 +27,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import shapely
 
 FloatArray = np.ndarray
 IntArray = np.ndarray
@@ -137,28 +138,38 @@ def tsp_order(
 
 
 def spiral_order(pts: FloatArray, *, start: int = 0) -> IntArray:
-    """Spiral order (outside in, counter-clockwise) by convex-layer peeling; begins at ``start``."""
+    """Spiral order (outside in, counter-clockwise) by convex-layer peeling; begins at ``start``.
+
+    A layer is every remaining point on the convex hull's boundary (collinear points included),
+    ordered along it counter-clockwise from the point nearest to where the previous layer ended.
+    """
     from scipy.spatial import ConvexHull, QhullError
+    from shapely.geometry import LinearRing
 
     p = np.asarray(pts, dtype=float)[:, :2]
-    remaining = list(range(len(p)))
+    remaining = np.arange(len(p))
     order: list[int] = []
     last = p[start]
-    while remaining:
-        idx = np.asarray(remaining)
-        if len(idx) >= 3:
+    scale = float(np.ptp(p, axis=0).max()) if len(p) > 1 else 1.0
+    while len(remaining):
+        layer = remaining
+        if len(remaining) >= 3:
             try:
-                layer = idx[ConvexHull(p[idx]).vertices]  # counter-clockwise
-            except QhullError:  # collinear rest: walk it nearest-first
-                layer = idx
-        else:
-            layer = idx
+                hull = ConvexHull(p[remaining])
+                ring = LinearRing(p[remaining][hull.vertices])
+                q = p[remaining]
+                dist = shapely.distance(ring, shapely.points(q))
+                on = dist <= 1e-9 * max(scale, 1.0)
+                layer = remaining[on]
+                pos = shapely.line_locate_point(ring, shapely.points(p[layer]))
+                layer = layer[np.argsort(pos, kind="stable")]
+            except QhullError:  # collinear rest: walk it nearest-first from `last`
+                layer = remaining[np.argsort(np.linalg.norm(p[remaining] - last, axis=1))]
         k = int(np.argmin(np.linalg.norm(p[layer] - last, axis=1)))
         layer = np.roll(layer, -k)
         order.extend(int(i) for i in layer)
         last = p[layer[-1]]
-        done = set(int(i) for i in layer)
-        remaining = [i for i in remaining if i not in done]
+        remaining = np.setdiff1d(remaining, layer, assume_unique=True)
     return rotate_to_start(np.asarray(order, dtype=np.intp), start)
 
 
