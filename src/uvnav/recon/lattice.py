@@ -252,11 +252,10 @@ def lattice_waypoints(area: Polygon, lam: float, x0: float, y0: float, R: float)
     pieces = _convex_pieces(area)
     vecs = _lattice_vectors(area, lam, R)
     a1, a2 = lattice_basis(lam, R)
-    o = _reduce(np.array([[x0, y0]]), a1, a2)[0]
-    shift = np.array([x0, y0]) - o
+    o = _reduce(np.array([[x0, y0]]), a1, a2)[0]  # same lattice, offset in the fundamental cell
     pts = o + vecs
     mask = meets_mask(pts, pieces, lam, R)
-    return np.asarray(pts[mask] + shift, dtype=float)
+    return np.asarray(pts[mask], dtype=float)
 
 
 def _reduce(o: FloatArray, a1: FloatArray, a2: FloatArray) -> FloatArray:
