@@ -18,7 +18,7 @@ Construction (horizontal plane, then altitude):
    ``r_min·(1 + 1e-3)``; coordinate descent over (Q_i, ψ_i), a few sweeps, shortens the tour.
 2. Every arc is split into pieces of at most π/4 and each piece is the standard cubic Bézier of a
    circular arc (handles ``4/3·tan(α/4)·r``, curvature within 0.02 % of 1/r, hence ≤ 1/r_min
-   with the 1e-3 margin); straight parts are Béziers with handles at thirds.  Headings are shared
+   with the 1e-3 margin); straight parts are Béziers of at most 20 m with handles at thirds.  Headings are shared
    at joints, so the unit tangent is continuous (G¹; C¹ after arc-length reparametrisation — the
    parametric speed changes at arc/line joints, which is why the check reports the tangent
    *angle* jump).
@@ -48,6 +48,8 @@ TWO_PI = 2.0 * math.pi
 #: r_plan = r_min·(1 + this): margin for the cubic approximation of circular arcs
 ARC_MARGIN = 1e-3
 MAX_ARC_PIECE = math.pi / 4
+#: longest straight Bézier piece [m] (keeps the cubic altitude close to its profile)
+MAX_LINE_PIECE = 20.0
 
 
 def check_turn_radius(r_min: float, delta: float) -> None:
@@ -200,11 +202,15 @@ def dubins_beziers_xy(path: DubinsPath) -> list[FloatArray]:
         if length <= 1e-9:
             continue
         if kind == "S":
-            x1, y1 = x + length * math.cos(h), y + length * math.sin(h)
+            # straight parts in pieces of <= MAX_LINE_PIECE so the altitude profile is followed
+            m = max(1, math.ceil(length / MAX_LINE_PIECE))
             u = np.array([math.cos(h), math.sin(h)])
-            b0 = np.array([x, y])
-            out.append(np.array([b0, b0 + u * length / 3, b0 + u * 2 * length / 3, [x1, y1]]))
-            x, y = x1, y1
+            for j in range(m):
+                b0 = np.array([x, y]) + u * length * j / m
+                b3 = np.array([x, y]) + u * length * (j + 1) / m
+                piece = length / m
+                out.append(np.array([b0, b0 + u * piece / 3, b0 + u * 2 * piece / 3, b3]))
+            x, y = x + length * math.cos(h), y + length * math.sin(h)
             continue
         ang = length / r
         n = max(1, math.ceil(ang / MAX_ARC_PIECE - 1e-12))
