@@ -44,6 +44,7 @@ from uvnav.scenarios import (
     scenario_to_yaml,
     validate_for_controller,
 )
+from uvnav.cli.recon import recon_app
 from uvnav.sim import METRIC_NAMES, run_episode, run_rng
 
 # ---------------------------------------------------------------------------------- error handling
@@ -128,6 +129,7 @@ controllers_app = typer.Typer(
 )
 app.add_typer(scenarios_app, name="scenarios")
 app.add_typer(controllers_app, name="controllers")
+app.add_typer(recon_app, name="recon")
 
 
 def _version(value: bool) -> None:
