@@ -84,8 +84,8 @@ def plot_fig7_4(plan: ReconPlan, path: str | Path | None = None) -> Figure:
         PatchCollection([Circle((x, y), plan.config.delta) for x, y in W[:, :2]], facecolor="yellow", edgecolor="k", lw=0.4, alpha=0.9)
     )
     ax.set_title(
-        f"(b) δ = {plan.config.delta:g} m neighbourhoods, footprints; coverage "
-        f"{100 * s['coverage_visible']:.2f} % of visible"
+        f"(b) δ = {plan.config.delta:g} m balls, footprints; "
+        f"coverage {100 * s['coverage_visible']:.1f} %"
     )
     ax = axs[1, 0]
     _background(ax, plan, shade)
