@@ -157,3 +157,14 @@ def recon_3d_html(plan: ReconPlan, path: str | Path) -> Path:
     out.parent.mkdir(parents=True, exist_ok=True)
     recon_3d_figure(plan).write_html(out, include_plotlyjs=True, full_html=True)
     return out
+
+
+def render_plan(plan: ReconPlan, prefix: str | Path) -> list[Path]:
+    """Fig. 7.4 PNG and the 3D HTML of one plan at ``<prefix>-fig7_4.png`` / ``<prefix>-3d.html``.
+
+    The shape :func:`uvnav.bench.reproduce_ch7.reproduce_ch7` takes as ``render_plan``.
+    """
+    p = Path(prefix)
+    png = p.parent / f"{p.name}-fig7_4.png"
+    plot_fig7_4(plan, png)
+    return [png, recon_3d_html(plan, p.parent / f"{p.name}-3d.html")]
