@@ -1,4 +1,4 @@
-"""``uvnav run``'s Ch. 7 part: rows measured from real plans, JSON written, figures via a renderer."""
+"""``uvnav run``'s Ch. 7 part: rows measured from real plans, JSON written, figures drawn."""
 
 from __future__ import annotations
 
@@ -17,7 +17,11 @@ def test_reproduce_ch7_rows_come_from_plans(tmp_path: Path) -> None:
         return [prefix]
 
     out = r7.reproduce_ch7(
-        tmp_path, render_plan=render, sizes=(150.0,), radii=(30.0, 50.0), plans=[("synthetic", 150.0, 30.0)]
+        tmp_path,
+        render_plan=render,
+        sizes=(150.0,),
+        radii=(30.0, 50.0),
+        plans=[("synthetic", 150.0, 30.0)],
     )
     assert drawn == ["ch7-synthetic-150m-R30"]
     plan = json.loads((tmp_path / "ch7-synthetic-150m-R30.json").read_text())
@@ -31,4 +35,3 @@ def test_reproduce_ch7_rows_come_from_plans(tmp_path: Path) -> None:
     for lat in out.lattice:
         assert lat["n"] <= lat["n_naive"]
         assert lat["n"] >= lat["bound_disc"]
-

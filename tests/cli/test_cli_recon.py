@@ -17,8 +17,22 @@ def test_recon_plan_writes_plan_files(tmp_path: Path) -> None:
     out = tmp_path / "plan"
     res = runner.invoke(
         app,
-        ["recon", "plan", "--synthetic", "2", "--area", "150", "--radius", "30", "--uavs", "2",
-         "--out", str(out), "--json", "--no-figures"],
+        [
+            "recon",
+            "plan",
+            "--synthetic",
+            "2",
+            "--area",
+            "150",
+            "--radius",
+            "30",
+            "--uavs",
+            "2",
+            "--out",
+            str(out),
+            "--json",
+            "--no-figures",
+        ],
     )
     assert res.exit_code == 0, res.output
     s = json.loads(res.output.strip().splitlines()[-1])
@@ -35,8 +49,21 @@ def test_recon_plan_writes_plan_files(tmp_path: Path) -> None:
 def test_recon_plan_figures(tmp_path: Path) -> None:
     out = tmp_path / "fig"
     res = runner.invoke(
-        app, ["recon", "plan", "--synthetic", "1", "--area", "120", "--radius", "40", "--uavs", "1",
-              "--out", str(out)],
+        app,
+        [
+            "recon",
+            "plan",
+            "--synthetic",
+            "1",
+            "--area",
+            "120",
+            "--radius",
+            "40",
+            "--uavs",
+            "1",
+            "--out",
+            str(out),
+        ],
     )
     assert res.exit_code == 0, res.output
     assert (out / "fig7_4.png").stat().st_size > 10_000
@@ -55,10 +82,15 @@ def test_recon_plan_errors_are_one_line(tmp_path: Path) -> None:
         (["--synthetic", "1", "--jacksboro"], "exclusive"),
     ]
     for extra, word in cases:
-        res = runner.invoke(app, ["recon", "plan", "--area", "100", "--out", str(tmp_path / "x"), *extra])
+        res = runner.invoke(
+            app, ["recon", "plan", "--area", "100", "--out", str(tmp_path / "x"), *extra]
+        )
         assert res.exit_code == 2, (extra, res.output)
         lines = [ln for ln in res.output.splitlines() if ln.strip()]
-        assert len(lines) == 1 and lines[0].startswith("error: ") and word in lines[0], (extra, res.output)
+        assert len(lines) == 1 and lines[0].startswith("error: ") and word in lines[0], (
+            extra,
+            res.output,
+        )
 
 
 def test_recon_plan_area_outside_dem(tmp_path: Path) -> None:
@@ -67,7 +99,19 @@ def test_recon_plan_area_outside_dem(tmp_path: Path) -> None:
     dem = tmp_path / "dem.npy"
     np.save(dem, np.zeros((21, 21)))
     res = runner.invoke(
-        app, ["recon", "plan", "--dem", str(dem), "--cell", "5", "--area", "0,0,300,300", "--out", str(tmp_path / "o")]
+        app,
+        [
+            "recon",
+            "plan",
+            "--dem",
+            str(dem),
+            "--cell",
+            "5",
+            "--area",
+            "0,0,300,300",
+            "--out",
+            str(tmp_path / "o"),
+        ],
     )
     assert res.exit_code == 2
     assert "dem.npy: area" in res.output

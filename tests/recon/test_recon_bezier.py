@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from uvnav.recon import bezier as Bz
+from uvnav.recon import bezier as Bz  # noqa: N812
 from uvnav.recon.checks import check_trajectory
 
 coord = st.floats(min_value=-80.0, max_value=80.0)
@@ -18,11 +18,13 @@ ang = st.floats(min_value=-math.pi, max_value=math.pi)
 
 @settings(max_examples=80, deadline=None)
 @given(x0=coord, y0=coord, h0=ang, x1=coord, y1=coord, h1=ang, r=st.floats(2.0, 40.0))
-def test_shortest_dubins_reaches_the_goal(x0: float, y0: float, h0: float, x1: float, y1: float, h1: float, r: float) -> None:
+def test_shortest_dubins_reaches_the_goal(
+    x0: float, y0: float, h0: float, x1: float, y1: float, h1: float, r: float
+) -> None:
     s = np.array([x0, y0, h0])
     e = np.array([x1, y1, h1])
     path = Bz.shortest_dubins(s, e, r)
-    x, y, h = Bz._integrate(path)
+    x, y, _ = Bz._integrate(path)
     assert math.hypot(x - x1, y - y1) < 1e-6 * max(1.0, r)
     assert path.length >= math.hypot(x1 - x0, y1 - y0) - 1e-9
     # no word of any type is shorter than the chosen one
@@ -53,9 +55,9 @@ def test_trajectory_respects_curvature_delta_and_is_smooth(seed: int, n: int, r_
 
 def test_turn_radius_rule() -> None:
     Bz.check_turn_radius(32.0, 5.0)
-    with pytest.raises(ValueError, match="^r_min"):
+    with pytest.raises(ValueError, match=r"^r_min"):
         Bz.check_turn_radius(33.0, 5.0)
-    with pytest.raises(ValueError, match="^r_min"):
+    with pytest.raises(ValueError, match=r"^r_min"):
         Bz.check_turn_radius(0.0, 5.0)
 
 
@@ -66,7 +68,9 @@ def test_altitude_bump_clears_a_ridge() -> None:
         return np.where((np.abs(np.asarray(x) - 100.0) < 10.0) & (np.asarray(y) < 60.0), 40.0, 0.0)
 
     P = np.array([[0.0, 0.0, 30.0], [200.0, 0.0, 30.0], [100.0, 150.0, 30.0]])
-    traj = Bz.build_trajectory(P, np.arange(3), r_min=10.0, delta=5.0, terrain_height=ridge, c2=10.0)
+    traj = Bz.build_trajectory(
+        P, np.arange(3), r_min=10.0, delta=5.0, terrain_height=ridge, c2=10.0
+    )
     pts = traj.sample(64)
     over = (np.abs(pts[:, 0] - 100.0) < 10.0) & (pts[:, 1] < 60.0)
     assert over.any()

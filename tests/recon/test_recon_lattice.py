@@ -1,4 +1,4 @@
-"""Stage 1 (thesis Ch. 7 §7.3.1): lattice covering, counting kernels, optimality vs exhaustive search."""
+"""Stage 1 (thesis Ch. 7 §7.3.1): lattice covering, counting kernels, optimality vs exhaustive."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shapely.geometry import Polygon
 
-from uvnav.recon import lattice as L
+from uvnav.recon import lattice as L  # noqa: N812
 from uvnav.recon.terrain import square_area
 
 SETTINGS = settings(max_examples=25, deadline=None)
@@ -23,7 +23,9 @@ R_st = st.floats(min_value=8.0, max_value=40.0)
 @st.composite
 def convex_areas(draw: st.DrawFn) -> Polygon:
     n = draw(st.integers(3, 8))
-    ang = np.sort(np.array(draw(st.lists(st.floats(0, 2 * math.pi), min_size=n, max_size=n, unique=True))))
+    ang = np.sort(
+        np.array(draw(st.lists(st.floats(0, 2 * math.pi), min_size=n, max_size=n, unique=True)))
+    )
     rad = np.array(draw(st.lists(st.floats(30.0, 120.0), min_size=n, max_size=n)))
     poly = Polygon(np.column_stack([rad * np.cos(ang), rad * np.sin(ang)])).convex_hull
     if not isinstance(poly, Polygon) or poly.area < 100.0:
@@ -50,7 +52,9 @@ def _sample_points(area: Polygon, rng: np.random.Generator, n: int = 600) -> np.
 
 @SETTINGS
 @given(area=st.one_of(convex_areas(), star_areas()), lam=lam_st, x0=off_st, y0=off_st, R=R_st)
-def test_every_point_of_d_is_within_r_of_a_waypoint(area: Polygon, lam: float, x0: float, y0: float, R: float) -> None:
+def test_every_point_of_d_is_within_r_of_a_waypoint(
+    area: Polygon, lam: float, x0: float, y0: float, R: float
+) -> None:
     wp = L.lattice_waypoints(area, lam, x0, y0, R)
     pts = _sample_points(area, np.random.default_rng(0))
     d = np.linalg.norm(pts[:, None, :] - wp[None, :, :], axis=2).min(axis=1)
@@ -59,12 +63,14 @@ def test_every_point_of_d_is_within_r_of_a_waypoint(area: Polygon, lam: float, x
 
 @SETTINGS
 @given(area=st.one_of(convex_areas(), star_areas()), lam=lam_st, x0=off_st, y0=off_st, R=R_st)
-def test_cell_count_matches_shapely_intersections(area: Polygon, lam: float, x0: float, y0: float, R: float) -> None:
+def test_cell_count_matches_shapely_intersections(
+    area: Polygon, lam: float, x0: float, y0: float, R: float
+) -> None:
     """The separating-axis count equals shapely's: cells whose intersection with D has area."""
     n = int(L.count_cells(np.array([[x0, y0]]), area, lam, R)[0])
     a1, a2 = L.lattice_basis(lam, R)
-    k = int(math.ceil((max(abs(c) for c in area.bounds) + 3 * R + 250) / (1.5 * R)))
-    I, J = np.meshgrid(np.arange(-k, k + 1), np.arange(-k, k + 1))
+    k = math.ceil((max(abs(c) for c in area.bounds) + 3 * R + 250) / (1.5 * R))
+    I, J = np.meshgrid(np.arange(-k, k + 1), np.arange(-k, k + 1))  # noqa: E741
     centres = np.array([x0, y0]) + I.ravel()[:, None] * a1 + J.ravel()[:, None] * a2
     hexes = shapely.polygons([L.hexagon_vertices(c, lam, R) for c in centres])
     inter = shapely.area(shapely.intersection(hexes, area))
@@ -97,11 +103,15 @@ def _exhaustive_minimum(area: Polygon, R: float, n_lambda: int) -> int:
     the row kernel (checked against the axis kernel and shapely above).
     """
     pieces = L._convex_pieces(area)
-    lams = np.unique(np.concatenate([np.arange(n_lambda) * L.PI3 / n_lambda, L.aligned_angles(area)]))
+    lams = np.unique(
+        np.concatenate([np.arange(n_lambda) * L.PI3 / n_lambda, L.aligned_angles(area)])
+    )
     best = 10**9
     for lam in lams:
         v = L._lattice_vectors(area, float(lam), R)
-        cand = np.vstack([L._grid_offsets(float(lam), R, 30), L._seed_offsets(pieces, float(lam), R, v, 10**6)])
+        cand = np.vstack(
+            [L._grid_offsets(float(lam), R, 30), L._seed_offsets(pieces, float(lam), R, v, 10**6)]
+        )
         best = min(best, int(L._count_rows(cand, pieces[0], v, float(lam), R, 4096).min()))
     return best
 
@@ -130,12 +140,12 @@ def test_optimum_never_above_naive_and_above_disc_bound(side: float, R: float) -
 
 
 def test_margins_rejected() -> None:
-    with pytest.raises(ValueError, match="^c1"):
+    with pytest.raises(ValueError, match=r"^c1"):
         L.check_margins(30.0, 5.0, 10.0, 6.0)
-    with pytest.raises(ValueError, match="^c2"):
+    with pytest.raises(ValueError, match=r"^c2"):
         L.check_margins(30.0, 5.0, 11.0, 5.0)
-    with pytest.raises(ValueError, match="^delta"):
+    with pytest.raises(ValueError, match=r"^delta"):
         L.check_margins(30.0, 0.0, 11.0, 6.0)
-    with pytest.raises(ValueError, match="^c1: lattice spacing"):
+    with pytest.raises(ValueError, match=r"^c1: lattice spacing"):
         L.check_margins(5.0, 4.0, 10.0, 6.0)
     L.check_margins(30.0, 5.0, 11.0, 6.0)

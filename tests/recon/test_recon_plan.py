@@ -70,10 +70,10 @@ def test_plan_is_deterministic(terrain, plan) -> None:  # type: ignore[no-untype
     ],
 )
 def test_invalid_inputs_rejected(terrain, change: dict, field: str) -> None:  # type: ignore[no-untyped-def]
-    with pytest.raises(ValueError, match=f"^{field}"):
+    with pytest.raises(ValueError, match=rf"^{field}"):
         plan_recon(terrain, square_area(100.0), replace(CFG, **change))
 
 
 def test_area_outside_dem_rejected(terrain) -> None:  # type: ignore[no-untyped-def]
-    with pytest.raises(ValueError, match="^area"):
+    with pytest.raises(ValueError, match=r"^area"):
         plan_recon(terrain, box(200.0, 200.0, 400.0, 400.0), CFG)

@@ -1,4 +1,4 @@
-"""Terrain (thesis Ch. 7 §7.2): bilinear heights, generators, loaders, Jacksboro DEM, area checks."""
+"""Terrain (thesis Ch. 7 §7.2): bilinear heights, generators, loaders, Jacksboro DEM, areas."""
 
 from __future__ import annotations
 
@@ -10,13 +10,16 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from shapely.geometry import box
 
-from uvnav.recon import terrain as T
+from uvnav.recon import terrain as T  # noqa: N812
 
 
 @settings(max_examples=50, deadline=None)
 @given(
-    a=st.floats(-2, 2), b=st.floats(-2, 2), c=st.floats(-50, 50),
-    x=st.floats(0, 95), y=st.floats(0, 70),
+    a=st.floats(-2, 2),
+    b=st.floats(-2, 2),
+    c=st.floats(-50, 50),
+    x=st.floats(0, 95),
+    y=st.floats(0, 70),
 )
 def test_bilinear_reproduces_planes(a: float, b: float, c: float, x: float, y: float) -> None:
     xs = np.arange(0, 101, 5.0)
@@ -68,7 +71,7 @@ def test_loaders_roundtrip(tmp_path: Path) -> None:
     t = T.load_dem(tmp_path / "dem.npz")
     assert (t.dx, t.dy, t.x0, t.y0) == (3.0, 4.0, 1.0, 2.0)
     np.savez(tmp_path / "bad.npz", q=z)
-    with pytest.raises(ValueError, match="bad.npz"):
+    with pytest.raises(ValueError, match=r"bad\.npz"):
         T.load_dem(tmp_path / "bad.npz")
     with pytest.raises(ValueError, match="unknown DEM format"):
         T.load_dem(tmp_path / "dem.txt")
@@ -79,8 +82,15 @@ def test_geotiff_roundtrip(tmp_path: Path) -> None:
     z = np.arange(20.0, dtype=np.float32).reshape(4, 5)  # row 0 = north
     path = tmp_path / "dem.tif"
     with rasterio.open(
-        path, "w", driver="GTiff", height=4, width=5, count=1, dtype="float32",
-        crs="EPSG:32617", transform=rasterio.Affine(10.0, 0.0, 1000.0, 0.0, -10.0, 2000.0),
+        path,
+        "w",
+        driver="GTiff",
+        height=4,
+        width=5,
+        count=1,
+        dtype="float32",
+        crs="EPSG:32617",
+        transform=rasterio.Affine(10.0, 0.0, 1000.0, 0.0, -10.0, 2000.0),
     ) as ds:
         ds.write(z, 1)
     t = T.load_dem(path)
@@ -94,11 +104,11 @@ def test_geotiff_roundtrip(tmp_path: Path) -> None:
 def test_area_checks() -> None:
     t = T.Terrain(np.zeros((11, 11)), 0.0, 0.0, 10.0, 10.0)
     T.check_area_inside(t, box(0, 0, 100, 100))
-    with pytest.raises(ValueError, match="^area"):
+    with pytest.raises(ValueError, match=r"^area"):
         T.check_area_inside(t, box(50, 50, 150, 100))
-    with pytest.raises(ValueError, match="^area"):
+    with pytest.raises(ValueError, match=r"^area"):
         T.area_polygon(np.array([[0, 0], [1, 1], [1, 0], [0, 1]]))
-    with pytest.raises(ValueError, match="^terrain"):
+    with pytest.raises(ValueError, match=r"^terrain"):
         T.Terrain(np.array([[0.0, np.nan], [0.0, 0.0]]))
     assert T.square_area(10.0, center=(5.0, 5.0)).bounds == (0.0, 0.0, 10.0, 10.0)
     nodes = t.nodes_in(box(0, 0, 20, 20))

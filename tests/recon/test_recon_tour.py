@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from uvnav.recon import tour as T
+from uvnav.recon import tour as T  # noqa: N812
 from uvnav.recon.lattice import optimal_lattice
 from uvnav.recon.terrain import square_area
 
@@ -55,9 +55,9 @@ def test_kmeans_clusters_and_cluster_tours() -> None:
     assert sorted(np.concatenate(tours).tolist()) == list(range(len(p)))
     for c, tour in enumerate(tours):
         assert np.all(lab[tour] == c)
-    with pytest.raises(ValueError, match="^uavs"):
+    with pytest.raises(ValueError, match=r"^uavs"):
         T.kmeans_clusters(p[:, :2], 0)
-    with pytest.raises(ValueError, match="^tour method"):
+    with pytest.raises(ValueError, match=r"^tour method"):
         T.cluster_tours(p, lab, method="zigzag")
 
 
@@ -72,4 +72,7 @@ def test_merge_keeps_first_tour_order_and_visits_all() -> None:
     assert kept == a.tolist()
     # the merge costs at most the two separate tours plus twice the gap between the clusters
     gap = np.linalg.norm(p[a][:, None, :] - p[b][None, :, :], axis=2).min()
-    assert T.tour_length(p, m) <= T.tour_length(p, a) + T.tour_length(p, b) + 2 * gap + 2 * math.sqrt(3) * 30
+    assert (
+        T.tour_length(p, m)
+        <= T.tour_length(p, a) + T.tour_length(p, b) + 2 * gap + 2 * math.sqrt(3) * 30
+    )

@@ -7,9 +7,9 @@ import math
 import numpy as np
 import pytest
 
+from uvnav.recon import visibility as V  # noqa: N812
 from uvnav.recon.lattice import optimal_lattice
 from uvnav.recon.terrain import Terrain, fractal_terrain, square_area
-from uvnav.recon import visibility as V
 
 
 def flat(size: float = 200.0, cell: float = 5.0, z: float = 0.0) -> Terrain:
@@ -27,9 +27,11 @@ def wall_terrain(height: float = 20.0) -> Terrain:
 
 def test_footprint_radius_and_theta_range() -> None:
     assert float(V.footprint_radius(50.0, math.pi / 2)) == pytest.approx(50.0)
-    assert float(V.footprint_radius(30.0, math.radians(60))) == pytest.approx(30 * math.tan(math.radians(30)))
+    assert float(V.footprint_radius(30.0, math.radians(60))) == pytest.approx(
+        30 * math.tan(math.radians(30))
+    )
     for bad in (0.0, math.pi, -1.0, 4.0):
-        with pytest.raises(ValueError, match="^theta"):
+        with pytest.raises(ValueError, match=r"^theta"):
             V.footprint_radius(10.0, bad)
 
 
@@ -94,9 +96,19 @@ def test_assign_altitudes_covers_everything_visible_at_zmax() -> None:
     assert V.seen_by_any(t, cams, nodes, theta).sum() == info["seen"]
     # clearance (7.4): every waypoint at least c2 above the terrain below it
     assert np.all(z - t.height(sol.xy[:, 0], sol.xy[:, 1]) >= 8.0 - 1e-9)
-    # lowest: dropping any waypoint by 1 m loses some ground it alone was responsible for, or
-    # hits its floor (Z_min / clearance)
+    # lowest: each waypoint sees every node of its own cell that it could see from z_max, and,
+    # unless it sits on its floor (clearance) or was raised by a repair, 0.5 m lower it would not
+    from scipy.spatial import cKDTree
+
+    owner = cKDTree(sol.xy).query(nodes[:, :2])[1]
     floors = np.array([V.clearance_altitude(t, p, 8.0) for p in sol.xy])
-    assert np.all((z <= floors + 1e-6) | (z > floors))
-    with pytest.raises(ValueError, match="^z_max"):
+    tight = 0
+    for i, (x, y) in enumerate(sol.xy):
+        mine = nodes[owner == i]
+        targets = mine[V.visible(t, np.array([x, y, z_max]), mine, theta)]
+        assert V.visible(t, np.array([x, y, z[i]]), targets, theta).all()
+        lower = V.visible(t, np.array([x, y, z[i] - 0.5]), targets, theta).all()
+        tight += int(z[i] <= floors[i] + 1e-6 or not lower)
+    assert tight >= len(z) - info["repairs"]
+    with pytest.raises(ValueError, match=r"^z_max"):
         V.assign_altitudes(t, sol.xy, nodes, theta, 0.0, 5.0, 8.0)

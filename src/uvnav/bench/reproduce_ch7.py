@@ -53,8 +53,12 @@ def experiment_terrain(kind: str, side: float) -> tuple[Terrain, Any]:
     if kind == "synthetic":
         pad = 150.0
         t = fractal_terrain(
-            (side + 2 * pad, side + 2 * pad), cell=5.0, seed=7, origin=(-pad, -pad),
-            relief=40.0, n_blocks=int(side * side / 6000),
+            (side + 2 * pad, side + 2 * pad),
+            cell=5.0,
+            seed=7,
+            origin=(-pad, -pad),
+            relief=40.0,
+            n_blocks=int(side * side / 6000),
         )
     elif kind == "jacksboro":
         t = load_jacksboro()
@@ -64,7 +68,9 @@ def experiment_terrain(kind: str, side: float) -> tuple[Terrain, Any]:
     return t, square_area(side, center=(0.5 * (xmin + xmax), 0.5 * (ymin + ymax)))
 
 
-def lattice_rows(sizes: tuple[float, ...] = SIZES, radii: tuple[float, ...] = RADII) -> list[dict[str, float]]:
+def lattice_rows(
+    sizes: tuple[float, ...] = SIZES, radii: tuple[float, ...] = RADII
+) -> list[dict[str, float]]:
     """Stage 1 counts for every size and R (pure geometry, no terrain)."""
     rows = []
     for side in sizes:
@@ -145,14 +151,20 @@ def reproduce_ch7(
                 "quantity": f"{label}: coverage of ground visible at Z_max",
                 "thesis": '"covered completely"',
                 "measured": f"{100 * s['coverage_visible']:.2f} %",
-                "note": f"{100 * s['coverage_all']:.2f} % of all {s['ground_nodes']} DEM nodes in D",
+                "note": (
+                    f"{100 * s['coverage_all']:.2f} % of all {s['ground_nodes']} DEM nodes in D"
+                ),
             },
             {
                 "quantity": f"{label}: tour length, 2 UAVs / 1 UAV integrated [m]",
                 "thesis": "not reported",
-                "measured": f"{s['trajectory_length_total']:.0f} / {s.get('integrated_length', float('nan')):.0f}",
+                "measured": (
+                    f"{s['trajectory_length_total']:.0f} / "
+                    f"{s.get('integrated_length', float('nan')):.0f}"
+                ),
                 "note": (
-                    f"TSP polygon {s['tsp_length_total']:.0f} m vs spiral {s['spiral_length_total']:.0f} m; "
+                    f"TSP polygon {s['tsp_length_total']:.0f} m vs spiral "
+                    f"{s['spiral_length_total']:.0f} m; "
                     f"max curvature {s['max_curvature']:.4f} ≤ {s['curvature_bound']:.4f} 1/m; "
                     f"max waypoint→τ {s['max_waypoint_distance']:.2f} ≤ δ = {s['delta']:g} m"
                 ),
@@ -160,8 +172,13 @@ def reproduce_ch7(
             {
                 "quantity": f"{label}: waypoint altitude min / mean / max [m]",
                 "thesis": '"the lowest altitude"',
-                "measured": f"{s['altitude_min']:.1f} / {s['altitude_mean']:.1f} / {s['altitude_max']:.1f}",
-                "note": f"N = {s['n_waypoints']}; Z_max = {s['z_max']:.1f} m (planning times in the JSON)",
+                "measured": (
+                    f"{s['altitude_min']:.1f} / {s['altitude_mean']:.1f} / {s['altitude_max']:.1f}"
+                ),
+                "note": (
+                    f"N = {s['n_waypoints']}; Z_max = {s['z_max']:.1f} m "
+                    "(planning times in the JSON)"
+                ),
             },
         ]
     summary.wall_time = time.perf_counter() - tic

@@ -25,6 +25,7 @@ import typer
 import yaml
 from typer.core import TyperGroup
 
+from uvnav.cli.recon import recon_app
 from uvnav.controllers import (
     ControllerInfo,
     ControllerParamsError,
@@ -44,7 +45,6 @@ from uvnav.scenarios import (
     scenario_to_yaml,
     validate_for_controller,
 )
-from uvnav.cli.recon import recon_app
 from uvnav.sim import METRIC_NAMES, run_episode, run_rng
 
 # ---------------------------------------------------------------------------------- error handling

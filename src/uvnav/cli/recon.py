@@ -1,4 +1,4 @@
-"""``uvnav recon``: plan UAV reconnaissance over terrain (thesis Ch. 7), write plan files and figures.
+"""``uvnav recon``: plan UAV reconnaissance over terrain (thesis Ch. 7), write plans and figures.
 
 ``uvnav recon plan [--dem FILE | --synthetic SEED | --jacksboro] --area SPEC --theta DEG
 --radius R --uavs K --out DIR`` writes into DIR:
@@ -71,9 +71,14 @@ def write_plan_files(plan: Any, out: Path) -> list[Path]:
         w = csv.writer(f)
         w.writerow(["id", "x", "y", "z", "cluster", "rank"])
         for i, (x, y, z) in enumerate(W):
-            w.writerow([i, f"{x:.3f}", f"{y:.3f}", f"{z:.3f}", int(plan.labels[i]), int(rank[i].max())])
+            w.writerow(
+                [i, f"{x:.3f}", f"{y:.3f}", f"{z:.3f}", int(plan.labels[i]), int(rank[i].max())]
+            )
     files.append(p)
-    crs_note = {"type": "name", "properties": {"name": "local metric frame of the DEM (x east, y north) [m]"}}
+    crs_note = {
+        "type": "name",
+        "properties": {"name": "local metric frame of the DEM (x east, y north) [m]"},
+    }
     feats = [
         {
             "type": "Feature",
@@ -119,22 +124,47 @@ def write_plan_files(plan: Any, out: Path) -> list[Path]:
 @recon_app.command("plan")
 def plan_cmd(
     out: Annotated[Path, typer.Option("--out", help="Output folder.")],
-    dem: Annotated[Path | None, typer.Option("--dem", help="DEM file: .tif (metric CRS), .npy or .npz.")] = None,
-    synthetic: Annotated[int | None, typer.Option("--synthetic", help="Generated fractal + urban terrain with this seed.")] = None,
-    jacksboro: Annotated[bool, typer.Option("--jacksboro", help="The USGS Jacksboro DEM shipped with matplotlib (cropped, scaled 1/6).")] = False,
-    area: Annotated[str, typer.Option("--area", help="SIDE (square centred in the DEM) or X0,Y0,X1,Y1 [m].")] = "300",
-    theta: Annotated[float, typer.Option("--theta", help="Camera cone full angle [deg], in (0, 180).")] = 90.0,
-    radius: Annotated[float, typer.Option("--radius", help="Footprint radius R [m] of the lattice.")] = 30.0,
+    dem: Annotated[
+        Path | None, typer.Option("--dem", help="DEM file: .tif (metric CRS), .npy or .npz.")
+    ] = None,
+    synthetic: Annotated[
+        int | None,
+        typer.Option("--synthetic", help="Generated fractal + urban terrain with this seed."),
+    ] = None,
+    jacksboro: Annotated[
+        bool,
+        typer.Option(
+            "--jacksboro",
+            help="The USGS Jacksboro DEM shipped with matplotlib (cropped, scaled 1/6).",
+        ),
+    ] = False,
+    area: Annotated[
+        str, typer.Option("--area", help="SIDE (square centred in the DEM) or X0,Y0,X1,Y1 [m].")
+    ] = "300",
+    theta: Annotated[
+        float, typer.Option("--theta", help="Camera cone full angle [deg], in (0, 180).")
+    ] = 90.0,
+    radius: Annotated[
+        float, typer.Option("--radius", help="Footprint radius R [m] of the lattice.")
+    ] = 30.0,
     uavs: Annotated[int, typer.Option("--uavs", help="Number of UAVs (clusters).")] = 2,
-    z_min: Annotated[float | None, typer.Option("--z-min", help="Lowest altitude [m] (default 0).")] = None,
-    z_max: Annotated[float | None, typer.Option("--z-max", help="Highest altitude [m] (default: auto).")] = None,
+    z_min: Annotated[
+        float | None, typer.Option("--z-min", help="Lowest altitude [m] (default 0).")
+    ] = None,
+    z_max: Annotated[
+        float | None, typer.Option("--z-max", help="Highest altitude [m] (default: auto).")
+    ] = None,
     delta: Annotated[float, typer.Option("--delta", help="δ [m].")] = 5.0,
     c1: Annotated[float, typer.Option("--c1", help="Waypoint-waypoint margin [m] (7.4).")] = 15.0,
     c2: Annotated[float, typer.Option("--c2", help="Waypoint-terrain margin [m] (7.4).")] = 10.0,
     r_min: Annotated[float, typer.Option("--r-min", help="UAV turning radius [m].")] = 15.0,
-    cell: Annotated[float, typer.Option("--cell", help="Node spacing [m] of .npy DEMs and synthetic terrain.")] = 5.0,
+    cell: Annotated[
+        float, typer.Option("--cell", help="Node spacing [m] of .npy DEMs and synthetic terrain.")
+    ] = 5.0,
     seed: Annotated[int, typer.Option("--seed", help="k-means seed.")] = 0,
-    figures: Annotated[bool, typer.Option("--figures/--no-figures", help="Write fig7_4.png and recon_3d.html.")] = True,
+    figures: Annotated[
+        bool, typer.Option("--figures/--no-figures", help="Write fig7_4.png and recon_3d.html.")
+    ] = True,
     as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
 ) -> None:
     """Plan minimum lattice waypoints at the lowest altitude and smooth closed tours (Ch. 7)."""
@@ -202,9 +232,18 @@ def plan_cmd(
     rows = [
         ("waypoints N (naive lattice)", f"{s['n_waypoints']} ({s['n_naive']})"),
         ("bounds A/(πR²), Kershner", f"{s['bound_disc']:.1f}, {s['bound_kershner']:.1f}"),
-        ("altitude min / mean / max [m]", f"{s['altitude_min']:.1f} / {s['altitude_mean']:.1f} / {s['altitude_max']:.1f}"),
-        ("coverage of visible / of all nodes", f"{100 * s['coverage_visible']:.2f} % / {100 * s['coverage_all']:.2f} %"),
-        ("TSP / spiral tour length [m]", f"{s['tsp_length_total']:.0f} / {s['spiral_length_total']:.0f}"),
+        (
+            "altitude min / mean / max [m]",
+            f"{s['altitude_min']:.1f} / {s['altitude_mean']:.1f} / {s['altitude_max']:.1f}",
+        ),
+        (
+            "coverage of visible / of all nodes",
+            f"{100 * s['coverage_visible']:.2f} % / {100 * s['coverage_all']:.2f} %",
+        ),
+        (
+            "TSP / spiral tour length [m]",
+            f"{s['tsp_length_total']:.0f} / {s['spiral_length_total']:.0f}",
+        ),
         ("trajectory length per UAV [m]", ", ".join(f"{v:.0f}" for v in s["trajectory_lengths"])),
         ("max waypoint→τ distance [m] (δ)", f"{s['max_waypoint_distance']:.2f} ({s['delta']:g})"),
         ("max curvature [1/m] (bound)", f"{s['max_curvature']:.4f} ({s['curvature_bound']:.4f})"),

@@ -18,10 +18,10 @@ Construction (horizontal plane, then altitude):
    ``r_min·(1 + 1e-3)``; coordinate descent over (Q_i, ψ_i), a few sweeps, shortens the tour.
 2. Every arc is split into pieces of at most π/4 and each piece is the standard cubic Bézier of a
    circular arc (handles ``4/3·tan(α/4)·r``, curvature within 0.02 % of 1/r, hence ≤ 1/r_min
-   with the 1e-3 margin); straight parts are Béziers of at most 20 m with handles at thirds.  Headings are shared
-   at joints, so the unit tangent is continuous (G¹; C¹ after arc-length reparametrisation — the
-   parametric speed changes at arc/line joints, which is why the check reports the tangent
-   *angle* jump).
+   with the 1e-3 margin); straight parts are Béziers of at most 20 m with handles at thirds.
+   Headings are shared at joints, so the unit tangent is continuous (G¹; C¹ after arc-length
+   reparametrisation — the parametric speed changes at arc/line joints, which is why the check
+   reports the tangent *angle* jump).
 3. Altitude: along each Dubins connection z goes from z_i to z_{i+1} by a smoothstep
    ``3u² − 2u³`` plus, where the terrain needs it, a bump ``b·16u²(1 − u)²`` (zero value and
    slope at both ends) raising it to clear ``F + c2``; the z control points follow the profile's
@@ -72,9 +72,7 @@ def _mod2pi(a: FloatArray) -> FloatArray:
 _WORDS = ("LSL", "RSR", "LSR", "RSL", "RLR", "LRL")
 
 
-def dubins_words(
-    start: FloatArray, end: FloatArray, r: float
-) -> tuple[FloatArray, FloatArray]:
+def dubins_words(start: FloatArray, end: FloatArray, r: float) -> tuple[FloatArray, FloatArray]:
     """All six Dubins words for configurations (M, 3) → (M, 3) [x, y, ψ].
 
     Returns:
@@ -175,7 +173,9 @@ def shortest_dubins(start: FloatArray, end: FloatArray, r: float) -> DubinsPath:
     raise RuntimeError("no valid Dubins path found")  # pragma: no cover - Dubins always exists
 
 
-def _step(x: float, y: float, h: float, kind: str, length: float, r: float) -> tuple[float, float, float]:
+def _step(
+    x: float, y: float, h: float, kind: str, length: float, r: float
+) -> tuple[float, float, float]:
     if kind == "S":
         return x + length * math.cos(h), y + length * math.sin(h), h
     sgn = 1.0 if kind == "L" else -1.0
@@ -286,8 +286,10 @@ def plan_dubins_tour(
     P = np.asarray(P, dtype=float)[:, :2]
     n = len(P)
     r = r_min * (1.0 + ARC_MARGIN)
-    ring = 0.9 * delta * np.column_stack(
-        [np.cos(np.arange(6) * math.pi / 3), np.sin(np.arange(6) * math.pi / 3)]
+    ring = (
+        0.9
+        * delta
+        * np.column_stack([np.cos(np.arange(6) * math.pi / 3), np.sin(np.arange(6) * math.pi / 3)])
     )
     offsets = np.vstack([np.zeros((1, 2)), ring])
     H = np.arange(n_headings) * TWO_PI / n_headings
@@ -365,7 +367,9 @@ def build_trajectory(
         raise ValueError("trajectory: no waypoints")
     if n == 1:  # a loiter circle of radius r_min through the waypoint
         W = np.vstack([W, W])
-    Q, psi, paths = plan_dubins_tour(W[:, :2], r_min=r_min, delta=delta, n_headings=n_headings, sweeps=sweeps)
+    Q, psi, paths = plan_dubins_tour(
+        W[:, :2], r_min=r_min, delta=delta, n_headings=n_headings, sweeps=sweeps
+    )
     pieces: list[FloatArray] = []
     if n == 1:
         paths = [p for p in paths if p.length > 1e-9] or paths
@@ -389,7 +393,9 @@ def build_trajectory(
             pieces.append(np.column_stack([b, z]))
     B = np.asarray(pieces)
     pass_pts = np.column_stack([Q, W[:, 2]])
-    return Trajectory(B, pass_pts[: n if n > 1 else 1], psi[: n if n > 1 else 1], order, float(r_min))
+    return Trajectory(
+        B, pass_pts[: n if n > 1 else 1], psi[: n if n > 1 else 1], order, float(r_min)
+    )
 
 
 def _bezier_len(b: FloatArray, m: int = 32) -> float:

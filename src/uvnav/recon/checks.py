@@ -86,7 +86,7 @@ def check_trajectory(
         curvature_bound=1.0 / traj.r_min,
         max_tangent_jump=jump,
         min_clearance=clear,
-        n_pieces=int(len(B)),
+        n_pieces=len(B),
     )
 
 

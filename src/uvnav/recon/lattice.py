@@ -139,19 +139,24 @@ def _lattice_vectors(area: Polygon, lam: float, R: float) -> FloatArray:
     xmin, ymin, xmax, ymax = area.bounds
     pad = R + 2.0 * math.sqrt(3.0) * R
     corners = np.array(
-        [[xmin - pad, ymin - pad], [xmax + pad, ymin - pad], [xmax + pad, ymax + pad], [xmin - pad, ymax + pad]]
+        [
+            [xmin - pad, ymin - pad],
+            [xmax + pad, ymin - pad],
+            [xmax + pad, ymax + pad],
+            [xmin - pad, ymax + pad],
+        ]
     )
     ij = corners @ Binv.T
     lo = np.floor(ij.min(axis=0)).astype(int)
     hi = np.ceil(ij.max(axis=0)).astype(int)
-    I, J = np.meshgrid(np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1), indexing="ij")
+    I, J = np.meshgrid(  # noqa: E741
+        np.arange(lo[0], hi[0] + 1), np.arange(lo[1], hi[1] + 1), indexing="ij"
+    )
     v = np.column_stack([I.ravel(), J.ravel()]) @ B.T
     return np.asarray(v, dtype=float)
 
 
-def meets_mask(
-    centers: FloatArray, pieces: list[FloatArray], lam: float, R: float
-) -> FloatArray:
+def meets_mask(centers: FloatArray, pieces: list[FloatArray], lam: float, R: float) -> FloatArray:
     """Whether each hexagon cell (centres (..., 2)) meets D's interior (separating axes)."""
     c = np.asarray(centers, dtype=float)
     out = np.zeros(c.shape[:-1], dtype=bool)
@@ -383,7 +388,9 @@ def optimal_lattice(
     results: dict[float, tuple[int, FloatArray]] = {}
     evals = 0
     for lam in lams:
-        c, o, e = best_offset(area, float(lam), R, n_grid=n_grid, max_pairs_k=max_pairs_k, pieces=pieces)
+        c, o, e = best_offset(
+            area, float(lam), R, n_grid=n_grid, max_pairs_k=max_pairs_k, pieces=pieces
+        )
         results[float(lam)] = (c, o)
         evals += e
     step = PI3 / n_lambda
@@ -396,7 +403,9 @@ def optimal_lattice(
                 lam = float((lam0 + d * step) % PI3)
                 if lam in results:
                     continue
-                c, o, e = best_offset(area, lam, R, n_grid=n_grid, max_pairs_k=max_pairs_k, pieces=pieces)
+                c, o, e = best_offset(
+                    area, lam, R, n_grid=n_grid, max_pairs_k=max_pairs_k, pieces=pieces
+                )
                 results[lam] = (c, o)
                 evals += e
     lam_best = min(results, key=lambda k: (results[k][0], k))
@@ -406,14 +415,17 @@ def optimal_lattice(
         lam_best, c_best, o_best = 0.0, n_naive, np.zeros(2)
     xy = lattice_waypoints(area, lam_best, float(o_best[0]), float(o_best[1]), R)
     A = float(area.area)
-    outside = ~(shapely.contains_xy(area, xy[:, 0], xy[:, 1]) | shapely.intersects_xy(area.boundary, xy[:, 0], xy[:, 1]))
+    outside = ~(
+        shapely.contains_xy(area, xy[:, 0], xy[:, 1])
+        | shapely.intersects_xy(area.boundary, xy[:, 0], xy[:, 1])
+    )
     return LatticeSolution(
         lam=float(lam_best),
         x0=float(o_best[0]),
         y0=float(o_best[1]),
         R=float(R),
         xy=xy,
-        n=int(len(xy)),
+        n=len(xy),
         n_naive=n_naive,
         bound_disc=A / (math.pi * R * R),
         bound_kershner=A / (1.5 * math.sqrt(3.0) * R * R),

@@ -226,7 +226,9 @@ def plan_recon(
         labels = np.asarray(labels, dtype=np.intp)
         if labels.shape != (lat.n,):
             raise ValueError(f"labels: need one label per waypoint ({lat.n}), got {labels.shape}")
-    tsp_tours = cluster_tours(W, labels, method="tsp", metaheuristic=cfg.tsp, time_limit_s=cfg.tsp_time_limit)
+    tsp_tours = cluster_tours(
+        W, labels, method="tsp", metaheuristic=cfg.tsp, time_limit_s=cfg.tsp_time_limit
+    )
     spiral_tours = cluster_tours(W, labels, method="spiral")
     timings["tours"] = time.perf_counter() - t
 
@@ -237,7 +239,13 @@ def plan_recon(
             W, tour, r_min=cfg.r_min, delta=cfg.delta, terrain_height=terrain.height, c2=cfg.c2
         )
         uavs.append(
-            UavPlan(tour, tour_length(W, tour), tour_length(W, sp), traj, check_trajectory(traj, W[tour], terrain))
+            UavPlan(
+                tour,
+                tour_length(W, tour),
+                tour_length(W, sp),
+                traj,
+                check_trajectory(traj, W[tour], terrain),
+            )
         )
     integrated = None
     if cfg.integrated and len(tsp_tours) > 1:

@@ -67,11 +67,15 @@ class Terrain:
     def __post_init__(self) -> None:
         z = np.asarray(self.z, dtype=float)
         if z.ndim != 2 or min(z.shape) < 2:
-            raise ValueError(f"terrain z: need a 2D grid of at least 2x2 nodes, got shape {z.shape}")
+            raise ValueError(
+                f"terrain z: need a 2D grid of at least 2x2 nodes, got shape {z.shape}"
+            )
         if not np.all(np.isfinite(z)):
             raise ValueError("terrain z: heights must be finite (fill no-data before use)")
         if not (self.dx > 0 and self.dy > 0):
-            raise ValueError(f"terrain: cell sizes must be positive, got dx={self.dx}, dy={self.dy}")
+            raise ValueError(
+                f"terrain: cell sizes must be positive, got dx={self.dx}, dy={self.dy}"
+            )
         object.__setattr__(self, "z", z)
 
     @property
@@ -182,8 +186,8 @@ def fractal_terrain(
         block_height: Range of block heights above the hills [m].
     """
     rng = np.random.default_rng(seed)
-    nx = int(round(size[0] / cell)) + 1
-    ny = int(round(size[1] / cell)) + 1
+    nx = round(size[0] / cell) + 1
+    ny = round(size[1] / cell) + 1
     z = fractal_heights((ny, nx), rng, beta=beta, relief=relief)
     xs = origin[0] + cell * np.arange(nx)
     ys = origin[1] + cell * np.arange(ny)
@@ -232,8 +236,9 @@ JACKSBORO_DEFAULT = JacksboroCrop()
 def jacksboro_terrain(data: dict[str, Any], crop: JacksboroCrop = JACKSBORO_DEFAULT) -> Terrain:
     """Terrain from the arrays of matplotlib's ``jacksboro_fault_dem.npz`` (pure; see loader).
 
-    ``data`` holds ``elevation`` (rows north to south), ``dx``/``dy`` (cell size [deg], 3 arc-seconds)
-    and ``ymin``/``ymax`` (latitude range [deg]).  Rows are flipped to south-up, lat/lon converted to metres at
+    ``data`` holds ``elevation`` (rows north to south), ``dx``/``dy`` (cell size [deg],
+    3 arc-seconds) and ``ymin``/``ymax`` (latitude range [deg]).  Rows are flipped to south-up,
+    lat/lon converted to metres at
     the crop's mean latitude, then cropped and scaled by ``crop``; the origin is the crop's
     south-west node at (0, 0).
     """
@@ -263,12 +268,19 @@ def jacksboro_terrain(data: dict[str, Any], crop: JacksboroCrop = JACKSBORO_DEFA
     )
 
 
-def square_area(side: float, *, center: tuple[float, float] | None = None, corner: tuple[float, float] = (0.0, 0.0)) -> Polygon:
+def square_area(
+    side: float,
+    *,
+    center: tuple[float, float] | None = None,
+    corner: tuple[float, float] = (0.0, 0.0),
+) -> Polygon:
     """The square target area D of side ``side`` [m] (by centre, or by south-west corner)."""
     if side <= 0:
         raise ValueError(f"area side must be positive, got {side}")
     if center is not None:
-        return box(center[0] - side / 2, center[1] - side / 2, center[0] + side / 2, center[1] + side / 2)
+        return box(
+            center[0] - side / 2, center[1] - side / 2, center[0] + side / 2, center[1] + side / 2
+        )
     return box(corner[0], corner[1], corner[0] + side, corner[1] + side)
 
 
@@ -359,6 +371,7 @@ def load_jacksboro(crop: JacksboroCrop = JACKSBORO_DEFAULT) -> Terrain:
     """The matplotlib-shipped USGS Jacksboro DEM, cropped and scaled by ``crop`` (no download)."""
     from matplotlib import cbook
 
-    with cbook.get_sample_data("jacksboro_fault_dem.npz") as d:
+    d: Any = cbook.get_sample_data("jacksboro_fault_dem.npz")  # an NpzFile for .npz names
+    with d:
         data = {k: d[k] for k in d.files}
     return jacksboro_terrain(data, crop)

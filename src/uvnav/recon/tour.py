@@ -49,7 +49,9 @@ def kmeans_clusters(xy: FloatArray, k: int, *, seed: int = 0) -> IntArray:
     try:
         from sklearn.cluster import KMeans
     except ImportError as exc:  # pragma: no cover - depends on the extra
-        raise ImportError("k-means clustering needs scikit-learn: pip install 'uvnav[recon]'") from exc
+        raise ImportError(
+            "k-means clustering needs scikit-learn: pip install 'uvnav[recon]'"
+        ) from exc
     km = KMeans(n_clusters=k, n_init=10, random_state=seed).fit(xy[:, :2])
     labels = np.asarray(km.labels_, dtype=np.intp)
     first = [int(np.lexsort((xy[labels == c, 1], xy[labels == c, 0]))[0]) for c in range(k)]
@@ -193,7 +195,10 @@ def merge_tours(pts: FloatArray, keep: IntArray, other: IntArray) -> IntArray:
     def d(u: IntArray, v: IntArray) -> FloatArray:
         return np.asarray(np.linalg.norm(p[u][:, None, :] - p[v][None, :, :], axis=2))
 
-    base = np.linalg.norm(p[a0] - p[a1], axis=1)[:, None] + np.linalg.norm(p[b0] - p[b1], axis=1)[None, :]
+    base = (
+        np.linalg.norm(p[a0] - p[a1], axis=1)[:, None]
+        + np.linalg.norm(p[b0] - p[b1], axis=1)[None, :]
+    )
     fwd = d(a0, b1) + d(b0, a1).T - base  # a_i -> b_{j+1} ... b_j -> a_{i+1}
     rev = d(a0, b0) + d(b1, a1).T - base  # a_i -> b_j ... (backwards) b_{j+1} -> a_{i+1}
     if fwd.min() <= rev.min():

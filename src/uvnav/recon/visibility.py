@@ -1,4 +1,4 @@
-"""Camera footprint, occlusion and the lowest altitude per waypoint (thesis Ch. 7 §7.2, (7.2), Fig. 7.1).
+"""Camera footprint, occlusion and the lowest altitude per waypoint (thesis Ch. 7 (7.2), Fig. 7.1).
 
 Thesis: Y. Zhang, Ch. 7 (ICCAR 2020); occlusion model after J. Zhang and H. Huang,
 "Occlusion-Aware UAV Path Planning for Reconnaissance and Surveillance", Drones 5 (2021) 98.
@@ -109,7 +109,9 @@ def line_of_sight(
     return out
 
 
-def _grid_crossings(a: FloatArray, b: FloatArray, o: float, h: float) -> tuple[FloatArray, FloatArray]:
+def _grid_crossings(
+    a: FloatArray, b: FloatArray, o: float, h: float
+) -> tuple[FloatArray, FloatArray]:
     """Parameters t in (0, 1) where segments a→b (per ray, one axis) cross grid lines o + k·h."""
     fa = (a - o) / h
     fb = (b - o) / h
@@ -126,7 +128,9 @@ def _grid_crossings(a: FloatArray, b: FloatArray, o: float, h: float) -> tuple[F
     return t, valid
 
 
-def visible(terrain: Terrain, cam: FloatArray, pts: FloatArray, theta: float, *, step: float | None = None) -> np.ndarray:
+def visible(
+    terrain: Terrain, cam: FloatArray, pts: FloatArray, theta: float, *, step: float | None = None
+) -> np.ndarray:
     """In the cone and in line of sight: the thesis's "seen" predicate for one camera (3,)."""
     vis = in_cone(cam, pts, theta)
     if vis.any():
@@ -185,7 +189,7 @@ def clearance_altitude(terrain: Terrain, xy: FloatArray, c2: float) -> float:
     clear every sample s by ``sqrt(c2² − d²)`` where d is its horizontal distance.
     """
     h = 0.25 * terrain.cell
-    k = int(math.ceil(c2 / h))
+    k = math.ceil(c2 / h)
     g = np.arange(-k, k + 1) * h
     X, Y = np.meshgrid(g, g)
     d2 = X**2 + Y**2
@@ -202,10 +206,10 @@ def terrain_distance(terrain: Terrain, pts: FloatArray, radius: float) -> FloatA
     """
     pts = np.asarray(pts, dtype=float)
     h = 0.25 * terrain.cell
-    k = int(math.ceil(radius / h))
+    k = math.ceil(radius / h)
     g = np.arange(-k, k + 1) * h
     X, Y = np.meshgrid(g, g)
-    m = X**2 + Y**2 <= radius * radius
+    m = radius * radius >= X**2 + Y**2
     ox, oy = X[m], Y[m]
     out = np.empty(len(pts))
     for i, p in enumerate(pts):
@@ -217,15 +221,13 @@ def terrain_distance(terrain: Terrain, pts: FloatArray, radius: float) -> FloatA
 def los_disagreement(
     terrain: Terrain, cams: FloatArray, pts: FloatArray, *, refine: int = 16
 ) -> float:
-    """Fraction of rays cams (m, 3) → pts (m, 3) whose verdict differs from a ``refine``x finer one."""
+    """Fraction of rays cams (m, 3) → pts (m, 3) whose verdict differs from a ``refine``x finer."""
     a = line_of_sight(terrain, cams, pts)
     b = line_of_sight(terrain, cams, pts, step=0.5 * terrain.cell / refine)
     return float(np.mean(a != b)) if len(a) else 0.0
 
 
-def seen_by_any(
-    terrain: Terrain, cams: FloatArray, pts: FloatArray, theta: float
-) -> np.ndarray:
+def seen_by_any(terrain: Terrain, cams: FloatArray, pts: FloatArray, theta: float) -> np.ndarray:
     """Whether each ground point (m, 3) is seen by at least one camera of ``cams`` (k, 3)."""
     seen = np.zeros(len(pts), dtype=bool)
     tan_h = math.tan(theta / 2.0)

@@ -39,7 +39,14 @@ def hillshade(terrain: Terrain) -> np.ndarray:
     from matplotlib import colormaps
 
     return np.asarray(
-        ls.shade(terrain.z, cmap=colormaps["gist_earth"], vert_exag=1.0, dx=terrain.dx, dy=terrain.dy, blend_mode="soft")
+        ls.shade(
+            terrain.z,
+            cmap=colormaps["gist_earth"],
+            vert_exag=1.0,
+            dx=terrain.dx,
+            dy=terrain.dy,
+            blend_mode="soft",
+        )
     )[..., :3]
 
 
@@ -78,10 +85,22 @@ def plot_fig7_4(plan: ReconPlan, path: str | Path | None = None) -> Figure:
     ground = plan.terrain.height(W[:, 0], W[:, 1])
     rad = np.maximum(W[:, 2] - ground, 0.0) * math.tan(plan.config.theta / 2)
     ax.add_collection(
-        PatchCollection([Circle((x, y), r) for (x, y), r in zip(W[:, :2], rad, strict=True)], facecolor="none", edgecolor="magenta", lw=0.5, alpha=0.7)
+        PatchCollection(
+            [Circle((x, y), r) for (x, y), r in zip(W[:, :2], rad, strict=True)],
+            facecolor="none",
+            edgecolor="magenta",
+            lw=0.5,
+            alpha=0.7,
+        )
     )
     ax.add_collection(
-        PatchCollection([Circle((x, y), plan.config.delta) for x, y in W[:, :2]], facecolor="yellow", edgecolor="k", lw=0.4, alpha=0.9)
+        PatchCollection(
+            [Circle((x, y), plan.config.delta) for x, y in W[:, :2]],
+            facecolor="yellow",
+            edgecolor="k",
+            lw=0.4,
+            alpha=0.9,
+        )
     )
     ax.set_title(
         f"(b) δ = {plan.config.delta:g} m balls, footprints; "
@@ -91,8 +110,20 @@ def plot_fig7_4(plan: ReconPlan, path: str | Path | None = None) -> Figure:
     _background(ax, plan, shade)
     for k, u in enumerate(plan.uavs):
         pts = u.trajectory.sample(16)
-        ax.plot(pts[:, 0], pts[:, 1], color=_UAV_COLOURS[k % len(_UAV_COLOURS)], lw=1.2, label=f"UAV {k + 1}: {u.check.length:.0f} m")
-        ax.plot(*W[u.indices[0], :2], marker="*", ms=12, color=_UAV_COLOURS[k % len(_UAV_COLOURS)], mec="k")
+        ax.plot(
+            pts[:, 0],
+            pts[:, 1],
+            color=_UAV_COLOURS[k % len(_UAV_COLOURS)],
+            lw=1.2,
+            label=f"UAV {k + 1}: {u.check.length:.0f} m",
+        )
+        ax.plot(
+            *W[u.indices[0], :2],
+            marker="*",
+            ms=12,
+            color=_UAV_COLOURS[k % len(_UAV_COLOURS)],
+            mec="k",
+        )
     ax.scatter(W[:, 0], W[:, 1], s=5, c="k", zorder=3)
     ax.legend(loc="upper right", fontsize=8)
     ax.set_title(f"(c) {len(plan.uavs)} UAV(s), one cluster each (scenario 1)")
@@ -107,8 +138,9 @@ def plot_fig7_4(plan: ReconPlan, path: str | Path | None = None) -> Figure:
     ax.set_title("(d) one UAV, integrated tour (scenario 2)")
     fig.suptitle(
         f"Ch. 7 plan over {plan.terrain.source}: r_min = {plan.config.r_min:g} m, "
-        f"max curvature {s['max_curvature']:.4f} ≤ {s['curvature_bound']:.4f} 1/m"
-    , fontsize=10)
+        f"max curvature {s['max_curvature']:.4f} ≤ {s['curvature_bound']:.4f} 1/m",
+        fontsize=10,
+    )
     if path is not None:
         out = Path(path)
         out.parent.mkdir(parents=True, exist_ok=True)
@@ -127,25 +159,60 @@ def recon_3d_figure(plan: ReconPlan, *, max_grid: int = 160) -> Any:
     sx = max(1, math.ceil(t.z.shape[1] / max_grid))
     fig = go.Figure()
     fig.add_trace(
-        go.Surface(x=t.xs[::sx], y=t.ys[::sy], z=t.z[::sy, ::sx], colorscale="Earth", showscale=False, opacity=0.95, name="terrain")
+        go.Surface(
+            x=t.xs[::sx],
+            y=t.ys[::sy],
+            z=t.z[::sy, ::sx],
+            colorscale="Earth",
+            showscale=False,
+            opacity=0.95,
+            name="terrain",
+        )
     )
     W = plan.waypoints
     fig.add_trace(
-        go.Scatter3d(x=W[:, 0], y=W[:, 1], z=W[:, 2], mode="markers", marker={"size": 3, "color": "black"}, name="waypoints")
+        go.Scatter3d(
+            x=W[:, 0],
+            y=W[:, 1],
+            z=W[:, 2],
+            mode="markers",
+            marker={"size": 3, "color": "black"},
+            name="waypoints",
+        )
     )
     for k, u in enumerate(plan.uavs):
         p = u.trajectory.sample(12)
         fig.add_trace(
-            go.Scatter3d(x=p[:, 0], y=p[:, 1], z=p[:, 2], mode="lines", line={"width": 4, "color": _UAV_COLOURS[k % len(_UAV_COLOURS)].replace("tab:", "")}, name=f"UAV {k + 1}")
+            go.Scatter3d(
+                x=p[:, 0],
+                y=p[:, 1],
+                z=p[:, 2],
+                mode="lines",
+                line={"width": 4, "color": _UAV_COLOURS[k % len(_UAV_COLOURS)].replace("tab:", "")},
+                name=f"UAV {k + 1}",
+            )
         )
     if plan.integrated is not None:
         p = plan.integrated.trajectory.sample(12)
         fig.add_trace(
-            go.Scatter3d(x=p[:, 0], y=p[:, 1], z=p[:, 2], mode="lines", line={"width": 3, "color": "orange"}, name="integrated (one UAV)", visible="legendonly")
+            go.Scatter3d(
+                x=p[:, 0],
+                y=p[:, 1],
+                z=p[:, 2],
+                mode="lines",
+                line={"width": 3, "color": "orange"},
+                name="integrated (one UAV)",
+                visible="legendonly",
+            )
         )
     fig.update_layout(
         title=f"Ch. 7 reconnaissance plan — {plan.lattice.n} waypoints, {len(plan.uavs)} UAV(s)",
-        scene={"aspectmode": "data", "xaxis_title": "x [m]", "yaxis_title": "y [m]", "zaxis_title": "z [m]"},
+        scene={
+            "aspectmode": "data",
+            "xaxis_title": "x [m]",
+            "yaxis_title": "y [m]",
+            "zaxis_title": "z [m]",
+        },
         margin={"l": 0, "r": 0, "t": 40, "b": 0},
     )
     return fig
