@@ -17,8 +17,9 @@ Construction (horizontal plane, then altitude):
    neighbours).  Consecutive (Q_i, ψ_i) are joined by the shortest Dubins path of radius
    ``r_min·(1 + 1e-3)``; coordinate descent over (Q_i, ψ_i), a few sweeps, shortens the tour.
 2. Every arc is split into pieces of at most π/4 and each piece is the standard cubic Bézier of a
-   circular arc (handles ``4/3·tan(α/4)·r``, curvature within 0.02 % of 1/r, hence ≤ 1/r_min
-   with the 1e-3 margin); straight parts are Béziers of at most 20 m with handles at thirds.
+   circular arc (handles ``4/3·tan(α/4)·r``, curvature between −0.15 % and +0.05 % of 1/r for a
+   π/4 piece, hence ≤ 1/r_min with the 1e-3 margin); straight parts are Béziers of at most
+   20 m with handles at thirds.
    Headings are shared at joints, so the unit tangent is continuous (G¹; C¹ after arc-length
    reparametrisation — the parametric speed changes at arc/line joints, which is why the check
    reports the tangent *angle* jump).
