@@ -380,7 +380,7 @@ def build_trajectory(
         xy = dubins_beziers_xy(path)
         if not xy:
             continue
-        seg_len = np.array([_bezier_len(b) for b in xy])
+        seg_len = _bezier_lengths(np.asarray(xy))
         s_edges = np.concatenate([[0.0], np.cumsum(seg_len)])
         Ltot = float(s_edges[-1])
         bump = _bump_height(xy, s_edges, Ltot, z0, z1, terrain_height, c2)
@@ -399,10 +399,10 @@ def build_trajectory(
     )
 
 
-def _bezier_len(b: FloatArray, m: int = 32) -> float:
-    t = np.linspace(0, 1, m + 1)
-    pos = bezier_eval(b[None], t)[0][0]
-    return float(np.linalg.norm(np.diff(pos, axis=0), axis=1).sum())
+def _bezier_lengths(B: FloatArray, m: int = 32) -> FloatArray:
+    """Lengths [m] of cubic Béziers (K, 4, d) by a 32-chord polyline each."""
+    pos = bezier_eval(B, np.linspace(0, 1, m + 1))[0]
+    return np.asarray(np.linalg.norm(np.diff(pos, axis=1), axis=2).sum(axis=1), dtype=float)
 
 
 def _profile(u: float, z0: float, z1: float, bump: float) -> tuple[float, float]:

@@ -73,11 +73,9 @@ def check_trajectory(
     jump = float(np.max(np.arccos(np.clip(cosang, -1.0, 1.0)))) if len(B) else 0.0
     pts = pos.reshape(-1, 3)
     W = np.asarray(waypoints, dtype=float)
-    dmin = np.full(len(W), np.inf)
-    for s in range(0, len(pts), 20000):
-        chunk = pts[s : s + 20000]
-        d = np.linalg.norm(W[:, None, :] - chunk[None, :, :], axis=2).min(axis=1)
-        dmin = np.minimum(dmin, d)
+    from scipy.spatial import cKDTree
+
+    dmin = cKDTree(pts).query(W)[0] if len(W) else np.zeros(0)
     clear = float(np.min(pts[:, 2] - terrain.height(pts[:, 0], pts[:, 1]))) if terrain else math.inf
     return TrajectoryCheck(
         length=float(seg),

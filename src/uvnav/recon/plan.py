@@ -65,6 +65,7 @@ class ReconConfig:
         seed: Seed for k-means.
         integrated: With several UAVs, also plan one UAV over the merged tour (Fig. 7.4(d)).
         n_lambda: λ samples of the lattice search.
+        lattice_pairs: Lattice vectors paired with the edge-aligned lines in that search.
         tsp: OR-Tools metaheuristic, "greedy" (reproducible) or "gls".
         tsp_time_limit: Cap on each TSP solve [s].
     """
@@ -80,7 +81,8 @@ class ReconConfig:
     uavs: int = 1
     seed: int = 0
     integrated: bool = True
-    n_lambda: int = 36
+    n_lambda: int = 24
+    lattice_pairs: int = 60
     tsp: str = "greedy"
     tsp_time_limit: float = 20.0
 
@@ -210,7 +212,9 @@ def plan_recon(
     z_min, z_max = validate_inputs(terrain, area, cfg)
 
     t = time.perf_counter()
-    lat = optimal_lattice(area, cfg.footprint_radius, n_lambda=cfg.n_lambda)
+    lat = optimal_lattice(
+        area, cfg.footprint_radius, n_lambda=cfg.n_lambda, max_pairs_k=cfg.lattice_pairs
+    )
     timings["lattice"] = time.perf_counter() - t
 
     t = time.perf_counter()
