@@ -10,8 +10,9 @@ on a plan, independently of how the plan was built:
 * max distance waypoint → trajectory (dense samples of τ, an upper bound of the true distance);
 * max horizontal curvature of τ (analytic Bézier derivatives at dense samples) vs 1/r_min;
 * max tangent-angle jump at the Bézier joints [rad];
-* min vertical clearance of τ above the terrain, min waypoint–terrain distance and min
-  waypoint–waypoint distance (7.4);
+* min vertical clearance of τ above the terrain (an upper bound of its 3D distance; near a
+  waypoint (7.4) guarantees c2 − δ, between waypoints the altitude bump aims at c2), min
+  waypoint–terrain distance and min waypoint–waypoint distance (7.4);
 * lengths (total and per UAV).
 
 Units: lengths [m], angles [rad], curvature [1/m].
