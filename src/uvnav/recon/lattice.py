@@ -201,9 +201,16 @@ def _count_rows(
     """
     ax = _piece_axes(piece, lam, R)
     a1, a2 = lattice_basis(lam, R)
-    B = np.column_stack([a1, a2])
-    jj = np.round(vecs @ np.linalg.inv(B).T[:, 1]).astype(int) if len(vecs) else np.zeros(0, int)
-    rows = np.arange(jj.min(), jj.max() + 1) if len(jj) else np.zeros(0, int)
+    offsets = _reduce(np.asarray(offsets, dtype=float), a1, a2)  # same lattices, o in the cell
+    # rows j whose line o + j·a2 + t·a1 can cross the sum: its projection on the normal of a1 is
+    # D's projection widened by the hexagon's support R there; o·n⊥ lies in [0, 1.5 R)
+    n_perp = np.array([-a1[1], a1[0]]) / np.linalg.norm(a1)
+    proj = piece @ n_perp
+    step = float(a2 @ n_perp)  # 1.5 R
+    rows = np.arange(
+        math.floor((proj.min() - R) / step) - 1, math.ceil((proj.max() + R) / step) + 1
+    )
+    del vecs  # rows come from the geometry; kept in the signature for symmetry with _count_sat
     an = a1 @ ax.n.T  # (A,)
     lo_b = ax.pmin - ax.h
     hi_b = ax.pmax + ax.h
