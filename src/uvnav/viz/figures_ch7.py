@@ -14,6 +14,7 @@ Figures use an explicit Agg canvas (no pyplot state), like :mod:`uvnav.viz.figur
 from __future__ import annotations
 
 import math
+import textwrap
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -137,8 +138,11 @@ def plot_fig7_4(plan: ReconPlan, path: str | Path | None = None) -> Figure:
     ax.legend(loc="upper right", fontsize=8)
     ax.set_title("(d) one UAV, integrated tour (scenario 2)")
     fig.suptitle(
-        f"Ch. 7 plan over {plan.terrain.source}: r_min = {plan.config.r_min:g} m, "
-        f"max curvature {s['max_curvature']:.4f} ≤ {s['curvature_bound']:.4f} 1/m",
+        textwrap.fill(
+            f"Ch. 7 plan over {plan.terrain.source}: r_min = {plan.config.r_min:g} m, max curvature "
+            f"{s['max_curvature']:.4f} ≤ {s['curvature_bound']:.4f} 1/m",
+            width=150,
+        ),
         fontsize=10,
     )
     if path is not None:
