@@ -139,8 +139,8 @@ def plot_fig7_4(plan: ReconPlan, path: str | Path | None = None) -> Figure:
     ax.set_title("(d) one UAV, integrated tour (scenario 2)")
     fig.suptitle(
         textwrap.fill(
-            f"Ch. 7 plan over {plan.terrain.source}: r_min = {plan.config.r_min:g} m, max curvature "
-            f"{s['max_curvature']:.4f} ≤ {s['curvature_bound']:.4f} 1/m",
+            f"Ch. 7 plan over {plan.terrain.source}: r_min = {plan.config.r_min:g} m, "
+            f"max curvature {s['max_curvature']:.4f} ≤ {s['curvature_bound']:.4f} 1/m",
             width=150,
         ),
         fontsize=10,
