@@ -75,3 +75,13 @@ def test_altitude_bump_clears_a_ridge() -> None:
     over = (np.abs(pts[:, 0] - 100.0) < 10.0) & (pts[:, 1] < 60.0)
     assert over.any()
     assert np.all(pts[over, 2] >= 50.0 - 1e-6)
+
+
+def test_single_waypoint_is_a_loiter_circle() -> None:
+    P = np.array([[10.0, 20.0, 40.0]])
+    traj = Bz.build_trajectory(P, np.array([0]), r_min=8.0, delta=5.0)
+    chk = check_trajectory(traj, P)
+    assert chk.max_waypoint_distance < 1e-9
+    assert chk.length == pytest.approx(2 * math.pi * 8.0 * (1 + Bz.ARC_MARGIN), rel=1e-3)
+    assert chk.max_curvature <= 1 / 8.0
+    assert chk.max_tangent_jump < 1e-6

@@ -367,13 +367,19 @@ def build_trajectory(
     if n == 0:
         raise ValueError("trajectory: no waypoints")
     if n == 1:  # a loiter circle of radius r_min through the waypoint
-        W = np.vstack([W, W])
-    Q, psi, paths = plan_dubins_tour(
-        W[:, :2], r_min=r_min, delta=delta, n_headings=n_headings, sweeps=sweeps
-    )
+        r = r_min * (1.0 + ARC_MARGIN)
+        Q = W[:, :2].copy()
+        psi = np.zeros(1)
+        paths = [
+            DubinsPath(
+                np.array([W[0, 0], W[0, 1], 0.0]), "LSL", np.array([TWO_PI * r, 0.0, 0.0]), r
+            )
+        ]
+    else:
+        Q, psi, paths = plan_dubins_tour(
+            W[:, :2], r_min=r_min, delta=delta, n_headings=n_headings, sweeps=sweeps
+        )
     pieces: list[FloatArray] = []
-    if n == 1:
-        paths = [p for p in paths if p.length > 1e-9] or paths
     for i, path in enumerate(paths):
         z0 = W[i, 2]
         z1 = W[(i + 1) % len(W), 2]
@@ -394,9 +400,7 @@ def build_trajectory(
             pieces.append(np.column_stack([b, z]))
     B = np.asarray(pieces)
     pass_pts = np.column_stack([Q, W[:, 2]])
-    return Trajectory(
-        B, pass_pts[: n if n > 1 else 1], psi[: n if n > 1 else 1], order, float(r_min)
-    )
+    return Trajectory(B, pass_pts, psi, order, float(r_min))
 
 
 def _bezier_lengths(B: FloatArray, m: int = 32) -> FloatArray:
