@@ -434,6 +434,7 @@ def reproduce(
     n_baseline_seeds: int | None = None,
     n_crowd_seeds: int | None = None,
     render: Renderer | None = None,
+    ch7: bool | None = None,
 ) -> ReproductionSummary:
     """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
 
@@ -453,6 +454,9 @@ def reproduce(
         controllers: laws to run (default both Ch. 2 laws).
         render: renderer callable (e.g. ``uvnav.viz.reproduction.render_reproduction``);
             ``None`` skips figures and report.
+        ch7: also run the thesis Ch. 7 reconnaissance experiments
+            (:mod:`uvnav.bench.reproduce_ch7`, rows appended to the table); ``None`` = only when
+            ``n_random`` is not given (test-sized runs skip it).
 
     Returns:
         The summary: table, database and report paths, random-campaign failures.
@@ -599,6 +603,11 @@ def reproduce(
         from uvnav.bench.reproduce_ch3 import reproduce_ch3
 
         table += reproduce_ch3(results_dir, report_dir, full=full, workers=workers).table
+    run_ch7 = ch7 if ch7 is not None else n_random is None
+    if run_ch7:  # thesis Ch. 7 (issue 8)
+        from uvnav.bench.reproduce_ch7 import reproduce_ch7
+
+        table += reproduce_ch7(results_dir / "ch7", full=full).table
     report_path: Path | None = None
     figures: list[Path] = []
     if render is not None:

@@ -26,6 +26,7 @@ import yaml
 from typer.core import TyperGroup
 
 from uvnav.cli.multi import multi_app
+from uvnav.cli.recon import recon_app
 from uvnav.controllers import (
     ControllerInfo,
     ControllerParamsError,
@@ -130,6 +131,7 @@ controllers_app = typer.Typer(
 app.add_typer(scenarios_app, name="scenarios")
 app.add_typer(controllers_app, name="controllers")
 app.add_typer(multi_app, name="multi")  # issue 9
+app.add_typer(recon_app, name="recon")
 
 
 def _version(value: bool) -> None:

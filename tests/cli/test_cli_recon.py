@@ -1,0 +1,117 @@
+"""``uvnav recon plan``: files written, summary measured, one-line errors with exit status 2."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from uvnav.cli.app import app
+
+runner = CliRunner()
+
+
+def test_recon_plan_writes_plan_files(tmp_path: Path) -> None:
+    out = tmp_path / "plan"
+    res = runner.invoke(
+        app,
+        [
+            "recon",
+            "plan",
+            "--synthetic",
+            "2",
+            "--area",
+            "150",
+            "--radius",
+            "30",
+            "--uavs",
+            "2",
+            "--out",
+            str(out),
+            "--json",
+            "--no-figures",
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    s = json.loads(res.output.strip().splitlines()[-1])
+    assert s["coverage_visible"] == 1.0
+    assert s["max_waypoint_distance"] <= 5.0
+    with (out / "waypoints.csv").open() as f:
+        rows = list(csv.DictReader(f))
+    assert len(rows) == s["n_waypoints"]
+    gj = json.loads((out / "trajectory.geojson").read_text())
+    assert {f["properties"]["uav"] for f in gj["features"]} == {0, 1, 2}
+    assert json.loads((out / "plan.json").read_text())["n_waypoints"] == s["n_waypoints"]
+
+
+def test_recon_plan_figures(tmp_path: Path) -> None:
+    out = tmp_path / "fig"
+    res = runner.invoke(
+        app,
+        [
+            "recon",
+            "plan",
+            "--synthetic",
+            "1",
+            "--area",
+            "120",
+            "--radius",
+            "40",
+            "--uavs",
+            "1",
+            "--out",
+            str(out),
+        ],
+    )
+    assert res.exit_code == 0, res.output
+    assert (out / "fig7_4.png").stat().st_size > 10_000
+    html = (out / "recon_3d.html").read_text()
+    assert "plotly" in html and "waypoints" in html
+
+
+def test_recon_plan_errors_are_one_line(tmp_path: Path) -> None:
+    cases = [
+        (["--theta", "180"], "--theta"),
+        (["--dem", str(tmp_path / "missing.npy")], "missing.npy"),
+        (["--c1", "8"], "c1"),
+        (["--z-min", "90", "--z-max", "50"], "z_min"),
+        (["--r-min", "100"], "r_min"),
+        (["--area", "abc"], "--area"),
+        (["--synthetic", "1", "--jacksboro"], "exclusive"),
+    ]
+    for extra, word in cases:
+        res = runner.invoke(
+            app, ["recon", "plan", "--area", "100", "--out", str(tmp_path / "x"), *extra]
+        )
+        assert res.exit_code == 2, (extra, res.output)
+        lines = [ln for ln in res.output.splitlines() if ln.strip()]
+        assert len(lines) == 1 and lines[0].startswith("error: ") and word in lines[0], (
+            extra,
+            res.output,
+        )
+
+
+def test_recon_plan_area_outside_dem(tmp_path: Path) -> None:
+    import numpy as np
+
+    dem = tmp_path / "dem.npy"
+    np.save(dem, np.zeros((21, 21)))
+    res = runner.invoke(
+        app,
+        [
+            "recon",
+            "plan",
+            "--dem",
+            str(dem),
+            "--cell",
+            "5",
+            "--area",
+            "0,0,300,300",
+            "--out",
+            str(tmp_path / "o"),
+        ],
+    )
+    assert res.exit_code == 2
+    assert "dem.npy: area" in res.output
