@@ -59,10 +59,10 @@ class CameraSpec:
     height_px: int = 66
     width_px: int = 200
     fov: float = np.deg2rad(90.0)
-    mount_height: float = 2.0
-    pitch: float = np.deg2rad(12.0)
+    mount_height: float = 3.0
+    pitch: float = np.deg2rad(8.0)
     forward: float = 1.0
-    far: float = 120.0
+    far: float = 150.0
 
 
 @dataclass(frozen=True)
