@@ -111,7 +111,7 @@ def build_pilotnet(config: PilotNetConfig | None = None) -> torch.nn.Module:
 
         def forward(self, images: Any, extra: Any = None) -> Any:
             # normalisation layer (thesis §6.2): [0, 255] -> [-1, 1], HWC -> CHW
-            x = images.float().permute(0, 3, 1, 2) / 127.5 - 1.0
+            x = (images.float().permute(0, 3, 1, 2) / 127.5 - 1.0).contiguous()
             f = self.features(x)
             if cfg.extra_inputs:
                 if extra is None:
