@@ -10,6 +10,7 @@ in flight, whose rows are written but not listed — they are kept, as a Udacity
 
 from __future__ import annotations
 
+import json
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -21,6 +22,8 @@ from uvnav.driving.expert import ExpertParams, PurePursuitExpert, ar1_noise
 from uvnav.driving.sim import DrivingSim
 
 DONE_NAME = "episodes.txt"
+#: what the dataset's images are (camera, size): read by training and evaluation
+META_NAME = "dataset.json"
 
 
 @dataclass(frozen=True)
@@ -78,7 +81,10 @@ def collect_episode(
     for k in range(p.max_steps):
         steer, throttle = expert.act(tel)
         if k % p.record_every == 0:
-            left, centre, right = sim.side_views()
+            if sim.camera == "front":
+                left, centre, right = sim.side_views()
+            else:  # the top-down view has no side cameras: the same image three times
+                left = centre = right = sim.topdown_view()
             writer.write(
                 f"{seed:05d}_{k:05d}",
                 (centre, left, right),
@@ -122,9 +128,21 @@ def collect(
     """
     root = Path(root)
     p = params or CollectParams()
+    root.mkdir(parents=True, exist_ok=True)
     done = done_seeds(root)
     own = sim is None
     sim = sim or DrivingSim(max_steps=p.max_steps)
+    meta = root / META_NAME
+    info = {"camera": sim.camera, "height": sim.frame_shape[0], "width": sim.frame_shape[1]}
+    if meta.is_file():
+        old = json.loads(meta.read_text())
+        if old.get("camera") != info["camera"]:
+            raise ValueError(
+                f"{meta}: field 'camera': dataset was recorded with {old.get('camera')!r}, "
+                f"not {info['camera']!r}"
+            )
+    else:
+        meta.write_text(json.dumps(info))
     writer = LogWriter(root)
     total = 0
     try:

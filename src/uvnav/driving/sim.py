@@ -254,6 +254,13 @@ class DrivingSim:
         assert self._obs is not None, "reset() first"
         return self._obs
 
+    @property
+    def frame_shape(self) -> tuple[int, int]:
+        """(H, W) of :meth:`frame`."""
+        if self.camera == "front":
+            return self.camera_spec.height_px, self.camera_spec.width_px
+        return 96, 96
+
     def frame(self) -> NDArray[np.uint8]:
         """The image of the configured camera."""
         return self.front_view() if self.camera == "front" else self.topdown_view()

@@ -147,7 +147,7 @@ def train_pilotnet(
             opt.zero_grad()
             loss.backward()
             opt.step()
-            total += float(loss) * len(idx)
+            total += float(loss.detach()) * len(idx)
             count += len(idx)
             n_seen += len(idx)
         hist.train_loss.append(total / count)
