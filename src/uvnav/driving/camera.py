@@ -79,7 +79,7 @@ def rasterize_track(
     polygons: list[NDArray[np.float64]],
     classes: list[int],
     *,
-    extent: float = 220.0,
+    margin: float = 5.0,
     res: float = 0.25,
 ) -> TrackRaster:
     """Rasterise the track polygons into a class map (later polygons drawn over earlier ones).
@@ -87,7 +87,7 @@ def rasterize_track(
     Args:
         polygons: list of ``(k, 2)`` vertex arrays [m].
         classes: class id of each polygon (``ROAD_A``, ``ROAD_B``, ``KERB_RED``, ``KERB_WHITE``).
-        extent: half-size of the square map around the origin [m].
+        margin: grass border around the polygons' bounding box [m].
         res: cell size [m].
 
     Returns:
@@ -95,13 +95,16 @@ def rasterize_track(
     """
     from PIL import Image, ImageDraw
 
-    n = int(np.ceil(2 * extent / res))
-    img = Image.new("L", (n, n), GRASS)
+    allp = np.concatenate([np.asarray(p, dtype=float) for p in polygons])
+    x0, y0 = allp.min(axis=0) - margin
+    x1, y1 = allp.max(axis=0) + margin
+    nx, ny = int(np.ceil((x1 - x0) / res)), int(np.ceil((y1 - y0) / res))
+    img = Image.new("L", (nx, ny), GRASS)
     draw = ImageDraw.Draw(img)
     for poly, cls in zip(polygons, classes, strict=True):
-        pts = (np.asarray(poly, dtype=float) + extent) / res
+        pts = (np.asarray(poly, dtype=float) - [x0, y0]) / res
         draw.polygon([(float(p[0]), float(p[1])) for p in pts], fill=int(cls))
-    return TrackRaster(np.asarray(img, dtype=np.uint8), -extent, -extent, res)
+    return TrackRaster(np.asarray(img, dtype=np.uint8), float(x0), float(y0), res)
 
 
 @dataclass(frozen=True)
@@ -179,10 +182,10 @@ def render_view(
     fy = pts[..., 1] + lateral_shift
     wx = x + c * fx - s * fy
     wy = y + s * fx + c * fy
-    n = raster.classes.shape[0]
+    ny, nx = raster.classes.shape
     j = np.floor((wx - raster.x0) / raster.res).astype(np.int64)
     i = np.floor((wy - raster.y0) / raster.res).astype(np.int64)
-    inside = (i >= 0) & (i < n) & (j >= 0) & (j < n)
+    inside = (i >= 0) & (i < ny) & (j >= 0) & (j < nx)
     cls = np.full(fx.shape, GRASS, dtype=np.int64)
     cls[inside] = raster.classes[i[inside], j[inside]]
     # CarRacing's grass has chequered patches of 20 m; alternate their shade

@@ -220,8 +220,15 @@ def steering_histogram(
     steering: NDArray[np.float64], *, n_bins: int = 25, lo: float = -1.0, hi: float = 1.0
 ) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
     """Histogram of steering values (Fig. 6.4): ``(counts, edges)`` over [lo, hi]."""
-    counts, edges = np.histogram(np.clip(steering, lo, hi), bins=n_bins, range=(lo, hi))
+    edges = np.linspace(lo, hi, n_bins + 1)
+    counts = np.bincount(_bin_index(steering, edges), minlength=n_bins)
     return counts.astype(np.int64), edges
+
+
+def _bin_index(steering: NDArray[np.float64], edges: NDArray[np.float64]) -> NDArray[np.int64]:
+    """Bin of each value: [e_k, e_k+1), the last bin closed; values outside are clipped in."""
+    s = np.clip(np.asarray(steering, dtype=float), edges[0], edges[-1])
+    return np.clip(np.searchsorted(edges, s, side="right") - 1, 0, len(edges) - 2).astype(np.int64)
 
 
 def balance_indices(
@@ -246,8 +253,7 @@ def balance_indices(
     Returns:
         Sorted indices of the kept samples.
     """
-    s = np.clip(np.asarray(steering, dtype=float), lo, hi)
-    b = np.minimum(((s - lo) / (hi - lo) * n_bins).astype(np.int64), n_bins - 1)
+    b = _bin_index(steering, np.linspace(lo, hi, n_bins + 1))
     keep: list[NDArray[np.int64]] = []
     for k in range(n_bins):
         idx = np.flatnonzero(b == k)
