@@ -583,6 +583,10 @@ def reproduce(
         table, failures = build_table(store, scenes, ctrls, straight_line=straight)
         if baselines:
             table += comparison_rows(store)
+        if full:  # Chapter 6 (CNN driving) only in full mode: training is minutes even when small
+            from uvnav.bench.reproduce_ch6 import reproduce_ch6
+
+            table += reproduce_ch6(results_dir / "ch6", full=True).table
         scene_episodes = []
         for s in scenes:
             for c in ctrls:

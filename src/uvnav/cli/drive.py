@@ -124,7 +124,7 @@ def train(
     batch_size: Annotated[int, typer.Option(min=1, help="Batch size (thesis: 100).")] = 100,
     lr: Annotated[float, typer.Option(min=0.0, help="Adam learning rate (thesis: 1e-3).")] = 1e-3,
     device: Annotated[str, typer.Option(help="torch device (cpu, cuda).")] = "cpu",
-    threads: Annotated[int, typer.Option(min=1, help="torch CPU threads.")] = 2,
+    threads: Annotated[int, typer.Option(min=1, max=2, help="torch CPU threads.")] = 1,
     max_per_bin: Annotated[int, typer.Option(min=0, help="Balancing threshold (0: none).")] = 200,
     bins: Annotated[int, typer.Option(min=1, help="Steering histogram bins.")] = 25,
     correction: Annotated[float, typer.Option(help="Left/right steering correction.")] = 0.2,
@@ -347,3 +347,41 @@ def dagger(
             rows[f"round-{r}"] = summarize(run_eval(policy, seed_list, on_reset=on_reset))
             typer.echo(f"round {r}: return {rows[f'round-{r}']['return']:.1f}")
         _print_rows(rows, False)
+
+
+@drive_app.command()
+def reproduce(
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("results/ch6"),
+    full: Annotated[bool, typer.Option("--full", help="Thesis-size run (hours on CPU).")] = False,
+    episodes: Annotated[int | None, typer.Option(help="Override: expert episodes.")] = None,
+    epochs: Annotated[int | None, typer.Option(help="Override: epochs.")] = None,
+    seeds: Annotated[str | None, typer.Option(help="Override: held-out seeds.")] = None,
+    max_steps: Annotated[int | None, typer.Option(help="Override: closed-loop steps.")] = None,
+) -> None:
+    """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table."""
+    with _user_errors():
+        from rich.console import Console
+        from rich.table import Table
+
+        from uvnav.bench.reproduce_ch6 import reproduce_ch6
+        from uvnav.viz.figures_ch6 import render_ch6
+
+        con = Console(stderr=True)
+        summary = reproduce_ch6(
+            out,
+            full=full,
+            episodes=episodes,
+            epochs=epochs,
+            eval_seeds=parse_seeds(seeds) if seeds else None,
+            max_steps=max_steps,
+            progress=lambda s: con.print(f"[dim]… {s}[/dim]"),
+        )
+        figures = render_ch6(summary, out / "figures")
+        table = Table(title="Chapter 6: thesis reported vs uvnav measured")
+        for col in ("quantity", "thesis", "measured", "note"):
+            table.add_column(col)
+        for row in summary.table:
+            table.add_row(*(row[c] for c in ("quantity", "thesis", "measured", "note")))
+        Console().print(table)
+        _print_rows(summary.closed_loop, False)
+        typer.echo(f"wrote {len(figures)} figures in {out / 'figures'} and {out / 'ch6.json'}")

@@ -172,7 +172,7 @@ class Predictor:
         device: torch device.
     """
 
-    def __init__(self, model: Any, *, threads: int = 2, device: str = "cpu") -> None:
+    def __init__(self, model: Any, *, threads: int = 1, device: str = "cpu") -> None:
         import torch
 
         torch.set_num_threads(max(1, threads))

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -164,3 +165,21 @@ def write_drive_video(
             art.set_data(np.asarray(im))
             writer.grab_frame()
     return out
+
+
+def render_ch6(summary: Any, out_dir: str | Path) -> list[Path]:
+    """All Chapter 6 figures of a :class:`uvnav.bench.reproduce_ch6.Ch6Summary`."""
+    out = Path(out_dir)
+    rec = summary.record
+    return [
+        fig_camera_views(summary.views, out / "fig6_1_cameras.png"),
+        fig_steering_histogram(
+            summary.steering_all, out / "fig6_4_steering.png", title="steering before balancing"
+        ),
+        fig_steering_histogram(
+            summary.steering_balanced, out / "fig6_5_balanced.png", title="after balancing"
+        ),
+        fig_split(summary.steering_train, summary.steering_val, out / "fig6_6_split.png"),
+        fig_augmentation(summary.augment_examples, out / "fig6_7_augmentation.png"),
+        fig_loss(rec["train_loss"], rec["val_loss"], out / "fig6_8_loss.png"),
+    ]
