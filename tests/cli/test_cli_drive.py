@@ -11,9 +11,9 @@ from typer.testing import CliRunner
 pytest.importorskip("torch")
 pytest.importorskip("gymnasium")
 
-from uvnav.cli.app import app  # noqa: E402
-from uvnav.cli.drive import parse_seeds  # noqa: E402
-from uvnav.driving.dataset import read_log  # noqa: E402
+from uvnav.cli.app import app
+from uvnav.cli.drive import parse_seeds
+from uvnav.driving.dataset import read_log
 
 runner = CliRunner()
 
@@ -24,8 +24,18 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     data = root / "data"
     r = runner.invoke(
         app,
-        ["drive", "collect", "--out", str(data), "--episodes", "1", "--max-steps", "240",
-         "--record-every", "2"],
+        [
+            "drive",
+            "collect",
+            "--out",
+            str(data),
+            "--episodes",
+            "1",
+            "--max-steps",
+            "240",
+            "--record-every",
+            "2",
+        ],
     )
     assert r.exit_code == 0, r.output
     assert len(read_log(data)) == 120
@@ -35,7 +45,8 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     assert again.exit_code == 0 and "wrote 0 rows" in again.output  # resumed: nothing new
     model = root / "m.safetensors"
     r = runner.invoke(
-        app, ["drive", "train", str(data), "--out", str(model), "--epochs", "1", "--batch-size", "30"]
+        app,
+        ["drive", "train", str(data), "--out", str(model), "--epochs", "1", "--batch-size", "30"],
     )
     assert r.exit_code == 0, r.output
     assert model.is_file() and model.with_suffix(".json").is_file()
@@ -46,8 +57,19 @@ def test_briefly_trained_model_moves_along_the_track(trained: tuple[Path, Path])
     _, model = trained
     r = runner.invoke(
         app,
-        ["drive", "evaluate", str(model), "--seeds", "1000", "--max-steps", "150",
-         "--throttle", "pi", "--no-expert", "--json"],
+        [
+            "drive",
+            "evaluate",
+            str(model),
+            "--seeds",
+            "1000",
+            "--max-steps",
+            "150",
+            "--throttle",
+            "pi",
+            "--no-expert",
+            "--json",
+        ],
     )
     assert r.exit_code == 0, r.output
     row = json.loads(r.output[r.output.index("{") :])["cnn-pi"]
@@ -75,7 +97,9 @@ def test_play_writes_a_gif(trained: tuple[Path, Path], tmp_path: Path) -> None:
         (["drive", "play", "x.safetensors", "--out", "x.avi"], "--out"),
     ],
 )
-def test_errors_are_one_line_exit_2(args: list[str], needle: str, tmp_path: Path, monkeypatch) -> None:
+def test_errors_are_one_line_exit_2(
+    args: list[str], needle: str, tmp_path: Path, monkeypatch
+) -> None:
     monkeypatch.chdir(tmp_path)
     r = runner.invoke(app, args)
     assert r.exit_code == 2

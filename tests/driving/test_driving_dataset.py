@@ -26,7 +26,14 @@ def _img(v: int) -> np.ndarray:
 def test_write_then_read_round_trip(tmp_path) -> None:
     w = LogWriter(tmp_path)
     for k in range(3):
-        w.write(f"k{k}", (_img(10), _img(20), _img(30)), steering=0.1 * k, throttle=0.5, brake=0.0, speed=12.0)
+        w.write(
+            f"k{k}",
+            (_img(10), _img(20), _img(30)),
+            steering=0.1 * k,
+            throttle=0.5,
+            brake=0.0,
+            speed=12.0,
+        )
     w.close()
     log = read_log(tmp_path)
     assert len(log) == 3

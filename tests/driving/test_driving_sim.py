@@ -8,14 +8,14 @@ import pytest
 pytest.importorskip("gymnasium")
 pytest.importorskip("Box2D")
 
-from uvnav.driving.evaluate import (  # noqa: E402
+from uvnav.driving.evaluate import (
     PISpeedController,
     autonomy_score,
     expert_policy,
     run_closed_loop,
 )
-from uvnav.driving.expert import PurePursuitExpert, ar1_noise  # noqa: E402
-from uvnav.driving.sim import HALF_WIDTH, DrivingSim  # noqa: E402
+from uvnav.driving.expert import PurePursuitExpert, ar1_noise
+from uvnav.driving.sim import HALF_WIDTH, DrivingSim
 
 
 @pytest.fixture(scope="module")

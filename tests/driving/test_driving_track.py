@@ -40,7 +40,8 @@ def test_curvature_and_speed_profile() -> None:
     v = corner_speed_profile(g, v_max=80.0, a_lat=50.0, a_brake=20.0)
     assert np.allclose(v, np.sqrt(50.0 / 0.01), rtol=0.02)
     # a straight into a tight corner: the profile brakes within a_brake before it
-    pts = np.concatenate([np.stack([np.linspace(0, 300, 100), np.zeros(100)], 1), _circle(20.0)[:50] + [300, 20]])
+    straight = np.stack([np.linspace(0, 300, 100), np.zeros(100)], 1)
+    pts = np.concatenate([straight, _circle(20.0)[:50] + np.array([300.0, 20.0])])
     g2 = track_geometry(pts)
     v2 = corner_speed_profile(g2, v_max=80.0, a_lat=50.0, a_brake=20.0)
     assert v2.max() <= 80.0

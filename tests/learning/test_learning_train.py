@@ -11,7 +11,6 @@ from uvnav.learning import PilotNetConfig, TrainConfig  # noqa: E402
 from uvnav.learning.augment import augment_batch  # noqa: E402
 from uvnav.learning.train import Predictor, evaluate_mse, train_pilotnet  # noqa: E402
 
-
 # a smaller input than the thesis's 66x200 keeps the tests fast on two shared CPU cores
 H, W = 48, 96
 SMALL = PilotNetConfig(height=H, width=W, dropout=0.1)
@@ -41,13 +40,17 @@ def test_flip_negates_steering_and_mirrors_the_image() -> None:
 def test_brightness_and_zoom_stay_in_range() -> None:
     g = torch.Generator().manual_seed(1)
     x = torch.full((8, 66, 200, 3), 100.0)
-    xa, _ = augment_batch(x, torch.zeros(8), g, flip_prob=0.0, brightness=(0.5, 0.8), zoom=(1.0, 1.0))
+    xa, _ = augment_batch(
+        x, torch.zeros(8), g, flip_prob=0.0, brightness=(0.5, 0.8), zoom=(1.0, 1.0)
+    )
     per = xa.mean(dim=(1, 2, 3))
     assert bool(((per >= 50 - 1e-3) & (per <= 80 + 1e-3)).all())
     # zoom on a uniform image keeps it uniform; on a centred box it enlarges the box
     box = torch.zeros(1, 66, 200, 3)
     box[:, 23:43, 80:120] = 255.0
-    xz, _ = augment_batch(box, torch.zeros(1), g, flip_prob=0.0, brightness=(1.0, 1.0), zoom=(1.5, 1.5))
+    xz, _ = augment_batch(
+        box, torch.zeros(1), g, flip_prob=0.0, brightness=(1.0, 1.0), zoom=(1.5, 1.5)
+    )
     assert float((xz > 127).sum()) > 1.8 * float((box > 127).sum())
 
 

@@ -155,9 +155,9 @@ def train_on(
     return model, record
 
 
-def cnn_policy(model: Any, *, throttle: Throttle = "learned", set_speed: float = 35.0) -> tuple[
-    Policy, Callable[[], None] | None
-]:
+def cnn_policy(
+    model: Any, *, throttle: Throttle = "learned", set_speed: float = 35.0
+) -> tuple[Policy, Callable[[], None] | None]:
     """A policy from the network: it sees the frame and the speed only.
 
     Args:

@@ -95,7 +95,14 @@ def reproduce_ch6(
     Returns:
         The summary (table rows "thesis vs measured", closed-loop means, arrays for figures).
     """
-    from uvnav.bench.ch6_pipeline import cnn_policy, evaluate, evaluate_expert, prepare_data, train_on
+    from uvnav.bench.ch6_pipeline import (
+        Throttle,
+        cnn_policy,
+        evaluate,
+        evaluate_expert,
+        prepare_data,
+        train_on,
+    )
     from uvnav.driving.collect import CollectParams, collect
     from uvnav.driving.evaluate import summarize
     from uvnav.driving.sim import DrivingSim
@@ -117,9 +124,10 @@ def reproduce_ch6(
     say(f"training {n_epochs} epochs on {data.info['n_train']} images")
     model, record = train_on(data, out / "model.safetensors", config=TrainConfig(epochs=n_epochs))
     rows: dict[str, dict[str, float]] = {}
-    for mode in ("learned", "pi"):
+    modes: tuple[Throttle, ...] = ("learned", "pi")
+    for mode in modes:
         say(f"closed loop, cnn + {mode} throttle, {len(seeds)} tracks")
-        policy, on_reset = cnn_policy(model, throttle=mode)  # type: ignore[arg-type]
+        policy, on_reset = cnn_policy(model, throttle=mode)
         rows[f"cnn-{mode}"] = summarize(evaluate(policy, seeds, on_reset=on_reset, max_steps=steps))
     say("closed loop, expert")
     rows["expert"] = summarize(evaluate_expert(seeds, max_steps=steps))
@@ -168,7 +176,9 @@ def reproduce_ch6(
         )
     wall = time.perf_counter() - tic
     (out / "ch6.json").write_text(
-        json.dumps({"closed_loop": rows, "record": record, "seeds": seeds, "wall_s": wall}, indent=2)
+        json.dumps(
+            {"closed_loop": rows, "record": record, "seeds": seeds, "wall_s": wall}, indent=2
+        )
     )
     return Ch6Summary(
         table=table,

@@ -193,7 +193,7 @@ def _load_policy(model_path: Path, throttle: str, set_speed: float) -> tuple[Any
 
     if throttle not in ("learned", "pi"):
         raise ValueError(f"--throttle: {throttle!r} (must be learned, pi or both)")
-    model, header = load_checkpoint(model_path)
+    model, _ = load_checkpoint(model_path)
     camera = "topdown" if (model.config.height, model.config.width) == (96, 96) else "front"
     policy, on_reset = cnn_policy(model, throttle=throttle, set_speed=set_speed)  # type: ignore[arg-type]
     return policy, on_reset, camera
@@ -229,7 +229,7 @@ def evaluate(
                     on_reset=on_reset,
                     max_steps=max_steps,
                     sim=sim,
-                    on_episode=lambda r, t=task: prog.advance(t),
+                    on_episode=lambda r, t=task: prog.advance(t),  # type: ignore[misc]
                 )
                 sim.close()
                 rows[f"cnn-{mode}"] = summarize(res)
@@ -246,7 +246,7 @@ def evaluate(
                 sim.close()
                 rows["expert"] = summarize(res)
         if "expert" in rows:
-            for name, row in rows.items():
+            for row in rows.values():
                 row["return_vs_expert"] = row["return"] / rows["expert"]["return"]
         _print_rows(rows, as_json)
 
@@ -258,8 +258,17 @@ def _print_rows(rows: dict[str, dict[str, float]], as_json: bool) -> None:
     from rich.console import Console
     from rich.table import Table
 
-    cols = ["n", "return", "return_vs_expert", "tiles_pct", "laps", "mean_centre_distance",
-            "off_track_events", "autonomy", "mean_speed"]
+    cols = [
+        "n",
+        "return",
+        "return_vs_expert",
+        "tiles_pct",
+        "laps",
+        "mean_centre_distance",
+        "off_track_events",
+        "autonomy",
+        "mean_speed",
+    ]
     table = Table(title="closed loop (means over seeds)")
     table.add_column("driver")
     for c in cols:
@@ -319,7 +328,9 @@ def dagger(
     rounds: Annotated[int, typer.Option(min=1, help="DAgger rounds.")] = 2,
     episodes: Annotated[int, typer.Option(min=1, help="Tracks driven per round.")] = 3,
     epochs: Annotated[int, typer.Option(min=1, help="Training epochs per round.")] = 3,
-    seeds: Annotated[str, typer.Option(help="Held-out seeds evaluated after each round.")] = "1000-1004",
+    seeds: Annotated[
+        str, typer.Option(help="Held-out seeds evaluated after each round.")
+    ] = "1000-1004",
     out_dir: Annotated[Path, typer.Option("--out-dir", help="Folder of the round models.")] = Path(
         "dagger"
     ),
@@ -341,7 +352,10 @@ def dagger(
             dagger_collect(net, data, range(500 + r * 100, 500 + r * 100 + episodes), round_id=r)
             prep = prepare_data(data)
             net, _ = train_on(
-                prep, out_dir / f"round{r}.safetensors", model=net, config=TrainConfig(epochs=epochs)
+                prep,
+                out_dir / f"round{r}.safetensors",
+                model=net,
+                config=TrainConfig(epochs=epochs),
             )
             policy, on_reset = cnn_policy(net, throttle="learned")
             rows[f"round-{r}"] = summarize(run_eval(policy, seed_list, on_reset=on_reset))

@@ -31,7 +31,7 @@ COLUMNS = ("center", "left", "right", "steering", "throttle", "brake", "speed")
 
 
 class DatasetError(ValueError):
-    """A malformed dataset: the message is one line naming the file, the row/field and the problem."""
+    """A malformed dataset: one line naming the file, the row/field and the problem."""
 
 
 @dataclass(frozen=True)
@@ -132,7 +132,9 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
                 try:
                     cols[c].append(float(x))
                 except ValueError:
-                    raise DatasetError(f"{log}: row {r}, column '{c}': {x!r} is not a number") from None
+                    raise DatasetError(
+                        f"{log}: row {r}, column '{c}': {x!r} is not a number"
+                    ) from None
     if not cols["center"]:
         raise DatasetError(f"{log}: no rows")
     return DrivingLog(
@@ -270,13 +272,11 @@ def split_indices(
     if not 0.0 < val_fraction < 1.0:
         raise ValueError(f"val_fraction: {val_fraction} (must be in (0, 1))")
     perm = rng.permutation(n)
-    n_val = int(round(n * val_fraction))
+    n_val = round(n * val_fraction)
     return np.sort(perm[n_val:]).astype(np.int64), np.sort(perm[:n_val]).astype(np.int64)
 
 
-def load_images(
-    paths: Sequence[Path], *, size: tuple[int, int] = (66, 200)
-) -> NDArray[np.uint8]:
+def load_images(paths: Sequence[Path], *, size: tuple[int, int] = (66, 200)) -> NDArray[np.uint8]:
     """Load images as ``(N, H, W, 3)`` uint8, resized to ``size`` = (H, W) where they differ.
 
     A Udacity 160×320 frame is first cropped as NVIDIA/Udacity pipelines do (top 60 rows of sky
@@ -292,6 +292,6 @@ def load_images(
             if img.size == (320, 160) and (h, w) != (160, 320):
                 img = img.crop((0, 60, 320, 135))
             if img.size != (w, h):
-                img = img.resize((w, h), Image.BILINEAR)
+                img = img.resize((w, h), Image.Resampling.BILINEAR)
             out[k] = np.asarray(img)
     return out

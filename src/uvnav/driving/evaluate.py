@@ -185,6 +185,7 @@ def expert_policy(sim: DrivingSim, **params: Any) -> Policy:
             assert sim.geometry is not None
             state["geom"] = sim.geometry
             state["expert"] = PurePursuitExpert(sim.geometry, ep)
-        return state["expert"].act(tel)  # type: ignore[no-any-return]
+        expert: PurePursuitExpert = state["expert"]
+        return expert.act(tel)
 
     return act

@@ -95,9 +95,7 @@ class PurePursuitExpert:
         return steer, throttle
 
 
-def ar1_noise(
-    rng: np.random.Generator, n: int, *, sigma: float, rho: float
-) -> NDArray[np.float64]:
+def ar1_noise(rng: np.random.Generator, n: int, *, sigma: float, rho: float) -> NDArray[np.float64]:
     """Stationary AR(1) sequence ``e_t = ρ e_{t−1} + σ √(1−ρ²) w_t`` with std ``sigma``.
 
     Args:

@@ -63,9 +63,7 @@ def track_geometry(points: NDArray[np.float64]) -> TrackGeometry:
     return TrackGeometry(p, heading, seg, s, curv, float(seg.sum()))
 
 
-def project(
-    geom: TrackGeometry, x: float, y: float
-) -> tuple[int, float, float]:
+def project(geom: TrackGeometry, x: float, y: float) -> tuple[int, float, float]:
     """Nearest centreline segment to a position.
 
     Args:

@@ -41,7 +41,7 @@ def augment_batch(
         ``(images, steering)`` augmented (new tensors).
     """
     import torch
-    import torch.nn.functional as F
+    from torch.nn import functional
 
     n = images.shape[0]
     dev = images.device
@@ -61,7 +61,9 @@ def augment_batch(
         theta[:, 0, 0] = 1.0 / z
         theta[:, 1, 1] = 1.0 / z
         chw = x.permute(0, 3, 1, 2)
-        grid = F.affine_grid(theta, list(chw.shape), align_corners=False)
-        chw = F.grid_sample(chw, grid, mode="bilinear", padding_mode="border", align_corners=False)
+        grid = functional.affine_grid(theta, list(chw.shape), align_corners=False)
+        chw = functional.grid_sample(
+            chw, grid, mode="bilinear", padding_mode="border", align_corners=False
+        )
         x = chw.permute(0, 2, 3, 1).contiguous()
     return x, s

@@ -13,7 +13,7 @@ from typing import Any
 
 @dataclass(frozen=True)
 class PilotNetConfig:
-    """Shape of the Chapter 6 network (thesis §6.2, Fig. 6.3; NVIDIA PilotNet, Bojarski et al. 2016).
+    """Shape of the Chapter 6 network (thesis §6.2, Fig. 6.3; NVIDIA PilotNet, Bojarski 2016).
 
     Attributes:
         height: input image height [px] (thesis/PilotNet: 66).

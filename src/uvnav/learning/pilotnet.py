@@ -84,7 +84,7 @@ def build_pilotnet(config: PilotNetConfig | None = None) -> torch.nn.Module:
     nn = torch.nn
     cfg = config or PilotNetConfig()
 
-    class PilotNet(nn.Module):  # type: ignore[misc, name-defined]
+    class PilotNet(nn.Module):  # type: ignore[name-defined]
         def __init__(self) -> None:
             super().__init__()
             self.config = cfg

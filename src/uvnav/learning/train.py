@@ -31,7 +31,9 @@ class TrainHistory:
     images_per_s: float = 0.0
 
 
-def _targets(steering: NDArray[np.float64], throttle: NDArray[np.float64] | None, n_out: int) -> Any:
+def _targets(
+    steering: NDArray[np.float64], throttle: NDArray[np.float64] | None, n_out: int
+) -> Any:
     import torch
 
     if n_out == 1 or throttle is None:
@@ -60,7 +62,9 @@ def evaluate_mse(
         for a in range(0, len(images), batch_size):
             xb = torch.as_tensor(images[a : a + batch_size]).to(device)
             eb = (
-                torch.as_tensor(np.asarray(speed[a : a + batch_size], dtype=np.float32)[:, None]).to(device)
+                torch.as_tensor(
+                    np.asarray(speed[a : a + batch_size], dtype=np.float32)[:, None]
+                ).to(device)
                 if cfg.extra_inputs and speed is not None
                 else None
             )
@@ -157,7 +161,9 @@ def train_pilotnet(
             hist.val_steering_mse.append(ms)
             hist.val_throttle_mse.append(mt)
         if on_epoch is not None:
-            on_epoch(epoch, hist.train_loss[-1], hist.val_loss[-1] if hist.val_loss else float("nan"))
+            on_epoch(
+                epoch, hist.train_loss[-1], hist.val_loss[-1] if hist.val_loss else float("nan")
+            )
     hist.images_per_s = n_seen / max(time.perf_counter() - tic, 1e-9)
     model.eval()
     return model, hist

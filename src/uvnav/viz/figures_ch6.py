@@ -40,7 +40,10 @@ def _save(fig: Figure, path: str | Path) -> Path:
 
 
 def fig_camera_views(
-    views: Sequence[NDArray[np.uint8]], path: str | Path, *, titles: Sequence[str] = ("left", "center", "right")
+    views: Sequence[NDArray[np.uint8]],
+    path: str | Path,
+    *,
+    titles: Sequence[str] = ("left", "center", "right"),
 ) -> Path:
     """Fig. 6.1: the three forward camera images side by side."""
     fig = _new_figure(3.0 * len(views), 1.4)
@@ -137,7 +140,7 @@ def write_drive_video(
     imgs = []
     for f, p, e in zip(frames, predicted, expert, strict=True):
         im = Image.fromarray(np.asarray(f, dtype=np.uint8)).resize(
-            (f.shape[1] * 3, f.shape[0] * 3), Image.NEAREST
+            (f.shape[1] * 3, f.shape[0] * 3), Image.Resampling.NEAREST
         )
         w, h = im.size
         d = ImageDraw.Draw(im)
