@@ -79,6 +79,7 @@ def reproduce_ch6(
     epochs: int | None = None,
     eval_seeds: list[int] | None = None,
     max_steps: int | None = None,
+    collect_steps: int | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> Ch6Summary:
     """Run the Chapter 6 experiment end to end.
@@ -90,6 +91,7 @@ def reproduce_ch6(
         epochs: override the epochs.
         eval_seeds: override the held-out tracks.
         max_steps: override the closed-loop step limit.
+        collect_steps: override the steps per expert episode.
         progress: called with a one-line status before each stage.
 
     Returns:
@@ -116,7 +118,7 @@ def reproduce_ch6(
     n_epochs = epochs or (30 if full else 3)
     seeds = eval_seeds or (list(range(1000, 1020)) if full else [1000, 1001, 1002])
     steps = max_steps or 2000
-    cp = CollectParams(max_steps=1200 if full else 600)
+    cp = CollectParams(max_steps=collect_steps or (1200 if full else 600))
     say(f"collecting {n_ep} expert episodes")
     collect(out / "data", range(n_ep), params=cp)
     say("balancing and splitting")
