@@ -116,7 +116,7 @@ def build_pilotnet(config: PilotNetConfig | None = None) -> torch.nn.Module:
             if cfg.extra_inputs:
                 if extra is None:
                     raise ValueError("PilotNet: this network needs the speed input (extra)")
-                f = torch.cat([f, extra.float().reshape(len(f), -1) / cfg.speed_scale], dim=1)
+                f = torch.cat([f, extra.float().reshape(f.shape[0], -1) / cfg.speed_scale], dim=1)
             return self.head(f)
 
     return PilotNet()
