@@ -591,6 +591,10 @@ def reproduce(
             from uvnav.bench.reproduce_ch9 import reproduce_ch9
 
             table += reproduce_ch9(full=full)
+        if full:  # Chapter 6 (CNN driving) only in full mode: training is minutes even when small
+            from uvnav.bench.reproduce_ch6 import reproduce_ch6
+
+            table += reproduce_ch6(results_dir / "ch6", full=True).table
         scene_episodes = []
         for s in scenes:
             for c in ctrls:

@@ -25,6 +25,7 @@ import typer
 import yaml
 from typer.core import TyperGroup
 
+from uvnav.cli.drive import drive_app
 from uvnav.cli.multi import multi_app
 from uvnav.cli.recon import recon_app
 from uvnav.controllers import (
@@ -132,6 +133,7 @@ app.add_typer(scenarios_app, name="scenarios")
 app.add_typer(controllers_app, name="controllers")
 app.add_typer(multi_app, name="multi")  # issue 9
 app.add_typer(recon_app, name="recon")
+app.add_typer(drive_app, name="drive")
 
 
 def _version(value: bool) -> None:

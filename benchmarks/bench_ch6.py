@@ -1,0 +1,147 @@
+"""Chapter 6 speed benchmarks: CNN training throughput and inference latency, simulator steps.
+
+Run ``.venv/bin/python benchmarks/bench_ch6.py --out benchmarks/results`` (``--quick`` for a smoke
+test).  Writes ``ch6.json`` with the machine, the parameters and:
+
+* ``train_images_per_s``: PilotNet (66×200, thesis configuration with the speed input) training
+  steps, batch 100, with the flip/brightness/zoom augmentation, per torch thread count (1, 2);
+* ``inference_ms``: one-frame forward pass in eval mode (median and p99), per thread count;
+* ``sim_steps_per_s``: :class:`uvnav.driving.DrivingSim` steps with the front camera rendered.
+
+Targets (issue 7; a prototype measured about 190 img/s training and about 2 ms inference on 2 CPU
+threads) are reported beside the measurement with a ``pass`` flag; the numbers move with the load
+of the machine (``load_average_1m`` is recorded).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import sys
+import time
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+TARGETS = {
+    "train_images_per_s_2_threads": {"limit": 190.0, "direction": ">="},
+    "inference_ms_median_2_threads": {"limit": 2.0, "direction": "<="},
+}
+
+
+def _machine() -> dict[str, Any]:
+    import torch
+
+    return {
+        "timestamp": datetime.now(UTC).isoformat(timespec="seconds"),
+        "platform": platform.platform(),
+        "cpu_count": os.cpu_count(),
+        "load_average_1m": os.getloadavg()[0] if hasattr(os, "getloadavg") else None,
+        "python": sys.version.split()[0],
+        "torch": torch.__version__,
+    }
+
+
+def bench_training(threads: int, batches: int) -> float:
+    """Training images per second (augmentation included) with ``threads`` torch threads."""
+    import torch
+
+    from uvnav.learning import PilotNetConfig
+    from uvnav.learning.augment import augment_batch
+    from uvnav.learning.pilotnet import build_pilotnet
+
+    torch.set_num_threads(threads)
+    torch.manual_seed(0)
+    model = build_pilotnet(PilotNetConfig()).train()
+    opt = torch.optim.Adam(model.parameters(), lr=1e-3)
+    gen = torch.Generator().manual_seed(0)
+    rng = np.random.default_rng(0)
+    imgs = torch.as_tensor(rng.integers(0, 255, (100, 66, 200, 3), dtype=np.uint8))
+    y = torch.as_tensor(rng.uniform(-1, 1, (100, 2)).astype(np.float32))
+    speed = torch.as_tensor(rng.uniform(0, 60, (100, 1)).astype(np.float32))
+
+    def step() -> None:
+        x, s = augment_batch(imgs.float(), y[:, 0], gen)
+        target = torch.stack([s, y[:, 1]], dim=1)
+        loss = ((model(x, speed) - target) ** 2).mean()
+        opt.zero_grad()
+        loss.backward()
+        opt.step()
+
+    step()  # warm-up
+    tic = time.perf_counter()
+    for _ in range(batches):
+        step()
+    return 100 * batches / (time.perf_counter() - tic)
+
+
+def bench_inference(threads: int, n: int) -> dict[str, float]:
+    """One-frame inference latency [ms] (median, p99)."""
+    import torch
+
+    from uvnav.learning import PilotNetConfig
+    from uvnav.learning.pilotnet import build_pilotnet
+
+    torch.set_num_threads(threads)
+    model = build_pilotnet(PilotNetConfig()).eval()
+    x = torch.randint(0, 255, (1, 66, 200, 3), dtype=torch.uint8)
+    e = torch.tensor([[30.0]])
+    times = []
+    with torch.no_grad():
+        for _ in range(5):
+            model(x, e)
+        for _ in range(n):
+            tic = time.perf_counter()
+            model(x, e)
+            times.append(1e3 * (time.perf_counter() - tic))
+    return {"median": float(np.median(times)), "p99": float(np.percentile(times, 99))}
+
+
+def bench_sim(steps: int) -> float:
+    """Simulator steps per second with the front camera rendered each step."""
+    from uvnav.driving.sim import DrivingSim
+
+    sim = DrivingSim(max_steps=steps + 10)
+    sim.reset(0)
+    tic = time.perf_counter()
+    for _ in range(steps):
+        sim.step(0.0, 0.3)
+    rate = steps / (time.perf_counter() - tic)
+    sim.close()
+    return rate
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--out", type=Path, default=Path("benchmarks/results"))
+    parser.add_argument("--quick", action="store_true", help="few samples (smoke test)")
+    args = parser.parse_args(argv)
+    batches, frames, steps = (2, 30, 100) if args.quick else (10, 300, 1000)
+    result: dict[str, Any] = {
+        "machine": _machine(),
+        "params": {"batches": batches, "frames": frames},
+    }
+    for t in (1, 2):
+        result[f"train_images_per_s_{t}_threads"] = bench_training(t, batches)
+        inf = bench_inference(t, frames)
+        result[f"inference_ms_median_{t}_threads"] = inf["median"]
+        result[f"inference_ms_p99_{t}_threads"] = inf["p99"]
+    result["sim_steps_per_s"] = bench_sim(steps)
+    result["targets"] = {}
+    for name, tgt in TARGETS.items():
+        val = result[name]
+        ok = val >= tgt["limit"] if tgt["direction"] == ">=" else val <= tgt["limit"]
+        result["targets"][name] = {**tgt, "measured": val, "pass": bool(ok)}
+    args.out.mkdir(parents=True, exist_ok=True)
+    path = args.out / "ch6.json"
+    path.write_text(json.dumps(result, indent=2) + "\n")
+    print(json.dumps({k: v for k, v in result.items() if k != "machine"}, indent=2))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,280 @@
+"""Chapter 6 pipeline: dataset → balanced split → trained CNN → closed-loop evaluation, DAgger.
+
+The glue between :mod:`uvnav.driving` (data, simulator, expert, evaluator) and
+:mod:`uvnav.learning` (the network), which are independent layers (DESIGN §1): a learned policy
+sees only what the car's camera and speedometer give — the frame and the speed — while the
+expert (an oracle) reads the pose and track.
+
+DAgger (Ross, Gordon & Bagnell, "A Reduction of Imitation Learning and Structured Prediction to
+No-Regret Online Learning", AISTATS 2011), beyond the thesis: the network drives, the expert
+labels the states the network visits, the new rows join the dataset, and the network is trained
+again; plain behaviour cloning only ever sees the expert's own states.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import NDArray
+
+from uvnav.driving.dataset import (
+    LogWriter,
+    balance_indices,
+    expand_cameras,
+    load_images,
+    read_log,
+    split_indices,
+    steering_histogram,
+)
+from uvnav.driving.evaluate import (
+    EpisodeResult,
+    PISpeedController,
+    Policy,
+    expert_policy,
+    run_closed_loop,
+    with_pi_throttle,
+)
+from uvnav.driving.expert import PurePursuitExpert
+from uvnav.driving.sim import DrivingSim, Telemetry
+from uvnav.learning.config import PilotNetConfig, TrainConfig
+
+Throttle = Literal["learned", "pi"]
+
+
+@dataclass
+class PreparedData:
+    """A dataset after camera expansion, balancing and the 8:2 split (arrays in memory)."""
+
+    steering_all: NDArray[np.float64]
+    steering_balanced: NDArray[np.float64]
+    train: tuple[NDArray[np.uint8], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+    val: tuple[NDArray[np.uint8], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+    n_rows: int
+    n_frames: int
+    info: dict[str, Any] = field(default_factory=dict)
+
+
+def prepare_data(
+    root: Path | str,
+    *,
+    correction: float = 0.2,
+    n_bins: int = 25,
+    max_per_bin: int | None = 200,
+    val_fraction: float = 0.2,
+    seed: int = 0,
+    size: tuple[int, int] = (66, 200),
+    sides: bool = True,
+) -> PreparedData:
+    """Read a Udacity-layout folder, expand cameras, balance (Fig. 6.5) and split (Fig. 6.6).
+
+    Args:
+        root: dataset folder.
+        correction: left/right steering correction.
+        n_bins: histogram bins.
+        max_per_bin: balancing threshold (``None``: no balancing).
+        val_fraction: validation share (thesis: 0.2).
+        seed: seed of balancing and split.
+        size: network input (H, W).
+        sides: use the left/right images (False for top-down datasets).
+
+    Returns:
+        The prepared arrays and counts.
+    """
+    rng = np.random.default_rng([seed, 66])
+    log = read_log(root)
+    samples = expand_cameras(log, correction=correction, sides=sides)
+    keep = (
+        balance_indices(samples.steering, rng, n_bins=n_bins, max_per_bin=max_per_bin)
+        if max_per_bin
+        else np.arange(len(samples))
+    )
+    bal = samples.take(keep)
+    tr, va = split_indices(len(bal), rng, val_fraction=val_fraction)
+    imgs = load_images(bal.paths, size=size)
+
+    def part(idx: NDArray[np.int64]) -> Any:
+        return (imgs[idx], bal.steering[idx], bal.throttle[idx], bal.speed[idx])
+
+    counts, _ = steering_histogram(samples.steering, n_bins=n_bins)
+    return PreparedData(
+        steering_all=samples.steering,
+        steering_balanced=bal.steering,
+        train=part(tr),
+        val=part(va),
+        n_rows=len(log),
+        n_frames=len(samples),
+        info={
+            "steering_mean": float(samples.steering.mean()),
+            "steering_std": float(samples.steering.std()),
+            "max_bin_before": int(counts.max()),
+            "n_balanced": len(bal),
+            "n_train": len(tr),
+            "n_val": len(va),
+        },
+    )
+
+
+def train_on(
+    data: PreparedData,
+    out: Path | str,
+    *,
+    net: PilotNetConfig | None = None,
+    config: TrainConfig | None = None,
+    model: Any = None,
+    on_epoch: Callable[[int, float, float], None] | None = None,
+) -> tuple[Any, dict[str, Any]]:
+    """Train on prepared data and save the checkpoint ``out`` (safetensors + JSON).
+
+    Returns:
+        ``(model, record)`` with the loss curves, data counts and timing in ``record``.
+    """
+    from uvnav.learning.checkpoint import save_checkpoint
+    from uvnav.learning.train import train_pilotnet
+
+    tic = time.process_time()
+    model, hist = train_pilotnet(
+        data.train, data.val, net=net, config=config, model=model, on_epoch=on_epoch
+    )
+    record = {
+        "train_loss": hist.train_loss,
+        "val_loss": hist.val_loss,
+        "val_steering_mse": hist.val_steering_mse,
+        "val_throttle_mse": hist.val_throttle_mse,
+        "images_per_s": hist.images_per_s,
+        "cpu_s": time.process_time() - tic,
+        "n_rows": data.n_rows,
+        "n_frames": data.n_frames,
+        **data.info,
+    }
+    save_checkpoint(model, out, record=record)
+    return model, record
+
+
+def cnn_policy(
+    model: Any, *, throttle: Throttle = "learned", set_speed: float = 35.0
+) -> tuple[Policy, Callable[[], None] | None]:
+    """A policy from the network: it sees the frame and the speed only.
+
+    Args:
+        model: trained network.
+        throttle: ``"learned"`` (the network's throttle head) or ``"pi"`` (PI to ``set_speed``).
+        set_speed: PI target speed [m/s].
+
+    Returns:
+        ``(policy, on_reset)``; ``on_reset`` clears the PI integral (``None`` for learned).
+    """
+    from uvnav.learning.train import Predictor
+
+    pred = Predictor(model)
+
+    def act(frame: NDArray[np.uint8], tel: Telemetry) -> tuple[float, float]:
+        return pred(frame, tel.speed)
+
+    if throttle == "pi" or model.config.n_outputs == 1:
+        pi = PISpeedController(set_speed=set_speed)
+        return with_pi_throttle(act, pi), pi.reset
+    return act, None
+
+
+def evaluate(
+    policy: Policy,
+    seeds: Sequence[int],
+    *,
+    on_reset: Callable[[], None] | None = None,
+    max_steps: int = 2000,
+    sim: DrivingSim | None = None,
+    on_episode: Callable[[EpisodeResult], None] | None = None,
+) -> list[EpisodeResult]:
+    """Closed-loop episodes of a policy on the front camera, one per seed."""
+    own = sim is None
+    sim = sim or DrivingSim(max_steps=max_steps)
+    out = []
+    try:
+        for s in seeds:
+            r = run_closed_loop(sim, policy, int(s), max_steps=max_steps, on_reset=on_reset)
+            out.append(r)
+            if on_episode is not None:
+                on_episode(r)
+    finally:
+        if own:
+            sim.close()
+    return out
+
+
+def evaluate_expert(seeds: Sequence[int], *, max_steps: int = 2000) -> list[EpisodeResult]:
+    """Closed-loop episodes of the (oracle) expert, the reference of the return ratio."""
+    sim = DrivingSim(max_steps=max_steps)
+    try:
+        return evaluate(expert_policy(sim), seeds, sim=sim, max_steps=max_steps)
+    finally:
+        sim.close()
+
+
+def dagger_collect(
+    model: Any,
+    root: Path | str,
+    seeds: Sequence[int],
+    *,
+    round_id: int,
+    beta: float = 0.0,
+    record_every: int = 4,
+    max_steps: int = 1200,
+) -> int:
+    """One DAgger round's data: the network drives (mixed with the expert by ``beta``), the
+    expert labels every recorded state, rows are appended to the dataset.
+
+    Args:
+        model: current network.
+        root: dataset folder (rows appended).
+        seeds: training tracks to drive.
+        round_id: used in the image names.
+        beta: probability per step that the expert's command is applied instead.
+        record_every: record every this many steps.
+        max_steps: steps per episode.
+
+    Returns:
+        Rows written.
+    """
+    from uvnav.learning.train import Predictor
+
+    pred = Predictor(model)
+    sim = DrivingSim(max_steps=max_steps)
+    writer = LogWriter(root)
+    rows = 0
+    try:
+        for seed in seeds:
+            rng = np.random.default_rng([seed, round_id, 7])
+            frame, tel = sim.reset(int(seed))
+            assert sim.geometry is not None
+            expert = PurePursuitExpert(sim.geometry)
+            for k in range(max_steps):
+                e_steer, e_thr = expert.act(tel)
+                if k % record_every == 0:
+                    left, centre, right = sim.side_views()
+                    writer.write(
+                        f"d{round_id}_{seed:05d}_{k:05d}",
+                        (centre, left, right),
+                        steering=e_steer,
+                        throttle=e_thr,
+                        brake=max(-e_thr, 0.0),
+                        speed=tel.speed,
+                    )
+                    rows += 1
+                steer, thr = (e_steer, e_thr) if rng.random() < beta else pred(frame, tel.speed)
+                st = sim.step(steer, thr)
+                frame, tel = st.frame, st.telemetry
+                if tel.off_track:
+                    tel = sim.put_back()
+                    frame = sim.frame()
+                if st.terminated or st.truncated:
+                    break
+            writer.flush()
+    finally:
+        writer.close()
+        sim.close()
+    return rows

@@ -1,0 +1,401 @@
+"""``uvnav drive``: thesis Chapter 6 — collect, train, evaluate, play, dagger (DESIGN §6).
+
+Thin Typer commands over :mod:`uvnav.driving`, :mod:`uvnav.learning` and
+:mod:`uvnav.bench.ch6_pipeline`.  User errors (a missing or malformed dataset or model, a bad
+seed list, a missing extra) are printed as ONE line ``error: ...`` and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+drive_app = typer.Typer(
+    name="drive",
+    help="Chapter 6: a CNN that drives (CarRacing-v3 with a forward camera).",
+    no_args_is_help=True,
+    add_completion=False,
+)
+
+
+def _fail(message: str) -> None:
+    typer.echo(f"error: {' '.join(str(message).split())}", err=True)
+    raise typer.Exit(2)
+
+
+@contextmanager
+def _user_errors() -> Iterator[None]:
+    """Turn user errors into one line and exit status 2 (a traceback means a bug)."""
+    try:
+        yield
+    except (typer.Exit, typer.Abort):
+        raise
+    except FileNotFoundError as exc:
+        _fail(f"{exc.strerror or 'not found'}: {exc.filename}")
+    except ImportError as exc:
+        _fail(str(exc))
+    except ValueError as exc:
+        _fail(str(exc))
+
+
+def parse_seeds(text: str) -> list[int]:
+    """Seeds from ``"1000-1019"``, ``"1,2,5"`` or a mix (``"1-3,7"``)."""
+    seeds: list[int] = []
+    for part in text.split(","):
+        part = part.strip()
+        if not part:
+            continue
+        try:
+            if "-" in part:
+                a, b = part.split("-", 1)
+                lo, hi = int(a), int(b)
+                if hi < lo or lo < 0:
+                    raise ValueError
+                seeds.extend(range(lo, hi + 1))
+            else:
+                seeds.append(int(part))
+                if seeds[-1] < 0:
+                    raise ValueError
+        except ValueError:
+            raise ValueError(f"--seeds: {part!r} is not a seed or a range a-b") from None
+    if not seeds:
+        raise ValueError("--seeds: no seeds given")
+    return seeds
+
+
+def _progress() -> Any:
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    return Progress(
+        TextColumn("{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        transient=False,
+    )
+
+
+@drive_app.command()
+def collect(
+    out: Annotated[Path, typer.Option("--out", help="Dataset folder (Udacity layout).")],
+    episodes: Annotated[int, typer.Option(min=1, help="Expert episodes (tracks).")] = 10,
+    seed_start: Annotated[int, typer.Option(help="First track seed.")] = 0,
+    camera: Annotated[str, typer.Option(help="front | topdown")] = "front",
+    record_every: Annotated[int, typer.Option(min=1, help="Record every N steps (50 Hz).")] = 4,
+    noise: Annotated[float, typer.Option(min=0.0, help="Std of the steering noise.")] = 0.25,
+    max_steps: Annotated[int, typer.Option(min=10, help="Steps per episode.")] = 1200,
+) -> None:
+    """Record expert demonstrations (driving_log.csv + IMG/); reruns resume."""
+    with _user_errors():
+        from uvnav.driving.collect import CollectParams
+        from uvnav.driving.collect import collect as run_collect
+        from uvnav.driving.sim import DrivingSim
+
+        if camera not in ("front", "topdown"):
+            raise ValueError(f"--camera: {camera!r} (must be 'front' or 'topdown')")
+        params = CollectParams(record_every=record_every, noise_sigma=noise, max_steps=max_steps)
+        sim = DrivingSim(camera=camera, max_steps=max_steps)  # type: ignore[arg-type]
+        seeds = range(seed_start, seed_start + episodes)
+        with _progress() as prog:
+            task = prog.add_task("collect", total=episodes)
+            rows = run_collect(
+                out,
+                seeds,
+                params=params,
+                sim=sim,
+                on_episode=lambda s, n: prog.advance(task),
+            )
+        sim.close()
+        typer.echo(f"wrote {rows} rows ({3 * rows} images) to {out}")
+
+
+@drive_app.command()
+def train(
+    data: Annotated[Path, typer.Argument(help="Dataset folder (driving_log.csv + IMG/).")],
+    out: Annotated[Path, typer.Option("--out", help="Model file (.safetensors).")] = Path(
+        "model.safetensors"
+    ),
+    epochs: Annotated[int, typer.Option(min=1, help="Epochs (thesis: 30).")] = 30,
+    batch_size: Annotated[int, typer.Option(min=1, help="Batch size (thesis: 100).")] = 100,
+    lr: Annotated[float, typer.Option(min=0.0, help="Adam learning rate (thesis: 1e-3).")] = 1e-3,
+    device: Annotated[str, typer.Option(help="torch device (cpu, cuda).")] = "cpu",
+    threads: Annotated[int, typer.Option(min=1, max=2, help="torch CPU threads.")] = 1,
+    max_per_bin: Annotated[int, typer.Option(min=0, help="Balancing threshold (0: none).")] = 200,
+    bins: Annotated[int, typer.Option(min=1, help="Steering histogram bins.")] = 25,
+    correction: Annotated[float, typer.Option(help="Left/right steering correction.")] = 0.2,
+    augment: Annotated[bool, typer.Option(help="Flip/brightness/zoom augmentation.")] = True,
+    speed_input: Annotated[bool, typer.Option(help="Feed the speed to the network.")] = True,
+    throttle_head: Annotated[bool, typer.Option(help="Learn the throttle too.")] = True,
+    seed: Annotated[int, typer.Option(help="Seed of split, init, shuffling.")] = 0,
+) -> None:
+    """Train the Chapter 6 CNN (Adam, MSE) and write the model and its loss curves."""
+    with _user_errors():
+        from uvnav.bench.ch6_pipeline import prepare_data, train_on
+        from uvnav.learning import PilotNetConfig, TrainConfig
+
+        meta = _dataset_meta(data)
+        size = (int(meta.get("height", 66)), int(meta.get("width", 200)))
+        sides = meta.get("camera", "front") == "front"
+        prep = prepare_data(
+            data,
+            correction=correction if sides else 0.0,
+            n_bins=bins,
+            max_per_bin=max_per_bin or None,
+            seed=seed,
+            size=size,
+            sides=sides,
+        )
+        net = PilotNetConfig(
+            height=size[0],
+            width=size[1],
+            n_outputs=2 if throttle_head else 1,
+            extra_inputs=1 if speed_input else 0,
+        )
+        cfg = TrainConfig(
+            epochs=epochs,
+            batch_size=batch_size,
+            lr=lr,
+            augment=augment,
+            seed=seed,
+            threads=threads,
+            device=device,
+        )
+        with _progress() as prog:
+            task = prog.add_task("train", total=epochs)
+
+            def on_epoch(e: int, tl: float, vl: float) -> None:
+                prog.update(task, advance=1, description=f"train {tl:.4f} val {vl:.4f}")
+
+            _, record = train_on(prep, out, net=net, config=cfg, on_epoch=on_epoch)
+        typer.echo(
+            f"{prep.n_frames} frames, {prep.info['n_balanced']} after balancing, "
+            f"train {prep.info['n_train']} / val {prep.info['n_val']}; final val MSE "
+            f"{record['val_loss'][-1]:.4f} (steering {record['val_steering_mse'][-1]:.4f})"
+        )
+        typer.echo(f"wrote {out}")
+
+
+def _dataset_meta(data: Path) -> dict[str, Any]:
+    from uvnav.driving.collect import META_NAME
+
+    f = Path(data) / META_NAME
+    return json.loads(f.read_text()) if f.is_file() else {"camera": "front"}
+
+
+def _load_policy(model_path: Path, throttle: str, set_speed: float) -> tuple[Any, Any, str]:
+    from uvnav.bench.ch6_pipeline import cnn_policy
+    from uvnav.learning.checkpoint import load_checkpoint
+
+    if throttle not in ("learned", "pi"):
+        raise ValueError(f"--throttle: {throttle!r} (must be learned, pi or both)")
+    model, _ = load_checkpoint(model_path)
+    camera = "topdown" if (model.config.height, model.config.width) == (96, 96) else "front"
+    policy, on_reset = cnn_policy(model, throttle=throttle, set_speed=set_speed)  # type: ignore[arg-type]
+    return policy, on_reset, camera
+
+
+@drive_app.command()
+def evaluate(
+    model: Annotated[Path, typer.Argument(help="Model file (.safetensors).")],
+    seeds: Annotated[str, typer.Option(help="Held-out track seeds, e.g. 1000-1019.")] = "1000-1019",
+    throttle: Annotated[str, typer.Option(help="learned | pi | both")] = "both",
+    set_speed: Annotated[float, typer.Option(help="PI target speed [m/s].")] = 35.0,
+    max_steps: Annotated[int, typer.Option(min=10, help="Steps per episode.")] = 2000,
+    expert: Annotated[bool, typer.Option(help="Also drive the (oracle) expert.")] = True,
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+) -> None:
+    """Closed loop on held-out tracks: return, tiles %, laps, centre distance, autonomy."""
+    with _user_errors():
+        from uvnav.bench.ch6_pipeline import evaluate as run_eval
+        from uvnav.driving.evaluate import expert_policy, summarize
+        from uvnav.driving.sim import DrivingSim
+
+        seed_list = parse_seeds(seeds)
+        modes = ["learned", "pi"] if throttle == "both" else [throttle]
+        rows: dict[str, dict[str, float]] = {}
+        with _progress() as prog:
+            for mode in modes:
+                policy, on_reset, camera = _load_policy(model, mode, set_speed)
+                sim = DrivingSim(camera=camera, max_steps=max_steps)  # type: ignore[arg-type]
+                task = prog.add_task(f"cnn + {mode} throttle", total=len(seed_list))
+                res = run_eval(
+                    policy,
+                    seed_list,
+                    on_reset=on_reset,
+                    max_steps=max_steps,
+                    sim=sim,
+                    on_episode=lambda r, t=task: prog.advance(t),  # type: ignore[misc]
+                )
+                sim.close()
+                rows[f"cnn-{mode}"] = summarize(res)
+            if expert:
+                sim = DrivingSim(max_steps=max_steps)
+                task = prog.add_task("expert (oracle)", total=len(seed_list))
+                res = run_eval(
+                    expert_policy(sim),
+                    seed_list,
+                    max_steps=max_steps,
+                    sim=sim,
+                    on_episode=lambda r: prog.advance(task),
+                )
+                sim.close()
+                rows["expert"] = summarize(res)
+        if "expert" in rows:
+            for row in rows.values():
+                row["return_vs_expert"] = row["return"] / rows["expert"]["return"]
+        _print_rows(rows, as_json)
+
+
+def _print_rows(rows: dict[str, dict[str, float]], as_json: bool) -> None:
+    if as_json:
+        typer.echo(json.dumps(rows, indent=2))
+        return
+    from rich.console import Console
+    from rich.table import Table
+
+    cols = [
+        "n",
+        "return",
+        "return_vs_expert",
+        "tiles_pct",
+        "laps",
+        "mean_centre_distance",
+        "off_track_events",
+        "autonomy",
+        "mean_speed",
+    ]
+    table = Table(title="closed loop (means over seeds)")
+    table.add_column("driver")
+    for c in cols:
+        table.add_column(c, justify="right")
+    for name, row in rows.items():
+        table.add_row(name, *(f"{row[c]:.3f}" if c in row else "—" for c in cols))
+    Console().print(table)
+
+
+@drive_app.command()
+def play(
+    model: Annotated[Path, typer.Argument(help="Model file (.safetensors).")],
+    out: Annotated[Path, typer.Option("--out", help="Output .gif or .mp4.")] = Path("drive.gif"),
+    seed: Annotated[int, typer.Option(help="Track seed.")] = 1000,
+    steps: Annotated[int, typer.Option(min=1, help="Steps to drive.")] = 500,
+    every: Annotated[int, typer.Option(min=1, help="Keep every N-th frame.")] = 5,
+    throttle: Annotated[str, typer.Option(help="learned | pi")] = "learned",
+) -> None:
+    """Drive one track and write the frames with predicted vs expert steering."""
+    with _user_errors():
+        from uvnav.driving.expert import PurePursuitExpert
+        from uvnav.driving.sim import DrivingSim
+        from uvnav.viz.figures_ch6 import write_drive_video
+
+        if out.suffix.lower() not in (".gif", ".mp4"):
+            raise ValueError(f"--out: {out} (must end in .gif or .mp4)")
+        policy, on_reset, camera = _load_policy(model, throttle, 35.0)
+        sim = DrivingSim(camera=camera, max_steps=steps)  # type: ignore[arg-type]
+        frame, tel = sim.reset(seed)
+        if on_reset:
+            on_reset()
+        assert sim.geometry is not None
+        exp = PurePursuitExpert(sim.geometry)
+        frames, pred, ref = [], [], []
+        for k in range(steps):
+            steer, thr = policy(frame, tel)
+            if k % every == 0:
+                frames.append(frame)
+                pred.append(steer)
+                ref.append(exp.act(tel)[0])
+            st = sim.step(steer, thr)
+            frame, tel = st.frame, st.telemetry
+            if tel.off_track:
+                tel = sim.put_back()
+                frame = sim.frame()
+            if st.terminated or st.truncated:
+                break
+        sim.close()
+        write_drive_video(frames, pred, ref, out, fps=max(1, 50 // every))
+        typer.echo(f"wrote {out} ({len(frames)} frames)")
+
+
+@drive_app.command()
+def dagger(
+    data: Annotated[Path, typer.Argument(help="Dataset folder (rows are appended).")],
+    model: Annotated[Path, typer.Argument(help="Starting model (.safetensors).")],
+    rounds: Annotated[int, typer.Option(min=1, help="DAgger rounds.")] = 2,
+    episodes: Annotated[int, typer.Option(min=1, help="Tracks driven per round.")] = 3,
+    epochs: Annotated[int, typer.Option(min=1, help="Training epochs per round.")] = 3,
+    seeds: Annotated[
+        str, typer.Option(help="Held-out seeds evaluated after each round.")
+    ] = "1000-1004",
+    out_dir: Annotated[Path, typer.Option("--out-dir", help="Folder of the round models.")] = Path(
+        "dagger"
+    ),
+) -> None:
+    """DAgger: the CNN drives, the expert labels, retrain; prints closed loop per round."""
+    with _user_errors():
+        from uvnav.bench.ch6_pipeline import cnn_policy, dagger_collect, prepare_data, train_on
+        from uvnav.bench.ch6_pipeline import evaluate as run_eval
+        from uvnav.driving.evaluate import summarize
+        from uvnav.learning import TrainConfig
+        from uvnav.learning.checkpoint import load_checkpoint
+
+        seed_list = parse_seeds(seeds)
+        net, _ = load_checkpoint(model)
+        rows: dict[str, dict[str, float]] = {}
+        policy, on_reset = cnn_policy(net, throttle="learned")
+        rows["round-0"] = summarize(run_eval(policy, seed_list, on_reset=on_reset))
+        for r in range(1, rounds + 1):
+            dagger_collect(net, data, range(500 + r * 100, 500 + r * 100 + episodes), round_id=r)
+            prep = prepare_data(data)
+            net, _ = train_on(
+                prep,
+                out_dir / f"round{r}.safetensors",
+                model=net,
+                config=TrainConfig(epochs=epochs),
+            )
+            policy, on_reset = cnn_policy(net, throttle="learned")
+            rows[f"round-{r}"] = summarize(run_eval(policy, seed_list, on_reset=on_reset))
+            typer.echo(f"round {r}: return {rows[f'round-{r}']['return']:.1f}")
+        _print_rows(rows, False)
+
+
+@drive_app.command()
+def reproduce(
+    out: Annotated[Path, typer.Option("--out", help="Output folder.")] = Path("results/ch6"),
+    full: Annotated[bool, typer.Option("--full", help="Thesis-size run (hours on CPU).")] = False,
+    episodes: Annotated[int | None, typer.Option(help="Override: expert episodes.")] = None,
+    epochs: Annotated[int | None, typer.Option(help="Override: epochs.")] = None,
+    seeds: Annotated[str | None, typer.Option(help="Override: held-out seeds.")] = None,
+    max_steps: Annotated[int | None, typer.Option(help="Override: closed-loop steps.")] = None,
+) -> None:
+    """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table."""
+    with _user_errors():
+        from rich.console import Console
+        from rich.table import Table
+
+        from uvnav.bench.reproduce_ch6 import reproduce_ch6
+        from uvnav.viz.figures_ch6 import render_ch6
+
+        con = Console(stderr=True)
+        summary = reproduce_ch6(
+            out,
+            full=full,
+            episodes=episodes,
+            epochs=epochs,
+            eval_seeds=parse_seeds(seeds) if seeds else None,
+            max_steps=max_steps,
+            progress=lambda s: con.print(f"[dim]… {s}[/dim]"),
+        )
+        figures = render_ch6(summary, out / "figures")
+        table = Table(title="Chapter 6: thesis reported vs uvnav measured")
+        for col in ("quantity", "thesis", "measured", "note"):
+            table.add_column(col)
+        for row in summary.table:
+            table.add_row(*(row[c] for c in ("quantity", "thesis", "measured", "note")))
+        Console().print(table)
+        _print_rows(summary.closed_loop, False)
+        typer.echo(f"wrote {len(figures)} figures in {out / 'figures'} and {out / 'ch6.json'}")

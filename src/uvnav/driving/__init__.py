@@ -1,0 +1,10 @@
+"""Driving (DESIGN §1, layer 6): thesis Chapter 6's data, simulator, expert and evaluator.
+
+Udacity-layout datasets (``driving_log.csv`` + ``IMG/``), steering balancing and the 8:2 split
+(:mod:`uvnav.driving.dataset`), the CarRacing-v3 simulator with a forward camera
+(:mod:`uvnav.driving.sim`), the pure-pursuit expert (:mod:`uvnav.driving.expert`) and the
+closed-loop evaluator (:mod:`uvnav.driving.evaluate`).  Torch is never imported here (the network
+lives in :mod:`uvnav.learning`); gymnasium is imported lazily by the simulator.
+"""
+
+from __future__ import annotations

@@ -1,0 +1,164 @@
+"""Demonstration recording in the Udacity layout (thesis Chapter 6 §6.3, Fig. 6.1).
+
+The expert (:class:`uvnav.driving.expert.PurePursuitExpert`) drives CarRacing tracks; while
+recording, correlated steering noise is applied (DART) but the recorded label is the clean expert
+command at the state the car is in.  Every ``record_every`` steps the three forward images
+(left, centre, right) are written with the labels.  Resumable: each finished episode's seed is
+appended to ``episodes.txt``; a rerun skips those seeds (a killed run loses at most the episode
+in flight, whose rows are written but not listed — they are kept, as a Udacity recording would be).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from uvnav.driving.dataset import LogWriter
+from uvnav.driving.expert import ExpertParams, PurePursuitExpert, ar1_noise
+from uvnav.driving.sim import DrivingSim
+
+DONE_NAME = "episodes.txt"
+#: what the dataset's images are (camera, size): read by training and evaluation
+META_NAME = "dataset.json"
+
+
+@dataclass(frozen=True)
+class CollectParams:
+    """Recording parameters.
+
+    Attributes:
+        record_every: record one row every this many simulator steps (50 Hz).
+        noise_sigma: standard deviation of the applied steering noise (normalised steering).
+        noise_rho: step-to-step correlation of the noise (0.97 ≈ 0.7 s time constant).
+        max_steps: steps per episode (the episode also ends when the lap is done).
+    """
+
+    record_every: int = 4
+    noise_sigma: float = 0.25
+    noise_rho: float = 0.97
+    max_steps: int = 1200
+
+
+def done_seeds(root: Path | str) -> set[int]:
+    """Seeds of the episodes already recorded in a dataset folder."""
+    f = Path(root) / DONE_NAME
+    if not f.is_file():
+        return set()
+    return {int(x) for x in f.read_text().split()}
+
+
+def collect_episode(
+    sim: DrivingSim,
+    writer: LogWriter,
+    seed: int,
+    *,
+    params: CollectParams | None = None,
+    expert_params: ExpertParams | None = None,
+) -> int:
+    """Record one expert episode on track ``seed``.
+
+    Args:
+        sim: simulator (its front camera geometry and side shift are used).
+        writer: dataset writer.
+        seed: track seed (also seeds the noise).
+        params: recording parameters.
+        expert_params: expert parameters.
+
+    Returns:
+        The number of rows written.
+    """
+    p = params or CollectParams()
+    rng = np.random.default_rng([seed, 6])
+    noise = ar1_noise(rng, p.max_steps, sigma=p.noise_sigma, rho=p.noise_rho)
+    _, tel = sim.reset(seed)
+    assert sim.geometry is not None
+    expert = PurePursuitExpert(sim.geometry, expert_params)
+    rows = 0
+    for k in range(p.max_steps):
+        steer, throttle = expert.act(tel)
+        if k % p.record_every == 0:
+            if sim.camera == "front":
+                left, centre, right = sim.side_views()
+            else:  # the top-down view has no side cameras: the same image three times
+                left = centre = right = sim.topdown_view()
+            writer.write(
+                f"{seed:05d}_{k:05d}",
+                (centre, left, right),
+                steering=steer,
+                throttle=throttle,
+                brake=max(-throttle, 0.0),
+                speed=tel.speed,
+            )
+            rows += 1
+        st = sim.step(steer + noise[k], throttle)
+        tel = st.telemetry
+        if tel.off_track:
+            tel = sim.put_back()
+        if st.terminated or st.truncated:
+            break
+    writer.flush()
+    return rows
+
+
+def collect(
+    root: Path | str,
+    seeds: Iterable[int],
+    *,
+    params: CollectParams | None = None,
+    expert_params: ExpertParams | None = None,
+    sim: DrivingSim | None = None,
+    on_episode: Callable[[int, int], None] | None = None,
+) -> int:
+    """Record expert episodes into a Udacity-layout folder, skipping seeds already recorded.
+
+    Args:
+        root: dataset folder (created).
+        seeds: track seeds.
+        params: recording parameters.
+        expert_params: expert parameters.
+        sim: simulator to use (default: front camera 66×200).
+        on_episode: called with ``(seed, rows)`` after each episode (progress bars).
+
+    Returns:
+        Rows written by this call.
+    """
+    root = Path(root)
+    p = params or CollectParams()
+    root.mkdir(parents=True, exist_ok=True)
+    done = done_seeds(root)
+    own = sim is None
+    sim = sim or DrivingSim(max_steps=p.max_steps)
+    meta = root / META_NAME
+    info = {"camera": sim.camera, "height": sim.frame_shape[0], "width": sim.frame_shape[1]}
+    if meta.is_file():
+        old = json.loads(meta.read_text())
+        if old.get("camera") != info["camera"]:
+            raise ValueError(
+                f"{meta}: field 'camera': dataset was recorded with {old.get('camera')!r}, "
+                f"not {info['camera']!r}"
+            )
+    else:
+        meta.write_text(json.dumps(info))
+    writer = LogWriter(root)
+    total = 0
+    try:
+        for seed in seeds:
+            if seed in done:
+                if on_episode:
+                    on_episode(seed, 0)
+                continue
+            n = collect_episode(sim, writer, seed, params=p, expert_params=expert_params)
+            with (root / DONE_NAME).open("a") as fh:
+                fh.write(f"{seed}\n")
+            total += n
+            if on_episode:
+                on_episode(seed, n)
+    finally:
+        writer.close()
+        if own:
+            sim.close()
+    return total

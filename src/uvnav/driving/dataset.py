@@ -1,0 +1,297 @@
+"""Udacity-layout driving data: ``driving_log.csv`` + ``IMG/``, balancing and the 8:2 split.
+
+Thesis Chapter 6 §6.3: 17,592 frames from the Udacity simulator's three cameras with steering and
+throttle (Fig. 6.1); the steering histogram (Fig. 6.4), balancing with a threshold of 200 samples
+per bin (Fig. 6.5), a random 8:2 training/validation split (Fig. 6.6).
+
+The layout is Udacity's ``self-driving-car-sim`` recorder's: one CSV row per time step, no
+header, columns ``center, left, right, steering, throttle, brake, speed`` with image paths that
+may be absolute (Windows or POSIX) from the recording machine — the loader resolves them by file
+name under ``IMG/`` next to the CSV, so real Udacity recordings and ours load the same way.
+Left/right images are used as extra samples with steering ``± correction`` (0.2 by default, the
+usual value for the Udacity car): the left camera sees the car as if it were left of where it is,
+so its label steers more to the right (+).
+
+Udacity's speed column is in mph; ours is CarRacing's [m/s] (the writer records what it is given).
+"""
+
+from __future__ import annotations
+
+import csv
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+from numpy.typing import NDArray
+
+LOG_NAME = "driving_log.csv"
+IMG_DIR = "IMG"
+COLUMNS = ("center", "left", "right", "steering", "throttle", "brake", "speed")
+
+
+class DatasetError(ValueError):
+    """A malformed dataset: one line naming the file, the row/field and the problem."""
+
+
+@dataclass(frozen=True)
+class DrivingLog:
+    """The rows of a ``driving_log.csv`` (paths resolved to existing files under ``IMG/``).
+
+    Attributes:
+        root: dataset folder.
+        center: centre image paths.
+        left: left image paths.
+        right: right image paths.
+        steering: steering in [-1, 1] (+ right).
+        throttle: throttle (Udacity: [0, 1]; ours: [-1, 1], negative = brake).
+        brake: brake in [0, 1].
+        speed: speed (Udacity [mph], ours [m/s]).
+    """
+
+    root: Path
+    center: list[Path]
+    left: list[Path]
+    right: list[Path]
+    steering: NDArray[np.float64]
+    throttle: NDArray[np.float64]
+    brake: NDArray[np.float64]
+    speed: NDArray[np.float64]
+
+    def __len__(self) -> int:
+        return len(self.center)
+
+
+@dataclass(frozen=True)
+class Samples:
+    """Flat training samples: one image path per sample and its labels."""
+
+    paths: list[Path]
+    steering: NDArray[np.float64]
+    throttle: NDArray[np.float64]
+    speed: NDArray[np.float64]
+
+    def __len__(self) -> int:
+        return len(self.paths)
+
+    def take(self, idx: NDArray[np.int64]) -> Samples:
+        """The samples at ``idx``."""
+        return Samples(
+            [self.paths[int(i)] for i in idx],
+            self.steering[idx],
+            self.throttle[idx],
+            self.speed[idx],
+        )
+
+
+def _resolve(root: Path, raw: str, log: Path, row: int, col: str) -> Path:
+    raw = raw.strip()
+    if not raw:
+        raise DatasetError(f"{log}: row {row}, column '{col}': empty image path")
+    name = raw.replace("\\", "/").split("/")[-1]
+    for cand in (root / IMG_DIR / name, root / raw):
+        if cand.is_file():
+            return cand
+    raise DatasetError(f"{log}: row {row}, column '{col}': image '{name}' not found in {IMG_DIR}/")
+
+
+def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
+    """Read a Udacity-layout dataset folder.
+
+    Args:
+        root: folder holding ``driving_log.csv`` and ``IMG/``.
+        check_images: resolve every path to an existing file (else keep ``IMG/<name>``).
+
+    Returns:
+        The log.
+
+    Raises:
+        DatasetError: missing CSV, wrong column count, non-numeric value, missing image.
+    """
+    root = Path(root)
+    log = root / LOG_NAME
+    if not log.is_file():
+        raise DatasetError(f"{log}: not found (a dataset folder holds {LOG_NAME} and {IMG_DIR}/)")
+    cols: dict[str, list[object]] = {c: [] for c in COLUMNS}
+    with log.open(newline="") as fh:
+        for r, rec in enumerate(csv.reader(fh), start=1):
+            if not rec or all(not x.strip() for x in rec):
+                continue
+            if r == 1 and rec[0].strip().lower() == "center":
+                continue  # header (some Udacity sample sets have one)
+            if len(rec) != len(COLUMNS):
+                raise DatasetError(
+                    f"{log}: row {r}: {len(rec)} columns (expected {len(COLUMNS)}: "
+                    f"{', '.join(COLUMNS)})"
+                )
+            for c, x in zip(COLUMNS[:3], rec[:3], strict=True):
+                cols[c].append(
+                    _resolve(root, x, log, r, c) if check_images else root / IMG_DIR / x.strip()
+                )
+            for c, x in zip(COLUMNS[3:], rec[3:], strict=True):
+                try:
+                    cols[c].append(float(x))
+                except ValueError:
+                    raise DatasetError(
+                        f"{log}: row {r}, column '{c}': {x!r} is not a number"
+                    ) from None
+    if not cols["center"]:
+        raise DatasetError(f"{log}: no rows")
+    return DrivingLog(
+        root,
+        [Path(str(p)) for p in cols["center"]],
+        [Path(str(p)) for p in cols["left"]],
+        [Path(str(p)) for p in cols["right"]],
+        *(np.asarray(cols[c], dtype=float) for c in COLUMNS[3:]),
+    )
+
+
+class LogWriter:
+    """Append rows and images to a Udacity-layout dataset (resumable: appends to an existing log).
+
+    Images are written as ``IMG/{camera}_{key}.jpg`` (Udacity's naming idea, our keys) and the CSV
+    holds paths relative to the dataset folder.
+    """
+
+    def __init__(self, root: Path | str) -> None:
+        self.root = Path(root)
+        (self.root / IMG_DIR).mkdir(parents=True, exist_ok=True)
+        self._fh = (self.root / LOG_NAME).open("a", newline="")
+        self._csv = csv.writer(self._fh)
+
+    def write(
+        self,
+        key: str,
+        images: Sequence[NDArray[np.uint8]],
+        *,
+        steering: float,
+        throttle: float,
+        brake: float,
+        speed: float,
+    ) -> None:
+        """Write one row: ``images`` = (center, left, right) uint8 RGB arrays."""
+        from PIL import Image
+
+        names = []
+        for cam, img in zip(("center", "left", "right"), images, strict=True):
+            name = f"{IMG_DIR}/{cam}_{key}.jpg"
+            Image.fromarray(np.asarray(img, dtype=np.uint8)).save(self.root / name, quality=95)
+            names.append(name)
+        self._csv.writerow(
+            [*names, f"{steering:.6f}", f"{throttle:.6f}", f"{brake:.6f}", f"{speed:.6f}"]
+        )
+
+    def flush(self) -> None:
+        """Flush the CSV (call at episode ends: a killed run keeps whole episodes)."""
+        self._fh.flush()
+
+    def close(self) -> None:
+        """Close the CSV."""
+        self._fh.close()
+
+
+def expand_cameras(log: DrivingLog, *, correction: float = 0.2, sides: bool = True) -> Samples:
+    """Flatten a log into samples: centre images, plus left (+correction) and right (−correction).
+
+    Args:
+        log: the dataset.
+        correction: steering added for the left camera and subtracted for the right one.
+        sides: include the left/right images.
+
+    Returns:
+        The samples (steering clipped to [-1, 1]).
+    """
+    paths = list(log.center)
+    steer = [log.steering]
+    thr = [log.throttle]
+    spd = [log.speed]
+    if sides:
+        paths += list(log.left) + list(log.right)
+        steer += [log.steering + correction, log.steering - correction]
+        thr += [log.throttle, log.throttle]
+        spd += [log.speed, log.speed]
+    return Samples(
+        paths,
+        np.clip(np.concatenate(steer), -1.0, 1.0),
+        np.concatenate(thr),
+        np.concatenate(spd),
+    )
+
+
+def steering_histogram(
+    steering: NDArray[np.float64], *, n_bins: int = 25, lo: float = -1.0, hi: float = 1.0
+) -> tuple[NDArray[np.int64], NDArray[np.float64]]:
+    """Histogram of steering values (Fig. 6.4): ``(counts, edges)`` over [lo, hi]."""
+    edges = np.linspace(lo, hi, n_bins + 1)
+    counts = np.bincount(_bin_index(steering, edges), minlength=n_bins)
+    return counts.astype(np.int64), edges
+
+
+def _bin_index(steering: NDArray[np.float64], edges: NDArray[np.float64]) -> NDArray[np.int64]:
+    """Bin of each value: [e_k, e_k+1), the last bin closed; values outside are clipped in."""
+    s = np.clip(np.asarray(steering, dtype=float), edges[0], edges[-1])
+    return np.clip(np.searchsorted(edges, s, side="right") - 1, 0, len(edges) - 2).astype(np.int64)
+
+
+def balance_indices(
+    steering: NDArray[np.float64],
+    rng: np.random.Generator,
+    *,
+    n_bins: int = 25,
+    max_per_bin: int = 200,
+    lo: float = -1.0,
+    hi: float = 1.0,
+) -> NDArray[np.int64]:
+    """Indices kept by the thesis's balancing (Fig. 6.5): at most ``max_per_bin`` per bin.
+
+    Args:
+        steering: steering labels.
+        rng: random generator (which samples of a full bin are kept).
+        n_bins: histogram bins over [lo, hi].
+        max_per_bin: threshold (thesis: 200).
+        lo: lowest steering.
+        hi: highest steering.
+
+    Returns:
+        Sorted indices of the kept samples.
+    """
+    b = _bin_index(steering, np.linspace(lo, hi, n_bins + 1))
+    keep: list[NDArray[np.int64]] = []
+    for k in range(n_bins):
+        idx = np.flatnonzero(b == k)
+        if len(idx) > max_per_bin:
+            idx = np.sort(rng.choice(idx, size=max_per_bin, replace=False))
+        keep.append(idx)
+    return np.sort(np.concatenate(keep)).astype(np.int64)
+
+
+def split_indices(
+    n: int, rng: np.random.Generator, *, val_fraction: float = 0.2
+) -> tuple[NDArray[np.int64], NDArray[np.int64]]:
+    """Random training/validation split (thesis: 8:2, Fig. 6.6): ``(train, val)`` indices."""
+    if not 0.0 < val_fraction < 1.0:
+        raise ValueError(f"val_fraction: {val_fraction} (must be in (0, 1))")
+    perm = rng.permutation(n)
+    n_val = round(n * val_fraction)
+    return np.sort(perm[n_val:]).astype(np.int64), np.sort(perm[:n_val]).astype(np.int64)
+
+
+def load_images(paths: Sequence[Path], *, size: tuple[int, int] = (66, 200)) -> NDArray[np.uint8]:
+    """Load images as ``(N, H, W, 3)`` uint8, resized to ``size`` = (H, W) where they differ.
+
+    A Udacity 160×320 frame is first cropped as NVIDIA/Udacity pipelines do (top 60 rows of sky
+    and bottom 25 rows of bonnet removed) and then resized; our 66×200 renders are used as is.
+    """
+    from PIL import Image
+
+    h, w = size
+    out = np.empty((len(paths), h, w, 3), dtype=np.uint8)
+    for k, p in enumerate(paths):
+        with Image.open(p) as im:
+            img = im.convert("RGB")
+            if img.size == (320, 160) and (h, w) != (160, 320):
+                img = img.crop((0, 60, 320, 135))
+            if img.size != (w, h):
+                img = img.resize((w, h), Image.Resampling.BILINEAR)
+            out[k] = np.asarray(img)
+    return out

@@ -1,0 +1,117 @@
+"""The demonstration driver: an ORACLE pure-pursuit expert with a corner-speed profile.
+
+Paper: R. C. Coulter, "Implementation of the Pure Pursuit Path Tracking Algorithm", CMU-RI-TR-92-01
+(1992).  Thesis Chapter 6 learns from a human driving the Udacity car; here the demonstrations come
+from this expert, which reads the ground truth (the car's pose and the track centreline, hence an
+oracle) and is never seen by the network.
+
+Steering: pure pursuit to the centreline point ``L = lookahead + lookahead_gain · v`` ahead,
+front-wheel angle ``δ = atan(2 W sin α / L)`` (W: CarRacing's wheelbase 3.24 m, α: bearing of the
+target in the car frame), normalised by the 0.4 rad wheel limit.
+Speed: the corner-speed profile of :func:`uvnav.driving.track.corner_speed_profile` ahead of the
+car; throttle = ``clip(k_v (v_target − v), −1, 1)`` (gas or brake).  The label is this smooth
+function of the state (speed, track ahead), which is what makes a learned throttle possible.
+
+Recording noise (DART, Laskey et al. 2017): while recording, correlated AR(1) noise is added to
+the steering that is APPLIED, but the label is the clean expert command at the perturbed state, so
+the data show how to recover from drifts the clean expert never makes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import NDArray
+
+from uvnav.driving.sim import MAX_WHEEL_ANGLE, Telemetry
+from uvnav.driving.track import TrackGeometry, corner_speed_profile, point_ahead, project
+
+#: CarRacing's wheelbase: front axle at +80, rear at −82 body units × SIZE 0.02 [m]
+WHEELBASE = 3.24
+
+
+@dataclass(frozen=True)
+class ExpertParams:
+    """Pure-pursuit expert parameters.
+
+    Attributes:
+        lookahead: base lookahead distance [m].
+        lookahead_gain: extra lookahead per unit speed [s].
+        v_max: top speed on straights [m/s].
+        a_lat: lateral acceleration in corners [m/s²].
+        a_brake: braking deceleration assumed by the profile [m/s²].
+        preview: the target speed is the minimum of the profile over this distance ahead [m].
+        k_speed: throttle per unit speed error [1/(m/s)].
+    """
+
+    lookahead: float = 8.0
+    lookahead_gain: float = 0.25
+    v_max: float = 120.0
+    a_lat: float = 90.0
+    a_brake: float = 50.0
+    preview: float = 10.0
+    k_speed: float = 0.15
+
+
+class PurePursuitExpert:
+    """ORACLE expert driver (reads pose and track).  ``act(telemetry) -> (steer, throttle)``."""
+
+    def __init__(self, geometry: TrackGeometry, params: ExpertParams | None = None) -> None:
+        self.geometry = geometry
+        self.params = params or ExpertParams()
+        p = self.params
+        self.profile = corner_speed_profile(
+            geometry, v_max=p.v_max, a_lat=p.a_lat, a_brake=p.a_brake
+        )
+
+    def target_speed(self, i: int) -> float:
+        """Minimum of the speed profile from segment ``i`` over the preview distance [m/s]."""
+        g = self.geometry
+        n = len(g.points)
+        k = int(np.ceil(self.params.preview / max(float(np.mean(g.seg_len)), 1e-9))) + 1
+        idx = (i + np.arange(k)) % n
+        return float(self.profile[idx].min())
+
+    def act(self, tel: Telemetry) -> tuple[float, float]:
+        """Clean expert command at the car's state.
+
+        Args:
+            tel: telemetry (pose and speed: ground truth).
+
+        Returns:
+            ``(steer, throttle)`` in [-1, 1]: normalised steering (+ right) and throttle.
+        """
+        p = self.params
+        i, t, _ = project(self.geometry, tel.x, tel.y)
+        L = p.lookahead + p.lookahead_gain * tel.speed
+        target = point_ahead(self.geometry, i, t, L)
+        dx, dy = target[0] - tel.x, target[1] - tel.y
+        alpha = np.arctan2(dy, dx) - tel.heading
+        alpha = (alpha + np.pi) % (2 * np.pi) - np.pi
+        delta = np.arctan2(2 * WHEELBASE * np.sin(alpha), L)  # + left
+        steer = float(np.clip(-delta / MAX_WHEEL_ANGLE, -1.0, 1.0))
+        throttle = float(np.clip(p.k_speed * (self.target_speed(i) - tel.speed), -1.0, 1.0))
+        return steer, throttle
+
+
+def ar1_noise(rng: np.random.Generator, n: int, *, sigma: float, rho: float) -> NDArray[np.float64]:
+    """Stationary AR(1) sequence ``e_t = ρ e_{t−1} + σ √(1−ρ²) w_t`` with std ``sigma``.
+
+    Args:
+        rng: random generator.
+        n: length.
+        sigma: stationary standard deviation.
+        rho: correlation between consecutive steps, in [0, 1).
+
+    Returns:
+        ``(n,)`` noise.
+    """
+    w = rng.standard_normal(n)
+    e = np.empty(n)
+    prev = sigma * rng.standard_normal()
+    k = sigma * np.sqrt(1.0 - rho**2)
+    for j in range(n):
+        prev = rho * prev + k * w[j]
+        e[j] = prev
+    return e

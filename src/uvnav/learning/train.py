@@ -1,0 +1,203 @@
+"""Training of the Chapter 6 CNN (thesis §6.3: Adam, lr 0.001, batch 100, 30 epochs, MSE (6.1)).
+
+``train_pilotnet`` takes numpy arrays (images ``(N, H, W, 3)`` uint8, labels, speeds) for the
+training and validation sets, augments training batches (:mod:`uvnav.learning.augment`), and
+returns the model and the per-epoch loss curves (Fig. 6.8).  The loss is eq. (6.1), the mean
+squared error, over steering plus ``throttle_weight`` × throttle when the network has a throttle
+head.  Determinism: torch's seed and generator come from ``TrainConfig.seed``; the number of CPU
+threads is set (2 by default: the machine is shared).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+from numpy.typing import NDArray
+
+from uvnav.learning.config import PilotNetConfig, TrainConfig
+
+
+@dataclass
+class TrainHistory:
+    """Loss curves: mean training and validation MSE (6.1) per epoch, and throughput."""
+
+    train_loss: list[float] = field(default_factory=list)
+    val_loss: list[float] = field(default_factory=list)
+    val_steering_mse: list[float] = field(default_factory=list)
+    val_throttle_mse: list[float] = field(default_factory=list)
+    images_per_s: float = 0.0
+
+
+def _targets(
+    steering: NDArray[np.float64], throttle: NDArray[np.float64] | None, n_out: int
+) -> Any:
+    import torch
+
+    if n_out == 1 or throttle is None:
+        return torch.as_tensor(np.asarray(steering, dtype=np.float32)[:, None])
+    return torch.as_tensor(np.stack([steering, throttle], axis=1).astype(np.float32))
+
+
+def evaluate_mse(
+    model: Any,
+    images: NDArray[np.uint8],
+    steering: NDArray[np.float64],
+    throttle: NDArray[np.float64] | None,
+    speed: NDArray[np.float64] | None,
+    *,
+    batch_size: int = 200,
+    device: str = "cpu",
+) -> tuple[float, float, float]:
+    """``(mse, steering mse, throttle mse)`` of the model in eval mode (NaN where absent)."""
+    import torch
+
+    model.eval()
+    cfg: PilotNetConfig = model.config
+    y = _targets(steering, throttle, cfg.n_outputs)
+    preds = []
+    with torch.no_grad():
+        for a in range(0, len(images), batch_size):
+            xb = torch.as_tensor(images[a : a + batch_size]).to(device)
+            eb = (
+                torch.as_tensor(
+                    np.asarray(speed[a : a + batch_size], dtype=np.float32)[:, None]
+                ).to(device)
+                if cfg.extra_inputs and speed is not None
+                else None
+            )
+            preds.append(model(xb, eb).cpu())
+    p = torch.cat(preds)
+    se = (p - y) ** 2
+    s_mse = float(se[:, 0].mean())
+    t_mse = float(se[:, 1].mean()) if se.shape[1] > 1 else float("nan")
+    return float(se.mean()), s_mse, t_mse
+
+
+def train_pilotnet(
+    train: tuple[NDArray[np.uint8], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]],
+    val: tuple[NDArray[np.uint8], NDArray[np.float64], NDArray[np.float64], NDArray[np.float64]]
+    | None,
+    *,
+    net: PilotNetConfig | None = None,
+    config: TrainConfig | None = None,
+    model: Any = None,
+    on_epoch: Callable[[int, float, float], None] | None = None,
+) -> tuple[Any, TrainHistory]:
+    """Train the network.
+
+    Args:
+        train: ``(images (N,H,W,3) uint8, steering, throttle, speed)`` training set.
+        val: the same for validation, or ``None``.
+        net: network shape (ignored when ``model`` is given).
+        config: schedule (default: the thesis's).
+        model: a model to continue training (e.g. a DAgger round), else a new one.
+        on_epoch: called with ``(epoch, train_loss, val_loss)`` after each epoch.
+
+    Returns:
+        ``(model, history)``.
+    """
+    import torch
+
+    from uvnav.learning.augment import augment_batch
+    from uvnav.learning.pilotnet import build_pilotnet
+
+    cfg = config or TrainConfig()
+    torch.set_num_threads(max(1, cfg.threads))
+    torch.manual_seed(cfg.seed)
+    if model is None:
+        model = build_pilotnet(net or PilotNetConfig())
+    model.to(cfg.device)
+    ncfg: PilotNetConfig = model.config
+    imgs, steer, thr, spd = train
+    if len(imgs) == 0:
+        raise ValueError("train_pilotnet: empty training set")
+    gen = torch.Generator(device=cfg.device)
+    gen.manual_seed(cfg.seed)
+    rng = np.random.default_rng(cfg.seed)
+    opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
+    w = torch.tensor([1.0, cfg.throttle_weight][: ncfg.n_outputs], device=cfg.device)
+    hist = TrainHistory()
+    n_seen = 0
+    import time
+
+    tic = time.perf_counter()
+    for epoch in range(cfg.epochs):
+        model.train()
+        perm = rng.permutation(len(imgs))
+        total, count = 0.0, 0
+        for a in range(0, len(perm), cfg.batch_size):
+            idx = np.sort(perm[a : a + cfg.batch_size])
+            xb = torch.as_tensor(imgs[idx]).to(cfg.device).float()
+            sb = torch.as_tensor(steer[idx].astype(np.float32)).to(cfg.device)
+            if cfg.augment:
+                xb, sb = augment_batch(
+                    xb, sb, gen, flip_prob=cfg.flip_prob, brightness=cfg.brightness, zoom=cfg.zoom
+                )
+            if ncfg.n_outputs == 2:
+                tb = torch.as_tensor(thr[idx].astype(np.float32)).to(cfg.device)
+                yb = torch.stack([sb, tb], dim=1)
+            else:
+                yb = sb[:, None]
+            eb = (
+                torch.as_tensor(spd[idx].astype(np.float32)[:, None]).to(cfg.device)
+                if ncfg.extra_inputs
+                else None
+            )
+            pred = model(xb, eb)
+            loss = (((pred - yb) ** 2) * w).mean()  # MSE, eq. (6.1)
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+            total += float(loss.detach()) * len(idx)
+            count += len(idx)
+            n_seen += len(idx)
+        hist.train_loss.append(total / count)
+        if val is not None and len(val[0]):
+            m, ms, mt = evaluate_mse(model, *val, device=cfg.device)
+            hist.val_loss.append(m)
+            hist.val_steering_mse.append(ms)
+            hist.val_throttle_mse.append(mt)
+        if on_epoch is not None:
+            on_epoch(
+                epoch, hist.train_loss[-1], hist.val_loss[-1] if hist.val_loss else float("nan")
+            )
+    hist.images_per_s = n_seen / max(time.perf_counter() - tic, 1e-9)
+    model.eval()
+    return model, hist
+
+
+class Predictor:
+    """Run a trained network on single frames: ``predictor(frame, speed) -> (steer, throttle)``.
+
+    Args:
+        model: the trained network (put in eval mode).
+        threads: torch CPU threads.
+        device: torch device.
+    """
+
+    def __init__(self, model: Any, *, threads: int = 1, device: str = "cpu") -> None:
+        import torch
+
+        torch.set_num_threads(max(1, threads))
+        self.model = model.to(device).eval()
+        self.device = device
+        self.config: PilotNetConfig = model.config
+
+    def __call__(self, frame: NDArray[np.uint8], speed: float = 0.0) -> tuple[float, float]:
+        """Steering and throttle (throttle 0 for a steering-only network) for one frame."""
+        import torch
+
+        with torch.no_grad():
+            x = torch.as_tensor(np.ascontiguousarray(frame)[None]).to(self.device)
+            e = (
+                torch.tensor([[speed]], dtype=torch.float32, device=self.device)
+                if self.config.extra_inputs
+                else None
+            )
+            out = self.model(x, e)[0].cpu().numpy()
+        steer = float(np.clip(out[0], -1.0, 1.0))
+        throttle = float(np.clip(out[1], -1.0, 1.0)) if len(out) > 1 else 0.0
+        return steer, throttle

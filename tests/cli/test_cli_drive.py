@@ -1,0 +1,113 @@
+"""``uvnav drive``: collect → train → evaluate → play on a tiny configuration, and its errors."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+pytest.importorskip("torch")
+pytest.importorskip("gymnasium")
+
+from uvnav.cli.app import app
+from uvnav.cli.drive import parse_seeds
+from uvnav.driving.dataset import read_log
+
+runner = CliRunner()
+
+
+@pytest.fixture(scope="module")
+def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
+    root = tmp_path_factory.mktemp("drive")
+    data = root / "data"
+    r = runner.invoke(
+        app,
+        [
+            "drive",
+            "collect",
+            "--out",
+            str(data),
+            "--episodes",
+            "1",
+            "--max-steps",
+            "240",
+            "--record-every",
+            "2",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    assert len(read_log(data)) == 120
+    again = runner.invoke(
+        app, ["drive", "collect", "--out", str(data), "--episodes", "1", "--max-steps", "240"]
+    )
+    assert again.exit_code == 0 and "wrote 0 rows" in again.output  # resumed: nothing new
+    model = root / "m.safetensors"
+    r = runner.invoke(
+        app,
+        ["drive", "train", str(data), "--out", str(model), "--epochs", "1", "--batch-size", "30"],
+    )
+    assert r.exit_code == 0, r.output
+    assert model.is_file() and model.with_suffix(".json").is_file()
+    return data, model
+
+
+def test_briefly_trained_model_moves_along_the_track(trained: tuple[Path, Path]) -> None:
+    _, model = trained
+    r = runner.invoke(
+        app,
+        [
+            "drive",
+            "evaluate",
+            str(model),
+            "--seeds",
+            "1000",
+            "--max-steps",
+            "150",
+            "--throttle",
+            "pi",
+            "--no-expert",
+            "--json",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    row = json.loads(r.output[r.output.index("{") :])["cnn-pi"]
+    assert row["n"] == 1
+    assert row["tiles_pct"] > 5.0  # it drove along the track, not in place
+    assert row["mean_speed"] > 5.0
+    assert row["mean_centre_distance"] < 40 / 6.0  # on average on the road
+
+
+def test_play_writes_a_gif(trained: tuple[Path, Path], tmp_path: Path) -> None:
+    _, model = trained
+    out = tmp_path / "d.gif"
+    r = runner.invoke(app, ["drive", "play", str(model), "--out", str(out), "--steps", "20"])
+    assert r.exit_code == 0, r.output
+    assert out.stat().st_size > 1000
+
+
+@pytest.mark.parametrize(
+    ("args", "needle"),
+    [
+        (["drive", "train", "missing-folder"], "driving_log.csv"),
+        (["drive", "evaluate", "missing.safetensors", "--seeds", "1"], "missing.safetensors"),
+        (["drive", "evaluate", "x.safetensors", "--seeds", "5-2"], "--seeds"),
+        (["drive", "collect", "--out", "x", "--camera", "side"], "--camera"),
+        (["drive", "play", "x.safetensors", "--out", "x.avi"], "--out"),
+    ],
+)
+def test_errors_are_one_line_exit_2(
+    args: list[str], needle: str, tmp_path: Path, monkeypatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    r = runner.invoke(app, args)
+    assert r.exit_code == 2
+    lines = [ln for ln in r.output.splitlines() if ln.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error:") and needle in lines[0]
+
+
+def test_parse_seeds() -> None:
+    assert parse_seeds("1000-1003,7") == [1000, 1001, 1002, 1003, 7]
+    with pytest.raises(ValueError, match="--seeds"):
+        parse_seeds("a-b")

@@ -1,0 +1,91 @@
+"""The CarRacing simulator wrapper, the expert, and closed-loop evaluation (short episodes)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+pytest.importorskip("gymnasium")
+pytest.importorskip("Box2D")
+
+from uvnav.driving.evaluate import (
+    PISpeedController,
+    autonomy_score,
+    expert_policy,
+    run_closed_loop,
+)
+from uvnav.driving.expert import PurePursuitExpert, ar1_noise
+from uvnav.driving.sim import HALF_WIDTH, DrivingSim
+
+
+@pytest.fixture(scope="module")
+def sim():
+    s = DrivingSim(max_steps=300)
+    yield s
+    s.close()
+
+
+def test_reset_is_deterministic_and_frames_have_the_camera_shape(sim) -> None:
+    f1, t1 = sim.reset(3)
+    f2, t2 = sim.reset(3)
+    assert f1.shape == (66, 200, 3) and f1.dtype == np.uint8
+    assert np.array_equal(f1, f2) and t1 == t2
+    assert abs(t1.centre_distance) < 0.5 and abs(t1.heading_error) < 0.1
+    left, centre, right = sim.side_views()
+    assert not np.array_equal(left, right)
+    # straight ahead and near, the centre camera sees road (grey); the top rows see sky (blue)
+    low = centre[46:, 50:150].reshape(-1, 3).astype(int)
+    grey = (np.abs(low[:, 0] - low[:, 1]) < 15) & (np.abs(low[:, 1] - low[:, 2]) < 15)
+    assert grey.mean() > 0.8
+    top = centre[:3].reshape(-1, 3).astype(int)
+    assert np.all(top[:, 2] > top[:, 0])
+
+
+def test_positive_steer_turns_right(sim) -> None:
+    _, tel = sim.reset(5)
+    for _ in range(40):
+        tel = sim.step(0.0, 0.4).telemetry
+    h0 = tel.heading
+    for _ in range(30):
+        tel = sim.step(1.0, 0.0).telemetry
+    assert tel.heading < h0 - 0.2
+
+
+def test_expert_drives_along_the_track(sim) -> None:
+    _, tel = sim.reset(7)
+    expert = PurePursuitExpert(sim.geometry)
+    worst = 0.0
+    for _ in range(250):
+        tel = sim.step(*expert.act(tel)).telemetry
+        worst = max(worst, abs(tel.centre_distance))
+    assert tel.tiles_visited > 0.15 * tel.n_tiles  # ~1/5 of the lap in 5 s
+    assert worst < HALF_WIDTH
+    assert tel.speed > 20.0
+
+
+def test_closed_loop_metrics_of_the_expert(sim) -> None:
+    r = run_closed_loop(sim, expert_policy(sim), 11, max_steps=200)
+    assert r.interventions == 0 and r.autonomy == 1.0
+    assert r.ret > 100.0 and r.steps == 200 and r.laps == 0
+
+
+def test_interventions_put_the_car_back(sim) -> None:
+    # full right lock and gas leaves the road quickly; every exit is one intervention
+    r = run_closed_loop(sim, lambda f, t: (1.0, 0.5), 2, max_steps=300)
+    assert r.interventions >= 1
+    assert r.autonomy == pytest.approx(autonomy_score(r.interventions, r.steps / 50))
+    assert r.autonomy < 1.0
+
+
+def test_autonomy_formula_and_pi_controller() -> None:
+    assert autonomy_score(0, 60.0) == 1.0
+    assert autonomy_score(1, 600.0) == pytest.approx(0.99)
+    assert autonomy_score(20, 60.0) == 0.0
+    pi = PISpeedController(set_speed=30.0)
+    assert pi(10.0) > 0 and pi(50.0) < 0
+
+
+def test_ar1_noise_statistics() -> None:
+    e = ar1_noise(np.random.default_rng(0), 20000, sigma=0.3, rho=0.9)
+    assert abs(e.std() - 0.3) < 0.03
+    assert abs(np.corrcoef(e[:-1], e[1:])[0, 1] - 0.9) < 0.03

@@ -1,0 +1,89 @@
+"""Training and augmentation of the Chapter 6 network (tiny configurations)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+torch = pytest.importorskip("torch")
+
+from uvnav.learning import PilotNetConfig, TrainConfig  # noqa: E402
+from uvnav.learning.augment import augment_batch  # noqa: E402
+from uvnav.learning.train import Predictor, evaluate_mse, train_pilotnet  # noqa: E402
+
+# a smaller input than the thesis's 66x200 keeps the tests fast on two shared CPU cores
+H, W = 48, 96
+SMALL = PilotNetConfig(height=H, width=W, dropout=0.1)
+
+
+def _road_like(n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Images whose bright band sits left or right; steering follows the band's position."""
+    imgs = np.full((n, H, W, 3), 60, dtype=np.uint8)
+    steer = rng.uniform(-0.8, 0.8, n)
+    for k in range(n):
+        c = int(W / 2 + 0.4 * W * steer[k])
+        imgs[k, 12:, max(c - 12, 0) : c + 12] = 200
+    return imgs, steer
+
+
+def test_flip_negates_steering_and_mirrors_the_image() -> None:
+    g = torch.Generator().manual_seed(0)
+    x = torch.rand(5, 66, 200, 3) * 255
+    s = torch.tensor([0.1, -0.3, 0.0, 0.7, -1.0])
+    xa, sa = augment_batch(x, s, g, flip_prob=1.0, brightness=(1.0, 1.0), zoom=(1.0, 1.0))
+    assert torch.allclose(sa, -s)
+    assert torch.allclose(xa, torch.flip(x, dims=[2]))
+    xn, sn = augment_batch(x, s, g, flip_prob=0.0, brightness=(1.0, 1.0), zoom=(1.0, 1.0))
+    assert torch.allclose(sn, s) and torch.allclose(xn, x)
+
+
+def test_brightness_and_zoom_stay_in_range() -> None:
+    g = torch.Generator().manual_seed(1)
+    x = torch.full((8, 66, 200, 3), 100.0)
+    xa, _ = augment_batch(
+        x, torch.zeros(8), g, flip_prob=0.0, brightness=(0.5, 0.8), zoom=(1.0, 1.0)
+    )
+    per = xa.mean(dim=(1, 2, 3))
+    assert bool(((per >= 50 - 1e-3) & (per <= 80 + 1e-3)).all())
+    # zoom on a uniform image keeps it uniform; on a centred box it enlarges the box
+    box = torch.zeros(1, 66, 200, 3)
+    box[:, 23:43, 80:120] = 255.0
+    xz, _ = augment_batch(
+        box, torch.zeros(1), g, flip_prob=0.0, brightness=(1.0, 1.0), zoom=(1.5, 1.5)
+    )
+    assert float((xz > 127).sum()) > 1.8 * float((box > 127).sum())
+
+
+def test_training_lowers_the_loss() -> None:
+    rng = np.random.default_rng(0)
+    imgs, steer = _road_like(100, rng)
+    thr = 0.5 - 0.5 * np.abs(steer)
+    spd = rng.uniform(10, 60, len(imgs))
+    val = (imgs[:40], steer[:40], thr[:40], spd[:40])
+    torch.manual_seed(0)
+    from uvnav.learning.pilotnet import build_pilotnet
+
+    model = build_pilotnet(SMALL)
+    before = evaluate_mse(model, *val)[0]
+    model, hist = train_pilotnet(
+        (imgs, steer, thr, spd),
+        val,
+        model=model,
+        config=TrainConfig(epochs=3, batch_size=20, augment=False, seed=0),
+    )
+    assert len(hist.train_loss) == 3 and len(hist.val_loss) == 3
+    assert hist.val_loss[-1] < 0.7 * before
+    assert hist.images_per_s > 0
+    steer_pred, thr_pred = Predictor(model, threads=1)(imgs[0], float(spd[0]))
+    assert -1.0 <= steer_pred <= 1.0 and -1.0 <= thr_pred <= 1.0
+
+
+def test_training_is_deterministic_with_a_seed() -> None:
+    rng = np.random.default_rng(3)
+    imgs, steer = _road_like(20, rng)
+    z = np.zeros(len(imgs))
+    cfg = TrainConfig(epochs=1, batch_size=10, seed=5)
+    net = PilotNetConfig(height=H, width=W, extra_inputs=0, n_outputs=1)
+    _, h1 = train_pilotnet((imgs, steer, z, z), None, net=net, config=cfg)
+    _, h2 = train_pilotnet((imgs, steer, z, z), None, net=net, config=cfg)
+    assert h1.train_loss == h2.train_loss
