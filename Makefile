@@ -3,8 +3,11 @@ PYTHON ?= python3.11
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 # Extras installed by `make run` / `make test`; later chapters add theirs here (see docs/design-notes.md).
-RUN_EXTRAS  ?= prediction,report,bench
-TEST_EXTRAS ?= prediction,report,bench,test
+RUN_EXTRAS  ?= prediction,report,bench,learning,envs
+TEST_EXTRAS ?= prediction,report,bench,learning,envs,test
+# torch is installed before the package (the CPU build is served to pip here; never torchvision)
+TORCH_PIN  ?= torch==2.13.0
+STAMP_TORCH := $(VENV)/.installed-torch
 STAMP_RUN  := $(VENV)/.installed-run
 STAMP_TEST := $(VENV)/.installed-test
 # Debian's Chromium for the report's browser test (playwright drives it; no browser download)
@@ -16,11 +19,15 @@ $(PY):
 	$(PYTHON) -m venv $(VENV) || python3 -m venv $(VENV)
 	$(PY) -m pip install --quiet --upgrade pip setuptools wheel
 
-$(STAMP_RUN): pyproject.toml | $(PY)
+$(STAMP_TORCH): | $(PY)
+	$(PY) -m pip install --quiet "$(TORCH_PIN)"
+	touch $@
+
+$(STAMP_RUN): pyproject.toml $(STAMP_TORCH) | $(PY)
 	$(PY) -m pip install --quiet -e ".[$(RUN_EXTRAS)]"
 	touch $@
 
-$(STAMP_TEST): pyproject.toml | $(PY)
+$(STAMP_TEST): pyproject.toml $(STAMP_TORCH) | $(PY)
 	$(PY) -m pip install --quiet -e ".[$(TEST_EXTRAS)]"
 	touch $@
 
