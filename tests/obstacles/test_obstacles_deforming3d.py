@@ -1,4 +1,4 @@
-"""Deforming 3D bodies (thesis Ch. 5 §5.2.4): 10 % bound, valid meshes, ray casts, nearest points."""
+"""Deforming 3D bodies (thesis Ch. 5 §5.2.4): 10 % bound, meshes, ray casts, nearest points."""
 
 from __future__ import annotations
 

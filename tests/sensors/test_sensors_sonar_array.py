@@ -22,7 +22,6 @@ from uvnav.sensors.sonar_array import (
     sonar_scan,
 )
 
-
 _UNIT_ERR = DeformingStar(centre=np.zeros(3), base_radius=1.0).tessellation_error(0.0)
 
 
@@ -135,8 +134,9 @@ def test_array_geometry_is_on_the_front_cap_and_not_coplanar() -> None:
     # the ring is evenly spread: 45 degrees between neighbours around the heading
     ring = n[1:] - np.outer(n[1:] @ heading, heading)
     ring /= np.linalg.norm(ring, axis=1)[:, None]
-    np.testing.assert_allclose(np.einsum("ij,ij->i", ring, np.roll(ring, -1, axis=0)),
-                               math.cos(math.pi / 4), atol=1e-12)
+    np.testing.assert_allclose(
+        np.einsum("ij,ij->i", ring, np.roll(ring, -1, axis=0)), math.cos(math.pi / 4), atol=1e-12
+    )
     assert ring[0][2] == pytest.approx(1.0)  # S2 is up
     # S1 leads; the others are set back (not in one plane with S1)
     assert np.all((s[1:] - s[0]) @ heading < -1e-3)
@@ -171,8 +171,9 @@ def test_noise_and_dropout_are_seeded_and_bounded() -> None:
     with pytest.raises(ValueError, match="Generator"):
         sonar_scan(arr, np.zeros(3), np.array([1.0, 0, 0]), tri)
     drops = [
-        (~sonar_scan(arr, np.zeros(3), np.array([1.0, 0, 0]), tri,
-                     np.random.default_rng(s)).echo).mean()
+        (
+            ~sonar_scan(arr, np.zeros(3), np.array([1.0, 0, 0]), tri, np.random.default_rng(s)).echo
+        ).mean()
         for s in range(40)
     ]
     assert 0.15 < float(np.mean(drops)) < 0.45

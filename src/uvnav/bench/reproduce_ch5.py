@@ -133,12 +133,18 @@ def learning_row(
     return row, model, ds
 
 
-def _episode_row(scene: str, locator: str, noise: float, seed: int, res: UUV3DResult) -> dict[str, Any]:
+def _episode_row(
+    scene: str, locator: str, noise: float, seed: int, res: UUV3DResult
+) -> dict[str, Any]:
     return {
-        "scene": scene, "locator": locator, "noise_std": noise, "seed": seed,
-        "status": res.status, "entered_inner_space": res.entered_inner_space,
+        "scene": scene,
+        "locator": locator,
+        "noise_std": noise,
+        "seed": seed,
+        "status": res.status,
+        "entered_inner_space": res.entered_inner_space,
         **res.metrics.to_dict(),
-    }  # fmt: skip
+    }
 
 
 def run_closed_loop(
@@ -186,46 +192,60 @@ def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
             g = [r["test_group"]["network"][out] for r in rs]
             ind = [r["independent"]["network"][out] for r in rs]
             base = [r["independent"]["baseline"][out] for r in rs]
-            rows.append({
-                "quantity": f"Ch5 BPNN {n} samples: {out} error, test group",
-                "thesis": _range(*ref[out]) if ref else "-",
-                "measured": _range(min(x["lo"] for x in g), max(x["hi"] for x in g)),
-                "note": f"union over {len(rs)} seeds; median MAE "
-                f"{np.median([x['mae'] for x in g]):.3g}",
-            })  # fmt: skip
-            rows.append({
-                "quantity": f"Ch5 BPNN {n} samples: {out} MAE, independent test (baseline)",
-                "thesis": "-",
-                "measured": f"{np.median([x['mae'] for x in ind]):.3g} "
-                f"({np.median([x['mae'] for x in base]):.3g})",
-                "note": f"{rs[0]['independent']['network'][out]['n']} samples; median of "
-                f"{len(rs)} seeds; baseline = min/argmin of readings",
-            })  # fmt: skip
+            rows.append(
+                {
+                    "quantity": f"Ch5 BPNN {n} samples: {out} error, test group",
+                    "thesis": _range(*ref[out]) if ref else "-",
+                    "measured": _range(min(x["lo"] for x in g), max(x["hi"] for x in g)),
+                    "note": f"union over {len(rs)} seeds; median MAE "
+                    f"{np.median([x['mae'] for x in g]):.3g}",
+                }
+            )
+            rows.append(
+                {
+                    "quantity": f"Ch5 BPNN {n} samples: {out} MAE, independent test (baseline)",
+                    "thesis": "-",
+                    "measured": f"{np.median([x['mae'] for x in ind]):.3g} "
+                    f"({np.median([x['mae'] for x in base]):.3g})",
+                    "note": f"{rs[0]['independent']['network'][out]['n']} samples; median of "
+                    f"{len(rs)} seeds; baseline = min/argmin of readings",
+                }
+            )
     cl = summary.closed_loop
     for group in sorted({(r["locator"], r["noise_std"]) for r in cl}):
         loc, noise = group
-        thesis_rows = [r for r in cl if (r["locator"], r["noise_std"]) == group
-                       and str(r["scene"]).startswith("thesis-ch5")]  # fmt: skip
-        rand_rows = [r for r in cl if (r["locator"], r["noise_std"]) == group
-                     and str(r["scene"]).startswith("random-ch5")]  # fmt: skip
+        thesis_rows = [
+            r
+            for r in cl
+            if (r["locator"], r["noise_std"]) == group and str(r["scene"]).startswith("thesis-ch5")
+        ]
+        rand_rows = [
+            r
+            for r in cl
+            if (r["locator"], r["noise_std"]) == group and str(r["scene"]).startswith("random-ch5")
+        ]
         if thesis_rows:
             ok = sum(bool(r["success"]) for r in thesis_rows)
             inner = sum(bool(r["entered_inner_space"]) for r in thesis_rows)
-            rows.append({
-                "quantity": f"Ch5 thesis scenes reached without collision ({loc}, noise {noise} m)",
-                "thesis": "3/3",
-                "measured": f"{ok}/{len(thesis_rows)}",
-                "note": f"entered Scene 2 inner space: {inner}",
-            })  # fmt: skip
+            rows.append(
+                {
+                    "quantity": f"Ch5 thesis scenes reached, no collision ({loc}, noise {noise} m)",
+                    "thesis": "3/3",
+                    "measured": f"{ok}/{len(thesis_rows)}",
+                    "note": f"entered Scene 2 inner space: {inner}",
+                }
+            )
         if rand_rows:
             ok = sum(bool(r["success"]) for r in rand_rows)
             fails = [f"{r['scene']}:{r['status']}" for r in rand_rows if not r["success"]]
-            rows.append({
-                "quantity": f"Ch5 random scenes success ({loc}, noise {noise} m)",
-                "thesis": "-",
-                "measured": f"{ok / len(rand_rows):.1%} of {len(rand_rows)}",
-                "note": ("failures: " + ", ".join(fails[:6])) if fails else "no failure",
-            })  # fmt: skip
+            rows.append(
+                {
+                    "quantity": f"Ch5 random scenes success ({loc}, noise {noise} m)",
+                    "thesis": "-",
+                    "measured": f"{ok / len(rand_rows):.1%} of {len(rand_rows)}",
+                    "note": ("failures: " + ", ".join(fails[:6])) if fails else "no failure",
+                }
+            )
     return rows
 
 
@@ -279,7 +299,7 @@ def reproduce_ch5(
                     summary.datasets[f"n{n}"] = ds
                 prog.advance(task)
         # the closed-loop network: trained once on CLOSED_LOOP_SAMPLES samples
-        cl_row, cl_model, _ = learning_row(CLOSED_LOOP_SAMPLES, 100, test)
+        _, cl_model, _ = learning_row(CLOSED_LOOP_SAMPLES, 100, test)
         save_checkpoint(cl_model, results_dir / "ch5_bpnn")
         summary.models["closed_loop"] = cl_model
         prog.advance(task)
@@ -290,17 +310,23 @@ def reproduce_ch5(
         }
         task2 = prog.add_task("Ch5 closed loop", total=n_episodes)
         rows, kept = run_closed_loop(
-            scenes, locators, noises=(0.0, NOISE_STD), record=True,
+            scenes,
+            locators,
+            noises=(0.0, NOISE_STD),
+            record=True,
             on_episode=lambda: prog.advance(task2),
-        )  # fmt: skip
+        )
         summary.closed_loop.extend(rows)
         summary.models["episodes"] = kept
         for g in range(n_rand):
             scn_name = f"random-ch5:{g}"
             r2, _ = run_closed_loop(
-                [scn_name], locators, noises=(0.0, NOISE_STD), seed=g,
+                [scn_name],
+                locators,
+                noises=(0.0, NOISE_STD),
+                seed=g,
                 on_episode=lambda: prog.advance(task2),
-            )  # fmt: skip
+            )
             summary.closed_loop.extend(r2)
     summary.table = build_ch5_table(summary)
     summary.wall_time = time.perf_counter() - tic
@@ -309,8 +335,14 @@ def reproduce_ch5(
         "closed_loop": summary.closed_loop,
         "table": summary.table,
         "wall_time": round(summary.wall_time, 2),
-        "config": {"sizes": list(sizes), "seeds": seeds, "n_random": n_rand, "n_test": n_test,
-                   "noise_std": NOISE_STD, "closed_loop_samples": CLOSED_LOOP_SAMPLES},  # fmt: skip
+        "config": {
+            "sizes": list(sizes),
+            "seeds": seeds,
+            "n_random": n_rand,
+            "n_test": n_test,
+            "noise_std": NOISE_STD,
+            "closed_loop_samples": CLOSED_LOOP_SAMPLES,
+        },
     }
     summary.json_path = results_dir / "ch5.json"
     summary.json_path.write_text(json.dumps(out, indent=1, default=_json_default))

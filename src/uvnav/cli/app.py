@@ -25,6 +25,7 @@ import typer
 import yaml
 from typer.core import TyperGroup
 
+from uvnav.cli.sonar import sonar_app
 from uvnav.controllers import (
     ControllerInfo,
     ControllerParamsError,
@@ -128,6 +129,7 @@ controllers_app = typer.Typer(
 )
 app.add_typer(scenarios_app, name="scenarios")
 app.add_typer(controllers_app, name="controllers")
+app.add_typer(sonar_app, name="sonar")
 
 
 def _version(value: bool) -> None:

@@ -39,9 +39,12 @@ def _progress() -> Any:
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     return Progress(
-        "[progress.description]{task.description}", BarColumn(), MofNCompleteColumn(),
-        TimeElapsedColumn(), transient=True,
-    )  # fmt: skip
+        "[progress.description]{task.description}",
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        transient=True,
+    )
 
 
 def _load_dataset(path: Path) -> Any:
@@ -76,15 +79,18 @@ def dataset_cmd(
     with _progress() as prog:
         task = prog.add_task("sampling", total=samples)
         ds = sample_sonar_dataset(
-            samples, np.random.default_rng(seed), array=array,
+            samples,
+            np.random.default_rng(seed),
+            array=array,
             on_sample=lambda k: prog.update(task, completed=k),
-        )  # fmt: skip
+        )
     out.parent.mkdir(parents=True, exist_ok=True)
-    np.savez_compressed(out, **ds.arrays())
+    np.savez_compressed(out, **ds.arrays())  # type: ignore[arg-type]
     gap = ds.baseline_distance - ds.target_distance
+    right = float(np.mean(ds.baseline_index == ds.target_index))
     typer.echo(
         f"wrote {out}: {len(ds)} samples; min/argmin baseline distance error "
-        f"[{-gap.max():.4f}, {-gap.min():.4f}] m, index right {np.mean(ds.baseline_index == ds.target_index):.1%}"
+        f"[{-gap.max():.4f}, {-gap.min():.4f}] m, index right {right:.1%}"
     )
 
 
@@ -115,8 +121,11 @@ def train_cmd(
     test = model.split["test"]
     table = error_table(model.predict(ds.inputs[test]), ds.targets()[test], ds.baseline()[test])
     if as_json:
-        typer.echo(json.dumps({"test": table, "best_epoch": model.best_epoch,
-                               "stop_reason": model.stop_reason}))  # fmt: skip
+        typer.echo(
+            json.dumps(
+                {"test": table, "best_epoch": model.best_epoch, "stop_reason": model.stop_reason}
+            )
+        )
     else:
         _print_table(table, len(ds), f"test group ({len(test)} samples)")
         typer.echo(f"stopped: {model.stop_reason} (best epoch {model.best_epoch})")
@@ -158,9 +167,12 @@ def _print_table(table: dict[str, Any], n_train: int | None, title: str) -> None
     for who, row in table.items():
         d, i = row["distance"], row["index"]
         t.add_row(
-            who, f"[{d['lo']:.4g}, {d['hi']:.4g}]", f"{d['mae']:.4g}",
-            f"[{i['lo']:.4g}, {i['hi']:.4g}]", f"{row['index_accuracy']:.1%}",
-        )  # fmt: skip
+            who,
+            f"[{d['lo']:.4g}, {d['hi']:.4g}]",
+            f"{d['mae']:.4g}",
+            f"[{i['lo']:.4g}, {i['hi']:.4g}]",
+            f"{row['index_accuracy']:.1%}",
+        )
     for n, ref in THESIS_ERROR_RANGES.items():
         if n_train is None or n_train == n:
             d, i = ref["distance"], ref["index"]
@@ -170,8 +182,12 @@ def _print_table(table: dict[str, Any], n_train: int | None, title: str) -> None
 
 @sonar_app.command("simulate")
 def simulate_cmd(
-    scenario: Annotated[str, typer.Argument(help="thesis-ch5-scene1|2|3, random-ch5:<seed>, or a YAML file.")],
-    locator: Annotated[str, typer.Option(help="geometric, network (needs --model) or oracle.")] = "",
+    scenario: Annotated[
+        str, typer.Argument(help="thesis-ch5-scene1|2|3, random-ch5:<seed>, or a YAML file.")
+    ],
+    locator: Annotated[
+        str, typer.Option(help="geometric, network (needs --model) or oracle.")
+    ] = "",
     model_path: Annotated[Path | None, typer.Option("--model", help="BPNN checkpoint.")] = None,
     seed: Annotated[int, typer.Option(min=0, help="Episode seed (sonar noise).")] = 0,
     noise: Annotated[float | None, typer.Option(min=0.0, help="Override sonar noise [m].")] = None,
@@ -200,6 +216,11 @@ def simulate_cmd(
         _fail(f"{scenario}: controller.params: {exc}")
     ctrl = ZhangUUV3D(params, loc)
     res = run_uuv3d_episode(build_uuv3d(scn, noise_std=noise), ctrl, np.random.default_rng(seed))
-    out = {"scenario": scn.name, "locator": name, "status": res.status,
-           "entered_inner_space": res.entered_inner_space, **res.metrics.to_dict()}  # fmt: skip
+    out = {
+        "scenario": scn.name,
+        "locator": name,
+        "status": res.status,
+        "entered_inner_space": res.entered_inner_space,
+        **res.metrics.to_dict(),
+    }
     typer.echo(json.dumps(out))

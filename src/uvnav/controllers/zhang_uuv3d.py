@@ -12,27 +12,29 @@ Law, at each decision (the thesis states it for the plane; lifted to 3D as the i
 
 1. **Locate.**  A *locator* turns the sonar readings R(t) (5.8) into ``(d, k)``: the distance [m]
    from the hull to the nearest obstacle point and the number of the sensor whose beam holds it.
-   Locators: :class:`GeometricLocator` (min/argmin of the readings, the baseline), :class:`ModelLocator`
-   (any model with ``predict(inputs (n, 9)) -> (n, 2)`` — the trained BPNN of
+   Locators: :class:`GeometricLocator` (min/argmin of the readings, the baseline),
+   :class:`ModelLocator` (any model with ``predict(inputs (n, 9)) -> (n, 2)`` — the trained BPNN of
    :mod:`uvnav.learning.bpnn` — fed the adapted readings), :class:`OracleLocator` (the true nearest
    point; an *oracle*: it reads ground truth the sonar cannot give).  The point to evade is
    ``p = s_k + d n_k`` (:func:`~uvnav.sensors.sonar_array.beam_point`).
-2. **Switch.**  ``d > L`` (or no echo): target approach (M1, V_max straight to B, the turn bounded by
-   U_max — :meth:`~uvnav.controllers.base3d.Vehicle3DController.approach`); ``d <= L``: avoidance (M2).
+2. **Switch.**  ``d > L`` (or no echo): target approach (M1, V_max straight to B, the turn
+   bounded by U_max — :meth:`~uvnav.controllers.base3d.Vehicle3DController.approach`);
+   ``d <= L``: avoidance (M2).
    A point behind the vehicle with respect to B (``(p - c) . (B - c) <= 0``) is no threat (the
    thesis returns to M1 "when the vehicle is away from the obstacle").  While in M2 the last point
    is remembered in world coordinates (the obstacles' centres are fixed), so that a point that
    slips out of the front-facing beams while the vehicle passes it is still evaded until it is
    behind or farther than L (the forecast history (4.11) keeps it too).
 3. **Forecast sphere** (4.11)-(4.12) in 3D: centre p, radius ``R = mean ||p(t-k) - p(t-k+1)||``
-   over the ``count`` decisions since M2 began, plus the hull radius and a ``margin`` [m] (the thesis
-   treats the vehicle as a point; a body of radius rho needs rho more).
+   over the ``count`` decisions since M2 began, plus the hull radius and a ``margin`` [m] (the
+   thesis treats the vehicle as a point; a body of radius rho needs rho more).
 4. **Plane, tag and tangent point.**  In the plane through the vehicle c, B and p, the two tangent
    lines from c to the forecast circle; the tag picks the one on B's side of the line c -> p
    (the shorter way round) at the switch to M2, and is then kept as a rotation sense about that
    plane's normal for the whole avoidance (``fixed_tag``; the thesis decides the tag once too),
-   so that two nearby points — the arms of Scene 2's narrow space — cannot make it chatter.  The vehicle heads for that tangent point at V_max with the bounded turn rate.  Inside
-   the forecast sphere it heads away from p, at ``escape_angle`` (default 120 deg) from the line
+   so that two nearby points — the arms of Scene 2's narrow space — cannot make it chatter.
+   The vehicle heads for that tangent point at V_max with the bounded turn rate.  Inside the
+   forecast sphere it heads away from p, at ``escape_angle`` (default 120 deg) from the line
    c -> p on B's side (escape).
 
 Ambiguities resolved (docs/thesis-notes.md): the thesis's '+'/'-' tag definition is given for the
@@ -206,10 +208,7 @@ def fixed_tag_direction(
     x = x / max(dist, 1e-12)
     y = np.cross(normal, x)
     ny = float(np.linalg.norm(y))
-    if ny < 1e-9:
-        y = horizontal_perpendicular(x)
-    else:
-        y = y / ny
+    y = horizontal_perpendicular(x) if ny < 1e-9 else y / ny
     if dist <= radius:
         return np.asarray(np.cos(escape_angle) * x + np.sin(escape_angle) * y)
     theta = math.asin(radius / dist)
@@ -308,14 +307,21 @@ class ZhangUUV3D(Vehicle3DController):
         self.last_located = loc
         p = self.params
         point: FloatArray | None = None
-        if loc is not None and loc.distance <= p.switch_distance:
-            if self._threat(obs, loc.point) is not None:
-                point = np.asarray(loc.point, dtype=float)
-                self._memory = point
-        if point is None and self._memory is not None and self._mode == "M2":
+        if (
+            loc is not None
+            and loc.distance <= p.switch_distance
+            and self._threat(obs, loc.point) is not None
+        ):
+            point = np.asarray(loc.point, dtype=float)
+            self._memory = point
+        if (
+            point is None
+            and self._memory is not None
+            and self._mode == "M2"
+            and self._threat(obs, self._memory) is not None
+        ):
             # the point left the beams: keep avoiding the remembered one (centres are fixed)
-            if self._threat(obs, self._memory) is not None:
-                point = self._memory
+            point = self._memory
         if point is None:
             self._mode = "M1"
             self._history = []
@@ -332,7 +338,9 @@ class ZhangUUV3D(Vehicle3DController):
         del self._history[: -p.max_history]
         radius = self.forecast_radius() + self._spec.radius + p.margin
         if p.fixed_tag:
-            direction = fixed_tag_direction(obs.position, point, radius, self._normal, p.escape_angle)
+            direction = fixed_tag_direction(
+                obs.position, point, radius, self._normal, p.escape_angle
+            )
         else:
             direction, _, _ = tangent_direction(
                 obs.position, self._goal, point, radius, self._normal, p.escape_angle
@@ -343,7 +351,7 @@ class ZhangUUV3D(Vehicle3DController):
 register3d(
     ControllerInfo(
         name=NAME,
-        factory=ZhangUUV3D,
+        factory=ZhangUUV3D,  # type: ignore[arg-type]  # a 3D law in the shared info record
         params_type=ZhangUUV3DParams,
         summary="Thesis Ch. 5: sonar array + located point (BPNN or min/argmin), forecast-sphere "
         "tangent avoidance in the plane through the vehicle, B and the point",

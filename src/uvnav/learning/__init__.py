@@ -1,1 +1,1 @@
-"""Learning (layer 6): the only package that imports torch — networks, training loops, safe checkpoints."""
+"""Learning (layer 6): the only package importing torch — networks, training, checkpoints."""

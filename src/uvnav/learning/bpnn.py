@@ -28,6 +28,7 @@ torch is imported inside the functions that need it (extra ``learning``), with a
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 from dataclasses import asdict, dataclass, field
@@ -186,7 +187,7 @@ def _init_weights(
     sizes: list[int], rng: np.random.Generator
 ) -> list[tuple[FloatArray, FloatArray]]:
     out = []
-    for fan_in, fan_out in zip(sizes[:-1], sizes[1:], strict=True):
+    for fan_in, fan_out in itertools.pairwise(sizes):
         lim = math.sqrt(6.0 / (fan_in + fan_out))
         out.append((rng.uniform(-lim, lim, (fan_out, fan_in)), np.zeros(fan_out)))
     return out
@@ -249,7 +250,10 @@ def train_bpnn(
     tr_t, va_t = torch.as_tensor(tr), torch.as_tensor(va)
     if cfg.optimizer == "lbfgs":
         opt = torch.optim.LBFGS(
-            net.parameters(), lr=1.0, max_iter=cfg.lbfgs_iterations, history_size=50,
+            net.parameters(),
+            lr=1.0,
+            max_iter=cfg.lbfgs_iterations,
+            history_size=50,
             line_search_fn="strong_wolfe",
         )
     else:
@@ -296,10 +300,17 @@ def train_bpnn(
     params = [p.numpy().copy() for p in best_state]
     weights = [(params[2 * i], params[2 * i + 1]) for i in range(len(params) // 2)]
     return TrainedBPNN(
-        config=cfg, weights=weights, x_lo=x_lo, x_hi=x_hi, y_lo=y_lo, y_hi=y_hi,
-        history=history, best_epoch=best_epoch, stop_reason=stop,
+        config=cfg,
+        weights=weights,
+        x_lo=x_lo,
+        x_hi=x_hi,
+        y_lo=y_lo,
+        y_hi=y_hi,
+        history=history,
+        best_epoch=best_epoch,
+        stop_reason=stop,
         split={"train": np.asarray(tr), "val": np.asarray(va), "test": np.asarray(te)},
-    )  # fmt: skip
+    )
 
 
 @dataclass(frozen=True)
@@ -325,9 +336,12 @@ class ErrorSummary:
         if e.size == 0:
             return ErrorSummary(math.nan, math.nan, math.nan, math.nan, 0)
         return ErrorSummary(
-            float(e.min()), float(e.max()), float(np.abs(e).mean()),
-            float(np.sqrt((e * e).mean())), int(e.size),
-        )  # fmt: skip
+            float(e.min()),
+            float(e.max()),
+            float(np.abs(e).mean()),
+            float(np.sqrt((e * e).mean())),
+            int(e.size),
+        )
 
 
 def error_table(
@@ -422,7 +436,9 @@ def load_checkpoint(path: Path) -> TrainedBPNN:
         cfg_d["fractions"] = tuple(cfg_d["fractions"])
         cfg = BPNNConfig(**cfg_d)
         n_layers = int(meta["n_layers"])
-        weights = [(tensors[f"layer{k}.weight"], tensors[f"layer{k}.bias"]) for k in range(n_layers)]
+        weights = [
+            (tensors[f"layer{k}.weight"], tensors[f"layer{k}.bias"]) for k in range(n_layers)
+        ]
         scal = {k: tensors[k] for k in ("x_lo", "x_hi", "y_lo", "y_hi")}
     except (KeyError, TypeError, ValueError) as exc:
         raise CheckpointError(f"{base}: incomplete checkpoint ({exc})") from exc
@@ -430,8 +446,11 @@ def load_checkpoint(path: Path) -> TrainedBPNN:
         if weights[k][0].shape[1] != weights[k - 1][0].shape[0]:
             raise CheckpointError(f"{st_path}: layer{k}.weight does not fit layer{k - 1}")
     return TrainedBPNN(
-        config=cfg, weights=weights, history=dict(meta.get("history", {})),
-        best_epoch=int(meta.get("best_epoch", 0)), stop_reason=str(meta.get("stop_reason", "")),
+        config=cfg,
+        weights=weights,
+        history=dict(meta.get("history", {})),
+        best_epoch=int(meta.get("best_epoch", 0)),
+        stop_reason=str(meta.get("stop_reason", "")),
         split={k: np.asarray(v, dtype=np.int64) for k, v in dict(meta.get("split", {})).items()},
         **scal,
-    )  # fmt: skip
+    )

@@ -195,7 +195,9 @@ class DeformingStar:
         b = harmonic_basis(dirs) if basis is None else basis
         return np.asarray(self.base_radius * (1.0 + b @ self.shape))
 
-    def deformation(self, dirs: FloatArray, t: float, basis: FloatArray | None = None) -> FloatArray:
+    def deformation(
+        self, dirs: FloatArray, t: float, basis: FloatArray | None = None
+    ) -> FloatArray:
         """delta(d, t) at unit directions (n, 3), time ``t`` [s]; |delta| <= delta_max."""
         b = harmonic_basis(dirs) if basis is None else basis
         return np.asarray(b @ (self.amplitude * np.sin(self.frequency * t + self.phase)))

@@ -182,19 +182,28 @@ def build_obstacles(scn: Scenario5) -> tuple[CompoundBody, ...]:
     for ob in scn.obstacles:
         if isinstance(ob, Star5):
             star = random_star(
-                np.random.default_rng(ob.seed), np.asarray(ob.centre, float), ob.base_radius,
-                shape_scale=ob.shape_scale, delta_max=ob.delta_max,
-                max_frequency=ob.max_frequency, subdivisions=scn.subdivisions,
-            )  # fmt: skip
+                np.random.default_rng(ob.seed),
+                np.asarray(ob.centre, float),
+                ob.base_radius,
+                shape_scale=ob.shape_scale,
+                delta_max=ob.delta_max,
+                max_frequency=ob.max_frequency,
+                subdivisions=scn.subdivisions,
+            )
             out.append(as_compound(star))
         else:
             out.append(
                 horseshoe(
-                    np.asarray(ob.centre, float), slot_width=ob.slot_width,
-                    arm_length=ob.arm_length, arm_thickness=ob.arm_thickness, height=ob.height,
-                    yaw=math.radians(ob.yaw_deg), delta_max=ob.delta_max,
-                    frequency=ob.frequency, subdivisions=scn.subdivisions,
-                )  # fmt: skip
+                    np.asarray(ob.centre, float),
+                    slot_width=ob.slot_width,
+                    arm_length=ob.arm_length,
+                    arm_thickness=ob.arm_thickness,
+                    height=ob.height,
+                    yaw=math.radians(ob.yaw_deg),
+                    delta_max=ob.delta_max,
+                    frequency=ob.frequency,
+                    subdivisions=scn.subdivisions,
+                )
             )
     return tuple(out)
 
@@ -213,11 +222,17 @@ def build_uuv3d(scn: Scenario5, *, noise_std: float | None = None) -> UUV3DSetup
     )
     head = np.asarray(r.heading, float)
     return UUV3DSetup(
-        start=np.asarray(r.start, float), heading=head / np.linalg.norm(head),
-        goal=np.asarray(r.goal, float), spec=Vehicle3DSpec(r.v_max, r.u_max, r.radius),
-        obstacles=build_obstacles(scn), array=array, dt=scn.dt,
-        control_period=scn.control_period, t_max=scn.t_max, goal_tolerance=scn.goal_tolerance,
-    )  # fmt: skip
+        start=np.asarray(r.start, float),
+        heading=head / np.linalg.norm(head),
+        goal=np.asarray(r.goal, float),
+        spec=Vehicle3DSpec(r.v_max, r.u_max, r.radius),
+        obstacles=build_obstacles(scn),
+        array=array,
+        dt=scn.dt,
+        control_period=scn.control_period,
+        t_max=scn.t_max,
+        goal_tolerance=scn.goal_tolerance,
+    )
 
 
 def random_ch5_scenario(
@@ -255,15 +270,24 @@ def random_ch5_scenario(
             continue
         centres.append(c)
         obstacles.append(
-            {"type": "star", "centre": [float(x) for x in c], "base_radius": r0,
-             "shape_scale": float(rng.uniform(0.0, 0.35)), "delta_max": 0.1,
-             "max_frequency": 0.5, "seed": int(rng.integers(0, 2**31))}  # fmt: skip
+            {
+                "type": "star",
+                "centre": [float(x) for x in c],
+                "base_radius": r0,
+                "shape_scale": float(rng.uniform(0.0, 0.35)),
+                "delta_max": 0.1,
+                "max_frequency": 0.5,
+                "seed": int(rng.integers(0, 2**31)),
+            }
         )
     data = {
         "name": f"{GENERATOR_CH5}:{seed}",
         "t_max": 120.0,
-        "robot": {"start": [0.0, 0.0, 0.0], "heading": [float(x) for x in d],
-                  "goal": [float(x) for x in goal]},  # fmt: skip
+        "robot": {
+            "start": [0.0, 0.0, 0.0],
+            "heading": [float(x) for x in d],
+            "goal": [float(x) for x in goal],
+        },
         "obstacles": obstacles,
         "controller": {"locator": locator},
     }

@@ -1,4 +1,4 @@
-"""The nine-sonar array of the 3D underwater vehicle (thesis Chapter 5, §5.2.3, Fig. 5.2, eq. (5.8)).
+"""The nine-sonar array of the 3D underwater vehicle (thesis Ch. 5, §5.2.3, Fig. 5.2, eq. (5.8)).
 
 Reference: Y. Zhang and J. Zhang, ICCAE 2022; thesis Chapter 5 §5.2.3: nine sonar sensors S1..S9
 "arranged evenly" over "a smooth and convex space in the front of the robot", S1 at its centre
@@ -310,7 +310,7 @@ def sonar_scan(
 def adaptive_coefficients(array: SonarArray, ranges: FloatArray) -> FloatArray:
     """k_i(R_i) = |s_i - s_1 + R_i n_i| / R_i (k_1 = 1): maps each reading to a distance from S1
     (module docstring).  Depends only on the array geometry and the readings [m], (9,) -> (9,).
-    A zero reading gets the limit R -> 0, i.e. k = inf is avoided by using |s_i - s_1| / max(R, eps).
+    A zero reading is divided by a tiny epsilon instead of 0 (its product k R stays exact).
     """
     r = np.asarray(ranges, dtype=float)
     body = array.body_directions()
@@ -329,7 +329,9 @@ def adapted_ranges(array: SonarArray, ranges: FloatArray) -> FloatArray:
     return np.asarray(np.linalg.norm(rel, axis=2).reshape(r.shape))
 
 
-def nearest_beam(array: SonarArray, position: FloatArray, heading: FloatArray, point: FloatArray) -> int:
+def nearest_beam(
+    array: SonarArray, position: FloatArray, heading: FloatArray, point: FloatArray
+) -> int:
     """1-based index of the sensor whose beam axis makes the smallest angle with the direction
     from that sensor to ``point`` [m] (the target "marked sensor" of the thesis's Fig. 5.4)."""
     s, n = array.placement(position, heading)

@@ -115,8 +115,14 @@ class SonarDataset:
         Raises:
             ValueError: a missing array or inconsistent shapes (one line naming it).
         """
-        need = ("ranges", "inputs", "target_distance", "target_index", "baseline_distance",
-                "baseline_index")  # fmt: skip
+        need = (
+            "ranges",
+            "inputs",
+            "target_distance",
+            "target_index",
+            "baseline_distance",
+            "baseline_index",
+        )
         for name in need:
             if name not in arrays:
                 raise ValueError(f"dataset misses the array {name!r}")
@@ -181,9 +187,13 @@ def sample_sonar_dataset(
             raise ValueError("sampling found no obstacle in the sonar array's view")
         r0 = float(rng.uniform(*smp.radius_range))
         body = random_star(
-            rng, np.zeros(3), r0, shape_scale=smp.shape_scale, delta_max=smp.delta_max,
+            rng,
+            np.zeros(3),
+            r0,
+            shape_scale=smp.shape_scale,
+            delta_max=smp.delta_max,
             subdivisions=subdivisions,
-        )  # fmt: skip
+        )
         t = float(rng.uniform(*smp.time_range))
         u = _random_unit(rng)
         gap = float(rng.uniform(*smp.gap_range))

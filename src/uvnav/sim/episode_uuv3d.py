@@ -118,7 +118,7 @@ def run_uuv3d_episode(
     head = head / np.linalg.norm(head)
     goal = np.asarray(setup.goal, dtype=float)
     controller.reset(spec, goal, rng)
-    n_steps = int(math.ceil(setup.t_max / setup.dt - 1e-9))
+    n_steps = math.ceil(setup.t_max / setup.dt - 1e-9)
     u_held = np.zeros(3)
     v_held = 0.0
     v_prev = 0.0
@@ -155,10 +155,16 @@ def run_uuv3d_episode(
             tri = merge_triangles([p.triangles(t) for ob in setup.obstacles for p in ob.parts])
             scan = sonar_scan(setup.array, pos, head, tri, rng)
             obs = SonarObservation3D(
-                time=t, position=pos.copy(), heading=head.copy(), speed=v_held, goal=goal,
-                ranges=scan.ranges, echo=scan.echo, array=setup.array,
+                time=t,
+                position=pos.copy(),
+                heading=head.copy(),
+                speed=v_held,
+                goal=goal,
+                ranges=scan.ranges,
+                echo=scan.echo,
+                array=setup.array,
                 truth_point=None if (q is None or not controller.oracle) else q.copy(),
-            )  # fmt: skip
+            )
             tic = _time.perf_counter()
             cmd = controller.act(obs)
             decision_us.append((_time.perf_counter() - tic) * 1e6)
@@ -210,8 +216,12 @@ def run_uuv3d_episode(
     )
     status = "success" if success else ("collision" if collided else "timeout")
     return UUV3DResult(
-        metrics=metrics, entered_inner_space=inner, status=status, times=res_times,
-        positions=res_pos, modes=res_modes, located=res_loc, true_nearest=res_true,
-    )  # fmt: skip
-
-
+        metrics=metrics,
+        entered_inner_space=inner,
+        status=status,
+        times=res_times,
+        positions=res_pos,
+        modes=res_modes,
+        located=res_loc,
+        true_nearest=res_true,
+    )

@@ -14,15 +14,15 @@ from typing import Any
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.figure import Figure
 
-from uvnav.geometry.angles import FloatArray  # noqa: E402
-from uvnav.learning.bpnn import TrainedBPNN  # noqa: E402
-from uvnav.obstacles.deforming3d import CompoundBody  # noqa: E402
-from uvnav.sensors.sonar_array import SonarArray  # noqa: E402
-from uvnav.sim.episode_uuv3d import UUV3DResult  # noqa: E402
+from uvnav.geometry.angles import FloatArray
+from uvnav.learning.bpnn import TrainedBPNN
+from uvnav.obstacles.deforming3d import CompoundBody
+from uvnav.sensors.sonar_array import SonarArray
+from uvnav.sim.episode_uuv3d import UUV3DResult
 
 
 def fig_array(array: SonarArray, *, beam_length: float = 2.0) -> Figure:
@@ -34,8 +34,13 @@ def fig_array(array: SonarArray, *, beam_length: float = 2.0) -> Figure:
         ax: Any = fig.add_subplot(1, 2, k + 1, projection="3d")
         u, v = np.mgrid[-np.pi / 2 : np.pi / 2 : 20j, 0 : np.pi : 20j]
         r = array.hull_radius
-        ax.plot_wireframe(r * np.cos(u) * np.sin(v), r * np.sin(u) * np.sin(v), r * np.cos(v),
-                          color="0.8", linewidth=0.4)  # fmt: skip
+        ax.plot_wireframe(
+            r * np.cos(u) * np.sin(v),
+            r * np.sin(u) * np.sin(v),
+            r * np.cos(v),
+            color="0.8",
+            linewidth=0.4,
+        )
         for i in range(9):
             ax.scatter(*s[i], color="C3", s=20)
             ax.text(*(s[i] + 0.08 * n[i]), f"S{i + 1}", fontsize=8)
@@ -43,7 +48,11 @@ def fig_array(array: SonarArray, *, beam_length: float = 2.0) -> Figure:
             e1 /= np.linalg.norm(e1)
             e2 = np.cross(n[i], e1)
             rad = beam_length * np.tan(array.half_angle)
-            rim = s[i] + beam_length * n[i] + rad * (np.outer(np.cos(th), e1) + np.outer(np.sin(th), e2))
+            rim = (
+                s[i]
+                + beam_length * n[i]
+                + rad * (np.outer(np.cos(th), e1) + np.outer(np.sin(th), e2))
+            )
             ax.plot(*rim.T, color=f"C{i % 10}", linewidth=0.6)
             ax.plot(*np.stack([s[i], s[i] + beam_length * n[i]]).T, color=f"C{i % 10}", lw=0.8)
         ax.view_init(elev=view[0], azim=view[1] + (180 if k == 0 else 0))
@@ -81,9 +90,12 @@ def fig_errors(
         ax = axes[0, j]
         ax.hist(err, bins=20, color="C0", alpha=0.8, label="network")
         if baseline is not None:
-            ax.hist(targets[:, j] - baseline[:, j], bins=20, color="0.5", alpha=0.5,
-                    label="min/argmin")  # fmt: skip
-        ax.set_title(f"(a) error = target - output, {names[j]}\nrange [{err.min():.3g}, {err.max():.3g}]")
+            ax.hist(
+                targets[:, j] - baseline[:, j], bins=20, color="0.5", alpha=0.5, label="min/argmin"
+            )
+        ax.set_title(
+            f"(a) error = target - output, {names[j]}\nrange [{err.min():.3g}, {err.max():.3g}]"
+        )
         ax.legend()
         ax = axes[1, j]
         ax.scatter(targets[:, j], predicted[:, j], s=8, label="network")
@@ -107,8 +119,12 @@ def fig_learning_curve(rows: Sequence[dict[str, Any]]) -> Figure:
     sizes = sorted({int(r["samples"]) for r in rows})
     for j, out in enumerate(("distance", "index")):
         for who, style in (("network", "o-"), ("baseline", "s--")):
-            med = [np.median([r["independent"][who][out]["mae"] for r in rows
-                              if int(r["samples"]) == n]) for n in sizes]  # fmt: skip
+            med = [
+                np.median(
+                    [r["independent"][who][out]["mae"] for r in rows if int(r["samples"]) == n]
+                )
+                for n in sizes
+            ]
             axes[j].loglog(sizes, med, style, label=who if who == "network" else "min/argmin")
         axes[j].set_xlabel("training samples")
         axes[j].set_ylabel(f"{out} MAE (independent test)")
@@ -127,8 +143,9 @@ def fig_trajectory3d(
     for ob in obstacles:
         for part in ob.parts:
             v = part.vertices(0.0)
-            ax.plot_trisurf(v[:, 0], v[:, 1], v[:, 2], triangles=part.faces, color="C1",
-                            alpha=0.25, linewidth=0)  # fmt: skip
+            ax.plot_trisurf(
+                v[:, 0], v[:, 1], v[:, 2], triangles=part.faces, color="C1", alpha=0.25, linewidth=0
+            )
     pos = np.asarray(result.positions)
     if len(pos):
         ax.plot(*pos.T, color="C0", lw=1.5, label="vehicle")
@@ -172,15 +189,23 @@ def render_ch5(summary: Any, report_dir: Path) -> list[Path]:
         grp = model.split["test"]
         save(fig_training(model, f"BPNN training, {key[1:]} samples"), f"ch5_training_{key}.png")
         save(
-            fig_errors(model.predict(ds.inputs[grp]), ds.targets()[grp], ds.baseline()[grp],
-                       f"{key[1:]} samples: test group"),  # fmt: skip
+            fig_errors(
+                model.predict(ds.inputs[grp]),
+                ds.targets()[grp],
+                ds.baseline()[grp],
+                f"{key[1:]} samples: test group",
+            ),
             f"ch5_errors_{key}_test_group.png",
         )
         test = summary.datasets.get("independent_test")
         if test is not None:
             save(
-                fig_errors(model.predict(test.inputs), test.targets(), test.baseline(),
-                           f"{key[1:]} samples: independent test set"),  # fmt: skip
+                fig_errors(
+                    model.predict(test.inputs),
+                    test.targets(),
+                    test.baseline(),
+                    f"{key[1:]} samples: independent test set",
+                ),
                 f"ch5_errors_{key}_independent.png",
             )
     if summary.learning:
