@@ -72,7 +72,9 @@ def test_residual_network_beats_the_min_argmin_baseline_on_distance(
 def test_adam_option_trains(data: tuple[SonarDataset, SonarDataset]) -> None:
     ds, _ = data
     m = train_bpnn(
-        ds.inputs, ds.targets(), np.random.default_rng(0),
+        ds.inputs,
+        ds.targets(),
+        np.random.default_rng(0),
         BPNNConfig(optimizer="adam", max_epochs=50, learning_rate=0.05),
     )
     assert m.history["train"][-1] < m.history["train"][0]

@@ -137,7 +137,10 @@ def scenario5_from_dict(data: dict[str, Any], source: str = "<dict>") -> Scenari
     try:
         return Scenario5.model_validate(data)
     except ValidationError as exc:
-        raise from_validation_error(exc, source, tags=("star", "horseshoe")) from None
+        err = from_validation_error(exc, source)
+        # drop the union-tag segment pydantic puts in the path (obstacles.0.star.x -> obstacles.0.x)
+        path = ".".join(p for p in err.path.split(".") if p not in ("star", "horseshoe"))
+        raise ScenarioError(err.source, path, err.problem) from None
 
 
 def _builtin_files() -> dict[str, Any]:
