@@ -11,7 +11,7 @@ import pytest
 pytest.importorskip("torch")
 pytest.importorskip("safetensors")
 
-from uvnav.learning.bpnn import (  # noqa: E402
+from uvnav.learning.bpnn import (
     BPNNConfig,
     CheckpointError,
     error_table,
@@ -20,7 +20,7 @@ from uvnav.learning.bpnn import (  # noqa: E402
     split_indices,
     train_bpnn,
 )
-from uvnav.sensors.sonar_dataset import SonarDataset, sample_sonar_dataset  # noqa: E402
+from uvnav.sensors.sonar_dataset import SonarDataset, sample_sonar_dataset
 
 
 @pytest.fixture(scope="module")

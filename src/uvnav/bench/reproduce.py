@@ -434,6 +434,8 @@ def reproduce(
     n_baseline_seeds: int | None = None,
     n_crowd_seeds: int | None = None,
     render: Renderer | None = None,
+    ch5: bool = False,
+    ch5_render: Callable[..., list[Path]] | None = None,
 ) -> ReproductionSummary:
     """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
 
@@ -453,6 +455,8 @@ def reproduce(
         controllers: laws to run (default both Ch. 2 laws).
         render: renderer callable (e.g. ``uvnav.viz.reproduction.render_reproduction``);
             ``None`` skips figures and report.
+        ch5: also run the Chapter 5 reproduction (:func:`uvnav.bench.reproduce_ch5.reproduce_ch5`;
+            its rows join the table); ``ch5_render`` draws its figures into ``report_dir/ch5``.
 
     Returns:
         The summary: table, database and report paths, random-campaign failures.
@@ -591,6 +595,12 @@ def reproduce(
                     status = str(store.episode_row(eid)["status"])
                     scene_episodes.append(SceneEpisode(s, c, 0, eid, status))
 
+    if ch5:  # thesis Chapter 5: BPNN experiment and closed-loop runs (needs the learning extra)
+        from uvnav.bench.reproduce_ch5 import reproduce_ch5
+
+        table += reproduce_ch5(
+            results_dir, full=full, progress=progress, render=ch5_render, report_dir=report_dir
+        ).table
     report_path: Path | None = None
     figures: list[Path] = []
     if render is not None:

@@ -53,15 +53,19 @@ from uvnav.scenarios.ch5 import (
 from uvnav.sensors.sonar_dataset import SonarDataset, sample_sonar_dataset
 from uvnav.sim.episode_uuv3d import UUV3DResult, run_uuv3d_episode
 
-QUICK_SIZES: tuple[int, ...] = (50, 150, 500)
+QUICK_SIZES: tuple[int, ...] = (50, 150)
 FULL_SIZES: tuple[int, ...] = (50, 150, 500, 5000)
-QUICK_SEEDS, FULL_SEEDS = 3, 5
-QUICK_RANDOM, FULL_RANDOM = 10, 300
+QUICK_SEEDS, FULL_SEEDS = 2, 5
+QUICK_RANDOM, FULL_RANDOM = 3, 300
+QUICK_NOISES: tuple[float, ...] = (0.0,)
 LOCATORS: tuple[str, ...] = ("geometric", "network", "oracle")
 #: sonar range noise [m] of the noisy closed-loop runs
 NOISE_STD = 0.05
 #: samples of the network used in closed loop
 CLOSED_LOOP_SAMPLES = 500
+#: tessellation level of the sampled obstacles (320 triangles: readings and targets are computed
+#: on the same mesh, so the data are consistent; the mesh is within a few cm of the analytic body)
+DATA_SUBDIVISIONS = 2
 
 
 def make_locator(
@@ -113,16 +117,20 @@ def learning_row(
 ) -> tuple[dict[str, Any], TrainedBPNN, SonarDataset]:
     """Train on ``n`` fresh samples (seed ``seed``) and measure errors (module docstring)."""
     rng = np.random.default_rng(10_000 + seed)
-    ds = sample_sonar_dataset(n, rng)
+    ds = sample_sonar_dataset(n, rng, subdivisions=DATA_SUBDIVISIONS)
+    cfg = config or BPNNConfig()
     tic = time.perf_counter()
-    model = train_bpnn(ds.inputs, ds.targets(), rng, config)
+    model = train_bpnn(ds.inputs, ds.targets(), rng, cfg, offset=ds.baseline())
     train_s = time.perf_counter() - tic
     grp = model.split["test"]
-    own = error_table(model.predict(ds.inputs[grp]), ds.targets()[grp], ds.baseline()[grp])
-    ind = error_table(model.predict(test.inputs), test.targets(), test.baseline())
+    own = error_table(
+        model.predict(ds.inputs[grp], ds.baseline()[grp]), ds.targets()[grp], ds.baseline()[grp]
+    )
+    ind = error_table(model.predict(test.inputs, test.baseline()), test.targets(), test.baseline())
     row = {
         "samples": n,
         "seed": seed,
+        "variant": "residual" if cfg.residual else "plain",
         "train_seconds": round(train_s, 3),
         "epochs": len(model.history["train"]),
         "best_epoch": model.best_epoch,
@@ -183,10 +191,10 @@ def _range(lo: float, hi: float) -> str:
 def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
     """Rows "thesis reported vs uvnav measured" from the measured rows only."""
     rows: list[dict[str, Any]] = []
-    by_n: dict[int, list[dict[str, Any]]] = {}
+    by_n: dict[tuple[str, int], list[dict[str, Any]]] = {}
     for r in summary.learning:
-        by_n.setdefault(int(r["samples"]), []).append(r)
-    for n, rs in sorted(by_n.items()):
+        by_n.setdefault((str(r["variant"]), int(r["samples"])), []).append(r)
+    for (variant, n), rs in sorted(by_n.items()):
         ref = THESIS_ERROR_RANGES.get(n)
         for out in ("distance", "index"):
             g = [r["test_group"]["network"][out] for r in rs]
@@ -194,7 +202,7 @@ def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
             base = [r["independent"]["baseline"][out] for r in rs]
             rows.append(
                 {
-                    "quantity": f"Ch5 BPNN {n} samples: {out} error, test group",
+                    "quantity": f"Ch5 BPNN ({variant}) {n} samples: {out} error, test group",
                     "thesis": _range(*ref[out]) if ref else "-",
                     "measured": _range(min(x["lo"] for x in g), max(x["hi"] for x in g)),
                     "note": f"union over {len(rs)} seeds; median MAE "
@@ -203,7 +211,7 @@ def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
             )
             rows.append(
                 {
-                    "quantity": f"Ch5 BPNN {n} samples: {out} MAE, independent test (baseline)",
+                    "quantity": f"Ch5 BPNN ({variant}) {n}: {out} MAE, indep. test (baseline)",
                     "thesis": "-",
                     "measured": f"{np.median([x['mae'] for x in ind]):.3g} "
                     f"({np.median([x['mae'] for x in base]):.3g})",
@@ -256,7 +264,9 @@ def reproduce_ch5(
     sizes: Sequence[int] | None = None,
     n_seeds: int | None = None,
     n_random: int | None = None,
-    n_test: int = 1000,
+    n_test: int = 500,
+    scenes: Sequence[str] | None = None,
+    noises: Sequence[float] | None = None,
     progress: bool = True,
     render: Callable[[Ch5Summary, Path], list[Path]] | None = None,
     report_dir: Path | None = None,
@@ -270,6 +280,8 @@ def reproduce_ch5(
         n_seeds: seeds per sample count (default 3 quick).
         n_random: random closed-loop scenes per locator and noise level (default 10 quick).
         n_test: size of the independent test set.
+        scenes: thesis scenes to run (default all three).
+        noises: sonar noise levels [m] of the closed-loop runs (default 0 quick, 0 and 0.05 full).
         progress: rich progress bar on stderr.
         render: figure renderer ``(summary, report_dir) -> files`` (e.g.
             :func:`uvnav.viz.figures_ch5.render_ch5`); ``None`` skips figures.
@@ -284,22 +296,30 @@ def reproduce_ch5(
     seeds = n_seeds if n_seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
     n_rand = n_random if n_random is not None else (FULL_RANDOM if full else QUICK_RANDOM)
     summary = Ch5Summary()
-    test = sample_sonar_dataset(n_test, np.random.default_rng(999_999))
+    test = sample_sonar_dataset(
+        n_test, np.random.default_rng(999_999), subdivisions=DATA_SUBDIVISIONS
+    )
     summary.datasets["independent_test"] = test
-    scenes = list_ch5_builtin()
-    n_episodes = (len(scenes) + n_rand) * len(LOCATORS) * 2
+    scene_list = list(scenes) if scenes is not None else list_ch5_builtin()
+    default_noises = (0.0, NOISE_STD) if full else QUICK_NOISES
+    noise_list = tuple(noises) if noises is not None else default_noises
+    n_episodes = (len(scene_list) + n_rand) * len(LOCATORS) * len(noise_list)
+    variants = (BPNNConfig(), BPNNConfig(residual=True))
     with Progress(disable=not progress, transient=True) as prog:
-        task = prog.add_task("Ch5 BPNN", total=len(sizes) * seeds + 1)
+        task = prog.add_task("Ch5 BPNN", total=len(sizes) * seeds * len(variants) + 1)
         for n in sizes:
             for s in range(seeds):
-                row, model, ds = learning_row(n, s, test)
-                summary.learning.append(row)
-                if s == 0:
-                    summary.models[f"n{n}"] = model
-                    summary.datasets[f"n{n}"] = ds
-                prog.advance(task)
-        # the closed-loop network: trained once on CLOSED_LOOP_SAMPLES samples
-        _, cl_model, _ = learning_row(CLOSED_LOOP_SAMPLES, 100, test)
+                for cfg in variants:
+                    row, model, ds = learning_row(n, s, test, cfg)
+                    summary.learning.append(row)
+                    if s == 0:
+                        key = f"n{n}" + ("r" if cfg.residual else "")
+                        summary.models[key] = model
+                        summary.datasets[key] = ds
+                    prog.advance(task)
+        # the closed-loop network: a residual one trained once on CLOSED_LOOP_SAMPLES samples
+        cl_row, cl_model, _ = learning_row(CLOSED_LOOP_SAMPLES, 100, test, variants[1])
+        summary.learning.append(cl_row)
         save_checkpoint(cl_model, results_dir / "ch5_bpnn")
         summary.models["closed_loop"] = cl_model
         prog.advance(task)
@@ -310,9 +330,9 @@ def reproduce_ch5(
         }
         task2 = prog.add_task("Ch5 closed loop", total=n_episodes)
         rows, kept = run_closed_loop(
-            scenes,
+            scene_list,
             locators,
-            noises=(0.0, NOISE_STD),
+            noises=noise_list,
             record=True,
             on_episode=lambda: prog.advance(task2),
         )
@@ -323,7 +343,7 @@ def reproduce_ch5(
             r2, _ = run_closed_loop(
                 [scn_name],
                 locators,
-                noises=(0.0, NOISE_STD),
+                noises=noise_list,
                 seed=g,
                 on_episode=lambda: prog.advance(task2),
             )
@@ -340,7 +360,7 @@ def reproduce_ch5(
             "seeds": seeds,
             "n_random": n_rand,
             "n_test": n_test,
-            "noise_std": NOISE_STD,
+            "noises": list(noise_list),
             "closed_loop_samples": CLOSED_LOOP_SAMPLES,
         },
     }

@@ -566,7 +566,11 @@ def run(
     """Reproduce the thesis's experiments: results database, report, and the comparison table."""
     reproduce = _optional("uvnav.bench.reproduce", "reproduce", "the reproduction job (uvnav run)")
     render = _optional("uvnav.viz.reproduction", "render_reproduction", "the report renderer")
-    summary = reproduce(results, report, full=full, workers=workers, progress=True, render=render)
+    render5 = _optional("uvnav.viz.figures_ch5", "render_ch5", "the Chapter 5 figures")
+    summary = reproduce(
+        results, report, full=full, workers=workers, progress=True, render=render, ch5=True,
+        ch5_render=render5,
+    )
     from rich.table import Table
 
     table = Table(title="thesis reported vs uvnav measured")

@@ -114,11 +114,24 @@ def fig_errors(
 
 
 def fig_learning_curve(rows: Sequence[dict[str, Any]]) -> Figure:
-    """Median MAE on the independent test set vs sample count, network and baseline."""
+    """Median MAE on the independent test set vs sample count, network (plain thesis-style and
+    residual) and baseline."""
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
-    sizes = sorted({int(r["samples"]) for r in rows})
     for j, out in enumerate(("distance", "index")):
-        for who, style in (("network", "o-"), ("baseline", "s--")):
+        for variant, style in (("plain", "o-"), ("residual", "^-")):
+            vr = [r for r in rows if r.get("variant", "plain") == variant]
+            sizes_v = sorted({int(r["samples"]) for r in vr})
+            if not sizes_v:
+                continue
+            med_v = [
+                np.median(
+                    [r["independent"]["network"][out]["mae"] for r in vr if int(r["samples"]) == n]
+                )
+                for n in sizes_v
+            ]
+            axes[j].loglog(sizes_v, med_v, style, label=f"network ({variant})")
+        sizes = sorted({int(r["samples"]) for r in rows})
+        for who, style in (("baseline", "s--"),):
             med = [
                 np.median(
                     [r["independent"][who][out]["mae"] for r in rows if int(r["samples"]) == n]
@@ -187,13 +200,14 @@ def render_ch5(summary: Any, report_dir: Path) -> list[Path]:
             continue
         ds = summary.datasets[key]
         grp = model.split["test"]
-        save(fig_training(model, f"BPNN training, {key[1:]} samples"), f"ch5_training_{key}.png")
+        label = f"{key[1:].rstrip('r')} samples, {'residual' if key.endswith('r') else 'plain'}"
+        save(fig_training(model, f"BPNN training, {label}"), f"ch5_training_{key}.png")
         save(
             fig_errors(
-                model.predict(ds.inputs[grp]),
+                model.predict(ds.inputs[grp], ds.baseline()[grp]),
                 ds.targets()[grp],
                 ds.baseline()[grp],
-                f"{key[1:]} samples: test group",
+                f"{label}: test group",
             ),
             f"ch5_errors_{key}_test_group.png",
         )
@@ -201,10 +215,10 @@ def render_ch5(summary: Any, report_dir: Path) -> list[Path]:
         if test is not None:
             save(
                 fig_errors(
-                    model.predict(test.inputs),
+                    model.predict(test.inputs, test.baseline()),
                     test.targets(),
                     test.baseline(),
-                    f"{key[1:]} samples: independent test set",
+                    f"{label}: independent test set",
                 ),
                 f"ch5_errors_{key}_independent.png",
             )
