@@ -70,6 +70,9 @@ def dataset_cmd(
     seed: Annotated[int, typer.Option(min=0, help="Seed of the sampling.")] = 0,
     noise: Annotated[float, typer.Option(min=0.0, help="Sonar range noise std [m].")] = 0.0,
     dropout: Annotated[float, typer.Option(min=0.0, max=1.0, help="Echo dropout rate.")] = 0.0,
+    subdivisions: Annotated[
+        int, typer.Option(min=1, max=4, help="Icosphere level of the obstacle meshes.")
+    ] = 2,
 ) -> None:
     """Sample sonar readings with true nearest distance and sensor targets."""
     from uvnav.sensors.sonar_array import SonarArray
@@ -82,6 +85,7 @@ def dataset_cmd(
             samples,
             np.random.default_rng(seed),
             array=array,
+            subdivisions=subdivisions,
             on_sample=lambda k: prog.update(task, completed=k),
         )
     out.parent.mkdir(parents=True, exist_ok=True)
