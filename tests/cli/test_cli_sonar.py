@@ -10,7 +10,7 @@ from typer.testing import CliRunner
 
 pytest.importorskip("torch")
 
-from uvnav.cli.app import app  # noqa: E402
+from uvnav.cli.app import app
 
 runner = CliRunner()
 

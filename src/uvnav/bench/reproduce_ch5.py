@@ -267,6 +267,7 @@ def reproduce_ch5(
     n_test: int = 500,
     scenes: Sequence[str] | None = None,
     noises: Sequence[float] | None = None,
+    closed_loop_samples: int = CLOSED_LOOP_SAMPLES,
     progress: bool = True,
     render: Callable[[Ch5Summary, Path], list[Path]] | None = None,
     report_dir: Path | None = None,
@@ -282,6 +283,7 @@ def reproduce_ch5(
         n_test: size of the independent test set.
         scenes: thesis scenes to run (default all three).
         noises: sonar noise levels [m] of the closed-loop runs (default 0 quick, 0 and 0.05 full).
+        closed_loop_samples: training samples of the closed-loop (residual) network.
         progress: rich progress bar on stderr.
         render: figure renderer ``(summary, report_dir) -> files`` (e.g.
             :func:`uvnav.viz.figures_ch5.render_ch5`); ``None`` skips figures.
@@ -318,7 +320,7 @@ def reproduce_ch5(
                         summary.datasets[key] = ds
                     prog.advance(task)
         # the closed-loop network: a residual one trained once on CLOSED_LOOP_SAMPLES samples
-        cl_row, cl_model, _ = learning_row(CLOSED_LOOP_SAMPLES, 100, test, variants[1])
+        cl_row, cl_model, _ = learning_row(closed_loop_samples, 100, test, variants[1])
         summary.learning.append(cl_row)
         save_checkpoint(cl_model, results_dir / "ch5_bpnn")
         summary.models["closed_loop"] = cl_model
@@ -361,7 +363,7 @@ def reproduce_ch5(
             "n_random": n_rand,
             "n_test": n_test,
             "noises": list(noise_list),
-            "closed_loop_samples": CLOSED_LOOP_SAMPLES,
+            "closed_loop_samples": closed_loop_samples,
         },
     }
     summary.json_path = results_dir / "ch5.json"
