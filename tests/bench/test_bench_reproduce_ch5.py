@@ -20,7 +20,7 @@ def test_small_reproduction_writes_measured_table_and_figures(tmp_path: Path) ->
         tmp_path / "results",
         sizes=(50,),
         n_seeds=1,
-        n_random=1,
+        n_random=0,
         n_test=30,
         scenes=["thesis-ch5-scene1"],
         noises=(0.0,),
