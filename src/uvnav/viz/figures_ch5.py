@@ -171,6 +171,7 @@ def fig_trajectory3d(
             ax.scatter(*loc[ok].T, color="k", s=3, label="point to evade")
         ax.scatter(*pos[0], color="g", s=30, label="A")
     ax.scatter(*goal, color="m", s=40, marker="*", label="B")
+    ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     ax.set_zlabel("z [m]")
