@@ -53,6 +53,8 @@ def main() -> None:
 
     repeat = 3 if args.quick else 10
     ds = sample_sonar_dataset(150, np.random.default_rng(0), subdivisions=2)
+    # warm-up (torch's first call initialises its thread pool and kernels): not timed
+    train_bpnn(ds.inputs, ds.targets(), np.random.default_rng(99), BPNNConfig(max_epochs=2))
     train = {}
     models = {}
     for name, cfg in (("plain", BPNNConfig()), ("residual", BPNNConfig(residual=True))):
