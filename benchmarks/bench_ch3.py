@@ -123,16 +123,26 @@ def main() -> None:
     med = dec["oracle"]["median_us"]
     sps = world["unrecorded"]["steps_per_s"]
     data = {
-        "machine": {"platform": platform.platform(), "python": platform.python_version(),
-                    "cpus": os.cpu_count(), "load": os.getloadavg()},
+        "machine": {
+            "platform": platform.platform(),
+            "python": platform.python_version(),
+            "cpus": os.cpu_count(),
+            "load": os.getloadavg(),
+        },
         "when": datetime.now(UTC).isoformat(),
         "decision_time": dec,
         "world_steps": world,
         "targets": {
-            "decision_us_median_10": {"limit": TARGETS["decision_us_median_10"], "value": med,
-                                      "pass": med <= TARGETS["decision_us_median_10"]},
-            "world_steps_per_s_10": {"limit": TARGETS["world_steps_per_s_10"], "value": sps,
-                                     "pass": sps >= TARGETS["world_steps_per_s_10"]},
+            "decision_us_median_10": {
+                "limit": TARGETS["decision_us_median_10"],
+                "value": med,
+                "pass": med <= TARGETS["decision_us_median_10"],
+            },
+            "world_steps_per_s_10": {
+                "limit": TARGETS["world_steps_per_s_10"],
+                "value": sps,
+                "pass": sps >= TARGETS["world_steps_per_s_10"],
+            },
         },
     }
     args.out.mkdir(parents=True, exist_ok=True)

@@ -348,6 +348,7 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
             figures=[report_dir / "a.png", report_dir / "b.png"],
         )
 
+    from uvnav.viz.figures_ch5 import render_ch5
     from uvnav.viz.reproduction import render_reproduction
 
     fake = types.ModuleType("uvnav.bench.reproduce")
@@ -368,6 +369,8 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
             "workers": 3,
             "progress": True,
             "render": render_reproduction,
+            "ch5": True,
+            "ch5_render": render_ch5,
         }
     ]
     assert "thesis reported vs uvnav measured" in result.stdout

@@ -65,8 +65,9 @@ def _box_signed(p: np.ndarray, h: np.ndarray) -> float:
 
 @settings(max_examples=200, deadline=None)
 @given(p=point, hx=st.floats(0.2, 3), hy=st.floats(0.2, 3), hz=st.floats(0.2, 3))
-def test_signed_distance_to_a_box_mesh_is_exact(p: np.ndarray, hx: float, hy: float,
-                                                hz: float) -> None:
+def test_signed_distance_to_a_box_mesh_is_exact(
+    p: np.ndarray, hx: float, hy: float, hz: float
+) -> None:
     h = np.array([hx, hy, hz])
     v, f = box_mesh(h)
     tri = Triangles.from_mesh(v, f)

@@ -44,8 +44,12 @@ def test_bad_3d_inputs_get_one_line_errors_naming_the_field() -> None:
     d["obstacles"][0]["motion"]["velocity"] = [1.5, 0, 0]
     assert "(3.9)" in _err(d)
     d = copy.deepcopy(BASE)
-    d["obstacles"][0]["body"] = {"mesh": {"vertices": [[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]],
-                                          "faces": [[0, 1, 2], [0, 1, 3], [1, 2, 3], [0, 2, 3]]}}
+    d["obstacles"][0]["body"] = {
+        "mesh": {
+            "vertices": [[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]],
+            "faces": [[0, 1, 2], [0, 1, 3], [1, 2, 3], [0, 2, 3]],
+        }
+    }
     assert "degenerate" in _err(d)
     d = copy.deepcopy(BASE)
     d["obstacles"][0]["start"]["position"] = [0.5, 0, 0]

@@ -435,6 +435,8 @@ def reproduce(
     n_crowd_seeds: int | None = None,
     render: Renderer | None = None,
     ch7: bool | None = None,
+    ch5: bool = False,
+    ch5_render: Callable[..., list[Path]] | None = None,
 ) -> ReproductionSummary:
     """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
 
@@ -457,6 +459,8 @@ def reproduce(
         ch7: also run the thesis Ch. 7 reconnaissance experiments
             (:mod:`uvnav.bench.reproduce_ch7`, rows appended to the table); ``None`` = only when
             ``n_random`` is not given (test-sized runs skip it).
+        ch5: also run the Chapter 5 reproduction (:func:`uvnav.bench.reproduce_ch5.reproduce_ch5`;
+            its rows join the table); ``ch5_render`` draws its figures into ``report_dir/ch5``.
 
     Returns:
         The summary: table, database and report paths, random-campaign failures.
@@ -612,6 +616,12 @@ def reproduce(
         from uvnav.bench.reproduce_ch7 import reproduce_ch7
 
         table += reproduce_ch7(results_dir / "ch7", full=full).table
+    if ch5:  # thesis Chapter 5: BPNN experiment and closed-loop runs (needs the learning extra)
+        from uvnav.bench.reproduce_ch5 import reproduce_ch5
+
+        table += reproduce_ch5(
+            results_dir, full=full, progress=progress, render=ch5_render, report_dir=report_dir
+        ).table
     report_path: Path | None = None
     figures: list[Path] = []
     if render is not None:

@@ -28,6 +28,7 @@ from typer.core import TyperGroup
 from uvnav.cli.drive import drive_app
 from uvnav.cli.multi import multi_app
 from uvnav.cli.recon import recon_app
+from uvnav.cli.sonar import sonar_app
 from uvnav.controllers import (
     ControllerInfo,
     ControllerParamsError,
@@ -134,6 +135,7 @@ app.add_typer(controllers_app, name="controllers")
 app.add_typer(multi_app, name="multi")  # issue 9
 app.add_typer(recon_app, name="recon")
 app.add_typer(drive_app, name="drive")
+app.add_typer(sonar_app, name="sonar")
 
 
 def _version(value: bool) -> None:
@@ -570,7 +572,17 @@ def run(
     """Reproduce the thesis's experiments: results database, report, and the comparison table."""
     reproduce = _optional("uvnav.bench.reproduce", "reproduce", "the reproduction job (uvnav run)")
     render = _optional("uvnav.viz.reproduction", "render_reproduction", "the report renderer")
-    summary = reproduce(results, report, full=full, workers=workers, progress=True, render=render)
+    render5 = _optional("uvnav.viz.figures_ch5", "render_ch5", "the Chapter 5 figures")
+    summary = reproduce(
+        results,
+        report,
+        full=full,
+        workers=workers,
+        progress=True,
+        render=render,
+        ch5=True,
+        ch5_render=render5,
+    )
     from rich.table import Table
 
     table = Table(title="thesis reported vs uvnav measured")

@@ -45,7 +45,7 @@ class Controller3D(Protocol):
 
 _REGISTRY3D: dict[str, ControllerInfo] = {}
 #: Modules of ``uvnav.controllers`` that register built-in 3D laws when imported.
-BUILTIN_MODULES_3D: tuple[str, ...] = ("zhang2020_3d", "apf3d", "vo3d")
+BUILTIN_MODULES_3D: tuple[str, ...] = ("zhang2020_3d", "apf3d", "vo3d", "zhang_uuv3d")
 
 
 def register3d(info: ControllerInfo) -> ControllerInfo:

@@ -40,9 +40,7 @@ def fibonacci_sphere(n: int) -> FloatArray:
     return np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
 
 
-def time_to_collision(
-    rel_pos: FloatArray, rel_vel: FloatArray, radius: FloatArray
-) -> FloatArray:
+def time_to_collision(rel_pos: FloatArray, rel_vel: FloatArray, radius: FloatArray) -> FloatArray:
     """Earliest t >= 0 at which ``rel_pos + rel_vel t`` enters the sphere of ``radius`` about 0.
 
     Args:

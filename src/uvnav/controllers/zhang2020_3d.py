@@ -141,9 +141,7 @@ def _psi(xy: FloatArray) -> FloatArray:
     return np.asarray(np.arctan2(-xy[..., 0], xy[..., 1]))
 
 
-def shadow_of(
-    frame: OnlineFrame, points: FloatArray, centre: FloatArray, radius: float
-) -> Shadow:
+def shadow_of(frame: OnlineFrame, points: FloatArray, centre: FloatArray, radius: float) -> Shadow:
     """Angular extent of ``points`` (world, (n, 3)) in the on-line plane, each inflated by a
     forecast circle of ``radius`` [m] (half-angle asin(radius / distance))."""
     q = frame.to_plane(points)
@@ -311,8 +309,10 @@ class Zhang2020Law(Vehicle3DController):
         return self.steer(obs, direction, speed, period)
 
     def passing_angle(
-        self, sh: Shadow, shadows: dict[int, tuple[Shadow, ObstacleReading3D, FloatArray,
-                                                   FloatArray]], tag: int
+        self,
+        sh: Shadow,
+        shadows: dict[int, tuple[Shadow, ObstacleReading3D, FloatArray, FloatArray]],
+        tag: int,
     ) -> float:
         """psi of l_J: the tangent on the tagged side rotated out by alpha0, pushed past any other
         shadow it falls into (item 4 of the module docstring).  '+' = clockwise (toward +X')."""

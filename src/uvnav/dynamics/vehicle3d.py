@@ -125,9 +125,7 @@ def vehicle3d_advance(
     return position + disp, a_new, u_new
 
 
-def vehicle3d_step(
-    state: Vehicle3DState, command: Vehicle3DCommand, dt: float
-) -> Vehicle3DState:
+def vehicle3d_step(state: Vehicle3DState, command: Vehicle3DCommand, dt: float) -> Vehicle3DState:
     """Exact motion (3.2)-(3.3) for ``dt`` [s] under ``command`` held (as an angular velocity).
 
     Raises:

@@ -56,9 +56,7 @@ class Triangles:
     def from_corners(a: FloatArray, b: FloatArray, c: FloatArray) -> Triangles:
         a, b, c = (np.ascontiguousarray(x, dtype=float) for x in (a, b, c))
         centre = (a + b + c) / 3.0
-        radius = np.sqrt(
-            np.maximum.reduce([((x - centre) ** 2).sum(axis=1) for x in (a, b, c)])
-        )
+        radius = np.sqrt(np.maximum.reduce([((x - centre) ** 2).sum(axis=1) for x in (a, b, c)]))
         return Triangles(a=a, b=b, c=c, ab=b - a, ac=c - a, centre=centre, radius=radius)
 
     @staticmethod
@@ -241,9 +239,7 @@ class PseudoNormals:
         def angle(p0: FloatArray, p1: FloatArray, p2: FloatArray) -> FloatArray:
             e1 = p1 - p0
             e2 = p2 - p0
-            return np.asarray(
-                np.arctan2(np.linalg.norm(np.cross(e1, e2), axis=1), _rowdot(e1, e2))
-            )
+            return np.asarray(np.arctan2(np.linalg.norm(np.cross(e1, e2), axis=1), _rowdot(e1, e2)))
 
         ang = np.stack([angle(a, b, c), angle(b, c, a), angle(c, a, b)], axis=1)
         vert_sum = np.zeros((len(v), 3))

@@ -146,8 +146,6 @@ class FiniteDifference3D:
                 u = rotation_to_vector(rd.rotation @ prev[2].T) / dt
             self._last[rd.obstacle_id] = (time, centre, rd.rotation)
             out.append(
-                replace(
-                    rd, centre=centre, velocity=v, rotation_rate=u, velocity_source="estimated"
-                )
+                replace(rd, centre=centre, velocity=v, rotation_rate=u, velocity_source="estimated")
             )
         return tuple(out)

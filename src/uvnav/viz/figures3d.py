@@ -75,8 +75,9 @@ def trajectory_figure(tr: Trajectory3D, title: str = "") -> Any:
     return fig
 
 
-def obstacle_motion_figure(tr: Trajectory3D, obstacle: int = 0,
-                           v_max: float | None = None, u_max: float | None = None) -> Any:
+def obstacle_motion_figure(
+    tr: Trajectory3D, obstacle: int = 0, v_max: float | None = None, u_max: float | None = None
+) -> Any:
     """Fig. 3.7: components of v_obs(t) and u_obs(t) and their norms V_obs, U_obs."""
     plt = _plt()
     fig, axes = plt.subplots(1, 2, figsize=(11, 4))

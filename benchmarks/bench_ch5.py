@@ -1,0 +1,114 @@
+"""Chapter 5 speed benchmarks (run: ``.venv/bin/python benchmarks/bench_ch5.py --out DIR``).
+
+Writes ``<out>/ch5.json`` with the machine, the parameters and:
+
+* ``train_150``: wall time [s] of training the BPNN (plain and residual, L-BFGS, 2 torch threads)
+  on 150 samples — the issue's target: "training 150 samples takes seconds on 2 CPU cores"
+  (target < 10 s, ``pass`` flag);
+* ``sonar_scan``: one R(t) of the nine-sonar array against a 1280-triangle deforming star [ms];
+* ``sample``: one dataset sample (obstacle, scan, true nearest point) [ms];
+* ``decision``: one ``zhang2022-uuv3d-v1`` decision with the geometric and the network locator [µs].
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+TARGET_TRAIN_S = 10.0
+
+
+def _median_time(fn: Any, repeat: int) -> float:
+    times = []
+    for _ in range(repeat):
+        tic = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - tic)
+    return float(np.median(times))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--out", type=Path, default=Path("benchmarks/results"))
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args()
+    from uvnav.controllers.zhang_uuv3d import (
+        GeometricLocator,
+        ModelLocator,
+        SonarObservation3D,
+        ZhangUUV3D,
+    )
+    from uvnav.dynamics.vehicle3d import Vehicle3DSpec
+    from uvnav.learning.bpnn import BPNNConfig, train_bpnn
+    from uvnav.obstacles.deforming3d import random_star
+    from uvnav.sensors.sonar_array import SonarArray, sonar_scan
+    from uvnav.sensors.sonar_dataset import sample_sonar_dataset
+
+    repeat = 3 if args.quick else 10
+    ds = sample_sonar_dataset(150, np.random.default_rng(0), subdivisions=2)
+    # warm-up (torch's first call initialises its thread pool and kernels): not timed
+    train_bpnn(ds.inputs, ds.targets(), np.random.default_rng(99), BPNNConfig(max_epochs=2))
+    train = {}
+    models = {}
+    for name, cfg in (("plain", BPNNConfig()), ("residual", BPNNConfig(residual=True))):
+        secs = []
+        for s in range(repeat):
+            tic = time.perf_counter()
+            m = train_bpnn(
+                ds.inputs, ds.targets(), np.random.default_rng(s), cfg, offset=ds.baseline()
+            )
+            secs.append(time.perf_counter() - tic)
+        models[name] = m
+        train[name] = {"median_s": float(np.median(secs)), "max_s": float(np.max(secs))}
+    worst = max(v["max_s"] for v in train.values())
+    star = random_star(np.random.default_rng(1), np.zeros(3), 2.0, subdivisions=3)
+    tri = star.triangles(0.0)
+    arr = SonarArray()
+    pos, head = np.array([5.0, 0.3, 0.2]), np.array([-1.0, 0.0, 0.0])
+    scan_s = _median_time(lambda: sonar_scan(arr, pos, head, tri), repeat * 5)
+    sample_s = _median_time(lambda: sample_sonar_dataset(1, np.random.default_rng(3)), repeat * 3)
+    scan = sonar_scan(arr, pos, head, tri)
+    obs = SonarObservation3D(
+        time=0.0,
+        position=pos,
+        heading=head,
+        speed=1.0,
+        goal=np.array([-20.0, 0, 0]),
+        ranges=scan.ranges,
+        echo=scan.echo,
+        array=arr,
+    )
+    dec = {}
+    for name, loc in (
+        ("geometric", GeometricLocator()),
+        ("network", ModelLocator(models["residual"])),
+    ):
+        ctrl = ZhangUUV3D(None, loc)
+        ctrl.reset(Vehicle3DSpec(1.0, 1.0, 0.5), obs.goal, np.random.default_rng(0))
+        dec[name] = _median_time(lambda c=ctrl: c.act(obs), repeat * 20) * 1e6
+    out = {
+        "machine": {
+            "platform": platform.platform(),
+            "cpus": os.cpu_count(),
+            "load": os.getloadavg(),
+        },
+        "train_150": {**train, "target_s": TARGET_TRAIN_S, "pass": worst < TARGET_TRAIN_S},
+        "sonar_scan_ms": scan_s * 1e3,
+        "sample_ms": sample_s * 1e3,
+        "decision_us": dec,
+    }
+    args.out.mkdir(parents=True, exist_ok=True)
+    path = args.out / "ch5.json"
+    path.write_text(json.dumps(out, indent=1))
+    print(json.dumps(out, indent=1))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,230 @@
+"""``uvnav sonar``: the Chapter 5 sonar array, its data and its BPNN (thesis Ch. 5, Figs. 5.4-5.8).
+
+Commands (thin: they parse, call the library, print):
+
+* ``dataset`` — sample R(t) with true-geometry targets (:mod:`uvnav.sensors.sonar_dataset`) into
+  an ``.npz`` file (plain arrays; read back with ``allow_pickle=False``);
+* ``train`` — train the BPNN (:mod:`uvnav.learning.bpnn`) with a random train/validation/test
+  division and early stopping, write a safetensors checkpoint + JSON;
+* ``evaluate`` — errors target - output of a checkpoint on a dataset, beside the min/argmin
+  baseline and the thesis's ranges;
+* ``simulate`` — one closed-loop episode of ``zhang2022-uuv3d-v1`` on a Chapter 5 scenario.
+
+Bad input (missing or malformed files, bad options) prints ONE line ``error: ...`` naming the
+file and the problem, and exits with status 2.
+"""
+
+from __future__ import annotations
+
+import json
+import zipfile
+from pathlib import Path
+from typing import Annotated, Any, NoReturn
+
+import numpy as np
+import typer
+
+sonar_app = typer.Typer(
+    no_args_is_help=True,
+    help="Chapter 5: nine-sonar array data, the BPNN locator, closed-loop runs.",
+)
+
+
+def _fail(message: str, code: int = 2) -> NoReturn:
+    typer.echo(f"error: {' '.join(str(message).split())}", err=True)
+    raise typer.Exit(code)
+
+
+def _progress() -> Any:
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
+
+    return Progress(
+        "[progress.description]{task.description}",
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+        transient=True,
+    )
+
+
+def _load_dataset(path: Path) -> Any:
+    from uvnav.sensors.sonar_dataset import SonarDataset
+
+    if not path.is_file():
+        _fail(f"{path}: dataset file not found")
+    try:
+        with np.load(path, allow_pickle=False) as data:
+            arrays = {k: data[k] for k in data.files}
+    except (ValueError, OSError, zipfile.BadZipFile) as exc:
+        _fail(f"{path}: not a uvnav sonar dataset (.npz): {exc}")
+    try:
+        return SonarDataset.from_arrays(arrays)
+    except ValueError as exc:
+        _fail(f"{path}: {exc}")
+
+
+@sonar_app.command("dataset")
+def dataset_cmd(
+    out: Annotated[Path, typer.Option("--out", help="Output .npz file.")] = Path("sonar.npz"),
+    samples: Annotated[int, typer.Option("--samples", "-n", min=1, help="Samples.")] = 150,
+    seed: Annotated[int, typer.Option(min=0, help="Seed of the sampling.")] = 0,
+    noise: Annotated[float, typer.Option(min=0.0, help="Sonar range noise std [m].")] = 0.0,
+    dropout: Annotated[float, typer.Option(min=0.0, max=1.0, help="Echo dropout rate.")] = 0.0,
+    subdivisions: Annotated[
+        int, typer.Option(min=1, max=4, help="Icosphere level of the obstacle meshes.")
+    ] = 2,
+) -> None:
+    """Sample sonar readings with true nearest distance and sensor targets."""
+    from uvnav.sensors.sonar_array import SonarArray
+    from uvnav.sensors.sonar_dataset import sample_sonar_dataset
+
+    array = SonarArray(noise_std=noise, dropout=dropout)
+    with _progress() as prog:
+        task = prog.add_task("sampling", total=samples)
+        ds = sample_sonar_dataset(
+            samples,
+            np.random.default_rng(seed),
+            array=array,
+            subdivisions=subdivisions,
+            on_sample=lambda k: prog.update(task, completed=k),
+        )
+    out.parent.mkdir(parents=True, exist_ok=True)
+    np.savez_compressed(out, **ds.arrays())  # type: ignore[arg-type]
+    gap = ds.baseline_distance - ds.target_distance
+    right = float(np.mean(ds.baseline_index == ds.target_index))
+    typer.echo(
+        f"wrote {out}: {len(ds)} samples; min/argmin baseline distance error "
+        f"[{-gap.max():.4f}, {-gap.min():.4f}] m, index right {right:.1%}"
+    )
+
+
+@sonar_app.command("train")
+def train_cmd(
+    data: Annotated[Path, typer.Argument(help="Dataset .npz from 'uvnav sonar dataset'.")],
+    out: Annotated[Path, typer.Option("--out", help="Checkpoint path (stem).")] = Path("bpnn"),
+    hidden: Annotated[str, typer.Option(help="Hidden layer sizes, e.g. '10' or '20,10'.")] = "10",
+    optimizer: Annotated[str, typer.Option(help="lbfgs (default) or adam.")] = "lbfgs",
+    seed: Annotated[int, typer.Option(min=0, help="Seed of the division and the weights.")] = 0,
+    max_epochs: Annotated[int, typer.Option(min=1, help="Largest number of epochs.")] = 1000,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the error table as JSON.")] = False,
+) -> None:
+    """Train the BPNN with a random division and early stopping; write a safe checkpoint."""
+    from uvnav.learning.bpnn import BPNNConfig, error_table, save_checkpoint, train_bpnn
+
+    ds = _load_dataset(data)
+    try:
+        sizes = tuple(int(h) for h in hidden.split(","))
+        cfg = BPNNConfig(hidden=sizes, optimizer=optimizer, max_epochs=max_epochs)
+    except ValueError as exc:
+        _fail(f"--hidden/--optimizer: {exc}")
+    try:
+        model = train_bpnn(ds.inputs, ds.targets(), np.random.default_rng(seed), cfg)
+    except ValueError as exc:
+        _fail(f"{data}: {exc}")
+    st, js = save_checkpoint(model, out)
+    test = model.split["test"]
+    table = error_table(model.predict(ds.inputs[test]), ds.targets()[test], ds.baseline()[test])
+    if as_json:
+        typer.echo(
+            json.dumps(
+                {"test": table, "best_epoch": model.best_epoch, "stop_reason": model.stop_reason}
+            )
+        )
+    else:
+        _print_table(table, len(ds), f"test group ({len(test)} samples)")
+        typer.echo(f"stopped: {model.stop_reason} (best epoch {model.best_epoch})")
+    typer.echo(f"wrote {st} and {js}")
+
+
+@sonar_app.command("evaluate")
+def evaluate_cmd(
+    model_path: Annotated[Path, typer.Argument(help="Checkpoint (.safetensors, .json or stem).")],
+    data: Annotated[Path, typer.Argument(help="Dataset .npz to evaluate on.")],
+    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+) -> None:
+    """Errors (target - output) of a trained network and of the min/argmin baseline."""
+    from uvnav.learning.bpnn import CheckpointError, error_table, load_checkpoint
+
+    try:
+        model = load_checkpoint(model_path)
+    except CheckpointError as exc:
+        _fail(str(exc))
+    ds = _load_dataset(data)
+    if ds.inputs.shape[1] != model.n_inputs:
+        _fail(f"{data}: {ds.inputs.shape[1]} inputs per sample, the model takes {model.n_inputs}")
+    table = error_table(model.predict(ds.inputs), ds.targets(), ds.baseline())
+    if as_json:
+        typer.echo(json.dumps(table))
+    else:
+        _print_table(table, None, f"{data} ({len(ds)} samples)")
+
+
+def _print_table(table: dict[str, Any], n_train: int | None, title: str) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    from uvnav.learning.bpnn import THESIS_ERROR_RANGES
+
+    t = Table(title=f"errors target - output, {title}")
+    for col in ("who", "distance range [m]", "distance MAE [m]", "index range", "index right"):
+        t.add_column(col)
+    for who, row in table.items():
+        d, i = row["distance"], row["index"]
+        t.add_row(
+            who,
+            f"[{d['lo']:.4g}, {d['hi']:.4g}]",
+            f"{d['mae']:.4g}",
+            f"[{i['lo']:.4g}, {i['hi']:.4g}]",
+            f"{row['index_accuracy']:.1%}",
+        )
+    for n, ref in THESIS_ERROR_RANGES.items():
+        if n_train is None or n_train == n:
+            d, i = ref["distance"], ref["index"]
+            t.add_row(f"thesis ({n} samples)", f"[{d[0]}, {d[1]}]", "", f"[{i[0]}, {i[1]}]", "")
+    Console().print(t)
+
+
+@sonar_app.command("simulate")
+def simulate_cmd(
+    scenario: Annotated[
+        str, typer.Argument(help="thesis-ch5-scene1|2|3, random-ch5:<seed>, or a YAML file.")
+    ],
+    locator: Annotated[
+        str, typer.Option(help="geometric, network (needs --model) or oracle.")
+    ] = "",
+    model_path: Annotated[Path | None, typer.Option("--model", help="BPNN checkpoint.")] = None,
+    seed: Annotated[int, typer.Option(min=0, help="Episode seed (sonar noise).")] = 0,
+    noise: Annotated[float | None, typer.Option(min=0.0, help="Override sonar noise [m].")] = None,
+) -> None:
+    """Run zhang2022-uuv3d-v1 on a Chapter 5 scenario and print its metrics as JSON."""
+    from uvnav.bench.reproduce_ch5 import make_locator
+    from uvnav.learning.bpnn import CheckpointError
+    from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
+    from uvnav.scenarios.errors import ScenarioError
+    from uvnav.sim.episode_uuv3d import run_uuv3d_episode
+
+    try:
+        scn = load_ch5_scenario(scenario)
+    except ScenarioError as exc:
+        _fail(str(exc))
+    name = locator or scn.controller.locator
+    try:
+        loc = make_locator(name, model_path)
+    except (CheckpointError, ValueError) as exc:
+        _fail(str(exc))
+    from uvnav.controllers.zhang_uuv3d import ZhangUUV3D, ZhangUUV3DParams
+
+    try:
+        params = ZhangUUV3DParams(**scn.controller.params)  # type: ignore[arg-type]
+    except (TypeError, ValueError) as exc:
+        _fail(f"{scenario}: controller.params: {exc}")
+    ctrl = ZhangUUV3D(params, loc)
+    res = run_uuv3d_episode(build_uuv3d(scn, noise_std=noise), ctrl, np.random.default_rng(seed))
+    out = {
+        "scenario": scn.name,
+        "locator": name,
+        "status": res.status,
+        "entered_inner_space": res.entered_inner_space,
+        **res.metrics.to_dict(),
+    }
+    typer.echo(json.dumps(out))

@@ -1,0 +1,456 @@
+"""Back-propagation neural network that locates the point to evade (thesis Chapter 5, §5.3-5.4).
+
+Reference: Y. Zhang and J. Zhang, "An Obstacle Avoidance Method for Sonar-based Robots Avoiding
+Shape Changeable Obstacles in Underwater Environments", ICCAE 2022; thesis Chapter 5: Fig. 5.1
+(input layer X, one hidden layer, output layer Y, weights W and V), Fig. 5.4 (nine inputs — the
+sonar readings after the adaptive coefficient, eq. (5.8) — and two outputs: the minimum robot-
+obstacle distance and the number of the sensor that achieves it), §5.4 (Matlab Neural Network
+Toolbox: data "divided randomly to three groups, training group, validation group and testing
+group"; training stops "as the network generalization no longer improves").
+
+What is reproduced from the toolbox's defaults (``fitnet``): one hidden layer of 10 tanh
+("tansig") neurons and a linear output layer; inputs and targets scaled to [-1, 1] by the
+training set's min/max ("mapminmax"); a random 70/15/15 division ("dividerand"); early stopping
+after 6 consecutive validation failures ("max_fail"), returning the weights of the best
+validation epoch; errors reported as target - output on each group.  The toolbox trains with
+Levenberg-Marquardt; here the default is full-batch L-BFGS with a strong-Wolfe line search
+(``torch.optim.LBFGS``) — the closest second-order method torch ships, for the same small-data
+regime — and Adam is an option.  Weights are initialised from the caller's
+``numpy.random.Generator`` (Glorot-uniform), so the same seed gives the same network.
+
+Checkpoints are a ``.safetensors`` file of the weights and normalisation arrays plus a ``.json``
+file of the configuration and the training history: loading parses data only and can never
+execute code (a pickle is refused with :class:`CheckpointError`).  The forward pass of a trained
+model is plain numpy (:meth:`TrainedBPNN.predict`), so the navigation law can use it without torch.
+
+torch is imported inside the functions that need it (extra ``learning``), with at most 2 threads.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+from dataclasses import asdict, dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from uvnav.geometry.angles import FloatArray
+
+#: the thesis's reported test-error ranges (target - output), Ch. 5 §5.4
+THESIS_ERROR_RANGES: dict[int, dict[str, tuple[float, float]]] = {
+    50: {"distance": (-1.688, 1.861), "index": (-2.806, 4.454)},
+    150: {"distance": (-0.04884, 0.3578), "index": (-0.08559, 0.1147)},
+}
+MAX_THREADS = 2
+
+
+class CheckpointError(ValueError):
+    """A model file that is not a valid uvnav BPNN checkpoint (one-line message)."""
+
+
+def _torch() -> Any:
+    try:
+        import torch
+    except ImportError as exc:  # pragma: no cover - depends on the environment
+        raise ImportError(
+            "the BPNN needs torch: install the 'learning' extra (pip install 'uvnav[learning]')"
+        ) from exc
+    torch.set_num_threads(min(MAX_THREADS, max(1, torch.get_num_threads())))
+    return torch
+
+
+@dataclass(frozen=True)
+class BPNNConfig:
+    """Network and training settings.
+
+    Attributes:
+        hidden: neurons per hidden layer (thesis Fig. 5.1: one hidden layer; toolbox default 10).
+        optimizer: ``"lbfgs"`` (default, small data) or ``"adam"``.
+        fractions: train/validation/test fractions of the random division (toolbox 0.7/0.15/0.15).
+        max_epochs: largest number of epochs (``lbfgs_iterations`` L-BFGS iterations or one
+            full-batch Adam step each).
+        max_fail: consecutive validation failures that stop training (toolbox 6).
+        learning_rate: Adam step size (L-BFGS uses 1 with a line search).
+        weight_decay: L2 penalty on the weights (0: none, as the toolbox).
+        residual: learn the correction to a per-sample ``offset`` (the min/argmin of the raw
+            readings) instead of the outputs themselves; the output layer starts at zero, so the
+            untrained network *is* the baseline (not in the thesis; off by default).
+        lbfgs_iterations: L-BFGS iterations per epoch (validation is checked once per epoch; one
+            toolbox Levenberg-Marquardt epoch moves about as far as several L-BFGS iterations).
+    """
+
+    hidden: tuple[int, ...] = (10,)
+    optimizer: str = "lbfgs"
+    fractions: tuple[float, float, float] = (0.7, 0.15, 0.15)
+    max_epochs: int = 1000
+    max_fail: int = 6
+    learning_rate: float = 1e-2
+    weight_decay: float = 0.0
+    residual: bool = False
+    lbfgs_iterations: int = 10
+
+    def __post_init__(self) -> None:
+        if self.optimizer not in ("lbfgs", "adam"):
+            raise ValueError(f"optimizer must be 'lbfgs' or 'adam' (got {self.optimizer!r})")
+        if not self.hidden or any(int(h) < 1 for h in self.hidden):
+            raise ValueError(f"hidden must list positive layer sizes (got {self.hidden!r})")
+        f = self.fractions
+        if len(f) != 3 or any(x < 0 for x in f) or abs(sum(f) - 1.0) > 1e-9 or f[0] <= 0:
+            raise ValueError(f"fractions must be three numbers >= 0 summing to 1 (got {f!r})")
+        if self.max_epochs < 1 or self.max_fail < 1:
+            raise ValueError("max_epochs and max_fail must be >= 1")
+
+
+def split_indices(
+    n: int, rng: np.random.Generator, fractions: tuple[float, float, float]
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Random train/validation/test division of ``range(n)`` (toolbox ``dividerand``): sizes are
+    rounded so that validation and test each get at least one sample when their fraction > 0."""
+    perm = rng.permutation(n)
+    n_val = max(1, round(fractions[1] * n)) if fractions[1] > 0 else 0
+    n_test = max(1, round(fractions[2] * n)) if fractions[2] > 0 else 0
+    n_train = n - n_val - n_test
+    if n_train < 1:
+        raise ValueError(f"too few samples ({n}) for the division {fractions}")
+    return perm[:n_train], perm[n_train : n_train + n_val], perm[n_train + n_val :]
+
+
+def _minmax(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+    lo, hi = x.min(axis=0), x.max(axis=0)
+    hi = np.where(hi - lo < 1e-12, lo + 1.0, hi)
+    return lo, hi
+
+
+def _scale(x: FloatArray, lo: FloatArray, hi: FloatArray) -> FloatArray:
+    return np.asarray(2.0 * (x - lo) / (hi - lo) - 1.0)
+
+
+def _unscale(y: FloatArray, lo: FloatArray, hi: FloatArray) -> FloatArray:
+    return np.asarray((y + 1.0) * 0.5 * (hi - lo) + lo)
+
+
+@dataclass
+class TrainedBPNN:
+    """A trained network: weights, normalisation, and what happened during training.
+
+    Attributes:
+        config: the settings it was trained with.
+        weights: per layer, ``(W (out, in), b (out,))``.
+        x_lo, x_hi, y_lo, y_hi: min/max scaling of inputs and outputs (training set).
+        history: ``{"train": [...], "val": [...]}`` mean squared error (scaled units) per epoch.
+        best_epoch: epoch whose weights were kept (lowest validation error).
+        stop_reason: why training stopped.
+        split: ``{"train": idx, "val": idx, "test": idx}`` of the division (may be empty).
+    """
+
+    config: BPNNConfig
+    weights: list[tuple[FloatArray, FloatArray]]
+    x_lo: FloatArray
+    x_hi: FloatArray
+    y_lo: FloatArray
+    y_hi: FloatArray
+    history: dict[str, list[float]] = field(default_factory=lambda: {"train": [], "val": []})
+    best_epoch: int = 0
+    stop_reason: str = ""
+    split: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def n_inputs(self) -> int:
+        return int(self.weights[0][0].shape[1])
+
+    def predict(self, inputs: FloatArray, offset: FloatArray | None = None) -> FloatArray:
+        """Outputs (n, 2) — distance [m], sensor index — for inputs (n, 9) or (9,) (numpy only).
+
+        Raises:
+            ValueError: wrong input width, or a residual network without its ``offset`` (n, 2).
+        """
+        x = np.atleast_2d(np.asarray(inputs, dtype=float))
+        if x.shape[1] != self.n_inputs:
+            raise ValueError(f"expected {self.n_inputs} inputs per sample, got {x.shape[1]}")
+        h = _scale(x, self.x_lo, self.x_hi)
+        for k, (w, b) in enumerate(self.weights):
+            h = h @ w.T + b
+            if k < len(self.weights) - 1:
+                h = np.tanh(h)
+        out = _unscale(h, self.y_lo, self.y_hi)
+        if self.config.residual:
+            if offset is None:
+                raise ValueError("a residual network needs the offset (min/argmin of readings)")
+            out = out + np.atleast_2d(np.asarray(offset, dtype=float))
+        return out
+
+
+def _init_weights(
+    sizes: list[int], rng: np.random.Generator
+) -> list[tuple[FloatArray, FloatArray]]:
+    out = []
+    for fan_in, fan_out in itertools.pairwise(sizes):
+        lim = math.sqrt(6.0 / (fan_in + fan_out))
+        out.append((rng.uniform(-lim, lim, (fan_out, fan_in)), np.zeros(fan_out)))
+    return out
+
+
+def train_bpnn(
+    inputs: FloatArray,
+    targets: FloatArray,
+    rng: np.random.Generator,
+    config: BPNNConfig | None = None,
+    *,
+    split: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None,
+    offset: FloatArray | None = None,
+) -> TrainedBPNN:
+    """Train the BPNN on ``inputs`` (n, 9) and ``targets`` (n, 2) with early stopping.
+
+    Args:
+        inputs: adapted sonar readings [m].
+        targets: true distance [m] and sensor index.
+        rng: generator of the division and the initial weights.
+        config: settings (defaults: the toolbox's ``fitnet`` shape, L-BFGS).
+        split: an explicit ``(train, val, test)`` division instead of a random one.
+        offset: (n, 2) per-sample baseline for ``config.residual`` (required then).
+
+    Returns:
+        The network with the weights of its best validation epoch (the last epoch when there is
+        no validation group).
+    """
+    cfg = config or BPNNConfig()
+    torch = _torch()
+    x = np.asarray(inputs, dtype=float)
+    y = np.asarray(targets, dtype=float)
+    if x.ndim != 2 or y.ndim != 2 or len(x) != len(y):
+        raise ValueError(f"inputs (n, k) and targets (n, m) must match (got {x.shape}, {y.shape})")
+    if cfg.residual:
+        if offset is None:
+            raise ValueError("residual training needs the per-sample offset (n, 2)")
+        y = y - np.asarray(offset, dtype=float)
+    tr, va, te = split if split is not None else split_indices(len(x), rng, cfg.fractions)
+    x_lo, x_hi = _minmax(x[tr])
+    y_lo, y_hi = _minmax(y[tr])
+    xs = torch.as_tensor(_scale(x, x_lo, x_hi), dtype=torch.float64)
+    ys = torch.as_tensor(_scale(y, y_lo, y_hi), dtype=torch.float64)
+    sizes = [x.shape[1], *[int(h) for h in cfg.hidden], y.shape[1]]
+    layers: list[Any] = []
+    init = _init_weights(sizes, rng)
+    if cfg.residual:
+        init[-1] = (np.zeros_like(init[-1][0]), np.zeros_like(init[-1][1]))
+        y_lo, y_hi = -np.abs(y[tr]).max(axis=0) - 1e-6, np.abs(y[tr]).max(axis=0) + 1e-6
+        ys = torch.as_tensor(_scale(y, y_lo, y_hi), dtype=torch.float64)
+    for k, (w, b) in enumerate(init):
+        lin = torch.nn.Linear(w.shape[1], w.shape[0]).double()
+        with torch.no_grad():
+            lin.weight.copy_(torch.as_tensor(w))
+            lin.bias.copy_(torch.as_tensor(b))
+        layers.append(lin)
+        if k < len(sizes) - 2:
+            layers.append(torch.nn.Tanh())
+    net = torch.nn.Sequential(*layers)
+    tr_t, va_t = torch.as_tensor(tr), torch.as_tensor(va)
+    if cfg.optimizer == "lbfgs":
+        opt = torch.optim.LBFGS(
+            net.parameters(),
+            lr=1.0,
+            max_iter=cfg.lbfgs_iterations,
+            history_size=50,
+            line_search_fn="strong_wolfe",
+        )
+    else:
+        opt = torch.optim.Adam(net.parameters(), lr=cfg.learning_rate)
+
+    def loss_on(idx: Any) -> Any:
+        err = net(xs[idx]) - ys[idx]
+        loss = (err * err).mean()
+        if cfg.weight_decay > 0:
+            loss = loss + cfg.weight_decay * sum((p * p).sum() for p in net.parameters())
+        return loss
+
+    def closure() -> Any:
+        opt.zero_grad()
+        loss = loss_on(tr_t)
+        loss.backward()
+        return loss
+
+    history: dict[str, list[float]] = {"train": [], "val": []}
+    best_state = [p.detach().clone() for p in net.parameters()]
+    best_val, best_epoch, fails = math.inf, 0, 0
+    stop = "max_epochs"
+    for epoch in range(1, cfg.max_epochs + 1):
+        opt.step(closure)
+        with torch.no_grad():
+            tl = float(loss_on(tr_t))
+            vl = float(loss_on(va_t)) if len(va) else tl
+        history["train"].append(tl)
+        history["val"].append(vl)
+        if not math.isfinite(tl):
+            stop = "diverged"
+            break
+        if vl < best_val:
+            best_val, best_epoch, fails = vl, epoch, 0
+            best_state = [p.detach().clone() for p in net.parameters()]
+        else:
+            fails += 1
+            if len(va) and fails >= cfg.max_fail:
+                stop = "validation_stop"
+                break
+        if tl < 1e-12:
+            stop = "min_error"
+            break
+    params = [p.numpy().copy() for p in best_state]
+    weights = [(params[2 * i], params[2 * i + 1]) for i in range(len(params) // 2)]
+    return TrainedBPNN(
+        config=cfg,
+        weights=weights,
+        x_lo=x_lo,
+        x_hi=x_hi,
+        y_lo=y_lo,
+        y_hi=y_hi,
+        history=history,
+        best_epoch=best_epoch,
+        stop_reason=stop,
+        split={"train": np.asarray(tr), "val": np.asarray(va), "test": np.asarray(te)},
+    )
+
+
+@dataclass(frozen=True)
+class ErrorSummary:
+    """Errors target - output of one output on one group.
+
+    Attributes:
+        lo, hi: error range (min, max).
+        mae: mean |error|.
+        rmse: root mean square error.
+        n: number of samples.
+    """
+
+    lo: float
+    hi: float
+    mae: float
+    rmse: float
+    n: int
+
+    @staticmethod
+    def of(errors: FloatArray) -> ErrorSummary:
+        e = np.asarray(errors, dtype=float)
+        if e.size == 0:
+            return ErrorSummary(math.nan, math.nan, math.nan, math.nan, 0)
+        return ErrorSummary(
+            float(e.min()),
+            float(e.max()),
+            float(np.abs(e).mean()),
+            float(np.sqrt((e * e).mean())),
+            int(e.size),
+        )
+
+
+def error_table(
+    predicted: FloatArray, targets: FloatArray, baseline: FloatArray | None = None
+) -> dict[str, dict[str, Any]]:
+    """Error summaries (target - output) for distance and index, the network's and the baseline's,
+    plus the rate at which the rounded index is exactly right."""
+    p, t = np.atleast_2d(predicted), np.atleast_2d(targets)
+    out: dict[str, dict[str, Any]] = {}
+    for name, pred in (("network", p), ("baseline", baseline)):
+        if pred is None:
+            continue
+        pr = np.atleast_2d(pred)
+        out[name] = {
+            "distance": asdict(ErrorSummary.of(t[:, 0] - pr[:, 0])),
+            "index": asdict(ErrorSummary.of(t[:, 1] - pr[:, 1])),
+            "index_accuracy": float(np.mean(np.clip(np.rint(pr[:, 1]), 1, 9) == t[:, 1]))
+            if len(pr)
+            else math.nan,
+        }
+    return out
+
+
+# ------------------------------------------------------------------------------------ checkpoints
+
+
+def save_checkpoint(model: TrainedBPNN, path: Path) -> tuple[Path, Path]:
+    """Write ``<path>.safetensors`` (weights, scaling) and ``<path>.json`` (config, history).
+
+    Returns:
+        The two paths written.
+    """
+    from safetensors.numpy import save_file
+
+    base = Path(path)
+    if base.suffix in (".safetensors", ".json"):
+        base = base.with_suffix("")
+    base.parent.mkdir(parents=True, exist_ok=True)
+    tensors = {"x_lo": model.x_lo, "x_hi": model.x_hi, "y_lo": model.y_lo, "y_hi": model.y_hi}
+    for k, (w, b) in enumerate(model.weights):
+        tensors[f"layer{k}.weight"] = np.ascontiguousarray(w)
+        tensors[f"layer{k}.bias"] = np.ascontiguousarray(b)
+    st_path = base.with_suffix(".safetensors")
+    save_file({k: np.asarray(v, dtype=np.float64) for k, v in tensors.items()}, str(st_path))
+    meta = {
+        "format": "uvnav-bpnn-v1",
+        "config": asdict(model.config),
+        "n_layers": len(model.weights),
+        "history": model.history,
+        "best_epoch": model.best_epoch,
+        "stop_reason": model.stop_reason,
+        "split": {k: [int(i) for i in v] for k, v in model.split.items()},
+    }
+    js_path = base.with_suffix(".json")
+    js_path.write_text(json.dumps(meta, indent=1))
+    return st_path, js_path
+
+
+def load_checkpoint(path: Path) -> TrainedBPNN:
+    """Read a checkpoint written by :func:`save_checkpoint` (either file's path, or the stem).
+
+    Only data are parsed (safetensors header + raw arrays, and JSON); nothing is unpickled.
+
+    Raises:
+        CheckpointError: missing file, a file that is not safetensors (e.g. a pickle), or
+            missing/inconsistent arrays — one line naming the file and the problem.
+    """
+    from safetensors import SafetensorError
+    from safetensors.numpy import load_file
+
+    base = Path(path)
+    if base.suffix in (".safetensors", ".json"):
+        base = base.with_suffix("")
+    st_path, js_path = base.with_suffix(".safetensors"), base.with_suffix(".json")
+    for p in (st_path, js_path):
+        if not p.is_file():
+            raise CheckpointError(f"{p}: checkpoint file not found")
+    try:
+        tensors = load_file(str(st_path))
+    except (SafetensorError, OSError, ValueError) as exc:
+        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise CheckpointError(f"{st_path}: not a safetensors checkpoint ({first})") from exc
+    try:
+        meta = json.loads(js_path.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise CheckpointError(f"{js_path}: not valid JSON ({exc.__class__.__name__})") from exc
+    if not isinstance(meta, dict) or meta.get("format") != "uvnav-bpnn-v1":
+        raise CheckpointError(f"{js_path}: field 'format' must be 'uvnav-bpnn-v1'")
+    try:
+        cfg_d = dict(meta["config"])
+        cfg_d["hidden"] = tuple(cfg_d["hidden"])
+        cfg_d["fractions"] = tuple(cfg_d["fractions"])
+        cfg = BPNNConfig(**cfg_d)
+        n_layers = int(meta["n_layers"])
+        weights = [
+            (tensors[f"layer{k}.weight"], tensors[f"layer{k}.bias"]) for k in range(n_layers)
+        ]
+        scal = {k: tensors[k] for k in ("x_lo", "x_hi", "y_lo", "y_hi")}
+    except (KeyError, TypeError, ValueError) as exc:
+        raise CheckpointError(f"{base}: incomplete checkpoint ({exc})") from exc
+    for k in range(1, n_layers):
+        if weights[k][0].shape[1] != weights[k - 1][0].shape[0]:
+            raise CheckpointError(f"{st_path}: layer{k}.weight does not fit layer{k - 1}")
+    return TrainedBPNN(
+        config=cfg,
+        weights=weights,
+        history=dict(meta.get("history", {})),
+        best_epoch=int(meta.get("best_epoch", 0)),
+        stop_reason=str(meta.get("stop_reason", "")),
+        split={k: np.asarray(v, dtype=np.int64) for k, v in dict(meta.get("split", {})).items()},
+        **scal,
+    )

@@ -1,0 +1,64 @@
+"""``uvnav sonar``: dataset -> train -> evaluate, simulate, and one-line errors with status 2."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+pytest.importorskip("torch")
+
+from uvnav.cli.app import app
+
+runner = CliRunner()
+
+
+def test_dataset_train_evaluate(tmp_path: Path) -> None:
+    data = tmp_path / "d.npz"
+    r = runner.invoke(
+        app,
+        ["sonar", "dataset", "-n", "30", "--seed", "1", "--subdivisions", "1", "--out", str(data)],
+    )
+    assert r.exit_code == 0, r.output
+    assert data.is_file() and "30 samples" in r.output
+    model = tmp_path / "m"
+    r = runner.invoke(
+        app, ["sonar", "train", str(data), "--out", str(model), "--max-epochs", "5", "--json"]
+    )
+    assert r.exit_code == 0, r.output
+    first = json.loads(r.output.splitlines()[0])
+    assert set(first["test"]) == {"network", "baseline"}
+    assert (tmp_path / "m.safetensors").is_file() and (tmp_path / "m.json").is_file()
+    r = runner.invoke(
+        app, ["sonar", "evaluate", str(tmp_path / "m.safetensors"), str(data), "--json"]
+    )
+    assert r.exit_code == 0, r.output
+    table = json.loads(r.output)
+    assert table["network"]["distance"]["n"] == 30
+
+
+def test_bad_inputs_are_one_line_errors(tmp_path: Path) -> None:
+    junk = tmp_path / "junk.npz"
+    junk.write_text("not a zip")
+    for args in (
+        ["sonar", "train", str(tmp_path / "missing.npz")],
+        ["sonar", "train", str(junk)],
+        ["sonar", "evaluate", str(tmp_path / "nomodel"), str(junk)],
+        ["sonar", "simulate", "random-ch5:x"],
+        ["sonar", "simulate", "thesis-ch5-scene1", "--locator", "network"],
+    ):
+        r = runner.invoke(app, args)
+        assert r.exit_code == 2, (args, r.output)
+        lines = [ln for ln in r.output.splitlines() if ln.strip()]
+        assert len(lines) == 1 and lines[0].startswith("error: "), r.output
+        assert "Traceback" not in r.output
+
+
+@pytest.mark.slow
+def test_simulate_prints_metrics(tmp_path: Path) -> None:
+    r = runner.invoke(app, ["sonar", "simulate", "thesis-ch5-scene1"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.output)
+    assert out["status"] == "success" and out["success"] is True

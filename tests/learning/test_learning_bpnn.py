@@ -1,0 +1,116 @@
+"""BPNN (thesis Ch. 5 Figs. 5.1/5.4): training with early stopping, safe checkpoints."""
+
+from __future__ import annotations
+
+import pickle
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+pytest.importorskip("torch")
+pytest.importorskip("safetensors")
+
+from uvnav.learning.bpnn import (
+    BPNNConfig,
+    CheckpointError,
+    error_table,
+    load_checkpoint,
+    save_checkpoint,
+    split_indices,
+    train_bpnn,
+)
+from uvnav.sensors.sonar_dataset import SonarDataset, sample_sonar_dataset
+
+
+@pytest.fixture(scope="module")
+def data() -> tuple[SonarDataset, SonarDataset]:
+    return (
+        sample_sonar_dataset(120, np.random.default_rng(1), subdivisions=1),
+        sample_sonar_dataset(100, np.random.default_rng(2), subdivisions=1),
+    )
+
+
+def test_split_is_random_disjoint_and_complete() -> None:
+    tr, va, te = split_indices(50, np.random.default_rng(0), (0.7, 0.15, 0.15))
+    assert (len(tr), len(va), len(te)) == (34, 8, 8)
+    assert sorted(np.concatenate([tr, va, te]).tolist()) == list(range(50))
+
+
+def test_network_learns_a_smooth_map_far_below_its_initial_error() -> None:
+    rng = np.random.default_rng(0)
+    x = rng.uniform(0, 5, (120, 9))
+    y = np.stack([x.min(axis=1) * 0 + np.sin(x[:, 0]) + x[:, 1], x[:, 2] * 0.5], axis=1)
+    m = train_bpnn(x, y, np.random.default_rng(1), BPNNConfig(hidden=(10,), max_epochs=20))
+    err = np.abs(m.predict(x) - y).mean()
+    assert err < 0.05 * np.abs(y - y.mean(axis=0)).mean()
+    assert m.stop_reason in ("validation_stop", "max_epochs", "min_error")
+    assert 1 <= m.best_epoch <= len(m.history["val"])
+    # the kept weights are those of the best validation epoch
+    assert min(m.history["val"]) == pytest.approx(m.history["val"][m.best_epoch - 1])
+
+
+def test_same_seed_same_network(data: tuple[SonarDataset, SonarDataset]) -> None:
+    ds, _ = data
+    a = train_bpnn(ds.inputs, ds.targets(), np.random.default_rng(5), BPNNConfig(max_epochs=5))
+    b = train_bpnn(ds.inputs, ds.targets(), np.random.default_rng(5), BPNNConfig(max_epochs=5))
+    np.testing.assert_array_equal(a.predict(ds.inputs), b.predict(ds.inputs))
+
+
+def test_residual_network_beats_the_min_argmin_baseline_on_distance(
+    data: tuple[SonarDataset, SonarDataset],
+) -> None:
+    ds, test = data
+    cfg = BPNNConfig(residual=True)
+    m = train_bpnn(ds.inputs, ds.targets(), np.random.default_rng(0), cfg, offset=ds.baseline())
+    table = error_table(m.predict(test.inputs, test.baseline()), test.targets(), test.baseline())
+    assert table["network"]["distance"]["mae"] < table["baseline"]["distance"]["mae"]
+    with pytest.raises(ValueError, match="offset"):
+        m.predict(test.inputs)
+
+
+def test_adam_option_trains(data: tuple[SonarDataset, SonarDataset]) -> None:
+    ds, _ = data
+    m = train_bpnn(
+        ds.inputs,
+        ds.targets(),
+        np.random.default_rng(0),
+        BPNNConfig(optimizer="adam", max_epochs=50, learning_rate=0.05),
+    )
+    assert m.history["train"][-1] < m.history["train"][0]
+    with pytest.raises(ValueError, match="optimizer"):
+        BPNNConfig(optimizer="sgd")
+
+
+def test_checkpoint_round_trip(tmp_path: Path, data: tuple[SonarDataset, SonarDataset]) -> None:
+    ds, _ = data
+    m = train_bpnn(ds.inputs, ds.targets(), np.random.default_rng(0), BPNNConfig(max_epochs=5))
+    st, js = save_checkpoint(m, tmp_path / "net")
+    assert st.suffix == ".safetensors" and js.suffix == ".json"
+    back = load_checkpoint(st)
+    np.testing.assert_array_equal(back.predict(ds.inputs), m.predict(ds.inputs))
+    assert back.config == m.config
+    np.testing.assert_array_equal(back.split["test"], m.split["test"])
+
+
+class _Evil:
+    def __reduce__(self):  # type: ignore[no-untyped-def]
+        return (Path.touch, (Path(self.marker),))  # type: ignore[attr-defined]
+
+
+def test_a_malicious_pickle_is_refused_and_never_runs(tmp_path: Path) -> None:
+    marker = tmp_path / "pwned"
+    evil = _Evil()
+    evil.marker = str(marker)  # type: ignore[attr-defined]
+    payload = pickle.dumps(evil)
+    # sanity: unpickling it WOULD run code
+    pickle.loads(payload)
+    assert marker.exists()
+    marker.unlink()
+    (tmp_path / "model.safetensors").write_bytes(payload)
+    (tmp_path / "model.json").write_text('{"format": "uvnav-bpnn-v1"}')
+    with pytest.raises(CheckpointError, match="not a safetensors checkpoint"):
+        load_checkpoint(tmp_path / "model.safetensors")
+    assert not marker.exists()
+    with pytest.raises(CheckpointError, match="not found"):
+        load_checkpoint(tmp_path / "missing")

@@ -1,0 +1,61 @@
+"""Chapter 5 scenarios: built-ins, one-line errors, the seeded random generator."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from uvnav.scenarios.ch5 import (
+    build_uuv3d,
+    list_ch5_builtin,
+    load_ch5_scenario,
+    random_ch5_scenario,
+)
+from uvnav.scenarios.errors import ScenarioError
+
+
+def test_builtins_are_the_three_thesis_scenes() -> None:
+    assert list_ch5_builtin() == ["thesis-ch5-scene1", "thesis-ch5-scene2", "thesis-ch5-scene3"]
+    counts = [len(load_ch5_scenario(n).obstacles) for n in list_ch5_builtin()]
+    assert counts == [1, 1, 2]
+    s2 = build_uuv3d(load_ch5_scenario("thesis-ch5-scene2"))
+    body = s2.obstacles[0]
+    assert body.inner_space is not None
+    # the slot is narrower than the vehicle
+    assert 2 * body.inner_space[2][1] < 2 * s2.spec.radius
+
+
+def test_bad_field_is_one_line_naming_file_and_field(tmp_path: Path) -> None:
+    f = tmp_path / "bad.yaml"
+    f.write_text("name: x\nrobot: {start: [0,0,0], heading: [1,0,0], goal: [9,0,0], v_max: -1}\n")
+    with pytest.raises(ScenarioError) as exc:
+        load_ch5_scenario(str(f))
+    msg = str(exc.value)
+    assert "\n" not in msg and "bad.yaml" in msg and "robot.v_max" in msg
+    f.write_text(
+        "name: x\nrobot: {start: [0,0,0], heading: [1,0,0], goal: [9,0,0]}\n"
+        "obstacles: [{type: star, centre: [1,1,1], base_radius: 1, delta_max: 0.5}]\n"
+    )
+    with pytest.raises(ScenarioError, match=r"obstacles\.0\.delta_max"):
+        load_ch5_scenario(str(f))
+    with pytest.raises(ScenarioError, match="seed"):
+        load_ch5_scenario("random-ch5:x")
+    with pytest.raises(ScenarioError, match="no such file"):
+        load_ch5_scenario("nope.yaml")
+
+
+def test_random_generator_is_seeded_and_within_assumptions() -> None:
+    for seed in range(15):
+        a = random_ch5_scenario(seed)
+        assert a == random_ch5_scenario(seed)
+        assert a == load_ch5_scenario(f"random-ch5:{seed}")
+        goal = np.asarray(a.robot.goal)
+        centres = [np.asarray(o.centre) for o in a.obstacles]
+        assert 1 <= len(centres) <= 3
+        for i, c in enumerate(centres):
+            assert np.linalg.norm(c) > 5 and np.linalg.norm(goal - c) > 5
+            for d in centres[i + 1 :]:
+                assert np.linalg.norm(c - d) >= 12.0
+    assert random_ch5_scenario(1) != random_ch5_scenario(2)

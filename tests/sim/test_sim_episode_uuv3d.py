@@ -1,0 +1,42 @@
+"""The Chapter 5 loop on the thesis scenes (Fig. 5.3): reach B, no collision, never in Scene 2's
+narrow inner space."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from uvnav.controllers.zhang_uuv3d import GeometricLocator, OracleLocator, ZhangUUV3D
+from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
+from uvnav.sim.episode_uuv3d import run_uuv3d_episode
+from uvnav.sim.metrics import METRIC_NAMES
+
+
+@pytest.mark.parametrize("scene", ["thesis-ch5-scene1", "thesis-ch5-scene2"])
+def test_thesis_scene_reached_without_collision(scene: str) -> None:
+    setup = build_uuv3d(load_ch5_scenario(scene))
+    res = run_uuv3d_episode(
+        setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(0), record=True
+    )
+    m = res.metrics
+    assert res.status == "success", res.status
+    assert m.success and not m.collision
+    assert m.min_clearance is not None and m.min_clearance > 0.2
+    assert not res.entered_inner_space
+    assert m.limit_violations == 0
+    assert m.mode_switches >= 2  # it did avoid (M1 -> M2 -> M1)
+    assert 1.0 <= m.detour_ratio < 1.3
+    assert set(m.to_dict()) == set(METRIC_NAMES)
+    assert "M2" in res.modes
+
+
+@pytest.mark.slow
+def test_scene3_with_the_oracle_and_noise_is_deterministic() -> None:
+    setup = build_uuv3d(load_ch5_scenario("thesis-ch5-scene3"), noise_std=0.05)
+    a = run_uuv3d_episode(setup, ZhangUUV3D(None, OracleLocator()), np.random.default_rng(4))
+    assert a.metrics.success
+    setup = build_uuv3d(load_ch5_scenario("thesis-ch5-scene3"), noise_std=0.05)
+    b = run_uuv3d_episode(setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(4))
+    c = run_uuv3d_episode(setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(4))
+    assert b.metrics.success
+    assert b.metrics.path_length == c.metrics.path_length
