@@ -56,6 +56,9 @@ class ControllerInfo:
     reference: str = ""
     #: obstacles must be slower than the robot for the law's guarantees (thesis (2.6)).
     requires_slower_obstacles: bool = False
+    #: the observation the law reads: ``"exact"`` (range-limited exact readings, Ch. 2/3) or a
+    #: sensor model's name (``"sonar-array"`` for the Ch. 5 nine-beam array)
+    sensing: str = "exact"
 
 
 _REGISTRY: dict[str, ControllerInfo] = {}

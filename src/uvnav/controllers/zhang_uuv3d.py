@@ -356,5 +356,6 @@ register3d(
         summary="Thesis Ch. 5: sonar array + located point (BPNN or min/argmin), forecast-sphere "
         "tangent avoidance in the plane through the vehicle, B and the point",
         reference="Y. Zhang, J. Zhang, ICCAE 2022; thesis Ch. 5 (and Ch. 4 §4.3)",
+        sensing="sonar-array",
     )
 )

@@ -126,7 +126,8 @@ class SphereBody:
         return 4.0 / 3.0 * math.pi * self.radius**3
 
     def nearest_body(self, p: FloatArray) -> tuple[FloatArray, float]:
-        n = math.sqrt(float(p @ p))
+        # hypot, not sqrt(p @ p): the squares of tiny coordinates underflow to subnormals
+        n = math.hypot(float(p[0]), float(p[1]), float(p[2]))
         direction = p / n if n > 0 else np.array([1.0, 0.0, 0.0])
         return direction * self.radius, n - self.radius
 
