@@ -82,5 +82,6 @@ def test_narrow_mouth_is_closed_and_wide_one_is_not() -> None:
     assert np.all(ids[seen] == 0)
     wide, _ = close_narrow_openings(r.origin, r.angles, r.ranges, r.hit_ids, width=0.2)
     # a vehicle narrower than the mouth could enter: the beams through it are left alone
-    assert np.array_equal(wide[inside], r.ranges[inside])
+    deep = inside & (r.ranges > 3.5)
+    assert deep.sum() >= 3 and np.all(wide[deep] > 3.5)
     assert np.allclose(wide, r.ranges, atol=0.05)
