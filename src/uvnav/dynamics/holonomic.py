@@ -27,8 +27,8 @@ How (4.4)-(4.6) are read (docs/thesis-notes.md, Chapter 4):
 * Integration is exact for piecewise-constant commands (straight motion at constant velocity).
 
 The simulator clips nothing silently: :meth:`HolonomicCommand.violates` counts commands outside the
-limits and :meth:`HolonomicCommand.clipped` saturates them (the turn to U_max T, then each
-component to the box).
+limits and :meth:`HolonomicCommand.clipped` saturates them (the turn to U_max T, then the speed to
+the box along the new direction).
 """
 
 from __future__ import annotations
@@ -86,20 +86,24 @@ class HolonomicCommand:
         return turn > spec.u_max * period + 1e-9
 
     def clipped(self, spec: HolonomicSpec, heading: float, period: float) -> HolonomicCommand:
-        """The command saturated: its direction turned to within U_max ``period`` of ``heading``
-        (speed kept), then each component clipped to [-V_max, V_max]; non-finite -> 0."""
+        """The command saturated: its direction turned to within U_max ``period`` of ``heading``,
+        then its speed reduced to the box bound along that direction; non-finite -> 0."""
         vx, vy = float(self.vx), float(self.vy)
         if not (math.isfinite(vx) and math.isfinite(vy)):
             return HolonomicCommand(0.0, 0.0)
         s = math.hypot(vx, vy)
-        if s > SPEED_EPS:
-            err = wrap_scalar(math.atan2(vy, vx) - heading)
-            lim = spec.u_max * period
-            if abs(err) > lim:
-                ang = heading + math.copysign(lim, err)
-                vx, vy = s * math.cos(ang), s * math.sin(ang)
+        if s <= SPEED_EPS:
+            return HolonomicCommand(0.0, 0.0)
+        ang = math.atan2(vy, vx)
+        err = wrap_scalar(ang - heading)
+        lim = spec.u_max * period
+        if abs(err) > lim:
+            ang = heading + math.copysign(lim, err)
+        s = min(s, max_speed_along(ang, spec.v_max))
         vm = float(spec.v_max)
-        return HolonomicCommand(min(max(vx, -vm), vm), min(max(vy, -vm), vm))
+        cx = min(max(s * math.cos(ang), -vm), vm)  # guards the last ulp
+        cy = min(max(s * math.sin(ang), -vm), vm)
+        return HolonomicCommand(cx, cy)
 
 
 def max_speed_along(angle: float, v_max: float) -> float:
