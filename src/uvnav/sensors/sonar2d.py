@@ -249,3 +249,32 @@ def close_narrow_openings(
     out_r[closed] = clip[closed]
     out_id[closed] = hit_ids[idx[ii][src[closed]]]
     return out_r, out_id
+
+
+@dataclass(frozen=True)
+class SonarObservation:
+    """Everything a Chapter-4 UUV law may use at one decision time.
+
+    Attributes:
+        time: simulation time [s].
+        pose: the vehicle's own ``[x, y, theta]`` ([m], [m], [rad]).
+        velocity: the velocity command being applied [m/s], (2,).
+        goal: the end point E [m], (2,).
+        sonar: the sweep taken now.
+        period: the decision period T [s].
+    """
+
+    time: float
+    pose: FloatArray
+    velocity: FloatArray
+    goal: FloatArray
+    sonar: SonarReading
+    period: float
+
+    @property
+    def position(self) -> FloatArray:
+        return self.pose[:2]
+
+    @property
+    def heading(self) -> float:
+        return float(self.pose[2])
