@@ -18,8 +18,10 @@ The thesis gives the idea, not the update rule.  This implementation:
 * **Forgetting.** Every sweep multiplies all counts by ``decay`` (exponential forgetting, so the
   map follows a shape that changes), and squares the beams saw *free* (strictly before the
   return, up to one square short of it) lose ``free_weight`` (floored at 0).  Both are
-  vectorised: one ``np.add.at``-free pass with ``np.unique`` on the flat indices, no per-square
-  Python loop.
+  vectorised, with no per-square Python loop: the decay is a scalar gain g = decay^n kept beside
+  the stored array (true count = stored * g; an update adds w / g), folded back into the array
+  when g falls below 1e-12, so a sweep costs O(beams x range / cell), not O(grid); squares hit
+  several times in one sweep are written by one buffered fancy assignment, so each changes once.
 * **r_imin.** The centre of the nearest square whose count reaches ``threshold``
   (:meth:`AmapsGrid.nearest`), searched in a window around the vehicle only.
 
@@ -46,6 +48,8 @@ class AmapsConfig:
         hit_weight: count added to a square seen covered in one sweep.
         free_weight: count removed from a square seen free in one sweep.
         hit_depth: depth [m] behind a return that is marked covered.
+        free_step: spacing of the free-space samples along a beam, in squares (1: a square may
+            be skipped where a beam only clips its corner, which only delays its clearing).
     """
 
     cell: float = 0.05
@@ -54,6 +58,7 @@ class AmapsConfig:
     hit_weight: float = 1.0
     free_weight: float = 0.35
     hit_depth: float = 0.1
+    free_step: float = 1.0
 
     def __post_init__(self) -> None:
         if not (self.cell > 0):
@@ -62,6 +67,8 @@ class AmapsConfig:
             raise ValueError(f"decay must be in (0, 1] (got {self.decay})")
         if not (self.threshold > 0 and self.hit_weight > 0):
             raise ValueError("threshold and hit_weight must be > 0")
+        if not (0 < self.free_step <= 2):
+            raise ValueError(f"free_step must be in (0, 2] squares (got {self.free_step})")
         if self.free_weight < 0 or self.hit_depth < 0:
             raise ValueError("free_weight and hit_depth must be >= 0")
 
@@ -82,7 +89,8 @@ class AmapsGrid:
         self.x0 = float(origin[0])
         self.y0 = float(origin[1])
         self.nx, self.ny = int(shape[0]), int(shape[1])
-        self.counts = np.zeros((self.ny, self.nx), dtype=np.float32)
+        self._stored = np.zeros((self.ny, self.nx), dtype=np.float32)
+        self._gain = 1.0
         self.labels = np.full((self.ny, self.nx), -1, dtype=np.int16)
         self.updates = 0
 
@@ -97,9 +105,14 @@ class AmapsGrid:
         return cls((float(lo[0]), float(lo[1])), (int(n[0]), int(n[1])), config)
 
     @property
+    def counts(self) -> FloatArray:
+        """(ny, nx) coverage counts (a new array)."""
+        return np.asarray(self._stored * np.float32(self._gain), dtype=float)
+
+    @property
     def nbytes(self) -> int:
         """Memory held by the grid arrays [bytes]."""
-        return int(self.counts.nbytes + self.labels.nbytes)
+        return int(self._stored.nbytes + self.labels.nbytes)
 
     def cell_of(self, points: FloatArray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """Column, row and inside-the-grid flag of each point (N, 2)."""
@@ -134,7 +147,11 @@ class AmapsGrid:
         cfg = self.config
         h = cfg.cell
         if cfg.decay < 1.0:
-            self.counts *= np.float32(cfg.decay)
+            self._gain *= cfg.decay
+            if self._gain < 1e-12:
+                self._stored *= np.float32(self._gain)
+                self._gain = 1.0
+        inv = 1.0 / self._gain
         ok = np.isfinite(ranges)
         ang = np.asarray(angles, dtype=float)[ok]
         rr = np.asarray(ranges, dtype=float)[ok]
@@ -142,19 +159,21 @@ class AmapsGrid:
         dirs = np.stack([np.cos(ang), np.sin(ang)], axis=-1)
         o = np.asarray(origin, dtype=float)
         step = 0.5 * h
-        flat_n = self.nx * self.ny
-        # free space: samples every h/2 from 0 to one square short of the return
+        view = self._stored.reshape(self.nx * self.ny)
+        # free space: samples every ``free_step`` from 0 to one square short of the return
         if cfg.free_weight > 0 and len(rr):
-            n_s = int(np.ceil(float(rr.max()) / step)) + 1
-            s = np.arange(n_s) * step  # (S,)
+            fs = cfg.free_step * h
+            n_s = int(np.ceil(float(rr.max()) / fs)) + 1
+            s = np.arange(n_s) * fs  # (S,)
             limit = np.where(ids >= 0, rr - h, rr)  # (B,)
-            mask = s[None, :] < limit[:, None]
-            pts = o + (s[None, :, None] * dirs[:, None, :])[mask]
-            c, r, inside = self.cell_of(pts)
-            flat = np.unique(r[inside] * self.nx + c[inside])
+            bi, si = np.nonzero(s[None, :] < limit[:, None])
+            c = np.floor((o[0] - self.x0 + s[si] * dirs[bi, 0]) / h).astype(np.intp)
+            r = np.floor((o[1] - self.y0 + s[si] * dirs[bi, 1]) / h).astype(np.intp)
+            inside = (c >= 0) & (c < self.nx) & (r >= 0) & (r < self.ny)
+            flat = r[inside] * self.nx + c[inside]
             if len(flat):
-                view = self.counts.reshape(flat_n)
-                view[flat] = np.maximum(view[flat] - np.float32(cfg.free_weight), 0.0)
+                # duplicates read the same old value and write the same new one: once each
+                view[flat] = np.maximum(view[flat] - np.float32(cfg.free_weight * inv), 0.0)
         # covered: from the return to hit_depth behind it
         hit = ids >= 0
         if np.any(hit):
@@ -164,10 +183,8 @@ class AmapsGrid:
             lab = np.repeat(ids[hit], n_d)
             c, r, inside = self.cell_of(pts.reshape(-1, 2))
             flat = r[inside] * self.nx + c[inside]
-            flat, first = np.unique(flat, return_index=True)
-            view = self.counts.reshape(flat_n)
-            view[flat] += np.float32(cfg.hit_weight)
-            self.labels.reshape(flat_n)[flat] = lab[inside][first].astype(np.int16)
+            view[flat] += np.float32(cfg.hit_weight * inv)  # buffered: +w once per square
+            self.labels.reshape(self.nx * self.ny)[flat] = lab[inside].astype(np.int16)
         self.updates += 1
 
     # -------------------------------------------------------------------------------- queries
@@ -184,8 +201,8 @@ class AmapsGrid:
         ``point`` (count >= threshold)."""
         p = np.asarray(point, dtype=float)
         rs, cs = self._window(p, radius)
-        sub = self.counts[rs, cs]
-        rows, cols = np.nonzero(sub >= self.config.threshold)
+        sub = self._stored[rs, cs]
+        rows, cols = np.nonzero(sub >= np.float32(self.config.threshold / self._gain))
         rows = rows + rs.start
         cols = cols + cs.start
         centres = self.centre_of(cols, rows)
