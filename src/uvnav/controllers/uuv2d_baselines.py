@@ -14,7 +14,9 @@
 Neither existing law is changed.  The adapter gives it a
 :class:`~uvnav.dynamics.UnicycleSpec` with the UUV's V_max and U_max and turns its (V, u) command
 into a velocity along theta + u T (T the decision period): |u| <= U_max keeps the turn bound (4.6)
-and V <= V_max keeps the box (4.4)-(4.5) in every direction.
+and V <= V_max keeps the box (4.4)-(4.5) in every direction.  A turn on the spot (V = 0, u != 0)
+becomes a creep at 0.1 % of V_max along the new direction, since the UUV's orientation is that of
+its velocity (:mod:`uvnav.dynamics.holonomic`).
 """
 
 from __future__ import annotations
@@ -37,6 +39,8 @@ from uvnav.sensors.observation import Observation, ObstacleReading
 from uvnav.sensors.sonar2d import SonarObservation, close_narrow_openings
 
 _SECTORS = 72
+#: fraction of V_max used to turn on the spot (the orientation follows the velocity)
+_CREEP = 1e-3
 
 
 def reading_from_points(
@@ -128,6 +132,10 @@ class _UnicycleOnUuv:
         u = float(cmd.u) if math.isfinite(cmd.u) else 0.0
         u = max(-self._spec.u_max, min(self._spec.u_max, u))
         ang = obs.heading + u * obs.period
+        if v < _CREEP * self._spec.v_max and u != 0.0:
+            # a unicycle turning on the spot: the UUV's orientation follows its velocity, so it
+            # creeps along the new direction to turn
+            v = _CREEP * self._spec.v_max
         return HolonomicCommand(v * math.cos(ang), v * math.sin(ang))
 
 
