@@ -36,9 +36,11 @@ How the text is read (docs/thesis-notes.md, Chapter 4, gives the reasons at more
    (no tangent) it heads along the limiting direction, the circle's tangent at the vehicle on the
    passing side, tilted outward in proportion to the penetration.
 4. *Switching back.*  "When the vehicle is away from the obstacle" the law returns to target
-   approaching: here, when d_imin > L, or when the straight run of ``2 L`` toward E clears every
-   covered AMAPS square by r_vehicle + margin (following a boundary at clearance below L would
-   otherwise circle a static obstacle for ever).
+   approaching: here, when d_imin > L, or when E lies more than ``leave_angle`` (90 degrees plus
+   a little) from the direction of r_imin (heading for E moves away from the nearest point), or
+   when the straight run of ``2 L`` toward E clears every covered AMAPS square by r_vehicle +
+   margin.  With "d_imin > L" alone, following a boundary at clearance below L would circle a
+   static obstacle for ever.  The tag is re-drawn when r_imin moves to another obstacle.
 5. *Fig. 4.2(b).*  Openings between returns narrower than the vehicle plus ``mouth_margin`` on
    each side are closed before the grid update (:func:`~uvnav.sensors.sonar2d.
    close_narrow_openings`): the inner space behind a narrow entry is marked unsafe and never
@@ -141,6 +143,8 @@ class Zhang2022Params:
         history: most past r_imin kept for (4.11).
         mouth_margin: openings narrower than 2 (r_vehicle + mouth_margin) are closed [m].
         clear_factor: the straight run toward E checked for leaving avoidance is this times L.
+        leave_angle: avoidance also ends while E lies more than this [rad] from the direction
+            of r_imin (heading for E then moves away from it).
     """
 
     switch_distance: float = 1.5
@@ -155,6 +159,7 @@ class Zhang2022Params:
     history: int = 64
     mouth_margin: float = 0.1
     clear_factor: float = 2.0
+    leave_angle: float = 0.5 * math.pi + 0.15
 
     def __post_init__(self) -> None:
         check_params(
@@ -166,6 +171,7 @@ class Zhang2022Params:
                 "threshold",
                 "history",
                 "clear_factor",
+                "leave_angle",
             ),
             non_negative=(
                 "free_weight",
@@ -209,6 +215,7 @@ class Zhang2022Uuv2dController:
         self.grid: AmapsGrid | None = None
         self._count = 0
         self._tag = 0
+        self._label = -1
         self._history: deque[FloatArray] = deque(maxlen=self.params.history + 1)
         self.last: Decision | None = None
 
@@ -223,6 +230,7 @@ class Zhang2022Uuv2dController:
         self.grid = None
         self._count = 0
         self._tag = 0
+        self._label = -1
         self._history.clear()
         self.last = None
 
@@ -272,6 +280,16 @@ class Zhang2022Uuv2dController:
         b = np.broadcast_to(end, centres.shape)
         return bool(points_to_segments(centres, a, b).min() > clearance)
 
+    def _receding(self, position: FloatArray, r_min: FloatArray) -> bool:
+        """True when E lies more than ``leave_angle`` from the direction of r_imin: heading for E
+        then moves away from the nearest covered square."""
+        to_goal = self._goal - position
+        to_near = np.asarray(r_min) - position
+        ang = abs(
+            wrap_scalar(math.atan2(to_goal[1], to_goal[0]) - math.atan2(to_near[1], to_near[0]))
+        )
+        return ang > self.params.leave_angle
+
     def _approach(self, obs: SonarObservation) -> HolonomicCommand:
         to_goal = self._goal - obs.position
         dist = float(np.hypot(*to_goal))
@@ -311,8 +329,9 @@ class Zhang2022Uuv2dController:
         self._history.append(np.array(r_min, dtype=float))
         centres = s.centres
         centre = centres[label] if 0 <= label < len(centres) else r_min
-        if self._count == 1 or self._tag == 0:
+        if self._count == 1 or self._tag == 0 or label != self._label:
             self._tag = self.direction_tag(pos, self._goal, centre)
+            self._label = label
         clearance = self._spec.radius + p.safety_margin
         r_i = self.forecast_radius()
         rho = min(r_i, p.radius_cap) + clearance
@@ -320,7 +339,7 @@ class Zhang2022Uuv2dController:
             obs.time, "M2", d_min, r_min, label, self._tag, self._count, rho, extra={"R_i": r_i}
         )
         self.last = decision
-        if self._path_clear(pos, grid, clearance + p.cell):
+        if self._receding(pos, r_min) or self._path_clear(pos, grid, clearance + p.cell):
             self._mode = "M1"
             decision.mode = "M1"
             return self._approach(obs)
