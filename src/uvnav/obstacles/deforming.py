@@ -104,6 +104,7 @@ class DeformingStar:
         phases: FloatArray | None = None,
         velocity: FloatArray | tuple[float, float] = (0.0, 0.0),
         n_vertices: int = 96,
+        calibrate: bool = True,
     ) -> DeformingStar:
         """A deforming star whose boundary points move at most ``max_rate`` [m/s].
 
@@ -116,6 +117,8 @@ class DeformingStar:
             phases: (K, 2) phases [rad] (default: 0).
             velocity: translation of the mass centre [m/s].
             n_vertices: boundary samples (>= 8).
+            calibrate: False skips the rate calibration (w0 = 1 rad/s, rate *not* bounded): a
+                cheap preview of the shapes for placement tests.
 
         Raises:
             ValueError: invalid area, amplitudes, rate or sample count.
@@ -153,6 +156,8 @@ class DeformingStar:
             velocity=np.asarray(velocity, dtype=float),
             n_vertices=int(n_vertices),
         )
+        if not calibrate:
+            return proto
         peak = proto.peak_phase_speed()
         omega0 = 0.0 if peak <= 0.0 or max_rate == 0.0 else max_rate / (RATE_MARGIN * peak)
         return cls(
@@ -180,6 +185,7 @@ class DeformingStar:
         roughness: float = 0.35,
         velocity: FloatArray | tuple[float, float] = (0.0, 0.0),
         n_vertices: int = 96,
+        calibrate: bool = True,
     ) -> DeformingStar:
         """A random deforming star (seeded): harmonics 2..n_harmonics+1 (harmonic 1 is only a
         shift, which the renormalisation removes), total relative amplitude ``roughness``
@@ -199,6 +205,7 @@ class DeformingStar:
             phases=ph,
             velocity=velocity,
             n_vertices=n_vertices,
+            calibrate=calibrate,
         )
 
     # -------------------------------------------------------------------------------- geometry
@@ -267,10 +274,10 @@ class DeformingStar:
         speed = np.hypot(*(plus - minus).transpose(2, 0, 1)) / (2.0 * h)
         return float(speed.max())
 
-    @property
+    @cached_property
     def bounding_radius(self) -> float:
-        """A radius [m] that contains the body at every time: r0 (1.6) sqrt(A / A_raw,min)."""
-        # r_raw <= 1.6 r0 and A_raw >= pi (0.4 r0)^2 / ... ; use the exact bound from samples.
+        """A radius [m] about the mass centre containing the body at every time: the largest
+        vertex distance over 256 phases of a period, plus 5 % for what lies between them."""
         th = np.linspace(0.0, 2.0 * np.pi, 256, endpoint=False)
         loc = self._normalise(self._raw_at_phase(th))
         return float(np.hypot(loc[..., 0], loc[..., 1]).max()) * 1.05

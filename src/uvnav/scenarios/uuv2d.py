@@ -16,7 +16,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable
-from functools import cache
+from functools import cache, lru_cache
 from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -93,15 +93,37 @@ class DeformingSpec(_Model):
     velocity: Point2 = Field((0.0, 0.0), description="velocity of the mass centre [m/s]")
 
     def to_shape(self) -> DeformingStar:
-        return DeformingStar.random(
-            np.random.default_rng(self.shape_seed),
+        """The body (memoised: the same spec gives the same, immutable, calibrated body)."""
+        return _star(
             self.centre,
             self.area,
-            max_rate=self.max_rate,
-            n_harmonics=self.n_harmonics,
-            roughness=self.roughness,
-            velocity=self.velocity,
+            self.max_rate,
+            self.shape_seed,
+            self.n_harmonics,
+            self.roughness,
+            self.velocity,
         )
+
+
+@lru_cache(maxsize=4096)
+def _star(
+    centre: tuple[float, float],
+    area: float,
+    max_rate: float,
+    seed: int,
+    n_harmonics: int,
+    roughness: float,
+    velocity: tuple[float, float],
+) -> DeformingStar:
+    return DeformingStar.random(
+        np.random.default_rng(seed),
+        centre,
+        area,
+        max_rate=max_rate,
+        n_harmonics=n_harmonics,
+        roughness=roughness,
+        velocity=velocity,
+    )
 
 
 class TrapSpec(_Model):
@@ -226,7 +248,10 @@ def uuv2d_from_dict(data: dict[str, Any], source: str = "<dict>") -> Uuv2dScenar
     try:
         sc = Uuv2dScenario.model_validate(data)
     except ValidationError as exc:
-        raise from_validation_error(exc, source, tags=("deforming", "trap")) from None
+        err = from_validation_error(exc, source)
+        # hide pydantic's discriminator segment: obstacles.0.trap.mouth -> obstacles.0.mouth
+        path = re.sub(r"^(obstacles\.\d+)\.(deforming|trap)(?=\.|$)", r"\1", err.path)
+        raise ScenarioError(source, path, err.problem) from None
     sc._source = source
     return sc
 
@@ -351,8 +376,10 @@ def random_ch4_scenario(
             "max_rate": round(rate, 3),
             "shape_seed": shape_seed,
         }
-        shape = DeformingSpec.model_validate(spec).to_shape()
-        br = shape.bounding_radius
+        # the shape (hence its bounding radius) does not depend on the rate: preview it uncalibrated
+        br = DeformingStar.random(
+            np.random.default_rng(shape_seed), (0.0, 0.0), area, max_rate=rate, calibrate=False
+        ).bounding_radius
         c = np.asarray(spec["centre"], dtype=float)
         if min(np.hypot(*(c - start)), np.hypot(*(c - goal))) - br < 1.5:
             continue
