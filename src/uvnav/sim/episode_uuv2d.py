@@ -78,6 +78,10 @@ class Uuv2dTrajectory:
     commands: FloatArray
     modes: list[str]
     decisions: list[Any]
+    #: the end point E [m]
+    goal: FloatArray = field(default_factory=lambda: np.zeros(2))
+    #: the law's AMAPS grid at the end of the episode (its ``grid`` attribute), if it has one
+    grid: Any = None
 
 
 @dataclass
@@ -260,6 +264,8 @@ def run_uuv2d_episode(
             commands=np.asarray(d_cmds).reshape(-1, 2),
             modes=d_modes,
             decisions=d_records,
+            goal=goal,
+            grid=getattr(controller, "grid", None),
         )
     return Uuv2dResult(
         metrics=metrics,
