@@ -591,6 +591,10 @@ def reproduce(
                     status = str(store.episode_row(eid)["status"])
                     scene_episodes.append(SceneEpisode(s, c, 0, eid, status))
 
+    if n_random is None:  # Chapter 4 (issue 5); tests that shrink the Ch. 2 campaign leave it out
+        from uvnav.bench.reproduce_ch4 import reproduce_ch4
+
+        table = table + reproduce_ch4(results_dir, report_dir, full=full, workers=workers).table
     report_path: Path | None = None
     figures: list[Path] = []
     if render is not None:
