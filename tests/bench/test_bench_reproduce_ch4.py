@@ -16,7 +16,10 @@ from uvnav.sim.metrics import METRIC_NAMES
 
 def test_jobs_are_stored_resumed_and_summarised(tmp_path: Path) -> None:
     out = tmp_path / "ch4" / "episodes.jsonl"
-    jobs = [Ch4Job("random-ch4:1", "zhang2022-uuv2d-v1", 1), Ch4Job("random-ch4:1", "apf-uuv2d-v1", 1)]
+    jobs = [
+        Ch4Job("random-ch4:1", "zhang2022-uuv2d-v1", 1),
+        Ch4Job("random-ch4:1", "apf-uuv2d-v1", 1),
+    ]
     rows = run_jobs(jobs[:1], out)
     assert len(read_rows(out)) == 1 and set(METRIC_NAMES) <= set(rows[0])
     calls = []

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
 from uvnav.controllers.uuv2d_baselines import reading_from_points
+from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
 from uvnav.scenarios.uuv2d import load_uuv2d_scenario
 from uvnav.sim.episode_uuv2d import run_uuv2d_episode
 
@@ -16,8 +16,9 @@ from uvnav.sim.episode_uuv2d import run_uuv2d_episode
 @pytest.mark.parametrize("name", ["apf-uuv2d-v1", "zhang2019-uuv2d-v1"])
 def test_baseline_runs_within_the_limits_and_avoids_the_fig_4_7_obstacle(name: str) -> None:
     sc = load_uuv2d_scenario("thesis-ch4-fig4-7-approach")
-    res = run_uuv2d_episode(sc.to_setup(), make_uuv2d_controller(name), np.random.default_rng(0),
-                            record=False)
+    res = run_uuv2d_episode(
+        sc.to_setup(), make_uuv2d_controller(name), np.random.default_rng(0), record=False
+    )
     assert res.metrics.limit_violations == 0
     assert res.status == "success"
     assert res.metrics.min_clearance is not None and res.metrics.min_clearance > 0

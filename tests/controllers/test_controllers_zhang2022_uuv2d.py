@@ -113,7 +113,9 @@ def test_fig_4_7_target_approaching_for_t_0_to_4() -> None:
     sc = load_uuv2d_scenario("thesis-ch4-fig4-7-approach")
     setup = sc.to_setup()
     setup.t_max = 4.2
-    res = run_uuv2d_episode(setup, make_uuv2d_controller(sc.controller.name), np.random.default_rng(0))
+    res = run_uuv2d_episode(
+        setup, make_uuv2d_controller(sc.controller.name), np.random.default_rng(0)
+    )
     tr = res.trajectory
     assert tr is not None and res.status == "timeout"
     early = tr.decision_times <= 4.0 + 1e-9

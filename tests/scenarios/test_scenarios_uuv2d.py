@@ -29,12 +29,15 @@ def test_builtins_are_listed() -> None:
     assert list_uuv2d_builtin() == THESIS
 
 
-@pytest.mark.parametrize("name", ["thesis-ch4-fig4-2b-trap", "thesis-ch4-fig4-7-approach",
-                                  "thesis-ch4-fig4-9-whole-run"])
+@pytest.mark.parametrize(
+    "name", ["thesis-ch4-fig4-2b-trap", "thesis-ch4-fig4-7-approach", "thesis-ch4-fig4-9-whole-run"]
+)
 def test_thesis_scene_is_collision_free_and_reaches_e(name: str) -> None:
     sc = load_uuv2d_scenario(name)
     res = run_uuv2d_episode(
-        sc.to_setup(), make_uuv2d_controller(sc.controller.name), np.random.default_rng(0),
+        sc.to_setup(),
+        make_uuv2d_controller(sc.controller.name),
+        np.random.default_rng(0),
         record=False,
     )
     assert res.status == "success"
@@ -51,8 +54,9 @@ def test_trap_scene_is_a_real_trap_and_is_never_entered() -> None:
     # the straight run from I to E crosses the inner space through the mouth
     inner = setup.forbidden[0]
     assert np.hypot(*(inner.mean(axis=0) - np.array([5.0, 5.0]))) < 1e-9
-    res = run_uuv2d_episode(setup, make_uuv2d_controller("zhang2022-uuv2d-v1"),
-                            np.random.default_rng(1))
+    res = run_uuv2d_episode(
+        setup, make_uuv2d_controller("zhang2022-uuv2d-v1"), np.random.default_rng(1)
+    )
     assert res.trajectory is not None
     poses = res.trajectory.poses[:, :2]
     # never inside the inner disc (radius 1.1 about (5, 5)), not even its mouth
@@ -84,16 +88,43 @@ def test_generator_is_seeded_and_keeps_the_assumptions() -> None:
     ("data", "where"),
     [
         ({"kind": "uuv2d", "name": "x"}, "vehicle"),
-        ({"kind": "uuv2d", "name": "x", "vehicle": {"start": [0, 0], "goal": [1, 1],
-          "v_max": -1, "u_max": 1}}, "vehicle.v_max"),
-        ({"kind": "uuv2d", "name": "x", "vehicle": {"start": [0, 0], "goal": [5, 5],
-          "v_max": 1, "u_max": 1}, "obstacles": [{"type": "deforming", "centre": [0, 0],
-          "area": 1.0, "max_rate": 0.1}]}, "vehicle.start"),
-        ({"kind": "uuv2d", "name": "x", "speed": 3, "vehicle": {"start": [0, 0],
-          "goal": [5, 5], "v_max": 1, "u_max": 1}}, "speed"),
-        ({"kind": "uuv2d", "name": "x", "vehicle": {"start": [0, 0], "goal": [5, 5],
-          "v_max": 1, "u_max": 1}, "obstacles": [{"type": "trap", "centre": [3, 3],
-          "mouth": 5.0}]}, "obstacles.0.mouth"),
+        (
+            {
+                "kind": "uuv2d",
+                "name": "x",
+                "vehicle": {"start": [0, 0], "goal": [1, 1], "v_max": -1, "u_max": 1},
+            },
+            "vehicle.v_max",
+        ),
+        (
+            {
+                "kind": "uuv2d",
+                "name": "x",
+                "vehicle": {"start": [0, 0], "goal": [5, 5], "v_max": 1, "u_max": 1},
+                "obstacles": [
+                    {"type": "deforming", "centre": [0, 0], "area": 1.0, "max_rate": 0.1}
+                ],
+            },
+            "vehicle.start",
+        ),
+        (
+            {
+                "kind": "uuv2d",
+                "name": "x",
+                "speed": 3,
+                "vehicle": {"start": [0, 0], "goal": [5, 5], "v_max": 1, "u_max": 1},
+            },
+            "speed",
+        ),
+        (
+            {
+                "kind": "uuv2d",
+                "name": "x",
+                "vehicle": {"start": [0, 0], "goal": [5, 5], "v_max": 1, "u_max": 1},
+                "obstacles": [{"type": "trap", "centre": [3, 3], "mouth": 5.0}],
+            },
+            "obstacles.0.mouth",
+        ),
     ],
 )
 def test_bad_input_is_one_line_naming_the_field(data: dict, where: str) -> None:

@@ -49,7 +49,9 @@ def test_returns_are_first_hits_on_the_outlines(x: float, y: float, th: float, f
         seg = shapely.linestrings([[x, y], [x + 8 * np.cos(a), y + 8 * np.sin(a)]])
         inter = shapely.intersection(seg, union)
         if hid < 0:
-            assert rng_ == 8.0 and (inter.is_empty or shapely.distance(shapely.points(x, y), inter) > 8 - 1e-9)
+            assert rng_ == 8.0 and (
+                inter.is_empty or shapely.distance(shapely.points(x, y), inter) > 8 - 1e-9
+            )
         else:
             assert abs(rng_ - shapely.distance(shapely.points(x, y), inter)) < 1e-7
 

@@ -55,10 +55,12 @@ def test_straight_run_collides_exactly_when_the_disc_touches_the_body() -> None:
 
 def test_same_seed_same_run_with_a_noisy_sonar() -> None:
     sc = random_ch4_scenario(5, noise_std=0.05, dropout=0.1)
-    a = run_uuv2d_episode(sc.to_setup(), make_uuv2d_controller("zhang2022-uuv2d-v1"),
-                          np.random.default_rng(9))
-    b = run_uuv2d_episode(sc.to_setup(), make_uuv2d_controller("zhang2022-uuv2d-v1"),
-                          np.random.default_rng(9))
+    a = run_uuv2d_episode(
+        sc.to_setup(), make_uuv2d_controller("zhang2022-uuv2d-v1"), np.random.default_rng(9)
+    )
+    b = run_uuv2d_episode(
+        sc.to_setup(), make_uuv2d_controller("zhang2022-uuv2d-v1"), np.random.default_rng(9)
+    )
     assert a.trajectory is not None and b.trajectory is not None
     assert np.array_equal(a.trajectory.poses, b.trajectory.poses)
     assert a.metrics.to_dict().keys() == set(METRIC_NAMES)

@@ -71,7 +71,9 @@ def run_ch4_job(job: Ch4Job, *, record: bool = False) -> tuple[dict[str, Any], U
     else:
         sc = load_uuv2d_scenario(job.scene)
     res = run_uuv2d_episode(
-        sc.to_setup(), make_uuv2d_controller(job.law), np.random.default_rng(job.seed),
+        sc.to_setup(),
+        make_uuv2d_controller(job.law),
+        np.random.default_rng(job.seed),
         record=record,
     )
     row: dict[str, Any] = {
@@ -215,7 +217,9 @@ class Ch4Summary:
     summary_path: Path | None = None
 
 
-def _table(scene_rows: list[dict[str, Any]], campaign: list[dict[str, Any]]) -> list[dict[str, Any]]:
+def _table(
+    scene_rows: list[dict[str, Any]], campaign: list[dict[str, Any]]
+) -> list[dict[str, Any]]:
     table: list[dict[str, Any]] = []
     for r in scene_rows:
         if r["law"] != LAW:
@@ -280,7 +284,11 @@ def reproduce_ch4(
             scene_rows.append(row)
             scene_results[(scene, law)] = res
     n = seeds if seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
-    nn = noise_seeds if noise_seeds is not None else (FULL_NOISE_SEEDS if full else QUICK_NOISE_SEEDS)
+    nn = (
+        noise_seeds
+        if noise_seeds is not None
+        else (FULL_NOISE_SEEDS if full else QUICK_NOISE_SEEDS)
+    )
     clean, noisy = campaign_jobs(n, nn)
     rows = run_jobs(clean + noisy, rows_path, workers=workers, progress=progress)
     campaign = summarise(rows)

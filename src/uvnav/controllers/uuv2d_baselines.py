@@ -109,7 +109,7 @@ class _UnicycleOnUuv:
         self._spec = spec
         self._goal = np.asarray(goal, dtype=float)
         uspec = UnicycleSpec(v_max=spec.v_max, u_max=spec.u_max, radius=spec.radius)
-        self.law.reset(uspec, self._goal, rng)  # type: ignore[arg-type]
+        self.law.reset(uspec, self._goal, rng)
         self._reset_adapter()
 
     def _reset_adapter(self) -> None:

@@ -266,7 +266,7 @@ class DeformingStar:
         return loc + (self.centre[None, :] + ts[:, None] * self.velocity[None, :])[:, None, :]
 
     def peak_phase_speed(self) -> float:
-        """max_j |d p_j / d theta| over one period (theta = w0 t) [m/rad], sampled on a fine grid."""
+        """max_j |d p_j / d theta| over one period (theta = w0 t) [m/rad], on a fine phase grid."""
         th = np.linspace(0.0, 2.0 * np.pi, _CALIBRATION_PHASES, endpoint=False)
         h = 1e-5
         plus = self._normalise(self._raw_at_phase(th + h))

@@ -51,9 +51,7 @@ class VehicleSpec(_Model):
 
     start: Point2 = Field(description="initial point I [m]")
     goal: Point2 = Field(description="end point E [m]")
-    heading: float | None = Field(
-        None, description="initial orientation [rad] (default: toward E)"
-    )
+    heading: float | None = Field(None, description="initial orientation [rad] (default: toward E)")
     v_max: float = Field(gt=0, description="V_max, bound of each velocity component [m/s]")
     u_max: float = Field(gt=0, description="U_max, bound of the turn rate [rad/s]")
     radius: float = Field(0.2, ge=0, description="radius of the vehicle's disc body [m]")

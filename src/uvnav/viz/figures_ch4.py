@@ -20,12 +20,12 @@ from typing import Any
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from matplotlib.axes import Axes  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 
-from uvnav.sim.episode_uuv2d import Uuv2dResult, Uuv2dTrajectory  # noqa: E402
+from uvnav.sim.episode_uuv2d import Uuv2dResult, Uuv2dTrajectory
 
 
 def _closed(o: np.ndarray) -> np.ndarray:
@@ -35,10 +35,14 @@ def _closed(o: np.ndarray) -> np.ndarray:
 def _frame(ax: Axes, traj: Uuv2dTrajectory, goal: np.ndarray | None = None) -> None:
     start = traj.poses[0, :2]
     ax.plot(*start, "ko", ms=6)
-    ax.annotate("I", start, textcoords="offset points", xytext=(5, -12))
+    ax.annotate(
+        "I", (float(start[0]), float(start[1])), textcoords="offset points", xytext=(5, -12)
+    )
     if goal is not None:
         ax.plot(*goal, "k^", ms=7)
-        ax.annotate("E", goal, textcoords="offset points", xytext=(5, 5))
+        ax.annotate(
+            "E", (float(goal[0]), float(goal[1])), textcoords="offset points", xytext=(5, 5)
+        )
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
@@ -46,7 +50,8 @@ def _frame(ax: Axes, traj: Uuv2dTrajectory, goal: np.ndarray | None = None) -> N
 
 
 def _index_at(traj: Uuv2dTrajectory, t: float) -> int:
-    return int(min(np.searchsorted(traj.decision_times, t - 1e-9), len(traj.decision_times) - 1))
+    k = int(np.searchsorted(traj.decision_times, t - 1e-9))
+    return min(k, len(traj.decision_times) - 1)
 
 
 def plot_approach(
