@@ -312,8 +312,8 @@ class Zhang2022Uuv2dController:
         width = 2.0 * (self._spec.radius + p.mouth_margin)
         ranges, ids = close_narrow_openings(s.origin, s.angles, s.ranges, s.hit_ids, width)
         grid.update(s.origin, s.angles, ranges, ids)
-        search = max(s.max_range, p.switch_distance)
-        d_grid, r_min, label = grid.nearest(pos, search)
+        # only a square within L matters to (4.12); a little more keeps d_grid exact near L
+        d_grid, r_min, label = grid.nearest(pos, p.switch_distance + 2.0 * p.cell)
         d_sonar = float(s.d_min.min()) if len(s.d_min) else math.inf
         d_min = min(d_grid, d_sonar)
         # (4.12)

@@ -50,6 +50,8 @@ class AmapsConfig:
         hit_depth: depth [m] behind a return that is marked covered.
         free_step: spacing of the free-space samples along a beam, in squares (1: a square may
             be skipped where a beam only clips its corner, which only delays its clearing).
+        free_range: free space is carved only this far [m] from the sonar (the law looks no
+            farther than its switching and clearance distances; this bounds the work).
     """
 
     cell: float = 0.05
@@ -59,6 +61,7 @@ class AmapsConfig:
     free_weight: float = 0.35
     hit_depth: float = 0.1
     free_step: float = 1.0
+    free_range: float = 3.0
 
     def __post_init__(self) -> None:
         if not (self.cell > 0):
@@ -67,6 +70,8 @@ class AmapsConfig:
             raise ValueError(f"decay must be in (0, 1] (got {self.decay})")
         if not (self.threshold > 0 and self.hit_weight > 0):
             raise ValueError("threshold and hit_weight must be > 0")
+        if not (self.free_range > 0):
+            raise ValueError(f"free_range must be > 0 m (got {self.free_range})")
         if not (0 < self.free_step <= 2):
             raise ValueError(f"free_step must be in (0, 2] squares (got {self.free_step})")
         if self.free_weight < 0 or self.hit_depth < 0:
@@ -163,9 +168,9 @@ class AmapsGrid:
         # free space: samples every ``free_step`` from 0 to one square short of the return
         if cfg.free_weight > 0 and len(rr):
             fs = cfg.free_step * h
-            n_s = int(np.ceil(float(rr.max()) / fs)) + 1
+            n_s = int(np.ceil(min(float(rr.max()), cfg.free_range) / fs)) + 1
             s = np.arange(n_s) * fs  # (S,)
-            limit = np.where(ids >= 0, rr - h, rr)  # (B,)
+            limit = np.minimum(np.where(ids >= 0, rr - h, rr), cfg.free_range)  # (B,)
             bi, si = np.nonzero(s[None, :] < limit[:, None])
             c = np.floor((o[0] - self.x0 + s[si] * dirs[bi, 0]) / h).astype(np.intp)
             r = np.floor((o[1] - self.y0 + s[si] * dirs[bi, 1]) / h).astype(np.intp)

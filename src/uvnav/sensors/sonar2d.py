@@ -233,9 +233,18 @@ def close_narrow_openings(
     dirs = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
     pts = origin + ranges[idx, None] * dirs[idx]
     d = np.hypot(*(pts[:, None, :] - pts[None, :, :]).transpose(2, 0, 1))
+    n = len(idx)
+    rr = ranges[idx]
+    # deepest return strictly between returns i and j (in return order): running max per row
+    upper = np.where(np.arange(n)[None, :] > np.arange(n)[:, None], rr[None, :], -np.inf)
+    runmax = np.maximum.accumulate(upper, axis=1)  # runmax[i, m] = max rr[i+1..m]
     ii, jj = np.nonzero(np.triu(d < width, k=1))
-    gap = idx[jj] - idx[ii] >= 2  # at least one beam between them
-    ii, jj = ii[gap], jj[gap]
+    # only pairs with something to close: a beam without a return between them, or a return
+    # deeper than both lips (a flat or convex stretch between two close returns is left alone)
+    missing = (idx[jj] - idx[ii]) > (jj - ii)
+    deeper = (jj - ii >= 2) & (runmax[ii, np.maximum(jj - 1, 0)] > np.maximum(rr[ii], rr[jj]))
+    keep = (idx[jj] - idx[ii] >= 2) & (missing | deeper)
+    ii, jj = ii[keep], jj[keep]
     if len(ii) == 0:
         return out_r, out_id
     t = rays_segments_hit(origin, dirs, pts[ii], pts[jj])  # (B, P)
