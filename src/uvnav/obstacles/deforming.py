@@ -20,7 +20,7 @@ module supplies one:
   exactly the fixed area A.  Positivity: sum_k |A_k| + |B_k| <= 0.6 keeps r_raw >= 0.4 r0.
 * **Bounded rate of change.**  The integer multipliers m_k, n_k make the deformation periodic with
   period 2 pi / w0, and every vertex velocity scales linearly with w0.  :meth:`DeformingStar.create`
-  measures max_j |dp_j / d(w0 t)| over one period on a fine phase grid (central differences, 512
+  measures max_j |dp_j / d(w0 t)| over one period on a fine phase grid (central differences, 720
   phases) and sets w0 so that the largest vertex speed is ``max_rate / 1.1`` — the 10 % covers what
   the grid could miss.  Hence every boundary point moves (relative to the mass centre) at most
   ``max_rate`` [m/s], and two outlines dt apart are within Hausdorff distance ``max_rate * dt``.
@@ -50,7 +50,7 @@ from uvnav.geometry.polygons import polygon_area, polygon_centroid
 
 #: margin between the calibrated rate and the requested bound (see module docstring)
 RATE_MARGIN = 1.1
-_CALIBRATION_PHASES = 512
+_CALIBRATION_PHASES = 720
 #: largest total relative amplitude sum_k |A_k| + |B_k|
 MAX_RELATIVE_AMPLITUDE = 0.6
 
