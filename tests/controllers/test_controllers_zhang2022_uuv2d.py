@@ -44,11 +44,12 @@ def test_direction_tag_is_the_side_of_the_mass_centre() -> None:
     assert tag(np.zeros(2), GOAL, np.array([6.0, 4.0])) == -1
 
 
-def test_avoidance_waypoint_is_the_tangent_point_away_from_the_mass_centre() -> None:
-    # a disc-like body centred left of the I->E line, its near side across the line
+@pytest.mark.parametrize("outer", [False, True])
+def test_avoidance_waypoint_is_a_tangent_away_from_the_mass_centre(outer: bool) -> None:
+    # a disc-like body centred right of the I->E line, its near side across the line
     body = DeformingStar.create((2.4, 2.0), math.pi * 0.8**2, np.zeros((1, 2)), max_rate=0.0)
     outline = body.outline(0.0)
-    ctrl = make_uuv2d_controller("zhang2022-uuv2d-v1")
+    ctrl = make_uuv2d_controller("zhang2022-uuv2d-v1", outer_tangent=outer)
     ctrl.reset(SPEC, GOAL, np.random.default_rng(0))
     pose = np.array([1.0, 1.0, math.pi / 4])
     cmd = ctrl.act(observe(pose, [outline], np.array([[2.4, 2.0]])))
@@ -57,15 +58,23 @@ def test_avoidance_waypoint_is_the_tangent_point_away_from_the_mass_centre() -> 
     assert d.count == 1
     # rho = R_i (0 at the first step) + radius + safety margin
     assert math.isclose(d.radius, SPEC.radius + ctrl.params.safety_margin)
-    # the waypoint is a tangent point of the forecast circle ...
     wp = d.waypoint
     assert wp is not None and d.r_min is not None
-    assert math.isclose(float(np.hypot(*(wp - d.r_min))), d.radius, rel_tol=1e-9)
-    assert abs(float(np.dot(wp - pose[:2], wp - d.r_min))) < 1e-9
-    # ... on the side away from the mass centre: counter-clockwise of the line to r_imin
     to_r = d.r_min - pose[:2]
     to_w = wp - pose[:2]
+    # on the side away from the mass centre: counter-clockwise of the line to r_imin
     assert to_r[0] * to_w[1] - to_r[1] * to_w[0] > 0
+    if not outer:  # the literal (4.13): the tangent point of r_imin's forecast circle
+        assert math.isclose(float(np.hypot(*(wp - d.r_min))), d.radius, rel_tol=1e-9)
+        assert abs(float(np.dot(wp - pose[:2], wp - d.r_min))) < 1e-9
+    else:  # the line ahead clears every covered square's forecast circle (within L, in front)
+        assert ctrl.grid is not None
+        centres, _ = ctrl.grid.occupied(pose[:2], ctrl.params.switch_distance)
+        u = to_w / np.hypot(*to_w)
+        along = (centres - pose[:2]) @ u
+        perp = np.abs((centres - pose[:2]) @ np.array([-u[1], u[0]]))
+        ahead = along > 0
+        assert np.all(perp[ahead] >= d.radius - 1e-9)
     v = np.array([cmd.vx, cmd.vy])
     assert not cmd.violates(SPEC, pose[2], 0.2)
     assert np.hypot(*v) > 0
