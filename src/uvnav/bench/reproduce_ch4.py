@@ -6,9 +6,9 @@
    ``zhang2022-uuv2d-v1`` and both baselines on the same sonar (``apf-uuv2d-v1``,
    ``zhang2019-uuv2d-v1``), seed 0, trajectories recorded for the figures;
 2. a random campaign on ``random-ch4:<seed>`` (1-5 deforming obstacles) with the three laws
-   (quick: 20 seeds; ``full``: 200);
+   (quick: 10 seeds; ``full``: 200);
 3. a sensor-noise sweep on the same generator: range noise 0.05 / 0.1 m and 10 % dropout
-   (quick: 8 seeds per level; ``full``: 50).
+   (quick: 4 seeds per level; ``full``: 50).
 
 Every episode becomes one JSON line in ``results_dir/ch4/episodes.jsonl`` (the metrics of
 :data:`~uvnav.sim.metrics.METRIC_NAMES` plus status, scene, law, noise, seed, whether a forbidden
@@ -43,8 +43,8 @@ BASELINES: tuple[str, ...] = ("apf-uuv2d-v1", "zhang2019-uuv2d-v1")
 LAWS: tuple[str, ...] = (LAW, *BASELINES)
 #: (range noise std [m], dropout probability) levels of the sweep
 NOISE_LEVELS: tuple[tuple[float, float], ...] = ((0.05, 0.0), (0.1, 0.0), (0.0, 0.1))
-QUICK_SEEDS, FULL_SEEDS = 20, 200
-QUICK_NOISE_SEEDS, FULL_NOISE_SEEDS = 8, 50
+QUICK_SEEDS, FULL_SEEDS = 10, 200
+QUICK_NOISE_SEEDS, FULL_NOISE_SEEDS = 4, 50
 
 
 @dataclass(frozen=True)
