@@ -622,6 +622,10 @@ def reproduce(
         table += reproduce_ch5(
             results_dir, full=full, progress=progress, render=ch5_render, report_dir=report_dir
         ).table
+    if n_random is None:  # Chapter 4 (issue 5); tests that shrink the Ch. 2 campaign leave it out
+        from uvnav.bench.reproduce_ch4 import reproduce_ch4
+
+        table = table + reproduce_ch4(results_dir, report_dir, full=full, workers=workers).table
     report_path: Path | None = None
     figures: list[Path] = []
     if render is not None:

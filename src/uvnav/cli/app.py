@@ -798,3 +798,8 @@ def bench(
 def main() -> None:
     """Console-script entry point (``uvnav``)."""
     app(prog_name="uvnav")
+
+
+from uvnav.cli.ch4 import ch4_app  # noqa: E402  (Chapter 4, issue 5: its own sub-app)
+
+app.add_typer(ch4_app, name="ch4")

@@ -1,0 +1,155 @@
+"""Chapter-4 benchmarks (issue 5): AMAPS memory over a long run, and decision time.
+
+Run ``.venv/bin/python benchmarks/bench_ch4.py --out benchmarks/results`` (``--quick`` for a smoke
+run).  Writes ``<out>/ch4.json``:
+
+* ``amaps_memory``: an AMAPS grid (0.05 m squares over the 10 x 10 m start-goal box plus 4 m
+  margins) absorbs 1e5 sonar sweeps (91 beams, a deforming obstacle, the vehicle moving on a
+  circle); the grid's arrays and the Python heap (tracemalloc) are sampled every 1e4 sweeps.
+  Bounded memory means: the arrays never change size and the traced heap does not grow with the
+  number of sweeps (target: growth between the first and last sample < 64 KiB).
+* ``decision_time``: wall and CPU time of ``zhang2022-uuv2d-v1``'s ``act`` [µs] (median, p99) on
+  the sweeps of the Fig. 4.9 scene, with the 0.05 m grid over 10 x 10 m (target: median <= 500
+  µs), beside ``apf-uuv2d-v1`` and ``zhang2019-uuv2d-v1`` and a reference numpy operation
+  (``np.zeros(3) + 1``) timed in the same run, so that a loaded machine can be recognised.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import platform
+import time
+import tracemalloc
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
+from uvnav.dynamics.holonomic import HolonomicSpec
+from uvnav.obstacles.deforming import DeformingStar
+from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
+from uvnav.scenarios.uuv2d import load_uuv2d_scenario
+from uvnav.sensors.sonar2d import SonarConfig, SonarObservation, sonar_scan
+
+TARGET_DECISION_US = 500.0
+TARGET_GROWTH_BYTES = 64 * 1024
+
+
+def bench_amaps_memory(sweeps: int) -> dict[str, Any]:
+    cfg = AmapsConfig(cell=0.05)
+    grid = AmapsGrid.covering(np.zeros(2), np.full(2, 10.0), cfg, margin=4.0)
+    body = DeformingStar.random(np.random.default_rng(0), (5.0, 5.0), 3.0, max_rate=0.2)
+    sonar = SonarConfig()
+    rng = np.random.default_rng(1)
+    # a fixed set of sweeps (the outline changes over a period; 64 phases of it) reused in turn
+    sweeps_cache = []
+    for k in range(64):
+        a = 2 * math.pi * k / 64
+        pose = np.array([5 + 3.5 * math.cos(a), 5 + 3.5 * math.sin(a), a + math.pi])
+        sweeps_cache.append(sonar_scan(pose, [body.outline(0.5 * k)], rng, sonar))
+    tracemalloc.start()
+    samples = []
+    every = max(sweeps // 10, 1)
+    t0 = time.perf_counter()
+    for i in range(sweeps):
+        r = sweeps_cache[i % 64]
+        grid.update(r.origin, r.angles, r.ranges, r.hit_ids)
+        if i % every == 0 or i == sweeps - 1:
+            cur, _ = tracemalloc.get_traced_memory()
+            samples.append({"sweep": i + 1, "traced_bytes": cur, "grid_bytes": grid.nbytes})
+    elapsed = time.perf_counter() - t0
+    tracemalloc.stop()
+    growth = samples[-1]["traced_bytes"] - samples[1]["traced_bytes"] if len(samples) > 1 else 0
+    return {
+        "sweeps": sweeps,
+        "grid_shape": [grid.ny, grid.nx],
+        "grid_bytes": grid.nbytes,
+        "samples": samples,
+        "heap_growth_bytes": growth,
+        "us_per_update": elapsed / sweeps * 1e6,
+        "target_growth_bytes": TARGET_GROWTH_BYTES,
+        "pass": bool(
+            growth < TARGET_GROWTH_BYTES and len({s["grid_bytes"] for s in samples}) == 1
+        ),
+    }
+
+
+def _observations(n: int) -> list[SonarObservation]:
+    sc = load_uuv2d_scenario("thesis-ch4-fig4-9-whole-run")
+    setup = sc.to_setup()
+    rng = np.random.default_rng(0)
+    out = []
+    # poses along the diagonal, close to and around the body (avoidance decisions)
+    for k in range(n):
+        t = 0.2 * k
+        a = 2 * math.pi * k / n
+        c = setup.shapes[0].centre_at(t)
+        pose = np.array([c[0] + 2.0 * math.cos(a), c[1] + 2.0 * math.sin(a), a + math.pi / 2])
+        centres = np.array([s.centre_at(t) for s in setup.shapes])
+        reading = sonar_scan(pose, [s.outline(t) for s in setup.shapes], rng, setup.sonar,
+                             centres=centres)
+        out.append(SonarObservation(t, pose, np.zeros(2), setup.goal, reading, 0.2))
+    return out
+
+
+def bench_decision(n: int) -> dict[str, Any]:
+    obs = _observations(n)
+    spec = HolonomicSpec(1.0, 2.0, 0.2)
+    res: dict[str, Any] = {}
+    t = time.perf_counter()
+    for _ in range(2000):
+        np.zeros(3) + 1
+    res["reference_numpy_op_us"] = (time.perf_counter() - t) / 2000 * 1e6
+    for name in ("zhang2022-uuv2d-v1", "apf-uuv2d-v1", "zhang2019-uuv2d-v1"):
+        ctrl = make_uuv2d_controller(name)
+        ctrl.reset(spec, np.array([10.0, 10.0]), np.random.default_rng(0))
+        wall, cpu = [], []
+        for o in obs:
+            w0, c0 = time.perf_counter_ns(), time.process_time_ns()
+            ctrl.act(o)
+            cpu.append((time.process_time_ns() - c0) / 1000)
+            wall.append((time.perf_counter_ns() - w0) / 1000)
+        w = np.asarray(wall[5:])
+        c = np.asarray(cpu[5:])
+        res[name] = {
+            "calls": len(w),
+            "wall_us_median": float(np.median(w)),
+            "wall_us_p99": float(np.percentile(w, 99)),
+            "cpu_us_median": float(np.median(c)),
+        }
+    z = res["zhang2022-uuv2d-v1"]
+    res["target_us"] = TARGET_DECISION_US
+    res["pass"] = bool(z["wall_us_median"] <= TARGET_DECISION_US)
+    return res
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=Path("benchmarks/results"))
+    ap.add_argument("--quick", action="store_true")
+    args = ap.parse_args()
+    payload = {
+        "machine": {"python": platform.python_version(), "platform": platform.platform()},
+        "amaps_memory": bench_amaps_memory(2000 if args.quick else 100_000),
+        "decision_time": bench_decision(60 if args.quick else 400),
+    }
+    args.out.mkdir(parents=True, exist_ok=True)
+    path = args.out / "ch4.json"
+    path.write_text(json.dumps(payload, indent=2) + "\n")
+    mem, dec = payload["amaps_memory"], payload["decision_time"]
+    print(
+        f"AMAPS {mem['sweeps']} sweeps: grid {mem['grid_bytes']} B, heap growth "
+        f"{mem['heap_growth_bytes']} B, {mem['us_per_update']:.0f} us/update, pass={mem['pass']}"
+    )
+    for k, v in dec.items():
+        if isinstance(v, dict):
+            print(f"{k}: median {v['wall_us_median']:.0f} us wall, {v['cpu_us_median']:.0f} us cpu")
+    print(f"reference numpy op {dec['reference_numpy_op_us']:.2f} us; wrote {path}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
