@@ -126,10 +126,14 @@ class SphereBody:
         return 4.0 / 3.0 * math.pi * self.radius**3
 
     def nearest_body(self, p: FloatArray) -> tuple[FloatArray, float]:
-        # hypot, not sqrt(p @ p): the squares of tiny coordinates underflow to subnormals
-        n = math.hypot(float(p[0]), float(p[1]), float(p[2]))
-        direction = p / n if n > 0 else np.array([1.0, 0.0, 0.0])
-        return direction * self.radius, n - self.radius
+        # scaled by the largest coordinate first: the squares (or the norm) of tiny coordinates
+        # underflow to subnormals, and dividing by those gives a direction that is not unit
+        m = float(np.max(np.abs(p)))
+        if m == 0.0:
+            return np.array([self.radius, 0.0, 0.0]), -self.radius
+        u = p / m
+        k = math.hypot(float(u[0]), float(u[1]), float(u[2]))
+        return u / k * self.radius, m * k - self.radius
 
     def contains_body(self, points: FloatArray) -> np.ndarray:
         pts = np.atleast_2d(points)
