@@ -38,7 +38,7 @@ from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
 from uvnav.sensors.exact import lidar_scan, sense_obstacles
 from uvnav.sensors.observation import Observation
-from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
 
 
@@ -363,24 +363,18 @@ def run_episode(
             field_now,
         )
     dec = np.asarray(decision_us) if decision_us else np.zeros(1)
-    success = status == "success"
     shortest = max(start_dist - goal_tolerance, 0.0)  # to the edge of the goal disc
-    straight_time = shortest / spec.v_max if spec.v_max > 0 else 0.0
-    metrics = EpisodeMetrics(
-        success=success,
-        collision=status == "collision",
-        min_clearance=float(min_clear) if has_obstacles else None,
+    metrics = episode_metrics(
+        status=status,
         path_length=path,
-        detour_ratio=(path / shortest) if success and shortest > 0 else None,
-        time_to_goal=reached_at,
-        time_ratio=(reached_at / straight_time)
-        if (reached_at is not None and straight_time > 0)
-        else None,
-        control_effort=float(effort),
+        shortest=shortest,
+        straight_time=shortest / spec.v_max if spec.v_max > 0 else 0.0,
+        reached_at=reached_at,
+        min_clearance=float(min_clear) if has_obstacles else None,
+        control_effort=effort,
         limit_violations=violations,
         mode_switches=switches,
-        decision_us_median=float(np.median(dec)),
-        decision_us_p99=float(np.percentile(dec, 99)),
+        decision_us=decision_us,
     )
     return EpisodeResult(
         metrics=metrics,

@@ -33,7 +33,7 @@ from uvnav.geometry.frames3d import check_unit
 from uvnav.obstacles.motion3d import Obstacle3D
 from uvnav.sensors.sensing3d import FiniteDifference3D, Observation3D, sense_obstacles3d
 from uvnav.sim.episode import EpisodeResult, decision_ratio
-from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.metrics import episode_metrics
 
 
 @dataclass(frozen=True)
@@ -343,24 +343,18 @@ def run_episode3d(
             dict(getattr(controller, "predictions", None) or {}),
         )  # fmt: skip
     dec = np.asarray(decision_us) if decision_us else np.zeros(1)
-    success = status == "success"
     shortest = max(start_dist - setup.goal_tolerance, 0.0)
-    straight_time = shortest / spec.v_max
-    metrics = EpisodeMetrics(
-        success=success,
-        collision=status == "collision",
-        min_clearance=float(min_clear) if obstacles else None,
+    metrics = episode_metrics(
+        status=status,
         path_length=path,
-        detour_ratio=(path / shortest) if success and shortest > 0 else None,
-        time_to_goal=reached_at,
-        time_ratio=(reached_at / straight_time)
-        if (reached_at is not None and straight_time > 0)
-        else None,
-        control_effort=float(effort),
+        shortest=shortest,
+        straight_time=shortest / spec.v_max,
+        reached_at=reached_at,
+        min_clearance=float(min_clear) if obstacles else None,
+        control_effort=effort,
         limit_violations=violations,
         mode_switches=switches,
-        decision_us_median=float(np.median(dec)),
-        decision_us_p99=float(np.percentile(dec, 99)),
+        decision_us=decision_us,
     )
     result = EpisodeResult(metrics=metrics, status=status, trajectory=None, decision_us=dec)
     return result, (rec.finish() if rec is not None else None)

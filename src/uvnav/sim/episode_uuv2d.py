@@ -33,7 +33,7 @@ from uvnav.geometry.polygons import closed_rings, rings_nearest
 from uvnav.obstacles.deforming import ShapeChanging
 from uvnav.sensors.sonar2d import SonarConfig, SonarObservation, sonar_scan
 from uvnav.sim.episode import decision_ratio
-from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
 
 
 @dataclass
@@ -233,25 +233,21 @@ def run_uuv2d_episode(
             status, reached = "success", t
             break
     dec = np.asarray(decision_us) if decision_us else np.zeros(1)
-    success = status == "success"
     shortest = max(start_dist - setup.goal_tolerance, 0.0)
     # the fastest straight run: along the start->goal direction at the box's speed there
     direction = math.atan2(goal[1] - setup.start[1], goal[0] - setup.start[0])
     v_line = spec.v_max / max(abs(math.cos(direction)), abs(math.sin(direction)))
-    straight_time = shortest / v_line if v_line > 0 else 0.0
-    metrics = EpisodeMetrics(
-        success=success,
-        collision=status == "collision",
-        min_clearance=float(min_clear) if shapes else None,
+    metrics = episode_metrics(
+        status=status,
         path_length=path,
-        detour_ratio=(path / shortest) if success and shortest > 0 else None,
-        time_to_goal=reached,
-        time_ratio=(reached / straight_time) if reached is not None and straight_time > 0 else None,
-        control_effort=float(effort),
+        shortest=shortest,
+        straight_time=shortest / v_line if v_line > 0 else 0.0,
+        reached_at=reached,
+        min_clearance=float(min_clear) if shapes else None,
+        control_effort=effort,
         limit_violations=violations,
         mode_switches=switches,
-        decision_us_median=float(np.median(dec)),
-        decision_us_p99=float(np.percentile(dec, 99)),
+        decision_us=decision_us,
     )
     traj = None
     if record:

@@ -30,7 +30,7 @@ from uvnav.geometry.mesh3d import nearest_on_mesh
 from uvnav.obstacles.deforming3d import CompoundBody
 from uvnav.sensors.sonar_array import SonarArray, merge_triangles, sonar_scan
 from uvnav.sim.episode import decision_ratio
-from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
 
 
 @dataclass(frozen=True)
@@ -199,22 +199,19 @@ def run_uuv3d_episode(
     straight = max(
         float(np.linalg.norm(goal - np.asarray(setup.start, float))) - setup.goal_tolerance, 1e-9
     )
-    us = np.asarray(decision_us) if decision_us else np.zeros(1)
-    metrics = EpisodeMetrics(
-        success=success,
-        collision=collided,
-        min_clearance=float(min_clear) if has_obstacles and math.isfinite(min_clear) else None,
+    status = "success" if success else ("collision" if collided else "timeout")
+    metrics = episode_metrics(
+        status=status,
         path_length=path,
-        detour_ratio=path / straight if success else None,
-        time_to_goal=reached_t if success else None,
-        time_ratio=(reached_t / (straight / spec.v_max)) if success and reached_t else None,
+        shortest=straight,
+        straight_time=straight / spec.v_max,
+        reached_at=reached_t if success else None,
+        min_clearance=float(min_clear) if has_obstacles and math.isfinite(min_clear) else None,
         control_effort=effort,
         limit_violations=violations,
         mode_switches=switches,
-        decision_us_median=float(np.median(us)),
-        decision_us_p99=float(np.percentile(us, 99)),
+        decision_us=decision_us,
     )
-    status = "success" if success else ("collision" if collided else "timeout")
     return UUV3DResult(
         metrics=metrics,
         entered_inner_space=inner,

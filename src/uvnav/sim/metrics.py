@@ -7,8 +7,11 @@ without obstacles) are ``None``, never NaN or infinite.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
+
+import numpy as np
 
 METRIC_NAMES: tuple[str, ...] = (
     "success",
@@ -62,3 +65,53 @@ class EpisodeMetrics:
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
+
+
+def episode_metrics(
+    *,
+    status: str,
+    path_length: float,
+    shortest: float,
+    straight_time: float,
+    reached_at: float | None,
+    min_clearance: float | None,
+    control_effort: float,
+    limit_violations: int,
+    mode_switches: int,
+    decision_us: Sequence[float] | np.ndarray,
+) -> EpisodeMetrics:
+    """The DESIGN §4 metrics of one finished episode, the same way for every simulator.
+
+    Args:
+        status: ``"success"``, ``"collision"`` or ``"timeout"``.
+        path_length: distance travelled [m].
+        shortest: straight distance from the start to the edge of the goal disc [m] (the detour
+            ratio's denominator).
+        straight_time: time [s] of the fastest straight run over ``shortest`` at the vehicle's top
+            speed (the time ratio's denominator; a vehicle model may have its own top speed along
+            the line, e.g. a UUV whose velocity components are bounded separately).
+        reached_at: arrival time [s], ``None`` when the goal was not reached.
+        min_clearance: smallest robot–obstacle gap [m], ``None`` without obstacles.
+        control_effort: see :class:`EpisodeMetrics`.
+        limit_violations: decisions whose command was outside the limits.
+        mode_switches: changes of the controller's reported mode.
+        decision_us: controller compute time of every decision [µs] (empty: no decision).
+    """
+    dec = np.asarray(decision_us, dtype=float) if len(decision_us) else np.zeros(1)
+    success = status == "success"
+    return EpisodeMetrics(
+        success=success,
+        collision=status == "collision",
+        min_clearance=None if min_clearance is None else float(min_clearance),
+        path_length=float(path_length),
+        detour_ratio=(path_length / shortest) if success and shortest > 0 else None,
+        time_to_goal=reached_at,
+        time_ratio=(reached_at / straight_time)
+        if reached_at is not None and straight_time > 0
+        else None,
+        control_effort=float(control_effort),
+        limit_violations=int(limit_violations),
+        mode_switches=int(mode_switches),
+        decision_us_median=float(np.median(dec)),
+        decision_us_p99=float(np.percentile(dec, 99)),
+    )

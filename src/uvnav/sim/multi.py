@@ -46,7 +46,7 @@ from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
 from uvnav.sensors.exact import sense_obstacles
 from uvnav.sensors.observation import Observation
 from uvnav.sim.episode import SensingConfig, decision_ratio
-from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
 
 GROUP_METRIC_NAMES: tuple[str, ...] = (
     "all_arrived",
@@ -316,25 +316,19 @@ def run_multi(setup: MultiSetup, rng: np.random.Generator, *, record: bool = Tru
 
     per_robot = []
     for i, r in enumerate(robots):
-        dec = np.asarray(decision_us[i]) if decision_us[i] else np.zeros(1)
         shortest = max(float(start_dist[i]) - tol, 0.0)
-        straight_time = shortest / r.spec.v_max if r.spec.v_max > 0 else 0.0
-        ok = status[i] == "success"
-        at = reached[i]
         per_robot.append(
-            EpisodeMetrics(
-                success=ok,
-                collision=status[i] == "collision",
-                min_clearance=float(min_clear[i]) if math.isfinite(min_clear[i]) else None,
+            episode_metrics(
+                status=status[i],
                 path_length=float(path[i]),
-                detour_ratio=float(path[i]) / shortest if ok and shortest > 0 else None,
-                time_to_goal=at,
-                time_ratio=at / straight_time if at is not None and straight_time > 0 else None,
+                shortest=shortest,
+                straight_time=shortest / r.spec.v_max if r.spec.v_max > 0 else 0.0,
+                reached_at=reached[i],
+                min_clearance=float(min_clear[i]) if math.isfinite(min_clear[i]) else None,
                 control_effort=float(effort[i]),
                 limit_violations=int(violations[i]),
                 mode_switches=int(switches[i]),
-                decision_us_median=float(np.median(dec)),
-                decision_us_p99=float(np.percentile(dec, 99)),
+                decision_us=decision_us[i],
             )
         )
     arrived = sum(s == "success" for s in status)
