@@ -19,7 +19,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from importlib import import_module
 from importlib.metadata import entry_points
-from typing import Any, ClassVar, Protocol, runtime_checkable
+from typing import Any, ClassVar, Generic, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
 
@@ -166,21 +166,24 @@ def params_dict(params: Any) -> dict[str, Any]:
     )
 
 
-class UnicycleController:
-    """State every unicycle law keeps: limits, goal, mode and the decision clock.
+SpecT = TypeVar("SpecT")
 
-    Subclasses call ``super().__init__()``, put their own per-episode state in
-    :meth:`_reset_law`, and get the decision period from :meth:`decision_period`.
+
+class LawState(Generic[SpecT]):
+    """State every law keeps whatever its vehicle: limits, goal, mode and the decision clock.
+
+    Subclasses call ``super().__init__(default_spec, goal_dim)``, put their own per-episode state
+    in :meth:`_reset_law`, and get the decision period from :meth:`decision_period`.
     """
 
     name: ClassVar[str]
     #: period [s] assumed at the first decision of an episode
     FIRST_PERIOD: ClassVar[float] = 0.1
 
-    def __init__(self) -> None:
+    def __init__(self, spec: SpecT, goal_dim: int) -> None:
         self.oracle = False
-        self._spec = UnicycleSpec(1.0, 1.0)
-        self._goal = np.zeros(2)
+        self._spec = spec
+        self._goal = np.zeros(goal_dim)
         self._mode = "M1"
         self._last_t: float | None = None
 
@@ -189,7 +192,7 @@ class UnicycleController:
         """Name of the current mode (for the mode-switch metric)."""
         return self._mode
 
-    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
+    def reset(self, spec: SpecT, goal: np.ndarray, rng: np.random.Generator) -> None:
         self._spec = spec
         self._goal = np.asarray(goal, dtype=float)
         self._mode = "M1"
@@ -207,6 +210,13 @@ class UnicycleController:
         period = self.FIRST_PERIOD if self._last_t is None else max(time - self._last_t, 1e-3)
         self._last_t = time
         return period
+
+
+class UnicycleController(LawState[UnicycleSpec]):
+    """:class:`LawState` of the unicycle laws (thesis Ch. 2 and the 2D baselines)."""
+
+    def __init__(self) -> None:
+        super().__init__(UnicycleSpec(1.0, 1.0), 2)
 
 
 def is_number(value: object) -> bool:

@@ -19,6 +19,7 @@ import numpy as np
 
 from uvnav.controllers.base import (
     ControllerInfo,
+    LawState,
     UnknownControllerError,
     build_params,
 )
@@ -73,40 +74,11 @@ def make_controller3d(name: str, *, oracle: bool = False, **params: Any) -> Cont
     return cast(Controller3D, ctrl)
 
 
-class Vehicle3DController:
-    """State every 3D law keeps: limits, goal, mode, decision clock; and the M1 approach law."""
-
-    name: ClassVar[str]
-    FIRST_PERIOD: ClassVar[float] = 0.1
+class Vehicle3DController(LawState[Vehicle3DSpec]):
+    """:class:`~uvnav.controllers.base.LawState` of the 3D laws, and the M1 approach law."""
 
     def __init__(self) -> None:
-        self.oracle = False
-        self._spec = Vehicle3DSpec(1.0, 1.0)
-        self._goal = np.zeros(3)
-        self._mode = "M1"
-        self._last_t: float | None = None
-
-    @property
-    def mode(self) -> str:
-        return self._mode
-
-    def reset(self, spec: Vehicle3DSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
-        self._spec = spec
-        self._goal = np.asarray(goal, dtype=float)
-        self._mode = "M1"
-        self._last_t = None
-        self._reset_law(rng)
-
-    def _reset_law(self, rng: np.random.Generator) -> None:
-        """Per-episode state of the law (none by default)."""
-
-    def decision_period(self, time: float) -> float:
-        """Seconds since the previous decision (``FIRST_PERIOD`` at the first, >= 1 ms)."""
-        if not math.isfinite(time):
-            return self.FIRST_PERIOD
-        period = self.FIRST_PERIOD if self._last_t is None else max(time - self._last_t, 1e-3)
-        self._last_t = time
-        return period
+        super().__init__(Vehicle3DSpec(1.0, 1.0), 3)
 
     def steer(
         self, obs: Observation3D, direction: FloatArray, speed: float, period: float
