@@ -43,19 +43,23 @@ _STATUS_COLOURS = {
     "timeout": "tab:orange",
     "error": "tab:gray",
 }
-_DPI = 120
+#: resolution of every report figure [dots per inch]
+DPI = 120
 
 
-def _new_figure(width: float, height: float) -> Figure:
-    fig = Figure(figsize=(width, height), dpi=_DPI, layout="constrained")
+def new_figure(width: float, height: float) -> Figure:
+    """A matplotlib figure on the Agg canvas (no pyplot state), constrained layout, ``width`` x
+    ``height`` inches."""
+    fig = Figure(figsize=(width, height), dpi=DPI, layout="constrained")
     FigureCanvasAgg(fig)
     return fig
 
 
-def _save(fig: Figure, path: str | Path) -> Path:
+def save_figure(fig: Figure, path: str | Path) -> Path:
+    """Write ``fig`` to ``path`` (its folder created) at the report's resolution."""
     out = Path(path)
     out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=_DPI)
+    fig.savefig(out, dpi=DPI)
     return out
 
 
@@ -293,7 +297,7 @@ def plot_episode(
         ValueError: the result has no trajectory.
     """
     traj = _require_trajectory(result)
-    fig = _new_figure(13.0, 8.0)
+    fig = new_figure(13.0, 8.0)
     gs = fig.add_gridspec(3, 2, width_ratios=[1.15, 1.0])
     ax_a = fig.add_subplot(gs[:, 0])
     ax_b = fig.add_subplot(gs[0, 1])
@@ -309,7 +313,7 @@ def plot_episode(
     ax_d.set_ylabel("path length [m]")
     ax_d.grid(True, alpha=0.3)
     fig.suptitle(f"{title}\n{_summary_line(result)}" if title else _summary_line(result))
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_comparison(
@@ -334,7 +338,7 @@ def plot_comparison(
         raise ValueError("nothing to compare")
     items = list(results.items())
     n = len(items)
-    fig = _new_figure(max(6.0, 5.2 * n), 9.0)
+    fig = new_figure(max(6.0, 5.2 * n), 9.0)
     gs = fig.add_gridspec(2, n, height_ratios=[1.6, 1.0])
     colours = [f"C{i}" for i in range(n)]
     lo, hi = _common_limits([(_require_trajectory(r), st) for r, st in results.values()])
@@ -370,7 +374,7 @@ def plot_comparison(
     ax_len.legend(loc="upper left", fontsize="small")  # again: includes the straight line
     if title:
         fig.suptitle(title)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def far_from_path(points: np.ndarray, path: np.ndarray, limit: float = 50.0) -> np.ndarray:
@@ -449,12 +453,12 @@ def plot_campaign_summary(df: pd.DataFrame, path: str | Path, *, title: str | No
     Returns:
         ``path``.
     """
-    fig = _new_figure(15.0, 5.5)
+    fig = new_figure(15.0, 5.5)
     ax_s, ax_c, ax_d = fig.subplots(1, 3, width_ratios=[1.3, 1.0, 1.0])
     if df.empty:
         for ax in (ax_s, ax_c, ax_d):
             ax.text(0.5, 0.5, "no episodes", ha="center", va="center", transform=ax.transAxes)
-        return _save(fig, path)
+        return save_figure(fig, path)
     family = df["family"] if "family" in df.columns else df["controller"].map(lambda _: "")
     groups = sorted({(str(f), str(c)) for f, c in zip(family, df["controller"], strict=True)})
     statuses = [s for s in _STATUS_COLOURS if (df["status"] == s).any()]
@@ -511,4 +515,4 @@ def plot_campaign_summary(df: pd.DataFrame, path: str | Path, *, title: str | No
     )
     if title:
         fig.suptitle(title)
-    return _save(fig, path)
+    return save_figure(fig, path)

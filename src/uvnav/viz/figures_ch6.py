@@ -19,24 +19,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from matplotlib.backends.backend_agg import FigureCanvasAgg
-from matplotlib.figure import Figure
 from numpy.typing import NDArray
 
-_DPI = 120
-
-
-def _new_figure(width: float, height: float) -> Figure:
-    fig = Figure(figsize=(width, height), dpi=_DPI, layout="constrained")
-    FigureCanvasAgg(fig)
-    return fig
-
-
-def _save(fig: Figure, path: str | Path) -> Path:
-    out = Path(path)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=_DPI)
-    return out
+from uvnav.viz.figures import DPI, new_figure, save_figure
 
 
 def fig_camera_views(
@@ -46,13 +31,13 @@ def fig_camera_views(
     titles: Sequence[str] = ("left", "center", "right"),
 ) -> Path:
     """Fig. 6.1: the three forward camera images side by side."""
-    fig = _new_figure(3.0 * len(views), 1.4)
+    fig = new_figure(3.0 * len(views), 1.4)
     for k, (img, title) in enumerate(zip(views, titles, strict=False)):
         ax = fig.add_subplot(1, len(views), k + 1)
         ax.imshow(img)
         ax.set_title(title, fontsize=9)
         ax.axis("off")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def fig_steering_histogram(
@@ -64,7 +49,7 @@ def fig_steering_histogram(
     title: str = "steering angle distribution",
 ) -> Path:
     """Figs. 6.4/6.5: steering histogram over [-1, 1] with the balancing threshold."""
-    fig = _new_figure(5.0, 3.0)
+    fig = new_figure(5.0, 3.0)
     ax = fig.add_subplot(1, 1, 1)
     ax.hist(np.clip(steering, -1, 1), bins=n_bins, range=(-1, 1), color="tab:blue", alpha=0.85)
     if threshold:
@@ -76,14 +61,14 @@ def fig_steering_histogram(
         f"{title} (n={len(steering)}, mean {np.mean(steering):.3f}, std {np.std(steering):.3f})",
         fontsize=9,
     )
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def fig_split(
     train: NDArray[np.float64], val: NDArray[np.float64], path: str | Path, *, n_bins: int = 25
 ) -> Path:
     """Fig. 6.6: steering distribution of the training and validation sets."""
-    fig = _new_figure(8.0, 3.0)
+    fig = new_figure(8.0, 3.0)
     for k, (vals, name, color) in enumerate(
         ((train, "training", "tab:blue"), (val, "validation", "tab:orange"))
     ):
@@ -91,26 +76,26 @@ def fig_split(
         ax.hist(np.clip(vals, -1, 1), bins=n_bins, range=(-1, 1), color=color)
         ax.set_title(f"{name} set ({len(vals)} images)", fontsize=9)
         ax.set_xlabel("steering")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def fig_augmentation(
     rows: Sequence[tuple[str, NDArray[np.uint8], NDArray[np.uint8], str]], path: str | Path
 ) -> Path:
     """Fig. 6.7: each row ``(name, original, augmented, caption)``."""
-    fig = _new_figure(7.0, 1.5 * len(rows))
+    fig = new_figure(7.0, 1.5 * len(rows))
     for k, (name, orig, aug, caption) in enumerate(rows):
         for j, (img, title) in enumerate(((orig, "original"), (aug, f"{name}: {caption}"))):
             ax = fig.add_subplot(len(rows), 2, 2 * k + j + 1)
             ax.imshow(np.asarray(img, dtype=np.uint8))
             ax.set_title(title, fontsize=8)
             ax.axis("off")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def fig_loss(train_loss: Sequence[float], val_loss: Sequence[float], path: str | Path) -> Path:
     """Fig. 6.8: MSE (6.1) per epoch."""
-    fig = _new_figure(5.0, 3.0)
+    fig = new_figure(5.0, 3.0)
     ax = fig.add_subplot(1, 1, 1)
     ep = np.arange(1, len(train_loss) + 1)
     ax.plot(ep, train_loss, "o-", label="training")
@@ -121,7 +106,7 @@ def fig_loss(train_loss: Sequence[float], val_loss: Sequence[float], path: str |
     ax.set_yscale("log")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def write_drive_video(
@@ -158,12 +143,12 @@ def write_drive_video(
 
     if not FFMpegWriter.isAvailable():
         raise ValueError(f"{out}: writing .mp4 needs ffmpeg on the PATH (use .gif)")
-    fig = _new_figure(imgs[0].size[0] / _DPI, imgs[0].size[1] / _DPI)
+    fig = new_figure(imgs[0].size[0] / DPI, imgs[0].size[1] / DPI)
     ax = fig.add_axes((0, 0, 1, 1))
     ax.axis("off")
     art = ax.imshow(np.asarray(imgs[0]))
     writer = FFMpegWriter(fps=fps)
-    with writer.saving(fig, str(out), dpi=_DPI):
+    with writer.saving(fig, str(out), dpi=DPI):
         for im in imgs:
             art.set_data(np.asarray(im))
             writer.grab_frame()
