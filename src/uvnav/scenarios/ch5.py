@@ -5,7 +5,7 @@ fixed; obstacles with smooth boundaries, fixed mass centres and shapes that chan
 extent".  Scene 1 (Fig. 5.3(a)): one ordinary obstacle deforming by at most 10 %.  Scene 2
 (Fig. 5.3(b)): an obstacle with "a really narrow space inside" that the robot is wider than.
 Scene 3 (Fig. 5.3(c)): two obstacles on the way.  The thesis gives no coordinates (its figures are
-bird's-eye sketches); the built-ins (``uvnav/scenarios/builtin_ch5/*.yaml``) place A and B 26-30 m
+bird's-eye sketches); the built-ins (``uvnav/scenarios/builtin/ch5/*.yaml``) place A and B 26-30 m
 apart with the obstacles across the straight line, sized for a vehicle of hull radius 0.5 m.
 
 The schema is a separate pydantic model (``extra="forbid"``) beside the 2D one; errors are one
@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import math
 from functools import cache
-from importlib import resources
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -28,11 +27,11 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from uvnav.dynamics.vehicle3d import Vehicle3DSpec
 from uvnav.obstacles.deforming3d import CompoundBody, as_compound, horseshoe, random_star
 from uvnav.scenarios.errors import ScenarioError, from_validation_error
-from uvnav.scenarios.loader import parse_yaml
+from uvnav.scenarios.loader import builtin_yaml_files, parse_yaml
 from uvnav.sensors.sonar_array import SonarArray
 from uvnav.sim.episode_uuv3d import UUV3DSetup
 
-BUILTIN_DIR_CH5 = "builtin_ch5"
+BUILTIN_SUBDIR = "ch5"  # of the built-in scenario folder
 GENERATOR_CH5 = "random-ch5"
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
@@ -144,8 +143,7 @@ def scenario5_from_dict(data: dict[str, Any], source: str = "<dict>") -> Scenari
 
 
 def _builtin_files() -> dict[str, Any]:
-    root = resources.files("uvnav.scenarios").joinpath(BUILTIN_DIR_CH5)
-    return {p.name[:-5]: p for p in root.iterdir() if p.name.endswith(".yaml")}
+    return builtin_yaml_files(BUILTIN_SUBDIR)
 
 
 def list_ch5_builtin() -> list[str]:

@@ -166,17 +166,21 @@ def scenario_from_dict(data: dict[str, Any], source: str = "<dict>") -> Scenario
     return scenario
 
 
-def _builtin_root() -> Any:
-    return resources.files(BUILTIN_PACKAGE).joinpath(BUILTIN_DIR)
-
-
-def _natural_key(name: str) -> list[Any]:
+def natural_key(name: str) -> list[Any]:
+    """Sort key putting ``fig2-9`` before ``fig2-10``."""
     return [int(tok) if tok.isdigit() else tok for tok in re.split(r"(\d+)", name)]
 
 
 @cache
-def _builtin_files() -> dict[str, Any]:
-    root = _builtin_root()
+def builtin_yaml_files(subdir: str = "") -> dict[str, Any]:
+    """The YAML files of the built-in scenario folder ``builtin/<subdir>`` by name (no suffix).
+
+    The top folder holds the 2D scenes; chapters whose scenes have their own schema keep them in
+    a sub-folder (``builtin/ch4``, ``builtin/ch5``).
+    """
+    root = resources.files(BUILTIN_PACKAGE).joinpath(BUILTIN_DIR)
+    if subdir:
+        root = root.joinpath(subdir)
     out: dict[str, Any] = {}
     if root.is_dir():
         for entry in root.iterdir():
@@ -185,12 +189,16 @@ def _builtin_files() -> dict[str, Any]:
     return out
 
 
+def _builtin_files() -> dict[str, Any]:
+    return builtin_yaml_files()
+
+
 def list_builtin() -> list[str]:
     """Names of the built-in scenarios: thesis experiments (``thesis-*``) first, then the others.
 
     Each group is sorted in natural order (``fig2-9`` before ``fig2-10``).
     """
-    names = sorted(_builtin_files(), key=_natural_key)
+    names = sorted(_builtin_files(), key=natural_key)
     return [n for n in names if n.startswith("thesis-")] + [
         n for n in names if not n.startswith("thesis-")
     ]

@@ -16,8 +16,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable
-from functools import cache, lru_cache
-from importlib import resources
+from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -34,12 +33,12 @@ from uvnav.obstacles.deforming import (
     trap_polygon,
 )
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.loader import parse_yaml
+from uvnav.scenarios.loader import builtin_yaml_files, natural_key, parse_yaml
 from uvnav.sensors.sonar2d import SonarConfig
 from uvnav.sim.episode_uuv2d import Uuv2dSetup, clearance_of, inside_any
 
 Point2 = Annotated[tuple[float, float], Field(description="[x, y] [m]")]
-BUILTIN_DIR = "builtin/ch4"
+BUILTIN_SUBDIR = "ch4"  # of the built-in scenario folder
 
 
 class _Model(BaseModel):
@@ -255,24 +254,13 @@ def uuv2d_from_dict(data: dict[str, Any], source: str = "<dict>") -> Uuv2dScenar
 
 
 # ------------------------------------------------------------------------------------ library
-@cache
 def _builtin_files() -> dict[str, Any]:
-    root = resources.files("uvnav.scenarios").joinpath(BUILTIN_DIR)
-    out: dict[str, Any] = {}
-    if root.is_dir():
-        for entry in root.iterdir():
-            if entry.name.endswith((".yaml", ".yml")):
-                out[entry.name.rsplit(".", 1)[0]] = entry
-    return out
+    return builtin_yaml_files(BUILTIN_SUBDIR)
 
 
 def list_uuv2d_builtin() -> list[str]:
     """Names of the Chapter-4 built-in scenes, in natural order."""
-
-    def key(n: str) -> list[Any]:
-        return [int(t) if t.isdigit() else t for t in re.split(r"(\d+)", n)]
-
-    return sorted(_builtin_files(), key=key)
+    return sorted(_builtin_files(), key=natural_key)
 
 
 def uuv2d_builtin_text(name: str) -> str:
