@@ -40,7 +40,8 @@ from uvnav.driving.camera import (
     rasterize_track,
     render_view,
 )
-from uvnav.driving.track import TrackGeometry, project, track_geometry, wrap_angle
+from uvnav.driving.track import TrackGeometry, project, track_geometry
+from uvnav.geometry.angles import wrap_to_pi
 
 Camera = Literal["front", "topdown"]
 #: CarRacing's front-wheel joint limit [rad]: steer = ±1 asks for it
@@ -228,7 +229,7 @@ class DrivingSim:
             heading=heading,
             speed=float(np.hypot(v[0], v[1])),
             centre_distance=d,
-            heading_error=float(wrap_angle(heading - self.geometry.heading[i])),
+            heading_error=float(wrap_to_pi(heading - self.geometry.heading[i])),
             track_index=i,
             tiles_visited=int(u.tile_visited_count),
             n_tiles=len(u.track),

@@ -13,10 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-
-def wrap_angle(a: NDArray[np.float64] | float) -> NDArray[np.float64]:
-    """Angle(s) wrapped to [-π, π) [rad]."""
-    return np.asarray((np.asarray(a) + np.pi) % (2 * np.pi) - np.pi, dtype=float)
+from uvnav.geometry.angles import wrap_to_pi
 
 
 @dataclass(frozen=True)
@@ -53,7 +50,7 @@ def track_geometry(points: NDArray[np.float64]) -> TrackGeometry:
     d = np.roll(p, -1, axis=0) - p
     seg = np.hypot(d[:, 0], d[:, 1])
     heading = np.arctan2(d[:, 1], d[:, 0])
-    dtheta = np.abs(wrap_angle(heading - np.roll(heading, 1)))
+    dtheta = np.abs(wrap_to_pi(heading - np.roll(heading, 1)))
     ds = 0.5 * (seg + np.roll(seg, 1))
     curv = dtheta / np.maximum(ds, 1e-9)
     # smooth over ±2 points: CarRacing's centreline turns in small steps

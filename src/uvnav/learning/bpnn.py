@@ -38,6 +38,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
+from uvnav.learning.runtime import require_torch
 
 #: the thesis's reported test-error ranges (target - output), Ch. 5 §5.4
 THESIS_ERROR_RANGES: dict[int, dict[str, tuple[float, float]]] = {
@@ -49,17 +50,6 @@ MAX_THREADS = 2
 
 class CheckpointError(ValueError):
     """A model file that is not a valid uvnav BPNN checkpoint (one-line message)."""
-
-
-def _torch() -> Any:
-    try:
-        import torch
-    except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise ImportError(
-            "the BPNN needs torch: install the 'learning' extra (pip install 'uvnav[learning]')"
-        ) from exc
-    torch.set_num_threads(min(MAX_THREADS, max(1, torch.get_num_threads())))
-    return torch
 
 
 @dataclass(frozen=True)
@@ -217,7 +207,7 @@ def train_bpnn(
         no validation group).
     """
     cfg = config or BPNNConfig()
-    torch = _torch()
+    torch = require_torch(MAX_THREADS)
     x = np.asarray(inputs, dtype=float)
     y = np.asarray(targets, dtype=float)
     if x.ndim != 2 or y.ndim != 2 or len(x) != len(y):

@@ -28,19 +28,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 from uvnav.learning.config import PilotNetConfig
+from uvnav.learning.runtime import require_torch
 
 if TYPE_CHECKING:
     import torch
-
-
-def _torch() -> Any:
-    try:
-        import torch
-    except ImportError as exc:  # pragma: no cover - depends on the environment
-        raise ImportError(
-            "uvnav.learning needs torch: pip install 'uvnav[learning]' (torch==2.13.0 first)"
-        ) from exc
-    return torch
 
 
 def conv_output_shape(config: PilotNetConfig) -> tuple[int, int, int]:
@@ -80,7 +71,7 @@ def build_pilotnet(config: PilotNetConfig | None = None) -> torch.nn.Module:
         float tensors ``(N, H, W, 3)`` in [0, 255] (HWC, as images are stored) and ``extra``
         ``(N, extra_inputs)`` (the speed [m/s], scaled inside), and returns ``(N, n_outputs)``.
     """
-    torch = _torch()
+    torch = require_torch()
     nn = torch.nn
     cfg = config or PilotNetConfig()
 
