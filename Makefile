@@ -13,7 +13,7 @@ STAMP_TEST := $(VENV)/.installed-test
 # Debian's Chromium for the report's browser test (playwright drives it; no browser download)
 CHROMIUM   ?= chromium
 
-.PHONY: run test bench lint clean venv browser
+.PHONY: run test fuzz bench lint clean venv browser
 
 $(PY):
 	$(PYTHON) -m venv $(VENV) || python3 -m venv $(VENV)
@@ -42,7 +42,11 @@ run: $(STAMP_RUN)
 	$(VENV)/bin/uvnav run
 
 test: $(STAMP_TEST) browser
-	$(PY) -m pytest -n 2 -q
+	$(PY) -m pytest -n 2 -q --hypothesis-profile=ci
+
+# fresh random hypothesis examples (not derandomised, more of them): looks for new counter-examples
+fuzz: $(STAMP_TEST)
+	$(PY) -m pytest -n 2 -q --hypothesis-profile=fuzz -m "not slow" tests
 
 lint: $(STAMP_TEST)
 	$(VENV)/bin/ruff check src tests benchmarks

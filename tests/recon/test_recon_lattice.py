@@ -82,6 +82,18 @@ def test_cell_count_matches_shapely_intersections(
     assert n == int((inter > 0).sum())
 
 
+def test_count_cells_reduces_an_offset_outside_the_fundamental_cell() -> None:
+    """Regression (found by hypothesis): an offset 50 m away lost a cell of a non-convex D."""
+    ang = np.linspace(0, 2 * math.pi, 8, endpoint=False)
+    rad = np.full(8, 30.0)
+    rad[7] = 73.0
+    area = Polygon(np.column_stack([rad * np.cos(ang), rad * np.sin(ang)]))
+    far = L.count_cells(np.array([[0.0, 50.0]]), area, 0.0, 8.0)[0]
+    a1, a2 = L.lattice_basis(0.0, 8.0)
+    near = L.count_cells(np.array([[0.0, 50.0]]) - 4 * a2 + 3 * a1, area, 0.0, 8.0)[0]
+    assert far == near == len(L.lattice_waypoints(area, 0.0, 0.0, 50.0, 8.0))
+
+
 def test_row_and_axis_kernels_agree() -> None:
     rng = np.random.default_rng(3)
     area = Polygon([(0, 0), (230, 40), (260, 200), (60, 250)])

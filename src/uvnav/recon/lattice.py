@@ -184,6 +184,9 @@ def _count(
     R: float,
     chunk: int,
 ) -> np.ndarray:
+    # both kernels assume o in the fundamental cell: ``vecs`` only spans D's box widened by a cell
+    a1, a2 = lattice_basis(lam, R)
+    offsets = _reduce(np.asarray(offsets, dtype=float), a1, a2)
     if len(pieces) == 1:
         return _count_rows(offsets, pieces[0], vecs, lam, R, chunk)
     return _count_sat(offsets, pieces, vecs, lam, R, chunk)
@@ -240,7 +243,11 @@ def _count_sat(
     R: float,
     chunk: int,
 ) -> np.ndarray:
-    """Any D (convex pieces): separating-axis test of every lattice cell against every piece."""
+    """Any D (convex pieces): separating-axis test of every lattice cell against every piece.
+
+    ``offsets`` must lie in the fundamental cell (see :func:`_reduce`): ``vecs`` only reaches D's
+    bounding box widened by one cell.
+    """
     axes = [_piece_axes(p, lam, R) for p in pieces]
     out = np.empty(len(offsets), dtype=np.intp)
     # per piece and axis: projections of the lattice vectors, computed once
