@@ -318,6 +318,21 @@ def test_controllers_list_and_show() -> None:
     assert table.exit_code == 0 and "slow_radius" in table.stdout
 
 
+def test_controllers_list_shows_every_vehicle_and_filters_by_one() -> None:
+    listed = json.loads(invoke("controllers", "list", "--json").stdout)
+    by_name = {row["name"]: row for row in listed}
+    assert by_name["zhang2019-v1"]["vehicle"] == "unicycle"
+    assert by_name["zhang2020-3d-v1"]["vehicle"] == "vehicle3d"
+    assert by_name["zhang2022-uuv3d-v1"]["sensing"] == "sonar-array"
+    assert by_name["zhang2022-uuv2d-v1"]["vehicle"] == "uuv2d"
+    only3d = json.loads(invoke("controllers", "list", "--vehicle", "vehicle3d", "--json").stdout)
+    assert {row["vehicle"] for row in only3d} == {"vehicle3d"}
+    assert "zhang2020-3d-v1" in {row["name"] for row in only3d}
+    bad = invoke("controllers", "list", "--vehicle", "boat")
+    assert bad.exit_code == 2
+    assert bad.stderr.strip().startswith("error: --vehicle: unknown vehicle 'boat'")
+
+
 # ------------------------------------------------------------------------------- run / report
 
 

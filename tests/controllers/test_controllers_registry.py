@@ -28,6 +28,28 @@ def test_unknown_name_lists_the_known_ones() -> None:
         make_controller("no-such-law-v1")
 
 
+def test_one_registry_views_each_vehicle_apart() -> None:
+    from uvnav.controllers.base import ControllerInfo, register
+    from uvnav.controllers.base3d import available_controllers3d, make_controller3d
+    from uvnav.controllers.zhang2022_uuv2d import available_uuv2d_controllers
+
+    unicycle = available_controllers()
+    everything = available_controllers(None)
+    assert {i.vehicle for i in unicycle.values()} == {"unicycle"}
+    assert set(available_controllers3d()) | set(available_uuv2d_controllers()) | set(
+        unicycle
+    ) == set(everything)
+    assert "zhang2020-3d-v1" not in unicycle and "zhang2020-3d-v1" in everything
+    # a law of another vehicle is named as such, not "unknown"
+    with pytest.raises(UnknownControllerError, match="drives the vehicle3d vehicle"):
+        make_controller("zhang2020-3d-v1")
+    with pytest.raises(UnknownControllerError, match="drives the unicycle vehicle"):
+        make_controller3d("zhang2019-v1")
+    with pytest.raises(ValueError, match="unknown vehicle 'boat'"):
+        register(ControllerInfo("boat-v1", object, None, "", vehicle="boat"))
+    assert "boat-v1" not in available_controllers(None)
+
+
 def test_unknown_parameter_is_rejected() -> None:
     with pytest.raises(ControllerParamsError, match="unknown parameter"):
         make_controller("savkin-wang2013-v1", gain=3.0)

@@ -37,6 +37,7 @@ from uvnav.controllers import (
     controller_info,
     make_controller,
 )
+from uvnav.controllers.base import VEHICLES
 from uvnav.scenarios import (
     Scenario,
     ScenarioError,
@@ -481,12 +482,23 @@ def _param_rows(info: ControllerInfo) -> list[dict[str, Any]]:
 @controllers_app.command("list")
 def controllers_list(
     json_out: Annotated[bool, typer.Option("--json", help="Print a JSON list.")] = False,
+    vehicle: Annotated[
+        str | None,
+        typer.Option(
+            "--vehicle",
+            help="Only one vehicle's laws: unicycle (Ch. 2), vehicle3d (Ch. 3/5), uuv2d (Ch. 4).",
+        ),
+    ] = None,
 ) -> None:
-    """List the registered controllers."""
-    infos = available_controllers()
+    """List the registered controllers of every vehicle (or of one)."""
+    if vehicle is not None and vehicle not in VEHICLES:
+        raise CliError(f"--vehicle: unknown vehicle {vehicle!r}; known: {', '.join(VEHICLES)}")
+    infos = available_controllers(vehicle)
     rows = [
         {
             "name": name,
+            "vehicle": info.vehicle,
+            "sensing": info.sensing,
             "summary": info.summary,
             "reference": info.reference,
             "requires_slower_obstacles": info.requires_slower_obstacles,
@@ -500,11 +512,15 @@ def controllers_list(
 
     table = Table(title="controllers")
     table.add_column("name", no_wrap=True)
+    table.add_column("vehicle", no_wrap=True)
+    table.add_column("sensing", no_wrap=True)
     table.add_column("summary")
     table.add_column("slower obstacles")
     for row in rows:
         table.add_row(
             _text(row["name"]),
+            _text(row["vehicle"]),
+            _text(row["sensing"]),
             _text(row["summary"]),
             "required" if row["requires_slower_obstacles"] else "",
         )

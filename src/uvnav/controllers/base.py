@@ -6,6 +6,12 @@ registered by versioned name (``zhang2019-v1``) with :func:`register`; third-par
 theirs through the ``uvnav.controllers`` entry-point group (the entry point must resolve to a
 :class:`ControllerInfo` or to a controller class with a ``name`` attribute).
 
+There is one registry for every vehicle.  Each entry says which vehicle it drives
+(:data:`VEHICLES`: the command it returns and the observation it reads) and what it senses;
+:func:`available_controllers` lists one vehicle's laws (the unicycle's by default, the contract the
+2D simulator and campaigns use) or all of them, and :func:`make_controller` builds unicycle laws
+(``make_controller3d`` and ``make_uuv2d_controller`` the others).
+
 Parameters are a frozen dataclass (``Params``) whose field docs carry units;
 ``make_controller`` builds
 it from keyword arguments and rejects unknown names with a clear message.
@@ -19,7 +25,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from importlib import import_module
 from importlib.metadata import entry_points
-from typing import Any, ClassVar, Generic, Protocol, TypeVar, runtime_checkable
+from typing import Any, ClassVar, Generic, Protocol, TypeVar, cast, runtime_checkable
 
 import numpy as np
 
@@ -50,7 +56,9 @@ class ControllerInfo:
     """Registry entry: versioned name, factory, parameter dataclass and a one-line summary."""
 
     name: str
-    factory: Callable[..., Controller]
+    #: builds the law: a :class:`Controller` for the unicycle, a ``Controller3D`` or a
+    #: ``Uuv2dController`` for the other vehicles
+    factory: Callable[..., Any]
     params_type: type | None
     summary: str
     reference: str = ""
@@ -59,10 +67,16 @@ class ControllerInfo:
     #: the observation the law reads: ``"exact"`` (range-limited exact readings, Ch. 2/3) or a
     #: sensor model's name (``"sonar-array"`` for the Ch. 5 nine-beam array)
     sensing: str = "exact"
+    #: the vehicle the law drives, one of :data:`VEHICLES`
+    vehicle: str = "unicycle"
 
+
+#: Vehicle kinds of the registry: the Ch. 2 unicycle (:class:`UnicycleCommand`), the Ch. 3/5 3D
+#: vehicle (``Vehicle3DCommand``) and the Ch. 4 holonomic underwater vehicle (``UuvCommand``).
+VEHICLES: tuple[str, ...] = ("unicycle", "vehicle3d", "uuv2d")
 
 _REGISTRY: dict[str, ControllerInfo] = {}
-#: Modules of ``uvnav.controllers`` that register built-in laws when imported.
+#: Modules of ``uvnav.controllers`` that register built-in unicycle laws when imported.
 BUILTIN_MODULES: tuple[str, ...] = (
     "zhang2019",
     "savkin_wang2013",
@@ -72,6 +86,12 @@ BUILTIN_MODULES: tuple[str, ...] = (
     "apf",
     "hybrid",
 )
+#: Built-in modules of every vehicle kind (imported on demand by :func:`available_controllers`).
+BUILTIN_MODULES_BY_VEHICLE: dict[str, tuple[str, ...]] = {
+    "unicycle": BUILTIN_MODULES,
+    "vehicle3d": ("zhang2020_3d", "apf3d", "vo3d", "zhang_uuv3d"),
+    "uuv2d": ("zhang2022_uuv2d", "uuv2d_baselines"),
+}
 _ENTRY_POINTS_LOADED = False
 
 
@@ -84,7 +104,16 @@ class ControllerParamsError(ValueError):
 
 
 def register(info: ControllerInfo) -> ControllerInfo:
-    """Add ``info`` to the registry (a later registration of the same name replaces it)."""
+    """Add ``info`` to the registry (a later registration of the same name replaces it).
+
+    Raises:
+        ValueError: ``info.vehicle`` is not one of :data:`VEHICLES`.
+    """
+    if info.vehicle not in VEHICLES:
+        raise ValueError(
+            f"controller {info.name!r}: unknown vehicle {info.vehicle!r}; "
+            f"known: {', '.join(VEHICLES)}"
+        )
     _REGISTRY[info.name] = info
     return info
 
@@ -106,21 +135,40 @@ def _load_entry_points() -> None:
             )
 
 
-def available_controllers() -> dict[str, ControllerInfo]:
-    """All registered controllers by name (built-ins and entry points)."""
-    # import the built-in modules for their registration side effect
-    for module in BUILTIN_MODULES:
-        import_module(f"uvnav.controllers.{module}")
+def available_controllers(vehicle: str | None = "unicycle") -> dict[str, ControllerInfo]:
+    """Registered controllers by name (built-ins and entry points).
 
+    Args:
+        vehicle: only the laws driving this vehicle (one of :data:`VEHICLES`); ``None`` = all.
+    """
+    kinds = VEHICLES if vehicle is None else (vehicle,)
+    for kind in kinds:
+        if kind not in BUILTIN_MODULES_BY_VEHICLE:
+            raise ValueError(f"unknown vehicle {kind!r}; known: {', '.join(VEHICLES)}")
+        # import the built-in modules for their registration side effect
+        for module in BUILTIN_MODULES_BY_VEHICLE[kind]:
+            import_module(f"uvnav.controllers.{module}")
     _load_entry_points()
-    return dict(sorted(_REGISTRY.items()))
+    return {n: i for n, i in sorted(_REGISTRY.items()) if i.vehicle in kinds}
 
 
-def controller_info(name: str) -> ControllerInfo:
-    ctrls = available_controllers()
-    if name not in ctrls:
-        raise UnknownControllerError(f"unknown controller {name!r}; known: {', '.join(ctrls)}")
-    return ctrls[name]
+def controller_info(name: str, vehicle: str | None = None) -> ControllerInfo:
+    """The registry entry of ``name`` (any vehicle, or only ``vehicle``'s laws).
+
+    Raises:
+        UnknownControllerError: not registered, or registered for another vehicle (the message
+            names the vehicle it drives).
+    """
+    everything = available_controllers(None)
+    if name not in everything:
+        known = available_controllers(vehicle)
+        raise UnknownControllerError(f"unknown controller {name!r}; known: {', '.join(known)}")
+    info = everything[name]
+    if vehicle is not None and info.vehicle != vehicle:
+        raise UnknownControllerError(
+            f"controller {name!r} drives the {info.vehicle} vehicle, not the {vehicle}"
+        )
+    return info
 
 
 def build_params(params_type: type | None, params: dict[str, Any]) -> Any:
@@ -150,11 +198,11 @@ def make_controller(name: str, *, oracle: bool = False, **params: Any) -> Contro
             ground-truth rates even when sensing is configured as estimated).
         **params: fields of the controller's ``Params`` dataclass.
     """
-    info = controller_info(name)
+    info = controller_info(name, "unicycle")
     p = build_params(info.params_type, params)
     ctrl = info.factory(p) if info.params_type is not None else info.factory()
     ctrl.oracle = oracle
-    return ctrl
+    return cast(Controller, ctrl)
 
 
 def params_dict(params: Any) -> dict[str, Any]:

@@ -4,15 +4,15 @@ A 3D law is reset with the vehicle's limits (:class:`~uvnav.dynamics.vehicle3d.V
 the goal and a generator, and asked for a :class:`~uvnav.dynamics.vehicle3d.Vehicle3DCommand`
 ``(V_R, u_R)`` with nothing but an :class:`~uvnav.sensors.sensing3d.Observation3D`.
 
-3D laws have their own registry (``available_controllers3d`` / ``make_controller3d``), built on the
-same :class:`~uvnav.controllers.base.ControllerInfo` and parameter checking as the 2D one: the
-2D registry's contract test feeds every law 2D observations, which a 3D law cannot take.
+3D laws live in the one registry of :mod:`uvnav.controllers.base` with ``vehicle="vehicle3d"``;
+``available_controllers3d`` / ``make_controller3d`` are its views for this vehicle (the unicycle
+views leave them out: a 3D law cannot take a 2D observation).
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from importlib import import_module
 from typing import Any, ClassVar, Protocol, cast, runtime_checkable
 
 import numpy as np
@@ -20,8 +20,10 @@ import numpy as np
 from uvnav.controllers.base import (
     ControllerInfo,
     LawState,
-    UnknownControllerError,
+    available_controllers,
     build_params,
+    controller_info,
+    register,
 )
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
 from uvnav.geometry.angles import FloatArray
@@ -44,30 +46,19 @@ class Controller3D(Protocol):
     def mode(self) -> str: ...
 
 
-_REGISTRY3D: dict[str, ControllerInfo] = {}
-#: Modules of ``uvnav.controllers`` that register built-in 3D laws when imported.
-BUILTIN_MODULES_3D: tuple[str, ...] = ("zhang2020_3d", "apf3d", "vo3d", "zhang_uuv3d")
-
-
 def register3d(info: ControllerInfo) -> ControllerInfo:
-    """Add a 3D law to the 3D registry."""
-    _REGISTRY3D[info.name] = info
-    return info
+    """Register a 3D law (``info`` with ``vehicle="vehicle3d"``)."""
+    return register(dataclasses.replace(info, vehicle="vehicle3d"))
 
 
 def available_controllers3d() -> dict[str, ControllerInfo]:
     """All registered 3D laws by name."""
-    for module in BUILTIN_MODULES_3D:
-        import_module(f"uvnav.controllers.{module}")
-    return dict(sorted(_REGISTRY3D.items()))
+    return available_controllers("vehicle3d")
 
 
 def make_controller3d(name: str, *, oracle: bool = False, **params: Any) -> Controller3D:
     """Build a registered 3D law by name with keyword parameters (see ``make_controller``)."""
-    ctrls = available_controllers3d()
-    if name not in ctrls:
-        raise UnknownControllerError(f"unknown 3D controller {name!r}; known: {', '.join(ctrls)}")
-    info = ctrls[name]
+    info = controller_info(name, "vehicle3d")
     p = build_params(info.params_type, params)
     ctrl = info.factory(p) if info.params_type is not None else info.factory()
     ctrl.oracle = oracle

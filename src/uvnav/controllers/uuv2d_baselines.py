@@ -28,9 +28,9 @@ from typing import Any, ClassVar
 import numpy as np
 
 from uvnav.controllers.apf import ApfController, ApfParams
-from uvnav.controllers.base import UnicycleController
+from uvnav.controllers.base import ControllerInfo, UnicycleController
 from uvnav.controllers.zhang2019 import Zhang2019Controller, Zhang2019Params
-from uvnav.controllers.zhang2022_uuv2d import Uuv2dControllerInfo, register_uuv2d
+from uvnav.controllers.zhang2022_uuv2d import register_uuv2d
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec
 from uvnav.dynamics.unicycle import UnicycleSpec
 from uvnav.geometry.angles import FloatArray
@@ -221,7 +221,7 @@ class Zhang2019Uuv2dController(_UnicycleOnUuv):
 
 
 register_uuv2d(
-    Uuv2dControllerInfo(
+    ControllerInfo(
         name=ApfUuv2dController.name,
         factory=ApfUuv2dController,
         params_type=ApfParams,
@@ -230,7 +230,7 @@ register_uuv2d(
     )
 )
 register_uuv2d(
-    Uuv2dControllerInfo(
+    ControllerInfo(
         name=Zhang2019Uuv2dController.name,
         factory=Zhang2019Uuv2dController,
         params_type=Zhang2019Uuv2dParams,

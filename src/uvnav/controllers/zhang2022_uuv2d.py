@@ -58,15 +58,22 @@ How the text is read (docs/thesis-notes.md, Chapter 4, gives the reasons at more
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections import deque
-from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Protocol, runtime_checkable
+from typing import Any, ClassVar, Protocol, cast, runtime_checkable
 
 import numpy as np
 
-from uvnav.controllers.base import build_params, check_params
+from uvnav.controllers.base import (
+    ControllerInfo,
+    available_controllers,
+    build_params,
+    check_params,
+    controller_info,
+    register,
+)
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec, velocity_toward
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.polygons import points_to_segments
@@ -90,47 +97,31 @@ class Uuv2dController(Protocol):
     def mode(self) -> str: ...
 
 
-@dataclass(frozen=True)
-class Uuv2dControllerInfo:
-    """Registry entry of a Chapter-4 law."""
+def register_uuv2d(info: ControllerInfo) -> ControllerInfo:
+    """Register a Chapter-4 law (``info`` with ``vehicle="uuv2d"`` and planar-sonar sensing).
 
-    name: str
-    factory: Callable[..., Uuv2dController]
-    params_type: type | None
-    summary: str
-    reference: str = ""
+    The laws join the one registry of :mod:`uvnav.controllers.base`; the unicycle views leave them
+    out because they take a different observation and command.
+    """
+    return register(dataclasses.replace(info, vehicle="uuv2d", sensing="sonar-fan"))
 
 
-#: The Chapter-4 laws by name.  They live apart from the unicycle registry of
-#: :mod:`uvnav.controllers.base` because they take a different observation and command.
-UUV2D_CONTROLLERS: dict[str, Uuv2dControllerInfo] = {}
-
-
-def register_uuv2d(info: Uuv2dControllerInfo) -> Uuv2dControllerInfo:
-    UUV2D_CONTROLLERS[info.name] = info
-    return info
-
-
-def available_uuv2d_controllers() -> dict[str, Uuv2dControllerInfo]:
+def available_uuv2d_controllers() -> dict[str, ControllerInfo]:
     """All Chapter-4 laws (the thesis's and the adapted baselines)."""
-    import uvnav.controllers.uuv2d_baselines  # noqa: F401  (registers the baselines)
-
-    return dict(sorted(UUV2D_CONTROLLERS.items()))
+    return available_controllers("uuv2d")
 
 
 def make_uuv2d_controller(name: str, **params: Any) -> Uuv2dController:
     """Build a Chapter-4 law by name with keyword parameters.
 
     Raises:
-        KeyError: unknown name.
+        uvnav.controllers.UnknownControllerError: unknown name (a ``KeyError``).
         uvnav.controllers.ControllerParamsError: unknown or invalid parameters.
     """
-    laws = available_uuv2d_controllers()
-    if name not in laws:
-        raise KeyError(f"unknown UUV 2D controller {name!r}; known: {', '.join(laws)}")
-    info = laws[name]
+    info = controller_info(name, "uuv2d")
     p = build_params(info.params_type, params)
-    return info.factory(p) if info.params_type is not None else info.factory()
+    law = info.factory(p) if info.params_type is not None else info.factory()
+    return cast(Uuv2dController, law)
 
 
 @dataclass(frozen=True)
@@ -405,7 +396,7 @@ class Zhang2022Uuv2dController:
 
 
 register_uuv2d(
-    Uuv2dControllerInfo(
+    ControllerInfo(
         name=Zhang2022Uuv2dController.name,
         factory=Zhang2022Uuv2dController,
         params_type=Zhang2022Params,

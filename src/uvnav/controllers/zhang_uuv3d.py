@@ -351,7 +351,7 @@ class ZhangUUV3D(Vehicle3DController):
 register3d(
     ControllerInfo(
         name=NAME,
-        factory=ZhangUUV3D,  # type: ignore[arg-type]  # a 3D law in the shared info record
+        factory=ZhangUUV3D,
         params_type=ZhangUUV3DParams,
         summary="Thesis Ch. 5: sonar array + located point (BPNN or min/argmin), forecast-sphere "
         "tangent avoidance in the plane through the vehicle, B and the point",

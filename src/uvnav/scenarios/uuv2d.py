@@ -158,7 +158,7 @@ ShapeSpec = Annotated[DeformingSpec | TrapSpec, Field(discriminator="type")]
 
 
 class ControllerChoice(_Model):
-    """The law a scene runs with by default (a name of ``UUV2D_CONTROLLERS``)."""
+    """The law a scene runs with by default (a law registered with ``vehicle="uuv2d"``)."""
 
     name: str = Field("zhang2022-uuv2d-v1", min_length=1)
     params: dict[str, Any] = Field(default_factory=dict)
