@@ -68,7 +68,7 @@ def test_obstacle_beside_the_path_does_not_trigger_avoidance() -> None:
 
 
 def test_registry_errors_are_clear() -> None:
-    with pytest.raises(UnknownControllerError, match="unknown controller .nope-v1.; known: apf3d"):
+    with pytest.raises(UnknownControllerError, match=r"unknown controller 'nope-v1'; known: apf3d"):
         make_controller3d("nope-v1")
     with pytest.raises(ControllerParamsError, match="alpha0"):
         make_controller3d("zhang2020-3d-v1", alpha0=-1.0)
