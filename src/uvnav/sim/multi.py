@@ -203,28 +203,33 @@ class _DiscPairs:
         """What :func:`~uvnav.sensors.exact.sense_obstacles` returns from robot i, robot i's own
         disc left out (nearest first, ties in robot order)."""
         dist = self.dist[i]
-        order = np.argsort(dist, kind="stable").tolist()
-        out = []
-        for j in order:
-            d = float(dist[j])
-            if d > sensing_range:
-                break
-            if j == i:
-                continue
-            out.append(
-                ObstacleReading(
-                    obstacle_id=j,
-                    distance=d,
-                    nearest_point=self.near[i, j].copy(),
-                    centre=fld.centres[j].copy(),
-                    velocity=fld.velocities[j].copy(),
-                    angular_velocity=float(fld.angular_velocities[j]),
-                    outline=_NO_OUTLINE,
-                    radius=float(fld.radii[j]),
-                    bounding_radius=float(fld.bounding_radii[j]),
-                )
+        order = np.argsort(dist, kind="stable")
+        sel = order[dist[order] <= sensing_range]
+        sel = sel[sel != i]
+        if len(sel) == 0:
+            return ()
+        # one gather per quantity (fresh arrays: each reading's rows belong to this robot alone)
+        near = self.near[i, sel]
+        centres = fld.centres[sel]
+        velocities = fld.velocities[sel]
+        d = dist[sel].tolist()
+        omega = fld.angular_velocities[sel].tolist()
+        rad = fld.radii[sel].tolist()
+        bound = fld.bounding_radii[sel].tolist()
+        return tuple(
+            ObstacleReading(
+                obstacle_id=j,
+                distance=d[m],
+                nearest_point=near[m],
+                centre=centres[m],
+                velocity=velocities[m],
+                angular_velocity=omega[m],
+                outline=_NO_OUTLINE,
+                radius=rad[m],
+                bounding_radius=bound[m],
             )
-        return tuple(out)
+            for m, j in enumerate(sel.tolist())
+        )
 
 
 def run_multi(
