@@ -318,19 +318,16 @@ def run_multi(
         if batched:
             dp = _DiscPairs(fld, state[:, :2], reach_arr)
             pairs_now[0] = dp
-            keep = dp.within.copy()
+            keep = dp.within & active[:, None]
             np.fill_diagonal(keep, False)
-            for i in np.flatnonzero(active).tolist():
-                row = keep[i]
-                if not row.any():
-                    continue
-                gaps = dp.signed[i][row] - radii[i]
-                min_clear[i] = min(min_clear[i], float(gaps.min()))
-                hit = gaps < 0
-                if hit.any():
-                    for j in np.flatnonzero(row)[hit].tolist():
-                        pairs.add((min(i, j), max(i, j)))
-                    status[i] = "collision"
+            gaps = dp.signed - radii[:, None]
+            seen = keep.any(axis=1)
+            low = np.where(keep, gaps, np.inf).min(axis=1)
+            min_clear[seen] = np.minimum(min_clear[seen], low[seen])
+            hit_i, hit_j = np.nonzero(keep & (gaps < 0))
+            for i, j in zip(hit_i.tolist(), hit_j.tolist(), strict=True):
+                pairs.add((min(i, j), max(i, j)))
+                status[i] = "collision"
             for i in range(n):
                 if status[i] == "collision":
                     active[i] = False
