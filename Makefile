@@ -55,6 +55,7 @@ lint: $(STAMP_TEST)
 
 bench: $(STAMP_RUN)
 	$(PY) benchmarks/run_benchmarks.py --out benchmarks/results
+	$(PY) benchmarks/bench_multi.py --out benchmarks/results
 
 clean:
 	rm -rf $(VENV) results report .pytest_cache .mypy_cache .ruff_cache

@@ -6,6 +6,8 @@ from typing import ClassVar
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from uvnav.controllers import make_controller
 from uvnav.controllers.base import UnicycleController
@@ -124,3 +126,84 @@ def test_orca_swaps_a_pair_without_collision() -> None:
 def test_bad_setup() -> None:
     with pytest.raises(ValueError, match="at least one robot"):
         run_multi(MultiSetup(robots=[]), np.random.default_rng(0))
+
+
+# ------------------------------------------------------- the all-robots-at-once (vectorised) path
+def _outcome(res):  # type: ignore[no-untyped-def]
+    per_robot = [
+        {k: v for k, v in m.to_dict().items() if not k.startswith("decision_us")}
+        for m in res.robots
+    ]
+    return res.statuses, res.group.to_dict(), res.collided_pairs, per_robot
+
+
+@pytest.mark.parametrize(
+    ("spec", "law", "params"),
+    [
+        ("antipodal:8", "zhang2019-v1", {}),
+        ("crossing:6", "zhang2019-v1", {"switch_distance": 2.5}),
+        ("antipodal:6", "apf-v1", {}),
+    ],
+)
+@pytest.mark.parametrize("velocities", ["known", "estimated"])
+def test_vectorised_checks_and_sensing_give_identical_episodes(
+    spec: str, law: str, params: dict, velocities: str
+) -> None:
+    from dataclasses import replace
+
+    from uvnav.scenarios.multi import build_multi, load_multi_scenario
+
+    runs = []
+    seen = []
+    for vectorised in (True, False):
+        setup = build_multi(load_multi_scenario(spec), 3, controller=law, params=params)
+        setup.t_max = 12.0
+        rec = Recording()
+        setup.robots[0].controller = rec
+        for r in setup.robots:
+            r.sensing = replace(r.sensing, velocities=velocities, position_noise=0.01)
+        runs.append(run_multi(setup, np.random.default_rng(3), vectorised=vectorised))
+        seen.append(rec.seen)
+    a, b = runs
+    assert _outcome(a) == _outcome(b)
+    np.testing.assert_array_equal(a.poses, b.poses)  # bit for bit, every robot, every step
+    assert len(seen[0]) == len(seen[1]) > 10
+    for oa, ob in zip(seen[0], seen[1], strict=True):  # robot 0 sensed exactly the same
+        assert [r.obstacle_id for r in oa.obstacles] == [r.obstacle_id for r in ob.obstacles]
+        for ra, rb in zip(oa.obstacles, ob.obstacles, strict=True):
+            assert ra.distance == rb.distance and ra.radius == rb.radius
+            np.testing.assert_array_equal(ra.nearest_point, rb.nearest_point)
+            np.testing.assert_array_equal(ra.velocity, rb.velocity)
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    pts=st.lists(
+        st.tuples(st.floats(-6, 6), st.floats(-6, 6), st.floats(0.0, 1.0)), min_size=1, max_size=7
+    ),
+    reach=st.floats(0.1, 8.0),
+)
+def test_disc_pairs_match_the_field_query_of_every_robot(
+    pts: list[tuple[float, float, float]], reach: float
+) -> None:
+    from uvnav.obstacles.bodies import DiscBody
+    from uvnav.obstacles.obstacle import FieldTemplate
+    from uvnav.sim.multi import _DiscPairs
+
+    xy = np.array([(x, y) for x, y, _ in pts])
+    rad = [max(r, 1e-6) for *_, r in pts]
+    if len(pts) > 1:
+        xy[-1] = xy[0]  # two robots on the same spot (a zero offset)
+    tpl = FieldTemplate.from_bodies([DiscBody(r) for r in rad])
+    n = len(pts)
+    fld = tpl.field(xy, np.zeros(n), np.ones((n, 2)), np.zeros(n))
+    dp = _DiscPairs(fld, xy, np.full(n, reach))
+    for i in range(n):
+        q = tpl.field(xy, np.zeros(n), np.ones((n, 2)), np.zeros(n)).query(
+            xy[i], reach, nearest=False
+        )
+        ids = q.ids
+        assert set(ids.tolist()) == set(np.flatnonzero(dp.within[i]).tolist())
+        np.testing.assert_array_equal(q.signed, dp.signed[i, ids])
+        np.testing.assert_array_equal(q.distance, dp.dist[i, ids])
+        np.testing.assert_array_equal(q.nearest, dp.near[i, ids])

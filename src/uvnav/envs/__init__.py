@@ -1,17 +1,18 @@
 """Gymnasium / PettingZoo environments (layer 6; issue 9).
 
 * ``uvnav/Nav2D-v0`` (:class:`uvnav.envs.nav2d.Nav2DEnv`): one robot on a uvnav scenario.
+* ``uvnav/Nav3D-v0`` (:class:`uvnav.envs.nav3d.Nav3DEnv`): the Chapter-3 3D flying robot.
+* ``uvnav/UUV2D-v0`` (:class:`uvnav.envs.uuv2d.Uuv2DEnv`): the Chapter-4 UUV with its sonar.
 * :class:`uvnav.envs.multi_robot.MultiNav2DParallelEnv`: a PettingZoo ``ParallelEnv`` of several
   robots on a multi-robot scenario (``antipodal:4`` ...).
 * :func:`as_policy`: any uvnav controller as a policy for them.
 
 gymnasium and pettingzoo (``uvnav[envs]``) are imported only when an env class is used.
-Registration: importing this package registers ``uvnav/Nav2D-v0`` with gymnasium (when it is
+Registration: importing this package registers the three envs with gymnasium (when it is
 installed), so ``gymnasium.make("uvnav.envs:uvnav/Nav2D-v0")`` works from anywhere;
 :func:`register_envs` is also the ``gymnasium.envs`` entry point declared in pyproject.toml
 (gymnasium < 1.0 loads that group at import; gymnasium 1.x dropped plugin loading, hence the
-``module:`` form or ``import uvnav.envs``).  Nav3D and UUV2D envs are future work (their worlds
-live in the 3D/UUV chapters' modules).
+``module:`` form or ``import uvnav.envs``).
 """
 
 from __future__ import annotations
@@ -21,19 +22,23 @@ from typing import Any
 
 from uvnav.envs.policy import ControllerPolicy, as_policy
 
-ENV_IDS = ("uvnav/Nav2D-v0",)
+ENV_IDS = ("uvnav/Nav2D-v0", "uvnav/Nav3D-v0", "uvnav/UUV2D-v0")
+_ENTRY_POINTS = {
+    "uvnav/Nav2D-v0": "uvnav.envs.nav2d:Nav2DEnv",
+    "uvnav/Nav3D-v0": "uvnav.envs.nav3d:Nav3DEnv",
+    "uvnav/UUV2D-v0": "uvnav.envs.uuv2d:Uuv2DEnv",
+}
 
 
 def register_envs() -> None:
-    """Register ``uvnav/Nav2D-v0`` with gymnasium (idempotent)."""
+    """Register the uvnav envs (:data:`ENV_IDS`) with gymnasium (idempotent)."""
     import gymnasium
 
-    if "uvnav/Nav2D-v0" not in gymnasium.registry:
-        gymnasium.register(
-            id="uvnav/Nav2D-v0",
-            entry_point="uvnav.envs.nav2d:Nav2DEnv",
-            disable_env_checker=False,
-        )
+    for env_id in ENV_IDS:
+        if env_id not in gymnasium.registry:
+            gymnasium.register(
+                id=env_id, entry_point=_ENTRY_POINTS[env_id], disable_env_checker=False
+            )
 
 
 def __getattr__(name: str) -> Any:
@@ -41,6 +46,14 @@ def __getattr__(name: str) -> Any:
         from uvnav.envs.nav2d import Nav2DEnv
 
         return Nav2DEnv
+    if name == "Nav3DEnv":
+        from uvnav.envs.nav3d import Nav3DEnv
+
+        return Nav3DEnv
+    if name == "Uuv2DEnv":
+        from uvnav.envs.uuv2d import Uuv2DEnv
+
+        return Uuv2DEnv
     if name == "MultiNav2DParallelEnv":
         from uvnav.envs.multi_robot import MultiNav2DParallelEnv
 

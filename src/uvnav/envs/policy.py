@@ -5,8 +5,11 @@ action``.  The controller sees exactly what it sees in the simulator — the
 :class:`~uvnav.sensors.Observation` the env puts in ``info["uvnav"]``
 (:class:`~uvnav.envs.core.ControllerView`; a controller never reads the flat observation
 vector, which is for learned policies) — and its command is mapped to
-the env's normalised action (the inverse of :meth:`uvnav.envs.core.NavWorld.command`), so a
-learned policy and the thesis's laws are run on equal terms, on the same env.  The controller is
+the env's normalised action (the inverse of :meth:`uvnav.envs.core.NavWorld.command`; for the
+Chapter 3 / 4 envs the view's own ``to_action``, :class:`uvnav.envs.common.SimView`), so a
+learned policy and the thesis's laws are run on equal terms, on the same env.  A law is named
+from any registry: the 2D laws, the 3D laws (``uvnav/Nav3D-v0``) or the Chapter-4 UUV laws
+(``uvnav/UUV2D-v0``).  The controller is
 reset whenever a new episode starts (the observation's time is 0 or goes back).
 """
 
@@ -22,7 +25,7 @@ from uvnav.controllers.base import Controller
 class ControllerPolicy:
     """A controller driving an env: ``policy(obs, info) -> action`` (see :func:`as_policy`)."""
 
-    def __init__(self, controller: Controller, seed: int = 0) -> None:
+    def __init__(self, controller: Controller | Any, seed: int = 0) -> None:
         self.controller = controller
         self._rng = np.random.default_rng(seed)
         self._last_t: float | None = None
@@ -34,17 +37,41 @@ class ControllerPolicy:
         if self._last_t is None or o.time <= self._last_t - 1e-12 or o.time == 0.0:
             self.controller.reset(spec, np.asarray(o.goal, dtype=float), self._rng.spawn(1)[0])
         self._last_t = float(o.time)
+        to_action = getattr(view, "to_action", None)
+        if to_action is not None:  # the Chapter 3 / 4 envs: their own inverse action map
+            return np.asarray(to_action(self.controller.act(o)), dtype=np.float32)
         cmd = self.controller.act(o).clipped(spec)
         a0 = 2.0 * cmd.v / spec.v_max - 1.0
         a1 = cmd.u / spec.u_max
         return np.clip(np.array([a0, a1], dtype=np.float32), -1.0, 1.0)
 
 
-def as_policy(controller: Controller | str, seed: int = 0, **params: Any) -> ControllerPolicy:
-    """``policy(obs, info) -> action`` driven by ``controller`` (an instance, or a registered
-    name with ``params``)."""
-    if isinstance(controller, str):
-        from uvnav.controllers.base import make_controller
+def make_any_controller(name: str, **params: Any) -> Any:
+    """A registered law by name, from the 2D, the 3D or the Chapter-4 UUV registry.
 
-        controller = make_controller(controller, **params)
+    Raises:
+        KeyError: no registry knows ``name``.
+    """
+    from uvnav.controllers.base import available_controllers, make_controller
+    from uvnav.controllers.base3d import available_controllers3d, make_controller3d
+    from uvnav.controllers.zhang2022_uuv2d import (
+        available_uuv2d_controllers,
+        make_uuv2d_controller,
+    )
+
+    if name in available_controllers():
+        return make_controller(name, **params)
+    if name in available_controllers3d():
+        return make_controller3d(name, **params)
+    if name in available_uuv2d_controllers():
+        return make_uuv2d_controller(name, **params)
+    known = [*available_controllers(), *available_controllers3d(), *available_uuv2d_controllers()]
+    raise KeyError(f"unknown controller {name!r}; known: {', '.join(sorted(known))}")
+
+
+def as_policy(controller: Any, seed: int = 0, **params: Any) -> ControllerPolicy:
+    """``policy(obs, info) -> action`` driven by ``controller`` (an instance, or a registered
+    name — 2D, 3D or Chapter-4 UUV law — with ``params``)."""
+    if isinstance(controller, str):
+        controller = make_any_controller(controller, **params)
     return ControllerPolicy(controller, seed)

@@ -33,7 +33,7 @@ from uvnav.geometry.frames3d import check_unit
 from uvnav.obstacles.motion3d import Obstacle3D
 from uvnav.sensors.sensing3d import FiniteDifference3D, Observation3D, sense_obstacles3d
 from uvnav.sim.episode import EpisodeResult, decision_ratio
-from uvnav.sim.metrics import episode_metrics
+from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
 
 
 @dataclass(frozen=True)
@@ -230,6 +230,147 @@ class _GapTracker:
         return out, out_i
 
 
+class Sim3D:
+    """The 3D world advanced one integration step at a time: the step-wise API behind
+    :func:`run_episode3d` and the Gymnasium env ``uvnav/Nav3D-v0`` (:mod:`uvnav.envs.nav3d`).
+
+    The caller alternates :meth:`observe` / :meth:`apply` at decision times (:attr:`decision_due`)
+    with :meth:`advance` every ``dt`` until :attr:`done`; the bookkeeping (path, effort, limit
+    violations, clearance, status) is the loop's, so both users get the same numbers.
+
+    Args:
+        setup: the episode (its obstacles are advanced in place).
+        sense_rng: generator of the sensing noise (the estimator's).
+        known: give the obstacles' true rates (oracle) instead of finite differences.
+        exact: exact clearance every step (:func:`clearance3d`); otherwise the
+            :class:`_GapTracker`'s bound, exact whenever it can set a new minimum.
+    """
+
+    def __init__(
+        self, setup: Episode3DSetup, sense_rng: np.random.Generator, *, known: bool, exact: bool
+    ) -> None:
+        self.setup = setup
+        self.spec = setup.spec
+        self.dt = float(setup.dt)
+        self.ratio = decision_ratio(float(setup.control_period), self.dt)
+        self.n_steps = round(setup.t_max / self.dt)
+        self.goal = np.asarray(setup.goal, dtype=float)
+        self.pos = np.asarray(setup.start, dtype=float).copy()
+        self.a = check_unit(setup.heading, name="heading").copy()
+        self.obstacles = setup.obstacles
+        self.sensing = setup.sensing
+        self.known = known
+        self.exact = exact
+        self.estimator = (
+            None if known else FiniteDifference3D(sense_rng, self.sensing.position_noise)
+        )
+
+    def start(self) -> None:
+        """Rates of the first step, clearance and status at t = 0 (after the law's reset)."""
+        spec = self.spec
+        obstacles = self.obstacles
+        # obstacle rates of the first step (so that the first sensing sees them)
+        for ob in obstacles:
+            ob.state.velocity, ob.state.rotation_rate = ob.motion.rates(0.0, ob.state)
+        self.clearance, self.nearest = clearance3d(self.pos, obstacles, spec.radius)
+        self.min_clear = self.clearance
+        self.tracker = (
+            None if self.exact or not obstacles else _GapTracker(obstacles, spec.radius, self.pos)
+        )
+        self.start_dist = float(np.linalg.norm(self.goal - self.pos))
+        self.path = 0.0
+        self.effort = 0.0
+        self.violations = 0
+        self.applied = Vehicle3DCommand(0.0, np.zeros(3))
+        self.u_held = np.zeros(3)
+        self.status = "timeout"
+        self.t = 0.0
+        self.step_index = 0
+        self.reached_at: float | None = None
+        self.done = False
+        if self.clearance < 0:
+            self.status, self.done = "collision", True
+        elif self.start_dist <= self.setup.goal_tolerance:
+            self.status, self.reached_at, self.done = "success", 0.0, True
+        self.done = self.done or self.n_steps <= 0
+
+    @property
+    def decision_due(self) -> bool:
+        """True at a decision time (every ``control_period``)."""
+        return self.step_index % self.ratio == 0
+
+    def observe(self) -> Observation3D:
+        """What the robot senses now (rates known or estimated; see :class:`Sensing3DConfig`)."""
+        readings = sense_obstacles3d(
+            self.pos, self.obstacles, sensing_range=self.sensing.sensing_range, known=self.known
+        )
+        if self.estimator is not None:
+            readings = self.estimator.update(self.t, readings)
+        return Observation3D(
+            time=self.t, position=self.pos.copy(), heading=self.a.copy(), speed=self.applied.v,
+            goal=self.goal, obstacles=readings,
+        )  # fmt: skip
+
+    def apply(self, cmd: Vehicle3DCommand) -> Vehicle3DCommand:
+        """Hold ``cmd`` from now on: counted in ``limit_violations`` when outside (3.4)-(3.6),
+        made physical (:meth:`Vehicle3DCommand.clipped`); returns what is applied."""
+        if cmd.violates(self.spec, self.a):
+            self.violations += 1
+        new = cmd.clipped(self.spec, self.a)
+        if self.step_index > 0:
+            self.effort += (new.v - self.applied.v) ** 2 / (self.ratio * self.dt)
+        self.applied = new
+        self.u_held = new.u
+        return new
+
+    def advance(self) -> None:
+        """One integration step ``dt``: robot, obstacles, clearance, collision and arrival."""
+        dt = self.dt
+        u_held = self.u_held
+        self.effort += float(u_held @ u_held) * dt
+        new_pos, self.a, self.u_held = vehicle3d_advance(
+            self.pos, self.a, self.applied.v, u_held, dt
+        )
+        self.path += float(np.linalg.norm(new_pos - self.pos))
+        self.pos = new_pos
+        t = self.t
+        for ob in self.obstacles:
+            ob.step(t, dt)
+        self.step_index += 1
+        self.t = t = self.step_index * dt
+        if self.tracker is None:
+            self.clearance, self.nearest = clearance3d(self.pos, self.obstacles, self.spec.radius)
+        else:  # (uses the rates held over the step just done)
+            self.clearance, self.nearest = self.tracker.step(
+                self.pos, self.applied.v, dt, self.min_clear
+            )
+        for ob in self.obstacles:  # rates of the next step, visible to the next sensing
+            ob.state.velocity, ob.state.rotation_rate = ob.motion.rates(t, ob.state)
+        self.min_clear = min(self.min_clear, self.clearance)
+        if self.clearance < 0:
+            self.status, self.done = "collision", True
+        elif float(np.linalg.norm(self.goal - self.pos)) <= self.setup.goal_tolerance:
+            self.status, self.reached_at, self.done = "success", t, True
+        elif self.step_index >= self.n_steps:
+            self.done = True
+
+    def metrics(self, *, mode_switches: int, decision_us: list[float]) -> EpisodeMetrics:
+        """The episode's metrics (:mod:`uvnav.sim.metrics`) so far."""
+        shortest = max(self.start_dist - self.setup.goal_tolerance, 0.0)
+        return episode_metrics(
+            status=self.status,
+            path_length=self.path,
+            shortest=shortest,
+            straight_time=shortest / self.spec.v_max,
+            reached_at=self.reached_at,
+            min_clearance=float(self.min_clear) if self.obstacles else None,
+            control_effort=self.effort,
+            limit_violations=self.violations,
+            mode_switches=mode_switches,
+            decision_us=decision_us,
+        )
+
+
 def run_episode3d(
     setup: Episode3DSetup,
     controller: Controller3D,
@@ -248,113 +389,39 @@ def run_episode3d(
             of ``dt``.
     """
     ctrl_rng, sense_rng = rng.spawn(2)
-    spec = setup.spec
-    dt = float(setup.dt)
-    ratio = decision_ratio(float(setup.control_period), dt)
-    n_steps = round(setup.t_max / dt)
-    goal = np.asarray(setup.goal, dtype=float)
-    pos = np.asarray(setup.start, dtype=float).copy()
-    a = check_unit(setup.heading, name="heading").copy()
-    obstacles = setup.obstacles
-    sensing = setup.sensing
     oracle = bool(getattr(controller, "oracle", False))
-    known = sensing.velocities == "known" or oracle
-    estimator = None if known else FiniteDifference3D(sense_rng, sensing.position_noise)
-    controller.reset(spec, goal, ctrl_rng)
+    sim = Sim3D(setup, sense_rng, known=setup.sensing.velocities == "known" or oracle, exact=record)
+    controller.reset(sim.spec, sim.goal, ctrl_rng)
+    sim.start()
+    obstacles = sim.obstacles
     rec = _Recorder(obstacles) if record else None
-
-    # obstacle rates of the first step (so that the first sensing sees them)
-    for ob in obstacles:
-        ob.state.velocity, ob.state.rotation_rate = ob.motion.rates(0.0, ob.state)
-
-    clearance, nearest = clearance3d(pos, obstacles, spec.radius)
-    min_clear = clearance
-    tracker = None if record or not obstacles else _GapTracker(obstacles, spec.radius, pos)
-    start_dist = float(np.linalg.norm(goal - pos))
-    path = 0.0
-    effort = 0.0
-    violations = 0
     switches = 0
     decision_us: list[float] = []
-    applied = Vehicle3DCommand(0.0, np.zeros(3))
-    u_held = np.zeros(3)
     last_mode: str | None = None
-    status = "timeout"
-    t = 0.0
-    reached_at: float | None = None
-    if clearance < 0:
-        status, n_steps = "collision", 0
-    elif start_dist <= setup.goal_tolerance:
-        status, reached_at, n_steps = "success", 0.0, 0
     perf_ns = _time.perf_counter_ns
-    for i in range(n_steps):
-        if i % ratio == 0:
-            readings = sense_obstacles3d(
-                pos, obstacles, sensing_range=sensing.sensing_range, known=known
-            )
-            if estimator is not None:
-                readings = estimator.update(t, readings)
-            obs = Observation3D(
-                time=t, position=pos.copy(), heading=a.copy(), speed=applied.v, goal=goal,
-                obstacles=readings,
-            )  # fmt: skip
+    while not sim.done:
+        if sim.decision_due:
+            obs = sim.observe()
             tic = perf_ns()
             cmd = controller.act(obs)
             decision_us.append((perf_ns() - tic) / 1000.0)
-            if cmd.violates(spec, a):
-                violations += 1
-            new = cmd.clipped(spec, a)
-            if i > 0:
-                effort += (new.v - applied.v) ** 2 / (ratio * dt)
-            applied = new
-            u_held = new.u
+            sim.apply(cmd)
             mode = controller.mode
             if last_mode is not None and mode != last_mode:
                 switches += 1
             last_mode = mode
         if rec is not None:
             rec.add(
-                t, pos, a, applied.v, u_held, last_mode or "", clearance, nearest, obstacles,
-                dict(getattr(controller, "predictions", None) or {}),
+                sim.t, sim.pos, sim.a, sim.applied.v, sim.u_held, last_mode or "", sim.clearance,
+                sim.nearest, obstacles, dict(getattr(controller, "predictions", None) or {}),
             )  # fmt: skip
-        effort += float(u_held @ u_held) * dt
-        new_pos, a, u_held = vehicle3d_advance(pos, a, applied.v, u_held, dt)
-        path += float(np.linalg.norm(new_pos - pos))
-        pos = new_pos
-        for ob in obstacles:
-            ob.step(t, dt)
-        t = (i + 1) * dt
-        if tracker is None:
-            clearance, nearest = clearance3d(pos, obstacles, spec.radius)
-        else:  # (uses the rates held over the step just done)
-            clearance, nearest = tracker.step(pos, applied.v, dt, min_clear)
-        for ob in obstacles:  # rates of the next step, visible to the next sensing
-            ob.state.velocity, ob.state.rotation_rate = ob.motion.rates(t, ob.state)
-        min_clear = min(min_clear, clearance)
-        if clearance < 0:
-            status = "collision"
-            break
-        if float(np.linalg.norm(goal - pos)) <= setup.goal_tolerance:
-            status, reached_at = "success", t
-            break
+        sim.advance()
     if rec is not None:
         rec.add(
-            t, pos, a, applied.v, u_held, last_mode or "", clearance, nearest, obstacles,
-            dict(getattr(controller, "predictions", None) or {}),
+            sim.t, sim.pos, sim.a, sim.applied.v, sim.u_held, last_mode or "", sim.clearance,
+            sim.nearest, obstacles, dict(getattr(controller, "predictions", None) or {}),
         )  # fmt: skip
     dec = np.asarray(decision_us) if decision_us else np.zeros(1)
-    shortest = max(start_dist - setup.goal_tolerance, 0.0)
-    metrics = episode_metrics(
-        status=status,
-        path_length=path,
-        shortest=shortest,
-        straight_time=shortest / spec.v_max,
-        reached_at=reached_at,
-        min_clearance=float(min_clear) if obstacles else None,
-        control_effort=effort,
-        limit_violations=violations,
-        mode_switches=switches,
-        decision_us=decision_us,
-    )
-    result = EpisodeResult(metrics=metrics, status=status, trajectory=None, decision_us=dec)
+    metrics = sim.metrics(mode_switches=switches, decision_us=decision_us)
+    result = EpisodeResult(metrics=metrics, status=sim.status, trajectory=None, decision_us=dec)
     return result, (rec.finish() if rec is not None else None)

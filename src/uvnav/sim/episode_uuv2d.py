@@ -120,6 +120,141 @@ def inside_any(point: tuple[float, float], polygons: list[FloatArray]) -> bool:
     return bool(inside is not None and inside.any())
 
 
+class SimUuv2d:
+    """The Chapter-4 world advanced one integration step at a time: the step-wise API behind
+    :func:`run_uuv2d_episode` and the Gymnasium env ``uvnav/UUV2D-v0``
+    (:mod:`uvnav.envs.uuv2d`).
+
+    The caller alternates :meth:`observe` / :meth:`apply` at decision times (:attr:`decision_due`)
+    with :meth:`advance` every ``dt`` until :attr:`done`; the bookkeeping (path, effort, limit
+    violations, clearance, forbidden regions, status) is the loop's, so both users get the same
+    numbers.
+
+    Args:
+        setup: the episode.
+        sense_rng: generator of the sonar's noise and dropout.
+    """
+
+    def __init__(self, setup: Uuv2dSetup, sense_rng: np.random.Generator) -> None:
+        self.setup = setup
+        self.sense_rng = sense_rng
+        self.spec = setup.spec
+        self.dt = float(setup.dt)
+        self.period = float(setup.control_period)
+        self.ratio = decision_ratio(self.period, self.dt)
+        self.n_steps = round(setup.t_max / self.dt)
+        self.goal = np.asarray(setup.goal, dtype=float)
+        self.state = np.asarray(setup.start, dtype=float).copy()
+        self.shapes = setup.shapes
+
+    def outlines_at(self, t: float) -> list[FloatArray]:
+        """Every obstacle's outline at time ``t`` [s]."""
+        return [s.outline(t) for s in self.shapes]
+
+    def start(self) -> None:
+        """Outlines, clearance and status at t = 0 (after the law's reset)."""
+        state = self.state
+        self.outlines = self.outlines_at(0.0)
+        self.clearance, _ = clearance_of((state[0], state[1]), self.outlines, self.spec.radius)
+        self.min_clear = self.clearance
+        self.entered = inside_any((state[0], state[1]), self.setup.forbidden)
+        self.start_dist = float(np.hypot(*(self.goal - state[:2])))
+        self.status = "timeout"
+        self.done = self.n_steps <= 0
+        if self.clearance < 0:
+            self.status, self.done = "collision", True
+        elif self.start_dist <= self.setup.goal_tolerance:
+            self.status, self.done = "success", True
+        self.path = 0.0
+        self.effort = 0.0
+        self.violations = 0
+        self.applied = HolonomicCommand(0.0, 0.0)
+        self.reached: float | None = None
+        self.t = 0.0
+        self.step_index = 0
+
+    @property
+    def decision_due(self) -> bool:
+        """True at a decision time (every ``control_period``)."""
+        return self.step_index % self.ratio == 0
+
+    def observe(self) -> SonarObservation:
+        """The sonar sweep now and the vehicle's own state (:class:`SonarObservation`)."""
+        t = self.t
+        state = self.state
+        centres = np.array([s.centre_at(t) for s in self.shapes]).reshape(-1, 2)
+        reading = sonar_scan(
+            state, self.outlines, self.sense_rng, self.setup.sonar, centres=centres
+        )
+        return SonarObservation(
+            time=t,
+            pose=state.copy(),
+            velocity=np.array([self.applied.vx, self.applied.vy]),
+            goal=self.goal,
+            sonar=reading,
+            period=self.period,
+        )
+
+    def apply(self, cmd: HolonomicCommand) -> HolonomicCommand:
+        """Hold ``cmd`` from now on: counted in ``limit_violations`` when outside (4.4)-(4.6),
+        saturated (:meth:`HolonomicCommand.clipped`); returns what is applied."""
+        state = self.state
+        period = self.period
+        if cmd.violates(self.spec, float(state[2]), period):
+            self.violations += 1
+        new = cmd.clipped(self.spec, float(state[2]), period)
+        if self.step_index > 0:
+            turn = (
+                wrap_scalar(math.atan2(new.vy, new.vx) - float(state[2])) if new.speed > 0 else 0.0
+            )
+            self.effort += turn * turn / period + (new.speed - self.applied.speed) ** 2 / period
+        self.applied = new
+        return new
+
+    def advance(self) -> None:
+        """One integration step ``dt``: vehicle, outlines, clearance, forbidden regions, collision
+        and arrival."""
+        state = self.state
+        nxt = holonomic_step(state, self.applied, self.dt)
+        self.path += math.hypot(nxt[0] - state[0], nxt[1] - state[1])
+        self.state = state = nxt
+        self.step_index += 1
+        self.t = t = self.step_index * self.dt
+        self.outlines = self.outlines_at(t)
+        self.clearance, _ = clearance_of((state[0], state[1]), self.outlines, self.spec.radius)
+        self.min_clear = min(self.min_clear, self.clearance)
+        self.entered = self.entered or inside_any((state[0], state[1]), self.setup.forbidden)
+        goal = self.goal
+        if self.clearance < 0:
+            self.status, self.done = "collision", True
+        elif math.hypot(goal[0] - state[0], goal[1] - state[1]) <= self.setup.goal_tolerance:
+            self.status, self.reached, self.done = "success", t, True
+        elif self.step_index >= self.n_steps:
+            self.done = True
+
+    def metrics(self, *, mode_switches: int, decision_us: list[float]) -> EpisodeMetrics:
+        """The episode's metrics (:mod:`uvnav.sim.metrics`) so far."""
+        setup = self.setup
+        spec = self.spec
+        goal = self.goal
+        shortest = max(self.start_dist - setup.goal_tolerance, 0.0)
+        # the fastest straight run: along the start->goal direction at the box's speed there
+        direction = math.atan2(goal[1] - setup.start[1], goal[0] - setup.start[0])
+        v_line = spec.v_max / max(abs(math.cos(direction)), abs(math.sin(direction)))
+        return episode_metrics(
+            status=self.status,
+            path_length=self.path,
+            shortest=shortest,
+            straight_time=shortest / v_line if v_line > 0 else 0.0,
+            reached_at=self.reached,
+            min_clearance=float(self.min_clear) if self.shapes else None,
+            control_effort=self.effort,
+            limit_violations=self.violations,
+            mode_switches=mode_switches,
+            decision_us=decision_us,
+        )
+
+
 def run_uuv2d_episode(
     setup: Uuv2dSetup,
     controller: Any,
@@ -137,118 +272,45 @@ def run_uuv2d_episode(
         record: keep the trajectory (for figures).
     """
     ctrl_rng, sense_rng = rng.spawn(2)
-    spec = setup.spec
-    dt = float(setup.dt)
-    period = float(setup.control_period)
-    ratio = decision_ratio(period, dt)
-    n_steps = round(setup.t_max / dt)
-    goal = np.asarray(setup.goal, dtype=float)
-    state = np.asarray(setup.start, dtype=float).copy()
-    shapes = setup.shapes
-    controller.reset(spec, goal, ctrl_rng)
-
-    def outlines_at(t: float) -> list[FloatArray]:
-        return [s.outline(t) for s in shapes]
-
-    outlines = outlines_at(0.0)
-    clear, _ = clearance_of((state[0], state[1]), outlines, spec.radius)
-    min_clear = clear
-    entered = inside_any((state[0], state[1]), setup.forbidden)
-    start_dist = float(np.hypot(*(goal - state[:2])))
-    status = "timeout"
-    if clear < 0:
-        status, n_steps = "collision", 0
-    elif start_dist <= setup.goal_tolerance:
-        status, n_steps = "success", 0
-    path = 0.0
-    effort = 0.0
-    violations = 0
+    sim = SimUuv2d(setup, sense_rng)
+    controller.reset(sim.spec, sim.goal, ctrl_rng)
+    sim.start()
     switches = 0
     last_mode: str | None = None
-    applied = HolonomicCommand(0.0, 0.0)
     decision_us: list[float] = []
-    reached: float | None = None
-    t = 0.0
     times = [0.0]
-    poses = [state.copy()]
-    clears = [clear]
+    poses = [sim.state.copy()]
+    clears = [sim.clearance]
     d_times: list[float] = []
     d_outlines: list[list[FloatArray]] = []
     d_cmds: list[tuple[float, float]] = []
     d_modes: list[str] = []
     d_records: list[Any] = []
     perf = _time.perf_counter_ns
-    for i in range(n_steps):
-        if i % ratio == 0:
-            centres = np.array([s.centre_at(t) for s in shapes]).reshape(-1, 2)
-            reading = sonar_scan(state, outlines, sense_rng, setup.sonar, centres=centres)
-            obs = SonarObservation(
-                time=t,
-                pose=state.copy(),
-                velocity=np.array([applied.vx, applied.vy]),
-                goal=goal,
-                sonar=reading,
-                period=period,
-            )
+    while not sim.done:
+        if sim.decision_due:
+            obs = sim.observe()
             tic = perf()
             cmd = controller.act(obs)
             decision_us.append((perf() - tic) / 1000.0)
-            if cmd.violates(spec, float(state[2]), period):
-                violations += 1
-            new = cmd.clipped(spec, float(state[2]), period)
-            if i > 0:
-                turn = (
-                    wrap_scalar(math.atan2(new.vy, new.vx) - float(state[2]))
-                    if new.speed > 0
-                    else 0.0
-                )
-                effort += turn * turn / period + (new.speed - applied.speed) ** 2 / period
-            applied = new
+            applied = sim.apply(cmd)
             mode = controller.mode
             if last_mode is not None and mode != last_mode:
                 switches += 1
             last_mode = mode
             if record:
-                d_times.append(t)
-                d_outlines.append(outlines)
+                d_times.append(sim.t)
+                d_outlines.append(sim.outlines)
                 d_cmds.append((applied.vx, applied.vy))
                 d_modes.append(mode)
                 d_records.append(getattr(controller, "last", None))
-        nxt = holonomic_step(state, applied, dt)
-        path += math.hypot(nxt[0] - state[0], nxt[1] - state[1])
-        state = nxt
-        t = (i + 1) * dt
-        outlines = outlines_at(t)
-        clear, _ = clearance_of((state[0], state[1]), outlines, spec.radius)
-        min_clear = min(min_clear, clear)
-        entered = entered or inside_any((state[0], state[1]), setup.forbidden)
+        sim.advance()
         if record:
-            times.append(t)
-            poses.append(state.copy())
-            clears.append(clear)
-        if clear < 0:
-            status = "collision"
-            break
-        if math.hypot(goal[0] - state[0], goal[1] - state[1]) <= setup.goal_tolerance:
-            status, reached = "success", t
-            break
+            times.append(sim.t)
+            poses.append(sim.state.copy())
+            clears.append(sim.clearance)
     dec = np.asarray(decision_us) if decision_us else np.zeros(1)
-    shortest = max(start_dist - setup.goal_tolerance, 0.0)
-    # the fastest straight run: along the start->goal direction at the box's speed there
-    direction = math.atan2(goal[1] - setup.start[1], goal[0] - setup.start[0])
-    v_line = spec.v_max / max(abs(math.cos(direction)), abs(math.sin(direction)))
-    metrics = episode_metrics(
-        status=status,
-        path_length=path,
-        shortest=shortest,
-        straight_time=shortest / v_line if v_line > 0 else 0.0,
-        reached_at=reached,
-        min_clearance=float(min_clear) if shapes else None,
-        control_effort=effort,
-        limit_violations=violations,
-        mode_switches=switches,
-        decision_us=decision_us,
-    )
+    metrics = sim.metrics(mode_switches=switches, decision_us=decision_us)
     traj = None
     if record:
         traj = Uuv2dTrajectory(
@@ -260,13 +322,13 @@ def run_uuv2d_episode(
             commands=np.asarray(d_cmds).reshape(-1, 2),
             modes=d_modes,
             decisions=d_records,
-            goal=goal,
+            goal=sim.goal,
             grid=getattr(controller, "grid", None),
         )
     return Uuv2dResult(
         metrics=metrics,
-        status=status,
-        entered_forbidden=entered,
+        status=sim.status,
+        entered_forbidden=sim.entered,
         trajectory=traj,
         decision_us=dec,
     )
