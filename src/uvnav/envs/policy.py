@@ -47,26 +47,21 @@ class ControllerPolicy:
 
 
 def make_any_controller(name: str, **params: Any) -> Any:
-    """A registered law by name, from the 2D, the 3D or the Chapter-4 UUV registry.
+    """A registered law by name, whatever vehicle it drives (unicycle, 3D or Chapter-4 UUV).
 
     Raises:
-        KeyError: no registry knows ``name``.
+        uvnav.controllers.UnknownControllerError: not registered (a ``KeyError``).
     """
-    from uvnav.controllers.base import available_controllers, make_controller
-    from uvnav.controllers.base3d import available_controllers3d, make_controller3d
-    from uvnav.controllers.zhang2022_uuv2d import (
-        available_uuv2d_controllers,
-        make_uuv2d_controller,
-    )
+    from uvnav.controllers.base import controller_info, make_controller
+    from uvnav.controllers.base3d import make_controller3d
+    from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
 
-    if name in available_controllers():
-        return make_controller(name, **params)
-    if name in available_controllers3d():
-        return make_controller3d(name, **params)
-    if name in available_uuv2d_controllers():
-        return make_uuv2d_controller(name, **params)
-    known = [*available_controllers(), *available_controllers3d(), *available_uuv2d_controllers()]
-    raise KeyError(f"unknown controller {name!r}; known: {', '.join(sorted(known))}")
+    builders = {
+        "unicycle": make_controller,
+        "vehicle3d": make_controller3d,
+        "uuv2d": make_uuv2d_controller,
+    }
+    return builders[controller_info(name).vehicle](name, **params)
 
 
 def as_policy(controller: Any, seed: int = 0, **params: Any) -> ControllerPolicy:
