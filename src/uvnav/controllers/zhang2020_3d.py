@@ -74,6 +74,7 @@ from uvnav.controllers.base3d import Vehicle3DController, register3d
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.frames3d import OnlineFrame, online_frame, rotation_from_vector
+from uvnav.geometry.kernels3d import numba_enabled, plane_shadow
 from uvnav.prediction.autoregressive import ARPredictor
 from uvnav.sensors.sensing3d import Observation3D, ObstacleReading3D
 
@@ -222,15 +223,36 @@ class Zhang2020Law(Vehicle3DController):
         room = max(rd.distance - base, 0.0)
         return base + min(move, 0.5 * room)
 
+    def _ahead(self, u: FloatArray, rd: ObstacleReading3D) -> FloatArray | None:
+        """The predicted rotation over one period, or None when it moves no boundary point by
+        more than 1 mm."""
+        ts = self.p.sample_period
+        if float(np.linalg.norm(u)) * ts * rd.bounding_radius > 1e-3:
+            return rotation_from_vector(u * ts)
+        return None
+
     def _points(self, rd: ObstacleReading3D, u: FloatArray) -> FloatArray:
         """Boundary points now and rotated as predicted one period ahead (the translation is
         covered by the forecast sphere)."""
-        ts = self.p.sample_period
-        if float(np.linalg.norm(u)) * ts * rd.bounding_radius > 1e-3:
-            rot = rotation_from_vector(u * ts)
+        rot = self._ahead(u, rd)
+        if rot is not None:
             ahead = (rd.outline - rd.centre) @ rot.T + rd.centre
             return np.concatenate([rd.outline, ahead])
         return rd.outline
+
+    def shadow(
+        self, frame: OnlineFrame, rd: ObstacleReading3D, u: FloatArray, rho: float
+    ) -> Shadow:
+        """The inflated shadow of one obstacle: the compiled one-pass kernel
+        (:func:`uvnav.geometry.kernels3d.plane_shadow`) when numba is installed, else
+        :func:`shadow_of` on :meth:`_points` (the same values to rounding)."""
+        if numba_enabled():
+            psi_c, lo, hi, inside = plane_shadow(
+                rd.outline, rd.centre, self._ahead(u, rd), frame.origin, frame.x_axis,
+                frame.y_axis, rho,
+            )  # fmt: skip
+            return Shadow(psi_c, lo, hi, inside)
+        return shadow_of(frame, self._points(rd, u), rd.centre, rho)
 
     def shadows(
         self, frame: OnlineFrame, obs: Observation3D
@@ -244,9 +266,7 @@ class Zhang2020Law(Vehicle3DController):
             if rd.obstacle_id == self._target:
                 v, u = self.predict(rd)
             rho = self.forecast_radius(rd, v)
-            out[rd.obstacle_id] = (
-                shadow_of(frame, self._points(rd, u), rd.centre, rho), rd, v, u,
-            )  # fmt: skip
+            out[rd.obstacle_id] = (self.shadow(frame, rd, u, rho), rd, v, u)
         return out
 
     def in_the_way(
