@@ -132,10 +132,11 @@ def bench_world(seconds: float) -> dict[str, Any]:
 
 def _with_kernels(fast: bool) -> None:
     """Select the compiled kernels (``fast``) or the numpy fallback for what follows."""
-    if fast:
-        os.environ.pop("UVNAV_NO_NUMBA", None)
-    else:
-        os.environ["UVNAV_NO_NUMBA"] = "1"
+    try:
+        from uvnav.geometry.kernels3d import use_compiled
+    except ImportError:  # a baseline tree from before the kernels
+        return
+    use_compiled(fast)
 
 
 def one_round(n_decisions: int, seconds: float, fast: bool) -> dict[str, Any]:

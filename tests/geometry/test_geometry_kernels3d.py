@@ -18,6 +18,7 @@ from uvnav.geometry.kernels3d import (
     numba_enabled,
     plane_shadow,
     plane_shadow_py,
+    use_compiled,
 )
 from uvnav.geometry.mesh3d import (
     box_mesh,
@@ -90,8 +91,11 @@ def test_compiled_and_numpy_paths_agree_to_1e_9(monkeypatch: pytest.MonkeyPatch)
         q2, d2, j2 = signed_nearest_numpy(p, body.tri, body.normals)
         assert abs(d - d2) <= 1e-9 and np.allclose(q, q2, atol=1e-9)
         assert j == j2  # same triangle (ties keep the lowest index on both paths)
-    monkeypatch.setenv("UVNAV_NO_NUMBA", "1")
+    monkeypatch.setattr("uvnav.geometry.kernels3d._ENABLED", True)
+    assert use_compiled(False) is True
     assert not numba_enabled()
+    _, d3, _ = signed_nearest(pts[0], body.tri, body.normals)  # now the numpy path
+    assert abs(d3 - signed_nearest_numpy(pts[0], body.tri, body.normals)[1]) == 0.0
 
 
 def test_cull_keeps_the_nearest_triangle_and_ties_the_lowest_index() -> None:

@@ -95,15 +95,16 @@ def test_compiled_kernels_and_numpy_fallback_give_the_same_episode(
 ) -> None:
     """The whole episode (sensing, zhang2020-3d decisions, exact clearance every step) with the
     numba kernels and with the numpy fallback: same status and metrics to 1e-9."""
-    from uvnav.geometry.kernels3d import numba_available
+    from uvnav.geometry.kernels3d import numba_available, use_compiled
 
     if not numba_available():
         pytest.skip("numba (the 'fast' extra) absent")
     from uvnav.scenarios.generators3d import random_ch3_scenario
 
     out = []
-    for flag in ("0", "1"):
-        monkeypatch.setenv("UVNAV_NO_NUMBA", flag)
+    for flag in (True, False):
+        monkeypatch.setattr("uvnav.geometry.kernels3d._ENABLED", flag)
+        assert use_compiled(flag) is flag
         sc = random_ch3_scenario(3)
         setup = sc.build(3, velocities="known")
         setup.t_max = 15.0

@@ -137,6 +137,11 @@ class Shadow:
         return self.lo - pad <= d <= self.hi + pad
 
 
+def _norm(x: FloatArray) -> float:
+    """Euclidean norm of a small vector (cheaper than ``np.linalg.norm`` per call)."""
+    return math.sqrt(float(x @ x))
+
+
 def _psi(xy: FloatArray) -> FloatArray:
     """Angle counter-clockwise from +Y' of plane vectors (..., 2)."""
     return np.asarray(np.arctan2(-xy[..., 0], xy[..., 1]))
@@ -219,7 +224,7 @@ class Zhang2020Law(Vehicle3DController):
         margin, with the horizon shortened near the body so that the robot stays outside the
         spheres (item 3 of the module docstring)."""
         base = self._spec.radius + self.p.safety_margin
-        move = float(np.linalg.norm(v)) * self.p.sample_period
+        move = _norm(v) * self.p.sample_period
         room = max(rd.distance - base, 0.0)
         return base + min(move, 0.5 * room)
 
@@ -227,7 +232,7 @@ class Zhang2020Law(Vehicle3DController):
         """The predicted rotation over one period, or None when it moves no boundary point by
         more than 1 mm."""
         ts = self.p.sample_period
-        if float(np.linalg.norm(u)) * ts * rd.bounding_radius > 1e-3:
+        if _norm(u) * ts * rd.bounding_radius > 1e-3:
             return rotation_from_vector(u * ts)
         return None
 
@@ -359,12 +364,12 @@ class Zhang2020Law(Vehicle3DController):
     ) -> float:
         """(3.21) or V_max (``speed_law``), floored at 1.5 ||v_i*|| ((3.9))."""
         vmax = self._spec.v_max
-        floor = min(vmax, max(1.5 * float(np.linalg.norm(v)) + 0.05 * vmax, 0.5 * vmax))
+        floor = min(vmax, max(1.5 * _norm(v) + 0.05 * vmax, 0.5 * vmax))
         if self.p.speed_law == "tangent":
             # ||l_J|| = ||v*|| / tan(gamma) = sqrt(d*^2 - r^2): the tangent length to the
             # forecast sphere at r*_min, covered in T_s
             d = max(rd.distance + self._spec.radius, 1e-9)
-            r = float(np.linalg.norm(v)) * self.p.sample_period
+            r = _norm(v) * self.p.sample_period
             length = math.sqrt(max(d * d - r * r, 0.0))
             return min(vmax, max(length / self.p.sample_period, floor))
         cos_b = float(np.clip(direction @ obs.heading, -1.0, 1.0))

@@ -14,8 +14,9 @@ by the forecast sphere (3.17)).  Two kernels run for every obstacle at every dec
 
 Both are exact (the same formulas as :mod:`uvnav.geometry.mesh3d` and
 :func:`uvnav.controllers.zhang2020_3d.shadow_of`, to rounding).  With numba installed (the ``fast``
-extra) they are compiled (``numba.njit(cache=True)``); without it (or with ``UVNAV_NO_NUMBA=1``)
-the callers use their vectorised numpy paths, and the tests check that both agree to 1e-9.
+extra) they are compiled (``numba.njit(cache=True)``); without it (or with ``UVNAV_NO_NUMBA=1`` at
+import, or after ``use_compiled(False)``) the callers use their vectorised numpy paths, and the
+tests check that both agree to 1e-9.
 
 Why numba and not a library BVH (python-fcl): a body has a few hundred triangles, so one compiled
 pass with the bounding-sphere cull is already a few microseconds, and the cost of a query from
@@ -40,6 +41,8 @@ from uvnav.geometry.angles import FloatArray
 
 #: numba is installed (the optional ``fast`` extra); it is imported on the first kernel call only
 _HAVE_NUMBA = importlib.util.find_spec("numba") is not None
+#: the compiled kernels are used (see :func:`use_compiled`)
+_ENABLED = _HAVE_NUMBA and os.environ.get("UVNAV_NO_NUMBA", "") != "1"
 
 
 def numba_available() -> bool:
@@ -48,8 +51,19 @@ def numba_available() -> bool:
 
 
 def numba_enabled() -> bool:
-    """The compiled kernels are used: numba is installed and ``UVNAV_NO_NUMBA`` is not ``1``."""
-    return _HAVE_NUMBA and os.environ.get("UVNAV_NO_NUMBA", "") != "1"
+    """The compiled kernels are used: numba is installed, ``UVNAV_NO_NUMBA`` was not ``1`` when
+    uvnav was imported, and :func:`use_compiled` has not turned them off."""
+    return _ENABLED
+
+
+def use_compiled(enabled: bool) -> bool:
+    """Use the compiled kernels (``True``, when numba is installed) or the numpy fallback
+    (``False``) from now on, in this process; returns the previous setting (benchmarks and tests
+    compare the two paths)."""
+    global _ENABLED
+    previous = _ENABLED
+    _ENABLED = bool(enabled) and _HAVE_NUMBA
+    return previous
 
 
 def closest_barycentric_scalar(
@@ -349,13 +363,11 @@ def plane_shadow(
     radius: float,
 ) -> tuple[float, float, float, bool]:
     """The compiled :func:`plane_shadow_py` (call only when :func:`numba_enabled`); ``rotation``
-    None: the points only."""
-    rot = _EYE if rotation is None else np.ascontiguousarray(rotation, dtype=float)
+    None: the points only.  The arrays must be float64 (numba compiles one version per layout)."""
+    rot = _EYE if rotation is None else rotation
     return _compiled()["shadow"](  # type: ignore[no-any-return]
-        np.ascontiguousarray(points, dtype=float), np.asarray(centre, dtype=float), rot,
-        rotation is not None, np.asarray(origin, dtype=float), np.asarray(x_axis, dtype=float),
-        np.asarray(y_axis, dtype=float), float(radius),
-    )  # fmt: skip
+        points, centre, rot, rotation is not None, origin, x_axis, y_axis, float(radius)
+    )
 
 
 _EYE = np.eye(3)
