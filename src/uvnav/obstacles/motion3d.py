@@ -173,7 +173,7 @@ class Obstacle3D:
     state: ObstacleState3D
     #: exp([u]x dt) of the last step and its key (u's bytes, dt): the rates are held for whole
     #: sampling periods, so the same rotation is reused bit for bit while they do not change
-    _step_rotation: tuple[bytes, float, FloatArray] | None = field(
+    _step_rotation: tuple[bytes, float, FloatArray | None] | None = field(
         default=None, init=False, repr=False, compare=False
     )
 
@@ -184,12 +184,13 @@ class Obstacle3D:
         self.state.velocity = v
         self.state.rotation_rate = u
         self.state.centre = self.state.centre + v * dt
-        if float(u @ u) > 0.0:
-            key = u.tobytes()
-            cached = self._step_rotation
-            if cached is None or cached[0] != key or cached[1] != dt:
-                cached = (key, dt, rotation_from_vector(u * dt))
-                self._step_rotation = cached
+        key = u.tobytes()
+        cached = self._step_rotation
+        if cached is None or cached[0] != key or cached[1] != dt:
+            # None: no rotation (u = 0)
+            cached = (key, dt, rotation_from_vector(u * dt) if float(u @ u) > 0.0 else None)
+            self._step_rotation = cached
+        if cached[2] is not None:
             self.state.rotation = cached[2] @ self.state.rotation
 
     def to_body(self, point: FloatArray) -> FloatArray:
