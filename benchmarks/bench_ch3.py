@@ -282,6 +282,7 @@ def run(quick: bool, against: Path | None = None, rounds: int | None = None) -> 
             "load_before": load_before,
             "load_after": os.getloadavg(),
         },
+        "load": {"before": load_before, "after": os.getloadavg()},
         "when": datetime.now(UTC).isoformat(),
         "params": {
             "decisions": n_dec,

@@ -23,6 +23,7 @@ hundred triangles a body has; ``scipy.spatial`` has no triangle queries.  All fu
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -456,8 +457,15 @@ def validate_mesh(
 def icosphere(subdivisions: int = 2) -> tuple[FloatArray, IntArray]:
     """Unit icosphere: (vertices (n, 3) on the unit sphere, outward faces (m, 3)).
 
-    ``subdivisions`` = 0, 1, 2, 3 gives 20, 80, 320, 1280 triangles.
+    ``subdivisions`` = 0, 1, 2, 3 gives 20, 80, 320, 1280 triangles.  Built once per level and
+    returned as fresh copies (every star body of a scene is tessellated on one).
     """
+    v, f = _icosphere(max(int(subdivisions), 0))
+    return v.copy(), f.copy()
+
+
+@functools.lru_cache(maxsize=8)
+def _icosphere(subdivisions: int) -> tuple[FloatArray, IntArray]:
     t = (1.0 + math.sqrt(5.0)) / 2.0
     verts = [
         (-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0),
