@@ -324,7 +324,7 @@ def _compiled() -> dict[str, Callable[..., Any]]:
         import numba
 
         def jit(fn: Callable[..., Any]) -> Callable[..., Any]:
-            return numba.njit(cache=True, nogil=True)(fn)  # type: ignore[no-any-return]
+            return numba.njit(cache=True, nogil=True)(fn)
 
         # callees first: a compiled kernel resolves the module globals it calls when compiled
         _bary = jit(closest_barycentric_scalar)
@@ -348,7 +348,7 @@ def signed_nearest_world(
     vertex: FloatArray,
 ) -> tuple[float, float, float, float, int]:
     """The compiled :func:`signed_nearest_world_py` (call only when :func:`numba_enabled`)."""
-    return _compiled()["signed"](  # type: ignore[no-any-return]
+    return _compiled()["signed"](
         p, centre, rotation, a, ab, ac, tri_centre, tri_radius, face, edge, vertex
     )
 
@@ -365,7 +365,7 @@ def plane_shadow(
     """The compiled :func:`plane_shadow_py` (call only when :func:`numba_enabled`); ``rotation``
     None: the points only.  The arrays must be float64 (numba compiles one version per layout)."""
     rot = _EYE if rotation is None else rotation
-    return _compiled()["shadow"](  # type: ignore[no-any-return]
+    return _compiled()["shadow"](
         points, centre, rot, rotation is not None, origin, x_axis, y_axis, float(radius)
     )
 
