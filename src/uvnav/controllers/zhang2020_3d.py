@@ -178,6 +178,8 @@ class Zhang2020Law(Vehicle3DController):
         self._x_prev: FloatArray | None = None
         self._pred_v: dict[int, ARPredictor] = {}
         self._pred_u: dict[int, ARPredictor] = {}
+        #: per obstacle: (u bytes, T_s) -> exp([u]x T_s) (see :meth:`_ahead`)
+        self._ahead_rot: dict[int, tuple[tuple[bytes, float], FloatArray]] = {}
         #: last predictions used, by obstacle id: (v*, u*, model name) — read by probes/figures
         self.predictions: dict[int, tuple[FloatArray, FloatArray, str]] = {}
 
@@ -187,6 +189,7 @@ class Zhang2020Law(Vehicle3DController):
         self._x_prev = None
         self._pred_v = {}
         self._pred_u = {}
+        self._ahead_rot = {}
         self.predictions = {}
 
     # ----------------------------------------------------------------------------- prediction
@@ -233,7 +236,11 @@ class Zhang2020Law(Vehicle3DController):
         more than 1 mm."""
         ts = self.p.sample_period
         if _norm(u) * ts * rd.bounding_radius > 1e-3:
-            return rotation_from_vector(u * ts)
+            key = (u.tobytes(), ts)
+            cached = self._ahead_rot.get(rd.obstacle_id)
+            if cached is None or cached[0] != key:  # rates (or predictions) are held a while
+                cached = self._ahead_rot[rd.obstacle_id] = (key, rotation_from_vector(u * ts))
+            return cached[1]
         return None
 
     def _points(self, rd: ObstacleReading3D, u: FloatArray) -> FloatArray:

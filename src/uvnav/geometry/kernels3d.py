@@ -289,7 +289,7 @@ def plane_shadow_py(
                 pz = cz + rotation[2, 0] * qx + rotation[2, 1] * qy + rotation[2, 2] * qz
             q1 = (px - ox) * xx + (py - oy) * xy + (pz - oz) * xz
             q2 = (px - ox) * yx + (py - oy) * yy + (pz - oz) * yz
-            dist = math.hypot(q1, q2)
+            dist = math.sqrt(q1 * q1 + q2 * q2)
             rel = math.atan2(-q1, q2) - psi_c  # in (-2 pi, 2 pi): wrapped once
             if rel > math.pi:
                 rel -= 2.0 * math.pi
