@@ -11,6 +11,16 @@ run).  Writes ``<out>/ch3.json`` with the machine, the parameters, the measureme
   rotating mesh obstacles (AR motion), a straight-flying robot beside them (so the episode never
   ends early), sensing every decision (0.1 s) and the exact clearance check every step (0.05 s);
   target >= 2,000 steps/s (issue 4).  Reported for recorded and unrecorded episodes.
+
+Both are measured side by side, in alternating rounds, for the compiled kernels
+(:mod:`uvnav.geometry.kernels3d`, numba) and their pure-numpy fallback (``UVNAV_NO_NUMBA=1``),
+and with ``--against DIR`` also for another uvnav source tree (e.g. the commit before a speed-up,
+``git archive <commit> src | tar -x -C DIR``), run in worker processes that alternate with one for
+this checkout; the ratios are what to compare on a busy machine.  Each timing is also taken in
+the process's own CPU time (``time.thread_time`` / ``process_time``; ``cpu_*`` keys), which on a
+machine shared with other jobs is close to what the wall time would be on an idle one.  The
+targets are checked on the compiled path (this checkout's default with the ``fast`` extra), in
+wall time (``pass``) and in CPU time (``pass_cpu``).
 """
 
 from __future__ import annotations
@@ -19,6 +29,8 @@ import argparse
 import json
 import os
 import platform
+import subprocess
+import sys
 import time
 from datetime import UTC, datetime
 from pathlib import Path
@@ -61,7 +73,7 @@ def bench_decision(n_decisions: int) -> dict[str, Any]:
         c = make_controller3d("zhang2020-3d-v1", oracle=mode == "oracle")
         c.reset(spec, goal, np.random.default_rng(0))
         est = FiniteDifference3D(np.random.default_rng(0))
-        times = []
+        times, cpu_times = [], []
         for k in range(n_decisions):
             t = 0.1 * k
             for ob in world:
@@ -70,14 +82,17 @@ def bench_decision(n_decisions: int) -> dict[str, Any]:
             if mode == "ar":
                 rd = est.update(t, rd)
             obs = Observation3D(t, np.zeros(3), np.array([0.0, 1.0, 0.0]), 1.0, goal, rd)
-            tic = time.perf_counter_ns()
+            tic, cpu = time.perf_counter_ns(), time.thread_time_ns()
             c.act(obs)
             times.append((time.perf_counter_ns() - tic) / 1000.0)
+            cpu_times.append((time.thread_time_ns() - cpu) / 1000.0)
             for ob in world:
                 ob.step(t, 0.1)
         arr = np.array(times[5:])
+        cpu_arr = np.array(cpu_times[5:])
         res[mode] = {"obstacles_in_range": len(rd), "median_us": float(np.median(arr)),
-                     "p99_us": float(np.percentile(arr, 99)), "n": len(arr)}  # fmt: skip
+                     "p99_us": float(np.percentile(arr, 99)), "n": len(arr),
+                     "cpu_median_us": float(np.median(cpu_arr))}  # fmt: skip
     return res
 
 
@@ -102,52 +117,235 @@ def bench_world(seconds: float) -> dict[str, Any]:
             obstacles=_obstacles(10, 2, np.array([0.0, 0.0, 3.5]), 0.5), dt=0.05,
             control_period=0.1, t_max=seconds, sensing=Sensing3DConfig(8.0, "estimated"),
         )  # fmt: skip
-        tic = time.perf_counter()
+        tic, cpu = time.perf_counter(), time.process_time()
         res, _ = run_episode3d(setup, _Straight(), np.random.default_rng(0), record=record)
         wall = time.perf_counter() - tic
+        cpu = time.process_time() - cpu
         steps = round(seconds / 0.05)
         out["recorded" if record else "unrecorded"] = {
             "steps": steps, "wall_s": wall, "steps_per_s": steps / wall, "status": res.status,
+            "cpu_s": cpu, "cpu_steps_per_s": steps / cpu,
             "min_clearance": res.metrics.min_clearance,
         }  # fmt: skip
     return out
+
+
+def _with_kernels(fast: bool) -> None:
+    """Select the compiled kernels (``fast``) or the numpy fallback for what follows."""
+    try:
+        from uvnav.geometry.kernels3d import use_compiled
+    except ImportError:  # a baseline tree from before the kernels
+        return
+    use_compiled(fast)
+
+
+def one_round(n_decisions: int, seconds: float, fast: bool) -> dict[str, Any]:
+    """One measurement of both quantities (decision median, unrecorded and recorded steps/s)."""
+    _with_kernels(fast)
+    dec = bench_decision(n_decisions)
+    world = bench_world(seconds)
+    return {
+        "decision_us_oracle": dec["oracle"]["median_us"],
+        "decision_us_ar": dec["ar"]["median_us"],
+        "obstacles_in_range": dec["oracle"]["obstacles_in_range"],
+        "steps_per_s": world["unrecorded"]["steps_per_s"],
+        "steps_per_s_recorded": world["recorded"]["steps_per_s"],
+        "cpu_decision_us_oracle": dec["oracle"]["cpu_median_us"],
+        "cpu_decision_us_ar": dec["ar"]["cpu_median_us"],
+        "cpu_steps_per_s": world["unrecorded"]["cpu_steps_per_s"],
+        "status": world["unrecorded"]["status"],
+        "min_clearance": world["unrecorded"]["min_clearance"],
+    }
+
+
+def _warm_up() -> None:
+    """Load (or compile) the numba kernels before anything is timed."""
+    _with_kernels(True)
+    bench_decision(8)
+    bench_world(0.2)
+
+
+class _Worker:
+    """A child process importing ``uvnav`` from ``src`` that answers :func:`one_round` calls."""
+
+    def __init__(self, src: Path) -> None:
+        env = dict(os.environ, PYTHONPATH=str(src))
+        self.proc = subprocess.Popen(
+            [sys.executable, __file__, "--worker"], stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE, text=True, env=env,
+        )  # fmt: skip
+        self.uvnav = self.call({"where": True})["uvnav"]
+
+    def call(self, msg: dict[str, Any]) -> dict[str, Any]:
+        assert self.proc.stdin is not None and self.proc.stdout is not None
+        self.proc.stdin.write(json.dumps(msg) + "\n")
+        self.proc.stdin.flush()
+        return dict(json.loads(self.proc.stdout.readline()))
+
+    def close(self) -> None:
+        if self.proc.stdin is not None:
+            self.proc.stdin.close()
+        self.proc.wait(timeout=60)
+
+
+def worker_main() -> None:
+    import uvnav
+
+    for line in sys.stdin:
+        msg = json.loads(line)
+        if msg.get("where"):
+            out: dict[str, Any] = {"uvnav": str(Path(uvnav.__file__).parent)}
+        else:
+            try:
+                _warm_up()
+                out = one_round(msg["n"], msg["seconds"], True)
+            except Exception as exc:
+                out = {"error": f"{type(exc).__name__}: {exc}"}
+        print(json.dumps(out), flush=True)
+
+
+def _summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    keys = (
+        "decision_us_oracle", "decision_us_ar", "steps_per_s", "steps_per_s_recorded",
+        "cpu_decision_us_oracle", "cpu_decision_us_ar", "cpu_steps_per_s",
+    )  # fmt: skip
+    out: dict[str, Any] = {k: float(np.median([r[k] for r in rows])) for k in keys}
+    out["rounds"] = rows
+    return out
+
+
+def _ratios(base: list[dict[str, Any]], cur: list[dict[str, Any]]) -> dict[str, float]:
+    """Medians of per-round ratios: how many times faster ``cur`` is than ``base``."""
+    pairs = list(zip(base, cur, strict=False))
+    return {
+        "decision_oracle_x": float(
+            np.median([b["decision_us_oracle"] / c["decision_us_oracle"] for b, c in pairs])
+        ),
+        "decision_ar_x": float(
+            np.median([b["decision_us_ar"] / c["decision_us_ar"] for b, c in pairs])
+        ),
+        "steps_per_s_x": float(np.median([c["steps_per_s"] / b["steps_per_s"] for b, c in pairs])),
+        "cpu_decision_oracle_x": float(
+            np.median([b["cpu_decision_us_oracle"] / c["cpu_decision_us_oracle"] for b, c in pairs])
+        ),
+        "cpu_steps_per_s_x": float(
+            np.median([c["cpu_steps_per_s"] / b["cpu_steps_per_s"] for b, c in pairs])
+        ),
+        "steps_per_s_recorded_x": float(
+            np.median([c["steps_per_s_recorded"] / b["steps_per_s_recorded"] for b, c in pairs])
+        ),
+    }
+
+
+def run(quick: bool, against: Path | None = None, rounds: int | None = None) -> dict[str, Any]:
+    """All Chapter 3 measurements (see the module docstring) as one JSON-ready report."""
+    n_dec, seconds = (60, 5.0) if quick else (300, 30.0)
+    n_rounds = rounds if rounds is not None else (2 if quick else 5)
+    load_before = os.getloadavg()
+    _warm_up()
+    sides: dict[str, list[dict[str, Any]]] = {"compiled": [], "numpy": []}
+    worker = (
+        _Worker(against / "src" if (against / "src").is_dir() else against) if against else None
+    )
+    if worker is not None:
+        sides["baseline"] = []
+    try:
+        for r in range(n_rounds):
+            order = list(sides) if r % 2 == 0 else list(reversed(sides))
+            for side in order:
+                if side == "baseline":
+                    assert worker is not None
+                    res = worker.call({"n": n_dec, "seconds": seconds})
+                    if "error" in res:
+                        raise RuntimeError(f"baseline worker: {res['error']}")
+                else:
+                    res = one_round(n_dec, seconds, side == "compiled")
+                sides[side].append(res)
+    finally:
+        _with_kernels(True)
+        if worker is not None:
+            worker.close()
+    med = sides["compiled"]
+    dec_med = float(np.median([r["decision_us_oracle"] for r in med]))
+    sps_med = float(np.median([r["steps_per_s"] for r in med]))
+    dec_cpu = float(np.median([r["cpu_decision_us_oracle"] for r in med]))
+    sps_cpu = float(np.median([r["cpu_steps_per_s"] for r in med]))
+    report: dict[str, Any] = {
+        "benchmark": "ch3",
+        "description": "thesis Ch. 3 (3D): zhang2020-3d-v1 decision time with 10 mesh obstacles "
+        "in range; run_episode3d steps/s with 10 moving mesh obstacles; compiled kernels vs "
+        "numpy fallback (and --against a baseline tree), alternating rounds",
+        "machine": {
+            "platform": platform.platform(),
+            "python": platform.python_version(),
+            "cpus": os.cpu_count(),
+            "load_before": load_before,
+            "load_after": os.getloadavg(),
+        },
+        "load": {"before": load_before, "after": os.getloadavg()},
+        "when": datetime.now(UTC).isoformat(),
+        "params": {
+            "decisions": n_dec,
+            "world_seconds": seconds,
+            "dt": 0.05,
+            "rounds": n_rounds,
+            "triangles_per_body": 320,
+            "obstacles": 10,
+        },
+        "results": {side: _summary(rows) for side, rows in sides.items()},
+        "speedup": {"compiled_vs_numpy": _ratios(sides["numpy"], sides["compiled"])},
+        "targets": {
+            "ch3_decision_us_median_10": {
+                "benchmark": "ch3",
+                "what": "zhang2020-3d-v1 median decision time, 10 mesh obstacles in range [µs]",
+                "limit": TARGETS["decision_us_median_10"],
+                "direction": "<=",
+                "measured": dec_med,
+                "pass": dec_med <= TARGETS["decision_us_median_10"],
+                "measured_cpu": dec_cpu,
+                "pass_cpu": dec_cpu <= TARGETS["decision_us_median_10"],
+            },
+            "ch3_world_steps_per_s_10": {
+                "benchmark": "ch3",
+                "what": "run_episode3d steps per second, 10 moving mesh obstacles",
+                "limit": TARGETS["world_steps_per_s_10"],
+                "direction": ">=",
+                "measured": sps_med,
+                "pass": sps_med >= TARGETS["world_steps_per_s_10"],
+                "measured_cpu": sps_cpu,
+                "pass_cpu": sps_cpu >= TARGETS["world_steps_per_s_10"],
+            },
+        },
+    }
+    if worker is not None:
+        report["sources"] = {"baseline": worker.uvnav}
+        report["speedup"]["compiled_vs_baseline"] = _ratios(sides["baseline"], sides["compiled"])
+    return report
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path("benchmarks/results"))
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--rounds", type=int, default=None, help="alternating rounds per side")
+    ap.add_argument("--against", type=Path, default=None, metavar="DIR",
+                    help="also time a baseline uvnav source tree (DIR or DIR/src)")  # fmt: skip
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
-    dec = bench_decision(60 if args.quick else 400)
-    world = bench_world(10.0 if args.quick else 60.0)
-    med = dec["oracle"]["median_us"]
-    sps = world["unrecorded"]["steps_per_s"]
-    data = {
-        "machine": {
-            "platform": platform.platform(),
-            "python": platform.python_version(),
-            "cpus": os.cpu_count(),
-            "load": os.getloadavg(),
-        },
-        "when": datetime.now(UTC).isoformat(),
-        "decision_time": dec,
-        "world_steps": world,
-        "targets": {
-            "decision_us_median_10": {
-                "limit": TARGETS["decision_us_median_10"],
-                "value": med,
-                "pass": med <= TARGETS["decision_us_median_10"],
-            },
-            "world_steps_per_s_10": {
-                "limit": TARGETS["world_steps_per_s_10"],
-                "value": sps,
-                "pass": sps >= TARGETS["world_steps_per_s_10"],
-            },
-        },
-    }
+    if args.worker:
+        worker_main()
+        return
+    data = run(args.quick, args.against, args.rounds)
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "ch3.json").write_text(json.dumps(data, indent=1), encoding="utf-8")
-    print(json.dumps(data, indent=1))
+    print(json.dumps({k: data[k] for k in ("machine", "speedup", "targets")}, indent=1))
+    for side, row in data["results"].items():
+        print(
+            f"{side:9s} decision median {row['decision_us_oracle']:8.1f} µs (oracle) "
+            f"{row['decision_us_ar']:8.1f} µs (AR); steps/s {row['steps_per_s']:8.1f} "
+            f"(recorded {row['steps_per_s_recorded']:8.1f}); CPU time: decision "
+            f"{row['cpu_decision_us_oracle']:8.1f} µs, steps/s {row['cpu_steps_per_s']:8.1f}"
+        )
 
 
 if __name__ == "__main__":

@@ -17,6 +17,9 @@ Benchmarks:
   early (the obstacles wander in an arena beside the robot's path).
 * ``episodes``: episodes per second of the thesis Ch. 2 one-obstacle scene (I = [0, 0],
   T = [10, 10], V_max = 0.707 m/s, U_max = 1.414 rad/s, one random-turn polygon) per controller.
+* ``ch3``: thesis Ch. 3 (3D), from ``benchmarks/bench_ch3.py``: ``zhang2020-3d-v1`` decision time
+  with 10 mesh obstacles in range (target <= 300 µs median) and ``run_episode3d`` steps per second
+  with 10 moving mesh obstacles (target >= 2,000), compiled kernels vs the numpy fallback.
 
 ``--quick`` runs a few hundred samples of each for a smoke test (numbers are then indicative only);
 ``--profile`` also writes a cProfile summary of the world step (``world_step_profile.json``);
@@ -811,6 +814,16 @@ def print_tables(reports: dict[str, dict[str, Any]]) -> None:
             console.print(t)
 
 
+def bench_ch3(quick: bool) -> dict[str, Any]:
+    """Thesis Ch. 3 (3D): ``benchmarks/bench_ch3.py`` (decision time of zhang2020-3d-v1 and
+    run_episode3d steps/s with 10 mesh obstacles; compiled kernels vs numpy fallback side by
+    side), with its targets (``ch3_decision_us_median_10``, ``ch3_world_steps_per_s_10``)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import bench_ch3 as ch3
+
+    return dict(ch3.run(quick))
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
@@ -822,7 +835,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--only",
         nargs="+",
-        choices=["decision", "world", "episodes"],
+        choices=["decision", "world", "episodes", "ch3"],
         help="run a subset (default: all)",
     )
     parser.add_argument("--profile", action="store_true", help="also cProfile the world step")
@@ -838,13 +851,14 @@ def main(argv: list[str] | None = None) -> int:
     if args.worker:
         return worker_main()
 
-    chosen = set(args.only or ["decision", "world", "episodes"])
+    chosen = set(args.only or ["decision", "world", "episodes", "ch3"])
     info = machine_info()
     reports: dict[str, dict[str, Any]] = {}
     runners: list[tuple[str, str, Callable[[bool], dict[str, Any]]]] = [
         ("decision", "decision_time", bench_decision),
         ("world", "world_steps", bench_world),
         ("episodes", "episodes", bench_episodes),
+        ("ch3", "ch3", bench_ch3),
     ]
     if args.profile:
         runners.append(("world", "world_step_profile", profile_world))

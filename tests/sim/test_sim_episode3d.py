@@ -88,3 +88,30 @@ def test_zhang2020_3d_reaches_e_without_collision_on_the_thesis_scenes(
     assert res.status == "success"
     assert res.metrics.min_clearance > 0.1
     assert res.metrics.limit_violations == 0
+
+
+def test_compiled_kernels_and_numpy_fallback_give_the_same_episode(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    """The whole episode (sensing, zhang2020-3d decisions, exact clearance every step) with the
+    numba kernels and with the numpy fallback: same status and metrics to 1e-9."""
+    from uvnav.geometry.kernels3d import numba_available, use_compiled
+
+    if not numba_available():
+        pytest.skip("numba (the 'fast' extra) absent")
+    from uvnav.scenarios.generators3d import random_ch3_scenario
+
+    out = []
+    for flag in (True, False):
+        monkeypatch.setattr("uvnav.geometry.kernels3d._ENABLED", flag)
+        assert use_compiled(flag) is flag
+        sc = random_ch3_scenario(3)
+        setup = sc.build(3, velocities="known")
+        setup.t_max = 15.0
+        c = make_controller3d("zhang2020-3d-v1", oracle=True)
+        res, _ = run_episode3d(setup, c, np.random.default_rng(3), record=False)
+        out.append(res)
+    a, b = out
+    assert a.status == b.status
+    for key in ("min_clearance", "path_length", "control_effort"):
+        assert getattr(a.metrics, key) == pytest.approx(getattr(b.metrics, key), abs=1e-9)

@@ -208,9 +208,15 @@ def reproduce_ch3(
             "note": f"collisions {int(grp['collision'].astype(float).sum())}",
         })  # fmt: skip
         for _, fr in grp[~grp["success"].astype(bool)].iterrows():
+            cause = (
+                f"collision (min clearance {fr['min_clearance']:.3f} m)"
+                if fr["status"] == "collision"
+                else f"{fr['status']} (did not reach E within t_max)"
+            )
             failures.append({
-                "scene": fr["scenario"], "controller": ctrl, "params": params,
-                "status": fr["status"], "min_clearance": fr["min_clearance"],
+                "scene": fr["scenario"], "seed": int(fr["seed"]), "controller": ctrl,
+                "motion": motion, "params": params, "status": fr["status"],
+                "min_clearance": fr["min_clearance"], "cause": cause,
             })  # fmt: skip
     table.append({
         "quantity": "one-step velocity prediction RMS error [m/s]",

@@ -286,6 +286,11 @@ def simulate(
     ``--param`` values override them.  With another ``--controller`` only ``--param`` values apply.
     """
     sc = load_scenario(scenario)
+    if getattr(sc, "dim", 2) == 3:  # thesis Ch. 3 scenes: the 3D simulator (cli/sim3d.py)
+        from uvnav.cli.sim3d import simulate3d
+
+        simulate3d(sc, controller, parse_params(param), seed, json_out=json_out, plot=plot)  # type: ignore[arg-type]
+        return
     name = controller or sc.controller.name
     params = dict(sc.controller.params) if name == sc.controller.name else {}
     params.update(parse_params(param))

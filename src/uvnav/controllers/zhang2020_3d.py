@@ -74,6 +74,7 @@ from uvnav.controllers.base3d import Vehicle3DController, register3d
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.frames3d import OnlineFrame, online_frame, rotation_from_vector
+from uvnav.geometry.kernels3d import numba_enabled, plane_shadow
 from uvnav.prediction.autoregressive import ARPredictor
 from uvnav.sensors.sensing3d import Observation3D, ObstacleReading3D
 
@@ -136,6 +137,11 @@ class Shadow:
         return self.lo - pad <= d <= self.hi + pad
 
 
+def _norm(x: FloatArray) -> float:
+    """Euclidean norm of a small vector (cheaper than ``np.linalg.norm`` per call)."""
+    return math.sqrt(float(x @ x))
+
+
 def _psi(xy: FloatArray) -> FloatArray:
     """Angle counter-clockwise from +Y' of plane vectors (..., 2)."""
     return np.asarray(np.arctan2(-xy[..., 0], xy[..., 1]))
@@ -172,6 +178,8 @@ class Zhang2020Law(Vehicle3DController):
         self._x_prev: FloatArray | None = None
         self._pred_v: dict[int, ARPredictor] = {}
         self._pred_u: dict[int, ARPredictor] = {}
+        #: per obstacle: (u bytes, T_s) -> exp([u]x T_s) (see :meth:`_ahead`)
+        self._ahead_rot: dict[int, tuple[tuple[bytes, float], FloatArray]] = {}
         #: last predictions used, by obstacle id: (v*, u*, model name) — read by probes/figures
         self.predictions: dict[int, tuple[FloatArray, FloatArray, str]] = {}
 
@@ -181,6 +189,7 @@ class Zhang2020Law(Vehicle3DController):
         self._x_prev = None
         self._pred_v = {}
         self._pred_u = {}
+        self._ahead_rot = {}
         self.predictions = {}
 
     # ----------------------------------------------------------------------------- prediction
@@ -218,19 +227,44 @@ class Zhang2020Law(Vehicle3DController):
         margin, with the horizon shortened near the body so that the robot stays outside the
         spheres (item 3 of the module docstring)."""
         base = self._spec.radius + self.p.safety_margin
-        move = float(np.linalg.norm(v)) * self.p.sample_period
+        move = _norm(v) * self.p.sample_period
         room = max(rd.distance - base, 0.0)
         return base + min(move, 0.5 * room)
+
+    def _ahead(self, u: FloatArray, rd: ObstacleReading3D) -> FloatArray | None:
+        """The predicted rotation over one period, or None when it moves no boundary point by
+        more than 1 mm."""
+        ts = self.p.sample_period
+        if _norm(u) * ts * rd.bounding_radius > 1e-3:
+            key = (u.tobytes(), ts)
+            cached = self._ahead_rot.get(rd.obstacle_id)
+            if cached is None or cached[0] != key:  # rates (or predictions) are held a while
+                cached = self._ahead_rot[rd.obstacle_id] = (key, rotation_from_vector(u * ts))
+            return cached[1]
+        return None
 
     def _points(self, rd: ObstacleReading3D, u: FloatArray) -> FloatArray:
         """Boundary points now and rotated as predicted one period ahead (the translation is
         covered by the forecast sphere)."""
-        ts = self.p.sample_period
-        if float(np.linalg.norm(u)) * ts * rd.bounding_radius > 1e-3:
-            rot = rotation_from_vector(u * ts)
+        rot = self._ahead(u, rd)
+        if rot is not None:
             ahead = (rd.outline - rd.centre) @ rot.T + rd.centre
             return np.concatenate([rd.outline, ahead])
         return rd.outline
+
+    def shadow(
+        self, frame: OnlineFrame, rd: ObstacleReading3D, u: FloatArray, rho: float
+    ) -> Shadow:
+        """The inflated shadow of one obstacle: the compiled one-pass kernel
+        (:func:`uvnav.geometry.kernels3d.plane_shadow`) when numba is installed, else
+        :func:`shadow_of` on :meth:`_points` (the same values to rounding)."""
+        if numba_enabled():
+            psi_c, lo, hi, inside = plane_shadow(
+                rd.outline, rd.centre, self._ahead(u, rd), frame.origin, frame.x_axis,
+                frame.y_axis, rho,
+            )  # fmt: skip
+            return Shadow(psi_c, lo, hi, inside)
+        return shadow_of(frame, self._points(rd, u), rd.centre, rho)
 
     def shadows(
         self, frame: OnlineFrame, obs: Observation3D
@@ -244,9 +278,7 @@ class Zhang2020Law(Vehicle3DController):
             if rd.obstacle_id == self._target:
                 v, u = self.predict(rd)
             rho = self.forecast_radius(rd, v)
-            out[rd.obstacle_id] = (
-                shadow_of(frame, self._points(rd, u), rd.centre, rho), rd, v, u,
-            )  # fmt: skip
+            out[rd.obstacle_id] = (self.shadow(frame, rd, u, rho), rd, v, u)
         return out
 
     def in_the_way(
@@ -339,12 +371,12 @@ class Zhang2020Law(Vehicle3DController):
     ) -> float:
         """(3.21) or V_max (``speed_law``), floored at 1.5 ||v_i*|| ((3.9))."""
         vmax = self._spec.v_max
-        floor = min(vmax, max(1.5 * float(np.linalg.norm(v)) + 0.05 * vmax, 0.5 * vmax))
+        floor = min(vmax, max(1.5 * _norm(v) + 0.05 * vmax, 0.5 * vmax))
         if self.p.speed_law == "tangent":
             # ||l_J|| = ||v*|| / tan(gamma) = sqrt(d*^2 - r^2): the tangent length to the
             # forecast sphere at r*_min, covered in T_s
             d = max(rd.distance + self._spec.radius, 1e-9)
-            r = float(np.linalg.norm(v)) * self.p.sample_period
+            r = _norm(v) * self.p.sample_period
             length = math.sqrt(max(d * d - r * r, 0.0))
             return min(vmax, max(length / self.p.sample_period, floor))
         cos_b = float(np.clip(direction @ obs.heading, -1.0, 1.0))

@@ -26,8 +26,6 @@ import numpy as np
 
 from uvnav.geometry.angles import FloatArray
 
-_Z = np.array([0.0, 0.0, 1.0])
-
 
 def skew(w: FloatArray) -> FloatArray:
     """The matrix [w]x with [w]x v = w x v."""
@@ -37,19 +35,30 @@ def skew(w: FloatArray) -> FloatArray:
 def rotation_from_vector(rotvec: FloatArray) -> FloatArray:
     """exp([r]x): rotation by ||r|| [rad] about r / ||r|| (Rodrigues); identity for r = 0."""
     r = np.asarray(rotvec, dtype=float)
-    theta = math.sqrt(float(r @ r))
+    x, y, z = float(r[0]), float(r[1]), float(r[2])
+    theta = math.sqrt(x * x + y * y + z * z)
     if theta < 1e-12:
-        return np.eye(3) + skew(r)
-    k = skew(r / theta)
-    return np.eye(3) + math.sin(theta) * k + (1.0 - math.cos(theta)) * (k @ k)
+        return np.array([[1.0, -z, y], [z, 1.0, -x], [-y, x, 1.0]])
+    # I + sin(t) K + (1 - cos(t)) K^2 with K = [k]x and K^2 = k k^T - I, on plain floats (one
+    # array built instead of five numpy operations: this runs per obstacle per step)
+    kx, ky, kz = x / theta, y / theta, z / theta
+    s, c = math.sin(theta), 1.0 - math.cos(theta)
+    return np.array(
+        [
+            [1.0 + c * (kx * kx - 1.0), c * kx * ky - s * kz, c * kx * kz + s * ky],
+            [c * kx * ky + s * kz, 1.0 + c * (ky * ky - 1.0), c * ky * kz - s * kx],
+            [c * kx * kz - s * ky, c * ky * kz + s * kx, 1.0 + c * (kz * kz - 1.0)],
+        ]
+    )
 
 
 def rotation_to_vector(rot: FloatArray) -> FloatArray:
     """log of a rotation matrix as a rotation vector [rad] (angle in [0, pi])."""
     m = np.asarray(rot, dtype=float)
-    cos_t = min(max((float(np.trace(m)) - 1.0) * 0.5, -1.0), 1.0)
+    (m00, m01, m02), (m10, m11, m12), (m20, m21, m22) = m.tolist()
+    cos_t = min(max((m00 + m11 + m22 - 1.0) * 0.5, -1.0), 1.0)
     theta = math.acos(cos_t)
-    w = np.array([m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]])
+    w = np.array([m21 - m12, m02 - m20, m10 - m01])
     if theta < 1e-6:
         return 0.5 * w  # first order; exact to O(theta^3)
     if math.pi - theta < 1e-6:
@@ -119,10 +128,10 @@ def horizontal_perpendicular(y_axis: FloatArray, previous: FloatArray | None = N
     ``X' = Y' x z / ||Y' x z||``.  When Y' is (nearly) vertical the previous X' projected off Y' is
     used (or world +x when there is none) — a choice the thesis leaves open.
     """
-    x = np.cross(y_axis, _Z)
-    n = math.sqrt(float(x @ x))
+    y0, y1 = float(y_axis[0]), float(y_axis[1])
+    n = math.hypot(y0, y1)  # ||Y' x z||, with Y' x z = (y1, -y0, 0)
     if n > 1e-6:
-        return x / n
+        return np.array([y1 / n, -y0 / n, 0.0])
     ref = np.array([1.0, 0.0, 0.0]) if previous is None else np.asarray(previous, dtype=float)
     x = ref - float(ref @ y_axis) * y_axis
     n = math.sqrt(float(x @ x))
@@ -181,7 +190,9 @@ def online_frame(
     n = math.sqrt(float(gap @ gap))
     y = gap / n if n > 1e-12 else np.array([0.0, 1.0, 0.0])
     x = horizontal_perpendicular(y, previous_x)
-    z = np.cross(x, y)
+    x0, x1, x2 = float(x[0]), float(x[1]), float(x[2])
+    y0, y1, y2 = float(y[0]), float(y[1]), float(y[2])
+    z = np.array([x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0])
     return OnlineFrame(origin=p, x_axis=x, y_axis=y, z_axis=z)
 
 

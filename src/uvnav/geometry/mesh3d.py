@@ -7,7 +7,9 @@ Chapter 5.  Methods:
 
 * nearest point on a triangle: the Voronoi-region test of C. Ericson, *Real-Time Collision
   Detection* (2005), §5.1.5, vectorised over all triangles (no loop, one pass of dot products);
-  exact to rounding;
+  exact to rounding; the nearest point of a whole mesh runs as one compiled pass with an exact
+  bounding-sphere cull when numba is installed (:mod:`uvnav.geometry.kernels3d`, which says why
+  numba rather than a BVH library), else as bounding-sphere candidates + these kernels;
 * ray–triangle: T. Möller and B. Trumbore, "Fast, minimum storage ray-triangle intersection",
   J. Graphics Tools 2(1), 1997, vectorised over rays x triangles;
 * inside/outside: the generalised winding number, the sum of the signed solid angles of the
@@ -21,14 +23,22 @@ hundred triangles a body has; ``scipy.spatial`` has no triangle queries.  All fu
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.kernels3d import (
+    closest_barycentric_scalar,
+    numba_enabled,
+    signed_nearest_world,
+)
 
 IntArray = np.ndarray
+_ZERO3 = np.zeros(3)
+_EYE3 = np.eye(3)
 #: at most this many candidate triangles are evaluated with plain floats instead of numpy
 SCALAR_CANDIDATES = 64
 
@@ -143,50 +153,6 @@ def closest_barycentric(point: FloatArray, tri: Triangles) -> tuple[FloatArray, 
     return v, w
 
 
-def closest_barycentric_scalar(
-    p: tuple[float, float, float],
-    a: tuple[float, float, float],
-    ab: tuple[float, float, float],
-    ac: tuple[float, float, float],
-) -> tuple[float, float]:
-    """:func:`closest_barycentric` for one triangle on plain floats (the same region tests in
-    the same order; faster than numpy for the handful of candidate triangles a query keeps)."""
-    apx, apy, apz = p[0] - a[0], p[1] - a[1], p[2] - a[2]
-    abx, aby, abz = ab
-    acx, acy, acz = ac
-    d1 = abx * apx + aby * apy + abz * apz
-    d2 = acx * apx + acy * apy + acz * apz
-    if d1 <= 0.0 and d2 <= 0.0:
-        return 0.0, 0.0
-    bpx, bpy, bpz = apx - abx, apy - aby, apz - abz
-    d3 = abx * bpx + aby * bpy + abz * bpz
-    d4 = acx * bpx + acy * bpy + acz * bpz
-    if d3 >= 0.0 and d4 <= d3:
-        return 1.0, 0.0
-    vc = d1 * d4 - d3 * d2
-    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
-        e = d1 - d3
-        return (d1 / e if e != 0.0 else 0.0), 0.0
-    cpx, cpy, cpz = apx - acx, apy - acy, apz - acz
-    d5 = abx * cpx + aby * cpy + abz * cpz
-    d6 = acx * cpx + acy * cpy + acz * cpz
-    if d6 >= 0.0 and d5 <= d6:
-        return 0.0, 1.0
-    vb = d5 * d2 - d1 * d6
-    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
-        e = d2 - d6
-        return 0.0, (d2 / e if e != 0.0 else 0.0)
-    va = d3 * d6 - d5 * d4
-    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
-        e = (d4 - d3) + (d5 - d6)
-        w = (d4 - d3) / e if e != 0.0 else 0.0
-        return 1.0 - w, w
-    denom = va + vb + vc
-    if denom == 0.0:
-        return 0.0, 0.0
-    return vb / denom, vc / denom
-
-
 def closest_points_on_triangles(point: FloatArray, tri: Triangles) -> tuple[FloatArray, FloatArray]:
     """Nearest point of every triangle to ``point`` (Ericson §5.1.5, vectorised).
 
@@ -270,7 +236,25 @@ def signed_nearest(
     point: FloatArray, tri: Triangles, normals: PseudoNormals
 ) -> tuple[FloatArray, float, int]:
     """Nearest surface point [m], signed distance [m] (negative inside) and triangle index, with
-    the sign from the angle-weighted pseudo-normals (exact for a closed, outward mesh)."""
+    the sign from the angle-weighted pseudo-normals (exact for a closed, outward mesh).
+
+    Uses the compiled one-pass kernel (:func:`uvnav.geometry.kernels3d.nearest_triangle`) when
+    numba is installed, else :func:`signed_nearest_numpy`; both give the same point to rounding."""
+    p = np.asarray(point, dtype=float)
+    if numba_enabled():
+        qx, qy, qz, d, j = signed_nearest_world(
+            p, _ZERO3, _EYE3, tri.a, tri.ab, tri.ac, tri.centre, tri.radius, normals.face,
+            normals.edge, normals.vertex,
+        )  # fmt: skip
+        return np.array((qx, qy, qz)), d, j
+    return signed_nearest_numpy(p, tri, normals)
+
+
+def signed_nearest_numpy(
+    point: FloatArray, tri: Triangles, normals: PseudoNormals
+) -> tuple[FloatArray, float, int]:
+    """:func:`signed_nearest` without the compiled kernel: bounding-sphere candidates, then plain
+    floats for a few or the vectorised kernel for many (the fallback when numba is absent)."""
     p = np.asarray(point, dtype=float)
     idx = tri.candidates(p)
     if len(idx) <= SCALAR_CANDIDATES:
@@ -473,8 +457,15 @@ def validate_mesh(
 def icosphere(subdivisions: int = 2) -> tuple[FloatArray, IntArray]:
     """Unit icosphere: (vertices (n, 3) on the unit sphere, outward faces (m, 3)).
 
-    ``subdivisions`` = 0, 1, 2, 3 gives 20, 80, 320, 1280 triangles.
+    ``subdivisions`` = 0, 1, 2, 3 gives 20, 80, 320, 1280 triangles.  Built once per level and
+    returned as fresh copies (every star body of a scene is tessellated on one).
     """
+    v, f = _icosphere(max(int(subdivisions), 0))
+    return v.copy(), f.copy()
+
+
+@functools.lru_cache(maxsize=8)
+def _icosphere(subdivisions: int) -> tuple[FloatArray, IntArray]:
     t = (1.0 + math.sqrt(5.0)) / 2.0
     verts = [
         (-1, t, 0), (1, t, 0), (-1, -t, 0), (1, -t, 0),

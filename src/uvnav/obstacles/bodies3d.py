@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.kernels3d import numba_enabled, signed_nearest_world
 from uvnav.geometry.mesh3d import (
     PseudoNormals,
     Triangles,
@@ -91,6 +92,21 @@ class MeshBody:
         q, d, _ = signed_nearest(p, self.tri, self.normals)
         return q, d
 
+    def nearest_world(
+        self, point: FloatArray, centre: FloatArray, rotation: FloatArray
+    ) -> tuple[FloatArray, float]:
+        """Nearest surface point (world) to the world point ``point`` and the signed distance
+        [m], for the pose ``world = centre + rotation @ body`` (one compiled call with numba)."""
+        if numba_enabled():
+            t, n = self.tri, self.normals
+            qx, qy, qz, d, _ = signed_nearest_world(
+                np.asarray(point, dtype=float), centre, rotation, t.a, t.ab, t.ac, t.centre,
+                t.radius, n.face, n.edge, n.vertex,
+            )  # fmt: skip
+            return np.array((qx, qy, qz)), d
+        q, d = self.nearest_body(rotation.T @ (np.asarray(point, dtype=float) - centre))
+        return rotation @ q + centre, d
+
     def contains_body(self, points: FloatArray) -> np.ndarray:
         """(n,) booleans: body-frame points inside the solid."""
         return contains_points(points, self.tri)
@@ -134,6 +150,14 @@ class SphereBody:
         u = p / m
         k = math.hypot(float(u[0]), float(u[1]), float(u[2]))
         return u / k * self.radius, m * k - self.radius
+
+    def nearest_world(
+        self, point: FloatArray, centre: FloatArray, rotation: FloatArray
+    ) -> tuple[FloatArray, float]:
+        """Nearest surface point (world) and signed distance [m] for the ball at ``centre`` (its
+        rotation is irrelevant)."""
+        q, d = self.nearest_body(np.asarray(point, dtype=float) - centre)
+        return q + centre, d
 
     def contains_body(self, points: FloatArray) -> np.ndarray:
         pts = np.atleast_2d(points)

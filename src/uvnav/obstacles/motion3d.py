@@ -171,6 +171,11 @@ class Obstacle3D:
     body: Body3D
     motion: MotionModel3D
     state: ObstacleState3D
+    #: exp([u]x dt) of the last step and its key (u's bytes, dt): the rates are held for whole
+    #: sampling periods, so the same rotation is reused bit for bit while they do not change
+    _step_rotation: tuple[bytes, float, FloatArray | None] | None = field(
+        default=None, init=False, repr=False, compare=False
+    )
 
     def step(self, t: float, dt: float) -> None:
         """Advance by ``dt`` [s] from time ``t`` [s] with the rates the model gives for the step
@@ -179,8 +184,14 @@ class Obstacle3D:
         self.state.velocity = v
         self.state.rotation_rate = u
         self.state.centre = self.state.centre + v * dt
-        if float(u @ u) > 0.0:
-            self.state.rotation = rotation_from_vector(u * dt) @ self.state.rotation
+        key = u.tobytes()
+        cached = self._step_rotation
+        if cached is None or cached[0] != key or cached[1] != dt:
+            # None: no rotation (u = 0)
+            cached = (key, dt, rotation_from_vector(u * dt) if float(u @ u) > 0.0 else None)
+            self._step_rotation = cached
+        if cached[2] is not None:
+            self.state.rotation = cached[2] @ self.state.rotation
 
     def to_body(self, point: FloatArray) -> FloatArray:
         """World point -> body frame."""
@@ -192,8 +203,7 @@ class Obstacle3D:
 
     def nearest(self, point: FloatArray) -> tuple[FloatArray, float]:
         """Nearest surface point (world) to ``point`` and the signed distance [m] (3.8)."""
-        q, d = self.body.nearest_body(self.to_body(point))
-        return self.state.rotation @ q + self.state.centre, d
+        return self.body.nearest_world(point, self.state.centre, self.state.rotation)
 
     def ray_cast(self, origins: FloatArray, directions: FloatArray) -> FloatArray:
         """Distance [m] along each world ray (unit directions) to the body (inf: miss)."""

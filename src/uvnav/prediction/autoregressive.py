@@ -228,6 +228,8 @@ class ARPredictor:
     _fits: list[ARFit | None] = field(default_factory=list)
     _since_fit: int = 0
     _since_select: int = 0
+    #: predictions by horizon k since the last kept sample (they change only with a new sample)
+    _cache: dict[int, VectorPrediction] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if self.min_samples < self.max_lag + 3:
@@ -255,6 +257,7 @@ class ARPredictor:
             del self._values[0], self._times[0]
         self._since_fit += 1
         self._since_select += 1
+        self._cache.clear()
         return True
 
     def _refit(self) -> None:
@@ -280,7 +283,16 @@ class ARPredictor:
             self._since_select = 0
 
     def predict(self, k: int = 1) -> VectorPrediction:
-        """Predictions for the next ``k`` periods (AR, or the constant-velocity fallback)."""
+        """Predictions for the next ``k`` periods (AR, or the constant-velocity fallback).
+
+        Between two kept samples the same prediction is returned (computed once: a controller
+        asks every decision, a sample arrives every T_s); do not modify its arrays."""
+        hit = self._cache.get(k)
+        if hit is None:
+            hit = self._cache[k] = self._predict(k)
+        return hit
+
+    def _predict(self, k: int) -> VectorPrediction:
         n = self.n_samples
         if n == 0:
             return VectorPrediction(

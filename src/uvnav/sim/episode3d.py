@@ -211,16 +211,28 @@ class _GapTracker:
         self.obstacles = obstacles
         self.radius = robot_radius
         self.low = [obstacles[i].nearest(pos)[1] - robot_radius for i in range(len(obstacles))]
+        # per obstacle: (velocity bytes, rotation-rate bytes) -> boundary speed bound [m/s]
+        self._speed: list[tuple[bytes, bytes, float]] = [(b"", b"", 0.0)] * len(obstacles)
+
+    def _boundary_speed(self, i: int, ob: Obstacle3D) -> float:
+        """||v_i|| + ||u_i|| R_i, recomputed only when the rates change (they are held for
+        whole sampling periods)."""
+        st = ob.state
+        kv, ku = st.velocity.tobytes(), st.rotation_rate.tobytes()
+        cached = self._speed[i]
+        if cached[0] == kv and cached[1] == ku:
+            return cached[2]
+        speed = (
+            math.sqrt(float(st.velocity @ st.velocity))
+            + math.sqrt(float(st.rotation_rate @ st.rotation_rate)) * ob.body.bounding_radius
+        )
+        self._speed[i] = (kv, ku, speed)
+        return speed
 
     def step(self, pos: FloatArray, v_robot: float, dt: float, best: float) -> tuple[float, int]:
         out, out_i = math.inf, -1
         for i, ob in enumerate(self.obstacles):
-            st = ob.state
-            drift = (
-                abs(v_robot)
-                + math.sqrt(float(st.velocity @ st.velocity))
-                + math.sqrt(float(st.rotation_rate @ st.rotation_rate)) * ob.body.bounding_radius
-            ) * dt
+            drift = (abs(v_robot) + self._boundary_speed(i, ob)) * dt
             low = self.low[i] - drift * (1.0 + 1e-9) - 1e-12
             if low < best:
                 low = ob.nearest(pos)[1] - self.radius

@@ -1,0 +1,373 @@
+"""Compiled kernels for the hot paths of the 3D world (thesis Chapter 3), with numpy fallbacks.
+
+Y. Zhang, thesis Chapter 3, §3.2, eq. (3.8) (d_min and r_min, the exact nearest point of a solid,
+possibly non-convex obstacle) and §3.3.2-§3.3.3 (the obstacle seen in the on-line plane, inflated
+by the forecast sphere (3.17)).  Two kernels run for every obstacle at every decision or step:
+
+* :func:`nearest_triangle` — the nearest point of a triangle mesh to a point: one pass over the
+  triangles with the Voronoi-region test of C. Ericson, *Real-Time Collision Detection* (2005),
+  §5.1.5 (:func:`closest_barycentric_scalar`), skipping a triangle when its bounding sphere's lower
+  bound ``||p - centre_j|| - radius_j`` already exceeds the best distance found (an exact cull: a
+  skipped triangle cannot be nearer);
+* :func:`plane_shadow` — the angular extent, in the on-line plane, of a body's boundary points
+  (now and rotated one sampling period ahead), each inflated by the forecast circle.
+
+Both are exact (the same formulas as :mod:`uvnav.geometry.mesh3d` and
+:func:`uvnav.controllers.zhang2020_3d.shadow_of`, to rounding).  With numba installed (the ``fast``
+extra) they are compiled (``numba.njit(cache=True)``); without it (or with ``UVNAV_NO_NUMBA=1`` at
+import, or after ``use_compiled(False)``) the callers use their vectorised numpy paths, and the
+tests check that both agree to 1e-9.
+
+Why numba and not a library BVH (python-fcl): a body has a few hundred triangles, so one compiled
+pass with the bounding-sphere cull is already a few microseconds, and the cost of a query from
+Python is dominated by the call itself, which a BVH does not reduce (fcl's Python binding builds a
+request/result object per query); fcl also returns no triangle index, which the exact inside/outside
+sign (angle-weighted pseudo-normals of the nearest feature) needs.  Numpy alone cannot reach the
+step rates of issue 4, because each query is a handful of array operations whose fixed overhead
+(~1 µs each) dominates arrays this small.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import os
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from uvnav.geometry.angles import FloatArray
+
+#: numba is installed (the optional ``fast`` extra); it is imported on the first kernel call only
+_HAVE_NUMBA = importlib.util.find_spec("numba") is not None
+#: the compiled kernels are used (see :func:`use_compiled`)
+_ENABLED = _HAVE_NUMBA and os.environ.get("UVNAV_NO_NUMBA", "") != "1"
+
+
+def numba_available() -> bool:
+    """numba can be imported (the ``fast`` extra is installed)."""
+    return _HAVE_NUMBA
+
+
+def numba_enabled() -> bool:
+    """The compiled kernels are used: numba is installed, ``UVNAV_NO_NUMBA`` was not ``1`` when
+    uvnav was imported, and :func:`use_compiled` has not turned them off."""
+    return _ENABLED
+
+
+def use_compiled(enabled: bool) -> bool:
+    """Use the compiled kernels (``True``, when numba is installed) or the numpy fallback
+    (``False``) from now on, in this process; returns the previous setting (benchmarks and tests
+    compare the two paths)."""
+    global _ENABLED
+    previous = _ENABLED
+    _ENABLED = bool(enabled) and _HAVE_NUMBA
+    return previous
+
+
+def closest_barycentric_scalar(
+    p: tuple[float, float, float],
+    a: tuple[float, float, float],
+    ab: tuple[float, float, float],
+    ac: tuple[float, float, float],
+) -> tuple[float, float]:
+    """Barycentric weights ``(v, w)`` (of b and c) of the nearest point of one triangle to ``p``
+    on plain floats (Ericson §5.1.5; the nearest point is ``a + v ab + w ac``)."""
+    apx, apy, apz = p[0] - a[0], p[1] - a[1], p[2] - a[2]
+    abx, aby, abz = ab[0], ab[1], ab[2]
+    acx, acy, acz = ac[0], ac[1], ac[2]
+    d1 = abx * apx + aby * apy + abz * apz
+    d2 = acx * apx + acy * apy + acz * apz
+    if d1 <= 0.0 and d2 <= 0.0:
+        return 0.0, 0.0
+    bpx, bpy, bpz = apx - abx, apy - aby, apz - abz
+    d3 = abx * bpx + aby * bpy + abz * bpz
+    d4 = acx * bpx + acy * bpy + acz * bpz
+    if d3 >= 0.0 and d4 <= d3:
+        return 1.0, 0.0
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        e = d1 - d3
+        return (d1 / e if e != 0.0 else 0.0), 0.0
+    cpx, cpy, cpz = apx - acx, apy - acy, apz - acz
+    d5 = abx * cpx + aby * cpy + abz * cpz
+    d6 = acx * cpx + acy * cpy + acz * cpz
+    if d6 >= 0.0 and d5 <= d6:
+        return 0.0, 1.0
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        e = d2 - d6
+        return 0.0, (d2 / e if e != 0.0 else 0.0)
+    va = d3 * d6 - d5 * d4
+    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+        e = (d4 - d3) + (d5 - d6)
+        w = (d4 - d3) / e if e != 0.0 else 0.0
+        return 1.0 - w, w
+    denom = va + vb + vc
+    if denom == 0.0:
+        return 0.0, 0.0
+    return vb / denom, vc / denom
+
+
+#: relative slack of the bounding-sphere cull (rounding of the bound against the exact distance)
+CULL_SLACK = 1e-9
+
+
+def nearest_triangle_py(
+    px: float,
+    py: float,
+    pz: float,
+    a: FloatArray,
+    ab: FloatArray,
+    ac: FloatArray,
+    centre: FloatArray,
+    radius: FloatArray,
+) -> tuple[int, float, float, float, float, float, float]:
+    """Nearest point of the triangles ``a + v ab + w ac`` (each (m, 3)) to ``(px, py, pz)``.
+
+    The triangle with the nearest centroid is evaluated first, then all others in index order; one
+    replaces the best when strictly nearer (exact ties keep the lowest index, as ``numpy.argmin``
+    does); triangle j is skipped when
+    ``||p - centre_j|| - radius_j > 0`` and its square exceeds the best squared distance by more
+    than the slack :data:`CULL_SLACK` (then it cannot be nearer).
+
+    Returns:
+        ``(j, v, w, qx, qy, qz, d2)``: triangle index, barycentric weights, nearest point [m] and
+        squared distance [m^2] (``j = -1`` without triangles).
+    """
+    best = math.inf
+    bj, bv, bw, bx, by, bz = -1, 0.0, 0.0, 0.0, 0.0, 0.0
+    m = a.shape[0]
+    # start from the triangle with the nearest centroid: a tight first bound for the cull
+    k, dk = 0, math.inf
+    for j in range(m):
+        gx, gy, gz = px - centre[j, 0], py - centre[j, 1], pz - centre[j, 2]
+        g = gx * gx + gy * gy + gz * gz
+        if g < dk:
+            k, dk = j, g
+    for i in range(m + 1):
+        j = k if i == 0 else i - 1
+        if i > 0 and j == k:
+            continue
+        gx, gy, gz = px - centre[j, 0], py - centre[j, 1], pz - centre[j, 2]
+        low = math.sqrt(gx * gx + gy * gy + gz * gz) - radius[j]
+        if low > 0.0 and low * low > best * (1.0 + CULL_SLACK):
+            continue
+        a0, a1, a2 = a[j, 0], a[j, 1], a[j, 2]
+        b0, b1, b2 = ab[j, 0], ab[j, 1], ab[j, 2]
+        c0, c1, c2 = ac[j, 0], ac[j, 1], ac[j, 2]
+        v, w = _bary((px, py, pz), (a0, a1, a2), (b0, b1, b2), (c0, c1, c2))
+        qx = a0 + b0 * v + c0 * w
+        qy = a1 + b1 * v + c1 * w
+        qz = a2 + b2 * v + c2 * w
+        dd = (px - qx) ** 2 + (py - qy) ** 2 + (pz - qz) ** 2
+        if dd < best or (dd == best and j < bj):
+            best, bj, bv, bw, bx, by, bz = dd, j, v, w, qx, qy, qz
+    return bj, bv, bw, bx, by, bz, best
+
+
+def signed_nearest_world_py(
+    p: FloatArray,
+    centre: FloatArray,
+    rotation: FloatArray,
+    a: FloatArray,
+    ab: FloatArray,
+    ac: FloatArray,
+    tri_centre: FloatArray,
+    tri_radius: FloatArray,
+    face: FloatArray,
+    edge: FloatArray,
+    vertex: FloatArray,
+) -> tuple[float, float, float, float, int]:
+    """Nearest surface point (world) of a mesh body at pose ``(centre, rotation)`` to the world
+    point ``p`` and the signed distance (negative inside; the sign of ``(p - q) . N`` with N the
+    angle-weighted pseudo-normal of the feature q lies on, as in
+    :meth:`uvnav.geometry.mesh3d.PseudoNormals.normal_at`).
+
+    Args:
+        p: (3,) world point [m]; centre: (3,) [m] and rotation: (3, 3) the body's pose.
+        a, ab, ac, tri_centre, tri_radius: the body-frame triangles
+            (:class:`uvnav.geometry.mesh3d.Triangles`).
+        face, edge, vertex: the pseudo-normals (:class:`uvnav.geometry.mesh3d.PseudoNormals`).
+
+    Returns:
+        ``(qx, qy, qz, d, j)``: the world nearest point [m], the signed distance [m] and the
+        triangle index.
+    """
+    gx, gy, gz = p[0] - centre[0], p[1] - centre[1], p[2] - centre[2]
+    bx = rotation[0, 0] * gx + rotation[1, 0] * gy + rotation[2, 0] * gz
+    by = rotation[0, 1] * gx + rotation[1, 1] * gy + rotation[2, 1] * gz
+    bz = rotation[0, 2] * gx + rotation[1, 2] * gy + rotation[2, 2] * gz
+    j, v, w, qx, qy, qz, d2 = _nearest(bx, by, bz, a, ab, ac, tri_centre, tri_radius)
+    d = math.sqrt(d2)
+    if d > 0.0:
+        tol = 1e-12
+        u = 1.0 - v - w
+        zu, zv, zw = u <= tol, v <= tol, w <= tol
+        if zv and zw:
+            n = vertex[j, 0]
+        elif zu and zw:
+            n = vertex[j, 1]
+        elif zu and zv:
+            n = vertex[j, 2]
+        elif zw:
+            n = edge[j, 0]
+        elif zu:
+            n = edge[j, 1]
+        elif zv:
+            n = edge[j, 2]
+        else:
+            n = face[j]
+        if (bx - qx) * n[0] + (by - qy) * n[1] + (bz - qz) * n[2] < 0.0:
+            d = -d
+    wx = centre[0] + rotation[0, 0] * qx + rotation[0, 1] * qy + rotation[0, 2] * qz
+    wy = centre[1] + rotation[1, 0] * qx + rotation[1, 1] * qy + rotation[1, 2] * qz
+    wz = centre[2] + rotation[2, 0] * qx + rotation[2, 1] * qy + rotation[2, 2] * qz
+    return wx, wy, wz, d, j
+
+
+def plane_shadow_py(
+    points: FloatArray,
+    centre: FloatArray,
+    rotation: FloatArray,
+    rotate: bool,
+    origin: FloatArray,
+    x_axis: FloatArray,
+    y_axis: FloatArray,
+    radius: float,
+) -> tuple[float, float, float, bool]:
+    """Angular extent in the on-line plane of ``points`` (world, (n, 3)) — and, with ``rotate``,
+    of the same points turned by ``rotation`` about ``centre`` — each inflated by a circle of
+    ``radius`` [m] (the forecast circle), as seen from ``origin`` (the robot).
+
+    Angles psi are counter-clockwise from Y' (``atan2(-x', y')``), measured relative to the
+    centre's psi_c and wrapped to [-pi, pi]; the inflation of a point at plane distance r is
+    ``asin(min(radius / r, 1))``, plus ``(radius - r) / radius * pi / 2`` when r < radius.  A
+    point whose inflation cannot widen the extent found so far (bounded by ``asin(x) <= x pi / 2``)
+    skips the asin: the result is the same.
+
+    Returns:
+        ``(psi_c, lo, hi, inside)``: the centre's angle [rad], the extent ``psi_c + [lo, hi]`` and
+        whether some point lies within its circle's radius of the robot.
+    """
+    ox, oy, oz = origin[0], origin[1], origin[2]
+    xx, xy, xz = x_axis[0], x_axis[1], x_axis[2]
+    yx, yy, yz = y_axis[0], y_axis[1], y_axis[2]
+    cx, cy, cz = centre[0], centre[1], centre[2]
+    c1 = (cx - ox) * xx + (cy - oy) * xy + (cz - oz) * xz
+    c2 = (cx - ox) * yx + (cy - oy) * yy + (cz - oz) * yz
+    n = points.shape[0]
+    reps = 2 if rotate else 1
+    if math.hypot(c1, c2) > 1e-9:
+        psi_c = math.atan2(-c1, c2)
+    else:  # the centre straight above/below the robot: the mean of the projected points
+        s1 = 0.0
+        s2 = 0.0
+        for r in range(reps):
+            for i in range(n):
+                px, py, pz = points[i, 0], points[i, 1], points[i, 2]
+                if r == 1:
+                    qx, qy, qz = px - cx, py - cy, pz - cz
+                    px = cx + rotation[0, 0] * qx + rotation[0, 1] * qy + rotation[0, 2] * qz
+                    py = cy + rotation[1, 0] * qx + rotation[1, 1] * qy + rotation[1, 2] * qz
+                    pz = cz + rotation[2, 0] * qx + rotation[2, 1] * qy + rotation[2, 2] * qz
+                s1 += (px - ox) * xx + (py - oy) * xy + (pz - oz) * xz
+                s2 += (px - ox) * yx + (py - oy) * yy + (pz - oz) * yz
+        psi_c = math.atan2(-s1 / (reps * n), s2 / (reps * n))
+    lo = math.inf
+    hi = -math.inf
+    inside = False
+    half_pi = 0.5 * math.pi
+    for r in range(reps):
+        for i in range(n):
+            px, py, pz = points[i, 0], points[i, 1], points[i, 2]
+            if r == 1:
+                qx, qy, qz = px - cx, py - cy, pz - cz
+                px = cx + rotation[0, 0] * qx + rotation[0, 1] * qy + rotation[0, 2] * qz
+                py = cy + rotation[1, 0] * qx + rotation[1, 1] * qy + rotation[1, 2] * qz
+                pz = cz + rotation[2, 0] * qx + rotation[2, 1] * qy + rotation[2, 2] * qz
+            q1 = (px - ox) * xx + (py - oy) * xy + (pz - oz) * xz
+            q2 = (px - ox) * yx + (py - oy) * yy + (pz - oz) * yz
+            dist = math.sqrt(q1 * q1 + q2 * q2)
+            rel = math.atan2(-q1, q2) - psi_c  # in (-2 pi, 2 pi): wrapped once
+            if rel > math.pi:
+                rel -= 2.0 * math.pi
+            elif rel < -math.pi:
+                rel += 2.0 * math.pi
+            if dist <= radius:
+                inside = True
+            ratio = min(max(radius / max(dist, 1e-12), 0.0), 1.0)
+            if dist >= radius and rel - ratio * half_pi >= lo and rel + ratio * half_pi <= hi:
+                continue  # asin(x) <= x pi / 2: this point cannot widen the extent
+            half = math.asin(ratio)
+            if dist < radius:
+                half += (radius - dist) / max(radius, 1e-9) * half_pi
+            if rel - half < lo:
+                lo = rel - half
+            if rel + half > hi:
+                hi = rel + half
+    return psi_c, lo, hi, inside
+
+
+# the pure-Python callees of the kernels; replaced by their compiled forms by _compiled()
+_bary: Callable[..., tuple[float, float]] = closest_barycentric_scalar
+_nearest: Callable[..., tuple[int, float, float, float, float, float, float]] = nearest_triangle_py
+_COMPILED: dict[str, Callable[..., Any]] = {}
+
+
+def _compiled() -> dict[str, Callable[..., Any]]:
+    """The numba-compiled kernels (imported and compiled, or loaded from numba's cache, on the
+    first call: importing uvnav does not import numba)."""
+    global _bary, _nearest
+    if not _COMPILED:
+        import numba
+
+        def jit(fn: Callable[..., Any]) -> Callable[..., Any]:
+            return numba.njit(cache=True, nogil=True)(fn)
+
+        # callees first: a compiled kernel resolves the module globals it calls when compiled
+        _bary = jit(closest_barycentric_scalar)
+        _nearest = jit(nearest_triangle_py)
+        _COMPILED["signed"] = jit(signed_nearest_world_py)
+        _COMPILED["shadow"] = jit(plane_shadow_py)
+    return _COMPILED
+
+
+def signed_nearest_world(
+    p: FloatArray,
+    centre: FloatArray,
+    rotation: FloatArray,
+    a: FloatArray,
+    ab: FloatArray,
+    ac: FloatArray,
+    tri_centre: FloatArray,
+    tri_radius: FloatArray,
+    face: FloatArray,
+    edge: FloatArray,
+    vertex: FloatArray,
+) -> tuple[float, float, float, float, int]:
+    """The compiled :func:`signed_nearest_world_py` (call only when :func:`numba_enabled`)."""
+    return _compiled()["signed"](
+        p, centre, rotation, a, ab, ac, tri_centre, tri_radius, face, edge, vertex
+    )
+
+
+def plane_shadow(
+    points: FloatArray,
+    centre: FloatArray,
+    rotation: FloatArray | None,
+    origin: FloatArray,
+    x_axis: FloatArray,
+    y_axis: FloatArray,
+    radius: float,
+) -> tuple[float, float, float, bool]:
+    """The compiled :func:`plane_shadow_py` (call only when :func:`numba_enabled`); ``rotation``
+    None: the points only.  The arrays must be float64 (numba compiles one version per layout)."""
+    rot = _EYE if rotation is None else rotation
+    return _compiled()["shadow"](
+        points, centre, rot, rotation is not None, origin, x_axis, y_axis, float(radius)
+    )
+
+
+_EYE = np.eye(3)
