@@ -31,7 +31,7 @@ def test_simulate_3d_with_another_law_and_bad_names() -> None:
     assert json.loads(res.stdout)["controller"] == "apf3d-v1"
     bad = runner.invoke(app, ["simulate", SCENE, "-c", "zhang2019-v1"])
     assert bad.exit_code == 2
-    assert "unknown 3D controller 'zhang2019-v1'" in bad.output
+    assert "controller 'zhang2019-v1' drives the unicycle vehicle, not the vehicle3d" in bad.output
     assert "Traceback" not in bad.output
     bad = runner.invoke(app, ["simulate", SCENE, "-p", "alpha0=-1"])
     assert bad.exit_code == 2 and "alpha0" in bad.output and "Traceback" not in bad.output
