@@ -630,9 +630,9 @@ def reproduce(
     real_run = n_random is None  # test-sized runs (n_random given) leave the other chapters out
     later: list[ChapterSection] = []  # issue 9 goes after the thesis chapters
     if baselines and real_run:  # issue 9 rows (a real run, not a quick look)
-        from uvnav.bench.reproduce_ch9 import reproduce_ch9
+        from uvnav.bench.reproduce_ch9 import replan_rows, reproduce_ch9
 
-        rows9 = reproduce_ch9(full=full)
+        rows9 = reproduce_ch9(full=full) + replan_rows()
         table += rows9
         figs9 = rend.ch9(report_dir / "beyond") if rend.ch9 is not None else []
         later.append(sec.beyond_section(rows9, figs9, full=full))

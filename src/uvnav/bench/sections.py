@@ -92,12 +92,8 @@ class ChapterRenderers:
 
 
 def mode_text(full: bool) -> str:
-    """``"full mode"`` or ``"quick mode"`` with what switches between them."""
-    return (
-        "full mode (uvnav run --full)"
-        if full
-        else "quick mode (uvnav run; --full for thesis-size runs)"
-    )
+    """``"full mode"`` (``uvnav run --full``, thesis-size runs) or ``"quick mode"``."""
+    return "full mode" if full else "quick mode"
 
 
 def caption_files(
@@ -278,18 +274,26 @@ def _ch5_caption(p: Path) -> str:
 
 def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
     """The Chapter 5 section from a :class:`uvnav.bench.reproduce_ch5.Ch5Summary`."""
+    import json
+
     from uvnav.bench import reproduce_ch5 as r5
 
-    sizes = r5.FULL_SIZES if full else r5.QUICK_SIZES
-    seeds = r5.FULL_SEEDS if full else r5.QUICK_SEEDS
-    n_rand = r5.FULL_RANDOM if full else r5.QUICK_RANDOM
-    noises = "0 and 0.05 m" if full else "0 m"
+    cfg: dict[str, Any] = {}
+    p = getattr(summary, "json_path", None)
+    if p is not None and Path(p).is_file():  # what was run, as ch5.json records it
+        cfg = json.loads(Path(p).read_text(encoding="utf-8")).get("config", {})
+    sizes = cfg.get("sizes", r5.FULL_SIZES if full else r5.QUICK_SIZES)
+    seeds = cfg.get("seeds", r5.FULL_SEEDS if full else r5.QUICK_SEEDS)
+    n_rand = cfg.get("n_random", r5.FULL_RANDOM if full else r5.QUICK_RANDOM)
+    noises = " and ".join(f"{x:g}" for x in cfg.get("noises", (0.0, 0.05) if full else (0.0,)))
+    noises += " m"
     intro = (
         f"3D UUV with a nine-sonar array and a BPNN locator ({mode_text(full)}). The BPNN "
         f"(9→10→2, plain and residual) trained on {', '.join(map(str, sizes))} samples with "
         f"{seeds} seeds each, tested on its own test group and on an independent set; "
         f"zhang2022-uuv3d-v1 then ran on the three thesis-ch5 scenes and random-ch5 seeds "
-        f"0–{n_rand - 1} with the {', '.join(r5.LOCATORS)} locators, sonar noise {noises}."
+        f"0–{n_rand - 1} with the {', '.join(r5.LOCATORS)} locators, sonar noise {noises}. "
+        "Results are stored as JSON (linked below)."
     )
     sec = ChapterSection(
         key="ch5",
@@ -298,7 +302,6 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
         rows=rows_of(summary.table),
     )
     sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch5_caption))
-    p = getattr(summary, "json_path", None)
     if p is not None:
         sec.links += caption_files([Path(p)], lambda _p: "Chapter 5 results (JSON)")
     if not sec.figures:
