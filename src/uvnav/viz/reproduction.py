@@ -114,8 +114,13 @@ def render_reproduction(req: RenderRequest) -> RenderResult:
         title="uvnav — reproduction of the thesis's experiments",
         summary_figure=False,
     )
-    files = [p for p, _ in figures] + [
-        f.path for s in sections if s.key != "ch2" for f in (*s.figures, *s.links)
+    root = report_dir.resolve()
+    files = [p for p, _ in figures] + [  # the other sections' files drawn into the report
+        f.path
+        for s in sections
+        if s.key != "ch2"
+        for f in (*s.figures, *s.links)
+        if f.path.resolve().is_relative_to(root)
     ]
     return RenderResult(report_path=report, figures=files)
 
