@@ -183,8 +183,14 @@ def test_reproduce_end_to_end_resume_and_staleness(
     html = summary.report_path.read_text(encoding="utf-8")
     assert "Thesis reported vs uvnav measured" in html
     for fig in summary.figures:
-        assert fig.is_file() and fig.parent == tmp_path / "report"
-        assert f'src="{fig.name}"' in html
+        assert fig.is_file() and fig.parent == tmp_path / "report" / "ch2"
+        assert f'src="ch2/{fig.name}"' in html
+    # test-sized run: only the Chapter 2 section, with its rows and every figure
+    assert [s.key for s in summary.sections] == ["ch2"]
+    ch2 = summary.sections[0]
+    assert [f.path for f in ch2.figures] == summary.figures
+    assert ch2.rows and {r["quantity"] for r in ch2.rows} <= {r["quantity"] for r in summary.table}
+    assert 'id="section-ch2"' in html and "seeds 0–2" in ch2.intro
     names = [f.name for f in summary.figures]
     # one per scene and law, the Fig. 2.10 comparison, the random-campaign summary
     assert len(names) == 2 * len(thesis) + 2

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from uvnav.bench.reproduce_ch9 import BEYOND, office_rows, swap_rows
+from uvnav.bench.reproduce_ch9 import BEYOND, office_rows, replan_rows, swap_rows
 
 
 def test_office_rows_measure_law_alone_and_hybrid() -> None:
@@ -21,3 +21,11 @@ def test_swap_rows_count_arrivals() -> None:
     assert "switch_distance=2.5" in rows[0]["quantity"]
     # straight lines through the centre: everyone collides
     assert rows[1]["measured"].startswith("0/4 arrived")
+
+
+def test_replan_row_compares_dstar_lite_with_astar_from_scratch() -> None:
+    (row,) = replan_rows(size=80, n_changes=2)
+    assert row["thesis"] == BEYOND and "80x80 grid" in row["quantity"]
+    expansions = float(row["measured"].split("x fewer expansions")[0])
+    assert expansions > 1.0  # the incremental replan expands fewer vertices than A* anew
+    assert "median of 2 changes" in row["note"]

@@ -363,7 +363,7 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
             figures=[report_dir / "a.png", report_dir / "b.png"],
         )
 
-    from uvnav.viz.figures_ch5 import render_ch5
+    from uvnav.bench.sections import ChapterRenderers
     from uvnav.viz.reproduction import render_reproduction
 
     fake = types.ModuleType("uvnav.bench.reproduce")
@@ -376,6 +376,7 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
         env={"COLUMNS": "200"},
     )
     assert result.exit_code == 0, result.output
+    renderers = calls[0].pop("renderers")
     assert calls == [
         {
             "results": res_dir,
@@ -385,9 +386,13 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
             "progress": True,
             "render": render_reproduction,
             "ch5": True,
-            "ch5_render": render_ch5,
         }
     ]
+    # every chapter with figures gets its renderer (Chapters 3-7 and issue 9)
+    assert isinstance(renderers, ChapterRenderers)
+    assert all(
+        getattr(renderers, k) is not None for k in ("ch3", "ch4", "ch5", "ch6", "ch7", "ch9")
+    )
     assert "thesis reported vs uvnav measured" in result.stdout
     assert "14.9 m" in result.stdout and "15.2 m" in result.stdout
     assert str(res_dir / "uvnav.sqlite") in result.stdout

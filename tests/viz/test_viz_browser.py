@@ -1,7 +1,8 @@
 """The HTML report in a real browser: headless Chromium (Debian's package) driven by playwright.
 
 Checks that the page renders with no console error, that its tables hold the numbers in the
-database, and that an animated trajectory view advances when played.  ``make test`` installs the
+database, that every image of the page (chapter sections in sub-folders included) loads, and that
+an animated trajectory view advances when played.  ``make test`` installs the
 browser; outside CI the test is skipped when no Chromium is on the PATH, in CI it fails.
 """
 
@@ -15,7 +16,10 @@ from pathlib import Path
 import pytest
 
 from uvnav.bench.campaign import Job, run_campaign
+from uvnav.bench.sections import ChapterSection, SectionFile
 from uvnav.bench.store import ResultsStore
+from uvnav.sim import EpisodeResult
+from uvnav.viz.figures import plot_episode
 from uvnav.viz.report import write_report
 
 playwright_api = pytest.importorskip("playwright.sync_api")
@@ -42,7 +46,33 @@ def report(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     ]
     with ResultsStore(db) as store:
         run_campaign(store, "browser-test", jobs, workers=1)
-    index = write_report(db, out / "report", summary_figure=False)
+        eid = store.find_episode(
+            "browser-test", scenario=SCENE, controller="savkin-wang2013-v1", seed=0
+        )
+        assert eid is not None
+        first: EpisodeResult = store.episode_result(eid)
+    import uvnav.scenarios as scenarios
+
+    setup = scenarios.build_episode(scenarios.load_scenario(SCENE), 0)
+    # a real episode figure inside the report (ch2/) and one outside it (copied into ch3/)
+    inside = plot_episode(first, setup, out / "report" / "ch2" / "episode.png", title="inside")
+    outside = plot_episode(first, setup, out / "elsewhere" / "episode.png", title="outside")
+    sections = [
+        ChapterSection(
+            "ch2",
+            "Chapter 2 — test section",
+            "one recorded episode",
+            rows=[{"quantity": "q2", "thesis": "t", "measured": "m2", "note": ""}],
+            figures=[SectionFile(inside, "inside the report")],
+        ),
+        ChapterSection(
+            "ch3",
+            "Chapter 3 — test section",
+            "the same figure, copied",
+            figures=[SectionFile(outside, "copied into the report")],
+        ),
+    ]
+    index = write_report(db, out / "report", sections=sections, summary_figure=False)
     return db, index
 
 
@@ -87,6 +117,17 @@ def test_report_renders_tables_and_animates(report: tuple[Path, Path]) -> None:
                 "() => document.querySelector('.js-plotly-plot')._fullLayout.sliders[0].active"
             )
             assert later > start
+            # every image loads (relative links into the section sub-folders resolve)
+            for img in page.locator("img").all():
+                img.scroll_into_view_if_needed()
+            sizes = page.evaluate(
+                "() => Array.from(document.images, i => [i.getAttribute('src'), i.complete, "
+                "i.naturalWidth])"
+            )
+            assert [s[0] for s in sizes] == ["ch2/episode.png", "ch3/episode.png"]
+            assert all(done and width > 0 for _, done, width in sizes), sizes
+            for title in ("Chapter 2 — test section", "Chapter 3 — test section"):
+                assert page.locator("section.chapter h2", has_text=title).is_visible()
             assert errors == []
         finally:
             browser.close()

@@ -37,6 +37,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.bench.campaign import Job, run_campaign
+from uvnav.bench.sections import ChapterRenderers, ChapterSection
 from uvnav.bench.store import STATUS_ERROR, ResultsStore
 
 CONTROLLERS: tuple[str, ...] = ("zhang2019-v1", "savkin-wang2013-v1")
@@ -130,7 +131,9 @@ class RenderRequest:
         scene_episodes: the recorded thesis-scene episodes (one figure each).
         comparison_scene: scene drawn as the Fig. 2.10 comparison of all controllers (or ``None``).
         random_campaign: name of the random campaign (summary figure).
-        table: the "thesis reported vs uvnav measured" rows.
+        table: the "thesis reported vs uvnav measured" rows (all chapters).
+        sections: one section per chapter run (:mod:`uvnav.bench.sections`); the renderer adds
+            the Chapter 2 figures to the ``"ch2"`` one.
     """
 
     db_path: Path
@@ -139,6 +142,7 @@ class RenderRequest:
     comparison_scene: str | None
     random_campaign: str
     table: list[dict[str, str]]
+    sections: list[ChapterSection] = field(default_factory=list)
 
 
 @dataclass
@@ -167,6 +171,7 @@ class ReproductionSummary:
         campaigns: per campaign: ``ran``, ``skipped``, ``errors``, ``wall_time`` [s],
             ``rerun_stale``.
         wall_time: total elapsed time [s].
+        sections: the report's chapter sections (rows, figures, links) in chapter order.
     """
 
     table: list[dict[str, str]]
@@ -176,6 +181,7 @@ class ReproductionSummary:
     figures: list[Path] = field(default_factory=list)
     campaigns: dict[str, dict[str, Any]] = field(default_factory=dict)
     wall_time: float = 0.0
+    sections: list[ChapterSection] = field(default_factory=list)
 
 
 #: Package parts whose code decides Ch. 2 episode outcomes (hashed by :func:`code_fingerprint`).
@@ -437,6 +443,7 @@ def reproduce(
     ch7: bool | None = None,
     ch5: bool = False,
     ch5_render: Callable[..., list[Path]] | None = None,
+    renderers: ChapterRenderers | None = None,
 ) -> ReproductionSummary:
     """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
 
@@ -461,6 +468,10 @@ def reproduce(
             ``n_random`` is not given (test-sized runs skip it).
         ch5: also run the Chapter 5 reproduction (:func:`uvnav.bench.reproduce_ch5.reproduce_ch5`;
             its rows join the table); ``ch5_render`` draws its figures into ``report_dir/ch5``.
+        renderers: the other chapters' figure renderers (the CLI passes
+            :func:`uvnav.viz.reproduction.chapter_renderers`); each chapter's figures go to
+            ``report_dir/chN`` (issue 9: ``report_dir/beyond``) and into its report section.
+            ``renderers.ch5`` is used when ``ch5_render`` is not given.
 
     Returns:
         The summary: table, database and report paths, random-campaign failures.
@@ -515,18 +526,18 @@ def reproduce(
                 ],
             ),
         ]
+        n_base = (
+            n_baseline_seeds
+            if n_baseline_seeds is not None
+            else (FULL_BASELINE_SEEDS if full else QUICK_BASELINE_SEEDS)
+        )
+        n_crowd = (
+            n_crowd_seeds
+            if n_crowd_seeds is not None
+            else (FULL_CROWD_SEEDS if full else QUICK_CROWD_SEEDS)
+        )
+        base = [b for b in baselines if b not in ctrls]
         if baselines:
-            n_base = (
-                n_baseline_seeds
-                if n_baseline_seeds is not None
-                else (FULL_BASELINE_SEEDS if full else QUICK_BASELINE_SEEDS)
-            )
-            n_crowd = (
-                n_crowd_seeds
-                if n_crowd_seeds is not None
-                else (FULL_CROWD_SEEDS if full else QUICK_CROWD_SEEDS)
-            )
-            base = [b for b in baselines if b not in ctrls]
             plans.append(
                 (
                     BASELINES_CAMPAIGN,
@@ -591,14 +602,6 @@ def reproduce(
         table, failures = build_table(store, scenes, ctrls, straight_line=straight)
         if baselines:
             table += comparison_rows(store)
-        if baselines and n_random is None:  # issue 9 rows (a real run, not a quick look)
-            from uvnav.bench.reproduce_ch9 import reproduce_ch9
-
-            table += reproduce_ch9(full=full)
-        if full:  # Chapter 6 (CNN driving) only in full mode: training is minutes even when small
-            from uvnav.bench.reproduce_ch6 import reproduce_ch6
-
-            table += reproduce_ch6(results_dir / "ch6", full=True).table
         scene_episodes = []
         for s in scenes:
             for c in ctrls:
@@ -607,25 +610,83 @@ def reproduce(
                     status = str(store.episode_row(eid)["status"])
                     scene_episodes.append(SceneEpisode(s, c, 0, eid, status))
 
-    if n_random is None:  # thesis Ch. 3 (3D): scenes + random campaign rows (bench/reproduce_ch3)
+    from uvnav.bench import sections as sec
+
+    rend = renderers or ChapterRenderers()
+    sections: list[ChapterSection] = [
+        sec.ch2_section(
+            table,
+            scenes=scenes,
+            controllers=ctrls,
+            n_random=n_seeds,
+            baselines=base,
+            n_baseline=n_base,
+            n_crowd=n_crowd,
+            crowd_generators=CROWD_GENERATORS,
+            crowd_v_max=CROWD_V_MAX,
+            full=full,
+        )
+    ]
+    real_run = n_random is None  # test-sized runs (n_random given) leave the other chapters out
+    later: list[ChapterSection] = []  # issue 9 goes after the thesis chapters
+    if baselines and real_run:  # issue 9 rows (a real run, not a quick look)
+        from uvnav.bench.reproduce_ch9 import replan_rows, reproduce_ch9
+
+        rows9 = reproduce_ch9(full=full) + replan_rows()
+        table += rows9
+        figs9 = rend.ch9(report_dir / "beyond") if rend.ch9 is not None else []
+        later.append(sec.beyond_section(rows9, figs9, full=full))
+    ch6_summary: Any = None
+    if full:  # Chapter 6 (CNN driving) only in full mode: training is minutes even when small
+        from uvnav.bench.reproduce_ch6 import reproduce_ch6
+
+        ch6_summary = reproduce_ch6(results_dir / "ch6", full=True)
+        if rend.ch6 is not None:
+            ch6_summary.figures = list(rend.ch6(ch6_summary, report_dir / "ch6"))
+        table += ch6_summary.table
+    by_key: dict[str, ChapterSection] = {}
+    if real_run:  # thesis Ch. 3 (3D): scenes + random campaign rows (bench/reproduce_ch3)
         from uvnav.bench.reproduce_ch3 import reproduce_ch3
 
-        table += reproduce_ch3(results_dir, report_dir, full=full, workers=workers).table
-    run_ch7 = ch7 if ch7 is not None else n_random is None
+        s3 = reproduce_ch3(results_dir, report_dir, full=full, workers=workers, render=rend.ch3)
+        table += s3.table
+        by_key["ch3"] = sec.ch3_section(s3, full=full)
+    run_ch7 = ch7 if ch7 is not None else real_run
     if run_ch7:  # thesis Ch. 7 (issue 8)
         from uvnav.bench.reproduce_ch7 import reproduce_ch7
 
-        table += reproduce_ch7(results_dir / "ch7", full=full).table
+        draw7 = rend.ch7
+        s7 = reproduce_ch7(
+            results_dir / "ch7",
+            full=full,
+            render_plan=None
+            if draw7 is None
+            else (lambda plan, prefix: draw7(plan, report_dir / "ch7" / Path(prefix).name)),
+        )
+        table += s7.table
+        by_key["ch7"] = sec.ch7_section(s7, full=full)
     if ch5:  # thesis Chapter 5: BPNN experiment and closed-loop runs (needs the learning extra)
         from uvnav.bench.reproduce_ch5 import reproduce_ch5
 
-        table += reproduce_ch5(
-            results_dir, full=full, progress=progress, render=ch5_render, report_dir=report_dir
-        ).table
-    if n_random is None:  # Chapter 4 (issue 5); tests that shrink the Ch. 2 campaign leave it out
+        s5 = reproduce_ch5(
+            results_dir,
+            full=full,
+            progress=progress,
+            render=ch5_render or rend.ch5,
+            report_dir=report_dir,
+        )
+        table += s5.table
+        by_key["ch5"] = sec.ch5_section(s5, full=full)
+    if real_run:  # Chapter 4 (issue 5); tests that shrink the Ch. 2 campaign leave it out
         from uvnav.bench.reproduce_ch4 import reproduce_ch4
 
-        table = table + reproduce_ch4(results_dir, report_dir, full=full, workers=workers).table
+        s4 = reproduce_ch4(results_dir, report_dir, full=full, workers=workers, render=rend.ch4)
+        table = table + s4.table
+        by_key["ch4"] = sec.ch4_section(s4, full=full)
+    if real_run or ch6_summary is not None:  # quick mode: a section that says how to run it
+        by_key["ch6"] = sec.ch6_section(ch6_summary, full=full)
+    sections += [by_key[k] for k in ("ch3", "ch4", "ch5", "ch6", "ch7") if k in by_key]
+    sections += later
     report_path: Path | None = None
     figures: list[Path] = []
     if render is not None:
@@ -638,6 +699,7 @@ def reproduce(
                 comparison_scene=COMPARISON_SCENE if COMPARISON_SCENE in scenes else None,
                 random_campaign=RANDOM_CAMPAIGN,
                 table=table,
+                sections=sections,
             )
         )
         report_path, figures = out.report_path, list(out.figures)
@@ -649,4 +711,5 @@ def reproduce(
         figures=figures,
         campaigns=summary_campaigns,
         wall_time=time.perf_counter() - tic,
+        sections=sections,
     )

@@ -593,7 +593,7 @@ def run(
     """Reproduce the thesis's experiments: results database, report, and the comparison table."""
     reproduce = _optional("uvnav.bench.reproduce", "reproduce", "the reproduction job (uvnav run)")
     render = _optional("uvnav.viz.reproduction", "render_reproduction", "the report renderer")
-    render5 = _optional("uvnav.viz.figures_ch5", "render_ch5", "the Chapter 5 figures")
+    renderers = _optional("uvnav.viz.reproduction", "chapter_renderers", "the chapter figures")
     summary = reproduce(
         results,
         report,
@@ -602,7 +602,7 @@ def run(
         progress=True,
         render=render,
         ch5=True,
-        ch5_render=render5,
+        renderers=renderers(),
     )
     from rich.table import Table
 

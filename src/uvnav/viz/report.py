@@ -7,7 +7,11 @@
   :func:`uvnav.bench.reproduce.reproduce`, whose measured values come from the runs),
 * a metric summary per scenario family and controller computed from the ``episodes`` table
   (episodes, success/collision/timeout rates, errors, mean / median of the distance metrics),
-* the figures, copied next to ``index.html`` and linked relatively,
+* one section per chapter (:class:`uvnav.bench.sections.ChapterSection`): heading, what was
+  run, that chapter's rows of the table, its figures with captions and links to its other files
+  (interactive views, JSON), every file linked relatively — a file already inside ``out_dir`` is
+  linked where it is, one outside is copied into ``out_dir/<section key>/``,
+* the other figures, copied next to ``index.html`` and linked relatively,
 * the episodes that raised errors, and the campaigns with their configs,
 * a note that the Chapter 2 obstacles are simulated.
 
@@ -30,6 +34,8 @@ import numpy as np
 
 if TYPE_CHECKING:
     import pandas as pd
+
+    from uvnav.bench.sections import ChapterSection
 
 SIMULATION_NOTE = (
     "In this chapter (thesis Ch. 2) the obstacles are simulated: their shapes and motions come "
@@ -265,11 +271,63 @@ def _copy_figures(figures: Sequence[FigureSpec], out_dir: Path) -> list[dict[str
     return out
 
 
+def _relative_file(src: Path, out_dir: Path, folder: str) -> str:
+    """Relative POSIX link from ``out_dir/index.html`` to ``src``; a file outside ``out_dir`` is
+    first copied to ``out_dir/folder/`` (a different file of the same name gets a numbered name)."""
+    src = Path(src)
+    if not src.is_file():
+        raise FileNotFoundError(f"figure {src} does not exist")
+    root = out_dir.resolve()
+    real = src.resolve()
+    if real.is_relative_to(root):
+        return real.relative_to(root).as_posix()
+    dest_dir = out_dir / folder
+    dest_dir.mkdir(parents=True, exist_ok=True)
+    dest = dest_dir / src.name
+    k = 1
+    while dest.exists() and dest.read_bytes() != src.read_bytes():
+        dest = dest_dir / f"{src.stem}-{k}{src.suffix}"
+        k += 1
+    if not dest.exists():
+        shutil.copyfile(src, dest)
+    return dest.resolve().relative_to(root).as_posix()
+
+
+def section_rows(sections: Sequence[ChapterSection], out_dir: Path) -> list[dict[str, Any]]:
+    """Template rows of the chapter sections, their files linked relatively to ``out_dir``."""
+    out: list[dict[str, Any]] = []
+    for sec in sections:
+        rows = [dict(r) for r in sec.rows]
+        columns = list(_TABLE_ORDER) if rows else []
+        for r in rows:
+            columns += [k for k in r if k not in columns]
+        out.append(
+            {
+                "key": sec.key,
+                "title": sec.title,
+                "intro": sec.intro,
+                "rows": rows,
+                "columns": columns,
+                "figures": [
+                    {"src": _relative_file(f.path, out_dir, sec.key), "caption": f.caption}
+                    for f in sec.figures
+                ],
+                "links": [
+                    {"href": _relative_file(f.path, out_dir, sec.key), "caption": f.caption}
+                    for f in sec.links
+                ],
+                "notes": list(sec.notes),
+            }
+        )
+    return out
+
+
 def write_report(
     db_path: Path,
     out_dir: Path,
     *,
     figures: Sequence[FigureSpec] | None = None,
+    sections: Sequence[ChapterSection] | None = None,
     table: Sequence[Mapping[str, Any]] | None = None,
     title: str = "uvnav results",
     summary_figure: bool = True,
@@ -283,6 +341,8 @@ def write_report(
         out_dir: output folder (created); receives ``index.html`` and the PNG figures.
         figures: PNG files to include, optionally as ``(path, caption)`` pairs; they are copied into
             ``out_dir`` (a file already there is used in place).
+        sections: chapter sections (:mod:`uvnav.bench.sections`), shown after the table in this
+            order, each with its rows, figures and links.
         table: rows of the "thesis reported vs uvnav measured" table, dicts with keys ``quantity``,
             ``thesis``, ``measured``, ``note`` (further keys become further columns).
         title: page title.
@@ -337,6 +397,7 @@ def write_report(
             )
         )
     figure_rows = _copy_figures(figure_specs, out_dir)
+    chapter_rows = section_rows(list(sections or []), out_dir)
 
     table_rows = [dict(r) for r in (table or [])]
     table_columns = list(_TABLE_ORDER) if table_rows else []
@@ -384,6 +445,7 @@ def write_report(
         benchmarks=benchmark_tables(Path(bench_dir)) if bench_dir is not None else [],
         text_columns=_TEXT_COLUMNS,
         figures=figure_rows,
+        sections=chapter_rows,
         errors=errors,
         animations=anim_sections,
         plotly_js=PLOTLY_JS,

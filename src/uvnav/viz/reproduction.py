@@ -1,18 +1,24 @@
-"""Figures and report of the thesis Chapter 2 reproduction (the renderer of
-:func:`uvnav.bench.reproduce.reproduce`).
+"""Figures and report of ``uvnav run`` (the renderers of :func:`uvnav.bench.reproduce.reproduce`).
 
-For each recorded thesis-scene episode a :func:`~uvnav.viz.figures.plot_episode` figure (Figs.
-2.7–2.9 style), the Fig. 2.10 comparison of all controllers on the comparison scene, a summary
-figure of the random campaign, then :func:`~uvnav.viz.report.write_report`.  The episode setups
-(start, goal, vehicle limits) are rebuilt from the scenario with the stored seed; the trajectories
-are read from the database.
+:func:`render_reproduction` draws the Chapter 2 figures into ``report_dir/ch2`` — for each
+recorded thesis-scene episode a :func:`~uvnav.viz.figures.plot_episode` figure (Figs. 2.7–2.9
+style), the Fig. 2.10 comparison of all controllers on the comparison scene, a summary figure of
+the random campaign — adds them to the Chapter 2 section, then writes the page with
+:func:`~uvnav.viz.report.write_report` (one section per chapter).  The episode setups (start, goal,
+vehicle limits) are rebuilt from the scenario with the stored seed; the trajectories are read from
+the database.
+
+:func:`chapter_renderers` gives the other chapters' figure renderers
+(:class:`uvnav.bench.sections.ChapterRenderers`) the CLI injects into ``reproduce``.
 """
 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 from uvnav.bench.reproduce import RenderRequest, RenderResult
+from uvnav.bench.sections import ChapterRenderers, ChapterSection, SectionFile
 from uvnav.bench.store import ResultsStore
 from uvnav.sim import EpisodeResult, EpisodeSetup
 from uvnav.viz.figures import plot_campaign_summary, plot_comparison, plot_episode
@@ -35,7 +41,8 @@ def render_reproduction(req: RenderRequest) -> RenderResult:
     """
     import uvnav.scenarios as scenarios
 
-    out_dir = Path(req.report_dir)
+    report_dir = Path(req.report_dir)
+    out_dir = report_dir / "ch2"
     out_dir.mkdir(parents=True, exist_ok=True)
     figures: list[tuple[Path, str]] = []
     by_scene: dict[str, dict[str, tuple[EpisodeResult, EpisodeSetup]]] = {}
@@ -91,12 +98,82 @@ def render_reproduction(req: RenderRequest) -> RenderResult:
         figures.append(
             (path, "Random campaign: outcomes, minimum clearance and detour ratio per law.")
         )
+    sections = list(req.sections)
+    ch2 = next((s for s in sections if s.key == "ch2"), None)
+    loose: list[tuple[Path, str]] = []
+    if ch2 is not None:
+        ch2.figures = [SectionFile(p, c) for p, c in figures] + ch2.figures
+    else:
+        loose = figures
     report = write_report(
         req.db_path,
-        out_dir,
-        figures=figures,
+        report_dir,
+        figures=loose,
+        sections=sections,
         table=req.table,
-        title="uvnav — thesis Chapter 2 reproduction",
+        title="uvnav — reproduction of the thesis's experiments",
         summary_figure=False,
     )
-    return RenderResult(report_path=report, figures=[p for p, _ in figures])
+    root = report_dir.resolve()
+    files = [p for p, _ in figures] + [  # the other sections' files drawn into the report
+        f.path
+        for s in sections
+        if s.key != "ch2"
+        for f in (*s.figures, *s.links)
+        if f.path.resolve().is_relative_to(root)
+    ]
+    return RenderResult(report_path=report, figures=files)
+
+
+def render_ch7_plan(plan: Any, prefix: Path) -> list[Path]:
+    """One Chapter 7 plan for the report: the Fig. 7.4-style PNG at ``<prefix>-fig7_4.png`` and the
+    interactive 3D view at ``<prefix>-3d.html``, which loads the report's shared
+    ``plotly.min.js`` (written one folder up, next to ``index.html``) instead of embedding its own
+    copy (about 3.5 MB per plan)."""
+    from uvnav.viz.figures_ch7 import plot_fig7_4, recon_3d_figure
+    from uvnav.viz.interactive import PLOTLY_JS, write_plotly_js
+
+    p = Path(prefix)
+    p.parent.mkdir(parents=True, exist_ok=True)
+    png = p.parent / f"{p.name}-fig7_4.png"
+    plot_fig7_4(plan, png)
+    write_plotly_js(p.parent.parent)
+    html = p.parent / f"{p.name}-3d.html"
+    recon_3d_figure(plan).write_html(html, include_plotlyjs=f"../{PLOTLY_JS}", full_html=True)
+    return [png, html]
+
+
+def _ch9(out_dir: Path) -> list[Path]:
+    from uvnav.viz.figures_ch9 import ch9_figures
+
+    return ch9_figures(out_dir)
+
+
+def chapter_renderers() -> ChapterRenderers:
+    """The figure renderers of Chapters 3–7 and issue 9 for :func:`uvnav.bench.reproduce.reproduce`
+    (imported lazily: a chapter's plotting extras load only when it draws)."""
+
+    def ch3(db_path: Path, report_dir: Path, recorded: list[tuple[str, str, Any]]) -> list[Path]:
+        from uvnav.viz.figures3d import render_ch3
+
+        return render_ch3(db_path, report_dir, recorded)
+
+    def ch4(out_dir: Path, scene_results: Any, summary: Any = None) -> list[Path]:
+        from uvnav.viz.figures_ch4 import render_ch4
+
+        return render_ch4(out_dir, scene_results, summary)
+
+    def ch5(summary: Any, report_dir: Path) -> list[Path]:
+        from uvnav.viz.figures_ch5 import render_ch5
+
+        return render_ch5(summary, report_dir)
+
+    def ch6(summary: Any, out_dir: Path) -> list[Path]:
+        from uvnav.viz.figures_ch6 import render_ch6
+
+        return render_ch6(summary, out_dir)
+
+    return ChapterRenderers(ch3=ch3, ch4=ch4, ch5=ch5, ch6=ch6, ch7=render_ch7_plan, ch9=_ch9)
+
+
+__all__ = ["ChapterSection", "chapter_renderers", "render_ch7_plan", "render_reproduction"]

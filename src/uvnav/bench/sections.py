@@ -1,0 +1,447 @@
+"""One report section per thesis chapter: the contract between ``uvnav run`` and the HTML report.
+
+:func:`uvnav.bench.reproduce.reproduce` runs every chapter's reproduction (``reproduce_chN``) and
+turns what each returns (its summary object: ``.table`` rows, ``.figures`` files) into a
+:class:`ChapterSection` with one of the ``*_section`` builders below; the renderer
+(:func:`uvnav.viz.reproduction.render_reproduction`) hands the sections to
+:func:`uvnav.viz.report.write_report`, which gives each a heading, its intro paragraph, its rows of
+the "thesis reported vs uvnav measured" table, its figures with captions and links to its other
+files (interactive 3D views, JSON results).
+
+Figures are *drawn* only in ``viz`` (layer 7), above this module: chapters whose figures need a
+renderer receive it injected through :class:`ChapterRenderers` (the CLI builds one with
+:func:`uvnav.viz.reproduction.chapter_renderers`), so ``bench`` never imports ``viz`` (DESIGN §1).
+
+To add a section: write a builder ``chN_section(summary, *, full) -> ChapterSection`` here (intro
+from the run's parameters, rows from ``summary.table``, figures from ``summary.figures`` with
+:func:`caption_files`), call it in :func:`uvnav.bench.reproduce.reproduce` after the chapter ran,
+and append the result to the list of sections; nothing else changes.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Callable, Iterable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, NamedTuple
+
+#: Image suffixes shown inline (``<img>``); other files become links.
+IMAGE_SUFFIXES = frozenset({".png", ".gif", ".jpg", ".jpeg", ".svg", ".webp"})
+
+
+class SectionFile(NamedTuple):
+    """A file of a section and its caption (a figure if an image, else a link)."""
+
+    path: Path
+    caption: str
+
+
+@dataclass
+class ChapterSection:
+    """One chapter's part of the report.
+
+    Attributes:
+        key: short id, used as the HTML anchor and the report sub-folder (``"ch3"``,
+            ``"beyond"``).
+        title: heading, e.g. ``"Chapter 3 — 3D flying robot among moving obstacles"``.
+        intro: one paragraph: what was run (scenes, laws, seeds, quick/full mode).
+        rows: this chapter's rows of the "thesis reported vs uvnav measured" table (dicts with
+            ``quantity``, ``thesis``, ``measured``, ``note``).
+        figures: images with captions, shown inline in this order.
+        links: other files (interactive HTML views, JSON results) with a label, linked.
+        notes: short remarks shown after the figures (what was not run, caveats).
+    """
+
+    key: str
+    title: str
+    intro: str
+    rows: list[dict[str, str]] = field(default_factory=list)
+    figures: list[SectionFile] = field(default_factory=list)
+    links: list[SectionFile] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    def add_files(self, files: Iterable[SectionFile]) -> None:
+        """Sort ``files`` into :attr:`figures` (images) and :attr:`links` (anything else)."""
+        for f in files:
+            (self.figures if f.path.suffix.lower() in IMAGE_SUFFIXES else self.links).append(f)
+
+
+#: Draws Ch. 3 figures: ``(db_path, report_dir, [(scene, law, trajectory)]) -> files``.
+Ch3Renderer = Callable[[Path, Path, list[tuple[str, str, Any]]], list[Path]]
+#: Draws Ch. 4 figures: ``(out_dir, {(scene, law): result}, summary) -> files``.
+Ch4Renderer = Callable[..., list[Path]]
+#: Draws Ch. 5 / Ch. 6 figures: ``(summary, folder) -> files``.
+SummaryRenderer = Callable[[Any, Path], list[Path]]
+#: Draws one Ch. 7 plan: ``(plan, path prefix) -> files``.
+PlanRenderer = Callable[[Any, Path], list[Path]]
+#: Runs and draws the issue-9 figures into a folder: ``(out_dir) -> files``.
+FolderRenderer = Callable[[Path], list[Path]]
+
+
+@dataclass(frozen=True)
+class ChapterRenderers:
+    """The figure renderers of the chapters, injected by the caller (``None``: no figures)."""
+
+    ch3: Ch3Renderer | None = None
+    ch4: Ch4Renderer | None = None
+    ch5: SummaryRenderer | None = None
+    ch6: SummaryRenderer | None = None
+    ch7: PlanRenderer | None = None
+    ch9: FolderRenderer | None = None
+
+
+def mode_text(full: bool) -> str:
+    """``"full mode"`` (``uvnav run --full``, thesis-size runs) or ``"quick mode"``."""
+    return "full mode" if full else "quick mode"
+
+
+def caption_files(
+    paths: Iterable[Path], caption: Callable[[Path], str | None]
+) -> list[SectionFile]:
+    """``paths`` that exist, each with ``caption(path)`` (``None`` or empty: a caption made from
+    the file name)."""
+    out = []
+    for p in paths:
+        p = Path(p)
+        if not p.is_file():
+            continue
+        out.append(SectionFile(p, caption(p) or p.stem.replace("-", " ").replace("_", " ")))
+    return out
+
+
+def rows_of(table: Sequence[Mapping[str, Any]]) -> list[dict[str, str]]:
+    """Table rows as ``str -> str`` dicts (the report shows text)."""
+    return [{str(k): "" if v is None else str(v) for k, v in r.items()} for r in table]
+
+
+# ---------------------------------------------------------------------------------- Chapter 2
+
+
+def ch2_section(
+    rows: Sequence[Mapping[str, Any]],
+    *,
+    scenes: Sequence[str],
+    controllers: Sequence[str],
+    n_random: int,
+    baselines: Sequence[str],
+    n_baseline: int,
+    n_crowd: int,
+    crowd_generators: Sequence[str],
+    crowd_v_max: float,
+    full: bool,
+) -> ChapterSection:
+    """The Chapter 2 section; its figures are drawn by the report renderer from the database."""
+    laws = ", ".join(controllers)
+    intro = (
+        f"Planar unicycle among moving obstacles ({mode_text(full)}). The thesis scenes "
+        f"({', '.join(scenes) or 'none'}) ran once each (seed 0) with {laws}, trajectories "
+        f"recorded; a random campaign on random-ch2 scenes ran seeds 0–{n_random - 1} with the "
+        "same laws."
+    )
+    if baselines:
+        intro += (
+            f" Classical baselines ({', '.join(baselines)}) ran on the thesis scenes and "
+            f"random-ch2 seeds 0–{n_baseline - 1}; every law crossed pedestrian crowds "
+            f"({', '.join(crowd_generators)}, {n_crowd} seeds each, robot V_max "
+            f"{crowd_v_max:g} m/s)."
+        )
+    return ChapterSection(
+        key="ch2",
+        title="Chapter 2 — a unicycle among moving, deforming obstacles",
+        intro=intro,
+        rows=rows_of(rows),
+    )
+
+
+# ---------------------------------------------------------------------------------- Chapter 3
+
+_CH3_KINDS = {
+    "trajectory": "the robot's path in 3D among the obstacles",
+    "clearance": "distance to the nearest obstacle over time",
+    "obstacle-motion": "the obstacles' motion",
+    "prediction": "AR-predicted vs true obstacle motion",
+}
+
+
+def _ch3_caption(p: Path) -> str:
+    parts = p.stem.split("--")
+    if p.suffix == ".html":
+        return f"{parts[0]} with {parts[-1]}: interactive 3D view (plotly)"
+    if len(parts) == 3:
+        scene, law, kind = parts
+        return f"{scene} with {law}: {_CH3_KINDS.get(kind, kind)}."
+    return ""
+
+
+def ch3_section(summary: Any, *, full: bool, n_random: int | None = None) -> ChapterSection:
+    """The Chapter 3 section from a :class:`uvnav.bench.reproduce_ch3.Ch3Summary`."""
+    from uvnav.bench import reproduce_ch3 as r3
+
+    n = n_random if n_random is not None else (r3.FULL_SEEDS if full else r3.QUICK_SEEDS)
+    intro = (
+        f"3D flying robot among moving obstacles ({mode_text(full)}). The thesis-ch3 scenes ran "
+        f"with {', '.join(r3.CONTROLLERS_3D)} (seed 0, obstacle rates estimated from sensing and "
+        f"AR-predicted by the thesis's law); the random-ch3 campaign ran seeds 0–{n - 1} with "
+        f"each law, obstacle motion known (oracle) and predicted; the AR one-step velocity "
+        "prediction is compared with constant velocity."
+    )
+    sec = ChapterSection(
+        key="ch3",
+        title="Chapter 3 — a 3D flying robot with AR prediction",
+        intro=intro,
+        rows=rows_of(summary.table),
+    )
+    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch3_caption))
+    if not sec.figures:
+        sec.notes.append("No figures: the run had no Chapter 3 renderer.")
+    return sec
+
+
+# ---------------------------------------------------------------------------------- Chapter 4
+
+_CH4_CAPTIONS = {
+    "fig4-7-approach": "Fig. 4.7 reproduced: the UUV approaching a deforming obstacle, sonar "
+    "cone and sensed boundary.",
+    "fig4-8-decision": "Fig. 4.8 reproduced: the avoidance decision — tagged point, forecast "
+    "circle and the tangent direction.",
+    "fig4-4b-amaps": "Fig. 4.4(b) reproduced: the AMAPS map of sensed points at the decision.",
+    "fig4-9-whole-run": "Fig. 4.9 reproduced: the whole run from I to E.",
+}
+
+
+def _ch4_caption(p: Path) -> str:
+    base = _CH4_CAPTIONS.get(p.stem, "")
+    if p.suffix == ".gif":
+        return f"Animation of the Fig. 4.9 run ({p.name})."
+    return base or f"{p.stem}: zhang2022-uuv2d-v1 run."
+
+
+def ch4_section(summary: Any, *, full: bool) -> ChapterSection:
+    """The Chapter 4 section from a :class:`uvnav.bench.reproduce_ch4.Ch4Summary`."""
+    from uvnav.bench import reproduce_ch4 as r4
+
+    n = r4.FULL_SEEDS if full else r4.QUICK_SEEDS
+    nn = r4.FULL_NOISE_SEEDS if full else r4.QUICK_NOISE_SEEDS
+    levels = ", ".join(f"noise {s:g} m" if s else f"dropout {d:.0%}" for s, d in r4.NOISE_LEVELS)
+    intro = (
+        f"Planar UUV with a viewing-cone sonar among shape-changing obstacles ({mode_text(full)}). "
+        f"The thesis-ch4 scenes ran with {', '.join(r4.LAWS)} (seed 0, trajectories recorded); "
+        f"the random-ch4 campaign ran {n} seeds per law, and a sensor sweep ({levels}) "
+        f"{nn} seeds per level."
+    )
+    sec = ChapterSection(
+        key="ch4",
+        title="Chapter 4 — a UUV among shape-changing obstacles",
+        intro=intro,
+        rows=rows_of(summary.table),
+    )
+    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch4_caption))
+    p = getattr(summary, "summary_path", None)
+    if p is not None:
+        sec.links += caption_files([Path(p)], lambda _p: "Chapter 4 results (JSON)")
+    if not sec.figures:
+        sec.notes.append("No figures: the run had no Chapter 4 renderer.")
+    return sec
+
+
+# ---------------------------------------------------------------------------------- Chapter 5
+
+
+def _ch5_caption(p: Path) -> str:
+    s = p.stem
+    if s == "ch5_array":
+        return "Fig. 5.2: the nine-sonar array on the vehicle's front surface and its beams."
+    if s == "ch5_learning_curve":
+        return (
+            "Learning curve: test error of the BPNN as the sample count grows, beside the "
+            "min/argmin-of-readings baseline."
+        )
+    if m := re.fullmatch(r"ch5_training_n(\d+)(r?)", s):
+        kind = "residual" if m[2] else "plain (thesis-style)"
+        return f"BPNN training on {m[1]} samples, {kind} network: loss per epoch."
+    if m := re.fullmatch(r"ch5_errors_n(\d+)(r?)_(test_group|independent)", s):
+        kind = "residual" if m[2] else "plain (thesis-style)"
+        where = "its own test group" if m[3] == "test_group" else "the independent test set"
+        return (
+            f"Figs. 5.5–5.8 style: errors and target-vs-output of the {m[1]}-sample {kind} "
+            f"network on {where}."
+        )
+    if m := re.fullmatch(r"ch5_traj_(.+)_([a-z]+)_([0-9.]+)", s):
+        return f"{m[1]}: the 3D run with the {m[2]} locator, sonar noise {m[3]} m."
+    return ""
+
+
+def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
+    """The Chapter 5 section from a :class:`uvnav.bench.reproduce_ch5.Ch5Summary`."""
+    import json
+
+    from uvnav.bench import reproduce_ch5 as r5
+
+    cfg: dict[str, Any] = {}
+    p = getattr(summary, "json_path", None)
+    if p is not None and Path(p).is_file():  # what was run, as ch5.json records it
+        cfg = json.loads(Path(p).read_text(encoding="utf-8")).get("config", {})
+    sizes = cfg.get("sizes", r5.FULL_SIZES if full else r5.QUICK_SIZES)
+    seeds = cfg.get("seeds", r5.FULL_SEEDS if full else r5.QUICK_SEEDS)
+    n_rand = cfg.get("n_random", r5.FULL_RANDOM if full else r5.QUICK_RANDOM)
+    noises = " and ".join(f"{x:g}" for x in cfg.get("noises", (0.0, 0.05) if full else (0.0,)))
+    noises += " m"
+    intro = (
+        f"3D UUV with a nine-sonar array and a BPNN locator ({mode_text(full)}). The BPNN "
+        f"(9→10→2, plain and residual) trained on {', '.join(map(str, sizes))} samples with "
+        f"{seeds} seeds each, tested on its own test group and on an independent set; "
+        f"zhang2022-uuv3d-v1 then ran on the three thesis-ch5 scenes and random-ch5 seeds "
+        f"0–{n_rand - 1} with the {', '.join(r5.LOCATORS)} locators, sonar noise {noises}. "
+        "Results are stored as JSON (linked below)."
+    )
+    sec = ChapterSection(
+        key="ch5",
+        title="Chapter 5 — a 3D UUV with nine sonars and a BPNN",
+        intro=intro,
+        rows=rows_of(summary.table),
+    )
+    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch5_caption))
+    if p is not None:
+        sec.links += caption_files([Path(p)], lambda _p: "Chapter 5 results (JSON)")
+    if not sec.figures:
+        sec.notes.append("No figures: the run had no Chapter 5 renderer.")
+    return sec
+
+
+# ---------------------------------------------------------------------------------- Chapter 6
+
+_CH6_CAPTIONS = {
+    "fig6_1_cameras": "Fig. 6.1: the left, centre and right camera views.",
+    "fig6_4_steering": "Fig. 6.4: steering angles of the collected frames before balancing.",
+    "fig6_5_balanced": "Fig. 6.5: steering angles after balancing.",
+    "fig6_6_split": "Fig. 6.6: the 8:2 training / validation split.",
+    "fig6_7_augmentation": "Fig. 6.7: augmentation examples.",
+    "fig6_8_loss": "Fig. 6.8: training and validation loss per epoch.",
+}
+
+
+def ch6_section(summary: Any | None, *, full: bool) -> ChapterSection:
+    """The Chapter 6 section from a :class:`uvnav.bench.reproduce_ch6.Ch6Summary` (``None``: not
+    run, as in quick mode)."""
+    title = "Chapter 6 — a CNN that drives (PilotNet on CarRacing)"
+    if summary is None:
+        return ChapterSection(
+            key="ch6",
+            title=title,
+            intro=(
+                f"Not run in {mode_text(full)}: training the CNN takes several CPU minutes even at "
+                "the quick size, more than the rest of the quick reproduction together."
+            ),
+            notes=[
+                "Run it with uvnav run --full (thesis size) or uvnav drive reproduce (quick size)."
+            ],
+        )
+    sec = ChapterSection(
+        key="ch6",
+        title=title,
+        intro=(
+            f"PilotNet trained on frames of the pure-pursuit expert in CarRacing ({mode_text(full)}"
+            "): collection, balancing, 8:2 split, training, then closed-loop laps on held-out "
+            "tracks with the learned and the PI throttle."
+        ),
+        rows=rows_of(summary.table),
+    )
+    sec.add_files(
+        caption_files(getattr(summary, "figures", []) or [], lambda p: _CH6_CAPTIONS.get(p.stem))
+    )
+    return sec
+
+
+# ---------------------------------------------------------------------------------- Chapter 7
+
+
+def _ch7_caption(p: Path) -> str:
+    name = p.stem.rsplit("-", 1)[0]
+    if p.suffix == ".html":
+        return f"{name}: interactive 3D view of terrain, waypoints and tours (plotly)"
+    return (
+        f"Fig. 7.4 style, {name}: terrain, the lattice waypoints at their lowest altitude and the "
+        "UAV tours."
+    )
+
+
+def ch7_section(summary: Any, *, full: bool) -> ChapterSection:
+    """The Chapter 7 section from a :class:`uvnav.bench.reproduce_ch7.Ch7Summary`."""
+    from uvnav.bench import reproduce_ch7 as r7
+
+    if full:
+        plans = "synthetic and Jacksboro terrains × 300/600 m × R 20/30/50 m"
+    else:
+        plans = ", ".join(f"{k} {s:.0f} m with R = {r:.0f} m" for k, s, r in r7.QUICK_PLANS)
+    sizes = "/".join(f"{s:.0f}" for s in r7.SIZES)
+    radii = "/".join(f"{r:.0f}" for r in r7.RADII)
+    intro = (
+        f"UAV reconnaissance of a terrain ({mode_text(full)}). Stage 1 lattice counts for "
+        f"{sizes} m squares and R = {radii} m; full plans (lattice, lowest altitudes, tours, "
+        f"Bézier paths) for {plans}."
+    )
+    sec = ChapterSection(
+        key="ch7",
+        title="Chapter 7 — UAV reconnaissance of a terrain",
+        intro=intro,
+        rows=rows_of(summary.table),
+    )
+    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch7_caption))
+    if not sec.figures:
+        sec.notes.append("No figures: the run had no Chapter 7 renderer.")
+    return sec
+
+
+# ----------------------------------------------------------------------------- beyond the thesis
+
+
+def _ch9_caption(p: Path) -> str:
+    s = p.stem
+    if s == "ch9-paths":
+        return (
+            "Global planners on the office-floor grid (walls grown by the robot radius): A*, the "
+            "visibility-graph path, and D* Lite's replan after a cabinet appears (red cells)."
+        )
+    if s == "ch9-office":
+        return (
+            "office-floor: the reactive law alone vs hybrid-v1 (D* Lite on the walls it senses) "
+            "with the same law; the legend gives each run's outcome."
+        )
+    if s.startswith("ch9-swap-"):
+        return (
+            f"Antipodal swap of 16 robots, every robot running {s[len('ch9-swap-') :]}: paths, "
+            "starts (circles), goals (stars), collisions (x)."
+        )
+    return ""
+
+
+def beyond_section(
+    rows: Sequence[Mapping[str, Any]], figures: Sequence[Path], *, full: bool
+) -> ChapterSection:
+    """The issue-9 section: global + local navigation (office floor) and multi-robot swap."""
+    from uvnav.bench import reproduce_ch9 as r9
+
+    laws = r9.FULL_LAWS if full else r9.QUICK_LAWS
+    swap = ", ".join(
+        n
+        + (" (tuned for peers)" if p == r9.ZHANG_MULTI else "")
+        + (f" (responsibility {p['responsibility']})" if "responsibility" in p else "")
+        for n, p in (r9.FULL_SWAP if full else r9.QUICK_SWAP)
+    )
+    intro = (
+        f"What the thesis's conclusion names as the next step ({mode_text(full)}). Global + "
+        f"local: on office-floor (seed 0), {', '.join(laws)} alone and inside hybrid-v1. "
+        f"Multi-robot: the antipodal swap of 16 robots (seed 0), every robot running {swap}; "
+        "ORCA (RVO2) is the multi-agent peer."
+    )
+    sec = ChapterSection(
+        key="beyond",
+        title="Beyond the thesis — global planners, hybrid navigation, multi-robot",
+        intro=intro,
+        rows=rows_of(rows),
+    )
+    sec.add_files(caption_files(figures, _ch9_caption))
+    if not sec.figures:
+        sec.notes.append("No figures: the run had no issue-9 renderer.")
+    return sec
