@@ -33,3 +33,8 @@ def test_render_ch3_writes_every_figure(tmp_path: Path) -> None:
                      "trajectory.png", "zhang2020-3d-v1.html"]  # fmt: skip
     assert all(f.stat().st_size > 1000 for f in files)
     assert "plotly" in interactive_trajectory(tr, "t")[:5000].lower()
+    # the report's views share one plotly.js next to index.html instead of embedding a copy each
+    (page,) = [f for f in files if f.suffix == ".html"]
+    text = page.read_text(encoding="utf-8")
+    assert 'src="../plotly.min.js"' in text and len(text) < 1_000_000
+    assert (tmp_path / "plotly.min.js").stat().st_size > 1_000_000

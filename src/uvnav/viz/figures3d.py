@@ -131,8 +131,16 @@ def clearance_figure(tr: Trajectory3D) -> Any:
     return fig
 
 
-def interactive_trajectory(tr: Trajectory3D, title: str = "") -> str:
-    """HTML (plotly, loaded from its bundled JS) of the trajectory and the obstacles' paths.
+def interactive_trajectory(
+    tr: Trajectory3D, title: str = "", plotly_js: bool | str = True
+) -> str:
+    """HTML (plotly) of the trajectory and the obstacles' paths.
+
+    Args:
+        tr: the recorded episode.
+        title: page title.
+        plotly_js: ``True`` embeds plotly.js (a standalone page, about 3.5 MB); a relative path
+            loads it from there instead (the report shares one copy).
 
     Raises:
         ImportError: plotly missing (install the ``report`` extra).
@@ -155,7 +163,7 @@ def interactive_trajectory(tr: Trajectory3D, title: str = "") -> str:
                                   name=f"obstacle {i} (mid-episode)"))  # fmt: skip
     fig = go.Figure(data=data)
     fig.update_layout(title=title, scene={"aspectmode": "data"})
-    return str(fig.to_html(include_plotlyjs=True, full_html=True))
+    return str(fig.to_html(include_plotlyjs=plotly_js, full_html=True))
 
 
 def render_ch3(db_path: Path, report_dir: Path, recorded: list[tuple[str, str, Any]]) -> list[Path]:
@@ -175,8 +183,12 @@ def render_ch3(db_path: Path, report_dir: Path, recorded: list[tuple[str, str, A
             figs["obstacle-motion"] = obstacle_motion_figure(tr)
             figs["prediction"] = prediction_figure(tr)
             try:
+                from uvnav.viz.interactive import PLOTLY_JS, write_plotly_js
+
+                write_plotly_js(Path(report_dir))  # one shared copy next to index.html
                 html = out / f"{stem}.html"
-                html.write_text(interactive_trajectory(tr, f"{scene}: {ctrl}"), encoding="utf-8")
+                page = interactive_trajectory(tr, f"{scene}: {ctrl}", plotly_js=f"../{PLOTLY_JS}")
+                html.write_text(page, encoding="utf-8")
                 files.append(html)
             except ImportError:
                 pass
