@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
+from uvnav.prediction.amaps_kernels import load_kernel
 
 
 @dataclass(frozen=True)
@@ -88,9 +89,21 @@ class AmapsGrid:
     """
 
     def __init__(
-        self, origin: tuple[float, float], shape: tuple[int, int], config: AmapsConfig
+        self,
+        origin: tuple[float, float],
+        shape: tuple[int, int],
+        config: AmapsConfig,
+        *,
+        engine: str = "auto",
     ) -> None:
+        if engine not in ("auto", "numpy", "numba"):
+            raise ValueError(f"engine must be 'auto', 'numpy' or 'numba' (got {engine!r})")
         self.config = config
+        self._kernel = None if engine == "numpy" else load_kernel()
+        if engine == "numba" and self._kernel is None:
+            raise ImportError("AMAPS engine 'numba' needs numba: pip install 'uvnav[fast]'")
+        #: the update path in use: ``"numba"`` (compiled, extra ``fast``) or ``"numpy"``
+        self.engine = "numpy" if self._kernel is None else "numba"
         self.x0 = float(origin[0])
         self.y0 = float(origin[1])
         self.nx, self.ny = int(shape[0]), int(shape[1])
@@ -104,13 +117,19 @@ class AmapsGrid:
 
     @classmethod
     def covering(
-        cls, low: FloatArray, high: FloatArray, config: AmapsConfig, *, margin: float = 0.0
+        cls,
+        low: FloatArray,
+        high: FloatArray,
+        config: AmapsConfig,
+        *,
+        margin: float = 0.0,
+        engine: str = "auto",
     ) -> AmapsGrid:
         """A grid covering the box ``[low, high]`` [m] grown by ``margin`` [m] on every side."""
         lo = np.asarray(low, dtype=float) - margin
         hi = np.asarray(high, dtype=float) + margin
         n = np.maximum(np.ceil((hi - lo) / config.cell).astype(int), 1)
-        return cls((float(lo[0]), float(lo[1])), (int(n[0]), int(n[1])), config)
+        return cls((float(lo[0]), float(lo[1])), (int(n[0]), int(n[1])), config, engine=engine)
 
     @property
     def counts(self) -> FloatArray:
@@ -167,7 +186,15 @@ class AmapsGrid:
         ok = np.isfinite(rr)
         if not ok.all():
             rr, ang, ids = rr[ok], ang[ok], ids[ok]
-        if len(rr):
+        if len(rr) and self._kernel is not None:
+            self._kernel(
+                self._stored, self.labels, float(origin[0]), float(origin[1]), self.x0, self.y0,
+                h, np.cos(ang), np.sin(ang), rr, ids.astype(np.intp, copy=False),
+                np.float32(cfg.free_weight * inv), np.float32(cfg.hit_weight * inv),
+                cfg.free_step * h, cfg.free_range, cfg.free_weight > 0,
+                int(np.floor(cfg.hit_depth / (0.5 * h))) + 1, 0.5 * h,
+            )  # fmt: skip
+        elif len(rr):
             # (2, B) beam directions, rows x and y; (2,) sonar offset from the grid origin [m]
             dirs = np.stack([np.cos(ang), np.sin(ang)])
             o = np.asarray(origin, dtype=float)
@@ -202,9 +229,10 @@ class AmapsGrid:
         # (2, B, S) sample positions relative to the grid origin, then square indices
         pos = (o - self._origin)[:, None, None] + s * dirs[:, :, None]
         cell = np.floor(pos / h).astype(np.intp)
-        # inside the grid: one unsigned compare per axis catches negative indices too
-        inside = (cell.view(np.uintp) < dims[:, None, None]).all(axis=0)
-        take = inside & (s < limit[:, None])
+        take = s < limit[:, None]
+        if not self._holds(o, cfg.free_range):
+            # inside the grid: one unsigned compare per axis catches negative indices too
+            take &= (cell.view(np.uintp) < dims[:, None, None]).all(axis=0)
         flat = (cell[1] * self.nx + cell[0])[take]
         if len(flat):
             # duplicates read the same old value and write the same new one: once each
@@ -234,6 +262,14 @@ class AmapsGrid:
         view[flat] += np.float32(cfg.hit_weight * inv)  # buffered: +w once per square
         lab = np.repeat(ids, n_d)[inside]
         self.labels.reshape(-1)[flat] = lab.astype(np.int16)
+
+    def _holds(self, point: FloatArray, reach: float) -> bool:
+        """True when every square within ``reach`` [m] of ``point`` (plus one square) lies in
+        the grid, so that samples up to that distance need no bounds test."""
+        h = self.config.cell
+        lo = (point - self._origin - reach) / h
+        hi = (point - self._origin + reach) / h
+        return bool(lo[0] >= 1 and lo[1] >= 1 and hi[0] <= self.nx - 1 and hi[1] <= self.ny - 1)
 
     def _free_samples(self, n: int) -> FloatArray:
         """The first ``n`` free-space sample distances ``k * free_step * cell`` [m] (cached)."""
