@@ -187,7 +187,7 @@ class AmapsGrid:
         if not ok.all():
             rr, ang, ids = rr[ok], ang[ok], ids[ok]
         if len(rr) and self._kernel is not None:
-            self._kernel(
+            self._kernel[0](
                 self._stored, self.labels, float(origin[0]), float(origin[1]), self.x0, self.y0,
                 h, np.cos(ang), np.sin(ang), rr, ids.astype(np.intp, copy=False),
                 np.float32(cfg.free_weight * inv), np.float32(cfg.hit_weight * inv),
@@ -298,10 +298,13 @@ class AmapsGrid:
         """
         p = np.asarray(point, dtype=float)
         rs, cs = self._window(p, radius)
-        sub = self._stored[rs, cs]
-        rows, cols = np.nonzero(sub >= np.float32(self.config.threshold / self._gain))
-        rows = rows + rs.start
-        cols = cols + cs.start
+        level = np.float32(self.config.threshold / self._gain)
+        if self._kernel is not None:
+            rows, cols = self._kernel[1](self._stored, rs.start, rs.stop, cs.start, cs.stop, level)
+        else:
+            rows, cols = np.nonzero(self._stored[rs, cs] >= level)
+            rows = rows + rs.start
+            cols = cols + cs.start
         centres = self.centre_of(cols, rows)
         d = np.hypot(centres[:, 0] - p[0], centres[:, 1] - p[1])
         keep = d <= radius

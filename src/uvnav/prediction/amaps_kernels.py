@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-_KERNEL: Callable[..., None] | None = None
+_KERNEL: tuple[Callable[..., None], Callable[..., tuple[Any, Any]]] | None = None
 _TRIED = False
 
 
@@ -109,8 +109,27 @@ def _sweep(
             flat_l[idx[j]] = lab[j]
 
 
-def load_kernel() -> Callable[..., None] | None:
-    """The compiled sweep update, or ``None`` when numba (extra ``fast``) is not installed."""
+def _scan(
+    stored: Any, r0: int, r1: int, c0: int, c1: int, level: Any
+) -> tuple[Any, Any]:  # pragma: no cover - compiled by numba
+    """Rows and columns (row-major) of the squares of ``stored[r0:r1, c0:c1]`` with a stored
+    count ``>= level`` (float32), as ``np.nonzero(sub >= level)`` gives them (offset added)."""
+    n = max(r1 - r0, 0) * max(c1 - c0, 0)
+    rows = np.empty(n, dtype=np.intp)
+    cols = np.empty(n, dtype=np.intp)
+    m = 0
+    for r in range(r0, r1):
+        for c in range(c0, c1):
+            if stored[r, c] >= level:
+                rows[m] = r
+                cols[m] = c
+                m += 1
+    return rows[:m], cols[:m]
+
+
+def load_kernel() -> tuple[Callable[..., None], Callable[..., tuple[Any, Any]]] | None:
+    """The compiled sweep update and window scan, or ``None`` when numba (extra ``fast``) is not
+    installed."""
     global _KERNEL, _TRIED
     if not _TRIED:
         _TRIED = True
@@ -118,5 +137,6 @@ def load_kernel() -> Callable[..., None] | None:
             import numba
         except ImportError:
             return None
-        _KERNEL = numba.njit(cache=True, nogil=True)(_sweep)
+        jit = numba.njit(cache=True, nogil=True)
+        _KERNEL = (jit(_sweep), jit(_scan))
     return _KERNEL
