@@ -77,9 +77,7 @@ def bench_amaps_memory(sweeps: int) -> dict[str, Any]:
         "us_per_update": elapsed / sweeps * 1e6,
         "engine": grid.engine,
         "target_growth_bytes": TARGET_GROWTH_BYTES,
-        "pass": bool(
-            growth < TARGET_GROWTH_BYTES and len({s["grid_bytes"] for s in samples}) == 1
-        ),
+        "pass": bool(growth < TARGET_GROWTH_BYTES and len({s["grid_bytes"] for s in samples}) == 1),
     }
 
 
@@ -95,8 +93,9 @@ def _observations(n: int) -> list[SonarObservation]:
         c = setup.shapes[0].centre_at(t)
         pose = np.array([c[0] + 2.0 * math.cos(a), c[1] + 2.0 * math.sin(a), a + math.pi / 2])
         centres = np.array([s.centre_at(t) for s in setup.shapes])
-        reading = sonar_scan(pose, [s.outline(t) for s in setup.shapes], rng, setup.sonar,
-                             centres=centres)
+        reading = sonar_scan(
+            pose, [s.outline(t) for s in setup.shapes], rng, setup.sonar, centres=centres
+        )
         out.append(SonarObservation(t, pose, np.zeros(2), setup.goal, reading, 0.2))
     return out
 

@@ -142,9 +142,7 @@ class ReferenceAmaps:
         rows, cols = np.nonzero(sub >= np.float32(self.config.threshold / self._gain))
         rows = rows + rs.start
         cols = cols + cs.start
-        centres = np.stack(
-            [self.x0 + (cols + 0.5) * h, self.y0 + (rows + 0.5) * h], axis=-1
-        )
+        centres = np.stack([self.x0 + (cols + 0.5) * h, self.y0 + (rows + 0.5) * h], axis=-1)
         d = np.hypot(centres[:, 0] - p[0], centres[:, 1] - p[1])
         keep = d <= radius
         return centres[keep], self.labels[rows[keep], cols[keep]].astype(np.intp)

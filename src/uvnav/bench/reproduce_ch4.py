@@ -423,9 +423,7 @@ def reproduce_ch4(
         ),
         encoding="utf-8",
     )
-    summary = Ch4Summary(
-        scene_rows, campaign, fails, table, [], db_path, summary_path, hard_fails
-    )
+    summary = Ch4Summary(scene_rows, campaign, fails, table, [], db_path, summary_path, hard_fails)
     if render is not None and report_dir is not None:
         summary.figures = list(render(Path(report_dir) / "ch4", scene_results, summary))
     return summary
@@ -439,9 +437,9 @@ __all__ = [
     "campaign_jobs",
     "failures",
     "hard_jobs",
-    "stored_rows",
     "reproduce_ch4",
     "run_ch4_job",
     "run_jobs",
+    "stored_rows",
     "summarise",
 ]

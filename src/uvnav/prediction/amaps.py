@@ -113,7 +113,7 @@ class AmapsGrid:
         self.updates = 0
         self._origin = np.array([self.x0, self.y0])
         self._dims = np.array([self.nx, self.ny], dtype=np.uintp)
-        self._samples = np.zeros(0)
+        self._samples: FloatArray = np.zeros(0)
 
     @classmethod
     def covering(
