@@ -274,7 +274,8 @@ class AmapsGrid:
     def _free_samples(self, n: int) -> FloatArray:
         """The first ``n`` free-space sample distances ``k * free_step * cell`` [m] (cached)."""
         if len(self._samples) < n:
-            self._samples = np.arange(n) * (self.config.free_step * self.config.cell)
+            fs = self.config.free_step * self.config.cell
+            self._samples = np.asarray(np.arange(n) * fs, dtype=float)
         return self._samples[:n]
 
     # -------------------------------------------------------------------------------- queries
