@@ -412,8 +412,10 @@ def random_ch4_hard_scenario(
     noise_std: float = 0.0,
     dropout: float = 0.0,
 ) -> Uuv2dScenario:
-    """A harder random Chapter-4 scene (``random-ch4-hard:<seed>``), still within the chapter's
-    assumptions as :func:`random_ch4_scenario` reads them.
+    """A harder random Chapter-4 scene: faster, translating bodies, narrow gaps (seeded).
+
+    ``random-ch4-hard:<seed>``, still within the chapter's assumptions as
+    :func:`random_ch4_scenario` reads them.
 
     What is harder: 2-6 bodies; deformation at the top of the rate range (boundary speed bound
     drawn from ``HARD_RATE`` = 0.3-0.6 m/s, against 0.05-0.3 m/s); every body but possibly the
