@@ -253,9 +253,7 @@ def close_narrow_openings(
         # only pairs with something to close: a beam without a return between them, or a
         # return deeper than both lips (a flat or convex stretch between close returns is left)
         missing = (idx[jj] - idx[ii]) > (jj - ii)
-        deeper = (jj - ii >= 2) & (
-            runmax[ii, np.maximum(jj - 1, 0)] > np.maximum(rr[ii], rr[jj])
-        )
+        deeper = (jj - ii >= 2) & (runmax[ii, np.maximum(jj - 1, 0)] > np.maximum(rr[ii], rr[jj]))
         keep = (idx[jj] - idx[ii] >= 2) & (missing | deeper)
         ii, jj = ii[keep], jj[keep]
     if len(ii) == 0:
