@@ -107,7 +107,7 @@ def test_compiled_opening_detector_matches_the_numpy_one(
     bodies = [
         DeformingStar.random(
             rng, tuple(rng.uniform(2, 8, 2)), float(rng.uniform(0.3, 3.0)), max_rate=0.2
-        )  # fmt: skip
+        )
         for _ in range(n_bodies)
     ]
     pose = np.array([*rng.uniform(0, 10, 2), rng.uniform(-3, 3)])
