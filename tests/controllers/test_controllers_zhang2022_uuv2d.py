@@ -161,3 +161,27 @@ def test_decisions_are_the_same_with_either_amaps_engine() -> None:
         seen[engine] = out
     assert seen["numpy"] == seen["numba"]
     assert any(o[2] == "M2" for o in seen["numpy"])  # avoidance decisions were compared too
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), r=st.floats(0.0, 4.0))
+def test_one_scan_answers_like_separate_scans(seed: int, r: float) -> None:
+    """The law's single window scan, filtered, equals a grid scan of the smaller radius."""
+    from uvnav.controllers.zhang2022_uuv2d import _Near
+
+    rng = np.random.default_rng(seed)
+    grid = AmapsGrid.covering(np.zeros(2), np.full(2, 6.0), AmapsConfig(decay=1.0))
+    for _ in range(5):
+        b = int(rng.integers(1, 40))
+        grid.update(rng.uniform(0, 6, 2), rng.uniform(-4, 4, b), rng.uniform(0.2, 3, b),
+                    rng.integers(-1, 3, b))  # fmt: skip
+    p = rng.uniform(0, 6, 2)
+    near = _Near(*grid.covered(p, 3.0), 3.0)
+    rr = min(r, 3.0)
+    want_c, want_l = grid.occupied(p, rr)
+    got_c, got_l = near.within(rr)
+    assert np.array_equal(got_c, want_c) and np.array_equal(got_l, want_l)
+    d, c, lab = near.nearest(rr)
+    wd, wc, wl = grid.nearest(p, rr)
+    assert d == wd and lab == wl and (c is None) == (wc is None)
+    assert c is None or np.array_equal(c, wc)

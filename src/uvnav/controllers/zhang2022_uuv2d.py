@@ -71,7 +71,7 @@ from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec, velocity_t
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.polygons import points_to_segments
 from uvnav.geometry.tangents import circle_tangents
-from uvnav.prediction.amaps import AmapsConfig, AmapsGrid, nearest_of
+from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
 from uvnav.sensors.sonar2d import SonarObservation, close_narrow_openings
 
 
@@ -203,14 +203,25 @@ class _Near:
     centres: FloatArray
     labels: np.ndarray
     distances: FloatArray
-
-    def within3(self, radius: float) -> tuple[FloatArray, np.ndarray, FloatArray]:
-        keep = self.distances <= radius
-        return self.centres[keep], self.labels[keep], self.distances[keep]
+    #: the radius [m] of the scan
+    radius: float
 
     def within(self, radius: float) -> tuple[FloatArray, np.ndarray]:
-        centres, labels, _ = self.within3(radius)
-        return centres, labels
+        """Centres and labels within ``radius`` [m] (row-major, as a scan of that radius)."""
+        if radius >= self.radius:  # everything scanned is within it
+            return self.centres, self.labels
+        keep = self.distances <= radius
+        return self.centres[keep], self.labels[keep]
+
+    def nearest(self, radius: float) -> tuple[float, FloatArray | None, int]:
+        """:meth:`AmapsGrid.nearest` within ``radius`` [m]: the first nearest square overall is
+        the first nearest of those within ``radius`` whenever it lies within it."""
+        if len(self.distances) == 0:
+            return math.inf, None, -1
+        j = int(np.argmin(self.distances))
+        if not self.distances[j] <= radius:
+            return math.inf, None, -1
+        return float(self.distances[j]), self.centres[j], int(self.labels[j])
 
 
 @dataclass
@@ -359,9 +370,10 @@ class Zhang2022Uuv2dController:
         ranges, ids = close_narrow_openings(s.origin, s.angles, s.ranges, s.hit_ids, width)
         grid.update(s.origin, s.angles, ranges, ids)
         # one window scan answers every grid question of this decision
-        near = _Near(*grid.covered(pos, self._query_radius()))
+        reach = self._query_radius()
+        near = _Near(*grid.covered(pos, reach), reach)
         # only a square within L matters to (4.12); a little more keeps d_grid exact near L
-        d_grid, r_min, label = nearest_of(*near.within3(p.switch_distance + 2.0 * p.cell))
+        d_grid, r_min, label = near.nearest(p.switch_distance + 2.0 * p.cell)
         d_sonar = float(s.d_min.min()) if len(s.d_min) else math.inf
         d_min = min(d_grid, d_sonar)
         # (4.12)
