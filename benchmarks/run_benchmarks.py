@@ -81,6 +81,12 @@ TARGETS = {
         "limit": 5000.0,
         "direction": ">=",
     },
+    "ch4_decision_us_median": {
+        "benchmark": "ch4_decision",
+        "what": "zhang2022-uuv2d-v1 median decision time, 0.05 m AMAPS grid over 10x10 m [µs]",
+        "limit": 500.0,
+        "direction": "<=",
+    },
 }
 CH2_SPEC = UnicycleSpec(v_max=0.707, u_max=1.414, radius=0.1)
 ARROW = np.array([[-0.6, -0.4], [0.7, -0.5], [0.2, 0.1], [0.6, 0.6], [-0.5, 0.5]])
@@ -698,6 +704,23 @@ def bench_world_ab(quick: bool, against: Path) -> dict[str, Any]:
 # report
 
 
+def bench_ch4_decision(quick: bool) -> dict[str, Any]:
+    """Chapter 4 (issue 5): decision time of the UUV laws and the AMAPS sweep update with each
+    engine side by side, from ``benchmarks/bench_ch4.py`` (which also has the 1e5-sweep memory
+    run: ``python benchmarks/bench_ch4.py``)."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    import bench_ch4
+
+    n = 60 if quick else 400
+    decision = bench_ch4.bench_decision(n)
+    measured = decision["zhang2022-uuv2d-v1"]["wall_us_median"]
+    return {
+        "decision_time": decision,
+        "amaps_update": bench_ch4.bench_amaps_update(n),
+        "targets": {"ch4_decision_us_median": _target("ch4_decision_us_median", measured)},
+    }
+
+
 def print_tables(reports: dict[str, dict[str, Any]]) -> None:
     from rich.console import Console
     from rich.table import Table
@@ -835,7 +858,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--only",
         nargs="+",
-        choices=["decision", "world", "episodes", "ch3"],
+        choices=["decision", "world", "episodes", "ch3", "ch4"],
         help="run a subset (default: all)",
     )
     parser.add_argument("--profile", action="store_true", help="also cProfile the world step")
@@ -851,7 +874,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.worker:
         return worker_main()
 
-    chosen = set(args.only or ["decision", "world", "episodes", "ch3"])
+    chosen = set(args.only or ["decision", "world", "episodes", "ch3", "ch4"])
     info = machine_info()
     reports: dict[str, dict[str, Any]] = {}
     runners: list[tuple[str, str, Callable[[bool], dict[str, Any]]]] = [
@@ -859,6 +882,7 @@ def main(argv: list[str] | None = None) -> int:
         ("world", "world_steps", bench_world),
         ("episodes", "episodes", bench_episodes),
         ("ch3", "ch3", bench_ch3),
+        ("ch4", "ch4_decision", bench_ch4_decision),
     ]
     if args.profile:
         runners.append(("world", "world_step_profile", profile_world))

@@ -17,6 +17,8 @@ from uvnav.controllers.zhang2022_uuv2d import (
 )
 from uvnav.dynamics.holonomic import HolonomicSpec
 from uvnav.obstacles.deforming import DeformingStar
+from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
+from uvnav.prediction.amaps_kernels import load_kernel
 from uvnav.scenarios.uuv2d import load_uuv2d_scenario
 from uvnav.sensors.sonar2d import SonarConfig, SonarObservation, sonar_scan
 from uvnav.sim.episode_uuv2d import run_uuv2d_episode
@@ -93,7 +95,7 @@ def test_count_and_forecast_radius_follow_4_11_and_4_12() -> None:
     assert [d.count for d in seen] == [1, 2, 3]
     r = np.array([d.r_min for d in seen])
     expected = float(np.hypot(*np.diff(r, axis=0).T).mean())
-    assert math.isclose(seen[-1].extra["R_i"], expected, rel_tol=1e-12)
+    assert seen[-1].extra["R_i"] == expected  # the same arithmetic as (4.11) written out
     # far from everything: count(t) = 0 and target approaching
     ctrl.act(observe(np.array([-6.0, -6.0, math.pi / 4]), [body.outline(0)], centres, 1.0))
     assert ctrl.last is not None and ctrl.last.mode == "M1" and ctrl._count == 0
@@ -132,3 +134,54 @@ def test_fig_4_7_target_approaching_for_t_0_to_4() -> None:
     assert all(d.d_min > sc.switch_distance for d, e in zip(tr.decisions, early, strict=True) if e)
     at4 = tr.poses[np.searchsorted(tr.times, 4.0)]
     assert np.allclose(at4[:2], [4.0, 4.0], atol=1e-6)  # sqrt(2) V_max along the diagonal
+
+
+@pytest.mark.skipif(load_kernel() is None, reason="numba (extra 'fast') not installed")
+def test_decisions_are_the_same_with_either_amaps_engine() -> None:
+    """The compiled AMAPS path changes no decision: same commands, modes, r_imin and R_i."""
+    body = DeformingStar.random(np.random.default_rng(3), (5.0, 5.0), 3.0, max_rate=0.3)
+    centres = np.array([[5.0, 5.0]])
+    seen: dict[str, list[tuple[object, ...]]] = {}
+    for engine in ("numpy", "numba"):
+        ctrl = make_uuv2d_controller("zhang2022-uuv2d-v1")
+        ctrl.reset(SPEC, GOAL, np.random.default_rng(0))
+        assert isinstance(ctrl, Zhang2022Uuv2dController)
+        ctrl.grid = AmapsGrid.covering(
+            np.zeros(2), GOAL, AmapsConfig(cell=0.05), margin=4.0, engine=engine
+        )
+        out = []
+        for k in range(40):
+            a = 2 * math.pi * k / 40
+            pose = np.array([5 + 2.0 * math.cos(a), 5 + 2.0 * math.sin(a), a + math.pi / 2])
+            cmd = ctrl.act(observe(pose, [body.outline(0.2 * k)], centres, 0.2 * k))
+            d = ctrl.last
+            assert d is not None
+            r_min = None if d.r_min is None else tuple(d.r_min)
+            out.append((cmd.vx, cmd.vy, d.mode, r_min, d.radius, d.extra.get("R_i")))
+        seen[engine] = out
+    assert seen["numpy"] == seen["numba"]
+    assert any(o[2] == "M2" for o in seen["numpy"])  # avoidance decisions were compared too
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), r=st.floats(0.0, 4.0))
+def test_one_scan_answers_like_separate_scans(seed: int, r: float) -> None:
+    """The law's single window scan, filtered, equals a grid scan of the smaller radius."""
+    from uvnav.controllers.zhang2022_uuv2d import _Near
+
+    rng = np.random.default_rng(seed)
+    grid = AmapsGrid.covering(np.zeros(2), np.full(2, 6.0), AmapsConfig(decay=1.0))
+    for _ in range(5):
+        b = int(rng.integers(1, 40))
+        grid.update(rng.uniform(0, 6, 2), rng.uniform(-4, 4, b), rng.uniform(0.2, 3, b),
+                    rng.integers(-1, 3, b))  # fmt: skip
+    p = rng.uniform(0, 6, 2)
+    near = _Near(*grid.covered(p, 3.0), 3.0)
+    rr = min(r, 3.0)
+    want_c, want_l = grid.occupied(p, rr)
+    got_c, got_l = near.within(rr)
+    assert np.array_equal(got_c, want_c) and np.array_equal(got_l, want_l)
+    d, c, lab = near.nearest(rr)
+    wd, wc, wl = grid.nearest(p, rr)
+    assert d == wd and lab == wl and (c is None) == (wc is None)
+    assert c is None or np.array_equal(c, wc)

@@ -12,6 +12,7 @@ from uvnav.scenarios.uuv2d import (
     UUV2D_GENERATORS,
     list_uuv2d_builtin,
     load_uuv2d_scenario,
+    random_ch4_hard_scenario,
     random_ch4_scenario,
     uuv2d_from_dict,
 )
@@ -82,6 +83,34 @@ def test_generator_is_seeded_and_keeps_the_assumptions() -> None:
             assert all(0.05 <= s.max_rate <= 0.3 for s in shapes)
     assert len(counts) >= 3
     assert random_ch4_scenario(3, n_obstacles=5).obstacles.__len__() == 5
+
+
+def test_hard_generator_is_seeded_and_keeps_the_assumptions() -> None:
+    """random-ch4-hard: 2-6 bodies, faster deformation, translation below the vehicle's speed,
+    bodies never closer than the narrow gap at any time of the episode, I and E kept clear."""
+    a, b = random_ch4_hard_scenario(5), load_uuv2d_scenario("random-ch4-hard:5")
+    assert a.model_dump() == b.model_dump()
+    times = np.linspace(0.0, a.t_max, 301)
+    moving = 0
+    for seed in range(4):
+        sc = random_ch4_hard_scenario(seed)
+        shapes = sc.shapes()
+        assert 2 <= len(shapes) <= 6
+        for s in shapes:
+            speed = float(np.hypot(*s.velocity))
+            assert 0.3 <= s.max_rate <= 0.6 and speed <= 0.3 + 1e-3
+            assert s.max_rate + speed < sc.vehicle.v_max  # slower than the vehicle
+            moving += speed > 0
+        paths = np.array([[s.centre_at(t) for t in times] for s in shapes])  # (n, T, 2)
+        radii = np.array([s.bounding_radius for s in shapes])
+        for i in range(len(shapes)):
+            for end in (sc.vehicle.start, sc.vehicle.goal):
+                gap_end = np.hypot(*(paths[i] - np.asarray(end)).T).min() - radii[i]
+                assert gap_end >= 1.0 - 1e-6
+            for j in range(i):
+                gap = np.hypot(*(paths[i] - paths[j]).T).min() - radii[i] - radii[j]
+                assert gap >= 2 * (sc.vehicle.radius + 0.05) - 1e-6
+    assert moving >= 4
 
 
 @pytest.mark.parametrize(

@@ -4,12 +4,14 @@ dropout, and the narrow-opening detector of Fig. 4.2(b)."""
 from __future__ import annotations
 
 import numpy as np
+import pytest
 import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from uvnav.obstacles.deforming import trap_polygon
+from uvnav.obstacles.deforming import DeformingStar, trap_polygon
 from uvnav.sensors.sonar2d import SonarConfig, close_narrow_openings, sonar_scan
+from uvnav.sensors.sonar2d_kernels import load_pairs_kernel
 
 
 def square(cx: float, cy: float, h: float) -> np.ndarray:
@@ -87,3 +89,30 @@ def test_narrow_mouth_is_closed_and_wide_one_is_not() -> None:
     deep = inside & (r.ranges > 3.5)
     assert deep.sum() >= 3 and np.all(wide[deep] > 3.5)
     assert np.allclose(wide, r.ranges, atol=0.05)
+
+
+@pytest.mark.skipif(load_pairs_kernel() is None, reason="numba (extra 'fast') not installed")
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n_bodies=st.integers(1, 4),
+    width=st.floats(0.2, 2.5),
+    noisy=st.booleans(),
+)
+def test_compiled_opening_detector_matches_the_numpy_one(
+    seed: int, n_bodies: int, width: float, noisy: bool
+) -> None:
+    """The compiled pair search closes exactly the beams the numpy matrices do."""
+    rng = np.random.default_rng(seed)
+    bodies = [
+        DeformingStar.random(
+            rng, tuple(rng.uniform(2, 8, 2)), float(rng.uniform(0.3, 3.0)), max_rate=0.2
+        )
+        for _ in range(n_bodies)
+    ]
+    pose = np.array([*rng.uniform(0, 10, 2), rng.uniform(-3, 3)])
+    cfg = SonarConfig(noise_std=0.05 if noisy else 0.0, dropout=0.1 if noisy else 0.0)
+    r = sonar_scan(pose, [b.outline(float(rng.uniform(0, 10))) for b in bodies], rng, cfg)
+    want = close_narrow_openings(r.origin, r.angles, r.ranges, r.hit_ids, width, engine="numpy")
+    got = close_narrow_openings(r.origin, r.angles, r.ranges, r.hit_ids, width)
+    assert np.array_equal(got[0], want[0], equal_nan=True) and np.array_equal(got[1], want[1])

@@ -4,18 +4,27 @@
 
 1. every built-in ``thesis-ch4-*`` scene (Figs. 4.2(b), 4.7-4.9) with the thesis's law
    ``zhang2022-uuv2d-v1`` and both baselines on the same sonar (``apf-uuv2d-v1``,
-   ``zhang2019-uuv2d-v1``), seed 0, trajectories recorded for the figures;
+   ``zhang2019-uuv2d-v1``), seed 0, trajectories recorded for the figures — campaign
+   ``ch4-thesis-scenes`` (re-run every time: the figures need the trajectories);
 2. a random campaign on ``random-ch4:<seed>`` (1-5 deforming obstacles) with the three laws
-   (quick: 10 seeds; ``full``: 200);
+   (quick: 10 seeds; ``full``: 200) — campaign ``ch4-random``;
 3. a sensor-noise sweep on the same generator: range noise 0.05 / 0.1 m and 10 % dropout
-   (quick: 4 seeds per level; ``full``: 50).
+   (quick: 4 seeds per level; ``full``: 50) — campaign ``ch4-noise``;
+4. the harder family ``random-ch4-hard:<seed>`` (faster deformation, translating bodies,
+   narrower gaps; :func:`~uvnav.scenarios.uuv2d.random_ch4_hard_scenario`) with the three laws
+   (quick: 4 seeds; ``full``: 100) — campaign ``ch4-hard``.
 
-Every episode becomes one JSON line in ``results_dir/ch4/episodes.jsonl`` (the metrics of
-:data:`~uvnav.sim.metrics.METRIC_NAMES` plus status, scene, law, noise, seed, whether a forbidden
-region was entered); a re-run skips the lines already there (resume), unless ``fresh``.  The summary
-(``summary.json``) and the table "thesis reported vs uvnav measured" are computed from those lines,
-never typed in.  The thesis reports no numbers for Chapter 4 (only Figs. 4.7-4.9: the vehicle
-reaches E without collision), so the table's thesis column states that.
+Every episode is a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
+``results_dir/uvnav.sqlite``, the database ``uvnav run`` and Chapter 3 use, DESIGN §5): the
+``controller`` column holds the law, ``params`` the sensing level (``{"noise_std", "dropout"}``,
+part of the resume key), ``family`` the generator (``random-ch4``, ``random-ch4-hard``) or the
+scene, the metrics of :data:`~uvnav.sim.metrics.METRIC_NAMES` their own columns; the two facts
+the store has no column for, the number of obstacles and whether a forbidden region (the
+Fig. 4.2(b) inner space) was entered, are kept in ``effective_params``.  Campaigns resume (a
+re-run skips the stored episodes) unless ``fresh``.  The summary (``results_dir/ch4/summary.json``)
+and the table "thesis reported vs uvnav measured" are computed from the stored rows, never typed
+in.  The thesis reports no numbers for Chapter 4 (only Figs. 4.7-4.9: the vehicle reaches E
+without collision), so the table's thesis column states that.
 
 Figures are made by a renderer injected by the caller (``render=``; the CLI passes
 :func:`uvnav.viz.figures_ch4.render_ch4`), because ``bench`` (layer 6) must not import ``viz``.
@@ -25,6 +34,7 @@ from __future__ import annotations
 
 import json
 import math
+import time
 from collections.abc import Callable, Iterable
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
@@ -32,9 +42,11 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
+from uvnav.bench.store import ResultsStore, params_hash
 from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
-from uvnav.scenarios.uuv2d import list_uuv2d_builtin, load_uuv2d_scenario, random_ch4_scenario
+from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin, load_uuv2d_scenario
 from uvnav.sim.episode_uuv2d import Uuv2dResult, run_uuv2d_episode
 from uvnav.sim.metrics import METRIC_NAMES
 
@@ -45,6 +57,14 @@ LAWS: tuple[str, ...] = (LAW, *BASELINES)
 NOISE_LEVELS: tuple[tuple[float, float], ...] = ((0.05, 0.0), (0.1, 0.0), (0.0, 0.1))
 QUICK_SEEDS, FULL_SEEDS = 10, 200
 QUICK_NOISE_SEEDS, FULL_NOISE_SEEDS = 4, 50
+QUICK_HARD_SEEDS, FULL_HARD_SEEDS = 4, 100
+HARD_FAMILY = "random-ch4-hard"
+DB_NAME = "uvnav.sqlite"  # the same results database as ``uvnav run`` and Chapter 3
+SCENES_CAMPAIGN = "ch4-thesis-scenes"
+RANDOM_CAMPAIGN = "ch4-random"
+NOISE_CAMPAIGN = "ch4-noise"
+HARD_CAMPAIGN = "ch4-hard"
+CAMPAIGNS: tuple[str, ...] = (RANDOM_CAMPAIGN, NOISE_CAMPAIGN, HARD_CAMPAIGN)
 
 
 @dataclass(frozen=True)
@@ -64,10 +84,9 @@ class Ch4Job:
 
 def run_ch4_job(job: Ch4Job, *, record: bool = False) -> tuple[dict[str, Any], Uuv2dResult]:
     """Run one job; returns its JSON row and the full result."""
-    if job.scene.startswith("random-ch4:"):
-        sc = random_ch4_scenario(
-            int(job.scene.split(":", 1)[1]), noise_std=job.noise_std, dropout=job.dropout
-        )
+    family, _, number = job.scene.partition(":")
+    if number and family in UUV2D_GENERATORS:
+        sc = UUV2D_GENERATORS[family](int(number), noise_std=job.noise_std, dropout=job.dropout)
     else:
         sc = load_uuv2d_scenario(job.scene)
     res = run_uuv2d_episode(
@@ -92,58 +111,115 @@ def run_ch4_job(job: Ch4Job, *, record: bool = False) -> tuple[dict[str, Any], U
 
 
 def _row_only(job: Ch4Job) -> dict[str, Any]:
-    return run_ch4_job(job)[0]
+    tic = time.perf_counter()
+    row = run_ch4_job(job)[0]
+    row["wall_time"] = time.perf_counter() - tic
+    return row
 
 
-def read_rows(path: Path) -> list[dict[str, Any]]:
-    """The episode rows stored in a JSONL file (missing file: none; a torn last line is
-    ignored)."""
+def _params(job_or_row: Ch4Job | dict[str, Any]) -> dict[str, float]:
+    """The job identity beyond scene/law/seed: the sensing level (the store's ``params``)."""
+    if isinstance(job_or_row, Ch4Job):
+        return {"noise_std": job_or_row.noise_std, "dropout": job_or_row.dropout}
+    return {"noise_std": job_or_row["noise_std"], "dropout": job_or_row["dropout"]}
+
+
+def store_row(store: ResultsStore, campaign_id: int, row: dict[str, Any]) -> int:
+    """Write one episode row to the store: controller = the law, params = the sensing level,
+    family = the scene's generator (or the scene), metrics in their columns; what the store has
+    no column for (``n_obstacles``, ``entered_forbidden``) goes into ``effective_params``."""
+    return store.add_episode(
+        campaign_id,
+        scenario=row["scene"],
+        controller=row["law"],
+        seed=int(row["seed"]),
+        status=row["status"],
+        params=_params(row),
+        metrics={m: row.get(m) for m in METRIC_NAMES},
+        family=row["scene"].split(":", 1)[0],
+        effective_params={
+            **_params(row),
+            "n_obstacles": int(row["n_obstacles"]),
+            "entered_forbidden": bool(row["entered_forbidden"]),
+        },
+        wall_time=row.get("wall_time"),
+    )
+
+
+def stored_rows(store: ResultsStore, campaign: str) -> list[dict[str, Any]]:
+    """The episode rows of a campaign, as :func:`run_ch4_job` makes them (store order)."""
+    if store.campaign_id(campaign) is None:
+        return []
+    frame = store.episodes_frame(campaign)
     rows: list[dict[str, Any]] = []
-    if not path.exists():
-        return rows
-    for line in path.read_text(encoding="utf-8").splitlines():
-        try:
-            rows.append(json.loads(line))
-        except json.JSONDecodeError:
-            continue
+    for rec in frame.to_dict("records"):
+        params = json.loads(rec["params"])
+        extra = json.loads(rec["effective_params"] or "{}")
+        row: dict[str, Any] = {
+            "scene": rec["scenario"],
+            "law": rec["controller"],
+            "seed": int(rec["seed"]),
+            "noise_std": float(params.get("noise_std", 0.0)),
+            "dropout": float(params.get("dropout", 0.0)),
+            "n_obstacles": int(extra.get("n_obstacles", 0)),
+            "status": rec["status"],
+            "entered_forbidden": bool(extra.get("entered_forbidden", False)),
+            "wall_time": _value(rec["wall_time"]),
+        }
+        for m in METRIC_NAMES:
+            row[m] = _value(rec[m])
+        row["key"] = Ch4Job(row["scene"], row["law"], row["seed"], row["noise_std"],
+                            row["dropout"]).key  # fmt: skip
+        rows.append(row)
     return rows
+
+
+def _value(v: Any) -> Any:
+    """A stored value as plain Python (missing -> None, numpy scalars -> Python)."""
+    if v is None or pd.isna(v):
+        return None
+    return v.item() if isinstance(v, np.generic) else v
 
 
 def run_jobs(
     jobs: Iterable[Ch4Job],
-    out: Path,
+    store: ResultsStore,
+    campaign: str,
     *,
     workers: int = 1,
     progress: Callable[[int, int], None] | None = None,
+    config: dict[str, Any] | None = None,
 ) -> list[dict[str, Any]]:
-    """Run the jobs not yet in ``out`` (JSONL, appended one line per finished episode).
+    """Run the jobs of ``campaign`` not yet in the store (one transaction per finished episode,
+    written by this process; workers only compute), so an interrupted campaign resumes.
 
     Returns:
-        The rows of all requested jobs (stored and new).
+        The rows of all requested jobs (stored and new), in job order.
     """
     jobs = list(jobs)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    done = {r["key"]: r for r in read_rows(out)}
-    todo = [j for j in jobs if j.key not in done]
+    cid = store.campaign(campaign, config or {"chapter": 4})
+    done_keys = store.done_keys(cid)
+    todo = [
+        j for j in jobs
+        if (j.scene, j.law, params_hash(_params(j)), j.seed) not in done_keys
+    ]  # fmt: skip
     total = len(todo)
-    with out.open("a", encoding="utf-8") as fh:
-        if workers <= 1:
-            results: Iterable[dict[str, Any]] = map(_row_only, todo)
-            pool = None
-        else:
-            pool = ProcessPoolExecutor(max_workers=workers)
-            results = pool.map(_row_only, todo, chunksize=1)
-        try:
-            for k, row in enumerate(results, 1):
-                fh.write(json.dumps(row) + "\n")
-                fh.flush()
-                done[row["key"]] = row
-                if progress is not None:
-                    progress(k, total)
-        finally:
-            if pool is not None:
-                pool.shutdown(cancel_futures=True)
-    return [done[j.key] for j in jobs if j.key in done]
+    if workers <= 1:
+        results: Iterable[dict[str, Any]] = map(_row_only, todo)
+        pool = None
+    else:
+        pool = ProcessPoolExecutor(max_workers=workers)
+        results = pool.map(_row_only, todo, chunksize=1)
+    try:
+        for k, row in enumerate(results, 1):
+            store_row(store, cid, row)
+            if progress is not None:
+                progress(k, total)
+    finally:
+        if pool is not None:
+            pool.shutdown(cancel_futures=True)
+    by_key = {r["key"]: r for r in stored_rows(store, campaign)}
+    return [by_key[j.key] for j in jobs if j.key in by_key]
 
 
 def campaign_jobs(
@@ -161,14 +237,23 @@ def campaign_jobs(
     return clean, noisy
 
 
+def hard_jobs(seeds: int, laws: Iterable[str] = LAWS) -> list[Ch4Job]:
+    """Jobs of the harder family ``random-ch4-hard`` (noise-free), seed by seed."""
+    return [Ch4Job(f"{HARD_FAMILY}:{s}", law, s) for s in range(seeds) for law in laws]
+
+
+def _family(row: dict[str, Any]) -> str:
+    return str(row["scene"]).split(":", 1)[0]
+
+
 def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
-    """Per (law, noise, dropout): episodes, success / collision / timeout rates, forbidden
-    entries, median path length, detour ratio, minimum clearance and decision time."""
-    groups: dict[tuple[str, float, float], list[dict[str, Any]]] = {}
+    """Per (scene family, law, noise, dropout): episodes, success / collision / timeout rates,
+    forbidden entries, median path length, detour ratio, minimum clearance and decision time."""
+    groups: dict[tuple[str, str, float, float], list[dict[str, Any]]] = {}
     for r in rows:
-        groups.setdefault((r["law"], r["noise_std"], r["dropout"]), []).append(r)
+        groups.setdefault((_family(r), r["law"], r["noise_std"], r["dropout"]), []).append(r)
     out = []
-    for (law, noise, drop), rs in sorted(groups.items()):
+    for (family, law, noise, drop), rs in sorted(groups.items()):
         n = len(rs)
 
         def med(name: str, rs: list[dict[str, Any]] = rs) -> float | None:
@@ -177,6 +262,7 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
 
         out.append(
             {
+                "family": family,
                 "law": law,
                 "noise_std": noise,
                 "dropout": drop,
@@ -198,10 +284,16 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     return out
 
 
-def failures(rows: list[dict[str, Any]], law: str = LAW) -> list[dict[str, Any]]:
-    """The episodes of ``law`` that did not succeed: seed, scene, status, obstacles, clearance."""
-    keep = ("scene", "seed", "noise_std", "dropout", "n_obstacles", "status", "min_clearance")
-    return [{k: r[k] for k in keep} for r in rows if r["law"] == law and r["status"] != "success"]
+def failures(rows: list[dict[str, Any]], law: str | None = LAW) -> list[dict[str, Any]]:
+    """The episodes (of ``law``; every law for ``None``) that did not succeed: scene, seed, law,
+    sensing level, obstacles, status (the cause: ``collision`` or ``timeout``), clearance."""
+    keep = ("scene", "seed", "law", "noise_std", "dropout", "n_obstacles", "status",
+            "min_clearance")  # fmt: skip
+    return [
+        {k: r[k] for k in keep}
+        for r in rows
+        if (law is None or r["law"] == law) and r["status"] != "success"
+    ]
 
 
 @dataclass
@@ -213,8 +305,11 @@ class Ch4Summary:
     failures: list[dict[str, Any]]
     table: list[dict[str, Any]]
     figures: list[Path] = field(default_factory=list)
+    #: the results database (``results_dir/uvnav.sqlite``) holding every episode
     rows_path: Path | None = None
     summary_path: Path | None = None
+    #: non-successes of every law on the harder family (seed, law, cause)
+    hard_failures: list[dict[str, Any]] = field(default_factory=list)
 
 
 def _table(
@@ -239,7 +334,7 @@ def _table(
         if c["noise_std"] == 0 and c["dropout"] == 0:
             table.append(
                 {
-                    "quantity": f"Ch.4 random-ch4 success ({c['law']}, n={c['episodes']})",
+                    "quantity": f"Ch.4 {c['family']} success ({c['law']}, n={c['episodes']})",
                     "thesis": "not reported",
                     "measured": f"{100 * c['success_rate']:.1f} %",
                     "note": f"collisions {100 * c['collision_rate']:.1f} %",
@@ -259,51 +354,76 @@ def reproduce_ch4(
     seeds: int | None = None,
     noise_seeds: int | None = None,
     progress: Callable[[int, int], None] | None = None,
+    hard_seeds: int | None = None,
 ) -> Ch4Summary:
     """Run the Chapter 4 reproduction and campaign (see the module docstring).
 
     Args:
-        results_dir: where ``ch4/episodes.jsonl`` and ``ch4/summary.json`` go.
+        results_dir: where the results database ``uvnav.sqlite`` and ``ch4/summary.json`` go.
         report_dir: where the renderer puts figures (``report_dir/ch4``).
-        full: thesis-size campaign (200 seeds, 50 per noise level) instead of the quick one.
+        full: thesis-size campaign (200 seeds, 50 per noise level, 100 hard) instead of the
+            quick one.
         workers: processes for the campaign.
-        fresh: discard stored episodes first.
+        fresh: discard the stored Chapter-4 campaigns first.
         render: ``render(out_dir, scene_results, summary) -> [paths]`` (figures).
-        seeds, noise_seeds: override the campaign sizes.
+        seeds, noise_seeds, hard_seeds: override the campaign sizes.
+        progress: ``progress(done, total)`` after each campaign episode.
     """
-    out_dir = Path(results_dir) / "ch4"
+    results_dir = Path(results_dir)
+    out_dir = results_dir / "ch4"
     out_dir.mkdir(parents=True, exist_ok=True)
-    rows_path = out_dir / "episodes.jsonl"
-    if fresh and rows_path.exists():
-        rows_path.unlink()
-    scene_results: dict[tuple[str, str], Uuv2dResult] = {}
-    scene_rows = []
-    for scene in list_uuv2d_builtin():
-        for law in LAWS:
-            row, res = run_ch4_job(Ch4Job(scene, law, 0), record=True)
-            scene_rows.append(row)
-            scene_results[(scene, law)] = res
+    db_path = results_dir / DB_NAME
     n = seeds if seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
     nn = (
         noise_seeds
         if noise_seeds is not None
         else (FULL_NOISE_SEEDS if full else QUICK_NOISE_SEEDS)
     )
-    clean, noisy = campaign_jobs(n, nn)
-    rows = run_jobs(clean + noisy, rows_path, workers=workers, progress=progress)
+    nh = hard_seeds if hard_seeds is not None else (FULL_HARD_SEEDS if full else QUICK_HARD_SEEDS)
+    scene_results: dict[tuple[str, str], Uuv2dResult] = {}
+    with ResultsStore(db_path) as store:
+        for name in (SCENES_CAMPAIGN, *(CAMPAIGNS if fresh else ())):
+            store.delete_campaign(name)  # the scene episodes are re-run for their trajectories
+        cid = store.campaign(SCENES_CAMPAIGN, {"chapter": 4, "laws": list(LAWS), "seed": 0})
+        for scene in list_uuv2d_builtin():
+            for law in LAWS:
+                tic = time.perf_counter()
+                row, res = run_ch4_job(Ch4Job(scene, law, 0), record=True)
+                row["wall_time"] = time.perf_counter() - tic
+                store_row(store, cid, row)
+                scene_results[(scene, law)] = res
+        scene_rows = stored_rows(store, SCENES_CAMPAIGN)
+        clean, noisy = campaign_jobs(n, nn)
+        size = {"chapter": 4, "laws": list(LAWS)}
+        rows_random = run_jobs(clean, store, RANDOM_CAMPAIGN, workers=workers,
+                               progress=progress, config={**size, "seeds": n})  # fmt: skip
+        rows_noise = run_jobs(noisy, store, NOISE_CAMPAIGN, workers=workers, progress=progress,
+                              config={**size, "seeds": nn, "levels": NOISE_LEVELS})  # fmt: skip
+        rows_hard = run_jobs(hard_jobs(nh), store, HARD_CAMPAIGN, workers=workers,
+                             progress=progress, config={**size, "seeds": nh})  # fmt: skip
+    rows = rows_random + rows_noise + rows_hard
     campaign = summarise(rows)
-    fails = failures([r for r in rows if r["noise_std"] == 0 and r["dropout"] == 0])
+    fails = failures(rows_random)
+    hard_fails = failures(rows_hard, law=None)
     table = _table(scene_rows, campaign)
     summary_path = out_dir / "summary.json"
     summary_path.write_text(
         json.dumps(
-            {"scenes": scene_rows, "campaign": campaign, "failures": fails, "table": table},
+            {
+                "scenes": scene_rows,
+                "campaign": campaign,
+                "failures": fails,
+                "hard_failures": hard_fails,
+                "table": table,
+                "database": str(db_path),
+                "campaigns": [SCENES_CAMPAIGN, *CAMPAIGNS],
+            },
             indent=1,
             default=lambda x: None if isinstance(x, float) and not math.isfinite(x) else str(x),
         ),
         encoding="utf-8",
     )
-    summary = Ch4Summary(scene_rows, campaign, fails, table, [], rows_path, summary_path)
+    summary = Ch4Summary(scene_rows, campaign, fails, table, [], db_path, summary_path, hard_fails)
     if render is not None and report_dir is not None:
         summary.figures = list(render(Path(report_dir) / "ch4", scene_results, summary))
     return summary
@@ -316,9 +436,10 @@ __all__ = [
     "Ch4Summary",
     "campaign_jobs",
     "failures",
-    "read_rows",
+    "hard_jobs",
     "reproduce_ch4",
     "run_ch4_job",
     "run_jobs",
+    "stored_rows",
     "summarise",
 ]

@@ -29,13 +29,14 @@ def scenes() -> None:
 
     for name in list_uuv2d_builtin():
         typer.echo(f"{name}: {load_uuv2d_scenario(name).description}")
-    for gen in UUV2D_GENERATORS:
-        typer.echo(f"{gen}:<seed>: seeded random scene, 1-5 deforming obstacles")
+    for gen, fn in UUV2D_GENERATORS.items():
+        first = (fn.__doc__ or "seeded random scene").strip().splitlines()[0]
+        typer.echo(f"{gen}:<seed>: {first}")
 
 
 @ch4_app.command("simulate")
 def simulate(
-    scene: Annotated[str, typer.Argument(help="built-in name, random-ch4:<seed> or YAML file")],
+    scene: Annotated[str, typer.Argument(help="built-in, random-ch4[-hard]:<seed> or YAML")],
     controller: Annotated[str | None, typer.Option(help="law (default: the scene's)")] = None,
     seed: Annotated[int, typer.Option(min=0, help="episode seed")] = 0,
     as_json: Annotated[bool, typer.Option("--json", help="print the metrics as JSON")] = False,

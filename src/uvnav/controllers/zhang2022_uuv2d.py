@@ -186,6 +186,35 @@ class Zhang2022Params:
         )
 
 
+@dataclass(frozen=True)
+class _Near:
+    """The covered squares around the vehicle from one :meth:`AmapsGrid.covered` scan (row-major
+    order); :meth:`within` gives exactly what a scan of a smaller radius would."""
+
+    centres: FloatArray
+    labels: np.ndarray
+    distances: FloatArray
+    #: the radius [m] of the scan
+    radius: float
+
+    def within(self, radius: float) -> tuple[FloatArray, np.ndarray]:
+        """Centres and labels within ``radius`` [m] (row-major, as a scan of that radius)."""
+        if radius >= self.radius:  # everything scanned is within it
+            return self.centres, self.labels
+        keep = self.distances <= radius
+        return self.centres[keep], self.labels[keep]
+
+    def nearest(self, radius: float) -> tuple[float, FloatArray | None, int]:
+        """:meth:`AmapsGrid.nearest` within ``radius`` [m]: the first nearest square overall is
+        the first nearest of those within ``radius`` whenever it lies within it."""
+        if len(self.distances) == 0:
+            return math.inf, None, -1
+        j = int(np.argmin(self.distances))
+        if not self.distances[j] <= radius:
+            return math.inf, None, -1
+        return float(self.distances[j]), self.centres[j], int(self.labels[j])
+
+
 @dataclass
 class Decision:
     """What the law computed at one decision (for figures and tests)."""
@@ -219,6 +248,8 @@ class Zhang2022Uuv2dController:
         self._tag = 0
         self._label = -1
         self._history: deque[FloatArray] = deque(maxlen=self.params.history + 1)
+        # |r_imin(k) - r_imin(k-1)| of the kept history, one fewer than the points (for (4.11))
+        self._steps: deque[float] = deque(maxlen=self.params.history)
         self.last: Decision | None = None
 
     @property
@@ -234,6 +265,7 @@ class Zhang2022Uuv2dController:
         self._tag = 0
         self._label = -1
         self._history.clear()
+        self._steps.clear()
         self.last = None
 
     # ----------------------------------------------------------------------------- pieces
@@ -261,21 +293,35 @@ class Zhang2022Uuv2dController:
 
     def forecast_radius(self) -> float:
         """R_i(t) of (4.11) over the last count(t) displacements of r_imin [m] (uncapped)."""
-        hist = list(self._history)
-        n = min(self._count, len(hist) - 1)
+        n = min(self._count, len(self._steps))
         if n <= 0:
             return 0.0
-        pts = np.asarray(hist[-(n + 1) :])
-        return float(np.hypot(*np.diff(pts, axis=0).T).mean())
+        steps = list(self._steps)
+        return float(np.array(steps[len(steps) - n :]).mean())
 
-    def _path_clear(self, position: FloatArray, grid: AmapsGrid, clearance: float) -> bool:
+    def _remember(self, r_min: FloatArray) -> None:
+        """Append r_imin to the history and its displacement from the last one to the steps."""
+        point = np.array(r_min, dtype=float)
+        if self._history:
+            d = point - self._history[-1]
+            self._steps.append(float(np.hypot(d[0], d[1])))
+        self._history.append(point)
+
+    def _query_radius(self) -> float:
+        """The one window radius [m] of a decision's AMAPS scan: it holds the squares (4.12)
+        needs (L + 2 cells), the clear-path check (2 L + clearance) and the outer tangent (L)."""
+        p = self.params
+        clear = p.clear_factor * p.switch_distance + self._spec.radius + p.safety_margin + p.cell
+        return max(p.switch_distance + 2.0 * p.cell, clear, p.switch_distance)
+
+    def _path_clear(self, position: FloatArray, near: _Near, clearance: float) -> bool:
         to_goal = self._goal - position
         dist = float(np.hypot(*to_goal))
         if dist < 1e-9:
             return True
         run = min(dist, self.params.clear_factor * self.params.switch_distance)
         end = position + to_goal / dist * run
-        centres, _ = grid.occupied(position, run + clearance)
+        centres, _ = near.within(run + clearance)
         if len(centres) == 0:
             return True
         a = np.broadcast_to(position, centres.shape)
@@ -314,8 +360,11 @@ class Zhang2022Uuv2dController:
         width = 2.0 * (self._spec.radius + p.mouth_margin)
         ranges, ids = close_narrow_openings(s.origin, s.angles, s.ranges, s.hit_ids, width)
         grid.update(s.origin, s.angles, ranges, ids)
+        # one window scan answers every grid question of this decision
+        reach = self._query_radius()
+        near = _Near(*grid.covered(pos, reach), reach)
         # only a square within L matters to (4.12); a little more keeps d_grid exact near L
-        d_grid, r_min, label = grid.nearest(pos, p.switch_distance + 2.0 * p.cell)
+        d_grid, r_min, label = near.nearest(p.switch_distance + 2.0 * p.cell)
         d_sonar = float(s.d_min.min()) if len(s.d_min) else math.inf
         d_min = min(d_grid, d_sonar)
         # (4.12)
@@ -324,11 +373,12 @@ class Zhang2022Uuv2dController:
         else:
             self._count = 0
             self._history.clear()
+            self._steps.clear()
         if self._count == 0 or r_min is None:
             self._mode = "M1"
             self.last = Decision(obs.time, "M1", d_min)
             return self._approach(obs)
-        self._history.append(np.array(r_min, dtype=float))
+        self._remember(r_min)
         centres = s.centres
         centre = centres[label] if 0 <= label < len(centres) else r_min
         if self._count == 1 or self._tag == 0 or label != self._label:
@@ -341,7 +391,7 @@ class Zhang2022Uuv2dController:
             obs.time, "M2", d_min, r_min, label, self._tag, self._count, rho, extra={"R_i": r_i}
         )
         self.last = decision
-        if self._receding(pos, r_min) or self._path_clear(pos, grid, clearance + p.cell):
+        if self._receding(pos, r_min) or self._path_clear(pos, near, clearance + p.cell):
             self._mode = "M1"
             decision.mode = "M1"
             return self._approach(obs)
@@ -361,7 +411,7 @@ class Zhang2022Uuv2dController:
             decision.waypoint = tan.points[j]
             direction = float(tan.angles[j])
             if p.outer_tangent:
-                direction = self._outermost(pos, r_min, rho, direction, grid)
+                direction = self._outermost(pos, r_min, rho, direction, near)
                 if direction != float(tan.angles[j]):
                     decision.waypoint = pos + tan.length * np.array(
                         [math.cos(direction), math.sin(direction)]
@@ -370,12 +420,12 @@ class Zhang2022Uuv2dController:
         return velocity_toward(direction, math.inf, self._spec, obs.heading, obs.period)
 
     def _outermost(
-        self, pos: FloatArray, r_min: FloatArray, rho: float, direction: float, grid: AmapsGrid
+        self, pos: FloatArray, r_min: FloatArray, rho: float, direction: float, near: _Near
     ) -> float:
         """The passing-side tangent direction [rad] that clears the forecast circles (radius
         ``rho``) of every covered square within L in front of the vehicle on the passing side,
         not only r_imin's (reading 3b of the module docstring)."""
-        centres, _ = grid.occupied(pos, self.params.switch_distance)
+        centres, _ = near.within(self.params.switch_distance)
         if len(centres) == 0:
             return direction
         rel = centres - pos

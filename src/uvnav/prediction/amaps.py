@@ -35,6 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
+from uvnav.prediction.amaps_kernels import load_kernel
 
 
 @dataclass(frozen=True)
@@ -88,9 +89,21 @@ class AmapsGrid:
     """
 
     def __init__(
-        self, origin: tuple[float, float], shape: tuple[int, int], config: AmapsConfig
+        self,
+        origin: tuple[float, float],
+        shape: tuple[int, int],
+        config: AmapsConfig,
+        *,
+        engine: str = "auto",
     ) -> None:
+        if engine not in ("auto", "numpy", "numba"):
+            raise ValueError(f"engine must be 'auto', 'numpy' or 'numba' (got {engine!r})")
         self.config = config
+        self._kernel = None if engine == "numpy" else load_kernel()
+        if engine == "numba" and self._kernel is None:
+            raise ImportError("AMAPS engine 'numba' needs numba: pip install 'uvnav[fast]'")
+        #: the update path in use: ``"numba"`` (compiled, extra ``fast``) or ``"numpy"``
+        self.engine = "numpy" if self._kernel is None else "numba"
         self.x0 = float(origin[0])
         self.y0 = float(origin[1])
         self.nx, self.ny = int(shape[0]), int(shape[1])
@@ -98,16 +111,25 @@ class AmapsGrid:
         self._gain = 1.0
         self.labels = np.full((self.ny, self.nx), -1, dtype=np.int16)
         self.updates = 0
+        self._origin = np.array([self.x0, self.y0])
+        self._dims = np.array([self.nx, self.ny], dtype=np.uintp)
+        self._samples: FloatArray = np.zeros(0)
 
     @classmethod
     def covering(
-        cls, low: FloatArray, high: FloatArray, config: AmapsConfig, *, margin: float = 0.0
+        cls,
+        low: FloatArray,
+        high: FloatArray,
+        config: AmapsConfig,
+        *,
+        margin: float = 0.0,
+        engine: str = "auto",
     ) -> AmapsGrid:
         """A grid covering the box ``[low, high]`` [m] grown by ``margin`` [m] on every side."""
         lo = np.asarray(low, dtype=float) - margin
         hi = np.asarray(high, dtype=float) + margin
         n = np.maximum(np.ceil((hi - lo) / config.cell).astype(int), 1)
-        return cls((float(lo[0]), float(lo[1])), (int(n[0]), int(n[1])), config)
+        return cls((float(lo[0]), float(lo[1])), (int(n[0]), int(n[1])), config, engine=engine)
 
     @property
     def counts(self) -> FloatArray:
@@ -140,7 +162,8 @@ class AmapsGrid:
         ranges: FloatArray,
         hit_ids: np.ndarray,
     ) -> None:
-        """Absorb one sonar sweep (vectorised).
+        """Absorb one sonar sweep (vectorised; only the squares the beams touch are read or
+        written).
 
         Args:
             origin: sonar position [m].
@@ -157,40 +180,103 @@ class AmapsGrid:
                 self._stored *= np.float32(self._gain)
                 self._gain = 1.0
         inv = 1.0 / self._gain
-        ok = np.isfinite(ranges)
-        ang = np.asarray(angles, dtype=float)[ok]
-        rr = np.asarray(ranges, dtype=float)[ok]
-        ids = np.asarray(hit_ids)[ok]
-        dirs = np.stack([np.cos(ang), np.sin(ang)], axis=-1)
-        o = np.asarray(origin, dtype=float)
-        step = 0.5 * h
-        view = self._stored.reshape(self.nx * self.ny)
-        # free space: samples every ``free_step`` from 0 to one square short of the return
-        if cfg.free_weight > 0 and len(rr):
-            fs = cfg.free_step * h
-            n_s = int(np.ceil(min(float(rr.max()), cfg.free_range) / fs)) + 1
-            s = np.arange(n_s) * fs  # (S,)
-            limit = np.minimum(np.where(ids >= 0, rr - h, rr), cfg.free_range)  # (B,)
-            bi, si = np.nonzero(s[None, :] < limit[:, None])
-            c = np.floor((o[0] - self.x0 + s[si] * dirs[bi, 0]) / h).astype(np.intp)
-            r = np.floor((o[1] - self.y0 + s[si] * dirs[bi, 1]) / h).astype(np.intp)
-            inside = (c >= 0) & (c < self.nx) & (r >= 0) & (r < self.ny)
-            flat = r[inside] * self.nx + c[inside]
-            if len(flat):
-                # duplicates read the same old value and write the same new one: once each
-                view[flat] = np.maximum(view[flat] - np.float32(cfg.free_weight * inv), 0.0)
-        # covered: from the return to hit_depth behind it
-        hit = ids >= 0
-        if np.any(hit):
-            n_d = int(np.floor(cfg.hit_depth / step)) + 1
-            s = np.arange(n_d) * step
-            pts = o + (rr[hit, None, None] + s[None, :, None]) * dirs[hit, None, :]
-            lab = np.repeat(ids[hit], n_d)
-            c, r, inside = self.cell_of(pts.reshape(-1, 2))
-            flat = r[inside] * self.nx + c[inside]
-            view[flat] += np.float32(cfg.hit_weight * inv)  # buffered: +w once per square
-            self.labels.reshape(self.nx * self.ny)[flat] = lab[inside].astype(np.int16)
+        rr = np.asarray(ranges, dtype=float)
+        ang = np.asarray(angles, dtype=float)
+        ids = np.asarray(hit_ids)
+        ok = np.isfinite(rr)
+        if not ok.all():
+            rr, ang, ids = rr[ok], ang[ok], ids[ok]
+        if len(rr) and self._kernel is not None:
+            self._kernel[0](
+                self._stored, self.labels, float(origin[0]), float(origin[1]), self.x0, self.y0,
+                h, np.cos(ang), np.sin(ang), rr, ids.astype(np.intp, copy=False),
+                np.float32(cfg.free_weight * inv), np.float32(cfg.hit_weight * inv),
+                cfg.free_step * h, cfg.free_range, cfg.free_weight > 0,
+                int(np.floor(cfg.hit_depth / (0.5 * h))) + 1, 0.5 * h,
+            )  # fmt: skip
+        elif len(rr):
+            # (2, B) beam directions, rows x and y; (2,) sonar offset from the grid origin [m]
+            dirs = np.stack([np.cos(ang), np.sin(ang)])
+            o = np.asarray(origin, dtype=float)
+            dims = self._dims
+            view = self._stored.reshape(-1)
+            hit = ids >= 0
+            if cfg.free_weight > 0:
+                self._carve_free(o, dirs, rr, hit, dims, view, inv)
+            if hit.any():
+                self._mark_hits(o, dirs[:, hit], rr[hit], ids[hit], dims, view, inv)
         self.updates += 1
+
+    def _carve_free(
+        self,
+        o: FloatArray,
+        dirs: FloatArray,
+        rr: FloatArray,
+        hit: np.ndarray,
+        dims: np.ndarray,
+        view: np.ndarray,
+        inv: float,
+    ) -> None:
+        """Squares seen free: samples every ``free_step`` squares from the sonar to one square
+        short of the return (or to the range without one), at most ``free_range`` away; each
+        square loses ``free_weight`` at most once per sweep."""
+        cfg = self.config
+        h = cfg.cell
+        fs = cfg.free_step * h
+        n_s = int(np.ceil(min(float(rr.max()), cfg.free_range) / fs)) + 1
+        s = self._free_samples(n_s)  # (S,)
+        limit = np.minimum(np.where(hit, rr - h, rr), cfg.free_range)  # (B,)
+        # (2, B, S) sample positions relative to the grid origin, then square indices
+        pos = (o - self._origin)[:, None, None] + s * dirs[:, :, None]
+        cell = np.floor(pos / h).astype(np.intp)
+        take = s < limit[:, None]
+        if not self._holds(o, cfg.free_range):
+            # inside the grid: one unsigned compare per axis catches negative indices too
+            take &= (cell.view(np.uintp) < dims[:, None, None]).all(axis=0)
+        flat = (cell[1] * self.nx + cell[0])[take]
+        if len(flat):
+            # duplicates read the same old value and write the same new one: once each
+            view[flat] = np.maximum(view[flat] - np.float32(cfg.free_weight * inv), 0.0)
+
+    def _mark_hits(
+        self,
+        o: FloatArray,
+        dirs: FloatArray,
+        rr: FloatArray,
+        ids: np.ndarray,
+        dims: np.ndarray,
+        view: np.ndarray,
+        inv: float,
+    ) -> None:
+        """Squares seen covered: from each return to ``hit_depth`` behind it, +``hit_weight``
+        once per square and sweep; the label of the obstacle written last wins."""
+        cfg = self.config
+        h = cfg.cell
+        n_d = int(np.floor(cfg.hit_depth / (0.5 * h))) + 1
+        s = np.arange(n_d) * (0.5 * h)
+        # (2, B, D) world points o + (rho + s) d, then their squares
+        pts = o[:, None, None] + (rr[:, None] + s)[None] * dirs[:, :, None]
+        cell = np.floor((pts - self._origin[:, None, None]) / h).astype(np.intp)
+        inside = (cell.view(np.uintp) < dims[:, None, None]).all(axis=0).reshape(-1)
+        flat = (cell[1] * self.nx + cell[0]).reshape(-1)[inside]
+        view[flat] += np.float32(cfg.hit_weight * inv)  # buffered: +w once per square
+        lab = np.repeat(ids, n_d)[inside]
+        self.labels.reshape(-1)[flat] = lab.astype(np.int16)
+
+    def _holds(self, point: FloatArray, reach: float) -> bool:
+        """True when every square within ``reach`` [m] of ``point`` (plus one square) lies in
+        the grid, so that samples up to that distance need no bounds test."""
+        h = self.config.cell
+        lo = (point - self._origin - reach) / h
+        hi = (point - self._origin + reach) / h
+        return bool(lo[0] >= 1 and lo[1] >= 1 and hi[0] <= self.nx - 1 and hi[1] <= self.ny - 1)
+
+    def _free_samples(self, n: int) -> FloatArray:
+        """The first ``n`` free-space sample distances ``k * free_step * cell`` [m] (cached)."""
+        if len(self._samples) < n:
+            fs = self.config.free_step * self.config.cell
+            self._samples = np.asarray(np.arange(n) * fs, dtype=float)
+        return self._samples[:n]
 
     # -------------------------------------------------------------------------------- queries
     def _window(self, point: FloatArray, radius: float) -> tuple[slice, slice]:
@@ -201,27 +287,48 @@ class AmapsGrid:
         r1 = min(int(np.floor((point[1] + radius - self.y0) / h)) + 1, self.ny)
         return slice(r0, max(r1, r0)), slice(c0, max(c1, c0))
 
-    def occupied(self, point: FloatArray, radius: float) -> tuple[FloatArray, np.ndarray]:
-        """Centres (N, 2) [m] and labels (N,) of covered squares within ``radius`` [m] of
-        ``point`` (count >= threshold)."""
+    def covered(
+        self, point: FloatArray, radius: float
+    ) -> tuple[FloatArray, np.ndarray, FloatArray]:
+        """Covered squares (count >= threshold) whose centres lie within ``radius`` [m] of
+        ``point``, in row-major order: ``(centres (N, 2) [m], labels (N,), distances (N,) [m])``.
+
+        Queries with a smaller radius about the same point are the leading-order subsets of this
+        one (``distances <= r``), which is how the law answers all its questions of one decision
+        from a single window scan.
+        """
         p = np.asarray(point, dtype=float)
         rs, cs = self._window(p, radius)
-        sub = self._stored[rs, cs]
-        rows, cols = np.nonzero(sub >= np.float32(self.config.threshold / self._gain))
-        rows = rows + rs.start
-        cols = cols + cs.start
+        level = np.float32(self.config.threshold / self._gain)
+        if self._kernel is not None:
+            rows, cols = self._kernel[1](self._stored, rs.start, rs.stop, cs.start, cs.stop, level)
+        else:
+            rows, cols = np.nonzero(self._stored[rs, cs] >= level)
+            rows = rows + rs.start
+            cols = cols + cs.start
         centres = self.centre_of(cols, rows)
         d = np.hypot(centres[:, 0] - p[0], centres[:, 1] - p[1])
         keep = d <= radius
-        return centres[keep], self.labels[rows[keep], cols[keep]].astype(np.intp)
+        return centres[keep], self.labels[rows[keep], cols[keep]].astype(np.intp), d[keep]
+
+    def occupied(self, point: FloatArray, radius: float) -> tuple[FloatArray, np.ndarray]:
+        """Centres (N, 2) [m] and labels (N,) of covered squares within ``radius`` [m] of
+        ``point`` (count >= threshold)."""
+        centres, labels, _ = self.covered(point, radius)
+        return centres, labels
 
     def nearest(self, point: FloatArray, radius: float) -> tuple[float, FloatArray | None, int]:
         """r_imin: ``(distance [m], centre of the nearest covered square, its label)`` within
         ``radius`` [m]; ``(inf, None, -1)`` when none passes the threshold."""
-        centres, labels = self.occupied(point, radius)
-        if len(centres) == 0:
-            return np.inf, None, -1
-        p = np.asarray(point, dtype=float)
-        d = np.hypot(centres[:, 0] - p[0], centres[:, 1] - p[1])
-        j = int(np.argmin(d))
-        return float(d[j]), centres[j], int(labels[j])
+        return nearest_of(*self.covered(point, radius))
+
+
+def nearest_of(
+    centres: FloatArray, labels: np.ndarray, distances: FloatArray
+) -> tuple[float, FloatArray | None, int]:
+    """The first nearest of covered squares given as :meth:`AmapsGrid.covered` returns them:
+    ``(distance [m], centre, label)``, ``(inf, None, -1)`` for none."""
+    if len(centres) == 0:
+        return np.inf, None, -1
+    j = int(np.argmin(distances))
+    return float(distances[j]), centres[j], int(labels[j])

@@ -391,5 +391,130 @@ def random_ch4_scenario(
     return uuv2d_from_dict(data, f"random-ch4:{seed}")
 
 
+def _closest_approach(p: np.ndarray, v: np.ndarray, horizon: float) -> float:
+    """Smallest |p + v t| [m] over t in [0, horizon] (relative position p, relative velocity v)."""
+    vv = float(v @ v)
+    t = 0.0 if vv == 0.0 else min(max(-float(p @ v) / vv, 0.0), horizon)
+    return float(np.hypot(*(p + v * t)))
+
+
+#: bounds of the harder family (:func:`random_ch4_hard_scenario`)
+HARD_RATE = (0.3, 0.6)  # deformation rate bound [m/s]: up to 0.6 V_max
+HARD_SPEED = 0.3  # largest translation speed of a mass centre [m/s]
+HARD_GAP_MARGIN = 0.05  # bounding discs at least 2 (radius + this) apart [m]
+HARD_T_MAX = 30.0  # time limit [s] (the straight run takes 10 s); every check covers it
+
+
+def random_ch4_hard_scenario(
+    seed: int,
+    *,
+    n_obstacles: int | None = None,
+    noise_std: float = 0.0,
+    dropout: float = 0.0,
+) -> Uuv2dScenario:
+    """A harder random Chapter-4 scene: faster, translating bodies, narrow gaps (seeded).
+
+    ``random-ch4-hard:<seed>``, still within the chapter's assumptions as
+    :func:`random_ch4_scenario` reads them.
+
+    What is harder: 2-6 bodies; deformation at the top of the rate range (boundary speed bound
+    drawn from ``HARD_RATE`` = 0.3-0.6 m/s, against 0.05-0.3 m/s); every body but possibly the
+    first translates (mass-centre speed up to ``HARD_SPEED`` = 0.3 m/s) roughly *across* the I-E
+    line, timed to cross it near when the vehicle (sqrt(2) V_max along the diagonal) gets there;
+    and the bounding discs of two bodies may come as close as 2 (vehicle radius + 0.05 m) — a gap
+    the vehicle fits through with 5 cm on each side — instead of 2 (radius + 0.3 m).
+
+    Assumptions kept (the chapter's): each body is one star-shaped, closed, smooth outline of fixed
+    area whose mass centre is known to the vehicle (§4.2); its boundary moves slower than the
+    vehicle (deformation rate + translation speed <= 0.9 m/s < V_max = 1 m/s per component);
+    bodies never touch one another (the closest approach of their bounding discs over the whole
+    episode, t_max = ``HARD_T_MAX`` = 30 s, computed from their constant velocities, is at least
+    the gap above, so no two bodies merge into a non-star body with a narrow inner space,
+    Fig. 4.2(b)); I and E stay clear (every bounding disc stays 1.0 m from both over t_max); at
+    least one body starts across the I-E line.  The time limit is 30 s (3 times the straight
+    run): a translating body may drift onto E after that.
+
+    Args:
+        seed: scene number.
+        n_obstacles: force the count (2-6); drawn uniformly otherwise.
+        noise_std: sonar range noise [m].
+        dropout: sonar dropout probability.
+    """
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2, 7)) if n_obstacles is None else int(n_obstacles)
+    if not 2 <= n <= 6:
+        raise ValueError("n_obstacles must be in 2..6")
+    horizon = HARD_T_MAX
+    start = np.array(CH4_START)
+    goal = np.array(CH4_GOAL)
+    u = (goal - start) / np.hypot(*(goal - start))
+    normal = np.array([-u[1], u[0]])
+    gap = 2.0 * (CH4_RADIUS + HARD_GAP_MARGIN)
+    cruise = math.sqrt(2.0) * CH4_V_MAX
+    placed: list[tuple[np.ndarray, np.ndarray, float]] = []
+    specs: list[dict[str, Any]] = []
+    for _ in range(40 * n):
+        if len(specs) == n:
+            break
+        area = float(rng.uniform(0.5, 4.0))
+        shape_seed = int(rng.integers(0, 2**31 - 1))
+        rate = float(rng.uniform(*HARD_RATE))
+        br = DeformingStar.random(
+            np.random.default_rng(shape_seed), (0.0, 0.0), area, max_rate=rate, calibrate=False
+        ).bounding_radius
+        for _ in range(25):  # places for this body (its bounding radius is costly to compute)
+            along = float(rng.uniform(2.5, 11.6))
+            lateral = float(rng.uniform(-0.3, 0.3)) if not specs else float(rng.uniform(-1.5, 1.5))
+            speed = 0.0 if not specs else float(rng.uniform(0.0, HARD_SPEED))
+            # across the line (within 45 degrees of its normal), either way
+            tilt = float(rng.uniform(-math.pi / 4, math.pi / 4))
+            side = 1.0 if rng.random() < 0.5 else -1.0
+            direction = side * (math.cos(tilt) * normal + math.sin(tilt) * u)
+            vel = np.round(speed * direction, 3) + 0.0  # + 0.0: no negative zeros
+            # where it is when the vehicle passes `along` is `lateral` off the line
+            c = np.round(start + along * u + lateral * normal - vel * (along / cruise), 3)
+            clear_ends = min(
+                _closest_approach(c - start, vel, horizon),
+                _closest_approach(c - goal, vel, horizon),
+            )
+            if clear_ends - br < 1.0:
+                continue
+            if any(_closest_approach(c - pc, vel - pv, horizon) - br - pr < gap
+                   for pc, pv, pr in placed):  # fmt: skip
+                continue
+            placed.append((c, vel, br))
+            specs.append(
+                {
+                    "type": "deforming",
+                    "centre": [float(c[0]), float(c[1])],
+                    "area": round(area, 3),
+                    "max_rate": round(rate, 3),
+                    "shape_seed": shape_seed,
+                    "velocity": [float(vel[0]), float(vel[1])],
+                }
+            )
+            break
+    data = {
+        "kind": "uuv2d",
+        "name": f"random-ch4-hard:{seed}",
+        "description": f"harder random Chapter-4 scene {seed}: {len(specs)} deforming obstacles, "
+        "fast deformation, translating, narrow gaps",
+        "t_max": HARD_T_MAX,
+        "vehicle": {
+            "start": list(CH4_START),
+            "goal": list(CH4_GOAL),
+            "v_max": CH4_V_MAX,
+            "u_max": CH4_U_MAX,
+            "radius": CH4_RADIUS,
+        },
+        "sonar": {"noise_std": noise_std, "dropout": dropout},
+        "obstacles": specs,
+    }
+    return uuv2d_from_dict(data, f"random-ch4-hard:{seed}")
+
+
 #: Seeded Chapter-4 scene generators by name (``load_uuv2d_scenario("random-ch4:7")``).
-UUV2D_GENERATORS: dict[str, Callable[..., Uuv2dScenario]] = {"random-ch4": random_ch4_scenario}
+UUV2D_GENERATORS: dict[str, Callable[..., Uuv2dScenario]] = {
+    "random-ch4": random_ch4_scenario,
+    "random-ch4-hard": random_ch4_hard_scenario,
+}

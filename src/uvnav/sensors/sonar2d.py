@@ -33,6 +33,7 @@ import numpy as np
 
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.polygons import closed_rings, rays_rings_hit, rays_segments_hit
+from uvnav.sensors.sonar2d_kernels import load_pairs_kernel
 
 
 @dataclass(frozen=True)
@@ -205,6 +206,8 @@ def close_narrow_openings(
     ranges: FloatArray,
     hit_ids: np.ndarray,
     width: float,
+    *,
+    engine: str = "auto",
 ) -> tuple[FloatArray, np.ndarray]:
     """Treat openings narrower than ``width`` [m] as walls (the Fig. 4.2(b) detector).
 
@@ -220,6 +223,8 @@ def close_narrow_openings(
         ranges: (B,) ranges [m] (NaN: dropout).
         hit_ids: (B,) obstacle per beam, -1 for none.
         width: the vehicle's width plus margin [m].
+        engine: ``"auto"`` (the compiled pair search of :mod:`~uvnav.sensors.sonar2d_kernels`
+            when numba is installed), ``"numpy"``; both give the same result.
 
     Returns:
         ``(ranges, hit_ids)`` with the closed beams clipped (copies).
@@ -232,19 +237,25 @@ def close_narrow_openings(
         return out_r, out_id
     dirs = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
     pts = origin + ranges[idx, None] * dirs[idx]
-    d = np.hypot(*(pts[:, None, :] - pts[None, :, :]).transpose(2, 0, 1))
-    n = len(idx)
     rr = ranges[idx]
-    # deepest return strictly between returns i and j (in return order): running max per row
-    upper = np.where(np.arange(n)[None, :] > np.arange(n)[:, None], rr[None, :], -np.inf)
-    runmax = np.maximum.accumulate(upper, axis=1)  # runmax[i, m] = max rr[i+1..m]
-    ii, jj = np.nonzero(np.triu(d < width, k=1))
-    # only pairs with something to close: a beam without a return between them, or a return
-    # deeper than both lips (a flat or convex stretch between two close returns is left alone)
-    missing = (idx[jj] - idx[ii]) > (jj - ii)
-    deeper = (jj - ii >= 2) & (runmax[ii, np.maximum(jj - 1, 0)] > np.maximum(rr[ii], rr[jj]))
-    keep = (idx[jj] - idx[ii] >= 2) & (missing | deeper)
-    ii, jj = ii[keep], jj[keep]
+    kernel = None if engine == "numpy" else load_pairs_kernel()
+    if kernel is not None:  # the same pairs in the same order, one compiled loop
+        ii, jj = kernel(
+            np.ascontiguousarray(pts[:, 0]), np.ascontiguousarray(pts[:, 1]), rr, idx, width
+        )
+    else:
+        d = np.hypot(*(pts[:, None, :] - pts[None, :, :]).transpose(2, 0, 1))
+        n = len(idx)
+        # deepest return strictly between returns i and j (in return order): running max per row
+        upper = np.where(np.arange(n)[None, :] > np.arange(n)[:, None], rr[None, :], -np.inf)
+        runmax = np.maximum.accumulate(upper, axis=1)  # runmax[i, m] = max rr[i+1..m]
+        ii, jj = np.nonzero(np.triu(d < width, k=1))
+        # only pairs with something to close: a beam without a return between them, or a
+        # return deeper than both lips (a flat or convex stretch between close returns is left)
+        missing = (idx[jj] - idx[ii]) > (jj - ii)
+        deeper = (jj - ii >= 2) & (runmax[ii, np.maximum(jj - 1, 0)] > np.maximum(rr[ii], rr[jj]))
+        keep = (idx[jj] - idx[ii] >= 2) & (missing | deeper)
+        ii, jj = ii[keep], jj[keep]
     if len(ii) == 0:
         return out_r, out_id
     t = rays_segments_hit(origin, dirs, pts[ii], pts[jj])  # (B, P)
