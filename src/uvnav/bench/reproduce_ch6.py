@@ -33,8 +33,8 @@ from numpy.typing import NDArray
 THESIS_VAL_MSE = 0.05
 THESIS_FRAMES = 17592
 THESIS_TRAIN, THESIS_VAL = 1199, 300
-#: DAgger rounds of the full run (beyond the thesis; measured gain in docs/thesis-notes.md)
-FULL_DAGGER_ROUNDS = 2
+#: DAgger rounds of the full run (beyond the thesis; the measured round, docs/thesis-notes.md)
+FULL_DAGGER_ROUNDS = 1
 #: training tracks the network drives per DAgger round, and epochs per round
 DAGGER_EPISODES, DAGGER_EPOCHS = 6, 5
 

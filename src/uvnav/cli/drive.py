@@ -325,7 +325,7 @@ def play(
 def dagger(
     data: Annotated[Path, typer.Argument(help="Dataset folder (rows are appended).")],
     model: Annotated[Path, typer.Argument(help="Starting model (.safetensors).")],
-    rounds: Annotated[int, typer.Option(min=1, help="DAgger rounds.")] = 2,
+    rounds: Annotated[int, typer.Option(min=1, help="DAgger rounds.")] = 1,
     episodes: Annotated[int, typer.Option(min=1, help="Training tracks driven per round.")] = 6,
     epochs: Annotated[int, typer.Option(min=1, help="Training epochs per round.")] = 5,
     first_seed: Annotated[int, typer.Option(help="First training track of round 1.")] = 600,
