@@ -15,6 +15,8 @@ Benchmarks:
   obstacle motion, ObstacleField rebuild, clearance check, plus sensing and a ``straight-v1``
   decision every step) with 10 and 100 ``random_turn`` non-convex polygons; the setup never ends
   early (the obstacles wander in an arena beside the robot's path).
+* ``ch6``: Chapter 6 CNN training images/s (augmentation on) and one-frame inference latency on 1
+  and 2 torch threads, simulator steps/s (``benchmarks/bench_ch6.py``, always its quick mode).
 * ``episodes``: episodes per second of the thesis Ch. 2 one-obstacle scene (I = [0, 0],
   T = [10, 10], V_max = 0.707 m/s, U_max = 1.414 rad/s, one random-turn polygon) per controller.
 * ``ch3``: thesis Ch. 3 (3D), from ``benchmarks/bench_ch3.py``: ``zhang2020-3d-v1`` decision time
@@ -847,6 +849,20 @@ def bench_ch3(quick: bool) -> dict[str, Any]:
     return dict(ch3.run(quick))
 
 
+def bench_ch6_quick(quick: bool) -> dict[str, Any]:
+    """Chapter 6 CNN training img/s and inference ms on 1 and 2 threads (``bench_ch6.py``), always
+    in its quick mode here (about 20 CPU-seconds); the full run is ``benchmarks/bench_ch6.py``."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    try:
+        import bench_ch6
+    except ImportError as exc:  # pragma: no cover - depends on the extras installed
+        return {"skipped": f"needs the learning,envs extras: {exc}"}
+    try:
+        return {k: v for k, v in bench_ch6.run(True).items() if k != "machine"}
+    except ImportError as exc:  # pragma: no cover - depends on the extras installed
+        return {"skipped": f"needs the learning,envs extras: {exc}"}
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument(
@@ -858,7 +874,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument(
         "--only",
         nargs="+",
-        choices=["decision", "world", "episodes", "ch3", "ch4"],
+        choices=["decision", "world", "episodes", "ch3", "ch4", "ch6"],
         help="run a subset (default: all)",
     )
     parser.add_argument("--profile", action="store_true", help="also cProfile the world step")
@@ -874,7 +890,7 @@ def main(argv: list[str] | None = None) -> int:
     if args.worker:
         return worker_main()
 
-    chosen = set(args.only or ["decision", "world", "episodes", "ch3", "ch4"])
+    chosen = set(args.only or ["decision", "world", "episodes", "ch3", "ch4", "ch6"])
     info = machine_info()
     reports: dict[str, dict[str, Any]] = {}
     runners: list[tuple[str, str, Callable[[bool], dict[str, Any]]]] = [
@@ -883,6 +899,7 @@ def main(argv: list[str] | None = None) -> int:
         ("episodes", "episodes", bench_episodes),
         ("ch3", "ch3", bench_ch3),
         ("ch4", "ch4_decision", bench_ch4_decision),
+        ("ch6", "ch6", bench_ch6_quick),
     ]
     if args.profile:
         runners.append(("world", "world_step_profile", profile_world))

@@ -19,11 +19,24 @@ from uvnav.learning.pilotnet import build_pilotnet
 
 def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     s = reproduce_ch6(
-        tmp_path, episodes=1, epochs=1, eval_seeds=[1000], max_steps=40, collect_steps=120
+        tmp_path,
+        episodes=1,
+        epochs=1,
+        eval_seeds=[1000],
+        max_steps=40,
+        collect_steps=120,
+        dagger_rounds=1,
+        dagger_episodes=1,
+        dagger_epochs=1,
     )
     assert s.record["n_frames"] == 90  # 30 rows x 3 cameras
     assert len(s.steering_train) + len(s.steering_val) == s.record["n_balanced"]
-    assert set(s.closed_loop) == {"cnn-learned", "cnn-pi", "expert"}
+    assert set(s.closed_loop) == {"cnn-learned", "cnn-pi", "dagger1-pi", "expert"}
+    # the DAgger rows go to a copy: data/ keeps the expert's 30 rows, the aggregate has more
+    assert s.closed_loop["dagger1-pi"]["rows_added"] == 30  # 120 steps, one row every 4
+    assert len(read_log(tmp_path / "data")) == 30
+    assert len(read_log(tmp_path / "dagger_data")) == 60
+    assert (tmp_path / "dagger1.safetensors").is_file()
     assert s.closed_loop["expert"]["return_vs_expert"] == pytest.approx(1.0)
     assert all(0.0 <= r["autonomy"] <= 1.0 for r in s.closed_loop.values())
     assert next(r["quantity"] for r in s.table) == "Ch6 frames before balancing"

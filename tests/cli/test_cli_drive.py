@@ -95,6 +95,7 @@ def test_play_writes_a_gif(trained: tuple[Path, Path], tmp_path: Path) -> None:
         (["drive", "evaluate", "x.safetensors", "--seeds", "5-2"], "--seeds"),
         (["drive", "collect", "--out", "x", "--camera", "side"], "--camera"),
         (["drive", "play", "x.safetensors", "--out", "x.avi"], "--out"),
+        (["drive", "dagger", "d", "x.safetensors", "--throttle", "turbo"], "--throttle"),
     ],
 )
 def test_errors_are_one_line_exit_2(

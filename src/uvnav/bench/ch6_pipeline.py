@@ -224,25 +224,31 @@ def dagger_collect(
     beta: float = 0.0,
     record_every: int = 4,
     max_steps: int = 1200,
+    throttle: Throttle = "pi",
+    set_speed: float = 35.0,
 ) -> int:
     """One DAgger round's data: the network drives (mixed with the expert by ``beta``), the
     expert labels every recorded state, rows are appended to the dataset.
 
+    The learner drives with the throttle it is evaluated with (``throttle``): with ``"pi"`` the
+    visited states are those of the PI-throttle closed loop, whose failures are in the steering
+    (measured: under-steer in the sharpest corners and no recovery from near the road's edge).
+
     Args:
         model: current network.
         root: dataset folder (rows appended).
-        seeds: training tracks to drive.
+        seeds: training tracks to drive (never the held-out evaluation tracks).
         round_id: used in the image names.
         beta: probability per step that the expert's command is applied instead.
         record_every: record every this many steps.
         max_steps: steps per episode.
+        throttle: the learner's throttle: ``"pi"`` (PI to ``set_speed``) or ``"learned"``.
+        set_speed: PI target speed [m/s].
 
     Returns:
         Rows written.
     """
-    from uvnav.learning.train import Predictor
-
-    pred = Predictor(model)
+    learner, on_reset = cnn_policy(model, throttle=throttle, set_speed=set_speed)
     sim = DrivingSim(max_steps=max_steps)
     writer = LogWriter(root)
     rows = 0
@@ -250,6 +256,8 @@ def dagger_collect(
         for seed in seeds:
             rng = np.random.default_rng([seed, round_id, 7])
             frame, tel = sim.reset(int(seed))
+            if on_reset is not None:
+                on_reset()
             assert sim.geometry is not None
             expert = PurePursuitExpert(sim.geometry)
             for k in range(max_steps):
@@ -265,7 +273,7 @@ def dagger_collect(
                         speed=tel.speed,
                     )
                     rows += 1
-                steer, thr = (e_steer, e_thr) if rng.random() < beta else pred(frame, tel.speed)
+                steer, thr = (e_steer, e_thr) if rng.random() < beta else learner(frame, tel)
                 st = sim.step(steer, thr)
                 frame, tel = st.frame, st.telemetry
                 if tel.off_track:
@@ -278,3 +286,90 @@ def dagger_collect(
         writer.close()
         sim.close()
     return rows
+
+
+@dataclass
+class DaggerRound:
+    """One DAgger round: rows added, the model after it, and its closed-loop means."""
+
+    round_id: int
+    rows: int
+    model_path: Path
+    record: dict[str, Any]
+    summary: dict[str, float]
+
+
+def run_dagger(
+    model: Any,
+    root: Path | str,
+    out_dir: Path | str,
+    *,
+    rounds: int,
+    episodes: int,
+    epochs: int,
+    eval_seeds: Sequence[int],
+    first_seed: int = 600,
+    throttle: Throttle = "pi",
+    set_speed: float = 35.0,
+    collect_steps: int = 1500,
+    max_steps: int = 2000,
+    threads: int = 1,
+    progress: Callable[[str], None] | None = None,
+) -> tuple[Any, list[DaggerRound]]:
+    """DAgger rounds: drive ``episodes`` training tracks, aggregate, fine-tune, evaluate.
+
+    Round ``r`` drives tracks ``first_seed + (r − 1)·episodes …`` (disjoint from the
+    demonstrations' seeds 0… and from the held-out ``eval_seeds``), appends the expert-labelled
+    rows to ``root``, rebalances and resplits the aggregate, and continues training the current
+    network on it for ``epochs`` (warm start; Ross et al. retrain on the aggregate).  The
+    resplit means a round's validation MSE is not a clean hold-out (images trained on before
+    may land in it): the measure of a round is the closed loop on the held-out tracks.
+
+    Args:
+        model: starting network (round 0, e.g. the behaviour-cloning one).
+        root: dataset folder (rows are appended).
+        out_dir: folder of ``dagger{r}.safetensors``.
+        rounds: DAgger rounds.
+        episodes: tracks driven per round.
+        epochs: training epochs per round.
+        eval_seeds: held-out tracks evaluated after each round.
+        first_seed: first training track of round 1.
+        throttle: the learner's throttle while driving and when evaluated.
+        set_speed: PI target speed [m/s].
+        collect_steps: steps per DAgger episode.
+        max_steps: closed-loop step limit of the evaluation.
+        threads: torch CPU threads for training.
+        progress: called with a one-line status before each stage.
+
+    Returns:
+        ``(final model, rounds)``.
+    """
+    from uvnav.driving.evaluate import summarize
+
+    say = progress or (lambda s: None)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    done: list[DaggerRound] = []
+    for r in range(1, rounds + 1):
+        seeds = range(first_seed + (r - 1) * episodes, first_seed + r * episodes)
+        say(f"DAgger round {r}: the network drives {episodes} training tracks")
+        rows = dagger_collect(
+            model,
+            root,
+            seeds,
+            round_id=r,
+            throttle=throttle,
+            set_speed=set_speed,
+            max_steps=collect_steps,
+        )
+        data = prepare_data(root)
+        say(f"DAgger round {r}: training {epochs} epochs on {data.info['n_train']} images")
+        path = out / f"dagger{r}.safetensors"
+        model, record = train_on(
+            data, path, model=model, config=TrainConfig(epochs=epochs, threads=threads)
+        )
+        say(f"DAgger round {r}: closed loop on {len(eval_seeds)} held-out tracks")
+        policy, on_reset = cnn_policy(model, throttle=throttle, set_speed=set_speed)
+        summary = summarize(evaluate(policy, eval_seeds, on_reset=on_reset, max_steps=max_steps))
+        done.append(DaggerRound(r, rows, path, record, summary))
+    return model, done

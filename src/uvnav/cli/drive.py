@@ -325,41 +325,55 @@ def play(
 def dagger(
     data: Annotated[Path, typer.Argument(help="Dataset folder (rows are appended).")],
     model: Annotated[Path, typer.Argument(help="Starting model (.safetensors).")],
-    rounds: Annotated[int, typer.Option(min=1, help="DAgger rounds.")] = 2,
-    episodes: Annotated[int, typer.Option(min=1, help="Tracks driven per round.")] = 3,
-    epochs: Annotated[int, typer.Option(min=1, help="Training epochs per round.")] = 3,
+    rounds: Annotated[int, typer.Option(min=1, help="DAgger rounds.")] = 1,
+    episodes: Annotated[int, typer.Option(min=1, help="Training tracks driven per round.")] = 6,
+    epochs: Annotated[int, typer.Option(min=1, help="Training epochs per round.")] = 5,
+    first_seed: Annotated[int, typer.Option(help="First training track of round 1.")] = 600,
     seeds: Annotated[
         str, typer.Option(help="Held-out seeds evaluated after each round.")
-    ] = "1000-1004",
+    ] = "1000-1019",
+    throttle: Annotated[
+        str, typer.Option(help="The learner's throttle while driving: pi or learned.")
+    ] = "pi",
+    set_speed: Annotated[float, typer.Option(help="PI target speed [m/s].")] = 35.0,
     out_dir: Annotated[Path, typer.Option("--out-dir", help="Folder of the round models.")] = Path(
         "dagger"
     ),
+    baseline: Annotated[
+        bool, typer.Option(help="Also evaluate the starting model (round 0).")
+    ] = True,
 ) -> None:
     """DAgger: the CNN drives, the expert labels, retrain; prints closed loop per round."""
     with _user_errors():
-        from uvnav.bench.ch6_pipeline import cnn_policy, dagger_collect, prepare_data, train_on
+        from uvnav.bench.ch6_pipeline import cnn_policy, run_dagger
         from uvnav.bench.ch6_pipeline import evaluate as run_eval
         from uvnav.driving.evaluate import summarize
-        from uvnav.learning import TrainConfig
         from uvnav.learning.checkpoint import load_checkpoint
 
+        if throttle not in ("learned", "pi"):
+            raise ValueError(f"--throttle: {throttle!r} (must be learned or pi)")
         seed_list = parse_seeds(seeds)
         net, _ = load_checkpoint(model)
         rows: dict[str, dict[str, float]] = {}
-        policy, on_reset = cnn_policy(net, throttle="learned")
-        rows["round-0"] = summarize(run_eval(policy, seed_list, on_reset=on_reset))
-        for r in range(1, rounds + 1):
-            dagger_collect(net, data, range(500 + r * 100, 500 + r * 100 + episodes), round_id=r)
-            prep = prepare_data(data)
-            net, _ = train_on(
-                prep,
-                out_dir / f"round{r}.safetensors",
-                model=net,
-                config=TrainConfig(epochs=epochs),
-            )
-            policy, on_reset = cnn_policy(net, throttle="learned")
-            rows[f"round-{r}"] = summarize(run_eval(policy, seed_list, on_reset=on_reset))
-            typer.echo(f"round {r}: return {rows[f'round-{r}']['return']:.1f}")
+        if baseline:
+            policy, on_reset = cnn_policy(net, throttle=throttle, set_speed=set_speed)  # type: ignore[arg-type]
+            rows["round-0"] = summarize(run_eval(policy, seed_list, on_reset=on_reset))
+        _, done = run_dagger(
+            net,
+            data,
+            out_dir,
+            rounds=rounds,
+            episodes=episodes,
+            epochs=epochs,
+            eval_seeds=seed_list,
+            first_seed=first_seed,
+            throttle=throttle,  # type: ignore[arg-type]
+            set_speed=set_speed,
+            progress=lambda s: typer.echo(s, err=True),
+        )
+        for d in done:
+            rows[f"round-{d.round_id}"] = {**d.summary, "rows_added": float(d.rows)}
+            typer.echo(f"round {d.round_id}: +{d.rows} rows, wrote {d.model_path}")
         _print_rows(rows, False)
 
 
@@ -371,6 +385,9 @@ def reproduce(
     epochs: Annotated[int | None, typer.Option(help="Override: epochs.")] = None,
     seeds: Annotated[str | None, typer.Option(help="Override: held-out seeds.")] = None,
     max_steps: Annotated[int | None, typer.Option(help="Override: closed-loop steps.")] = None,
+    dagger_rounds: Annotated[
+        int | None, typer.Option(min=0, help="Override: DAgger rounds (0: the thesis's recipe).")
+    ] = None,
 ) -> None:
     """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table."""
     with _user_errors():
@@ -388,6 +405,7 @@ def reproduce(
             epochs=epochs,
             eval_seeds=parse_seeds(seeds) if seeds else None,
             max_steps=max_steps,
+            dagger_rounds=dagger_rounds,
             progress=lambda s: con.print(f"[dim]… {s}[/dim]"),
         )
         figures = render_ch6(summary, out / "figures")
