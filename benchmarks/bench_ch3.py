@@ -29,7 +29,6 @@ import argparse
 import json
 import os
 import platform
-import subprocess
 import sys
 import time
 from datetime import UTC, datetime
@@ -37,6 +36,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ab_worker import SourceTreeWorker, serve, source_dir
 
 from uvnav.controllers.base3d import make_controller3d
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
@@ -165,43 +167,14 @@ def _warm_up() -> None:
     bench_world(0.2)
 
 
-class _Worker:
-    """A child process importing ``uvnav`` from ``src`` that answers :func:`one_round` calls."""
-
-    def __init__(self, src: Path) -> None:
-        env = dict(os.environ, PYTHONPATH=str(src))
-        self.proc = subprocess.Popen(
-            [sys.executable, __file__, "--worker"], stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE, text=True, env=env,
-        )  # fmt: skip
-        self.uvnav = self.call({"where": True})["uvnav"]
-
-    def call(self, msg: dict[str, Any]) -> dict[str, Any]:
-        assert self.proc.stdin is not None and self.proc.stdout is not None
-        self.proc.stdin.write(json.dumps(msg) + "\n")
-        self.proc.stdin.flush()
-        return dict(json.loads(self.proc.stdout.readline()))
-
-    def close(self) -> None:
-        if self.proc.stdin is not None:
-            self.proc.stdin.close()
-        self.proc.wait(timeout=60)
+def _worker_round(msg: dict[str, Any]) -> dict[str, Any]:
+    _warm_up()
+    return one_round(msg["n"], msg["seconds"], True)
 
 
 def worker_main() -> None:
-    import uvnav
-
-    for line in sys.stdin:
-        msg = json.loads(line)
-        if msg.get("where"):
-            out: dict[str, Any] = {"uvnav": str(Path(uvnav.__file__).parent)}
-        else:
-            try:
-                _warm_up()
-                out = one_round(msg["n"], msg["seconds"], True)
-            except Exception as exc:
-                out = {"error": f"{type(exc).__name__}: {exc}"}
-        print(json.dumps(out), flush=True)
+    """``--worker``: time rounds with the ``uvnav`` this interpreter imports (``ab_worker``)."""
+    serve(_worker_round)
 
 
 def _summary(rows: list[dict[str, Any]]) -> dict[str, Any]:
@@ -245,7 +218,7 @@ def run(quick: bool, against: Path | None = None, rounds: int | None = None) -> 
     _warm_up()
     sides: dict[str, list[dict[str, Any]]] = {"compiled": [], "numpy": []}
     worker = (
-        _Worker(against / "src" if (against / "src").is_dir() else against) if against else None
+        SourceTreeWorker(Path(__file__), source_dir(against), 60.0) if against else None
     )
     if worker is not None:
         sides["baseline"] = []
@@ -255,7 +228,7 @@ def run(quick: bool, against: Path | None = None, rounds: int | None = None) -> 
             for side in order:
                 if side == "baseline":
                     assert worker is not None
-                    res = worker.call({"n": n_dec, "seconds": seconds})
+                    res = worker.run({"n": n_dec, "seconds": seconds})
                     if "error" in res:
                         raise RuntimeError(f"baseline worker: {res['error']}")
                 else:

@@ -41,7 +41,6 @@ import math
 import os
 import platform
 import pstats
-import subprocess
 import sys
 import time
 import traceback
@@ -51,6 +50,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from ab_worker import SourceTreeWorker, serve, source_dir
 
 from uvnav.controllers import available_controllers, make_controller
 from uvnav.dynamics import UnicycleSpec, unicycle_step
@@ -578,67 +580,13 @@ def _world_job(job: dict[str, Any]) -> dict[str, Any]:
     return {"wall": wall, "status": res.status}
 
 
+_HERE_SRC = Path(__file__).resolve().parents[1] / "src"
+
+
 def worker_main() -> int:
-    """``--worker``: run the world jobs read from stdin (one JSON object a line) with whichever
-    ``uvnav`` this interpreter imports; answer one JSON line each."""
-    import uvnav
-
-    print(json.dumps({"uvnav": str(Path(uvnav.__file__).parent)}), flush=True)
-    for line in sys.stdin:
-        job = json.loads(line)
-        try:
-            out = _world_job(job)
-        except Exception as exc:
-            out = {"error": f"{type(exc).__name__}: {exc}"}
-        print(json.dumps(out), flush=True)
-    return 0
-
-
-class _Worker:
-    """A ``--worker`` subprocess importing ``uvnav`` from ``src``."""
-
-    def __init__(self, src: Path) -> None:
-        env = dict(os.environ)
-        env["PYTHONPATH"] = os.pathsep.join(
-            [str(src), *([env["PYTHONPATH"]] if env.get("PYTHONPATH") else [])]
-        )
-        self.proc = subprocess.Popen(
-            [sys.executable, str(Path(__file__).resolve()), "--worker"],
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            text=True,
-            env=env,
-        )
-        self.uvnav = str(self._read().get("uvnav"))
-
-    def _read(self) -> dict[str, Any]:
-        assert self.proc.stdout is not None
-        line = self.proc.stdout.readline()
-        if not line:
-            raise RuntimeError("benchmark worker exited (see its stderr above)")
-        out: dict[str, Any] = json.loads(line)
-        return out
-
-    def run(self, job: dict[str, Any]) -> dict[str, Any]:
-        assert self.proc.stdin is not None
-        self.proc.stdin.write(json.dumps(job) + "\n")
-        self.proc.stdin.flush()
-        return self._read()
-
-    def close(self) -> None:
-        if self.proc.stdin is not None:
-            self.proc.stdin.close()
-        self.proc.wait(timeout=60)
-
-
-def _source_dir(path: Path) -> Path:
-    """``path`` itself if it holds ``uvnav/``, else ``path/src``."""
-    path = path.resolve()
-    if (path / "uvnav" / "__init__.py").exists():
-        return path
-    if (path / "src" / "uvnav" / "__init__.py").exists():
-        return path / "src"
-    raise SystemExit(f"--against {path}: no uvnav/ or src/uvnav/ there")
+    """``--worker``: run the world jobs read from stdin with whichever ``uvnav`` this interpreter
+    imports (see ``ab_worker``)."""
+    return serve(_world_job)
 
 
 def bench_world_ab(quick: bool, against: Path) -> dict[str, Any]:
@@ -651,8 +599,8 @@ def bench_world_ab(quick: bool, against: Path) -> dict[str, Any]:
     rounds = 1 if quick else 5
     steps = {10: 300 if quick else 3000, 100: 100 if quick else 1000}
     sides = {
-        "baseline": _Worker(_source_dir(against)),
-        "current": _Worker(Path(__file__).resolve().parents[1] / "src"),
+        "baseline": SourceTreeWorker(Path(__file__), source_dir(against), 60.0),
+        "current": SourceTreeWorker(Path(__file__), _HERE_SRC, 60.0),
     }
     results: dict[str, Any] = {}
     try:
