@@ -86,3 +86,15 @@ def test_gymnasium_entry_point_resolves_to_the_registration() -> None:
     assert ep.load() is uvnav.envs.register_envs
     uvnav.envs.register_envs()  # idempotent
     assert gym.spec("uvnav/Nav2D-v0").entry_point == "uvnav.envs.nav2d:Nav2DEnv"
+
+
+def test_one_reward_formula_for_every_env() -> None:
+    """``RewardConfig.reward`` (used by Nav2D, Nav3D, UUV2D and the multi-robot env)."""
+    from uvnav.envs.core import RewardConfig
+
+    rw = RewardConfig(progress=2.0, time=0.1, clearance=1.0, clearance_margin=0.5)
+    assert rw.reward(0.3, 1.0, "running") == pytest.approx(2.0 * 0.3 - 0.1)
+    assert rw.reward(0.0, 0.2, "running") == pytest.approx(-0.1 - 0.3)  # 0.3 m inside the margin
+    assert rw.reward(0.0, 1.0, "success") == pytest.approx(-0.1 + rw.success)
+    assert rw.reward(0.0, 1.0, "collision") == pytest.approx(-0.1 - rw.collision)
+    assert rw.reward(0.0, 1.0, "timeout") == pytest.approx(-0.1)

@@ -68,6 +68,17 @@ class RewardConfig:
     success: float = 10.0
     collision: float = 10.0
 
+    def reward(self, progress: float, clearance: float, status: str) -> float:
+        """One decision's reward: ``progress`` [m] toward the goal, the ``clearance`` [m] over the
+        decision, and the episode status after it (``"success"``/``"collision"`` end it)."""
+        r = self.progress * progress - self.time
+        r -= self.clearance * max(0.0, self.clearance_margin - clearance)
+        if status == "success":
+            r += self.success
+        elif status == "collision":
+            r -= self.collision
+        return r
+
 
 @dataclass
 class WorldRobot:
@@ -329,13 +340,9 @@ class NavWorld:
             if not was_active[i]:
                 continue
             self.clearance[i] = min_clear[i] if np.isfinite(min_clear[i]) else self.clearance[i]
-            r = rw.progress * (before[i] - self.distance(i)) - rw.time
-            r -= rw.clearance * max(0.0, rw.clearance_margin - float(self.clearance[i]))
-            if self.status[i] == "success":
-                r += rw.success
-            elif self.status[i] == "collision":
-                r -= rw.collision
-            rewards[i] = r
+            rewards[i] = rw.reward(
+                before[i] - self.distance(i), float(self.clearance[i]), self.status[i]
+            )
         return rewards
 
     def close(self) -> None:

@@ -264,14 +264,9 @@ class Nav3DEnv(gym.Env[np.ndarray, np.ndarray]):
                 break
         self._clearance = low
         after = float(np.linalg.norm(sim.goal - sim.pos))
-        reward = rw.progress * (before - after) - rw.time
-        reward -= rw.clearance * max(0.0, rw.clearance_margin - low)
         terminated = sim.done and sim.status in ("success", "collision")
         truncated = sim.done and not terminated
-        if sim.status == "success" and sim.done:
-            reward += rw.success
-        elif sim.status == "collision":
-            reward -= rw.collision
+        reward = rw.reward(before - after, low, sim.status if terminated else "running")
         self._obs = sim.observe()
         return self._vector(), float(reward), terminated, truncated, self._info()
 

@@ -218,14 +218,9 @@ class Uuv2DEnv(gym.Env[np.ndarray, np.ndarray]):
                 break
         self._clearance = low
         after = float(math.hypot(*(sim.goal - sim.state[:2])))
-        reward = rw.progress * (before - after) - rw.time
-        reward -= rw.clearance * max(0.0, rw.clearance_margin - low)
         terminated = sim.done and sim.status in ("success", "collision")
         truncated = sim.done and not terminated
-        if terminated and sim.status == "success":
-            reward += rw.success
-        elif terminated:
-            reward -= rw.collision
+        reward = rw.reward(before - after, low, sim.status if terminated else "running")
         self._obs = sim.observe()
         return self._vector(), float(reward), terminated, truncated, self._info()
 
