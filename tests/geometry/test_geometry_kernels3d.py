@@ -13,6 +13,8 @@ from hypothesis import strategies as st
 from uvnav.controllers.zhang2020_3d import shadow_of
 from uvnav.geometry.frames3d import online_frame, rotation_from_vector
 from uvnav.geometry.kernels3d import (
+    ATAN2_BOUND_ERROR,
+    atan2_bound,
     nearest_triangle_py,
     numba_available,
     numba_enabled,
@@ -136,3 +138,19 @@ def test_plane_shadow_equals_the_numpy_shadow(
         assert inside == ref.inside
         assert math.isclose(psi_c, ref.centre_angle, abs_tol=1e-9)
         assert math.isclose(lo, ref.lo, abs_tol=1e-9) and math.isclose(hi, ref.hi, abs_tol=1e-9)
+
+
+def test_atan2_bound_is_within_its_error_everywhere() -> None:
+    """The cheap angle that decides which points to skip is within ATAN2_BOUND_ERROR of atan2,
+    over all directions and 12 decades of length (and exact on the axes' signs)."""
+    angles = np.linspace(-math.pi, math.pi, 100_001)
+    lengths = np.geomspace(1e-6, 1e6, angles.size)
+    ys, xs = lengths * np.sin(angles), lengths * np.cos(angles)
+    worst = max(
+        abs(atan2_bound(y, x) - math.atan2(y, x))
+        for y, x in zip(ys.tolist(), xs.tolist(), strict=True)
+    )
+    assert worst < 1.5e-5 < ATAN2_BOUND_ERROR
+    assert atan2_bound(0.0, 0.0) == 0.0
+    assert atan2_bound(1.0, 0.0) == pytest.approx(0.5 * math.pi, abs=1.5e-5)
+    assert atan2_bound(-1.0, -1.0) == pytest.approx(-0.75 * math.pi, abs=1.5e-5)

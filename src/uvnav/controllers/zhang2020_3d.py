@@ -65,7 +65,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any, ClassVar, Literal, cast
+from typing import Any, ClassVar, Literal, NamedTuple, cast
 
 import numpy as np
 
@@ -117,9 +117,11 @@ class Zhang2020Params:
             raise ValueError(f"ar_max_lag must be an integer in 1..10 (got {self.ar_max_lag!r})")
 
 
-@dataclass(frozen=True)
-class Shadow:
+class Shadow(NamedTuple):
     """An obstacle seen in the on-line plane: angles psi measured counter-clockwise from Y' [rad].
+
+    A named tuple (not a frozen dataclass: several are built at every decision, and a tuple is the
+    cheapest immutable record in Python).
 
     Attributes:
         centre_angle: psi of the mass centre.
@@ -138,8 +140,12 @@ class Shadow:
 
 
 def _norm(x: FloatArray) -> float:
-    """Euclidean norm of a small vector (cheaper than ``np.linalg.norm`` per call)."""
-    return math.sqrt(float(x @ x))
+    """Euclidean norm of a small vector.
+
+    ``math.hypot`` on the list of its components: on a 3-vector every numpy call (``x @ x``,
+    ``np.linalg.norm``) costs microseconds of fixed overhead, ten times the arithmetic.
+    """
+    return math.hypot(*x.tolist())
 
 
 def _psi(xy: FloatArray) -> FloatArray:
@@ -178,6 +184,8 @@ class Zhang2020Law(Vehicle3DController):
         self._x_prev: FloatArray | None = None
         self._pred_v: dict[int, ARPredictor] = {}
         self._pred_u: dict[int, ARPredictor] = {}
+        #: per obstacle: the time [s] from which its predictors keep the next sample
+        self._next_sample: dict[int, float] = {}
         #: per obstacle: (u bytes, T_s) -> exp([u]x T_s) (see :meth:`_ahead`)
         self._ahead_rot: dict[int, tuple[tuple[bytes, float], FloatArray]] = {}
         #: last predictions used, by obstacle id: (v*, u*, model name) — read by probes/figures
@@ -189,6 +197,7 @@ class Zhang2020Law(Vehicle3DController):
         self._x_prev = None
         self._pred_v = {}
         self._pred_u = {}
+        self._next_sample = {}
         self._ahead_rot = {}
         self.predictions = {}
 
@@ -206,9 +215,14 @@ class Zhang2020Law(Vehicle3DController):
         """Feed the sensed rates to the per-obstacle AR models (kept once per T_s)."""
         if self.p.prediction != "ar" or self.oracle:
             return
+        due = self._next_sample
         for rd in obs.obstacles:
-            self._predictor(self._pred_v, rd.obstacle_id).observe(obs.time, rd.velocity)
-            self._predictor(self._pred_u, rd.obstacle_id).observe(obs.time, rd.rotation_rate)
+            i = rd.obstacle_id
+            if obs.time < due.get(i, -math.inf):  # between samples: nothing to offer
+                continue
+            self._predictor(self._pred_v, i).observe(obs.time, rd.velocity)
+            self._predictor(self._pred_u, i).observe(obs.time, rd.rotation_rate)
+            due[i] = self._pred_v[i].next_sample_time
 
     def predict(self, rd: ObstacleReading3D) -> tuple[FloatArray, FloatArray]:
         """Predicted (v_i*, u_i*) for the next sampling period (step 1)."""
@@ -290,11 +304,20 @@ class Zhang2020Law(Vehicle3DController):
             return True
         if sh.contains(0.0, pad):
             return True
-        rel = frame.vector_to_plane(self._spec.v_max * frame.y_axis - v)
-        if float(np.hypot(*rel)) > 1e-9 and sh.contains(float(_psi(rel)), pad):
+        # scalar arithmetic on the components (3-vectors: numpy's per-call overhead dominates)
+        x0, x1, x2 = frame.x_axis.tolist()
+        y0, y1, y2 = frame.y_axis.tolist()
+        v0, v1, v2 = v.tolist()
+        vm = self._spec.v_max
+        w0, w1, w2 = vm * y0 - v0, vm * y1 - v1, vm * y2 - v2  # V_max toward E, relative
+        r1, r2 = w0 * x0 + w1 * x1 + w2 * x2, w0 * y0 + w1 * y1 + w2 * y2
+        if math.hypot(r1, r2) > 1e-9 and sh.contains(math.atan2(-r1, r2), pad):
             return True
-        vel = frame.vector_to_plane(obs.heading * max(obs.speed, 1e-3) - v)
-        return bool(float(np.hypot(*vel)) > 1e-9 and sh.contains(float(_psi(vel)), pad))
+        s = max(obs.speed, 1e-3)
+        h0, h1, h2 = obs.heading.tolist()
+        w0, w1, w2 = h0 * s - v0, h1 * s - v1, h2 * s - v2  # the robot's velocity, relative
+        r1, r2 = w0 * x0 + w1 * x1 + w2 * x2, w0 * y0 + w1 * y1 + w2 * y2
+        return math.hypot(r1, r2) > 1e-9 and sh.contains(math.atan2(-r1, r2), pad)
 
     # ------------------------------------------------------------------------------------ act
     def act(self, obs: Observation3D) -> Vehicle3DCommand:
@@ -335,8 +358,12 @@ class Zhang2020Law(Vehicle3DController):
             if other not in shadows:
                 del self._tag[other]
         psi = self.passing_angle(sh, shadows, tag)
-        direction2 = np.array([-math.sin(psi), math.cos(psi)])
-        direction = frame.plane_to_world(direction2)
+        sin_psi, cos_psi = math.sin(psi), math.cos(psi)
+        x0, x1, x2 = frame.x_axis.tolist()
+        y0, y1, y2 = frame.y_axis.tolist()
+        # l_J in the world: -sin(psi) X' + cos(psi) Y' (in the on-line plane)
+        direction = np.array([cos_psi * y0 - sin_psi * x0, cos_psi * y1 - sin_psi * x1,
+                              cos_psi * y2 - sin_psi * x2])  # fmt: skip
         speed = self.speed(obs, rd, v, direction, sh)
         return self.steer(obs, direction, speed, period)
 
@@ -379,7 +406,9 @@ class Zhang2020Law(Vehicle3DController):
             r = _norm(v) * self.p.sample_period
             length = math.sqrt(max(d * d - r * r, 0.0))
             return min(vmax, max(length / self.p.sample_period, floor))
-        cos_b = float(np.clip(direction @ obs.heading, -1.0, 1.0))
+        d0, d1, d2 = direction.tolist()
+        h0, h1, h2 = obs.heading.tolist()
+        cos_b = min(d0 * h0 + d1 * h1 + d2 * h2, 1.0)
         return min(vmax, max(vmax * max(cos_b, 0.0), floor))
 
 

@@ -186,12 +186,24 @@ def online_frame(
 
     A robot exactly at the goal gets Y' = world +y (the frame is then irrelevant)."""
     p = np.asarray(position, dtype=float)
-    gap = np.asarray(goal, dtype=float) - p
-    n = math.sqrt(float(gap @ gap))
-    y = gap / n if n > 1e-12 else np.array([0.0, 1.0, 0.0])
-    x = horizontal_perpendicular(y, previous_x)
-    x0, x1, x2 = float(x[0]), float(x[1]), float(x[2])
-    y0, y1, y2 = float(y[0]), float(y[1]), float(y[2])
+    g = np.asarray(goal, dtype=float)
+    # scalar arithmetic on Python floats: a decision builds one frame, and numpy's per-call
+    # overhead (~1 µs) dominates 3-vectors
+    (p0, p1, p2), (e0, e1, e2) = p.tolist(), g.tolist()
+    g0, g1, g2 = e0 - p0, e1 - p1, e2 - p2
+    n = math.sqrt(g0 * g0 + g1 * g1 + g2 * g2)
+    if n > 1e-12:
+        y0, y1, y2 = g0 / n, g1 / n, g2 / n
+    else:
+        y0, y1, y2 = 0.0, 1.0, 0.0
+    h = math.hypot(y0, y1)
+    if h > 1e-6:  # the usual case of horizontal_perpendicular, inlined
+        x0, x1, x2 = y1 / h, -y0 / h, 0.0
+        x = np.array([x0, x1, x2])
+    else:
+        x = horizontal_perpendicular(np.array([y0, y1, y2]), previous_x)
+        x0, x1, x2 = float(x[0]), float(x[1]), float(x[2])
+    y = np.array([y0, y1, y2])
     z = np.array([x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0])
     return OnlineFrame(origin=p, x_axis=x, y_axis=y, z_axis=z)
 
@@ -209,19 +221,23 @@ def turn_toward(a: FloatArray, direction: FloatArray, u_max: float, period: floa
     ``direction`` along the great circle: rate ``u_max`` outside a boundary layer, and the rate that
     closes the angle in one ``period`` [s] inside it (the 3D form of the sliding-mode law with a
     boundary layer used in Ch. 2).  Zero for a zero direction or one already aligned."""
-    d = np.asarray(direction, dtype=float)
-    nd = math.sqrt(float(d @ d))
+    d0, d1, d2 = np.asarray(direction, dtype=float).tolist()
+    nd = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
     if nd < 1e-12:
         return np.zeros(3)
-    d = d / nd
-    perp = d - float(d @ a) * a
-    n_perp = math.sqrt(float(perp @ perp))
-    angle = math.atan2(n_perp, float(d @ a))
+    a0, a1, a2 = np.asarray(a, dtype=float).tolist()
+    d0, d1, d2 = d0 / nd, d1 / nd, d2 / nd
+    cos_da = d0 * a0 + d1 * a1 + d2 * a2
+    p0, p1, p2 = d0 - cos_da * a0, d1 - cos_da * a1, d2 - cos_da * a2
+    n_perp = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2)
+    angle = math.atan2(n_perp, cos_da)
     if n_perp < 1e-12:
         if angle < 0.5 * math.pi:
             return np.zeros(3)
         # exactly opposite: turn about any axis, horizontal first
-        perp = horizontal_perpendicular(a)
+        hp = horizontal_perpendicular(np.asarray(a, dtype=float))
+        p0, p1, p2 = float(hp[0]), float(hp[1]), float(hp[2])
         n_perp = 1.0
     rate = min(u_max, angle / period) if period > 0 else u_max
-    return perp * (rate / n_perp)
+    k = rate / n_perp
+    return np.array([p0 * k, p1 * k, p2 * k])

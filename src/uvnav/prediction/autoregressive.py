@@ -246,6 +246,11 @@ class ARPredictor:
         """(n, dim) samples, oldest first."""
         return np.array(self._values).reshape(-1, self.dim)
 
+    @property
+    def next_sample_time(self) -> float:
+        """The earliest time [s] at which :meth:`observe` keeps a measurement (-inf when empty)."""
+        return self._times[-1] + self.period - 1e-9 if self._times else -math.inf
+
     def observe(self, t: float, value: FloatArray) -> bool:
         """Offer a measurement at time ``t`` [s]; it is kept when a period has passed since the
         last kept sample (sampling at T_s).  Returns True when kept."""
