@@ -76,7 +76,6 @@ from uvnav.controllers.base import (
 )
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec, velocity_toward
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-from uvnav.geometry.polygons import points_to_segments
 from uvnav.geometry.tangents import circle_tangents
 from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
 from uvnav.sensors.sonar2d import SonarObservation, close_narrow_openings
@@ -297,14 +296,14 @@ class Zhang2022Uuv2dController:
         if n <= 0:
             return 0.0
         steps = list(self._steps)
-        return float(np.array(steps[len(steps) - n :]).mean())
+        return math.fsum(steps[len(steps) - n :]) / n
 
     def _remember(self, r_min: FloatArray) -> None:
         """Append r_imin to the history and its displacement from the last one to the steps."""
         point = np.array(r_min, dtype=float)
         if self._history:
-            d = point - self._history[-1]
-            self._steps.append(float(np.hypot(d[0], d[1])))
+            last = self._history[-1]
+            self._steps.append(math.hypot(float(point[0] - last[0]), float(point[1] - last[1])))
         self._history.append(point)
 
     def _query_radius(self) -> float:
@@ -315,36 +314,38 @@ class Zhang2022Uuv2dController:
         return max(p.switch_distance + 2.0 * p.cell, clear, p.switch_distance)
 
     def _path_clear(self, position: FloatArray, near: _Near, clearance: float) -> bool:
-        to_goal = self._goal - position
-        dist = float(np.hypot(*to_goal))
+        px, py = float(position[0]), float(position[1])
+        gx, gy = float(self._goal[0]) - px, float(self._goal[1]) - py
+        dist = math.hypot(gx, gy)
         if dist < 1e-9:
             return True
         run = min(dist, self.params.clear_factor * self.params.switch_distance)
-        end = position + to_goal / dist * run
         centres, _ = near.within(run + clearance)
         if len(centres) == 0:
             return True
-        a = np.broadcast_to(position, centres.shape)
-        b = np.broadcast_to(end, centres.shape)
-        return bool(points_to_segments(centres, a, b).min() > clearance)
+        # distance of each square's centre to the segment position -> position + run (unit to E):
+        # along = clip(<c - p, e>, 0, run), off = |c - p - along e| (few array calls per decision)
+        ex, ey = gx / dist, gy / dist
+        rx, ry = centres[:, 0] - px, centres[:, 1] - py
+        along = np.minimum(np.maximum(rx * ex + ry * ey, 0.0), run)
+        return bool(np.min(np.hypot(rx - along * ex, ry - along * ey)) > clearance)
 
     def _receding(self, position: FloatArray, r_min: FloatArray) -> bool:
         """True when E lies more than ``leave_angle`` from the direction of r_imin: heading for E
         then moves away from the nearest covered square."""
-        to_goal = self._goal - position
-        to_near = np.asarray(r_min) - position
-        ang = abs(
-            wrap_scalar(math.atan2(to_goal[1], to_goal[0]) - math.atan2(to_near[1], to_near[0]))
-        )
-        return ang > self.params.leave_angle
+        px, py = float(position[0]), float(position[1])
+        to_goal = math.atan2(float(self._goal[1]) - py, float(self._goal[0]) - px)
+        to_near = math.atan2(float(r_min[1]) - py, float(r_min[0]) - px)
+        return abs(wrap_scalar(to_goal - to_near)) > self.params.leave_angle
 
     def _approach(self, obs: SonarObservation) -> HolonomicCommand:
-        to_goal = self._goal - obs.position
-        dist = float(np.hypot(*to_goal))
+        gx = float(self._goal[0]) - float(obs.position[0])
+        gy = float(self._goal[1]) - float(obs.position[1])
+        dist = math.hypot(gx, gy)
         if dist < 1e-12:
             return HolonomicCommand(0.0, 0.0)
         return velocity_toward(
-            math.atan2(to_goal[1], to_goal[0]),
+            math.atan2(gy, gx),
             dist / obs.period,
             self._spec,
             obs.heading,

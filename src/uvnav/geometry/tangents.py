@@ -8,6 +8,7 @@ radius in place of ||v_i||).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,23 +45,28 @@ def circle_tangents(point: FloatArray, centre: FloatArray, radius: float) -> Cir
     centre (gamma = 0); a point inside or on the circle gives the perpendicular limit described in
     :class:`CircleTangents`; a point at the centre uses the +x axis as the radius direction.
     """
-    p = np.asarray(point, dtype=float)
-    c = np.asarray(centre, dtype=float)
+    # scalar arithmetic (a 2D point and circle: numpy's per-call overhead would dominate)
+    p0, p1 = float(point[0]), float(point[1])
+    o0, o1 = float(centre[0]) - p0, float(centre[1]) - p1
     r = max(float(radius), 0.0)
-    offset = c - p
-    dist = float(np.hypot(offset[0], offset[1]))
-    base = float(np.arctan2(offset[1], offset[0])) if dist > 0.0 else 0.0
+    dist = math.hypot(o0, o1)
+    base = math.atan2(o1, o0) if dist > 0.0 else 0.0
     if dist <= r:
-        gamma = 0.5 * np.pi
+        gamma = 0.5 * math.pi
         length = 0.0
         inside = True
     else:
-        gamma = float(np.arcsin(r / dist))
-        length = float(np.sqrt(max(dist * dist - r * r, 0.0)))
+        gamma = math.asin(r / dist)
+        length = math.sqrt(max(dist * dist - r * r, 0.0))
         inside = False
-    angles = np.array([wrap_scalar(base + gamma), wrap_scalar(base - gamma)])
-    directions = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
-    points = p + length * directions
+    a0, a1 = wrap_scalar(base + gamma), wrap_scalar(base - gamma)
+    angles = np.array([a0, a1])
+    points = np.array(
+        [
+            [p0 + length * math.cos(a0), p1 + length * math.sin(a0)],
+            [p0 + length * math.cos(a1), p1 + length * math.sin(a1)],
+        ]
+    )
     return CircleTangents(points=points, angles=angles, length=length, gamma=gamma, inside=inside)
 
 

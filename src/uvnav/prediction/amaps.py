@@ -30,6 +30,7 @@ Squares outside the grid are ignored (a scene larger than the grid loses memory 
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -110,6 +111,10 @@ class AmapsGrid:
         self._stored = np.zeros((self.ny, self.nx), dtype=np.float32)
         self._gain = 1.0
         self.labels = np.full((self.ny, self.nx), -1, dtype=np.int16)
+        # compiled path only: per row, the lowest and highest column ever marked covered (the
+        # only squares that can pass the threshold; read by the near-squares scan)
+        self._row_lo = np.full(self.ny, self.nx, dtype=np.intp)
+        self._row_hi = np.full(self.ny, -1, dtype=np.intp)
         self.updates = 0
         self._origin = np.array([self.x0, self.y0])
         self._dims = np.array([self.nx, self.ny], dtype=np.uintp)
@@ -192,7 +197,8 @@ class AmapsGrid:
                 h, np.cos(ang), np.sin(ang), rr, ids.astype(np.intp, copy=False),
                 np.float32(cfg.free_weight * inv), np.float32(cfg.hit_weight * inv),
                 cfg.free_step * h, cfg.free_range, cfg.free_weight > 0,
-                int(np.floor(cfg.hit_depth / (0.5 * h))) + 1, 0.5 * h,
+                int(np.floor(cfg.hit_depth / (0.5 * h))) + 1, 0.5 * h, self._row_lo,
+                self._row_hi,
             )  # fmt: skip
         elif len(rr):
             # (2, B) beam directions, rows x and y; (2,) sonar offset from the grid origin [m]
@@ -281,10 +287,11 @@ class AmapsGrid:
     # -------------------------------------------------------------------------------- queries
     def _window(self, point: FloatArray, radius: float) -> tuple[slice, slice]:
         h = self.config.cell
-        c0 = max(int(np.floor((point[0] - radius - self.x0) / h)), 0)
-        c1 = min(int(np.floor((point[0] + radius - self.x0) / h)) + 1, self.nx)
-        r0 = max(int(np.floor((point[1] - radius - self.y0) / h)), 0)
-        r1 = min(int(np.floor((point[1] + radius - self.y0) / h)) + 1, self.ny)
+        px, py, x0, y0 = float(point[0]), float(point[1]), float(self.x0), float(self.y0)
+        c0 = max(math.floor((px - radius - x0) / h), 0)
+        c1 = min(math.floor((px + radius - x0) / h) + 1, self.nx)
+        r0 = max(math.floor((py - radius - y0) / h), 0)
+        r1 = min(math.floor((py + radius - y0) / h) + 1, self.ny)
         return slice(r0, max(r1, r0)), slice(c0, max(c1, c0))
 
     def covered(
@@ -300,8 +307,12 @@ class AmapsGrid:
         p = np.asarray(point, dtype=float)
         rs, cs = self._window(p, radius)
         level = np.float32(self.config.threshold / self._gain)
-        if self._kernel is not None:
-            rows, cols = self._kernel[1](self._stored, rs.start, rs.stop, cs.start, cs.stop, level)
+        if self._kernel is not None:  # one compiled pass, the same values as below
+            return self._kernel[1](
+                self._stored, self.labels, self._row_lo, self._row_hi, rs.start, rs.stop,
+                cs.start, cs.stop, level, self.x0, self.y0, self.config.cell, float(p[0]),
+                float(p[1]), float(radius),
+            )  # fmt: skip
         else:
             rows, cols = np.nonzero(self._stored[rs, cs] >= level)
             rows = rows + rs.start

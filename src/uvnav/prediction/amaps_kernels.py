@@ -22,12 +22,13 @@ numba is imported lazily by :func:`load_kernel`; without it the grid keeps the n
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-_KERNEL: tuple[Callable[..., None], Callable[..., tuple[Any, Any]]] | None = None
+_KERNEL: tuple[Callable[..., None], Callable[..., tuple[Any, Any, Any]]] | None = None
 _TRIED = False
 
 
@@ -50,9 +51,15 @@ def _sweep(
     do_free: bool,
     n_d: int,
     step: float,
+    row_lo: Any,
+    row_hi: Any,
 ) -> None:  # pragma: no cover - compiled by numba; the numpy path is the reference
     """One sweep on the flat ``stored`` (float32) and ``labels`` (int16) arrays of an
-    ``ny x nx`` grid (see the module docstring for the arithmetic)."""
+    ``ny x nx`` grid (see the module docstring for the arithmetic).
+
+    ``row_lo``/``row_hi`` (ny,) hold, per row, the lowest and highest column ever marked covered:
+    only those squares can hold a positive count (free space only lowers counts, decay only
+    scales them), so :func:`_scan_near` need not look elsewhere."""
     ny, nx = stored.shape
     flat_s = stored.reshape(-1)
     flat_l = labels.reshape(-1)
@@ -98,9 +105,15 @@ def _sweep(
                 c = np.floor(((ox + t * dx[i]) - x0) / h)
                 r = np.floor(((oy + t * dy[i]) - y0) / h)
                 if c >= 0 and c < nx and r >= 0 and r < ny:
-                    idx[m] = int(r) * nx + int(c)
+                    ir = int(r)
+                    ic = int(c)
+                    idx[m] = ir * nx + ic
                     lab[m] = ids[i]
                     m += 1
+                    if ic < row_lo[ir]:
+                        row_lo[ir] = ic
+                    if ic > row_hi[ir]:
+                        row_hi[ir] = ic
         new = np.empty(m, dtype=np.float32)
         for j in range(m):
             new[j] = flat_s[idx[j]] + hit_w
@@ -109,27 +122,54 @@ def _sweep(
             flat_l[idx[j]] = lab[j]
 
 
-def _scan(
-    stored: Any, r0: int, r1: int, c0: int, c1: int, level: Any
-) -> tuple[Any, Any]:  # pragma: no cover - compiled by numba
-    """Rows and columns (row-major) of the squares of ``stored[r0:r1, c0:c1]`` with a stored
-    count ``>= level`` (float32), as ``np.nonzero(sub >= level)`` gives them (offset added)."""
-    n = max(r1 - r0, 0) * max(c1 - c0, 0)
-    rows = np.empty(n, dtype=np.intp)
-    cols = np.empty(n, dtype=np.intp)
+def _scan_near(
+    stored: Any,
+    labels: Any,
+    row_lo: Any,
+    row_hi: Any,
+    r0: int,
+    r1: int,
+    c0: int,
+    c1: int,
+    level: Any,
+    x0: float,
+    y0: float,
+    h: float,
+    px: float,
+    py: float,
+    radius: float,
+) -> tuple[Any, Any, Any]:  # pragma: no cover - compiled by numba
+    """:meth:`AmapsGrid.covered` in one pass: the squares of ``stored[r0:r1, c0:c1]`` with a count
+    ``>= level`` whose centres lie within ``radius`` of ``(px, py)``, row-major, as ``(centres
+    (m, 2), labels (m,), distances (m,))`` — the centre ``x0 + (c + 0.5) h`` and the distance
+    ``hypot`` computed as the numpy path does, so the results are identical.  Per row only the
+    columns between ``row_lo`` and ``row_hi`` (ever marked covered, see :func:`_sweep`) are read.
+    """
+    n = 0
+    for r in range(r0, r1):
+        n += max(min(c1, row_hi[r] + 1) - max(c0, row_lo[r]), 0)
+    centres = np.empty((n, 2))
+    labs = np.empty(n, dtype=np.intp)
+    dists = np.empty(n)
     m = 0
     for r in range(r0, r1):
-        for c in range(c0, c1):
+        cy = y0 + (r + 0.5) * h
+        for c in range(max(c0, row_lo[r]), min(c1, row_hi[r] + 1)):
             if stored[r, c] >= level:
-                rows[m] = r
-                cols[m] = c
-                m += 1
-    return rows[:m], cols[:m]
+                cx = x0 + (c + 0.5) * h
+                d = math.hypot(cx - px, cy - py)
+                if d <= radius:
+                    centres[m, 0] = cx
+                    centres[m, 1] = cy
+                    labs[m] = labels[r, c]
+                    dists[m] = d
+                    m += 1
+    return centres[:m], labs[:m], dists[:m]
 
 
-def load_kernel() -> tuple[Callable[..., None], Callable[..., tuple[Any, Any]]] | None:
-    """The compiled sweep update and window scan, or ``None`` when numba (extra ``fast``) is not
-    installed."""
+def load_kernel() -> tuple[Callable[..., None], Callable[..., tuple[Any, Any, Any]]] | None:
+    """The compiled sweep update and near-squares scan, or ``None`` when numba
+    (extra ``fast``) is not installed."""
     global _KERNEL, _TRIED
     if not _TRIED:
         _TRIED = True
@@ -138,5 +178,5 @@ def load_kernel() -> tuple[Callable[..., None], Callable[..., tuple[Any, Any]]] 
         except ImportError:
             return None
         jit = numba.njit(cache=True, nogil=True)
-        _KERNEL = (jit(_sweep), jit(_scan))
+        _KERNEL = (jit(_sweep), jit(_scan_near))
     return _KERNEL
