@@ -426,16 +426,18 @@ class Zhang2022Uuv2dController:
         """The passing-side tangent direction [rad] that clears the forecast circles (radius
         ``rho``) of every covered square within L in front of the vehicle on the passing side,
         not only r_imin's (reading 3b of the module docstring)."""
-        centres, _ = near.within(self.params.switch_distance)
-        if len(centres) == 0:
+        centres, dist = near.centres, near.distances  # distances from pos (the scan's)
+        if self.params.switch_distance < near.radius:
+            keep = dist <= self.params.switch_distance
+            centres, dist = centres[keep], dist[keep]
+        if len(dist) == 0:
             return direction
-        rel = centres - pos
-        dist = np.hypot(rel[:, 0], rel[:, 1])
-        base_r = math.atan2(r_min[1] - pos[1], r_min[0] - pos[0])
-        ang = np.arctan2(rel[:, 1], rel[:, 0]) - base_r
+        px, py = float(pos[0]), float(pos[1])
+        base_r = math.atan2(float(r_min[1]) - py, float(r_min[0]) - px)
+        ang = np.arctan2(centres[:, 1] - py, centres[:, 0] - px) - base_r
         ang = np.pi - np.mod(np.pi - ang, 2.0 * np.pi)
         front = (np.abs(ang) <= 0.5 * np.pi) & (dist > rho)
-        if not np.any(front):
+        if not front.any():
             return direction
         gamma = np.arcsin(rho / dist[front])
         current = wrap_scalar(direction - base_r)
