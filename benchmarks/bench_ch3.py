@@ -33,7 +33,7 @@ import sys
 import time
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -99,7 +99,7 @@ def bench_decision(n_decisions: int) -> dict[str, Any]:
 
 
 class _Straight:
-    name = "straight-bench"
+    name: ClassVar[str] = "straight-bench"
     oracle = False
     mode = "M1"
 
@@ -217,27 +217,29 @@ def run(quick: bool, against: Path | None = None, rounds: int | None = None) -> 
     load_before = os.getloadavg()
     _warm_up()
     sides: dict[str, list[dict[str, Any]]] = {"compiled": [], "numpy": []}
-    worker = (
-        SourceTreeWorker(Path(__file__), source_dir(against), 60.0) if against else None
-    )
-    if worker is not None:
+    # with a baseline, this checkout's compiled side also runs in a fresh worker process, so that
+    # both sides are timed alike (the main process has also run the numpy rounds)
+    workers: dict[str, SourceTreeWorker] = {}
+    if against:
+        here = Path(__file__).resolve().parents[1] / "src"
+        workers["compiled"] = SourceTreeWorker(Path(__file__), source_dir(here), 60.0)
+        workers["baseline"] = SourceTreeWorker(Path(__file__), source_dir(against), 60.0)
         sides["baseline"] = []
     try:
         for r in range(n_rounds):
             order = list(sides) if r % 2 == 0 else list(reversed(sides))
             for side in order:
-                if side == "baseline":
-                    assert worker is not None
-                    res = worker.run({"n": n_dec, "seconds": seconds})
+                if side in workers:
+                    res = workers[side].run({"n": n_dec, "seconds": seconds})
                     if "error" in res:
-                        raise RuntimeError(f"baseline worker: {res['error']}")
+                        raise RuntimeError(f"{side} worker: {res['error']}")
                 else:
                     res = one_round(n_dec, seconds, side == "compiled")
                 sides[side].append(res)
     finally:
         _with_kernels(True)
-        if worker is not None:
-            worker.close()
+        for w in workers.values():
+            w.close()
     med = sides["compiled"]
     dec_med = float(np.median([r["decision_us_oracle"] for r in med]))
     sps_med = float(np.median([r["steps_per_s"] for r in med]))
@@ -290,8 +292,8 @@ def run(quick: bool, against: Path | None = None, rounds: int | None = None) -> 
             },
         },
     }
-    if worker is not None:
-        report["sources"] = {"baseline": worker.uvnav}
+    if workers:
+        report["sources"] = {side: w.uvnav for side, w in workers.items()}
         report["speedup"]["compiled_vs_baseline"] = _ratios(sides["baseline"], sides["compiled"])
     return report
 
