@@ -99,3 +99,18 @@ def test_3d_commands_are_finite_within_limits_and_orthogonal(
         cmd = c.act(_obs(world, pos=pos, heading=heading, t=0.1 * k))
         assert math.isfinite(cmd.v) and np.all(np.isfinite(cmd.u))
         assert not cmd.violates(SPEC, heading), (cmd, heading)
+
+
+@pytest.mark.parametrize(("seed", "motion"), [(281, "known"), (462, "known"), (368, "estimated")])
+def test_a_group_is_passed_on_one_side(seed: int, motion: str) -> None:
+    """Random scenes where two moving bodies close in on the robot: tagged by their own alphas,
+    the two got opposite passing sides and the robot was squeezed into the closing gap (these
+    seeds collided).  Passed on one side, the robot reaches E and keeps off both."""
+    from uvnav.scenarios import load_scenario
+    from uvnav.sim.episode3d import run_episode3d
+
+    setup = load_scenario(f"random-ch3:{seed}").build(seed, velocities=motion)
+    law = make_controller3d("zhang2020-3d-v1", oracle=motion == "known")
+    res, _ = run_episode3d(setup, law, np.random.default_rng(seed))
+    assert res.status == "success"
+    assert res.metrics.min_clearance > 0.05

@@ -42,9 +42,13 @@ Where the thesis is ambiguous this implementation chooses as follows (docs/thesi
    body this is the tangent to the circle at r*_min, for a non-convex one it never grazes a spike
    beyond r*_min.  Other obstacles within D whose inflated silhouettes contain that direction push
    it further out on the same side (the robot avoids the nearest obstacle "and its neighbours");
-   neighbours count up to 2 D.  When the nearest blocking obstacle changes during M2 the new one
-   inherits the passing side (the robot goes round a group instead of turning back between its
-   bodies); the alpha rule (3.15) sets the side when M2 starts.
+   neighbours count up to 2 D.  *A group is passed on one side*: when the nearest blocking
+   obstacle changes during M2 the new one takes the previous one's passing side (even if it had
+   one from before), and a new target with no side takes that of the nearest obstacle within 2 D
+   that has one; only a target with no tagged neighbour gets its side from the alpha rule (3.15).
+   Two bodies tagged by their own alphas with opposite sides steer the robot into the gap between
+   them, which moving bodies close (the cause of every collision of the 500-scene campaign
+   before this rule).
 5. *J.* The thesis compares |l^1| and |l^2|, which are equal (both are ||v*|| / tan gamma); the
    tangent on the tagged side is used, which is what the tag is for.
 6. *f and the sign of u.* u_R* = -U_max f would turn the robot away from l_J with beta measured
@@ -345,11 +349,17 @@ class Zhang2020Law(Vehicle3DController):
             shadows = self.shadows(frame, obs)  # the target's rates are now the predicted ones
         self._mode = "M2"
         sh, rd, v, _u = shadows[target]
-        if target not in self._tag:
-            if previous is not None and previous in self._tag:
-                # handing over from one obstacle to the next during M2: keep the passing side,
-                # so the robot goes round the group instead of turning back between bodies
-                self._tag[target] = self._tag[previous]
+        if previous is not None and previous != target and previous in self._tag:
+            # handing over from one obstacle to the next during M2: the new one takes the
+            # passing side, even if it had one from before, so the robot goes round the group
+            # instead of turning back between bodies (two sides would steer it into the gap)
+            self._tag[target] = self._tag[previous]
+        elif target not in self._tag:
+            tagged = [(shadows[i][1].distance, i) for i in self._tag if i in shadows]
+            if tagged:
+                # a neighbour (within 2 D) is still being passed on a side: take that side, for
+                # the same reason — the group is passed on one side
+                self._tag[target] = self._tag[min(tagged)[1]]
             else:
                 # (3.15): alpha = angle of L_center from Y', counter-clockwise
                 self._tag[target] = 1 if sh.centre_angle >= 0.0 else -1
