@@ -50,12 +50,14 @@ fuzz: $(STAMP_TEST)
 
 lint: $(STAMP_TEST)
 	$(VENV)/bin/ruff check src tests benchmarks
+	$(VENV)/bin/ruff format --check src tests benchmarks
 	$(VENV)/bin/mypy
 	$(VENV)/bin/lint-imports
 
 bench: $(STAMP_RUN)
 	$(PY) benchmarks/run_benchmarks.py --out benchmarks/results
 	$(PY) benchmarks/bench_multi.py --out benchmarks/results
+	$(PY) benchmarks/bench_ch7.py --out benchmarks/results
 
 clean:
 	rm -rf $(VENV) results report .pytest_cache .mypy_cache .ruff_cache

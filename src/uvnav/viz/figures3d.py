@@ -131,9 +131,7 @@ def clearance_figure(tr: Trajectory3D) -> Any:
     return fig
 
 
-def interactive_trajectory(
-    tr: Trajectory3D, title: str = "", plotly_js: bool | str = True
-) -> str:
+def interactive_trajectory(tr: Trajectory3D, title: str = "", plotly_js: bool | str = True) -> str:
     """HTML (plotly) of the trajectory and the obstacles' paths.
 
     Args:
