@@ -185,3 +185,18 @@ def test_one_scan_answers_like_separate_scans(seed: int, r: float) -> None:
     wd, wc, wl = grid.nearest(p, rr)
     assert d == wd and lab == wl and (c is None) == (wc is None)
     assert c is None or np.array_equal(c, wc)
+
+
+@pytest.mark.parametrize("seed", [12, 32])
+def test_the_passing_side_is_kept_when_r_min_moves_to_another_body(seed: int) -> None:
+    """Hard scenes where r_imin alternates between two bodies: re-drawing the tag at each switch
+    turned the vehicle back between them and a moving body hit it (these seeds collided).  With
+    the tag kept while count(t) > 0 the vehicle reaches E clear of every body."""
+    from uvnav.scenarios.uuv2d import random_ch4_hard_scenario
+
+    sc = random_ch4_hard_scenario(seed)
+    res = run_uuv2d_episode(
+        sc.to_setup(), make_uuv2d_controller("zhang2022-uuv2d-v1"), np.random.default_rng(seed)
+    )
+    assert res.status == "success"
+    assert res.metrics.min_clearance > 0.05
