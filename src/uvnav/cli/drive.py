@@ -131,6 +131,13 @@ def train(
     augment: Annotated[bool, typer.Option(help="Flip/brightness/zoom augmentation.")] = True,
     speed_input: Annotated[bool, typer.Option(help="Feed the speed to the network.")] = True,
     throttle_head: Annotated[bool, typer.Option(help="Learn the throttle too.")] = True,
+    head: Annotated[
+        str,
+        typer.Option(
+            help="Second output: throttle (the thesis's pedal head) or target-speed (the "
+            "expert's target speed; drive it with --throttle learned-speed)."
+        ),
+    ] = "throttle",
     seed: Annotated[int, typer.Option(help="Seed of split, init, shuffling.")] = 0,
 ) -> None:
     """Train the Chapter 6 CNN (Adam, MSE) and write the model and its loss curves."""
@@ -138,6 +145,7 @@ def train(
         from uvnav.bench.ch6_pipeline import prepare_data, train_on
         from uvnav.learning import PilotNetConfig, TrainConfig
 
+        second = _parse_head(head)
         meta = _dataset_meta(data)
         size = (int(meta.get("height", 66)), int(meta.get("width", 200)))
         sides = meta.get("camera", "front") == "front"
@@ -155,6 +163,7 @@ def train(
             width=size[1],
             n_outputs=2 if throttle_head else 1,
             extra_inputs=1 if speed_input else 0,
+            second_output=second,
         )
         cfg = TrainConfig(
             epochs=epochs,
@@ -172,12 +181,26 @@ def train(
                 prog.update(task, advance=1, description=f"train {tl:.4f} val {vl:.4f}")
 
             _, record = train_on(prep, out, net=net, config=cfg, on_epoch=on_epoch)
+        extra = (
+            f", target speed RMSE {record['val_target_speed_rmse'][-1]:.2f} m/s"
+            if record["val_target_speed_rmse"]
+            else ""
+        )
         typer.echo(
             f"{prep.n_frames} frames, {prep.info['n_balanced']} after balancing, "
             f"train {prep.info['n_train']} / val {prep.info['n_val']}; final val MSE "
-            f"{record['val_loss'][-1]:.4f} (steering {record['val_steering_mse'][-1]:.4f})"
+            f"{record['val_loss'][-1]:.4f} (steering {record['val_steering_mse'][-1]:.4f}, "
+            f"second output {record['val_throttle_mse'][-1]:.4f}{extra})"
         )
         typer.echo(f"wrote {out}")
+
+
+def _parse_head(head: str) -> str:
+    """``--head`` value → ``PilotNetConfig.second_output``."""
+    heads = {"throttle": "throttle", "target-speed": "target_speed", "target_speed": "target_speed"}
+    if head not in heads:
+        raise ValueError(f"--head: {head!r} (must be throttle or target-speed)")
+    return heads[head]
 
 
 def _dataset_meta(data: Path) -> dict[str, Any]:
@@ -188,11 +211,11 @@ def _dataset_meta(data: Path) -> dict[str, Any]:
 
 
 def _load_policy(model_path: Path, throttle: str, set_speed: float) -> tuple[Any, Any, str]:
-    from uvnav.bench.ch6_pipeline import cnn_policy
+    from uvnav.bench.ch6_pipeline import THROTTLE_MODES, cnn_policy
     from uvnav.learning.checkpoint import load_checkpoint
 
-    if throttle not in ("learned", "pi"):
-        raise ValueError(f"--throttle: {throttle!r} (must be learned, pi or both)")
+    if throttle not in THROTTLE_MODES:
+        raise ValueError(f"--throttle: {throttle!r} (must be {', '.join(THROTTLE_MODES)} or both)")
     model, _ = load_checkpoint(model_path)
     camera = "topdown" if (model.config.height, model.config.width) == (96, 96) else "front"
     policy, on_reset = cnn_policy(model, throttle=throttle, set_speed=set_speed)  # type: ignore[arg-type]
@@ -203,7 +226,13 @@ def _load_policy(model_path: Path, throttle: str, set_speed: float) -> tuple[Any
 def evaluate(
     model: Annotated[Path, typer.Argument(help="Model file (.safetensors).")],
     seeds: Annotated[str, typer.Option(help="Held-out track seeds, e.g. 1000-1019.")] = "1000-1019",
-    throttle: Annotated[str, typer.Option(help="learned | pi | both")] = "both",
+    throttle: Annotated[
+        str,
+        typer.Option(
+            help="learned (throttle head) | learned-speed (target-speed head tracked by the "
+            "expert's P law) | pi | both (the model's learned mode and pi)"
+        ),
+    ] = "both",
     set_speed: Annotated[float, typer.Option(help="PI target speed [m/s].")] = 35.0,
     max_steps: Annotated[int, typer.Option(min=10, help="Steps per episode.")] = 2000,
     expert: Annotated[bool, typer.Option(help="Also drive the (oracle) expert.")] = True,
@@ -211,12 +240,19 @@ def evaluate(
 ) -> None:
     """Closed loop on held-out tracks: return, tiles %, laps, centre distance, autonomy."""
     with _user_errors():
+        from uvnav.bench.ch6_pipeline import default_learned_mode
         from uvnav.bench.ch6_pipeline import evaluate as run_eval
         from uvnav.driving.evaluate import expert_policy, summarize
         from uvnav.driving.sim import DrivingSim
+        from uvnav.learning.checkpoint import load_checkpoint
 
         seed_list = parse_seeds(seeds)
-        modes = ["learned", "pi"] if throttle == "both" else [throttle]
+        modes: list[str]
+        if throttle == "both":
+            net, _ = load_checkpoint(model)
+            modes = [default_learned_mode(net), "pi"]
+        else:
+            modes = [throttle]
         rows: dict[str, dict[str, float]] = {}
         with _progress() as prog:
             for mode in modes:
@@ -285,7 +321,7 @@ def play(
     seed: Annotated[int, typer.Option(help="Track seed.")] = 1000,
     steps: Annotated[int, typer.Option(min=1, help="Steps to drive.")] = 500,
     every: Annotated[int, typer.Option(min=1, help="Keep every N-th frame.")] = 5,
-    throttle: Annotated[str, typer.Option(help="learned | pi")] = "learned",
+    throttle: Annotated[str, typer.Option(help="learned | learned-speed | pi")] = "learned",
 ) -> None:
     """Drive one track and write the frames with predicted vs expert steering."""
     with _user_errors():
@@ -333,7 +369,8 @@ def dagger(
         str, typer.Option(help="Held-out seeds evaluated after each round.")
     ] = "1000-1019",
     throttle: Annotated[
-        str, typer.Option(help="The learner's throttle while driving: pi or learned.")
+        str,
+        typer.Option(help="The learner's throttle while driving: pi, learned or learned-speed."),
     ] = "pi",
     set_speed: Annotated[float, typer.Option(help="PI target speed [m/s].")] = 35.0,
     out_dir: Annotated[Path, typer.Option("--out-dir", help="Folder of the round models.")] = Path(
@@ -345,13 +382,13 @@ def dagger(
 ) -> None:
     """DAgger: the CNN drives, the expert labels, retrain; prints closed loop per round."""
     with _user_errors():
-        from uvnav.bench.ch6_pipeline import cnn_policy, run_dagger
+        from uvnav.bench.ch6_pipeline import THROTTLE_MODES, cnn_policy, run_dagger
         from uvnav.bench.ch6_pipeline import evaluate as run_eval
         from uvnav.driving.evaluate import summarize
         from uvnav.learning.checkpoint import load_checkpoint
 
-        if throttle not in ("learned", "pi"):
-            raise ValueError(f"--throttle: {throttle!r} (must be learned or pi)")
+        if throttle not in THROTTLE_MODES:
+            raise ValueError(f"--throttle: {throttle!r} (must be {', '.join(THROTTLE_MODES)})")
         seed_list = parse_seeds(seeds)
         net, _ = load_checkpoint(model)
         rows: dict[str, dict[str, float]] = {}
@@ -388,6 +425,13 @@ def reproduce(
     dagger_rounds: Annotated[
         int | None, typer.Option(min=0, help="Override: DAgger rounds (0: the thesis's recipe).")
     ] = None,
+    head: Annotated[
+        str,
+        typer.Option(
+            help="Second output: throttle (thesis; closed loop 'learned') or target-speed "
+            "(closed loop 'learned-speed')."
+        ),
+    ] = "throttle",
 ) -> None:
     """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table."""
     with _user_errors():
@@ -406,6 +450,7 @@ def reproduce(
             eval_seeds=parse_seeds(seeds) if seeds else None,
             max_steps=max_steps,
             dagger_rounds=dagger_rounds,
+            head=_parse_head(head),
             progress=lambda s: con.print(f"[dim]… {s}[/dim]"),
         )
         figures = render_ch6(summary, out / "figures")
