@@ -148,7 +148,9 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
                 )
             for c, x in zip(COLUMNS[:3], rec[:3], strict=True):
                 cols[c].append(
-                    _resolve(root, x, log, r, c) if check_images else root / IMG_DIR / x.strip()
+                    _resolve(root, x, log, r, c)
+                    if check_images
+                    else root / IMG_DIR / x.strip().replace("\\", "/").split("/")[-1]
                 )
             for c, x in zip(COLUMNS[3:], rec[3:7], strict=True):
                 cols[c].append(_number(x, log, r, c))

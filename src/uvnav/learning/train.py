@@ -111,13 +111,19 @@ def train_pilotnet(
     cfg = config or TrainConfig()
     torch.set_num_threads(max(1, cfg.threads))
     torch.manual_seed(cfg.seed)
-    if model is None:
-        model = build_pilotnet(net or PilotNetConfig())
-    model.to(cfg.device)
-    ncfg: PilotNetConfig = model.config
     imgs, steer, thr, spd = train
     if len(imgs) == 0:
         raise ValueError("train_pilotnet: empty training set")
+    if model is None:
+        model = build_pilotnet(net or PilotNetConfig())
+        if model.config.predicts_target_speed:
+            # a target-speed output starts at the labels' mean (about 1.3, i.e. 65 m/s) rather
+            # than at 0 (standstill): the usual output-bias initialisation for a regression
+            # whose labels are far from zero; the throttle and steering heads keep torch's
+            with torch.no_grad():
+                model.head[-1].bias[1] = float(np.mean(thr))
+    model.to(cfg.device)
+    ncfg: PilotNetConfig = model.config
     gen = torch.Generator(device=cfg.device)
     gen.manual_seed(cfg.seed)
     rng = np.random.default_rng(cfg.seed)
