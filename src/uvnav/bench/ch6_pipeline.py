@@ -204,7 +204,12 @@ def train_on(
 
 
 def cnn_policy(
-    model: Any, *, throttle: Throttle = "learned", set_speed: float = 35.0
+    model: Any,
+    *,
+    throttle: Throttle = "learned",
+    set_speed: float = 35.0,
+    speed_factor: float = 1.0,
+    max_speed: float | None = None,
 ) -> tuple[Policy, Callable[[], None] | None]:
     """A policy from the network: it sees the frame and the speed only.
 
@@ -215,6 +220,11 @@ def cnn_policy(
             ``clip(0.15 (v̂ − v))``, :func:`uvnav.driving.evaluate.speed_law_throttle`) or
             ``"pi"`` (PI to ``set_speed``).  A steering-only network always uses the PI.
         set_speed: PI target speed [m/s].
+        speed_factor: "learned-speed" only: the car tracks ``speed_factor · v̂`` (1 = the
+            expert's speeds; below 1 leaves the learned steering a margin, see
+            docs/thesis-notes.md).
+        max_speed: "learned-speed" only: a speed limiter [m/s], the car tracks
+            ``min(speed_factor · v̂, max_speed)`` (``None``: none).
 
     Returns:
         ``(policy, on_reset)``; ``on_reset`` clears the PI integral (``None`` otherwise).
@@ -227,6 +237,11 @@ def cnn_policy(
 
     if throttle not in THROTTLE_MODES:
         raise ValueError(f"throttle: {throttle!r} (must be one of {', '.join(THROTTLE_MODES)})")
+    if not 0.0 < speed_factor <= 2.0:
+        raise ValueError(f"speed_factor: {speed_factor} (must be in (0, 2])")
+    if max_speed is not None and max_speed <= 0:
+        raise ValueError(f"max_speed: {max_speed} (must be > 0)")
+    cap = float("inf") if max_speed is None else max_speed
     cfg: PilotNetConfig = model.config
     pred = Predictor(model)
 
@@ -245,7 +260,7 @@ def cnn_policy(
 
         def act_speed(frame: NDArray[np.uint8], tel: Telemetry) -> tuple[float, float]:
             steer, v_hat = pred.outputs(frame, tel.speed)
-            return steer, speed_law_throttle(v_hat, tel.speed)
+            return steer, speed_law_throttle(min(speed_factor * v_hat, cap), tel.speed)
 
         return act_speed, None
     if cfg.predicts_target_speed:
