@@ -138,6 +138,10 @@ def train(
             "expert's target speed; drive it with --throttle learned-speed)."
         ),
     ] = "throttle",
+    target_speed_max: Annotated[
+        float | None,
+        typer.Option(min=1.0, help="target-speed head: cap of the label [m/s] (the top speed)."),
+    ] = None,
     seed: Annotated[int, typer.Option(help="Seed of split, init, shuffling.")] = 0,
 ) -> None:
     """Train the Chapter 6 CNN (Adam, MSE) and write the model and its loss curves."""
@@ -164,6 +168,7 @@ def train(
             n_outputs=2 if throttle_head else 1,
             extra_inputs=1 if speed_input else 0,
             second_output=second,
+            target_speed_max=target_speed_max or PilotNetConfig.target_speed_max,
         )
         cfg = TrainConfig(
             epochs=epochs,
