@@ -55,7 +55,7 @@ def target_speed_label(v_target: ArrayLike, config: PilotNetConfig) -> NDArray[n
         config: network configuration (cap and scale).
 
     Returns:
-        The label (dimensionless, 0.64–2.0 for the expert's 32–100 m/s).
+        The label (dimensionless; 0.64–1.0 for the expert's 32–50 m/s with the default cap).
     """
     v = np.asarray(v_target, dtype=float)
     if not np.all(np.isfinite(v)):
