@@ -130,6 +130,43 @@ def test_target_speed_head_trains_and_drives_with_the_learned_speed_throttle(
     assert bad.exit_code == 2 and "learned-speed" in bad.output
 
 
+def test_speed_head_readout_keeps_the_steering_and_drives(
+    trained: tuple[Path, Path], tmp_path: Path
+) -> None:
+    data, model = trained
+    out = tmp_path / "ro.safetensors"
+    r = runner.invoke(app, ["drive", "speed-head", str(model), str(data), "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "target speed readout" in r.output
+    from uvnav.learning.checkpoint import load_checkpoint
+
+    old, _ = load_checkpoint(model)
+    new, _ = load_checkpoint(out)
+    assert new.config.second_output == "target_speed"
+    sd_old, sd_new = old.state_dict(), new.state_dict()
+    assert all((sd_old[k] == sd_new[k]).all() for k in sd_old if not k.startswith("head.6"))
+    assert (sd_old["head.6.weight"][0] == sd_new["head.6.weight"][0]).all()  # steering row kept
+    r = runner.invoke(
+        app,
+        [
+            "drive",
+            "evaluate",
+            str(out),
+            "--seeds",
+            "1000",
+            "--max-steps",
+            "150",
+            "--throttle",
+            "learned-speed",
+            "--no-expert",
+            "--json",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    row = json.loads(r.output[r.output.index("{") :])["cnn-learned-speed"]
+    assert row["tiles_pct"] > 5.0 and row["mean_speed"] > 5.0
+
+
 def test_play_writes_a_gif(trained: tuple[Path, Path], tmp_path: Path) -> None:
     _, model = trained
     out = tmp_path / "d.gif"

@@ -203,6 +203,78 @@ def train_on(
     return model, record
 
 
+def fit_target_speed_readout(
+    model: Any,
+    data: PreparedData,
+    *,
+    target_speed_max: float | None = None,
+    ridge: float = 1e-3,
+) -> tuple[Any, dict[str, Any]]:
+    """Give a trained network a target-speed output by a linear readout, without retraining.
+
+    The output layer reads 10 hidden units; its steering row is kept, and its second row (the
+    throttle's) is replaced by the ridge least-squares fit of the scaled target-speed label
+    (:func:`uvnav.learning.pilotnet.target_speed_label`) on those units over the training split
+    (eval mode, no augmentation).  Everything the steering depends on is unchanged, so the
+    network steers exactly as before; the hidden units already carry the road ahead and the speed
+    (they were trained to predict the expert's throttle, ``clip(k (v_target − v))``).
+
+    Args:
+        model: a trained two-output network with the speed input.
+        data: prepared data with the target_speed column (the same split as its training).
+        target_speed_max: label cap [m/s] (default: :class:`PilotNetConfig`'s).
+        ridge: ridge regularisation of the least squares.
+
+    Returns:
+        ``(new model, record)``; the record has the validation MSE of both outputs (the second
+        in label units), the target speed RMSE [m/s] and the R² of the readout.
+    """
+    import torch
+
+    from uvnav.learning.pilotnet import build_pilotnet, target_speed_label
+    from uvnav.learning.train import evaluate_mse, hidden_features
+
+    cfg: PilotNetConfig = model.config
+    if cfg.n_outputs != 2:
+        raise ValueError("fit_target_speed_readout: the network has no second output")
+    if data.target_speed_train is None or data.target_speed_val is None:
+        raise ValueError(
+            "target_speed: the dataset has no target_speed column (8th column of "
+            "driving_log.csv, written by `uvnav drive collect`)"
+        )
+    new_cfg = PilotNetConfig.from_dict(
+        {
+            **cfg.to_dict(),
+            "second_output": "target_speed",
+            "target_speed_max": target_speed_max or PilotNetConfig.target_speed_max,
+        }
+    )
+    new: Any = build_pilotnet(new_cfg)
+    new.load_state_dict(model.state_dict())
+    f_tr = hidden_features(new, data.train[0], data.train[3])
+    y_tr = target_speed_label(data.target_speed_train, new_cfg)
+    a = np.c_[f_tr, np.ones(len(f_tr))]
+    w = np.linalg.solve(a.T @ a + ridge * np.eye(a.shape[1]), a.T @ y_tr)
+    with torch.no_grad():
+        new.head[-1].weight[1] = torch.as_tensor(w[:-1], dtype=torch.float32)
+        new.head[-1].bias[1] = float(w[-1])
+    y_va = target_speed_label(data.target_speed_val, new_cfg)
+    m, ms, mt = evaluate_mse(new, data.val[0], data.val[1], y_va, data.val[3])
+    var = float(np.var(y_va))
+    record = {
+        "second_output": "target_speed",
+        "readout": "ridge least squares on the last hidden layer",
+        "val_loss": [m],
+        "val_steering_mse": [ms],
+        "val_throttle_mse": [mt],
+        "val_target_speed_rmse": [float(np.sqrt(mt)) * new_cfg.speed_scale],
+        "val_target_speed_r2": 1.0 - mt / var if var > 0 else float("nan"),
+        "n_train": len(y_tr),
+        "n_val": len(y_va),
+    }
+    return new.eval(), record
+
+
 def cnn_policy(
     model: Any,
     *,

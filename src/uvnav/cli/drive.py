@@ -1,4 +1,5 @@
-"""``uvnav drive``: thesis Chapter 6 — collect, train, evaluate, play, dagger (DESIGN §6).
+"""``uvnav drive``: thesis Chapter 6 — collect, train, speed-head, evaluate, play, dagger,
+reproduce (DESIGN §6).
 
 Thin Typer commands over :mod:`uvnav.driving`, :mod:`uvnav.learning` and
 :mod:`uvnav.bench.ch6_pipeline`.  User errors (a missing or malformed dataset or model, a bad
@@ -198,6 +199,35 @@ def train(
             f"second output {record['val_throttle_mse'][-1]:.4f}{extra})"
         )
         typer.echo(f"wrote {out}")
+
+
+@drive_app.command("speed-head")
+def speed_head(
+    model: Annotated[Path, typer.Argument(help="Trained throttle-head model (.safetensors).")],
+    data: Annotated[Path, typer.Argument(help="Its dataset (with the target_speed column).")],
+    out: Annotated[Path, typer.Option("--out", help="Output model (.safetensors).")] = Path(
+        "model-speed.safetensors"
+    ),
+    target_speed_max: Annotated[
+        float | None, typer.Option(min=1.0, help="Cap of the target-speed label [m/s].")
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the split (as in training).")] = 0,
+) -> None:
+    """Replace the throttle output by a linear target-speed readout (steering unchanged)."""
+    with _user_errors():
+        from uvnav.bench.ch6_pipeline import fit_target_speed_readout, prepare_data
+        from uvnav.learning.checkpoint import load_checkpoint, save_checkpoint
+
+        net, _ = load_checkpoint(model)
+        prep = prepare_data(data, seed=seed, size=(net.config.height, net.config.width))
+        new, record = fit_target_speed_readout(net, prep, target_speed_max=target_speed_max)
+        save_checkpoint(new, out, record={**record, "source": str(model)})
+        typer.echo(
+            f"target speed readout: val RMSE {record['val_target_speed_rmse'][0]:.2f} m/s "
+            f"(R² {record['val_target_speed_r2']:.3f}), steering val MSE "
+            f"{record['val_steering_mse'][0]:.4f}; wrote {out} "
+            "(drive it with --throttle learned-speed)"
+        )
 
 
 def _parse_head(head: str) -> str:

@@ -137,7 +137,8 @@ def build_pilotnet(config: PilotNetConfig | None = None) -> torch.nn.Module:
                 nn.Linear(10, cfg.n_outputs),
             )
 
-        def forward(self, images: Any, extra: Any = None) -> Any:
+        def hidden(self, images: Any, extra: Any = None) -> Any:
+            """The last hidden layer (the 10 units the output layer reads)."""
             # normalisation layer (thesis §6.2): [0, 255] -> [-1, 1], HWC -> CHW
             x = (images.float().permute(0, 3, 1, 2) / 127.5 - 1.0).contiguous()
             f = self.features(x)
@@ -145,6 +146,9 @@ def build_pilotnet(config: PilotNetConfig | None = None) -> torch.nn.Module:
                 if extra is None:
                     raise ValueError("PilotNet: this network needs the speed input (extra)")
                 f = torch.cat([f, extra.float().reshape(f.shape[0], -1) / cfg.speed_scale], dim=1)
-            return self.head(f)
+            return self.head[:-1](f)
+
+        def forward(self, images: Any, extra: Any = None) -> Any:
+            return self.head[-1](self.hidden(images, extra))
 
     return PilotNet()

@@ -179,6 +179,34 @@ def train_pilotnet(
     return model, hist
 
 
+def hidden_features(
+    model: Any,
+    images: NDArray[np.uint8],
+    speed: NDArray[np.float64] | None,
+    *,
+    batch_size: int = 200,
+    device: str = "cpu",
+) -> NDArray[np.float64]:
+    """The last hidden layer's activations (eval mode), ``(N, 10)``: what the output layer reads."""
+    import torch
+
+    model.eval()
+    cfg: PilotNetConfig = model.config
+    out = []
+    with torch.no_grad():
+        for a in range(0, len(images), batch_size):
+            xb = torch.as_tensor(images[a : a + batch_size]).to(device)
+            eb = (
+                torch.as_tensor(
+                    np.asarray(speed[a : a + batch_size], dtype=np.float32)[:, None]
+                ).to(device)
+                if cfg.extra_inputs and speed is not None
+                else None
+            )
+            out.append(model.hidden(xb, eb).cpu())
+    return torch.cat(out).numpy().astype(np.float64)
+
+
 class Predictor:
     """Run a trained network on single frames: ``predictor(frame, speed) -> (steer, throttle)``.
 
