@@ -102,5 +102,7 @@ def test_throttle_modes_of_the_cnn_policy() -> None:
         cnn_policy(model, throttle="learned")
     with pytest.raises(ValueError, match="throttle head"):
         cnn_policy(build_pilotnet(PilotNetConfig(height=48, width=96)), throttle="learned-speed")
+    with pytest.raises(ValueError, match="speed_factor"):
+        cnn_policy(model, throttle="learned-speed", speed_factor=0.0)
     with pytest.raises(ValueError, match="must be one of"):
         cnn_policy(model, throttle="turbo")  # type: ignore[arg-type]

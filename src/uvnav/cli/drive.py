@@ -245,7 +245,13 @@ def _dataset_meta(data: Path) -> dict[str, Any]:
     return json.loads(f.read_text()) if f.is_file() else {"camera": "front"}
 
 
-def _load_policy(model_path: Path, throttle: str, set_speed: float) -> tuple[Any, Any, str]:
+def _load_policy(
+    model_path: Path,
+    throttle: str,
+    set_speed: float,
+    speed_factor: float = 1.0,
+    max_speed: float | None = None,
+) -> tuple[Any, Any, str]:
     from uvnav.bench.ch6_pipeline import THROTTLE_MODES, cnn_policy
     from uvnav.learning.checkpoint import load_checkpoint
 
@@ -253,7 +259,13 @@ def _load_policy(model_path: Path, throttle: str, set_speed: float) -> tuple[Any
         raise ValueError(f"--throttle: {throttle!r} (must be {', '.join(THROTTLE_MODES)} or both)")
     model, _ = load_checkpoint(model_path)
     camera = "topdown" if (model.config.height, model.config.width) == (96, 96) else "front"
-    policy, on_reset = cnn_policy(model, throttle=throttle, set_speed=set_speed)  # type: ignore[arg-type]
+    policy, on_reset = cnn_policy(
+        model,
+        throttle=throttle,  # type: ignore[arg-type]
+        set_speed=set_speed,
+        speed_factor=speed_factor,
+        max_speed=max_speed,
+    )
     return policy, on_reset, camera
 
 
@@ -269,6 +281,12 @@ def evaluate(
         ),
     ] = "both",
     set_speed: Annotated[float, typer.Option(help="PI target speed [m/s].")] = 35.0,
+    speed_factor: Annotated[
+        float, typer.Option(help="learned-speed: track this fraction of the predicted speed.")
+    ] = 1.0,
+    max_speed: Annotated[
+        float | None, typer.Option(help="learned-speed: speed limiter [m/s].")
+    ] = None,
     max_steps: Annotated[int, typer.Option(min=10, help="Steps per episode.")] = 2000,
     expert: Annotated[bool, typer.Option(help="Also drive the (oracle) expert.")] = True,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
@@ -291,7 +309,9 @@ def evaluate(
         rows: dict[str, dict[str, float]] = {}
         with _progress() as prog:
             for mode in modes:
-                policy, on_reset, camera = _load_policy(model, mode, set_speed)
+                policy, on_reset, camera = _load_policy(
+                    model, mode, set_speed, speed_factor, max_speed
+                )
                 sim = DrivingSim(camera=camera, max_steps=max_steps)  # type: ignore[arg-type]
                 task = prog.add_task(f"cnn + {mode} throttle", total=len(seed_list))
                 res = run_eval(
