@@ -28,10 +28,13 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
         dagger_rounds=1,
         dagger_episodes=1,
         dagger_epochs=1,
+        head="target_speed",  # the thesis's throttle head is driven in tests/cli
     )
     assert s.record["n_frames"] == 90  # 30 rows x 3 cameras
     assert len(s.steering_train) + len(s.steering_val) == s.record["n_balanced"]
-    assert set(s.closed_loop) == {"cnn-learned", "cnn-pi", "dagger1-pi", "expert"}
+    assert set(s.closed_loop) == {"cnn-learned-speed", "cnn-pi", "dagger1-pi", "expert"}
+    assert s.record["second_output"] == "target_speed" and s.record["val_target_speed_rmse"]
+    assert "target speed RMSE" in s.table[2]["note"]
     # the DAgger rows go to a copy: data/ keeps the expert's 30 rows, the aggregate has more
     assert s.closed_loop["dagger1-pi"]["rows_added"] == 30  # 120 steps, one row every 4
     assert len(read_log(tmp_path / "data")) == 30
@@ -63,3 +66,43 @@ def test_dagger_round_appends_expert_labelled_rows(tmp_path: Path) -> None:
     assert np.all(np.abs(log.steering) <= 1.0) and np.all(np.abs(log.throttle) <= 1.0)
     # the first state is the start of the track, where the expert's label is near straight
     assert abs(log.steering[0]) < 0.3
+
+
+def test_throttle_modes_of_the_cnn_policy() -> None:
+    """learned-speed = the expert's P law on the network's target speed; modes match the head."""
+    import torch
+
+    from uvnav.bench.ch6_pipeline import cnn_policy, default_learned_mode
+    from uvnav.driving.sim import Telemetry
+
+    torch.manual_seed(0)
+    net = PilotNetConfig(height=48, width=96, second_output="target_speed")
+    model = build_pilotnet(net).eval()
+    with torch.no_grad():  # the second output is 0.8 whatever the image: 0.8 * 50 = 40 m/s
+        model.head[-1].weight[1].zero_()
+        model.head[-1].bias[1] = 0.8
+    frame = np.zeros((48, 96, 3), dtype=np.uint8)
+
+    def tel(v: float) -> Telemetry:
+        return Telemetry(0, 0.0, 0.0, 0.0, v, 0.0, 0.0, 0, 0, 10, False)
+
+    assert default_learned_mode(model) == "learned-speed"
+    act, on_reset = cnn_policy(model, throttle="learned-speed")
+    assert on_reset is None
+    assert act(frame, tel(36.0))[1] == pytest.approx(0.15 * (40.0 - 36.0))
+    assert act(frame, tel(45.0))[1] == pytest.approx(0.15 * (40.0 - 45.0))  # brakes above it
+    assert act(frame, tel(0.0))[1] == 1.0  # clipped
+    slow, _ = cnn_policy(model, throttle="learned-speed", speed_factor=0.5)
+    assert slow(frame, tel(15.0))[1] == pytest.approx(0.15 * (20.0 - 15.0))
+    capped, _ = cnn_policy(model, throttle="learned-speed", max_speed=32.0)
+    assert capped(frame, tel(30.0))[1] == pytest.approx(0.15 * (32.0 - 30.0))
+    pi, reset = cnn_policy(model, throttle="pi", set_speed=35.0)
+    assert reset is not None and pi(frame, tel(10.0))[1] > 0 and pi(frame, tel(60.0))[1] < 0
+    with pytest.raises(ValueError, match="learned-speed"):
+        cnn_policy(model, throttle="learned")
+    with pytest.raises(ValueError, match="throttle head"):
+        cnn_policy(build_pilotnet(PilotNetConfig(height=48, width=96)), throttle="learned-speed")
+    with pytest.raises(ValueError, match="speed_factor"):
+        cnn_policy(model, throttle="learned-speed", speed_factor=0.0)
+    with pytest.raises(ValueError, match="must be one of"):
+        cnn_policy(model, throttle="turbo")  # type: ignore[arg-type]

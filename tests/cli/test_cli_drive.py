@@ -79,6 +79,94 @@ def test_briefly_trained_model_moves_along_the_track(trained: tuple[Path, Path])
     assert row["mean_centre_distance"] < 40 / 6.0  # on average on the road
 
 
+def test_target_speed_head_trains_and_drives_with_the_learned_speed_throttle(
+    trained: tuple[Path, Path], tmp_path: Path
+) -> None:
+    data, _ = trained
+    assert read_log(data).target_speed is not None  # collect records the 8th column
+    model = tmp_path / "ts.safetensors"
+    r = runner.invoke(
+        app,
+        [
+            "drive",
+            "train",
+            str(data),
+            "--out",
+            str(model),
+            "--epochs",
+            "2",
+            "--batch-size",
+            "30",
+            "--head",
+            "target-speed",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    rec = json.loads(model.with_suffix(".json").read_text())["record"]
+    assert rec["second_output"] == "target_speed"
+    assert rec["train_loss"][-1] < rec["train_loss"][0]  # the new head trains
+    assert len(rec["val_target_speed_rmse"]) == 2
+    r = runner.invoke(
+        app,
+        [
+            "drive",
+            "evaluate",
+            str(model),
+            "--seeds",
+            "1000",
+            "--max-steps",
+            "150",
+            "--no-expert",
+            "--json",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    rows = json.loads(r.output[r.output.index("{") :])
+    assert set(rows) == {"cnn-learned-speed", "cnn-pi"}  # "both" = the model's learned mode + PI
+    row = rows["cnn-learned-speed"]
+    assert row["tiles_pct"] > 5.0  # the network's own speed choice moves the car along
+    assert row["mean_speed"] > 5.0
+    bad = runner.invoke(app, ["drive", "evaluate", str(model), "--throttle", "learned"])
+    assert bad.exit_code == 2 and "learned-speed" in bad.output
+
+
+def test_speed_head_readout_keeps_the_steering_and_drives(
+    trained: tuple[Path, Path], tmp_path: Path
+) -> None:
+    data, model = trained
+    out = tmp_path / "ro.safetensors"
+    r = runner.invoke(app, ["drive", "speed-head", str(model), str(data), "--out", str(out)])
+    assert r.exit_code == 0, r.output
+    assert "target speed readout" in r.output
+    from uvnav.learning.checkpoint import load_checkpoint
+
+    old, _ = load_checkpoint(model)
+    new, _ = load_checkpoint(out)
+    assert new.config.second_output == "target_speed"
+    sd_old, sd_new = old.state_dict(), new.state_dict()
+    assert all((sd_old[k] == sd_new[k]).all() for k in sd_old if not k.startswith("head.6"))
+    assert (sd_old["head.6.weight"][0] == sd_new["head.6.weight"][0]).all()  # steering row kept
+    r = runner.invoke(
+        app,
+        [
+            "drive",
+            "evaluate",
+            str(out),
+            "--seeds",
+            "1000",
+            "--max-steps",
+            "150",
+            "--throttle",
+            "learned-speed",
+            "--no-expert",
+            "--json",
+        ],
+    )
+    assert r.exit_code == 0, r.output
+    row = json.loads(r.output[r.output.index("{") :])["cnn-learned-speed"]
+    assert row["tiles_pct"] > 5.0 and row["mean_speed"] > 5.0
+
+
 def test_play_writes_a_gif(trained: tuple[Path, Path], tmp_path: Path) -> None:
     _, model = trained
     out = tmp_path / "d.gif"
@@ -96,6 +184,8 @@ def test_play_writes_a_gif(trained: tuple[Path, Path], tmp_path: Path) -> None:
         (["drive", "collect", "--out", "x", "--camera", "side"], "--camera"),
         (["drive", "play", "x.safetensors", "--out", "x.avi"], "--out"),
         (["drive", "dagger", "d", "x.safetensors", "--throttle", "turbo"], "--throttle"),
+        (["drive", "train", "d", "--head", "pedal"], "--head"),
+        (["drive", "evaluate", "x.safetensors", "--throttle", "turbo"], "--throttle"),
     ],
 )
 def test_errors_are_one_line_exit_2(

@@ -127,3 +127,45 @@ def test_split_is_8_to_2_disjoint_and_complete() -> None:
     assert set(tr).isdisjoint(va) and set(tr) | set(va) == set(range(1499))
     tr2, _ = split_indices(1499, np.random.default_rng(0))
     assert np.array_equal(tr, tr2)
+
+
+def test_target_speed_column_is_optional_and_udacity_rows_still_load(tmp_path) -> None:
+    w = LogWriter(tmp_path)
+    w.write("a", (_img(1), _img(2), _img(3)), steering=0.1, throttle=0.3, brake=0.0, speed=5.0)
+    w.close()
+    plain = read_log(tmp_path)
+    assert plain.target_speed is None  # seven columns, as Udacity's recorder writes
+    assert expand_cameras(plain).target_speed is None
+    w = LogWriter(tmp_path)  # resumed with the 8th column (e.g. DAgger rows)
+    w.write(
+        "b",
+        (_img(1), _img(2), _img(3)),
+        steering=0.2,
+        throttle=0.3,
+        brake=0.0,
+        speed=5.0,
+        target_speed=42.5,
+    )
+    w.close()
+    lines = (tmp_path / "driving_log.csv").read_text().splitlines()
+    assert [len(x.split(",")) for x in lines] == [7, 8]
+    log = read_log(tmp_path)
+    assert log.target_speed is not None
+    assert np.isnan(log.target_speed[0]) and log.target_speed[1] == 42.5
+    s = expand_cameras(log, correction=0.2)
+    assert s.target_speed is not None and len(s.target_speed) == 6
+    assert np.allclose(s.target_speed[[1, 3, 5]], 42.5)  # side cameras keep the target speed
+    assert np.allclose(s.take(np.array([3])).target_speed, [42.5])
+
+
+def test_bad_target_speed_names_the_column(tmp_path) -> None:
+    (tmp_path / "IMG").mkdir()
+    from PIL import Image
+
+    Image.fromarray(_img(1)).save(tmp_path / "IMG" / "c.jpg")
+    (tmp_path / "driving_log.csv").write_text("IMG/c.jpg,IMG/c.jpg,IMG/c.jpg,0,0,0,0,fast\n")
+    with pytest.raises(DatasetError, match="column 'target_speed'"):
+        read_log(tmp_path)
+    (tmp_path / "driving_log.csv").write_text("IMG/c.jpg,IMG/c.jpg,IMG/c.jpg,0,0,0,0,1,2\n")
+    with pytest.raises(DatasetError, match="row 1: 9 columns"):
+        read_log(tmp_path)

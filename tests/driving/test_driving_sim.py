@@ -13,6 +13,7 @@ from uvnav.driving.evaluate import (
     autonomy_score,
     expert_policy,
     run_closed_loop,
+    speed_law_throttle,
 )
 from uvnav.driving.expert import PurePursuitExpert, ar1_noise
 from uvnav.driving.sim import HALF_WIDTH, DrivingSim
@@ -89,3 +90,21 @@ def test_ar1_noise_statistics() -> None:
     e = ar1_noise(np.random.default_rng(0), 20000, sigma=0.3, rho=0.9)
     assert abs(e.std() - 0.3) < 0.03
     assert abs(np.corrcoef(e[:-1], e[1:])[0, 1] - 0.9) < 0.03
+
+
+def test_expert_target_speed_label_gives_its_throttle(sim) -> None:
+    """The recorded target speed: the expert's pedal is the P law on it, and it slows corners."""
+    _, tel = sim.reset(7)
+    expert = PurePursuitExpert(sim.geometry)
+    targets, curv = [], []
+    for _ in range(250):
+        steer, throttle, v_target = expert.label(tel)
+        assert (steer, throttle) == expert.act(tel)
+        assert throttle == pytest.approx(speed_law_throttle(v_target, tel.speed))
+        targets.append(v_target)
+        curv.append(float(np.abs(sim.geometry.curvature).max()))
+        tel = sim.step(steer, throttle).telemetry
+    p = expert.params
+    v_corner = np.sqrt(p.a_lat / max(curv))  # the tightest corner's speed limit
+    assert min(targets) >= v_corner - 1e-6 and max(targets) <= p.v_max
+    assert max(targets) - min(targets) > 10.0  # it does change along the track

@@ -87,3 +87,34 @@ def test_training_is_deterministic_with_a_seed() -> None:
     _, h1 = train_pilotnet((imgs, steer, z, z), None, net=net, config=cfg)
     _, h2 = train_pilotnet((imgs, steer, z, z), None, net=net, config=cfg)
     assert h1.train_loss == h2.train_loss
+
+
+def test_target_speed_head_trains_and_predicts_a_speed() -> None:
+    """The "learned-speed" head: the second output learns the (scaled) target speed."""
+    from uvnav.learning.pilotnet import target_speed_from_output, target_speed_label
+
+    rng = np.random.default_rng(2)
+    imgs, steer = _road_like(120, rng)
+    net = PilotNetConfig(height=H, width=W, dropout=0.1, second_output="target_speed")
+    # the road band's position also sets the target speed (a sharp turn ahead: slow)
+    v_target = 50.0 - 25.0 * np.abs(steer)  # 30-50 m/s, below the cap
+    label = target_speed_label(v_target, net)
+    spd = rng.uniform(10, 60, len(imgs))
+    train = (imgs[40:], steer[40:], label[40:], spd[40:])
+    val = (imgs[:40], steer[:40], label[:40], spd[:40])
+    cfg = TrainConfig(epochs=4, batch_size=20, augment=False, seed=0)
+    model, hist = train_pilotnet(train, val, net=net, config=cfg)
+    assert hist.val_throttle_mse[-1] < 0.7 * hist.val_throttle_mse[0]
+    assert hist.train_loss[-1] < hist.train_loss[0]
+    pred = Predictor(model)
+    with pytest.raises(ValueError, match="learned-speed"):
+        pred(imgs[0], 30.0)  # not a throttle
+    errs = [abs(pred.outputs(imgs[k], float(spd[k]))[1] - v_target[k]) for k in range(40)]
+    # better than the best constant guess (the mean), in [m/s]
+    assert np.mean(errs) < np.mean(np.abs(v_target[:40] - np.mean(v_target[40:])))
+    assert target_speed_from_output(target_speed_label([50.0, 150.0], net), net).tolist() == [
+        50.0,
+        net.target_speed_max,
+    ]
+    with pytest.raises(ValueError, match="target_speed"):
+        target_speed_label([np.nan], net)

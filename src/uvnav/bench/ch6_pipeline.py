@@ -37,18 +37,28 @@ from uvnav.driving.evaluate import (
     Policy,
     expert_policy,
     run_closed_loop,
+    speed_law_throttle,
     with_pi_throttle,
 )
 from uvnav.driving.expert import PurePursuitExpert
 from uvnav.driving.sim import DrivingSim, Telemetry
 from uvnav.learning.config import PilotNetConfig, TrainConfig
 
-Throttle = Literal["learned", "pi"]
+#: the closed loop's throttle: the network's throttle head ("learned", the thesis's), the
+#: proportional law tracking the network's target-speed output ("learned-speed"), or a PI to a
+#: constant set speed ("pi", Udacity's drive.py)
+Throttle = Literal["learned", "learned-speed", "pi"]
+THROTTLE_MODES: tuple[str, ...] = ("learned", "learned-speed", "pi")
 
 
 @dataclass
 class PreparedData:
-    """A dataset after camera expansion, balancing and the 8:2 split (arrays in memory)."""
+    """A dataset after camera expansion, balancing and the 8:2 split (arrays in memory).
+
+    ``train``/``val`` are ``(images, steering, throttle, speed)``; ``target_speed_train`` /
+    ``target_speed_val`` the expert's target speed [m/s] of the same samples (``None`` when the
+    log has no target_speed column).
+    """
 
     steering_all: NDArray[np.float64]
     steering_balanced: NDArray[np.float64]
@@ -57,6 +67,8 @@ class PreparedData:
     n_rows: int
     n_frames: int
     info: dict[str, Any] = field(default_factory=dict)
+    target_speed_train: NDArray[np.float64] | None = None
+    target_speed_val: NDArray[np.float64] | None = None
 
 
 def prepare_data(
@@ -101,6 +113,7 @@ def prepare_data(
         return (imgs[idx], bal.steering[idx], bal.throttle[idx], bal.speed[idx])
 
     counts, _ = steering_histogram(samples.steering, n_bins=n_bins)
+    ts = bal.target_speed
     return PreparedData(
         steering_all=samples.steering,
         steering_balanced=bal.steering,
@@ -116,6 +129,27 @@ def prepare_data(
             "n_train": len(tr),
             "n_val": len(va),
         },
+        target_speed_train=None if ts is None else ts[tr],
+        target_speed_val=None if ts is None else ts[va],
+    )
+
+
+def _labelled(data: PreparedData, net: PilotNetConfig) -> tuple[Any, Any]:
+    """``(train, val)`` with the third array the network's second-output label."""
+    if not net.predicts_target_speed:
+        return data.train, data.val
+    from uvnav.learning.pilotnet import target_speed_label
+
+    if data.target_speed_train is None or data.target_speed_val is None:
+        raise ValueError(
+            "target_speed: the dataset has no target_speed column (8th column of "
+            "driving_log.csv, written by `uvnav drive collect`); train the throttle head instead"
+        )
+    im, st, _, sp = data.train
+    vim, vst, _, vsp = data.val
+    return (
+        (im, st, target_speed_label(data.target_speed_train, net), sp),
+        (vim, vst, target_speed_label(data.target_speed_val, net), vsp),
     )
 
 
@@ -130,21 +164,35 @@ def train_on(
 ) -> tuple[Any, dict[str, Any]]:
     """Train on prepared data and save the checkpoint ``out`` (safetensors + JSON).
 
+    The second output is trained on the throttle or, for ``net.second_output ==
+    "target_speed"``, on the expert's scaled target speed; ``val_throttle_mse`` is that second
+    output's term either way (``second_output`` in the record says which), and for a target-speed
+    network ``val_target_speed_rmse`` gives it in [m/s].
+
     Returns:
         ``(model, record)`` with the loss curves, data counts and timing in ``record``.
     """
     from uvnav.learning.checkpoint import save_checkpoint
     from uvnav.learning.train import train_pilotnet
 
+    ncfg: PilotNetConfig = model.config if model is not None else (net or PilotNetConfig())
+    train, val = _labelled(data, ncfg)
     tic = time.process_time()
     model, hist = train_pilotnet(
-        data.train, data.val, net=net, config=config, model=model, on_epoch=on_epoch
+        train, val, net=ncfg, config=config, model=model, on_epoch=on_epoch
     )
+    second = ncfg.second_output if ncfg.n_outputs == 2 else "none"
     record = {
+        "second_output": second,
         "train_loss": hist.train_loss,
         "val_loss": hist.val_loss,
         "val_steering_mse": hist.val_steering_mse,
         "val_throttle_mse": hist.val_throttle_mse,
+        "val_target_speed_rmse": [
+            float(np.sqrt(m)) * ncfg.speed_scale for m in hist.val_throttle_mse
+        ]
+        if second == "target_speed"
+        else [],
         "images_per_s": hist.images_per_s,
         "cpu_s": time.process_time() - tic,
         "n_rows": data.n_rows,
@@ -155,30 +203,149 @@ def train_on(
     return model, record
 
 
+def fit_target_speed_readout(
+    model: Any,
+    data: PreparedData,
+    *,
+    target_speed_max: float | None = None,
+    ridge: float = 1e-3,
+) -> tuple[Any, dict[str, Any]]:
+    """Give a trained network a target-speed output by a linear readout, without retraining.
+
+    The output layer reads 10 hidden units; its steering row is kept, and its second row (the
+    throttle's) is replaced by the ridge least-squares fit of the scaled target-speed label
+    (:func:`uvnav.learning.pilotnet.target_speed_label`) on those units over the training split
+    (eval mode, no augmentation).  Everything the steering depends on is unchanged, so the
+    network steers exactly as before; the hidden units already carry the road ahead and the speed
+    (they were trained to predict the expert's throttle, ``clip(k (v_target − v))``).
+
+    Args:
+        model: a trained two-output network with the speed input.
+        data: prepared data with the target_speed column (the same split as its training).
+        target_speed_max: label cap [m/s] (default: :class:`PilotNetConfig`'s).
+        ridge: ridge regularisation of the least squares.
+
+    Returns:
+        ``(new model, record)``; the record has the validation MSE of both outputs (the second
+        in label units), the target speed RMSE [m/s] and the R² of the readout.
+    """
+    import torch
+
+    from uvnav.learning.pilotnet import build_pilotnet, target_speed_label
+    from uvnav.learning.train import evaluate_mse, hidden_features
+
+    cfg: PilotNetConfig = model.config
+    if cfg.n_outputs != 2:
+        raise ValueError("fit_target_speed_readout: the network has no second output")
+    if data.target_speed_train is None or data.target_speed_val is None:
+        raise ValueError(
+            "target_speed: the dataset has no target_speed column (8th column of "
+            "driving_log.csv, written by `uvnav drive collect`)"
+        )
+    new_cfg = PilotNetConfig.from_dict(
+        {
+            **cfg.to_dict(),
+            "second_output": "target_speed",
+            "target_speed_max": target_speed_max or PilotNetConfig.target_speed_max,
+        }
+    )
+    new: Any = build_pilotnet(new_cfg)
+    new.load_state_dict(model.state_dict())
+    f_tr = hidden_features(new, data.train[0], data.train[3])
+    y_tr = target_speed_label(data.target_speed_train, new_cfg)
+    a = np.c_[f_tr, np.ones(len(f_tr))]
+    w = np.linalg.solve(a.T @ a + ridge * np.eye(a.shape[1]), a.T @ y_tr)
+    with torch.no_grad():
+        new.head[-1].weight[1] = torch.as_tensor(w[:-1], dtype=torch.float32)
+        new.head[-1].bias[1] = float(w[-1])
+    y_va = target_speed_label(data.target_speed_val, new_cfg)
+    m, ms, mt = evaluate_mse(new, data.val[0], data.val[1], y_va, data.val[3])
+    var = float(np.var(y_va))
+    record = {
+        "second_output": "target_speed",
+        "readout": "ridge least squares on the last hidden layer",
+        "val_loss": [m],
+        "val_steering_mse": [ms],
+        "val_throttle_mse": [mt],
+        "val_target_speed_rmse": [float(np.sqrt(mt)) * new_cfg.speed_scale],
+        "val_target_speed_r2": 1.0 - mt / var if var > 0 else float("nan"),
+        "n_train": len(y_tr),
+        "n_val": len(y_va),
+    }
+    return new.eval(), record
+
+
 def cnn_policy(
-    model: Any, *, throttle: Throttle = "learned", set_speed: float = 35.0
+    model: Any,
+    *,
+    throttle: Throttle = "learned",
+    set_speed: float = 35.0,
+    speed_factor: float = 1.0,
+    max_speed: float | None = None,
 ) -> tuple[Policy, Callable[[], None] | None]:
     """A policy from the network: it sees the frame and the speed only.
 
     Args:
         model: trained network.
-        throttle: ``"learned"`` (the network's throttle head) or ``"pi"`` (PI to ``set_speed``).
+        throttle: ``"learned"`` (the network's throttle head, the thesis's), ``"learned-speed"``
+            (the network's target-speed output tracked by the expert's proportional law
+            ``clip(0.15 (v̂ − v))``, :func:`uvnav.driving.evaluate.speed_law_throttle`) or
+            ``"pi"`` (PI to ``set_speed``).  A steering-only network always uses the PI.
         set_speed: PI target speed [m/s].
+        speed_factor: "learned-speed" only: the car tracks ``speed_factor · v̂`` (1 = the
+            expert's speeds; below 1 leaves the learned steering a margin, see
+            docs/thesis-notes.md).
+        max_speed: "learned-speed" only: a speed limiter [m/s], the car tracks
+            ``min(speed_factor · v̂, max_speed)`` (``None``: none).
 
     Returns:
-        ``(policy, on_reset)``; ``on_reset`` clears the PI integral (``None`` for learned).
+        ``(policy, on_reset)``; ``on_reset`` clears the PI integral (``None`` otherwise).
+
+    Raises:
+        ValueError: an unknown mode, or a mode the network's second output does not serve
+            ("learned" needs a throttle head, "learned-speed" a target-speed head).
     """
     from uvnav.learning.train import Predictor
 
+    if throttle not in THROTTLE_MODES:
+        raise ValueError(f"throttle: {throttle!r} (must be one of {', '.join(THROTTLE_MODES)})")
+    if not 0.0 < speed_factor <= 2.0:
+        raise ValueError(f"speed_factor: {speed_factor} (must be in (0, 2])")
+    if max_speed is not None and max_speed <= 0:
+        raise ValueError(f"max_speed: {max_speed} (must be > 0)")
+    cap = float("inf") if max_speed is None else max_speed
+    cfg: PilotNetConfig = model.config
     pred = Predictor(model)
 
     def act(frame: NDArray[np.uint8], tel: Telemetry) -> tuple[float, float]:
-        return pred(frame, tel.speed)
+        return pred.outputs(frame, tel.speed)
 
-    if throttle == "pi" or model.config.n_outputs == 1:
+    if throttle == "pi" or cfg.n_outputs == 1:
         pi = PISpeedController(set_speed=set_speed)
         return with_pi_throttle(act, pi), pi.reset
+    if throttle == "learned-speed":
+        if not cfg.predicts_target_speed:
+            raise ValueError(
+                "throttle 'learned-speed' needs a network trained on the target speed "
+                "(second_output='target_speed'); this one has a throttle head: use 'learned'"
+            )
+
+        def act_speed(frame: NDArray[np.uint8], tel: Telemetry) -> tuple[float, float]:
+            steer, v_hat = pred.outputs(frame, tel.speed)
+            return steer, speed_law_throttle(min(speed_factor * v_hat, cap), tel.speed)
+
+        return act_speed, None
+    if cfg.predicts_target_speed:
+        raise ValueError(
+            "throttle 'learned' needs a throttle head; this network predicts the target "
+            "speed: use 'learned-speed'"
+        )
     return act, None
+
+
+def default_learned_mode(model: Any) -> Throttle:
+    """The learned throttle mode a network serves: "learned-speed" or "learned"."""
+    return "learned-speed" if model.config.predicts_target_speed else "learned"
 
 
 def evaluate(
@@ -242,7 +409,9 @@ def dagger_collect(
         beta: probability per step that the expert's command is applied instead.
         record_every: record every this many steps.
         max_steps: steps per episode.
-        throttle: the learner's throttle: ``"pi"`` (PI to ``set_speed``) or ``"learned"``.
+        throttle: the learner's throttle: ``"pi"`` (PI to ``set_speed``), ``"learned"`` or
+            ``"learned-speed"`` (then the states visited include the learner's own speed
+            mistakes, e.g. too fast before corners, and the expert labels them).
         set_speed: PI target speed [m/s].
 
     Returns:
@@ -261,7 +430,7 @@ def dagger_collect(
             assert sim.geometry is not None
             expert = PurePursuitExpert(sim.geometry)
             for k in range(max_steps):
-                e_steer, e_thr = expert.act(tel)
+                e_steer, e_thr, e_target = expert.label(tel)
                 if k % record_every == 0:
                     left, centre, right = sim.side_views()
                     writer.write(
@@ -271,6 +440,7 @@ def dagger_collect(
                         throttle=e_thr,
                         brake=max(-e_thr, 0.0),
                         speed=tel.speed,
+                        target_speed=e_target,
                     )
                     rows += 1
                 steer, thr = (e_steer, e_thr) if rng.random() < beta else learner(frame, tel)

@@ -1,4 +1,5 @@
-"""``uvnav drive``: thesis Chapter 6 — collect, train, evaluate, play, dagger (DESIGN §6).
+"""``uvnav drive``: thesis Chapter 6 — collect, train, speed-head, evaluate, play, dagger,
+reproduce (DESIGN §6).
 
 Thin Typer commands over :mod:`uvnav.driving`, :mod:`uvnav.learning` and
 :mod:`uvnav.bench.ch6_pipeline`.  User errors (a missing or malformed dataset or model, a bad
@@ -131,6 +132,17 @@ def train(
     augment: Annotated[bool, typer.Option(help="Flip/brightness/zoom augmentation.")] = True,
     speed_input: Annotated[bool, typer.Option(help="Feed the speed to the network.")] = True,
     throttle_head: Annotated[bool, typer.Option(help="Learn the throttle too.")] = True,
+    head: Annotated[
+        str,
+        typer.Option(
+            help="Second output: throttle (the thesis's pedal head) or target-speed (the "
+            "expert's target speed; drive it with --throttle learned-speed)."
+        ),
+    ] = "throttle",
+    target_speed_max: Annotated[
+        float | None,
+        typer.Option(min=1.0, help="target-speed head: cap of the label [m/s] (the top speed)."),
+    ] = None,
     seed: Annotated[int, typer.Option(help="Seed of split, init, shuffling.")] = 0,
 ) -> None:
     """Train the Chapter 6 CNN (Adam, MSE) and write the model and its loss curves."""
@@ -138,6 +150,7 @@ def train(
         from uvnav.bench.ch6_pipeline import prepare_data, train_on
         from uvnav.learning import PilotNetConfig, TrainConfig
 
+        second = _parse_head(head)
         meta = _dataset_meta(data)
         size = (int(meta.get("height", 66)), int(meta.get("width", 200)))
         sides = meta.get("camera", "front") == "front"
@@ -155,6 +168,8 @@ def train(
             width=size[1],
             n_outputs=2 if throttle_head else 1,
             extra_inputs=1 if speed_input else 0,
+            second_output=second,
+            target_speed_max=target_speed_max or PilotNetConfig.target_speed_max,
         )
         cfg = TrainConfig(
             epochs=epochs,
@@ -172,12 +187,55 @@ def train(
                 prog.update(task, advance=1, description=f"train {tl:.4f} val {vl:.4f}")
 
             _, record = train_on(prep, out, net=net, config=cfg, on_epoch=on_epoch)
+        extra = (
+            f", target speed RMSE {record['val_target_speed_rmse'][-1]:.2f} m/s"
+            if record["val_target_speed_rmse"]
+            else ""
+        )
         typer.echo(
             f"{prep.n_frames} frames, {prep.info['n_balanced']} after balancing, "
             f"train {prep.info['n_train']} / val {prep.info['n_val']}; final val MSE "
-            f"{record['val_loss'][-1]:.4f} (steering {record['val_steering_mse'][-1]:.4f})"
+            f"{record['val_loss'][-1]:.4f} (steering {record['val_steering_mse'][-1]:.4f}, "
+            f"second output {record['val_throttle_mse'][-1]:.4f}{extra})"
         )
         typer.echo(f"wrote {out}")
+
+
+@drive_app.command("speed-head")
+def speed_head(
+    model: Annotated[Path, typer.Argument(help="Trained throttle-head model (.safetensors).")],
+    data: Annotated[Path, typer.Argument(help="Its dataset (with the target_speed column).")],
+    out: Annotated[Path, typer.Option("--out", help="Output model (.safetensors).")] = Path(
+        "model-speed.safetensors"
+    ),
+    target_speed_max: Annotated[
+        float | None, typer.Option(min=1.0, help="Cap of the target-speed label [m/s].")
+    ] = None,
+    seed: Annotated[int, typer.Option(help="Seed of the split (as in training).")] = 0,
+) -> None:
+    """Replace the throttle output by a linear target-speed readout (steering unchanged)."""
+    with _user_errors():
+        from uvnav.bench.ch6_pipeline import fit_target_speed_readout, prepare_data
+        from uvnav.learning.checkpoint import load_checkpoint, save_checkpoint
+
+        net, _ = load_checkpoint(model)
+        prep = prepare_data(data, seed=seed, size=(net.config.height, net.config.width))
+        new, record = fit_target_speed_readout(net, prep, target_speed_max=target_speed_max)
+        save_checkpoint(new, out, record={**record, "source": str(model)})
+        typer.echo(
+            f"target speed readout: val RMSE {record['val_target_speed_rmse'][0]:.2f} m/s "
+            f"(R² {record['val_target_speed_r2']:.3f}), steering val MSE "
+            f"{record['val_steering_mse'][0]:.4f}; wrote {out} "
+            "(drive it with --throttle learned-speed)"
+        )
+
+
+def _parse_head(head: str) -> str:
+    """``--head`` value → ``PilotNetConfig.second_output``."""
+    heads = {"throttle": "throttle", "target-speed": "target_speed", "target_speed": "target_speed"}
+    if head not in heads:
+        raise ValueError(f"--head: {head!r} (must be throttle or target-speed)")
+    return heads[head]
 
 
 def _dataset_meta(data: Path) -> dict[str, Any]:
@@ -187,15 +245,27 @@ def _dataset_meta(data: Path) -> dict[str, Any]:
     return json.loads(f.read_text()) if f.is_file() else {"camera": "front"}
 
 
-def _load_policy(model_path: Path, throttle: str, set_speed: float) -> tuple[Any, Any, str]:
-    from uvnav.bench.ch6_pipeline import cnn_policy
+def _load_policy(
+    model_path: Path,
+    throttle: str,
+    set_speed: float,
+    speed_factor: float = 1.0,
+    max_speed: float | None = None,
+) -> tuple[Any, Any, str]:
+    from uvnav.bench.ch6_pipeline import THROTTLE_MODES, cnn_policy
     from uvnav.learning.checkpoint import load_checkpoint
 
-    if throttle not in ("learned", "pi"):
-        raise ValueError(f"--throttle: {throttle!r} (must be learned, pi or both)")
+    if throttle not in THROTTLE_MODES:
+        raise ValueError(f"--throttle: {throttle!r} (must be {', '.join(THROTTLE_MODES)} or both)")
     model, _ = load_checkpoint(model_path)
     camera = "topdown" if (model.config.height, model.config.width) == (96, 96) else "front"
-    policy, on_reset = cnn_policy(model, throttle=throttle, set_speed=set_speed)  # type: ignore[arg-type]
+    policy, on_reset = cnn_policy(
+        model,
+        throttle=throttle,  # type: ignore[arg-type]
+        set_speed=set_speed,
+        speed_factor=speed_factor,
+        max_speed=max_speed,
+    )
     return policy, on_reset, camera
 
 
@@ -203,24 +273,45 @@ def _load_policy(model_path: Path, throttle: str, set_speed: float) -> tuple[Any
 def evaluate(
     model: Annotated[Path, typer.Argument(help="Model file (.safetensors).")],
     seeds: Annotated[str, typer.Option(help="Held-out track seeds, e.g. 1000-1019.")] = "1000-1019",
-    throttle: Annotated[str, typer.Option(help="learned | pi | both")] = "both",
+    throttle: Annotated[
+        str,
+        typer.Option(
+            help="learned (throttle head) | learned-speed (target-speed head tracked by the "
+            "expert's P law) | pi | both (the model's learned mode and pi)"
+        ),
+    ] = "both",
     set_speed: Annotated[float, typer.Option(help="PI target speed [m/s].")] = 35.0,
+    speed_factor: Annotated[
+        float, typer.Option(help="learned-speed: track this fraction of the predicted speed.")
+    ] = 1.0,
+    max_speed: Annotated[
+        float | None, typer.Option(help="learned-speed: speed limiter [m/s].")
+    ] = None,
     max_steps: Annotated[int, typer.Option(min=10, help="Steps per episode.")] = 2000,
     expert: Annotated[bool, typer.Option(help="Also drive the (oracle) expert.")] = True,
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Closed loop on held-out tracks: return, tiles %, laps, centre distance, autonomy."""
     with _user_errors():
+        from uvnav.bench.ch6_pipeline import default_learned_mode
         from uvnav.bench.ch6_pipeline import evaluate as run_eval
         from uvnav.driving.evaluate import expert_policy, summarize
         from uvnav.driving.sim import DrivingSim
+        from uvnav.learning.checkpoint import load_checkpoint
 
         seed_list = parse_seeds(seeds)
-        modes = ["learned", "pi"] if throttle == "both" else [throttle]
+        modes: list[str]
+        if throttle == "both":
+            net, _ = load_checkpoint(model)
+            modes = [default_learned_mode(net), "pi"]
+        else:
+            modes = [throttle]
         rows: dict[str, dict[str, float]] = {}
         with _progress() as prog:
             for mode in modes:
-                policy, on_reset, camera = _load_policy(model, mode, set_speed)
+                policy, on_reset, camera = _load_policy(
+                    model, mode, set_speed, speed_factor, max_speed
+                )
                 sim = DrivingSim(camera=camera, max_steps=max_steps)  # type: ignore[arg-type]
                 task = prog.add_task(f"cnn + {mode} throttle", total=len(seed_list))
                 res = run_eval(
@@ -285,7 +376,7 @@ def play(
     seed: Annotated[int, typer.Option(help="Track seed.")] = 1000,
     steps: Annotated[int, typer.Option(min=1, help="Steps to drive.")] = 500,
     every: Annotated[int, typer.Option(min=1, help="Keep every N-th frame.")] = 5,
-    throttle: Annotated[str, typer.Option(help="learned | pi")] = "learned",
+    throttle: Annotated[str, typer.Option(help="learned | learned-speed | pi")] = "learned",
 ) -> None:
     """Drive one track and write the frames with predicted vs expert steering."""
     with _user_errors():
@@ -333,7 +424,8 @@ def dagger(
         str, typer.Option(help="Held-out seeds evaluated after each round.")
     ] = "1000-1019",
     throttle: Annotated[
-        str, typer.Option(help="The learner's throttle while driving: pi or learned.")
+        str,
+        typer.Option(help="The learner's throttle while driving: pi, learned or learned-speed."),
     ] = "pi",
     set_speed: Annotated[float, typer.Option(help="PI target speed [m/s].")] = 35.0,
     out_dir: Annotated[Path, typer.Option("--out-dir", help="Folder of the round models.")] = Path(
@@ -345,13 +437,13 @@ def dagger(
 ) -> None:
     """DAgger: the CNN drives, the expert labels, retrain; prints closed loop per round."""
     with _user_errors():
-        from uvnav.bench.ch6_pipeline import cnn_policy, run_dagger
+        from uvnav.bench.ch6_pipeline import THROTTLE_MODES, cnn_policy, run_dagger
         from uvnav.bench.ch6_pipeline import evaluate as run_eval
         from uvnav.driving.evaluate import summarize
         from uvnav.learning.checkpoint import load_checkpoint
 
-        if throttle not in ("learned", "pi"):
-            raise ValueError(f"--throttle: {throttle!r} (must be learned or pi)")
+        if throttle not in THROTTLE_MODES:
+            raise ValueError(f"--throttle: {throttle!r} (must be {', '.join(THROTTLE_MODES)})")
         seed_list = parse_seeds(seeds)
         net, _ = load_checkpoint(model)
         rows: dict[str, dict[str, float]] = {}
@@ -388,6 +480,13 @@ def reproduce(
     dagger_rounds: Annotated[
         int | None, typer.Option(min=0, help="Override: DAgger rounds (0: the thesis's recipe).")
     ] = None,
+    head: Annotated[
+        str,
+        typer.Option(
+            help="Second output: throttle (thesis; closed loop 'learned') or target-speed "
+            "(closed loop 'learned-speed')."
+        ),
+    ] = "throttle",
 ) -> None:
     """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table."""
     with _user_errors():
@@ -406,6 +505,7 @@ def reproduce(
             eval_seeds=parse_seeds(seeds) if seeds else None,
             max_steps=max_steps,
             dagger_rounds=dagger_rounds,
+            head=_parse_head(head),
             progress=lambda s: con.print(f"[dim]… {s}[/dim]"),
         )
         figures = render_ch6(summary, out / "figures")

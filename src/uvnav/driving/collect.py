@@ -2,7 +2,8 @@
 
 The expert (:class:`uvnav.driving.expert.PurePursuitExpert`) drives CarRacing tracks; while
 recording, correlated steering noise is applied (DART) but the recorded label is the clean expert
-command at the state the car is in.  Every ``record_every`` steps the three forward images
+command at the state the car is in (steering, throttle, and the expert's target speed as an 8th
+column, see :mod:`uvnav.driving.dataset`).  Every ``record_every`` steps the three forward images
 (left, centre, right) are written with the labels.  Resumable: each finished episode's seed is
 appended to ``episodes.txt``; a rerun skips those seeds (a killed run loses at most the episode
 in flight, whose rows are written but not listed — they are kept, as a Udacity recording would be).
@@ -79,7 +80,7 @@ def collect_episode(
     expert = PurePursuitExpert(sim.geometry, expert_params)
     rows = 0
     for k in range(p.max_steps):
-        steer, throttle = expert.act(tel)
+        steer, throttle, v_target = expert.label(tel)
         if k % p.record_every == 0:
             if sim.camera == "front":
                 left, centre, right = sim.side_views()
@@ -92,6 +93,7 @@ def collect_episode(
                 throttle=throttle,
                 brake=max(-throttle, 0.0),
                 speed=tel.speed,
+                target_speed=v_target,
             )
             rows += 1
         st = sim.step(steer + noise[k], throttle)

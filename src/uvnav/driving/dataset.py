@@ -13,6 +13,13 @@ usual value for the Udacity car): the left camera sees the car as if it were lef
 so its label steers more to the right (+).
 
 Udacity's speed column is in mph; ours is CarRacing's [m/s] (the writer records what it is given).
+
+One optional column beyond Udacity's seven: ``target_speed`` [m/s], the speed the expert is
+tracking at that row (the minimum of its corner-speed profile over the preview distance,
+:meth:`uvnav.driving.expert.PurePursuitExpert.target_speed`).  It is a function of the road ahead,
+hence observable from one forward image, unlike the expert's throttle, which also depends on the
+speed; the "learned-speed" throttle trains the network's second output on it.  Rows without it
+(real Udacity logs, datasets recorded before the column existed) load as before, with NaN there.
 """
 
 from __future__ import annotations
@@ -28,6 +35,8 @@ from numpy.typing import NDArray
 LOG_NAME = "driving_log.csv"
 IMG_DIR = "IMG"
 COLUMNS = ("center", "left", "right", "steering", "throttle", "brake", "speed")
+#: optional columns after Udacity's seven (ours only)
+EXTRA_COLUMNS = ("target_speed",)
 
 
 class DatasetError(ValueError):
@@ -47,6 +56,8 @@ class DrivingLog:
         throttle: throttle (Udacity: [0, 1]; ours: [-1, 1], negative = brake).
         brake: brake in [0, 1].
         speed: speed (Udacity [mph], ours [m/s]).
+        target_speed: the expert's target speed [m/s] (optional 8th column; NaN where a row
+            has none, ``None`` when no row has it, e.g. a real Udacity log).
     """
 
     root: Path
@@ -57,6 +68,7 @@ class DrivingLog:
     throttle: NDArray[np.float64]
     brake: NDArray[np.float64]
     speed: NDArray[np.float64]
+    target_speed: NDArray[np.float64] | None = None
 
     def __len__(self) -> int:
         return len(self.center)
@@ -64,12 +76,16 @@ class DrivingLog:
 
 @dataclass(frozen=True)
 class Samples:
-    """Flat training samples: one image path per sample and its labels."""
+    """Flat training samples: one image path per sample and its labels.
+
+    ``target_speed`` [m/s] is the expert's target speed (NaN where the log has none).
+    """
 
     paths: list[Path]
     steering: NDArray[np.float64]
     throttle: NDArray[np.float64]
     speed: NDArray[np.float64]
+    target_speed: NDArray[np.float64] | None = None
 
     def __len__(self) -> int:
         return len(self.paths)
@@ -81,6 +97,7 @@ class Samples:
             self.steering[idx],
             self.throttle[idx],
             self.speed[idx],
+            None if self.target_speed is None else self.target_speed[idx],
         )
 
 
@@ -105,6 +122,9 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
     Returns:
         The log.
 
+    Rows have Udacity's seven columns, or eight with our ``target_speed`` (both may be mixed in
+    one log, e.g. a Udacity recording extended by DAgger rows; absent values are NaN).
+
     Raises:
         DatasetError: missing CSV, wrong column count, non-numeric value, missing image.
     """
@@ -113,37 +133,51 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
     if not log.is_file():
         raise DatasetError(f"{log}: not found (a dataset folder holds {LOG_NAME} and {IMG_DIR}/)")
     cols: dict[str, list[object]] = {c: [] for c in COLUMNS}
+    target: list[float] = []
+    n_all = len(COLUMNS) + len(EXTRA_COLUMNS)
     with log.open(newline="") as fh:
         for r, rec in enumerate(csv.reader(fh), start=1):
             if not rec or all(not x.strip() for x in rec):
                 continue
             if r == 1 and rec[0].strip().lower() == "center":
                 continue  # header (some Udacity sample sets have one)
-            if len(rec) != len(COLUMNS):
+            if len(rec) not in (len(COLUMNS), n_all):
                 raise DatasetError(
                     f"{log}: row {r}: {len(rec)} columns (expected {len(COLUMNS)}: "
-                    f"{', '.join(COLUMNS)})"
+                    f"{', '.join(COLUMNS)}; or {n_all} with {', '.join(EXTRA_COLUMNS)})"
                 )
             for c, x in zip(COLUMNS[:3], rec[:3], strict=True):
                 cols[c].append(
-                    _resolve(root, x, log, r, c) if check_images else root / IMG_DIR / x.strip()
+                    _resolve(root, x, log, r, c)
+                    if check_images
+                    else root / IMG_DIR / x.strip().replace("\\", "/").split("/")[-1]
                 )
-            for c, x in zip(COLUMNS[3:], rec[3:], strict=True):
-                try:
-                    cols[c].append(float(x))
-                except ValueError:
-                    raise DatasetError(
-                        f"{log}: row {r}, column '{c}': {x!r} is not a number"
-                    ) from None
+            for c, x in zip(COLUMNS[3:], rec[3:7], strict=True):
+                cols[c].append(_number(x, log, r, c))
+            target.append(
+                _number(rec[7], log, r, EXTRA_COLUMNS[0]) if len(rec) == n_all else float("nan")
+            )
     if not cols["center"]:
         raise DatasetError(f"{log}: no rows")
+    ts = np.asarray(target, dtype=float)
     return DrivingLog(
         root,
         [Path(str(p)) for p in cols["center"]],
         [Path(str(p)) for p in cols["left"]],
         [Path(str(p)) for p in cols["right"]],
-        *(np.asarray(cols[c], dtype=float) for c in COLUMNS[3:]),
+        np.asarray(cols["steering"], dtype=float),
+        np.asarray(cols["throttle"], dtype=float),
+        np.asarray(cols["brake"], dtype=float),
+        np.asarray(cols["speed"], dtype=float),
+        None if np.isnan(ts).all() else ts,
     )
+
+
+def _number(x: str, log: Path, row: int, col: str) -> float:
+    try:
+        return float(x)
+    except ValueError:
+        raise DatasetError(f"{log}: row {row}, column '{col}': {x!r} is not a number") from None
 
 
 class LogWriter:
@@ -168,8 +202,12 @@ class LogWriter:
         throttle: float,
         brake: float,
         speed: float,
+        target_speed: float | None = None,
     ) -> None:
-        """Write one row: ``images`` = (center, left, right) uint8 RGB arrays."""
+        """Write one row: ``images`` = (center, left, right) uint8 RGB arrays.
+
+        ``target_speed`` [m/s] (the expert's), when given, is written as an 8th column.
+        """
         from PIL import Image
 
         names = []
@@ -177,9 +215,10 @@ class LogWriter:
             name = f"{IMG_DIR}/{cam}_{key}.jpg"
             Image.fromarray(np.asarray(img, dtype=np.uint8)).save(self.root / name, quality=95)
             names.append(name)
-        self._csv.writerow(
-            [*names, f"{steering:.6f}", f"{throttle:.6f}", f"{brake:.6f}", f"{speed:.6f}"]
-        )
+        row = [*names, f"{steering:.6f}", f"{throttle:.6f}", f"{brake:.6f}", f"{speed:.6f}"]
+        if target_speed is not None:
+            row.append(f"{target_speed:.6f}")
+        self._csv.writerow(row)
 
     def flush(self) -> None:
         """Flush the CSV (call at episode ends: a killed run keeps whole episodes)."""
@@ -205,6 +244,7 @@ def expand_cameras(log: DrivingLog, *, correction: float = 0.2, sides: bool = Tr
     steer = [log.steering]
     thr = [log.throttle]
     spd = [log.speed]
+    ts = log.target_speed
     if sides:
         paths += list(log.left) + list(log.right)
         steer += [log.steering + correction, log.steering - correction]
@@ -215,6 +255,7 @@ def expand_cameras(log: DrivingLog, *, correction: float = 0.2, sides: bool = Tr
         np.clip(np.concatenate(steer), -1.0, 1.0),
         np.concatenate(thr),
         np.concatenate(spd),
+        None if ts is None else np.concatenate([ts, ts, ts] if sides else [ts]),
     )
 
 

@@ -8,7 +8,12 @@ an intervention being the car more than one track half-width off the centreline,
 car is put back on the centreline at rest (:meth:`DrivingSim.put_back`) and driving continues.
 
 Throttle: the policy's own (learned) throttle, or a PI speed controller in its place, as in
-Udacity's ``drive.py`` (:class:`PISpeedController`, :func:`with_pi_throttle`).
+Udacity's ``drive.py`` (:class:`PISpeedController`, :func:`with_pi_throttle`), or the expert's own
+proportional law tracking a speed the policy chooses (:func:`speed_law_throttle`: the
+"learned-speed" throttle, whose network predicts the expert's target speed — a function of the
+road ahead, visible in one image — instead of the pedal, which also depends on the speed and is
+saturated most of the time; measured: a direct throttle head enters sharp corners at 46–52 m/s
+where the expert brakes to about 32 m/s).
 """
 
 from __future__ import annotations
@@ -20,6 +25,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
+from uvnav.driving.expert import ExpertParams
 from uvnav.driving.sim import FPS, DrivingSim, Telemetry
 
 #: ``policy(frame, telemetry) -> (steer, throttle)``; a learned policy reads only the frame and
@@ -94,6 +100,21 @@ class PISpeedController:
         e = self.set_speed - speed
         self.integral = float(np.clip(self.integral + e * dt, -50.0, 50.0))
         return float(np.clip(self.kp * e + self.ki * self.integral, -1.0, 1.0))
+
+
+def speed_law_throttle(target_speed: float, speed: float, k: float | None = None) -> float:
+    """The expert's speed law: ``clip(k (target_speed − speed), −1, 1)``.
+
+    Args:
+        target_speed: the speed to drive at [m/s] (the expert's profile, or a network's guess).
+        speed: measured speed [m/s].
+        k: gain [1/(m/s)] (default: the expert's ``ExpertParams.k_speed``, 0.15).
+
+    Returns:
+        Throttle in [-1, 1] (negative = brake).
+    """
+    gain = ExpertParams().k_speed if k is None else k
+    return float(np.clip(gain * (target_speed - speed), -1.0, 1.0))
 
 
 def with_pi_throttle(policy: Policy, pi: PISpeedController) -> Policy:

@@ -82,6 +82,21 @@ class PurePursuitExpert:
         Returns:
             ``(steer, throttle)`` in [-1, 1]: normalised steering (+ right) and throttle.
         """
+        steer, throttle, _ = self.label(tel)
+        return steer, throttle
+
+    def label(self, tel: Telemetry) -> tuple[float, float, float]:
+        """Clean expert command and the speed it is tracking (the recorded labels).
+
+        Args:
+            tel: telemetry (pose and speed: ground truth).
+
+        Returns:
+            ``(steer, throttle, target_speed)``: as :meth:`act`, and the target speed [m/s] of
+            the corner-speed profile at the car's position (``throttle = clip(k_speed ·
+            (target_speed − speed), −1, 1)``).  The target speed depends on the road ahead
+            only, not on the car's speed.
+        """
         p = self.params
         i, t, _ = project(self.geometry, tel.x, tel.y)
         L = p.lookahead + p.lookahead_gain * tel.speed
@@ -91,8 +106,9 @@ class PurePursuitExpert:
         alpha = (alpha + np.pi) % (2 * np.pi) - np.pi
         delta = np.arctan2(2 * WHEELBASE * np.sin(alpha), L)  # + left
         steer = float(np.clip(-delta / MAX_WHEEL_ANGLE, -1.0, 1.0))
-        throttle = float(np.clip(p.k_speed * (self.target_speed(i) - tel.speed), -1.0, 1.0))
-        return steer, throttle
+        v_target = self.target_speed(i)
+        throttle = float(np.clip(p.k_speed * (v_target - tel.speed), -1.0, 1.0))
+        return steer, throttle, v_target
 
 
 def ar1_noise(rng: np.random.Generator, n: int, *, sigma: float, rho: float) -> NDArray[np.float64]:

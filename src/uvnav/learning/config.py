@@ -10,6 +10,9 @@ import dataclasses
 from dataclasses import dataclass, field
 from typing import Any
 
+#: what the network's second output can be trained on
+SECOND_OUTPUTS = ("throttle", "target_speed")
+
 
 @dataclass(frozen=True)
 class PilotNetConfig:
@@ -26,7 +29,18 @@ class PilotNetConfig:
             layer gives on 66×200; NVIDIA's PilotNet has two (flatten 1152).  Default 1 (thesis).
         extra_inputs: scalars concatenated to the flattened features (1 = the car's speed, which
             the learned throttle needs: from one image alone the right throttle is ambiguous).
-        speed_scale: divisor of the speed input [m/s] (keeps it about unit size).
+        speed_scale: divisor of the speed input [m/s] (keeps it about unit size); also the
+            scale of a target-speed output.
+        second_output: what the second output (``n_outputs=2``) is trained on: ``"throttle"``
+            (the thesis's throttle head: the expert's pedal) or ``"target_speed"`` (the speed
+            the expert tracks, ``min(v_target, target_speed_max) / speed_scale``; at drive time
+            a proportional law turns it into the pedal: the "learned-speed" throttle).
+        target_speed_max: cap of the target-speed label [m/s], the learned driver's top speed
+            (default 50).  Measured (docs/thesis-notes.md): the 30-epoch network's steering with
+            the expert's own (oracle) speed profile, up to 75–95 m/s on straights, still leaves
+            the road about once a lap at 66–75 m/s; capped at 50 m/s it does not.  Below the cap
+            the label is the expert's corner-speed profile (32–50 m/s near corners), so the
+            network still decides where and how hard to brake.
     """
 
     height: int = 66
@@ -37,6 +51,8 @@ class PilotNetConfig:
     conv3x3_layers: int = 1
     extra_inputs: int = 1
     speed_scale: float = 50.0
+    second_output: str = "throttle"
+    target_speed_max: float = 50.0
 
     def __post_init__(self) -> None:
         if self.height < 32 or self.width < 32:
@@ -47,6 +63,18 @@ class PilotNetConfig:
             raise ValueError(f"PilotNetConfig.dropout: {self.dropout} (must be in [0, 1))")
         if self.conv3x3_layers < 0 or self.extra_inputs < 0:
             raise ValueError("PilotNetConfig: conv3x3_layers and extra_inputs must be >= 0")
+        if self.second_output not in SECOND_OUTPUTS:
+            raise ValueError(
+                f"PilotNetConfig.second_output: {self.second_output!r} "
+                f"(must be one of {', '.join(SECOND_OUTPUTS)})"
+            )
+        if self.speed_scale <= 0 or self.target_speed_max <= 0:
+            raise ValueError("PilotNetConfig: speed_scale and target_speed_max must be > 0")
+
+    @property
+    def predicts_target_speed(self) -> bool:
+        """True when the second output is the target speed (the "learned-speed" throttle)."""
+        return self.n_outputs == 2 and self.second_output == "target_speed"
 
     def to_dict(self) -> dict[str, Any]:
         """Plain JSON-able dict."""

@@ -3,9 +3,13 @@
 ``train_pilotnet`` takes numpy arrays (images ``(N, H, W, 3)`` uint8, labels, speeds) for the
 training and validation sets, augments training batches (:mod:`uvnav.learning.augment`), and
 returns the model and the per-epoch loss curves (Fig. 6.8).  The loss is eq. (6.1), the mean
-squared error, over steering plus ``throttle_weight`` × throttle when the network has a throttle
-head.  Determinism: torch's seed and generator come from ``TrainConfig.seed``; the number of CPU
-threads is set (2 by default: the machine is shared).
+squared error, over steering plus ``throttle_weight`` × the second output when the network has
+one.  The third array of a set is that second output's label: the throttle, or for a network with
+``second_output="target_speed"`` the scaled target speed
+(:func:`uvnav.learning.pilotnet.target_speed_label`; the caller converts), so the "throttle"
+MSE of :class:`TrainHistory` is then the target-speed term in those units.  Determinism:
+torch's seed and generator come from ``TrainConfig.seed``; the number of CPU threads is set
+(1 by default: the machine is shared).
 """
 
 from __future__ import annotations
@@ -107,13 +111,19 @@ def train_pilotnet(
     cfg = config or TrainConfig()
     torch.set_num_threads(max(1, cfg.threads))
     torch.manual_seed(cfg.seed)
-    if model is None:
-        model = build_pilotnet(net or PilotNetConfig())
-    model.to(cfg.device)
-    ncfg: PilotNetConfig = model.config
     imgs, steer, thr, spd = train
     if len(imgs) == 0:
         raise ValueError("train_pilotnet: empty training set")
+    if model is None:
+        model = build_pilotnet(net or PilotNetConfig())
+        if model.config.predicts_target_speed:
+            # a target-speed output starts at the labels' mean (about 1.3, i.e. 65 m/s) rather
+            # than at 0 (standstill): the usual output-bias initialisation for a regression
+            # whose labels are far from zero; the throttle and steering heads keep torch's
+            with torch.no_grad():
+                model.head[-1].bias[1] = float(np.mean(thr))
+    model.to(cfg.device)
+    ncfg: PilotNetConfig = model.config
     gen = torch.Generator(device=cfg.device)
     gen.manual_seed(cfg.seed)
     rng = np.random.default_rng(cfg.seed)
@@ -169,8 +179,40 @@ def train_pilotnet(
     return model, hist
 
 
+def hidden_features(
+    model: Any,
+    images: NDArray[np.uint8],
+    speed: NDArray[np.float64] | None,
+    *,
+    batch_size: int = 200,
+    device: str = "cpu",
+) -> NDArray[np.float64]:
+    """The last hidden layer's activations (eval mode), ``(N, 10)``: what the output layer reads."""
+    import torch
+
+    model.eval()
+    cfg: PilotNetConfig = model.config
+    out = []
+    with torch.no_grad():
+        for a in range(0, len(images), batch_size):
+            xb = torch.as_tensor(images[a : a + batch_size]).to(device)
+            eb = (
+                torch.as_tensor(
+                    np.asarray(speed[a : a + batch_size], dtype=np.float32)[:, None]
+                ).to(device)
+                if cfg.extra_inputs and speed is not None
+                else None
+            )
+            out.append(model.hidden(xb, eb).cpu())
+    return torch.cat(out).numpy().astype(np.float64)
+
+
 class Predictor:
     """Run a trained network on single frames: ``predictor(frame, speed) -> (steer, throttle)``.
+
+    For a network whose second output is the target speed (``second_output="target_speed"``)
+    use :meth:`outputs`, which returns ``(steer, target speed [m/s])``; turning that into a pedal
+    is the driver's business (:mod:`uvnav.bench.ch6_pipeline`, the "learned-speed" throttle).
 
     Args:
         model: the trained network (put in eval mode).
@@ -186,9 +228,12 @@ class Predictor:
         self.device = device
         self.config: PilotNetConfig = model.config
 
-    def __call__(self, frame: NDArray[np.uint8], speed: float = 0.0) -> tuple[float, float]:
-        """Steering and throttle (throttle 0 for a steering-only network) for one frame."""
+    def outputs(self, frame: NDArray[np.uint8], speed: float = 0.0) -> tuple[float, float]:
+        """``(steer, second)`` for one frame: ``second`` is the throttle in [-1, 1] (0 for a
+        steering-only network) or, for a target-speed network, the target speed [m/s]."""
         import torch
+
+        from uvnav.learning.pilotnet import target_speed_from_output
 
         with torch.no_grad():
             x = torch.as_tensor(np.ascontiguousarray(frame)[None]).to(self.device)
@@ -199,5 +244,21 @@ class Predictor:
             )
             out = self.model(x, e)[0].cpu().numpy()
         steer = float(np.clip(out[0], -1.0, 1.0))
-        throttle = float(np.clip(out[1], -1.0, 1.0)) if len(out) > 1 else 0.0
-        return steer, throttle
+        if len(out) < 2:
+            return steer, 0.0
+        if self.config.predicts_target_speed:
+            return steer, float(target_speed_from_output(out[1], self.config))
+        return steer, float(np.clip(out[1], -1.0, 1.0))
+
+    def __call__(self, frame: NDArray[np.uint8], speed: float = 0.0) -> tuple[float, float]:
+        """Steering and throttle (throttle 0 for a steering-only network) for one frame.
+
+        Raises:
+            ValueError: the network predicts a target speed, not a throttle (use :meth:`outputs`).
+        """
+        if self.config.predicts_target_speed:
+            raise ValueError(
+                "this network predicts the target speed, not the throttle "
+                "(drive it with the 'learned-speed' or 'pi' throttle)"
+            )
+        return self.outputs(frame, speed)
