@@ -47,5 +47,13 @@ def test_small_reproduction_writes_measured_table_and_figures(tmp_path: Path) ->
     assert {"ch5_array.png", "ch5_learning_curve.png"} <= names
     assert any(n.startswith("ch5_traj_thesis-ch5-scene1") for n in names)
     assert all(p.stat().st_size > 5000 for p in s.figures)
+    assert "ch5_anim_thesis-ch5-scene1_network.gif" in names  # the animated run
+    from uvnav.bench.reproduce_ch5 import SCENES_CAMPAIGN, stored_rows
+    from uvnav.bench.store import ResultsStore
+
+    with ResultsStore(tmp_path / "results" / "uvnav.sqlite") as store:
+        stored = stored_rows(store, SCENES_CAMPAIGN)
+    assert sorted(r["locator"] for r in stored) == ["geometric", "network", "oracle"]
+    assert [r["status"] for r in stored] == [r["status"] for r in data["closed_loop"]]
     with pytest.raises(ValueError, match="unknown locator"):
         make_locator("psychic")
