@@ -250,7 +250,6 @@ def reproduce_cmd(
     """The Chapter 5 reproduction alone (BPNN experiment + closed-loop campaigns); resumable:
     an interrupted run continues where it stopped."""
     from uvnav.bench.reproduce_ch5 import reproduce_ch5
-
     from uvnav.viz.figures_ch5 import render_ch5
 
     s = reproduce_ch5(
