@@ -15,7 +15,12 @@ from uvnav.viz.figures_ch5 import render_ch5
 
 
 @pytest.mark.slow
-def test_small_reproduction_writes_measured_table_and_figures(tmp_path: Path) -> None:
+def test_small_reproduction_writes_measured_table_and_figures(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import uvnav.viz.figures_ch5 as f5
+
+    monkeypatch.setattr(f5, "ANIMATION_FRAMES", 3)  # the GIF's content is tested in tests/viz
     s = reproduce_ch5(
         tmp_path / "results",
         sizes=(50,),

@@ -363,6 +363,9 @@ def render_ch5(summary: Any, report_dir: Path) -> list[Path]:
     return files
 
 
+#: frames of the report's animation (each redraws the bodies in two 3D views: ~0.3 s a frame)
+ANIMATION_FRAMES = 24
+
 #: the run animated in the report: Scene 3 (two obstacles) first, with the BPNN locator
 ANIMATION_PREFERENCE: tuple[tuple[str, str], ...] = (
     ("thesis-ch5-scene3", "network"),
@@ -388,5 +391,6 @@ def _animate_one(episodes: dict[tuple[str, str, float], UUV3DResult], out: Path)
             out / f"ch5_anim_{scene}_{loc}.gif",
             radius=setup.spec.radius,
             title=f"{scene}, {loc} locator",
+            max_frames=ANIMATION_FRAMES,
         )
     return None
