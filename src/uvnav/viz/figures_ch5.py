@@ -249,7 +249,7 @@ def save_animation3d(
     ax_all.set_xlim(lo[0], hi[0])
     ax_all.set_ylim(lo[1], hi[1])
     ax_all.set_zlim(lo[2], hi[2])
-    ax_all.set_box_aspect(tuple(hi - lo), zoom=1.3)
+    ax_all.set_box_aspect(tuple(hi - lo), zoom=1.05)
     size = "x".join(f"{x:.0f}" for x in hi - lo)
     ax_all.set_title(f"whole scene ({size} m box)", fontsize=9)
     ax_zoom.set_box_aspect((1, 1, 1), zoom=1.2)
