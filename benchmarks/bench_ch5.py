@@ -7,7 +7,10 @@ Writes ``<out>/ch5.json`` with the machine, the parameters and:
   (target < 10 s, ``pass`` flag);
 * ``sonar_scan``: one R(t) of the nine-sonar array against a 1280-triangle deforming star [ms];
 * ``sample``: one dataset sample (obstacle, scan, true nearest point) [ms];
-* ``decision``: one ``zhang2022-uuv3d-v1`` decision with the geometric and the network locator [µs].
+* ``decision``: one ``zhang2022-uuv3d-v1`` decision with the geometric and the network locator [µs];
+* ``episode_s``: one recorded closed-loop episode of ``thesis-ch5-scene3`` (geometric locator) [s];
+* ``animation_s``: its report GIF (:func:`uvnav.viz.figures_ch5.save_animation3d`, 24 frames) [s]
+  — what the animation adds to the quick ``uvnav run``.
 """
 
 from __future__ import annotations
@@ -93,6 +96,20 @@ def main() -> None:
         ctrl = ZhangUUV3D(None, loc)
         ctrl.reset(Vehicle3DSpec(1.0, 1.0, 0.5), obs.goal, np.random.default_rng(0))
         dec[name] = _median_time(lambda c=ctrl: c.act(obs), repeat * 20) * 1e6
+    import tempfile
+
+    from uvnav.bench.reproduce_ch5 import Ch5Job, run_ch5_job
+    from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
+    from uvnav.viz.figures_ch5 import save_animation3d
+
+    tic = time.perf_counter()
+    _, res = run_ch5_job(Ch5Job("thesis-ch5-scene3", "geometric", 0), record=True)
+    episode_s = time.perf_counter() - tic
+    setup = build_uuv3d(load_ch5_scenario("thesis-ch5-scene3"))
+    with tempfile.TemporaryDirectory() as tmp:
+        tic = time.perf_counter()
+        save_animation3d(res, setup.obstacles, setup.goal, Path(tmp) / "a.gif")
+        animation_s = time.perf_counter() - tic
     out = {
         "machine": {
             "platform": platform.platform(),
@@ -103,6 +120,8 @@ def main() -> None:
         "sonar_scan_ms": scan_s * 1e3,
         "sample_ms": sample_s * 1e3,
         "decision_us": dec,
+        "episode_s": episode_s,
+        "animation_s": animation_s,
     }
     args.out.mkdir(parents=True, exist_ok=True)
     path = args.out / "ch5.json"

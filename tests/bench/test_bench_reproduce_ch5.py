@@ -15,7 +15,12 @@ from uvnav.viz.figures_ch5 import render_ch5
 
 
 @pytest.mark.slow
-def test_small_reproduction_writes_measured_table_and_figures(tmp_path: Path) -> None:
+def test_small_reproduction_writes_measured_table_and_figures(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import uvnav.viz.figures_ch5 as f5
+
+    monkeypatch.setattr(f5, "ANIMATION_FRAMES", 3)  # the GIF's content is tested in tests/viz
     s = reproduce_ch5(
         tmp_path / "results",
         sizes=(50,),
@@ -47,5 +52,13 @@ def test_small_reproduction_writes_measured_table_and_figures(tmp_path: Path) ->
     assert {"ch5_array.png", "ch5_learning_curve.png"} <= names
     assert any(n.startswith("ch5_traj_thesis-ch5-scene1") for n in names)
     assert all(p.stat().st_size > 5000 for p in s.figures)
+    assert "ch5_anim_thesis-ch5-scene1_network.gif" in names  # the animated run
+    from uvnav.bench.reproduce_ch5 import SCENES_CAMPAIGN, stored_rows
+    from uvnav.bench.store import ResultsStore
+
+    with ResultsStore(tmp_path / "results" / "uvnav.sqlite") as store:
+        stored = stored_rows(store, SCENES_CAMPAIGN)
+    assert sorted(r["locator"] for r in stored) == ["geometric", "network", "oracle"]
+    assert [r["status"] for r in stored] == [r["status"] for r in data["closed_loop"]]
     with pytest.raises(ValueError, match="unknown locator"):
         make_locator("psychic")

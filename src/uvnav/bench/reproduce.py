@@ -674,6 +674,7 @@ def reproduce(
             progress=progress,
             render=ch5_render or rend.ch5,
             report_dir=report_dir,
+            workers=workers,
         )
         table += s5.table
         by_key["ch5"] = sec.ch5_section(s5, full=full)

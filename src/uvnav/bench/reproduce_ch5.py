@@ -8,25 +8,53 @@ groups; reported test errors (target - output) of [-1.688, 1.861] (distance) and
 :func:`reproduce_ch5` measures, for every sample count and seed: the network's error range on its
 own random test group (what the thesis reports) and on an independent test set of
 ``n_test`` samples (a fairer estimate with so few samples), beside the min/argmin-of-readings
-baseline on the same samples; and runs ``zhang2022-uuv3d-v1`` on the three thesis scenes and on
-``random-ch5:<seed>`` scenes with the geometric (baseline), network and oracle locators, with and
-without sonar noise.  Everything is written to ``results_dir/ch5.json`` and the table rows
-"thesis reported vs uvnav measured" are built from those measurements only.  Figures are drawn by
-a renderer the caller injects (``bench`` may not import ``viz``, DESIGN §1).
+baseline on the same samples; and runs ``zhang2022-uuv3d-v1`` with the geometric (min/argmin,
+the baseline), network (the BPNN) and oracle (true geometry) locators:
+
+1. on the three thesis scenes, seed 0, trajectories recorded for the figures and the animation —
+   campaign ``ch5-thesis-scenes`` (re-run every time);
+2. on ``random-ch5:<seed>`` scenes without sensor noise (quick: 3 seeds; ``full``: 300) —
+   campaign ``ch5-random``;
+3. on the same scenes with sonar range noise :data:`NOISE_STD` (quick: none; ``full``: 300) —
+   campaign ``ch5-noise``.
+
+Every episode is a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
+``results_dir/uvnav.sqlite``, the database of ``uvnav run``, DESIGN §5), as Chapter 4 does: the
+``controller`` column holds the law, ``params`` the locator and the noise level (plus, for the
+network, a digest of its checkpoint: part of the resume key, so a different network re-runs),
+``family`` the generator or the scene; the facts the store has no column for (number of
+obstacles, whether Scene 2's inner space was entered) go to ``effective_params``.
+
+**Resumable.**  Nothing measured is lost when a run is interrupted: every sampled data set (with
+the generator state after sampling, so training continues exactly as in one go), every learning
+row and its trained network are cached under ``results_dir/ch5/cache`` as they finish, and every
+random-campaign episode is one transaction of the store; a re-run skips what is there (``fresh``
+starts over).  ``results_dir/ch5.json`` (rows, table, per-group summary, failures) and the table
+"thesis reported vs uvnav measured" are computed from the measured rows only.  Figures are drawn
+by a renderer the caller injects (``bench`` may not import ``viz``, DESIGN §1).
 """
 
 from __future__ import annotations
 
+import hashlib
 import json
 import math
+import os
+import shutil
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pandas as pd
 
+from uvnav.bench.store import ResultsStore, params_hash
+from uvnav.controllers.zhang_uuv3d import (
+    NAME as LAW,
+)
 from uvnav.controllers.zhang_uuv3d import (
     GeometricLocator,
     Locator,
@@ -52,6 +80,7 @@ from uvnav.scenarios.ch5 import (
 )
 from uvnav.sensors.sonar_dataset import SonarDataset, sample_sonar_dataset
 from uvnav.sim.episode_uuv3d import UUV3DResult, run_uuv3d_episode
+from uvnav.sim.metrics import METRIC_NAMES
 
 QUICK_SIZES: tuple[int, ...] = (50, 150)
 FULL_SIZES: tuple[int, ...] = (50, 150, 500, 5000)
@@ -66,6 +95,13 @@ CLOSED_LOOP_SAMPLES = 500
 #: tessellation level of the sampled obstacles (320 triangles: readings and targets are computed
 #: on the same mesh, so the data are consistent; the mesh is within a few cm of the analytic body)
 DATA_SUBDIVISIONS = 2
+DB_NAME = "uvnav.sqlite"  # the results database of ``uvnav run`` (Chapters 2-4 too)
+SCENES_CAMPAIGN = "ch5-thesis-scenes"
+RANDOM_CAMPAIGN = "ch5-random"
+NOISE_CAMPAIGN = "ch5-noise"
+CAMPAIGNS: tuple[str, ...] = (SCENES_CAMPAIGN, RANDOM_CAMPAIGN, NOISE_CAMPAIGN)
+#: seed of the closed-loop network's data and of the independent test set
+CLOSED_LOOP_SEED, TEST_SEED = 100, 999_999
 
 
 def make_locator(
@@ -93,11 +129,14 @@ class Ch5Summary:
     """What :func:`reproduce_ch5` measured.
 
     Attributes:
-        learning: one row per (samples, seed): error summaries on the split's test group and on
-            the independent test set, network and baseline, training time [s], epochs.
+        learning: one row per (samples, seed, variant): error summaries on the split's test group
+            and on the independent test set, network and baseline, training time [s], epochs.
         closed_loop: one row per episode: scene, locator, noise, seed, status, metrics.
         table: rows ``{quantity, thesis, measured, note}``.
+        campaign: per (family, locator, noise): episodes, success/collision/timeout rates, ...
+        failures: the non-successful episodes (scene, seed, locator, noise, status, clearance).
         json_path: where everything was written.
+        db_path: the results database holding every closed-loop episode.
         figures: figure files written by the renderer.
         wall_time: seconds.
     """
@@ -105,20 +144,83 @@ class Ch5Summary:
     learning: list[dict[str, Any]] = field(default_factory=list)
     closed_loop: list[dict[str, Any]] = field(default_factory=list)
     table: list[dict[str, Any]] = field(default_factory=list)
+    campaign: list[dict[str, Any]] = field(default_factory=list)
+    failures: list[dict[str, Any]] = field(default_factory=list)
     json_path: Path | None = None
+    db_path: Path | None = None
     figures: list[Path] = field(default_factory=list)
     wall_time: float = 0.0
     models: dict[str, Any] = field(default_factory=dict, repr=False)
     datasets: dict[str, Any] = field(default_factory=dict, repr=False)
 
 
+# ------------------------------------------------------------------------------------- learning
+
+
+def _write_atomic(path: Path, write: Callable[[Any], None], mode: str = "wb") -> None:
+    """Write ``path`` through a temporary file and rename it (an interrupted write leaves no
+    half file that a resumed run would trust)."""
+    tmp = path.with_name(path.name + ".part")
+    with open(tmp, mode) as fh:
+        write(fh)
+    os.replace(tmp, path)
+
+
+def cached_dataset(
+    n: int,
+    rng_seed: int,
+    cache: Path | None = None,
+    on_sample: Callable[[int], None] | None = None,
+) -> tuple[SonarDataset, np.random.Generator]:
+    """``n`` samples drawn with ``default_rng(rng_seed)`` and that generator *after* sampling.
+
+    With ``cache`` the data set and the generator's state are read from / written to
+    ``cache/data_n<n>_r<rng_seed>.npz`` (+ ``.rng.json``), so a resumed run trains on the same
+    data with the same random stream as an uninterrupted one.
+    """
+    rng = np.random.default_rng(rng_seed)
+    f = st = None
+    if cache is not None:
+        cache.mkdir(parents=True, exist_ok=True)
+        f = cache / f"data_n{n}_r{rng_seed}.npz"
+        st = cache / f"data_n{n}_r{rng_seed}.rng.json"
+        if f.is_file() and st.is_file():
+            with np.load(f, allow_pickle=False) as z:
+                ds = SonarDataset.from_arrays({k: z[k] for k in z.files})
+            rng.bit_generator.state = json.loads(st.read_text())
+            return ds, rng
+    ds = sample_sonar_dataset(n, rng, subdivisions=DATA_SUBDIVISIONS, on_sample=on_sample)
+    if f is not None and st is not None:
+        arrays: dict[str, Any] = ds.arrays()
+        _write_atomic(f, lambda fh: np.savez(fh, **arrays))
+        state = json.dumps(rng.bit_generator.state)
+        _write_atomic(st, lambda fh: fh.write(state), "w")
+    return ds, rng
+
+
 def learning_row(
-    n: int, seed: int, test: SonarDataset, config: BPNNConfig | None = None
+    n: int,
+    seed: int,
+    test: SonarDataset,
+    config: BPNNConfig | None = None,
+    *,
+    cache: Path | None = None,
+    on_sample: Callable[[int], None] | None = None,
 ) -> tuple[dict[str, Any], TrainedBPNN, SonarDataset]:
-    """Train on ``n`` fresh samples (seed ``seed``) and measure errors (module docstring)."""
-    rng = np.random.default_rng(10_000 + seed)
-    ds = sample_sonar_dataset(n, rng, subdivisions=DATA_SUBDIVISIONS)
+    """Train on ``n`` fresh samples (seed ``seed``) and measure errors (module docstring).
+
+    With ``cache`` the data set, the row and the trained network are kept there and reused by a
+    later call with the same ``(n, seed, variant)`` (resume).
+    """
     cfg = config or BPNNConfig()
+    variant = "residual" if cfg.residual else "plain"
+    ds, rng = cached_dataset(n, 10_000 + seed, cache, on_sample)
+    key = f"n{n}_s{seed}_{variant}"
+    if cache is not None:
+        row_f = cache / f"row_{key}.json"
+        model_base = cache / f"model_{key}"
+        if row_f.is_file() and model_base.with_suffix(".safetensors").is_file():
+            return json.loads(row_f.read_text()), load_checkpoint(model_base), ds
     tic = time.perf_counter()
     model = train_bpnn(ds.inputs, ds.targets(), rng, cfg, offset=ds.baseline())
     train_s = time.perf_counter() - tic
@@ -130,7 +232,7 @@ def learning_row(
     row = {
         "samples": n,
         "seed": seed,
-        "variant": "residual" if cfg.residual else "plain",
+        "variant": variant,
         "train_seconds": round(train_s, 3),
         "epochs": len(model.history["train"]),
         "best_epoch": model.best_epoch,
@@ -138,7 +240,80 @@ def learning_row(
         "test_group": own,
         "independent": ind,
     }
+    if cache is not None:
+        save_checkpoint(model, cache / f"model_{key}")
+        text = json.dumps(row, default=_json_default)
+        _write_atomic(cache / f"row_{key}.json", lambda fh: fh.write(text), "w")
     return row, model, ds
+
+
+# ---------------------------------------------------------------------------------- closed loop
+
+
+@dataclass(frozen=True)
+class Ch5Job:
+    """One closed-loop episode: a scene (built-in or ``random-ch5:<seed>``), a locator, a seed,
+    the sonar range noise [m]; ``model`` is the network's checkpoint (``network`` only) and
+    ``model_id`` its digest (part of the resume key)."""
+
+    scene: str
+    locator: str
+    seed: int
+    noise_std: float = 0.0
+    model: str | None = None
+    model_id: str = ""
+
+    @property
+    def params(self) -> dict[str, Any]:
+        """The store's ``params`` (hashed into the resume key)."""
+        p: dict[str, Any] = {"locator": self.locator, "noise_std": float(self.noise_std)}
+        if self.locator == "network":
+            p["model"] = self.model_id
+        return p
+
+    @property
+    def key(self) -> tuple[str, str, str, int]:
+        return (self.scene, LAW, params_hash(self.params), int(self.seed))
+
+
+def checkpoint_digest(path: Path) -> str:
+    """First 16 hex digits of the SHA-256 of a checkpoint's weights file."""
+    st = Path(path).with_suffix(".safetensors")
+    return hashlib.sha256(st.read_bytes()).hexdigest()[:16]
+
+
+_MODEL_CACHE: dict[str, TrainedBPNN] = {}
+
+
+def _job_locator(job: Ch5Job, model: TrainedBPNN | None) -> Locator:
+    if job.locator == "network" and model is None:
+        if job.model is None:
+            raise ValueError("a 'network' job needs a checkpoint (Ch5Job.model)")
+        if job.model not in _MODEL_CACHE:  # once per worker process
+            _MODEL_CACHE[job.model] = load_checkpoint(Path(job.model))
+        model = _MODEL_CACHE[job.model]
+    return make_locator(job.locator, model=model)
+
+
+def run_ch5_job(
+    job: Ch5Job, *, record: bool = False, model: TrainedBPNN | None = None
+) -> tuple[dict[str, Any], UUV3DResult]:
+    """Run one job (``model`` overrides the job's checkpoint); returns its row and result."""
+    tic = time.perf_counter()
+    scn = load_ch5_scenario(job.scene)
+    setup = build_uuv3d(scn, noise_std=job.noise_std)
+    params = ZhangUUV3DParams(**scn.controller.params)  # type: ignore[arg-type]
+    law = ZhangUUV3D(params, _job_locator(job, model))
+    res = run_uuv3d_episode(setup, law, np.random.default_rng(job.seed), record=record)
+    row = _episode_row(job.scene, job.locator, job.noise_std, job.seed, res)
+    row["n_obstacles"] = len(scn.obstacles)
+    row["model"] = job.model_id if job.locator == "network" else ""
+    row["wall_time"] = time.perf_counter() - tic
+    return row, res
+
+
+def _row_only(job: Ch5Job) -> dict[str, Any]:
+    return run_ch5_job(job)[0]
 
 
 def _episode_row(
@@ -155,6 +330,111 @@ def _episode_row(
     }
 
 
+def store_row(store: ResultsStore, campaign_id: int, row: dict[str, Any]) -> int:
+    """Write one episode row: controller = the law, params = locator + noise (+ model digest),
+    family = the generator or the scene, metrics in their columns; ``n_obstacles`` and
+    ``entered_inner_space`` (no column) in ``effective_params``."""
+    job = Ch5Job(
+        row["scene"],
+        row["locator"],
+        int(row["seed"]),
+        float(row["noise_std"]),
+        None,
+        str(row.get("model", "")),
+    )
+    return store.add_episode(
+        campaign_id,
+        scenario=row["scene"],
+        controller=LAW,
+        seed=int(row["seed"]),
+        status=row["status"],
+        params=job.params,
+        metrics={m: row.get(m) for m in METRIC_NAMES},
+        family=str(row["scene"]).split(":", 1)[0],
+        effective_params={
+            **job.params,
+            "n_obstacles": int(row.get("n_obstacles", 0)),
+            "entered_inner_space": bool(row["entered_inner_space"]),
+        },
+        wall_time=row.get("wall_time"),
+    )
+
+
+def _value(v: Any) -> Any:
+    """A stored value as plain Python (missing -> None, numpy scalars -> Python)."""
+    if v is None or (not isinstance(v, str) and pd.isna(v)):
+        return None
+    return v.item() if isinstance(v, np.generic) else v
+
+
+def stored_rows(store: ResultsStore, campaign: str) -> list[dict[str, Any]]:
+    """The episode rows of a campaign, as :func:`run_ch5_job` makes them (store order)."""
+    if store.campaign_id(campaign) is None:
+        return []
+    rows: list[dict[str, Any]] = []
+    for rec in store.episodes_frame(campaign).to_dict("records"):
+        params = json.loads(rec["params"])
+        extra = json.loads(rec["effective_params"] or "{}")
+        row: dict[str, Any] = {
+            "scene": rec["scenario"],
+            "locator": params["locator"],
+            "noise_std": float(params.get("noise_std", 0.0)),
+            "seed": int(rec["seed"]),
+            "status": rec["status"],
+            "entered_inner_space": bool(extra.get("entered_inner_space", False)),
+            "n_obstacles": int(extra.get("n_obstacles", 0)),
+            "model": str(params.get("model", "")),
+            "wall_time": _value(rec["wall_time"]),
+        }
+        for m in METRIC_NAMES:
+            row[m] = _value(rec[m])
+        rows.append(row)
+    return rows
+
+
+def run_jobs(
+    jobs: Iterable[Ch5Job],
+    store: ResultsStore,
+    campaign: str,
+    *,
+    workers: int = 1,
+    on_episode: Callable[[], None] | None = None,
+    config: dict[str, Any] | None = None,
+) -> list[dict[str, Any]]:
+    """Run the jobs of ``campaign`` not yet in the store (one transaction per finished episode,
+    written by this process; workers only compute), so an interrupted campaign resumes.
+
+    Returns:
+        The rows of all requested jobs (stored and new), in job order.
+    """
+    jobs = list(jobs)
+    cid = store.campaign(campaign, config or {"chapter": 5})
+    done = store.done_keys(cid)
+    todo = [j for j in jobs if j.key not in done]
+    for _ in range(len(jobs) - len(todo)):
+        if on_episode is not None:
+            on_episode()
+    pool = None
+    if workers <= 1 or len(todo) < 2:
+        results: Iterable[dict[str, Any]] = map(_row_only, todo)
+    else:
+        pool = ProcessPoolExecutor(max_workers=workers)
+        results = pool.map(_row_only, todo, chunksize=1)
+    try:
+        for row in results:
+            store_row(store, cid, row)
+            if on_episode is not None:
+                on_episode()
+    finally:
+        if pool is not None:
+            pool.shutdown(cancel_futures=True)
+    by_key: dict[tuple[str, str, str, int], dict[str, Any]] = {}
+    for r in stored_rows(store, campaign):
+        j = Ch5Job(r["scene"], r["locator"], r["seed"], r["noise_std"], None, r["model"])
+        by_key[j.key] = r
+    return [by_key[j.key] for j in jobs if j.key in by_key]
+
+
 def run_closed_loop(
     scenes: Sequence[str],
     locators: dict[str, Locator],
@@ -164,7 +444,8 @@ def run_closed_loop(
     on_episode: Callable[[], None] | None = None,
     record: bool = False,
 ) -> tuple[list[dict[str, Any]], dict[tuple[str, str, float], UUV3DResult]]:
-    """Every scene x locator x noise once with ``seed``; rows and (when ``record``) results."""
+    """Every scene x locator x noise once with ``seed`` (in-process, not stored); rows and (when
+    ``record``) results."""
     rows: list[dict[str, Any]] = []
     kept: dict[tuple[str, str, float], UUV3DResult] = {}
     for scene in scenes:
@@ -184,6 +465,54 @@ def run_closed_loop(
     return rows, kept
 
 
+def _family(row: dict[str, Any]) -> str:
+    return str(row["scene"]).split(":", 1)[0]
+
+
+def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """Per (scene family, locator, noise): episodes, success / collision / timeout rates, inner
+    space entries, median path length and detour ratio, minimum clearance, decision time."""
+    groups: dict[tuple[str, str, float], list[dict[str, Any]]] = {}
+    for r in rows:
+        groups.setdefault((_family(r), r["locator"], float(r["noise_std"])), []).append(r)
+    out = []
+    for (family, loc, noise), rs in sorted(groups.items()):
+        n = len(rs)
+
+        def med(name: str, rs: list[dict[str, Any]] = rs) -> float | None:
+            vals = [r[name] for r in rs if r.get(name) is not None]
+            return float(np.median(vals)) if vals else None
+
+        out.append(
+            {
+                "family": family,
+                "locator": loc,
+                "noise_std": noise,
+                "episodes": n,
+                "success_rate": sum(r["status"] == "success" for r in rs) / n,
+                "collision_rate": sum(r["status"] == "collision" for r in rs) / n,
+                "timeout_rate": sum(r["status"] == "timeout" for r in rs) / n,
+                "entered_inner_space": sum(bool(r["entered_inner_space"]) for r in rs),
+                "path_length": med("path_length"),
+                "detour_ratio": med("detour_ratio"),
+                "min_clearance": min(
+                    (r["min_clearance"] for r in rs if r.get("min_clearance") is not None),
+                    default=None,
+                ),
+                "decision_us_median": med("decision_us_median"),
+            }
+        )
+    return out
+
+
+def failures(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
+    """The episodes that did not succeed: scene, seed, locator, noise, obstacles, status (the
+    cause: ``collision`` or ``timeout``), minimum clearance [m]."""
+    keep = ("scene", "seed", "locator", "noise_std", "n_obstacles", "status", "min_clearance")
+    return [{k: r.get(k) for k in keep} for r in rows if r["status"] != "success"]
+
+
+# ---------------------------------------------------------------------------------------- table
 def _range(lo: float, hi: float) -> str:
     return f"[{lo:.4g}, {hi:.4g}]"
 
@@ -245,16 +574,46 @@ def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
             )
         if rand_rows:
             ok = sum(bool(r["success"]) for r in rand_rows)
-            fails = [f"{r['scene']}:{r['status']}" for r in rand_rows if not r["success"]]
+            fails = [f"{r['scene']} {r['status']}" for r in rand_rows if not r["success"]]
             rows.append(
                 {
                     "quantity": f"Ch5 random scenes success ({loc}, noise {noise} m)",
                     "thesis": "-",
                     "measured": f"{ok / len(rand_rows):.1%} of {len(rand_rows)}",
-                    "note": ("failures: " + ", ".join(fails[:6])) if fails else "no failure",
+                    "note": (
+                        f"{len(fails)} failures: "
+                        + ", ".join(fails[:6])
+                        + (", ..." if len(fails) > 6 else "")
+                    )
+                    if fails
+                    else "no failure",
                 }
             )
     return rows
+
+
+def _campaign_jobs(
+    n_rand: int, noises: Sequence[float], model_path: Path, model_id: str
+) -> dict[str, list[Ch5Job]]:
+    """The random-scene jobs of each campaign (noise 0: ``ch5-random``; else ``ch5-noise``),
+    scene by scene (all locators of a scene together)."""
+    out: dict[str, list[Ch5Job]] = {RANDOM_CAMPAIGN: [], NOISE_CAMPAIGN: []}
+    for noise in noises:
+        name = RANDOM_CAMPAIGN if noise == 0 else NOISE_CAMPAIGN
+        for g in range(n_rand):
+            for loc in LOCATORS:
+                net = loc == "network"
+                out[name].append(
+                    Ch5Job(
+                        f"random-ch5:{g}",
+                        loc,
+                        g,
+                        float(noise),
+                        str(model_path) if net else None,
+                        model_id if net else "",
+                    )
+                )
+    return out
 
 
 def reproduce_ch5(
@@ -271,92 +630,148 @@ def reproduce_ch5(
     progress: bool = True,
     render: Callable[[Ch5Summary, Path], list[Path]] | None = None,
     report_dir: Path | None = None,
+    workers: int = 1,
+    fresh: bool = False,
 ) -> Ch5Summary:
-    """Run the Chapter 5 reproduction (module docstring) and write ``results_dir/ch5.json``.
+    """Run the Chapter 5 reproduction (module docstring); write ``results_dir/ch5.json`` and the
+    closed-loop episodes to ``results_dir/uvnav.sqlite``.  Resumes an interrupted run.
 
     Args:
-        results_dir: folder of ``ch5.json`` and the closed-loop network's checkpoint.
-        full: thesis-size runs (sizes up to 5000, 5 seeds, 300 random scenes).
-        sizes: sample counts (default 50, 150, 500 quick).
-        n_seeds: seeds per sample count (default 3 quick).
-        n_random: random closed-loop scenes per locator and noise level (default 10 quick).
+        results_dir: folder of ``ch5.json``, the results database, the closed-loop network's
+            checkpoint ``ch5_bpnn`` and the resume cache ``ch5/cache``.
+        full: thesis-size runs (sizes up to 5000, 5 seeds, 300 random scenes, noise 0 and 0.05).
+        sizes: sample counts (default 50, 150 quick).
+        n_seeds: seeds per sample count (default 2 quick).
+        n_random: random closed-loop scenes per locator and noise level (default 3 quick).
         n_test: size of the independent test set.
         scenes: thesis scenes to run (default all three).
         noises: sonar noise levels [m] of the closed-loop runs (default 0 quick, 0 and 0.05 full).
         closed_loop_samples: training samples of the closed-loop (residual) network.
-        progress: rich progress bar on stderr.
+        progress: rich progress bars on stderr.
         render: figure renderer ``(summary, report_dir) -> files`` (e.g.
             :func:`uvnav.viz.figures_ch5.render_ch5`); ``None`` skips figures.
         report_dir: folder of the figures.
+        workers: processes for the random-scene campaigns.
+        fresh: discard the cache and the stored Chapter 5 campaigns first.
     """
-    from rich.progress import Progress
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     tic = time.perf_counter()
     results_dir = Path(results_dir)
     results_dir.mkdir(parents=True, exist_ok=True)
+    cache = results_dir / "ch5" / "cache"
+    db_path = results_dir / DB_NAME
+    if fresh and cache.exists():
+        shutil.rmtree(cache)
     sizes = tuple(sizes) if sizes is not None else (FULL_SIZES if full else QUICK_SIZES)
     seeds = n_seeds if n_seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
     n_rand = n_random if n_random is not None else (FULL_RANDOM if full else QUICK_RANDOM)
-    summary = Ch5Summary()
-    test = sample_sonar_dataset(
-        n_test, np.random.default_rng(999_999), subdivisions=DATA_SUBDIVISIONS
-    )
-    summary.datasets["independent_test"] = test
+    summary = Ch5Summary(db_path=db_path)
     scene_list = list(scenes) if scenes is not None else list_ch5_builtin()
     default_noises = (0.0, NOISE_STD) if full else QUICK_NOISES
     noise_list = tuple(noises) if noises is not None else default_noises
-    n_episodes = (len(scene_list) + n_rand) * len(LOCATORS) * len(noise_list)
     variants = (BPNNConfig(), BPNNConfig(residual=True))
-    with Progress(disable=not progress, transient=True) as prog:
-        task = prog.add_task("Ch5 BPNN", total=len(sizes) * seeds * len(variants) + 1)
+    columns = (
+        "[progress.description]{task.description}",
+        BarColumn(),
+        MofNCompleteColumn(),
+        TimeElapsedColumn(),
+    )
+    with Progress(*columns, disable=not progress, transient=True) as prog:
+        n_units = len(sizes) * seeds * len(variants) + 1
+        task = prog.add_task("Ch5 BPNN data + training", total=n_units)
+        sampling = prog.add_task("Ch5 sampling", total=None, visible=False)
+
+        def sampler(n: int) -> Callable[[int], None]:
+            prog.reset(sampling, total=n, visible=True, description=f"Ch5 sampling {n}")
+            return lambda k: prog.update(sampling, completed=k)
+
+        test, _ = cached_dataset(n_test, TEST_SEED, cache, sampler(n_test))
+        summary.datasets["independent_test"] = test
         for n in sizes:
             for s in range(seeds):
                 for cfg in variants:
-                    row, model, ds = learning_row(n, s, test, cfg)
+                    row, model, ds = learning_row(
+                        n, s, test, cfg, cache=cache, on_sample=sampler(n)
+                    )
                     summary.learning.append(row)
                     if s == 0:
                         key = f"n{n}" + ("r" if cfg.residual else "")
                         summary.models[key] = model
                         summary.datasets[key] = ds
                     prog.advance(task)
-        # the closed-loop network: a residual one trained once on CLOSED_LOOP_SAMPLES samples
-        cl_row, cl_model, _ = learning_row(closed_loop_samples, 100, test, variants[1])
+        # the closed-loop network: a residual one trained once on ``closed_loop_samples``
+        cl_row, cl_model, _ = learning_row(
+            closed_loop_samples,
+            CLOSED_LOOP_SEED,
+            test,
+            variants[1],
+            cache=cache,
+            on_sample=sampler(closed_loop_samples),
+        )
+        prog.update(sampling, visible=False)
         summary.learning.append(cl_row)
-        save_checkpoint(cl_model, results_dir / "ch5_bpnn")
+        model_path = results_dir / "ch5_bpnn"
+        save_checkpoint(cl_model, model_path)
+        model_id = checkpoint_digest(model_path)
         summary.models["closed_loop"] = cl_model
         prog.advance(task)
-        locators: dict[str, Locator] = {
-            "geometric": GeometricLocator(),
-            "network": ModelLocator(cl_model),
-            "oracle": OracleLocator(),
-        }
-        task2 = prog.add_task("Ch5 closed loop", total=n_episodes)
-        rows, kept = run_closed_loop(
-            scene_list,
-            locators,
-            noises=noise_list,
-            record=True,
-            on_episode=lambda: prog.advance(task2),
+
+        jobs = _campaign_jobs(n_rand, noise_list, model_path, model_id)
+        n_episodes = len(scene_list) * len(LOCATORS) * len(noise_list) + sum(
+            map(len, jobs.values())
         )
-        summary.closed_loop.extend(rows)
-        summary.models["episodes"] = kept
-        for g in range(n_rand):
-            scn_name = f"random-ch5:{g}"
-            r2, _ = run_closed_loop(
-                [scn_name],
-                locators,
-                noises=noise_list,
-                seed=g,
-                on_episode=lambda: prog.advance(task2),
-            )
-            summary.closed_loop.extend(r2)
+        task2 = prog.add_task("Ch5 closed loop", total=n_episodes)
+        kept: dict[tuple[str, str, float], UUV3DResult] = {}
+        base_cfg = {"chapter": 5, "law": LAW, "locators": list(LOCATORS), "model": model_id}
+        with ResultsStore(db_path) as store:
+            for name in CAMPAIGNS if fresh else (SCENES_CAMPAIGN,):
+                store.delete_campaign(name)  # the scenes re-run for their trajectories
+            cid = store.campaign(SCENES_CAMPAIGN, {**base_cfg, "noises": list(noise_list)})
+            for scene in scene_list:
+                for noise in noise_list:
+                    for loc in LOCATORS:
+                        job = Ch5Job(
+                            scene,
+                            loc,
+                            0,
+                            float(noise),
+                            str(model_path),
+                            model_id if loc == "network" else "",
+                        )
+                        row, res = run_ch5_job(job, record=True, model=cl_model)
+                        store_row(store, cid, row)
+                        kept[(scene, loc, float(noise))] = res
+                        prog.advance(task2)
+            scene_rows = stored_rows(store, SCENES_CAMPAIGN)
+            rand_rows: list[dict[str, Any]] = []
+            for name, js in jobs.items():
+                if not js:
+                    continue
+                cfg_c = {**base_cfg, "seeds": n_rand, "noise_std": js[0].noise_std}
+                rand_rows += run_jobs(
+                    js,
+                    store,
+                    name,
+                    workers=workers,
+                    config=cfg_c,
+                    on_episode=lambda: prog.advance(task2),
+                )
+    summary.models["episodes"] = kept
+    summary.closed_loop = scene_rows + rand_rows
+    summary.campaign = summarise(summary.closed_loop)
+    summary.failures = failures(summary.closed_loop)
     summary.table = build_ch5_table(summary)
     summary.wall_time = time.perf_counter() - tic
     out = {
         "learning": summary.learning,
         "closed_loop": summary.closed_loop,
+        "campaign": summary.campaign,
+        "failures": summary.failures,
         "table": summary.table,
         "wall_time": round(summary.wall_time, 2),
+        "database": DB_NAME,
+        "campaigns": list(CAMPAIGNS),
         "config": {
             "sizes": list(sizes),
             "seeds": seeds,
@@ -364,6 +779,7 @@ def reproduce_ch5(
             "n_test": n_test,
             "noises": list(noise_list),
             "closed_loop_samples": closed_loop_samples,
+            "model": model_id,
         },
     }
     summary.json_path = results_dir / "ch5.json"
@@ -382,11 +798,21 @@ def _json_default(x: Any) -> Any:
 
 
 __all__ = [
+    "CAMPAIGNS",
+    "LAW",
+    "Ch5Job",
     "Ch5Summary",
     "build_ch5_table",
+    "cached_dataset",
+    "checkpoint_digest",
+    "failures",
     "learning_row",
     "make_locator",
     "random_ch5_scenario",
     "reproduce_ch5",
+    "run_ch5_job",
     "run_closed_loop",
+    "run_jobs",
+    "stored_rows",
+    "summarise",
 ]

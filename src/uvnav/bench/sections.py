@@ -267,6 +267,12 @@ def _ch5_caption(p: Path) -> str:
             f"Figs. 5.5–5.8 style: errors and target-vs-output of the {m[1]}-sample {kind} "
             f"network on {where}."
         )
+    if m := re.fullmatch(r"ch5_anim_(.+)_([a-z]+)", s):
+        return (
+            f"Animation of {m[1]} with the {m[2]} locator: the vehicle (blue sphere), the "
+            "deforming obstacles redrawn at each decision time, the located point to evade "
+            "(black cross); right, a close-up around the vehicle."
+        )
     if m := re.fullmatch(r"ch5_traj_(.+)_([a-z]+)_([0-9.]+)", s):
         return f"{m[1]}: the 3D run with the {m[2]} locator, sonar noise {m[3]} m."
     return ""
@@ -293,7 +299,8 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
         f"{seeds} seeds each, tested on its own test group and on an independent set; "
         f"zhang2022-uuv3d-v1 then ran on the three thesis-ch5 scenes and random-ch5 seeds "
         f"0–{n_rand - 1} with the {', '.join(r5.LOCATORS)} locators, sonar noise {noises}. "
-        "Results are stored as JSON (linked below)."
+        f"Every closed-loop episode is a row of the results database (campaigns "
+        f"{', '.join(r5.CAMPAIGNS)}); the summary with the failures is the JSON linked below."
     )
     sec = ChapterSection(
         key="ch5",
@@ -304,6 +311,14 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
     sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch5_caption))
     if p is not None:
         sec.links += caption_files([Path(p)], lambda _p: "Chapter 5 results (JSON)")
+    fails = list(getattr(summary, "failures", []) or [])
+    if fails:
+        shown = ", ".join(
+            f"{f['scene']} ({f['locator']}, noise {f['noise_std']:g} m): {f['status']}"
+            for f in fails[:8]
+        )
+        more = f" and {len(fails) - 8} more" if len(fails) > 8 else ""
+        sec.notes.append(f"Closed-loop failures: {shown}{more}.")
     if not sec.figures:
         sec.notes.append("No figures: the run had no Chapter 5 renderer.")
     return sec

@@ -228,3 +228,45 @@ def simulate_cmd(
         **res.metrics.to_dict(),
     }
     typer.echo(json.dumps(out))
+
+
+@sonar_app.command("reproduce")
+def reproduce_cmd(
+    results_dir: Annotated[
+        Path, typer.Option("--results", help="Folder of ch5.json, uvnav.sqlite and the cache.")
+    ] = Path("results"),
+    report_dir: Annotated[
+        Path | None, typer.Option("--report", help="Folder of the figures (ch5/); none: skip.")
+    ] = None,
+    full: Annotated[
+        bool, typer.Option("--full", help="Thesis-size: sizes to 5000, 300 scenes, noise.")
+    ] = False,
+    workers: Annotated[int, typer.Option(min=1, help="Processes for the random scenes.")] = 1,
+    fresh: Annotated[bool, typer.Option("--fresh", help="Start over (drop the cache).")] = False,
+    n_random: Annotated[
+        int | None, typer.Option("--n-random", min=0, help="Random scenes (override).")
+    ] = None,
+) -> None:
+    """The Chapter 5 reproduction alone (BPNN experiment + closed-loop campaigns); resumable:
+    an interrupted run continues where it stopped."""
+    from uvnav.bench.reproduce_ch5 import reproduce_ch5
+    from uvnav.viz.figures_ch5 import render_ch5
+
+    s = reproduce_ch5(
+        results_dir,
+        full=full,
+        workers=workers,
+        fresh=fresh,
+        n_random=n_random,
+        render=render_ch5 if report_dir is not None else None,
+        report_dir=report_dir,
+    )
+    for c in s.campaign:
+        typer.echo(
+            f"{c['family']:<18} {c['locator']:<9} noise {c['noise_std']:<5g} "
+            f"n={c['episodes']:<4} success {100 * c['success_rate']:.1f} % "
+            f"collision {100 * c['collision_rate']:.1f} % timeout {100 * c['timeout_rate']:.1f} %"
+        )
+    for f in s.failures:
+        typer.echo(f"failure: {json.dumps(f)}")
+    typer.echo(f"wall time {s.wall_time:.1f} s; results {s.json_path}")

@@ -1,5 +1,7 @@
 """Chapter 5 figures: the sonar array (Fig. 5.2), training curves, error histograms and
-target-vs-output regressions (Figs. 5.5-5.8), the learning curve, and 3D trajectories (Fig. 5.3).
+target-vs-output regressions (Figs. 5.5-5.8), the learning curve, 3D trajectories (Fig. 5.3) and
+an animated GIF of a whole 3D run (:func:`save_animation3d`: vehicle, deforming obstacles at each
+decision time, the located point to evade).
 
 Thesis Chapter 5 (Y. Zhang and J. Zhang, ICCAE 2022).  Pure plotting of what the library measured
 (matplotlib, Agg backend); nothing here computes a result.
@@ -180,6 +182,130 @@ def fig_trajectory3d(
     return fig
 
 
+def _draw_bodies(ax: Any, obstacles: Sequence[CompoundBody], t: float, **kw: Any) -> None:
+    for ob in obstacles:
+        for part in ob.parts:
+            v = part.vertices(t)
+            ax.plot_trisurf(v[:, 0], v[:, 1], v[:, 2], triangles=part.faces, linewidth=0, **kw)
+
+
+def _sphere(centre: FloatArray, radius: float, n: int = 10) -> tuple[Any, Any, Any]:
+    u, v = np.mgrid[0 : 2 * np.pi : complex(0, n), 0 : np.pi : complex(0, n // 2 + 1)]
+    return (
+        centre[0] + radius * np.cos(u) * np.sin(v),
+        centre[1] + radius * np.sin(u) * np.sin(v),
+        centre[2] + radius * np.cos(v),
+    )
+
+
+def animation_frames(n_decisions: int, max_frames: int) -> list[int]:
+    """Decision indices shown by :func:`save_animation3d`: evenly spread, first and last kept,
+    at most ``max_frames`` (>= 2) of them."""
+    if n_decisions <= 0:
+        return []
+    k = min(n_decisions, max(2, int(max_frames)))
+    return sorted({round(float(x)) for x in np.linspace(0, n_decisions - 1, k)})
+
+
+def save_animation3d(
+    result: UUV3DResult,
+    obstacles: Sequence[CompoundBody],
+    goal: FloatArray,
+    path: Path,
+    *,
+    radius: float = 0.5,
+    title: str = "",
+    max_frames: int = 24,
+    fps: int = 4,
+    close_up: float = 5.0,
+    dpi: int = 70,
+) -> Path | None:
+    """A recorded 3D run as an animated GIF (matplotlib + Pillow): left, the whole scene (path so
+    far, obstacles at that time, A and B); right, a close-up box of half-side ``close_up`` [m]
+    around the vehicle (hull sphere of ``radius`` [m]) where the surfaces' deformation and the
+    located point to evade (black cross, joined to the vehicle) are visible.  The obstacles are
+    redrawn at each frame's decision time.  ``None`` when Pillow is not installed or the run was
+    not recorded.
+    """
+    try:
+        from matplotlib.animation import FuncAnimation, PillowWriter
+    except ImportError:  # pragma: no cover
+        return None
+    pos = np.asarray(result.positions, dtype=float)
+    frames = animation_frames(len(result.times), max_frames)
+    if len(frames) < 2:
+        return None
+    loc = np.asarray(result.located, dtype=float)
+    goal = np.asarray(goal, dtype=float)
+    pts = [pos, goal[None]]
+    for ob in obstacles:
+        pts += [p.vertices(0.0) for p in ob.parts]
+    allp = np.concatenate(pts)
+    lo, hi = allp.min(axis=0) - 1.0, allp.max(axis=0) + 1.0
+    fig = plt.figure(figsize=(10, 4.8))
+    ax_all: Any = fig.add_subplot(1, 2, 1, projection="3d")
+    ax_zoom: Any = fig.add_subplot(1, 2, 2, projection="3d")
+    fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.88, wspace=0.0)
+    ax_all.set_xlim(lo[0], hi[0])
+    ax_all.set_ylim(lo[1], hi[1])
+    ax_all.set_zlim(lo[2], hi[2])
+    ax_all.set_box_aspect(tuple(hi - lo), zoom=1.05)
+    size = "x".join(f"{x:.0f}" for x in hi - lo)
+    ax_all.set_title(f"whole scene ({size} m box)", fontsize=9)
+    ax_zoom.set_box_aspect((1, 1, 1), zoom=1.2)
+    ax_zoom.set_title(f"close-up ({2 * close_up:.0f} m box); x: located point", fontsize=9)
+    # static and updated artists; axes off: tick text would dominate the drawing time
+    lines: list[Any] = []
+    marks: list[Any] = []
+    links: list[Any] = []
+    moving: list[Any] = []
+    for ax in (ax_all, ax_zoom):
+        ax.set_axis_off()
+        ax.scatter(*pos[0], color="g", s=25)
+        ax.scatter(*goal, color="m", s=60, marker="*")
+        lines.append(ax.plot([], [], [], color="C0", lw=1.4)[0])
+        marks.append(ax.plot([], [], [], "kx", ms=7)[0])
+        links.append(ax.plot([], [], [], "k:", lw=1)[0])
+    alphas = (0.35, 0.5)
+
+    def draw(i: int) -> list[Any]:
+        k = frames[i]
+        t = float(result.times[k])
+        c = pos[k]
+        while moving:
+            moving.pop().remove()
+        ax_zoom.set_xlim(c[0] - close_up, c[0] + close_up)
+        ax_zoom.set_ylim(c[1] - close_up, c[1] + close_up)
+        ax_zoom.set_zlim(c[2] - close_up, c[2] + close_up)
+        seen = k < len(loc) and bool(np.all(np.isfinite(loc[k])))
+        for j, ax in enumerate((ax_all, ax_zoom)):
+            for ob in obstacles:
+                for part in ob.parts:
+                    v = part.vertices(t)
+                    moving.append(
+                        ax.plot_trisurf(
+                            *v.T, triangles=part.faces, color="C1", alpha=alphas[j], linewidth=0
+                        )
+                    )
+            moving.append(ax.plot_surface(*_sphere(c, radius), color="C0", linewidth=0))
+            lines[j].set_data_3d(*pos[: k + 1].T)
+            pts = np.stack([c, loc[k]]) if seen else np.zeros((0, 3))
+            marks[j].set_data_3d(*pts[1:].T)
+            links[j].set_data_3d(*pts.T)
+        mode = result.modes[k] if k < len(result.modes) else ""
+        fig.suptitle(f"{title}  t = {t:.1f} s  ({mode})", fontsize=10)
+        return []
+
+    anim = FuncAnimation(fig, draw, frames=len(frames), blit=False)
+    try:
+        anim.save(str(path), writer=PillowWriter(fps=fps), dpi=dpi)
+    except (ImportError, RuntimeError, ValueError):  # Pillow missing or unusable
+        plt.close(fig)
+        return None
+    plt.close(fig)
+    return Path(path)
+
+
 def render_ch5(summary: Any, report_dir: Path) -> list[Path]:
     """All Chapter 5 figures of a :class:`~uvnav.bench.reproduce_ch5.Ch5Summary` as PNG files in
     ``report_dir/ch5``."""
@@ -231,4 +357,40 @@ def render_ch5(summary: Any, report_dir: Path) -> list[Path]:
             fig_trajectory3d(res, setup.obstacles, setup.goal, f"{scene}, {loc}, noise {noise} m"),
             f"ch5_traj_{scene}_{loc}_{noise}.png",
         )
+    gif = _animate_one(dict(summary.models.get("episodes", {})), out)
+    if gif is not None:
+        files.append(gif)
     return files
+
+
+#: frames of the report's animation (each redraws the bodies in two 3D views: ~0.3 s a frame)
+ANIMATION_FRAMES = 24
+
+#: the run animated in the report: Scene 3 (two obstacles) first, with the BPNN locator
+ANIMATION_PREFERENCE: tuple[tuple[str, str], ...] = (
+    ("thesis-ch5-scene3", "network"),
+    ("thesis-ch5-scene1", "network"),
+    ("thesis-ch5-scene3", "geometric"),
+    ("thesis-ch5-scene1", "geometric"),
+)
+
+
+def _animate_one(episodes: dict[tuple[str, str, float], UUV3DResult], out: Path) -> Path | None:
+    """Animate the preferred recorded noise-free thesis run (:data:`ANIMATION_PREFERENCE`)."""
+    from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
+
+    for scene, loc in ANIMATION_PREFERENCE:
+        res = episodes.get((scene, loc, 0.0))
+        if res is None or len(res.times) < 2:
+            continue
+        setup = build_uuv3d(load_ch5_scenario(scene))
+        return save_animation3d(
+            res,
+            setup.obstacles,
+            setup.goal,
+            out / f"ch5_anim_{scene}_{loc}.gif",
+            radius=setup.spec.radius,
+            title=f"{scene}, {loc} locator",
+            max_frames=ANIMATION_FRAMES,
+        )
+    return None

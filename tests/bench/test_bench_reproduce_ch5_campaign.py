@@ -1,0 +1,142 @@
+"""Chapter 5 campaign plumbing: episodes in the results store, resume after an interruption,
+cached data sets that continue the same random stream."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from uvnav.bench import reproduce_ch5 as r5
+from uvnav.bench.reproduce_ch5 import (
+    LAW,
+    Ch5Job,
+    cached_dataset,
+    run_jobs,
+    stored_rows,
+    summarise,
+)
+from uvnav.bench.store import ResultsStore
+from uvnav.sensors.sonar_dataset import sample_sonar_dataset
+
+#: a short scene (8 m, one small deforming star across the line): ~1 s per episode
+SHORT_SCENE = """
+name: short-ch5
+dim: 3
+t_max: 30
+robot: {start: [0, 0, 0], heading: [1, 0, 0], goal: [9, 0, 0], v_max: 1.0, u_max: 1.0, radius: 0.5}
+sonar: {ring_angle_deg: 35, half_angle_deg: 20, max_range: 8.0}
+obstacles:
+  - {type: star, centre: [4.5, 0.3, 0.0], base_radius: 1.0, shape_scale: 0.2, delta_max: 0.1,
+     max_frequency: 0.5, seed: 3}
+controller: {name: zhang2022-uuv3d-v1, locator: geometric}
+"""
+
+
+@pytest.fixture
+def short_scene(tmp_path: Path) -> str:
+    p = tmp_path / "short.yaml"
+    p.write_text(SHORT_SCENE)
+    return str(p)
+
+
+class _KilledError(Exception):
+    pass
+
+
+def test_campaign_rows_are_stored_and_an_interrupted_campaign_resumes(
+    tmp_path: Path, short_scene: str
+) -> None:
+    jobs = [Ch5Job(short_scene, "geometric", 0), Ch5Job(short_scene, "oracle", 0, 0.05)]
+    db = tmp_path / "uvnav.sqlite"
+
+    def stop_after_first() -> None:
+        raise _KilledError  # the run is "killed" right after the first episode was stored
+
+    with ResultsStore(db) as store, pytest.raises(_KilledError):
+        run_jobs(jobs, store, r5.RANDOM_CAMPAIGN, on_episode=stop_after_first)
+    with ResultsStore(db) as store:
+        first = stored_rows(store, r5.RANDOM_CAMPAIGN)
+        assert [(r["locator"], r["noise_std"]) for r in first] == [("geometric", 0.0)]
+        first_id = store.find_episode(
+            r5.RANDOM_CAMPAIGN,
+            scenario=short_scene,
+            controller=LAW,
+            seed=0,
+            params=jobs[0].params,
+        )
+        rows = run_jobs(jobs, store, r5.RANDOM_CAMPAIGN)
+        assert store.count(r5.RANDOM_CAMPAIGN) == 2  # only the missing episode ran
+        again = store.find_episode(
+            r5.RANDOM_CAMPAIGN,
+            scenario=short_scene,
+            controller=LAW,
+            seed=0,
+            params=jobs[0].params,
+        )
+        assert again == first_id
+        frame = store.episodes_frame(r5.RANDOM_CAMPAIGN)
+    assert [r["locator"] for r in rows] == ["geometric", "oracle"]
+    assert all(r["status"] == "success" and r["min_clearance"] > 0 for r in rows)
+    assert set(frame["controller"]) == {LAW}
+    extra = [json.loads(e) for e in frame["effective_params"]]
+    assert all(e["n_obstacles"] == 1 and e["entered_inner_space"] is False for e in extra)
+    params = [json.loads(p) for p in frame["params"]]
+    assert {p["locator"] for p in params} == {"geometric", "oracle"}
+    assert {p["noise_std"] for p in params} == {0.0, 0.05}
+    groups = summarise(rows)
+    assert {(g["locator"], g["success_rate"]) for g in groups} == {
+        ("geometric", 1.0),
+        ("oracle", 1.0),
+    }
+
+
+def test_network_jobs_key_on_the_checkpoint_digest() -> None:
+    a = Ch5Job("random-ch5:1", "network", 1, 0.0, "m", "aaaa")
+    b = Ch5Job("random-ch5:1", "network", 1, 0.0, "m", "bbbb")
+    g1 = Ch5Job("random-ch5:1", "geometric", 1, 0.0, None, "")
+    g2 = Ch5Job("random-ch5:1", "geometric", 1, 0.0, "m", "cccc")
+    assert a.key != b.key  # another network: the episode runs again
+    assert g1.key == g2.key  # the digest means nothing to the other locators
+
+
+def test_cached_dataset_resumes_the_same_data_and_random_stream(tmp_path: Path) -> None:
+    ds, rng = cached_dataset(4, 123, tmp_path)
+    files = sorted(p.name for p in tmp_path.iterdir())
+    assert files == ["data_n4_r123.npz", "data_n4_r123.rng.json"]
+    again, rng2 = cached_dataset(4, 123, tmp_path)  # read back, nothing sampled
+    np.testing.assert_array_equal(again.ranges, ds.ranges)
+    np.testing.assert_array_equal(again.target_index, ds.target_index)
+    # one uninterrupted run: sample, then continue with the same generator
+    ref_rng = np.random.default_rng(123)
+    ref = sample_sonar_dataset(4, ref_rng, subdivisions=r5.DATA_SUBDIVISIONS)
+    np.testing.assert_array_equal(ref.ranges, ds.ranges)
+    expect = ref_rng.random(3)
+    np.testing.assert_array_equal(rng.random(3), expect)
+    np.testing.assert_array_equal(rng2.random(3), expect)
+
+
+def test_ch5_section_shows_the_animation_and_names_failures(tmp_path: Path) -> None:
+    from types import SimpleNamespace
+
+    from uvnav.bench.sections import ch5_section
+
+    gif = tmp_path / "ch5_anim_thesis-ch5-scene3_network.gif"
+    gif.write_bytes(b"GIF89a")
+    fail = {
+        "scene": "random-ch5:7",
+        "seed": 7,
+        "locator": "network",
+        "noise_std": 0.05,
+        "n_obstacles": 2,
+        "status": "collision",
+        "min_clearance": -0.01,
+    }
+    summary = SimpleNamespace(table=[], figures=[gif], json_path=None, failures=[fail])
+    sec = ch5_section(summary, full=True)
+    assert [f.path for f in sec.figures] == [gif]
+    assert "Animation of thesis-ch5-scene3 with the network locator" in sec.figures[0].caption
+    assert any("random-ch5:7 (network, noise 0.05 m): collision" in n for n in sec.notes)
+    assert "ch5-random" in sec.intro and "ch5-noise" in sec.intro
