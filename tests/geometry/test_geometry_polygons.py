@@ -16,6 +16,8 @@ from uvnav.geometry.polygons import (
     closed_rings,
     edge_soup,
     nearest_on_polygons,
+    points_to_segment,
+    points_to_segments,
     polygon_area,
     polygon_centroid,
     polygon_nearest,
@@ -308,3 +310,22 @@ def test_transform_rings_equals_transform_points(
 def test_closed_rings_empty() -> None:
     rings, counts = closed_rings([])
     assert rings.shape == (2, 0, 1) and counts.shape == (0,)
+
+
+@given(
+    pts=st.lists(st.tuples(small, small), min_size=1, max_size=12),
+    a=st.tuples(small, small),
+    b=st.tuples(small, small),
+)
+def test_points_to_one_segment_is_the_general_distance(
+    pts: list[tuple[float, float]], a: tuple[float, float], b: tuple[float, float]
+) -> None:
+    """The one-segment helper equals :func:`points_to_segments` (a degenerate segment included)
+    and shapely's point-to-line distance."""
+    p = np.array(pts)
+    got = points_to_segment(p, a, b)
+    ref = points_to_segments(p, np.broadcast_to(a, p.shape), np.broadcast_to(b, p.shape))
+    assert np.allclose(got, ref, atol=1e-9)
+    # shapely measures a subnormal-length line as infinitely far: take such a segment as a point
+    line = LineString([a, b]) if math.dist(a, b) > 1e-6 else Point(a)
+    assert np.allclose(got, [line.distance(Point(q)) for q in pts], atol=2e-6)

@@ -45,6 +45,7 @@ import numpy as np
 import pandas as pd
 
 from uvnav.bench.store import ResultsStore, params_hash
+from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
 from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin, load_uuv2d_scenario
 from uvnav.sim.episode_uuv2d import Uuv2dResult, run_uuv2d_episode
@@ -252,36 +253,18 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     groups: dict[tuple[str, str, float, float], list[dict[str, Any]]] = {}
     for r in rows:
         groups.setdefault((_family(r), r["law"], r["noise_std"], r["dropout"]), []).append(r)
-    out = []
-    for (family, law, noise, drop), rs in sorted(groups.items()):
-        n = len(rs)
-
-        def med(name: str, rs: list[dict[str, Any]] = rs) -> float | None:
-            vals = [r[name] for r in rs if r.get(name) is not None]
-            return float(np.median(vals)) if vals else None
-
-        out.append(
-            {
-                "family": family,
-                "law": law,
-                "noise_std": noise,
-                "dropout": drop,
-                "episodes": n,
-                "success_rate": sum(r["status"] == "success" for r in rs) / n,
-                "collision_rate": sum(r["status"] == "collision" for r in rs) / n,
-                "timeout_rate": sum(r["status"] == "timeout" for r in rs) / n,
-                "entered_forbidden": sum(bool(r["entered_forbidden"]) for r in rs),
-                "path_length": med("path_length"),
-                "detour_ratio": med("detour_ratio"),
-                "min_clearance": min(
-                    (r["min_clearance"] for r in rs if r["min_clearance"] is not None),
-                    default=None,
-                ),
-                "decision_us_median": med("decision_us_median"),
-                "limit_violations": sum(int(r["limit_violations"]) for r in rs),
-            }
-        )
-    return out
+    return [
+        {
+            "family": family,
+            "law": law,
+            "noise_std": noise,
+            "dropout": drop,
+            **outcome_stats(rs),
+            "entered_forbidden": sum(bool(r["entered_forbidden"]) for r in rs),
+            "limit_violations": sum(int(r["limit_violations"]) for r in rs),
+        }
+        for (family, law, noise, drop), rs in sorted(groups.items())
+    ]
 
 
 def failures(rows: list[dict[str, Any]], law: str | None = LAW) -> list[dict[str, Any]]:

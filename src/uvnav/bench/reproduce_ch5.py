@@ -52,6 +52,7 @@ import numpy as np
 import pandas as pd
 
 from uvnav.bench.store import ResultsStore, params_hash
+from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.zhang_uuv3d import (
     NAME as LAW,
 )
@@ -475,34 +476,16 @@ def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     groups: dict[tuple[str, str, float], list[dict[str, Any]]] = {}
     for r in rows:
         groups.setdefault((_family(r), r["locator"], float(r["noise_std"])), []).append(r)
-    out = []
-    for (family, loc, noise), rs in sorted(groups.items()):
-        n = len(rs)
-
-        def med(name: str, rs: list[dict[str, Any]] = rs) -> float | None:
-            vals = [r[name] for r in rs if r.get(name) is not None]
-            return float(np.median(vals)) if vals else None
-
-        out.append(
-            {
-                "family": family,
-                "locator": loc,
-                "noise_std": noise,
-                "episodes": n,
-                "success_rate": sum(r["status"] == "success" for r in rs) / n,
-                "collision_rate": sum(r["status"] == "collision" for r in rs) / n,
-                "timeout_rate": sum(r["status"] == "timeout" for r in rs) / n,
-                "entered_inner_space": sum(bool(r["entered_inner_space"]) for r in rs),
-                "path_length": med("path_length"),
-                "detour_ratio": med("detour_ratio"),
-                "min_clearance": min(
-                    (r["min_clearance"] for r in rs if r.get("min_clearance") is not None),
-                    default=None,
-                ),
-                "decision_us_median": med("decision_us_median"),
-            }
-        )
-    return out
+    return [
+        {
+            "family": family,
+            "locator": loc,
+            "noise_std": noise,
+            **outcome_stats(rs),
+            "entered_inner_space": sum(bool(r["entered_inner_space"]) for r in rs),
+        }
+        for (family, loc, noise), rs in sorted(groups.items())
+    ]
 
 
 def failures(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:

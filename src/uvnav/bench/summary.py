@@ -24,6 +24,8 @@ import json
 import math
 from typing import Any
 
+import numpy as np
+
 from uvnav.bench.store import STATUS_ERROR, ResultsStore
 
 #: Columns of a summary row, in display order.
@@ -96,3 +98,30 @@ def controller_summary(store: ResultsStore, campaign: int | str) -> list[dict[st
         )
     rows.sort(key=lambda r: (r["controller"], r["params"]))
     return rows
+
+
+def outcome_stats(rows: list[dict[str, Any]]) -> dict[str, Any]:
+    """Outcome statistics of a group of episode rows (dicts with ``status``, ``path_length``,
+    ``detour_ratio``, ``min_clearance``, ``decision_us_median``), as the chapter reproductions
+    (Ch. 4, Ch. 5) summarise them: ``episodes``, ``success_rate``, ``collision_rate``,
+    ``timeout_rate``, the medians of path length [m], detour ratio and decision time [µs], and the
+    smallest ``min_clearance`` [m] (None where no row has the value)."""
+    n = len(rows)
+
+    def median(name: str) -> float | None:
+        vals = [r[name] for r in rows if r.get(name) is not None]
+        return float(np.median(vals)) if vals else None
+
+    return {
+        "episodes": n,
+        "success_rate": sum(r["status"] == "success" for r in rows) / n,
+        "collision_rate": sum(r["status"] == "collision" for r in rows) / n,
+        "timeout_rate": sum(r["status"] == "timeout" for r in rows) / n,
+        "path_length": median("path_length"),
+        "detour_ratio": median("detour_ratio"),
+        "min_clearance": min(
+            (r["min_clearance"] for r in rows if r.get("min_clearance") is not None),
+            default=None,
+        ),
+        "decision_us_median": median("decision_us_median"),
+    }

@@ -79,6 +79,7 @@ from uvnav.controllers.base import (
 )
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec, velocity_toward
 from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.geometry.polygons import points_to_segment
 from uvnav.geometry.tangents import circle_tangents
 from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
 from uvnav.sensors.sonar2d import SonarObservation, close_narrow_openings
@@ -326,12 +327,8 @@ class Zhang2022Uuv2dController:
         centres, _ = near.within(run + clearance)
         if len(centres) == 0:
             return True
-        # distance of each square's centre to the segment position -> position + run (unit to E):
-        # along = clip(<c - p, e>, 0, run), off = |c - p - along e| (few array calls per decision)
-        ex, ey = gx / dist, gy / dist
-        rx, ry = centres[:, 0] - px, centres[:, 1] - py
-        along = np.minimum(np.maximum(rx * ex + ry * ey, 0.0), run)
-        return bool(np.min(np.hypot(rx - along * ex, ry - along * ey)) > clearance)
+        end = (px + gx / dist * run, py + gy / dist * run)
+        return bool(points_to_segment(centres, (px, py), end).min() > clearance)
 
     def _receding(self, position: FloatArray, r_min: FloatArray) -> bool:
         """True when E lies more than ``leave_angle`` from the direction of r_imin: heading for E

@@ -254,6 +254,23 @@ def points_to_segments(points: FloatArray, starts: FloatArray, ends: FloatArray)
     return np.sqrt(np.einsum("ij,ij->i", diff, diff))
 
 
+def points_to_segment(
+    points: FloatArray,
+    start: FloatArray | tuple[float, float],
+    end: FloatArray | tuple[float, float],
+) -> FloatArray:
+    """Distance [m] from each point (N, 2) to ONE segment ``start``-``end`` (2,), -> (N,).
+
+    The one-segment case of :func:`points_to_segments` in a few array calls (no broadcast copies
+    of the segment, no einsum): a controller asks it at every decision."""
+    p0, p1 = float(start[0]), float(start[1])
+    d0, d1 = float(end[0]) - p0, float(end[1]) - p1
+    len2 = max(d0 * d0 + d1 * d1, _EPS)
+    rx, ry = points[:, 0] - p0, points[:, 1] - p1
+    t = np.minimum(np.maximum((rx * d0 + ry * d1) / len2, 0.0), 1.0)
+    return np.asarray(np.hypot(rx - t * d0, ry - t * d1))
+
+
 # --------------------------------------------------------------------------------------------
 # padded closed rings: many polygons as one (2, m, n_max + 1) array, no per-call grouping
 

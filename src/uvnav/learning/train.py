@@ -45,6 +45,36 @@ def _targets(
     return torch.as_tensor(np.stack([steering, throttle], axis=1).astype(np.float32))
 
 
+def _batched_eval(
+    model: Any,
+    forward: Any,
+    images: NDArray[np.uint8],
+    speed: NDArray[np.float64] | None,
+    batch_size: int,
+    device: str,
+) -> Any:
+    """``forward(images, speed)`` in eval mode without gradients, batch by batch, concatenated
+    on the CPU (``forward`` is the model or one of its methods; the speed input is passed when the
+    model's config takes it)."""
+    import torch
+
+    model.eval()
+    cfg: PilotNetConfig = model.config
+    out = []
+    with torch.no_grad():
+        for a in range(0, len(images), batch_size):
+            xb = torch.as_tensor(images[a : a + batch_size]).to(device)
+            eb = (
+                torch.as_tensor(
+                    np.asarray(speed[a : a + batch_size], dtype=np.float32)[:, None]
+                ).to(device)
+                if cfg.extra_inputs and speed is not None
+                else None
+            )
+            out.append(forward(xb, eb).cpu())
+    return torch.cat(out)
+
+
 def evaluate_mse(
     model: Any,
     images: NDArray[np.uint8],
@@ -56,24 +86,9 @@ def evaluate_mse(
     device: str = "cpu",
 ) -> tuple[float, float, float]:
     """``(mse, steering mse, throttle mse)`` of the model in eval mode (NaN where absent)."""
-    import torch
 
-    model.eval()
-    cfg: PilotNetConfig = model.config
-    y = _targets(steering, throttle, cfg.n_outputs)
-    preds = []
-    with torch.no_grad():
-        for a in range(0, len(images), batch_size):
-            xb = torch.as_tensor(images[a : a + batch_size]).to(device)
-            eb = (
-                torch.as_tensor(
-                    np.asarray(speed[a : a + batch_size], dtype=np.float32)[:, None]
-                ).to(device)
-                if cfg.extra_inputs and speed is not None
-                else None
-            )
-            preds.append(model(xb, eb).cpu())
-    p = torch.cat(preds)
+    y = _targets(steering, throttle, model.config.n_outputs)
+    p = _batched_eval(model, model, images, speed, batch_size, device)
     se = (p - y) ** 2
     s_mse = float(se[:, 0].mean())
     t_mse = float(se[:, 1].mean()) if se.shape[1] > 1 else float("nan")
@@ -188,23 +203,8 @@ def hidden_features(
     device: str = "cpu",
 ) -> NDArray[np.float64]:
     """The last hidden layer's activations (eval mode), ``(N, 10)``: what the output layer reads."""
-    import torch
-
-    model.eval()
-    cfg: PilotNetConfig = model.config
-    out = []
-    with torch.no_grad():
-        for a in range(0, len(images), batch_size):
-            xb = torch.as_tensor(images[a : a + batch_size]).to(device)
-            eb = (
-                torch.as_tensor(
-                    np.asarray(speed[a : a + batch_size], dtype=np.float32)[:, None]
-                ).to(device)
-                if cfg.extra_inputs and speed is not None
-                else None
-            )
-            out.append(model.hidden(xb, eb).cpu())
-    return torch.cat(out).numpy().astype(np.float64)
+    out = _batched_eval(model, model.hidden, images, speed, batch_size, device)
+    return np.asarray(out.numpy(), dtype=np.float64)
 
 
 class Predictor:
