@@ -19,6 +19,7 @@ from uvnav.bench.reproduce_ch5 import (
     summarise,
 )
 from uvnav.bench.store import ResultsStore
+from uvnav.scenarios.ch5 import RANDOM_CH5_VERSION
 from uvnav.sensors.sonar_dataset import sample_sonar_dataset
 
 #: a short scene (8 m, one small deforming star across the line): ~1 s per episode
@@ -100,6 +101,9 @@ def test_network_jobs_key_on_the_checkpoint_digest() -> None:
     g2 = Ch5Job("random-ch5:1", "geometric", 1, 0.0, "m", "cccc")
     assert a.key != b.key  # another network: the episode runs again
     assert g1.key == g2.key  # the digest means nothing to the other locators
+    # random scenes carry the generator's version: a store of older scenes is not reused
+    assert g1.params["generator"] == RANDOM_CH5_VERSION
+    assert "generator" not in Ch5Job("thesis-ch5-scene1", "geometric", 0).params
 
 
 def test_cached_dataset_resumes_the_same_data_and_random_stream(tmp_path: Path) -> None:
@@ -140,3 +144,25 @@ def test_ch5_section_shows_the_animation_and_names_failures(tmp_path: Path) -> N
     assert "Animation of thesis-ch5-scene3 with the network locator" in sec.figures[0].caption
     assert any("random-ch5:7 (network, noise 0.05 m): collision" in n for n in sec.notes)
     assert "ch5-random" in sec.intro and "ch5-noise" in sec.intro
+
+
+def test_beam_ties_names_the_samples_whose_true_sensor_is_not_argmin() -> None:
+    ranges = np.full((3, 9), 8.0)
+    ranges[0, 0] = 2.0  # S1 nearest, and it is the true sensor
+    ranges[1, [1, 8]] = [1.076, 1.077]  # argmin S2, but the true point is in S9's beam
+    ranges[2, 4] = 3.0
+    ds = r5.SonarDataset(
+        ranges=ranges,
+        inputs=ranges,
+        target_distance=np.array([1.9, 1.05, 2.9]),
+        target_index=np.array([1, 9, 5]),
+        baseline_distance=ranges.min(axis=1),
+        baseline_index=np.argmin(ranges, axis=1) + 1,
+    )
+    predicted = np.array([[1.9, 1.2], [1.05, 2.0], [2.9, 4.9]])
+    ties = r5.beam_ties(ds, np.arange(3), predicted)
+    assert ties["n"] == 1
+    assert ties["max_reading_gap"] == pytest.approx(0.001)
+    assert ties["index_error_others"] == pytest.approx([-0.2, 0.1])
+    only_tie = r5.beam_ties(ds, np.array([1]), predicted[[1]])["index_error_others"]
+    assert all(np.isnan(only_tie))

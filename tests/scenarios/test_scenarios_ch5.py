@@ -11,6 +11,8 @@ from uvnav.scenarios.ch5 import (
     build_uuv3d,
     list_ch5_builtin,
     load_ch5_scenario,
+    random_ch5_end_clearance,
+    random_ch5_min_spacing,
     random_ch5_scenario,
 )
 from uvnav.scenarios.errors import ScenarioError
@@ -47,15 +49,28 @@ def test_bad_field_is_one_line_naming_file_and_field(tmp_path: Path) -> None:
 
 
 def test_random_generator_is_seeded_and_within_assumptions() -> None:
-    for seed in range(15):
+    counts = []
+    for seed in range(40):
         a = random_ch5_scenario(seed)
         assert a == random_ch5_scenario(seed)
         assert a == load_ch5_scenario(f"random-ch5:{seed}")
         goal = np.asarray(a.robot.goal)
+        assert 26.0 <= float(np.linalg.norm(goal)) <= 40.0
+        direction = goal / np.linalg.norm(goal)
         centres = [np.asarray(o.centre) for o in a.obstacles]
-        assert 1 <= len(centres) <= 3
-        for i, c in enumerate(centres):
-            assert np.linalg.norm(c) > 5 and np.linalg.norm(goal - c) > 5
-            for d in centres[i + 1 :]:
-                assert np.linalg.norm(c - d) >= 12.0
+        radii = [o.base_radius for o in a.obstacles]
+        counts.append(len(centres))
+        for i, (c, r) in enumerate(zip(centres, radii, strict=True)):
+            clear = random_ch5_end_clearance(r)
+            assert np.linalg.norm(c) >= clear and np.linalg.norm(goal - c) >= clear
+            # it blocks the straight line: sideways offset at most its base radius
+            assert np.linalg.norm(c - (c @ direction) * direction) <= r + 1e-9
+            for d, rd in zip(centres[i + 1 :], radii[i + 1 :], strict=True):
+                assert np.linalg.norm(c - d) >= random_ch5_min_spacing(r, rd) - 1e-9
+    # every count the generator draws is built (v1's fixed 12 m spacing never fitted three)
+    assert set(counts) == {1, 2, 3}
+    three = random_ch5_scenario(0, n_obstacles=3)
+    assert len(three.obstacles) == 3
+    with pytest.raises(ValueError, match=r"1\.\.3"):
+        random_ch5_scenario(0, n_obstacles=4)
     assert random_ch5_scenario(1) != random_ch5_scenario(2)

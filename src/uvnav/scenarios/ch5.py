@@ -16,6 +16,7 @@ straddling the A-B line, within the assumptions the law needs (listed in its doc
 
 from __future__ import annotations
 
+import itertools
 import math
 from functools import cache
 from pathlib import Path
@@ -236,40 +237,72 @@ def build_uuv3d(scn: Scenario5, *, noise_std: float | None = None) -> UUV3DSetup
     )
 
 
+#: version of the ``random-ch5`` generator; part of the campaign's resume key, so that a store
+#: written by an older generator is not mistaken for the current scenes.  v1 asked for 1-3 bodies
+#: but its fixed 12 m spacing never fitted a third; v2 spaces bodies by their size and lengthens
+#: the A-B line when they do not fit, so every drawn count is built.
+RANDOM_CH5_VERSION = 2
+#: largest growth of a body's centre distance under deformation (thesis: 10 %)
+_DEFORM = 1.1
+
+
+def random_ch5_min_spacing(r_a: float, r_b: float, hull_radius: float = 0.5) -> float:
+    """Smallest centre-to-centre distance [m] of two consecutive bodies of base radii ``r_a``,
+    ``r_b`` [m] in a ``random-ch5`` scene: their deformed radii (x1.1), the vehicle's width
+    (2 rho), the switch distance L = 3 m and one turn radius V_max/U_max = 1 m — so the vehicle
+    can finish one avoidance before the next body is within L (the law evades one point at a
+    time; thesis §5.3)."""
+    return _DEFORM * (r_a + r_b) + 2.0 * hull_radius + 3.0 + 1.0
+
+
+def random_ch5_end_clearance(r0: float) -> float:
+    """Smallest distance [m] from A or B to the centre of a body of base radius ``r0`` [m]:
+    5 m (the switch distance L = 3 m plus the turn) plus 1.4 radii."""
+    return 5.0 + 1.4 * r0
+
+
 def random_ch5_scenario(
     seed: int, *, n_obstacles: int | None = None, locator: str = "geometric"
 ) -> Scenario5:
-    """A random scene within the assumptions of the Chapter 5 law (seeded).
+    """A random scene within the assumptions of the Chapter 5 law (seeded; generator v2).
 
-    A = origin, B 26-32 m away in a random direction up to 30 deg from horizontal, heading toward
-    B.  1-3 deforming stars (base radius 1-2.2 m, deformation <= 10 %) centred on points spread
-    along the middle 70 % of A-B, each offset sideways by at most its radius (so it blocks the
-    straight line), with at least 12 m between centres and at least 5 m of clearance around A
-    and B (the switch distance L = 3 m plus the vehicle's turning radius).
+    A = origin, heading toward B; B at least 26-32 m away in a random direction up to 30 deg
+    from horizontal.  1-3 deforming stars (base radius 1-2.2 m, deformation <= 10 %), each
+    offset sideways from the A-B line by at most its radius (so it blocks the straight line).
+    Consecutive centres lie at least :func:`random_ch5_min_spacing` apart along the line (7.2-
+    9.8 m), the first and last at least :func:`random_ch5_end_clearance` from A and B; when the
+    drawn bodies do not fit on the drawn line, the line is lengthened to fit them plus 2 m, and
+    the free length is spread at random between the gaps.  Every drawn count is thus built and
+    no scene is filtered after the fact.
+
+    Raises:
+        ValueError: ``n_obstacles`` outside 1..3.
     """
     rng = np.random.default_rng(seed)
     n = int(n_obstacles) if n_obstacles is not None else int(rng.integers(1, 4))
+    if not 1 <= n <= 3:
+        raise ValueError(f"n_obstacles must be in 1..3 (got {n})")
     dist = float(rng.uniform(26.0, 32.0))
     az = float(rng.uniform(0, 2 * math.pi))
     el = float(rng.uniform(-math.pi / 6, math.pi / 6))
     d = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
+    radii = [float(rng.uniform(1.0, 2.2)) for _ in range(n)]
+    gaps = [random_ch5_end_clearance(radii[0])]
+    gaps += [random_ch5_min_spacing(a, b) for a, b in itertools.pairwise(radii)]
+    gaps.append(random_ch5_end_clearance(radii[-1]))
+    dist = max(dist, sum(gaps) + 2.0)
+    # the free length, split at n uniform cut points into n + 1 random shares
+    shares = np.diff(np.concatenate([[0.0], np.sort(rng.uniform(size=n)), [1.0]]))
+    free = dist - sum(gaps)
     goal = d * dist
     obstacles: list[dict[str, Any]] = []
-    centres: list[np.ndarray] = []
-    tries = 0
-    while len(obstacles) < n and tries < 200:
-        tries += 1
-        r0 = float(rng.uniform(1.0, 2.2))
-        s = float(rng.uniform(0.15, 0.85)) * dist
+    s = 0.0
+    for k, r0 in enumerate(radii):
+        s += gaps[k] + float(shares[k]) * free
         side = rng.normal(size=3)
         side -= float(side @ d) * d
         side /= np.linalg.norm(side)
         c = d * s + side * float(rng.uniform(0, r0))
-        if np.linalg.norm(c) < r0 * 1.4 + 5.0 or np.linalg.norm(goal - c) < r0 * 1.4 + 5.0:
-            continue
-        if any(np.linalg.norm(c - o) < 12.0 for o in centres):
-            continue
-        centres.append(c)
         obstacles.append(
             {
                 "type": "star",
