@@ -38,12 +38,14 @@ import traceback
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, TypeVar
 
 from uvnav.bench.store import STATUS_ERROR, EpisodeKey, ResultsStore, canonical_json, params_hash
 from uvnav.sim import EpisodeSetup, Trajectory, run_episode, run_rng
 
 ENGINES = ("local", "ray")
+T = TypeVar("T")
+R = TypeVar("R")
 
 SetupFactory = Callable[[int], EpisodeSetup]
 
@@ -391,7 +393,7 @@ def run_campaign(
             for job in todo:
                 handle(run_job(job))
         elif todo:
-            _run_pool(todo, handle, workers, mp_context or default_mp_context())
+            _run_pool(todo, run_job, handle, workers, mp_context or default_mp_context())
     finally:
         if bar is not None:
             bar.stop()
@@ -418,13 +420,41 @@ def _stop_workers(executor: ProcessPoolExecutor) -> None:
             proc.terminate()
 
 
+def run_in_workers(
+    items: Sequence[T],
+    compute: Callable[[T], R],
+    handle: Callable[[R], None],
+    *,
+    workers: int = 1,
+    mp_context: mp.context.BaseContext | None = None,
+) -> None:
+    """``handle(compute(item))`` for every item: ``compute`` in worker processes, ``handle`` here.
+
+    The loop of every resumable campaign (this module's and the chapters' own stores): workers
+    only compute, this process writes each result as it finishes (one store transaction each),
+    so an interrupted run keeps all it finished.  ``workers <= 1`` or a single item runs
+    in-process, in order; otherwise results come in the order they finish.  ``compute`` must be
+    picklable (a module-level function).
+
+    Raises:
+        KeyboardInterrupt: re-raised after stopping the workers (see :func:`_run_pool`).
+    """
+    if workers <= 1 or len(items) < 2:
+        for item in items:
+            handle(compute(item))
+        return
+    _run_pool(items, compute, handle, workers, mp_context or default_mp_context())
+
+
 def _run_pool(
-    todo: Sequence[Job],
-    handle: Callable[[JobOutcome], None],
+    todo: Sequence[T],
+    compute: Callable[[T], R],
+    handle: Callable[[R], None],
     workers: int,
     ctx: mp.context.BaseContext,
 ) -> None:
-    """Run ``todo`` on a process pool, handing each outcome to ``handle`` as it finishes.
+    """Run ``compute`` over ``todo`` on a process pool, handing each result to ``handle`` as it
+    finishes.
 
     Workers ignore SIGINT, so a Ctrl-C (sent by the terminal to the whole process group) reaches
     only this process: it stops the workers at once — without waiting for the episodes in flight,
@@ -432,15 +462,16 @@ def _run_pool(
     """
     executor = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_ignore_sigint)
     queue = iter(todo)
-    pending: set[Future[JobOutcome]] = set()
+    pending: set[Future[R]] = set()
     window = 2 * workers
     try:
         while True:
             while len(pending) < window:
-                job = next(queue, None)
-                if job is None:
+                try:
+                    item = next(queue)
+                except StopIteration:
                     break
-                pending.add(executor.submit(run_job, job))
+                pending.add(executor.submit(compute, item))
             if not pending:
                 break
             finished, pending = wait(pending, return_when=FIRST_COMPLETED)

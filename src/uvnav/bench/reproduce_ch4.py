@@ -36,7 +36,6 @@ import json
 import math
 import time
 from collections.abc import Callable, Iterable
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -44,6 +43,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from uvnav.bench.campaign import run_in_workers
 from uvnav.bench.store import ResultsStore, params_hash
 from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
@@ -205,20 +205,16 @@ def run_jobs(
         if (j.scene, j.law, params_hash(_params(j)), j.seed) not in done_keys
     ]  # fmt: skip
     total = len(todo)
-    if workers <= 1:
-        results: Iterable[dict[str, Any]] = map(_row_only, todo)
-        pool = None
-    else:
-        pool = ProcessPoolExecutor(max_workers=workers)
-        results = pool.map(_row_only, todo, chunksize=1)
-    try:
-        for k, row in enumerate(results, 1):
-            store_row(store, cid, row)
-            if progress is not None:
-                progress(k, total)
-    finally:
-        if pool is not None:
-            pool.shutdown(cancel_futures=True)
+    done = 0
+
+    def write(row: dict[str, Any]) -> None:
+        nonlocal done
+        store_row(store, cid, row)
+        done += 1
+        if progress is not None:
+            progress(done, total)
+
+    run_in_workers(todo, _row_only, write, workers=workers)
     by_key = {r["key"]: r for r in stored_rows(store, campaign)}
     return [by_key[j.key] for j in jobs if j.key in by_key]
 

@@ -43,7 +43,6 @@ import os
 import shutil
 import time
 from collections.abc import Callable, Iterable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -51,6 +50,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from uvnav.bench.campaign import run_in_workers
 from uvnav.bench.store import ResultsStore, params_hash
 from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.zhang_uuv3d import (
@@ -443,20 +443,13 @@ def run_jobs(
     for _ in range(len(jobs) - len(todo)):
         if on_episode is not None:
             on_episode()
-    pool = None
-    if workers <= 1 or len(todo) < 2:
-        results: Iterable[dict[str, Any]] = map(_row_only, todo)
-    else:
-        pool = ProcessPoolExecutor(max_workers=workers)
-        results = pool.map(_row_only, todo, chunksize=1)
-    try:
-        for row in results:
-            store_row(store, cid, row)
-            if on_episode is not None:
-                on_episode()
-    finally:
-        if pool is not None:
-            pool.shutdown(cancel_futures=True)
+
+    def write(row: dict[str, Any]) -> None:
+        store_row(store, cid, row)
+        if on_episode is not None:
+            on_episode()
+
+    run_in_workers(todo, _row_only, write, workers=workers)
     by_key: dict[tuple[str, str, str, int], dict[str, Any]] = {}
     for r in stored_rows(store, campaign):
         j = Ch5Job(r["scene"], r["locator"], r["seed"], r["noise_std"], None, r["model"])
