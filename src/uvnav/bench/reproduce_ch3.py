@@ -28,13 +28,13 @@ import argparse
 import json
 import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from uvnav.bench.campaign import run_in_workers
 from uvnav.bench.store import ResultsStore
 
 CONTROLLERS_3D: tuple[str, ...] = ("zhang2020-3d-v1", "apf3d-v1", "vo3d-v1")
@@ -93,20 +93,17 @@ def run_one(job: tuple[str, str, int, str, bool]) -> dict[str, Any]:
 def _run_jobs(
     jobs: list[tuple[str, str, int, str, bool]], workers: int, progress: bool
 ) -> list[dict[str, Any]]:
-    rows: list[dict[str, Any]] = []
-    if workers <= 1:
-        for k, job in enumerate(jobs):
-            rows.append(run_one(job))
-            if progress:
-                print(f"  {k + 1}/{len(jobs)} {job[0]} {job[1]} {job[3]}: {rows[-1]['status']}")
-        return rows
-    with ProcessPoolExecutor(max_workers=workers) as pool:
-        for k, row in enumerate(pool.map(run_one, jobs, chunksize=1)):
-            rows.append(row)
-            if progress:
-                print(f"  {k + 1}/{len(jobs)} {row['scene']} {row['controller']} "
-                      f"{row['motion']}: {row['status']}")  # fmt: skip
-    return rows
+    """Run the jobs (in worker processes when ``workers > 1``); rows in job order."""
+    by_key: dict[tuple[str, str, int, str], dict[str, Any]] = {}
+
+    def keep(row: dict[str, Any]) -> None:
+        by_key[(row["scene"], row["controller"], row["seed"], row["motion"])] = row
+        if progress:
+            print(f"  {len(by_key)}/{len(jobs)} {row['scene']} {row['controller']} "
+                  f"{row['motion']}: {row['status']}")  # fmt: skip
+
+    run_in_workers(jobs, run_one, keep, workers=workers)
+    return [by_key[(j[0], j[1], j[2], j[3])] for j in jobs]
 
 
 def prediction_errors(n_series: int = 20, length: int = 120) -> dict[str, float]:
