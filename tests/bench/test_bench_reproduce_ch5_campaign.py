@@ -166,3 +166,22 @@ def test_beam_ties_names_the_samples_whose_true_sensor_is_not_argmin() -> None:
     assert ties["index_error_others"] == pytest.approx([-0.2, 0.1])
     only_tie = r5.beam_ties(ds, np.array([1]), predicted[[1]])["index_error_others"]
     assert all(np.isnan(only_tie))
+
+
+def test_dense_jobs_form_their_own_campaign_and_table_rows() -> None:
+    jobs = r5._campaign_jobs(2, (0.0, 0.05), Path("m"), "digest", n_dense=1)
+    assert len(jobs[r5.RANDOM_CAMPAIGN]) == len(jobs[r5.NOISE_CAMPAIGN]) == 2 * len(r5.LOCATORS)
+    dense = jobs[r5.DENSE_CAMPAIGN]
+    assert [j.scene for j in dense] == ["random-ch5-dense:0"] * len(r5.LOCATORS)
+    assert all(j.noise_std == 0.0 and "generator" in j.params for j in dense)
+    row = {"locator": "geometric", "noise_std": 0.0, "success": True, "entered_inner_space": False}
+    summary = r5.Ch5Summary(db_path=Path("x"))
+    summary.closed_loop = [
+        {**row, "scene": "random-ch5:0", "status": "success"},
+        {**row, "scene": "random-ch5-dense:0", "status": "collision", "success": False},
+    ]
+    table = {t["quantity"]: t for t in r5.build_ch5_table(summary)}
+    assert table["Ch5 random scenes success (geometric, noise 0.0 m)"]["measured"] == "100.0% of 1"
+    dense_row = table["Ch5 dense scenes (beyond the assumptions) success (geometric, noise 0.0 m)"]
+    assert dense_row["measured"] == "0.0% of 1"
+    assert "random-ch5-dense:0 collision" in dense_row["note"]

@@ -74,3 +74,25 @@ def test_random_generator_is_seeded_and_within_assumptions() -> None:
     with pytest.raises(ValueError, match=r"1\.\.3"):
         random_ch5_scenario(0, n_obstacles=4)
     assert random_ch5_scenario(1) != random_ch5_scenario(2)
+
+
+def test_dense_family_is_closer_than_the_assumptions_and_loads_by_name() -> None:
+    counts = set()
+    for seed in range(20):
+        a = load_ch5_scenario(f"random-ch5-dense:{seed}")
+        assert a == random_ch5_scenario(seed, dense=True)
+        assert a.name == f"random-ch5-dense:{seed}"
+        centres = [np.asarray(o.centre) for o in a.obstacles]
+        radii = [o.base_radius for o in a.obstacles]
+        counts.add(len(centres))
+        gaps = [
+            np.linalg.norm(c - d) - random_ch5_min_spacing(r, rd, dense=True)
+            for c, d, r, rd in zip(centres, centres[1:], radii, radii[1:], strict=False)
+        ]
+        assert min(gaps) >= -1e-9
+    assert counts == {2, 3, 4}
+    # dense: 1 m between deformed surfaces instead of L + one turn radius (4 m): 3 m closer
+    closer = random_ch5_min_spacing(1.0, 1.0) - random_ch5_min_spacing(1.0, 1.0, dense=True)
+    assert closer == pytest.approx(3.0)
+    with pytest.raises(ScenarioError, match="seed"):
+        load_ch5_scenario("random-ch5-dense:x")

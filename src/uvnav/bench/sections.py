@@ -291,6 +291,7 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
     sizes = cfg.get("sizes", r5.FULL_SIZES if full else r5.QUICK_SIZES)
     seeds = cfg.get("seeds", r5.FULL_SEEDS if full else r5.QUICK_SEEDS)
     n_rand = cfg.get("n_random", r5.FULL_RANDOM if full else r5.QUICK_RANDOM)
+    n_dense = cfg.get("n_dense", r5.FULL_DENSE if full else r5.QUICK_DENSE)
     noises = " and ".join(f"{x:g}" for x in cfg.get("noises", (0.0, 0.05) if full else (0.0,)))
     noises += " m"
     intro = (
@@ -298,8 +299,14 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
         f"(9→10→2, plain and residual) trained on {', '.join(map(str, sizes))} samples with "
         f"{seeds} seeds each, tested on its own test group and on an independent set; "
         f"zhang2022-uuv3d-v1 then ran on the three thesis-ch5 scenes and random-ch5 seeds "
-        f"0–{n_rand - 1} with the {', '.join(r5.LOCATORS)} locators, sonar noise {noises}. "
-        f"Every closed-loop episode is a row of the results database (campaigns "
+        f"0–{n_rand - 1} with the {', '.join(r5.LOCATORS)} locators, sonar noise {noises}"
+        + (
+            f", and on random-ch5-dense seeds 0–{n_dense - 1} (bodies closer than the law "
+            "assumes, noise 0). "
+            if n_dense
+            else ". "
+        )
+        + f"Every closed-loop episode is a row of the results database (campaigns "
         f"{', '.join(r5.CAMPAIGNS)}); the summary with the failures is the JSON linked below."
     )
     sec = ChapterSection(

@@ -246,6 +246,12 @@ def reproduce_cmd(
     n_random: Annotated[
         int | None, typer.Option("--n-random", min=0, help="Random scenes (override).")
     ] = None,
+    n_dense: Annotated[
+        int | None,
+        typer.Option(
+            "--n-dense", min=0, help="Scenes of the harder random-ch5-dense family (override)."
+        ),
+    ] = None,
 ) -> None:
     """The Chapter 5 reproduction alone (BPNN experiment + closed-loop campaigns); resumable:
     an interrupted run continues where it stopped."""
@@ -258,6 +264,7 @@ def reproduce_cmd(
         workers=workers,
         fresh=fresh,
         n_random=n_random,
+        n_dense=n_dense,
         render=render_ch5 if report_dir is not None else None,
         report_dir=report_dir,
     )

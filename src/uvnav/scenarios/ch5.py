@@ -34,6 +34,7 @@ from uvnav.sim.episode_uuv3d import UUV3DSetup
 
 BUILTIN_SUBDIR = "ch5"  # of the built-in scenario folder
 GENERATOR_CH5 = "random-ch5"
+GENERATOR_CH5_DENSE = "random-ch5-dense"  # beyond the assumptions: bodies closer than the law needs
 
 Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Pos = Annotated[float, Field(gt=0)]
@@ -159,16 +160,20 @@ def _load_builtin(name: str) -> Scenario5:
 
 
 def load_ch5_scenario(name: str) -> Scenario5:
-    """A built-in name, a ``random-ch5:<seed>`` spec or a YAML path.
+    """A built-in name, a ``random-ch5:<seed>`` or ``random-ch5-dense:<seed>`` spec or a YAML
+    path.
 
     Raises:
         ScenarioError: unknown name, unreadable file or invalid content (one line).
     """
-    if name.startswith(GENERATOR_CH5 + ":"):
-        seed_text = name.split(":", 1)[1]
-        if not seed_text.isdigit():
-            raise ScenarioError(name, "seed", f"must be a non-negative integer (got {seed_text!r})")
-        return random_ch5_scenario(int(seed_text))
+    for generator in (GENERATOR_CH5, GENERATOR_CH5_DENSE):
+        if name.startswith(generator + ":"):
+            seed_text = name.split(":", 1)[1]
+            if not seed_text.isdigit():
+                raise ScenarioError(
+                    name, "seed", f"must be a non-negative integer (got {seed_text!r})"
+                )
+            return random_ch5_scenario(int(seed_text), dense=generator == GENERATOR_CH5_DENSE)
     if name in _builtin_files():
         return _load_builtin(name)
     path = Path(name)
@@ -246,12 +251,18 @@ RANDOM_CH5_VERSION = 2
 _DEFORM = 1.1
 
 
-def random_ch5_min_spacing(r_a: float, r_b: float, hull_radius: float = 0.5) -> float:
+def random_ch5_min_spacing(
+    r_a: float, r_b: float, hull_radius: float = 0.5, *, dense: bool = False
+) -> float:
     """Smallest centre-to-centre distance [m] of two consecutive bodies of base radii ``r_a``,
     ``r_b`` [m] in a ``random-ch5`` scene: their deformed radii (x1.1), the vehicle's width
     (2 rho), the switch distance L = 3 m and one turn radius V_max/U_max = 1 m — so the vehicle
     can finish one avoidance before the next body is within L (the law evades one point at a
-    time; thesis §5.3)."""
+    time; thesis §5.3).  ``dense`` (``random-ch5-dense``, beyond the assumptions): the deformed
+    radii, the vehicle's width and 1 m only, so the next body is within L while one avoidance is
+    still under way."""
+    if dense:
+        return _DEFORM * (r_a + r_b) + 2.0 * hull_radius + 1.0
     return _DEFORM * (r_a + r_b) + 2.0 * hull_radius + 3.0 + 1.0
 
 
@@ -262,9 +273,13 @@ def random_ch5_end_clearance(r0: float) -> float:
 
 
 def random_ch5_scenario(
-    seed: int, *, n_obstacles: int | None = None, locator: str = "geometric"
+    seed: int, *, n_obstacles: int | None = None, locator: str = "geometric", dense: bool = False
 ) -> Scenario5:
     """A random scene within the assumptions of the Chapter 5 law (seeded; generator v2).
+
+    ``dense=True`` (``random-ch5-dense:<seed>``) is a harder family *beyond* those assumptions,
+    to measure how the law degrades: 2-4 bodies spaced by :func:`random_ch5_min_spacing` with
+    ``dense`` (the next body is within the switch distance before one avoidance ends).
 
     A = origin, heading toward B; B at least 26-32 m away in a random direction up to 30 deg
     from horizontal.  1-3 deforming stars (base radius 1-2.2 m, deformation <= 10 %), each
@@ -276,19 +291,21 @@ def random_ch5_scenario(
     no scene is filtered after the fact.
 
     Raises:
-        ValueError: ``n_obstacles`` outside 1..3.
+        ValueError: ``n_obstacles`` outside 1..3 (2..4 with ``dense``).
     """
     rng = np.random.default_rng(seed)
-    n = int(n_obstacles) if n_obstacles is not None else int(rng.integers(1, 4))
-    if not 1 <= n <= 3:
-        raise ValueError(f"n_obstacles must be in 1..3 (got {n})")
+    lo, hi = (2, 4) if dense else (1, 3)
+    n = int(n_obstacles) if n_obstacles is not None else int(rng.integers(lo, hi + 1))
+    if not lo <= n <= hi:
+        raise ValueError(f"n_obstacles must be in {lo}..{hi} (got {n})")
+    generator = GENERATOR_CH5_DENSE if dense else GENERATOR_CH5
     dist = float(rng.uniform(26.0, 32.0))
     az = float(rng.uniform(0, 2 * math.pi))
     el = float(rng.uniform(-math.pi / 6, math.pi / 6))
     d = np.array([math.cos(el) * math.cos(az), math.cos(el) * math.sin(az), math.sin(el)])
     radii = [float(rng.uniform(1.0, 2.2)) for _ in range(n)]
     gaps = [random_ch5_end_clearance(radii[0])]
-    gaps += [random_ch5_min_spacing(a, b) for a, b in itertools.pairwise(radii)]
+    gaps += [random_ch5_min_spacing(a, b, dense=dense) for a, b in itertools.pairwise(radii)]
     gaps.append(random_ch5_end_clearance(radii[-1]))
     dist = max(dist, sum(gaps) + 2.0)
     # the free length, split at n uniform cut points into n + 1 random shares
@@ -315,7 +332,7 @@ def random_ch5_scenario(
             }
         )
     data = {
-        "name": f"{GENERATOR_CH5}:{seed}",
+        "name": f"{generator}:{seed}",
         "t_max": 120.0,
         "robot": {
             "start": [0.0, 0.0, 0.0],
@@ -325,4 +342,4 @@ def random_ch5_scenario(
         "obstacles": obstacles,
         "controller": {"locator": locator},
     }
-    return scenario5_from_dict(data, f"{GENERATOR_CH5}:{seed}")
+    return scenario5_from_dict(data, f"{generator}:{seed}")
