@@ -187,7 +187,10 @@ def _print_table(table: dict[str, Any], n_train: int | None, title: str) -> None
 @sonar_app.command("simulate")
 def simulate_cmd(
     scenario: Annotated[
-        str, typer.Argument(help="thesis-ch5-scene1|2|3, random-ch5:<seed>, or a YAML file.")
+        str,
+        typer.Argument(
+            help="thesis-ch5-scene1|2|3, random-ch5:<seed>, random-ch5-dense:<seed> or a YAML file."
+        ),
     ],
     locator: Annotated[
         str, typer.Option(help="geometric, network (needs --model) or oracle.")
