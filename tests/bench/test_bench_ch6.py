@@ -54,6 +54,18 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
 
     figs = render_ch6(s, tmp_path / "figs")
     assert len(figs) == 6 and all(f.stat().st_size > 5000 for f in figs)
+    # the report section of a quick run: every figure with its thesis caption, the table
+    from uvnav.bench.sections import ch6_section
+
+    s.figures = figs
+    sec = ch6_section(s, full=False)
+    captions = " ".join(f.caption for f in sec.figures)
+    for fig in ("6.1", "6.4", "6.5", "6.6", "6.7", "6.8"):
+        assert f"Fig. {fig}" in captions
+    assert [f.path for f in sec.figures] == figs
+    quantities = [r["quantity"] for r in sec.rows]
+    assert sum("closed loop" in q for q in quantities) == 4  # 3 network rows + the expert
+    assert "Quick size" in sec.notes[0] and "1 held-out track of up to 40 steps" in sec.intro
 
 
 def test_full_chain_stages_and_resume(tmp_path: Path) -> None:
