@@ -113,12 +113,15 @@ def test_full_chain_stages_and_resume(tmp_path: Path) -> None:
     assert sorted(s3.reused) == sorted(["train", "readout", *chain[:3]])
     assert len(read_log(tmp_path / "dagger_data")) == 40  # copied afresh, driven once
     assert json.loads((stages / "dagger1.json").read_text())["value"]["rows_after"] == 40
-    # other settings (more epochs) invalidate training and every stage built on it
-    s4 = reproduce_ch6(tmp_path, **{**kw, "epochs": 2, "dagger_rounds": 0, "readout": False})
-    assert s4.reused == ["expert"] and list(s4.closed_loop) == ["cnn-learned", "cnn-pi", "expert"]
+    # other settings (more epochs) invalidate training and every stage built on it; without
+    # the readout, DAgger drives with the PI throttle
+    s4 = reproduce_ch6(tmp_path, **{**kw, "epochs": 2, "readout": False})
+    assert s4.reused == ["expert"]
+    assert list(s4.closed_loop) == ["cnn-learned", "cnn-pi", "dagger1-pi", "expert"]
     assert len(s4.record["train_loss"]) == 2
-    s5 = reproduce_ch6(tmp_path, **{**kw, "epochs": 2, "dagger_rounds": 0}, fresh=True)
-    assert s5.reused == []
+    assert s4.stage_records["dagger1"]["second_output"] == "throttle"
+    s5 = reproduce_ch6(tmp_path, **{**kw, "dagger_rounds": 0, "readout": False}, fresh=True)
+    assert s5.reused == [] and list(s5.closed_loop) == ["cnn-learned", "cnn-pi", "expert"]
 
 
 def test_dagger_round_appends_expert_labelled_rows(tmp_path: Path) -> None:

@@ -245,7 +245,8 @@ def reproduce_ch6(
         dagger_epochs: override the training epochs per DAgger round.
         dagger_throttle: the learner's throttle in DAgger (driving and evaluation):
             ``"learned-speed"`` (default when the chain has a target-speed output: the readout
-            or ``head="target_speed"``), ``"pi"`` or ``"learned"``.
+            or ``head="target_speed"``), ``"pi"`` (default otherwise, i.e. ``readout=False``
+            with the thesis head) or ``"learned"``.
         readout: with ``head="throttle"``, fit the target-speed readout (row
             ``cnn-learned-speed``) and start DAgger from it.
         threads: torch CPU threads for training.
@@ -361,7 +362,9 @@ def reproduce_ch6(
 
     # 3. DAgger rounds, from the learner above
     n_rounds = (FULL_DAGGER_ROUNDS if full else 0) if dagger_rounds is None else dagger_rounds
-    d_mode: Throttle = dagger_throttle or default_learned_mode(learner)  # type: ignore[assignment]
+    d_mode: Throttle = dagger_throttle or (  # type: ignore[assignment]
+        "learned-speed" if learner.config.predicts_target_speed else "pi"
+    )
     if n_rounds:
         # the aggregate is a copy of the demonstrations: data/ stays the expert's alone, so a
         # rerun (resumable collect) trains behaviour cloning on the same rows
