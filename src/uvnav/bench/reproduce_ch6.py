@@ -16,9 +16,10 @@ The chain (each stage a row of the closed-loop table, evaluated on the same held
    5 epochs of fine-tuning on the aggregate.  Rows ``dagger{r}-learned-speed``.
 4. The (oracle) **expert**, the reference of ``return_vs_expert``.  Row ``expert``.
 
-Measured at the thesis's size on 20 held-out tracks (docs/thesis-notes.md): the pedal head
-drives at autonomy 0.00 (it does not brake for corners), PI 1.00, the readout 0.947, and one
-DAgger round with the learned-speed throttle 1.00 (also on 20 further unseen tracks).
+Measured on 20 held-out tracks (docs/thesis-notes.md), with the network trained on 12 episodes:
+the pedal head drives at autonomy 0.00 (it does not brake for corners), PI 1.00, the readout
+0.947, and one DAgger round with the learned-speed throttle 1.00 (also on 20 further unseen
+tracks); in the ``--full`` run itself (20 episodes): 0.00, 1.00, 1.00 and 0.986.
 ``head="target_speed"`` trains the second output on the target speed directly instead (rows
 ``cnn-learned-speed``, ``cnn-pi``, then the DAgger rows; no readout stage).
 
@@ -56,8 +57,9 @@ THESIS_VAL_MSE = 0.05
 THESIS_FRAMES = 17592
 THESIS_TRAIN, THESIS_VAL = 1199, 300
 #: DAgger rounds of the full run: one, driven with the learned-speed throttle (measured on the 20
-#: held-out tracks: the readout alone 0.947 autonomy, after one round 1.00, and 1.00 on 20 more
-#: unseen tracks; docs/thesis-notes.md); ``dagger_rounds`` overrides it
+#: held-out tracks from a 12-episode network: the readout alone 0.947 autonomy, after one round
+#: 1.00, and 1.00 on 20 more unseen tracks; in the 20-episode ``--full`` run the readout alone
+#: reached 1.00 and the round 0.986; docs/thesis-notes.md); ``dagger_rounds`` overrides it
 FULL_DAGGER_ROUNDS = 1
 #: training tracks the network drives per DAgger round, and epochs per round
 DAGGER_EPISODES, DAGGER_EPOCHS = 6, 5
