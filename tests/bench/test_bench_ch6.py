@@ -28,21 +28,23 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
         dagger_rounds=1,
         dagger_episodes=1,
         dagger_epochs=1,
-        head="target_speed",  # the thesis's throttle head is driven in tests/cli
+        head="target_speed",  # the thesis's throttle head: the chain test below
     )
     assert s.record["n_frames"] == 90  # 30 rows x 3 cameras
     assert len(s.steering_train) + len(s.steering_val) == s.record["n_balanced"]
-    assert set(s.closed_loop) == {"cnn-learned-speed", "cnn-pi", "dagger1-pi", "expert"}
+    # the target-speed head drives DAgger with its own learned-speed throttle
+    assert set(s.closed_loop) == {"cnn-learned-speed", "cnn-pi", "dagger1-learned-speed", "expert"}
     assert s.record["second_output"] == "target_speed" and s.record["val_target_speed_rmse"]
     assert "target speed RMSE" in s.table[2]["note"]
     # the DAgger rows go to a copy: data/ keeps the expert's 30 rows, the aggregate has more
-    assert s.closed_loop["dagger1-pi"]["rows_added"] == 30  # 120 steps, one row every 4
+    assert s.closed_loop["dagger1-learned-speed"]["rows_added"] == 30  # 120 steps, every 4th
     assert len(read_log(tmp_path / "data")) == 30
     assert len(read_log(tmp_path / "dagger_data")) == 60
     assert (tmp_path / "dagger1.safetensors").is_file()
     assert s.closed_loop["expert"]["return_vs_expert"] == pytest.approx(1.0)
     assert all(0.0 <= r["autonomy"] <= 1.0 for r in s.closed_loop.values())
-    assert next(r["quantity"] for r in s.table) == "Ch6 frames before balancing"
+    assert next(r["quantity"] for r in s.table).startswith("Ch6 frames before balancing")
+    assert all("[quick size]" in r["quantity"] for r in s.table)
     assert (tmp_path / "ch6.json").is_file() and s.model_path.is_file()
     names = [name for name, *_ in s.augment_examples]
     assert names == ["flip", "brightness", "zoom"]
@@ -52,6 +54,74 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
 
     figs = render_ch6(s, tmp_path / "figs")
     assert len(figs) == 6 and all(f.stat().st_size > 5000 for f in figs)
+    # the report section of a quick run: every figure with its thesis caption, the table
+    from uvnav.bench.sections import ch6_section
+
+    s.figures = figs
+    sec = ch6_section(s, full=False)
+    captions = " ".join(f.caption for f in sec.figures)
+    for fig in ("6.1", "6.4", "6.5", "6.6", "6.7", "6.8"):
+        assert f"Fig. {fig}" in captions
+    assert [f.path for f in sec.figures] == figs
+    quantities = [r["quantity"] for r in sec.rows]
+    assert sum("closed loop" in q for q in quantities) == 4  # 3 network rows + the expert
+    assert "Quick size" in sec.notes[0] and "1 held-out track of up to 40 steps" in sec.intro
+
+
+def test_full_chain_stages_and_resume(tmp_path: Path) -> None:
+    """The thesis head's chain: pedal head, PI, readout, one DAgger round with learned-speed,
+    expert — each stage saved as it finishes and skipped on a rerun."""
+    import json
+
+    kw: dict = {
+        "episodes": 1,
+        "epochs": 1,
+        "eval_seeds": [1000],
+        "max_steps": 30,
+        "collect_steps": 80,
+        "dagger_rounds": 1,
+        "dagger_episodes": 1,
+        "dagger_epochs": 1,
+    }
+    s = reproduce_ch6(tmp_path, **kw)
+    chain = ["cnn-learned", "cnn-pi", "cnn-learned-speed", "dagger1-learned-speed", "expert"]
+    assert list(s.closed_loop) == chain
+    assert s.reused == []
+    stages = tmp_path / "stages"
+    assert {p.stem for p in stages.glob("*.json")} == {"train", "readout", "dagger1", *chain}
+    for f in ("model", "readout", "dagger1"):
+        assert (tmp_path / f"{f}.safetensors").is_file()
+    assert s.stage_records["readout"]["second_output"] == "target_speed"
+    assert s.stage_records["dagger1"]["second_output"] == "target_speed"
+    assert any("target-speed readout" in r["quantity"] for r in s.table)
+    for r in s.closed_loop.values():
+        assert r["interventions_per_lap"] >= 0.0
+    # a rerun with the same settings reuses every stage and reports the same numbers
+    before = {p.name: p.stat().st_mtime_ns for p in tmp_path.glob("*.safetensors")}
+    s2 = reproduce_ch6(tmp_path, **kw)
+    assert sorted(s2.reused) == sorted(["train", "readout", "dagger1", *chain])
+    assert {p.name: p.stat().st_mtime_ns for p in tmp_path.glob("*.safetensors")} == before
+    assert s2.closed_loop == s.closed_loop
+    assert len(read_log(tmp_path / "dagger_data")) == 20 + 20  # not driven again
+    # an interrupted run: the DAgger round's and a later closed loop's stage files are gone,
+    # and the aggregate holds a partial round (rows of a round that did not finish)
+    (stages / "dagger1.json").unlink()
+    (stages / "expert.json").unlink()
+    log = tmp_path / "dagger_data" / "driving_log.csv"
+    log.write_text(log.read_text() + log.read_text().splitlines(keepends=True)[-1])
+    s3 = reproduce_ch6(tmp_path, **kw)
+    assert sorted(s3.reused) == sorted(["train", "readout", *chain[:3]])
+    assert len(read_log(tmp_path / "dagger_data")) == 40  # copied afresh, driven once
+    assert json.loads((stages / "dagger1.json").read_text())["value"]["rows_after"] == 40
+    # other settings (more epochs) invalidate training and every stage built on it; without
+    # the readout, DAgger drives with the PI throttle
+    s4 = reproduce_ch6(tmp_path, **{**kw, "epochs": 2, "readout": False})
+    assert s4.reused == ["expert"]
+    assert list(s4.closed_loop) == ["cnn-learned", "cnn-pi", "dagger1-pi", "expert"]
+    assert len(s4.record["train_loss"]) == 2
+    assert s4.stage_records["dagger1"]["second_output"] == "throttle"
+    s5 = reproduce_ch6(tmp_path, **{**kw, "dagger_rounds": 0, "readout": False}, fresh=True)
+    assert s5.reused == [] and list(s5.closed_loop) == ["cnn-learned", "cnn-pi", "expert"]
 
 
 def test_dagger_round_appends_expert_labelled_rows(tmp_path: Path) -> None:

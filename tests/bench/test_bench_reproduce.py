@@ -187,6 +187,7 @@ def test_reproduce_end_to_end_resume_and_staleness(
         assert f'src="ch2/{fig.name}"' in html
     # test-sized run: only the Chapter 2 section, with its rows and every figure
     assert [s.key for s in summary.sections] == ["ch2"]
+    assert not (tmp_path / "results" / "ch6-quick").exists()  # no CNN training in tests
     ch2 = summary.sections[0]
     assert [f.path for f in ch2.figures] == summary.figures
     assert ch2.rows and {r["quantity"] for r in ch2.rows} <= {r["quantity"] for r in summary.table}

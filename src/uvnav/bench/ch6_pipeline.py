@@ -469,6 +469,55 @@ class DaggerRound:
     summary: dict[str, float]
 
 
+def dagger_round(
+    model: Any,
+    root: Path | str,
+    out_dir: Path | str,
+    *,
+    round_id: int,
+    episodes: int,
+    epochs: int,
+    first_seed: int = 600,
+    throttle: Throttle = "pi",
+    set_speed: float = 35.0,
+    collect_steps: int = 1500,
+    threads: int = 1,
+    progress: Callable[[str], None] | None = None,
+) -> tuple[Any, int, Path, dict[str, Any]]:
+    """One DAgger round without its evaluation: drive, aggregate, fine-tune, save.
+
+    Round ``round_id`` drives tracks ``first_seed + (round_id − 1)·episodes …`` (disjoint from
+    the demonstrations' seeds 0… and from the held-out evaluation tracks), appends the
+    expert-labelled rows to ``root``, rebalances and resplits the aggregate, and continues
+    training ``model`` on it for ``epochs`` (warm start; Ross et al. retrain on the aggregate).
+
+    Returns:
+        ``(model, rows added, checkpoint path out_dir/dagger{round_id}.safetensors, record)``.
+    """
+    say = progress or (lambda s: None)
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    r = round_id
+    seeds = range(first_seed + (r - 1) * episodes, first_seed + r * episodes)
+    say(f"DAgger round {r}: the network drives {episodes} training tracks ({throttle} throttle)")
+    rows = dagger_collect(
+        model,
+        root,
+        seeds,
+        round_id=r,
+        throttle=throttle,
+        set_speed=set_speed,
+        max_steps=collect_steps,
+    )
+    data = prepare_data(root)
+    say(f"DAgger round {r}: training {epochs} epochs on {data.info['n_train']} images")
+    path = out / f"dagger{r}.safetensors"
+    model, record = train_on(
+        data, path, model=model, config=TrainConfig(epochs=epochs, threads=threads)
+    )
+    return model, rows, path, record
+
+
 def run_dagger(
     model: Any,
     root: Path | str,
@@ -488,10 +537,7 @@ def run_dagger(
 ) -> tuple[Any, list[DaggerRound]]:
     """DAgger rounds: drive ``episodes`` training tracks, aggregate, fine-tune, evaluate.
 
-    Round ``r`` drives tracks ``first_seed + (r − 1)·episodes …`` (disjoint from the
-    demonstrations' seeds 0… and from the held-out ``eval_seeds``), appends the expert-labelled
-    rows to ``root``, rebalances and resplits the aggregate, and continues training the current
-    network on it for ``epochs`` (warm start; Ross et al. retrain on the aggregate).  The
+    Each round is :func:`dagger_round` followed by a closed loop on ``eval_seeds``.  The
     resplit means a round's validation MSE is not a clean hold-out (images trained on before
     may land in it): the measure of a round is the closed loop on the held-out tracks.
 
@@ -517,26 +563,21 @@ def run_dagger(
     from uvnav.driving.evaluate import summarize
 
     say = progress or (lambda s: None)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
     done: list[DaggerRound] = []
     for r in range(1, rounds + 1):
-        seeds = range(first_seed + (r - 1) * episodes, first_seed + r * episodes)
-        say(f"DAgger round {r}: the network drives {episodes} training tracks")
-        rows = dagger_collect(
+        model, rows, path, record = dagger_round(
             model,
             root,
-            seeds,
+            out_dir,
             round_id=r,
+            episodes=episodes,
+            epochs=epochs,
+            first_seed=first_seed,
             throttle=throttle,
             set_speed=set_speed,
-            max_steps=collect_steps,
-        )
-        data = prepare_data(root)
-        say(f"DAgger round {r}: training {epochs} epochs on {data.info['n_train']} images")
-        path = out / f"dagger{r}.safetensors"
-        model, record = train_on(
-            data, path, model=model, config=TrainConfig(epochs=epochs, threads=threads)
+            collect_steps=collect_steps,
+            threads=threads,
+            progress=say,
         )
         say(f"DAgger round {r}: closed loop on {len(eval_seeds)} held-out tracks")
         policy, on_reset = cnn_policy(model, throttle=throttle, set_speed=set_speed)

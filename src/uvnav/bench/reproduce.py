@@ -8,6 +8,10 @@
 2. a random campaign on ``random_ch2_scenario(seed)`` for seeds ``0..199`` (``1000`` with
    ``full=True``) with both laws — campaign ``ch2-random``;
 
+and, in a real run (``n_random`` not given), the other chapters' reproductions (Chapter 6, the
+CNN that drives: at :data:`uvnav.bench.reproduce_ch6.RUN_QUICK`'s size in quick mode, the
+thesis size with ``full=True``; in ``results_dir/ch6-quick`` and ``results_dir/ch6``);
+
 stores everything in ``results_dir/uvnav.sqlite``, and builds the table "thesis reported vs uvnav
 measured" whose *measured* column is read back from the stored episodes (never typed in).  Figures
 and the HTML report are then made by a *renderer* passed in by the caller
@@ -426,6 +430,13 @@ def comparison_rows(store: ResultsStore) -> list[dict[str, str]]:
     return rows
 
 
+def _say_ch6(message: str) -> None:
+    """Chapter 6's stage messages on stderr (its training takes minutes)."""
+    import sys
+
+    print(f"ch6: {message}", file=sys.stderr, flush=True)
+
+
 def reproduce(
     results_dir: Path,
     report_dir: Path,
@@ -637,10 +648,16 @@ def reproduce(
         figs9 = rend.ch9(report_dir / "beyond") if rend.ch9 is not None else []
         later.append(sec.beyond_section(rows9, figs9, full=full))
     ch6_summary: Any = None
-    if full:  # Chapter 6 (CNN driving) only in full mode: training is minutes even when small
-        from uvnav.bench.reproduce_ch6 import reproduce_ch6
+    if real_run:  # Chapter 6 (CNN driving): the thesis size with --full, else RUN_QUICK's size
+        from uvnav.bench.reproduce_ch6 import RUN_QUICK, reproduce_ch6
 
-        ch6_summary = reproduce_ch6(results_dir / "ch6", full=True)
+        ch6_summary = reproduce_ch6(
+            results_dir / ("ch6" if full else "ch6-quick"),
+            full=full,
+            fresh=fresh,
+            progress=_say_ch6 if progress else None,
+            **({} if full else RUN_QUICK),
+        )
         if rend.ch6 is not None:
             ch6_summary.figures = list(rend.ch6(ch6_summary, report_dir / "ch6"))
         table += ch6_summary.table
@@ -684,7 +701,7 @@ def reproduce(
         s4 = reproduce_ch4(results_dir, report_dir, full=full, workers=workers, render=rend.ch4)
         table = table + s4.table
         by_key["ch4"] = sec.ch4_section(s4, full=full)
-    if real_run or ch6_summary is not None:  # quick mode: a section that says how to run it
+    if ch6_summary is not None:
         by_key["ch6"] = sec.ch6_section(ch6_summary, full=full)
     sections += [by_key[k] for k in ("ch3", "ch4", "ch5", "ch6", "ch7") if k in by_key]
     sections += later

@@ -345,30 +345,45 @@ _CH6_CAPTIONS = {
 
 def ch6_section(summary: Any | None, *, full: bool) -> ChapterSection:
     """The Chapter 6 section from a :class:`uvnav.bench.reproduce_ch6.Ch6Summary` (``None``: not
-    run, as in quick mode)."""
+    run, as in a test-sized run)."""
     title = "Chapter 6 — a CNN that drives (PilotNet on CarRacing)"
     if summary is None:
         return ChapterSection(
             key="ch6",
             title=title,
-            intro=(
-                f"Not run in {mode_text(full)}: training the CNN takes several CPU minutes even at "
-                "the quick size, more than the rest of the quick reproduction together."
-            ),
+            intro=f"Not run in this {mode_text(full)} run (a test-sized run leaves it out).",
             notes=[
-                "Run it with uvnav run --full (thesis size) or uvnav drive reproduce (quick size)."
+                "Run it with uvnav run (quick size), uvnav run --full (thesis size) or "
+                "uvnav drive reproduce [--full]."
             ],
         )
+    size = getattr(summary, "size", {}) or {}
+    how = ""
+    if size:
+        n = len(size["eval_seeds"])
+        how = (
+            f" Size: {size['episodes']} expert episodes of {size['collect_steps']} steps, "
+            f"{size['epochs']} epochs, {n} held-out track{'s' if n != 1 else ''} of up to "
+            f"{size['max_steps']} steps."
+        )
+    names = ", ".join(k for k in summary.closed_loop if k != "expert")
     sec = ChapterSection(
         key="ch6",
         title=title,
         intro=(
             f"PilotNet trained on frames of the pure-pursuit expert in CarRacing ({mode_text(full)}"
             "): collection, balancing, 8:2 split, training, then closed-loop laps on held-out "
-            "tracks with the learned and the PI throttle."
+            f"tracks ({names}; the expert for reference).{how}"
         ),
         rows=rows_of(summary.table),
     )
+    if not full:
+        sec.notes.append(
+            "Quick size: a smoke run of the whole pipeline. A network trained this briefly does "
+            "not drive well, so its closed-loop numbers are far below the thesis-size ones "
+            "(uvnav run --full or uvnav drive reproduce --full; measured figures in "
+            "docs/thesis-notes.md)."
+        )
     sec.add_files(
         caption_files(getattr(summary, "figures", []) or [], lambda p: _CH6_CAPTIONS.get(p.stem))
     )

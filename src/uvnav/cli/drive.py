@@ -478,7 +478,8 @@ def reproduce(
     seeds: Annotated[str | None, typer.Option(help="Override: held-out seeds.")] = None,
     max_steps: Annotated[int | None, typer.Option(help="Override: closed-loop steps.")] = None,
     dagger_rounds: Annotated[
-        int | None, typer.Option(min=0, help="Override: DAgger rounds (0: the thesis's recipe).")
+        int | None,
+        typer.Option(min=0, help="Override: DAgger rounds (default 1 with --full, else 0)."),
     ] = None,
     head: Annotated[
         str,
@@ -487,8 +488,20 @@ def reproduce(
             "(closed loop 'learned-speed')."
         ),
     ] = "throttle",
+    readout: Annotated[
+        bool,
+        typer.Option(help="Thesis head: also fit the target-speed readout (cnn-learned-speed)."),
+    ] = True,
+    fresh: Annotated[
+        bool, typer.Option("--fresh", help="Rerun finished stages (episodes are kept).")
+    ] = False,
 ) -> None:
-    """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table."""
+    """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table.
+
+    The chain: the thesis's network (learned pedal head and PI rows), the target-speed readout
+    (learned-speed row), DAgger rounds with the learned-speed throttle (one in --full), the
+    expert.  Resumable: finished stages (out/stages/*.json) are skipped on a rerun.
+    """
     with _user_errors():
         from rich.console import Console
         from rich.table import Table
@@ -506,6 +519,8 @@ def reproduce(
             max_steps=max_steps,
             dagger_rounds=dagger_rounds,
             head=_parse_head(head),
+            readout=readout,
+            fresh=fresh,
             progress=lambda s: con.print(f"[dim]… {s}[/dim]"),
         )
         figures = render_ch6(summary, out / "figures")
