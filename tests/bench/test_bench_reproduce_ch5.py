@@ -35,7 +35,13 @@ def test_small_reproduction_writes_measured_table_and_figures(
         report_dir=tmp_path / "report",
     )
     data = json.loads((tmp_path / "results" / "ch5.json").read_text())
-    assert len(data["learning"]) == 3  # plain + residual at 50, and the closed-loop network
+    # plain, residual and residual-Huber at 50, and the closed-loop network
+    assert [r["variant"] for r in data["learning"]] == [
+        "plain",
+        "residual",
+        "residual-huber",
+        "residual",
+    ]
     assert {r["locator"] for r in data["closed_loop"]} == {"geometric", "network", "oracle"}
     assert len(data["closed_loop"]) == 3  # 1 thesis scene x 3 locators
     quantities = [r["quantity"] for r in s.table]

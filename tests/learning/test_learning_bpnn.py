@@ -69,6 +69,27 @@ def test_residual_network_beats_the_min_argmin_baseline_on_distance(
         m.predict(test.inputs)
 
 
+def test_huber_loss_keeps_a_few_wild_labels_from_pulling_the_others() -> None:
+    # a residual task whose correction is 0 except 3 % of labels shifted by 5 to 8 (like the
+    # beam ties of the sensor index): the robust loss fits the clean samples far better
+    rng = np.random.default_rng(3)
+    x = rng.uniform(0, 5, (200, 9))
+    offset = np.stack([x.min(axis=1), np.argmin(x, axis=1) + 1.0], axis=1)
+    y = offset.copy()
+    wild = rng.choice(200, 6, replace=False)
+    y[wild, 1] += rng.uniform(5, 8, 6)
+    clean = np.setdiff1d(np.arange(200), wild)
+    worst = {}
+    for delta in (0.0, 0.02):
+        cfg = BPNNConfig(residual=True, huber_delta=delta)
+        assert cfg.variant == ("residual-huber" if delta else "residual")
+        m = train_bpnn(x, y, np.random.default_rng(4), cfg, offset=offset)
+        worst[delta] = float(np.abs(m.predict(x, offset)[clean, 1] - y[clean, 1]).max())
+    assert worst[0.02] < 0.1 < worst[0.0]
+    with pytest.raises(ValueError, match="huber_delta"):
+        BPNNConfig(huber_delta=-1.0)
+
+
 def test_adam_option_trains(data: tuple[SonarDataset, SonarDataset]) -> None:
     ds, _ = data
     m = train_bpnn(

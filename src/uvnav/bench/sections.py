@@ -257,11 +257,12 @@ def _ch5_caption(p: Path) -> str:
             "Learning curve: test error of the BPNN as the sample count grows, beside the "
             "min/argmin-of-readings baseline."
         )
-    if m := re.fullmatch(r"ch5_training_n(\d+)(r?)", s):
-        kind = "residual" if m[2] else "plain (thesis-style)"
+    kinds = {"r": "residual", "h": "residual (Huber loss)", "": "plain (thesis-style)"}
+    if m := re.fullmatch(r"ch5_training_n(\d+)([rh]?)", s):
+        kind = kinds[m[2]]
         return f"BPNN training on {m[1]} samples, {kind} network: loss per epoch."
-    if m := re.fullmatch(r"ch5_errors_n(\d+)(r?)_(test_group|independent)", s):
-        kind = "residual" if m[2] else "plain (thesis-style)"
+    if m := re.fullmatch(r"ch5_errors_n(\d+)([rh]?)_(test_group|independent)", s):
+        kind = kinds[m[2]]
         where = "its own test group" if m[3] == "test_group" else "the independent test set"
         return (
             f"Figs. 5.5–5.8 style: errors and target-vs-output of the {m[1]}-sample {kind} "
@@ -296,7 +297,8 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
     noises += " m"
     intro = (
         f"3D UUV with a nine-sonar array and a BPNN locator ({mode_text(full)}). The BPNN "
-        f"(9→10→2, plain and residual) trained on {', '.join(map(str, sizes))} samples with "
+        f"(9→10→2: plain, residual, residual with a Huber loss) trained on "
+        f"{', '.join(map(str, sizes))} samples with "
         f"{seeds} seeds each, tested on its own test group and on an independent set; "
         f"zhang2022-uuv3d-v1 then ran on the three thesis-ch5 scenes and random-ch5 seeds "
         f"0–{n_rand - 1} with the {', '.join(r5.LOCATORS)} locators, sonar noise {noises}"

@@ -120,7 +120,7 @@ def fig_learning_curve(rows: Sequence[dict[str, Any]]) -> Figure:
     residual) and baseline."""
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for j, out in enumerate(("distance", "index")):
-        for variant, style in (("plain", "o-"), ("residual", "^-")):
+        for variant, style in (("plain", "o-"), ("residual", "^-"), ("residual-huber", "D-")):
             vr = [r for r in rows if r.get("variant", "plain") == variant]
             sizes_v = sorted({int(r["samples"]) for r in vr})
             if not sizes_v:
@@ -327,7 +327,8 @@ def render_ch5(summary: Any, report_dir: Path) -> list[Path]:
             continue
         ds = summary.datasets[key]
         grp = model.split["test"]
-        label = f"{key[1:].rstrip('r')} samples, {'residual' if key.endswith('r') else 'plain'}"
+        kind = {"r": "residual", "h": "residual, Huber loss"}.get(key[-1], "plain")
+        label = f"{key[1:].rstrip('rh')} samples, {kind}"
         save(fig_training(model, f"BPNN training, {label}"), f"ch5_training_{key}.png")
         save(
             fig_errors(
