@@ -99,8 +99,9 @@ NOISE_STD = 0.05
 #: samples of the network used in closed loop
 CLOSED_LOOP_SAMPLES = 500
 #: Huber threshold of the robust residual variant, in scaled output units (2 % of the largest
-#: training correction); measured on 20 fresh 150-sample sets (seeds 5-24): index error inside
-#: the thesis's range on 11/20 (squared loss: 1/20), inside but for beam ties on 19/20 (4/20)
+#: training correction); measured on 20 150-sample sets the reproduction does not use (seeds
+#: 5-24): index error inside the thesis's range on 12/20 (squared loss: 1/20), inside but for
+#: the beam ties on 20/20 (4/20); distance inside on 18/20 (19/20)
 HUBER_DELTA = 0.02
 #: suffix of each variant in the names of models and figures
 VARIANT_KEYS = {"plain": "", "residual": "r", "residual-huber": "h", "plain-huber": "p"}
