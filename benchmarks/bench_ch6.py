@@ -123,6 +123,44 @@ def bench_inference(threads: int, n: int) -> dict[str, float]:
     }
 
 
+def bench_inference_onnx(threads: int, n: int) -> dict[str, float]:
+    """One-frame inference latency [ms] of the same network exported to ONNX and run by
+    onnxruntime (``intra_op_num_threads = threads``); the export is checked against torch."""
+    import tempfile
+
+    import onnxruntime as ort
+
+    from uvnav.learning import PilotNetConfig
+    from uvnav.learning.export import export_onnx
+    from uvnav.learning.pilotnet import build_pilotnet
+
+    model = build_pilotnet(PilotNetConfig()).eval()
+    with tempfile.TemporaryDirectory() as d:
+        path = Path(d) / "pilotnet.onnx"
+        export_onnx(model, path)
+        opts = ort.SessionOptions()
+        opts.intra_op_num_threads = threads
+        opts.inter_op_num_threads = 1
+        sess = ort.InferenceSession(str(path), opts, providers=["CPUExecutionProvider"])
+    names = [i.name for i in sess.get_inputs()]
+    rng = np.random.default_rng(0)
+    feed = {names[0]: rng.uniform(0, 255, (1, 66, 200, 3)).astype(np.float32)}
+    if len(names) > 1:
+        feed[names[1]] = np.array([[30.0]], dtype=np.float32)
+    times = []
+    for _ in range(5):
+        sess.run(None, feed)
+    for _ in range(n):
+        tic = time.perf_counter()
+        sess.run(None, feed)
+        times.append(1e3 * (time.perf_counter() - tic))
+    return {
+        "median": float(np.median(times)),
+        "p95": float(np.percentile(times, 95)),
+        "p99": float(np.percentile(times, 99)),
+    }
+
+
 def bench_sim(steps: int) -> float:
     """Simulator steps per second with the front camera rendered each step."""
     from uvnav.driving.sim import DrivingSim
@@ -151,6 +189,9 @@ def run(quick: bool) -> dict[str, Any]:
         inf = bench_inference(t, frames)
         for q in ("median", "p95", "p99"):
             result[f"inference_ms_{q}_{t}_threads"] = inf[q]
+        ort_inf = bench_inference_onnx(t, frames)
+        for q in ("median", "p95", "p99"):
+            result[f"onnxruntime_inference_ms_{q}_{t}_threads"] = ort_inf[q]
     result["sim_steps_per_s"] = bench_sim(steps)
     result["load_average_1_5_15m_end"] = (
         list(os.getloadavg()) if hasattr(os, "getloadavg") else None
