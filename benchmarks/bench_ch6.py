@@ -24,6 +24,7 @@ import os
 import platform
 import sys
 import time
+from collections.abc import Callable
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
@@ -97,6 +98,22 @@ def bench_training(threads: int, batches: int) -> tuple[float, float]:
     return 100 * batches / wall, 100 * batches / cpu
 
 
+def _latency_ms(call: Callable[[], Any], n: int, warmup: int = 5) -> dict[str, float]:
+    """Latency [ms] of ``call()`` over ``n`` calls after ``warmup``: median, p95, p99."""
+    for _ in range(warmup):
+        call()
+    times = []
+    for _ in range(n):
+        tic = time.perf_counter()
+        call()
+        times.append(1e3 * (time.perf_counter() - tic))
+    return {
+        "median": float(np.median(times)),
+        "p95": float(np.percentile(times, 95)),
+        "p99": float(np.percentile(times, 99)),
+    }
+
+
 def bench_inference(threads: int, n: int) -> dict[str, float]:
     """One-frame inference latency [ms] (median, p95, p99)."""
     import torch
@@ -108,19 +125,8 @@ def bench_inference(threads: int, n: int) -> dict[str, float]:
     model = build_pilotnet(PilotNetConfig()).eval()
     x = torch.randint(0, 255, (1, 66, 200, 3), dtype=torch.uint8)
     e = torch.tensor([[30.0]])
-    times = []
     with torch.no_grad():
-        for _ in range(5):
-            model(x, e)
-        for _ in range(n):
-            tic = time.perf_counter()
-            model(x, e)
-            times.append(1e3 * (time.perf_counter() - tic))
-    return {
-        "median": float(np.median(times)),
-        "p95": float(np.percentile(times, 95)),
-        "p99": float(np.percentile(times, 99)),
-    }
+        return _latency_ms(lambda: model(x, e), n)
 
 
 def bench_inference_onnx(threads: int, n: int) -> dict[str, float]:
@@ -147,18 +153,7 @@ def bench_inference_onnx(threads: int, n: int) -> dict[str, float]:
     feed = {names[0]: rng.uniform(0, 255, (1, 66, 200, 3)).astype(np.float32)}
     if len(names) > 1:
         feed[names[1]] = np.array([[30.0]], dtype=np.float32)
-    times = []
-    for _ in range(5):
-        sess.run(None, feed)
-    for _ in range(n):
-        tic = time.perf_counter()
-        sess.run(None, feed)
-        times.append(1e3 * (time.perf_counter() - tic))
-    return {
-        "median": float(np.median(times)),
-        "p95": float(np.percentile(times, 95)),
-        "p99": float(np.percentile(times, 99)),
-    }
+    return _latency_ms(lambda: sess.run(None, feed), n)
 
 
 def bench_sim(steps: int) -> float:

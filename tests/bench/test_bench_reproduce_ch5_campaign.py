@@ -185,3 +185,19 @@ def test_dense_jobs_form_their_own_campaign_and_table_rows() -> None:
     dense_row = table["Ch5 dense scenes (beyond the assumptions) success (geometric, noise 0.0 m)"]
     assert dense_row["measured"] == "0.0% of 1"
     assert "random-ch5-dense:0 collision" in dense_row["note"]
+
+
+def test_model_keys_name_every_variant_and_nothing_else() -> None:
+    assert r5.split_model_key("n150") == (150, "plain")
+    assert r5.split_model_key("n150r") == (150, "residual")
+    assert r5.split_model_key("n5000h") == (5000, "residual-huber")
+    assert r5.split_model_key("n50p") == (50, "plain-huber")
+    for other in ("closed_loop", "episodes", "n", "nx", "n150rh", "x150"):
+        assert r5.split_model_key(other) is None
+    for variant, suffix in r5.VARIANT_KEYS.items():  # every config variant has a key and label
+        assert r5.split_model_key(f"n7{suffix}") == (7, variant)
+        assert variant in r5.VARIANT_LABELS
+    from uvnav.bench.sections import _ch5_caption
+
+    caption = _ch5_caption(Path("ch5_errors_n150h_independent.png"))
+    assert "150-sample residual (Huber loss) network on the independent test set" in caption

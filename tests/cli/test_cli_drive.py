@@ -53,26 +53,18 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     return data, model
 
 
+def _short_evaluation(model: Path, *options: str) -> dict[str, dict[str, float]]:
+    """``uvnav drive evaluate`` on track 1000 for 150 steps, without the expert: its JSON rows."""
+    args = ["drive", "evaluate", str(model), "--seeds", "1000", "--max-steps", "150", *options]
+    r = runner.invoke(app, [*args, "--no-expert", "--json"])
+    assert r.exit_code == 0, r.output
+    rows: dict[str, dict[str, float]] = json.loads(r.output[r.output.index("{") :])
+    return rows
+
+
 def test_briefly_trained_model_moves_along_the_track(trained: tuple[Path, Path]) -> None:
     _, model = trained
-    r = runner.invoke(
-        app,
-        [
-            "drive",
-            "evaluate",
-            str(model),
-            "--seeds",
-            "1000",
-            "--max-steps",
-            "150",
-            "--throttle",
-            "pi",
-            "--no-expert",
-            "--json",
-        ],
-    )
-    assert r.exit_code == 0, r.output
-    row = json.loads(r.output[r.output.index("{") :])["cnn-pi"]
+    row = _short_evaluation(model, "--throttle", "pi")["cnn-pi"]
     assert row["n"] == 1
     assert row["tiles_pct"] > 5.0  # it drove along the track, not in place
     assert row["mean_speed"] > 5.0
@@ -106,22 +98,7 @@ def test_target_speed_head_trains_and_drives_with_the_learned_speed_throttle(
     assert rec["second_output"] == "target_speed"
     assert rec["train_loss"][-1] < rec["train_loss"][0]  # the new head trains
     assert len(rec["val_target_speed_rmse"]) == 2
-    r = runner.invoke(
-        app,
-        [
-            "drive",
-            "evaluate",
-            str(model),
-            "--seeds",
-            "1000",
-            "--max-steps",
-            "150",
-            "--no-expert",
-            "--json",
-        ],
-    )
-    assert r.exit_code == 0, r.output
-    rows = json.loads(r.output[r.output.index("{") :])
+    rows = _short_evaluation(model)
     assert set(rows) == {"cnn-learned-speed", "cnn-pi"}  # "both" = the model's learned mode + PI
     row = rows["cnn-learned-speed"]
     assert row["tiles_pct"] > 5.0  # the network's own speed choice moves the car along
@@ -146,24 +123,7 @@ def test_speed_head_readout_keeps_the_steering_and_drives(
     sd_old, sd_new = old.state_dict(), new.state_dict()
     assert all((sd_old[k] == sd_new[k]).all() for k in sd_old if not k.startswith("head.6"))
     assert (sd_old["head.6.weight"][0] == sd_new["head.6.weight"][0]).all()  # steering row kept
-    r = runner.invoke(
-        app,
-        [
-            "drive",
-            "evaluate",
-            str(out),
-            "--seeds",
-            "1000",
-            "--max-steps",
-            "150",
-            "--throttle",
-            "learned-speed",
-            "--no-expert",
-            "--json",
-        ],
-    )
-    assert r.exit_code == 0, r.output
-    row = json.loads(r.output[r.output.index("{") :])["cnn-learned-speed"]
+    row = _short_evaluation(out, "--throttle", "learned-speed")["cnn-learned-speed"]
     assert row["tiles_pct"] > 5.0 and row["mean_speed"] > 5.0
 
 

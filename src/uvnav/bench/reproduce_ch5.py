@@ -103,8 +103,27 @@ CLOSED_LOOP_SAMPLES = 500
 #: 5-24): index error inside the thesis's range on 12/20 (squared loss: 1/20), inside but for
 #: the beam ties on 20/20 (4/20); distance inside on 18/20 (19/20)
 HUBER_DELTA = 0.02
-#: suffix of each variant in the names of models and figures
+#: suffix of each network variant (:attr:`BPNNConfig.variant`) in the names of models and
+#: figures (``n150h`` = 150 samples, residual-huber), and its label in captions
 VARIANT_KEYS = {"plain": "", "residual": "r", "residual-huber": "h", "plain-huber": "p"}
+VARIANT_LABELS = {
+    "plain": "plain (thesis-style)",
+    "residual": "residual",
+    "residual-huber": "residual (Huber loss)",
+    "plain-huber": "plain (Huber loss)",
+}
+
+
+def split_model_key(key: str) -> tuple[int, str] | None:
+    """``"n150h"`` -> ``(150, "residual-huber")``; ``None`` for any other name."""
+    digits = key[1:].rstrip("".join(VARIANT_KEYS.values()))
+    suffix = key[1 + len(digits) :]
+    variant = next((v for v, k in VARIANT_KEYS.items() if k == suffix), None)
+    if not key.startswith("n") or not digits.isdigit() or variant is None:
+        return None
+    return int(digits), variant
+
+
 #: tessellation level of the sampled obstacles (320 triangles: readings and targets are computed
 #: on the same mesh, so the data are consistent; the mesh is within a few cm of the analytic body)
 DATA_SUBDIVISIONS = 2

@@ -249,6 +249,8 @@ def ch4_section(summary: Any, *, full: bool) -> ChapterSection:
 
 
 def _ch5_caption(p: Path) -> str:
+    from uvnav.bench import reproduce_ch5 as r5
+
     s = p.stem
     if s == "ch5_array":
         return "Fig. 5.2: the nine-sonar array on the vehicle's front surface and its beams."
@@ -257,15 +259,15 @@ def _ch5_caption(p: Path) -> str:
             "Learning curve: test error of the BPNN as the sample count grows, beside the "
             "min/argmin-of-readings baseline."
         )
-    kinds = {"r": "residual", "h": "residual (Huber loss)", "": "plain (thesis-style)"}
-    if m := re.fullmatch(r"ch5_training_n(\d+)([rh]?)", s):
-        kind = kinds[m[2]]
-        return f"BPNN training on {m[1]} samples, {kind} network: loss per epoch."
-    if m := re.fullmatch(r"ch5_errors_n(\d+)([rh]?)_(test_group|independent)", s):
-        kind = kinds[m[2]]
-        where = "its own test group" if m[3] == "test_group" else "the independent test set"
+    if (m := re.fullmatch(r"ch5_training_(n\w+)", s)) and (nv := r5.split_model_key(m[1])):
+        kind = r5.VARIANT_LABELS[nv[1]]
+        return f"BPNN training on {nv[0]} samples, {kind} network: loss per epoch."
+    m = re.fullmatch(r"ch5_errors_(n[^_]+)_(test_group|independent)", s)
+    if m and (nv := r5.split_model_key(m[1])):
+        kind = r5.VARIANT_LABELS[nv[1]]
+        where = "its own test group" if m[2] == "test_group" else "the independent test set"
         return (
-            f"Figs. 5.5–5.8 style: errors and target-vs-output of the {m[1]}-sample {kind} "
+            f"Figs. 5.5–5.8 style: errors and target-vs-output of the {nv[0]}-sample {kind} "
             f"network on {where}."
         )
     if m := re.fullmatch(r"ch5_anim_(.+)_([a-z]+)", s):

@@ -20,6 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
+from uvnav.bench.reproduce_ch5 import VARIANT_LABELS, split_model_key
 from uvnav.geometry.angles import FloatArray
 from uvnav.learning.bpnn import TrainedBPNN
 from uvnav.obstacles.deforming3d import CompoundBody
@@ -120,7 +121,7 @@ def fig_learning_curve(rows: Sequence[dict[str, Any]]) -> Figure:
     residual) and baseline."""
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for j, out in enumerate(("distance", "index")):
-        for variant, style in (("plain", "o-"), ("residual", "^-"), ("residual-huber", "D-")):
+        for variant, style in zip(VARIANT_LABELS, ("o-", "^-", "D-", "v-"), strict=True):
             vr = [r for r in rows if r.get("variant", "plain") == variant]
             sizes_v = sorted({int(r["samples"]) for r in vr})
             if not sizes_v:
@@ -323,12 +324,14 @@ def render_ch5(summary: Any, report_dir: Path) -> list[Path]:
 
     save(fig_array(SonarArray()), "ch5_array.png")
     for key, model in summary.models.items():
-        if not key.startswith("n") or key not in summary.datasets:
+        if key not in summary.datasets:
             continue
         ds = summary.datasets[key]
         grp = model.split["test"]
-        kind = {"r": "residual", "h": "residual, Huber loss"}.get(key[-1], "plain")
-        label = f"{key[1:].rstrip('rh')} samples, {kind}"
+        n_variant = split_model_key(key)
+        if n_variant is None:
+            continue
+        label = f"{n_variant[0]} samples, {VARIANT_LABELS[n_variant[1]]}"
         save(fig_training(model, f"BPNN training, {label}"), f"ch5_training_{key}.png")
         save(
             fig_errors(
