@@ -35,7 +35,12 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     # the target-speed head drives DAgger with its own learned-speed throttle
     assert set(s.closed_loop) == {"cnn-learned-speed", "cnn-pi", "dagger1-learned-speed", "expert"}
     assert s.record["second_output"] == "target_speed" and s.record["val_target_speed_rmse"]
-    assert "target speed RMSE" in s.table[2]["note"]
+    assert "target speed RMSE" in s.table[3]["note"]
+    # the steering row compares eq. (6.1) with the thesis, by camera, with exact side labels
+    steer_row = s.table[2]
+    assert steer_row["measured"] == f"{s.record['val_steering_mse'][-1]:.4f}"
+    assert "side-image labels: exact" in steer_row["note"]
+    assert set(s.record["val_steering_mse_by_camera"]) <= {"centre", "left", "right"}
     # the DAgger rows go to a copy: data/ keeps the expert's 30 rows, the aggregate has more
     assert s.closed_loop["dagger1-learned-speed"]["rows_added"] == 30  # 120 steps, every 4th
     assert len(read_log(tmp_path / "data")) == 30

@@ -169,3 +169,44 @@ def test_bad_target_speed_names_the_column(tmp_path) -> None:
     (tmp_path / "driving_log.csv").write_text("IMG/c.jpg,IMG/c.jpg,IMG/c.jpg,0,0,0,0,1,2\n")
     with pytest.raises(DatasetError, match="row 1: 9 columns"):
         read_log(tmp_path)
+
+
+def test_exact_side_labels_replace_the_correction_where_a_row_has_them(tmp_path) -> None:
+    w = LogWriter(tmp_path)
+    w.write("a", (_img(1), _img(2), _img(3)), steering=0.1, throttle=0.3, brake=0.0, speed=5.0)
+    w.write(
+        "b",
+        (_img(1), _img(2), _img(3)),
+        steering=0.1,
+        throttle=0.3,
+        brake=0.0,
+        speed=5.0,
+        side_steering=(0.45, -0.05),
+    )
+    w.write(
+        "c",
+        (_img(1), _img(2), _img(3)),
+        steering=-0.2,
+        throttle=0.3,
+        brake=0.0,
+        speed=5.0,
+        target_speed=30.0,
+        side_steering=(0.05, -0.6),
+    )
+    w.close()
+    lines = (tmp_path / "driving_log.csv").read_text().splitlines()
+    assert [len(x.split(",")) for x in lines] == [7, 10, 10]
+    log = read_log(tmp_path)
+    assert log.target_speed is not None and np.isnan(log.target_speed[:2]).all()
+    assert log.steering_left is not None and log.steering_right is not None
+    assert np.isnan(log.steering_left[0]) and log.steering_left[1:].tolist() == [0.45, 0.05]
+    s = expand_cameras(log, correction=0.2)
+    # centre a, b, c; left a (0.1 + 0.2: no exact label), b, c; right a, b, c
+    assert np.allclose(s.steering, [0.1, 0.1, -0.2, 0.3, 0.45, 0.05, -0.1, -0.05, -0.6])
+    assert s.camera is not None and s.camera.tolist() == [0] * 3 + [1] * 3 + [2] * 3
+    assert s.take(np.array([4, 8])).camera.tolist() == [1, 2]
+    fixed = expand_cameras(log, correction=0.2, exact_sides=False)  # the thesis's recipe
+    assert np.allclose(fixed.steering[3:], [0.3, 0.3, 0.0, -0.1, -0.1, -0.4])
+    (tmp_path / "driving_log.csv").write_text(lines[2].rsplit(",", 1)[0] + ",left\n")
+    with pytest.raises(DatasetError, match="column 'steering_right'"):
+        read_log(tmp_path)

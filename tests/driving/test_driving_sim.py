@@ -108,3 +108,33 @@ def test_expert_target_speed_label_gives_its_throttle(sim) -> None:
     v_corner = np.sqrt(p.a_lat / max(curv))  # the tightest corner's speed limit
     assert min(targets) >= v_corner - 1e-6 and max(targets) <= p.v_max
     assert max(targets) - min(targets) > 10.0  # it does change along the track
+
+
+def test_side_camera_sees_the_centre_view_of_a_shifted_car_and_gets_its_label(sim) -> None:
+    """A side image is the centre camera's image at the shifted pose; its label is the expert's
+    command there: left of the line, steer right (+), and the reverse."""
+    from dataclasses import replace
+
+    from uvnav.driving.camera import render_view
+
+    _, tel = sim.reset(4)
+    for _ in range(60):
+        tel = sim.step(0.0, 0.5).telemetry
+    expert = PurePursuitExpert(sim.geometry)
+    s = sim.side_shift
+    nx, ny = -np.sin(tel.heading), np.cos(tel.heading)
+    left, _, right = sim.side_views()
+    for side, img in ((1.0, left), (-1.0, right)):
+        at = render_view(
+            sim._raster, sim._rays, tel.x + side * s * nx, tel.y + side * s * ny, tel.heading
+        )
+        assert np.mean(np.all(at == img, axis=-1)) > 0.999  # rounding at a few edges only
+    e_left, e_right = expert.side_steering(tel, s)
+    moved = replace(tel, x=tel.x + s * nx, y=tel.y + s * ny)
+    assert e_left == pytest.approx(expert.label(moved)[0])
+    steer = expert.label(tel)[0]
+    assert e_left > steer + 0.05 and e_right < steer - 0.05
+    # the exact correction shrinks as the lookahead grows with speed (a fixed ±0.2 cannot)
+    fast = replace(tel, speed=tel.speed + 40.0)
+    f_left, f_right = expert.side_steering(fast, s)
+    assert f_left - f_right < e_left - e_right

@@ -69,6 +69,8 @@ class PreparedData:
     info: dict[str, Any] = field(default_factory=dict)
     target_speed_train: NDArray[np.float64] | None = None
     target_speed_val: NDArray[np.float64] | None = None
+    #: camera of each validation sample (:data:`uvnav.driving.dataset.CAMERA_NAMES` indices)
+    camera_val: NDArray[np.int8] | None = None
 
 
 def prepare_data(
@@ -81,6 +83,7 @@ def prepare_data(
     seed: int = 0,
     size: tuple[int, int] = (66, 200),
     sides: bool = True,
+    exact_sides: bool = True,
 ) -> PreparedData:
     """Read a Udacity-layout folder, expand cameras, balance (Fig. 6.5) and split (Fig. 6.6).
 
@@ -93,13 +96,16 @@ def prepare_data(
         seed: seed of balancing and split.
         size: network input (H, W).
         sides: use the left/right images (False for top-down datasets).
+        exact_sides: label side images with the log's exact side labels where it has them
+            (False: ``± correction`` everywhere, the thesis's recipe).
 
     Returns:
-        The prepared arrays and counts.
+        The prepared arrays and counts; ``info["side_labels"]`` says which side labels were
+        used (``"exact"``, ``"correction"``, ``"mixed"`` or ``"none"``).
     """
     rng = np.random.default_rng([seed, 66])
     log = read_log(root)
-    samples = expand_cameras(log, correction=correction, sides=sides)
+    samples = expand_cameras(log, correction=correction, sides=sides, exact_sides=exact_sides)
     keep = (
         balance_indices(samples.steering, rng, n_bins=n_bins, max_per_bin=max_per_bin)
         if max_per_bin
@@ -128,10 +134,22 @@ def prepare_data(
             "n_balanced": len(bal),
             "n_train": len(tr),
             "n_val": len(va),
+            "side_labels": _side_label_kind(log, sides=sides, exact_sides=exact_sides),
         },
         target_speed_train=None if ts is None else ts[tr],
         target_speed_val=None if ts is None else ts[va],
+        camera_val=None if bal.camera is None else bal.camera[va],
     )
+
+
+def _side_label_kind(log: Any, *, sides: bool, exact_sides: bool) -> str:
+    """Which side labels :func:`expand_cameras` used: exact, correction, mixed or none."""
+    if not sides:
+        return "none"
+    if not exact_sides or log.steering_left is None or log.steering_right is None:
+        return "correction"
+    have = ~(np.isnan(log.steering_left) | np.isnan(log.steering_right))
+    return "exact" if have.all() else "mixed"
 
 
 def _labelled(data: PreparedData, net: PilotNetConfig) -> tuple[Any, Any]:
@@ -181,6 +199,7 @@ def train_on(
     model, hist = train_pilotnet(
         train, val, net=ncfg, config=config, model=model, on_epoch=on_epoch
     )
+    cpu_s = time.process_time() - tic
     second = ncfg.second_output if ncfg.n_outputs == 2 else "none"
     record = {
         "second_output": second,
@@ -193,14 +212,40 @@ def train_on(
         ]
         if second == "target_speed"
         else [],
+        "val_steering_mse_by_camera": steering_mse_by_camera(model, data, val),
         "images_per_s": hist.images_per_s,
-        "cpu_s": time.process_time() - tic,
+        "cpu_s": cpu_s,
         "n_rows": data.n_rows,
         "n_frames": data.n_frames,
         **data.info,
     }
     save_checkpoint(model, out, record=record)
     return model, record
+
+
+def steering_mse_by_camera(model: Any, data: PreparedData, val: Any = None) -> dict[str, float]:
+    """Validation steering MSE of the trained network on each camera's images (eval mode).
+
+    Args:
+        model: trained network.
+        data: prepared data (its ``camera_val``; an empty dict when unknown).
+        val: the validation tuple with the network's labels (default ``data.val``).
+
+    Returns:
+        ``{"centre": mse, "left": mse, "right": mse}`` for the cameras present.
+    """
+    from uvnav.driving.dataset import CAMERA_NAMES
+    from uvnav.learning.train import evaluate_mse
+
+    if data.camera_val is None:
+        return {}
+    im, st, second, sp = data.val if val is None else val
+    out: dict[str, float] = {}
+    for k, name in enumerate(CAMERA_NAMES):
+        idx = np.flatnonzero(data.camera_val == k)
+        if len(idx):
+            out[name] = evaluate_mse(model, im[idx], st[idx], second[idx], sp[idx])[1]
+    return out
 
 
 def fit_target_speed_readout(
@@ -441,6 +486,7 @@ def dagger_collect(
                         brake=max(-e_thr, 0.0),
                         speed=tel.speed,
                         target_speed=e_target,
+                        side_steering=expert.side_steering(tel, sim.side_shift),
                     )
                     rows += 1
                 steer, thr = (e_steer, e_thr) if rng.random() < beta else learner(frame, tel)

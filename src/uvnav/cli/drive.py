@@ -128,7 +128,17 @@ def train(
     threads: Annotated[int, typer.Option(min=1, max=2, help="torch CPU threads.")] = 1,
     max_per_bin: Annotated[int, typer.Option(min=0, help="Balancing threshold (0: none).")] = 200,
     bins: Annotated[int, typer.Option(min=1, help="Steering histogram bins.")] = 25,
-    correction: Annotated[float, typer.Option(help="Left/right steering correction.")] = 0.2,
+    correction: Annotated[
+        float,
+        typer.Option(help="Left/right steering correction where a row has no exact side label."),
+    ] = 0.2,
+    exact_sides: Annotated[
+        bool,
+        typer.Option(
+            help="Label side images with the recorded exact side labels (columns 9-10, written "
+            "by `uvnav drive collect`); --no-exact-sides: ±correction everywhere (the thesis)."
+        ),
+    ] = True,
     augment: Annotated[bool, typer.Option(help="Flip/brightness/zoom augmentation.")] = True,
     speed_input: Annotated[bool, typer.Option(help="Feed the speed to the network.")] = True,
     throttle_head: Annotated[bool, typer.Option(help="Learn the throttle too.")] = True,
@@ -162,6 +172,7 @@ def train(
             seed=seed,
             size=size,
             sides=sides,
+            exact_sides=exact_sides,
         )
         net = PilotNetConfig(
             height=size[0],
@@ -198,6 +209,13 @@ def train(
             f"{record['val_loss'][-1]:.4f} (steering {record['val_steering_mse'][-1]:.4f}, "
             f"second output {record['val_throttle_mse'][-1]:.4f}{extra})"
         )
+        by_cam = record["val_steering_mse_by_camera"]
+        if by_cam:
+            typer.echo(
+                "validation steering MSE by camera: "
+                + ", ".join(f"{k} {v:.4f}" for k, v in by_cam.items())
+                + f" (side labels: {prep.info['side_labels']})"
+            )
         typer.echo(f"wrote {out}")
 
 

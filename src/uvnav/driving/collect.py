@@ -2,8 +2,9 @@
 
 The expert (:class:`uvnav.driving.expert.PurePursuitExpert`) drives CarRacing tracks; while
 recording, correlated steering noise is applied (DART) but the recorded label is the clean expert
-command at the state the car is in (steering, throttle, and the expert's target speed as an 8th
-column, see :mod:`uvnav.driving.dataset`).  Every ``record_every`` steps the three forward images
+command at the state the car is in (steering, throttle, the expert's target speed as an 8th
+column and, with the front camera, the exact labels of the left and right images as the 9th and
+10th, see :mod:`uvnav.driving.dataset`).  Every ``record_every`` steps the three forward images
 (left, centre, right) are written with the labels.  Resumable: each finished episode's seed is
 appended to ``episodes.txt``; a rerun skips those seeds (a killed run loses at most the episode
 in flight, whose rows are written but not listed — they are kept, as a Udacity recording would be).
@@ -82,8 +83,10 @@ def collect_episode(
     for k in range(p.max_steps):
         steer, throttle, v_target = expert.label(tel)
         if k % p.record_every == 0:
+            sides: tuple[float, float] | None = None
             if sim.camera == "front":
                 left, centre, right = sim.side_views()
+                sides = expert.side_steering(tel, sim.side_shift)
             else:  # the top-down view has no side cameras: the same image three times
                 left = centre = right = sim.topdown_view()
             writer.write(
@@ -94,6 +97,7 @@ def collect_episode(
                 brake=max(-throttle, 0.0),
                 speed=tel.speed,
                 target_speed=v_target,
+                side_steering=sides,
             )
             rows += 1
         st = sim.step(steer + noise[k], throttle)
@@ -135,7 +139,13 @@ def collect(
     own = sim is None
     sim = sim or DrivingSim(max_steps=p.max_steps)
     meta = root / META_NAME
-    info = {"camera": sim.camera, "height": sim.frame_shape[0], "width": sim.frame_shape[1]}
+    info: dict[str, object] = {
+        "camera": sim.camera,
+        "height": sim.frame_shape[0],
+        "width": sim.frame_shape[1],
+    }
+    if sim.camera == "front":
+        info["side_shift"] = sim.side_shift
     if meta.is_file():
         old = json.loads(meta.read_text())
         if old.get("camera") != info["camera"]:

@@ -20,6 +20,14 @@ tracking at that row (the minimum of its corner-speed profile over the preview d
 hence observable from one forward image, unlike the expert's throttle, which also depends on the
 speed; the "learned-speed" throttle trains the network's second output on it.  Rows without it
 (real Udacity logs, datasets recorded before the column existed) load as before, with NaN there.
+
+Two more optional columns (ours only, beyond the thesis): ``steering_left, steering_right``, the
+exact labels of the left and right images — the expert's command at the pose the side camera
+sees (:meth:`uvnav.driving.expert.PurePursuitExpert.side_steering`).  A row then has 10 columns
+(``target_speed`` is written as ``nan`` if unknown).  :func:`expand_cameras` uses them where a
+row has them and the fixed ``± correction`` elsewhere; the fixed correction is what lifted the
+thesis-size run's validation steering MSE from 0.035 on centre images to 0.065/0.085 on the side
+images (docs/thesis-notes.md, Chapter 6).
 """
 
 from __future__ import annotations
@@ -35,8 +43,11 @@ from numpy.typing import NDArray
 LOG_NAME = "driving_log.csv"
 IMG_DIR = "IMG"
 COLUMNS = ("center", "left", "right", "steering", "throttle", "brake", "speed")
-#: optional columns after Udacity's seven (ours only)
-EXTRA_COLUMNS = ("target_speed",)
+#: optional columns after Udacity's seven (ours only): a row has 7, 8 or all 10
+EXTRA_COLUMNS = ("target_speed", "steering_left", "steering_right")
+#: camera of each sample in :class:`Samples` (``Samples.camera``)
+CAMERA_CENTRE, CAMERA_LEFT, CAMERA_RIGHT = 0, 1, 2
+CAMERA_NAMES = ("centre", "left", "right")
 
 
 class DatasetError(ValueError):
@@ -58,6 +69,9 @@ class DrivingLog:
         speed: speed (Udacity [mph], ours [m/s]).
         target_speed: the expert's target speed [m/s] (optional 8th column; NaN where a row
             has none, ``None`` when no row has it, e.g. a real Udacity log).
+        steering_left: exact label of the left image (optional 9th column; NaN where a row has
+            none, ``None`` when no row has it).
+        steering_right: exact label of the right image (10th column; as ``steering_left``).
     """
 
     root: Path
@@ -69,6 +83,8 @@ class DrivingLog:
     brake: NDArray[np.float64]
     speed: NDArray[np.float64]
     target_speed: NDArray[np.float64] | None = None
+    steering_left: NDArray[np.float64] | None = None
+    steering_right: NDArray[np.float64] | None = None
 
     def __len__(self) -> int:
         return len(self.center)
@@ -78,7 +94,9 @@ class DrivingLog:
 class Samples:
     """Flat training samples: one image path per sample and its labels.
 
-    ``target_speed`` [m/s] is the expert's target speed (NaN where the log has none).
+    ``target_speed`` [m/s] is the expert's target speed (NaN where the log has none);
+    ``camera`` is the camera of each sample (:data:`CAMERA_CENTRE`, :data:`CAMERA_LEFT`,
+    :data:`CAMERA_RIGHT`; ``None``: not known).
     """
 
     paths: list[Path]
@@ -86,6 +104,7 @@ class Samples:
     throttle: NDArray[np.float64]
     speed: NDArray[np.float64]
     target_speed: NDArray[np.float64] | None = None
+    camera: NDArray[np.int8] | None = None
 
     def __len__(self) -> int:
         return len(self.paths)
@@ -98,6 +117,7 @@ class Samples:
             self.throttle[idx],
             self.speed[idx],
             None if self.target_speed is None else self.target_speed[idx],
+            None if self.camera is None else self.camera[idx],
         )
 
 
@@ -122,8 +142,9 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
     Returns:
         The log.
 
-    Rows have Udacity's seven columns, or eight with our ``target_speed`` (both may be mixed in
-    one log, e.g. a Udacity recording extended by DAgger rows; absent values are NaN).
+    Rows have Udacity's seven columns, eight with our ``target_speed`` or ten with the exact
+    side labels too (they may be mixed in one log, e.g. a Udacity recording extended by DAgger
+    rows; absent values are NaN).
 
     Raises:
         DatasetError: missing CSV, wrong column count, non-numeric value, missing image.
@@ -133,18 +154,20 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
     if not log.is_file():
         raise DatasetError(f"{log}: not found (a dataset folder holds {LOG_NAME} and {IMG_DIR}/)")
     cols: dict[str, list[object]] = {c: [] for c in COLUMNS}
-    target: list[float] = []
+    extra: dict[str, list[float]] = {c: [] for c in EXTRA_COLUMNS}
     n_all = len(COLUMNS) + len(EXTRA_COLUMNS)
+    allowed = (len(COLUMNS), len(COLUMNS) + 1, n_all)
     with log.open(newline="") as fh:
         for r, rec in enumerate(csv.reader(fh), start=1):
             if not rec or all(not x.strip() for x in rec):
                 continue
             if r == 1 and rec[0].strip().lower() == "center":
                 continue  # header (some Udacity sample sets have one)
-            if len(rec) not in (len(COLUMNS), n_all):
+            if len(rec) not in allowed:
                 raise DatasetError(
                     f"{log}: row {r}: {len(rec)} columns (expected {len(COLUMNS)}: "
-                    f"{', '.join(COLUMNS)}; or {n_all} with {', '.join(EXTRA_COLUMNS)})"
+                    f"{', '.join(COLUMNS)}; {len(COLUMNS) + 1} with {EXTRA_COLUMNS[0]}; or "
+                    f"{n_all} with {', '.join(EXTRA_COLUMNS)})"
                 )
             for c, x in zip(COLUMNS[:3], rec[:3], strict=True):
                 cols[c].append(
@@ -154,12 +177,11 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
                 )
             for c, x in zip(COLUMNS[3:], rec[3:7], strict=True):
                 cols[c].append(_number(x, log, r, c))
-            target.append(
-                _number(rec[7], log, r, EXTRA_COLUMNS[0]) if len(rec) == n_all else float("nan")
-            )
+            for j, c in enumerate(EXTRA_COLUMNS, start=len(COLUMNS)):
+                extra[c].append(_number(rec[j], log, r, c) if len(rec) > j else float("nan"))
     if not cols["center"]:
         raise DatasetError(f"{log}: no rows")
-    ts = np.asarray(target, dtype=float)
+    ts, sl, sr = (_optional(extra[c]) for c in EXTRA_COLUMNS)
     return DrivingLog(
         root,
         [Path(str(p)) for p in cols["center"]],
@@ -169,8 +191,16 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
         np.asarray(cols["throttle"], dtype=float),
         np.asarray(cols["brake"], dtype=float),
         np.asarray(cols["speed"], dtype=float),
-        None if np.isnan(ts).all() else ts,
+        ts,
+        sl,
+        sr,
     )
+
+
+def _optional(values: list[float]) -> NDArray[np.float64] | None:
+    """An optional column: ``None`` when no row has a value."""
+    a = np.asarray(values, dtype=float)
+    return None if np.isnan(a).all() else a
 
 
 def _number(x: str, log: Path, row: int, col: str) -> float:
@@ -203,10 +233,13 @@ class LogWriter:
         brake: float,
         speed: float,
         target_speed: float | None = None,
+        side_steering: tuple[float, float] | None = None,
     ) -> None:
         """Write one row: ``images`` = (center, left, right) uint8 RGB arrays.
 
-        ``target_speed`` [m/s] (the expert's), when given, is written as an 8th column.
+        ``target_speed`` [m/s] (the expert's), when given, is written as an 8th column;
+        ``side_steering`` (exact labels of the left and right images), when given, as the 9th
+        and 10th (with ``nan`` in the 8th if there is no target speed).
         """
         from PIL import Image
 
@@ -216,8 +249,10 @@ class LogWriter:
             Image.fromarray(np.asarray(img, dtype=np.uint8)).save(self.root / name, quality=95)
             names.append(name)
         row = [*names, f"{steering:.6f}", f"{throttle:.6f}", f"{brake:.6f}", f"{speed:.6f}"]
-        if target_speed is not None:
-            row.append(f"{target_speed:.6f}")
+        if target_speed is not None or side_steering is not None:
+            row.append("nan" if target_speed is None else f"{target_speed:.6f}")
+        if side_steering is not None:
+            row += [f"{side_steering[0]:.6f}", f"{side_steering[1]:.6f}"]
         self._csv.writerow(row)
 
     def flush(self) -> None:
@@ -229,33 +264,57 @@ class LogWriter:
         self._fh.close()
 
 
-def expand_cameras(log: DrivingLog, *, correction: float = 0.2, sides: bool = True) -> Samples:
-    """Flatten a log into samples: centre images, plus left (+correction) and right (−correction).
+def expand_cameras(
+    log: DrivingLog, *, correction: float = 0.2, sides: bool = True, exact_sides: bool = True
+) -> Samples:
+    """Flatten a log into samples: centre images, then left and right images.
+
+    A side image's label is the row's exact side label (``steering_left``/``steering_right``)
+    where the row has one and ``exact_sides`` is set, else the centre label ``+ correction``
+    (left) or ``− correction`` (right), the Udacity recipe.
 
     Args:
         log: the dataset.
-        correction: steering added for the left camera and subtracted for the right one.
+        correction: steering added for the left camera and subtracted for the right one, where
+            there is no exact label.
         sides: include the left/right images.
+        exact_sides: use the exact side labels where present (False: the fixed correction
+            everywhere, the thesis's recipe).
 
     Returns:
-        The samples (steering clipped to [-1, 1]).
+        The samples (steering clipped to [-1, 1]), with the camera of each.
     """
+    n = len(log)
     paths = list(log.center)
     steer = [log.steering]
     thr = [log.throttle]
     spd = [log.speed]
+    cams = [np.full(n, CAMERA_CENTRE, dtype=np.int8)]
     ts = log.target_speed
     if sides:
+
+        def side(
+            exact: NDArray[np.float64] | None, fixed: NDArray[np.float64]
+        ) -> NDArray[np.float64]:
+            if exact is None or not exact_sides:
+                return fixed
+            return np.asarray(np.where(np.isnan(exact), fixed, exact), dtype=float)
+
         paths += list(log.left) + list(log.right)
-        steer += [log.steering + correction, log.steering - correction]
+        steer += [
+            side(log.steering_left, log.steering + correction),
+            side(log.steering_right, log.steering - correction),
+        ]
         thr += [log.throttle, log.throttle]
         spd += [log.speed, log.speed]
+        cams += [np.full(n, CAMERA_LEFT, dtype=np.int8), np.full(n, CAMERA_RIGHT, dtype=np.int8)]
     return Samples(
         paths,
         np.clip(np.concatenate(steer), -1.0, 1.0),
         np.concatenate(thr),
         np.concatenate(spd),
         None if ts is None else np.concatenate([ts, ts, ts] if sides else [ts]),
+        np.concatenate(cams),
     )
 
 

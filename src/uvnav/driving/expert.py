@@ -98,17 +98,49 @@ class PurePursuitExpert:
             only, not on the car's speed.
         """
         p = self.params
-        i, t, _ = project(self.geometry, tel.x, tel.y)
-        L = p.lookahead + p.lookahead_gain * tel.speed
-        target = point_ahead(self.geometry, i, t, L)
-        dx, dy = target[0] - tel.x, target[1] - tel.y
-        alpha = np.arctan2(dy, dx) - tel.heading
-        alpha = (alpha + np.pi) % (2 * np.pi) - np.pi
-        delta = np.arctan2(2 * WHEELBASE * np.sin(alpha), L)  # + left
-        steer = float(np.clip(-delta / MAX_WHEEL_ANGLE, -1.0, 1.0))
+        i, _, _ = project(self.geometry, tel.x, tel.y)
+        steer = self.steer_at(tel.x, tel.y, tel.heading, tel.speed)
         v_target = self.target_speed(i)
         throttle = float(np.clip(p.k_speed * (v_target - tel.speed), -1.0, 1.0))
         return steer, throttle, v_target
+
+    def steer_at(self, x: float, y: float, heading: float, speed: float) -> float:
+        """Pure-pursuit steering at pose ``(x [m], y [m], heading [rad])`` and ``speed`` [m/s].
+
+        Returns:
+            Normalised steering in [-1, 1] (+ right).
+        """
+        p = self.params
+        i, t, _ = project(self.geometry, x, y)
+        L = p.lookahead + p.lookahead_gain * speed
+        target = point_ahead(self.geometry, i, t, L)
+        alpha = np.arctan2(target[1] - y, target[0] - x) - heading
+        alpha = (alpha + np.pi) % (2 * np.pi) - np.pi
+        delta = np.arctan2(2 * WHEELBASE * np.sin(alpha), L)  # + left
+        return float(np.clip(-delta / MAX_WHEEL_ANGLE, -1.0, 1.0))
+
+    def side_steering(self, tel: Telemetry, shift: float) -> tuple[float, float]:
+        """Exact steering labels of the left and right camera images (beyond the thesis).
+
+        The image a camera ``shift`` [m] to the car's left sees is the centre camera's image of
+        a car ``shift`` to the left with the same heading
+        (:func:`uvnav.driving.camera.render_view`), so its label is the expert's command at that
+        pose, at the same speed.  Udacity recordings have no such label and use a fixed
+        ``± correction`` (0.2) instead; the true correction shrinks with speed (the lookahead
+        grows) and grows near the road's edge, which the fixed value cannot follow.
+
+        Args:
+            tel: telemetry of the car (ground truth).
+            shift: lateral offset of the side cameras [m] (:attr:`DrivingSim.side_shift`).
+
+        Returns:
+            ``(left, right)`` normalised steering (+ right).
+        """
+        nx, ny = -np.sin(tel.heading), np.cos(tel.heading)  # the car's left
+        return (
+            self.steer_at(tel.x + shift * nx, tel.y + shift * ny, tel.heading, tel.speed),
+            self.steer_at(tel.x - shift * nx, tel.y - shift * ny, tel.heading, tel.speed),
+        )
 
 
 def ar1_noise(rng: np.random.Generator, n: int, *, sigma: float, rho: float) -> NDArray[np.float64]:
