@@ -513,6 +513,9 @@ def reproduce(
     fresh: Annotated[
         bool, typer.Option("--fresh", help="Rerun finished stages (episodes are kept).")
     ] = False,
+    threads: Annotated[
+        int, typer.Option(min=1, max=2, help="torch CPU threads for training.")
+    ] = 1,
 ) -> None:
     """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table.
 
@@ -539,6 +542,7 @@ def reproduce(
             head=_parse_head(head),
             readout=readout,
             fresh=fresh,
+            threads=threads,
             progress=lambda s: con.print(f"[dim]… {s}[/dim]"),
         )
         figures = render_ch6(summary, out / "figures")
