@@ -513,9 +513,7 @@ def reproduce(
     fresh: Annotated[
         bool, typer.Option("--fresh", help="Rerun finished stages (episodes are kept).")
     ] = False,
-    threads: Annotated[
-        int, typer.Option(min=1, max=2, help="torch CPU threads for training.")
-    ] = 1,
+    threads: Annotated[int, typer.Option(min=1, max=2, help="torch CPU threads for training.")] = 1,
 ) -> None:
     """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table.
 
