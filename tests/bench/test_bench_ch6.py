@@ -36,6 +36,7 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     assert set(s.closed_loop) == {"cnn-learned-speed", "cnn-pi", "dagger1-learned-speed", "expert"}
     assert s.record["second_output"] == "target_speed" and s.record["val_target_speed_rmse"]
     assert "target speed RMSE" in s.table[3]["note"]
+    assert not list(tmp_path.glob("*.train-state.safetensors"))  # removed once models are saved
     # the steering row compares eq. (6.1) with the thesis, by camera, with exact side labels
     steer_row = s.table[2]
     assert steer_row["measured"] == f"{s.record['val_steering_mse'][-1]:.4f}"

@@ -118,3 +118,44 @@ def test_target_speed_head_trains_and_predicts_a_speed() -> None:
     ]
     with pytest.raises(ValueError, match="target_speed"):
         target_speed_label([np.nan], net)
+
+
+def test_interrupted_training_resumes_to_the_uninterrupted_result(tmp_path) -> None:
+    """Stopped after epoch 1 of 3 and rerun, training continues from the saved state and ends
+    with exactly the weights and curves of a run that was never stopped (dropout, shuffling and
+    augmentation included); another run's state is not used."""
+    rng = np.random.default_rng(4)
+    imgs, steer = _road_like(40, rng)
+    thr = 0.5 - 0.5 * np.abs(steer)
+    spd = rng.uniform(10, 60, len(imgs))
+    data = ((imgs, steer, thr, spd), (imgs[:10], steer[:10], thr[:10], spd[:10]))
+    cfg = TrainConfig(epochs=3, batch_size=16, seed=1)
+    whole, h_whole = train_pilotnet(*data, net=SMALL, config=cfg)
+
+    state = tmp_path / "run.train-state.safetensors"
+
+    class StopError(Exception):
+        pass
+
+    def stop_after_first(epoch: int, _tl: float, _vl: float) -> None:
+        if epoch == 0:
+            raise StopError
+
+    with pytest.raises(StopError):
+        train_pilotnet(*data, net=SMALL, config=cfg, resume=state, on_epoch=stop_after_first)
+    assert state.is_file()
+    ran: list[int] = []
+    resumed, h_resumed = train_pilotnet(
+        *data, net=SMALL, config=cfg, resume=state, on_epoch=lambda e, *_: ran.append(e)
+    )
+    assert ran == [1, 2]  # epoch 0 was not run again
+    assert h_resumed.train_loss == h_whole.train_loss and h_resumed.val_loss == h_whole.val_loss
+    for k, v in whole.state_dict().items():
+        assert torch.equal(v, resumed.state_dict()[k]), k
+    # a different run (another seed) ignores the state and starts from epoch 0
+    ran.clear()
+    other = TrainConfig(epochs=3, batch_size=16, seed=2)
+    train_pilotnet(
+        *data, net=SMALL, config=other, resume=state, on_epoch=lambda e, *_: ran.append(e)
+    )
+    assert ran == [0, 1, 2]

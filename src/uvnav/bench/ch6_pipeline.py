@@ -187,17 +187,23 @@ def train_on(
     output's term either way (``second_output`` in the record says which), and for a target-speed
     network ``val_target_speed_rmse`` gives it in [m/s].
 
+    Interruptible: the state after each epoch is kept in :func:`training_state_path` of ``out``
+    and a rerun on the same data and settings continues from the last finished epoch.
+
     Returns:
-        ``(model, record)`` with the loss curves, data counts and timing in ``record``.
+        ``(model, record)`` with the loss curves, data counts and timing in ``record``
+        (``cpu_s`` and ``images_per_s`` are those of this call's epochs).
     """
     from uvnav.learning.checkpoint import save_checkpoint
     from uvnav.learning.train import train_pilotnet
 
     ncfg: PilotNetConfig = model.config if model is not None else (net or PilotNetConfig())
     train, val = _labelled(data, ncfg)
+    out = Path(out)
+    state = training_state_path(out)
     tic = time.process_time()
     model, hist = train_pilotnet(
-        train, val, net=ncfg, config=config, model=model, on_epoch=on_epoch
+        train, val, net=ncfg, config=config, model=model, on_epoch=on_epoch, resume=state
     )
     cpu_s = time.process_time() - tic
     second = ncfg.second_output if ncfg.n_outputs == 2 else "none"
@@ -220,7 +226,15 @@ def train_on(
         **data.info,
     }
     save_checkpoint(model, out, record=record)
+    state.unlink(missing_ok=True)
     return model, record
+
+
+def training_state_path(checkpoint: Path | str) -> Path:
+    """Where :func:`train_on` keeps the per-epoch training state of ``checkpoint`` until the
+    model is saved (an interrupted training continues from its last finished epoch)."""
+    p = Path(checkpoint)
+    return p.with_name(p.stem + ".train-state.safetensors")
 
 
 def steering_mse_by_camera(model: Any, data: PreparedData, val: Any = None) -> dict[str, float]:

@@ -74,3 +74,103 @@ def load_checkpoint(path: Path | str) -> tuple[Any, dict[str, Any]]:
     model.load_state_dict(load_file(str(path)))
     model.eval()
     return model, header
+
+
+#: format of the per-epoch training state (:func:`save_training_state`)
+TRAINING_STATE_FORMAT = "uvnav-pilotnet-training-state-v1"
+
+
+def save_training_state(
+    path: Path | str,
+    *,
+    model: Any,
+    optimizer: Any,
+    generator: Any,
+    rng: Any,
+    epochs_done: int,
+    history: dict[str, Any],
+    key: str,
+) -> Path:
+    """Write everything needed to continue a training run after ``epochs_done`` epochs.
+
+    One safetensors file (no pickle, like :func:`save_checkpoint`): the weights, the optimizer's
+    tensors, torch's global and augmentation random states as tensors; the optimizer's
+    hyper-parameters, the numpy generator's state, the loss curves and ``key`` (what the run
+    is: data and settings) in the JSON metadata.  Written to a temporary name and renamed, so an
+    interruption while writing leaves the previous epoch's state.
+
+    Args:
+        path: output file.
+        model: the network being trained.
+        optimizer: its torch optimizer.
+        generator: the torch generator of the augmentation.
+        rng: the numpy generator of the shuffling.
+        epochs_done: finished epochs.
+        history: JSON-able loss curves so far.
+        key: fingerprint of the run; :func:`load_training_state` refuses another one.
+
+    Returns:
+        The path.
+    """
+    import torch
+    from safetensors.torch import save_file
+
+    path = Path(path)
+    tensors = {f"model.{k}": v.detach().cpu().contiguous() for k, v in model.state_dict().items()}
+    opt = optimizer.state_dict()
+    for i, st in opt["state"].items():
+        for name, v in st.items():
+            tensors[f"opt.{i}.{name}"] = torch.as_tensor(v).detach().cpu().contiguous()
+    tensors["rng.torch"] = torch.get_rng_state()
+    tensors["rng.generator"] = generator.get_state()
+    header = {
+        "format": TRAINING_STATE_FORMAT,
+        "key": key,
+        "epochs_done": epochs_done,
+        "history": history,
+        "param_groups": opt["param_groups"],
+        "numpy_rng": rng.bit_generator.state,
+    }
+    tmp = path.with_name(path.name + ".tmp")
+    save_file(tensors, str(tmp), metadata={"uvnav": json.dumps(header)})
+    tmp.replace(path)
+    return path
+
+
+def load_training_state(
+    path: Path | str, *, model: Any, optimizer: Any, generator: Any, rng: Any, key: str
+) -> tuple[int, dict[str, Any]] | None:
+    """Restore a state written by :func:`save_training_state` into the given objects.
+
+    Returns:
+        ``(epochs_done, history)``, or ``None`` (nothing restored) when there is no file, it is
+        not a training state, or it belongs to another run (a different ``key``).
+    """
+    import torch
+    from safetensors import safe_open
+    from safetensors.torch import load_file
+
+    path = Path(path)
+    if not path.is_file():
+        return None
+    try:
+        with safe_open(str(path), framework="pt") as fh:
+            header = json.loads((fh.metadata() or {}).get("uvnav", "{}"))
+    except Exception:
+        return None
+    if header.get("format") != TRAINING_STATE_FORMAT or header.get("key") != key:
+        return None
+    tensors = load_file(str(path))
+    model.load_state_dict(
+        {k.removeprefix("model."): v for k, v in tensors.items() if k.startswith("model.")}
+    )
+    state: dict[int, dict[str, Any]] = {}
+    for k, v in tensors.items():
+        if k.startswith("opt."):
+            _, i, name = k.split(".", 2)
+            state.setdefault(int(i), {})[name] = v
+    optimizer.load_state_dict({"state": state, "param_groups": header["param_groups"]})
+    torch.set_rng_state(tensors["rng.torch"])
+    generator.set_state(tensors["rng.generator"])
+    rng.bit_generator.state = header["numpy_rng"]
+    return int(header["epochs_done"]), dict(header["history"])

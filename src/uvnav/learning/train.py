@@ -9,13 +9,20 @@ one.  The third array of a set is that second output's label: the throttle, or f
 (:func:`uvnav.learning.pilotnet.target_speed_label`; the caller converts), so the "throttle"
 MSE of :class:`TrainHistory` is then the target-speed term in those units.  Determinism:
 torch's seed and generator come from ``TrainConfig.seed``; the number of CPU threads is set
-(1 by default: the machine is shared).
+(1 by default: the machine is shared).  Interruptible: with ``resume=`` the state after each epoch
+is written (:func:`uvnav.learning.checkpoint.save_training_state`) and a rerun on the same data
+and settings continues from the last finished epoch, with the same result as an uninterrupted
+run (the weights, the optimizer and every random state are restored).
 """
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
+import json
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -104,6 +111,7 @@ def train_pilotnet(
     config: TrainConfig | None = None,
     model: Any = None,
     on_epoch: Callable[[int, float, float], None] | None = None,
+    resume: Path | str | None = None,
 ) -> tuple[Any, TrainHistory]:
     """Train the network.
 
@@ -114,9 +122,12 @@ def train_pilotnet(
         config: schedule (default: the thesis's).
         model: a model to continue training (e.g. a DAgger round), else a new one.
         on_epoch: called with ``(epoch, train_loss, val_loss)`` after each epoch.
+        resume: training-state file: written after every epoch, and read at the start when it
+            holds the same run (same data, settings and initial weights; a larger ``epochs`` is
+            the same run continued); the caller deletes it once the model is saved.
 
     Returns:
-        ``(model, history)``.
+        ``(model, history)``; ``images_per_s`` counts the epochs run in this call.
     """
     import torch
 
@@ -145,11 +156,22 @@ def train_pilotnet(
     opt = torch.optim.Adam(model.parameters(), lr=cfg.lr)
     w = torch.tensor([1.0, cfg.throttle_weight][: ncfg.n_outputs], device=cfg.device)
     hist = TrainHistory()
+    start = 0
+    key = _run_key(model, cfg, train, val) if resume is not None else ""
+    if resume is not None:
+        from uvnav.learning.checkpoint import load_training_state
+
+        got = load_training_state(
+            resume, model=model, optimizer=opt, generator=gen, rng=rng, key=key
+        )
+        if got is not None:
+            start, saved = got
+            hist = TrainHistory(**saved)
     n_seen = 0
     import time
 
     tic = time.perf_counter()
-    for epoch in range(cfg.epochs):
+    for epoch in range(start, cfg.epochs):
         model.train()
         perm = rng.permutation(len(imgs))
         total, count = 0.0, 0
@@ -185,6 +207,19 @@ def train_pilotnet(
             hist.val_loss.append(m)
             hist.val_steering_mse.append(ms)
             hist.val_throttle_mse.append(mt)
+        if resume is not None:
+            from uvnav.learning.checkpoint import save_training_state
+
+            save_training_state(
+                resume,
+                model=model,
+                optimizer=opt,
+                generator=gen,
+                rng=rng,
+                epochs_done=epoch + 1,
+                history=dataclasses.asdict(hist),
+                key=key,
+            )
         if on_epoch is not None:
             on_epoch(
                 epoch, hist.train_loss[-1], hist.val_loss[-1] if hist.val_loss else float("nan")
@@ -192,6 +227,21 @@ def train_pilotnet(
     hist.images_per_s = n_seen / max(time.perf_counter() - tic, 1e-9)
     model.eval()
     return model, hist
+
+
+def _run_key(model: Any, cfg: TrainConfig, train: Any, val: Any) -> str:
+    """Fingerprint of a training run: settings (but the epoch count, threads and device), the
+    network's shape and initial weights, and the data."""
+    h = hashlib.blake2b(digest_size=16)
+    settings = {
+        k: v for k, v in dataclasses.asdict(cfg).items() if k not in ("epochs", "threads", "device")
+    }
+    h.update(json.dumps([settings, model.config.to_dict()], sort_keys=True, default=str).encode())
+    for t in model.state_dict().values():
+        h.update(t.detach().cpu().numpy().tobytes())
+    for arr in (*train, *(val or ())):
+        h.update(np.ascontiguousarray(arr).tobytes())
+    return h.hexdigest()
 
 
 def hidden_features(
