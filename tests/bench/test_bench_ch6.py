@@ -37,6 +37,11 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     assert s.record["second_output"] == "target_speed" and s.record["val_target_speed_rmse"]
     assert "target speed RMSE" in s.table[3]["note"]
     assert not list(tmp_path.glob("*.train-state.safetensors"))  # removed once models are saved
+    # every closed-loop row keeps each track's metrics, and the means are theirs
+    for name, row in s.closed_loop.items():
+        per = s.tracks[name]
+        assert [t["seed"] for t in per] == [1000]
+        assert row["return"] == pytest.approx(np.mean([t["return"] for t in per]))
     # the steering row compares eq. (6.1) with the thesis, by camera, with exact side labels
     steer_row = s.table[2]
     assert steer_row["measured"] == f"{s.record['val_steering_mse'][-1]:.4f}"
@@ -182,3 +187,13 @@ def test_throttle_modes_of_the_cnn_policy() -> None:
         cnn_policy(model, throttle="learned-speed", speed_factor=0.0)
     with pytest.raises(ValueError, match="must be one of"):
         cnn_policy(model, throttle="turbo")  # type: ignore[arg-type]
+
+
+def test_closed_loop_notes_name_the_tracks_with_interventions() -> None:
+    from uvnav.bench.reproduce_ch6 import _intervention_tracks
+
+    tracks = [{"seed": 1000 + k, "interventions": n} for k, n in enumerate([0, 1, 0, 2])]
+    assert _intervention_tracks(tracks) == "; interventions on tracks 1001 (1), 1003 (2)"
+    assert _intervention_tracks(tracks[:1]) == ""  # none
+    many = [{"seed": k, "interventions": 1} for k in range(6)]
+    assert _intervention_tracks(many) == ""  # everywhere: the mean says it

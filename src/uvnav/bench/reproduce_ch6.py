@@ -61,6 +61,9 @@ THESIS_TRAIN, THESIS_VAL = 1199, 300
 #: 1.00, and 1.00 on 20 more unseen tracks; in the 20-episode ``--full`` run the readout alone
 #: reached 1.00 and the round 0.986; docs/thesis-notes.md); ``dagger_rounds`` overrides it
 FULL_DAGGER_ROUNDS = 1
+#: closed-loop stage files keep every track's metrics, not only the means (part of their key,
+#: so stage files of the means-only format are recomputed)
+PER_TRACK = {"per_track": 1}
 #: training tracks the network drives per DAgger round, and epochs per round
 DAGGER_EPISODES, DAGGER_EPOCHS = 6, 5
 #: sizes of the quick (``full=False``) and full runs: expert episodes, steps per episode, epochs,
@@ -98,6 +101,8 @@ class Ch6Summary:
     table: list[dict[str, str]]
     closed_loop: dict[str, dict[str, float]]
     record: dict[str, Any]
+    #: per closed-loop row, each held-out track's metrics (:meth:`EpisodeResult.to_dict`)
+    tracks: dict[str, list[dict[str, Any]]]
     steering_all: NDArray[np.float64]
     steering_balanced: NDArray[np.float64]
     steering_train: NDArray[np.float64]
@@ -311,17 +316,20 @@ def reproduce_ch6(
     rows: dict[str, dict[str, float]] = {}
     records: dict[str, dict[str, Any]] = {}
 
+    tracks: dict[str, list[dict[str, Any]]] = {}
+
     def closed_loop(name: str, model: Any, mode: Throttle, parent: dict[str, Any]) -> None:
-        key = {"model": parent, "throttle": mode, "seeds": seeds, "max_steps": steps}
+        key = {"model": parent, "throttle": mode, "seeds": seeds, "max_steps": steps, **PER_TRACK}
         done = stages.get(name, key)
         if done is not None:
             say(f"closed loop {name}: done before (stages/{name}.json)")
-            rows[name] = done
-            return
-        say(f"closed loop {name}, {len(seeds)} tracks")
-        policy, on_reset = cnn_policy(model, throttle=mode)
-        rows[name] = summarize(evaluate(policy, seeds, on_reset=on_reset, max_steps=steps))
-        stages.put(name, key, rows[name])
+        else:
+            say(f"closed loop {name}, {len(seeds)} tracks")
+            policy, on_reset = cnn_policy(model, throttle=mode)
+            eps = evaluate(policy, seeds, on_reset=on_reset, max_steps=steps)
+            done = {"summary": summarize(eps), "tracks": [e.to_dict() for e in eps]}
+            stages.put(name, key, done)
+        rows[name], tracks[name] = done["summary"], done["tracks"]
 
     # 1. behaviour cloning (the thesis's recipe)
     train_key: dict[str, Any] = {
@@ -418,13 +426,14 @@ def reproduce_ch6(
             rows[f"dagger{r}-{d_mode}"]["rows_added"] = float(done["rows_added"])
 
     # 4. the expert
-    ex_key = {"seeds": seeds, "max_steps": steps}
+    ex_key = {"seeds": seeds, "max_steps": steps, **PER_TRACK}
     ex = stages.get("expert", ex_key)
     if ex is None:
         say("closed loop, expert")
-        ex = summarize(evaluate_expert(seeds, max_steps=steps))
+        eps = evaluate_expert(seeds, max_steps=steps)
+        ex = {"summary": summarize(eps), "tracks": [e.to_dict() for e in eps]}
         stages.put("expert", ex_key, ex)
-    rows["expert"] = ex
+    rows["expert"], tracks["expert"] = ex["summary"], ex["tracks"]
     for row in rows.values():
         row["return_vs_expert"] = row["return"] / rows["expert"]["return"]
         _per_lap(row)
@@ -435,12 +444,13 @@ def reproduce_ch6(
     sim.close()
     k = int(np.argmax(np.abs(data.train[1]))) if len(data.train[1]) else 0
     examples = augmentation_examples(data.train[0][k], float(data.train[1][k]))
-    table = _table(data, record, records, rows, size, head=head, full=full)
+    table = _table(data, record, records, rows, size, head=head, full=full, tracks=tracks)
     wall = time.perf_counter() - tic
     (out / "ch6.json").write_text(
         json.dumps(
             {
                 "closed_loop": rows,
+                "tracks": tracks,
                 "record": record,
                 "stage_records": records,
                 "size": size,
@@ -457,6 +467,7 @@ def reproduce_ch6(
         table=table,
         closed_loop=rows,
         record=record,
+        tracks=tracks,
         steering_all=data.steering_all,
         steering_balanced=data.steering_balanced,
         steering_train=data.train[1],
@@ -480,8 +491,10 @@ def _table(
     *,
     head: str,
     full: bool,
+    tracks: dict[str, list[dict[str, Any]]] | None = None,
 ) -> list[dict[str, str]]:
-    """The "thesis vs measured" rows of a run."""
+    """The "thesis vs measured" rows of a run (closed-loop notes name the tracks with
+    interventions when ``tracks`` is given)."""
 
     def pct(x: float) -> str:
         return f"{100 * x:.1f} %"
@@ -554,7 +567,8 @@ def _table(
                     else f"no lap completed, {r['interventions']:.1f} interventions per track, "
                 )
                 + f"laps {r['laps']:.2f}, "
-                f"mean speed {r['mean_speed']:.1f} m/s",
+                f"mean speed {r['mean_speed']:.1f} m/s"
+                + _intervention_tracks((tracks or {}).get(name, [])),
             }
         )
     table.append(
@@ -566,3 +580,12 @@ def _table(
         }
     )
     return table
+
+
+def _intervention_tracks(tracks: list[dict[str, Any]], most: int = 5) -> str:
+    """``"; interventions on tracks 1007 (1), 1012 (2)"``: where a row's interventions were,
+    when they were on at most ``most`` tracks (empty otherwise, or with none)."""
+    hit = [(int(t["seed"]), int(t["interventions"])) for t in tracks if t["interventions"]]
+    if not hit or len(hit) > most:
+        return ""
+    return "; interventions on tracks " + ", ".join(f"{s} ({n})" for s, n in hit)
