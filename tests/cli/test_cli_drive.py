@@ -71,6 +71,18 @@ def test_briefly_trained_model_moves_along_the_track(trained: tuple[Path, Path])
     assert row["mean_centre_distance"] < 40 / 6.0  # on average on the road
 
 
+def test_onnxruntime_backend_drives_the_same_episode(trained: tuple[Path, Path]) -> None:
+    """The same network through onnxruntime drives track 1000 as torch does (outputs agree to
+    1e-5; over 150 steps the episode's metrics agree to rounding)."""
+    pytest.importorskip("onnxruntime")
+    _, model = trained
+    ref = _short_evaluation(model, "--throttle", "pi")["cnn-pi"]
+    fast = _short_evaluation(model, "--throttle", "pi", "--backend", "onnxruntime")["cnn-pi"]
+    assert fast["tiles_pct"] == pytest.approx(ref["tiles_pct"], abs=1.0)
+    assert fast["return"] == pytest.approx(ref["return"], abs=5.0)
+    assert fast["mean_centre_distance"] == pytest.approx(ref["mean_centre_distance"], abs=0.1)
+
+
 def test_target_speed_head_trains_and_drives_with_the_learned_speed_throttle(
     trained: tuple[Path, Path], tmp_path: Path
 ) -> None:

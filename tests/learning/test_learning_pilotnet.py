@@ -81,3 +81,25 @@ def test_onnx_matches_torch(tmp_path) -> None:
     assert diff <= 1e-5
     assert (tmp_path / "m.onnx").stat().st_size > 100_000
     assert np.isfinite(diff)
+
+
+@pytest.mark.parametrize("second_output", ["throttle", "target_speed"])
+def test_onnxruntime_predictor_drives_like_torch(second_output: str) -> None:
+    """``Predictor(backend="onnxruntime")`` gives torch's steering and second output (throttle,
+    or the target speed in m/s) to float32 rounding, frame by frame."""
+    pytest.importorskip("onnxruntime")
+    from uvnav.learning.train import Predictor
+
+    torch.manual_seed(3)
+    net = build_pilotnet(PilotNetConfig(second_output=second_output))
+    ref, fast = Predictor(net), Predictor(net, backend="onnxruntime")
+    rng = np.random.default_rng(0)
+    for _ in range(3):
+        frame = rng.integers(0, 256, size=(66, 200, 3), dtype=np.uint8)
+        speed = float(rng.uniform(0, 80))
+        a, b = ref.outputs(frame, speed), fast.outputs(frame, speed)
+        scale = net.config.speed_scale if second_output == "target_speed" else 1.0
+        assert a[0] == pytest.approx(b[0], abs=1e-5)
+        assert a[1] == pytest.approx(b[1], abs=1e-5 * scale)
+    with pytest.raises(ValueError, match="backend"):
+        Predictor(net, backend="tensorrt")

@@ -341,6 +341,7 @@ def cnn_policy(
     set_speed: float = 35.0,
     speed_factor: float = 1.0,
     max_speed: float | None = None,
+    backend: str = "torch",
 ) -> tuple[Policy, Callable[[], None] | None]:
     """A policy from the network: it sees the frame and the speed only.
 
@@ -356,6 +357,8 @@ def cnn_policy(
             docs/thesis-notes.md).
         max_speed: "learned-speed" only: a speed limiter [m/s], the car tracks
             ``min(speed_factor · v̂, max_speed)`` (``None``: none).
+        backend: inference backend, ``"torch"`` or ``"onnxruntime"``
+            (:class:`uvnav.learning.train.Predictor`).
 
     Returns:
         ``(policy, on_reset)``; ``on_reset`` clears the PI integral (``None`` otherwise).
@@ -374,7 +377,7 @@ def cnn_policy(
         raise ValueError(f"max_speed: {max_speed} (must be > 0)")
     cap = float("inf") if max_speed is None else max_speed
     cfg: PilotNetConfig = model.config
-    pred = Predictor(model)
+    pred = Predictor(model, backend=backend)
 
     def act(frame: NDArray[np.uint8], tel: Telemetry) -> tuple[float, float]:
         return pred.outputs(frame, tel.speed)

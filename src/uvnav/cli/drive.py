@@ -269,6 +269,7 @@ def _load_policy(
     set_speed: float,
     speed_factor: float = 1.0,
     max_speed: float | None = None,
+    backend: str = "torch",
 ) -> tuple[Any, Any, str]:
     from uvnav.bench.ch6_pipeline import THROTTLE_MODES, cnn_policy
     from uvnav.learning.checkpoint import load_checkpoint
@@ -283,6 +284,7 @@ def _load_policy(
         set_speed=set_speed,
         speed_factor=speed_factor,
         max_speed=max_speed,
+        backend=backend,
     )
     return policy, on_reset, camera
 
@@ -307,6 +309,9 @@ def evaluate(
     ] = None,
     max_steps: Annotated[int, typer.Option(min=10, help="Steps per episode.")] = 2000,
     expert: Annotated[bool, typer.Option(help="Also drive the (oracle) expert.")] = True,
+    backend: Annotated[
+        str, typer.Option(help="Inference: torch, or onnxruntime (checked against torch).")
+    ] = "torch",
     as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
 ) -> None:
     """Closed loop on held-out tracks: return, tiles %, laps, centre distance, autonomy."""
@@ -328,7 +333,7 @@ def evaluate(
         with _progress() as prog:
             for mode in modes:
                 policy, on_reset, camera = _load_policy(
-                    model, mode, set_speed, speed_factor, max_speed
+                    model, mode, set_speed, speed_factor, max_speed, backend
                 )
                 sim = DrivingSim(camera=camera, max_steps=max_steps)  # type: ignore[arg-type]
                 task = prog.add_task(f"cnn + {mode} throttle", total=len(seed_list))

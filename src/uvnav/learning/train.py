@@ -30,6 +30,9 @@ from numpy.typing import NDArray
 
 from uvnav.learning.config import PilotNetConfig, TrainConfig
 
+#: inference backends of :class:`Predictor`
+BACKENDS = ("torch", "onnxruntime")
+
 
 @dataclass
 class TrainHistory:
@@ -266,24 +269,39 @@ class Predictor:
 
     Args:
         model: the trained network (put in eval mode).
-        threads: torch CPU threads.
+        threads: torch (or onnxruntime) CPU threads.
         device: torch device.
+        backend: ``"torch"`` or ``"onnxruntime"`` (the network exported in memory and checked
+            against torch to 1e-5, :func:`uvnav.learning.export.onnx_session`; CPU only;
+            measured 1.7 vs 4.2 ms a frame at 2 threads, ``benchmarks/bench_ch6.py``).
     """
 
-    def __init__(self, model: Any, *, threads: int = 1, device: str = "cpu") -> None:
+    def __init__(
+        self, model: Any, *, threads: int = 1, device: str = "cpu", backend: str = "torch"
+    ) -> None:
         import torch
 
+        if backend not in BACKENDS:
+            raise ValueError(f"backend: {backend!r} (must be one of {', '.join(BACKENDS)})")
         torch.set_num_threads(max(1, threads))
         self.model = model.to(device).eval()
         self.device = device
         self.config: PilotNetConfig = model.config
+        self.backend = backend
+        self._session: Any = None
+        if backend == "onnxruntime":
+            from uvnav.learning.export import onnx_session
 
-    def outputs(self, frame: NDArray[np.uint8], speed: float = 0.0) -> tuple[float, float]:
-        """``(steer, second)`` for one frame: ``second`` is the throttle in [-1, 1] (0 for a
-        steering-only network) or, for a target-speed network, the target speed [m/s]."""
+            self._session = onnx_session(self.model, threads=threads)
+
+    def _forward(self, frame: NDArray[np.uint8], speed: float) -> NDArray[np.float32]:
+        """The network's raw outputs for one frame."""
+        if self._session is not None:
+            feeds = {"images": np.ascontiguousarray(frame, dtype=np.float32)[None]}
+            if self.config.extra_inputs:
+                feeds["speed"] = np.array([[speed]], dtype=np.float32)
+            return np.asarray(self._session.run(None, feeds)[0][0])
         import torch
-
-        from uvnav.learning.pilotnet import target_speed_from_output
 
         with torch.no_grad():
             x = torch.as_tensor(np.ascontiguousarray(frame)[None]).to(self.device)
@@ -292,7 +310,14 @@ class Predictor:
                 if self.config.extra_inputs
                 else None
             )
-            out = self.model(x, e)[0].cpu().numpy()
+            return np.asarray(self.model(x, e)[0].cpu().numpy())
+
+    def outputs(self, frame: NDArray[np.uint8], speed: float = 0.0) -> tuple[float, float]:
+        """``(steer, second)`` for one frame: ``second`` is the throttle in [-1, 1] (0 for a
+        steering-only network) or, for a target-speed network, the target speed [m/s]."""
+        from uvnav.learning.pilotnet import target_speed_from_output
+
+        out = self._forward(frame, speed)
         steer = float(np.clip(out[0], -1.0, 1.0))
         if len(out) < 2:
             return steer, 0.0
