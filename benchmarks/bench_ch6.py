@@ -9,7 +9,11 @@ Writes ``ch6.json`` with the machine, the parameters and:
   count ``t`` (1, 2); ``train_images_per_cpu_s_{t}_threads`` the same per CPU second;
 * ``inference_ms_{median,p95,p99}_{t}_threads``: one-frame forward pass in eval mode, per torch
   thread count ``t`` (1, 2);
-* ``sim_steps_per_s``: :class:`uvnav.driving.DrivingSim` steps with the front camera rendered.
+* ``onnxruntime_inference_ms_*``: the same for the network exported to ONNX;
+* ``sim_steps_per_s``: :class:`uvnav.driving.DrivingSim` steps with the front camera rendered;
+* ``closed_loop_steps_per_s_{backend}``: the whole control loop of ``uvnav drive evaluate`` at 1
+  thread (render, the network through :class:`uvnav.learning.train.Predictor` with that backend,
+  the PI throttle, one physics step), on track 0.
 
 Targets (issue 7; a prototype measured about 190 img/s training and about 2 ms inference on 2 CPU
 threads) are reported beside the measurement with a ``pass`` flag; the numbers move with the load
@@ -170,6 +174,29 @@ def bench_sim(steps: int) -> float:
     return rate
 
 
+def bench_closed_loop(backend: str, steps: int) -> float:
+    """Closed-loop control steps per second (frame → network → command → physics step)."""
+    import torch
+
+    from uvnav.bench.ch6_pipeline import cnn_policy
+    from uvnav.driving.sim import DrivingSim
+    from uvnav.learning import PilotNetConfig
+    from uvnav.learning.pilotnet import build_pilotnet
+
+    torch.manual_seed(0)
+    policy, _ = cnn_policy(build_pilotnet(PilotNetConfig()), throttle="pi", backend=backend)
+    sim = DrivingSim(max_steps=steps + 10)
+    frame, tel = sim.reset(0)
+    policy(frame, tel)  # warm-up
+    tic = time.perf_counter()
+    for _ in range(steps):
+        st = sim.step(*policy(frame, tel))
+        frame, tel = st.frame, st.telemetry
+    rate = steps / (time.perf_counter() - tic)
+    sim.close()
+    return rate
+
+
 def run(quick: bool) -> dict[str, Any]:
     """All Chapter 6 measurements (``quick``: 2 batches, 30 frames, 100 steps: indicative)."""
     batches, frames, steps = (2, 30, 100) if quick else (10, 300, 1000)
@@ -188,6 +215,8 @@ def run(quick: bool) -> dict[str, Any]:
         for q in ("median", "p95", "p99"):
             result[f"onnxruntime_inference_ms_{q}_{t}_threads"] = ort_inf[q]
     result["sim_steps_per_s"] = bench_sim(steps)
+    for backend in ("torch", "onnxruntime"):
+        result[f"closed_loop_steps_per_s_{backend}"] = bench_closed_loop(backend, steps)
     result["load_average_1_5_15m_end"] = (
         list(os.getloadavg()) if hasattr(os, "getloadavg") else None
     )
