@@ -231,6 +231,7 @@ def reproduce_ch6(
     dagger_throttle: str | None = None,
     readout: bool = True,
     threads: int = 1,
+    noise_sigma: float | None = None,
     head: str = "throttle",
     fresh: bool = False,
     progress: Callable[[str], None] | None = None,
@@ -257,6 +258,9 @@ def reproduce_ch6(
         readout: with ``head="throttle"``, fit the target-speed readout (row
             ``cnn-learned-speed``) and start DAgger from it.
         threads: torch CPU threads for training.
+        noise_sigma: std of the recording's steering noise (default
+            :class:`uvnav.driving.collect.CollectParams`'s); a dataset folder keeps the one it
+            was recorded with (another one is refused).
         head: the second output: ``"throttle"`` (thesis; closed loop with the "learned"
             throttle) or ``"target_speed"`` (trained directly; "learned-speed" throttle).
         fresh: rerun every stage (the recorded expert episodes are kept).
@@ -308,7 +312,11 @@ def reproduce_ch6(
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     stages = _Stages(out, fresh=fresh)
-    cp = CollectParams(max_steps=c_steps)
+    cp = (
+        CollectParams(max_steps=c_steps)
+        if noise_sigma is None
+        else CollectParams(max_steps=c_steps, noise_sigma=noise_sigma)
+    )
     say(f"collecting {n_ep} expert episodes")
     collect(out / "data", range(n_ep), params=cp)
     say("balancing and splitting")

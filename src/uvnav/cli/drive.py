@@ -519,6 +519,10 @@ def reproduce(
         bool, typer.Option("--fresh", help="Rerun finished stages (episodes are kept).")
     ] = False,
     threads: Annotated[int, typer.Option(min=1, max=2, help="torch CPU threads for training.")] = 1,
+    noise: Annotated[
+        float | None,
+        typer.Option(min=0.0, help="Std of the recording's steering noise (default 0.25)."),
+    ] = None,
 ) -> None:
     """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table.
 
@@ -546,6 +550,7 @@ def reproduce(
             readout=readout,
             fresh=fresh,
             threads=threads,
+            noise_sigma=noise,
             progress=lambda s: con.print(f"[dim]… {s}[/dim]"),
         )
         figures = render_ch6(summary, out / "figures")

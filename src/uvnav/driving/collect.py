@@ -146,13 +146,16 @@ def collect(
     }
     if sim.camera == "front":
         info["side_shift"] = sim.side_shift
+    info["noise_sigma"], info["noise_rho"] = p.noise_sigma, p.noise_rho
     if meta.is_file():
         old = json.loads(meta.read_text())
-        if old.get("camera") != info["camera"]:
-            raise ValueError(
-                f"{meta}: field 'camera': dataset was recorded with {old.get('camera')!r}, "
-                f"not {info['camera']!r}"
-            )
+        # datasets recorded before a field was written do not constrain it
+        for name in ("camera", "noise_sigma", "noise_rho"):
+            if name in old and old[name] != info[name]:
+                raise ValueError(
+                    f"{meta}: field '{name}': dataset was recorded with {old[name]!r}, "
+                    f"not {info[name]!r} (record into another folder)"
+                )
     else:
         meta.write_text(json.dumps(info))
     writer = LogWriter(root)
