@@ -147,6 +147,10 @@ def test_dagger_round_appends_expert_labelled_rows(tmp_path: Path) -> None:
     assert np.all(np.abs(log.steering) <= 1.0) and np.all(np.abs(log.throttle) <= 1.0)
     # the first state is the start of the track, where the expert's label is near straight
     assert abs(log.steering[0]) < 0.3
+    # the side images carry the expert's command at the shifted poses: from 1.5 m left of the
+    # car, steer more to the right (+), and the reverse
+    assert log.steering_left is not None and log.steering_right is not None
+    assert log.steering_left[0] > log.steering[0] + 0.05 > log.steering_right[0] + 0.1
 
 
 def test_throttle_modes_of_the_cnn_policy() -> None:

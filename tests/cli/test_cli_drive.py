@@ -43,6 +43,8 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
         app, ["drive", "collect", "--out", str(data), "--episodes", "1", "--max-steps", "240"]
     )
     assert again.exit_code == 0 and "wrote 0 rows" in again.output  # resumed: nothing new
+    other = runner.invoke(app, ["drive", "collect", "--out", str(data), "--noise", "0.1"])
+    assert other.exit_code == 2 and "'noise_sigma'" in other.output  # not mixed into one folder
     model = root / "m.safetensors"
     r = runner.invoke(
         app,
