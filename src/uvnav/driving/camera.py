@@ -49,7 +49,12 @@ class CameraSpec:
     Attributes:
         height_px: image height [px].
         width_px: image width [px].
-        fov: horizontal field of view [rad].
+        fov: horizontal field of view [rad].  120°: with 90° the expert's pure-pursuit aim
+            point lay outside the image in 7 % of the recorded frames (the recoveries the
+            recording noise creates), and those frames held 68 % of the validation steering
+            error; 120° (Udacity's Unity camera at its default 60° vertical is ≈ 98° across a
+            2:1 frame) lowered the thesis-size validation MSE from 0.057 to 0.041 on the same
+            labels and split (docs/thesis-notes.md, Chapter 6).
         mount_height: camera height above the ground [m] (CarRacing units).
         pitch: downward tilt of the optical axis [rad].
         forward: camera position ahead of the car's centre [m].
@@ -58,7 +63,7 @@ class CameraSpec:
 
     height_px: int = 66
     width_px: int = 200
-    fov: float = np.deg2rad(90.0)
+    fov: float = np.deg2rad(120.0)
     mount_height: float = 3.0
     pitch: float = np.deg2rad(8.0)
     forward: float = 1.0
