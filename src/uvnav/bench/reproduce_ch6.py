@@ -20,8 +20,9 @@ Measured on 20 held-out tracks (docs/thesis-notes.md), with the network trained 
 the pedal head drives at autonomy 0.00 (it does not brake for corners), PI 1.00, the readout
 0.947, and one DAgger round with the learned-speed throttle 1.00 (also on 20 further unseen
 tracks); in the ``--full`` run itself (20 episodes): 0.00, 1.00, 1.00 and 0.986 with the fixed
-±0.2 side-camera correction, and 0.00, 1.00, 0.939 and 1.00 with the exact side labels the
-recorder now writes.
+±0.2 side-camera correction, 0.00, 1.00, 0.939 and 1.00 with the exact side labels the
+recorder now writes, and 0.00, 1.00, 1.00 and 0.926 with them and the 120° camera (the default;
+validation steering MSE 0.041).
 ``head="target_speed"`` trains the second output on the target speed directly instead (rows
 ``cnn-learned-speed``, ``cnn-pi``, then the DAgger rows; no readout stage).
 
@@ -61,7 +62,8 @@ THESIS_TRAIN, THESIS_VAL = 1199, 300
 #: DAgger rounds of the full run: one, driven with the learned-speed throttle (measured on the 20
 #: held-out tracks from a 12-episode network: the readout alone 0.947 autonomy, after one round
 #: 1.00, and 1.00 on 20 more unseen tracks; in the 20-episode ``--full`` runs the readout alone
-#: reached 1.00 then 0.939, and the round 0.986 then 1.00; docs/thesis-notes.md);
+#: reached 1.00, 0.939, 1.00, and the round 0.986, 1.00, 0.926: within the run-to-run spread;
+#: docs/thesis-notes.md);
 #: ``dagger_rounds`` overrides it
 FULL_DAGGER_ROUNDS = 1
 #: closed-loop stage files keep every track's metrics, not only the means (part of their key,
