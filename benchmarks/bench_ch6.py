@@ -46,6 +46,11 @@ TARGETS = {
         "limit": 2.0,
         "direction": "<=",
     },
+    "onnxruntime_inference_ms_median_2_threads": {
+        "what": "Ch6 PilotNet one-frame inference median (ms), onnxruntime, 2 threads",
+        "limit": 2.0,
+        "direction": "<=",
+    },
 }
 
 
