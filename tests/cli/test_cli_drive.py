@@ -45,6 +45,8 @@ def trained(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, Path]:
     assert again.exit_code == 0 and "wrote 0 rows" in again.output  # resumed: nothing new
     other = runner.invoke(app, ["drive", "collect", "--out", str(data), "--noise", "0.1"])
     assert other.exit_code == 2 and "'noise_sigma'" in other.output  # not mixed into one folder
+    meta = json.loads((data / "dataset.json").read_text())
+    assert meta["fov_deg"] == 120.0 and meta["noise_sigma"] == 0.25
     model = root / "m.safetensors"
     r = runner.invoke(
         app,
@@ -71,6 +73,22 @@ def test_briefly_trained_model_moves_along_the_track(trained: tuple[Path, Path])
     assert row["tiles_pct"] > 5.0  # it drove along the track, not in place
     assert row["mean_speed"] > 5.0
     assert row["mean_centre_distance"] < 40 / 6.0  # on average on the road
+
+
+def test_camera_field_of_view_travels_from_the_data_to_the_model(
+    trained: tuple[Path, Path], tmp_path: Path
+) -> None:
+    """The model's record keeps the field of view of its data (evaluation renders with it), and a
+    dataset recorded before the field was written (then 90°) is not extended at 120°."""
+    from uvnav.learning.checkpoint import read_header
+
+    data, model = trained
+    assert read_header(model)["record"]["camera_fov_deg"] == 120.0
+    old = tmp_path / "old"
+    old.mkdir()
+    (old / "dataset.json").write_text(json.dumps({"camera": "front", "height": 66, "width": 200}))
+    r = runner.invoke(app, ["drive", "collect", "--out", str(old), "--episodes", "1"])
+    assert r.exit_code == 2 and "'fov_deg'" in r.output and "90.0" in r.output
 
 
 def test_onnxruntime_backend_drives_the_same_episode(trained: tuple[Path, Path]) -> None:

@@ -135,11 +135,28 @@ def prepare_data(
             "n_train": len(tr),
             "n_val": len(va),
             "side_labels": _side_label_kind(log, sides=sides, exact_sides=exact_sides),
+            "camera_fov_deg": recorded_fov_deg(root),
         },
         target_speed_train=None if ts is None else ts[tr],
         target_speed_val=None if ts is None else ts[va],
         camera_val=None if bal.camera is None else bal.camera[va],
     )
+
+
+def recorded_fov_deg(root: Path | str) -> float | None:
+    """The front camera's field of view [deg] a dataset folder was recorded with (``None``: not
+    ours, e.g. a Udacity recording, or a top-down dataset)."""
+    import json
+
+    from uvnav.driving.collect import LEGACY_FOV_DEG, META_NAME
+
+    f = Path(root) / META_NAME
+    if not f.is_file():
+        return None
+    meta = json.loads(f.read_text())
+    if meta.get("camera", "front") != "front":
+        return None
+    return float(meta.get("fov_deg", LEGACY_FOV_DEG))
 
 
 def _side_label_kind(log: Any, *, sides: bool, exact_sides: bool) -> str:
@@ -328,6 +345,7 @@ def fit_target_speed_readout(
         "val_throttle_mse": [mt],
         "val_target_speed_rmse": [float(np.sqrt(mt)) * new_cfg.speed_scale],
         "val_target_speed_r2": 1.0 - mt / var if var > 0 else float("nan"),
+        "camera_fov_deg": data.info.get("camera_fov_deg"),
         "n_train": len(y_tr),
         "n_val": len(y_va),
     }

@@ -9,6 +9,7 @@ seed list, a missing extra) are printed as ONE line ``error: ...`` and exit with
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -270,14 +271,25 @@ def _load_policy(
     speed_factor: float = 1.0,
     max_speed: float | None = None,
     backend: str = "torch",
-) -> tuple[Any, Any, str]:
+) -> tuple[Any, Any, dict[str, Any]]:
+    """The model's policy and the simulator settings it was trained for: ``(policy, on_reset,
+    DrivingSim keyword arguments)`` — the camera, and the front camera's field of view from the
+    training record (90° for checkpoints older than that record)."""
     from uvnav.bench.ch6_pipeline import THROTTLE_MODES, cnn_policy
+    from uvnav.driving.camera import CameraSpec
+    from uvnav.driving.collect import LEGACY_FOV_DEG
     from uvnav.learning.checkpoint import load_checkpoint
 
     if throttle not in THROTTLE_MODES:
         raise ValueError(f"--throttle: {throttle!r} (must be {', '.join(THROTTLE_MODES)} or both)")
-    model, _ = load_checkpoint(model_path)
-    camera = "topdown" if (model.config.height, model.config.width) == (96, 96) else "front"
+    model, header = load_checkpoint(model_path)
+    sim_kw: dict[str, Any] = {
+        "camera": "topdown" if (model.config.height, model.config.width) == (96, 96) else "front"
+    }
+    if sim_kw["camera"] == "front":
+        fov = header.get("record", {}).get("camera_fov_deg", LEGACY_FOV_DEG)
+        if fov is not None:
+            sim_kw["camera_spec"] = CameraSpec(fov=math.radians(float(fov)))
     policy, on_reset = cnn_policy(
         model,
         throttle=throttle,  # type: ignore[arg-type]
@@ -286,7 +298,7 @@ def _load_policy(
         max_speed=max_speed,
         backend=backend,
     )
-    return policy, on_reset, camera
+    return policy, on_reset, sim_kw
 
 
 @drive_app.command()
@@ -332,10 +344,10 @@ def evaluate(
         rows: dict[str, dict[str, float]] = {}
         with _progress() as prog:
             for mode in modes:
-                policy, on_reset, camera = _load_policy(
+                policy, on_reset, sim_kw = _load_policy(
                     model, mode, set_speed, speed_factor, max_speed, backend
                 )
-                sim = DrivingSim(camera=camera, max_steps=max_steps)  # type: ignore[arg-type]
+                sim = DrivingSim(**sim_kw, max_steps=max_steps)
                 task = prog.add_task(f"cnn + {mode} throttle", total=len(seed_list))
                 res = run_eval(
                     policy,
@@ -409,8 +421,8 @@ def play(
 
         if out.suffix.lower() not in (".gif", ".mp4"):
             raise ValueError(f"--out: {out} (must end in .gif or .mp4)")
-        policy, on_reset, camera = _load_policy(model, throttle, 35.0)
-        sim = DrivingSim(camera=camera, max_steps=steps)  # type: ignore[arg-type]
+        policy, on_reset, sim_kw = _load_policy(model, throttle, 35.0)
+        sim = DrivingSim(**sim_kw, max_steps=steps)
         frame, tel = sim.reset(seed)
         if on_reset:
             on_reset()

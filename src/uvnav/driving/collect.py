@@ -24,8 +24,11 @@ from uvnav.driving.expert import ExpertParams, PurePursuitExpert, ar1_noise
 from uvnav.driving.sim import DrivingSim
 
 DONE_NAME = "episodes.txt"
-#: what the dataset's images are (camera, size): read by training and evaluation
+#: what the dataset's images are (camera, size, field of view, recording noise): read by training
+#: and evaluation
 META_NAME = "dataset.json"
+#: the front camera's field of view [deg] of datasets whose ``dataset.json`` does not say
+LEGACY_FOV_DEG = 90.0
 
 
 @dataclass(frozen=True)
@@ -146,14 +149,18 @@ def collect(
     }
     if sim.camera == "front":
         info["side_shift"] = sim.side_shift
+        info["fov_deg"] = round(float(np.degrees(sim.camera_spec.fov)), 6)
     info["noise_sigma"], info["noise_rho"] = p.noise_sigma, p.noise_rho
     if meta.is_file():
         old = json.loads(meta.read_text())
-        # datasets recorded before a field was written do not constrain it
-        for name in ("camera", "noise_sigma", "noise_rho"):
-            if name in old and old[name] != info[name]:
+        # a field written later does not constrain older datasets, but the front camera's field
+        # of view was 90° until it was written
+        legacy = {"fov_deg": LEGACY_FOV_DEG} if old.get("camera") == "front" else {}
+        for name in ("camera", "fov_deg", "noise_sigma", "noise_rho"):
+            was = old.get(name, legacy.get(name))
+            if name in info and was is not None and was != info[name]:
                 raise ValueError(
-                    f"{meta}: field '{name}': dataset was recorded with {old[name]!r}, "
+                    f"{meta}: field '{name}': dataset was recorded with {was!r}, "
                     f"not {info[name]!r} (record into another folder)"
                 )
     else:
