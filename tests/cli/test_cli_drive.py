@@ -82,7 +82,7 @@ def test_camera_field_of_view_travels_from_the_data_to_the_model(
     dataset recorded before the field was written (then 90°) is not extended at 120°."""
     from uvnav.learning.checkpoint import read_header
 
-    data, model = trained
+    _, model = trained
     assert read_header(model)["record"]["camera_fov_deg"] == 120.0
     old = tmp_path / "old"
     old.mkdir()
