@@ -133,6 +133,21 @@ def test_full_chain_stages_and_resume(tmp_path: Path) -> None:
     assert s4.stage_records["dagger1"]["second_output"] == "throttle"
     s5 = reproduce_ch6(tmp_path, **{**kw, "dagger_rounds": 0, "readout": False}, fresh=True)
     assert s5.reused == [] and list(s5.closed_loop) == ["cnn-learned", "cnn-pi", "expert"]
+    # a data/ folder recorded with another camera (an older 90° recording) is kept aside, not
+    # extended, and nothing trained on it is reused
+    import json
+
+    meta_path = tmp_path / "data" / "dataset.json"
+    meta = json.loads(meta_path.read_text())
+    meta_path.write_text(json.dumps({k: v for k, v in meta.items() if k != "fov_deg"}))
+    train_path = tmp_path / "stages" / "train.json"  # as trained on that recording
+    stage = json.loads(train_path.read_text())
+    stage["key"]["dataset"]["fov_deg"] = 90.0
+    train_path.write_text(json.dumps(stage))
+    s6 = reproduce_ch6(tmp_path, **{**kw, "dagger_rounds": 0, "readout": False})
+    assert (tmp_path / "data.old1" / "driving_log.csv").is_file()
+    assert json.loads(meta_path.read_text())["fov_deg"] == meta["fov_deg"] == 120.0
+    assert "train" not in s6.reused and s6.record["camera_fov_deg"] == 120.0
 
 
 def test_dagger_round_appends_expert_labelled_rows(tmp_path: Path) -> None:

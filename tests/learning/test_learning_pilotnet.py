@@ -103,3 +103,5 @@ def test_onnxruntime_predictor_drives_like_torch(second_output: str) -> None:
         assert a[1] == pytest.approx(b[1], abs=1e-5 * scale)
     with pytest.raises(ValueError, match="backend"):
         Predictor(net, backend="tensorrt")
+    with pytest.raises(ValueError, match="device"):
+        Predictor(net, backend="onnxruntime", device="cuda")

@@ -22,6 +22,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
+from uvnav.driving.collect import dataset_meta
 from uvnav.driving.dataset import (
     LogWriter,
     balance_indices,
@@ -135,28 +136,12 @@ def prepare_data(
             "n_train": len(tr),
             "n_val": len(va),
             "side_labels": _side_label_kind(log, sides=sides, exact_sides=exact_sides),
-            "camera_fov_deg": recorded_fov_deg(root),
+            "camera_fov_deg": dataset_meta(root).get("fov_deg"),
         },
         target_speed_train=None if ts is None else ts[tr],
         target_speed_val=None if ts is None else ts[va],
         camera_val=None if bal.camera is None else bal.camera[va],
     )
-
-
-def recorded_fov_deg(root: Path | str) -> float | None:
-    """The front camera's field of view [deg] a dataset folder was recorded with (``None``: not
-    ours, e.g. a Udacity recording, or a top-down dataset)."""
-    import json
-
-    from uvnav.driving.collect import LEGACY_FOV_DEG, META_NAME
-
-    f = Path(root) / META_NAME
-    if not f.is_file():
-        return None
-    meta = json.loads(f.read_text())
-    if meta.get("camera", "front") != "front":
-        return None
-    return float(meta.get("fov_deg", LEGACY_FOV_DEG))
 
 
 def _side_label_kind(log: Any, *, sides: bool, exact_sides: bool) -> str:

@@ -286,8 +286,13 @@ def reproduce_ch6(
         prepare_data,
         train_on,
     )
-    from uvnav.driving.collect import CollectParams, collect
-    from uvnav.driving.evaluate import summarize
+    from uvnav.driving.collect import (
+        CollectParams,
+        collect,
+        dataset_meta,
+        meta_conflict,
+        recording_meta,
+    )
     from uvnav.driving.sim import DrivingSim
     from uvnav.learning import PilotNetConfig, TrainConfig
     from uvnav.learning.checkpoint import load_checkpoint, save_checkpoint
@@ -322,8 +327,21 @@ def reproduce_ch6(
         if noise_sigma is None
         else CollectParams(max_steps=c_steps, noise_sigma=noise_sigma)
     )
+    rec_sim = DrivingSim(max_steps=cp.max_steps)
+    recorded = dataset_meta(out / "data")
+    conflict = meta_conflict(recorded, recording_meta(rec_sim, cp))
+    if conflict:
+        # the folder is this reproduction's own cache: keep the old recording, start a new one
+        k = 1
+        while (out / f"data.old{k}").exists():
+            k += 1
+        (out / "data").rename(out / f"data.old{k}")
+        say(f"data/: {conflict}; kept as data.old{k}/, recording afresh")
     say(f"collecting {n_ep} expert episodes")
-    collect(out / "data", range(n_ep), params=cp)
+    try:
+        collect(out / "data", range(n_ep), params=cp, sim=rec_sim)
+    finally:
+        rec_sim.close()
     say("balancing and splitting")
     data = prepare_data(out / "data")
     rows: dict[str, dict[str, float]] = {}
@@ -339,8 +357,7 @@ def reproduce_ch6(
         else:
             say(f"closed loop {name}, {len(seeds)} tracks")
             policy, on_reset = cnn_policy(model, throttle=mode)
-            eps = evaluate(policy, seeds, on_reset=on_reset, max_steps=steps)
-            done = {"summary": summarize(eps), "tracks": [e.to_dict() for e in eps]}
+            done = _loop_record(evaluate(policy, seeds, on_reset=on_reset, max_steps=steps))
             stages.put(name, key, done)
         rows[name], tracks[name] = done["summary"], done["tracks"]
 
@@ -351,6 +368,7 @@ def reproduce_ch6(
         "epochs": n_epochs,
         "head": head,
         "side_labels": data.info["side_labels"],
+        "dataset": dataset_meta(out / "data"),
     }
     model_path = out / "model.safetensors"
     record = stages.get("train", train_key, (model_path,))
@@ -443,8 +461,7 @@ def reproduce_ch6(
     ex = stages.get("expert", ex_key)
     if ex is None:
         say("closed loop, expert")
-        eps = evaluate_expert(seeds, max_steps=steps)
-        ex = {"summary": summarize(eps), "tracks": [e.to_dict() for e in eps]}
+        ex = _loop_record(evaluate_expert(seeds, max_steps=steps))
         stages.put("expert", ex_key, ex)
     rows["expert"], tracks["expert"] = ex["summary"], ex["tracks"]
     for row in rows.values():
@@ -593,6 +610,13 @@ def _table(
         }
     )
     return table
+
+
+def _loop_record(episodes: list[Any]) -> dict[str, Any]:
+    """A closed-loop stage's value: the means (``summary``) and each track's metrics."""
+    from uvnav.driving.evaluate import summarize
+
+    return {"summary": summarize(episodes), "tracks": [e.to_dict() for e in episodes]}
 
 
 def _intervention_tracks(tracks: list[dict[str, Any]], most: int = 5) -> str:

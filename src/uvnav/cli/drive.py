@@ -258,10 +258,9 @@ def _parse_head(head: str) -> str:
 
 
 def _dataset_meta(data: Path) -> dict[str, Any]:
-    from uvnav.driving.collect import META_NAME
+    from uvnav.driving.collect import dataset_meta
 
-    f = Path(data) / META_NAME
-    return json.loads(f.read_text()) if f.is_file() else {"camera": "front"}
+    return dataset_meta(data) or {"camera": "front"}
 
 
 def _load_policy(

@@ -16,6 +16,7 @@ import json
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -46,6 +47,45 @@ class CollectParams:
     noise_sigma: float = 0.25
     noise_rho: float = 0.97
     max_steps: int = 1200
+
+
+def recording_meta(sim: DrivingSim, params: CollectParams) -> dict[str, Any]:
+    """What :func:`collect` records with ``sim`` and ``params`` (the ``dataset.json`` fields)."""
+    info: dict[str, Any] = {
+        "camera": sim.camera,
+        "height": sim.frame_shape[0],
+        "width": sim.frame_shape[1],
+    }
+    if sim.camera == "front":
+        info["side_shift"] = sim.side_shift
+        info["fov_deg"] = round(float(np.degrees(sim.camera_spec.fov)), 6)
+    info["noise_sigma"], info["noise_rho"] = params.noise_sigma, params.noise_rho
+    return info
+
+
+def dataset_meta(root: Path | str) -> dict[str, Any]:
+    """A dataset folder's ``dataset.json`` (``{}`` when there is none, e.g. a Udacity recording).
+
+    A field written later does not constrain older folders, except the front camera's field of
+    view: it was :data:`LEGACY_FOV_DEG` until it was written, and is filled in as such.
+    """
+    f = Path(root) / META_NAME
+    if not f.is_file():
+        return {}
+    meta: dict[str, Any] = json.loads(f.read_text())
+    if meta.get("camera") == "front":
+        meta.setdefault("fov_deg", LEGACY_FOV_DEG)
+    return meta
+
+
+def meta_conflict(recorded: dict[str, Any], new: dict[str, Any]) -> str | None:
+    """The first field a folder was recorded with differently (one line), or ``None``."""
+    for name in ("camera", "fov_deg", "noise_sigma", "noise_rho"):
+        if name in recorded and name in new and recorded[name] != new[name]:
+            return (
+                f"field '{name}': dataset was recorded with {recorded[name]!r}, not {new[name]!r}"
+            )
+    return None
 
 
 def done_seeds(root: Path | str) -> set[int]:
@@ -142,27 +182,11 @@ def collect(
     own = sim is None
     sim = sim or DrivingSim(max_steps=p.max_steps)
     meta = root / META_NAME
-    info: dict[str, object] = {
-        "camera": sim.camera,
-        "height": sim.frame_shape[0],
-        "width": sim.frame_shape[1],
-    }
-    if sim.camera == "front":
-        info["side_shift"] = sim.side_shift
-        info["fov_deg"] = round(float(np.degrees(sim.camera_spec.fov)), 6)
-    info["noise_sigma"], info["noise_rho"] = p.noise_sigma, p.noise_rho
+    info = recording_meta(sim, p)
     if meta.is_file():
-        old = json.loads(meta.read_text())
-        # a field written later does not constrain older datasets, but the front camera's field
-        # of view was 90° until it was written
-        legacy = {"fov_deg": LEGACY_FOV_DEG} if old.get("camera") == "front" else {}
-        for name in ("camera", "fov_deg", "noise_sigma", "noise_rho"):
-            was = old.get(name, legacy.get(name))
-            if name in info and was is not None and was != info[name]:
-                raise ValueError(
-                    f"{meta}: field '{name}': dataset was recorded with {was!r}, "
-                    f"not {info[name]!r} (record into another folder)"
-                )
+        conflict = meta_conflict(dataset_meta(root), info)
+        if conflict:
+            raise ValueError(f"{meta}: {conflict} (record into another folder)")
     else:
         meta.write_text(json.dumps(info))
     writer = LogWriter(root)

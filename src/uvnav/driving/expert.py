@@ -98,8 +98,8 @@ class PurePursuitExpert:
             only, not on the car's speed.
         """
         p = self.params
-        i, _, _ = project(self.geometry, tel.x, tel.y)
-        steer = self.steer_at(tel.x, tel.y, tel.heading, tel.speed)
+        i, t, _ = project(self.geometry, tel.x, tel.y)
+        steer = self._steer(tel.x, tel.y, tel.heading, tel.speed, i, t)
         v_target = self.target_speed(i)
         throttle = float(np.clip(p.k_speed * (v_target - tel.speed), -1.0, 1.0))
         return steer, throttle, v_target
@@ -110,8 +110,13 @@ class PurePursuitExpert:
         Returns:
             Normalised steering in [-1, 1] (+ right).
         """
-        p = self.params
         i, t, _ = project(self.geometry, x, y)
+        return self._steer(x, y, heading, speed, i, t)
+
+    def _steer(self, x: float, y: float, heading: float, speed: float, i: int, t: float) -> float:
+        """:meth:`steer_at` with the pose's projection on the centreline (segment ``i``,
+        fraction ``t``) already known."""
+        p = self.params
         L = p.lookahead + p.lookahead_gain * speed
         target = point_ahead(self.geometry, i, t, L)
         alpha = np.arctan2(target[1] - y, target[0] - x) - heading

@@ -283,6 +283,8 @@ class Predictor:
 
         if backend not in BACKENDS:
             raise ValueError(f"backend: {backend!r} (must be one of {', '.join(BACKENDS)})")
+        if backend == "onnxruntime" and device != "cpu":
+            raise ValueError(f"device: {device!r} (the onnxruntime backend runs on the CPU)")
         torch.set_num_threads(max(1, threads))
         self.model = model.to(device).eval()
         self.device = device
