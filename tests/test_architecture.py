@@ -29,6 +29,7 @@ DESIGN_LAYERS = [
     {"uvnav.sensors", "uvnav.prediction"},
     {"uvnav.dynamics", "uvnav.obstacles"},
     {"uvnav.geometry"},
+    {"uvnav.core"},  # issue 16: the contract every layer reads
 ]
 
 

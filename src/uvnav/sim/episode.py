@@ -24,13 +24,14 @@ stepped by its own model, exact nearest points of every obstacle at every step).
 from __future__ import annotations
 
 import math
-import time as _time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
 from uvnav.controllers.base import Controller
+from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.obstacles.batch import ObstacleBatch
@@ -196,14 +197,214 @@ def decision_ratio(control_period: float, dt: float) -> int:
     return int(n)
 
 
+class UnicycleWorld:
+    """The Chapter-2 world: one unicycle among rigid moving bodies (:class:`uvnav.core.World`).
+
+    Bookkeeping (path, effort, limit violations, clearance, status) lives here, so
+    :func:`run_episode` and the Gymnasium env ``uvnav/Nav2D-v0`` get the same numbers.  Without
+    ``exact`` the minimum clearance is tracked by :class:`_MinClearance` (the same minimum, and
+    the per-step ``clearance`` only exact when it can matter).
+
+    Args:
+        setup: the episode; its obstacles are advanced in place and written back by
+            :meth:`close`.
+        rng: the episode generator; two independent children feed the law and the sensors.
+        exact: the exact clearance and nearest obstacle at every step (recorded runs).
+    """
+
+    vehicle: ClassVar[str] = "unicycle"
+    sensing: ClassVar[str] = "exact"
+    n_agents: ClassVar[int] = 1
+
+    def __init__(self, setup: EpisodeSetup, rng: np.random.Generator, *, exact: bool) -> None:
+        self.setup = setup
+        self._law_rng, self.sense_rng = rng.spawn(2)
+        self.spec = setup.spec
+        self.dt = float(setup.dt)
+        self.ratio = decision_ratio(float(setup.control_period), self.dt)
+        self.n_steps = round(setup.t_max / self.dt)
+        self.goal = np.asarray(setup.goal, dtype=float)
+        start = np.asarray(setup.start, dtype=float)
+        self.x, self.y, self.th = float(start[0]), float(start[1]), float(start[2])
+        self.obstacles = setup.obstacles
+        self.template = FieldTemplate.from_bodies([o.body for o in self.obstacles])
+        self.batch = ObstacleBatch(self.obstacles)
+        self.field = self.batch.field(self.template)
+        self.sensing_range = float(setup.sensing.sensing_range)
+        self.exact = exact
+        self.t = 0.0
+        self.done = False
+
+    def law_setup(self, agent: int = 0) -> tuple[UnicycleSpec, FloatArray, np.random.Generator]:
+        """The law's limits, goal and generator."""
+        return self.spec, self.goal, self._law_rng
+
+    @property
+    def pose(self) -> FloatArray:
+        """``[x, y, theta]`` now."""
+        return np.array((self.x, self.y, self.th))
+
+    def _clearance(self, radius: float) -> tuple[float, int]:
+        """Exact gap [m] to the nearest obstacle (negative on overlap) and its index; the query
+        also covers ``radius`` [m] for the sensors."""
+        if not self.obstacles:
+            return math.inf, -1
+        q = self.field.query((self.x, self.y), radius, nearest=True)
+        if len(q.ids) == 0:
+            return math.inf, -1
+        gaps = q.signed - float(self.spec.radius)
+        j = int(gaps.argmin())
+        return float(gaps[j]), int(q.ids[j])
+
+    def start(self, oracles: Sequence[bool] = (False,)) -> None:
+        """Clearance and status at t = 0; the finite-difference estimator unless the law is an
+        oracle or the velocities are known."""
+        sensing = self.setup.sensing
+        self.estimator = None
+        if sensing.velocities == "estimated" and not oracles[0]:
+            self.estimator = FiniteDifferenceEstimator(self.sense_rng, sensing.position_noise)
+        self.clearance, self.nearest = self._clearance(self.sensing_range)
+        self.min_clear = self.clearance
+        self.tracker = (
+            _MinClearance(float(self.spec.radius), self.clearance)
+            if self.obstacles and not self.exact
+            else None
+        )
+        self.start_dist = math.hypot(self.goal[0] - self.x, self.goal[1] - self.y)
+        self.path = 0.0
+        self.effort = 0.0
+        self.violations = 0
+        self.applied = UnicycleCommand(0.0, 0.0)
+        self.status = "timeout"
+        self.reached_at: float | None = None
+        self.step_index = 0
+        if self.clearance < 0:
+            self.status, self.done = "collision", True
+        elif self.start_dist <= float(self.setup.goal_tolerance):
+            self.status, self.reached_at, self.done = "success", 0.0, True
+        self.done = self.done or self.n_steps <= 0
+
+    def acting(self) -> tuple[int, ...]:
+        """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
+        return (0,) if self.step_index % self.ratio == 0 else ()
+
+    def observe(self, agent: int = 0) -> Observation:
+        """Readings within the sensing range (estimated rates unless known), the lidar scan."""
+        robot = self.pose
+        readings = sense_obstacles(robot[:2], self.field, sensing_range=self.sensing_range)
+        if self.estimator is not None:
+            readings = self.estimator.update(self.t, readings)
+        scan = None
+        lc = self.setup.sensing.lidar
+        if lc is not None:
+            scan = lidar_scan(
+                robot, self.field, self.sense_rng, n_rays=lc.n_rays, max_range=lc.max_range,
+                fov=lc.fov, noise_std=lc.noise_std, dropout=lc.dropout,
+            )  # fmt: skip
+        return Observation(
+            time=self.t, pose=robot, speed=self.applied.v, goal=self.goal, obstacles=readings,
+            lidar=scan,
+        )  # fmt: skip
+
+    def apply(self, cmd: UnicycleCommand, agent: int = 0) -> UnicycleCommand:
+        """Hold ``cmd``: counted in ``limit_violations`` when outside (2.4), saturated."""
+        spec = self.spec
+        if cmd.violates(spec):
+            self.violations += 1
+        new = cmd.clipped(spec)
+        if self.step_index > 0:
+            self.effort += (new.v - self.applied.v) ** 2 / (self.ratio * self.dt)
+        self.applied = new
+        return new
+
+    def advance(self) -> None:
+        """One step ``dt``: robot (exact), obstacles, clearance, collision and arrival."""
+        dt = self.dt
+        v, u = self.applied.v, self.applied.u
+        self.effort += u**2 * dt
+        x, y = self.x, self.y
+        nx, ny, self.th = unicycle_advance(x, y, self.th, v, u, dt)
+        self.path += math.hypot(nx - x, ny - y)
+        self.x, self.y = nx, ny
+        self.batch.step(self.t, dt)
+        self.step_index = i = self.step_index + 1
+        self.t = i * dt
+        self.field = self.batch.field(self.template)
+        radius = self.sensing_range if i % self.ratio == 0 else 0.0
+        if self.tracker is None:
+            self.clearance, self.nearest = self._clearance(radius)
+            self.min_clear = min(self.min_clear, self.clearance)
+        else:
+            self.clearance = self.tracker.step(self.field, nx, ny, radius)
+        if self.clearance < 0:
+            self.status, self.done = "collision", True
+        elif math.hypot(self.goal[0] - nx, self.goal[1] - ny) <= float(self.setup.goal_tolerance):
+            self.status, self.reached_at, self.done = "success", self.t, True
+        elif i >= self.n_steps:
+            self.done = True
+
+    def close(self) -> None:
+        """Write the obstacles' states back to their models (the setup's objects)."""
+        self.batch.write_back()
+
+    def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
+        """The episode's metrics (:mod:`uvnav.sim.metrics`)."""
+        if self.tracker is not None:
+            self.min_clear = self.tracker.finish()
+            self.tracker = None
+        spec = self.spec
+        shortest = max(self.start_dist - float(self.setup.goal_tolerance), 0.0)
+        return episode_metrics(
+            status=self.status,
+            path_length=self.path,
+            shortest=shortest,
+            straight_time=shortest / spec.v_max if spec.v_max > 0 else 0.0,
+            reached_at=self.reached_at,
+            min_clearance=float(self.min_clear) if self.obstacles else None,
+            control_effort=self.effort,
+            limit_violations=self.violations,
+            mode_switches=log.mode_switches,
+            decision_us=log.decision_us,
+        )
+
+
+class TrajectoryProbe(BaseProbe):
+    """Records a :class:`UnicycleWorld` at every integration step and at the end."""
+
+    def __init__(self) -> None:
+        self.recorder: TrajectoryRecorder | None = None
+        self.mode = ""  # the law's mode at its last decision
+
+    def on_start(self, world: Any, laws: Sequence[Any]) -> None:
+        self.recorder = TrajectoryRecorder([o.body.outline() for o in world.obstacles])
+
+    def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
+        self.mode = law.mode
+
+    def on_step(self, world: Any, laws: Sequence[Any]) -> None:
+        assert self.recorder is not None
+        self.recorder.add(
+            world.t, world.pose, (world.applied.v, world.applied.u), self.mode,
+            world.clearance, world.nearest, world.field,
+        )  # fmt: skip
+
+    on_end = on_step
+
+    def finish(self) -> Trajectory:
+        assert self.recorder is not None
+        return self.recorder.finish()
+
+
 def run_episode(
     setup: EpisodeSetup,
     controller: Controller,
     rng: np.random.Generator,
     *,
     record: bool = True,
+    probes: Sequence[Probe] = (),
 ) -> EpisodeResult:
-    """Run one episode to success, collision or ``t_max``.
+    """Run one episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
+    :class:`UnicycleWorld`).
 
     Args:
         setup: the instantiated scenario; its obstacles' states (and their motion models' internal
@@ -211,174 +412,22 @@ def run_episode(
         controller: a fresh or reusable controller; it is reset here.
         rng: the episode generator; independent children feed the controller and the sensors.
         record: keep the full trajectory (needed for figures; off for large campaigns).
+        probes: more probes to run in the loop.
 
     Raises:
         ValueError: ``setup.control_period`` is not a whole multiple of ``setup.dt``.
     """
-    ctrl_rng, sense_rng = rng.spawn(2)
-    spec = setup.spec
-    dt = float(setup.dt)
-    ratio = decision_ratio(float(setup.control_period), dt)
-    n_steps = round(setup.t_max / dt)
-    goal = np.asarray(setup.goal, dtype=float)
-    gx, gy = float(goal[0]), float(goal[1])
-    start = np.asarray(setup.start, dtype=float)
-    x, y, th = float(start[0]), float(start[1]), float(start[2])
-    obstacles = setup.obstacles
-    template = FieldTemplate.from_bodies([o.body for o in obstacles])
-    batch = ObstacleBatch(obstacles)
-    field_now = batch.field(template)
-    sensing = setup.sensing
-    sensing_range = float(sensing.sensing_range)
-    robot_radius = float(spec.radius)
-    goal_tolerance = float(setup.goal_tolerance)
-    estimator = None
-    if sensing.velocities == "estimated" and not getattr(controller, "oracle", False):
-        estimator = FiniteDifferenceEstimator(sense_rng, sensing.position_noise)
-
-    controller.reset(spec, goal, ctrl_rng)
-    recorder = TrajectoryRecorder([o.body.outline() for o in obstacles]) if record else None
-    has_obstacles = len(obstacles) > 0
-
-    def clearance_of(
-        fld: ObstacleField, px: float, py: float, radius: float, with_nearest: bool
-    ) -> tuple[float, int]:
-        """Gap [m] between the robot's disc and the nearest obstacle (negative on overlap), and
-        that obstacle; the query also covers ``radius`` [m] for the sensors.  Without
-        ``with_nearest`` only obstacles within ``radius`` are examined: ``(inf, -1)`` if none."""
-        if not has_obstacles:
-            return math.inf, -1
-        q = fld.query((px, py), radius, nearest=with_nearest)
-        if len(q.ids) == 0:
-            return math.inf, -1
-        gaps = q.signed - robot_radius
-        j = int(gaps.argmin())
-        return float(gaps[j]), int(q.ids[j])
-
-    clearance, nearest = clearance_of(field_now, x, y, sensing_range, True)
-    min_clear = clearance
-    # unrecorded, only the minimum clearance and collisions are visible: defer what can wait
-    tracker = _MinClearance(robot_radius, clearance) if has_obstacles and not record else None
-    start_dist = math.hypot(gx - x, gy - y)
-    path = 0.0
-    effort = 0.0
-    violations = 0
-    switches = 0
-    decision_us: list[float] = []
-    applied = UnicycleCommand(0.0, 0.0)
-    last_mode: str | None = None
-    status = "timeout"
-    t = 0.0
-    reached_at: float | None = None
-    if clearance < 0:
-        status = "collision"
-        n_steps = 0
-    elif start_dist <= goal_tolerance:
-        status, reached_at, n_steps = "success", 0.0, 0
-
-    perf_ns = _time.perf_counter_ns
+    world = UnicycleWorld(setup, rng, exact=record)
+    rec = TrajectoryProbe() if record else None
     try:
-        for i in range(n_steps):
-            if i % ratio == 0:
-                robot = np.array((x, y, th))
-                readings = sense_obstacles(robot[:2], field_now, sensing_range=sensing_range)
-                if estimator is not None:
-                    readings = estimator.update(t, readings)
-                scan = None
-                if sensing.lidar is not None:
-                    lc = sensing.lidar
-                    scan = lidar_scan(
-                        robot,
-                        field_now,
-                        sense_rng,
-                        n_rays=lc.n_rays,
-                        max_range=lc.max_range,
-                        fov=lc.fov,
-                        noise_std=lc.noise_std,
-                        dropout=lc.dropout,
-                    )
-                obs = Observation(
-                    time=t,
-                    pose=robot,
-                    speed=applied.v,
-                    goal=goal,
-                    obstacles=readings,
-                    lidar=scan,
-                )
-                tic = perf_ns()
-                cmd = controller.act(obs)
-                decision_us.append((perf_ns() - tic) / 1000.0)
-                if cmd.violates(spec):
-                    violations += 1
-                new = cmd.clipped(spec)
-                effort += ((new.v - applied.v) ** 2) / (ratio * dt) if i > 0 else 0.0
-                applied = new
-                mode = controller.mode
-                if last_mode is not None and mode != last_mode:
-                    switches += 1
-                last_mode = mode
-            if recorder is not None:
-                recorder.add(
-                    t,
-                    np.array((x, y, th)),
-                    (applied.v, applied.u),
-                    last_mode or "",
-                    clearance,
-                    nearest,
-                    field_now,
-                )
-            effort += applied.u**2 * dt
-            nx, ny, th = unicycle_advance(x, y, th, applied.v, applied.u, dt)
-            path += math.hypot(nx - x, ny - y)
-            x, y = nx, ny
-            batch.step(t, dt)
-            t = (i + 1) * dt
-            field_now = batch.field(template)
-            radius = sensing_range if (i + 1) % ratio == 0 else 0.0
-            if recorder is not None or tracker is None:
-                clearance, nearest = clearance_of(field_now, x, y, radius, True)
-                min_clear = min(min_clear, clearance)
-            else:
-                clearance = tracker.step(field_now, x, y, radius)
-            if clearance < 0:
-                status = "collision"
-                break
-            if math.hypot(gx - x, gy - y) <= goal_tolerance:
-                status = "success"
-                reached_at = t
-                break
+        (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
     finally:
-        batch.write_back()
-    if tracker is not None:
-        min_clear = tracker.finish()
-
-    if recorder is not None:
-        recorder.add(
-            t,
-            np.array((x, y, th)),
-            (applied.v, applied.u),
-            last_mode or "",
-            clearance,
-            nearest,
-            field_now,
-        )
-    dec = np.asarray(decision_us) if decision_us else np.zeros(1)
-    shortest = max(start_dist - goal_tolerance, 0.0)  # to the edge of the goal disc
-    metrics = episode_metrics(
-        status=status,
-        path_length=path,
-        shortest=shortest,
-        straight_time=shortest / spec.v_max if spec.v_max > 0 else 0.0,
-        reached_at=reached_at,
-        min_clearance=float(min_clear) if has_obstacles else None,
-        control_effort=effort,
-        limit_violations=violations,
-        mode_switches=switches,
-        decision_us=decision_us,
-    )
+        world.close()
+    metrics = world.metrics(log)
+    dec = np.asarray(log.decision_us) if log.decision_us else np.zeros(1)
     return EpisodeResult(
         metrics=metrics,
-        status=status,
-        trajectory=recorder.finish() if recorder is not None else None,
+        status=world.status,
+        trajectory=rec.finish() if rec is not None else None,
         decision_us=dec,
     )

@@ -1,0 +1,212 @@
+"""The navigation contract every layer reads: worlds, laws, probes, and the one step loop.
+
+A **world** holds one scene of one vehicle kind (the Ch. 2 unicycle, the Ch. 3 flyer, the Ch. 4
+planar UUV, the Ch. 5 UUV with its sonar array) with one or more agents.  It owns the exact
+integration, the obstacles' motion, the collision checks, the sensors and the metrics'
+bookkeeping.  A **law** (``Law[Obs, Cmd]``) is reset with an agent's limits, goal and generator,
+then sees only the observation its world's sensor makes and returns a command.  **Probes**
+watch the loop (recorders, traces of a law's internal state) without the loop knowing them.
+
+:func:`run_loop` is the only place where decisions are taken and timed (Gymnasium's ``Env`` and
+PettingZoo's ``ParallelEnv`` wrap the same world step by step, so an env episode and
+``uvnav simulate`` give the same trajectory)::
+
+    laws reset -> world.start()
+    while not world.done:
+        for i in world.acting():           # agents whose decision is due now
+            obs = world.observe(i)         # sensor of the world (the law's only input)
+            cmd = law_i.act(obs)           # timed: thread CPU time and wall time
+            world.apply(i, cmd)            # saturated and counted when outside the limits
+            probes.on_decision(...)
+        probes.on_step(...)                # the state before the step
+        world.advance()                    # every dt: vehicles, bodies, clearance, status
+    probes.on_end(...)                     # the final state
+
+Decision period and integration step are separate: a world says when a decision is due (every
+``control_period``, a whole multiple of ``dt``).  The loop counts each agent's mode switches and
+times each decision with :func:`time.thread_time_ns` (CPU time of this thread, immune to other
+processes on a loaded machine; wall time is kept beside it).
+
+This module imports nothing from uvnav: it is the bottom layer.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any, ClassVar, Protocol, TypeVar, runtime_checkable
+
+import numpy as np
+
+ObsT_co = TypeVar("ObsT_co", covariant=True)
+CmdT = TypeVar("CmdT")
+ObsT_contra = TypeVar("ObsT_contra", contravariant=True)
+CmdT_co = TypeVar("CmdT_co", covariant=True)
+
+#: Vehicle kinds: the Ch. 2 unicycle (also the Ch. 8 multi-robot agents), the Ch. 3/5 3D vehicle
+#: and the Ch. 4 planar underwater vehicle (holonomic, velocity-commanded).
+VEHICLES: tuple[str, ...] = ("unicycle", "vehicle3d", "uuv2d")
+
+#: Observation kinds a world's sensor makes and a law reads: range-limited exact readings of the
+#: bodies (Ch. 2/3), the Ch. 4 viewing-cone sonar, the Ch. 5 nine-beam sonar array.
+SENSINGS: tuple[str, ...] = ("exact", "sonar-fan", "sonar-array")
+
+#: Episode outcomes (``timeout`` also while an episode runs and at ``t_max``).
+STATUSES: tuple[str, ...] = ("success", "collision", "timeout")
+
+
+@runtime_checkable
+class Law(Protocol[ObsT_contra, CmdT_co]):
+    """A navigation law: it sees only its observation and returns its vehicle's command.
+
+    ``oracle`` is True when the law reads ground truth it could not sense (the world then hands
+    it the true rates instead of estimates); ``mode`` names the law's current mode (``"M1"``...)
+    for the mode-switch metric.
+    """
+
+    name: ClassVar[str]
+    oracle: bool
+
+    def reset(self, spec: Any, goal: np.ndarray, rng: np.random.Generator) -> None: ...
+
+    def act(self, obs: ObsT_contra) -> CmdT_co: ...
+
+    @property
+    def mode(self) -> str: ...
+
+
+class World(Protocol[ObsT_co, CmdT]):
+    """One scene stepped by :func:`run_loop`.
+
+    Class attributes ``vehicle`` and ``sensing`` (one of :data:`VEHICLES` / :data:`SENSINGS`)
+    say which laws can drive it.  ``t`` is the time [s], ``dt`` the integration step [s];
+    ``done`` becomes True when every agent has arrived, collided, or ``t_max`` is reached.
+    """
+
+    vehicle: ClassVar[str]
+    sensing: ClassVar[str]
+    t: float
+    dt: float
+    done: bool
+
+    @property
+    def n_agents(self) -> int: ...
+
+    def law_setup(self, agent: int) -> tuple[Any, np.ndarray, np.random.Generator]:
+        """``(spec, goal, rng)`` to reset agent ``agent``'s law with."""
+        ...
+
+    def start(self, oracles: Sequence[bool]) -> None:
+        """State, clearance and status at t = 0, after the laws' reset; ``oracles[i]`` says
+        whether agent i's law reads ground truth."""
+        ...
+
+    def acting(self) -> Sequence[int]:
+        """Agents whose decision is due now (empty between decisions)."""
+        ...
+
+    def observe(self, agent: int = 0) -> ObsT_co: ...
+
+    def apply(self, cmd: CmdT, agent: int = 0) -> CmdT:
+        """Hold ``cmd`` from now on (saturated and counted when outside the limits); returns the
+        command applied."""
+        ...
+
+    def advance(self) -> None:
+        """One integration step ``dt``."""
+        ...
+
+
+class Probe(Protocol):
+    """Watches :func:`run_loop`.  Every hook is optional (see :class:`BaseProbe`)."""
+
+    def on_start(self, world: Any, laws: Sequence[Any]) -> None: ...
+
+    def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None: ...
+
+    def on_step(self, world: Any, laws: Sequence[Any]) -> None: ...
+
+    def on_end(self, world: Any, laws: Sequence[Any]) -> None: ...
+
+
+class BaseProbe:
+    """A probe that does nothing; subclasses override the hooks they need."""
+
+    def on_start(self, world: Any, laws: Sequence[Any]) -> None:
+        """After ``world.start()``."""
+
+    def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
+        """After agent ``agent``'s law decided and ``applied`` was applied."""
+
+    def on_step(self, world: Any, laws: Sequence[Any]) -> None:
+        """Before each ``world.advance()`` (the state the step starts from)."""
+
+    def on_end(self, world: Any, laws: Sequence[Any]) -> None:
+        """After the last step (the final state)."""
+
+
+@dataclass
+class AgentLog:
+    """What the loop measured for one agent.
+
+    Attributes:
+        mode_switches: changes of the law's reported mode between consecutive decisions.
+        decision_us: CPU time of each decision [µs] (:func:`time.thread_time_ns`).
+        decision_wall_us: wall time of each decision [µs].
+        last_mode: the mode reported at the last decision (``""`` before any).
+    """
+
+    mode_switches: int = 0
+    decision_us: list[float] = field(default_factory=list)
+    decision_wall_us: list[float] = field(default_factory=list)
+    last_mode: str = ""
+    _decided: bool = False
+
+    def record(self, mode: str, cpu_ns: int, wall_ns: int) -> None:
+        """Account for one decision."""
+        if self._decided and mode != self.last_mode:
+            self.mode_switches += 1
+        self._decided = True
+        self.last_mode = mode
+        self.decision_us.append(cpu_ns / 1000.0)
+        self.decision_wall_us.append(wall_ns / 1000.0)
+
+
+def run_loop(
+    world: World[Any, Any], laws: Sequence[Law[Any, Any]], probes: Sequence[Probe] = ()
+) -> list[AgentLog]:
+    """Run ``world`` to its end with ``laws[i]`` driving agent i; returns each agent's log.
+
+    The laws are reset here (with :meth:`World.law_setup`), then the world is started.
+
+    Raises:
+        ValueError: the number of laws is not the world's number of agents.
+    """
+    if len(laws) != world.n_agents:
+        raise ValueError(f"{len(laws)} law(s) for a world with {world.n_agents} agent(s)")
+    for i, law in enumerate(laws):
+        spec, goal, rng = world.law_setup(i)
+        law.reset(spec, goal, rng)
+    world.start([bool(getattr(law, "oracle", False)) for law in laws])
+    logs = [AgentLog() for _ in laws]
+    for p in probes:
+        p.on_start(world, laws)
+    cpu_ns, wall_ns = _time.thread_time_ns, _time.perf_counter_ns
+    while not world.done:
+        for i in world.acting():
+            law = laws[i]
+            obs = world.observe(i)
+            c0, w0 = cpu_ns(), wall_ns()
+            cmd = law.act(obs)
+            c1, w1 = cpu_ns(), wall_ns()
+            applied = world.apply(cmd, i)
+            logs[i].record(law.mode, c1 - c0, w1 - w0)
+            for p in probes:
+                p.on_decision(world, i, law, obs, applied)
+        for p in probes:
+            p.on_step(world, laws)
+        world.advance()
+    for p in probes:
+        p.on_end(world, laws)
+    return logs
