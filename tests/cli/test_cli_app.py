@@ -117,9 +117,9 @@ def test_plot_calls_the_figure_module(
     free_scene: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     calls: list[tuple[Any, ...]] = []
-    fake = types.ModuleType("uvnav.viz.figures")
-    fake.plot_episode = lambda result, setup, path: calls.append((result, setup, path))  # type: ignore[attr-defined]
-    monkeypatch.setitem(sys.modules, "uvnav.viz.figures", fake)
+    fake = types.ModuleType("uvnav.viz.episode")
+    fake.plot_outcome = lambda out, path: calls.append((out.result, out.setup, path))  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "uvnav.viz.episode", fake)
     out = tmp_path / "ep.png"
     result = invoke("simulate", str(free_scene), "--json", "--plot", str(out))
     assert result.exit_code == 0, result.output
@@ -257,8 +257,9 @@ def test_scenarios_list_json_and_table() -> None:
     result = invoke("scenarios", "list", "--json")
     assert result.exit_code == 0
     rows = json.loads(result.stdout)
-    assert [r["name"] for r in rows] == list_builtin()
-    assert all(r["description"] for r in rows)
+    flat = [r["name"] for r in rows if r["kind"] == "nav2d" and r["obstacles"] is not None]
+    assert flat == [n for n in list_builtin() if load_scenario(n).dim == 2]
+    assert all(r["description"] for r in rows if r["kind"] == "nav2d")
     table = invoke("scenarios", "list")
     assert table.exit_code == 0
     for name in list_builtin():
@@ -279,7 +280,7 @@ def test_scenarios_show_prints_loadable_yaml() -> None:
 
 
 def test_scenarios_schema_is_the_model_schema() -> None:
-    result = invoke("scenarios", "schema")
+    result = invoke("scenarios", "schema", "--kind", "nav2d")
     assert result.exit_code == 0
     assert json.loads(result.stdout) == json.loads(json.dumps(Scenario.model_json_schema()))
 
@@ -295,11 +296,14 @@ def test_scenarios_validate_reports_each_file(free_scene: Path, tmp_path: Path) 
     bad.write_text(FREE_SCENE.replace("v_max: 0.7", "v_max: 0"))
     ok = invoke("scenarios", "validate", str(free_scene), "thesis-ch2-six-obstacles")
     assert ok.exit_code == 0, ok.output
-    assert ok.stdout.splitlines() == [f"OK {free_scene}", "OK thesis-ch2-six-obstacles"]
+    assert ok.stdout.splitlines() == [
+        f"OK {free_scene} [nav2d]",
+        "OK thesis-ch2-six-obstacles [nav2d]",
+    ]
     mixed = invoke("scenarios", "validate", str(free_scene), str(twitchy), str(bad))
     assert mixed.exit_code == 2
-    assert f"OK {free_scene}" in mixed.stdout
-    assert f"OK {twitchy} (1 warning)" in mixed.stdout
+    assert f"OK {free_scene} [nav2d]" in mixed.stdout
+    assert f"OK {twitchy} [nav2d] (1 warning)" in mixed.stdout
     assert "(2.8) Delta distance" in mixed.stdout
     assert mixed.stderr.strip() == f"error: {bad}: robot.v_max: must be > 0 (got 0)"
 

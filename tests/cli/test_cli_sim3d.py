@@ -31,7 +31,7 @@ def test_simulate_3d_with_another_law_and_bad_names() -> None:
     assert json.loads(res.stdout)["controller"] == "apf3d-v1"
     bad = runner.invoke(app, ["simulate", SCENE, "-c", "zhang2019-v1"])
     assert bad.exit_code == 2
-    assert "controller 'zhang2019-v1' drives the unicycle vehicle, not the vehicle3d" in bad.output
+    assert "zhang2019-v1 drives a unicycle with exact sensing; this nav3d scene" in bad.output
     assert "Traceback" not in bad.output
     bad = runner.invoke(app, ["simulate", SCENE, "-p", "alpha0=-1"])
     assert bad.exit_code == 2 and "alpha0" in bad.output and "Traceback" not in bad.output

@@ -17,6 +17,8 @@ import importlib
 import inspect
 import json
 import re
+import shutil
+import sys
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -26,7 +28,6 @@ import yaml
 from typer.core import TyperGroup
 
 from uvnav.cli.drive import drive_app
-from uvnav.cli.multi import multi_app
 from uvnav.cli.recon import recon_app
 from uvnav.cli.sonar import sonar_app
 from uvnav.controllers import (
@@ -39,17 +40,10 @@ from uvnav.controllers import (
 )
 from uvnav.controllers.base import VEHICLES
 from uvnav.scenarios import (
-    Scenario,
     ScenarioError,
-    build_episode,
     check_constraints,
-    list_builtin,
-    load_scenario,
-    scenario_text,
-    scenario_to_yaml,
-    validate_for_controller,
 )
-from uvnav.sim import METRIC_NAMES, run_episode, run_rng
+from uvnav.sim import METRIC_NAMES
 
 # ---------------------------------------------------------------------------------- error handling
 
@@ -114,6 +108,8 @@ def _one_line(text: str) -> str:
 
 def _first_sentence(text: str) -> str:
     """Up to the first full stop that ends a sentence (not the one in "Fig. 2.7")."""
+    if not text.strip():
+        return ""
     return re.split(r"(?<=[a-z0-9)\]])\.\s+(?=[A-Z])", text, maxsplit=1)[0].rstrip(".") + "."
 
 
@@ -133,7 +129,6 @@ controllers_app = typer.Typer(
 )
 app.add_typer(scenarios_app, name="scenarios")
 app.add_typer(controllers_app, name="controllers")
-app.add_typer(multi_app, name="multi")  # issue 9
 app.add_typer(recon_app, name="recon")
 app.add_typer(drive_app, name="drive")
 app.add_typer(sonar_app, name="sonar")
@@ -163,9 +158,12 @@ def _root(
 
 
 def _console(stderr: bool = False) -> Any:
+    """A rich console; into a file or a pipe, wide enough that no identifier is cut."""
     from rich.console import Console
 
-    return Console(stderr=stderr, highlight=False)
+    stream = sys.stderr if stderr else sys.stdout
+    width = None if stream.isatty() else 1000
+    return Console(stderr=stderr, highlight=False, width=width)
 
 
 def _text(value: Any) -> Any:
@@ -260,19 +258,30 @@ def _make_controller(name: str, params: dict[str, Any]) -> Any:
 @app.command()
 def simulate(
     scenario: Annotated[
-        str, typer.Argument(help="Built-in name, YAML file, or random-ch2:<seed>.")
+        str,
+        typer.Argument(
+            help="Built-in name, YAML file, or GENERATOR:SEED (random-ch2:3, random-ch4:1, "
+            "antipodal:8 = 8 robots; see 'uvnav scenarios list')."
+        ),
     ],
     controller: Annotated[
         str | None,
-        typer.Option("--controller", "-c", help="Controller name (default: the scenario's)."),
+        typer.Option("--controller", "-c", help="Law name (default: the scenario's)."),
     ] = None,
     param: Annotated[
         list[str] | None,
         typer.Option(
-            "--param", "-p", help="Controller parameter KEY=VALUE (repeatable; value read as YAML)."
+            "--param", "-p", help="Law parameter KEY=VALUE (repeatable; value read as YAML)."
         ),
     ] = None,
-    seed: Annotated[int, typer.Option(help="Episode seed (obstacle motion, sensing noise).")] = 0,
+    seed: Annotated[
+        int | None,
+        typer.Option(
+            min=0,
+            help="Episode seed (obstacle motion, sensing noise); default 0, or the generator's "
+            "seed for GENERATOR:SEED.",
+        ),
+    ] = None,
     json_out: Annotated[
         bool, typer.Option("--json", help="Print one JSON object instead of a table.")
     ] = False,
@@ -280,38 +289,35 @@ def simulate(
         Path | None, typer.Option(help="Also draw the episode into this image file.")
     ] = None,
 ) -> None:
-    """Run one episode of SCENARIO and print the metrics (DESIGN §4).
+    """Run one episode of SCENARIO (any vehicle) and print its metrics.
 
-    The scenario's controller parameters are used when the controller is the scenario's own;
-    ``--param`` values override them.  With another ``--controller`` only ``--param`` values apply.
+    The scenario's law parameters are used when the law is the scenario's own; ``--param``
+    values override them.  With another ``--controller`` only ``--param`` values apply.  A law
+    that drives another vehicle or reads another sensor than the scene's is refused.
     """
-    sc = load_scenario(scenario)
-    if getattr(sc, "dim", 2) == 3:  # thesis Ch. 3 scenes: the 3D simulator (cli/sim3d.py)
-        from uvnav.cli.sim3d import simulate3d
+    from uvnav.scenarios.catalog import resolve
+    from uvnav.scenarios.episodes import run_scene
 
-        simulate3d(sc, controller, parse_params(param), seed, json_out=json_out, plot=plot)  # type: ignore[arg-type]
-        return
-    name = controller or sc.controller.name
-    params = dict(sc.controller.params) if name == sc.controller.name else {}
-    params.update(parse_params(param))
-    validate_for_controller(sc, name)
-    ctrl = _make_controller(name, params)
-    plot_episode = (
-        _optional("uvnav.viz.figures", "plot_episode", "plotting (--plot)") if plot else None
+    resolved = resolve(scenario)
+    plot_outcome = (
+        _optional("uvnav.viz.episode", "plot_outcome", "plotting (--plot)") if plot else None
     )
-    setup = build_episode(sc, seed)
-    result = run_episode(setup, ctrl, run_rng(seed), record=plot is not None)
-    metrics = result.metrics.to_dict()
+    out = run_scene(resolved, controller, parse_params(param), seed, record=plot is not None)
     record: dict[str, Any] = {
-        "scenario": sc.name,
-        "controller": name,
-        "params": params,
-        "seed": seed,
-        "status": result.status,
-        **{k: metrics[k] for k in METRIC_NAMES},
+        "scenario": out.scene,
+        "kind": out.kind,
+        "controller": out.law,
+        "params": out.params,
+        "seed": out.seed,
+        "status": out.status,
+        **{k: out.metrics[k] for k in METRIC_NAMES},
+        **out.extra,
     }
-    if plot_episode is not None and plot is not None:
-        plot_episode(result, setup, plot)
+    if plot_outcome is not None and plot is not None:
+        try:
+            plot_outcome(out, plot)
+        except ValueError as exc:
+            raise CliError(str(exc)) from None
     if json_out:
         typer.echo(_dumps(record))
         if plot is not None:
@@ -319,14 +325,27 @@ def simulate(
         return
     from rich.table import Table
 
-    table = Table(title=f"{sc.name} | {name} | seed {seed} | {result.status}")
+    table = Table(title=f"{out.scene} | {out.law} | seed {out.seed} | {out.status}")
     table.add_column("metric")
     table.add_column("value", justify="right")
     table.add_column("unit")
     for key in METRIC_NAMES:
-        table.add_row(key, _fmt(metrics[key]), _METRIC_UNITS.get(key, ""))
+        table.add_row(key, _fmt(out.metrics[key]), _METRIC_UNITS.get(key, ""))
+    for key, value in out.extra.items():
+        if not isinstance(value, dict | list):
+            table.add_row(key, _fmt(value), "")
     con = _console()
     con.print(table)
+    robots = out.extra.get("robots")
+    if robots:
+        for row in robots:
+            t = row["time_to_goal"]
+            con.print(
+                _text(
+                    f"  {row['name']:>12}  {row['status']:<9}  path {row['path_length']:.2f} m"
+                    + (f"  arrived {t:.1f} s" if t is not None else "")
+                )
+            )
     if plot is not None:
         typer.echo(f"wrote {plot}")
 
@@ -334,43 +353,67 @@ def simulate(
 # --------------------------------------------------------------------------------------- scenarios
 
 
+def _scene_description(sc: Any) -> str:
+    return _one_line(str(getattr(sc, "description", "") or ""))
+
+
 @scenarios_app.command("list")
 def scenarios_list(
     json_out: Annotated[bool, typer.Option("--json", help="Print a JSON list.")] = False,
 ) -> None:
-    """List the built-in scenarios (thesis experiments first)."""
+    """List the built-in scenes of every kind (thesis experiments first) and the generators."""
+    from uvnav.scenarios.catalog import builtin_names, generators
+
     rows: list[dict[str, Any]] = []
-    for name in list_builtin():
-        sc = load_scenario(name)
+    for name, kind in builtin_names():
+        sc = kind.load(name)
         rows.append(
             {
                 "name": name,
-                "description": _one_line(sc.description),
-                "obstacles": len(sc.obstacles),
+                "kind": kind.name,
+                "description": _scene_description(sc),
+                "obstacles": len(getattr(sc, "obstacles", []) or []),
                 "controller": sc.controller.name,
+            }
+        )
+    for gen, kind in generators().items():
+        number = "<seed>" if kind.spec_is_seed else "<robots>"
+        rows.append(
+            {
+                "name": f"{gen}:{number}",
+                "kind": kind.name,
+                "description": f"generator of {kind.summary} scenes",
+                "obstacles": None,
+                "controller": None,
             }
         )
     if json_out:
         typer.echo(_dumps(rows))
         return
-    from rich.table import Table
-
-    table = Table(
-        title="built-in scenarios", caption="also: random-ch2:<seed> (random Chapter-2 scene)"
-    )
-    table.add_column("name", no_wrap=True)
-    table.add_column("obstacles", justify="right")
-    table.add_column("description (first sentence; `uvnav scenarios show NAME` for all)")
+    width = max(len(r["name"]) for r in rows)
+    cols = shutil.get_terminal_size().columns if sys.stdout.isatty() else None
+    typer.echo(f"{'name':<{width}}  {'kind':<7}  description ('uvnav scenarios show NAME')")
     for row in rows:
-        table.add_row(
-            _text(row["name"]), str(row["obstacles"]), _text(_first_sentence(row["description"]))
-        )
-    _console().print(table)
+        line = f"{row['name']:<{width}}  {row['kind']:<7}  {_first_sentence(row['description'])}"
+        if cols is not None and len(line) > cols:
+            line = line[: cols - 1] + "…"
+        typer.echo(line.rstrip())
+
+
+def _model_yaml(model: Any) -> str:
+    from uvnav.scenarios.loader import scenario_to_yaml
+    from uvnav.scenarios.schema import Scenario
+
+    if isinstance(model, Scenario):
+        return scenario_to_yaml(model)
+    import yaml
+
+    return str(yaml.safe_dump(model.model_dump(mode="json"), sort_keys=False))
 
 
 @scenarios_app.command("show")
 def scenarios_show(
-    name: Annotated[str, typer.Argument(help="Built-in name, YAML file, or random-ch2:<seed>.")],
+    name: Annotated[str, typer.Argument(help="Built-in name, YAML file, or GENERATOR:SEED.")],
     resolved: Annotated[
         bool,
         typer.Option(
@@ -378,40 +421,68 @@ def scenarios_show(
         ),
     ] = False,
 ) -> None:
-    """Print a scenario as YAML (the file as written, or --resolved)."""
-    sc = load_scenario(name)
-    if resolved or name.startswith("random-ch2:"):
-        typer.echo(scenario_to_yaml(sc), nl=False)
+    """Print a scenario as YAML (the file as written; a generated one, or --resolved, with
+    every default filled in)."""
+    from uvnav.scenarios.catalog import resolve
+
+    res = resolve(name)
+    if resolved or res.spec.partition(":")[1]:
+        typer.echo(_model_yaml(res.scenario), nl=False)
         return
-    _, text = scenario_text(name)
+    from uvnav.scenarios.loader import builtin_yaml_files
+
+    path = Path(name)
+    if not path.is_file():
+        subdir = {"uuv2d": "ch4", "uuv3d": "ch5"}.get(res.kind.name, "")
+        path = builtin_yaml_files(subdir)[name]
+    text = path.read_text()
     typer.echo(text, nl=not text.endswith("\n"))
 
 
 @scenarios_app.command("schema")
-def scenarios_schema() -> None:
-    """Print the JSON Schema of a scenario file."""
-    typer.echo(_dumps(Scenario.model_json_schema(), indent=2))
+def scenarios_schema(
+    kind: Annotated[
+        str | None,
+        typer.Option(help="Only this kind's schema (nav2d, nav3d, uuv2d, uuv3d, multi2d)."),
+    ] = None,
+) -> None:
+    """Print the JSON Schema of scenario files (every kind: one of the kinds' models)."""
+    from uvnav.scenarios.catalog import KINDS, kinds, scene_file_adapter
+
+    if kind is None:
+        typer.echo(_dumps(scene_file_adapter().json_schema(), indent=2))
+        return
+    if kind not in KINDS:
+        raise CliError(f"--kind: unknown kind {kind!r}; known: {', '.join(KINDS)}")
+    typer.echo(_dumps(kinds()[kind].model.model_json_schema(), indent=2))  # type: ignore[attr-defined]
 
 
 @scenarios_app.command("validate")
 def scenarios_validate(
     files: Annotated[list[str], typer.Argument(help="Scenario files (or built-in names).")],
 ) -> None:
-    """Check scenario files: OK, or one error line each, plus (2.6)-(2.8) constraint warnings.
+    """Check scenario files of any kind: OK, or one error line each, plus the law's assumption
+    warnings ((2.6)-(2.8) for the 2D scenes).
 
     Exit status 2 when any file is invalid.
     """
+    from uvnav.scenarios.catalog import resolve
+    from uvnav.scenarios.episodes import check_law
+
     invalid = 0
     for item in files:
         try:
-            sc = load_scenario(item)
+            res = resolve(item)
         except ScenarioError as exc:
             typer.echo(f"error: {exc}", err=True)
             invalid += 1
             continue
-        warnings = [f"{item}: {w}" for w in check_constraints(sc)]
+        sc = res.scenario
+        warnings = (
+            [f"{item}: {w}" for w in check_constraints(sc)] if res.kind.name == "nav2d" else []
+        )
         try:
-            validate_for_controller(sc, sc.controller.name)
+            check_law(res, sc.controller.name)
         except ScenarioError as exc:
             typer.echo(f"error: {item}: {exc.path}: {exc.problem}", err=True)
             invalid += 1
@@ -423,7 +494,7 @@ def scenarios_validate(
         suffix = (
             f" ({len(warnings)} warning{'s' if len(warnings) != 1 else ''})" if warnings else ""
         )
-        typer.echo(f"OK {item}{suffix}")
+        typer.echo(f"OK {item} [{res.kind.name}]{suffix}")
         for w in warnings:
             typer.echo(f"  warning: {w}")
     if invalid:

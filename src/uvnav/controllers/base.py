@@ -29,6 +29,8 @@ from typing import Any, ClassVar, Generic, Protocol, TypeVar, cast, runtime_chec
 
 import numpy as np
 
+from uvnav.core import SENSINGS
+from uvnav.core import VEHICLES as CORE_VEHICLES
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.sensors.observation import Observation
 
@@ -71,9 +73,10 @@ class ControllerInfo:
     vehicle: str = "unicycle"
 
 
-#: Vehicle kinds of the registry: the Ch. 2 unicycle (:class:`UnicycleCommand`), the Ch. 3/5 3D
-#: vehicle (``Vehicle3DCommand``) and the Ch. 4 holonomic underwater vehicle (``UuvCommand``).
-VEHICLES: tuple[str, ...] = ("unicycle", "vehicle3d", "uuv2d")
+#: Vehicle kinds of the registry (:data:`uvnav.core.VEHICLES`): the Ch. 2 unicycle
+#: (:class:`UnicycleCommand`), the Ch. 3/5 3D vehicle (``Vehicle3DCommand``) and the Ch. 4
+#: holonomic underwater vehicle (``HolonomicCommand``).
+VEHICLES: tuple[str, ...] = CORE_VEHICLES
 
 _REGISTRY: dict[str, ControllerInfo] = {}
 #: Modules of ``uvnav.controllers`` that register built-in unicycle laws when imported.
@@ -104,18 +107,35 @@ class ControllerParamsError(ValueError):
 
 
 def register(info: ControllerInfo) -> ControllerInfo:
-    """Add ``info`` to the registry (a later registration of the same name replaces it).
+    """Add ``info`` to the registry (registering the same entry again is a no-op).
 
     Raises:
-        ValueError: ``info.vehicle`` is not one of :data:`VEHICLES`.
+        ValueError: ``info.vehicle`` is not one of :data:`VEHICLES`, ``info.sensing`` not one of
+            :data:`uvnav.core.SENSINGS`, or another law already has the name.
     """
     if info.vehicle not in VEHICLES:
         raise ValueError(
             f"controller {info.name!r}: unknown vehicle {info.vehicle!r}; "
             f"known: {', '.join(VEHICLES)}"
         )
+    if info.sensing not in SENSINGS:
+        raise ValueError(
+            f"controller {info.name!r}: unknown sensing {info.sensing!r}; "
+            f"known: {', '.join(SENSINGS)}"
+        )
+    old = _REGISTRY.get(info.name)
+    if old is not None and old != info:
+        raise ValueError(
+            f"controller {info.name!r} is already registered (by {_origin(old)}); "
+            "choose another name"
+        )
     _REGISTRY[info.name] = info
     return info
+
+
+def _origin(info: ControllerInfo) -> str:
+    factory = info.factory
+    return f"{getattr(factory, '__module__', '?')}.{getattr(factory, '__qualname__', '?')}"
 
 
 def _load_entry_points() -> None:
@@ -198,11 +218,22 @@ def make_controller(name: str, *, oracle: bool = False, **params: Any) -> Contro
             ground-truth rates even when sensing is configured as estimated).
         **params: fields of the controller's ``Params`` dataclass.
     """
-    info = controller_info(name, "unicycle")
+    return cast(Controller, make_law(name, vehicle="unicycle", oracle=oracle, **params))
+
+
+def make_law(name: str, *, vehicle: str | None = None, oracle: bool = False, **params: Any) -> Any:
+    """Build any registered law by name (of ``vehicle`` only, when given) with keyword
+    parameters; ``oracle`` lets it read ground truth.
+
+    Raises:
+        UnknownControllerError: not registered (or another vehicle's law).
+        ControllerParamsError: unknown or invalid parameters.
+    """
+    info = controller_info(name, vehicle)
     p = build_params(info.params_type, params)
-    ctrl = info.factory(p) if info.params_type is not None else info.factory()
-    ctrl.oracle = oracle
-    return cast(Controller, ctrl)
+    law = info.factory(p) if info.params_type is not None else info.factory()
+    law.oracle = oracle
+    return law
 
 
 def params_dict(params: Any) -> dict[str, Any]:

@@ -1,0 +1,305 @@
+"""One scenario model for every vehicle: scene kinds, one name resolver, one generator registry.
+
+A scene is one of five **kinds** (:data:`KINDS`), each with its vehicle and sensing (the
+contract of :mod:`uvnav.core`), its pydantic model, its built-ins and its generators:
+
+=========  ============  ===========  ==============================================
+kind       vehicle       sensing      what
+=========  ============  ===========  ==============================================
+nav2d      unicycle      exact        Ch. 2 unicycle among moving bodies, crowds
+nav3d      vehicle3d     exact        Ch. 3 flyer among moving 3D bodies
+uuv2d      uuv2d         sonar-fan    Ch. 4 planar UUV, viewing-cone sonar, AMAPS
+uuv3d      vehicle3d     sonar-array  Ch. 5 UUV, nine sonars, deforming bodies
+multi2d    unicycle      exact        Ch. 8 N unicycles in one world
+=========  ============  ===========  ==============================================
+
+:func:`resolve` turns what a user types into a scene: a built-in name, a YAML file (its kind is
+read from its content: ``kind:``, ``robots:``, ``dim: 3`` with ``sonar:``, ``dim: 3``, else
+2D) or ``generator:seed``.  ``generator:seed`` is scene number ``seed`` of the generator *and*
+episode seed ``seed``, in ``uvnav simulate``, ``uvnav bench`` and the API alike (the multi-robot
+generators' number is the number of robots: ``antipodal:8``).
+
+:data:`SceneFile` is the discriminated union of the five models (for ``uvnav scenarios schema``):
+the discriminator is :func:`infer_kind`, the same rule as the resolver's.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Annotated, Any, Union
+
+import numpy as np
+from pydantic import Discriminator, Tag, TypeAdapter
+
+from uvnav.scenarios.errors import ScenarioError
+
+
+@dataclass(frozen=True)
+class SceneKind:
+    """A kind of scene.
+
+    Attributes:
+        name: the kind's name (:data:`KINDS`).
+        vehicle: the vehicle of :data:`uvnav.core.VEHICLES` its laws must drive.
+        sensing: the observation of :data:`uvnav.core.SENSINGS` its world makes.
+        summary: one line for listings.
+        model: the pydantic model of its files.
+        load: built-in name, path or ``generator:seed`` -> validated model.
+        builtins: names of its built-in scenes.
+        generators: generator names (``name:seed`` specs).
+        episode_rng: the episode generator of seed ``s`` (the stream the chapter's reproduction
+            uses, so that a seed reproduces the reproduction's episode).
+        spec_is_seed: the number of ``generator:N`` is the scene's seed (else a size, as the
+            number of robots of ``antipodal:N``).
+    """
+
+    name: str
+    vehicle: str
+    sensing: str
+    summary: str
+    model: type
+    load: Callable[[str], Any]
+    builtins: Callable[[], list[str]]
+    generators: tuple[str, ...]
+    episode_rng: Callable[[int], np.random.Generator]
+    spec_is_seed: bool = True
+
+
+@dataclass(frozen=True)
+class Resolved:
+    """A resolved scene: its kind, the validated model, the text typed, and the episode seed a
+    ``generator:seed`` spec fixes (``None`` for a built-in or a file)."""
+
+    kind: SceneKind
+    scenario: Any
+    spec: str
+    seed: int | None
+
+    @property
+    def name(self) -> str:
+        return str(getattr(self.scenario, "name", self.spec))
+
+
+def _run_rng(seed: int) -> np.random.Generator:
+    from uvnav.sim.seeding import run_rng
+
+    return run_rng(seed)
+
+
+def _plain_rng(seed: int) -> np.random.Generator:
+    return np.random.default_rng(seed)
+
+
+def _nav2d_load(spec: str) -> Any:
+    from uvnav.scenarios.loader import load_scenario
+
+    sc = load_scenario(spec)
+    if getattr(sc, "dim", 2) != 2:
+        raise ScenarioError(spec, "dim", "is a 3D scene (kind nav3d), not a 2D one")
+    return sc
+
+
+def _nav3d_load(spec: str) -> Any:
+    from uvnav.scenarios.loader import load_scenario
+
+    sc = load_scenario(spec)
+    if getattr(sc, "dim", 2) != 3:
+        raise ScenarioError(spec, "dim", "is a 2D scene (kind nav2d), not a 3D one")
+    return sc
+
+
+def _builtins_of_dim(dim: int) -> list[str]:
+    from uvnav.scenarios.loader import builtin_yaml_files, list_builtin
+
+    files = builtin_yaml_files()
+    out = []
+    for name in list_builtin():
+        text = files[name].read_text()
+        is3d = any(line.split("#")[0].strip() == "dim: 3" for line in text.splitlines())
+        if is3d == (dim == 3):
+            out.append(name)
+    return out
+
+
+def _uuv2d_load(spec: str) -> Any:
+    from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, load_uuv2d_scenario
+
+    gen, sep, number = spec.partition(":")
+    if sep and gen in UUV2D_GENERATORS:
+        return UUV2D_GENERATORS[gen](_seed_of(spec, number))
+    return load_uuv2d_scenario(spec)
+
+
+def _uuv3d_load(spec: str) -> Any:
+    from uvnav.scenarios.ch5 import load_ch5_scenario
+
+    return load_ch5_scenario(spec)
+
+
+def _multi_load(spec: str) -> Any:
+    from uvnav.scenarios.multi import load_multi_scenario
+
+    return load_multi_scenario(spec)
+
+
+def _models() -> dict[str, type]:
+    from uvnav.scenarios.ch5 import Scenario5
+    from uvnav.scenarios.multi import MultiScenario
+    from uvnav.scenarios.schema import Scenario
+    from uvnav.scenarios.schema3d import Scenario3D
+    from uvnav.scenarios.uuv2d import Uuv2dScenario
+
+    return {
+        "nav2d": Scenario,
+        "nav3d": Scenario3D,
+        "uuv2d": Uuv2dScenario,
+        "uuv3d": Scenario5,
+        "multi2d": MultiScenario,
+    }
+
+
+def _kinds() -> dict[str, SceneKind]:
+    from uvnav.scenarios.ch5 import GENERATOR_CH5, GENERATOR_CH5_DENSE, list_ch5_builtin
+    from uvnav.scenarios.generators import GENERATORS
+    from uvnav.scenarios.multi import MULTI_GENERATORS
+    from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin
+
+    models = _models()
+    gen2d = tuple(g for g in GENERATORS if g != "random-ch3")
+    return {
+        k.name: k
+        for k in (
+            SceneKind(
+                "nav2d", "unicycle", "exact", "Ch. 2 unicycle among moving bodies and crowds",
+                models["nav2d"], _nav2d_load, lambda: _builtins_of_dim(2), gen2d, _run_rng,
+            ),
+            SceneKind(
+                "nav3d", "vehicle3d", "exact", "Ch. 3 flying robot among moving 3D bodies",
+                models["nav3d"], _nav3d_load, lambda: _builtins_of_dim(3), ("random-ch3",),
+                _plain_rng,
+            ),
+            SceneKind(
+                "uuv2d", "uuv2d", "sonar-fan", "Ch. 4 planar UUV, sonar only, deforming bodies",
+                models["uuv2d"], _uuv2d_load, list_uuv2d_builtin, tuple(UUV2D_GENERATORS),
+                _plain_rng,
+            ),
+            SceneKind(
+                "uuv3d", "vehicle3d", "sonar-array", "Ch. 5 UUV with nine sonars among "
+                "deforming bodies", models["uuv3d"], _uuv3d_load, list_ch5_builtin,
+                (GENERATOR_CH5, GENERATOR_CH5_DENSE), _plain_rng,
+            ),
+            SceneKind(
+                "multi2d", "unicycle", "exact", "N unicycles in one world (Ch. 8)",
+                models["multi2d"], _multi_load, list, tuple(MULTI_GENERATORS), _run_rng,
+                spec_is_seed=False,
+            ),
+        )
+    }  # fmt: skip
+
+
+_KINDS: dict[str, SceneKind] | None = None
+
+
+def kinds() -> Mapping[str, SceneKind]:
+    """Every scene kind by name (:data:`KINDS` order)."""
+    global _KINDS
+    if _KINDS is None:
+        _KINDS = _kinds()
+    return _KINDS
+
+
+#: Scene kinds, in the order of the thesis's chapters.
+KINDS: tuple[str, ...] = ("nav2d", "nav3d", "uuv2d", "uuv3d", "multi2d")
+
+
+def generators() -> dict[str, SceneKind]:
+    """Every generator name and the kind of scene it makes (one registry; duplicates refused)."""
+    out: dict[str, SceneKind] = {}
+    for k in kinds().values():
+        for g in k.generators:
+            if g in out:
+                raise RuntimeError(f"generator {g!r} is registered by {out[g].name} and {k.name}")
+            out[g] = k
+    return out
+
+
+def infer_kind(data: Any) -> str:
+    """The kind of a scene file's mapping: its ``kind``; else ``robots`` -> multi2d; ``dim: 3``
+    with ``sonar`` -> uuv3d; ``dim: 3`` -> nav3d; else nav2d."""
+    if isinstance(data, Mapping):
+        kind = data.get("kind")
+        if isinstance(kind, str) and kind in KINDS:
+            return kind
+        if "robots" in data:
+            return "multi2d"
+        if data.get("dim") == 3:
+            return "uuv3d" if "sonar" in data else "nav3d"
+        return "nav2d"
+    # a validated model
+    for name, model in _models().items():
+        if isinstance(data, model):
+            return name
+    return "nav2d"
+
+
+def _seed_of(spec: str, text: str) -> int:
+    if not text.isdigit():
+        raise ScenarioError(spec, "seed", f"must be a non-negative integer (got {text!r})")
+    seed = int(text)
+    if seed >= 2**63:
+        raise ScenarioError(spec, "seed", f"must be below 2**63 (got {text})")
+    return seed
+
+
+def _file_kind(path: Path) -> str:
+    from uvnav.scenarios.loader import parse_yaml
+
+    try:
+        text = path.read_text()
+    except UnicodeDecodeError:
+        raise ScenarioError(str(path), "", "is not a text (YAML) file") from None
+    except OSError as exc:
+        raise ScenarioError(str(path), "", f"cannot be read ({exc.strerror or exc})") from None
+    return infer_kind(parse_yaml(text, str(path)))
+
+
+def resolve(spec: str) -> Resolved:
+    """The scene ``spec`` names: ``generator:seed``, a built-in name or a YAML file.
+
+    Raises:
+        ScenarioError: unknown name, unreadable or invalid file, bad seed (one line).
+    """
+    gen, sep, number = spec.partition(":")
+    by_gen = generators()
+    if sep and gen in by_gen:
+        seed = _seed_of(spec, number)
+        kind = by_gen[gen]
+        return Resolved(kind, kind.load(spec), spec, seed if kind.spec_is_seed else None)
+    for kind in kinds().values():
+        if spec in kind.builtins():
+            return Resolved(kind, kind.load(spec), spec, None)
+    path = Path(spec)
+    if path.is_dir():
+        raise ScenarioError(spec, "", "is a directory, not a scenario file")
+    if path.is_file():
+        kind = kinds()[_file_kind(path)]
+        return Resolved(kind, kind.load(spec), spec, None)
+    raise ScenarioError(
+        spec,
+        "",
+        "no such file or built-in scene, nor a GENERATOR:N spec (see 'uvnav scenarios list')",
+    )
+
+
+def builtin_names() -> list[tuple[str, SceneKind]]:
+    """Every built-in scene with its kind, in :data:`KINDS` order."""
+    return [(name, k) for k in kinds().values() for name in k.builtins()]
+
+
+def scene_file_adapter() -> TypeAdapter[Any]:
+    """A pydantic adapter of :data:`SceneFile` (validation and JSON Schema of every kind)."""
+    members = tuple(Annotated[model, Tag(name)] for name, model in _models().items())
+    union: Any = Annotated[Union[members], Discriminator(infer_kind)]  # noqa: UP007
+    return TypeAdapter(union)

@@ -1,0 +1,270 @@
+"""One episode of any scene kind with any compatible law: the one path behind ``uvnav simulate``
+(and the API): law/scene compatibility and the law's assumptions are checked here, once.
+
+A law fits a scene when it drives the scene's vehicle and reads the observation the scene's
+sensor makes (:class:`~uvnav.scenarios.catalog.SceneKind`'s ``vehicle`` and ``sensing`` against
+the registry's :class:`~uvnav.controllers.ControllerInfo`); otherwise :class:`LawMismatchError`
+says so in one line.  A law that declares obstacles slower than the robot (thesis (2.6)) is
+refused on a 2D scene that breaks it (:func:`uvnav.scenarios.validate_for_controller`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from uvnav.controllers.base import (
+    ControllerInfo,
+    ControllerParamsError,
+    controller_info,
+    make_law,
+)
+from uvnav.scenarios.catalog import Resolved
+from uvnav.scenarios.errors import ScenarioError
+
+METRIC_NAMES: tuple[str, ...] = (
+    "success",
+    "collision",
+    "min_clearance",
+    "path_length",
+    "detour_ratio",
+    "time_to_goal",
+    "time_ratio",
+    "control_effort",
+    "limit_violations",
+    "mode_switches",
+    "decision_us_median",
+    "decision_us_p99",
+)
+
+
+class LawMismatchError(ScenarioError):
+    """The law cannot drive the scene (another vehicle or another sensor)."""
+
+
+@dataclass
+class Outcome:
+    """One episode's result in a kind-independent form.
+
+    Attributes:
+        kind: the scene kind; scene: its name; law: the law's name; params: its parameters;
+        seed: the episode seed.
+        status: ``success``/``collision``/``timeout`` (multi-robot: ``success`` when every
+            robot arrived, ``collision`` when any collided, else ``timeout``).
+        metrics: the :data:`METRIC_NAMES` of the episode (multi-robot: of the group: success
+            = all arrived, collision = any, the others the robots' mean).
+        extra: the kind's own results (forbidden regions, inner space, group metrics, robots).
+        result, setup: the simulator's own result and setup (for figures).
+    """
+
+    kind: str
+    scene: str
+    law: str
+    params: dict[str, Any]
+    seed: int
+    status: str
+    metrics: dict[str, Any]
+    extra: dict[str, Any] = field(default_factory=dict)
+    result: Any = None
+    setup: Any = None
+    trajectory: Any = None
+
+
+def default_law(resolved: Resolved) -> tuple[str, dict[str, Any]]:
+    """The scene's own law and parameters."""
+    ctrl = resolved.scenario.controller
+    return str(ctrl.name), dict(getattr(ctrl, "params", {}) or {})
+
+
+def check_law(resolved: Resolved, law: str) -> ControllerInfo:
+    """The registry entry of ``law`` if it fits ``resolved``'s scene.
+
+    Raises:
+        UnknownControllerError: no such law.
+        LawMismatchError: the law drives another vehicle or reads another sensor.
+        ScenarioError: the scene breaks an assumption the law declares (thesis (2.6)).
+    """
+    info = controller_info(law)
+    kind = resolved.kind
+    if (info.vehicle, info.sensing) != (kind.vehicle, kind.sensing):
+        raise LawMismatchError(
+            resolved.spec,
+            "controller",
+            f"{law} drives a {info.vehicle} with {info.sensing} sensing; this {kind.name} scene "
+            f"has a {kind.vehicle} with {kind.sensing} sensing "
+            f"(see 'uvnav controllers list --vehicle {kind.vehicle}')",
+        )
+    if kind.name == "nav2d":
+        from uvnav.scenarios.build import validate_for_controller
+
+        validate_for_controller(resolved.scenario, law)
+    return info
+
+
+def episode_seed(resolved: Resolved, seed: int | None) -> int:
+    """The episode seed: the generator's number for ``generator:seed``, else ``seed`` (0).
+
+    Raises:
+        ScenarioError: another ``seed`` is given with a ``generator:seed`` spec.
+    """
+    if resolved.seed is not None:
+        if seed is not None and seed != resolved.seed:
+            raise ScenarioError(
+                resolved.spec,
+                "seed",
+                f"is {resolved.seed} for this generator spec; run "
+                f"'{resolved.spec.partition(':')[0]}:{seed}' for seed {seed}",
+            )
+        return resolved.seed
+    return 0 if seed is None else int(seed)
+
+
+def run_scene(
+    resolved: Resolved,
+    law: str | None = None,
+    params: dict[str, Any] | None = None,
+    seed: int | None = None,
+    *,
+    record: bool = False,
+) -> Outcome:
+    """Run one episode of ``resolved`` with ``law`` (default: the scene's own, with its
+    parameters; ``params`` override them, and are the only ones for another law).
+
+    Raises:
+        UnknownControllerError, ControllerParamsError, LawMismatchError, ScenarioError: as above.
+    """
+    own, own_params = default_law(resolved)
+    name = law or own
+    merged = dict(own_params) if name == own else {}
+    merged.update(params or {})
+    check_law(resolved, name)
+    s = episode_seed(resolved, seed)
+    runner = _RUNNERS[resolved.kind.name]
+    try:
+        return runner(resolved, name, merged, s, record)
+    except ControllerParamsError as exc:
+        if str(exc).startswith(f"controller {name}"):
+            raise
+        raise ControllerParamsError(f"controller {name}: {exc}") from None
+
+
+def _single(
+    resolved: Resolved, name: str, params: dict[str, Any], seed: int, res: Any, **kw: Any
+) -> Outcome:
+    return Outcome(
+        kind=resolved.kind.name,
+        scene=resolved.name,
+        law=name,
+        params=params,
+        seed=seed,
+        status=res.status,
+        metrics=res.metrics.to_dict(),
+        result=res,
+        **kw,
+    )
+
+
+def _nav2d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
+    from uvnav.scenarios.build import build_episode
+    from uvnav.sim.episode import run_episode
+
+    setup = build_episode(r.scenario, seed)
+    res = run_episode(setup, make_law(name, **params), r.kind.episode_rng(seed), record=record)
+    return _single(r, name, params, seed, res, setup=setup, trajectory=res.trajectory)
+
+
+def _nav3d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
+    from uvnav.sim.episode3d import run_episode3d
+
+    setup = r.scenario.build(seed)
+    law = make_law(name, **params)
+    res, traj = run_episode3d(setup, law, r.kind.episode_rng(seed), record=record)
+    return _single(r, name, params, seed, res, setup=setup, trajectory=traj)
+
+
+def _uuv2d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
+    from uvnav.sim.episode_uuv2d import run_uuv2d_episode
+
+    setup = r.scenario.to_setup()
+    law = make_law(name, **params)
+    res = run_uuv2d_episode(setup, law, r.kind.episode_rng(seed), record=record)
+    out = _single(r, name, params, seed, res, setup=setup, trajectory=res.trajectory)
+    out.extra["entered_forbidden"] = bool(res.entered_forbidden)
+    return out
+
+
+def _uuv3d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
+    from uvnav.controllers.zhang_uuv3d import GeometricLocator, OracleLocator
+    from uvnav.scenarios.ch5 import build_uuv3d
+    from uvnav.sim.episode_uuv3d import run_uuv3d_episode
+
+    locator = r.scenario.controller.locator
+    if locator == "network":
+        raise ScenarioError(
+            r.spec,
+            "controller.locator",
+            "'network' needs a trained model: run 'uvnav sonar simulate --model CHECKPOINT'",
+        )
+    law = make_law(name, **params)
+    law.locator = OracleLocator() if locator == "oracle" else GeometricLocator()
+    law.oracle = locator == "oracle"
+    setup = build_uuv3d(r.scenario)
+    res = run_uuv3d_episode(setup, law, r.kind.episode_rng(seed), record=record)
+    out = _single(r, name, params, seed, res, setup=setup)
+    out.extra["entered_inner_space"] = bool(res.entered_inner_space)
+    out.extra["locator"] = locator
+    return out
+
+
+def _mean(values: list[Any]) -> float | None:
+    nums = [float(v) for v in values if v is not None]
+    return sum(nums) / len(nums) if nums else None
+
+
+def _multi(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
+    from uvnav.scenarios.multi import build_multi
+    from uvnav.sim.multi import run_multi
+
+    own, own_params = default_law(r)
+    if name == own and params == own_params:  # each robot keeps its own law, if it has one
+        setup = build_multi(r.scenario, seed)
+    else:
+        setup = build_multi(r.scenario, seed, controller=name, params=params)
+    res = run_multi(setup, r.kind.episode_rng(seed), record=record)
+    robots = [m.to_dict() for m in res.robots]
+    g = res.group
+    status = (
+        "success"
+        if g.all_arrived
+        else ("collision" if any(s == "collision" for s in res.statuses) else "timeout")
+    )
+    metrics: dict[str, Any] = {key: _mean([row[key] for row in robots]) for key in METRIC_NAMES[2:]}
+    metrics["success"] = bool(g.all_arrived)
+    metrics["collision"] = status == "collision"
+    clear = [row["min_clearance"] for row in robots if row["min_clearance"] is not None]
+    metrics["min_clearance"] = min(clear) if clear else None
+    for key in ("limit_violations", "mode_switches"):
+        metrics[key] = int(sum(row[key] for row in robots))
+    metrics["decision_us_p99"] = max(row["decision_us_p99"] for row in robots)
+    metrics = {k: metrics[k] for k in METRIC_NAMES}
+    names = [rb.name for rb in setup.robots]
+    extra = {
+        "group": g.to_dict(),
+        "robots": [
+            {"name": n, "status": s, **row}
+            for n, s, row in zip(names, res.statuses, robots, strict=True)
+        ],
+    }
+    return Outcome(
+        kind=r.kind.name, scene=r.name, law=name, params=params, seed=seed, status=status,
+        metrics=metrics, extra=extra, result=res, setup=setup,
+    )  # fmt: skip
+
+
+_RUNNERS = {
+    "nav2d": _nav2d,
+    "nav3d": _nav3d,
+    "uuv2d": _uuv2d,
+    "uuv3d": _uuv3d,
+    "multi2d": _multi,
+}
