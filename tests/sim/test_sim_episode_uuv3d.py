@@ -3,12 +3,15 @@ narrow inner space."""
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 from uvnav.controllers.zhang_uuv3d import GeometricLocator, OracleLocator, ZhangUUV3D
+from uvnav.core import SENSINGS, VEHICLES
 from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
-from uvnav.sim.episode_uuv3d import run_uuv3d_episode
+from uvnav.sim.episode_uuv3d import UUV3DWorld, run_uuv3d_episode
 from uvnav.sim.metrics import METRIC_NAMES
 
 
@@ -40,3 +43,29 @@ def test_scene3_with_the_oracle_and_noise_is_deterministic() -> None:
     c = run_uuv3d_episode(setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(4))
     assert b.metrics.success
     assert b.metrics.path_length == c.metrics.path_length
+
+
+def test_world_contract_shared_generator_and_oracle_truth() -> None:
+    setup = build_uuv3d(load_ch5_scenario("thesis-ch5-scene1"))
+    rng = np.random.default_rng(0)
+    world = UUV3DWorld(setup, rng)
+    assert world.vehicle in VEHICLES and world.sensing in SENSINGS and world.n_agents == 1
+    spec, goal, law_rng = world.law_setup(0)
+    assert law_rng is rng  # the Ch. 5 quirk: the law and the sonar share one generator
+    assert spec is setup.spec and np.array_equal(goal, setup.goal)
+    world.start([False])
+    assert world.t == 0.0 and not world.done and world.acting() == (0,)
+    assert world.observe().truth_point is None
+    world.start([True])
+    assert world.observe().truth_point is not None
+
+
+def test_step_count_and_trace_ends_at_t_max() -> None:
+    setup = dataclasses.replace(build_uuv3d(load_ch5_scenario("thesis-ch5-scene1")), t_max=0.5)
+    res = run_uuv3d_episode(
+        setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(0), record=True
+    )
+    assert res.status == "timeout"
+    assert res.times == pytest.approx([0.0, 0.2, 0.4, 0.5])  # decisions, then the final state
+    assert len(res.located) == len(res.true_nearest) == len(res.modes) == 4
+    assert np.isnan(res.located[-1]).all()

@@ -1,30 +1,33 @@
-"""The Chapter 5 step loop: a 3D vehicle with the nine-sonar array among shape-changing obstacles.
+"""The Chapter 5 world: a 3D vehicle with the nine-sonar array among shape-changing obstacles.
 
 Thesis Chapter 5 (Y. Zhang and J. Zhang, ICCAE 2022): vehicle (5.1)-(5.7), sonar array (5.8),
-obstacles with fixed centres whose surfaces deform (§5.2.4).  Same conventions as the 2D loop
-(:mod:`uvnav.sim.episode`): the controller is asked every ``control_period`` [s] (a whole multiple
-of ``dt``), vehicle and obstacles advance every ``dt`` [s] with the command held (the vehicle's
-exact sphere integration, :func:`~uvnav.dynamics.vehicle3d.vehicle3d_advance`), a command outside
-the limits is saturated *and* counted in ``limit_violations``, and collisions are checked at every
+obstacles with fixed centres whose surfaces deform (§5.2.4).  :class:`UUV3DWorld` is stepped by
+the one loop :func:`uvnav.core.run_loop`, with the 2D world's conventions
+(:mod:`uvnav.sim.episode`): the law is asked every ``control_period`` [s] (a whole multiple of
+``dt``), vehicle and obstacles advance every ``dt`` [s] with the command held (the vehicle's exact
+sphere integration, :func:`~uvnav.dynamics.vehicle3d.vehicle3d_advance`), a command outside the
+limits is saturated *and* counted in ``limit_violations``, and collisions are checked at every
 integration step against the obstacles' tessellations at that time (hull sphere against triangle
 meshes, exact for the mesh; the mesh is within ``tessellation_error`` of the analytic surface).
 Metrics carry the names of :data:`uvnav.sim.metrics.METRIC_NAMES`.
 
 Scene 2's check that the vehicle never enters an obstacle's inner space is reported separately
-(:attr:`UUV3DResult.entered_inner_space`), as is the located-point error when recorded.
+(:attr:`UUV3DResult.entered_inner_space`), as is the located-point error when recorded
+(:class:`LocatedTraceProbe`).
 """
 
 from __future__ import annotations
 
 import math
-import time as _time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any, ClassVar
 
 import numpy as np
 
 from uvnav.controllers.zhang_uuv3d import SonarObservation3D, ZhangUUV3D
-from uvnav.dynamics.vehicle3d import Vehicle3DSpec, vehicle3d_advance
+from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
+from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec, vehicle3d_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.mesh3d import nearest_on_mesh
 from uvnav.obstacles.deforming3d import CompoundBody
@@ -99,126 +102,228 @@ def _nearest(
     return best, point
 
 
+class UUV3DWorld:
+    """The Chapter-5 world: one 3D UUV, its sonar array, deforming obstacles
+    (:class:`uvnav.core.World`).
+
+    Every integration step ends with the checks (clearance to the nearest mesh point, inner
+    space, arrival): :meth:`start` makes them at t = 0, :meth:`advance` integrates one ``dt`` and
+    makes them at the new time.  The episode ends on collision, arrival or after
+    ``n_steps = ceil(t_max / dt - 1e-9)`` steps.
+
+    Random streams: unlike the other worlds, one generator serves both the law and the sonar:
+    :meth:`law_setup` returns ``rng`` itself (not a child), so the law's reset draws and each
+    :func:`~uvnav.sensors.sonar_array.sonar_scan` draw from the same stream, in the order the
+    chapter's original loop used them (the recorded numbers depend on it; do not split it).
+
+    Args:
+        setup: the episode (not modified: the obstacles' surfaces are functions of time).
+        rng: the episode generator, shared by the law and the sonar (above).
+    """
+
+    vehicle: ClassVar[str] = "vehicle3d"
+    sensing: ClassVar[str] = "sonar-array"
+    n_agents: ClassVar[int] = 1
+
+    def __init__(self, setup: UUV3DSetup, rng: np.random.Generator) -> None:
+        self.setup = setup
+        self.rng = rng
+        self.spec = setup.spec
+        self.dt = float(setup.dt)
+        self.ratio = decision_ratio(setup.control_period, setup.dt)
+        self.n_steps = math.ceil(setup.t_max / setup.dt - 1e-9)
+        self.goal = np.asarray(setup.goal, dtype=float)
+        self.pos = np.asarray(setup.start, dtype=float).copy()
+        head = np.asarray(setup.heading, dtype=float)
+        self.head = head / np.linalg.norm(head)
+        self.obstacles = setup.obstacles
+        self.t = 0.0
+        self.done = False
+
+    def law_setup(self, agent: int = 0) -> tuple[Vehicle3DSpec, FloatArray, np.random.Generator]:
+        """The law's limits, goal and generator (the world's own ``rng``: class docstring)."""
+        return self.spec, self.goal, self.rng
+
+    def start(self, oracles: Sequence[bool] = (False,)) -> None:
+        """Bookkeeping and the checks at t = 0; an oracle law gets the true nearest point."""
+        self.oracle = bool(oracles[0])
+        self.step_index = 0
+        self.v_held = 0.0
+        self.u_held = np.zeros(3)
+        self.v_prev = 0.0
+        self.effort = 0.0
+        self.path = 0.0
+        self.violations = 0
+        self.min_clear = math.inf
+        self.collided = False
+        self.inner = False
+        self.reached_at: float | None = None
+        self._check()
+
+    def _check(self) -> None:
+        """Clearance, nearest point, inner space and arrival at ``t``; ends the episode on
+        collision, arrival or the last step."""
+        pos, t = self.pos, self.t
+        if self.obstacles:
+            d, self.nearest = _nearest(pos, self.obstacles, t, math.inf)
+        else:
+            d, self.nearest = math.inf, None
+        self.clearance = d - self.spec.radius
+        self.min_clear = min(self.min_clear, self.clearance)
+        if self.clearance < 0:
+            self.collided = True
+        if not self.inner and any(bool(ob.in_inner_space(pos[None])[0]) for ob in self.obstacles):
+            self.inner = True
+        if float(np.linalg.norm(self.goal - pos)) <= self.setup.goal_tolerance:
+            self.reached_at = t
+        self.done = self.collided or self.reached_at is not None or self.step_index >= self.n_steps
+
+    def acting(self) -> tuple[int, ...]:
+        """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
+        return (0,) if self.step_index % self.ratio == 0 else ()
+
+    def observe(self, agent: int = 0) -> SonarObservation3D:
+        """The nine-sonar scan of the tessellations now (noise and dropout from ``rng``); the
+        true nearest point only for an oracle law."""
+        t = self.t
+        tri = merge_triangles([p.triangles(t) for ob in self.obstacles for p in ob.parts])
+        scan = sonar_scan(self.setup.array, self.pos, self.head, tri, self.rng)
+        q = self.nearest
+        return SonarObservation3D(
+            time=t,
+            position=self.pos.copy(),
+            heading=self.head.copy(),
+            speed=self.v_held,
+            goal=self.goal,
+            ranges=scan.ranges,
+            echo=scan.echo,
+            array=self.setup.array,
+            truth_point=None if (q is None or not self.oracle) else q.copy(),
+        )
+
+    def apply(self, cmd: Vehicle3DCommand, agent: int = 0) -> Vehicle3DCommand:
+        """Hold ``cmd``: counted in ``limit_violations`` when outside the limits (judged against
+        the current heading, as the turn rate must be normal to it), saturated."""
+        if cmd.violates(self.spec, self.head):
+            self.violations += 1
+        cmd = cmd.clipped(self.spec, self.head)
+        self.v_held, self.u_held = float(cmd.v), np.asarray(cmd.u, dtype=float)
+        return cmd
+
+    def advance(self) -> None:
+        """One step ``dt``: effort, the vehicle (exact), then the checks at the new time."""
+        dt = self.dt
+        self.effort += float(self.u_held @ self.u_held) * dt
+        if self.step_index % self.ratio == 0:
+            # Ch. 5's speed term differs from the other worlds' on purpose (the recorded Ch. 5
+            # numbers use it): it is counted at every decision, the first included (from rest,
+            # v = 0), as ((v - v_prev) / period)^2 * period.
+            period = self.setup.control_period
+            self.effort += ((self.v_held - self.v_prev) / period) ** 2 * period
+            self.v_prev = self.v_held
+        new_pos, self.head, self.u_held = vehicle3d_advance(
+            self.pos, self.head, self.v_held, self.u_held, dt
+        )
+        self.path += float(np.linalg.norm(new_pos - self.pos))
+        self.pos = new_pos
+        self.step_index = k = self.step_index + 1
+        self.t = k * dt
+        self._check()
+
+    @property
+    def status(self) -> str:
+        """``success`` (arrived without collision), ``collision`` or ``timeout``."""
+        if self.collided:
+            return "collision"
+        return "success" if self.reached_at is not None else "timeout"
+
+    def close(self) -> None:
+        """Nothing to write back (the obstacles' surfaces are functions of time)."""
+
+    def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
+        """The episode's metrics (:mod:`uvnav.sim.metrics`)."""
+        spec, status = self.spec, self.status
+        straight = max(
+            float(np.linalg.norm(self.goal - np.asarray(self.setup.start, float)))
+            - self.setup.goal_tolerance,
+            1e-9,
+        )
+        finite = bool(self.obstacles) and math.isfinite(self.min_clear)
+        return episode_metrics(
+            status=status,
+            path_length=self.path,
+            shortest=straight,
+            straight_time=straight / spec.v_max,
+            reached_at=self.reached_at if status == "success" else None,
+            min_clearance=float(self.min_clear) if finite else None,
+            control_effort=self.effort,
+            limit_violations=self.violations,
+            mode_switches=log.mode_switches,
+            decision_us=log.decision_us,
+        )
+
+
+class LocatedTraceProbe(BaseProbe):
+    """Records a :class:`UUV3DWorld` at each decision and at the end: time, position, the law's
+    mode, the law's located point and the true nearest obstacle point.
+
+    The located point is a trace of the law's internal state (``law.last_located`` of
+    :class:`~uvnav.controllers.zhang_uuv3d.ZhangUUV3D`, NaN when it located nothing), read here
+    so that neither the world nor the loop knows it.
+    """
+
+    def __init__(self) -> None:
+        self.times: list[float] = []
+        self.positions: list[FloatArray] = []
+        self.modes: list[str] = []
+        self.located: list[FloatArray] = []
+        self.true_nearest: list[FloatArray] = []
+
+    def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
+        self.times.append(world.t)
+        self.positions.append(world.pos.copy())
+        self.modes.append(law.mode)
+        loc = getattr(law, "last_located", None)
+        self.located.append(loc.point.copy() if loc is not None else np.full(3, np.nan))
+        q = world.nearest
+        self.true_nearest.append(q.copy() if q is not None else np.full(3, np.nan))
+
+    def on_end(self, world: Any, laws: Sequence[Any]) -> None:
+        self.times.append(world.t)
+        self.positions.append(world.pos.copy())
+        self.modes.append(laws[0].mode)
+        self.located.append(np.full(3, np.nan))
+        self.true_nearest.append(np.full(3, np.nan))
+
+
 def run_uuv3d_episode(
     setup: UUV3DSetup,
     controller: ZhangUUV3D,
     rng: np.random.Generator,
     *,
     record: bool = False,
+    probes: Sequence[Probe] = (),
 ) -> UUV3DResult:
-    """Run one episode (module docstring).
+    """Run one episode (:func:`uvnav.core.run_loop` over a :class:`UUV3DWorld`).
+
+    Args:
+        setup: the instantiated scene.
+        controller: the Ch. 5 law; it is reset here with ``rng`` itself (shared with the sonar).
+        rng: the episode generator.
+        record: keep the trace at decisions (:class:`LocatedTraceProbe`).
+        probes: more probes to run in the loop.
 
     Raises:
         ValueError: ``control_period`` is not a whole multiple of ``dt``.
     """
-    spec = setup.spec
-    ratio = decision_ratio(setup.control_period, setup.dt)
-    pos = np.asarray(setup.start, dtype=float).copy()
-    head = np.asarray(setup.heading, dtype=float)
-    head = head / np.linalg.norm(head)
-    goal = np.asarray(setup.goal, dtype=float)
-    controller.reset(spec, goal, rng)
-    n_steps = math.ceil(setup.t_max / setup.dt - 1e-9)
-    u_held = np.zeros(3)
-    v_held = 0.0
-    v_prev = 0.0
-    effort = 0.0
-    path = 0.0
-    violations = 0
-    switches = 0
-    last_mode = controller.mode
-    decision_us: list[float] = []
-    min_clear = math.inf
-    collided = False
-    inner = False
-    reached_t: float | None = None
-    res_times: list[float] = []
-    res_pos: list[FloatArray] = []
-    res_modes: list[str] = []
-    res_loc: list[FloatArray] = []
-    res_true: list[FloatArray] = []
-    has_obstacles = bool(setup.obstacles)
-    for k in range(n_steps + 1):
-        t = k * setup.dt
-        d, q = _nearest(pos, setup.obstacles, t, math.inf) if has_obstacles else (math.inf, None)
-        clear = d - spec.radius
-        min_clear = min(min_clear, clear)
-        if clear < 0:
-            collided = True
-        if any(bool(ob.in_inner_space(pos[None])[0]) for ob in setup.obstacles):
-            inner = True
-        if float(np.linalg.norm(goal - pos)) <= setup.goal_tolerance:
-            reached_t = t
-        if collided or reached_t is not None or k == n_steps:
-            break
-        if k % ratio == 0:
-            tri = merge_triangles([p.triangles(t) for ob in setup.obstacles for p in ob.parts])
-            scan = sonar_scan(setup.array, pos, head, tri, rng)
-            obs = SonarObservation3D(
-                time=t,
-                position=pos.copy(),
-                heading=head.copy(),
-                speed=v_held,
-                goal=goal,
-                ranges=scan.ranges,
-                echo=scan.echo,
-                array=setup.array,
-                truth_point=None if (q is None or not controller.oracle) else q.copy(),
-            )
-            tic = _time.perf_counter()
-            cmd = controller.act(obs)
-            decision_us.append((_time.perf_counter() - tic) * 1e6)
-            if cmd.violates(spec, head):
-                violations += 1
-            cmd = cmd.clipped(spec, head)
-            v_held, u_held = float(cmd.v), np.asarray(cmd.u, dtype=float)
-            if controller.mode != last_mode:
-                switches += 1
-                last_mode = controller.mode
-            if record:
-                res_times.append(t)
-                res_pos.append(pos.copy())
-                res_modes.append(controller.mode)
-                loc = controller.last_located
-                res_loc.append(loc.point.copy() if loc is not None else np.full(3, np.nan))
-                res_true.append(q.copy() if q is not None else np.full(3, np.nan))
-        effort += float(u_held @ u_held) * setup.dt
-        if k % ratio == 0:
-            effort += ((v_held - v_prev) / setup.control_period) ** 2 * setup.control_period
-            v_prev = v_held
-        new_pos, head, u_held = vehicle3d_advance(pos, head, v_held, u_held, setup.dt)
-        path += float(np.linalg.norm(new_pos - pos))
-        pos = new_pos
-    if record:
-        res_times.append(k * setup.dt)
-        res_pos.append(pos.copy())
-        res_modes.append(controller.mode)
-        res_loc.append(np.full(3, np.nan))
-        res_true.append(np.full(3, np.nan))
-    success = reached_t is not None and not collided
-    straight = max(
-        float(np.linalg.norm(goal - np.asarray(setup.start, float))) - setup.goal_tolerance, 1e-9
-    )
-    status = "success" if success else ("collision" if collided else "timeout")
-    metrics = episode_metrics(
-        status=status,
-        path_length=path,
-        shortest=straight,
-        straight_time=straight / spec.v_max,
-        reached_at=reached_t if success else None,
-        min_clearance=float(min_clear) if has_obstacles and math.isfinite(min_clear) else None,
-        control_effort=effort,
-        limit_violations=violations,
-        mode_switches=switches,
-        decision_us=decision_us,
-    )
-    return UUV3DResult(
-        metrics=metrics,
-        entered_inner_space=inner,
-        status=status,
-        times=res_times,
-        positions=res_pos,
-        modes=res_modes,
-        located=res_loc,
-        true_nearest=res_true,
-    )
+    world = UUV3DWorld(setup, rng)
+    rec = LocatedTraceProbe() if record else None
+    try:
+        (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
+    finally:
+        world.close()
+    out = UUV3DResult(world.metrics(log), world.inner, world.status)
+    if rec is not None:
+        out.times, out.positions, out.modes = rec.times, rec.positions, rec.modes
+        out.located, out.true_nearest = rec.located, rec.true_nearest
+    return out
