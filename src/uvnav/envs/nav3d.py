@@ -1,10 +1,11 @@
 """``uvnav/Nav3D-v0``: a Gymnasium environment on the 3D world of the thesis's Chapter 3.
 
 One flying robot (the vehicle (3.1)-(3.6) of :mod:`uvnav.dynamics.vehicle3d`) among a Chapter-3
-scene's moving, rotating 3D obstacles.  The world is stepped by the simulator's own step-wise API
-(:class:`uvnav.sim.episode3d.Sim3D`, the code behind :func:`~uvnav.sim.episode3d.run_episode3d`):
-one env step is one decision (``control_period``), integrated exactly with the scene's ``dt``,
-with the exact clearance checked at every integration step.
+scene's moving, rotating 3D obstacles.  The env steps the simulator's own world
+(:class:`uvnav.sim.episode3d.Vehicle3DWorld`, the one
+:func:`~uvnav.sim.episode3d.run_episode3d` runs): one env step is one decision
+(``control_period``), integrated exactly with the scene's ``dt``, with the exact clearance
+checked at every integration step.
 
 **Sensing.**  The observation is built only from what the robot's sensor returns
 (:func:`uvnav.sensors.sensing3d.sense_obstacles3d`, thesis (3.8): for each obstacle within
@@ -65,7 +66,7 @@ from uvnav.envs.common import SimView, fill_polygon, pixel_grid, scene_for_episo
 from uvnav.envs.core import ROBOT_COLOURS, RewardConfig
 from uvnav.envs.nav2d import reward_config
 from uvnav.sensors.sensing3d import Observation3D
-from uvnav.sim.episode3d import Sim3D
+from uvnav.sim.episode3d import Vehicle3DWorld
 
 try:
     import gymnasium as gym
@@ -199,35 +200,35 @@ class Nav3DEnv(gym.Env[np.ndarray, np.ndarray]):
             low[5 + SLOT * j + 2 : 5 + SLOT * j + 8] = -1.0
         self.observation_space = spaces.Box(low=low, high=np.ones_like(low), dtype=np.float32)
         self.action_space = spaces.Box(low=-1.0, high=1.0, shape=(3,), dtype=np.float32)
-        self._sim: Sim3D | None = None
+        self._world: Vehicle3DWorld | None = None
         self._obs: Observation3D | None = None
         self._clearance = math.inf
 
     # ------------------------------------------------------------------------------ helpers
     def _vector(self) -> np.ndarray:
-        sim, obs = self._sim, self._obs
-        assert sim is not None and obs is not None
+        world, obs = self._world, self._obs
+        assert world is not None and obs is not None
         return observation_vector(
             obs,
-            v_max=sim.spec.v_max,
+            v_max=world.spec.v_max,
             goal_scale=self.goal_scale,
-            sensing_range=sim.sensing.sensing_range,
+            sensing_range=world.sensing_range,
             n_obstacles=self.n_obstacles,
         )
 
     def _info(self) -> dict[str, Any]:
-        sim, obs = self._sim, self._obs
-        assert sim is not None and obs is not None
-        spec, heading = sim.spec, obs.heading.copy()
+        world, obs = self._world, self._obs
+        assert world is not None and obs is not None
+        spec, heading = world.spec, obs.heading.copy()
 
         def to_action(cmd: Vehicle3DCommand) -> np.ndarray:
             return action_of(cmd.clipped(spec, heading), heading, spec.v_max, spec.u_max)
 
         return {
-            "status": sim.status if sim.done else "running",
-            "distance": float(np.linalg.norm(sim.goal - sim.pos)),
+            "status": world.status if world.done else "running",
+            "distance": float(np.linalg.norm(world.goal - world.pos)),
             "clearance": float(self._clearance),
-            "time": sim.t,
+            "time": world.t,
             "uvnav": SimView(obs, spec, to_action),
         }
 
@@ -240,56 +241,55 @@ class Nav3DEnv(gym.Env[np.ndarray, np.ndarray]):
         sc = scene_for_episode(self.scenario, self._generators, episode_seed)
         velocities = "known" if self.oracle else "estimated"
         setup = sc.build(episode_seed, velocities=velocities)
-        sense_rng = np.random.default_rng(episode_seed).spawn(2)[1]
-        self._sim = sim = Sim3D(setup, sense_rng, known=self.oracle, exact=True)
-        sim.start()
-        self._clearance = sim.clearance
-        self._obs = sim.observe()
+        self._world = world = Vehicle3DWorld(setup, np.random.default_rng(episode_seed), exact=True)
+        world.start([self.oracle])
+        self._clearance = world.clearance
+        self._obs = world.observe()
         return self._vector(), self._info()
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        sim = self._sim
-        if sim is None:
+        world = self._world
+        if world is None:
             raise RuntimeError("call reset() before step()")
-        if sim.done:
+        if world.done:
             raise RuntimeError("the episode is over: call reset()")
         rw = self.reward_config
-        before = float(np.linalg.norm(sim.goal - sim.pos))
-        sim.apply(command_of(action, sim.a, sim.spec.v_max, sim.spec.u_max))
+        before = float(np.linalg.norm(world.goal - world.pos))
+        world.apply(command_of(action, world.a, world.spec.v_max, world.spec.u_max))
         low = math.inf
-        for _ in range(sim.ratio):
-            sim.advance()
-            low = min(low, sim.clearance)
-            if sim.done:
+        for _ in range(world.ratio):
+            world.advance()
+            low = min(low, world.clearance)
+            if world.done:
                 break
         self._clearance = low
-        after = float(np.linalg.norm(sim.goal - sim.pos))
-        terminated = sim.done and sim.status in ("success", "collision")
-        truncated = sim.done and not terminated
-        reward = rw.reward(before - after, low, sim.status if terminated else "running")
-        self._obs = sim.observe()
+        after = float(np.linalg.norm(world.goal - world.pos))
+        terminated = world.done and world.status in ("success", "collision")
+        truncated = world.done and not terminated
+        reward = rw.reward(before - after, low, world.status if terminated else "running")
+        self._obs = world.observe()
         return self._vector(), float(reward), terminated, truncated, self._info()
 
     def render(self) -> np.ndarray | None:
-        if self.render_mode != "rgb_array" or self._sim is None:
+        if self.render_mode != "rgb_array" or self._world is None:
             return None
-        return render_frame3d(self._sim)
+        return render_frame3d(self._world)
 
     def close(self) -> None:
-        self._sim = None
+        self._world = None
         self._obs = None
 
 
-def render_frame3d(sim: Sim3D, size: int = 256) -> np.ndarray:
+def render_frame3d(world: Vehicle3DWorld, size: int = 256) -> np.ndarray:
     """A (size, 2 size, 3) uint8 frame: top view (x-y) left, side view (x-z) right; obstacles
     grey (convex hull of their projected vertices), the robot a coloured disc with its path's
     goal as a square."""
     import shapely
 
     img = np.full((size, 2 * size, 3), 255, dtype=np.uint8)
-    start = np.asarray(sim.setup.start, dtype=float)
-    pts = [start[None, :], sim.goal[None, :], sim.pos[None, :]]
-    outlines = [ob.world_outline() for ob in sim.obstacles]
+    start = np.asarray(world.setup.start, dtype=float)
+    pts = [start[None, :], world.goal[None, :], world.pos[None, :]]
+    outlines = [ob.world_outline() for ob in world.obstacles]
     pts += outlines
     allp = np.vstack(pts)
     col = ROBOT_COLOURS[0]
@@ -302,12 +302,12 @@ def render_frame3d(sim: Sim3D, size: int = 256) -> np.ndarray:
             if hull.geom_type == "Polygon":
                 fill_polygon(view, np.asarray(hull.exterior.coords), (120, 120, 120), gx, gy)
         px = (bounds[2] - bounds[0]) / size
-        g = sim.goal[list(axes)]
+        g = world.goal[list(axes)]
         view[(np.abs(gx - g[0]) <= 2.5 * px) & (np.abs(gy - g[1]) <= 2.5 * px)] = col
-        p = sim.pos[list(axes)]
-        rad = max(float(sim.spec.radius), 2.0 * px)
+        p = world.pos[list(axes)]
+        rad = max(float(world.spec.radius), 2.0 * px)
         view[np.hypot(gx - p[0], gy - p[1]) <= rad] = col
-        tip = p + rad * sim.a[list(axes)]
+        tip = p + rad * world.a[list(axes)]
         view[np.hypot(gx - tip[0], gy - tip[1]) <= 1.5 * px] = (0, 0, 0)
     img[:, size - 1 : size + 1] = 0
     return img

@@ -3,9 +3,9 @@
 One planar UUV (the vehicle (4.1)-(4.6) of :mod:`uvnav.dynamics.holonomic`: a world-frame
 velocity, each component bounded by V_max, its direction turning at most U_max per second) among
 a Chapter-4 scene's shape-changing obstacles, sensed by the viewing-cone sonar of §4.2
-(:func:`uvnav.sensors.sonar2d.sonar_scan`).  The world is stepped by the simulator's own
-step-wise API (:class:`uvnav.sim.episode_uuv2d.SimUuv2d`, the code behind
-:func:`~uvnav.sim.episode_uuv2d.run_uuv2d_episode`): one env step is one decision
+(:func:`uvnav.sensors.sonar2d.sonar_scan`).  The env steps the simulator's own world
+(:class:`uvnav.sim.episode_uuv2d.Uuv2dWorld`, the one
+:func:`~uvnav.sim.episode_uuv2d.run_uuv2d_episode` runs): one env step is one decision
 (``control_period``), integrated with the scene's ``dt``, with the exact clearance to the
 outlines of that instant checked at every integration step.
 
@@ -60,7 +60,7 @@ from uvnav.envs.core import ROBOT_COLOURS, RewardConfig
 from uvnav.envs.nav2d import reward_config
 from uvnav.geometry.angles import wrap_scalar
 from uvnav.sensors.sonar2d import SonarObservation
-from uvnav.sim.episode_uuv2d import SimUuv2d
+from uvnav.sim.episode_uuv2d import Uuv2dWorld
 
 try:
     import gymnasium as gym
@@ -155,35 +155,35 @@ class Uuv2DEnv(gym.Env[np.ndarray, np.ndarray]):
         self.observation_space = spaces.Box(low=low, high=np.ones_like(low), dtype=np.float32)
         self.action_space = spaces.Box(low=-1.0, high=1.0, shape=(2,), dtype=np.float32)
         self._n_beams = n
-        self._sim: SimUuv2d | None = None
+        self._world: Uuv2dWorld | None = None
         self._obs: SonarObservation | None = None
         self._clearance = math.inf
 
     def _vector(self) -> np.ndarray:
-        sim, obs = self._sim, self._obs
-        assert sim is not None and obs is not None
+        world, obs = self._world, self._obs
+        assert world is not None and obs is not None
         if len(obs.sonar.ranges) != self._n_beams:
             raise ValueError(
                 f"scene {self.scenario!r}: its sonar has {len(obs.sonar.ranges)} beams, the "
                 f"observation space {self._n_beams}"
             )
-        return observation_vector(obs, v_max=sim.spec.v_max, goal_scale=self.goal_scale)
+        return observation_vector(obs, v_max=world.spec.v_max, goal_scale=self.goal_scale)
 
     def _info(self) -> dict[str, Any]:
-        sim, obs = self._sim, self._obs
-        assert sim is not None and obs is not None
-        spec, heading, period = sim.spec, float(obs.heading), sim.period
+        world, obs = self._world, self._obs
+        assert world is not None and obs is not None
+        spec, heading, period = world.spec, float(obs.heading), world.period
 
         def to_action(cmd: HolonomicCommand) -> np.ndarray:
             applied = cmd.clipped(spec, heading, period)
             return action_of(applied, heading, spec.v_max, spec.u_max, period)
 
         return {
-            "status": sim.status if sim.done else "running",
-            "distance": float(math.hypot(*(sim.goal - sim.state[:2]))),
+            "status": world.status if world.done else "running",
+            "distance": float(math.hypot(*(world.goal - world.state[:2]))),
             "clearance": float(self._clearance),
-            "time": sim.t,
-            "entered_forbidden": bool(sim.entered),
+            "time": world.t,
+            "entered_forbidden": bool(world.entered),
             "uvnav": SimView(obs, spec, to_action),
         }
 
@@ -193,71 +193,70 @@ class Uuv2DEnv(gym.Env[np.ndarray, np.ndarray]):
         super().reset(seed=seed)
         episode_seed = int(self.np_random.integers(2**31 - 1))
         sc = scene_for_episode(self.scenario, self._generators, episode_seed)
-        sense_rng = np.random.default_rng(episode_seed).spawn(2)[1]
-        self._sim = sim = SimUuv2d(sc.to_setup(), sense_rng)
-        sim.start()
-        self._clearance = sim.clearance
-        self._obs = sim.observe()
+        self._world = world = Uuv2dWorld(sc.to_setup(), np.random.default_rng(episode_seed))
+        world.start()
+        self._clearance = world.clearance
+        self._obs = world.observe()
         return self._vector(), self._info()
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        sim = self._sim
-        if sim is None:
+        world = self._world
+        if world is None:
             raise RuntimeError("call reset() before step()")
-        if sim.done:
+        if world.done:
             raise RuntimeError("the episode is over: call reset()")
         rw = self.reward_config
-        before = float(math.hypot(*(sim.goal - sim.state[:2])))
-        spec = sim.spec
-        sim.apply(command_of(action, float(sim.state[2]), spec.v_max, spec.u_max, sim.period))
+        before = float(math.hypot(*(world.goal - world.state[:2])))
+        spec = world.spec
+        world.apply(command_of(action, float(world.state[2]), spec.v_max, spec.u_max, world.period))
         low = math.inf
-        for _ in range(sim.ratio):
-            sim.advance()
-            low = min(low, sim.clearance)
-            if sim.done:
+        for _ in range(world.ratio):
+            world.advance()
+            low = min(low, world.clearance)
+            if world.done:
                 break
         self._clearance = low
-        after = float(math.hypot(*(sim.goal - sim.state[:2])))
-        terminated = sim.done and sim.status in ("success", "collision")
-        truncated = sim.done and not terminated
-        reward = rw.reward(before - after, low, sim.status if terminated else "running")
-        self._obs = sim.observe()
+        after = float(math.hypot(*(world.goal - world.state[:2])))
+        terminated = world.done and world.status in ("success", "collision")
+        truncated = world.done and not terminated
+        reward = rw.reward(before - after, low, world.status if terminated else "running")
+        self._obs = world.observe()
         return self._vector(), float(reward), terminated, truncated, self._info()
 
     def render(self) -> np.ndarray | None:
-        if self.render_mode != "rgb_array" or self._sim is None:
+        if self.render_mode != "rgb_array" or self._world is None:
             return None
-        return render_frame_uuv2d(self._sim, self._obs)
+        return render_frame_uuv2d(self._world, self._obs)
 
     def close(self) -> None:
-        self._sim = None
+        self._world = None
         self._obs = None
 
 
 def render_frame_uuv2d(
-    sim: SimUuv2d, obs: SonarObservation | None = None, size: int = 256
+    world: Uuv2dWorld, obs: SonarObservation | None = None, size: int = 256
 ) -> np.ndarray:
     """A (size, size, 3) uint8 frame of the scene now: obstacles grey, trap inner spaces pink,
     the last sonar returns black, the vehicle a coloured disc and its goal a square; y up."""
     img = np.full((size, size, 3), 255, dtype=np.uint8)
-    start = np.asarray(sim.setup.start, dtype=float)[None, :2]
-    allp = np.vstack([start, sim.goal[None, :], sim.state[None, :2], *sim.outlines])
+    start = np.asarray(world.setup.start, dtype=float)[None, :2]
+    allp = np.vstack([start, world.goal[None, :], world.state[None, :2], *world.outlines])
     bounds = square_bounds(allp, 1.0)
     gx, gy = pixel_grid(bounds, size, size)
     px = (bounds[2] - bounds[0]) / size
-    for region in sim.setup.forbidden:
+    for region in world.setup.forbidden:
         fill_polygon(img, region, (255, 200, 200), gx, gy)
-    for ol in sim.outlines:
+    for ol in world.outlines:
         fill_polygon(img, ol, (120, 120, 120), gx, gy)
     if obs is not None:
         for p in obs.sonar.points:
             if np.all(np.isfinite(p)):
                 img[np.hypot(gx - p[0], gy - p[1]) <= 1.2 * px] = (0, 0, 0)
     col = ROBOT_COLOURS[0]
-    g = sim.goal
+    g = world.goal
     img[(np.abs(gx - g[0]) <= 2.5 * px) & (np.abs(gy - g[1]) <= 2.5 * px)] = col
-    x, y, th = sim.state
-    rad = max(float(sim.spec.radius), 2.0 * px)
+    x, y, th = world.state
+    rad = max(float(world.spec.radius), 2.0 * px)
     img[np.hypot(gx - x, gy - y) <= rad] = col
     tip = np.hypot(gx - (x + rad * math.cos(th)), gy - (y + rad * math.sin(th))) <= 1.5 * px
     img[tip] = (0, 0, 0)

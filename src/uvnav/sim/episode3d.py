@@ -1,5 +1,6 @@
-"""The 3D step loop: sensing, decisions, exact integration, exact collision checks, metrics
-(DESIGN §2, §4; thesis Chapter 3).
+"""The Chapter-3 world: sensing, exact integration, exact collision checks, metrics (DESIGN §2,
+§4; thesis Chapter 3), stepped by the one loop :func:`uvnav.core.run_loop` (which times each
+decision in CPU time).
 
 The controller is asked every ``control_period`` [s] (a whole multiple of ``dt``); the robot
 (:func:`uvnav.dynamics.vehicle3d.vehicle3d_advance`, exact on the sphere of headings) and the
@@ -20,13 +21,14 @@ is sensed (``"estimated"``, :class:`uvnav.sensors.sensing3d.FiniteDifference3D`)
 from __future__ import annotations
 
 import math
-import time as _time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 
 from uvnav.controllers.base3d import Controller3D
+from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec, vehicle3d_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.frames3d import check_unit
@@ -111,62 +113,6 @@ class Trajectory3D:
     obstacle_faces: list[np.ndarray | None]
 
 
-class _Recorder:
-    def __init__(self, obstacles: list[Obstacle3D]) -> None:
-        self.rows: list[tuple[Any, ...]] = []
-        self.outlines = [o.body.outline_points() for o in obstacles]
-        self.faces = [getattr(o.body, "faces", None) for o in obstacles]
-
-    def add(
-        self,
-        t: float,
-        pos: FloatArray,
-        a: FloatArray,
-        v: float,
-        u: FloatArray,
-        mode: str,
-        clearance: float,
-        nearest: int,
-        obstacles: list[Obstacle3D],
-        predicted: dict[int, Any],
-    ) -> None:
-        n = len(obstacles)
-        pred = np.full((n, 3), np.nan)
-        for i, val in predicted.items():
-            if 0 <= i < n:
-                pred[i] = val[0]
-        self.rows.append(
-            (
-                t, pos.copy(), a.copy(), v, u.copy(), mode, clearance, nearest,
-                np.array([o.state.centre for o in obstacles]).reshape(n, 3),
-                np.array([o.state.velocity for o in obstacles]).reshape(n, 3),
-                np.array([o.state.rotation_rate for o in obstacles]).reshape(n, 3),
-                pred,
-                np.array([o.state.rotation for o in obstacles]).reshape(n, 3, 3),
-            )
-        )  # fmt: skip
-
-    def finish(self) -> Trajectory3D:
-        cols = list(zip(*self.rows, strict=True))
-        return Trajectory3D(
-            time=np.array(cols[0]),
-            position=np.array(cols[1]),
-            heading=np.array(cols[2]),
-            speed=np.array(cols[3]),
-            turn=np.array(cols[4]),
-            mode=np.array(cols[5]),
-            clearance=np.array(cols[6]),
-            nearest=np.array(cols[7]),
-            obstacle_centres=np.array(cols[8]),
-            obstacle_velocity=np.array(cols[9]),
-            obstacle_rotation_rate=np.array(cols[10]),
-            predicted_velocity=np.array(cols[11]),
-            obstacle_rotations=np.array(cols[12]),
-            obstacle_outlines=self.outlines,
-            obstacle_faces=self.faces,
-        )
-
-
 def clearance3d(
     position: FloatArray, obstacles: list[Obstacle3D], robot_radius: float
 ) -> tuple[float, int]:
@@ -242,26 +188,33 @@ class _GapTracker:
         return out, out_i
 
 
-class Sim3D:
-    """The 3D world advanced one integration step at a time: the step-wise API behind
-    :func:`run_episode3d` and the Gymnasium env ``uvnav/Nav3D-v0`` (:mod:`uvnav.envs.nav3d`).
+class Vehicle3DWorld:
+    """The Chapter-3 world: one 3D vehicle among moving, rotating bodies
+    (:class:`uvnav.core.World`), run by :func:`run_episode3d` and stepped by the Gymnasium env
+    ``uvnav/Nav3D-v0`` (:mod:`uvnav.envs.nav3d`).
 
-    The caller alternates :meth:`observe` / :meth:`apply` at decision times (:attr:`decision_due`)
-    with :meth:`advance` every ``dt`` until :attr:`done`; the bookkeeping (path, effort, limit
-    violations, clearance, status) is the loop's, so both users get the same numbers.
+    The bookkeeping (path, effort, limit violations, clearance, status) lives here, so both users
+    get the same numbers.
 
     Args:
         setup: the episode (its obstacles are advanced in place).
-        sense_rng: generator of the sensing noise (the estimator's).
-        known: give the obstacles' true rates (oracle) instead of finite differences.
+        rng: the episode generator; two independent children feed the law and the sensing noise
+            (the estimator's).
         exact: exact clearance every step (:func:`clearance3d`); otherwise the
             :class:`_GapTracker`'s bound, exact whenever it can set a new minimum.
+
+    Raises:
+        ValueError: a non-unit initial heading, or a control period that is not a whole multiple
+            of ``dt``.
     """
 
-    def __init__(
-        self, setup: Episode3DSetup, sense_rng: np.random.Generator, *, known: bool, exact: bool
-    ) -> None:
+    vehicle: ClassVar[str] = "vehicle3d"
+    sensing: ClassVar[str] = "exact"
+    n_agents: ClassVar[int] = 1
+
+    def __init__(self, setup: Episode3DSetup, rng: np.random.Generator, *, exact: bool) -> None:
         self.setup = setup
+        self._law_rng, self.sense_rng = rng.spawn(2)
         self.spec = setup.spec
         self.dt = float(setup.dt)
         self.ratio = decision_ratio(float(setup.control_period), self.dt)
@@ -270,17 +223,26 @@ class Sim3D:
         self.pos = np.asarray(setup.start, dtype=float).copy()
         self.a = check_unit(setup.heading, name="heading").copy()
         self.obstacles = setup.obstacles
-        self.sensing = setup.sensing
-        self.known = known
+        self.sensing_range = float(setup.sensing.sensing_range)
         self.exact = exact
-        self.estimator = (
-            None if known else FiniteDifference3D(sense_rng, self.sensing.position_noise)
-        )
+        self.t = 0.0
+        self.done = False
 
-    def start(self) -> None:
-        """Rates of the first step, clearance and status at t = 0 (after the law's reset)."""
+    def law_setup(self, agent: int = 0) -> tuple[Vehicle3DSpec, FloatArray, np.random.Generator]:
+        """The law's limits, goal and generator."""
+        return self.spec, self.goal, self._law_rng
+
+    def start(self, oracles: Sequence[bool] = (False,)) -> None:
+        """Rates of the first step, clearance and status at t = 0 (after the law's reset).  The
+        obstacles' true rates are sensed when the velocities are known or the law is an oracle,
+        finite differences otherwise (see :class:`Sensing3DConfig`)."""
         spec = self.spec
         obstacles = self.obstacles
+        sensing = self.setup.sensing
+        self.known = sensing.velocities == "known" or bool(oracles[0])
+        self.estimator = (
+            None if self.known else FiniteDifference3D(self.sense_rng, sensing.position_noise)
+        )
         # obstacle rates of the first step (so that the first sensing sees them)
         for ob in obstacles:
             ob.state.velocity, ob.state.rotation_rate = ob.motion.rates(0.0, ob.state)
@@ -306,15 +268,14 @@ class Sim3D:
             self.status, self.reached_at, self.done = "success", 0.0, True
         self.done = self.done or self.n_steps <= 0
 
-    @property
-    def decision_due(self) -> bool:
-        """True at a decision time (every ``control_period``)."""
-        return self.step_index % self.ratio == 0
+    def acting(self) -> tuple[int, ...]:
+        """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
+        return (0,) if self.step_index % self.ratio == 0 else ()
 
-    def observe(self) -> Observation3D:
+    def observe(self, agent: int = 0) -> Observation3D:
         """What the robot senses now (rates known or estimated; see :class:`Sensing3DConfig`)."""
         readings = sense_obstacles3d(
-            self.pos, self.obstacles, sensing_range=self.sensing.sensing_range, known=self.known
+            self.pos, self.obstacles, sensing_range=self.sensing_range, known=self.known
         )
         if self.estimator is not None:
             readings = self.estimator.update(self.t, readings)
@@ -323,7 +284,7 @@ class Sim3D:
             goal=self.goal, obstacles=readings,
         )  # fmt: skip
 
-    def apply(self, cmd: Vehicle3DCommand) -> Vehicle3DCommand:
+    def apply(self, cmd: Vehicle3DCommand, agent: int = 0) -> Vehicle3DCommand:
         """Hold ``cmd`` from now on: counted in ``limit_violations`` when outside (3.4)-(3.6),
         made physical (:meth:`Vehicle3DCommand.clipped`); returns what is applied."""
         if cmd.violates(self.spec, self.a):
@@ -366,7 +327,7 @@ class Sim3D:
         elif self.step_index >= self.n_steps:
             self.done = True
 
-    def metrics(self, *, mode_switches: int, decision_us: list[float]) -> EpisodeMetrics:
+    def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
         """The episode's metrics (:mod:`uvnav.sim.metrics`) so far."""
         shortest = max(self.start_dist - self.setup.goal_tolerance, 0.0)
         return episode_metrics(
@@ -378,8 +339,72 @@ class Sim3D:
             min_clearance=float(self.min_clear) if self.obstacles else None,
             control_effort=self.effort,
             limit_violations=self.violations,
-            mode_switches=mode_switches,
-            decision_us=decision_us,
+            mode_switches=log.mode_switches,
+            decision_us=log.decision_us,
+        )
+
+
+class Trajectory3DProbe(BaseProbe):
+    """Records a :class:`Vehicle3DWorld` at every integration step and at the end.
+
+    Besides the world's state it keeps a trace of the law's state: its mode at its last decision
+    and its predicted obstacle velocities (the law's ``predictions`` attribute, ``{obstacle id:
+    (v_i, ...)}``, when it has one), read at every step.
+    """
+
+    def __init__(self) -> None:
+        self.rows: list[tuple[Any, ...]] = []
+        self.outlines: list[FloatArray] = []
+        self.faces: list[np.ndarray | None] = []
+        self.mode = ""  # the law's mode at its last decision
+
+    def on_start(self, world: Any, laws: Sequence[Any]) -> None:
+        self.outlines = [o.body.outline_points() for o in world.obstacles]
+        self.faces = [getattr(o.body, "faces", None) for o in world.obstacles]
+
+    def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
+        self.mode = law.mode
+
+    def on_step(self, world: Any, laws: Sequence[Any]) -> None:
+        obstacles = world.obstacles
+        n = len(obstacles)
+        pred = np.full((n, 3), np.nan)
+        for i, val in (getattr(laws[0], "predictions", None) or {}).items():
+            if 0 <= i < n:
+                pred[i] = val[0]
+        states = [o.state for o in obstacles]
+        self.rows.append(
+            (
+                world.t, world.pos.copy(), world.a.copy(), world.applied.v, world.u_held.copy(),
+                self.mode, world.clearance, world.nearest,
+                np.array([s.centre for s in states]).reshape(n, 3),
+                np.array([s.velocity for s in states]).reshape(n, 3),
+                np.array([s.rotation_rate for s in states]).reshape(n, 3),
+                pred,
+                np.array([s.rotation for s in states]).reshape(n, 3, 3),
+            )
+        )  # fmt: skip
+
+    on_end = on_step
+
+    def finish(self) -> Trajectory3D:
+        cols = list(zip(*self.rows, strict=True))
+        return Trajectory3D(
+            time=np.array(cols[0]),
+            position=np.array(cols[1]),
+            heading=np.array(cols[2]),
+            speed=np.array(cols[3]),
+            turn=np.array(cols[4]),
+            mode=np.array(cols[5]),
+            clearance=np.array(cols[6]),
+            nearest=np.array(cols[7]),
+            obstacle_centres=np.array(cols[8]),
+            obstacle_velocity=np.array(cols[9]),
+            obstacle_rotation_rate=np.array(cols[10]),
+            predicted_velocity=np.array(cols[11]),
+            obstacle_rotations=np.array(cols[12]),
+            obstacle_outlines=self.outlines,
+            obstacle_faces=self.faces,
         )
 
 
@@ -389,8 +414,17 @@ def run_episode3d(
     rng: np.random.Generator,
     *,
     record: bool = True,
+    probes: Sequence[Probe] = (),
 ) -> tuple[EpisodeResult, Trajectory3D | None]:
-    """Run one 3D episode to success, collision or ``t_max``.
+    """Run one 3D episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
+    :class:`Vehicle3DWorld`).
+
+    Args:
+        setup: the instantiated scene; its obstacles are left as they are at the end.
+        controller: a Chapter-3 law; it is reset here.
+        rng: the episode generator; independent children feed the controller and the sensing.
+        record: keep the trajectory (for figures).
+        probes: more probes to run in the loop.
 
     Returns:
         ``(result, trajectory)``: the result carries the metrics of :mod:`uvnav.sim.metrics`
@@ -400,40 +434,11 @@ def run_episode3d(
         ValueError: a non-unit initial heading, or a control period that is not a whole multiple
             of ``dt``.
     """
-    ctrl_rng, sense_rng = rng.spawn(2)
-    oracle = bool(getattr(controller, "oracle", False))
-    sim = Sim3D(setup, sense_rng, known=setup.sensing.velocities == "known" or oracle, exact=record)
-    controller.reset(sim.spec, sim.goal, ctrl_rng)
-    sim.start()
-    obstacles = sim.obstacles
-    rec = _Recorder(obstacles) if record else None
-    switches = 0
-    decision_us: list[float] = []
-    last_mode: str | None = None
-    perf_ns = _time.perf_counter_ns
-    while not sim.done:
-        if sim.decision_due:
-            obs = sim.observe()
-            tic = perf_ns()
-            cmd = controller.act(obs)
-            decision_us.append((perf_ns() - tic) / 1000.0)
-            sim.apply(cmd)
-            mode = controller.mode
-            if last_mode is not None and mode != last_mode:
-                switches += 1
-            last_mode = mode
-        if rec is not None:
-            rec.add(
-                sim.t, sim.pos, sim.a, sim.applied.v, sim.u_held, last_mode or "", sim.clearance,
-                sim.nearest, obstacles, dict(getattr(controller, "predictions", None) or {}),
-            )  # fmt: skip
-        sim.advance()
-    if rec is not None:
-        rec.add(
-            sim.t, sim.pos, sim.a, sim.applied.v, sim.u_held, last_mode or "", sim.clearance,
-            sim.nearest, obstacles, dict(getattr(controller, "predictions", None) or {}),
-        )  # fmt: skip
-    dec = np.asarray(decision_us) if decision_us else np.zeros(1)
-    metrics = sim.metrics(mode_switches=switches, decision_us=decision_us)
-    result = EpisodeResult(metrics=metrics, status=sim.status, trajectory=None, decision_us=dec)
+    world = Vehicle3DWorld(setup, rng, exact=record)
+    rec = Trajectory3DProbe() if record else None
+    (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
+    dec = np.asarray(log.decision_us) if log.decision_us else np.zeros(1)
+    result = EpisodeResult(
+        metrics=world.metrics(log), status=world.status, trajectory=None, decision_us=dec
+    )
     return result, (rec.finish() if rec is not None else None)

@@ -1,9 +1,10 @@
-"""The Chapter-4 step loop: a planar UUV among shape-changing obstacles, sensed by sonar only.
+"""The Chapter-4 world: a planar UUV among shape-changing obstacles, sensed by sonar only,
+stepped by the one loop :func:`uvnav.core.run_loop` (which times each decision in CPU time).
 
 Same structure and metrics as :mod:`uvnav.sim.episode` (DESIGN §2, §4; the names of
 :data:`~uvnav.sim.metrics.METRIC_NAMES`), for the vehicle of :mod:`uvnav.dynamics.holonomic` and
 the bodies of :mod:`uvnav.obstacles.deforming`, whose outlines change every step (the unicycle
-loop's rigid-body field cannot hold them):
+world's rigid-body field cannot hold them):
 
 * every ``control_period`` [s] (a whole multiple of ``dt``) the sonar sweeps the viewing cone
   and the law is asked for a velocity; a command outside the limits (4.4)-(4.6) is counted in
@@ -21,12 +22,13 @@ loop's rigid-body field cannot hold them):
 from __future__ import annotations
 
 import math
-import time as _time
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
+from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec, holonomic_step
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.polygons import closed_rings, rings_nearest
@@ -120,24 +122,27 @@ def inside_any(point: tuple[float, float], polygons: list[FloatArray]) -> bool:
     return bool(inside is not None and inside.any())
 
 
-class SimUuv2d:
-    """The Chapter-4 world advanced one integration step at a time: the step-wise API behind
-    :func:`run_uuv2d_episode` and the Gymnasium env ``uvnav/UUV2D-v0``
-    (:mod:`uvnav.envs.uuv2d`).
+class Uuv2dWorld:
+    """The Chapter-4 world: one planar UUV among shape-changing bodies, sensed by its sonar
+    (:class:`uvnav.core.World`), run by :func:`run_uuv2d_episode` and stepped by the Gymnasium
+    env ``uvnav/UUV2D-v0`` (:mod:`uvnav.envs.uuv2d`).
 
-    The caller alternates :meth:`observe` / :meth:`apply` at decision times (:attr:`decision_due`)
-    with :meth:`advance` every ``dt`` until :attr:`done`; the bookkeeping (path, effort, limit
-    violations, clearance, forbidden regions, status) is the loop's, so both users get the same
-    numbers.
+    The bookkeeping (path, effort, limit violations, clearance, forbidden regions, status) lives
+    here, so both users get the same numbers.
 
     Args:
         setup: the episode.
-        sense_rng: generator of the sonar's noise and dropout.
+        rng: the episode generator; two independent children feed the law and the sonar's noise
+            and dropout.
     """
 
-    def __init__(self, setup: Uuv2dSetup, sense_rng: np.random.Generator) -> None:
+    vehicle: ClassVar[str] = "uuv2d"
+    sensing: ClassVar[str] = "sonar-fan"
+    n_agents: ClassVar[int] = 1
+
+    def __init__(self, setup: Uuv2dSetup, rng: np.random.Generator) -> None:
         self.setup = setup
-        self.sense_rng = sense_rng
+        self._law_rng, self.sense_rng = rng.spawn(2)
         self.spec = setup.spec
         self.dt = float(setup.dt)
         self.period = float(setup.control_period)
@@ -146,13 +151,20 @@ class SimUuv2d:
         self.goal = np.asarray(setup.goal, dtype=float)
         self.state = np.asarray(setup.start, dtype=float).copy()
         self.shapes = setup.shapes
+        self.t = 0.0
+        self.done = False
+
+    def law_setup(self, agent: int = 0) -> tuple[HolonomicSpec, FloatArray, np.random.Generator]:
+        """The law's limits, goal and generator."""
+        return self.spec, self.goal, self._law_rng
 
     def outlines_at(self, t: float) -> list[FloatArray]:
         """Every obstacle's outline at time ``t`` [s]."""
         return [s.outline(t) for s in self.shapes]
 
-    def start(self) -> None:
-        """Outlines, clearance and status at t = 0 (after the law's reset)."""
+    def start(self, oracles: Sequence[bool] = (False,)) -> None:
+        """Outlines, clearance and status at t = 0 (after the law's reset); the sonar is the
+        only sensor, oracle or not."""
         state = self.state
         self.outlines = self.outlines_at(0.0)
         self.clearance, _ = clearance_of((state[0], state[1]), self.outlines, self.spec.radius)
@@ -173,12 +185,11 @@ class SimUuv2d:
         self.t = 0.0
         self.step_index = 0
 
-    @property
-    def decision_due(self) -> bool:
-        """True at a decision time (every ``control_period``)."""
-        return self.step_index % self.ratio == 0
+    def acting(self) -> tuple[int, ...]:
+        """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
+        return (0,) if self.step_index % self.ratio == 0 else ()
 
-    def observe(self) -> SonarObservation:
+    def observe(self, agent: int = 0) -> SonarObservation:
         """The sonar sweep now and the vehicle's own state (:class:`SonarObservation`)."""
         t = self.t
         state = self.state
@@ -195,7 +206,7 @@ class SimUuv2d:
             period=self.period,
         )
 
-    def apply(self, cmd: HolonomicCommand) -> HolonomicCommand:
+    def apply(self, cmd: HolonomicCommand, agent: int = 0) -> HolonomicCommand:
         """Hold ``cmd`` from now on: counted in ``limit_violations`` when outside (4.4)-(4.6),
         saturated (:meth:`HolonomicCommand.clipped`); returns what is applied."""
         state = self.state
@@ -232,7 +243,7 @@ class SimUuv2d:
         elif self.step_index >= self.n_steps:
             self.done = True
 
-    def metrics(self, *, mode_switches: int, decision_us: list[float]) -> EpisodeMetrics:
+    def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
         """The episode's metrics (:mod:`uvnav.sim.metrics`) so far."""
         setup = self.setup
         spec = self.spec
@@ -250,8 +261,58 @@ class SimUuv2d:
             min_clearance=float(self.min_clear) if self.shapes else None,
             control_effort=self.effort,
             limit_violations=self.violations,
-            mode_switches=mode_switches,
-            decision_us=decision_us,
+            mode_switches=log.mode_switches,
+            decision_us=log.decision_us,
+        )
+
+
+class Uuv2dTrajectoryProbe(BaseProbe):
+    """Records a :class:`Uuv2dWorld`: times, poses and clearances at every integration step and at
+    the end; at every decision the outlines, the applied command, the law's mode and the law's own
+    record of it (its ``last`` attribute, when it has one); at the end the law's AMAPS grid (its
+    ``grid`` attribute, when it has one).  The law's attributes are a trace of its state."""
+
+    def __init__(self) -> None:
+        self.times: list[float] = []
+        self.poses: list[FloatArray] = []
+        self.clears: list[float] = []
+        self.d_times: list[float] = []
+        self.d_outlines: list[list[FloatArray]] = []
+        self.d_cmds: list[tuple[float, float]] = []
+        self.d_modes: list[str] = []
+        self.d_records: list[Any] = []
+        self.goal = np.zeros(2)
+        self.grid: Any = None
+
+    def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
+        self.d_times.append(world.t)
+        self.d_outlines.append(world.outlines)
+        self.d_cmds.append((applied.vx, applied.vy))
+        self.d_modes.append(law.mode)
+        self.d_records.append(getattr(law, "last", None))
+
+    def on_step(self, world: Any, laws: Sequence[Any]) -> None:
+        self.times.append(world.t)
+        self.poses.append(world.state.copy())
+        self.clears.append(world.clearance)
+
+    def on_end(self, world: Any, laws: Sequence[Any]) -> None:
+        self.on_step(world, laws)
+        self.goal = world.goal
+        self.grid = getattr(laws[0], "grid", None)
+
+    def finish(self) -> Uuv2dTrajectory:
+        return Uuv2dTrajectory(
+            times=np.asarray(self.times),
+            poses=np.asarray(self.poses),
+            clearance=np.asarray(self.clears),
+            decision_times=np.asarray(self.d_times),
+            outlines=self.d_outlines,
+            commands=np.asarray(self.d_cmds).reshape(-1, 2),
+            modes=self.d_modes,
+            decisions=self.d_records,
+            goal=self.goal,
+            grid=self.grid,
         )
 
 
@@ -261,8 +322,10 @@ def run_uuv2d_episode(
     rng: np.random.Generator,
     *,
     record: bool = True,
+    probes: Sequence[Probe] = (),
 ) -> Uuv2dResult:
-    """Run one episode to success, collision or ``t_max``.
+    """Run one episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
+    :class:`Uuv2dWorld`).
 
     Args:
         setup: the instantiated scene.
@@ -270,65 +333,16 @@ def run_uuv2d_episode(
             it is reset here.
         rng: the episode generator; independent children feed the controller and the sonar.
         record: keep the trajectory (for figures).
+        probes: more probes to run in the loop.
     """
-    ctrl_rng, sense_rng = rng.spawn(2)
-    sim = SimUuv2d(setup, sense_rng)
-    controller.reset(sim.spec, sim.goal, ctrl_rng)
-    sim.start()
-    switches = 0
-    last_mode: str | None = None
-    decision_us: list[float] = []
-    times = [0.0]
-    poses = [sim.state.copy()]
-    clears = [sim.clearance]
-    d_times: list[float] = []
-    d_outlines: list[list[FloatArray]] = []
-    d_cmds: list[tuple[float, float]] = []
-    d_modes: list[str] = []
-    d_records: list[Any] = []
-    perf = _time.perf_counter_ns
-    while not sim.done:
-        if sim.decision_due:
-            obs = sim.observe()
-            tic = perf()
-            cmd = controller.act(obs)
-            decision_us.append((perf() - tic) / 1000.0)
-            applied = sim.apply(cmd)
-            mode = controller.mode
-            if last_mode is not None and mode != last_mode:
-                switches += 1
-            last_mode = mode
-            if record:
-                d_times.append(sim.t)
-                d_outlines.append(sim.outlines)
-                d_cmds.append((applied.vx, applied.vy))
-                d_modes.append(mode)
-                d_records.append(getattr(controller, "last", None))
-        sim.advance()
-        if record:
-            times.append(sim.t)
-            poses.append(sim.state.copy())
-            clears.append(sim.clearance)
-    dec = np.asarray(decision_us) if decision_us else np.zeros(1)
-    metrics = sim.metrics(mode_switches=switches, decision_us=decision_us)
-    traj = None
-    if record:
-        traj = Uuv2dTrajectory(
-            times=np.asarray(times),
-            poses=np.asarray(poses),
-            clearance=np.asarray(clears),
-            decision_times=np.asarray(d_times),
-            outlines=d_outlines,
-            commands=np.asarray(d_cmds).reshape(-1, 2),
-            modes=d_modes,
-            decisions=d_records,
-            goal=sim.goal,
-            grid=getattr(controller, "grid", None),
-        )
+    world = Uuv2dWorld(setup, rng)
+    rec = Uuv2dTrajectoryProbe() if record else None
+    (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
+    dec = np.asarray(log.decision_us) if log.decision_us else np.zeros(1)
     return Uuv2dResult(
-        metrics=metrics,
-        status=sim.status,
-        entered_forbidden=sim.entered,
-        trajectory=traj,
+        metrics=world.metrics(log),
+        status=world.status,
+        entered_forbidden=world.entered,
+        trajectory=rec.finish() if rec is not None else None,
         decision_us=dec,
     )
