@@ -160,3 +160,19 @@ def test_sigkill_then_resume_equals_an_uninterrupted_run(tmp_path: Path) -> None
             "FROM episodes"
         ).fetchone()
     assert n == keys == 30
+
+
+def test_errored_episodes_exit_non_zero_with_the_first_error(tmp_path: Path) -> None:
+    # a generator parameter that breaks every scene (checked only when the scene is built)
+    path = tmp_path / "broken.yaml"
+    path.write_text(
+        "name: broken\nscenarios:\n  - generator: random-ch2\n    seeds: [0, 1]\n"
+        "    params: {n_obstacles: -3}\ncontrollers:\n  - name: straight-v1\n"
+    )
+    db = tmp_path / "b.sqlite"
+    res = invoke("bench", str(path), "--db", str(db), "--workers", "1", "--json")
+    assert res.exit_code == 1, res.output
+    last = res.stderr.strip().splitlines()[-1]
+    assert last.startswith("error: 1 episode(s) errored; the first: random-ch2")
+    assert "Traceback" not in res.output
+    assert json.loads(res.stdout)["errors"] == 1

@@ -840,6 +840,7 @@ def bench(
             raise typer.Exit(130) from None
         elapsed = time.perf_counter() - tic
         rows = controller_summary(store, spec.name)
+        first_error = _first_error(store, spec.name) if result.errors else None
     rate = result.ran / elapsed if result.ran and elapsed > 0 else None
     if json_out:
         record = {
@@ -854,8 +855,10 @@ def bench(
             "wall_time": elapsed,
             "episodes_per_s": rate,
             "controllers": rows,
+            "first_error": first_error,
         }
         typer.echo(_dumps(record))
+        _fail_on_errors(result.errors, first_error)
         return
     from rich import box
     from rich.table import Table
@@ -885,6 +888,25 @@ def bench(
         f"ran {result.ran} episode(s) ({result.errors} error(s)), skipped {result.skipped} already "
         f"stored, in {elapsed:.1f} s{speed} on {engine} × {n_workers}; results in {db}"
     )
+    _fail_on_errors(result.errors, first_error)
+
+
+def _first_error(store: Any, campaign: str) -> str | None:
+    """The message of the first stored ``error`` episode of ``campaign``, with its job."""
+    frame = store.episodes_frame(campaign)
+    bad = frame[frame["status"] == "error"]
+    if bad.empty:
+        return None
+    row = bad.iloc[0]
+    message = _one_line(str(row["error"]))
+    return f"{row['scenario']} | {row['controller']} | seed {row['seed']}: {message}"
+
+
+def _fail_on_errors(errors: int, first: str | None) -> None:
+    """Exit status 1 when episodes errored (their rows are kept, as ``error``)."""
+    if errors:
+        typer.echo(f"error: {errors} episode(s) errored; the first: {first}", err=True)
+        raise typer.Exit(1)
 
 
 def main() -> None:
