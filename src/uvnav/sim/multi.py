@@ -11,6 +11,11 @@ sensing, the finite-difference estimate of robot i's own
 else passes between them.  Obstacle ids in the observations are the world's obstacles first
 (0..k-1), then the robots (k + j).
 
+The world is :class:`MultiUnicycleWorld` (N agents of :class:`uvnav.core.World`), stepped by
+the one loop :func:`uvnav.core.run_loop` (:func:`run_multi`; the PettingZoo env
+:mod:`uvnav.envs.multi_robot` steps the same world): at each decision time the active robots
+decide in index order, each reading the world as it is before anyone moves.
+
 Integration, collision checks and the per-robot metrics follow :func:`uvnav.sim.run_episode`
 (same names, :data:`uvnav.sim.metrics.METRIC_NAMES`): the robot's clearance is the gap to the
 nearest obstacle *or other robot*.  A robot that reaches its goal stops there and stays in the
@@ -35,14 +40,14 @@ against the per-robot path, ``vectorised=False``).
 from __future__ import annotations
 
 import math
-import time as _time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from uvnav.controllers.base import Controller
+from uvnav.core import AgentLog, BaseProbe, run_loop
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.obstacles.batch import ObstacleBatch
@@ -232,6 +237,289 @@ class _DiscPairs:
         )
 
 
+class MultiUnicycleWorld:
+    """N unicycles (and the world's obstacles) in one world (:class:`uvnav.core.World`, see the
+    module docstring), stepped by :func:`uvnav.core.run_loop` (:func:`run_multi`) or, one
+    decision at a time, by the PettingZoo env :mod:`uvnav.envs.multi_robot`.
+
+    Agent i is robot i.  Per-robot bookkeeping (path, effort, limit violations, clearance,
+    status) and the group's (robot pairs that overlapped, obstacle hits, the deadlock window)
+    live here.  ``clearance[i]`` is robot i's gap after the last step [m] (``inf`` when nothing
+    is within its reach, or once it is done).
+
+    Args:
+        setup: the scene; its obstacles are advanced in place and written back by :meth:`close`.
+        rng: the episode generator: ``rng.spawn(2 N)``, robot i's law gets child 2i and its
+            finite-difference estimator child 2i + 1.
+        vectorised: check and sense all robots at once (:class:`_DiscPairs`) when the world holds
+            only robots (identical results; ``False`` forces one field query per robot).
+
+    Raises:
+        ValueError: no robot, or ``control_period`` is not a whole multiple of ``dt``.
+    """
+
+    vehicle: ClassVar[str] = "unicycle"
+    sensing: ClassVar[str] = "exact"
+
+    def __init__(
+        self, setup: MultiSetup, rng: np.random.Generator, *, vectorised: bool = True
+    ) -> None:
+        robots = setup.robots
+        n = len(robots)
+        if n == 0:
+            raise ValueError("a multi-robot episode needs at least one robot")
+        self.setup = setup
+        self.robots = robots
+        self.dt = dt = float(setup.dt)
+        self.ratio = decision_ratio(float(setup.control_period), dt)
+        self.n_steps = round(setup.t_max / dt)
+        self.tol = float(setup.goal_tolerance)
+        self._children = rng.spawn(2 * n)
+        self.obstacles = setup.obstacles
+        self.k = k = len(setup.obstacles)
+        bodies: list[Body] = [o.body for o in setup.obstacles]
+        bodies += [DiscBody(max(float(r.spec.radius), 1e-6)) for r in robots]
+        self.template = FieldTemplate.from_bodies(bodies)
+        self.batch = ObstacleBatch(setup.obstacles)
+        self.radii = np.array([float(r.spec.radius) for r in robots])
+        floor = 4.0 * float(self.radii.max()) + 1.0  # the reach covers any robot that can touch
+        self.reach = np.array([max(float(r.sensing.sensing_range), floor) for r in robots])
+        self.state = np.array([np.asarray(r.start, dtype=float)[:3] for r in robots])
+        self.goals = np.array([np.asarray(r.goal, dtype=float)[:2] for r in robots])
+        self.batched = vectorised and k == 0
+        self.t = 0.0
+        self.done = False
+
+    @property
+    def n_agents(self) -> int:
+        return len(self.robots)
+
+    def law_setup(self, agent: int) -> tuple[UnicycleSpec, FloatArray, np.random.Generator]:
+        """Robot ``agent``'s limits, goal and generator."""
+        return self.robots[agent].spec, self.goals[agent], self._children[2 * agent]
+
+    def _field(self) -> ObstacleField:
+        """The obstacles and the robots (discs moving at their held commands; done robots
+        still)."""
+        n, k, active, state = self.n_agents, self.k, self.active, self.state
+        vel = np.array([_robot_velocity(self.speeds[i], state[i, 2]) for i in range(n)])
+        vel[~active] = 0.0
+        omegas = np.where(active, self.turns, 0.0)
+        if not k:
+            return self.template.field(state[:, :2].copy(), state[:, 2].copy(), vel, omegas)
+        b = self.batch
+        return self.template.field(
+            np.vstack((b.positions, state[:, :2])),
+            np.concatenate((b.headings, state[:, 2])),
+            np.vstack((b.velocities, vel)),
+            np.concatenate((b.angular_velocities, omegas)),
+        )
+
+    def start(self, oracles: Sequence[bool]) -> None:
+        """Clearances, collisions and arrivals at t = 0; robot i's finite-difference estimator
+        unless its law is an oracle or its velocities are known."""
+        n = self.n_agents
+        self.estimators: list[FiniteDifferenceEstimator | None] = []
+        for i, r in enumerate(self.robots):
+            est = None
+            if r.sensing.velocities == "estimated" and not oracles[i]:
+                est = FiniteDifferenceEstimator(self._children[2 * i + 1], r.sensing.position_noise)
+            self.estimators.append(est)
+        self.speeds = np.zeros(n)
+        self.turns = np.zeros(n)
+        self.active = np.ones(n, dtype=bool)  # neither arrived nor collided
+        self.status = ["timeout"] * n
+        self.reached: list[float | None] = [None] * n
+        self.start_dist = np.hypot(*(self.goals - self.state[:, :2]).T)
+        self.path = np.zeros(n)
+        self.effort = np.zeros(n)
+        self.violations = np.zeros(n, dtype=int)
+        self.min_clear = np.full(n, np.inf)
+        self.clearance = np.full(n, np.inf)
+        self.pairs: set[tuple[int, int]] = set()
+        self.obstacle_hits = 0
+        self.window = max(1, round(self.setup.deadlock_window / self.dt))
+        self.history: list[FloatArray] = []
+        self.applied = [UnicycleCommand(0.0, 0.0) for _ in range(n)]
+        self.step_index = 0
+        self._pairs: _DiscPairs | None = None
+        self.field = self._field()
+        self._check()
+        for i in range(n):
+            if self.active[i] and self.start_dist[i] <= self.tol:
+                self.status[i], self.reached[i], self.active[i] = "success", 0.0, False
+        self.done = not self.active.any() or self.n_steps <= 0
+
+    def _check(self) -> None:
+        """Clearances, collisions (robot pairs, obstacle hits) after a step or at t = 0."""
+        n, k, fld, active, status = self.n_agents, self.k, self.field, self.active, self.status
+        if self.batched:
+            dp = _DiscPairs(fld, self.state[:, :2], self.reach)
+            self._pairs = dp
+            keep = dp.within & active[:, None]
+            np.fill_diagonal(keep, False)
+            gaps = dp.signed - self.radii[:, None]
+            seen = keep.any(axis=1)
+            low = np.where(keep, gaps, np.inf).min(axis=1)
+            self.clearance = low
+            self.min_clear[seen] = np.minimum(self.min_clear[seen], low[seen])
+            hit_i, hit_j = np.nonzero(keep & (gaps < 0))
+            for i, j in zip(hit_i.tolist(), hit_j.tolist(), strict=True):
+                self.pairs.add((min(i, j), max(i, j)))
+                status[i] = "collision"
+        else:
+            self.clearance = np.full(n, np.inf)
+            for i in range(n):
+                if not active[i]:
+                    continue  # an arrived or wrecked robot's episode is over (as in run_episode)
+                # the own disc is always nearest: ask for everything within the reach instead
+                # (clearances beyond it are not tracked: min_clearance is exact when below it)
+                q = fld.query(self.state[i, :2], float(self.reach[i]), nearest=False)
+                own = q.ids == k + i
+                gaps = (q.signed - self.radii[i])[~own]
+                ids = q.ids[~own]
+                if len(gaps) == 0:
+                    continue
+                self.clearance[i] = low_i = float(gaps.min())
+                self.min_clear[i] = min(self.min_clear[i], low_i)
+                for j in ids[gaps < 0].tolist():
+                    if j >= k:
+                        self.pairs.add((min(i, j - k), max(i, j - k)))
+                    else:
+                        self.obstacle_hits += 1
+                    status[i] = "collision"
+        for i in range(n):
+            if status[i] == "collision":
+                active[i] = False
+
+    def acting(self) -> list[int]:
+        """The active robots, in index order, at a decision time (every ``control_period``)."""
+        if self.step_index % self.ratio:
+            return []
+        return np.flatnonzero(self.active).tolist()
+
+    def observe(self, agent: int = 0) -> Observation:
+        """Robot ``agent``'s readings of the obstacles and the other robots (its own disc left
+        out; estimated rates unless known)."""
+        i = agent
+        sensing_range = float(self.robots[i].sensing.sensing_range)
+        pose = self.state[i].copy()
+        if self._pairs is not None:
+            readings = self._pairs.readings(i, self.field, sensing_range)
+        else:
+            readings = sense_obstacles(pose[:2], self.field, sensing_range=sensing_range)
+            readings = tuple(rd for rd in readings if rd.obstacle_id != self.k + i)
+        est = self.estimators[i]
+        if est is not None:
+            readings = est.update(self.t, readings)
+        return Observation(
+            time=self.t, pose=pose, speed=self.applied[i].v, goal=self.goals[i], obstacles=readings
+        )
+
+    def apply(self, cmd: UnicycleCommand, agent: int = 0) -> UnicycleCommand:
+        """Hold ``cmd`` for robot ``agent``: counted in its ``limit_violations`` when outside
+        (2.4), saturated."""
+        i = agent
+        spec = self.robots[i].spec
+        if cmd.violates(spec):
+            self.violations[i] += 1
+        new = cmd.clipped(spec)
+        prev = self.applied[i].v
+        self.effort[i] += ((new.v - prev) ** 2) / (self.ratio * self.dt) if self.step_index else 0.0
+        self.applied[i] = new
+        return new
+
+    def advance(self) -> None:
+        """One step ``dt``: the active robots (exact), the obstacles, clearances, collisions,
+        arrivals."""
+        dt, state, active = self.dt, self.state, self.active
+        self.history.append(state[:, :2].copy())
+        if len(self.history) > self.window + 1:
+            self.history.pop(0)
+        for i in range(self.n_agents):
+            if not active[i]:
+                self.speeds[i] = self.turns[i] = 0.0
+                continue
+            v, u = self.applied[i].v, self.applied[i].u
+            self.effort[i] += u * u * dt
+            x, y, th = state[i]
+            nx, ny, nth = unicycle_advance(float(x), float(y), float(th), v, u, dt)
+            self.path[i] += math.hypot(nx - x, ny - y)
+            state[i] = (nx, ny, nth)
+            self.speeds[i], self.turns[i] = v, u
+        self.batch.step(self.t, dt)
+        self.step_index = step = self.step_index + 1
+        self.t = step * dt
+        self.field = self._field()
+        self._check()
+        for i in range(self.n_agents):
+            if active[i] and math.hypot(*(self.goals[i] - state[i, :2])) <= self.tol:
+                self.status[i], self.reached[i], active[i] = "success", self.t, False
+        self.done = not active.any() or step >= self.n_steps
+
+    def close(self) -> None:
+        """Write the obstacles' states back to their models (the setup's objects)."""
+        self.batch.write_back()
+
+    def metrics(self, log: AgentLog, agent: int) -> EpisodeMetrics:
+        """Robot ``agent``'s metrics (the names of a single-robot episode's)."""
+        i = agent
+        spec = self.robots[i].spec
+        shortest = max(float(self.start_dist[i]) - self.tol, 0.0)
+        return episode_metrics(
+            status=self.status[i],
+            path_length=float(self.path[i]),
+            shortest=shortest,
+            straight_time=shortest / spec.v_max if spec.v_max > 0 else 0.0,
+            reached_at=self.reached[i],
+            min_clearance=float(self.min_clear[i]) if math.isfinite(self.min_clear[i]) else None,
+            control_effort=float(self.effort[i]),
+            limit_violations=int(self.violations[i]),
+            mode_switches=log.mode_switches,
+            decision_us=log.decision_us,
+        )
+
+    def group_metrics(self) -> GroupMetrics:
+        """The group's outcome (module docstring); a robot is stuck when it moved less than
+        ``deadlock_distance`` between the start of the deadlock window and now."""
+        n, status, setup = self.n_agents, self.status, self.setup
+        arrived = sum(s == "success" for s in status)
+        all_arrived = arrived == n
+        arrival_times = [a for a in self.reached if a is not None]
+        moved = np.hypot(*(self.state[:, :2] - self.history[0]).T) if self.history else np.zeros(n)
+        stuck = sum(
+            1
+            for i in range(n)
+            if status[i] == "timeout"
+            and self.t >= setup.deadlock_window
+            and moved[i] < setup.deadlock_distance
+        )
+        return GroupMetrics(
+            all_arrived=all_arrived,
+            arrived=int(arrived),
+            robot_collisions=len(self.pairs),
+            obstacle_collisions=int(self.obstacle_hits),
+            makespan=max(arrival_times) if all_arrived else None,
+            sum_of_times=float(sum(arrival_times)) if all_arrived else None,
+            deadlocks=int(stuck),
+        )
+
+
+class PosesProbe(BaseProbe):
+    """Records every robot's pose of a :class:`MultiUnicycleWorld` at every step and at the
+    end."""
+
+    def __init__(self) -> None:
+        self.times: list[float] = []
+        self.poses: list[FloatArray] = []
+
+    def on_step(self, world: Any, laws: Sequence[Any]) -> None:
+        self.times.append(world.t)
+        self.poses.append(world.state.copy())
+
+    on_end = on_step
+
+
 def run_multi(
     setup: MultiSetup,
     rng: np.random.Generator,
@@ -239,7 +527,8 @@ def run_multi(
     record: bool = True,
     vectorised: bool = True,
 ) -> MultiResult:
-    """Run one multi-robot episode (see the module docstring).
+    """Run one multi-robot episode (:func:`uvnav.core.run_loop` over a
+    :class:`MultiUnicycleWorld`; see the module docstring).
 
     Args:
         setup: the instantiated scene; its obstacles are advanced in place.
@@ -251,232 +540,20 @@ def run_multi(
     Raises:
         ValueError: ``control_period`` is not a whole multiple of ``dt``, or no robot.
     """
-    robots = setup.robots
-    n = len(robots)
-    if n == 0:
-        raise ValueError("a multi-robot episode needs at least one robot")
-    dt = float(setup.dt)
-    ratio = decision_ratio(float(setup.control_period), dt)
-    n_steps = round(setup.t_max / dt)
-    tol = float(setup.goal_tolerance)
-    children = rng.spawn(2 * n)
-    k = len(setup.obstacles)
-    bodies: list[Body] = [o.body for o in setup.obstacles]
-    bodies += [DiscBody(max(float(r.spec.radius), 1e-6)) for r in robots]
-    template = FieldTemplate.from_bodies(bodies)
-    batch = ObstacleBatch(setup.obstacles)
-    radii = np.array([float(r.spec.radius) for r in robots])
-    reach = [max(float(r.sensing.sensing_range), 4.0 * float(radii.max()) + 1.0) for r in robots]
-    state = np.array([np.asarray(r.start, dtype=float)[:3] for r in robots])
-    goals = np.array([np.asarray(r.goal, dtype=float)[:2] for r in robots])
-    speeds = np.zeros(n)
-    turns = np.zeros(n)
-    active = np.ones(n, dtype=bool)  # neither arrived nor collided
-    status = ["timeout"] * n
-    reached: list[float | None] = [None] * n
-    estimators: list[FiniteDifferenceEstimator | None] = []
-    for i, r in enumerate(robots):
-        r.controller.reset(r.spec, goals[i], children[2 * i])
-        est = None
-        if r.sensing.velocities == "estimated" and not getattr(r.controller, "oracle", False):
-            est = FiniteDifferenceEstimator(children[2 * i + 1], r.sensing.position_noise)
-        estimators.append(est)
-    start_dist = np.hypot(*(goals - state[:, :2]).T)
-    path = np.zeros(n)
-    effort = np.zeros(n)
-    violations = np.zeros(n, dtype=int)
-    switches = np.zeros(n, dtype=int)
-    last_mode: list[str | None] = [None] * n
-    decision_us: list[list[float]] = [[] for _ in range(n)]
-    min_clear = np.full(n, np.inf)
-    pairs: set[tuple[int, int]] = set()
-    obstacle_hits = 0
-    times: list[float] = []
-    poses: list[FloatArray] = []
-    window = max(1, round(setup.deadlock_window / dt))
-    history: list[FloatArray] = []
-    perf_ns = _time.perf_counter_ns
-
-    def world(t_batch: ObstacleBatch) -> ObstacleField:
-        vel = np.array([_robot_velocity(speeds[i], state[i, 2]) for i in range(n)])
-        vel[~active] = 0.0
-        centres = np.vstack((t_batch.positions, state[:, :2])) if k else state[:, :2].copy()
-        headings = np.concatenate((t_batch.headings, state[:, 2])) if k else state[:, 2].copy()
-        velocities = np.vstack((t_batch.velocities, vel)) if k else vel
-        omegas = np.concatenate((t_batch.angular_velocities, np.where(active, turns, 0.0)))
-        if not k:
-            omegas = np.where(active, turns, 0.0)
-        return template.field(centres, headings, velocities, omegas)
-
-    batched = vectorised and k == 0
-    reach_arr = np.array(reach)
-    pairs_now: list[_DiscPairs | None] = [None]
-
-    def check(fld: ObstacleField) -> None:
-        """Clearances, collisions and arrivals after a step (or at t = 0)."""
-        nonlocal obstacle_hits
-        if batched:
-            dp = _DiscPairs(fld, state[:, :2], reach_arr)
-            pairs_now[0] = dp
-            keep = dp.within & active[:, None]
-            np.fill_diagonal(keep, False)
-            gaps = dp.signed - radii[:, None]
-            seen = keep.any(axis=1)
-            low = np.where(keep, gaps, np.inf).min(axis=1)
-            min_clear[seen] = np.minimum(min_clear[seen], low[seen])
-            hit_i, hit_j = np.nonzero(keep & (gaps < 0))
-            for i, j in zip(hit_i.tolist(), hit_j.tolist(), strict=True):
-                pairs.add((min(i, j), max(i, j)))
-                status[i] = "collision"
-            for i in range(n):
-                if status[i] == "collision":
-                    active[i] = False
-            return
-        for i in range(n):
-            if not active[i]:
-                continue  # an arrived or wrecked robot's episode is over (as in run_episode)
-            # the own disc is always nearest: ask for everything within the sensing range instead
-            # (clearances beyond it are not tracked: min_clearance is exact when below it)
-            q = fld.query(state[i, :2], reach[i], nearest=False)
-            ids = q.ids
-            gaps = q.signed - radii[i]
-            own = ids == k + i
-            gaps = gaps[~own]
-            ids = ids[~own]
-            if len(gaps) == 0:
-                continue
-            min_clear[i] = min(min_clear[i], float(gaps.min()))
-            hit = gaps < 0
-            if hit.any():
-                for j in ids[hit]:
-                    j = int(j)
-                    if j >= k:
-                        pairs.add((min(i, j - k), max(i, j - k)))
-                    else:
-                        obstacle_hits += 1
-                status[i] = "collision"
-        for i in range(n):
-            if status[i] == "collision":
-                active[i] = False
-
-    fld = world(batch)
-    check(fld)
-    for i in range(n):
-        if active[i] and start_dist[i] <= tol:
-            status[i], reached[i], active[i] = "success", 0.0, False
-    t = 0.0
-    applied = [UnicycleCommand(0.0, 0.0) for _ in range(n)]
+    world = MultiUnicycleWorld(setup, rng, vectorised=vectorised)
+    rec = PosesProbe() if record else None
     try:
-        for step in range(n_steps):
-            if not active.any():
-                break
-            if step % ratio == 0:
-                for i in range(n):
-                    if not active[i]:
-                        continue
-                    r = robots[i]
-                    pose = state[i].copy()
-                    dp = pairs_now[0]
-                    if dp is not None:
-                        readings = dp.readings(i, fld, float(r.sensing.sensing_range))
-                    else:
-                        readings = sense_obstacles(
-                            pose[:2], fld, sensing_range=float(r.sensing.sensing_range)
-                        )
-                        readings = tuple(rd for rd in readings if rd.obstacle_id != k + i)
-                    est = estimators[i]
-                    if est is not None:
-                        readings = est.update(t, readings)
-                    obs = Observation(
-                        time=t, pose=pose, speed=applied[i].v, goal=goals[i], obstacles=readings
-                    )
-                    tic = perf_ns()
-                    cmd = r.controller.act(obs)
-                    decision_us[i].append((perf_ns() - tic) / 1000.0)
-                    if cmd.violates(r.spec):
-                        violations[i] += 1
-                    new = cmd.clipped(r.spec)
-                    effort[i] += ((new.v - applied[i].v) ** 2) / (ratio * dt) if step > 0 else 0.0
-                    applied[i] = new
-                    mode = r.controller.mode
-                    if last_mode[i] is not None and mode != last_mode[i]:
-                        switches[i] += 1
-                    last_mode[i] = mode
-            if record:
-                times.append(t)
-                poses.append(state.copy())
-            history.append(state[:, :2].copy())
-            if len(history) > window + 1:
-                history.pop(0)
-            for i in range(n):
-                if not active[i]:
-                    speeds[i] = turns[i] = 0.0
-                    continue
-                v, u = applied[i].v, applied[i].u
-                effort[i] += u * u * dt
-                x, y, th = state[i]
-                nx, ny, nth = unicycle_advance(float(x), float(y), float(th), v, u, dt)
-                path[i] += math.hypot(nx - x, ny - y)
-                state[i] = (nx, ny, nth)
-                speeds[i], turns[i] = v, u
-            batch.step(t, dt)
-            t = (step + 1) * dt
-            fld = world(batch)
-            check(fld)
-            for i in range(n):
-                if active[i] and math.hypot(*(goals[i] - state[i, :2])) <= tol:
-                    status[i], reached[i], active[i] = "success", t, False
+        logs = run_loop(world, [r.controller for r in setup.robots], [rec] if rec else [])
     finally:
-        batch.write_back()
-    if record:
-        times.append(t)
-        poses.append(state.copy())
-    history.append(state[:, :2].copy())
-
-    per_robot = []
-    for i, r in enumerate(robots):
-        shortest = max(float(start_dist[i]) - tol, 0.0)
-        per_robot.append(
-            episode_metrics(
-                status=status[i],
-                path_length=float(path[i]),
-                shortest=shortest,
-                straight_time=shortest / r.spec.v_max if r.spec.v_max > 0 else 0.0,
-                reached_at=reached[i],
-                min_clearance=float(min_clear[i]) if math.isfinite(min_clear[i]) else None,
-                control_effort=float(effort[i]),
-                limit_violations=int(violations[i]),
-                mode_switches=int(switches[i]),
-                decision_us=decision_us[i],
-            )
-        )
-    arrived = sum(s == "success" for s in status)
-    all_arrived = arrived == n
-    arrival_times = [a for a in reached if a is not None]
-    moved = np.hypot(*(history[-1] - history[0]).T)
-    stuck = sum(
-        1
-        for i in range(n)
-        if status[i] == "timeout"
-        and t >= setup.deadlock_window
-        and moved[i] < setup.deadlock_distance
-    )
-    group = GroupMetrics(
-        all_arrived=all_arrived,
-        arrived=int(arrived),
-        robot_collisions=len(pairs),
-        obstacle_collisions=int(obstacle_hits),
-        makespan=max(arrival_times) if all_arrived else None,
-        sum_of_times=float(sum(arrival_times)) if all_arrived else None,
-        deadlocks=int(stuck),
-    )
+        world.close()
+    n = world.n_agents
     return MultiResult(
-        robots=per_robot,
-        statuses=status,
-        group=group,
-        times=np.asarray(times),
-        poses=np.asarray(poses) if poses else np.zeros((0, n, 3)),
-        collided_pairs=sorted(pairs),
+        robots=[world.metrics(log, i) for i, log in enumerate(logs)],
+        statuses=world.status,
+        group=world.group_metrics(),
+        times=np.asarray(rec.times) if rec else np.zeros(0),
+        poses=np.asarray(rec.poses) if rec and rec.poses else np.zeros((0, n, 3)),
+        collided_pairs=sorted(world.pairs),
     )
 
 
