@@ -318,6 +318,8 @@ def simulate(
             plot_outcome(out, plot)
         except ValueError as exc:
             raise CliError(str(exc)) from None
+        except ImportError as exc:
+            raise CliError(f"plotting (--plot) is not available: {exc}", code=1) from None
     if json_out:
         typer.echo(_dumps(record))
         if plot is not None:
