@@ -164,8 +164,9 @@ def test_env_episode_is_the_simulators_bit_for_bit(
 def test_raw_commands_are_applied_as_the_simulator_applies_them() -> None:
     env = Nav2DEnv("open-field", raw_commands=True)
     spec = env.scenario.robot
-    assert env.action_space.dtype == np.float64
-    np.testing.assert_array_equal(env.action_space.high, [spec.v_max, spec.u_max])
+    box = env.action_space
+    assert isinstance(box, gym.spaces.Box) and box.dtype == np.float64
+    np.testing.assert_array_equal(box.high, [spec.v_max, spec.u_max])
     env.reset(seed=0)
     env.step(np.array([2.0 * spec.v_max, 0.0]))  # outside the limits: saturated and counted
     assert env.world.violations == 1 and env.world.applied.v == spec.v_max
