@@ -8,8 +8,14 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import uvnav.envs
+from uvnav.controllers import make_controller
+from uvnav.core import AgentLog
 from uvnav.envs.core import RewardConfig
 from uvnav.envs.nav2d import Nav2DEnv
+from uvnav.scenarios import load_scenario
+from uvnav.scenarios.build import build_episode
+from uvnav.scenarios.schema import Scenario
+from uvnav.sim import run_episode, run_rng
 
 
 def test_check_env_passes() -> None:
@@ -98,3 +104,99 @@ def test_one_reward_formula_for_every_env() -> None:
     assert rw.reward(0.0, 1.0, "success") == pytest.approx(-0.1 + rw.success)
     assert rw.reward(0.0, 1.0, "collision") == pytest.approx(-0.1 - rw.collision)
     assert rw.reward(0.0, 1.0, "timeout") == pytest.approx(-0.1)
+
+
+# ------------------------------------------------- the env steps the simulator's world, bit for bit
+def _scene(name: str, **changes: object) -> Scenario:
+    sc = load_scenario(name)
+    return Scenario.model_validate({**sc.model_dump(), **changes}) if changes else sc
+
+
+NOISY = {
+    "control_period": 0.3,  # three integration steps per env step
+    "sensing": {
+        "range": 5.0,
+        "velocities": "estimated",  # the world's estimator, fed by its sensor generator
+        "position_noise": 0.02,
+        "lidar": {"n_rays": 36, "noise_std": 0.01, "dropout": 0.05},  # noisy: the same stream
+    },
+}
+
+
+@pytest.mark.parametrize(
+    ("scene", "changes", "law", "k"),
+    [
+        ("thesis-ch2-fig2-10-comparison", {}, "zhang2019-v1", 0),
+        ("random-ch2:2", {}, "dwa-v1", 2),
+        ("random-ch2:3", NOISY, "zhang2019-v1", 3),
+    ],
+)
+def test_env_episode_is_the_simulators_bit_for_bit(
+    scene: str, changes: dict, law: str, k: int
+) -> None:
+    """The law's own commands as raw actions (``raw_commands=True``: the normalised float32 map
+    cannot carry them exactly), its generator the world's (``law_setup``), episode ``k``: every
+    pose at every decision and the episode's metrics equal ``run_episode``'s (no tolerance)."""
+    sc = _scene(scene, **changes)
+    env = Nav2DEnv(sc, raw_commands=True)
+    _, info = env.reset(options={"episode_seed": k})
+    ctrl = make_controller(law)
+    ctrl.reset(*env.world.law_setup())
+    poses = [env.world.pose]
+    term = trunc = False
+    while not (term or trunc):
+        cmd = ctrl.act(info["uvnav"].observation)
+        _, _, term, trunc, info = env.step(np.array([cmd.v, cmd.u]))
+        poses.append(env.world.pose)
+    sim = run_episode(build_episode(sc, k), make_controller(law), run_rng(k), record=True)
+    tr = sim.trajectory
+    assert tr is not None
+    ratio = env.world.ratio
+    expected = [*tr.robot[: len(tr.robot) - 1 : ratio], tr.robot[-1]]
+    np.testing.assert_array_equal(np.array(poses), np.array(expected))
+    assert info["status"] == sim.status and info["time"] == tr.times[-1]
+    timing = ("mode_switches", "decision_us_median", "decision_us_p99")
+    got = {m: v for m, v in env.world.metrics(AgentLog()).to_dict().items() if m not in timing}
+    assert got == {m: v for m, v in sim.metrics.to_dict().items() if m not in timing}
+    env.close()
+
+
+def test_raw_commands_are_applied_as_the_simulator_applies_them() -> None:
+    env = Nav2DEnv("open-field", raw_commands=True)
+    spec = env.scenario.robot
+    box = env.action_space
+    assert isinstance(box, gym.spaces.Box) and box.dtype == np.float64
+    np.testing.assert_array_equal(box.high, [spec.v_max, spec.u_max])
+    env.reset(seed=0)
+    env.step(np.array([2.0 * spec.v_max, 0.0]))  # outside the limits: saturated and counted
+    assert env.world.violations == 1 and env.world.applied.v == spec.v_max
+
+
+@pytest.mark.parametrize(
+    "code",
+    [
+        # Gymnasium 1.x loads no plugin entry points: import the module, name it for linters
+        "import gymnasium as gym, uvnav.envs; gym.register_envs(uvnav.envs); "
+        "env = gym.make('uvnav/Nav2D-v0', scenario='office-floor')",
+        # or let gymnasium import it
+        "import gymnasium as gym; env = gym.make('uvnav.envs:uvnav/Nav2D-v0', scenario='corridor')",
+    ],
+)
+def test_gymnasium_make_in_a_fresh_interpreter(code: str) -> None:
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    src = str(Path(uvnav.envs.__file__).resolve().parents[2])
+    path = os.pathsep.join(p for p in (src, os.environ.get("PYTHONPATH", "")) if p)
+    check = "; obs, _ = env.reset(seed=0); assert env.observation_space.contains(obs); print('ok')"
+    out = subprocess.run(
+        [sys.executable, "-c", code + check],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "PYTHONPATH": path},
+        timeout=120,
+        check=False,
+    )
+    assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr

@@ -8,11 +8,27 @@
 * :func:`as_policy`: any uvnav controller as a policy for them.
 
 gymnasium and pettingzoo (``uvnav[envs]``) are imported only when an env class is used.
-Registration: importing this package registers the three envs with gymnasium (when it is
-installed), so ``gymnasium.make("uvnav.envs:uvnav/Nav2D-v0")`` works from anywhere;
-:func:`register_envs` is also the ``gymnasium.envs`` entry point declared in pyproject.toml
-(gymnasium < 1.0 loads that group at import; gymnasium 1.x dropped plugin loading, hence the
-``module:`` form or ``import uvnav.envs``).
+
+Making the envs with Gymnasium 1.x, which does not load plugin entry points (a plain
+``gymnasium.make("uvnav/Nav2D-v0")`` in a fresh interpreter raises ``NamespaceNotFound``)::
+
+    import gymnasium as gym
+    import uvnav.envs
+
+    gym.register_envs(uvnav.envs)  # importing uvnav.envs registers them; this names the import
+    env = gym.make("uvnav/Nav2D-v0", scenario="office-floor")
+
+or, with no import of uvnav, the ``module:`` form (Gymnasium imports the module first)::
+
+    env = gym.make("uvnav.envs:uvnav/Nav2D-v0", scenario="office-floor")
+
+Importing this package registers the three envs with gymnasium (when it is installed);
+:func:`register_envs` does it (idempotent) and is also the ``gymnasium.envs`` entry point
+declared in pyproject.toml, which only gymnasium < 1.0 loads at its own import.
+
+The 2D envs step the simulator's worlds (:mod:`uvnav.envs.core`): ``Nav2DEnv(...,
+raw_commands=True)`` driven by a law's commands gives :func:`uvnav.sim.run_episode`'s episode bit
+for bit (``reset(options={"episode_seed": k})`` is ``uvnav simulate SCENE --seed k``).
 """
 
 from __future__ import annotations

@@ -1,10 +1,14 @@
-"""The stepping world behind the Gymnasium and PettingZoo environments (no gymnasium import).
+"""What the Gymnasium and PettingZoo environments add to the loop's worlds (no gymnasium import).
 
-:class:`NavWorld` advances N unicycle robots (N = 1 for ``uvnav/Nav2D-v0``) and the scenario's
-obstacles one *decision* at a time: each call to :meth:`NavWorld.step` holds every robot's
-command for ``control_period`` [s] and integrates with ``dt`` [s], checking collisions at every
-integration step exactly as :func:`uvnav.sim.run_episode` does (robots are discs; a robot sees
-the other robots as moving discs, as in :mod:`uvnav.sim.multi`).
+The envs step the worlds of the one step loop (:mod:`uvnav.core`): ``uvnav/Nav2D-v0`` a
+:class:`uvnav.sim.episode.UnicycleWorld`, the multi-robot ParallelEnv a
+:class:`uvnav.sim.multi.MultiUnicycleWorld`.  :class:`EnvWorld` steps such a world one *decision*
+at a time — the agents' commands are applied at a decision time, then the world advances (every
+``dt``, integration, obstacles and collision checks are the world's own) until the next decision
+or the end — so an env episode is, bit for bit, the simulator's episode
+(:func:`uvnav.sim.run_episode`, :func:`uvnav.sim.multi.run_multi`) driven by the same commands.
+What is genuinely the env's is here: the observation vector, the action map, the reward and the
+frames.
 
 Observation vector of a robot (float32, documented in :data:`OBS_DOC`):
 
@@ -19,33 +23,41 @@ index                 what                                                      
 ====================  ==========================================================  =========
 
 Action (float32, in [-1, 1]^2): ``v = (a0 + 1) / 2 * V_max``, ``u = a1 * U_max`` (inside the
-limits (2.4) by construction, so no limit is ever violated).
+limits (2.4) by construction, so no limit is ever violated).  With ``raw_commands=True`` the
+action is instead the command itself, ``(v [m/s], u [rad/s])`` as float64, handed to the world
+as a uvnav law's command is (saturated and counted in ``limit_violations`` when outside the
+limits): the normalised float32 map cannot carry a law's command exactly (a law's ``u`` rounded
+to float32 moves the trajectory by ~1e-9 m per step), the raw one can.
 
 Reward per decision (weights in :class:`RewardConfig`): ``progress`` x (decrease of the distance
 to the goal [m]) ``- time`` ``- clearance`` x max(0, ``clearance_margin`` - clearance [m]) ``+
-success`` on arrival ``- collision`` on a collision.
+success`` on arrival ``- collision`` on a collision, where the clearance is the smallest gap of
+the robot's disc to an obstacle or another robot over the decision's integration steps
+(``max_range`` when nothing is within the robot's reach).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
-from uvnav.geometry.angles import FloatArray
-from uvnav.obstacles.batch import ObstacleBatch
+from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.obstacles.bodies import Body, DiscBody
-from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
-from uvnav.sensors.exact import lidar_scan, sense_obstacles
+from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
+from uvnav.sensors.exact import lidar_scan
 from uvnav.sensors.observation import Observation
-from uvnav.sim.episode import SensingConfig, decision_ratio
+from uvnav.sim.episode import UnicycleWorld
+from uvnav.sim.multi import MultiUnicycleWorld
 
 OBS_DOC = (
     "[goal distance / goal_scale, cos(goal bearing), sin(goal bearing), speed / v_max, "
     "lidar ranges / max_range x n_rays]"
 )
+
+#: A robot's episode is over (terminated) in these statuses; it is ``"running"`` before.
+TERMINAL = ("success", "collision")
 
 
 @dataclass(frozen=True)
@@ -80,20 +92,11 @@ class RewardConfig:
         return r
 
 
-@dataclass
-class WorldRobot:
-    """One robot: limits, start pose, goal, sensing."""
-
-    spec: UnicycleSpec
-    start: FloatArray
-    goal: FloatArray
-    sensing: SensingConfig = field(default_factory=SensingConfig)
-
-
 @dataclass(frozen=True, eq=False)
 class ControllerView:
-    """What a uvnav controller would be given at this decision: its
-    :class:`~uvnav.sensors.Observation` and its vehicle limits (``info["uvnav"]`` of the envs).
+    """What a uvnav controller is given at this decision: its
+    :class:`~uvnav.sensors.Observation` (made by the world's sensor, as in the simulator) and its
+    vehicle limits (``info["uvnav"]`` of the envs), and whether the env takes raw commands.
 
     Equality compares the contents (numpy arrays element-wise), so Gymnasium's determinism
     checks can compare infos.
@@ -101,6 +104,7 @@ class ControllerView:
 
     observation: Observation
     spec: UnicycleSpec
+    raw_commands: bool = False  # the env's action is the command (v, u) itself
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, ControllerView):
@@ -123,240 +127,186 @@ class ControllerView:
     __hash__ = None  # type: ignore[assignment]
 
 
-class NavWorld:
-    """N robots and the obstacles, advanced one decision at a time (module docstring).
+class EnvWorld:
+    """A loop world stepped one decision at a time, and the env's view of it (module docstring).
+
+    Robot i is agent i of ``world`` (a :class:`UnicycleWorld` or a :class:`MultiUnicycleWorld`,
+    started here as for laws that are not oracles: with ``velocities: estimated`` sensing the
+    observations carry estimated rates).
 
     Args:
-        robots: the robots.
-        obstacles: fresh obstacles for this episode (advanced in place).
-        dt: integration step [s].
-        control_period: decision period [s].
-        goal_tolerance: arrival radius [m].
+        world: a fresh world.
         n_rays: lidar beams in the observation vector.
         max_range: lidar range [m].
         goal_scale: distance [m] mapped to 1 in the observation.
         reward: reward weights.
+        raw_commands: actions are commands ``(v, u)`` (module docstring).
     """
 
     def __init__(
         self,
-        robots: list[WorldRobot],
-        obstacles: list[Obstacle],
+        world: UnicycleWorld | MultiUnicycleWorld,
         *,
-        dt: float,
-        control_period: float,
-        goal_tolerance: float,
         n_rays: int = 32,
         max_range: float = 5.0,
         goal_scale: float = 20.0,
         reward: RewardConfig | None = None,
+        raw_commands: bool = False,
     ) -> None:
-        self.robots = robots
-        self.obstacles = obstacles
-        self.dt = float(dt)
-        self.ratio = decision_ratio(float(control_period), self.dt)
-        self.tol = float(goal_tolerance)
+        self.world = world
+        self.multi = isinstance(world, MultiUnicycleWorld)
         self.n_rays = int(n_rays)
         self.max_range = float(max_range)
         self.goal_scale = float(goal_scale)
         self.reward = reward or RewardConfig()
-        n = len(robots)
-        self.k = len(obstacles)
-        bodies: list[Body] = [o.body for o in obstacles]
-        bodies += [DiscBody(max(float(r.spec.radius), 1e-6)) for r in robots]
-        self.template = FieldTemplate.from_bodies(bodies)
-        self.batch = ObstacleBatch(obstacles)
-        self.state = np.array([np.asarray(r.start, dtype=float)[:3] for r in robots])
-        self.goals = np.array([np.asarray(r.goal, dtype=float)[:2] for r in robots])
-        self.radii = np.array([float(r.spec.radius) for r in robots])
-        self.speeds = np.zeros(n)
-        self.turns = np.zeros(n)
-        self.active = np.ones(n, dtype=bool)
-        self.status = ["running"] * n
-        self.t = 0.0
-        self.field = self._field()
-        self.clearance = np.array([self._clearance(i) for i in range(n)])
-        for i in range(n):
-            if self.clearance[i] < 0:
-                self.status[i] = "collision"
-                self.active[i] = False
-            elif self.distance(i) <= self.tol:
-                self.status[i] = "success"
-                self.active[i] = False
+        self.raw_commands = raw_commands
+        self.k = len(world.obstacles)
+        world.start([False] * world.n_agents)
+        self.clearance = np.array([self._gap(i) for i in range(self.n)])
+        self._lidar_fields: dict[int, tuple[FieldTemplate, np.ndarray]] = {}
 
+    # ----------------------------------------------------------------- robot i of either world
     @property
     def n(self) -> int:
-        return len(self.robots)
+        return self.world.n_agents
 
+    @property
+    def field(self) -> ObstacleField:
+        """The world's field now (the obstacles first, then, in a multi-robot world, the
+        robots)."""
+        return self.world.field
+
+    def pose(self, i: int) -> np.ndarray:
+        w = self.world
+        return w.state[i] if isinstance(w, MultiUnicycleWorld) else w.pose
+
+    def goal(self, i: int) -> np.ndarray:
+        w = self.world
+        return w.goals[i] if isinstance(w, MultiUnicycleWorld) else w.goal
+
+    def spec(self, i: int) -> UnicycleSpec:
+        w = self.world
+        return w.robots[i].spec if isinstance(w, MultiUnicycleWorld) else w.spec
+
+    def status(self, i: int) -> str:
+        """``"success"``, ``"collision"`` or ``"running"``."""
+        w = self.world
+        s = w.status[i] if isinstance(w, MultiUnicycleWorld) else w.status
+        return s if s in TERMINAL else "running"
+
+    def running(self, i: int) -> bool:
+        return self.status(i) == "running"
+
+    def speed(self, i: int) -> float:
+        """The speed held now [m/s] (0 once the robot's episode is over)."""
+        w = self.world
+        if not self.running(i):
+            return 0.0
+        return float(w.applied[i].v if isinstance(w, MultiUnicycleWorld) else w.applied.v)
+
+    def _gap(self, i: int) -> float:
+        """Robot i's gap after the last step [m] (``max_range`` when nothing is within reach)."""
+        w = self.world
+        c = float(w.clearance[i] if isinstance(w, MultiUnicycleWorld) else w.clearance)
+        return c if math.isfinite(c) else self.max_range
+
+    def distance(self, i: int) -> float:
+        return float(math.hypot(*(self.goal(i) - self.pose(i)[:2])))
+
+    # ------------------------------------------------------------------------ what the env adds
     def obs_size(self) -> int:
         return 4 + self.n_rays
 
-    def distance(self, i: int) -> float:
-        return float(math.hypot(*(self.goals[i] - self.state[i, :2])))
-
-    def _field(self) -> ObstacleField:
-        vel = np.column_stack(
-            (self.speeds * np.cos(self.state[:, 2]), self.speeds * np.sin(self.state[:, 2]))
-        )
-        vel[~self.active] = 0.0
-        omega = np.where(self.active, self.turns, 0.0)
-        if self.k:
-            b = self.batch
-            return self.template.field(
-                np.vstack((b.positions, self.state[:, :2])),
-                np.concatenate((b.headings, self.state[:, 2])),
-                np.vstack((b.velocities, vel)),
-                np.concatenate((b.angular_velocities, omega)),
-            )
-        return self.template.field(self.state[:, :2].copy(), self.state[:, 2].copy(), vel, omega)
-
-    def _clearance(self, i: int) -> float:
-        """Gap [m] from robot i's disc to the nearest obstacle or other robot (``max_range`` when
-        nothing is within ``max_range``)."""
-        q = self.field.query(
-            self.state[i, :2], self.max_range + self.radii.max() * 2, nearest=False
-        )
-        keep = q.ids != self.k + i
-        if not keep.any() or self.n == 0:
-            return self.max_range
-        return float((q.signed[keep] - self.radii[i]).min())
-
-    def observation(self, i: int) -> Observation:
-        """What robot i's sensors give (the uvnav controller contract), other robots included."""
-        r = self.robots[i]
-        pose = self.state[i].copy()
-        readings = sense_obstacles(pose[:2], self.field, sensing_range=r.sensing.sensing_range)
-        readings = tuple(rd for rd in readings if rd.obstacle_id != self.k + i)
-        return Observation(
-            time=self.t,
-            pose=pose,
-            speed=float(self.speeds[i]),
-            goal=self.goals[i].copy(),
-            obstacles=readings,
-        )
-
     def view(self, i: int) -> ControllerView:
-        """Robot i's :class:`ControllerView` (observation and limits)."""
-        return ControllerView(self.observation(i), self.robots[i].spec)
+        """Robot i's :class:`ControllerView`: the world's observation (call once per decision:
+        an estimator, a noisy lidar, advance with it) and its limits."""
+        return ControllerView(self.world.observe(i), self.spec(i), self.raw_commands)
 
     def vector(self, i: int) -> np.ndarray:
         """Robot i's observation vector (module docstring), float32."""
-        _x, _y, th = self.state[i]
-        gap = self.goals[i] - self.state[i, :2]
-        dist = float(math.hypot(*gap))
-        bearing = math.atan2(gap[1], gap[0]) - th
-        scan = lidar_scan(
-            self.state[i], self._field_without(i), n_rays=self.n_rays, max_range=self.max_range
-        )
+        pose = self.pose(i)
+        gap = self.goal(i) - pose[:2]
+        bearing = math.atan2(gap[1], gap[0]) - pose[2]
+        scan = lidar_scan(pose, self._lidar_field(i), n_rays=self.n_rays, max_range=self.max_range)
         out = np.empty(self.obs_size(), dtype=np.float32)
-        out[0] = min(dist / self.goal_scale, 1.0)
+        out[0] = min(float(math.hypot(*gap)) / self.goal_scale, 1.0)
         out[1] = math.cos(bearing)
         out[2] = math.sin(bearing)
-        out[3] = min(max(self.speeds[i] / self.robots[i].spec.v_max, 0.0), 1.0)
+        out[3] = min(max(self.speed(i) / self.spec(i).v_max, 0.0), 1.0)
         out[4:] = np.clip(scan.ranges / self.max_range, 0.0, 1.0)
         return out
 
-    def _field_without(self, i: int) -> ObstacleField:
-        if self.n == 1:
-            return self._obstacles_only()
-        return self._drop(self.k + i)
-
-    def _obstacles_only(self) -> ObstacleField:
-        # the robot's own disc must not block its own lidar: a field of the obstacles only
-        if not hasattr(self, "_tpl_obs"):
-            self._tpl_obs = FieldTemplate.from_bodies([o.body for o in self.obstacles])
-        b = self.batch
-        return self._tpl_obs.field(b.positions, b.headings, b.velocities, b.angular_velocities)
-
-    def _drop(self, j: int) -> ObstacleField:
-        if not hasattr(self, "_drop_cache"):
-            self._drop_cache: dict[int, tuple[FieldTemplate, np.ndarray]] = {}
-        if j not in self._drop_cache:
-            bodies: list[Body] = [o.body for o in self.obstacles]
-            bodies += [DiscBody(max(float(r.spec.radius), 1e-6)) for r in self.robots]
-            idx = np.array([m for m in range(len(bodies)) if m != j], dtype=int)
-            self._drop_cache[j] = (FieldTemplate.from_bodies([bodies[m] for m in idx]), idx)
-        tpl, keep = self._drop_cache[j]
-        f = self.field
+    def _lidar_field(self, i: int) -> ObstacleField:
+        """The field robot i's lidar sees: everything but its own disc."""
+        w = self.world
+        if not isinstance(w, MultiUnicycleWorld):
+            return w.field  # the obstacles only
+        if i not in self._lidar_fields:
+            bodies: list[Body] = [o.body for o in w.obstacles]
+            bodies += [DiscBody(max(float(r.spec.radius), 1e-6)) for r in w.robots]
+            keep = np.array([m for m in range(len(bodies)) if m != self.k + i], dtype=int)
+            self._lidar_fields[i] = (FieldTemplate.from_bodies([bodies[m] for m in keep]), keep)
+        tpl, keep = self._lidar_fields[i]
+        f = w.field
         return tpl.field(
             f.centres[keep], f.headings[keep], f.velocities[keep], f.angular_velocities[keep]
         )
 
     def command(self, i: int, action: np.ndarray) -> UnicycleCommand:
-        """The unicycle command of a normalised action in [-1, 1]^2 (clipped)."""
+        """The unicycle command of an action: ``(v, u)`` itself with ``raw_commands``, else the
+        map of a normalised action in [-1, 1]^2 (clipped; non-finite components 0)."""
+        if self.raw_commands:
+            v, u = np.asarray(action, dtype=float).reshape(2).tolist()
+            return UnicycleCommand(v, u)
         a = np.clip(np.asarray(action, dtype=float).reshape(2), -1.0, 1.0)
         a = np.where(np.isfinite(a), a, 0.0)
-        spec = self.robots[i].spec
+        spec = self.spec(i)
         return UnicycleCommand(0.5 * (a[0] + 1.0) * spec.v_max, a[1] * spec.u_max)
 
     def step(self, actions: dict[int, np.ndarray]) -> np.ndarray:
-        """Hold the robots' commands for one decision period; returns the rewards (0 for robots
-        that were already done)."""
-        n = self.n
-        rw = self.reward
-        before = np.array([self.distance(i) for i in range(n)])
-        was_active = self.active.copy()
-        cmds = {i: self.command(i, actions[i]) for i in range(n) if self.active[i] and i in actions}
-        for i in range(n):
-            if self.active[i]:
-                c = cmds.get(i, UnicycleCommand(0.0, 0.0))
-                self.speeds[i], self.turns[i] = c.v, c.u
-        min_clear = np.full(n, np.inf)
-        for _ in range(self.ratio):
-            if not self.active.any():
-                break
-            for i in range(n):
-                if not self.active[i]:
-                    self.speeds[i] = self.turns[i] = 0.0
-                    continue
-                x, y, th = self.state[i]
-                self.state[i] = unicycle_advance(
-                    float(x),
-                    float(y),
-                    float(th),
-                    float(self.speeds[i]),
-                    float(self.turns[i]),
-                    self.dt,
-                )
-            self.batch.step(self.t, self.dt)
-            self.t += self.dt
-            self.field = self._field()
-            for i in range(n):
-                if not self.active[i]:
-                    continue
-                gap = self._clearance(i)
-                min_clear[i] = min(min_clear[i], gap)
-                if gap < 0:
-                    self.status[i] = "collision"
-                elif self.distance(i) <= self.tol:
-                    self.status[i] = "success"
-            for i in range(n):
-                if self.active[i] and self.status[i] != "running":
-                    self.active[i] = False
-                    self.speeds[i] = self.turns[i] = 0.0
-        self.field = self._field()
+        """One decision: the acting robots' commands (a robot without an action stands still)
+        are applied, then the world advances to the next decision time or the end.  Returns the
+        rewards (0 for robots that were already done)."""
+        n, w = self.n, self.world
+        before = [self.distance(i) for i in range(n)]
+        was_running = [self.running(i) for i in range(n)]
+        low = np.full(n, np.inf)
+        if not w.done:
+            for i in w.acting():
+                cmd = self.command(i, actions[i]) if i in actions else UnicycleCommand(0.0, 0.0)
+                w.apply(cmd, i)
+            while True:
+                alive = [i for i in range(n) if self.running(i)]
+                w.advance()
+                for i in alive:
+                    low[i] = min(low[i], self._gap(i))
+                if w.done or w.acting():
+                    break
         rewards = np.zeros(n)
         for i in range(n):
-            if not was_active[i]:
+            if not was_running[i]:
                 continue
-            self.clearance[i] = min_clear[i] if np.isfinite(min_clear[i]) else self.clearance[i]
-            rewards[i] = rw.reward(
-                before[i] - self.distance(i), float(self.clearance[i]), self.status[i]
+            if math.isfinite(low[i]):
+                self.clearance[i] = low[i]
+            rewards[i] = self.reward.reward(
+                before[i] - self.distance(i), float(self.clearance[i]), self.status(i)
             )
         return rewards
 
     def close(self) -> None:
-        self.batch.write_back()
+        """Write the obstacles' states back (the world's :meth:`close`)."""
+        self.world.close()
 
 
-def scene_bounds(world: NavWorld, margin: float = 1.5) -> tuple[float, float, float, float]:
+def scene_bounds(world: EnvWorld, margin: float = 1.5) -> tuple[float, float, float, float]:
     """A box [m] around the robots' starts and goals and the obstacles' initial bounding discs
-    (pedestrians parked far away are left out), grown by ``margin``."""
-    pts = [world.state[:, :2], world.goals]
+    (pedestrians parked far away are left out), grown by ``margin``; call it at reset."""
+    starts = np.array([world.pose(i)[:2] for i in range(world.n)])
+    pts = [starts, np.array([world.goal(i) for i in range(world.n)])]
     if world.k:
-        c = world.batch.positions
-        rad = world.template.bounding_radii[: world.k]
-        near = np.hypot(*(c - world.state[0, :2]).T) < 100.0
+        c = world.world.batch.positions
+        rad = world.world.template.bounding_radii[: world.k]
+        near = np.hypot(*(c - starts[0]).T) < 100.0
         if near.any():
             pts += [c[near] - rad[near, None], c[near] + rad[near, None]]
     allp = np.vstack(pts)
@@ -383,7 +333,7 @@ ROBOT_COLOURS = np.array(
 
 
 def render_frame(
-    world: NavWorld, bounds: tuple[float, float, float, float], size: int = 256
+    world: EnvWorld, bounds: tuple[float, float, float, float], size: int = 256
 ) -> np.ndarray:
     """An RGB frame (size, size, 3) uint8 of the world: obstacles grey, robots coloured discs,
     goals coloured squares; y up.  Pure numpy + shapely (no plotting library)."""
@@ -409,10 +359,10 @@ def render_frame(
     px = (xmax - xmin) / size
     for i in range(world.n):
         col = ROBOT_COLOURS[i % len(ROBOT_COLOURS)]
-        g = world.goals[i]
+        g = world.goal(i)
         img[(np.abs(gx - g[0]) <= 2.5 * px) & (np.abs(gy - g[1]) <= 2.5 * px)] = col
-        x, y, th = world.state[i]
-        rad = max(float(world.radii[i]), 2.0 * px)
+        x, y, th = (float(c) for c in world.pose(i))
+        rad = max(float(world.spec(i).radius), 2.0 * px)
         img[np.hypot(gx - x, gy - y) <= rad] = col
         tip = np.hypot(gx - (x + rad * math.cos(th)), gy - (y + rad * math.sin(th))) <= 1.5 * px
         img[tip] = (0, 0, 0)

@@ -1,13 +1,18 @@
 """A PettingZoo ``ParallelEnv`` of several robots (issue 9): every robot is an agent.
 
-The world is :class:`uvnav.envs.core.NavWorld` built from a multi-robot scenario
+The world is the simulator's own :class:`uvnav.sim.multi.MultiUnicycleWorld`, stepped one
+decision at a time (:class:`uvnav.envs.core.EnvWorld`), built from a multi-robot scenario
 (:mod:`uvnav.scenarios.multi`: ``antipodal:N``, ``crossing:N``, ``thesis-ch2-multi:N`` or a YAML
-file).  Agents ``robot_0 ... robot_{N-1}`` have the observation and action spaces of
-``uvnav/Nav2D-v0`` (:mod:`uvnav.envs.nav2d`); each robot's lidar and its ``info["uvnav"]``
-observation include the other robots as moving discs.  An agent terminates on arrival or
-collision (and is then removed from ``agents``, PettingZoo's convention; it stays in the world as
-a parked disc or wreck), and all are truncated at the scenario's ``t_max``.  Rewards are
-per-agent, :class:`~uvnav.envs.core.RewardConfig`.
+file); episode ``k`` (``reset(options={"episode_seed": k})``) is
+:func:`uvnav.sim.multi.run_multi`'s on ``build_multi(scenario, k)`` with ``run_rng(k)``, bit for
+bit when the agents' actions are their laws' commands (``raw_commands=True``).
+
+Agents ``robot_0 ... robot_{N-1}`` have the observation and action spaces of ``uvnav/Nav2D-v0``
+(:mod:`uvnav.envs.nav2d`); each robot's lidar and its ``info["uvnav"]`` observation include the
+other robots as moving discs.  An agent terminates on arrival or collision (and is then removed
+from ``agents``, PettingZoo's convention; it stays in the world as a parked disc or wreck), and
+all are truncated at the scenario's ``t_max``.  Rewards are per-agent,
+:class:`~uvnav.envs.core.RewardConfig`.
 """
 
 from __future__ import annotations
@@ -17,9 +22,11 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.envs.core import NavWorld, RewardConfig, WorldRobot, render_frame, scene_bounds
-from uvnav.envs.nav2d import act_space, obs_space, reward_config
+from uvnav.envs.core import TERMINAL, EnvWorld, RewardConfig, render_frame, scene_bounds
+from uvnav.envs.nav2d import act_space, episode_seed, obs_space, reward_config
 from uvnav.scenarios.multi import MultiScenario, build_multi, load_multi_scenario
+from uvnav.sim.multi import MultiUnicycleWorld
+from uvnav.sim.seeding import run_rng
 
 try:
     from gymnasium import spaces
@@ -42,6 +49,7 @@ class MultiNav2DParallelEnv(ParallelEnv):
         goal_scale: distance [m] mapped to 1 in the observation (default 1.5 x the longest
             start-goal distance).
         reward: reward weights.
+        raw_commands: actions are unicycle commands ``(v, u)`` (:mod:`uvnav.envs.core`).
     """
 
     metadata: ClassVar[dict[str, Any]] = {
@@ -59,6 +67,7 @@ class MultiNav2DParallelEnv(ParallelEnv):
         max_range: float = 5.0,
         goal_scale: float | None = None,
         reward: RewardConfig | dict[str, float] | None = None,
+        raw_commands: bool = False,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
@@ -73,12 +82,23 @@ class MultiNav2DParallelEnv(ParallelEnv):
         longest = float(np.hypot(*(goals - starts).T).max())
         self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * longest, 1.0)
         self.reward_config = reward_config(reward)
+        self.raw_commands = raw_commands
         self.possible_agents = [f"robot_{i}" for i in range(len(self.scenario.robots))]
         self.agents: list[str] = []
         self._index = {a: i for i, a in enumerate(self.possible_agents)}
-        self._world: NavWorld | None = None
+        self._world: EnvWorld | None = None
         self._bounds = (0.0, 0.0, 1.0, 1.0)
         self._rng = np.random.default_rng()
+        self.episode_seed: int | None = None
+
+    @property
+    def world(self) -> MultiUnicycleWorld:
+        """The loop world of the current episode (metrics, ``law_setup``...)."""
+        if self._world is None:
+            raise RuntimeError("call reset() first")
+        world = self._world.world
+        assert isinstance(world, MultiUnicycleWorld)
+        return world
 
     @functools.cache  # noqa: B019 - one space object per agent, as PettingZoo asks
     def observation_space(self, agent: str) -> spaces.Box:
@@ -86,16 +106,17 @@ class MultiNav2DParallelEnv(ParallelEnv):
 
     @functools.cache  # noqa: B019
     def action_space(self, agent: str) -> spaces.Box:
-        return act_space()
+        r = self.scenario.robots[self._index[agent]]
+        return act_space(r.v_max, r.u_max, raw=self.raw_commands)
 
     def _info(self, i: int) -> dict[str, Any]:
         w = self._world
         assert w is not None
         return {
-            "status": w.status[i],
+            "status": w.status(i),
             "distance": w.distance(i),
             "clearance": float(w.clearance[i]),
-            "time": w.t,
+            "time": w.world.t,
             "uvnav": w.view(i),
         }
 
@@ -106,21 +127,17 @@ class MultiNav2DParallelEnv(ParallelEnv):
             self._rng = np.random.default_rng(seed)
         if self._world is not None:
             self._world.close()
-        setup = build_multi(self.scenario, int(self._rng.integers(2**31 - 1)))
-        robots = [WorldRobot(r.spec, r.start, r.goal, r.sensing) for r in setup.robots]
-        self._world = NavWorld(
-            robots,
-            setup.obstacles,
-            dt=setup.dt,
-            control_period=setup.control_period,
-            goal_tolerance=setup.goal_tolerance,
+        self.episode_seed = k = episode_seed(self._rng, options)
+        self._world = EnvWorld(
+            MultiUnicycleWorld(build_multi(self.scenario, k), run_rng(k)),
             n_rays=self.n_rays,
             max_range=self.max_range,
             goal_scale=self.goal_scale,
             reward=self.reward_config,
+            raw_commands=self.raw_commands,
         )
         self._bounds = scene_bounds(self._world)
-        self.agents = [a for a in self.possible_agents if self._world.active[self._index[a]]]
+        self.agents = [a for a in self.possible_agents if self._world.running(self._index[a])]
         obs = {a: self._world.vector(self._index[a]) for a in self.agents}
         infos = {a: self._info(self._index[a]) for a in self.agents}
         return obs, infos
@@ -139,13 +156,13 @@ class MultiNav2DParallelEnv(ParallelEnv):
             raise RuntimeError("call reset() before step()")
         live = list(self.agents)
         rewards_arr = w.step({self._index[a]: np.asarray(actions[a]) for a in live if a in actions})
-        timeout = w.t >= float(self.scenario.t_max) - 1e-9
+        timeout = w.world.done
         obs, rewards, terms, truncs, infos = {}, {}, {}, {}, {}
         for a in live:
             i = self._index[a]
             obs[a] = w.vector(i)
             rewards[a] = float(rewards_arr[i])
-            terms[a] = w.status[i] in ("success", "collision")
+            terms[a] = w.status(i) in TERMINAL
             truncs[a] = bool(timeout and not terms[a])
             infos[a] = self._info(i)
             if truncs[a]:

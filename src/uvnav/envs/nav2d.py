@@ -1,13 +1,18 @@
 """``uvnav/Nav2D-v0``: a Gymnasium environment on the 2D world of the thesis's Ch. 2.
 
-One robot (unicycle, (2.1)-(2.4)) among a scenario's obstacles; one env step is one decision
-(``control_period``), integrated with the scenario's ``dt`` and checked for collisions at every
-integration step (:mod:`uvnav.envs.core`).
+One robot (unicycle, (2.1)-(2.4)) among a scenario's obstacles.  The env steps the simulator's
+own world, :class:`uvnav.sim.episode.UnicycleWorld` (:class:`uvnav.envs.core.EnvWorld`): one env
+step is one decision (``control_period``), integrated with the scenario's ``dt`` and checked for
+collisions at every integration step by the world, so that an env episode driven by a law's
+commands (``raw_commands=True``) is bit for bit :func:`uvnav.sim.run_episode`'s.
 
 * **Observation** ``Box(4 + n_rays,)`` float32: goal distance / ``goal_scale`` in [0, 1], cos and
   sin of the goal bearing in the robot frame, speed / V_max, then ``n_rays`` lidar ranges /
   ``max_range`` in [0, 1] (first beam straight behind, counter-clockwise).
-* **Action** ``Box([-1, -1], [1, 1])`` float32: ``v = (a0 + 1) / 2 V_max``, ``u = a1 U_max``.
+* **Action** ``Box([-1, -1], [1, 1])`` float32: ``v = (a0 + 1) / 2 V_max``, ``u = a1 U_max``;
+  with ``raw_commands=True``, ``Box([0, -U_max], [V_max, U_max])`` float64: the command
+  ``(v [m/s], u [rad/s])`` itself, saturated and counted as a limit violation when outside, as
+  the simulator does with a law's command (:mod:`uvnav.envs.core`).
 * **Reward**: :class:`uvnav.envs.core.RewardConfig` (progress, time, clearance, success,
   collision), configurable with ``reward={...}``.
 * **Termination**: arrival (``info["status"] == "success"``) or collision; **truncation** at the
@@ -18,9 +23,11 @@ integration step (:mod:`uvnav.envs.core`).
   simulator would give the controller and the vehicle limits.
 * ``render_mode="rgb_array"``: 256 x 256 RGB frames.
 
-Each ``reset(seed=...)`` draws an episode seed from the env's generator and builds the scenario
-for it (:func:`uvnav.scenarios.build.build_episode`), so random obstacles differ per episode and
-the same seed gives the same episode.
+Each ``reset(seed=...)`` draws an episode seed from the env's generator, so random obstacles
+differ per episode and the same seed gives the same episode; ``reset(options={"episode_seed":
+k})`` runs episode ``k`` itself.  Episode ``k`` is the simulator's (``uvnav simulate SCENE
+--seed k``): the scene :func:`uvnav.scenarios.build.build_episode` ``(scenario, k)``, the world's
+generator :func:`uvnav.sim.run_rng` ``(k)`` (the law's generator is ``env.world.law_setup()``'s).
 """
 
 from __future__ import annotations
@@ -30,10 +37,12 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.envs.core import NavWorld, RewardConfig, WorldRobot, render_frame, scene_bounds
+from uvnav.envs.core import TERMINAL, EnvWorld, RewardConfig, render_frame, scene_bounds
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.scenarios.schema import Scenario
+from uvnav.sim.episode import UnicycleWorld
+from uvnav.sim.seeding import run_rng
 
 try:
     import gymnasium as gym
@@ -57,8 +66,20 @@ def obs_space(n_rays: int) -> spaces.Box:
     return spaces.Box(low=low, high=np.ones(4 + n_rays, dtype=np.float32), dtype=np.float32)
 
 
-def act_space() -> spaces.Box:
+def act_space(v_max: float = 1.0, u_max: float = 1.0, *, raw: bool = False) -> spaces.Box:
+    """The normalised action box, or (``raw``) the command box ``[0, V_max] x [-U_max, U_max]``."""
+    if raw:
+        return spaces.Box(
+            low=np.array([0.0, -u_max]), high=np.array([v_max, u_max]), dtype=np.float64
+        )
     return spaces.Box(low=-1.0, high=1.0, shape=(2,), dtype=np.float32)
+
+
+def episode_seed(rng: np.random.Generator, options: dict[str, Any] | None) -> int:
+    """``options["episode_seed"]`` when given, else one drawn from ``rng``."""
+    if options and options.get("episode_seed") is not None:
+        return int(options["episode_seed"])
+    return int(rng.integers(2**31 - 1))
 
 
 class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
@@ -72,6 +93,7 @@ class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
         max_range: lidar range [m].
         goal_scale: distance [m] mapped to 1 (default: the scenario's start-goal distance x 1.5).
         reward: reward weights (:class:`RewardConfig` or a dict of its fields).
+        raw_commands: actions are unicycle commands ``(v, u)`` (module docstring).
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 10}  # noqa: RUF012 - gymnasium declares it an instance variable
@@ -85,6 +107,7 @@ class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
         max_range: float = 5.0,
         goal_scale: float | None = None,
         reward: RewardConfig | dict[str, float] | None = None,
+        raw_commands: bool = False,
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
@@ -97,19 +120,29 @@ class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
         self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
         self.reward_config = reward_config(reward)
         self.observation_space = obs_space(self.n_rays)
-        self.action_space = act_space()
-        self._world: NavWorld | None = None
+        self.raw_commands = raw_commands
+        self.action_space = act_space(r.v_max, r.u_max, raw=raw_commands)
+        self._world: EnvWorld | None = None
         self._bounds = (0.0, 0.0, 1.0, 1.0)
-        self._t_max = float(self.scenario.t_max)
+        self.episode_seed: int | None = None
+
+    @property
+    def world(self) -> UnicycleWorld:
+        """The loop world of the current episode (metrics, ``law_setup``...)."""
+        if self._world is None:
+            raise RuntimeError("call reset() first")
+        world = self._world.world
+        assert isinstance(world, UnicycleWorld)
+        return world
 
     def _info(self) -> dict[str, Any]:
         w = self._world
         assert w is not None
         return {
-            "status": w.status[0],
+            "status": w.status(0),
             "distance": w.distance(0),
             "clearance": float(w.clearance[0]),
-            "time": w.t,
+            "time": w.world.t,
             "uvnav": w.view(0),
         }
 
@@ -119,19 +152,14 @@ class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
         super().reset(seed=seed)
         if self._world is not None:
             self._world.close()
-        episode_seed = int(self.np_random.integers(2**31 - 1))
-        setup = build_episode(self.scenario, episode_seed)
-        robot = WorldRobot(setup.spec, setup.start, setup.goal, setup.sensing)
-        self._world = NavWorld(
-            [robot],
-            setup.obstacles,
-            dt=setup.dt,
-            control_period=setup.control_period,
-            goal_tolerance=setup.goal_tolerance,
+        self.episode_seed = k = episode_seed(self.np_random, options)
+        self._world = EnvWorld(
+            UnicycleWorld(build_episode(self.scenario, k), run_rng(k), exact=True),
             n_rays=self.n_rays,
             max_range=self.max_range,
             goal_scale=self.goal_scale,
             reward=self.reward_config,
+            raw_commands=self.raw_commands,
         )
         self._bounds = scene_bounds(self._world)
         return self._world.vector(0), self._info()
@@ -141,8 +169,8 @@ class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
         if w is None:
             raise RuntimeError("call reset() before step()")
         reward = float(w.step({0: np.asarray(action)})[0])
-        terminated = w.status[0] in ("success", "collision")
-        truncated = not terminated and w.t >= self._t_max - 1e-9
+        terminated = w.status(0) in TERMINAL
+        truncated = not terminated and w.world.done
         info = self._info()
         if truncated:
             info["status"] = "timeout"

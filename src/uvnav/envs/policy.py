@@ -5,9 +5,12 @@ action``.  The controller sees exactly what it sees in the simulator — the
 :class:`~uvnav.sensors.Observation` the env puts in ``info["uvnav"]``
 (:class:`~uvnav.envs.core.ControllerView`; a controller never reads the flat observation
 vector, which is for learned policies) — and its command is mapped to
-the env's normalised action (the inverse of :meth:`uvnav.envs.core.NavWorld.command`; for the
-Chapter 3 / 4 envs the view's own ``to_action``, :class:`uvnav.envs.common.SimView`), so a
-learned policy and the thesis's laws are run on equal terms, on the same env.  A law is named
+the env's normalised action (the inverse of :meth:`uvnav.envs.core.EnvWorld.command`, float32,
+so not exact; for the Chapter 3 / 4 envs the view's own ``to_action``,
+:class:`uvnav.envs.common.SimView`), so a learned policy and the thesis's laws are run on equal
+terms, on the same env.  On a 2D env made with ``raw_commands=True`` the command itself is the
+action (float64, unclipped), and the episode is bit for bit the simulator's (given the same law
+generator).  A law is named
 from any registry: the 2D laws, the 3D laws (``uvnav/Nav3D-v0``) or the Chapter-4 UUV laws
 (``uvnav/UUV2D-v0``).  The controller is
 reset whenever a new episode starts (the observation's time is 0 or goes back).
@@ -40,6 +43,9 @@ class ControllerPolicy:
         to_action = getattr(view, "to_action", None)
         if to_action is not None:  # the Chapter 3 / 4 envs: their own inverse action map
             return np.asarray(to_action(self.controller.act(o)), dtype=np.float32)
+        if getattr(view, "raw_commands", False):  # the command itself, exactly
+            raw = self.controller.act(o)
+            return np.array([raw.v, raw.u], dtype=float)
         cmd = self.controller.act(o).clipped(spec)
         a0 = 2.0 * cmd.v / spec.v_max - 1.0
         a1 = cmd.u / spec.u_max
