@@ -8,13 +8,13 @@ Ray twice.
 from __future__ import annotations
 
 import json
-import logging
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
 
+from uvnav.bench.ray_engine import start_local_ray
 from uvnav.bench.spec import campaign_from_dict, run_campaign_spec
 from uvnav.bench.store import ResultsStore
 from uvnav.bench.summary import TIMING_COLUMNS
@@ -38,9 +38,7 @@ controllers: [{name: straight-v1}, {name: zhang2019-v1}]
 
 @pytest.fixture(scope="module")
 def ray_instance() -> Iterator[object]:
-    ray.init(
-        num_cpus=2, include_dashboard=False, log_to_driver=False, logging_level=logging.WARNING
-    )
+    start_local_ray(ray, 2)  # as uvnav starts it: loopback only
     yield ray
     ray.shutdown()
 

@@ -185,17 +185,19 @@ def _fmt(value: Any) -> str:
 
 
 def _jsonable(value: Any) -> Any:
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, np.ndarray):
-        return value.tolist()
-    if isinstance(value, Path):
-        return str(value)
+    """``json.dumps`` fallback: numpy values and paths as JSON data (non-finite floats: null)."""
+    from uvnav.cli.checks import json_safe
+
+    if isinstance(value, np.generic | np.ndarray | Path):
+        return json_safe(value)
     raise TypeError(f"not JSON serialisable: {type(value).__name__}")
 
 
 def _dumps(data: Any, *, indent: int | None = None) -> str:
-    return json.dumps(data, default=_jsonable, indent=indent, allow_nan=False)
+    """Strict JSON: a NaN/±inf float (a missing value) is printed as ``null``, never ``NaN``."""
+    from uvnav.cli.checks import json_safe
+
+    return json.dumps(json_safe(data), default=_jsonable, indent=indent, allow_nan=False)
 
 
 def _optional(module: str, attr: str, what: str) -> Any:

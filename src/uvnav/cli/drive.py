@@ -8,7 +8,6 @@ seed list, a missing extra) are printed as ONE line ``error: ...`` and exit with
 
 from __future__ import annotations
 
-import json
 import math
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -16,6 +15,8 @@ from pathlib import Path
 from typing import Annotated, Any
 
 import typer
+
+from uvnav.cli.checks import dumps, finite
 
 drive_app = typer.Typer(
     name="drive",
@@ -89,7 +90,9 @@ def collect(
     seed_start: Annotated[int, typer.Option(help="First track seed.")] = 0,
     camera: Annotated[str, typer.Option(help="front | topdown")] = "front",
     record_every: Annotated[int, typer.Option(min=1, help="Record every N steps (50 Hz).")] = 4,
-    noise: Annotated[float, typer.Option(min=0.0, help="Std of the steering noise.")] = 0.25,
+    noise: Annotated[
+        float, typer.Option(min=0.0, callback=finite, help="Std of the steering noise.")
+    ] = 0.25,
     max_steps: Annotated[int, typer.Option(min=10, help="Steps per episode.")] = 1200,
 ) -> None:
     """Record expert demonstrations (driving_log.csv + IMG/); reruns resume."""
@@ -124,14 +127,19 @@ def train(
     ),
     epochs: Annotated[int, typer.Option(min=1, help="Epochs (thesis: 30).")] = 30,
     batch_size: Annotated[int, typer.Option(min=1, help="Batch size (thesis: 100).")] = 100,
-    lr: Annotated[float, typer.Option(min=0.0, help="Adam learning rate (thesis: 1e-3).")] = 1e-3,
+    lr: Annotated[
+        float, typer.Option(min=0.0, callback=finite, help="Adam learning rate (thesis: 1e-3).")
+    ] = 1e-3,
     device: Annotated[str, typer.Option(help="torch device (cpu, cuda).")] = "cpu",
     threads: Annotated[int, typer.Option(min=1, max=2, help="torch CPU threads.")] = 1,
     max_per_bin: Annotated[int, typer.Option(min=0, help="Balancing threshold (0: none).")] = 200,
     bins: Annotated[int, typer.Option(min=1, help="Steering histogram bins.")] = 25,
     correction: Annotated[
         float,
-        typer.Option(help="Left/right steering correction where a row has no exact side label."),
+        typer.Option(
+            callback=finite,
+            help="Left/right steering correction where a row has no exact side label.",
+        ),
     ] = 0.2,
     exact_sides: Annotated[
         bool,
@@ -152,7 +160,11 @@ def train(
     ] = "throttle",
     target_speed_max: Annotated[
         float | None,
-        typer.Option(min=1.0, help="target-speed head: cap of the label [m/s] (the top speed)."),
+        typer.Option(
+            min=1.0,
+            callback=finite,
+            help="target-speed head: cap of the label [m/s] (the top speed).",
+        ),
     ] = None,
     seed: Annotated[int, typer.Option(help="Seed of split, init, shuffling.")] = 0,
 ) -> None:
@@ -228,7 +240,8 @@ def speed_head(
         "model-speed.safetensors"
     ),
     target_speed_max: Annotated[
-        float | None, typer.Option(min=1.0, help="Cap of the target-speed label [m/s].")
+        float | None,
+        typer.Option(min=1.0, callback=finite, help="Cap of the target-speed label [m/s]."),
     ] = None,
     seed: Annotated[int, typer.Option(help="Seed of the split (as in training).")] = 0,
 ) -> None:
@@ -311,12 +324,17 @@ def evaluate(
             "expert's P law) | pi | both (the model's learned mode and pi)"
         ),
     ] = "both",
-    set_speed: Annotated[float, typer.Option(help="PI target speed [m/s].")] = 35.0,
+    set_speed: Annotated[
+        float, typer.Option(callback=finite, help="PI target speed [m/s].")
+    ] = 35.0,
     speed_factor: Annotated[
-        float, typer.Option(help="learned-speed: track this fraction of the predicted speed.")
+        float,
+        typer.Option(
+            callback=finite, help="learned-speed: track this fraction of the predicted speed."
+        ),
     ] = 1.0,
     max_speed: Annotated[
-        float | None, typer.Option(help="learned-speed: speed limiter [m/s].")
+        float | None, typer.Option(callback=finite, help="learned-speed: speed limiter [m/s].")
     ] = None,
     max_steps: Annotated[int, typer.Option(min=10, help="Steps per episode.")] = 2000,
     expert: Annotated[bool, typer.Option(help="Also drive the (oracle) expert.")] = True,
@@ -378,7 +396,7 @@ def evaluate(
 
 def _print_rows(rows: dict[str, dict[str, float]], as_json: bool) -> None:
     if as_json:
-        typer.echo(json.dumps(rows, indent=2))
+        typer.echo(dumps(rows, indent=2))  # strict JSON: a missing value is null, never NaN
         return
     from rich.console import Console
     from rich.table import Table
@@ -461,7 +479,9 @@ def dagger(
         str,
         typer.Option(help="The learner's throttle while driving: pi, learned or learned-speed."),
     ] = "pi",
-    set_speed: Annotated[float, typer.Option(help="PI target speed [m/s].")] = 35.0,
+    set_speed: Annotated[
+        float, typer.Option(callback=finite, help="PI target speed [m/s].")
+    ] = 35.0,
     out_dir: Annotated[Path, typer.Option("--out-dir", help="Folder of the round models.")] = Path(
         "dagger"
     ),
@@ -532,7 +552,11 @@ def reproduce(
     threads: Annotated[int, typer.Option(min=1, max=2, help="torch CPU threads for training.")] = 1,
     noise: Annotated[
         float | None,
-        typer.Option(min=0.0, help="Std of the recording's steering noise (default 0.25)."),
+        typer.Option(
+            min=0.0,
+            callback=finite,
+            help="Std of the recording's steering noise (default 0.25).",
+        ),
     ] = None,
 ) -> None:
     """Chapter 6 end to end: data, Figs. 6.1/6.4–6.8, training, closed-loop table.

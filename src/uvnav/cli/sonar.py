@@ -16,13 +16,14 @@ file and the problem, and exits with status 2.
 
 from __future__ import annotations
 
-import json
 import zipfile
 from pathlib import Path
 from typing import Annotated, Any, NoReturn
 
 import numpy as np
 import typer
+
+from uvnav.cli.checks import dumps, finite
 
 sonar_app = typer.Typer(
     no_args_is_help=True,
@@ -68,8 +69,12 @@ def dataset_cmd(
     out: Annotated[Path, typer.Option("--out", help="Output .npz file.")] = Path("sonar.npz"),
     samples: Annotated[int, typer.Option("--samples", "-n", min=1, help="Samples.")] = 150,
     seed: Annotated[int, typer.Option(min=0, help="Seed of the sampling.")] = 0,
-    noise: Annotated[float, typer.Option(min=0.0, help="Sonar range noise std [m].")] = 0.0,
-    dropout: Annotated[float, typer.Option(min=0.0, max=1.0, help="Echo dropout rate.")] = 0.0,
+    noise: Annotated[
+        float, typer.Option(min=0.0, callback=finite, help="Sonar range noise std [m].")
+    ] = 0.0,
+    dropout: Annotated[
+        float, typer.Option(min=0.0, max=1.0, callback=finite, help="Echo dropout rate.")
+    ] = 0.0,
     subdivisions: Annotated[
         int, typer.Option(min=1, max=4, help="Icosphere level of the obstacle meshes.")
     ] = 2,
@@ -126,9 +131,7 @@ def train_cmd(
     table = error_table(model.predict(ds.inputs[test]), ds.targets()[test], ds.baseline()[test])
     if as_json:
         typer.echo(
-            json.dumps(
-                {"test": table, "best_epoch": model.best_epoch, "stop_reason": model.stop_reason}
-            )
+            dumps({"test": table, "best_epoch": model.best_epoch, "stop_reason": model.stop_reason})
         )
     else:
         _print_table(table, len(ds), f"test group ({len(test)} samples)")
@@ -154,7 +157,7 @@ def evaluate_cmd(
         _fail(f"{data}: {ds.inputs.shape[1]} inputs per sample, the model takes {model.n_inputs}")
     table = error_table(model.predict(ds.inputs), ds.targets(), ds.baseline())
     if as_json:
-        typer.echo(json.dumps(table))
+        typer.echo(dumps(table))
     else:
         _print_table(table, None, f"{data} ({len(ds)} samples)")
 
@@ -197,7 +200,9 @@ def simulate_cmd(
     ] = "",
     model_path: Annotated[Path | None, typer.Option("--model", help="BPNN checkpoint.")] = None,
     seed: Annotated[int, typer.Option(min=0, help="Episode seed (sonar noise).")] = 0,
-    noise: Annotated[float | None, typer.Option(min=0.0, help="Override sonar noise [m].")] = None,
+    noise: Annotated[
+        float | None, typer.Option(min=0.0, callback=finite, help="Override sonar noise [m].")
+    ] = None,
 ) -> None:
     """Run zhang2022-uuv3d-v1 on a Chapter 5 scenario and print its metrics as JSON."""
     from uvnav.bench.reproduce_ch5 import make_locator
@@ -230,7 +235,7 @@ def simulate_cmd(
         "entered_inner_space": res.entered_inner_space,
         **res.metrics.to_dict(),
     }
-    typer.echo(json.dumps(out))
+    typer.echo(dumps(out))  # strict JSON: a missing metric is null, never NaN
 
 
 @sonar_app.command("reproduce")
@@ -278,5 +283,5 @@ def reproduce_cmd(
             f"collision {100 * c['collision_rate']:.1f} % timeout {100 * c['timeout_rate']:.1f} %"
         )
     for f in s.failures:
-        typer.echo(f"failure: {json.dumps(f)}")
+        typer.echo(f"failure: {dumps(f)}")
     typer.echo(f"wall time {s.wall_time:.1f} s; results {s.json_path}")

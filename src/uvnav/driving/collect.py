@@ -13,6 +13,7 @@ in flight, whose rows are written but not listed — they are kept, as a Udacity
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.driving.dataset import LogWriter
+from uvnav.driving.dataset import DatasetError, LogWriter
 from uvnav.driving.expert import ExpertParams, PurePursuitExpert, ar1_noise
 from uvnav.driving.sim import DrivingSim
 
@@ -68,11 +69,23 @@ def dataset_meta(root: Path | str) -> dict[str, Any]:
 
     A field written later does not constrain older folders, except the front camera's field of
     view: it was :data:`LEGACY_FOV_DEG` until it was written, and is filled in as such.
+
+    Raises:
+        DatasetError: the file is not a JSON object, or a number in it is NaN or ±inf (one line
+            naming the file and the field).
     """
     f = Path(root) / META_NAME
     if not f.is_file():
         return {}
-    meta: dict[str, Any] = json.loads(f.read_text())
+    try:
+        meta: dict[str, Any] = json.loads(f.read_text())
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise DatasetError(f"{f}: not valid JSON ({type(exc).__name__})") from None
+    if not isinstance(meta, dict):
+        raise DatasetError(f"{f}: expected a JSON object, got {type(meta).__name__}")
+    for name, value in meta.items():
+        if isinstance(value, float) and not math.isfinite(value):
+            raise DatasetError(f"{f}: field '{name}': {value} is not a finite number")
     if meta.get("camera") == "front":
         meta.setdefault("fov_deg", LEGACY_FOV_DEG)
     return meta

@@ -34,6 +34,7 @@ was 0.065 / 0.085 against 0.035 on centre images; with exact labels the three ca
 from __future__ import annotations
 
 import csv
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -148,7 +149,9 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
     rows; absent values are NaN).
 
     Raises:
-        DatasetError: missing CSV, wrong column count, non-numeric value, missing image.
+        DatasetError: missing CSV, wrong column count, non-numeric value, NaN or ±inf where a
+            finite number is meant (``nan`` is allowed only in the optional columns, where it
+            means "no value"), missing image.
     """
     root = Path(root)
     log = root / LOG_NAME
@@ -179,7 +182,8 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
             for c, x in zip(COLUMNS[3:], rec[3:7], strict=True):
                 cols[c].append(_number(x, log, r, c))
             for j, c in enumerate(EXTRA_COLUMNS, start=len(COLUMNS)):
-                extra[c].append(_number(rec[j], log, r, c) if len(rec) > j else float("nan"))
+                value = _number(rec[j], log, r, c, missing=True) if len(rec) > j else math.nan
+                extra[c].append(value)
     if not cols["center"]:
         raise DatasetError(f"{log}: no rows")
     ts, sl, sr = (_optional(extra[c]) for c in EXTRA_COLUMNS)
@@ -204,11 +208,22 @@ def _optional(values: list[float]) -> NDArray[np.float64] | None:
     return None if np.isnan(a).all() else a
 
 
-def _number(x: str, log: Path, row: int, col: str) -> float:
+def _number(x: str, log: Path, row: int, col: str, *, missing: bool = False) -> float:
+    """One CSV field as a finite float (``missing``: ``nan`` is allowed, meaning "no value").
+
+    Raises:
+        DatasetError: not a number, or not finite (``nan`` where a value is required, ``±inf``).
+    """
     try:
-        return float(x)
+        value = float(x)
     except ValueError:
         raise DatasetError(f"{log}: row {row}, column '{col}': {x!r} is not a number") from None
+    if math.isfinite(value) or (missing and math.isnan(value)):
+        return value
+    raise DatasetError(
+        f"{log}: row {row}, column '{col}': {x.strip()!r} is not a finite number"
+        + ("" if missing else " (a value is required)")
+    )
 
 
 class LogWriter:
@@ -244,6 +259,17 @@ class LogWriter:
         """
         from PIL import Image
 
+        labels = {"steering": steering, "throttle": throttle, "brake": brake, "speed": speed}
+        if target_speed is not None:
+            labels["target_speed"] = target_speed
+        if side_steering is not None:
+            labels["steering_left"], labels["steering_right"] = side_steering
+        bad = next((k for k, v in labels.items() if not math.isfinite(v)), None)
+        if bad is not None:
+            raise DatasetError(
+                f"{self.root / LOG_NAME}: row {key!r}, column '{bad}': {labels[bad]} is not a "
+                "finite number (not written)"
+            )
         names = []
         for cam, img in zip(("center", "left", "right"), images, strict=True):
             name = f"{IMG_DIR}/{cam}_{key}.jpg"

@@ -52,6 +52,36 @@ class CheckpointError(ValueError):
     """A model file that is not a valid uvnav BPNN checkpoint (one-line message)."""
 
 
+class NonFiniteError(ValueError):
+    """A NaN or ±inf where a finite number is meant: in the data, the loss or the weights."""
+
+
+def first_non_finite(arrays: dict[str, Any]) -> str | None:
+    """Where the first NaN/±inf of some named arrays is (``"name[i, j] = nan"``), or ``None``."""
+    for name, value in arrays.items():
+        a = np.asarray(value, dtype=float)
+        bad = np.argwhere(~np.isfinite(a))
+        if len(bad):
+            where = tuple(int(i) for i in bad[0])
+            index = ", ".join(str(i) for i in where)
+            return f"{name}[{index}] = {float(a[where])}" if where else f"{name} = {float(a)}"
+    return None
+
+
+def _model_arrays(model: TrainedBPNN) -> dict[str, Any]:
+    """A trained network's arrays by checkpoint name (weights and min/max scaling)."""
+    arrays: dict[str, Any] = {
+        "x_lo": model.x_lo,
+        "x_hi": model.x_hi,
+        "y_lo": model.y_lo,
+        "y_hi": model.y_hi,
+    }
+    for k, (w, b) in enumerate(model.weights):
+        arrays[f"layer{k}.weight"] = w
+        arrays[f"layer{k}.bias"] = b
+    return arrays
+
+
 @dataclass(frozen=True)
 class BPNNConfig:
     """Network and training settings.
@@ -220,6 +250,11 @@ def train_bpnn(
     Returns:
         The network with the weights of its best validation epoch (the last epoch when there is
         no validation group).
+
+    Raises:
+        NonFiniteError: a NaN/±inf in ``inputs``, ``targets`` or ``offset``, or a training loss
+            or weight that stops being finite (training diverged): no network is returned.
+        ValueError: inconsistent shapes.
     """
     cfg = config or BPNNConfig()
     torch = require_torch(MAX_THREADS)
@@ -227,6 +262,10 @@ def train_bpnn(
     y = np.asarray(targets, dtype=float)
     if x.ndim != 2 or y.ndim != 2 or len(x) != len(y):
         raise ValueError(f"inputs (n, k) and targets (n, m) must match (got {x.shape}, {y.shape})")
+    given = {"inputs": x, "targets": y, **({"offset": offset} if offset is not None else {})}
+    bad = first_non_finite(given)
+    if bad is not None:
+        raise NonFiniteError(f"training data: {bad} is not a finite number")
     if cfg.residual:
         if offset is None:
             raise ValueError("residual training needs the per-sample offset (n, 2)")
@@ -294,9 +333,13 @@ def train_bpnn(
             vl = float(loss_on(va_t)) if len(va) else tl
         history["train"].append(tl)
         history["val"].append(vl)
-        if not math.isfinite(tl):
-            stop = "diverged"
-            break
+        if not (math.isfinite(tl) and math.isfinite(vl)):
+            which = "training" if not math.isfinite(tl) else "validation"
+            raise NonFiniteError(
+                f"training diverged at epoch {epoch}: the {which} loss is "
+                f"{tl if which == 'training' else vl} (try --optimizer lbfgs or a smaller "
+                "learning rate); no model was kept"
+            )
         if vl < best_val:
             best_val, best_epoch, fails = vl, epoch, 0
             best_state = [p.detach().clone() for p in net.parameters()]
@@ -310,7 +353,7 @@ def train_bpnn(
             break
     params = [p.numpy().copy() for p in best_state]
     weights = [(params[2 * i], params[2 * i + 1]) for i in range(len(params) // 2)]
-    return TrainedBPNN(
+    model = TrainedBPNN(
         config=cfg,
         weights=weights,
         x_lo=x_lo,
@@ -322,6 +365,10 @@ def train_bpnn(
         stop_reason=stop,
         split={"train": np.asarray(tr), "val": np.asarray(va), "test": np.asarray(te)},
     )
+    bad = first_non_finite(_model_arrays(model))
+    if bad is not None:
+        raise NonFiniteError(f"training produced a non-finite network: {bad}")
+    return model
 
 
 @dataclass(frozen=True)
@@ -384,17 +431,22 @@ def save_checkpoint(model: TrainedBPNN, path: Path) -> tuple[Path, Path]:
 
     Returns:
         The two paths written.
+
+    Raises:
+        NonFiniteError: a weight or scaling value is NaN/±inf (nothing is written).
     """
     from safetensors.numpy import save_file
 
+    from uvnav.learning.checkpoint import json_safe
+
+    tensors = {k: np.ascontiguousarray(v) for k, v in _model_arrays(model).items()}
+    bad = first_non_finite(tensors)
+    if bad is not None:
+        raise NonFiniteError(f"{path}: refusing to save a network with {bad}")
     base = Path(path)
     if base.suffix in (".safetensors", ".json"):
         base = base.with_suffix("")
     base.parent.mkdir(parents=True, exist_ok=True)
-    tensors = {"x_lo": model.x_lo, "x_hi": model.x_hi, "y_lo": model.y_lo, "y_hi": model.y_hi}
-    for k, (w, b) in enumerate(model.weights):
-        tensors[f"layer{k}.weight"] = np.ascontiguousarray(w)
-        tensors[f"layer{k}.bias"] = np.ascontiguousarray(b)
     st_path = base.with_suffix(".safetensors")
     save_file({k: np.asarray(v, dtype=np.float64) for k, v in tensors.items()}, str(st_path))
     meta = {
@@ -407,7 +459,7 @@ def save_checkpoint(model: TrainedBPNN, path: Path) -> tuple[Path, Path]:
         "split": {k: [int(i) for i in v] for k, v in model.split.items()},
     }
     js_path = base.with_suffix(".json")
-    js_path.write_text(json.dumps(meta, indent=1))
+    js_path.write_text(json.dumps(json_safe(meta), indent=1, allow_nan=False))
     return st_path, js_path
 
 
@@ -417,8 +469,9 @@ def load_checkpoint(path: Path) -> TrainedBPNN:
     Only data are parsed (safetensors header + raw arrays, and JSON); nothing is unpickled.
 
     Raises:
-        CheckpointError: missing file, a file that is not safetensors (e.g. a pickle), or
-            missing/inconsistent arrays — one line naming the file and the problem.
+        CheckpointError: missing file, a file that is not safetensors (e.g. a pickle),
+            missing/inconsistent arrays, or a weight or scaling value that is NaN/±inf — one
+            line naming the file and the problem.
     """
     from safetensors import SafetensorError
     from safetensors.numpy import load_file
@@ -456,6 +509,9 @@ def load_checkpoint(path: Path) -> TrainedBPNN:
     for k in range(1, n_layers):
         if weights[k][0].shape[1] != weights[k - 1][0].shape[0]:
             raise CheckpointError(f"{st_path}: layer{k}.weight does not fit layer{k - 1}")
+    bad = first_non_finite(tensors)
+    if bad is not None:
+        raise CheckpointError(f"{st_path}: {bad} is not a finite number (a diverged network)")
     return TrainedBPNN(
         config=cfg,
         weights=weights,

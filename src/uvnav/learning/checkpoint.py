@@ -9,12 +9,31 @@ A JSON copy of the header is written beside the weights for people and tools.
 from __future__ import annotations
 
 import json
+import math
 from pathlib import Path
 from typing import Any
 
 from uvnav.learning.config import PilotNetConfig
 
 FORMAT = "uvnav-pilotnet-v1"
+
+
+class NonFiniteWeightsError(ValueError):
+    """A network whose weights hold NaN or ±inf (a diverged training): never saved or loaded."""
+
+
+def non_finite_tensor(state: dict[str, Any]) -> str | None:
+    """``"name: k of n values are not finite"`` for the first tensor of ``state`` (a
+    ``state_dict``) with a NaN/±inf among its floating-point values, else ``None``."""
+    import torch
+
+    for name, t in state.items():
+        if not torch.is_tensor(t) or not torch.is_floating_point(t):
+            continue
+        bad = int((~torch.isfinite(t)).sum())
+        if bad:
+            return f"{name}: {bad} of {t.numel()} values are not finite"
+    return None
 
 
 def save_checkpoint(model: Any, path: Path | str, *, record: dict[str, Any] | None = None) -> Path:
@@ -27,16 +46,38 @@ def save_checkpoint(model: Any, path: Path | str, *, record: dict[str, Any] | No
 
     Returns:
         The weights path.
+
+    Raises:
+        NonFiniteWeightsError: a weight is NaN/±inf (nothing is written).
     """
     from safetensors.torch import save_file
 
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    header = {"format": FORMAT, "config": model.config.to_dict(), "record": record or {}}
     state = {k: v.detach().cpu().contiguous() for k, v in model.state_dict().items()}
-    save_file(state, str(path), metadata={"uvnav": json.dumps(header)})
-    path.with_suffix(".json").write_text(json.dumps(header, indent=2))
+    bad = non_finite_tensor(state)
+    if bad is not None:
+        raise NonFiniteWeightsError(f"{path}: refusing to save a network with {bad}")
+    path.parent.mkdir(parents=True, exist_ok=True)
+    header = {"format": FORMAT, "config": model.config.to_dict(), "record": json_safe(record or {})}
+    save_file(state, str(path), metadata={"uvnav": json.dumps(header, allow_nan=False)})
+    path.with_suffix(".json").write_text(json.dumps(header, indent=2, allow_nan=False))
     return path
+
+
+def json_safe(value: Any) -> Any:
+    """``value`` with every NaN/±inf float replaced by ``None`` (strict JSON ``null``: "no value").
+
+    Dicts, lists and tuples are walked; numpy scalars are converted to Python numbers.
+    """
+    if isinstance(value, dict):
+        return {k: json_safe(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [json_safe(v) for v in value]
+    if hasattr(value, "item") and callable(value.item) and getattr(value, "ndim", None) == 0:
+        value = value.item()  # numpy / torch scalar
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
+    return value
 
 
 def read_header(path: Path | str) -> dict[str, Any]:
@@ -64,14 +105,23 @@ def read_header(path: Path | str) -> dict[str, Any]:
 
 
 def load_checkpoint(path: Path | str) -> tuple[Any, dict[str, Any]]:
-    """Rebuild the network from a checkpoint: ``(model in eval mode, header)``."""
+    """Rebuild the network from a checkpoint: ``(model in eval mode, header)``.
+
+    Raises:
+        ValueError: not a uvnav PilotNet checkpoint.
+        NonFiniteWeightsError: a weight is NaN/±inf (one line naming the file and the tensor).
+    """
     from safetensors.torch import load_file
 
     from uvnav.learning.pilotnet import build_pilotnet
 
     header = read_header(path)
+    state = load_file(str(path))
+    bad = non_finite_tensor(state)
+    if bad is not None:
+        raise NonFiniteWeightsError(f"{path}: {bad} (a diverged network; retrain it)")
     model = build_pilotnet(PilotNetConfig.from_dict(header["config"]))
-    model.load_state_dict(load_file(str(path)))
+    model.load_state_dict(state)
     model.eval()
     return model, header
 
@@ -144,7 +194,8 @@ def load_training_state(
 
     Returns:
         ``(epochs_done, history)``, or ``None`` (nothing restored) when there is no file, it is
-        not a training state, or it belongs to another run (a different ``key``).
+        not a training state, it belongs to another run (a different ``key``), or its weights
+        are not finite.
     """
     import torch
     from safetensors import safe_open
@@ -161,6 +212,8 @@ def load_training_state(
     if header.get("format") != TRAINING_STATE_FORMAT or header.get("key") != key:
         return None
     tensors = load_file(str(path))
+    if non_finite_tensor({k: v for k, v in tensors.items() if k.startswith("model.")}):
+        return None  # a diverged state is not continued: train again from the start
     model.load_state_dict(
         {k.removeprefix("model."): v for k, v in tensors.items() if k.startswith("model.")}
     )

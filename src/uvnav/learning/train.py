@@ -20,6 +20,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -32,6 +33,11 @@ from uvnav.learning.config import PilotNetConfig, TrainConfig
 
 #: inference backends of :class:`Predictor`
 BACKENDS = ("torch", "onnxruntime")
+
+
+class NonFiniteTrainingError(ValueError):
+    """NaN or ±inf in the training data, the loss or the weights: training stops, nothing is
+    saved (one-line message)."""
 
 
 @dataclass
@@ -131,6 +137,12 @@ def train_pilotnet(
 
     Returns:
         ``(model, history)``; ``images_per_s`` counts the epochs run in this call.
+
+    Raises:
+        NonFiniteTrainingError: a label or speed is NaN/±inf, or the loss or a weight stops
+            being finite (training diverged); no model is returned (the per-epoch state of the
+            last finite epoch is kept for ``resume``).
+        ValueError: an empty training set.
     """
     import torch
 
@@ -143,6 +155,13 @@ def train_pilotnet(
     imgs, steer, thr, spd = train
     if len(imgs) == 0:
         raise ValueError("train_pilotnet: empty training set")
+    for part, arrays in (("training", train), ("validation", val or ())):
+        for name, arr in zip(
+            ("steering", "second output label", "speed"), arrays[1:], strict=False
+        ):
+            bad = _non_finite(arr)
+            if bad:
+                raise NonFiniteTrainingError(f"{part} {name}: {bad}")
     if model is None:
         model = build_pilotnet(net or PilotNetConfig())
         if model.config.predicts_target_speed:
@@ -198,6 +217,11 @@ def train_pilotnet(
             )
             pred = model(xb, eb)
             loss = (((pred - yb) ** 2) * w).mean()  # MSE, eq. (6.1)
+            if not bool(torch.isfinite(loss)):
+                raise NonFiniteTrainingError(
+                    f"training diverged in epoch {epoch + 1}: the loss is {float(loss.detach())} "
+                    f"(try a smaller learning rate than {cfg.lr:g}); no model was written"
+                )
             opt.zero_grad()
             loss.backward()
             opt.step()
@@ -205,8 +229,19 @@ def train_pilotnet(
             count += len(idx)
             n_seen += len(idx)
         hist.train_loss.append(total / count)
+        bad = _non_finite_weights(model)
+        if bad:
+            raise NonFiniteTrainingError(
+                f"training diverged in epoch {epoch + 1}: {bad} (try a smaller learning rate "
+                f"than {cfg.lr:g}); no model was written"
+            )
         if val is not None and len(val[0]):
             m, ms, mt = evaluate_mse(model, *val, device=cfg.device)
+            if not math.isfinite(m):
+                raise NonFiniteTrainingError(
+                    f"training diverged in epoch {epoch + 1}: the validation loss is {m}; "
+                    "no model was written"
+                )
             hist.val_loss.append(m)
             hist.val_steering_mse.append(ms)
             hist.val_throttle_mse.append(mt)
@@ -230,6 +265,24 @@ def train_pilotnet(
     hist.images_per_s = n_seen / max(time.perf_counter() - tic, 1e-9)
     model.eval()
     return model, hist
+
+
+def _non_finite(arr: Any) -> str:
+    """``"k of n values are not finite (first at sample i: nan)"`` for a 1-D array of labels,
+    or ``""`` when all are finite."""
+    a = np.ravel(np.asarray(arr, dtype=float))
+    bad = np.flatnonzero(~np.isfinite(a))
+    if not len(bad):
+        return ""
+    i = int(bad[0])
+    return f"{len(bad)} of {len(a)} values are not finite (first at sample {i}: {float(a[i])})"
+
+
+def _non_finite_weights(model: Any) -> str:
+    """``"<parameter>: k of n values are not finite"`` for the first such tensor, or ``""``."""
+    from uvnav.learning.checkpoint import non_finite_tensor
+
+    return non_finite_tensor(dict(model.state_dict())) or ""
 
 
 def _run_key(model: Any, cfg: TrainConfig, train: Any, val: Any) -> str:
@@ -316,10 +369,18 @@ class Predictor:
 
     def outputs(self, frame: NDArray[np.uint8], speed: float = 0.0) -> tuple[float, float]:
         """``(steer, second)`` for one frame: ``second`` is the throttle in [-1, 1] (0 for a
-        steering-only network) or, for a target-speed network, the target speed [m/s]."""
+        steering-only network) or, for a target-speed network, the target speed [m/s].
+
+        Raises:
+            ValueError: the network's output is NaN/±inf (e.g. a NaN speed input).
+        """
         from uvnav.learning.pilotnet import target_speed_from_output
 
         out = self._forward(frame, speed)
+        if not np.isfinite(out).all():
+            raise ValueError(
+                f"the network's output {out.tolist()} is not finite (speed input {speed})"
+            )
         steer = float(np.clip(out[0], -1.0, 1.0))
         if len(out) < 2:
             return steer, 0.0

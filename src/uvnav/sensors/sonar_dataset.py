@@ -113,7 +113,9 @@ class SonarDataset:
         """Inverse of :meth:`arrays`.
 
         Raises:
-            ValueError: a missing array or inconsistent shapes (one line naming it).
+            ValueError: a missing array, inconsistent shapes, a value that is not a finite
+                number (NaN, ±inf), or a sensor index outside 1..9 (one line naming the array
+                and the row).
         """
         need = (
             "ranges",
@@ -132,6 +134,16 @@ class SonarDataset:
             want = (n, N_SONARS) if name in ("ranges", "inputs") else (n,)
             if a.shape != want:
                 raise ValueError(f"dataset array {name!r} has shape {a.shape}, expected {want}")
+            _check_finite(name, a)
+        for name in ("target_index", "baseline_index"):
+            a = np.asarray(arrays[name], dtype=float)
+            bad = np.flatnonzero((a != np.round(a)) | (a < 1) | (a > N_SONARS))
+            if len(bad):
+                value = float(a[bad[0]])
+                raise ValueError(
+                    f"dataset array {name!r}, row {int(bad[0])}: {value:g} is not a sensor "
+                    f"number 1..{N_SONARS}"
+                )
         return SonarDataset(
             ranges=np.asarray(arrays["ranges"], dtype=float),
             inputs=np.asarray(arrays["inputs"], dtype=float),
@@ -139,6 +151,25 @@ class SonarDataset:
             target_index=np.asarray(arrays["target_index"]).astype(np.int64),
             baseline_distance=np.asarray(arrays["baseline_distance"], dtype=float),
             baseline_index=np.asarray(arrays["baseline_index"]).astype(np.int64),
+        )
+
+
+def _check_finite(name: str, a: np.ndarray) -> None:
+    """Raise a one-line :class:`ValueError` at the first entry of ``a`` that is not finite.
+
+    Raises:
+        ValueError: a non-numeric array, or a NaN/±inf entry (naming the array, row and column).
+    """
+    if not (np.issubdtype(a.dtype, np.number) or a.dtype == np.bool_):
+        raise ValueError(f"dataset array {name!r} has dtype {a.dtype}, expected numbers")
+    if np.issubdtype(a.dtype, np.integer) or a.dtype == np.bool_:
+        return
+    bad = np.argwhere(~np.isfinite(a))
+    if len(bad):
+        where = bad[0]
+        cell = f"row {int(where[0])}" + (f", column {int(where[1])}" if len(where) > 1 else "")
+        raise ValueError(
+            f"dataset array {name!r}, {cell}: {float(a[tuple(where)])} is not a finite number"
         )
 
 
