@@ -29,6 +29,12 @@ Design choices, after what sweep tools such as Optuna's RDB storage and Sacred's
   episode never is, so a resumed campaign cannot duplicate or silently change results.
 * Opening an older database adds any metric column it lacks (``ALTER TABLE ADD COLUMN``), so
   adding a metric to :data:`~uvnav.sim.METRIC_NAMES` does not break existing result files.
+* One campaign writer per database: :meth:`ResultsStore.writer_lease` holds an exclusive
+  ``flock`` on ``<db>.lock`` beside the file (with the holder's pid in it) while a campaign
+  runs, so a second ``uvnav bench`` on the same database refuses at once
+  (:class:`StoreInUseError`) instead of running every episode again and failing on the first
+  duplicate.  The lock is the kernel's: it goes away with the process, however it ends, and the
+  file left behind is harmless.
 """
 
 from __future__ import annotations
@@ -38,9 +44,10 @@ import hashlib
 import io
 import json
 import math
+import os
 import sqlite3
 from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from contextlib import AbstractContextManager, contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -153,6 +160,75 @@ def trajectory_from_bytes(blob: bytes) -> Trajectory:
 
 
 # --------------------------------------------------------------------------------------------------
+# one writer per database
+# --------------------------------------------------------------------------------------------------
+
+
+class StoreInUseError(RuntimeError):
+    """Another process holds the database's writer lease (one line: the file and its pid)."""
+
+
+#: leases held by this process: lock-file path -> [file descriptor, nesting depth]
+_LEASES: dict[str, list[int]] = {}
+
+
+def lock_path(db: str | Path) -> Path:
+    """The lock file of a database: ``<db>.lock`` beside it."""
+    db = Path(db)
+    return db.with_name(db.name + ".lock")
+
+
+@contextmanager
+def writer_lease(db: str | Path) -> Iterator[None]:
+    """Hold the exclusive right to write campaigns into ``db`` (re-entrant within a process).
+
+    An exclusive, non-blocking ``flock`` on :func:`lock_path` whose file holds this process's pid;
+    released on exit (or by the kernel when the process dies).  Where ``flock`` does not exist
+    (Windows) there is no lease.
+
+    Raises:
+        StoreInUseError: another process holds it (at once, without waiting).
+    """
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lease
+        yield
+        return
+    path = lock_path(db)
+    key = str(path.resolve())
+    held = _LEASES.get(key)
+    if held is not None:
+        held[1] += 1
+        try:
+            yield
+        finally:
+            held[1] -= 1
+        return
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+        os.close(fd)
+        raise StoreInUseError(
+            f"database {db} is in use by another uvnav process (pid {holder}); wait for it to "
+            "finish or use another --db"
+        ) from None
+    except BaseException:
+        os.close(fd)
+        raise
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    _LEASES[key] = [fd, 1]
+    try:
+        yield
+    finally:
+        del _LEASES[key]
+        os.ftruncate(fd, 0)
+        os.close(fd)  # closing the descriptor releases the flock
+
+
+# --------------------------------------------------------------------------------------------------
 # the store
 # --------------------------------------------------------------------------------------------------
 
@@ -178,6 +254,14 @@ class ResultsStore:
         self._create_schema()
 
     # -- lifecycle
+
+    def writer_lease(self) -> AbstractContextManager[None]:
+        """This database's campaign-writer lease (:func:`writer_lease`).
+
+        Raises:
+            StoreInUseError: another process holds it.
+        """
+        return writer_lease(self.path)
 
     def close(self) -> None:
         """Close the connection (idempotent)."""

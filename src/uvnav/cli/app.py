@@ -725,7 +725,7 @@ def bench(
     from uvnav.bench.campaign import ENGINES
     from uvnav.bench.ray_engine import EngineUnavailableError, import_ray
     from uvnav.bench.spec import load_campaign, run_campaign_spec
-    from uvnav.bench.store import ResultsStore
+    from uvnav.bench.store import ResultsStore, StoreInUseError
     from uvnav.bench.summary import SUMMARY_COLUMNS, controller_summary
 
     if engine not in ENGINES:
@@ -762,6 +762,8 @@ def bench(
             )
         except EngineUnavailableError as exc:
             raise CliError(str(exc), code=1) from None
+        except StoreInUseError as exc:
+            raise CliError(str(exc)) from None
         except KeyboardInterrupt:
             typer.echo(
                 f"interrupted: {store.count(spec.name)} episode(s) of {spec.name!r} are stored in "
