@@ -46,6 +46,7 @@ import json
 import math
 import os
 import sqlite3
+import urllib.parse
 from collections.abc import Iterator, Mapping
 from contextlib import AbstractContextManager, contextmanager
 from datetime import UTC, datetime
@@ -233,6 +234,56 @@ def writer_lease(db: str | Path) -> Iterator[None]:
 # --------------------------------------------------------------------------------------------------
 
 
+class NotAStoreError(ValueError):
+    """A file that is not a uvnav results database (one line naming it and what is missing)."""
+
+
+#: tables and columns a uvnav results database has whatever its age (metrics may be missing)
+_REQUIRED = {
+    "campaigns": {"id", "name", "created", "config"},
+    "episodes": {"id", "campaign_id", "scenario", "controller", "params_hash", "seed", "status"},
+    "trajectories": {"episode_id", "data"},
+}
+
+
+def connect_readonly(path: str | Path) -> sqlite3.Connection:
+    """An SQLite connection that cannot write ``path`` (URI ``mode=ro``; never creates it).
+
+    Raises:
+        FileNotFoundError: no such file.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(2, "No such database file", str(path))
+    uri = f"file:{urllib.parse.quote(str(path.resolve()))}?mode=ro"
+    return sqlite3.connect(uri, uri=True, timeout=30.0, isolation_level=None)
+
+
+def check_store(conn: sqlite3.Connection, path: str | Path) -> None:
+    """Refuse a database that is not a uvnav results store (read-only check).
+
+    Raises:
+        NotAStoreError: not an SQLite file, or a table or column of the schema is missing.
+    """
+    try:
+        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        for table, columns in _REQUIRED.items():
+            if table not in tables:
+                raise NotAStoreError(
+                    f"{path}: not a uvnav results database (no '{table}' table; written by "
+                    "uvnav bench / uvnav run)"
+                )
+            have = {r[1] for r in conn.execute(f"PRAGMA table_info({table})")}
+            missing = sorted(columns - have)
+            if missing:
+                raise NotAStoreError(
+                    f"{path}: not a uvnav results database (table '{table}' has no column "
+                    f"'{missing[0]}')"
+                )
+    except sqlite3.DatabaseError as exc:
+        raise NotAStoreError(f"{path}: not a uvnav results database ({exc})") from None
+
+
 class ResultsStore:
     """Campaign results in one SQLite file (see the module docstring for the schema).
 
@@ -240,11 +291,29 @@ class ResultsStore:
     main process owns the store and workers send their results back to it.
 
     Args:
-        path: database file; created with its parent directory if missing.
+        path: database file; created with its parent directory if missing (writer).
+        readonly: open an existing store for reading only (reports, figures): the file is opened
+            with SQLite's ``mode=ro`` and never written — no schema is created or migrated, and
+            a file that is not a uvnav results database is refused.  SQLite may leave its
+            ``-wal``/``-shm`` companions beside a WAL database it read.
+
+    Raises:
+        FileNotFoundError: ``readonly`` and the file does not exist.
+        NotAStoreError: ``readonly`` and the file is not a uvnav results database.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, *, readonly: bool = False) -> None:
         self.path = Path(path)
+        self.readonly = readonly
+        if readonly:
+            self._conn = connect_readonly(self.path)
+            self._conn.row_factory = sqlite3.Row
+            try:
+                check_store(self._conn, self.path)
+            except BaseException:
+                self._conn.close()
+                raise
+            return
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._conn = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
         self._conn.row_factory = sqlite3.Row
@@ -575,6 +644,9 @@ class ResultsStore:
             args = (-1 if cid is None else cid,)
         sql += " ORDER BY e.id"
         df = pd.read_sql(sql, self._conn, params=args)
+        for m in METRIC_NAMES:  # an older database opened read-only lacks newer metrics
+            if m not in df.columns:
+                df[m] = None
         for m in _BOOLEAN_METRICS:
             df[m] = df[m].astype("boolean")
         return df

@@ -647,13 +647,19 @@ def report_cmd(
         ),
     ] = None,
 ) -> None:
-    """Turn a results database into the HTML report."""
+    """Turn a results database into the HTML report (the database is only read)."""
     if not db.exists():
         raise CliError(f"{db}: no such database file")
     if not db.is_file():
         raise CliError(f"{db}: not a file")
     if bench is not None and not bench.is_dir():
         raise CliError(f"{bench}: --bench must be a folder of benchmark JSON files")
+    from uvnav.bench.store import NotAStoreError, ResultsStore
+
+    try:  # before anything is written: a foreign or empty file is refused as it is
+        ResultsStore(db, readonly=True).close()
+    except NotAStoreError as exc:
+        raise CliError(str(exc)) from None
     write_report = _optional("uvnav.viz.report", "write_report", "the report (uvnav report)")
     try:
         path = write_report(db, out, bench_dir=bench)
