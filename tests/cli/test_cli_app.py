@@ -409,8 +409,10 @@ def test_run_without_bench_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> 
 
 
 def test_report_calls_write_report(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from uvnav.bench.store import ResultsStore
+
     db = tmp_path / "uvnav.sqlite"
-    db.write_bytes(b"")
+    ResultsStore(db).close()  # an empty store (an empty file is not one: test_cli_report_readonly)
     seen: list[tuple[Path, Path]] = []
 
     def write_report(db_path: Path, out_dir: Path, bench_dir: Path | None = None) -> Path:

@@ -343,6 +343,8 @@ def run_campaign(
 
     Raises:
         KeyboardInterrupt: re-raised after cancelling queued jobs; stored episodes stay stored.
+        uvnav.bench.store.StoreInUseError: another process runs a campaign into this database
+            (:meth:`ResultsStore.writer_lease`); nothing was run.
         concurrent.futures.process.BrokenProcessPool: a worker died (not a Python exception).
         ValueError: unknown ``engine``.
         uvnav.bench.ray_engine.EngineUnavailableError: ``engine="ray"`` without Ray installed.
@@ -353,6 +355,37 @@ def run_campaign(
         from uvnav.bench.ray_engine import import_ray
 
         import_ray()  # fail before touching the store when Ray is missing
+    with store.writer_lease():  # one campaign writer per database (refuses a second at once)
+        return _run_campaign(
+            store,
+            name,
+            jobs,
+            config=config,
+            workers=workers,
+            progress=progress,
+            retry_errors=retry_errors,
+            mp_context=mp_context,
+            on_outcome=on_outcome,
+            engine=engine,
+            address=address,
+        )
+
+
+def _run_campaign(
+    store: ResultsStore,
+    name: str,
+    jobs: Sequence[Job],
+    *,
+    config: Mapping[str, Any] | None,
+    workers: int,
+    progress: bool,
+    retry_errors: bool,
+    mp_context: mp.context.BaseContext | None,
+    on_outcome: Callable[[JobOutcome, int], None] | None,
+    engine: str,
+    address: str | None,
+) -> CampaignRun:
+    """:func:`run_campaign` once the writer lease is held."""
     tic = time.perf_counter()
     cfg = dict(config) if config is not None else {"n_jobs": len(jobs)}
     campaign_id = store.campaign(name, cfg)

@@ -375,22 +375,24 @@ def run_campaign_spec(
 
     Raises:
         CampaignError: the campaign exists and ``resume`` is false.
+        uvnav.bench.store.StoreInUseError: another process runs a campaign into this database.
     """
-    if not resume and store.campaign_id(spec.name) is not None:
-        raise CampaignError(
-            str(store.path),
-            "",
-            f"campaign {spec.name!r} is already in this database: pass --resume to continue it, "
-            "or --db for another database",
+    with store.writer_lease():  # before the check below: another writer may be creating it
+        if not resume and store.campaign_id(spec.name) is not None:
+            raise CampaignError(
+                str(store.path),
+                "",
+                f"campaign {spec.name!r} is already in this database: pass --resume to continue "
+                "it, or --db for another database",
+            )
+        return run_campaign(
+            store,
+            spec.name,
+            spec.jobs(),
+            config=spec.config(),
+            workers=workers,
+            progress=progress,
+            retry_errors=retry_errors,
+            engine=engine,
+            address=address,
         )
-    return run_campaign(
-        store,
-        spec.name,
-        spec.jobs(),
-        config=spec.config(),
-        workers=workers,
-        progress=progress,
-        retry_errors=retry_errors,
-        engine=engine,
-        address=address,
-    )

@@ -29,6 +29,12 @@ Design choices, after what sweep tools such as Optuna's RDB storage and Sacred's
   episode never is, so a resumed campaign cannot duplicate or silently change results.
 * Opening an older database adds any metric column it lacks (``ALTER TABLE ADD COLUMN``), so
   adding a metric to :data:`~uvnav.sim.METRIC_NAMES` does not break existing result files.
+* One campaign writer per database: :meth:`ResultsStore.writer_lease` holds an exclusive
+  ``flock`` on ``<db>.lock`` beside the file (with the holder's pid in it) while a campaign
+  runs, so a second ``uvnav bench`` on the same database refuses at once
+  (:class:`StoreInUseError`) instead of running every episode again and failing on the first
+  duplicate.  The lock is the kernel's: it goes away with the process, however it ends, and the
+  file left behind is harmless.
 """
 
 from __future__ import annotations
@@ -38,9 +44,11 @@ import hashlib
 import io
 import json
 import math
+import os
 import sqlite3
+import urllib.parse
 from collections.abc import Iterator, Mapping
-from contextlib import contextmanager
+from contextlib import AbstractContextManager, contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -153,8 +161,127 @@ def trajectory_from_bytes(blob: bytes) -> Trajectory:
 
 
 # --------------------------------------------------------------------------------------------------
+# one writer per database
+# --------------------------------------------------------------------------------------------------
+
+
+class StoreInUseError(RuntimeError):
+    """Another process holds the database's writer lease (one line: the file and its pid)."""
+
+
+#: leases held by this process: lock-file path -> [file descriptor, nesting depth]
+_LEASES: dict[str, list[int]] = {}
+
+
+def lock_path(db: str | Path) -> Path:
+    """The lock file of a database: ``<db>.lock`` beside it."""
+    db = Path(db)
+    return db.with_name(db.name + ".lock")
+
+
+@contextmanager
+def writer_lease(db: str | Path) -> Iterator[None]:
+    """Hold the exclusive right to write campaigns into ``db`` (re-entrant within a process).
+
+    An exclusive, non-blocking ``flock`` on :func:`lock_path` whose file holds this process's pid;
+    released on exit (or by the kernel when the process dies).  Where ``flock`` does not exist
+    (Windows) there is no lease.
+
+    Raises:
+        StoreInUseError: another process holds it (at once, without waiting).
+    """
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lease
+        yield
+        return
+    path = lock_path(db)
+    key = str(path.resolve())
+    held = _LEASES.get(key)
+    if held is not None:
+        held[1] += 1
+        try:
+            yield
+        finally:
+            held[1] -= 1
+        return
+    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+        os.close(fd)
+        raise StoreInUseError(
+            f"database {db} is in use by another uvnav process (pid {holder}); wait for it to "
+            "finish or use another --db"
+        ) from None
+    except BaseException:
+        os.close(fd)
+        raise
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    _LEASES[key] = [fd, 1]
+    try:
+        yield
+    finally:
+        del _LEASES[key]
+        os.ftruncate(fd, 0)
+        os.close(fd)  # closing the descriptor releases the flock
+
+
+# --------------------------------------------------------------------------------------------------
 # the store
 # --------------------------------------------------------------------------------------------------
+
+
+class NotAStoreError(ValueError):
+    """A file that is not a uvnav results database (one line naming it and what is missing)."""
+
+
+#: tables and columns a uvnav results database has whatever its age (metrics may be missing)
+_REQUIRED = {
+    "campaigns": {"id", "name", "created", "config"},
+    "episodes": {"id", "campaign_id", "scenario", "controller", "params_hash", "seed", "status"},
+    "trajectories": {"episode_id", "data"},
+}
+
+
+def connect_readonly(path: str | Path) -> sqlite3.Connection:
+    """An SQLite connection that cannot write ``path`` (URI ``mode=ro``; never creates it).
+
+    Raises:
+        FileNotFoundError: no such file.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(2, "No such database file", str(path))
+    uri = f"file:{urllib.parse.quote(str(path.resolve()))}?mode=ro"
+    return sqlite3.connect(uri, uri=True, timeout=30.0, isolation_level=None)
+
+
+def check_store(conn: sqlite3.Connection, path: str | Path) -> None:
+    """Refuse a database that is not a uvnav results store (read-only check).
+
+    Raises:
+        NotAStoreError: not an SQLite file, or a table or column of the schema is missing.
+    """
+    try:
+        tables = {r[0] for r in conn.execute("SELECT name FROM sqlite_master WHERE type = 'table'")}
+        for table, columns in _REQUIRED.items():
+            if table not in tables:
+                raise NotAStoreError(
+                    f"{path}: not a uvnav results database (no '{table}' table; written by "
+                    "uvnav bench / uvnav run)"
+                )
+            have = {r[1] for r in conn.execute(f"PRAGMA table_info({table})")}
+            missing = sorted(columns - have)
+            if missing:
+                raise NotAStoreError(
+                    f"{path}: not a uvnav results database (table '{table}' has no column "
+                    f"'{missing[0]}')"
+                )
+    except sqlite3.DatabaseError as exc:
+        raise NotAStoreError(f"{path}: not a uvnav results database ({exc})") from None
 
 
 class ResultsStore:
@@ -164,11 +291,29 @@ class ResultsStore:
     main process owns the store and workers send their results back to it.
 
     Args:
-        path: database file; created with its parent directory if missing.
+        path: database file; created with its parent directory if missing (writer).
+        readonly: open an existing store for reading only (reports, figures): the file is opened
+            with SQLite's ``mode=ro`` and never written — no schema is created or migrated, and
+            a file that is not a uvnav results database is refused.  SQLite may leave its
+            ``-wal``/``-shm`` companions beside a WAL database it read.
+
+    Raises:
+        FileNotFoundError: ``readonly`` and the file does not exist.
+        NotAStoreError: ``readonly`` and the file is not a uvnav results database.
     """
 
-    def __init__(self, path: str | Path) -> None:
+    def __init__(self, path: str | Path, *, readonly: bool = False) -> None:
         self.path = Path(path)
+        self.readonly = readonly
+        if readonly:
+            self._conn = connect_readonly(self.path)
+            self._conn.row_factory = sqlite3.Row
+            try:
+                check_store(self._conn, self.path)
+            except BaseException:
+                self._conn.close()
+                raise
+            return
         self.path.parent.mkdir(parents=True, exist_ok=True)
         self._conn = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
         self._conn.row_factory = sqlite3.Row
@@ -178,6 +323,14 @@ class ResultsStore:
         self._create_schema()
 
     # -- lifecycle
+
+    def writer_lease(self) -> AbstractContextManager[None]:
+        """This database's campaign-writer lease (:func:`writer_lease`).
+
+        Raises:
+            StoreInUseError: another process holds it.
+        """
+        return writer_lease(self.path)
 
     def close(self) -> None:
         """Close the connection (idempotent)."""
@@ -491,6 +644,9 @@ class ResultsStore:
             args = (-1 if cid is None else cid,)
         sql += " ORDER BY e.id"
         df = pd.read_sql(sql, self._conn, params=args)
+        for m in METRIC_NAMES:  # an older database opened read-only lacks newer metrics
+            if m not in df.columns:
+                df[m] = None
         for m in _BOOLEAN_METRICS:
             df[m] = df[m].astype("boolean")
         return df

@@ -720,13 +720,19 @@ def report_cmd(
         ),
     ] = None,
 ) -> None:
-    """Turn a results database into the HTML report."""
+    """Turn a results database into the HTML report (the database is only read)."""
     if not db.exists():
         raise CliError(f"{db}: no such database file")
     if not db.is_file():
         raise CliError(f"{db}: not a file")
     if bench is not None and not bench.is_dir():
         raise CliError(f"{bench}: --bench must be a folder of benchmark JSON files")
+    from uvnav.bench.store import NotAStoreError, ResultsStore
+
+    try:  # before anything is written: a foreign or empty file is refused as it is
+        ResultsStore(db, readonly=True).close()
+    except NotAStoreError as exc:
+        raise CliError(str(exc)) from None
     write_report = _optional("uvnav.viz.report", "write_report", "the report (uvnav report)")
     try:
         path = write_report(db, out, bench_dir=bench)
@@ -798,7 +804,7 @@ def bench(
     from uvnav.bench.campaign import ENGINES
     from uvnav.bench.ray_engine import EngineUnavailableError, import_ray
     from uvnav.bench.spec import load_campaign, run_campaign_spec
-    from uvnav.bench.store import ResultsStore
+    from uvnav.bench.store import ResultsStore, StoreInUseError
     from uvnav.bench.summary import SUMMARY_COLUMNS, controller_summary
 
     if engine not in ENGINES:
@@ -835,6 +841,8 @@ def bench(
             )
         except EngineUnavailableError as exc:
             raise CliError(str(exc), code=1) from None
+        except StoreInUseError as exc:
+            raise CliError(str(exc)) from None
         except KeyboardInterrupt:
             typer.echo(
                 f"interrupted: {store.count(spec.name)} episode(s) of {spec.name!r} are stored in "

@@ -11,7 +11,6 @@ database, as HTML ``<div>`` fragments that load ``plotly.min.js`` from the repor
 from __future__ import annotations
 
 import math
-import sqlite3
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -241,9 +240,11 @@ def animation_sections(db_path: Path, *, limit: int = 12) -> list[dict[str, str]
     Returns:
         ``[{"title": ..., "html": <div> fragment}]``; empty when nothing was recorded.
     """
-    from uvnav.bench.store import ResultsStore
+    from contextlib import closing
 
-    with sqlite3.connect(db_path) as conn:
+    from uvnav.bench.store import ResultsStore, connect_readonly
+
+    with closing(connect_readonly(db_path)) as conn:  # a report never writes its input
         rows = conn.execute(
             "SELECT e.id, e.scenario, e.controller, e.seed, e.status FROM episodes e "
             "JOIN trajectories t ON t.episode_id = e.id ORDER BY e.scenario, e.controller, e.seed "
@@ -255,7 +256,7 @@ def animation_sections(db_path: Path, *, limit: int = 12) -> list[dict[str, str]
     from uvnav.scenarios import ScenarioError, load_scenario
 
     sections = []
-    with ResultsStore(db_path) as store:
+    with ResultsStore(db_path, readonly=True) as store:
         for ep_id, scenario, controller, seed, status in rows:
             traj = store.load_trajectory(int(ep_id))
             if traj is None or len(traj.times) == 0:

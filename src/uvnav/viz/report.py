@@ -373,7 +373,7 @@ def write_report(
             raise FileNotFoundError(f"figure {src} does not exist")
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
-    with ResultsStore(db_path) as store:
+    with ResultsStore(db_path, readonly=True) as store:  # a report never writes its input
         df = store.episodes_frame()
         campaigns = store.campaigns()
     counts = df["campaign_id"].value_counts().to_dict() if not df.empty else {}
