@@ -31,12 +31,15 @@ from __future__ import annotations
 
 import functools
 import multiprocessing as mp
+import os
 import signal
 import sys
+import threading
 import time
 import traceback
-from collections.abc import Callable, Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
@@ -343,6 +346,7 @@ def run_campaign(
 
     Raises:
         KeyboardInterrupt: re-raised after cancelling queued jobs; stored episodes stay stored.
+            SIGTERM raises :class:`Terminated`, a :class:`KeyboardInterrupt`, the same way.
         uvnav.bench.store.StoreInUseError: another process runs a campaign into this database
             (:meth:`ResultsStore.writer_lease`); nothing was run.
         concurrent.futures.process.BrokenProcessPool: a worker died (not a Python exception).
@@ -355,7 +359,8 @@ def run_campaign(
         from uvnav.bench.ray_engine import import_ray
 
         import_ray()  # fail before touching the store when Ray is missing
-    with store.writer_lease():  # one campaign writer per database (refuses a second at once)
+    # one campaign writer per database (a second refuses at once); SIGTERM is handled as Ctrl-C
+    with store.writer_lease(), sigterm_as_interrupt():
         return _run_campaign(
             store,
             name,
@@ -434,9 +439,64 @@ def _run_campaign(
     return run
 
 
-def _ignore_sigint() -> None:
-    """Worker initializer: Ctrl-C is handled by the main process alone (see :func:`_run_pool`)."""
+class Terminated(KeyboardInterrupt):
+    """SIGTERM reached the campaign's main process: handled as Ctrl-C is (workers stopped, the
+    episodes already stored kept; ``--resume`` continues)."""
+
+
+@contextmanager
+def sigterm_as_interrupt() -> Iterator[None]:
+    """Within the block, SIGTERM raises :class:`Terminated` (a :class:`KeyboardInterrupt`) in the
+    main thread instead of killing the process outright; the previous handler is restored after.
+    Elsewhere than in the main thread (where Python allows no handler) nothing changes."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+
+    def _raise(signum: int, frame: object) -> None:
+        raise Terminated(f"signal {signal.Signals(signum).name}")
+
+    previous = signal.signal(signal.SIGTERM, _raise)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
+
+
+#: how often a worker checks that the campaign's main process is still there [s]
+WATCHDOG_PERIOD = 0.5
+
+
+def _process_alive(pid: int) -> bool:
+    """Whether process ``pid`` exists and has not exited (a zombie counts as exited on Linux)."""
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:
+        return True
+    try:
+        with open(f"/proc/{pid}/stat", "rb") as fh:
+            return fh.read().rsplit(b")", 1)[1].split()[0] != b"Z"
+    except (OSError, IndexError):
+        return True  # no /proc: os.kill said it exists
+
+
+def _watch_main(main_pid: int, parent_pid: int) -> None:
+    """Worker thread: end this worker when the campaign's main process is gone or this worker was
+    orphaned (its parent, the fork server, changed), e.g. after a SIGKILL of the main process."""
+    while _process_alive(main_pid) and os.getppid() == parent_pid:
+        time.sleep(WATCHDOG_PERIOD)
+    os._exit(1)  # nothing to clean up: results only ever go to the (gone) main process
+
+
+def _worker_init(main_pid: int) -> None:
+    """Worker initializer: Ctrl-C is handled by the main process alone (see :func:`_run_pool`),
+    and a watchdog thread ends the worker with the main process (:func:`_watch_main`)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(
+        target=_watch_main, args=(main_pid, os.getppid()), name="uvnav-watchdog", daemon=True
+    ).start()
 
 
 def _stop_workers(executor: ProcessPoolExecutor) -> None:
@@ -470,13 +530,15 @@ def run_in_workers(
     picklable (a module-level function).
 
     Raises:
-        KeyboardInterrupt: re-raised after stopping the workers (see :func:`_run_pool`).
+        KeyboardInterrupt: re-raised after stopping the workers (see :func:`_run_pool`); SIGTERM
+            raises :class:`Terminated`, a :class:`KeyboardInterrupt`, the same way.
     """
-    if workers <= 1 or len(items) < 2:
-        for item in items:
-            handle(compute(item))
-        return
-    _run_pool(items, compute, handle, workers, mp_context or default_mp_context())
+    with sigterm_as_interrupt():
+        if workers <= 1 or len(items) < 2:
+            for item in items:
+                handle(compute(item))
+            return
+        _run_pool(items, compute, handle, workers, mp_context or default_mp_context())
 
 
 def _run_pool(
@@ -491,9 +553,14 @@ def _run_pool(
 
     Workers ignore SIGINT, so a Ctrl-C (sent by the terminal to the whole process group) reaches
     only this process: it stops the workers at once — without waiting for the episodes in flight,
-    whose results would be discarded — and re-raises :class:`KeyboardInterrupt`.
+    whose results would be discarded — and re-raises :class:`KeyboardInterrupt`.  SIGTERM does the
+    same where the caller handles it (:func:`sigterm_as_interrupt`).  Should this process die
+    without cleaning up (SIGKILL, a crash), each worker's watchdog ends it within
+    :data:`WATCHDOG_PERIOD`, and the fork server follows its last worker.
     """
-    executor = ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_ignore_sigint)
+    executor = ProcessPoolExecutor(
+        max_workers=workers, mp_context=ctx, initializer=_worker_init, initargs=(os.getpid(),)
+    )
     queue = iter(todo)
     pending: set[Future[R]] = set()
     window = 2 * workers

@@ -165,8 +165,12 @@ def trajectory_from_bytes(blob: bytes) -> Trajectory:
 # --------------------------------------------------------------------------------------------------
 
 
-class StoreInUseError(RuntimeError):
-    """Another process holds the database's writer lease (one line: the file and its pid)."""
+class StoreInUseError(PermissionError):
+    """Another process holds the database's writer lease (one line: the file and its pid).
+
+    A :class:`PermissionError` (the database may not be written now), so every command of the
+    CLI reports it as one ``error:`` line with exit status 2, ``uvnav run`` included.
+    """
 
 
 #: leases held by this process: lock-file path -> [file descriptor, nesting depth]
