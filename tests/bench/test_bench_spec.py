@@ -82,7 +82,11 @@ def test_seed_forms() -> None:
 
 
 def test_generator_params_oracle_and_file_entries(tmp_path: Path) -> None:
-    scene = write(tmp_path, "name: lane\nrobot: {start: [0, 0], goal: [4, 0]}\n", "lane.yaml")
+    scene = write(
+        tmp_path,
+        "name: lane\nrobot: {start: [0, 0], goal: [4, 0], v_max: 1.0, u_max: 1.0}\n",
+        "lane.yaml",
+    )
     spec = campaign_from_dict(
         {
             "name": "mixed",

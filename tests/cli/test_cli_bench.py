@@ -162,17 +162,32 @@ def test_sigkill_then_resume_equals_an_uninterrupted_run(tmp_path: Path) -> None
     assert n == keys == 30
 
 
-def test_errored_episodes_exit_non_zero_with_the_first_error(tmp_path: Path) -> None:
-    # a generator parameter that breaks every scene (checked only when the scene is built)
+def test_bad_generator_parameters_stop_the_campaign_before_it_runs(tmp_path: Path) -> None:
     path = tmp_path / "broken.yaml"
     path.write_text(
         "name: broken\nscenarios:\n  - generator: random-ch2\n    seeds: [0, 1]\n"
         "    params: {n_obstacles: -3}\ncontrollers:\n  - name: straight-v1\n"
     )
     db = tmp_path / "b.sqlite"
-    res = invoke("bench", str(path), "--db", str(db), "--workers", "1", "--json")
+    res = invoke("bench", str(path), "--db", str(db), "--workers", "1")
+    assert res.exit_code == 2, res.output
+    assert res.output.count("\n") == 1 and "scenarios.0.params" in res.output
+    assert "n_obstacles must be >= 0" in res.output and not db.exists()
+
+
+def test_errored_episodes_exit_non_zero_with_the_first_error(
+    campaign: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import uvnav.scenarios.episodes as episodes
+
+    def broken(*args: Any, **kwargs: Any) -> Any:
+        raise RuntimeError("law exploded")
+
+    monkeypatch.setattr(episodes, "run_scene", broken)  # one worker runs in this process
+    db = tmp_path / "b.sqlite"
+    res = invoke("bench", str(campaign), "--db", str(db), "--workers", "1", "--json")
     assert res.exit_code == 1, res.output
     last = res.stderr.strip().splitlines()[-1]
-    assert last.startswith("error: 1 episode(s) errored; the first: random-ch2")
-    assert "Traceback" not in res.output
-    assert json.loads(res.stdout)["errors"] == 1
+    assert last.startswith("error: 6 episode(s) errored; the first: random-ch2")
+    assert "RuntimeError: law exploded" in last and "Traceback" not in res.output
+    assert json.loads(res.stdout)["errors"] == 6

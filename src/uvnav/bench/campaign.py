@@ -29,6 +29,7 @@ under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already 
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import multiprocessing as mp
 import os
@@ -43,7 +44,14 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
-from uvnav.bench.store import STATUS_ERROR, EpisodeKey, ResultsStore, canonical_json, params_hash
+from uvnav.bench.store import (
+    STATUS_ERROR,
+    STATUS_REFUSED,
+    EpisodeKey,
+    ResultsStore,
+    canonical_json,
+    params_hash,
+)
 from uvnav.sim import EpisodeSetup, Trajectory, run_episode, run_rng
 
 ENGINES = ("local", "ray")
@@ -86,6 +94,8 @@ class Job:
         use_scenario_params: start from the scenario's ``controller.params`` when the scenario names
             this controller (default ``True``).
         record: keep the trajectory and store it (for figures; costs memory and disk).
+        beyond_assumptions: run the law even where the scene breaks an assumption it declares
+            (thesis (2.6)); by default such an episode is stored as ``refused``.
     """
 
     controller: str
@@ -100,6 +110,7 @@ class Job:
     params: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
     use_scenario_params: bool = True
     record: bool = False
+    beyond_assumptions: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", _freeze(self.params))
@@ -112,11 +123,12 @@ class Job:
         if self.setup_factory is not None and self.label is None:
             raise ValueError("a Job with a setup_factory needs a label")
         if self.generator_seed is not None:
-            from uvnav.scenarios.generators import GENERATORS  # layer 5, imported when needed
+            from uvnav.scenarios.catalog import generators  # layer 5, imported when needed
 
-            if self.generator not in GENERATORS:
+            known = generators()
+            if self.generator not in known:
                 raise ValueError(
-                    f"unknown generator {self.generator!r}; known: {', '.join(sorted(GENERATORS))}"
+                    f"unknown generator {self.generator!r}; known: {', '.join(sorted(known))}"
                 )
         elif self.generator_params:
             raise ValueError("generator_params need a generator_seed")
@@ -196,24 +208,39 @@ def _plain(params: Any) -> dict[str, Any]:
 
 @functools.lru_cache(maxsize=256)
 def _generated(name: str, seed: int, params: tuple[tuple[str, Any], ...]) -> Any:
-    """A generated scenario, kept for the next jobs on the same scene (other controllers or
-    parameter sets): generators are pure functions of their seed and parameters, and
-    ``build_episode`` never modifies the scenario it instantiates."""
-    import uvnav.scenarios as scenarios
+    """A generated scene (any kind), kept for the next jobs on the same scene (other controllers
+    or parameter sets): generators are pure functions of their seed and parameters, and building
+    an episode never modifies the scenario it instantiates."""
+    from uvnav.scenarios.catalog import generate
 
-    return scenarios.generate(name, seed, **dict(params))
+    return generate(name, seed, dict(params))
+
+
+@functools.lru_cache(maxsize=64)
+def _resolved(spec: str) -> Any:
+    from uvnav.scenarios.catalog import resolve
+
+    return resolve(spec)
+
+
+def job_scene(job: Job) -> Any:
+    """The job's scene (a :class:`uvnav.scenarios.catalog.Resolved`; runs in the worker)."""
+    if job.scenario is not None:
+        return _resolved(job.scenario)
+    scene = _generated(job.generator, int(job.generator_seed or 0), job.generator_params)
+    if scene.seed != job.seed:  # a scene drawn with one seed, run with another
+        scene = dataclasses.replace(scene, seed=None)
+    return scene
 
 
 def build_job(job: Job) -> tuple[EpisodeSetup, dict[str, Any]]:
-    """Instantiate the job's episode and the controller parameters to use (runs in the worker)."""
+    """A 2D job's episode and the controller parameters to use (the scenario's own parameters
+    under the job's when the scenario names the same law)."""
     if job.setup_factory is not None:
         return job.setup_factory(int(job.seed)), job.params_dict
     import uvnav.scenarios as scenarios  # layer 5; imported lazily so bench works without it
 
-    if job.scenario is not None:
-        scenario = scenarios.load_scenario(job.scenario)
-    else:
-        scenario = _generated(job.generator, int(job.generator_seed or 0), job.generator_params)
+    scenario = job_scene(job).scenario
     params = job.params_dict
     ctrl = getattr(scenario, "controller", None)
     if (
@@ -225,35 +252,60 @@ def build_job(job: Job) -> tuple[EpisodeSetup, dict[str, Any]]:
     return scenarios.build_episode(scenario, int(job.seed)), params
 
 
+def _error(job: Job, exc: BaseException, tic: float, params: dict[str, Any]) -> JobOutcome:
+    tb = traceback.extract_tb(exc.__traceback__)
+    where = f" (at {tb[-1].filename}:{tb[-1].lineno})" if tb else ""
+    return JobOutcome(
+        job, STATUS_ERROR, None, f"{type(exc).__name__}: {exc}{where}",
+        time.perf_counter() - tic, None, params,
+    )  # fmt: skip
+
+
 def run_job(job: Job) -> JobOutcome:
-    """Build and run one job; any exception becomes an ``error`` outcome (never raises it)."""
-    from uvnav.controllers import make_controller
+    """Build and run one job; any exception becomes an ``error`` outcome (never raises it), a
+    scene that breaks an assumption the law declares a ``refused`` one.
+
+    Jobs with a scene (any kind) run through :func:`uvnav.scenarios.episodes.run_scene`, the
+    path of ``uvnav simulate``; jobs with a ``setup_factory`` run the 2D loop directly.
+    """
+    from uvnav.scenarios.errors import ScenarioError
 
     tic = time.perf_counter()
     params: dict[str, Any] = job.params_dict
     try:
-        setup, params = build_job(job)
-        controller = make_controller(job.controller, **params)
-        result = run_episode(setup, controller, run_rng(int(job.seed)), record=job.record)
+        if job.setup_factory is not None:
+            from uvnav.controllers import make_controller
+
+            setup = job.setup_factory(int(job.seed))
+            result = run_episode(
+                setup, make_controller(job.controller, **params), run_rng(int(job.seed)),
+                record=job.record,
+            )  # fmt: skip
+            status, metrics, traj = result.status, result.metrics.to_dict(), result.trajectory
+        else:
+            from uvnav.scenarios.episodes import run_scene
+
+            try:
+                out = run_scene(
+                    job_scene(job), job.controller, params, int(job.seed), record=job.record,
+                    use_scene_params=job.use_scenario_params,
+                    beyond_assumptions=job.beyond_assumptions,
+                )  # fmt: skip
+            except ScenarioError as exc:  # the law's assumption does not hold on this scene
+                return JobOutcome(
+                    job, STATUS_REFUSED, None, exc.problem, time.perf_counter() - tic, None,
+                    params,
+                )  # fmt: skip
+            status, metrics, traj, params = out.status, out.metrics, out.trajectory, out.params
     except Exception as exc:  # a failing job is data, not a crash of the campaign
-        tb = traceback.extract_tb(exc.__traceback__)
-        where = f" (at {tb[-1].filename}:{tb[-1].lineno})" if tb else ""
-        return JobOutcome(
-            job,
-            STATUS_ERROR,
-            None,
-            f"{type(exc).__name__}: {exc}{where}",
-            time.perf_counter() - tic,
-            None,
-            params,
-        )
+        return _error(job, exc, tic, params)
     return JobOutcome(
         job=job,
-        status=result.status,
-        metrics=result.metrics.to_dict(),
+        status=status,
+        metrics=metrics,
         error=None,
         wall_time=time.perf_counter() - tic,
-        trajectory=result.trajectory if job.record else None,
+        trajectory=traj if job.record and isinstance(traj, Trajectory) else None,
         effective_params=params,
     )
 

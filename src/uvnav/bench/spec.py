@@ -5,13 +5,15 @@ Example (``uvnav bench ch2.yaml``)::
     name: ch2-baselines            # campaign name in the results database (the resume identity)
     description: optional text
     scenarios:
-      - generator: random-ch2      # a key of uvnav.scenarios.GENERATORS
+      - generator: random-ch2      # a seed generator of any kind (uvnav scenarios list)
         seeds: [0, 200]            # two integers: the range [start, stop)
         params: {n_obstacles: 3}   # optional generator keyword arguments
-      - builtin: thesis-ch2-one-obstacle
+      - builtin: thesis-ch2-one-obstacle   # a built-in scene of any kind
         seeds: {values: [0, 7]}    # explicit seeds (any list that is not two integers is too)
-      - file: scenes/corridor.yaml # a scenario YAML file, relative to this file
+      - file: scenes/corridor.yaml # a scenario YAML file of any kind, relative to this file
         seeds: [0, 5]
+      - scene: antipodal:8         # anything `uvnav simulate` takes (8 robots here)
+        seeds: [0, 3]
     controllers:
       - name: zhang2019-v1
         params: {alpha0: 0.1}                 # fixed parameters
@@ -20,11 +22,16 @@ Example (``uvnav bench ch2.yaml``)::
       - name: savkin-wang2013-v1
     record: false                  # store trajectories (figures; costs disk)
 
-Expansion (:meth:`CampaignSpec.jobs`): every scenario entry × every controller entry × every grid
-point × every seed is one :class:`~uvnav.bench.campaign.Job`; the episode seed is the scenario seed
-(for a generator, the same number draws the scene and seeds the episode).  Controller parameters are
-checked against the controller's ``Params`` when the file is loaded, so a typo stops the campaign
-before it starts rather than filling the database with ``error`` rows.
+Expansion (:meth:`CampaignSpec.jobs`): every scenario entry × every controller entry that can
+drive it (same vehicle and sensing, :mod:`uvnav.scenarios.episodes`) × every grid point × every
+seed is one :class:`~uvnav.bench.campaign.Job`; the episode seed is the scenario seed (for a
+generator, the same number draws the scene and seeds the episode).  When the file is loaded,
+controller parameters are checked against the controller's ``Params``, generator parameters by
+drawing the entry's first scene (names, types and ranges, as the generator checks them), and every
+controller must fit at least one scenario entry and every entry at least one controller, so a typo
+stops the campaign before it starts rather than filling the database with ``error`` rows.  An
+episode whose scene breaks an assumption the law declares (thesis (2.6)) is stored as ``refused``
+with the reason, not run.
 
 The schema is pydantic v2 with ``extra="forbid"`` (DESIGN §3); :func:`load_campaign` turns every
 problem into one :class:`CampaignError` line ``FILE: FIELD: PROBLEM``.
@@ -32,7 +39,7 @@ problem into one :class:`CampaignError` line ``FILE: FIELD: PROBLEM``.
 
 from __future__ import annotations
 
-import inspect
+import dataclasses
 import itertools
 from collections.abc import Mapping
 from pathlib import Path
@@ -50,8 +57,9 @@ from pydantic import (
 
 from uvnav.bench.campaign import CampaignRun, Job, run_campaign
 from uvnav.bench.store import ResultsStore
-from uvnav.controllers import ControllerParamsError, available_controllers, make_controller
-from uvnav.scenarios import GENERATORS, ScenarioError, list_builtin, load_scenario
+from uvnav.controllers import ControllerParamsError, available_controllers
+from uvnav.controllers.base import controller_info, make_law
+from uvnav.scenarios import ScenarioError
 from uvnav.scenarios.errors import FieldError, from_validation_error
 from uvnav.scenarios.loader import parse_yaml
 
@@ -103,9 +111,10 @@ class ScenarioEntry(_Strict):
     """Where episodes come from: exactly one of ``generator``, ``builtin``, ``file``; and seeds.
 
     Attributes:
-        generator: scenario generator name (a key of :data:`uvnav.scenarios.GENERATORS`).
-        builtin: built-in scenario name (``uvnav scenarios list``).
-        file: scenario YAML file, relative to the campaign file.
+        generator: seed generator of any scene kind (``uvnav scenarios list``).
+        builtin: built-in scene name of any kind (``uvnav scenarios list``).
+        file: scenario YAML file of any kind, relative to the campaign file.
+        scene: anything ``uvnav simulate`` takes (built-in, file, ``antipodal:8``).
         seeds: ``[start, stop]`` (a range), or any other list of seeds, or ``{values: [...]}``.
         params: generator keyword arguments (generator entries only).
     """
@@ -113,51 +122,81 @@ class ScenarioEntry(_Strict):
     generator: str | None = None
     builtin: str | None = None
     file: str | None = None
+    scene: str | None = None
     seeds: list[int] | SeedValues
     params: dict[str, Any] = Field(default_factory=dict)
 
     _path: Path | None = PrivateAttr(default=None)
+    _kind: Any = PrivateAttr(default=None)
 
     @model_validator(mode="after")
     def _check(self, info: ValidationInfo) -> ScenarioEntry:
-        given = [k for k in ("generator", "builtin", "file") if getattr(self, k) is not None]
+        from uvnav.scenarios.catalog import builtin_names, generate, resolve
+
+        sources = ("generator", "builtin", "file", "scene")
+        given = [k for k in sources if getattr(self, k) is not None]
         if len(given) != 1:
             got = ", ".join(given) if given else "none"
-            raise FieldError("", f"needs exactly one of generator, builtin, file (got {got})")
-        _seed_list(self.seeds)
+            raise FieldError("", f"needs exactly one of {', '.join(sources)} (got {got})")
+        seeds = _seed_list(self.seeds)
         if self.generator is not None:
-            if self.generator not in GENERATORS:
-                known = ", ".join(sorted(GENERATORS))
-                raise FieldError(
-                    "generator", f"unknown generator {self.generator!r} (known: {known})"
-                )
-            try:
-                inspect.signature(GENERATORS[self.generator]).bind(0, **self.params)
-            except TypeError as exc:
-                raise FieldError("params", f"{self.generator}: {exc}") from None
+            try:  # names, types and ranges, as the generator itself checks them
+                self._kind = generate(self.generator, seeds[0], self.params).kind
+            except ScenarioError as exc:
+                if exc.path in ("generator", "params"):
+                    raise FieldError(exc.path, exc.problem) from None
+                problem = f"{self.generator}: {exc.path}: {exc.problem}"
+                raise FieldError("params", problem) from None
             return self
         if self.params:
             raise FieldError("params", "only generator entries take params")
-        if self.builtin is not None and self.builtin not in list_builtin():
-            raise FieldError(
-                "builtin",
-                f"unknown built-in scenario {self.builtin!r} (known: {', '.join(list_builtin())}; "
-                "for a YAML file use file:)",
-            )
+        if self.builtin is not None:
+            names = [n for n, _ in builtin_names()]
+            if self.builtin not in names:
+                raise FieldError(
+                    "builtin",
+                    f"unknown built-in scenario {self.builtin!r} (known: {', '.join(names)}; "
+                    "for a YAML file use file:)",
+                )
+            self._kind = resolve(self.builtin).kind
+        spec = self.scene
         if self.file is not None:
             base = (info.context or {}).get("base_dir") or Path.cwd()
             path = Path(self.file).expanduser()
             self._path = path if path.is_absolute() else Path(base) / path
             if not self._path.is_file():
                 raise FieldError("file", f"no such scenario file {str(self._path)!r}")
+            spec = str(self._path)
+        if spec is not None:
+            try:
+                resolved = resolve(spec)
+            except ScenarioError as exc:
+                raise FieldError("file" if self.file else "scene", str(exc)) from None
+            if resolved.seed is not None:
+                raise FieldError(
+                    "scene",
+                    f"{spec} fixes its seed; write generator: {spec.partition(':')[0]} with seeds",
+                )
+            self._kind = resolved.kind
         return self
+
+    def fits(self, info: Any) -> bool:
+        """Whether the law of registry entry ``info`` can drive this entry's scenes."""
+        return bool((info.vehicle, info.sensing) == (self._kind.vehicle, self._kind.sensing))
 
     def seed_list(self) -> list[int]:
         """The seeds of this entry, in order."""
         return _seed_list(self.seeds)
 
-    def job(self, controller: str, params: Mapping[str, Any], seed: int, record: bool) -> Job:
+    def job(
+        self, controller: str, params: Mapping[str, Any], seed: int, record: bool, beyond: bool
+    ) -> Job:
         """The job of one controller parameter set and one seed on this scenario entry."""
+        return dataclasses.replace(
+            self._job(controller, params, seed, record), beyond_assumptions=beyond
+        )
+
+    def _job(self, controller: str, params: Mapping[str, Any], seed: int, record: bool) -> Job:
         if self.generator is not None:
             return Job(
                 controller=controller,
@@ -168,12 +207,12 @@ class ScenarioEntry(_Strict):
                 generator_params=self.params,
                 record=record,
             )
-        if self.builtin is not None:
+        if self.builtin is not None or self.scene is not None:
             return Job(
                 controller=controller,
                 params=params,
                 seed=seed,
-                scenario=self.builtin,
+                scenario=self.builtin or self.scene,
                 record=record,
             )
         assert self.file is not None and self._path is not None
@@ -206,7 +245,7 @@ class ControllerEntry(_Strict):
 
     @model_validator(mode="after")
     def _check(self) -> ControllerEntry:
-        known = available_controllers()
+        known = available_controllers(None)
         if self.name not in known:
             raise FieldError(
                 "name", f"unknown controller {self.name!r} (known: {', '.join(sorted(known))})"
@@ -220,7 +259,7 @@ class ControllerEntry(_Strict):
                 raise FieldError(f"grid.{key}", "is also in params (give it in one place)")
         for point in self.param_sets():
             try:
-                make_controller(self.name, **point)
+                make_law(self.name, **point)
             except ControllerParamsError as exc:
                 where = "grid" if set(point) & set(self.grid) else "params"
                 raise FieldError(where, f"{self.name}: {exc}") from None
@@ -247,6 +286,8 @@ class CampaignSpec(_Strict):
         scenarios: scenario entries.
         controllers: controller entries.
         record: store every episode's trajectory.
+        beyond_assumptions: run every law even on scenes that break an assumption it declares
+            (thesis (2.6)), to measure it there; by default those episodes are ``refused``.
     """
 
     name: str = Field(min_length=1, pattern=r"^\S(.*\S)?$")
@@ -254,6 +295,7 @@ class CampaignSpec(_Strict):
     scenarios: list[ScenarioEntry] = Field(min_length=1)
     controllers: list[ControllerEntry] = Field(min_length=1)
     record: bool = False
+    beyond_assumptions: bool = False
 
     def jobs(self) -> list[Job]:
         """The campaign's jobs: scenario entries × seeds × controller entries × grid points.
@@ -262,13 +304,38 @@ class CampaignSpec(_Strict):
         and a worker generates the scene once for all of them (see
         :func:`uvnav.bench.campaign.build_job`).
         """
-        sets = [(ctrl.name, params) for ctrl in self.controllers for params in ctrl.param_sets()]
+        sets = [
+            (ctrl.name, params, controller_info(ctrl.name))
+            for ctrl in self.controllers
+            for params in ctrl.param_sets()
+        ]
         return [
-            sc.job(name, params, seed, self.record)
+            sc.job(name, params, seed, self.record, self.beyond_assumptions)
             for sc in self.scenarios
             for seed in sc.seed_list()
-            for name, params in sets
+            for name, params, info in sets
+            if sc.fits(info)
         ]
+
+    @model_validator(mode="after")
+    def _pairs(self) -> CampaignSpec:
+        infos = [controller_info(c.name) for c in self.controllers]
+        for j, info in enumerate(infos):
+            if not any(sc.fits(info) for sc in self.scenarios):
+                kinds = ", ".join(sorted({sc._kind.name for sc in self.scenarios}))
+                raise FieldError(
+                    f"controllers.{j}.name",
+                    f"{info.name} drives a {info.vehicle} with {info.sensing} sensing: no "
+                    f"scenario entry fits it (their kinds: {kinds})",
+                )
+        for i, sc in enumerate(self.scenarios):
+            if not any(sc.fits(info) for info in infos):
+                raise FieldError(
+                    f"scenarios.{i}",
+                    f"no controller entry can drive its {sc._kind.name} scenes "
+                    f"({sc._kind.vehicle} with {sc._kind.sensing} sensing)",
+                )
+        return self
 
     def config(self) -> dict[str, Any]:
         """What the store keeps with the campaign: the file's content, defaults filled in."""
@@ -339,12 +406,6 @@ def load_campaign(path: str | Path) -> CampaignSpec:
         raise CampaignError(source, "", f"cannot read: {exc}") from None
     data = parse_yaml(text, source, kind="campaign", error=CampaignError)
     spec = campaign_from_dict(data, source, base_dir=path.parent)
-    for i, entry in enumerate(spec.scenarios):
-        if entry.file is not None:
-            try:
-                load_scenario(str(entry._path))
-            except ScenarioError as exc:
-                raise CampaignError(source, f"scenarios.{i}.file", str(exc)) from None
     return spec
 
 

@@ -68,6 +68,8 @@ _BOOLEAN_METRICS = ("success", "collision")
 EpisodeKey = tuple[str, str, str, int]
 
 STATUS_ERROR = "error"
+#: an episode not run: its scene breaks an assumption the law declares (the reason is stored)
+STATUS_REFUSED = "refused"
 
 
 def _metric_sql_type(name: str) -> str:

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.bench.store import STATUS_ERROR, ResultsStore
+from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 
 #: Columns of a summary row, in display order.
 SUMMARY_COLUMNS = (
@@ -34,6 +34,7 @@ SUMMARY_COLUMNS = (
     "params",
     "episodes",
     "errors",
+    "refused",
     "success_rate",
     "collision_rate",
     "min_clearance",
@@ -76,7 +77,8 @@ def controller_summary(store: ResultsStore, campaign: int | str) -> list[dict[st
     df = df.sort_values(["controller", "params_hash", "scenario", "seed"], kind="mergesort")
     rows: list[dict[str, Any]] = []
     for (controller, _), group in df.groupby(["controller", "params_hash"], sort=True):
-        ok = group[group["status"] != STATUS_ERROR]
+        ok = group[~group["status"].isin((STATUS_ERROR, STATUS_REFUSED))]
+        refused = int((group["status"] == STATUS_REFUSED).sum())
         success = ok["success"].fillna(False).astype(bool)
         collision = ok["collision"].fillna(False).astype(bool)
         wins = ok[success]
@@ -86,7 +88,8 @@ def controller_summary(store: ResultsStore, campaign: int | str) -> list[dict[st
                 "controller": str(controller),
                 "params": params_text(str(group["params"].iloc[0])),
                 "episodes": len(group),
-                "errors": len(group) - n,
+                "errors": len(group) - n - refused,
+                "refused": refused,
                 "success_rate": _num(success.mean()) if n else None,
                 "collision_rate": _num(collision.mean()) if n else None,
                 "min_clearance": _num(ok["min_clearance"].min()) if n else None,

@@ -746,6 +746,7 @@ def report_cmd(
 _SUMMARY_HEADERS = {
     "episodes": "n",
     "errors": "err",
+    "refused": "ref.",
     "success_rate": "success",
     "collision_rate": "collide",
     "min_clearance": "min\nclear.\n[m]",

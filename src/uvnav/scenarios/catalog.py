@@ -132,6 +132,19 @@ def _uuv2d_load(spec: str) -> Any:
     return load_uuv2d_scenario(spec)
 
 
+def _generate(name: str, seed: int, params: Mapping[str, Any]) -> Any:
+    """Scene ``seed`` of the seed generator ``name`` with keyword ``params`` (any kind)."""
+    from uvnav.scenarios.ch5 import GENERATOR_CH5_DENSE, random_ch5_scenario
+    from uvnav.scenarios.generators import GENERATORS
+    from uvnav.scenarios.uuv2d import UUV2D_GENERATORS
+
+    if name in GENERATORS:
+        return GENERATORS[name](seed, **params)
+    if name in UUV2D_GENERATORS:
+        return UUV2D_GENERATORS[name](seed, **params)
+    return random_ch5_scenario(seed, dense=name == GENERATOR_CH5_DENSE, **params)
+
+
 def _uuv3d_load(spec: str) -> Any:
     from uvnav.scenarios.ch5 import load_ch5_scenario
 
@@ -291,6 +304,42 @@ def resolve(spec: str) -> Resolved:
         "",
         "no such file or built-in scene, nor a GENERATOR:N spec (see 'uvnav scenarios list')",
     )
+
+
+def generate(name: str, seed: int, params: Mapping[str, Any] | None = None) -> Resolved:
+    """Scene ``seed`` of the seed generator ``name`` (any kind) with keyword ``params``; the
+    episode seed is ``seed``, as for ``name:seed``.
+
+    Raises:
+        ScenarioError: unknown generator, a size generator (``antipodal``: write ``antipodal:N``
+            as a scene), or parameters the generator refuses (one line).
+    """
+    by_gen = generators()
+    spec = f"{name}:{seed}"
+    if name not in by_gen:
+        raise ScenarioError(
+            spec,
+            "generator",
+            f"unknown generator {name!r}; known: "
+            f"{', '.join(g for g, k in by_gen.items() if k.spec_is_seed)}",
+        )
+    kind = by_gen[name]
+    if not kind.spec_is_seed:
+        raise ScenarioError(
+            spec,
+            "generator",
+            f"{name}:N makes a scene of N robots; give it as a scene "
+            f"('{name}:8'), with episode seeds",
+        )
+    if not params:
+        return Resolved(kind, kind.load(spec), spec, seed)
+    try:
+        scenario = _generate(name, seed, params)
+    except ScenarioError:
+        raise
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ScenarioError(spec, "params", f"{name}: {exc}") from None
+    return Resolved(kind, scenario, spec, seed)
 
 
 def builtin_names() -> list[tuple[str, SceneKind]]:

@@ -76,8 +76,9 @@ def default_law(resolved: Resolved) -> tuple[str, dict[str, Any]]:
     return str(ctrl.name), dict(getattr(ctrl, "params", {}) or {})
 
 
-def check_law(resolved: Resolved, law: str) -> ControllerInfo:
-    """The registry entry of ``law`` if it fits ``resolved``'s scene.
+def check_law(resolved: Resolved, law: str, *, assumptions: bool = True) -> ControllerInfo:
+    """The registry entry of ``law`` if it fits ``resolved``'s scene (and, with
+    ``assumptions``, if the scene keeps the assumptions the law declares).
 
     Raises:
         UnknownControllerError: no such law.
@@ -94,7 +95,7 @@ def check_law(resolved: Resolved, law: str) -> ControllerInfo:
             f"has a {kind.vehicle} with {kind.sensing} sensing "
             f"(see 'uvnav controllers list --vehicle {kind.vehicle}')",
         )
-    if kind.name == "nav2d":
+    if assumptions and kind.name == "nav2d":
         from uvnav.scenarios.build import validate_for_controller
 
         validate_for_controller(resolved.scenario, law)
@@ -126,18 +127,22 @@ def run_scene(
     seed: int | None = None,
     *,
     record: bool = False,
+    use_scene_params: bool = True,
+    beyond_assumptions: bool = False,
 ) -> Outcome:
     """Run one episode of ``resolved`` with ``law`` (default: the scene's own, with its
-    parameters; ``params`` override them, and are the only ones for another law).
+    parameters unless ``use_scene_params`` is false; ``params`` override them, and are the only
+    ones for another law).  ``beyond_assumptions`` runs a law on a scene that breaks an
+    assumption it declares (a deliberate experiment; never the default).
 
     Raises:
         UnknownControllerError, ControllerParamsError, LawMismatchError, ScenarioError: as above.
     """
     own, own_params = default_law(resolved)
     name = law or own
-    merged = dict(own_params) if name == own else {}
+    merged = dict(own_params) if name == own and use_scene_params else {}
     merged.update(params or {})
-    check_law(resolved, name)
+    check_law(resolved, name, assumptions=not beyond_assumptions)
     s = episode_seed(resolved, seed)
     runner = _RUNNERS[resolved.kind.name]
     try:
