@@ -346,28 +346,32 @@ class FakeSummary:
     db_path: Path
     report_path: Path | None
     figures: list[Path] = field(default_factory=list)
+    sections: list[Any] = field(default_factory=list)
 
 
 def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[dict[str, Any]] = []
 
+    from uvnav.bench.sections import ChapterRenderers, ChapterSection
+
+    row = {
+        "quantity": "path length Fig. 2.10 (Zhang)",
+        "thesis": "14.9 m",
+        "measured": "15.2 m",
+        "note": "geometry chosen from the text",
+    }
+    long_title = "Chapter 2 — a unicycle among moving, rotating, non-convex obstacles " * 2
+
     def reproduce(results_dir: Path, report_dir: Path, **kwargs: Any) -> FakeSummary:
         calls.append({"results": results_dir, "report": report_dir, **kwargs})
         return FakeSummary(
-            table=[
-                {
-                    "quantity": "path length Fig. 2.10 (Zhang)",
-                    "thesis": "14.9 m",
-                    "measured": "15.2 m",
-                    "note": "geometry chosen from the text",
-                }
-            ],
+            table=[row],
             db_path=results_dir / "uvnav.sqlite",
             report_path=report_dir / "index.html",
             figures=[report_dir / "a.png", report_dir / "b.png"],
+            sections=[ChapterSection("ch2", long_title, "", rows=[row])],
         )
 
-    from uvnav.bench.sections import ChapterRenderers
     from uvnav.viz.reproduction import render_reproduction
 
     fake = types.ModuleType("uvnav.bench.reproduce")
@@ -398,7 +402,10 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
         getattr(renderers, k) is not None for k in ("ch3", "ch4", "ch5", "ch6", "ch7", "ch9")
     )
     assert "thesis reported vs uvnav measured" in result.stdout
-    assert "14.9 m" in result.stdout and "15.2 m" in result.stdout
+    assert "thesis 14.9 m | uvnav 15.2 m" in result.stdout
+    assert max(len(line) for line in result.stdout.splitlines()[:4]) <= 80  # one screen
+    table = (res_dir / "thesis-vs-uvnav.md").read_text()
+    assert "| path length Fig. 2.10 (Zhang) | 14.9 m | 15.2 m | geometry chosen" in table
     assert str(res_dir / "uvnav.sqlite") in result.stdout
     assert "2 figure file(s)" in result.stdout
 

@@ -679,17 +679,11 @@ def run(
         ch5=True,
         renderers=renderers(),
     )
-    from rich.table import Table
-
-    table = Table(title="thesis reported vs uvnav measured")
-    for col in ("quantity", "thesis", "measured", "note"):
-        table.add_column(col, justify="right" if col in ("thesis", "measured") else "left")
-    for row in getattr(summary, "table", []) or []:
-        table.add_row(
-            *(_text(_fmt(row.get(col))) for col in ("quantity", "thesis", "measured", "note"))
-        )
-    con = _console()
-    con.print(table)
+    rows = list(getattr(summary, "table", []) or [])
+    table_path = write_comparison_table(rows, results)
+    for line in run_summary_lines(getattr(summary, "sections", []) or [], rows):
+        typer.echo(line)
+    typer.echo(f"wrote {table_path} (the whole table: {len(rows)} rows)")
     written: list[Path] = []
     for attr in ("db_path", "report_path"):
         value = getattr(summary, attr, None)
@@ -704,6 +698,41 @@ def run(
     if figures:
         folders = sorted({str(f.parent) for f in figures})
         typer.echo(f"wrote {len(figures)} figure file(s) in {', '.join(folders)}")
+
+
+def _cut(text: str, width: int) -> str:
+    text = _one_line(text)
+    return text if len(text) <= width else text[: width - 1] + "…"
+
+
+def run_summary_lines(sections: list[Any], rows: list[dict[str, Any]]) -> list[str]:
+    """One screen after ``uvnav run``: per chapter its title, how many table rows it has, and
+    its first row (quantity, the thesis's figure and ours), each line at most 80 characters."""
+    lines = ["thesis reported vs uvnav measured (first row of each chapter)"]
+    for sec in sections:
+        sec_rows = list(getattr(sec, "rows", []) or [])
+        lines.append(_cut(f"{sec.title} ({len(sec_rows)} rows)", 80))
+        if sec_rows:
+            head = sec_rows[0]
+            lines.append("  " + _cut(str(head.get("quantity", "")), 78))
+            figures = f"thesis {_fmt(head.get('thesis'))} | uvnav {_fmt(head.get('measured'))}"
+            lines.append("    " + _cut(figures, 76))
+    if not sections:
+        lines.append(f"  {len(rows)} rows")
+    return lines
+
+
+def write_comparison_table(rows: list[dict[str, Any]], results: Path) -> Path:
+    """The whole "thesis reported vs uvnav measured" table as Markdown in ``results``."""
+    path = results / "thesis-vs-uvnav.md"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    cols = ("quantity", "thesis", "measured", "note")
+    out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for row in rows:
+        cells = [_one_line(_fmt(row.get(c))).replace("|", "\\|") for c in cols]
+        out.append("| " + " | ".join(cells) + " |")
+    path.write_text("\n".join(out) + "\n", encoding="utf-8")
+    return path
 
 
 @app.command("report")
