@@ -27,6 +27,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
+from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Annotated, Any, Union
 
@@ -227,15 +228,66 @@ def kinds() -> Mapping[str, SceneKind]:
 KINDS: tuple[str, ...] = ("nav2d", "nav3d", "uuv2d", "uuv3d", "multi2d")
 
 
+#: Entry-point group of third-party scene generators.  An entry point's name is the generator's;
+#: it loads a callable ``f(seed, **params)`` returning a scenario model of one kind, whose
+#: ``scene_kind`` attribute names that kind (``nav2d`` when absent).  A name already taken is
+#: refused.
+GENERATOR_GROUP = "uvnav.generators"
+_PLUGINS: dict[str, Callable[..., Any]] | None = None
+
+
+def plugin_generators() -> dict[str, Callable[..., Any]]:
+    """The generators of the :data:`GENERATOR_GROUP` entry points (loaded once)."""
+    global _PLUGINS
+    if _PLUGINS is None:
+        plugins: dict[str, Callable[..., Any]] = {}
+        builtin = {g for k in kinds().values() for g in k.generators}
+        for ep in entry_points(group=GENERATOR_GROUP):
+            if ep.name in builtin or ep.name in plugins:
+                raise RuntimeError(
+                    f"scene generator {ep.name!r} of {ep.value} is already registered"
+                )
+            fn = ep.load()
+            kind = getattr(fn, "scene_kind", "nav2d")
+            if kind not in KINDS:
+                raise RuntimeError(
+                    f"scene generator {ep.name!r}: unknown scene_kind {kind!r}; "
+                    f"known: {', '.join(KINDS)}"
+                )
+            plugins[ep.name] = fn
+        _PLUGINS = plugins
+    return _PLUGINS
+
+
 def generators() -> dict[str, SceneKind]:
-    """Every generator name and the kind of scene it makes (one registry; duplicates refused)."""
+    """Every generator name and the kind of scene it makes (one registry: the built-in kinds'
+    and :data:`GENERATOR_GROUP`'s; duplicates refused)."""
     out: dict[str, SceneKind] = {}
     for k in kinds().values():
         for g in k.generators:
             if g in out:
                 raise RuntimeError(f"generator {g!r} is registered by {out[g].name} and {k.name}")
             out[g] = k
+    for name, fn in plugin_generators().items():
+        out[name] = kinds()[getattr(fn, "scene_kind", "nav2d")]
     return out
+
+
+def _plugin_scene(name: str, seed: int, params: Mapping[str, Any]) -> Any:
+    spec = f"{name}:{seed}"
+    kind = generators()[name]
+    try:
+        scenario = plugin_generators()[name](seed, **params)
+    except ScenarioError:
+        raise
+    except (TypeError, ValueError, OverflowError) as exc:
+        raise ScenarioError(spec, "params", f"{name}: {exc}") from None
+    if not isinstance(scenario, kind.model):
+        raise ScenarioError(
+            spec, "generator", f"{name} returned a {type(scenario).__name__}, not a "
+            f"{kind.model.__name__} ({kind.name} scene)"
+        )  # fmt: skip
+    return scenario
 
 
 def infer_kind(data: Any) -> str:
@@ -289,6 +341,8 @@ def resolve(spec: str) -> Resolved:
     if sep and gen in by_gen:
         seed = _seed_of(spec, number)
         kind = by_gen[gen]
+        if gen in plugin_generators():
+            return Resolved(kind, _plugin_scene(gen, seed, {}), spec, seed)
         return Resolved(kind, kind.load(spec), spec, seed if kind.spec_is_seed else None)
     for kind in kinds().values():
         if spec in kind.builtins():
@@ -331,6 +385,8 @@ def generate(name: str, seed: int, params: Mapping[str, Any] | None = None) -> R
             f"{name}:N makes a scene of N robots; give it as a scene "
             f"('{name}:8'), with episode seeds",
         )
+    if name in plugin_generators():
+        return Resolved(kind, _plugin_scene(name, seed, params or {}), spec, seed)
     if not params:
         return Resolved(kind, kind.load(spec), spec, seed)
     try:
