@@ -73,7 +73,7 @@ def test_plugin_returning_another_kind_is_refused(plugins: Any) -> None:
 
 def test_a_taken_generator_name_is_refused(plugins: Any) -> None:
     plugins(random_ch2=random_ch2_scenario)
-    with pytest.raises(RuntimeError, match="'random-ch2'.*already registered"):
+    with pytest.raises(RuntimeError, match=r"'random-ch2'.*already registered"):
         catalog.generators()
 
 
