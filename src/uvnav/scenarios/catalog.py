@@ -25,6 +25,7 @@ the discriminator is :func:`infer_kind`, the same rule as the resolver's.
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from importlib.metadata import entry_points
@@ -111,17 +112,18 @@ def _nav3d_load(spec: str) -> Any:
     return sc
 
 
-def _builtins_of_dim(dim: int) -> list[str]:
-    from uvnav.scenarios.loader import builtin_yaml_files, list_builtin
+@functools.lru_cache(maxsize=2)
+def _builtins_of_dim(dim: int) -> tuple[str, ...]:
+    """The top-level built-ins of dimension ``dim`` (read by :func:`infer_kind`'s rule)."""
+    from uvnav.scenarios.loader import builtin_yaml_files, list_builtin, parse_yaml
 
     files = builtin_yaml_files()
-    out = []
-    for name in list_builtin():
-        text = files[name].read_text()
-        is3d = any(line.split("#")[0].strip() == "dim: 3" for line in text.splitlines())
-        if is3d == (dim == 3):
-            out.append(name)
-    return out
+    want = "nav3d" if dim == 3 else "nav2d"
+    return tuple(
+        name
+        for name in list_builtin()
+        if infer_kind(parse_yaml(files[name].read_text(), name)) == want
+    )
 
 
 def _uuv2d_load(spec: str) -> Any:
@@ -187,11 +189,11 @@ def _kinds() -> dict[str, SceneKind]:
         for k in (
             SceneKind(
                 "nav2d", "unicycle", "exact", "Ch. 2 unicycle among moving bodies and crowds",
-                models["nav2d"], _nav2d_load, lambda: _builtins_of_dim(2), gen2d, _run_rng,
+                models["nav2d"], _nav2d_load, lambda: list(_builtins_of_dim(2)), gen2d, _run_rng,
             ),
             SceneKind(
                 "nav3d", "vehicle3d", "exact", "Ch. 3 flying robot among moving 3D bodies",
-                models["nav3d"], _nav3d_load, lambda: _builtins_of_dim(3), ("random-ch3",),
+                models["nav3d"], _nav3d_load, lambda: list(_builtins_of_dim(3)), ("random-ch3",),
                 _plain_rng,
             ),
             SceneKind(

@@ -21,21 +21,7 @@ from uvnav.controllers.base import (
 )
 from uvnav.scenarios.catalog import Resolved
 from uvnav.scenarios.errors import ScenarioError
-
-METRIC_NAMES: tuple[str, ...] = (
-    "success",
-    "collision",
-    "min_clearance",
-    "path_length",
-    "detour_ratio",
-    "time_to_goal",
-    "time_ratio",
-    "control_effort",
-    "limit_violations",
-    "mode_switches",
-    "decision_us_median",
-    "decision_us_p99",
-)
+from uvnav.sim.metrics import METRIC_NAMES
 
 
 class LawMismatchError(ScenarioError):
