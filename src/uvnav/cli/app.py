@@ -228,7 +228,10 @@ def simulate(
     param: Annotated[
         list[str] | None,
         typer.Option(
-            "--param", "-p", help="Law parameter KEY=VALUE (repeatable; value read as YAML)."
+            "--param",
+            "-p",
+            metavar="KEY=VALUE",
+            help="Law parameter KEY=VALUE (repeatable; value read as YAML).",
         ),
     ] = None,
     seed: Annotated[
@@ -240,7 +243,7 @@ def simulate(
         ),
     ] = None,
     json_out: Annotated[
-        bool, typer.Option("--json", help="Print one JSON object instead of a table.")
+        bool, typer.Option("--json", help="Print one JSON object instead of the table.")
     ] = False,
     plot: Annotated[
         Path | None, typer.Option(help="Also draw the episode into this image file.")
@@ -248,9 +251,9 @@ def simulate(
 ) -> None:
     """Run one episode of SCENARIO (any vehicle) and print its metrics.
 
-    The scenario's law parameters are used when the law is the scenario's own; ``--param``
-    values override them.  With another ``--controller`` only ``--param`` values apply.  A law
-    that drives another vehicle or reads another sensor than the scene's is refused.
+    The scenario's law parameters are used when the law is the scenario's own; --param values
+    override them.  With another --controller only --param values apply.  A law that drives
+    another vehicle or reads another sensor than the scene's is refused.
     """
     from uvnav.scenarios.catalog import resolve
     from uvnav.scenarios.episodes import run_scene
@@ -318,7 +321,9 @@ def _scene_description(sc: Any) -> str:
 
 @scenarios_app.command("list")
 def scenarios_list(
-    json_out: Annotated[bool, typer.Option("--json", help="Print a JSON list.")] = False,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print one JSON array instead of the table.")
+    ] = False,
 ) -> None:
     """List the built-in scenes of every kind (thesis experiments first) and the generators."""
     from uvnav.scenarios.catalog import builtin_names, generators
@@ -516,7 +521,9 @@ def _param_rows(info: ControllerInfo) -> list[dict[str, Any]]:
 
 @controllers_app.command("list")
 def controllers_list(
-    json_out: Annotated[bool, typer.Option("--json", help="Print a JSON list.")] = False,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print one JSON array instead of the table.")
+    ] = False,
     vehicle: Annotated[
         str | None,
         typer.Option(
@@ -565,7 +572,9 @@ def controllers_list(
 @controllers_app.command("show")
 def controllers_show(
     name: Annotated[str, typer.Argument(help="Registered controller name, e.g. zhang2019-v1.")],
-    json_out: Annotated[bool, typer.Option("--json", help="Print a JSON object.")] = False,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object instead of the table.")
+    ] = False,
 ) -> None:
     """Show a controller: summary, reference and parameters with defaults and units."""
     info = controller_info(name)
@@ -745,7 +754,10 @@ def bench(
         bool, typer.Option("--retry-errors", help="With --resume: run 'error' episodes again.")
     ] = False,
     json_out: Annotated[
-        bool, typer.Option("--json", help="Print the run and the summary as one JSON object.")
+        bool,
+        typer.Option(
+            "--json", help="Print one JSON object (the run and the summary) instead of the table."
+        ),
     ] = False,
 ) -> None:
     """Run a benchmark campaign into a results database, then print a per-controller summary.

@@ -141,7 +141,7 @@ def train(
         bool,
         typer.Option(
             help="Label side images with the recorded exact side labels (columns 9-10, written "
-            "by `uvnav drive collect`); --no-exact-sides: ±correction everywhere (the thesis)."
+            "by 'uvnav drive collect'); --no-exact-sides: ±correction everywhere (the thesis)."
         ),
     ] = True,
     augment: Annotated[bool, typer.Option(help="Flip/brightness/zoom augmentation.")] = True,

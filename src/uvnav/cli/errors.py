@@ -177,9 +177,49 @@ def summary(help_text: str | None) -> str:
     return one_line(text.split("\n\n", 1)[0].replace("\b", ""))
 
 
+_NO_BREAK_HYPHEN = "\u2011"
+# click's classes as Typer vendors them (reached through TyperGroup, not a private import path).
+_Context: Any = TyperGroup.context_class
+_HelpFormatter: Any = _Context.formatter_class
+
+
+class HelpFormatter(_HelpFormatter):
+    """click's help formatter, but a line never breaks inside a hyphenated word: names such as
+    ``random-ch5-dense`` or ``--no-exact-sides`` stay whole at 80 columns."""
+
+    def _whole_words(self, start: int) -> None:
+        self.buffer[start:] = [s.replace(_NO_BREAK_HYPHEN, "-") for s in self.buffer[start:]]
+
+    def write_text(self, text: str) -> None:
+        start = len(self.buffer)
+        super().write_text(text.replace("-", _NO_BREAK_HYPHEN))
+        self._whole_words(start)
+
+    def write_dl(self, rows: Any, col_max: int = 30, col_spacing: int = 2) -> None:
+        start = len(self.buffer)
+        rows = [(a, b.replace("-", _NO_BREAK_HYPHEN)) for a, b in rows]
+        super().write_dl(rows, col_max, col_spacing)
+        self._whole_words(start)
+
+
+class HelpContext(_Context):
+    """click context whose help uses :class:`HelpFormatter`."""
+
+    formatter_class = HelpFormatter
+
+
 class UvnavGroup(TyperGroup):
     """Typer group of every ``uvnav`` (sub-)command: the one error path of the module doc, and
-    command lists that wrap each command's summary instead of cutting it."""
+    help that reads well at 80 columns (command summaries wrapped, not cut; no line broken
+    inside a hyphenated word)."""
+
+    context_class = HelpContext
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        for cmd in self.commands.values():
+            if not isinstance(cmd, TyperGroup):
+                cmd.context_class = HelpContext
 
     def make_context(self, info_name: Any, args: Any, parent: Any = None, **extra: Any) -> Any:
         try:
