@@ -28,8 +28,9 @@ def test_dataset_train_evaluate(tmp_path: Path) -> None:
         app, ["sonar", "train", str(data), "--out", str(model), "--max-epochs", "5", "--json"]
     )
     assert r.exit_code == 0, r.output
-    first = json.loads(r.output.splitlines()[0])
+    first = json.loads(r.stdout)  # --json: stdout holds one JSON object, nothing else
     assert set(first["test"]) == {"network", "baseline"}
+    assert "wrote" in r.stderr
     assert (tmp_path / "m.safetensors").is_file() and (tmp_path / "m.json").is_file()
     r = runner.invoke(
         app, ["sonar", "evaluate", str(tmp_path / "m.safetensors"), str(data), "--json"]

@@ -1,10 +1,11 @@
-"""The ``uvnav`` command line (DESIGN §6, layer 8): thin Typer commands over the library.
+"""The ``uvnav`` command line (layer 8): thin Typer commands over the library.
 
 Commands parse their arguments, call the library and print with rich (or plain JSON/YAML where the
-output is meant for machines).  User errors — a bad scenario file, an unknown controller or
-parameter, a missing file, a malformed ``--param`` — are turned into ONE line
-``error: <message>`` on stderr and exit status 2 in a single place, :class:`UvnavGroup`; a
-traceback means a bug.
+output is meant for machines).  Errors take one path, :class:`~uvnav.cli.errors.UvnavGroup`: a
+user error — a bad scenario file, an unknown controller or parameter, a missing file, a malformed
+``--param`` — is ONE line ``error: <message>`` on stderr and exit status 2; a bug is ONE line
+``internal error: ...`` naming the crash log that holds its traceback, exit status 70
+(``uvnav --debug`` shows the traceback instead).
 
 Heavy or optional parts (the reproduction job, figures, the report) are imported inside the
 command that needs them, so ``uvnav scenarios list`` stays fast and works without them.
@@ -25,9 +26,14 @@ from typing import Annotated, Any
 import numpy as np
 import typer
 import yaml
-from typer.core import TyperGroup
 
 from uvnav.cli.drive import drive_app
+from uvnav.cli.errors import (
+    DEBUG_KEY,
+    CliError,
+    one_line,
+    uvnav_typer,
+)
 from uvnav.cli.recon import recon_app
 from uvnav.cli.sonar import sonar_app
 from uvnav.controllers import (
@@ -46,64 +52,10 @@ from uvnav.scenarios import (
 from uvnav.sim import METRIC_NAMES
 
 # ---------------------------------------------------------------------------------- error handling
+# One path for every command (see uvnav.cli.errors): user errors are one ``error:`` line and exit
+# status 2, bugs one ``internal error:`` line (traceback in a crash log) and exit status 70.
 
-
-class CliError(Exception):
-    """A user-facing error: printed as ``error: <message>``, exit status ``code``."""
-
-    def __init__(self, message: str, code: int = 2) -> None:
-        super().__init__(message)
-        self.message = message
-        self.code = code
-
-
-def _is_usage_error(exc: BaseException) -> bool:
-    # Typer vendors click in recent versions; match click's classes by name, not by import path.
-    names = {cls.__name__ for cls in type(exc).__mro__}
-    return "UsageError" in names and "NoArgsIsHelpError" not in names
-
-
-def user_error(exc: BaseException) -> tuple[str, int] | None:
-    """``(one-line message, exit status)`` for an exception caused by the user, else ``None``."""
-    if isinstance(exc, CliError):
-        return exc.message, exc.code
-    if isinstance(exc, ScenarioError):
-        return str(exc), 2
-    if isinstance(exc, UnknownControllerError):
-        return str(exc.args[0]) if exc.args else "unknown controller", 2
-    if isinstance(exc, ControllerParamsError):
-        return str(exc), 2
-    if isinstance(
-        exc, FileNotFoundError | IsADirectoryError | NotADirectoryError | PermissionError
-    ):
-        name = f": {exc.filename}" if exc.filename else ""
-        return f"{exc.strerror or exc}{name}", 2
-    if _is_usage_error(exc):
-        ctx = getattr(exc, "ctx", None)
-        hint = f" (see '{ctx.command_path} --help')" if ctx is not None else ""
-        return f"{exc.format_message()}{hint}", int(getattr(exc, "exit_code", 2))  # type: ignore[attr-defined]
-    return None
-
-
-class UvnavGroup(TyperGroup):
-    """Typer group that turns user errors into one ``error:`` line and exit status 2 (DESIGN §3)."""
-
-    def invoke(self, ctx: Any) -> Any:
-        try:
-            return super().invoke(ctx)
-        except typer.Exit:
-            raise
-        except Exception as exc:
-            handled = user_error(exc)
-            if handled is None:
-                raise
-            message, code = handled
-            typer.echo(f"error: {_one_line(message)}", err=True)
-            raise typer.Exit(code) from None
-
-
-def _one_line(text: str) -> str:
-    return re.sub(r"\s+", " ", text).strip()
+_one_line = one_line
 
 
 def _first_sentence(text: str) -> str:
@@ -113,20 +65,12 @@ def _first_sentence(text: str) -> str:
     return re.split(r"(?<=[a-z0-9)\]])\.\s+(?=[A-Z])", text, maxsplit=1)[0].rstrip(".") + "."
 
 
-app = typer.Typer(
-    cls=UvnavGroup,
+app = uvnav_typer(
     name="uvnav",
     help="Real-time navigation of unmanned vehicles: simulate, benchmark and report.",
-    no_args_is_help=True,
-    add_completion=False,
-    pretty_exceptions_show_locals=False,
 )
-scenarios_app = typer.Typer(
-    cls=UvnavGroup, no_args_is_help=True, help="Built-in and user scenarios."
-)
-controllers_app = typer.Typer(
-    cls=UvnavGroup, no_args_is_help=True, help="Registered navigation laws."
-)
+scenarios_app = uvnav_typer(help="Built-in and user scenarios.")
+controllers_app = uvnav_typer(help="Registered navigation laws.")
 app.add_typer(scenarios_app, name="scenarios")
 app.add_typer(controllers_app, name="controllers")
 app.add_typer(recon_app, name="recon")
@@ -144,14 +88,25 @@ def _version(value: bool) -> None:
 
 @app.callback()
 def _root(
+    ctx: typer.Context,
     version: Annotated[
         bool,
         typer.Option(
             "--version", callback=_version, is_eager=True, help="Print the version and exit."
         ),
     ] = False,
+    debug: Annotated[
+        bool,
+        typer.Option(
+            "--debug",
+            help="On an internal error, show the Python traceback instead of writing it to a "
+            "crash log (also: UVNAV_DEBUG=1).",
+        ),
+    ] = False,
 ) -> None:
     """Real-time navigation of unmanned vehicles: simulate, benchmark and report."""
+    if debug:
+        ctx.meta[DEBUG_KEY] = True
 
 
 # ----------------------------------------------------------------------------------------- helpers
@@ -273,7 +228,10 @@ def simulate(
     param: Annotated[
         list[str] | None,
         typer.Option(
-            "--param", "-p", help="Law parameter KEY=VALUE (repeatable; value read as YAML)."
+            "--param",
+            "-p",
+            metavar="KEY=VALUE",
+            help="Law parameter KEY=VALUE (repeatable; value read as YAML).",
         ),
     ] = None,
     seed: Annotated[
@@ -285,7 +243,7 @@ def simulate(
         ),
     ] = None,
     json_out: Annotated[
-        bool, typer.Option("--json", help="Print one JSON object instead of a table.")
+        bool, typer.Option("--json", help="Print one JSON object instead of the table.")
     ] = False,
     plot: Annotated[
         Path | None, typer.Option(help="Also draw the episode into this image file.")
@@ -293,9 +251,9 @@ def simulate(
 ) -> None:
     """Run one episode of SCENARIO (any vehicle) and print its metrics.
 
-    The scenario's law parameters are used when the law is the scenario's own; ``--param``
-    values override them.  With another ``--controller`` only ``--param`` values apply.  A law
-    that drives another vehicle or reads another sensor than the scene's is refused.
+    The scenario's law parameters are used when the law is the scenario's own; --param values
+    override them.  With another --controller only --param values apply.  A law that drives
+    another vehicle or reads another sensor than the scene's is refused.
     """
     from uvnav.scenarios.catalog import resolve
     from uvnav.scenarios.episodes import run_scene
@@ -363,7 +321,9 @@ def _scene_description(sc: Any) -> str:
 
 @scenarios_app.command("list")
 def scenarios_list(
-    json_out: Annotated[bool, typer.Option("--json", help="Print a JSON list.")] = False,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print one JSON array instead of the table.")
+    ] = False,
 ) -> None:
     """List the built-in scenes of every kind (thesis experiments first) and the generators."""
     from uvnav.scenarios.catalog import builtin_names, generators
@@ -561,7 +521,9 @@ def _param_rows(info: ControllerInfo) -> list[dict[str, Any]]:
 
 @controllers_app.command("list")
 def controllers_list(
-    json_out: Annotated[bool, typer.Option("--json", help="Print a JSON list.")] = False,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print one JSON array instead of the table.")
+    ] = False,
     vehicle: Annotated[
         str | None,
         typer.Option(
@@ -610,7 +572,9 @@ def controllers_list(
 @controllers_app.command("show")
 def controllers_show(
     name: Annotated[str, typer.Argument(help="Registered controller name, e.g. zhang2019-v1.")],
-    json_out: Annotated[bool, typer.Option("--json", help="Print a JSON object.")] = False,
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object instead of the table.")
+    ] = False,
 ) -> None:
     """Show a controller: summary, reference and parameters with defaults and units."""
     info = controller_info(name)
@@ -820,7 +784,10 @@ def bench(
         bool, typer.Option("--retry-errors", help="With --resume: run 'error' episodes again.")
     ] = False,
     json_out: Annotated[
-        bool, typer.Option("--json", help="Print the run and the summary as one JSON object.")
+        bool,
+        typer.Option(
+            "--json", help="Print one JSON object (the run and the summary) instead of the table."
+        ),
     ] = False,
 ) -> None:
     """Run a benchmark campaign into a results database, then print a per-controller summary.

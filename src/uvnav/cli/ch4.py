@@ -11,21 +11,24 @@ from typing import Annotated
 
 import typer
 
-from uvnav.cli.app import UvnavGroup, _console, _text
+from uvnav.cli.app import _console, _text
+from uvnav.cli.errors import uvnav_typer
 
-ch4_app = typer.Typer(
-    cls=UvnavGroup,
-    no_args_is_help=True,
+ch4_app = uvnav_typer(
     help="Chapter 4: a UUV among shape-changing obstacles, sonar only, AMAPS grid.",
 )
 
 
 @ch4_app.command("run")
 def run(
-    full: Annotated[bool, typer.Option("--full", help="200-seed campaign")] = False,
-    workers: Annotated[int, typer.Option(min=1, help="worker processes")] = 2,
-    results: Annotated[Path, typer.Option(help="results directory")] = Path("results"),
-    report: Annotated[Path, typer.Option(help="figures go to REPORT/ch4")] = Path("report"),
+    full: Annotated[
+        bool, typer.Option("--full", help="Thesis-size runs (200-seed campaign).")
+    ] = False,
+    workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 2,
+    results: Annotated[Path, typer.Option(help="Directory of the results.")] = Path("results"),
+    report: Annotated[Path, typer.Option(help="Directory of the figures (in REPORT/ch4).")] = Path(
+        "report"
+    ),
 ) -> None:
     """Chapter-4 reproduction (thesis scenes, random campaign, noise sweep) with figures."""
     from rich.table import Table

@@ -1,9 +1,10 @@
 """``uvnav drive``: thesis Chapter 6 — collect, train, speed-head, evaluate, play, dagger,
-reproduce (DESIGN §6).
+reproduce.
 
 Thin Typer commands over :mod:`uvnav.driving`, :mod:`uvnav.learning` and
 :mod:`uvnav.bench.ch6_pipeline`.  User errors (a missing or malformed dataset or model, a bad
-seed list, a missing extra) are printed as ONE line ``error: ...`` and exit with status 2.
+seed list, a missing extra) are raised as :class:`~uvnav.cli.errors.CliError`: ONE line
+``error: ...`` and exit status 2 (the CLI's one error path).
 """
 
 from __future__ import annotations
@@ -17,33 +18,26 @@ from typing import Annotated, Any
 import typer
 
 from uvnav.cli.checks import dumps, finite
+from uvnav.cli.errors import CliError, uvnav_typer
 
-drive_app = typer.Typer(
+drive_app = uvnav_typer(
     name="drive",
     help="Chapter 6: a CNN that drives (CarRacing-v3 with a forward camera).",
-    no_args_is_help=True,
-    add_completion=False,
 )
-
-
-def _fail(message: str) -> None:
-    typer.echo(f"error: {' '.join(str(message).split())}", err=True)
-    raise typer.Exit(2)
 
 
 @contextmanager
 def _user_errors() -> Iterator[None]:
-    """Turn user errors into one line and exit status 2 (a traceback means a bug)."""
+    """The library's input errors here (a missing file, a missing extra, a malformed dataset or
+    model: ``ValueError``) as :class:`CliError`; anything else propagates as a bug."""
     try:
         yield
-    except (typer.Exit, typer.Abort):
-        raise
     except FileNotFoundError as exc:
-        _fail(f"{exc.strerror or 'not found'}: {exc.filename}")
+        raise CliError(f"{exc.strerror or 'not found'}: {exc.filename}") from None
     except ImportError as exc:
-        _fail(str(exc))
+        raise CliError(str(exc)) from None
     except ValueError as exc:
-        _fail(str(exc))
+        raise CliError(str(exc)) from None
 
 
 def parse_seeds(text: str) -> list[int]:
@@ -72,6 +66,7 @@ def parse_seeds(text: str) -> list[int]:
 
 
 def _progress() -> Any:
+    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
     return Progress(
@@ -80,6 +75,7 @@ def _progress() -> Any:
         MofNCompleteColumn(),
         TimeElapsedColumn(),
         transient=False,
+        console=Console(stderr=True),  # stdout is for results (--json)
     )
 
 
@@ -145,7 +141,7 @@ def train(
         bool,
         typer.Option(
             help="Label side images with the recorded exact side labels (columns 9-10, written "
-            "by `uvnav drive collect`); --no-exact-sides: ±correction everywhere (the thesis)."
+            "by 'uvnav drive collect'); --no-exact-sides: ±correction everywhere (the thesis)."
         ),
     ] = True,
     augment: Annotated[bool, typer.Option(help="Flip/brightness/zoom augmentation.")] = True,
@@ -166,7 +162,12 @@ def train(
             help="target-speed head: cap of the label [m/s] (the top speed).",
         ),
     ] = None,
-    seed: Annotated[int, typer.Option(help="Seed of split, init, shuffling.")] = 0,
+    seed: Annotated[
+        int,
+        typer.Option(
+            "--seed", min=0, help="Seed of the split, the initial weights and the shuffling."
+        ),
+    ] = 0,
 ) -> None:
     """Train the Chapter 6 CNN (Adam, MSE) and write the model and its loss curves."""
     with _user_errors():
@@ -243,7 +244,9 @@ def speed_head(
         float | None,
         typer.Option(min=1.0, callback=finite, help="Cap of the target-speed label [m/s]."),
     ] = None,
-    seed: Annotated[int, typer.Option(help="Seed of the split (as in training).")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", min=0, help="Seed of the split (as in training).")
+    ] = 0,
 ) -> None:
     """Replace the throttle output by a linear target-speed readout (steering unchanged)."""
     with _user_errors():
@@ -341,7 +344,9 @@ def evaluate(
     backend: Annotated[
         str, typer.Option(help="Inference: torch, or onnxruntime (checked against torch).")
     ] = "torch",
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object instead of the table.")
+    ] = False,
 ) -> None:
     """Closed loop on held-out tracks: return, tiles %, laps, centre distance, autonomy."""
     with _user_errors():
@@ -425,7 +430,9 @@ def _print_rows(rows: dict[str, dict[str, float]], as_json: bool) -> None:
 def play(
     model: Annotated[Path, typer.Argument(help="Model file (.safetensors).")],
     out: Annotated[Path, typer.Option("--out", help="Output .gif or .mp4.")] = Path("drive.gif"),
-    seed: Annotated[int, typer.Option(help="Track seed.")] = 1000,
+    seed: Annotated[
+        int, typer.Option("--seed", min=0, help="Episode seed (the track driven).")
+    ] = 1000,
     steps: Annotated[int, typer.Option(min=1, help="Steps to drive.")] = 500,
     every: Annotated[int, typer.Option(min=1, help="Keep every N-th frame.")] = 5,
     throttle: Annotated[str, typer.Option(help="learned | learned-speed | pi")] = "learned",

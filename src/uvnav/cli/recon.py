@@ -23,19 +23,13 @@ from typing import Annotated, Any
 
 import numpy as np
 import typer
-from typer.core import TyperGroup
 
-recon_app = typer.Typer(
-    cls=TyperGroup,
-    no_args_is_help=True,
+from uvnav.cli.checks import dumps
+from uvnav.cli.errors import CliError, uvnav_typer
+
+recon_app = uvnav_typer(
     help="UAV reconnaissance over terrain (thesis Ch. 7): lattice waypoints, smooth tours.",
 )
-
-
-def _fail(message: str) -> None:
-    from uvnav.cli.app import CliError
-
-    raise CliError(message, 2)
 
 
 def parse_area(spec: str, bounds: tuple[float, float, float, float]) -> Any:
@@ -161,11 +155,13 @@ def plan_cmd(
     cell: Annotated[
         float, typer.Option("--cell", help="Node spacing [m] of .npy DEMs and synthetic terrain.")
     ] = 5.0,
-    seed: Annotated[int, typer.Option("--seed", help="k-means seed.")] = 0,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the k-means clustering.")] = 0,
     figures: Annotated[
         bool, typer.Option("--figures/--no-figures", help="Write fig7_4.png and recon_3d.html.")
     ] = True,
-    as_json: Annotated[bool, typer.Option("--json", help="Print the summary as JSON.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object instead of the table.")
+    ] = False,
 ) -> None:
     """Plan minimum lattice waypoints at the lowest altitude and smooth closed tours (Ch. 7)."""
     from uvnav.recon.plan import ReconConfig, plan_recon
@@ -173,12 +169,12 @@ def plan_cmd(
 
     chosen = sum([dem is not None, synthetic is not None, jacksboro])
     if chosen > 1:
-        _fail("recon plan: --dem, --synthetic and --jacksboro are exclusive; give one")
+        raise CliError("recon plan: --dem, --synthetic and --jacksboro are exclusive; give one")
     source = str(dem) if dem is not None else "recon plan"
     try:
         if dem is not None:
             if not dem.is_file():
-                _fail(f"{dem}: --dem: file not found")
+                raise CliError(f"{dem}: --dem: file not found")
             terrain = load_dem(dem, cell=cell)
         elif jacksboro:
             terrain = load_jacksboro()
@@ -210,8 +206,7 @@ def plan_cmd(
         msg = str(exc)
         if msg.startswith("theta"):
             msg = f"--theta: must be in (0, 180) degrees, got {theta:g}"
-        _fail(f"{source}: {msg}")
-        return
+        raise CliError(f"{source}: {msg}") from None
     files = write_plan_files(plan, out)
     if figures:
         from uvnav.viz.figures_ch7 import plot_fig7_4, recon_3d_html
@@ -221,7 +216,7 @@ def plan_cmd(
         files.append(recon_3d_html(plan, out / "recon_3d.html"))
     s = plan.summary()
     if as_json:
-        typer.echo(json.dumps(s, default=float))
+        typer.echo(dumps(s, default=float))  # strict JSON: a missing value is null
         return
     from rich.console import Console
     from rich.table import Table

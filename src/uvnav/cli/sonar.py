@@ -18,25 +18,21 @@ from __future__ import annotations
 
 import zipfile
 from pathlib import Path
-from typing import Annotated, Any, NoReturn
+from typing import Annotated, Any
 
 import numpy as np
 import typer
 
 from uvnav.cli.checks import dumps, finite
+from uvnav.cli.errors import CliError, uvnav_typer
 
-sonar_app = typer.Typer(
-    no_args_is_help=True,
+sonar_app = uvnav_typer(
     help="Chapter 5: nine-sonar array data, the BPNN locator, closed-loop runs.",
 )
 
 
-def _fail(message: str, code: int = 2) -> NoReturn:
-    typer.echo(f"error: {' '.join(str(message).split())}", err=True)
-    raise typer.Exit(code)
-
-
 def _progress() -> Any:
+    from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     return Progress(
@@ -45,6 +41,7 @@ def _progress() -> Any:
         MofNCompleteColumn(),
         TimeElapsedColumn(),
         transient=True,
+        console=Console(stderr=True),  # stdout is for results (--json)
     )
 
 
@@ -52,23 +49,23 @@ def _load_dataset(path: Path) -> Any:
     from uvnav.sensors.sonar_dataset import SonarDataset
 
     if not path.is_file():
-        _fail(f"{path}: dataset file not found")
+        raise CliError(f"{path}: dataset file not found")
     try:
         with np.load(path, allow_pickle=False) as data:
             arrays = {k: data[k] for k in data.files}
     except (ValueError, OSError, zipfile.BadZipFile) as exc:
-        _fail(f"{path}: not a uvnav sonar dataset (.npz): {exc}")
+        raise CliError(f"{path}: not a uvnav sonar dataset (.npz): {exc}") from None
     try:
         return SonarDataset.from_arrays(arrays)
     except ValueError as exc:
-        _fail(f"{path}: {exc}")
+        raise CliError(f"{path}: {exc}") from None
 
 
 @sonar_app.command("dataset")
 def dataset_cmd(
     out: Annotated[Path, typer.Option("--out", help="Output .npz file.")] = Path("sonar.npz"),
     samples: Annotated[int, typer.Option("--samples", "-n", min=1, help="Samples.")] = 150,
-    seed: Annotated[int, typer.Option(min=0, help="Seed of the sampling.")] = 0,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the sampling.")] = 0,
     noise: Annotated[
         float, typer.Option(min=0.0, callback=finite, help="Sonar range noise std [m].")
     ] = 0.0,
@@ -109,9 +106,13 @@ def train_cmd(
     out: Annotated[Path, typer.Option("--out", help="Checkpoint path (stem).")] = Path("bpnn"),
     hidden: Annotated[str, typer.Option(help="Hidden layer sizes, e.g. '10' or '20,10'.")] = "10",
     optimizer: Annotated[str, typer.Option(help="lbfgs (default) or adam.")] = "lbfgs",
-    seed: Annotated[int, typer.Option(min=0, help="Seed of the division and the weights.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", min=0, help="Seed of the division and the initial weights.")
+    ] = 0,
     max_epochs: Annotated[int, typer.Option(min=1, help="Largest number of epochs.")] = 1000,
-    as_json: Annotated[bool, typer.Option("--json", help="Print the error table as JSON.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object instead of the table.")
+    ] = False,
 ) -> None:
     """Train the BPNN with a random division and early stopping; write a safe checkpoint."""
     from uvnav.learning.bpnn import BPNNConfig, error_table, save_checkpoint, train_bpnn
@@ -121,11 +122,11 @@ def train_cmd(
         sizes = tuple(int(h) for h in hidden.split(","))
         cfg = BPNNConfig(hidden=sizes, optimizer=optimizer, max_epochs=max_epochs)
     except ValueError as exc:
-        _fail(f"--hidden/--optimizer: {exc}")
+        raise CliError(f"--hidden/--optimizer: {exc}") from None
     try:
         model = train_bpnn(ds.inputs, ds.targets(), np.random.default_rng(seed), cfg)
     except ValueError as exc:
-        _fail(f"{data}: {exc}")
+        raise CliError(f"{data}: {exc}") from None
     st, js = save_checkpoint(model, out)
     test = model.split["test"]
     table = error_table(model.predict(ds.inputs[test]), ds.targets()[test], ds.baseline()[test])
@@ -136,14 +137,16 @@ def train_cmd(
     else:
         _print_table(table, len(ds), f"test group ({len(test)} samples)")
         typer.echo(f"stopped: {model.stop_reason} (best epoch {model.best_epoch})")
-    typer.echo(f"wrote {st} and {js}")
+    typer.echo(f"wrote {st} and {js}", err=as_json)  # --json: stdout holds the JSON alone
 
 
 @sonar_app.command("evaluate")
 def evaluate_cmd(
     model_path: Annotated[Path, typer.Argument(help="Checkpoint (.safetensors, .json or stem).")],
     data: Annotated[Path, typer.Argument(help="Dataset .npz to evaluate on.")],
-    as_json: Annotated[bool, typer.Option("--json", help="Print JSON.")] = False,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object instead of the table.")
+    ] = False,
 ) -> None:
     """Errors (target - output) of a trained network and of the min/argmin baseline."""
     from uvnav.learning.bpnn import CheckpointError, error_table, load_checkpoint
@@ -151,10 +154,12 @@ def evaluate_cmd(
     try:
         model = load_checkpoint(model_path)
     except CheckpointError as exc:
-        _fail(str(exc))
+        raise CliError(str(exc)) from None
     ds = _load_dataset(data)
     if ds.inputs.shape[1] != model.n_inputs:
-        _fail(f"{data}: {ds.inputs.shape[1]} inputs per sample, the model takes {model.n_inputs}")
+        raise CliError(
+            f"{data}: {ds.inputs.shape[1]} inputs per sample, the model takes {model.n_inputs}"
+        )
     table = error_table(model.predict(ds.inputs), ds.targets(), ds.baseline())
     if as_json:
         typer.echo(dumps(table))
@@ -199,7 +204,7 @@ def simulate_cmd(
         str, typer.Option(help="geometric, network (needs --model) or oracle.")
     ] = "",
     model_path: Annotated[Path | None, typer.Option("--model", help="BPNN checkpoint.")] = None,
-    seed: Annotated[int, typer.Option(min=0, help="Episode seed (sonar noise).")] = 0,
+    seed: Annotated[int, typer.Option("--seed", min=0, help="Episode seed (sonar noise).")] = 0,
     noise: Annotated[
         float | None, typer.Option(min=0.0, callback=finite, help="Override sonar noise [m].")
     ] = None,
@@ -214,18 +219,18 @@ def simulate_cmd(
     try:
         scn = load_ch5_scenario(scenario)
     except ScenarioError as exc:
-        _fail(str(exc))
+        raise CliError(str(exc)) from None
     name = locator or scn.controller.locator
     try:
         loc = make_locator(name, model_path)
     except (CheckpointError, ValueError) as exc:
-        _fail(str(exc))
+        raise CliError(str(exc)) from None
     from uvnav.controllers.zhang_uuv3d import ZhangUUV3D, ZhangUUV3DParams
 
     try:
         params = ZhangUUV3DParams(**scn.controller.params)  # type: ignore[arg-type]
     except (TypeError, ValueError) as exc:
-        _fail(f"{scenario}: controller.params: {exc}")
+        raise CliError(f"{scenario}: controller.params: {exc}") from None
     ctrl = ZhangUUV3D(params, loc)
     res = run_uuv3d_episode(build_uuv3d(scn, noise_std=noise), ctrl, np.random.default_rng(seed))
     out = {
