@@ -163,6 +163,13 @@ class AgentLog:
     last_mode: str = ""
     _decided: bool = False
 
+    @property
+    def timed_us(self) -> list[float]:
+        """The decisions' CPU times [µs] that the metrics summarise: all but the first when
+        there are several (the first carries the warm-up: lazy imports, JIT compilation, caches;
+        it stays in :attr:`decision_us`)."""
+        return self.decision_us[1:] if len(self.decision_us) > 1 else list(self.decision_us)
+
     def record(self, mode: str, cpu_ns: int, wall_ns: int) -> None:
         """Account for one decision."""
         if self._decided and mode != self.last_mode:

@@ -364,7 +364,7 @@ class UnicycleWorld:
             control_effort=self.effort,
             limit_violations=self.violations,
             mode_switches=log.mode_switches,
-            decision_us=log.decision_us,
+            decision_us=log.timed_us,
         )
 
 

@@ -340,7 +340,7 @@ class Vehicle3DWorld:
             control_effort=self.effort,
             limit_violations=self.violations,
             mode_switches=log.mode_switches,
-            decision_us=log.decision_us,
+            decision_us=log.timed_us,
         )
 
 

@@ -259,7 +259,7 @@ class UUV3DWorld:
             control_effort=self.effort,
             limit_violations=self.violations,
             mode_switches=log.mode_switches,
-            decision_us=log.decision_us,
+            decision_us=log.timed_us,
         )
 
 

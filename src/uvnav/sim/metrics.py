@@ -46,7 +46,9 @@ class EpisodeMetrics:
         control_effort: integral of u_R^2 dt [rad^2/s] plus integral of (dV_R/dt)^2 dt [m^2/s^3].
         limit_violations: number of decisions whose command was outside the vehicle limits.
         mode_switches: number of changes of the controller's reported mode.
-        decision_us_median: median controller compute time per decision [µs].
+        decision_us_median: median controller compute time per decision [µs]: thread CPU time
+            (:func:`time.thread_time_ns`), the first decision (warm-up) left out when there are
+            several (:attr:`uvnav.core.AgentLog.timed_us`).
         decision_us_p99: 99th percentile of the same [µs].
     """
 

@@ -476,7 +476,7 @@ class MultiUnicycleWorld:
             control_effort=float(self.effort[i]),
             limit_violations=int(self.violations[i]),
             mode_switches=log.mode_switches,
-            decision_us=log.decision_us,
+            decision_us=log.timed_us,
         )
 
     def group_metrics(self) -> GroupMetrics:
