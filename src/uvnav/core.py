@@ -44,9 +44,10 @@ CmdT = TypeVar("CmdT")
 ObsT_contra = TypeVar("ObsT_contra", contravariant=True)
 CmdT_co = TypeVar("CmdT_co", covariant=True)
 
-#: Vehicle kinds: the Ch. 2 unicycle (also the Ch. 8 multi-robot agents), the Ch. 3/5 3D vehicle
-#: and the Ch. 4 planar underwater vehicle (holonomic, velocity-commanded).
-VEHICLES: tuple[str, ...] = ("unicycle", "vehicle3d", "uuv2d")
+#: Vehicle kinds: the Ch. 2 unicycle (also the Ch. 8 multi-robot agents), the Ch. 3/5 3D vehicle,
+#: the Ch. 4 planar underwater vehicle (velocity-commanded, box bound, bounded turn) and the
+#: holonomic disc robot of the crowd-navigation benchmarks (any 2D scene can hold it).
+VEHICLES: tuple[str, ...] = ("unicycle", "vehicle3d", "uuv2d", "holonomic")
 
 #: Observation kinds a world's sensor makes and a law reads: range-limited exact readings of the
 #: bodies (Ch. 2/3), the Ch. 4 viewing-cone sonar, the Ch. 5 nine-beam sonar array.

@@ -36,9 +36,10 @@ def test_one_registry_views_each_vehicle_apart() -> None:
     unicycle = available_controllers()
     everything = available_controllers(None)
     assert {i.vehicle for i in unicycle.values()} == {"unicycle"}
+    holonomic = available_controllers("holonomic")
     assert set(available_controllers3d()) | set(available_uuv2d_controllers()) | set(
         unicycle
-    ) == set(everything)
+    ) | set(holonomic) == set(everything)
     assert "zhang2020-3d-v1" not in unicycle and "zhang2020-3d-v1" in everything
     # a law of another vehicle is named as such, not "unknown"
     with pytest.raises(UnknownControllerError, match="drives the vehicle3d vehicle"):

@@ -182,7 +182,7 @@ class ScenarioEntry(_Strict):
 
     def fits(self, info: Any) -> bool:
         """Whether the law of registry entry ``info`` can drive this entry's scenes."""
-        return bool((info.vehicle, info.sensing) == (self._kind.vehicle, self._kind.sensing))
+        return bool(self._kind.fits(info))
 
     def seed_list(self) -> list[int]:
         """The seeds of this entry, in order."""
@@ -333,7 +333,7 @@ class CampaignSpec(_Strict):
                 raise FieldError(
                     f"scenarios.{i}",
                     f"no controller entry can drive its {sc._kind.name} scenes "
-                    f"({sc._kind.vehicle} with {sc._kind.sensing} sensing)",
+                    f"({sc._kind.describe()})",
                 )
         return self
 

@@ -7,6 +7,7 @@ contract of :mod:`uvnav.core`), its pydantic model, its built-ins and its genera
 kind       vehicle       sensing      what
 =========  ============  ===========  ==============================================
 nav2d      unicycle      exact        Ch. 2 unicycle among moving bodies, crowds
+           (holonomic)                (or the holonomic disc robot of crowd benchmarks)
 nav3d      vehicle3d     exact        Ch. 3 flyer among moving 3D bodies
 uuv2d      uuv2d         sonar-fan    Ch. 4 planar UUV, viewing-cone sonar, AMAPS
 uuv3d      vehicle3d     sonar-array  Ch. 5 UUV, nine sonars, deforming bodies
@@ -44,7 +45,8 @@ class SceneKind:
 
     Attributes:
         name: the kind's name (:data:`KINDS`).
-        vehicle: the vehicle of :data:`uvnav.core.VEHICLES` its laws must drive.
+        vehicles: the vehicles of :data:`uvnav.core.VEHICLES` its laws may drive (the first is
+            the scene's own; a 2D scene also holds the holonomic robot).
         sensing: the observation of :data:`uvnav.core.SENSINGS` its world makes.
         summary: one line for listings.
         model: the pydantic model of its files.
@@ -58,7 +60,7 @@ class SceneKind:
     """
 
     name: str
-    vehicle: str
+    vehicles: tuple[str, ...]
     sensing: str
     summary: str
     model: type
@@ -67,6 +69,20 @@ class SceneKind:
     generators: tuple[str, ...]
     episode_rng: Callable[[int], np.random.Generator]
     spec_is_seed: bool = True
+
+    @property
+    def vehicle(self) -> str:
+        """The scene's own vehicle."""
+        return self.vehicles[0]
+
+    def fits(self, info: Any) -> bool:
+        """Whether a law (its registry entry) can drive this kind's scenes: one of its vehicles,
+        its sensing."""
+        return bool(info.vehicle in self.vehicles and info.sensing == self.sensing)
+
+    def describe(self) -> str:
+        """``a unicycle or holonomic with exact sensing``."""
+        return f"a {' or '.join(self.vehicles)} with {self.sensing} sensing"
 
 
 @dataclass(frozen=True)
@@ -188,26 +204,27 @@ def _kinds() -> dict[str, SceneKind]:
         k.name: k
         for k in (
             SceneKind(
-                "nav2d", "unicycle", "exact", "Ch. 2 unicycle among moving bodies and crowds",
+                "nav2d", ("unicycle", "holonomic"), "exact",
+                "Ch. 2 unicycle among moving bodies and crowds",
                 models["nav2d"], _nav2d_load, lambda: list(_builtins_of_dim(2)), gen2d, _run_rng,
             ),
             SceneKind(
-                "nav3d", "vehicle3d", "exact", "Ch. 3 flying robot among moving 3D bodies",
+                "nav3d", ("vehicle3d",), "exact", "Ch. 3 flying robot among moving 3D bodies",
                 models["nav3d"], _nav3d_load, lambda: list(_builtins_of_dim(3)), ("random-ch3",),
                 _plain_rng,
             ),
             SceneKind(
-                "uuv2d", "uuv2d", "sonar-fan", "Ch. 4 planar UUV, sonar only, deforming bodies",
+                "uuv2d", ("uuv2d",), "sonar-fan", "Ch. 4 planar UUV, sonar only, deforming bodies",
                 models["uuv2d"], _uuv2d_load, list_uuv2d_builtin, tuple(UUV2D_GENERATORS),
                 _plain_rng,
             ),
             SceneKind(
-                "uuv3d", "vehicle3d", "sonar-array", "Ch. 5 UUV with nine sonars among "
+                "uuv3d", ("vehicle3d",), "sonar-array", "Ch. 5 UUV with nine sonars among "
                 "deforming bodies", models["uuv3d"], _uuv3d_load, list_ch5_builtin,
                 (GENERATOR_CH5, GENERATOR_CH5_DENSE), _plain_rng,
             ),
             SceneKind(
-                "multi2d", "unicycle", "exact", "N unicycles in one world (Ch. 8)",
+                "multi2d", ("unicycle",), "exact", "N unicycles in one world (Ch. 8)",
                 models["multi2d"], _multi_load, list, tuple(MULTI_GENERATORS), _run_rng,
                 spec_is_seed=False,
             ),

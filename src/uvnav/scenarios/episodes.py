@@ -73,13 +73,12 @@ def check_law(resolved: Resolved, law: str, *, assumptions: bool = True) -> Cont
     """
     info = controller_info(law)
     kind = resolved.kind
-    if (info.vehicle, info.sensing) != (kind.vehicle, kind.sensing):
+    if not kind.fits(info):
         raise LawMismatchError(
             resolved.spec,
             "controller",
             f"{law} drives a {info.vehicle} with {info.sensing} sensing; this {kind.name} scene "
-            f"has a {kind.vehicle} with {kind.sensing} sensing "
-            f"(see 'uvnav controllers list --vehicle {kind.vehicle}')",
+            f"has {kind.describe()} (see 'uvnav controllers list --vehicle {kind.vehicle}')",
         )
     if assumptions and kind.name == "nav2d":
         from uvnav.scenarios.build import validate_for_controller
@@ -160,7 +159,10 @@ def _nav2d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bo
     from uvnav.sim.episode import run_episode
 
     setup = build_episode(r.scenario, seed)
-    res = run_episode(setup, make_law(name, **params), r.kind.episode_rng(seed), record=record)
+    vehicle = controller_info(name).vehicle  # the unicycle, or the holonomic robot
+    res = run_episode(
+        setup, make_law(name, **params), r.kind.episode_rng(seed), record=record, vehicle=vehicle
+    )
     return _single(r, name, params, seed, res, setup=setup, trajectory=res.trajectory)
 
 

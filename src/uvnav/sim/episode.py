@@ -32,6 +32,7 @@ import numpy as np
 
 from uvnav.controllers.base import Controller
 from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
+from uvnav.dynamics.omni import OmniSpec, VelocityCommand, omni_advance
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.obstacles.batch import ObstacleBatch
@@ -215,11 +216,13 @@ class UnicycleWorld:
     vehicle: ClassVar[str] = "unicycle"
     sensing: ClassVar[str] = "exact"
     n_agents: ClassVar[int] = 1
+    #: what :meth:`command_pair` returns, with units
+    COMMAND_NAMES: ClassVar[tuple[str, str]] = ("V_R [m/s]", "u_R [rad/s]")
 
     def __init__(self, setup: EpisodeSetup, rng: np.random.Generator, *, exact: bool) -> None:
         self.setup = setup
         self._law_rng, self.sense_rng = rng.spawn(2)
-        self.spec = setup.spec
+        self.spec: Any = setup.spec  # UnicycleSpec (OmniSpec in HolonomicWorld)
         self.dt = float(setup.dt)
         self.ratio = decision_ratio(float(setup.control_period), self.dt)
         self.n_steps = round(setup.t_max / self.dt)
@@ -274,7 +277,7 @@ class UnicycleWorld:
         self.path = 0.0
         self.effort = 0.0
         self.violations = 0
-        self.applied = UnicycleCommand(0.0, 0.0)
+        self.applied: Any = UnicycleCommand(0.0, 0.0)  # the command held now
         self.status = "timeout"
         self.reached_at: float | None = None
         self.step_index = 0
@@ -302,9 +305,22 @@ class UnicycleWorld:
                 fov=lc.fov, noise_std=lc.noise_std, dropout=lc.dropout,
             )  # fmt: skip
         return Observation(
-            time=self.t, pose=robot, speed=self.applied.v, goal=self.goal, obstacles=readings,
+            time=self.t, pose=robot, speed=self.speed, goal=self.goal, obstacles=readings,
             lidar=scan,
         )  # fmt: skip
+
+    @property
+    def speed(self) -> float:
+        """The robot's speed now [m/s] (its applied command's)."""
+        return float(self.applied.v)
+
+    def command_pair(self) -> tuple[float, float]:
+        """The applied command as two numbers for the trajectory: ``(V_R, u_R)``."""
+        return self.applied.v, self.applied.u
+
+    def _speed_change(self, new: Any) -> float:
+        """Squared change of the velocity command from the applied one [m^2/s^2]."""
+        return float((new.v - self.applied.v) ** 2)
 
     def apply(self, cmd: UnicycleCommand, agent: int = 0) -> UnicycleCommand:
         """Hold ``cmd``: counted in ``limit_violations`` when outside (2.4), saturated."""
@@ -313,17 +329,23 @@ class UnicycleWorld:
             self.violations += 1
         new = cmd.clipped(spec)
         if self.step_index > 0:
-            self.effort += (new.v - self.applied.v) ** 2 / (self.ratio * self.dt)
+            self.effort += self._speed_change(new) / (self.ratio * self.dt)
         self.applied = new
         return new
+
+    def _move(self, dt: float) -> tuple[float, float]:
+        """Integrate the robot over ``dt`` [s] (exact); returns the new position, updates the
+        heading and the turn part of the control effort."""
+        v, u = self.applied.v, self.applied.u
+        self.effort += u**2 * dt
+        nx, ny, self.th = unicycle_advance(self.x, self.y, self.th, v, u, dt)
+        return nx, ny
 
     def advance(self) -> None:
         """One step ``dt``: robot (exact), obstacles, clearance, collision and arrival."""
         dt = self.dt
-        v, u = self.applied.v, self.applied.u
-        self.effort += u**2 * dt
         x, y = self.x, self.y
-        nx, ny, self.th = unicycle_advance(x, y, self.th, v, u, dt)
+        nx, ny = self._move(dt)
         self.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
         self.batch.step(self.t, dt)
@@ -368,6 +390,51 @@ class UnicycleWorld:
         )
 
 
+class HolonomicWorld(UnicycleWorld):
+    """Any 2D scene with the holonomic disc robot (:mod:`uvnav.dynamics.omni`) instead of the
+    unicycle: the scene's V_max and radius, a velocity command ``(vx, vy)`` of norm <= V_max
+    held over the decision period, exact straight motion.  Bodies, sensing, clearance and metrics
+    are the unicycle world's; ``pose[2]`` is the direction of the last non-zero velocity, the
+    control effort is the integral of ||dv/dt||^2 (no turn term), and the trajectory's command
+    columns hold ``(vx, vy)``.
+    """
+
+    vehicle: ClassVar[str] = "holonomic"
+    COMMAND_NAMES: ClassVar[tuple[str, str]] = ("v_x [m/s]", "v_y [m/s]")
+
+    def __init__(self, setup: EpisodeSetup, rng: np.random.Generator, *, exact: bool) -> None:
+        super().__init__(setup, rng, exact=exact)
+        self.spec = OmniSpec(v_max=float(setup.spec.v_max), radius=float(setup.spec.radius))
+
+    def start(self, oracles: Sequence[bool] = (False,)) -> None:
+        super().start(oracles)
+        self.applied = VelocityCommand(0.0, 0.0)
+
+    @property
+    def speed(self) -> float:
+        return float(self.applied.speed)
+
+    def command_pair(self) -> tuple[float, float]:
+        """``(vx, vy)`` [m/s]."""
+        return self.applied.vx, self.applied.vy
+
+    def _speed_change(self, new: Any) -> float:
+        return float((new.vx - self.applied.vx) ** 2 + (new.vy - self.applied.vy) ** 2)
+
+    def _move(self, dt: float) -> tuple[float, float]:
+        vx, vy = self.applied.vx, self.applied.vy
+        if vx != 0.0 or vy != 0.0:
+            self.th = math.atan2(vy, vx)
+        return omni_advance(self.x, self.y, vx, vy, dt)
+
+
+#: The 2D worlds by the vehicle of the law that drives them.
+WORLDS_2D: dict[str, type[UnicycleWorld]] = {
+    "unicycle": UnicycleWorld,
+    "holonomic": HolonomicWorld,
+}
+
+
 class TrajectoryProbe(BaseProbe):
     """Records a :class:`UnicycleWorld` at every integration step and at the end."""
 
@@ -376,7 +443,9 @@ class TrajectoryProbe(BaseProbe):
         self.mode = ""  # the law's mode at its last decision
 
     def on_start(self, world: Any, laws: Sequence[Any]) -> None:
-        self.recorder = TrajectoryRecorder([o.body.outline() for o in world.obstacles])
+        self.recorder = TrajectoryRecorder(
+            [o.body.outline() for o in world.obstacles], world.COMMAND_NAMES
+        )
 
     def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
         self.mode = law.mode
@@ -384,8 +453,8 @@ class TrajectoryProbe(BaseProbe):
     def on_step(self, world: Any, laws: Sequence[Any]) -> None:
         assert self.recorder is not None
         self.recorder.add(
-            world.t, world.pose, (world.applied.v, world.applied.u), self.mode,
-            world.clearance, world.nearest, world.field,
+            world.t, world.pose, world.command_pair(), self.mode, world.clearance,
+            world.nearest, world.field,
         )  # fmt: skip
 
     on_end = on_step
@@ -402,6 +471,7 @@ def run_episode(
     *,
     record: bool = True,
     probes: Sequence[Probe] = (),
+    vehicle: str = "unicycle",
 ) -> EpisodeResult:
     """Run one episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
     :class:`UnicycleWorld`).
@@ -413,11 +483,14 @@ def run_episode(
         rng: the episode generator; independent children feed the controller and the sensors.
         record: keep the full trajectory (needed for figures; off for large campaigns).
         probes: more probes to run in the loop.
+        vehicle: the robot the law drives (:data:`WORLDS_2D`: ``unicycle`` or ``holonomic``).
 
     Raises:
         ValueError: ``setup.control_period`` is not a whole multiple of ``setup.dt``.
     """
-    world = UnicycleWorld(setup, rng, exact=record)
+    if vehicle not in WORLDS_2D:
+        raise ValueError(f"no 2D world for vehicle {vehicle!r}; known: {', '.join(WORLDS_2D)}")
+    world = WORLDS_2D[vehicle](setup, rng, exact=record)
     rec = TrajectoryProbe() if record else None
     try:
         (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])

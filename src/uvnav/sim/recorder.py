@@ -24,6 +24,8 @@ class Trajectory:
         obstacle_centres: (n, k, 2) [m]; obstacle_headings: (n, k) [rad];
         obstacle_velocities: (n, k, 2) [m/s]; obstacle_omegas: (n, k) [rad/s].
         obstacle_shapes: per obstacle, its outline in the body frame (k entries of (m, 2)) [m].
+        command_names: what the two command columns hold, with units (``V_R``, ``u_R`` for the
+            unicycle; ``v_x``, ``v_y`` for the holonomic robot).
     """
 
     times: FloatArray
@@ -37,6 +39,7 @@ class Trajectory:
     obstacle_velocities: FloatArray
     obstacle_omegas: FloatArray
     obstacle_shapes: list[FloatArray] = field(default_factory=list)
+    command_names: tuple[str, str] = ("V_R [m/s]", "u_R [rad/s]")
 
     def obstacle_outline(self, j: int, i: int) -> FloatArray:
         """World outline of obstacle ``j`` at sample ``i`` [m]."""
@@ -51,6 +54,7 @@ class TrajectoryRecorder:
     """Appends samples to lists and stacks them into a :class:`Trajectory` at the end."""
 
     shapes: list[FloatArray]
+    command_names: tuple[str, str] = ("V_R [m/s]", "u_R [rad/s]")
     _t: list[float] = field(default_factory=list)
     _robot: list[FloatArray] = field(default_factory=list)
     _cmd: list[tuple[float, float]] = field(default_factory=list)
@@ -100,4 +104,5 @@ class TrajectoryRecorder:
             obstacle_velocities=np.asarray(self._ov).reshape(n, k, 2),
             obstacle_omegas=np.asarray(self._ow).reshape(n, k),
             obstacle_shapes=list(self.shapes),
+            command_names=self.command_names,
         )

@@ -206,24 +206,21 @@ def _shade_modes(ax: Axes, traj: Trajectory) -> list[Any]:
 
 
 def _draw_signals(ax: Axes, traj: Trajectory, setup: EpisodeSetup) -> None:
-    """Panel (b): V_R(t), u_R(t) and the clearance d_min(t) (twin axis)."""
+    """Panel (b): the two commands (V_R(t), u_R(t) for the unicycle, v_x(t), v_y(t) for the
+    holonomic robot) and the clearance d_min(t) (twin axis)."""
     t = traj.times
     handles = _shade_modes(ax, traj)
-    (hv,) = ax.plot(
-        t, traj.commands[:, 0], color="tab:blue", drawstyle="steps-post", label="V_R [m/s]"
-    )
+    first, second = traj.command_names
+    (hv,) = ax.plot(t, traj.commands[:, 0], color="tab:blue", drawstyle="steps-post", label=first)
     (hu,) = ax.plot(
-        t,
-        traj.commands[:, 1],
-        color="tab:orange",
-        drawstyle="steps-post",
-        lw=0.9,
-        label="u_R [rad/s]",
+        t, traj.commands[:, 1], color="tab:orange", drawstyle="steps-post", lw=0.9, label=second
     )
     spec = setup.spec
-    for y in (spec.v_max, spec.u_max, -spec.u_max):
+    unicycle = second.startswith("u_R")
+    limits = (spec.v_max, spec.u_max, -spec.u_max) if unicycle else (spec.v_max, -spec.v_max)
+    for y in limits:
         ax.axhline(y, color="0.5", ls="--", lw=0.6)
-    ax.set_ylabel("V_R [m/s], u_R [rad/s]")
+    ax.set_ylabel(f"{first}, {second}")
     ax.grid(True, alpha=0.3)
     ax2 = ax.twinx()
     (hd,) = ax2.plot(t, _finite(traj.clearance), color="tab:green", lw=1.4, label="d_min [m]")
@@ -232,7 +229,8 @@ def _draw_signals(ax: Axes, traj: Trajectory, setup: EpisodeSetup) -> None:
     ax.legend(
         handles=[hv, hu, hd, *handles], loc="upper right", fontsize="small", ncols=2, framealpha=0.8
     )
-    ax.set_title("(b) robot speed, turn rate and clearance", fontsize="medium", loc="left")
+    what = "speed, turn rate" if unicycle else "velocity"
+    ax.set_title(f"(b) robot {what} and clearance", fontsize="medium", loc="left")
 
 
 def _draw_nearest(ax: Axes, traj: Trajectory) -> None:
