@@ -641,12 +641,12 @@ def reproduce(
     real_run = n_random is None  # test-sized runs (n_random given) leave the other chapters out
     later: list[ChapterSection] = []  # issue 9 goes after the thesis chapters
     if baselines and real_run:  # issue 9 rows (a real run, not a quick look)
-        from uvnav.bench.reproduce_ch9 import replan_rows, reproduce_ch9
+        from uvnav.bench.reproduce_beyond import replan_rows, reproduce_beyond
 
-        rows9 = reproduce_ch9(full=full) + replan_rows()
-        table += rows9
-        figs9 = rend.ch9(report_dir / "beyond") if rend.ch9 is not None else []
-        later.append(sec.beyond_section(rows9, figs9, full=full))
+        rows_b = reproduce_beyond(full=full) + replan_rows()
+        table += rows_b
+        figs_b = rend.beyond(report_dir / "beyond") if rend.beyond is not None else []
+        later.append(sec.beyond_section(rows_b, figs_b, full=full))
     ch6_summary: Any = None
     if real_run:  # Chapter 6 (CNN driving): the thesis size with --full, else RUN_QUICK's size
         from uvnav.bench.reproduce_ch6 import RUN_QUICK, reproduce_ch6

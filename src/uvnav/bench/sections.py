@@ -88,7 +88,7 @@ class ChapterRenderers:
     ch5: SummaryRenderer | None = None
     ch6: SummaryRenderer | None = None
     ch7: PlanRenderer | None = None
-    ch9: FolderRenderer | None = None
+    beyond: FolderRenderer | None = None
 
 
 def mode_text(full: bool) -> str:
@@ -437,21 +437,21 @@ def ch7_section(summary: Any, *, full: bool) -> ChapterSection:
 # ----------------------------------------------------------------------------- beyond the thesis
 
 
-def _ch9_caption(p: Path) -> str:
+def _beyond_caption(p: Path) -> str:
     s = p.stem
-    if s == "ch9-paths":
+    if s == "beyond-paths":
         return (
             "Global planners on the office-floor grid (walls grown by the robot radius): A*, the "
             "visibility-graph path, and D* Lite's replan after a cabinet appears (red cells)."
         )
-    if s == "ch9-office":
+    if s == "beyond-office":
         return (
             "office-floor: the reactive law alone vs hybrid-v1 (D* Lite on the walls it senses) "
             "with the same law; the legend gives each run's outcome."
         )
-    if s.startswith("ch9-swap-"):
+    if s.startswith("beyond-swap-"):
         return (
-            f"Antipodal swap of 16 robots, every robot running {s[len('ch9-swap-') :]}: paths, "
+            f"Antipodal swap of 16 robots, every robot running {s[len('beyond-swap-') :]}: paths, "
             "starts (circles), goals (stars), collisions (x)."
         )
     return ""
@@ -461,14 +461,14 @@ def beyond_section(
     rows: Sequence[Mapping[str, Any]], figures: Sequence[Path], *, full: bool
 ) -> ChapterSection:
     """The issue-9 section: global + local navigation (office floor) and multi-robot swap."""
-    from uvnav.bench import reproduce_ch9 as r9
+    from uvnav.bench import reproduce_beyond as rb
 
-    laws = r9.FULL_LAWS if full else r9.QUICK_LAWS
+    laws = rb.FULL_LAWS if full else rb.QUICK_LAWS
     swap = ", ".join(
         n
-        + (" (tuned for peers)" if p == r9.ZHANG_MULTI else "")
+        + (" (tuned for peers)" if p == rb.ZHANG_MULTI else "")
         + (f" (responsibility {p['responsibility']})" if "responsibility" in p else "")
-        for n, p in (r9.FULL_SWAP if full else r9.QUICK_SWAP)
+        for n, p in (rb.FULL_SWAP if full else rb.QUICK_SWAP)
     )
     intro = (
         f"What the thesis's conclusion names as the next step ({mode_text(full)}). Global + "
@@ -482,7 +482,7 @@ def beyond_section(
         intro=intro,
         rows=rows_of(rows),
     )
-    sec.add_files(caption_files(figures, _ch9_caption))
+    sec.add_files(caption_files(figures, _beyond_caption))
     if not sec.figures:
-        sec.notes.append("No figures: the run had no issue-9 renderer.")
+        sec.notes.append("No figures: the run had no beyond-the-thesis renderer.")
     return sec
