@@ -190,7 +190,7 @@ def test_captions_of_every_chapter() -> None:
 def test_ch6_section_when_not_run_says_how_to_run_it() -> None:
     s = sec.ch6_section(None, full=False)
     assert s.key == "ch6" and not s.rows and not s.figures
-    assert "Not run" in s.intro and "uvnav run --full" in s.notes[0]
+    assert "Not run" in s.intro and "uvnav reproduce ch6" in s.notes[0]
 
 
 def test_chapter_renderers_cover_every_chapter_with_figures() -> None:
