@@ -73,6 +73,8 @@ def user_error(exc: BaseException) -> tuple[str, int] | None:
         return str(exc.args[0]) if exc.args else "unknown controller", 2
     if isinstance(exc, ControllerParamsError):
         return str(exc), 2
+    if type(exc).__name__ == "StaleCampaignError":  # bench.store, not imported here (fast start)
+        return str(exc), 2
     if isinstance(
         exc, FileNotFoundError | IsADirectoryError | NotADirectoryError | PermissionError
     ):
@@ -926,6 +928,7 @@ def main() -> None:
     app(prog_name="uvnav")
 
 
-from uvnav.cli.ch4 import ch4_app  # noqa: E402  (Chapter 4, issue 5: its own sub-app)
+from uvnav.cli.reproduce import forget_cmd, reproduce_cmd  # noqa: E402  (one chapter at a time)
 
-app.add_typer(ch4_app, name="ch4")
+app.command("reproduce")(reproduce_cmd)
+app.command("forget")(forget_cmd)

@@ -1,5 +1,5 @@
-"""Figures of the "beyond the thesis" experiments (issue 9): planner paths on the occupancy grid, global + local trajectories, and the
-multi-robot antipodal swap.
+"""Figures of the "beyond the thesis" experiments (issue 9): planner paths on the occupancy
+grid, global + local trajectories, and the multi-robot antipodal swap.
 
 * :func:`plot_grid_paths` — the occupancy grid (inflated static obstacles) with planned paths
   (A*, D* Lite after a map change, the visibility-graph path) on it.
