@@ -415,7 +415,9 @@ def test_report_calls_write_report(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     ResultsStore(db).close()  # an empty store (an empty file is not one: test_cli_report_readonly)
     seen: list[tuple[Path, Path]] = []
 
-    def write_report(db_path: Path, out_dir: Path, bench_dir: Path | None = None) -> Path:
+    def write_report(
+        db_path: Path, out_dir: Path, bench_dir: Path | None = None, **_kw: Any
+    ) -> Path:
         seen.append((db_path, out_dir))
         if bench_dir is not None and not (bench_dir / "summary.json").exists():
             raise ValueError(f"{bench_dir}: benchmark file without the expected field 'targets'")

@@ -129,3 +129,45 @@ def test_forget_removes_only_the_named_campaigns(tmp_path: Path) -> None:
     with ResultsStore(db) as store:
         assert store.count("b") == 1
     _one_line_error(runner.invoke(app, ["forget", str(tmp_path / "no.sqlite"), "b"]), "no such")
+
+
+def test_report_rebuilds_the_chapter_sections_it_can(tmp_path: Path) -> None:
+    """``uvnav report DB`` of a ``uvnav run`` database keeps the chapters: saved sections as
+    they are, Ch. 2 rebuilt from its stored rows, the rest named with the command to rerun."""
+    from uvnav.bench import reproduce as rp
+
+    db = tmp_path / "uvnav.sqlite"
+    with ResultsStore(db) as store:
+        cid = store.campaign(
+            rp.SCENES_CAMPAIGN,
+            {"scenes": [rp.COMPARISON_SCENE], "controllers": ["zhang2019-v1"], "fingerprint": "x"},
+        )
+        store.add_episode(
+            cid,
+            scenario=rp.COMPARISON_SCENE,
+            controller="zhang2019-v1",
+            seed=0,
+            status="success",
+            metrics={"path_length": 15.0, "min_clearance": 0.5},
+        )
+        store.campaign("ch3-random", {})
+    (tmp_path / "ch7").mkdir()
+    save_section(
+        ChapterSection("beyond", "Beyond the thesis", "saved", rows=[{"quantity": "swap"}]),
+        tmp_path / SECTIONS_DIR,
+    )
+    before = db.read_bytes()
+    secs = chapters.report_sections(db)
+    assert [s.key for s in secs] == ["ch2", "ch3", "ch7", "beyond"]
+    ch2 = secs[0]
+    assert any("Fig. 2.10 path length, zhang2019-v1" in r["quantity"] for r in ch2.rows)
+    assert "uvnav reproduce ch3" in secs[1].notes[0] and "uvnav reproduce ch7" in secs[2].notes[0]
+    out = tmp_path / "site"
+    result = runner.invoke(app, ["report", str(db), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "No reproduction table was given" not in html
+    for key in ("ch2", "ch3", "ch7", "beyond"):
+        assert f'id="section-{key}"' in html
+    assert "15.00 m" in html or "15.0" in html
+    assert db.read_bytes() == before  # the report only reads

@@ -347,11 +347,114 @@ def reproduce_chapter(
     )
 
 
+# ------------------------------------------------------------------ sections for ``uvnav report``
+
+#: Chapters whose results are files under the results folder, not store campaigns.
+_FILE_CHAPTERS = {"ch6": ("ch6", "ch6-quick"), "ch7": ("ch7",)}
+
+
+def _rerun_section(key: str, why: str) -> ChapterSection:
+    name = "the experiments beyond the thesis" if key == "beyond" else f"Chapter {key[2:]}"
+    return ChapterSection(
+        key=key,
+        title=f"{name[0].upper()}{name[1:]}",
+        intro=why,
+        notes=[
+            f"Run 'uvnav reproduce {key}' to rebuild this section (stored episodes are reused)."
+        ],
+    )
+
+
+def _ch2_from_store(store: Any) -> ChapterSection | None:
+    from uvnav.bench import reproduce as rp
+    from uvnav.bench.sections import rows_of
+
+    cfg = next((c["config"] for c in store.campaigns() if c["name"] == rp.SCENES_CAMPAIGN), None)
+    if cfg is None:
+        return None
+    scenes, ctrls = list(cfg.get("scenes", [])), list(cfg.get("controllers", []))
+    straight: float | None = None
+    if rp.COMPARISON_SCENE in scenes:
+        import numpy as np
+
+        import uvnav.scenarios as scenarios
+
+        setup = scenarios.build_episode(scenarios.load_scenario(rp.COMPARISON_SCENE), 0)
+        straight = float(np.hypot(*(np.asarray(setup.goal) - np.asarray(setup.start)[:2])))
+    table, _ = rp.build_table(store, scenes, ctrls, straight_line=straight)
+    if store.campaign_id(rp.BASELINES_CAMPAIGN) is not None:
+        table += rp.comparison_rows(store)
+    return ChapterSection(
+        key="ch2",
+        title="Chapter 2 — a unicycle among moving, deforming obstacles",
+        intro="Rebuilt from the episodes stored in the database (thesis scenes, random, baseline "
+        "and crowd campaigns).",
+        rows=rows_of(table),
+        notes=["No figures: they are drawn by 'uvnav reproduce ch2' (or 'uvnav run')."],
+    )
+
+
+def _ch4_from_store(store: Any) -> ChapterSection:
+    from uvnav.bench import reproduce_ch4 as r4
+    from uvnav.bench.sections import rows_of
+
+    rows = [r for name in r4.CAMPAIGNS for r in r4.stored_rows(store, name)]
+    table = r4._table(r4.stored_rows(store, r4.SCENES_CAMPAIGN), r4.summarise(rows))
+    return ChapterSection(
+        key="ch4",
+        title="Chapter 4 — a UUV among shape-changing obstacles",
+        intro="Rebuilt from the episodes stored in the database (thesis scenes, random, noise and "
+        "hard campaigns).",
+        rows=rows_of(table),
+        notes=["No figures: they are drawn by 'uvnav reproduce ch4' (or 'uvnav run')."],
+    )
+
+
+def report_sections(db_path: Path) -> list[ChapterSection]:
+    """The chapter sections of the report of a results database (``uvnav report DB``).
+
+    A section saved by the last run of its chapter (``DB folder/sections``) is used as it is;
+    otherwise Chapters 2 and 4, whose tables are computed from stored rows only, are rebuilt from
+    the database's episodes; a chapter with stored campaigns or result files but no saved
+    section gets a section that says to rerun ``uvnav reproduce CH``.  The database is only read.
+    """
+    from uvnav.bench.sections import SECTION_ORDER, load_sections
+    from uvnav.bench.store import ResultsStore
+
+    db_path = Path(db_path)
+    saved = {s.key: s for s in load_sections(db_path.parent / SECTIONS_DIR)}
+    out: list[ChapterSection] = []
+    with ResultsStore(db_path, readonly=True) as store:
+        names = {str(c["name"]) for c in store.campaigns()}
+        for key in SECTION_ORDER:
+            if key in saved:
+                out.append(saved[key])
+                continue
+            stored = any(n.startswith(f"{key}-") for n in names)
+            files = any((db_path.parent / d).is_dir() for d in _FILE_CHAPTERS.get(key, ()))
+            section: ChapterSection | None = None
+            if key == "ch2" and stored:
+                section = _ch2_from_store(store)
+            elif key == "ch4" and stored:
+                section = _ch4_from_store(store)
+            if section is None and (stored or files):
+                what = "campaigns are stored" if stored else "result files exist"
+                section = _rerun_section(
+                    key,
+                    f"Its {what} next to this database, but its section (table, figures) is "
+                    "computed by the chapter's run and was not saved with it.",
+                )
+            if section is not None:
+                out.append(section)
+    return out
+
+
 __all__ = [
     "CHAPTERS",
     "SEEDED",
     "ChapterError",
     "ChapterRun",
+    "report_sections",
     "reproduce_chapter",
     "run_beyond",
     "run_ch3",

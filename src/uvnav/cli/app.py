@@ -736,8 +736,17 @@ def report_cmd(
     except NotAStoreError as exc:
         raise CliError(str(exc)) from None
     write_report = _optional("uvnav.viz.report", "write_report", "the report (uvnav report)")
+    from uvnav.bench.chapters import report_sections
+
+    sections = report_sections(db)  # saved by the chapters' runs, or rebuilt from stored rows
     try:
-        path = write_report(db, out, bench_dir=bench)
+        path = write_report(
+            db,
+            out,
+            bench_dir=bench,
+            sections=sections,
+            table=[r for s in sections for r in s.rows],
+        )
     except ValueError as exc:
         raise CliError(str(exc)) from None
     typer.echo(f"wrote {path}")
