@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 
 from uvnav.bench import reproduce as rp
-from uvnav.bench.store import ResultsStore
+from uvnav.bench.store import ResultsStore, StaleCampaignError
 
 SCENES = ["thesis-ch2-fig2-10-comparison", "thesis-ch2-one-obstacle"]
 LAWS = ["zhang2019-v1", "savkin-wang2013-v1"]
@@ -220,13 +220,24 @@ def test_reproduce_end_to_end_resume_and_staleness(
     assert again.campaigns[rp.RANDOM_CAMPAIGN]["skipped"] == 6
     assert again.table == summary.table and again.report_path is None
 
-    # changed code: stale campaigns are replaced, never mixed
+    # changed code: the run refuses, names the campaigns to remove, and deletes nothing
     monkeypatch.setattr(rp, "code_fingerprint", lambda: "b" * 16)
-    stale = rp.reproduce(tmp_path / "results", tmp_path / "report", render=None, **kw)
-    c = stale.campaigns[rp.RANDOM_CAMPAIGN]
-    assert (c["ran"], c["skipped"], c["rerun_stale"]) == (6, 0, True)
     with ResultsStore(summary.db_path) as store:
-        assert store.count(rp.RANDOM_CAMPAIGN) == 6
+        before = {c["name"]: store.count(c["name"]) for c in store.campaigns()}
+    with pytest.raises(StaleCampaignError) as err:
+        rp.reproduce(tmp_path / "results", tmp_path / "report", render=None, **kw)
+    message = str(err.value)
+    assert "\n" not in message and "uvnav forget" in message
+    assert set(err.value.campaigns) == set(before)  # every stale campaign at once
+    with ResultsStore(summary.db_path) as store:
+        assert {c["name"]: store.count(c["name"]) for c in store.campaigns()} == before
+    # removed (uvnav forget), they run again
+    with ResultsStore(summary.db_path) as store:
+        for name in before:
+            store.delete_campaign(name)
+    rerun = rp.reproduce(tmp_path / "results", tmp_path / "report", render=None, **kw)
+    c = rerun.campaigns[rp.RANDOM_CAMPAIGN]
+    assert (c["ran"], c["skipped"]) == (6, 0)
 
 
 def test_baseline_and_crowd_rows_come_from_the_store(tmp_path: Path) -> None:

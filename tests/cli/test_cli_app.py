@@ -399,7 +399,7 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
     # every chapter with figures gets its renderer (Chapters 3-7 and issue 9)
     assert isinstance(renderers, ChapterRenderers)
     assert all(
-        getattr(renderers, k) is not None for k in ("ch3", "ch4", "ch5", "ch6", "ch7", "ch9")
+        getattr(renderers, k) is not None for k in ("ch3", "ch4", "ch5", "ch6", "ch7", "beyond")
     )
     assert "thesis reported vs uvnav measured" in result.stdout
     assert "thesis 14.9 m | uvnav 15.2 m" in result.stdout
@@ -422,7 +422,9 @@ def test_report_calls_write_report(tmp_path: Path, monkeypatch: pytest.MonkeyPat
     ResultsStore(db).close()  # an empty store (an empty file is not one: test_cli_report_readonly)
     seen: list[tuple[Path, Path]] = []
 
-    def write_report(db_path: Path, out_dir: Path, bench_dir: Path | None = None) -> Path:
+    def write_report(
+        db_path: Path, out_dir: Path, bench_dir: Path | None = None, **_kw: Any
+    ) -> Path:
         seen.append((db_path, out_dir))
         if bench_dir is not None and not (bench_dir / "summary.json").exists():
             raise ValueError(f"{bench_dir}: benchmark file without the expected field 'targets'")

@@ -144,16 +144,16 @@ def test_ch4_section_from_a_real_recorded_run(tmp_path: Path) -> None:
 
 def test_beyond_section_from_a_real_swap(tmp_path: Path) -> None:
     """Issue 9: rows and a swap figure from a real 4-robot antipodal swap."""
-    from uvnav.bench.reproduce_ch9 import ZHANG_MULTI, swap_rows
+    from uvnav.bench.reproduce_beyond import ZHANG_MULTI, swap_rows
     from uvnav.scenarios.multi import build_multi, load_multi_scenario
     from uvnav.sim.multi import run_multi
     from uvnav.sim.seeding import run_rng
-    from uvnav.viz.figures_ch9 import plot_swap
+    from uvnav.viz.figures_beyond import plot_swap
 
     rows = swap_rows("antipodal:4", [("zhang2019-v1", ZHANG_MULTI)])
     ms = load_multi_scenario("antipodal:4")
     res = run_multi(build_multi(ms, 0, controller="zhang2019-v1", params=ZHANG_MULTI), run_rng(0))
-    fig = tmp_path / "beyond" / "ch9-swap-zhang2019-v1.png"
+    fig = tmp_path / "beyond" / "beyond-swap-zhang2019-v1.png"
     plot_swap(res, np.array([r.goal for r in ms.robots]), path=fig)
     s = sec.beyond_section(rows, [fig, tmp_path / "missing.png"], full=False)
     assert s.key == "beyond" and "antipodal swap of 16 robots" in s.intro
@@ -180,7 +180,7 @@ def test_captions_of_every_chapter() -> None:
             "ch7-synthetic-300m-R30-fig7_4.png": "Fig. 7.4 style, ch7-synthetic-300m-R30",
             "ch7-synthetic-300m-R30-3d.html": "interactive 3D",
         },
-        sec._ch9_caption: {"ch9-paths.png": "D* Lite", "ch9-office.png": "hybrid-v1"},
+        sec._beyond_caption: {"beyond-paths.png": "D* Lite", "beyond-office.png": "hybrid-v1"},
     }
     for fn, names in cases.items():
         for name, expected in names.items():
@@ -190,11 +190,11 @@ def test_captions_of_every_chapter() -> None:
 def test_ch6_section_when_not_run_says_how_to_run_it() -> None:
     s = sec.ch6_section(None, full=False)
     assert s.key == "ch6" and not s.rows and not s.figures
-    assert "Not run" in s.intro and "uvnav run --full" in s.notes[0]
+    assert "Not run" in s.intro and "uvnav reproduce ch6" in s.notes[0]
 
 
 def test_chapter_renderers_cover_every_chapter_with_figures() -> None:
     r = chapter_renderers()
     assert isinstance(r, ChapterRenderers)
-    for key in ("ch3", "ch4", "ch5", "ch6", "ch7", "ch9"):
+    for key in ("ch3", "ch4", "ch5", "ch6", "ch7", "beyond"):
         assert callable(getattr(r, key)), key

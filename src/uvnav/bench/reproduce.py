@@ -25,12 +25,14 @@ it: the renderer is injected (``render=``), which keeps the layer contract enfor
 Resume and staleness: both campaigns carry a fingerprint of the code and scenario files that decide
 episode outcomes (:func:`code_fingerprint`).  Re-running with unchanged code resumes (an interrupted
 run only finishes what is missing; a finished one costs nothing).  If the code changed since a
-campaign was stored, that campaign is deleted and run again, so the table never mixes results of
-different code.  ``fresh=True`` always reruns.
+campaign was stored, the run refuses (:class:`~uvnav.bench.store.StaleCampaignError`, one line
+naming the campaign to remove with ``uvnav forget``), so the table never mixes results of
+different code and no run deletes another run's episodes.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import time
 from collections.abc import Callable, Sequence
@@ -42,7 +44,7 @@ import numpy as np
 
 from uvnav.bench.campaign import Job, run_campaign
 from uvnav.bench.sections import ChapterRenderers, ChapterSection
-from uvnav.bench.store import STATUS_ERROR, ResultsStore
+from uvnav.bench.store import STATUS_ERROR, ResultsStore, StaleCampaignError
 
 CONTROLLERS: tuple[str, ...] = ("zhang2019-v1", "savkin-wang2013-v1")
 #: Classical baselines run beside the thesis's comparison (not in the thesis).
@@ -172,8 +174,7 @@ class ReproductionSummary:
         failures: ``(controller, seed, status)`` of every random-campaign episode that did not
             succeed (status ``collision``, ``timeout`` or ``error``).
         figures: figure files written.
-        campaigns: per campaign: ``ran``, ``skipped``, ``errors``, ``wall_time`` [s],
-            ``rerun_stale``.
+        campaigns: per campaign: ``ran``, ``skipped``, ``errors``, ``wall_time`` [s].
         wall_time: total elapsed time [s].
         sections: the report's chapter sections (rows, figures, links) in chapter order.
     """
@@ -229,16 +230,23 @@ def code_fingerprint() -> str:
     return h.hexdigest()[:16]
 
 
-def _prepare_campaign(store: ResultsStore, name: str, config: dict[str, Any], fresh: bool) -> bool:
-    """Delete campaign ``name`` if ``fresh`` or its fingerprint differs; True if it was deleted."""
+def _check_campaigns(store: ResultsStore, configs: dict[str, dict[str, Any]]) -> None:
+    """Check that every stored campaign of ``configs`` (name -> config) was made by the same code
+    (fingerprint); never deletes one.
+
+    Raises:
+        StaleCampaignError: naming every stored campaign whose fingerprint differs (its episodes
+            cannot be resumed and would be mixed with new ones; the user removes them).
+    """
+    stale = []
     for c in store.campaigns():
-        if c["name"] != name:
-            continue
-        stale = c["config"].get("fingerprint") != config["fingerprint"]
-        if fresh or stale:
-            store.delete_campaign(name)
-            return True
-    return False
+        cfg = configs.get(c["name"])
+        if cfg is not None and c["config"].get("fingerprint") != cfg["fingerprint"]:
+            stale.append(c["name"])
+    if stale:
+        raise StaleCampaignError(
+            store.path, stale, f"{'was' if len(stale) == 1 else 'were'} stored by other code"
+        )
 
 
 def _fmt_m(x: Any, digits: int = 2) -> str:
@@ -446,6 +454,7 @@ def reproduce(
     progress: bool = True,
     fresh: bool = False,
     n_random: int | None = None,
+    start_seed: int = 0,
     controllers: Sequence[str] = CONTROLLERS,
     baselines: Sequence[str] = BASELINES,
     n_baseline_seeds: int | None = None,
@@ -455,6 +464,7 @@ def reproduce(
     ch5: bool = False,
     ch5_render: Callable[..., list[Path]] | None = None,
     renderers: ChapterRenderers | None = None,
+    save_sections: bool = True,
 ) -> ReproductionSummary:
     """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
 
@@ -464,8 +474,9 @@ def reproduce(
         full: thesis-size random campaign (1000 seeds instead of 200).
         workers: worker processes (1 = in-process).
         progress: show rich progress bars on stderr.
-        fresh: delete and rerun both campaigns even when the stored ones are current.
+        fresh: rerun Chapter 6's finished stages (its files; stored episodes are never deleted).
         n_random: override the number of random seeds (tests, quick looks).
+        start_seed: first random seed of the random and baseline campaigns.
         baselines: classical controllers run beside the thesis's two laws: on the thesis scenes
             and a subset of the random seeds (campaign ``ch2-baselines``), and with the two laws
             on crowd crossings of the ETH recordings (campaign ``crowds-eth``); empty to skip both.
@@ -483,6 +494,8 @@ def reproduce(
             :func:`uvnav.viz.reproduction.chapter_renderers`); each chapter's figures go to
             ``report_dir/chN`` (issue 9: ``report_dir/beyond``) and into its report section.
             ``renderers.ch5`` is used when ``ch5_render`` is not given.
+        save_sections: save every section in ``results_dir/sections`` (so ``uvnav report`` and
+            ``uvnav reproduce CH`` show them beside later single-chapter runs).
 
     Returns:
         The summary: table, database and report paths, random-campaign failures.
@@ -532,7 +545,7 @@ def reproduce(
                 random_cfg,
                 [
                     Job(controller=c, seed=g, generator_seed=g)
-                    for g in range(n_seeds)
+                    for g in range(start_seed, start_seed + n_seeds)
                     for c in ctrls
                 ],
             ),
@@ -563,7 +576,7 @@ def reproduce(
                     [Job(controller=c, seed=0, scenario=s) for s in scenes for c in base]
                     + [
                         Job(controller=c, seed=g, generator_seed=g)
-                        for g in range(n_base)
+                        for g in range(start_seed, start_seed + n_base)
                         for c in base
                     ],
                 )
@@ -596,8 +609,8 @@ def reproduce(
                     ],
                 )
             )
+        _check_campaigns(store, {name: cfg for name, cfg, _ in plans})
         for name, cfg, jobs in plans:
-            stale = _prepare_campaign(store, name, cfg, fresh)
             run = run_campaign(store, name, jobs, config=cfg, workers=workers, progress=progress)
             summary_campaigns[name] = {
                 "jobs": run.total,
@@ -606,7 +619,6 @@ def reproduce(
                 "errors": run.errors,
                 "statuses": dict(run.statuses),
                 "wall_time": round(run.wall_time, 2),
-                "rerun_stale": stale,
             }
 
         straight: float | None = None
@@ -633,6 +645,7 @@ def reproduce(
             scenes=scenes,
             controllers=ctrls,
             n_random=n_seeds,
+            start_seed=start_seed,
             baselines=base,
             n_baseline=n_base,
             n_crowd=n_crowd,
@@ -643,69 +656,38 @@ def reproduce(
     ]
     real_run = n_random is None  # test-sized runs (n_random given) leave the other chapters out
     later: list[ChapterSection] = []  # issue 9 goes after the thesis chapters
-    if baselines and real_run:  # issue 9 rows (a real run, not a quick look)
-        from uvnav.bench.reproduce_ch9 import replan_rows, reproduce_ch9
-
-        rows9 = reproduce_ch9(full=full) + replan_rows()
-        table += rows9
-        figs9 = rend.ch9(report_dir / "beyond") if rend.ch9 is not None else []
-        later.append(sec.beyond_section(rows9, figs9, full=full))
-    ch6_summary: Any = None
-    if real_run:  # Chapter 6 (CNN driving): the thesis size with --full, else RUN_QUICK's size
-        from uvnav.bench.reproduce_ch6 import RUN_QUICK, reproduce_ch6
-
-        ch6_summary = reproduce_ch6(
-            results_dir / ("ch6" if full else "ch6-quick"),
-            full=full,
-            fresh=fresh,
-            progress=_say_ch6 if progress else None,
-            **({} if full else RUN_QUICK),
-        )
-        if rend.ch6 is not None:
-            ch6_summary.figures = list(rend.ch6(ch6_summary, report_dir / "ch6"))
-        table += ch6_summary.table
     by_key: dict[str, ChapterSection] = {}
-    if real_run:  # thesis Ch. 3 (3D): scenes + random campaign rows (bench/reproduce_ch3)
-        from uvnav.bench.reproduce_ch3 import reproduce_ch3
+    from uvnav.bench import chapters
 
-        s3 = reproduce_ch3(results_dir, report_dir, full=full, workers=workers, render=rend.ch3)
+    if baselines and real_run:  # beyond the thesis (a real run, not a quick look)
+        sec_b, rows_b = chapters.run_beyond(report_dir, full=full, renderers=rend)
+        table += rows_b
+        later.append(sec_b)
+    if real_run:  # Chapter 6 (CNN driving): the thesis size with --full, else RUN_QUICK's size
+        by_key["ch6"], s6 = chapters.run_ch6(
+            results_dir, report_dir, full=full, renderers=rend, fresh=fresh, progress=progress
+        )
+        table += s6.table
+    if real_run:  # thesis Ch. 3 (3D): scenes + random campaign rows (bench/reproduce_ch3)
+        by_key["ch3"], s3 = chapters.run_ch3(
+            results_dir, report_dir, full=full, workers=workers, renderers=rend
+        )
         table += s3.table
-        by_key["ch3"] = sec.ch3_section(s3, full=full)
     run_ch7 = ch7 if ch7 is not None else real_run
     if run_ch7:  # thesis Ch. 7 (issue 8)
-        from uvnav.bench.reproduce_ch7 import reproduce_ch7
-
-        draw7 = rend.ch7
-        s7 = reproduce_ch7(
-            results_dir / "ch7",
-            full=full,
-            render_plan=None
-            if draw7 is None
-            else (lambda plan, prefix: draw7(plan, report_dir / "ch7" / Path(prefix).name)),
-        )
+        by_key["ch7"], s7 = chapters.run_ch7(results_dir, report_dir, full=full, renderers=rend)
         table += s7.table
-        by_key["ch7"] = sec.ch7_section(s7, full=full)
     if ch5:  # thesis Chapter 5: BPNN experiment and closed-loop runs (needs the learning extra)
-        from uvnav.bench.reproduce_ch5 import reproduce_ch5
-
-        s5 = reproduce_ch5(
-            results_dir,
-            full=full,
-            progress=progress,
-            render=ch5_render or rend.ch5,
-            report_dir=report_dir,
-            workers=workers,
+        r5 = rend if ch5_render is None else dataclasses.replace(rend, ch5=ch5_render)
+        by_key["ch5"], s5 = chapters.run_ch5(
+            results_dir, report_dir, full=full, workers=workers, renderers=r5, progress=progress
         )
         table += s5.table
-        by_key["ch5"] = sec.ch5_section(s5, full=full)
     if real_run:  # Chapter 4 (issue 5); tests that shrink the Ch. 2 campaign leave it out
-        from uvnav.bench.reproduce_ch4 import reproduce_ch4
-
-        s4 = reproduce_ch4(results_dir, report_dir, full=full, workers=workers, render=rend.ch4)
+        by_key["ch4"], s4 = chapters.run_ch4(
+            results_dir, report_dir, full=full, workers=workers, renderers=rend
+        )
         table = table + s4.table
-        by_key["ch4"] = sec.ch4_section(s4, full=full)
-    if ch6_summary is not None:
-        by_key["ch6"] = sec.ch6_section(ch6_summary, full=full)
     sections += [by_key[k] for k in ("ch3", "ch4", "ch5", "ch6", "ch7") if k in by_key]
     sections += later
     report_path: Path | None = None
@@ -724,6 +706,9 @@ def reproduce(
             )
         )
         report_path, figures = out.report_path, list(out.figures)
+    if save_sections:  # after rendering: the renderer adds the Chapter 2 figures to its section
+        for section in sections:
+            sec.save_section(section, results_dir / sec.SECTIONS_DIR)
     return ReproductionSummary(
         table=table,
         db_path=db_path,

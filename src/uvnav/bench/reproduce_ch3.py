@@ -19,12 +19,12 @@ the table "thesis reported vs uvnav measured" is read back from the stored rows.
 by an injected renderer (``render=``; the CLI passes :func:`uvnav.viz.figures3d.render_ch3`), so
 this module never imports ``viz`` (DESIGN §1 layers).
 
-Run it alone with ``python -m uvnav.bench.reproduce_ch3 [--seeds N] [--workers W]``.
+Run it alone with ``uvnav reproduce ch3 [--seeds N] [--start-seed S] [--workers W]``; a run adds
+to the store (resume), it never replaces another run's episodes.
 """
 
 from __future__ import annotations
 
-import argparse
 import json
 import time
 from collections.abc import Callable, Sequence
@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.bench.campaign import run_in_workers
-from uvnav.bench.store import ResultsStore
+from uvnav.bench.store import ResultsStore, params_hash
 
 CONTROLLERS_3D: tuple[str, ...] = ("zhang2020-3d-v1", "apf3d-v1", "vo3d-v1")
 SCENES_CAMPAIGN = "ch3-thesis-scenes"
@@ -131,6 +131,56 @@ def prediction_errors(n_series: int = 20, length: int = 120) -> dict[str, float]
     return {"ar_rms": ar, "constant_rms": cv, "series": float(len(e_ar)), "ratio": ar / cv}
 
 
+def _job_key(job: tuple[str, str, int, str, bool]) -> tuple[str, str, str, int]:
+    """The store's resume key ``(scenario, controller, params_hash, seed)`` of a job."""
+    return (job[0], job[1], params_hash({"motion": job[3]}), int(job[2]))
+
+
+def _store_jobs(
+    store: ResultsStore,
+    campaign: str,
+    config: dict[str, Any],
+    jobs: list[tuple[str, str, int, str, bool]],
+    workers: int,
+    progress: bool,
+    *,
+    rerun: bool = False,
+) -> list[dict[str, Any]]:
+    """Run the jobs of ``campaign`` the store lacks and store each as it finishes (resume); with
+    ``rerun`` run the stored ones too (for their trajectories) without storing them again.
+    Episodes of other jobs (other controllers, seeds) already in the campaign are kept.
+
+    Returns:
+        The rows this call ran (job order)."""
+    cid = store.campaign(campaign, config)
+    done = store.done_keys(cid)
+    todo = [j for j in jobs if rerun or _job_key(j) not in done]
+    rows = _run_jobs(todo, workers, progress)
+    for r in rows:
+        key = (r["scene"], r["controller"], params_hash({"motion": r["motion"]}), int(r["seed"]))
+        if key in done:
+            continue
+        store.add_episode(
+            cid, scenario=r["scene"], controller=r["controller"], seed=r["seed"],
+            status=r["status"], params={"motion": r["motion"]}, metrics=r["metrics"],
+            family=r["scene"].split(":")[0], wall_time=r["wall"],
+        )  # fmt: skip
+    return rows
+
+
+def _requested(frame: Any, jobs: list[tuple[str, str, int, str, bool]]) -> Any:
+    """The rows of ``frame`` (a campaign's episodes) that belong to ``jobs``: the table of a run
+    describes what it asked for; the store keeps every other run's rows."""
+    keys = {_job_key(j) for j in jobs}
+    mask = [
+        (str(sc), str(c), str(h), int(sd)) in keys
+        for sc, c, h, sd in zip(
+            frame["scenario"], frame["controller"], frame["params_hash"], frame["seed"], strict=True
+        )
+    ]
+    return frame[mask]
+
+
 def reproduce_ch3(
     results_dir: Path,
     report_dir: Path,
@@ -139,6 +189,7 @@ def reproduce_ch3(
     workers: int = 2,
     progress: bool = False,
     n_random: int | None = None,
+    start_seed: int = 0,
     controllers: Sequence[str] = CONTROLLERS_3D,
     render: Renderer | None = None,
 ) -> Ch3Summary:
@@ -151,8 +202,13 @@ def reproduce_ch3(
         workers: worker processes.
         progress: print one line per episode.
         n_random: override the number of random scenes.
+        start_seed: first random scene (scenes ``start_seed .. start_seed + n - 1``).
         controllers: the 3D laws to compare.
         render: figure renderer ``(db_path, report_dir, recorded) -> figure paths``.
+
+    Resumable and additive: episodes already in the store are not run again (the thesis scenes
+    run again only for the figures' trajectories), and another run's episodes (other
+    controllers, other seeds) are kept; the table describes the episodes this call asked for.
     """
     import uvnav.scenarios as scenarios
 
@@ -165,23 +221,19 @@ def reproduce_ch3(
     scene_jobs = [(s, c, 0, "predicted", True) for s in scenes for c in controllers]
     rand_jobs = [
         (f"{RANDOM_FAMILY}:{g}", c, g, m, False)
-        for g in range(n_seeds) for m in MOTIONS for c in controllers
+        for g in range(start_seed, start_seed + n_seeds) for m in MOTIONS for c in controllers
     ]  # fmt: skip
-    scene_rows = _run_jobs(scene_jobs, workers, progress)
-    rand_rows = _run_jobs(rand_jobs, workers, progress)
+    scene_rows: list[dict[str, Any]] = []
     with ResultsStore(db_path) as store:
-        for name, rows in ((SCENES_CAMPAIGN, scene_rows), (RANDOM_CAMPAIGN, rand_rows)):
-            store.delete_campaign(name)
-            cid = store.campaign(name, {"chapter": 3, "controllers": list(controllers),
-                                        "seeds": n_seeds})  # fmt: skip
-            for r in rows:
-                store.add_episode(
-                    cid, scenario=r["scene"], controller=r["controller"], seed=r["seed"],
-                    status=r["status"], params={"motion": r["motion"]}, metrics=r["metrics"],
-                    family=r["scene"].split(":")[0], wall_time=r["wall"],
-                )  # fmt: skip
-        frame = store.episodes_frame(RANDOM_CAMPAIGN)
-        scene_frame = store.episodes_frame(SCENES_CAMPAIGN)
+        size = {"chapter": 3, "controllers": list(controllers)}
+        # the thesis scenes run again when figures are drawn (the trajectories are not stored);
+        # only episodes missing from the store are written, stored ones are never replaced
+        scene_rows = _store_jobs(store, SCENES_CAMPAIGN, {**size, "seed": 0}, scene_jobs,
+                                 workers, progress, rerun=render is not None)  # fmt: skip
+        _store_jobs(store, RANDOM_CAMPAIGN, {**size, "seeds": n_seeds}, rand_jobs, workers,
+                    progress)  # fmt: skip
+        frame = _requested(store.episodes_frame(RANDOM_CAMPAIGN), rand_jobs)
+        scene_frame = _requested(store.episodes_frame(SCENES_CAMPAIGN), scene_jobs)
     pred = prediction_errors()
     table: list[dict[str, str]] = []
     for _, row in scene_frame.iterrows():
@@ -226,21 +278,3 @@ def reproduce_ch3(
         recorded = [(r["scene"], r["controller"], r["trajectory"]) for r in scene_rows]
         figures = render(db_path, Path(report_dir), recorded)
     return Ch3Summary(table, db_path, failures, pred, figures, time.perf_counter() - tic)
-
-
-def main(argv: Sequence[str] | None = None) -> None:
-    """``python -m uvnav.bench.reproduce_ch3``: the campaign alone, JSON summary on stdout."""
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=QUICK_SEEDS)
-    ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--results", type=Path, default=Path("results"))
-    ap.add_argument("--controllers", nargs="*", default=list(CONTROLLERS_3D))
-    args = ap.parse_args(argv)
-    s = reproduce_ch3(args.results, Path("report"), workers=args.workers, n_random=args.seeds,
-                      controllers=args.controllers, progress=True)  # fmt: skip
-    print(json.dumps({"table": s.table, "failures": s.failures, "prediction": s.prediction,
-                      "wall_time": s.wall_time}, indent=1, default=str))  # fmt: skip
-
-
-if __name__ == "__main__":
-    main()

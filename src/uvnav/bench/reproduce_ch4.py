@@ -5,7 +5,8 @@
 1. every built-in ``thesis-ch4-*`` scene (Figs. 4.2(b), 4.7-4.9) with the thesis's law
    ``zhang2022-uuv2d-v1`` and both baselines on the same sonar (``apf-uuv2d-v1``,
    ``zhang2019-uuv2d-v1``), seed 0, trajectories recorded for the figures — campaign
-   ``ch4-thesis-scenes`` (re-run every time: the figures need the trajectories);
+   ``ch4-thesis-scenes`` (re-run every time: the figures need the trajectories; a missing
+   episode is stored, a stored one is kept);
 2. a random campaign on ``random-ch4:<seed>`` (1-5 deforming obstacles) with the three laws
    (quick: 10 seeds; ``full``: 200) — campaign ``ch4-random``;
 3. a sensor-noise sweep on the same generator: range noise 0.05 / 0.1 m and 10 % dropout
@@ -21,7 +22,8 @@ part of the resume key), ``family`` the generator (``random-ch4``, ``random-ch4-
 scene, the metrics of :data:`~uvnav.sim.metrics.METRIC_NAMES` their own columns; the two facts
 the store has no column for, the number of obstacles and whether a forbidden region (the
 Fig. 4.2(b) inner space) was entered, are kept in ``effective_params``.  Campaigns resume (a
-re-run skips the stored episodes) unless ``fresh``.  The summary (``results_dir/ch4/summary.json``)
+re-run skips the stored episodes) and only add to the store: no run deletes or replaces another
+run's episodes.  The summary (``results_dir/ch4/summary.json``)
 and the table "thesis reported vs uvnav measured" are computed from the stored rows, never typed
 in.  The thesis reports no numbers for Chapter 4 (only Figs. 4.7-4.9: the vehicle reaches E
 without collision), so the table's thesis column states that.
@@ -220,23 +222,26 @@ def run_jobs(
 
 
 def campaign_jobs(
-    seeds: int, noise_seeds: int, laws: Iterable[str] = LAWS
+    seeds: int, noise_seeds: int, laws: Iterable[str] = LAWS, start: int = 0
 ) -> tuple[list[Ch4Job], list[Ch4Job]]:
-    """Jobs of the random campaign (noise-free) and of the sensor-noise sweep."""
+    """Jobs of the random campaign (noise-free) and of the sensor-noise sweep (seeds ``start``
+    onwards)."""
     laws = tuple(laws)
-    clean = [Ch4Job(f"random-ch4:{s}", law, s) for law in laws for s in range(seeds)]
+    clean = [Ch4Job(f"random-ch4:{s}", law, s) for law in laws for s in range(start, start + seeds)]
     noisy = [
         Ch4Job(f"random-ch4:{s}", law, s, noise, drop)
         for noise, drop in NOISE_LEVELS
         for law in laws
-        for s in range(noise_seeds)
+        for s in range(start, start + noise_seeds)
     ]
     return clean, noisy
 
 
-def hard_jobs(seeds: int, laws: Iterable[str] = LAWS) -> list[Ch4Job]:
-    """Jobs of the harder family ``random-ch4-hard`` (noise-free), seed by seed."""
-    return [Ch4Job(f"{HARD_FAMILY}:{s}", law, s) for s in range(seeds) for law in laws]
+def hard_jobs(seeds: int, laws: Iterable[str] = LAWS, start: int = 0) -> list[Ch4Job]:
+    """Jobs of the harder family ``random-ch4-hard`` (noise-free), seed by seed from ``start``."""
+    return [
+        Ch4Job(f"{HARD_FAMILY}:{s}", law, s) for s in range(start, start + seeds) for law in laws
+    ]
 
 
 def _family(row: dict[str, Any]) -> str:
@@ -328,12 +333,12 @@ def reproduce_ch4(
     *,
     full: bool = False,
     workers: int = 1,
-    fresh: bool = False,
     render: Callable[..., list[Path]] | None = None,
     seeds: int | None = None,
     noise_seeds: int | None = None,
     progress: Callable[[int, int], None] | None = None,
     hard_seeds: int | None = None,
+    start_seed: int = 0,
 ) -> Ch4Summary:
     """Run the Chapter 4 reproduction and campaign (see the module docstring).
 
@@ -343,10 +348,14 @@ def reproduce_ch4(
         full: thesis-size campaign (200 seeds, 50 per noise level, 100 hard) instead of the
             quick one.
         workers: processes for the campaign.
-        fresh: discard the stored Chapter-4 campaigns first.
         render: ``render(out_dir, scene_results, summary) -> [paths]`` (figures).
         seeds, noise_seeds, hard_seeds: override the campaign sizes.
         progress: ``progress(done, total)`` after each campaign episode.
+        start_seed: first seed of every random family (seeds ``start_seed`` onwards).
+
+    Additive: an episode already in the store is never run again nor replaced (the thesis
+    scenes run again for the figures' trajectories, but only missing ones are stored), and
+    other runs' episodes are kept.
     """
     results_dir = Path(results_dir)
     out_dir = results_dir / "ch4"
@@ -361,24 +370,29 @@ def reproduce_ch4(
     nh = hard_seeds if hard_seeds is not None else (FULL_HARD_SEEDS if full else QUICK_HARD_SEEDS)
     scene_results: dict[tuple[str, str], Uuv2dResult] = {}
     with ResultsStore(db_path) as store:
-        for name in (SCENES_CAMPAIGN, *(CAMPAIGNS if fresh else ())):
-            store.delete_campaign(name)  # the scene episodes are re-run for their trajectories
         cid = store.campaign(SCENES_CAMPAIGN, {"chapter": 4, "laws": list(LAWS), "seed": 0})
+        stored = store.done_keys(cid)
         for scene in list_uuv2d_builtin():
             for law in LAWS:
+                job = Ch4Job(scene, law, 0)
                 tic = time.perf_counter()
-                row, res = run_ch4_job(Ch4Job(scene, law, 0), record=True)
+                row, res = run_ch4_job(job, record=True)  # for the figures' trajectories
                 row["wall_time"] = time.perf_counter() - tic
-                store_row(store, cid, row)
+                if (scene, law, params_hash(_params(job)), 0) not in stored:
+                    store_row(store, cid, row)
                 scene_results[(scene, law)] = res
-        scene_rows = stored_rows(store, SCENES_CAMPAIGN)
-        clean, noisy = campaign_jobs(n, nn)
+        scene_rows = [
+            r
+            for r in stored_rows(store, SCENES_CAMPAIGN)
+            if (r["scene"], r["law"]) in scene_results
+        ]
+        clean, noisy = campaign_jobs(n, nn, start=start_seed)
         size = {"chapter": 4, "laws": list(LAWS)}
         rows_random = run_jobs(clean, store, RANDOM_CAMPAIGN, workers=workers,
                                progress=progress, config={**size, "seeds": n})  # fmt: skip
         rows_noise = run_jobs(noisy, store, NOISE_CAMPAIGN, workers=workers, progress=progress,
                               config={**size, "seeds": nn, "levels": NOISE_LEVELS})  # fmt: skip
-        rows_hard = run_jobs(hard_jobs(nh), store, HARD_CAMPAIGN, workers=workers,
+        rows_hard = run_jobs(hard_jobs(nh, start=start_seed), store, HARD_CAMPAIGN, workers=workers,
                              progress=progress, config={**size, "seeds": nh})  # fmt: skip
     rows = rows_random + rows_noise + rows_hard
     campaign = summarise(rows)

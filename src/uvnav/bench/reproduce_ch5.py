@@ -29,7 +29,8 @@ obstacles, whether Scene 2's inner space was entered) go to ``effective_params``
 the generator state after sampling, so training continues exactly as in one go), every learning
 row and its trained network are cached under ``results_dir/ch5/cache`` as they finish, and every
 random-campaign episode is one transaction of the store; a re-run skips what is there (``fresh``
-starts over).  ``results_dir/ch5.json`` (rows, table, per-group summary, failures) and the table
+drops the cache; stored episodes are never deleted or replaced by a later run).
+``results_dir/ch5.json`` (rows, table, per-group summary, failures) and the table
 "thesis reported vs uvnav measured" are computed from the measured rows only.  Figures are drawn
 by a renderer the caller injects (``bench`` may not import ``viz``, DESIGN §1).
 """
@@ -390,11 +391,9 @@ def _episode_row(
     }
 
 
-def store_row(store: ResultsStore, campaign_id: int, row: dict[str, Any]) -> int:
-    """Write one episode row: controller = the law, params = locator + noise (+ model digest),
-    family = the generator or the scene, metrics in their columns; ``n_obstacles`` and
-    ``entered_inner_space`` (no column) in ``effective_params``."""
-    job = Ch5Job(
+def _row_job(row: dict[str, Any]) -> Ch5Job:
+    """The job of a row (its resume key is the store's)."""
+    return Ch5Job(
         row["scene"],
         row["locator"],
         int(row["seed"]),
@@ -402,6 +401,13 @@ def store_row(store: ResultsStore, campaign_id: int, row: dict[str, Any]) -> int
         None,
         str(row.get("model", "")),
     )
+
+
+def store_row(store: ResultsStore, campaign_id: int, row: dict[str, Any]) -> int:
+    """Write one episode row: controller = the law, params = locator + noise (+ model digest),
+    family = the generator or the scene, metrics in their columns; ``n_obstacles`` and
+    ``entered_inner_space`` (no column) in ``effective_params``."""
+    job = _row_job(row)
     return store.add_episode(
         campaign_id,
         scenario=row["scene"],
@@ -651,7 +657,12 @@ def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
 
 
 def _campaign_jobs(
-    n_rand: int, noises: Sequence[float], model_path: Path, model_id: str, n_dense: int = 0
+    n_rand: int,
+    noises: Sequence[float],
+    model_path: Path,
+    model_id: str,
+    n_dense: int = 0,
+    start: int = 0,
 ) -> dict[str, list[Ch5Job]]:
     """The random-scene jobs of each campaign (noise 0: ``ch5-random``; else ``ch5-noise``;
     the dense family, noise 0: ``ch5-dense``), scene by scene (all locators of a scene
@@ -661,7 +672,7 @@ def _campaign_jobs(
             for noise in noises]  # fmt: skip
     plan.append((DENSE_CAMPAIGN, GENERATOR_CH5_DENSE, 0.0, n_dense))
     for name, generator, noise, count in plan:
-        for g in range(count):
+        for g in range(start, start + count):
             for loc in LOCATORS:
                 net = loc == "network"
                 out[name].append(
@@ -694,6 +705,7 @@ def reproduce_ch5(
     report_dir: Path | None = None,
     workers: int = 1,
     fresh: bool = False,
+    start_seed: int = 0,
 ) -> Ch5Summary:
     """Run the Chapter 5 reproduction (module docstring); write ``results_dir/ch5.json`` and the
     closed-loop episodes to ``results_dir/uvnav.sqlite``.  Resumes an interrupted run.
@@ -716,7 +728,13 @@ def reproduce_ch5(
             :func:`uvnav.viz.figures_ch5.render_ch5`); ``None`` skips figures.
         report_dir: folder of the figures.
         workers: processes for the random-scene campaigns.
-        fresh: discard the cache and the stored Chapter 5 campaigns first.
+        fresh: discard the cache first (data sets, learning rows, networks); the stored
+            episodes are kept (a network trained again to the same weights resumes them).
+        start_seed: first scene of the random families (``random-ch5:<start_seed>`` onwards).
+
+    Additive: an episode already in the store is never run again nor replaced (the thesis
+    scenes run again for the figures' trajectories, but only missing ones are stored), and other
+    runs' episodes are kept.
     """
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
@@ -786,7 +804,7 @@ def reproduce_ch5(
         summary.models["closed_loop"] = cl_model
         prog.advance(task)
 
-        jobs = _campaign_jobs(n_rand, noise_list, model_path, model_id, n_dns)
+        jobs = _campaign_jobs(n_rand, noise_list, model_path, model_id, n_dns, start_seed)
         n_episodes = len(scene_list) * len(LOCATORS) * len(noise_list) + sum(
             map(len, jobs.values())
         )
@@ -794,9 +812,9 @@ def reproduce_ch5(
         kept: dict[tuple[str, str, float], UUV3DResult] = {}
         base_cfg = {"chapter": 5, "law": LAW, "locators": list(LOCATORS), "model": model_id}
         with ResultsStore(db_path) as store:
-            for name in CAMPAIGNS if fresh else (SCENES_CAMPAIGN,):
-                store.delete_campaign(name)  # the scenes re-run for their trajectories
             cid = store.campaign(SCENES_CAMPAIGN, {**base_cfg, "noises": list(noise_list)})
+            stored = store.done_keys(cid)
+            wanted: set[tuple[str, str, str, int]] = set()
             for scene in scene_list:
                 for noise in noise_list:
                     for loc in LOCATORS:
@@ -808,11 +826,16 @@ def reproduce_ch5(
                             str(model_path),
                             model_id if loc == "network" else "",
                         )
+                        # run again for the figures' trajectories; stored only when missing
                         row, res = run_ch5_job(job, record=True, model=cl_model)
-                        store_row(store, cid, row)
+                        if job.key not in stored:
+                            store_row(store, cid, row)
+                        wanted.add(job.key)
                         kept[(scene, loc, float(noise))] = res
                         prog.advance(task2)
-            scene_rows = stored_rows(store, SCENES_CAMPAIGN)
+            scene_rows = [
+                r for r in stored_rows(store, SCENES_CAMPAIGN) if _row_job(r).key in wanted
+            ]
             rand_rows: list[dict[str, Any]] = []
             for name, js in jobs.items():
                 if not js:
@@ -849,6 +872,7 @@ def reproduce_ch5(
             "sizes": list(sizes),
             "seeds": seeds,
             "n_random": n_rand,
+            "start_seed": start_seed,
             "n_dense": n_dns,
             "n_test": n_test,
             "noises": list(noise_list),

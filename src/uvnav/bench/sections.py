@@ -88,7 +88,7 @@ class ChapterRenderers:
     ch5: SummaryRenderer | None = None
     ch6: SummaryRenderer | None = None
     ch7: PlanRenderer | None = None
-    ch9: FolderRenderer | None = None
+    beyond: FolderRenderer | None = None
 
 
 def mode_text(full: bool) -> str:
@@ -125,6 +125,7 @@ def ch2_section(
     controllers: Sequence[str],
     n_random: int,
     baselines: Sequence[str],
+    start_seed: int = 0,
     n_baseline: int,
     n_crowd: int,
     crowd_generators: Sequence[str],
@@ -136,13 +137,15 @@ def ch2_section(
     intro = (
         f"Planar unicycle among moving obstacles ({mode_text(full)}). The thesis scenes "
         f"({', '.join(scenes) or 'none'}) ran once each (seed 0) with {laws}, trajectories "
-        f"recorded; a random campaign on random-ch2 scenes ran seeds 0–{n_random - 1} with the "
+        f"recorded; a random campaign on random-ch2 scenes ran seeds "
+        f"{start_seed}–{start_seed + n_random - 1} with the "
         "same laws."
     )
     if baselines:
         intro += (
             f" Classical baselines ({', '.join(baselines)}) ran on the thesis scenes and "
-            f"random-ch2 seeds 0–{n_baseline - 1}; every law crossed pedestrian crowds "
+            f"random-ch2 seeds {start_seed}–{start_seed + n_baseline - 1}; every law crossed "
+            "pedestrian crowds "
             f"({', '.join(crowd_generators)}, {n_crowd} seeds each, robot V_max "
             f"{crowd_v_max:g} m/s)."
         )
@@ -174,7 +177,9 @@ def _ch3_caption(p: Path) -> str:
     return ""
 
 
-def ch3_section(summary: Any, *, full: bool, n_random: int | None = None) -> ChapterSection:
+def ch3_section(
+    summary: Any, *, full: bool, n_random: int | None = None, start_seed: int = 0
+) -> ChapterSection:
     """The Chapter 3 section from a :class:`uvnav.bench.reproduce_ch3.Ch3Summary`."""
     from uvnav.bench import reproduce_ch3 as r3
 
@@ -182,7 +187,8 @@ def ch3_section(summary: Any, *, full: bool, n_random: int | None = None) -> Cha
     intro = (
         f"3D flying robot among moving obstacles ({mode_text(full)}). The thesis-ch3 scenes ran "
         f"with {', '.join(r3.CONTROLLERS_3D)} (seed 0, obstacle rates estimated from sensing and "
-        f"AR-predicted by the thesis's law); the random-ch3 campaign ran seeds 0–{n - 1} with "
+        f"AR-predicted by the thesis's law); the random-ch3 campaign ran seeds "
+        f"{start_seed}–{start_seed + n - 1} with "
         f"each law, obstacle motion known (oracle) and predicted; the AR one-step velocity "
         "prediction is compared with constant velocity."
     )
@@ -217,18 +223,21 @@ def _ch4_caption(p: Path) -> str:
     return base or f"{p.stem}: zhang2022-uuv2d-v1 run."
 
 
-def ch4_section(summary: Any, *, full: bool) -> ChapterSection:
-    """The Chapter 4 section from a :class:`uvnav.bench.reproduce_ch4.Ch4Summary`."""
+def ch4_section(
+    summary: Any, *, full: bool, seeds: int | None = None, start_seed: int = 0
+) -> ChapterSection:
+    """The Chapter 4 section from a :class:`uvnav.bench.reproduce_ch4.Ch4Summary` (``seeds``:
+    the run's override of every family's seed count)."""
     from uvnav.bench import reproduce_ch4 as r4
 
-    n = r4.FULL_SEEDS if full else r4.QUICK_SEEDS
-    nn = r4.FULL_NOISE_SEEDS if full else r4.QUICK_NOISE_SEEDS
+    n = seeds if seeds is not None else (r4.FULL_SEEDS if full else r4.QUICK_SEEDS)
+    nn = seeds if seeds is not None else (r4.FULL_NOISE_SEEDS if full else r4.QUICK_NOISE_SEEDS)
     levels = ", ".join(f"noise {s:g} m" if s else f"dropout {d:.0%}" for s, d in r4.NOISE_LEVELS)
     intro = (
         f"Planar UUV with a viewing-cone sonar among shape-changing obstacles ({mode_text(full)}). "
         f"The thesis-ch4 scenes ran with {', '.join(r4.LAWS)} (seed 0, trajectories recorded); "
-        f"the random-ch4 campaign ran {n} seeds per law, and a sensor sweep ({levels}) "
-        f"{nn} seeds per level."
+        f"the random-ch4 campaign ran {n} seeds per law (from seed {start_seed}), and a sensor "
+        f"sweep ({levels}) {nn} seeds per level."
     )
     sec = ChapterSection(
         key="ch4",
@@ -294,6 +303,7 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
     sizes = cfg.get("sizes", r5.FULL_SIZES if full else r5.QUICK_SIZES)
     seeds = cfg.get("seeds", r5.FULL_SEEDS if full else r5.QUICK_SEEDS)
     n_rand = cfg.get("n_random", r5.FULL_RANDOM if full else r5.QUICK_RANDOM)
+    first = int(cfg.get("start_seed", 0))
     n_dense = cfg.get("n_dense", r5.FULL_DENSE if full else r5.QUICK_DENSE)
     noises = " and ".join(f"{x:g}" for x in cfg.get("noises", (0.0, 0.05) if full else (0.0,)))
     noises += " m"
@@ -303,10 +313,11 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
         f"{', '.join(map(str, sizes))} samples with "
         f"{seeds} seeds each, tested on its own test group and on an independent set; "
         f"zhang2022-uuv3d-v1 then ran on the three thesis-ch5 scenes and random-ch5 seeds "
-        f"0–{n_rand - 1} with the {', '.join(r5.LOCATORS)} locators, sonar noise {noises}"
+        f"{first}–{first + n_rand - 1} with the {', '.join(r5.LOCATORS)} locators, sonar "
+        f"noise {noises}"
         + (
-            f", and on random-ch5-dense seeds 0–{n_dense - 1} (bodies closer than the law "
-            "assumes, noise 0). "
+            f", and on random-ch5-dense seeds {first}–{first + n_dense - 1} (bodies closer "
+            "than the law assumes, noise 0). "
             if n_dense
             else ". "
         )
@@ -357,8 +368,8 @@ def ch6_section(summary: Any | None, *, full: bool) -> ChapterSection:
             title=title,
             intro=f"Not run in this {mode_text(full)} run (a test-sized run leaves it out).",
             notes=[
-                "Run it with uvnav run (quick size), uvnav run --full (thesis size) or "
-                "uvnav drive reproduce [--full]."
+                "Run it with uvnav reproduce ch6 [--full] (or uvnav run [--full]; the pipeline "
+                "with every option: uvnav drive reproduce)."
             ],
         )
     size = getattr(summary, "size", {}) or {}
@@ -385,7 +396,7 @@ def ch6_section(summary: Any | None, *, full: bool) -> ChapterSection:
         sec.notes.append(
             "Quick size: a smoke run of the whole pipeline. A network trained this briefly does "
             "not drive well, so its closed-loop numbers are far below the thesis-size ones "
-            "(uvnav run --full or uvnav drive reproduce --full; measured figures in "
+            "(uvnav reproduce ch6 --full or uvnav drive reproduce --full; measured figures in "
             "docs/thesis-notes.md)."
         )
     sec.add_files(
@@ -437,21 +448,21 @@ def ch7_section(summary: Any, *, full: bool) -> ChapterSection:
 # ----------------------------------------------------------------------------- beyond the thesis
 
 
-def _ch9_caption(p: Path) -> str:
+def _beyond_caption(p: Path) -> str:
     s = p.stem
-    if s == "ch9-paths":
+    if s == "beyond-paths":
         return (
             "Global planners on the office-floor grid (walls grown by the robot radius): A*, the "
             "visibility-graph path, and D* Lite's replan after a cabinet appears (red cells)."
         )
-    if s == "ch9-office":
+    if s == "beyond-office":
         return (
             "office-floor: the reactive law alone vs hybrid-v1 (D* Lite on the walls it senses) "
             "with the same law; the legend gives each run's outcome."
         )
-    if s.startswith("ch9-swap-"):
+    if s.startswith("beyond-swap-"):
         return (
-            f"Antipodal swap of 16 robots, every robot running {s[len('ch9-swap-') :]}: paths, "
+            f"Antipodal swap of 16 robots, every robot running {s[len('beyond-swap-') :]}: paths, "
             "starts (circles), goals (stars), collisions (x)."
         )
     return ""
@@ -461,14 +472,14 @@ def beyond_section(
     rows: Sequence[Mapping[str, Any]], figures: Sequence[Path], *, full: bool
 ) -> ChapterSection:
     """The issue-9 section: global + local navigation (office floor) and multi-robot swap."""
-    from uvnav.bench import reproduce_ch9 as r9
+    from uvnav.bench import reproduce_beyond as rb
 
-    laws = r9.FULL_LAWS if full else r9.QUICK_LAWS
+    laws = rb.FULL_LAWS if full else rb.QUICK_LAWS
     swap = ", ".join(
         n
-        + (" (tuned for peers)" if p == r9.ZHANG_MULTI else "")
+        + (" (tuned for peers)" if p == rb.ZHANG_MULTI else "")
         + (f" (responsibility {p['responsibility']})" if "responsibility" in p else "")
-        for n, p in (r9.FULL_SWAP if full else r9.QUICK_SWAP)
+        for n, p in (rb.FULL_SWAP if full else rb.QUICK_SWAP)
     )
     intro = (
         f"What the thesis's conclusion names as the next step ({mode_text(full)}). Global + "
@@ -482,7 +493,73 @@ def beyond_section(
         intro=intro,
         rows=rows_of(rows),
     )
-    sec.add_files(caption_files(figures, _ch9_caption))
+    sec.add_files(caption_files(figures, _beyond_caption))
     if not sec.figures:
-        sec.notes.append("No figures: the run had no issue-9 renderer.")
+        sec.notes.append("No figures: the run had no beyond-the-thesis renderer.")
     return sec
+
+
+# ------------------------------------------------------------------------- sections on disk
+
+#: Every section key in report order: the thesis chapters, then what goes beyond the thesis.
+SECTION_ORDER: tuple[str, ...] = ("ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "beyond")
+#: Folder, next to the results database, of the last section each chapter's run produced.
+SECTIONS_DIR = "sections"
+
+
+def save_section(section: ChapterSection, folder: Path) -> Path:
+    """Write ``section`` to ``folder/<key>.json`` (file paths absolute), replacing that chapter's
+    previous section only; the report of a later single-chapter run (``uvnav reproduce CH``) or of
+    ``uvnav report`` shows it beside the other chapters' sections."""
+    import json
+
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    data = {
+        "key": section.key,
+        "title": section.title,
+        "intro": section.intro,
+        "rows": section.rows,
+        "figures": [[str(Path(f.path).resolve()), f.caption] for f in section.figures],
+        "links": [[str(Path(f.path).resolve()), f.caption] for f in section.links],
+        "notes": section.notes,
+    }
+    path = folder / f"{section.key}.json"
+    tmp = path.with_name(path.name + ".part")
+    tmp.write_text(json.dumps(data, indent=1, ensure_ascii=False), encoding="utf-8")
+    tmp.replace(path)
+    return path
+
+
+def load_sections(folder: Path) -> list[ChapterSection]:
+    """The sections saved by :func:`save_section` in ``folder``, in :data:`SECTION_ORDER`; files
+    that no longer exist are left out (noted in the section).  A missing folder: no sections."""
+    import json
+
+    out: list[ChapterSection] = []
+    for key in SECTION_ORDER:
+        path = Path(folder) / f"{key}.json"
+        if not path.is_file():
+            continue
+        try:
+            d = json.loads(path.read_text(encoding="utf-8"))
+        except (OSError, ValueError):
+            continue
+        sec = ChapterSection(
+            key=str(d["key"]),
+            title=str(d["title"]),
+            intro=str(d["intro"]),
+            rows=rows_of(d.get("rows", [])),
+            notes=[str(n) for n in d.get("notes", [])],
+        )
+        missing = 0
+        for kind in ("figures", "links"):
+            for p, caption in d.get(kind, []):
+                if Path(p).is_file():
+                    getattr(sec, kind).append(SectionFile(Path(p), str(caption)))
+                else:
+                    missing += 1
+        if missing:
+            sec.notes.append(f"{missing} file(s) of this section no longer exist.")
+        out.append(sec)
+    return out

@@ -47,7 +47,7 @@ import math
 import os
 import sqlite3
 import urllib.parse
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from contextlib import AbstractContextManager, contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
@@ -242,6 +242,23 @@ def writer_lease(db: str | Path) -> Iterator[None]:
 
 class NotAStoreError(ValueError):
     """A file that is not a uvnav results database (one line naming it and what is missing)."""
+
+
+class StaleCampaignError(RuntimeError):
+    """A reproduction would have to start a stored campaign over (its rows were made by other
+    code, or another generator or model version): it refuses instead of deleting another run's
+    rows.  The message is one line naming the campaign, the database and how to remove it."""
+
+    def __init__(self, db: str | Path, campaigns: str | Sequence[str], why: str) -> None:
+        self.db = Path(db)
+        self.campaigns = [campaigns] if isinstance(campaigns, str) else list(campaigns)
+        names = ", ".join(map(repr, self.campaigns))
+        it = "it" if len(self.campaigns) == 1 else "them"
+        super().__init__(
+            f"campaign{'s' if len(self.campaigns) > 1 else ''} {names} in {db} {why}; the rows "
+            f"are kept, not mixed with new ones: remove {it} with 'uvnav forget {db} "
+            f"{' '.join(self.campaigns)}' or use another --results folder"
+        )
 
 
 #: tables and columns a uvnav results database has whatever its age (metrics may be missing)

@@ -727,8 +727,17 @@ def report_cmd(
     except NotAStoreError as exc:
         raise CliError(str(exc)) from None
     write_report = _optional("uvnav.viz.report", "write_report", "the report (uvnav report)")
+    from uvnav.bench.chapters import report_sections
+
+    sections = report_sections(db)  # saved by the chapters' runs, or rebuilt from stored rows
     try:
-        path = write_report(db, out, bench_dir=bench)
+        path = write_report(
+            db,
+            out,
+            bench_dir=bench,
+            sections=sections,
+            table=[r for s in sections for r in s.rows],
+        )
     except ValueError as exc:
         raise CliError(str(exc)) from None
     typer.echo(f"wrote {path}")
@@ -923,6 +932,7 @@ def main() -> None:
     app(prog_name="uvnav")
 
 
-from uvnav.cli.ch4 import ch4_app  # noqa: E402  (Chapter 4, issue 5: its own sub-app)
+from uvnav.cli.reproduce import forget_cmd, reproduce_cmd  # noqa: E402  (one chapter at a time)
 
-app.add_typer(ch4_app, name="ch4")
+app.command("reproduce")(reproduce_cmd)
+app.command("forget")(forget_cmd)

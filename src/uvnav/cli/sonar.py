@@ -10,6 +10,8 @@ Commands (thin: they parse, call the library, print):
   baseline and the thesis's ranges;
 * ``simulate`` — one closed-loop episode of ``zhang2022-uuv3d-v1`` on a Chapter 5 scenario.
 
+The chapter's reproduction (BPNN experiment + closed-loop campaigns) is ``uvnav reproduce ch5``.
+
 Bad input (missing or malformed files, bad options) prints ONE line ``error: ...`` naming the
 file and the problem, and exits with status 2.
 """
@@ -241,52 +243,3 @@ def simulate_cmd(
         **res.metrics.to_dict(),
     }
     typer.echo(dumps(out))  # strict JSON: a missing metric is null, never NaN
-
-
-@sonar_app.command("reproduce")
-def reproduce_cmd(
-    results_dir: Annotated[
-        Path, typer.Option("--results", help="Folder of ch5.json, uvnav.sqlite and the cache.")
-    ] = Path("results"),
-    report_dir: Annotated[
-        Path | None, typer.Option("--report", help="Folder of the figures (ch5/); none: skip.")
-    ] = None,
-    full: Annotated[
-        bool, typer.Option("--full", help="Thesis-size: sizes to 5000, 300 scenes, noise.")
-    ] = False,
-    workers: Annotated[int, typer.Option(min=1, help="Processes for the random scenes.")] = 1,
-    fresh: Annotated[bool, typer.Option("--fresh", help="Start over (drop the cache).")] = False,
-    n_random: Annotated[
-        int | None, typer.Option("--n-random", min=0, help="Random scenes (override).")
-    ] = None,
-    n_dense: Annotated[
-        int | None,
-        typer.Option(
-            "--n-dense", min=0, help="Scenes of the harder random-ch5-dense family (override)."
-        ),
-    ] = None,
-) -> None:
-    """The Chapter 5 reproduction alone (BPNN experiment + closed-loop campaigns); resumable:
-    an interrupted run continues where it stopped."""
-    from uvnav.bench.reproduce_ch5 import reproduce_ch5
-    from uvnav.viz.figures_ch5 import render_ch5
-
-    s = reproduce_ch5(
-        results_dir,
-        full=full,
-        workers=workers,
-        fresh=fresh,
-        n_random=n_random,
-        n_dense=n_dense,
-        render=render_ch5 if report_dir is not None else None,
-        report_dir=report_dir,
-    )
-    for c in s.campaign:
-        typer.echo(
-            f"{c['family']:<18} {c['locator']:<9} noise {c['noise_std']:<5g} "
-            f"n={c['episodes']:<4} success {100 * c['success_rate']:.1f} % "
-            f"collision {100 * c['collision_rate']:.1f} % timeout {100 * c['timeout_rate']:.1f} %"
-        )
-    for f in s.failures:
-        typer.echo(f"failure: {dumps(f)}")
-    typer.echo(f"wall time {s.wall_time:.1f} s; results {s.json_path}")

@@ -196,29 +196,3 @@ def render_ch3(db_path: Path, report_dir: Path, recorded: list[tuple[str, str, A
             plt.close(fig)
             files.append(path)
     return files
-
-
-def main(argv: list[str] | None = None) -> None:
-    """``python -m uvnav.viz.figures3d [--seeds N] [--workers W] [--report DIR]``: the Chapter 3
-    reproduction with its figures (``DIR/ch3``); prints the table."""
-    import argparse
-
-    from uvnav.bench.reproduce_ch3 import QUICK_SEEDS, reproduce_ch3
-
-    ap = argparse.ArgumentParser(description="thesis Ch. 3 reproduction with figures")
-    ap.add_argument("--seeds", type=int, default=QUICK_SEEDS)
-    ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--results", type=Path, default=Path("results"))
-    ap.add_argument("--report", type=Path, default=Path("report"))
-    args = ap.parse_args(argv)
-    s = reproduce_ch3(args.results, args.report, workers=args.workers, n_random=args.seeds,
-                      render=render_ch3)  # fmt: skip
-    for row in s.table:
-        print(" | ".join(row[k] for k in ("quantity", "thesis", "measured", "note")))
-    for f in s.failures:
-        print("failure:", f)
-    print(f"{len(s.figures)} figure files in {args.report / 'ch3'}; {s.wall_time:.0f} s")
-
-
-if __name__ == "__main__":
-    main()

@@ -143,10 +143,10 @@ def render_ch7_plan(plan: Any, prefix: Path) -> list[Path]:
     return [png, html]
 
 
-def _ch9(out_dir: Path) -> list[Path]:
-    from uvnav.viz.figures_ch9 import ch9_figures
+def _beyond(out_dir: Path) -> list[Path]:
+    from uvnav.viz.figures_beyond import beyond_figures
 
-    return ch9_figures(out_dir)
+    return beyond_figures(out_dir)
 
 
 def chapter_renderers() -> ChapterRenderers:
@@ -173,7 +173,7 @@ def chapter_renderers() -> ChapterRenderers:
 
         return render_ch6(summary, out_dir)
 
-    return ChapterRenderers(ch3=ch3, ch4=ch4, ch5=ch5, ch6=ch6, ch7=render_ch7_plan, ch9=_ch9)
+    return ChapterRenderers(ch3=ch3, ch4=ch4, ch5=ch5, ch6=ch6, ch7=render_ch7_plan, beyond=_beyond)
 
 
 __all__ = ["ChapterSection", "chapter_renderers", "render_ch7_plan", "render_reproduction"]

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from uvnav.bench.reproduce_ch9 import BEYOND, office_rows, replan_rows, swap_rows
+from uvnav.bench.reproduce_beyond import BEYOND, office_rows, replan_rows, swap_rows
 
 
 def test_office_rows_measure_law_alone_and_hybrid() -> None:

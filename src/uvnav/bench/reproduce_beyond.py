@@ -1,4 +1,5 @@
-"""``uvnav run``'s issue-9 sections: global + local navigation and multi-robot navigation.
+"""The "beyond the thesis" experiments of ``uvnav run`` (issue 9): global + local navigation and
+multi-robot navigation.
 
 Beyond the thesis (its Ch. 8 conclusion names both as the next step), so there is no thesis
 number to reproduce: the rows put each configuration next to its baseline, measured here.
@@ -94,7 +95,7 @@ def swap_rows(
     return rows
 
 
-def reproduce_ch9(*, full: bool = False) -> list[dict[str, str]]:
+def reproduce_beyond(*, full: bool = False) -> list[dict[str, str]]:
     """The issue-9 rows of the "thesis reported vs uvnav measured" table (quick: about half a
     minute; ``full`` adds laws and ORCA's reciprocal variant)."""
     return office_rows(FULL_LAWS if full else QUICK_LAWS) + swap_rows(

@@ -8,7 +8,7 @@ import pytest
 from uvnav.planners import DStarLite, astar, occupancy_grid, visibility_path
 from uvnav.scenarios.multi import build_multi, load_multi_scenario
 from uvnav.sim.multi import run_multi
-from uvnav.viz.figures_ch9 import plot_grid_paths, plot_swap, plot_trajectories
+from uvnav.viz.figures_beyond import plot_grid_paths, plot_swap, plot_trajectories
 
 
 def test_grid_paths_figure(tmp_path) -> None:
@@ -61,18 +61,18 @@ def test_swap_and_trajectory_figures(tmp_path) -> None:
         plot_swap(unrecorded, goals)
 
 
-def test_ch9_figures_are_written(tmp_path) -> None:
-    from uvnav.viz.figures_ch9 import ch9_figures
+def test_beyond_figures_are_written(tmp_path) -> None:
+    from uvnav.viz.figures_beyond import beyond_figures
 
-    files = ch9_figures(
+    files = beyond_figures(
         tmp_path,
         office_law="savkin-wang2013-v1",
         swap="antipodal:4",
         swap_laws=(("straight-v1", {}),),
     )
     assert [f.name for f in files] == [
-        "ch9-paths.png",
-        "ch9-office.png",
-        "ch9-swap-straight-v1.png",
+        "beyond-paths.png",
+        "beyond-office.png",
+        "beyond-swap-straight-v1.png",
     ]
     assert all(f.stat().st_size > 5_000 for f in files)

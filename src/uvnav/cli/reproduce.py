@@ -1,0 +1,171 @@
+"""``uvnav reproduce CHAPTER`` and ``uvnav forget``: one chapter's reproduction, and the removal of
+a stored campaign a reproduction refused to mix with (thin: parse, call the library, print).
+
+``uvnav reproduce CH`` runs :func:`uvnav.bench.chapters.reproduce_chapter` into the results store
+(``--results``), draws the chapter's figures (the viz renderers are injected, as ``uvnav run``
+does) and rewrites the report (``--report``) with the chapter's section beside the sections the
+earlier runs saved (``RESULTS/sections``).  ``uvnav reproduce all`` is ``uvnav run``.
+
+Chapter 6's pipeline with every option (noise, threads, head, DAgger rounds, ...) stays
+``uvnav drive reproduce``; ``uvnav reproduce ch6`` runs the same function at ``uvnav run``'s size
+(``RESULTS/ch6-quick``, or ``RESULTS/ch6`` with ``--full``).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from uvnav.cli.app import CliError, _console, _fmt, _optional, _text
+
+_COLUMNS = ("quantity", "thesis", "measured", "note")
+_TITLE = "uvnav — reproduction of the thesis's experiments"
+
+
+def reproduce_cmd(
+    chapter: Annotated[
+        str,
+        typer.Argument(
+            help="ch2, ch3, ch4, ch5, ch6, ch7, beyond (planners, office floor, multi-robot), "
+            "or all (= uvnav run)."
+        ),
+    ],
+    full: Annotated[
+        bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
+    ] = False,
+    workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 2,
+    results: Annotated[Path, typer.Option(help="Directory of the results database.")] = Path(
+        "results"
+    ),
+    report: Annotated[Path, typer.Option(help="Directory of the HTML report.")] = Path("report"),
+    seeds: Annotated[
+        int | None,
+        typer.Option(
+            min=1,
+            help="Random scenes to run (ch2-ch5; default: the chapter's quick or full size).",
+        ),
+    ] = None,
+    start_seed: Annotated[
+        int,
+        typer.Option("--start-seed", min=0, help="First random scene (ch2-ch5): seeds S .. S+N-1."),
+    ] = 0,
+) -> None:
+    """Reproduce one chapter into the results store and its report section.
+
+    Adds to the store: stored episodes are skipped, no other run's episodes are deleted or
+    replaced; a campaign stored by other code is refused (remove it with 'uvnav forget').
+    """
+    chapter = chapter.strip().lower()
+    if chapter == "all":
+        if seeds is not None or start_seed:
+            raise CliError("reproduce all: --seeds/--start-seed apply to one chapter (ch2-ch5)")
+        from uvnav.cli.app import run
+
+        run(full=full, workers=workers, results=results, report=report)
+        return
+    chapters = _optional("uvnav.bench.chapters", "reproduce_chapter", "the reproduction job")
+    from uvnav.bench.chapters import ChapterError
+    from uvnav.bench.sections import SECTIONS_DIR, load_sections
+    from uvnav.bench.store import StaleCampaignError
+
+    renderers = _optional("uvnav.viz.reproduction", "chapter_renderers", "the chapter figures")
+    render_reproduction = _optional(
+        "uvnav.viz.reproduction", "render_reproduction", "the report renderer"
+    )
+    saved = results / SECTIONS_DIR
+
+    def render_ch2(req: Any) -> Any:  # Chapter 2's figures, then the page with every section
+        others = [s for s in load_sections(saved) if s.key != "ch2"]
+        req.sections = [*req.sections, *others]
+        req.table = list(req.table) + [r for s in others for r in s.rows]
+        return render_reproduction(req)
+
+    try:
+        out = chapters(
+            chapter,
+            results,
+            report,
+            full=full,
+            workers=workers,
+            seeds=seeds,
+            start_seed=start_seed,
+            renderers=renderers(),
+            render=render_ch2,
+            progress=True,
+        )
+    except (ChapterError, StaleCampaignError) as exc:
+        raise CliError(str(exc)) from None
+    report_path = out.report_path
+    if report_path is None:
+        report_path = _write_report(out.db_path, report, load_sections(saved))
+    from rich.table import Table
+
+    table = Table(title=f"{out.section.title}: thesis reported vs uvnav measured")
+    for col in _COLUMNS:
+        table.add_column(col, justify="right" if col in ("thesis", "measured") else "left")
+    for row in out.section.rows:
+        table.add_row(*(_text(_fmt(row.get(col))) for col in _COLUMNS))
+    _console().print(table)
+    for f in out.failures[:20]:
+        typer.echo(f"failure: {f}")
+    if len(out.failures) > 20:
+        typer.echo(f"... and {len(out.failures) - 20} more failure(s) (see the report)")
+    n_files = len(out.section.figures) + len(out.section.links)
+    typer.echo(f"wrote {out.db_path}")
+    typer.echo(f"wrote {report_path} ({n_files} file(s) in the {chapter} section)")
+
+
+def _write_report(db: Path, report: Path, sections: list[Any]) -> Path:
+    """The report page from the saved sections (the database is created empty if a chapter
+    stores no episodes, as Chapters 6, 7 and beyond)."""
+    from uvnav.bench.store import ResultsStore
+
+    if not db.exists():
+        ResultsStore(db).close()
+    write_report = _optional("uvnav.viz.report", "write_report", "the report")
+    path: Path = write_report(
+        db,
+        report,
+        sections=sections,
+        table=[r for s in sections for r in s.rows],
+        title=_TITLE,
+        summary_figure=False,
+    )
+    return path
+
+
+def forget_cmd(
+    db: Annotated[Path, typer.Argument(help="Results database (SQLite).")],
+    campaigns: Annotated[list[str], typer.Argument(help="Campaign name(s) to remove.")],
+) -> None:
+    """Remove stored campaigns (their episodes and trajectories) from a results database.
+
+    The only command that deletes results: a reproduction never does; when it cannot resume a
+    campaign it names it, and this removes it.
+    """
+    from uvnav.bench.store import NotAStoreError, ResultsStore, StoreInUseError
+
+    if not db.is_file():
+        raise CliError(f"{db}: no such database file")
+    try:
+        ResultsStore(db, readonly=True).close()
+    except NotAStoreError as exc:
+        raise CliError(str(exc)) from None
+    with ResultsStore(db) as store:
+        known = {c["name"] for c in store.campaigns()}
+        unknown = [c for c in campaigns if c not in known]
+        if unknown:
+            raise CliError(
+                f"{db}: no campaign {', '.join(map(repr, unknown))}; stored: "
+                f"{', '.join(sorted(known)) or 'none'}"
+            )
+        try:
+            with store.writer_lease():
+                for name in campaigns:
+                    n = store.count(name)
+                    store.delete_campaign(name)
+                    typer.echo(f"removed campaign {name!r} ({n} episode(s)) from {db}")
+        except StoreInUseError as exc:
+            raise CliError(str(exc)) from None

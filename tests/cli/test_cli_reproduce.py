@@ -1,0 +1,173 @@
+"""``uvnav reproduce CHAPTER`` (one chapter, additive) and ``uvnav forget`` (the only delete)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+from typer.testing import CliRunner
+
+from uvnav.bench import chapters
+from uvnav.bench.chapters import ChapterRun
+from uvnav.bench.sections import SECTIONS_DIR, ChapterRenderers, ChapterSection, save_section
+from uvnav.bench.store import ResultsStore, StaleCampaignError
+from uvnav.cli.app import app
+
+runner = CliRunner()
+
+
+def _one_line_error(result: Any, *fragments: str) -> None:
+    assert result.exit_code == 2, result.output
+    lines = result.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("error: "), result.stderr
+    for f in fragments:
+        assert f in lines[0]
+    assert "Traceback" not in result.output
+
+
+def test_reproduce_one_chapter_writes_its_section_beside_the_saved_ones(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    res, rep = tmp_path / "res", tmp_path / "rep"
+    earlier = ChapterSection("ch4", "Chapter 4 — earlier", "run before", rows=[{"quantity": "q4"}])
+    save_section(earlier, res / SECTIONS_DIR)
+    calls: list[dict[str, Any]] = []
+
+    def fake(chapter: str, results_dir: Path, report_dir: Path, **kw: Any) -> ChapterRun:
+        calls.append({"chapter": chapter, "results": results_dir, "report": report_dir, **kw})
+        section = ChapterSection(
+            "ch3", "Chapter 3 — now", "ran now", rows=[{"quantity": "q3", "measured": "42 %"}]
+        )
+        path = save_section(section, results_dir / SECTIONS_DIR)
+        return ChapterRun(chapter, section, None, results_dir / "uvnav.sqlite", path)
+
+    monkeypatch.setattr(chapters, "reproduce_chapter", fake)
+    result = runner.invoke(
+        app,
+        [
+            *("reproduce", "ch3", "--seeds", "2", "--start-seed", "7", "--workers", "1"),
+            *("--results", str(res), "--report", str(rep)),
+        ],
+        env={"COLUMNS": "200"},
+    )
+    assert result.exit_code == 0, result.output
+    (call,) = calls
+    assert (call["chapter"], call["seeds"], call["start_seed"], call["workers"]) == ("ch3", 2, 7, 1)
+    assert call["full"] is False and callable(call["render"])
+    assert isinstance(call["renderers"], ChapterRenderers) and call["renderers"].ch3 is not None
+    html = (rep / "index.html").read_text(encoding="utf-8")
+    # the chapter just run and the one saved by an earlier run, in chapter order
+    assert html.index('id="section-ch3"') < html.index('id="section-ch4"')
+    assert "42 %" in html and "q4" in html
+    assert "42 %" in result.stdout and f"wrote {rep / 'index.html'}" in result.stdout
+
+
+@pytest.mark.parametrize(
+    ("args", "fragments"),
+    [
+        (["ch7", "--seeds", "2"], ["ch7 runs no random seeds"]),
+        (["beyond", "--start-seed", "1"], ["beyond runs no random seeds"]),
+        (["ch9"], ["unknown chapter 'ch9'", "beyond"]),
+        (["all", "--seeds", "3"], ["reproduce all", "--seeds"]),
+    ],
+)
+def test_reproduce_bad_options_are_one_line_errors(
+    tmp_path: Path, args: list[str], fragments: list[str]
+) -> None:
+    res = tmp_path / "res"
+    result = runner.invoke(app, ["reproduce", *args, "--results", str(res)])
+    _one_line_error(result, *fragments)
+    assert not (res / "uvnav.sqlite").exists()
+
+
+def test_a_stale_campaign_is_refused_in_one_line(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    def stale(*_a: Any, **_k: Any) -> None:
+        raise StaleCampaignError(
+            tmp_path / "uvnav.sqlite", ["ch2-random"], "was stored by other code"
+        )
+
+    monkeypatch.setattr(chapters, "reproduce_chapter", stale)
+    result = runner.invoke(app, ["reproduce", "ch2", "--results", str(tmp_path)])
+    _one_line_error(result, "'ch2-random'", "uvnav forget", "ch2-random' or use another")
+
+
+def test_reproduce_all_is_uvnav_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    import sys
+
+    cli_app = sys.modules["uvnav.cli.app"]  # the package's ``app`` attribute is the Typer app
+    seen: list[dict[str, Any]] = []
+    monkeypatch.setattr(cli_app, "run", lambda **kw: seen.append(kw))
+    result = runner.invoke(app, ["reproduce", "all", "--full", "--results", str(tmp_path)])
+    assert result.exit_code == 0, result.output
+    assert seen == [{"full": True, "workers": 2, "results": tmp_path, "report": Path("report")}]
+
+
+def test_the_old_entry_points_are_gone() -> None:
+    for args in (["ch4", "run"], ["sonar", "reproduce"]):
+        result = runner.invoke(app, args)
+        assert result.exit_code == 2, (args, result.output)
+    import uvnav.bench.reproduce_ch3 as r3
+
+    assert not hasattr(r3, "main")
+
+
+def test_forget_removes_only_the_named_campaigns(tmp_path: Path) -> None:
+    db = tmp_path / "uvnav.sqlite"
+    with ResultsStore(db) as store:
+        for name in ("a", "b"):
+            cid = store.campaign(name, {})
+            store.add_episode(cid, scenario="s", controller="c", seed=0, status="success")
+    result = runner.invoke(app, ["forget", str(db), "a"])
+    assert result.exit_code == 0, result.output
+    assert "removed campaign 'a' (1 episode(s))" in result.stdout
+    with ResultsStore(db) as store:
+        assert [c["name"] for c in store.campaigns()] == ["b"] and store.count("b") == 1
+    _one_line_error(runner.invoke(app, ["forget", str(db), "zzz"]), "no campaign 'zzz'", "b")
+    with ResultsStore(db) as store:
+        assert store.count("b") == 1
+    _one_line_error(runner.invoke(app, ["forget", str(tmp_path / "no.sqlite"), "b"]), "no such")
+
+
+def test_report_rebuilds_the_chapter_sections_it_can(tmp_path: Path) -> None:
+    """``uvnav report DB`` of a ``uvnav run`` database keeps the chapters: saved sections as
+    they are, Ch. 2 rebuilt from its stored rows, the rest named with the command to rerun."""
+    from uvnav.bench import reproduce as rp
+
+    db = tmp_path / "uvnav.sqlite"
+    with ResultsStore(db) as store:
+        cid = store.campaign(
+            rp.SCENES_CAMPAIGN,
+            {"scenes": [rp.COMPARISON_SCENE], "controllers": ["zhang2019-v1"], "fingerprint": "x"},
+        )
+        store.add_episode(
+            cid,
+            scenario=rp.COMPARISON_SCENE,
+            controller="zhang2019-v1",
+            seed=0,
+            status="success",
+            metrics={"path_length": 15.0, "min_clearance": 0.5},
+        )
+        store.campaign("ch3-random", {})
+    (tmp_path / "ch7").mkdir()
+    save_section(
+        ChapterSection("beyond", "Beyond the thesis", "saved", rows=[{"quantity": "swap"}]),
+        tmp_path / SECTIONS_DIR,
+    )
+    before = db.read_bytes()
+    secs = chapters.report_sections(db)
+    assert [s.key for s in secs] == ["ch2", "ch3", "ch7", "beyond"]
+    ch2 = secs[0]
+    assert any("Fig. 2.10 path length, zhang2019-v1" in r["quantity"] for r in ch2.rows)
+    assert "uvnav reproduce ch3" in secs[1].notes[0] and "uvnav reproduce ch7" in secs[2].notes[0]
+    out = tmp_path / "site"
+    result = runner.invoke(app, ["report", str(db), "--out", str(out)])
+    assert result.exit_code == 0, result.output
+    html = (out / "index.html").read_text(encoding="utf-8")
+    assert "No reproduction table was given" not in html
+    for key in ("ch2", "ch3", "ch7", "beyond"):
+        assert f'id="section-{key}"' in html
+    assert "15.00 m" in html or "15.0" in html
+    assert db.read_bytes() == before  # the report only reads
