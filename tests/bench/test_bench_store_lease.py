@@ -101,7 +101,7 @@ def test_the_lease_is_reentrant_in_one_process_and_released(tmp_path: Path) -> N
 
 def test_every_command_reports_a_database_in_use_as_one_line() -> None:
     from uvnav.bench.store import StoreInUseError
-    from uvnav.cli.app import user_error
+    from uvnav.cli.errors import user_error
 
     msg = "database r.sqlite is in use by another uvnav process (pid 7); wait for it to finish"
     assert user_error(StoreInUseError(msg)) == (msg, 2)
