@@ -14,9 +14,10 @@ episode at once with :class:`uvnav.obstacles.batch.ObstacleBatch`, which reprodu
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Protocol
+from importlib.metadata import entry_points
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -52,6 +53,33 @@ class MotionModel(Protocol):
     def turn_bound(self) -> float:
         """Largest |u_i| [rad/s] the model can produce (for the (2.7)-(2.8) checks)."""
         ...
+
+
+#: Entry-point group of third-party motion models.  An entry point's name is the motion's; it
+#: loads a factory ``make(rng, **params) -> MotionModel`` (``rng``: the obstacle's own generator,
+#: the only source of its randomness).  Scenes use it as ``motion: {type: plugin, name: ...,
+#: params: {...}}``.
+MOTION_GROUP = "uvnav.motions"
+#: motion types of the scenario schema (a plug-in may not take these names)
+BUILTIN_MOTIONS: tuple[str, ...] = ("constant", "random_turn", "waypoints", "replay", "plugin")
+_PLUGINS: dict[str, Callable[..., Any]] | None = None
+
+
+def motion_plugins() -> dict[str, Callable[..., Any]]:
+    """The motion-model factories of the :data:`MOTION_GROUP` entry points (loaded once).
+
+    Raises:
+        RuntimeError: a plug-in takes a built-in name or another plug-in's.
+    """
+    global _PLUGINS
+    if _PLUGINS is None:
+        found: dict[str, Callable[..., Any]] = {}
+        for ep in entry_points(group=MOTION_GROUP):
+            if ep.name in BUILTIN_MOTIONS or ep.name in found:
+                raise RuntimeError(f"motion {ep.name!r} of {ep.value} is already registered")
+            found[ep.name] = ep.load()
+        _PLUGINS = found
+    return _PLUGINS
 
 
 class MotionGroup(Protocol):

@@ -43,8 +43,10 @@ from uvnav.obstacles import (
     Replay,
     Waypoints,
 )
+from uvnav.obstacles.motion import motion_plugins
 from uvnav.scenarios import pedestrians
 from uvnav.scenarios.errors import FieldError, ScenarioError
+from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sim import LidarConfig, SensingConfig
 
 Point2 = Annotated[tuple[float, float], Field(description="[x, y] [m]")]
@@ -115,6 +117,21 @@ class LidarSpec(_Model):
         )
 
 
+class SensorPluginSpec(_Model):
+    """A third-party sensor mounted on the robot (:mod:`uvnav.sensors.plugins`)."""
+
+    name: str = Field(min_length=1, description="the plug-in's entry-point name")
+    params: dict[str, Any] = Field(default_factory=dict, description="its keyword arguments")
+
+    @model_validator(mode="after")
+    def _known(self) -> SensorPluginSpec:
+        try:
+            sensor_plugin(self.name)
+        except KeyError as exc:
+            raise FieldError("name", str(exc.args[0])) from None
+        return self
+
+
 class SensingSpec(_Model):
     """What the robot can know about obstacles (thesis §2.2 sensing model)."""
 
@@ -127,6 +144,11 @@ class SensingSpec(_Model):
         0.0, ge=0, description="std of the noise on sensed centres when estimating [m]"
     )
     lidar: LidarSpec | None = Field(None, description="optional range scanner")
+    plugins: list[SensorPluginSpec] = Field(
+        default_factory=list,
+        description="third-party sensors (entry-point group uvnav.sensors); readings in "
+        "Observation.extras",
+    )
 
     def to_config(self) -> SensingConfig:
         """The simulator's :class:`~uvnav.sim.SensingConfig`."""
@@ -135,6 +157,7 @@ class SensingSpec(_Model):
             velocities=self.velocities,
             position_noise=self.position_noise,
             lidar=self.lidar.to_config() if self.lidar is not None else None,
+            plugins=tuple((p.name, dict(p.params)) for p in self.plugins),
         )
 
 
@@ -305,8 +328,38 @@ class ReplayMotion(_Model):
         return Replay(np.asarray(self.times, dtype=float), np.asarray(self.positions, dtype=float))
 
 
+class PluginMotion(_Model):
+    """A third-party motion model (entry-point group ``uvnav.motions``, see
+    :data:`uvnav.obstacles.motion.MOTION_GROUP`), built from its keyword ``params``."""
+
+    type: Literal["plugin"]
+    name: str = Field(min_length=1, description="the plug-in's entry-point name")
+    params: dict[str, Any] = Field(default_factory=dict, description="its keyword arguments")
+
+    @model_validator(mode="after")
+    def _builds(self) -> PluginMotion:
+        plugins = motion_plugins()
+        if self.name not in plugins:
+            known = ", ".join(sorted(plugins)) or "none installed"
+            raise FieldError("name", f"unknown motion plug-in {self.name!r} (known: {known})")
+        self.to_model(np.random.default_rng(0))  # its own parameter checks, at load time
+        return self
+
+    def to_model(self, rng: np.random.Generator) -> MotionModel:
+        """The plug-in's motion model, drawing from ``rng`` (the obstacle's own generator).
+
+        Raises:
+            FieldError: the plug-in refuses ``params``.
+        """
+        try:
+            model: MotionModel = motion_plugins()[self.name](rng, **self.params)
+        except (TypeError, ValueError) as exc:
+            raise FieldError("params", f"{self.name}: {exc}") from None
+        return model
+
+
 MotionSpec = Annotated[
-    ConstantMotion | RandomTurnMotion | WaypointsMotion | ReplayMotion,
+    ConstantMotion | RandomTurnMotion | WaypointsMotion | ReplayMotion | PluginMotion,
     Field(discriminator="type"),
 ]
 """One of the motion specs, chosen by its ``type`` field."""
@@ -316,6 +369,7 @@ MOTION_TYPES: dict[str, type[_Model]] = {
     "random_turn": RandomTurnMotion,
     "waypoints": WaypointsMotion,
     "replay": ReplayMotion,
+    "plugin": PluginMotion,
 }
 
 
@@ -389,6 +443,8 @@ class ObstacleSpec(_Model):
                 velocity=np.asarray(m.velocity, dtype=float),
                 angular_velocity=float(m.angular_velocity),
             )
+        if isinstance(m, PluginMotion):  # at rest until its first step sets its rates
+            return ObstacleState(position=pos, heading=heading)
         speed = 0.5 * (m.speed[0] + m.speed[1])
         vel = speed * np.array([np.cos(heading), np.sin(heading)])
         return ObstacleState(

@@ -9,7 +9,9 @@ simulator's sensing configuration and written in :attr:`ObstacleReading.velocity
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
@@ -75,6 +77,8 @@ class Observation:
         goal: target point T [m], shape (2,).
         obstacles: readings of the obstacles within sensing range, nearest first.
         lidar: optional range scan.
+        extras: readings of the plug-in sensors the scene mounts, by sensor name
+            (:mod:`uvnav.sensors.plugins`).
     """
 
     time: float
@@ -83,6 +87,7 @@ class Observation:
     goal: FloatArray
     obstacles: tuple[ObstacleReading, ...] = ()
     lidar: LidarScan | None = None
+    extras: Mapping[str, Any] = field(default_factory=dict)
 
     @property
     def position(self) -> FloatArray:

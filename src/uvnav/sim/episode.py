@@ -40,6 +40,7 @@ from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
 from uvnav.sensors.exact import lidar_scan, sense_obstacles
 from uvnav.sensors.observation import Observation
+from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
 
@@ -66,12 +67,15 @@ class SensingConfig:
             (:class:`FiniteDifferenceEstimator`).
         position_noise: std [m] of the noise on the observed centre when estimating.
         lidar: optional range scanner.
+        plugins: ``(name, params)`` of plug-in sensors (:mod:`uvnav.sensors.plugins`), read
+            after the built-in sensors from the same sensing generator.
     """
 
     sensing_range: float = 5.0
     velocities: Literal["known", "estimated"] = "known"
     position_noise: float = 0.0
     lidar: LidarConfig | None = None
+    plugins: tuple[tuple[str, dict[str, Any]], ...] = ()
 
 
 @dataclass
@@ -304,9 +308,13 @@ class UnicycleWorld:
                 robot, self.field, self.sense_rng, n_rays=lc.n_rays, max_range=lc.max_range,
                 fov=lc.fov, noise_std=lc.noise_std, dropout=lc.dropout,
             )  # fmt: skip
+        extras = {
+            name: sensor_plugin(name)(robot, self.field, self.sense_rng, **params)
+            for name, params in self.setup.sensing.plugins
+        }
         return Observation(
             time=self.t, pose=robot, speed=self.speed, goal=self.goal, obstacles=readings,
-            lidar=scan,
+            lidar=scan, extras=extras,
         )  # fmt: skip
 
     @property

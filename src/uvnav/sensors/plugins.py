@@ -1,0 +1,52 @@
+"""Third-party sensors of the 2D worlds (entry-point group ``uvnav.sensors``).
+
+An entry point's name is the sensor's; it loads a callable
+``sensor(pose, field, rng, **params) -> reading``: ``pose`` the robot's ``[x, y, theta]``
+([m], [m], [rad]), ``field`` the bodies now (:class:`~uvnav.obstacles.ObstacleField`), ``rng`` the
+world's sensing generator (the one its noise must come from, for determinism).  A scene lists the
+sensors it mounts under ``sensing.plugins`` (``[{name: ..., params: {...}}]``); at every decision
+the world calls each and hands its reading to the law in ``Observation.extras[name]``.  The
+built-in sensors (exact readings, lidar) are not plug-ins and their names are refused.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from importlib.metadata import entry_points
+from typing import Any
+
+SENSOR_GROUP = "uvnav.sensors"
+#: names of the built-in sensors (a plug-in may not take them)
+BUILTIN_SENSORS: tuple[str, ...] = ("exact", "lidar", "sonar-fan", "sonar-array")
+
+_PLUGINS: dict[str, Callable[..., Any]] | None = None
+
+
+def sensor_plugins() -> dict[str, Callable[..., Any]]:
+    """The sensors of the :data:`SENSOR_GROUP` entry points by name (loaded once).
+
+    Raises:
+        RuntimeError: a plug-in takes a built-in name or another plug-in's.
+    """
+    global _PLUGINS
+    if _PLUGINS is None:
+        found: dict[str, Callable[..., Any]] = {}
+        for ep in entry_points(group=SENSOR_GROUP):
+            if ep.name in BUILTIN_SENSORS or ep.name in found:
+                raise RuntimeError(f"sensor {ep.name!r} of {ep.value} is already registered")
+            found[ep.name] = ep.load()
+        _PLUGINS = found
+    return _PLUGINS
+
+
+def sensor_plugin(name: str) -> Callable[..., Any]:
+    """The plug-in sensor ``name``.
+
+    Raises:
+        KeyError: no such plug-in (the message lists the known ones).
+    """
+    plugins = sensor_plugins()
+    if name not in plugins:
+        known = ", ".join(sorted(plugins)) or "none installed"
+        raise KeyError(f"unknown sensor plug-in {name!r} (known: {known})")
+    return plugins[name]
