@@ -41,6 +41,7 @@ from uvnav.obstacles.motion3d import (
     ObstacleState3D,
     Waypoints3D,
 )
+from uvnav.scenarios.limits import check_episode_steps
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
 from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, clearance3d
 
@@ -290,6 +291,7 @@ class Scenario3D(_Model):
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario3D:
+        check_episode_steps(self.t_max, self.dt)
         ratio = self.control_period / self.dt
         if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
             raise FieldError("control_period", f"must be a positive multiple of dt={self.dt:g} s")
