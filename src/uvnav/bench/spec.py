@@ -53,6 +53,7 @@ from uvnav.bench.store import ResultsStore
 from uvnav.controllers import ControllerParamsError, available_controllers, make_controller
 from uvnav.scenarios import GENERATORS, ScenarioError, list_builtin, load_scenario
 from uvnav.scenarios.errors import FieldError, from_validation_error
+from uvnav.scenarios.limits import MAX_CAMPAIGN_EPISODES
 from uvnav.scenarios.loader import parse_yaml
 
 
@@ -85,6 +86,13 @@ def _seed_list(seeds: list[int] | SeedValues) -> list[int]:
                 "seeds",
                 f"[{start}, {stop}] is read as the range [start, stop) and needs start < stop "
                 "(write {values: [a, b]} for two explicit seeds)",
+            )
+        if stop - start > MAX_CAMPAIGN_EPISODES:
+            raise FieldError(
+                "seeds",
+                f"[{start}, {stop}) is {stop - start} seeds, more than the limit of "
+                f"{MAX_CAMPAIGN_EPISODES} episodes of a campaign "
+                "(uvnav.scenarios.limits.MAX_CAMPAIGN_EPISODES)",
             )
         values = list(range(start, stop))
     elif not seeds:
@@ -135,6 +143,16 @@ class ScenarioEntry(_Strict):
                 inspect.signature(GENERATORS[self.generator]).bind(0, **self.params)
             except TypeError as exc:
                 raise FieldError("params", f"{self.generator}: {exc}") from None
+            if self.params:  # the values too: build the first scene with them
+                first = _seed_list(self.seeds)[0]
+                try:
+                    GENERATORS[self.generator](first, **self.params)
+                except ScenarioError as exc:
+                    where = f"{exc.path}: " if exc.path else ""
+                    raise FieldError("params", f"{self.generator}: {where}{exc.problem}") from None
+                except (ValueError, TypeError, OverflowError) as exc:
+                    given = ", ".join(f"{k}={v!r}" for k, v in self.params.items())
+                    raise FieldError("params", f"{self.generator} with {given}: {exc}") from None
             return self
         if self.params:
             raise FieldError("params", "only generator entries take params")
@@ -254,6 +272,18 @@ class CampaignSpec(_Strict):
     scenarios: list[ScenarioEntry] = Field(min_length=1)
     controllers: list[ControllerEntry] = Field(min_length=1)
     record: bool = False
+
+    @model_validator(mode="after")
+    def _bounded(self) -> CampaignSpec:
+        sets = sum(len(ctrl.param_sets()) for ctrl in self.controllers)
+        n = sets * sum(len(sc.seed_list()) for sc in self.scenarios)
+        if n > MAX_CAMPAIGN_EPISODES:
+            raise FieldError(
+                "scenarios",
+                f"the campaign has {n} episodes, more than the limit of {MAX_CAMPAIGN_EPISODES} "
+                "(uvnav.scenarios.limits.MAX_CAMPAIGN_EPISODES); split it into several campaigns",
+            )
+        return self
 
     def jobs(self) -> list[Job]:
         """The campaign's jobs: scenario entries × seeds × controller entries × grid points.

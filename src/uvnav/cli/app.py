@@ -73,6 +73,10 @@ def user_error(exc: BaseException) -> tuple[str, int] | None:
         return str(exc.args[0]) if exc.args else "unknown controller", 2
     if isinstance(exc, ControllerParamsError):
         return str(exc), 2
+    from uvnav.bench.store import NotAStoreError
+
+    if isinstance(exc, NotAStoreError):
+        return str(exc), 2
     if isinstance(
         exc, FileNotFoundError | IsADirectoryError | NotADirectoryError | PermissionError
     ):
