@@ -28,7 +28,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from uvnav.dynamics.vehicle3d import Vehicle3DSpec
 from uvnav.obstacles.deforming3d import CompoundBody, as_compound, horseshoe, random_star
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import check_episode_steps
+from uvnav.scenarios.limits import check_episode_steps, check_magnitudes
 from uvnav.scenarios.loader import builtin_yaml_files, parse_yaml
 from uvnav.sensors.sonar_array import SonarArray
 from uvnav.sim.episode_uuv3d import UUV3DSetup
@@ -128,6 +128,12 @@ class Scenario5(_Model):
     sonar: Sonar5 = Sonar5()
     obstacles: list[Obstacle5Spec] = Field(default_factory=list)
     controller: Controller5 = Controller5()
+
+    @model_validator(mode="before")
+    @classmethod
+    def _bounded(cls, data: Any) -> Any:
+        check_magnitudes(data)
+        return data
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario5:

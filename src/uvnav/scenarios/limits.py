@@ -16,6 +16,7 @@ loading.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from uvnav.scenarios.errors import FieldError
 
@@ -39,3 +40,30 @@ def check_episode_steps(t_max: float, dt: float) -> None:
             f"the limit of {MAX_EPISODE_STEPS:.0e} (uvnav.scenarios.limits.MAX_EPISODE_STEPS); "
             "raise dt or lower t_max",
         )
+
+
+#: largest magnitude of a number in a 3D scene file (coordinates [m], sizes [m], speeds [m/s]):
+#: beyond it squared distances overflow float64 in the mesh geometry; seeds are exempt
+MAX_MAGNITUDE = 1e9
+
+
+def check_magnitudes(data: Any, path: str = "") -> None:
+    """Refuse a number above :data:`MAX_MAGNITUDE` anywhere in a scene mapping (not seeds).
+
+    Raises:
+        FieldError: naming the field's dotted path and the number.
+    """
+    if isinstance(data, dict):
+        for key, value in data.items():
+            if "seed" not in str(key):
+                check_magnitudes(value, f"{path}.{key}" if path else str(key))
+    elif isinstance(data, list | tuple):
+        for i, value in enumerate(data):
+            check_magnitudes(value, f"{path}.{i}" if path else str(i))
+    elif isinstance(data, int | float) and not isinstance(data, bool):
+        if math.isfinite(data) and abs(data) > MAX_MAGNITUDE:
+            raise FieldError(
+                path,
+                f"{data:g} is above the limit of {MAX_MAGNITUDE:g} in magnitude "
+                "(uvnav.scenarios.limits.MAX_MAGNITUDE)",
+            )

@@ -41,7 +41,7 @@ from uvnav.obstacles.motion3d import (
     ObstacleState3D,
     Waypoints3D,
 )
-from uvnav.scenarios.limits import check_episode_steps
+from uvnav.scenarios.limits import check_episode_steps, check_magnitudes
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
 from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, clearance3d
 
@@ -288,6 +288,12 @@ class Scenario3D(_Model):
         return self.__dict__ == other.__dict__
 
     __hash__ = None  # type: ignore[assignment]  # lists inside: not hashable
+
+    @model_validator(mode="before")
+    @classmethod
+    def _bounded(cls, data: Any) -> Any:
+        check_magnitudes(data)
+        return data
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario3D:
