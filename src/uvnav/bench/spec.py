@@ -151,8 +151,8 @@ class ScenarioEntry(_Strict):
                     where = f"{exc.path}: " if exc.path else ""
                     raise FieldError("params", f"{self.generator}: {where}{exc.problem}") from None
                 except (ValueError, TypeError, OverflowError) as exc:
-                    given = ", ".join(f"{k}={v!r}" for k, v in self.params.items())
-                    raise FieldError("params", f"{self.generator} with {given}: {exc}") from None
+                    values = ", ".join(f"{k}={v!r}" for k, v in self.params.items())
+                    raise FieldError("params", f"{self.generator} with {values}: {exc}") from None
             return self
         if self.params:
             raise FieldError("params", "only generator entries take params")

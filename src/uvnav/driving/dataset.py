@@ -169,7 +169,9 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
     try:
         text = log.read_text(encoding="utf-8")
     except UnicodeDecodeError as exc:
-        raise DatasetError(f"{log}: not a text (CSV) file (byte {exc.start} is not UTF-8)") from None
+        raise DatasetError(
+            f"{log}: not a text (CSV) file (byte {exc.start} is not UTF-8)"
+        ) from None
     if "\x00" in text:
         raise DatasetError(f"{log}: not a text (CSV) file (it holds NUL bytes)")
     with io.StringIO(text, newline="") as fh:

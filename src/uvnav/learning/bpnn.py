@@ -127,8 +127,7 @@ class BPNNConfig:
         if self.optimizer not in ("lbfgs", "adam"):
             raise ValueError(f"optimizer must be 'lbfgs' or 'adam' (got {self.optimizer!r})")
         if not self.hidden or any(
-            isinstance(h, bool) or int(h) != h or not 1 <= int(h) <= MAX_HIDDEN
-            for h in self.hidden
+            isinstance(h, bool) or int(h) != h or not 1 <= int(h) <= MAX_HIDDEN for h in self.hidden
         ):
             raise ValueError(
                 f"hidden must list layer sizes in 1..{MAX_HIDDEN} (got {self.hidden!r}; "
@@ -514,9 +513,7 @@ def load_checkpoint(path: Path) -> TrainedBPNN:
         cfg_d = dict(cfg_d)
         for key in ("hidden", "fractions"):
             value = cfg_d.get(key)
-            if not isinstance(value, list | tuple) or any(
-                isinstance(v, bool | str) for v in value
-            ):
+            if not isinstance(value, list | tuple) or any(isinstance(v, bool | str) for v in value):
                 raise ValueError(f"{key}: must be a list of numbers (got {value!r:.40})")
             cfg_d[key] = tuple(value)
         cfg = BPNNConfig(**cfg_d)

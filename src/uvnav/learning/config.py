@@ -113,7 +113,9 @@ class PilotNetConfig:
         for name in ("speed_scale", "target_speed_max"):
             value = getattr(self, name)
             if not 0 < value <= MAX_SPEED:
-                raise ValueError(f"PilotNetConfig.{name}: {value} (must be in (0, {MAX_SPEED:g}] m/s)")
+                raise ValueError(
+                    f"PilotNetConfig.{name}: {value} (must be in (0, {MAX_SPEED:g}] m/s)"
+                )
 
     @property
     def predicts_target_speed(self) -> bool:

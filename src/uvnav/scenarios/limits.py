@@ -60,10 +60,14 @@ def check_magnitudes(data: Any, path: str = "") -> None:
     elif isinstance(data, list | tuple):
         for i, value in enumerate(data):
             check_magnitudes(value, f"{path}.{i}" if path else str(i))
-    elif isinstance(data, int | float) and not isinstance(data, bool):
-        if math.isfinite(data) and abs(data) > MAX_MAGNITUDE:
-            raise FieldError(
-                path,
-                f"{data:g} is above the limit of {MAX_MAGNITUDE:g} in magnitude "
-                "(uvnav.scenarios.limits.MAX_MAGNITUDE)",
-            )
+    elif (
+        isinstance(data, int | float)
+        and not isinstance(data, bool)
+        and math.isfinite(data)
+        and abs(data) > MAX_MAGNITUDE
+    ):
+        raise FieldError(
+            path,
+            f"{data:g} is above the limit of {MAX_MAGNITUDE:g} in magnitude "
+            "(uvnav.scenarios.limits.MAX_MAGNITUDE)",
+        )

@@ -29,8 +29,8 @@ import yaml
 from pydantic import Field, PrivateAttr, ValidationError, model_validator
 
 from uvnav.controllers.base import make_controller
-from uvnav.scenarios.limits import check_episode_steps
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
+from uvnav.scenarios.limits import check_episode_steps
 from uvnav.scenarios.schema import (
     MOTION_TYPES,
     ControllerSpec,

@@ -44,8 +44,8 @@ from uvnav.obstacles import (
     Waypoints,
 )
 from uvnav.scenarios import pedestrians
-from uvnav.scenarios.limits import check_episode_steps
 from uvnav.scenarios.errors import FieldError, ScenarioError
+from uvnav.scenarios.limits import check_episode_steps
 from uvnav.sim import LidarConfig, SensingConfig
 
 Point2 = Annotated[tuple[float, float], Field(description="[x, y] [m]")]

@@ -41,8 +41,8 @@ from uvnav.obstacles.motion3d import (
     ObstacleState3D,
     Waypoints3D,
 )
-from uvnav.scenarios.limits import check_episode_steps, check_magnitudes
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
+from uvnav.scenarios.limits import check_episode_steps, check_magnitudes
 from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, clearance3d
 
 Point3 = Annotated[tuple[float, float, float], Field(description="[x, y, z] [m]")]

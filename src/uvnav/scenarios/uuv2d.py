@@ -32,8 +32,8 @@ from uvnav.obstacles.deforming import (
     trap_inner_space,
     trap_polygon,
 )
-from uvnav.scenarios.limits import check_episode_steps
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
+from uvnav.scenarios.limits import check_episode_steps
 from uvnav.scenarios.loader import builtin_yaml_files, natural_key, parse_yaml
 from uvnav.sensors.sonar2d import SonarConfig
 from uvnav.sim.episode_uuv2d import Uuv2dSetup, clearance_of, inside_any

@@ -128,9 +128,7 @@ class SonarDataset:
         for name in need:
             if name not in arrays:
                 raise ValueError(f"dataset misses the array {name!r}")
-        n = np.asarray(arrays["ranges"]).shape[0] if np.ndim(arrays["ranges"]) else 0
-        if n == 0:
-            raise ValueError("dataset array 'ranges' has no samples")
+        n = np.asarray(arrays["ranges"]).shape[0]
         for name in need:
             a = np.asarray(arrays[name])
             want = (n, N_SONARS) if name in ("ranges", "inputs") else (n,)
