@@ -76,8 +76,8 @@ def test_recon_plan_errors_are_one_line(tmp_path: Path) -> None:
         (["--theta", "180"], "--theta"),
         (["--dem", str(tmp_path / "missing.npy")], "missing.npy"),
         (["--c1", "8"], "c1"),
-        (["--z-min", "90", "--z-max", "50"], "z_min"),
-        (["--r-min", "100"], "r_min"),
+        (["--z-min", "90", "--z-max", "50"], "--z-min"),
+        (["--r-min", "100"], "--r-min"),
         (["--area", "abc"], "--area"),
         (["--synthetic", "1", "--jacksboro"], "exclusive"),
     ]

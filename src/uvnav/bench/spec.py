@@ -61,6 +61,7 @@ from uvnav.controllers import ControllerParamsError, available_controllers
 from uvnav.controllers.base import controller_info, make_law
 from uvnav.scenarios import ScenarioError
 from uvnav.scenarios.errors import FieldError, from_validation_error
+from uvnav.scenarios.limits import MAX_CAMPAIGN_EPISODES
 from uvnav.scenarios.loader import parse_yaml
 
 
@@ -93,6 +94,13 @@ def _seed_list(seeds: list[int] | SeedValues) -> list[int]:
                 "seeds",
                 f"[{start}, {stop}] is read as the range [start, stop) and needs start < stop "
                 "(write {values: [a, b]} for two explicit seeds)",
+            )
+        if stop - start > MAX_CAMPAIGN_EPISODES:
+            raise FieldError(
+                "seeds",
+                f"[{start}, {stop}) is {stop - start} seeds, more than the limit of "
+                f"{MAX_CAMPAIGN_EPISODES} episodes of a campaign "
+                "(uvnav.scenarios.limits.MAX_CAMPAIGN_EPISODES)",
             )
         values = list(range(start, stop))
     elif not seeds:
@@ -296,6 +304,18 @@ class CampaignSpec(_Strict):
     controllers: list[ControllerEntry] = Field(min_length=1)
     record: bool = False
     beyond_assumptions: bool = False
+
+    @model_validator(mode="after")
+    def _bounded(self) -> CampaignSpec:
+        sets = sum(len(ctrl.param_sets()) for ctrl in self.controllers)
+        n = sets * sum(len(sc.seed_list()) for sc in self.scenarios)
+        if n > MAX_CAMPAIGN_EPISODES:
+            raise FieldError(
+                "scenarios",
+                f"the campaign has {n} episodes, more than the limit of {MAX_CAMPAIGN_EPISODES} "
+                "(uvnav.scenarios.limits.MAX_CAMPAIGN_EPISODES); split it into several campaigns",
+            )
+        return self
 
     def jobs(self) -> list[Job]:
         """The campaign's jobs: scenario entries × seeds × controller entries × grid points.

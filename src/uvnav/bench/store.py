@@ -322,7 +322,8 @@ class ResultsStore:
 
     Raises:
         FileNotFoundError: ``readonly`` and the file does not exist.
-        NotAStoreError: ``readonly`` and the file is not a uvnav results database.
+        NotAStoreError: the file is not a uvnav results database (a directory, not SQLite, a
+            corrupt or another program's SQLite database); nothing is written to it.
     """
 
     def __init__(self, path: str | Path, *, readonly: bool = False) -> None:
@@ -337,13 +338,38 @@ class ResultsStore:
                 self._conn.close()
                 raise
             return
+        if self.path.is_dir():
+            raise NotAStoreError(f"{self.path}: is a directory, not a results database file")
         self.path.parent.mkdir(parents=True, exist_ok=True)
-        self._conn = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
-        self._conn.row_factory = sqlite3.Row
-        self._conn.execute("PRAGMA journal_mode=WAL")
-        self._conn.execute("PRAGMA synchronous=NORMAL")
-        self._conn.execute("PRAGMA foreign_keys=ON")
-        self._create_schema()
+        existing = self.path.is_file() and self.path.stat().st_size > 0
+        try:
+            self._conn = sqlite3.connect(self.path, timeout=30.0, isolation_level=None)
+        except sqlite3.Error as exc:
+            raise NotAStoreError(f"{self.path}: cannot open the results database ({exc})") from None
+        try:
+            if existing:  # never add our tables to another program's database
+                tables = {
+                    r[0]
+                    for r in self._conn.execute("SELECT name FROM sqlite_master WHERE type='table'")
+                }
+                if tables and "campaigns" not in tables:
+                    raise NotAStoreError(
+                        f"{self.path}: not a uvnav results database (no 'campaigns' table; "
+                        "written by uvnav bench / uvnav run)"
+                    )
+            self._conn.row_factory = sqlite3.Row
+            self._conn.execute("PRAGMA journal_mode=WAL")
+            self._conn.execute("PRAGMA synchronous=NORMAL")
+            self._conn.execute("PRAGMA foreign_keys=ON")
+            self._create_schema()
+            if existing:
+                check_store(self._conn, self.path)
+        except sqlite3.DatabaseError as exc:
+            self._conn.close()
+            raise NotAStoreError(f"{self.path}: not a uvnav results database ({exc})") from None
+        except BaseException:
+            self._conn.close()
+            raise
 
     # -- lifecycle
 

@@ -175,6 +175,7 @@ def train(
         from uvnav.learning import PilotNetConfig, TrainConfig
 
         second = _parse_head(head)
+        _check_device(device)
         meta = _dataset_meta(data)
         size = (int(meta.get("height", 66)), int(meta.get("width", 200)))
         sides = meta.get("camera", "front") == "front"
@@ -263,6 +264,29 @@ def speed_head(
             f"{record['val_steering_mse'][0]:.4f}; wrote {out} "
             "(drive it with --throttle learned-speed)"
         )
+
+
+def _check_device(device: str) -> None:
+    """Refuse a ``--device`` torch does not know, or one this machine does not have."""
+    import torch
+
+    try:
+        dev = torch.device(device)
+    except (RuntimeError, TypeError, ValueError) as exc:
+        raise ValueError(f"--device: {device!r} is not a torch device ({exc})") from None
+    if dev.type == "cpu":
+        return
+    if dev.type == "cuda":
+        if not torch.cuda.is_available():
+            raise ValueError(f"--device: {device!r}: CUDA is not available on this machine")
+        if dev.index is not None and dev.index >= torch.cuda.device_count():
+            raise ValueError(
+                f"--device: {device!r}: this machine has {torch.cuda.device_count()} CUDA device(s)"
+            )
+        return
+    if dev.type == "mps" and torch.backends.mps.is_available():
+        return
+    raise ValueError(f"--device: {device!r} is not available (use cpu or cuda)")
 
 
 def _parse_head(head: str) -> str:
@@ -357,6 +381,8 @@ def evaluate(
         from uvnav.learning.checkpoint import load_checkpoint
 
         seed_list = parse_seeds(seeds)
+        if backend not in ("torch", "onnxruntime"):
+            raise ValueError(f"--backend: {backend!r} (must be torch or onnxruntime)")
         modes: list[str]
         if throttle == "both":
             net, _ = load_checkpoint(model)

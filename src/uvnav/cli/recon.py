@@ -24,12 +24,46 @@ from typing import Annotated, Any
 import numpy as np
 import typer
 
-from uvnav.cli.checks import dumps
+from uvnav.cli.checks import dumps, finite
 from uvnav.cli.errors import CliError, uvnav_typer
 
 recon_app = uvnav_typer(
     help="UAV reconnaissance over terrain (thesis Ch. 7): lattice waypoints, smooth tours.",
 )
+
+
+def _positive(value: float | None) -> float | None:
+    """Option callback: a finite number > 0 (or ``None``: not given)."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise typer.BadParameter(f"{value:g} is not a finite number > 0")
+    return value
+
+
+#: ReconConfig field -> the option that sets it (its errors name the option)
+_OPTION_OF = {
+    "theta": "--theta",
+    "radius": "--radius",
+    "footprint_radius": "--radius",
+    "uavs": "--uavs",
+    "delta": "--delta",
+    "c1": "--c1",
+    "c2": "--c2",
+    "r_min": "--r-min",
+    "z_min": "--z-min",
+    "z_max": "--z-max",
+    "seed": "--seed",
+}
+
+
+def _name_option(msg: str) -> str:
+    """``"radius: must be > 0"`` -> ``"--radius: must be > 0"`` (the option the user typed)."""
+    field, sep, rest = msg.partition(":")
+    if sep and field.strip() in _OPTION_OF:
+        opt = _OPTION_OF[field.strip()]
+        if "z_max" in rest and opt == "--z-min":
+            opt = "--z-min/--z-max"
+        return f"{opt}:{rest}"
+    return msg
 
 
 def parse_area(spec: str, bounds: tuple[float, float, float, float]) -> Any:
@@ -38,11 +72,7 @@ def parse_area(spec: str, bounds: tuple[float, float, float, float]) -> Any:
 
     from uvnav.recon.terrain import square_area
 
-    parts = [p.strip() for p in spec.split(",")]
-    try:
-        vals = [float(p) for p in parts]
-    except ValueError:
-        raise ValueError(f"--area: expected SIDE or X0,Y0,X1,Y1 in metres, got {spec!r}") from None
+    vals = _area_numbers(spec)
     if len(vals) == 1:
         cx = 0.5 * (bounds[0] + bounds[2])
         cy = 0.5 * (bounds[1] + bounds[3])
@@ -123,7 +153,9 @@ def plan_cmd(
     ] = None,
     synthetic: Annotated[
         int | None,
-        typer.Option("--synthetic", help="Generated fractal + urban terrain with this seed."),
+        typer.Option(
+            "--synthetic", min=0, help="Generated fractal + urban terrain with this seed."
+        ),
     ] = None,
     jacksboro: Annotated[
         bool,
@@ -136,26 +168,43 @@ def plan_cmd(
         str, typer.Option("--area", help="SIDE (square centred in the DEM) or X0,Y0,X1,Y1 [m].")
     ] = "300",
     theta: Annotated[
-        float, typer.Option("--theta", help="Camera cone full angle [deg], in (0, 180).")
+        float,
+        typer.Option("--theta", callback=finite, help="Camera cone full angle [deg], in (0, 180)."),
     ] = 90.0,
     radius: Annotated[
-        float, typer.Option("--radius", help="Footprint radius R [m] of the lattice.")
+        float,
+        typer.Option("--radius", callback=_positive, help="Footprint radius R [m] of the lattice."),
     ] = 30.0,
-    uavs: Annotated[int, typer.Option("--uavs", help="Number of UAVs (clusters).")] = 2,
+    uavs: Annotated[int, typer.Option("--uavs", min=1, help="Number of UAVs (clusters).")] = 2,
     z_min: Annotated[
-        float | None, typer.Option("--z-min", help="Lowest altitude [m] (default 0).")
+        float | None,
+        typer.Option("--z-min", callback=finite, help="Lowest altitude [m] (default 0)."),
     ] = None,
     z_max: Annotated[
-        float | None, typer.Option("--z-max", help="Highest altitude [m] (default: auto).")
+        float | None,
+        typer.Option("--z-max", callback=finite, help="Highest altitude [m] (default: auto)."),
     ] = None,
-    delta: Annotated[float, typer.Option("--delta", help="δ [m].")] = 5.0,
-    c1: Annotated[float, typer.Option("--c1", help="Waypoint-waypoint margin [m] (7.4).")] = 15.0,
-    c2: Annotated[float, typer.Option("--c2", help="Waypoint-terrain margin [m] (7.4).")] = 10.0,
-    r_min: Annotated[float, typer.Option("--r-min", help="UAV turning radius [m].")] = 15.0,
+    delta: Annotated[float, typer.Option("--delta", callback=_positive, help="δ [m].")] = 5.0,
+    c1: Annotated[
+        float, typer.Option("--c1", callback=finite, help="Waypoint-waypoint margin [m] (7.4).")
+    ] = 15.0,
+    c2: Annotated[
+        float, typer.Option("--c2", callback=finite, help="Waypoint-terrain margin [m] (7.4).")
+    ] = 10.0,
+    r_min: Annotated[
+        float, typer.Option("--r-min", callback=_positive, help="UAV turning radius [m].")
+    ] = 15.0,
     cell: Annotated[
-        float, typer.Option("--cell", help="Node spacing [m] of .npy DEMs and synthetic terrain.")
+        float,
+        typer.Option(
+            "--cell",
+            callback=_positive,
+            help="Node spacing [m] of .npy DEMs and synthetic terrain.",
+        ),
     ] = 5.0,
-    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the k-means clustering.")] = 0,
+    seed: Annotated[
+        int, typer.Option("--seed", min=0, max=2**32 - 1, help="Seed of the k-means clustering.")
+    ] = 0,
     figures: Annotated[
         bool, typer.Option("--figures/--no-figures", help="Write fig7_4.png and recon_3d.html.")
     ] = True,
@@ -165,7 +214,13 @@ def plan_cmd(
 ) -> None:
     """Plan minimum lattice waypoints at the lowest altitude and smooth closed tours (Ch. 7)."""
     from uvnav.recon.plan import ReconConfig, plan_recon
-    from uvnav.recon.terrain import fractal_terrain, load_dem, load_jacksboro
+    from uvnav.recon.terrain import (
+        MAX_TERRAIN_NODES,
+        fractal_terrain,
+        load_dem,
+        load_jacksboro,
+        terrain_nodes,
+    )
 
     chosen = sum([dem is not None, synthetic is not None, jacksboro])
     if chosen > 1:
@@ -181,6 +236,15 @@ def plan_cmd(
         else:
             x0, y0, w, h = _area_box(area)
             pad = 2.0 * radius + 50.0
+            size = (w + 2 * pad, h + 2 * pad)
+            nodes = terrain_nodes(size, cell)
+            if nodes > MAX_TERRAIN_NODES:
+                raise CliError(
+                    f"--area/--cell: a {size[0]:g} m x {size[1]:g} m terrain (the area plus "
+                    f"margins) at --cell {cell:g} m is {nodes:.3g} nodes, more than the limit of "
+                    f"{MAX_TERRAIN_NODES:.0e} (uvnav.recon.terrain.MAX_TERRAIN_NODES: raise it "
+                    "in Python for a larger run); use a smaller --area or a larger --cell"
+                )
             terrain = fractal_terrain(
                 (w + 2 * pad, h + 2 * pad),
                 cell=cell,
@@ -203,10 +267,10 @@ def plan_cmd(
         )
         plan = plan_recon(terrain, D, cfg)
     except ValueError as exc:
-        msg = str(exc)
-        if msg.startswith("theta"):
+        msg = _name_option(str(exc))
+        if msg.startswith("--theta"):
             msg = f"--theta: must be in (0, 180) degrees, got {theta:g}"
-        raise CliError(f"{source}: {msg}") from None
+        raise CliError(msg if msg.startswith("--") else f"{source}: {msg}") from None
     files = write_plan_files(plan, out)
     if figures:
         from uvnav.viz.figures_ch7 import plot_fig7_4, recon_3d_html
@@ -256,11 +320,7 @@ def plan_cmd(
 
 def _area_box(spec: str) -> tuple[float, float, float, float]:
     """(x0, y0, width, height) [m] of the area spec for sizing generated terrain."""
-    parts = spec.split(",")
-    try:
-        vals = [float(p) for p in parts]
-    except ValueError:
-        raise ValueError(f"--area: expected SIDE or X0,Y0,X1,Y1 in metres, got {spec!r}") from None
+    vals = _area_numbers(spec)
     if len(vals) == 1:
         if vals[0] <= 0:
             raise ValueError(f"--area: side must be positive, got {vals[0]:g}")
@@ -268,3 +328,16 @@ def _area_box(spec: str) -> tuple[float, float, float, float]:
     if len(vals) == 4 and vals[2] > vals[0] and vals[3] > vals[1]:
         return vals[0], vals[1], vals[2] - vals[0], vals[3] - vals[1]
     raise ValueError(f"--area: expected SIDE or X0,Y0,X1,Y1 with X1 > X0 and Y1 > Y0, got {spec!r}")
+
+
+def _area_numbers(spec: str) -> list[float]:
+    """The finite numbers of an ``--area`` spec (one side, or a box X0,Y0,X1,Y1) [m]."""
+    try:
+        vals = [float(p.strip()) for p in spec.split(",")]
+    except ValueError:
+        raise ValueError(f"--area: expected SIDE or X0,Y0,X1,Y1 in metres, got {spec!r}") from None
+    if not all(math.isfinite(v) for v in vals):
+        raise ValueError(f"--area: expected finite numbers in metres, got {spec!r}")
+    if len(vals) == 1 and vals[0] <= 0:
+        raise ValueError(f"--area: side must be positive, got {vals[0]:g}")
+    return vals

@@ -55,8 +55,10 @@ def _load_dataset(path: Path) -> Any:
     try:
         with np.load(path, allow_pickle=False) as data:
             arrays = {k: data[k] for k in data.files}
-    except (ValueError, OSError, zipfile.BadZipFile) as exc:
-        raise CliError(f"{path}: not a uvnav sonar dataset (.npz): {exc}") from None
+    except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
+        raise CliError(
+            f"{path}: not a uvnav sonar dataset (.npz): {exc or type(exc).__name__}"
+        ) from None
     try:
         return SonarDataset.from_arrays(arrays)
     except ValueError as exc:

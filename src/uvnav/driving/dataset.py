@@ -34,6 +34,7 @@ was 0.065 / 0.085 against 0.035 on centre images; with exact labels the three ca
 from __future__ import annotations
 
 import csv
+import io
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -50,6 +51,10 @@ EXTRA_COLUMNS = ("target_speed", "steering_left", "steering_right")
 #: camera of each sample in :class:`Samples` (``Samples.camera``)
 CAMERA_CENTRE, CAMERA_LEFT, CAMERA_RIGHT = 0, 1, 2
 CAMERA_NAMES = ("centre", "left", "right")
+
+
+#: largest image (width x height) a driving log may hold; a module constant
+MAX_IMAGE_PIXELS = 4096 * 4096
 
 
 class DatasetError(ValueError):
@@ -161,7 +166,15 @@ def read_log(root: Path | str, *, check_images: bool = True) -> DrivingLog:
     extra: dict[str, list[float]] = {c: [] for c in EXTRA_COLUMNS}
     n_all = len(COLUMNS) + len(EXTRA_COLUMNS)
     allowed = (len(COLUMNS), len(COLUMNS) + 1, n_all)
-    with log.open(newline="") as fh:
+    try:
+        text = log.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise DatasetError(
+            f"{log}: not a text (CSV) file (byte {exc.start} is not UTF-8)"
+        ) from None
+    if "\x00" in text:
+        raise DatasetError(f"{log}: not a text (CSV) file (it holds NUL bytes)")
+    with io.StringIO(text, newline="") as fh:
         for r, rec in enumerate(csv.reader(fh), start=1):
             if not rec or all(not x.strip() for x in rec):
                 continue
@@ -414,11 +427,21 @@ def load_images(paths: Sequence[Path], *, size: tuple[int, int] = (66, 200)) -> 
     h, w = size
     out = np.empty((len(paths), h, w, 3), dtype=np.uint8)
     for k, p in enumerate(paths):
-        with Image.open(p) as im:
-            img = im.convert("RGB")
-            if img.size == (320, 160) and (h, w) != (160, 320):
-                img = img.crop((0, 60, 320, 135))
-            if img.size != (w, h):
-                img = img.resize((w, h), Image.Resampling.BILINEAR)
-            out[k] = np.asarray(img)
+        try:
+            with Image.open(p) as im:
+                if im.width * im.height > MAX_IMAGE_PIXELS:
+                    raise DatasetError(
+                        f"{p}: {im.width}x{im.height} image is above the limit of "
+                        f"{MAX_IMAGE_PIXELS} pixels (uvnav.driving.dataset.MAX_IMAGE_PIXELS)"
+                    )
+                img = im.convert("RGB")
+                if img.size == (320, 160) and (h, w) != (160, 320):
+                    img = img.crop((0, 60, 320, 135))
+                if img.size != (w, h):
+                    img = img.resize((w, h), Image.Resampling.BILINEAR)
+                out[k] = np.asarray(img)
+        except (OSError, ValueError, Image.DecompressionBombError) as exc:
+            if isinstance(exc, DatasetError):
+                raise
+            raise DatasetError(f"{p}: not a readable image ({exc})") from None
     return out

@@ -48,6 +48,11 @@ THESIS_ERROR_RANGES: dict[int, dict[str, tuple[float, float]]] = {
 MAX_THREADS = 2
 
 
+#: most neurons of one hidden layer (the thesis uses 10; a typo like 100000000 would allocate
+#: gigabytes): a module constant, raise it before building a larger network
+MAX_HIDDEN = 10_000
+
+
 class CheckpointError(ValueError):
     """A model file that is not a valid uvnav BPNN checkpoint (one-line message)."""
 
@@ -121,8 +126,13 @@ class BPNNConfig:
     def __post_init__(self) -> None:
         if self.optimizer not in ("lbfgs", "adam"):
             raise ValueError(f"optimizer must be 'lbfgs' or 'adam' (got {self.optimizer!r})")
-        if not self.hidden or any(int(h) < 1 for h in self.hidden):
-            raise ValueError(f"hidden must list positive layer sizes (got {self.hidden!r})")
+        if not self.hidden or any(
+            isinstance(h, bool) or int(h) != h or not 1 <= int(h) <= MAX_HIDDEN for h in self.hidden
+        ):
+            raise ValueError(
+                f"hidden must list layer sizes in 1..{MAX_HIDDEN} (got {self.hidden!r}; "
+                "uvnav.learning.bpnn.MAX_HIDDEN)"
+            )
         f = self.fractions
         if len(f) != 3 or any(x < 0 for x in f) or abs(sum(f) - 1.0) > 1e-9 or f[0] <= 0:
             raise ValueError(f"fractions must be three numbers >= 0 summing to 1 (got {f!r})")
@@ -494,11 +504,22 @@ def load_checkpoint(path: Path) -> TrainedBPNN:
         raise CheckpointError(f"{js_path}: not valid JSON ({exc.__class__.__name__})") from exc
     if not isinstance(meta, dict) or meta.get("format") != "uvnav-bpnn-v1":
         raise CheckpointError(f"{js_path}: field 'format' must be 'uvnav-bpnn-v1'")
+    cfg_d = meta.get("config")
+    if not isinstance(cfg_d, dict):
+        raise CheckpointError(
+            f"{js_path}: config: must be a mapping (got {type(cfg_d).__name__}: {cfg_d!r:.40})"
+        )
     try:
-        cfg_d = dict(meta["config"])
-        cfg_d["hidden"] = tuple(cfg_d["hidden"])
-        cfg_d["fractions"] = tuple(cfg_d["fractions"])
+        cfg_d = dict(cfg_d)
+        for key in ("hidden", "fractions"):
+            value = cfg_d.get(key)
+            if not isinstance(value, list | tuple) or any(isinstance(v, bool | str) for v in value):
+                raise ValueError(f"{key}: must be a list of numbers (got {value!r:.40})")
+            cfg_d[key] = tuple(value)
         cfg = BPNNConfig(**cfg_d)
+    except (TypeError, ValueError) as exc:
+        raise CheckpointError(f"{js_path}: config: {exc}") from None
+    try:
         n_layers = int(meta["n_layers"])
         weights = [
             (tensors[f"layer{k}.weight"], tensors[f"layer{k}.bias"]) for k in range(n_layers)
@@ -509,6 +530,12 @@ def load_checkpoint(path: Path) -> TrainedBPNN:
     for k in range(1, n_layers):
         if weights[k][0].shape[1] != weights[k - 1][0].shape[0]:
             raise CheckpointError(f"{st_path}: layer{k}.weight does not fit layer{k - 1}")
+    sizes = [int(w.shape[0]) for w, _ in weights[:-1]]
+    if sizes != [int(h) for h in cfg.hidden]:
+        raise CheckpointError(
+            f"{js_path}: config.hidden {list(cfg.hidden)} does not match the weights' hidden "
+            f"layer sizes {sizes} in {st_path.name}"
+        )
     bad = first_non_finite(tensors)
     if bad is not None:
         raise CheckpointError(f"{st_path}: {bad} is not a finite number (a diverged network)")

@@ -98,7 +98,12 @@ def read_header(path: Path | str) -> dict[str, Any]:
         raise ValueError(f"{path}: not a safetensors file ({exc})") from None
     if "uvnav" not in meta:
         raise ValueError(f"{path}: no 'uvnav' header (not a uvnav PilotNet checkpoint)")
-    header: dict[str, Any] = json.loads(meta["uvnav"])
+    try:
+        header: dict[str, Any] = json.loads(meta["uvnav"])
+    except json.JSONDecodeError as exc:
+        raise ValueError(f"{path}: the 'uvnav' header is not JSON ({exc})") from None
+    if not isinstance(header, dict):
+        raise ValueError(f"{path}: the 'uvnav' header is not a JSON object")
     if header.get("format") != FORMAT:
         raise ValueError(f"{path}: header format {header.get('format')!r} (expected {FORMAT!r})")
     return header
@@ -116,14 +121,34 @@ def load_checkpoint(path: Path | str) -> tuple[Any, dict[str, Any]]:
     from uvnav.learning.pilotnet import build_pilotnet
 
     header = read_header(path)
-    state = load_file(str(path))
+    config = header.get("config")
+    if not isinstance(config, dict):
+        raise ValueError(f"{path}: header field 'config' must be a mapping (got {config!r:.40})")
+    try:
+        cfg = PilotNetConfig.from_dict(config)
+    except (TypeError, ValueError) as exc:
+        raise ValueError(f"{path}: header config: {exc}") from None
+    try:
+        state = load_file(str(path))
+    except Exception as exc:  # safetensors raises its own error types
+        raise ValueError(f"{path}: unreadable weights ({_first_line(exc)})") from None
     bad = non_finite_tensor(state)
     if bad is not None:
         raise NonFiniteWeightsError(f"{path}: {bad} (a diverged network; retrain it)")
-    model = build_pilotnet(PilotNetConfig.from_dict(header["config"]))
-    model.load_state_dict(state)
+    model = build_pilotnet(cfg)
+    try:
+        model.load_state_dict(state)
+    except RuntimeError as exc:
+        raise ValueError(
+            f"{path}: the weights do not fit the header config ({_first_line(exc, 1)})"
+        ) from None
     model.eval()
     return model, header
+
+
+def _first_line(exc: BaseException, index: int = 0) -> str:
+    lines = [ln.strip() for ln in str(exc).splitlines() if ln.strip()]
+    return lines[min(index, len(lines) - 1)] if lines else type(exc).__name__
 
 
 #: format of the per-epoch training state (:func:`save_training_state`)

@@ -7,11 +7,36 @@ without the ``learning`` extra, and so that a checkpoint's JSON header round-tri
 from __future__ import annotations
 
 import dataclasses
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
+#: largest input image side [px] a configuration (or a checkpoint's header) may ask for; a
+#: module constant (raise it before loading for larger images)
+MAX_IMAGE_SIDE = 1024
+#: largest speed scale / target-speed cap [m/s]
+MAX_SPEED = 1000.0
+
 #: what the network's second output can be trained on
 SECOND_OUTPUTS = ("throttle", "target_speed")
+
+
+def _check_types(cfg: Any) -> None:
+    """Refuse a field of the wrong type (a header's ``height: "66"``) or a non-finite number."""
+    for f in dataclasses.fields(cfg):
+        value = getattr(cfg, f.name)
+        kind = type(f.default)
+        name = f"{type(cfg).__name__}.{f.name}"
+        if kind is int:
+            if isinstance(value, bool) or not isinstance(value, int):
+                raise ValueError(f"{name}: expected an integer (got {value!r:.40})")
+        elif kind is float:
+            if isinstance(value, bool) or not isinstance(value, int | float):
+                raise ValueError(f"{name}: expected a number (got {value!r:.40})")
+            if not math.isfinite(value):
+                raise ValueError(f"{name}: expected a finite number (got {value})")
+        elif kind is str and not isinstance(value, str):
+            raise ValueError(f"{name}: expected a string (got {value!r:.40})")
 
 
 @dataclass(frozen=True)
@@ -55,8 +80,25 @@ class PilotNetConfig:
     target_speed_max: float = 50.0
 
     def __post_init__(self) -> None:
-        if self.height < 32 or self.width < 32:
-            raise ValueError(f"PilotNetConfig: input {self.height}x{self.width} is below 32x32")
+        _check_types(self)
+        for name in ("height", "width"):
+            side = getattr(self, name)
+            if side < 32:
+                raise ValueError(
+                    f"PilotNetConfig.{name}: input {self.height}x{self.width} is below 32x32"
+                )
+            if side > MAX_IMAGE_SIDE:
+                raise ValueError(
+                    f"PilotNetConfig.{name}: input {self.height}x{self.width} is above the limit "
+                    f"of {MAX_IMAGE_SIDE} px a side (uvnav.learning.config.MAX_IMAGE_SIDE)"
+                )
+        if not 1 <= self.channels <= 4:
+            raise ValueError(f"PilotNetConfig.channels: {self.channels} (must be 1..4)")
+        if self.conv3x3_layers > 8 or self.extra_inputs > 64:
+            raise ValueError(
+                "PilotNetConfig: conv3x3_layers must be <= 8 and extra_inputs <= 64 "
+                f"(got {self.conv3x3_layers}, {self.extra_inputs})"
+            )
         if self.n_outputs not in (1, 2):
             raise ValueError(f"PilotNetConfig.n_outputs: {self.n_outputs} (must be 1 or 2)")
         if not 0.0 <= self.dropout < 1.0:
@@ -68,8 +110,12 @@ class PilotNetConfig:
                 f"PilotNetConfig.second_output: {self.second_output!r} "
                 f"(must be one of {', '.join(SECOND_OUTPUTS)})"
             )
-        if self.speed_scale <= 0 or self.target_speed_max <= 0:
-            raise ValueError("PilotNetConfig: speed_scale and target_speed_max must be > 0")
+        for name in ("speed_scale", "target_speed_max"):
+            value = getattr(self, name)
+            if not 0 < value <= MAX_SPEED:
+                raise ValueError(
+                    f"PilotNetConfig.{name}: {value} (must be in (0, {MAX_SPEED:g}] m/s)"
+                )
 
     @property
     def predicts_target_speed(self) -> bool:

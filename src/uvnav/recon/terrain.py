@@ -29,6 +29,9 @@ Units: lengths [m].
 
 from __future__ import annotations
 
+import math
+import re
+import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -38,6 +41,10 @@ import shapely
 from shapely.geometry import Polygon, box
 
 FloatArray = np.ndarray
+
+#: Most nodes of a terrain grid, loaded or generated (10^8 nodes: 800 MB of float64 heights); a
+#: module constant: raise it before loading for a larger DEM.
+MAX_TERRAIN_NODES = 100_000_000
 
 #: Metres per arc-second of latitude (WGS84 mean) used by the equirectangular projection.
 METRES_PER_ARCSEC = 30.87
@@ -72,6 +79,11 @@ class Terrain:
             )
         if not np.all(np.isfinite(z)):
             raise ValueError("terrain z: heights must be finite (fill no-data before use)")
+        if not all(math.isfinite(v) for v in (self.x0, self.y0, self.dx, self.dy)):
+            raise ValueError(
+                f"terrain: origin and cell sizes must be finite, got x0={self.x0}, "
+                f"y0={self.y0}, dx={self.dx}, dy={self.dy}"
+            )
         if not (self.dx > 0 and self.dy > 0):
             raise ValueError(
                 f"terrain: cell sizes must be positive, got dx={self.dx}, dy={self.dy}"
@@ -160,6 +172,13 @@ def fractal_heights(
     return (h - h.min()) * (relief / span if span > 0 else 0.0)
 
 
+def terrain_nodes(size: tuple[float, float], cell: float) -> float:
+    """Nodes of a (width, height) [m] grid at spacing ``cell`` [m] (inf when not finite)."""
+    if not (cell > 0 and all(math.isfinite(v) and v >= 0 for v in (*size, cell))):
+        return math.inf
+    return (size[0] / cell + 1.0) * (size[1] / cell + 1.0)
+
+
 def fractal_terrain(
     size: tuple[float, float],
     *,
@@ -185,6 +204,12 @@ def fractal_terrain(
         block_size: Range of block side lengths [m].
         block_height: Range of block heights above the hills [m].
     """
+    nodes = terrain_nodes(size, cell)
+    if nodes > MAX_TERRAIN_NODES:
+        raise ValueError(
+            f"terrain: {size[0]:g} m x {size[1]:g} m at cell {cell:g} m is {nodes:.3g} nodes, more "
+            f"than the limit of {MAX_TERRAIN_NODES:.0e} (uvnav.recon.terrain.MAX_TERRAIN_NODES)"
+        )
     rng = np.random.default_rng(seed)
     nx = round(size[0] / cell) + 1
     ny = round(size[1] / cell) + 1
@@ -328,22 +353,49 @@ def load_dem(path: str | Path, *, cell: float | None = None) -> Terrain:
         if suffix == ".npy":
             z = np.load(p, allow_pickle=False)
             c = 1.0 if cell is None else float(cell)
-            return Terrain(np.asarray(z, dtype=float), 0.0, 0.0, c, c, source=f"{p.name}")
+            return Terrain(_heights(z, "array"), 0.0, 0.0, c, c, source=f"{p.name}")
         if suffix == ".npz":
             with np.load(p, allow_pickle=False) as d:
                 key = "z" if "z" in d else "elevation" if "elevation" in d else None
                 if key is None:
                     raise ValueError("needs an array named 'z' (or 'elevation')")
-                dx = float(d["dx"]) if "dx" in d else (1.0 if cell is None else float(cell))
-                dy = float(d["dy"]) if "dy" in d else dx
-                x0 = float(d["x0"]) if "x0" in d else 0.0
-                y0 = float(d["y0"]) if "y0" in d else 0.0
-                return Terrain(np.asarray(d[key], dtype=float), x0, y0, dx, dy, source=p.name)
+                default = 1.0 if cell is None else float(cell)
+                dx = _npz_number(d, "dx", default)
+                dy = _npz_number(d, "dy", dx)
+                x0 = _npz_number(d, "x0", 0.0)
+                y0 = _npz_number(d, "y0", 0.0)
+                return Terrain(_heights(d[key], key), x0, y0, dx, dy, source=p.name)
         if suffix in (".tif", ".tiff"):
             return _load_geotiff(p)
     except ValueError as exc:
         raise ValueError(f"{p}: {exc}") from None
+    except (EOFError, OSError, zipfile.BadZipFile, KeyError) as exc:
+        what = {".npy": "a .npy array", ".npz": "a .npz archive"}.get(suffix, "a DEM file")
+        raise ValueError(f"{p}: not {what} ({exc or type(exc).__name__})") from None
     raise ValueError(f"{p}: unknown DEM format {suffix!r} (use .tif, .npy or .npz)")
+
+
+def _heights(z: Any, name: str) -> FloatArray:
+    """``z`` as float heights; a non-numeric array (strings, complex, objects) is refused."""
+    a = np.asarray(z)
+    if a.dtype.kind not in "biuf":
+        raise ValueError(f"{name}: heights must be real numbers (got dtype {a.dtype})")
+    if a.size > MAX_TERRAIN_NODES:
+        raise ValueError(f"{name}: {a.size} nodes, more than the limit of {MAX_TERRAIN_NODES}")
+    return np.asarray(a, dtype=float)
+
+
+def _npz_number(d: Any, key: str, default: float) -> float:
+    """The scalar ``d[key]`` (a finite real number) or ``default`` when absent."""
+    if key not in d:
+        return default
+    a = np.asarray(d[key])
+    if a.size != 1 or a.dtype.kind not in "biuf":
+        raise ValueError(f"{key}: must be one real number (got {a.dtype} array of shape {a.shape})")
+    v = float(a.reshape(()))
+    if not math.isfinite(v):
+        raise ValueError(f"{key}: must be a finite number (got {v})")
+    return v
 
 
 def _load_geotiff(p: Path) -> Terrain:
@@ -351,15 +403,26 @@ def _load_geotiff(p: Path) -> Terrain:
         import rasterio
     except ImportError as exc:  # pragma: no cover - depends on the extra
         raise ValueError("reading GeoTIFF needs rasterio: pip install 'uvnav[recon]'") from exc
-    with rasterio.open(p) as ds:
-        band = ds.read(1, masked=True).astype(float)
-        t = ds.transform
-        if ds.crs is not None and ds.crs.is_geographic:
-            raise ValueError("GeoTIFF CRS is geographic (degrees); reproject to a metric CRS first")
-        if abs(t.b) > 1e-12 or abs(t.d) > 1e-12:
-            raise ValueError("GeoTIFF is rotated; only north-up rasters are supported")
-        fill = float(band.min()) if band.count() else 0.0
-        z = np.ma.filled(band, fill)
+    from rasterio.errors import RasterioError
+
+    try:
+        with rasterio.open(p) as ds:
+            if ds.width * ds.height > MAX_TERRAIN_NODES:
+                raise ValueError(
+                    f"{ds.width} x {ds.height} nodes, more than the limit of {MAX_TERRAIN_NODES}"
+                )
+            band = ds.read(1, masked=True).astype(float)
+            t = ds.transform
+            if ds.crs is not None and ds.crs.is_geographic:
+                raise ValueError(
+                    "GeoTIFF CRS is geographic (degrees); reproject to a metric CRS first"
+                )
+            if abs(t.b) > 1e-12 or abs(t.d) > 1e-12:
+                raise ValueError("GeoTIFF is rotated; only north-up rasters are supported")
+            fill = float(band.min()) if band.count() else 0.0
+            z = np.ma.filled(band, fill)
+    except RasterioError as exc:
+        raise ValueError(f"not a readable GeoTIFF ({_one_line(str(exc))})") from None
     dx, dy = abs(t.a), abs(t.e)
     z = z[::-1] if t.e < 0 else z
     x0 = t.c + dx / 2
@@ -375,3 +438,7 @@ def load_jacksboro(crop: JacksboroCrop = JACKSBORO_DEFAULT) -> Terrain:
     with d:
         data = {k: d[k] for k in d.files}
     return jacksboro_terrain(data, crop)
+
+
+def _one_line(text: str) -> str:
+    return re.sub(r"\s+", " ", text).strip()

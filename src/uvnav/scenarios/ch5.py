@@ -27,7 +27,8 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 
 from uvnav.dynamics.vehicle3d import Vehicle3DSpec
 from uvnav.obstacles.deforming3d import CompoundBody, as_compound, horseshoe, random_star
-from uvnav.scenarios.errors import ScenarioError, from_validation_error
+from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
+from uvnav.scenarios.limits import check_episode_steps, check_magnitudes
 from uvnav.scenarios.loader import builtin_yaml_files, parse_yaml
 from uvnav.sensors.sonar_array import SonarArray
 from uvnav.sim.episode_uuv3d import UUV3DSetup
@@ -41,7 +42,7 @@ Pos = Annotated[float, Field(gt=0)]
 
 
 class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
 
 
 class Robot5(_Model):
@@ -128,6 +129,38 @@ class Scenario5(_Model):
     obstacles: list[Obstacle5Spec] = Field(default_factory=list)
     controller: Controller5 = Controller5()
 
+    @model_validator(mode="before")
+    @classmethod
+    def _bounded(cls, data: Any) -> Any:
+        check_magnitudes(data)
+        return data
+
+    @model_validator(mode="after")
+    def _consistent(self) -> Scenario5:
+        check_episode_steps(self.t_max, self.dt)
+        ratio = self.control_period / self.dt
+        if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
+            raise FieldError(
+                "control_period",
+                f"must be a positive multiple of dt={self.dt:g} s (got {self.control_period:g})",
+            )
+        r = self.robot
+        start, goal = np.asarray(r.start, float), np.asarray(r.goal, float)
+        if float(np.linalg.norm(goal - start)) <= self.goal_tolerance:
+            raise FieldError(
+                "robot.goal", f"is within goal_tolerance={self.goal_tolerance:g} m of the start"
+            )
+        for j, body in enumerate(build_obstacles(self)):
+            if bool(body.contains(goal, 0.0)[0]):
+                raise FieldError("robot.goal", f"lies inside obstacle {j} at t=0")
+            inside = bool(body.contains(start, 0.0)[0])
+            if inside or body.nearest(start, 0.0)[1] < r.radius:
+                raise FieldError(
+                    "robot.start",
+                    f"vehicle (radius {r.radius:g} m) overlaps obstacle {j} at t=0",
+                )
+        return self
+
 
 def scenario5_from_dict(data: dict[str, Any], source: str = "<dict>") -> Scenario5:
     """Validate a mapping as a :class:`Scenario5`.
@@ -180,7 +213,13 @@ def load_ch5_scenario(name: str) -> Scenario5:
     if not path.is_file():
         known = ", ".join(list_ch5_builtin())
         raise ScenarioError(name, "", f"no such file or Chapter 5 scenario (built-in: {known})")
-    return scenario5_from_dict(parse_yaml(path.read_text(), str(path)), str(path))
+    try:
+        text = path.read_text()
+    except UnicodeDecodeError:
+        raise ScenarioError(str(path), "", "is not a text (YAML) file") from None
+    except OSError as exc:
+        raise ScenarioError(str(path), "", f"cannot be read ({exc.strerror or exc})") from None
+    return scenario5_from_dict(parse_yaml(text, str(path)), str(path))
 
 
 def build_obstacles(scn: Scenario5) -> tuple[CompoundBody, ...]:

@@ -46,6 +46,7 @@ from uvnav.obstacles import (
 from uvnav.obstacles.motion import motion_plugins
 from uvnav.scenarios import pedestrians
 from uvnav.scenarios.errors import FieldError, ScenarioError
+from uvnav.scenarios.limits import check_episode_steps
 from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sim import LidarConfig, SensingConfig
 
@@ -622,6 +623,7 @@ class Scenario(_Model):
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
+        check_episode_steps(self.t_max, self.dt)
         ratio = self.control_period / self.dt
         if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
             raise FieldError(

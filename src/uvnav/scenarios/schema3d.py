@@ -42,6 +42,7 @@ from uvnav.obstacles.motion3d import (
     Waypoints3D,
 )
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
+from uvnav.scenarios.limits import check_episode_steps, check_magnitudes
 from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, clearance3d
 
 Point3 = Annotated[tuple[float, float, float], Field(description="[x, y, z] [m]")]
@@ -288,8 +289,15 @@ class Scenario3D(_Model):
 
     __hash__ = None  # type: ignore[assignment]  # lists inside: not hashable
 
+    @model_validator(mode="before")
+    @classmethod
+    def _bounded(cls, data: Any) -> Any:
+        check_magnitudes(data)
+        return data
+
     @model_validator(mode="after")
     def _consistent(self) -> Scenario3D:
+        check_episode_steps(self.t_max, self.dt)
         ratio = self.control_period / self.dt
         if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
             raise FieldError("control_period", f"must be a positive multiple of dt={self.dt:g} s")

@@ -1,0 +1,73 @@
+"""Documented limits on the size of what a file or an option can ask for (issue 17).
+
+A scenario, a campaign or a terrain request that would need more than these is refused when it
+is read, with one line naming the field (or the option), the number it asks for and the limit,
+instead of running for days or allocating petabytes.  They are module constants: a caller that
+really needs more can raise them (``uvnav.scenarios.limits.MAX_EPISODE_STEPS = ...``) before
+loading.
+
+* :data:`MAX_EPISODE_STEPS` — integration steps of one episode, ``ceil(t_max / dt)`` (10^7: about
+  a day of simulated time at dt = 0.01 s; the built-ins need at most 10^4).
+* :data:`MAX_CAMPAIGN_EPISODES` — episodes (jobs) of one campaign file (10^6).
+
+(The terrain of ``uvnav recon plan`` has its own: :data:`uvnav.recon.terrain.MAX_TERRAIN_NODES`.)
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from uvnav.scenarios.errors import FieldError
+
+#: most integration steps ``t_max / dt`` of one episode
+MAX_EPISODE_STEPS = 10_000_000
+#: most episodes of one campaign (scenario seeds x controller parameter sets)
+MAX_CAMPAIGN_EPISODES = 1_000_000
+
+
+def check_episode_steps(t_max: float, dt: float) -> None:
+    """Refuse an episode of more than :data:`MAX_EPISODE_STEPS` integration steps.
+
+    Raises:
+        FieldError: on ``dt``, naming the number of steps and the limit.
+    """
+    steps = t_max / dt
+    if not math.isfinite(steps) or steps > MAX_EPISODE_STEPS:
+        raise FieldError(
+            "dt",
+            f"t_max / dt = {t_max:g} s / {dt:g} s = {steps:.3g} integration steps is more than "
+            f"the limit of {MAX_EPISODE_STEPS:.0e} (uvnav.scenarios.limits.MAX_EPISODE_STEPS); "
+            "raise dt or lower t_max",
+        )
+
+
+#: largest magnitude of a number in a 3D scene file (coordinates [m], sizes [m], speeds [m/s]):
+#: beyond it squared distances overflow float64 in the mesh geometry; seeds are exempt
+MAX_MAGNITUDE = 1e9
+
+
+def check_magnitudes(data: Any, path: str = "") -> None:
+    """Refuse a number above :data:`MAX_MAGNITUDE` anywhere in a scene mapping (not seeds).
+
+    Raises:
+        FieldError: naming the field's dotted path and the number.
+    """
+    if isinstance(data, dict):
+        for key, value in data.items():
+            if "seed" not in str(key):
+                check_magnitudes(value, f"{path}.{key}" if path else str(key))
+    elif isinstance(data, list | tuple):
+        for i, value in enumerate(data):
+            check_magnitudes(value, f"{path}.{i}" if path else str(i))
+    elif (
+        isinstance(data, int | float)
+        and not isinstance(data, bool)
+        and math.isfinite(data)
+        and abs(data) > MAX_MAGNITUDE
+    ):
+        raise FieldError(
+            path,
+            f"{data:g} is above the limit of {MAX_MAGNITUDE:g} in magnitude "
+            "(uvnav.scenarios.limits.MAX_MAGNITUDE)",
+        )
