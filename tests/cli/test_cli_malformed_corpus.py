@@ -675,7 +675,8 @@ def _option_cases() -> list[Case]:
         (["drive", "collect", "--out", "d", "--episodes", "0"], "--episodes"),
         (["drive", "collect", "--out", "d", "--noise", "nan"], "--noise"),
         (["drive", "play", "m.safetensors", "--out", "x.txt"], "--out"),
-        (["ch4", "--help-me"], "--help-me"),
+        (["sonar", "--help-me"], "--help-me"),
+        (["ch4", "simulate"], "ch4"),
     ]
     cases = []
     for argv, word in specs:

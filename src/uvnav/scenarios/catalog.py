@@ -413,7 +413,8 @@ def generate(name: str, seed: int, params: Mapping[str, Any] | None = None) -> R
     except ScenarioError:
         raise
     except (TypeError, ValueError, OverflowError) as exc:
-        raise ScenarioError(spec, "params", f"{name}: {exc}") from None
+        values = ", ".join(f"{k}={v!r}" for k, v in params.items())
+        raise ScenarioError(spec, "params", f"{name} with {values}: {exc}") from None
     return Resolved(kind, scenario, spec, seed)
 
 
