@@ -52,27 +52,38 @@ class ControllerPolicy:
         return np.clip(np.array([a0, a1], dtype=np.float32), -1.0, 1.0)
 
 
-def make_any_controller(name: str, **params: Any) -> Any:
-    """A registered law by name, whatever vehicle it drives (unicycle, 3D or Chapter-4 UUV).
+def check_env_law(env: Any, name: str) -> None:
+    """Refuse a registered law that cannot drive ``env``'s scene, or whose declared assumptions
+    the scene breaks (thesis (2.6)): the check of ``uvnav simulate`` and ``uvnav bench``
+    (:func:`uvnav.scenarios.episodes.check_law`), on the env's scenario.  An env that draws a new
+    scene at every reset (a generator name without a seed) is checked on its first scene.
 
     Raises:
-        uvnav.controllers.UnknownControllerError: not registered (a ``KeyError``).
+        uvnav.scenarios.episodes.LawMismatchError: another vehicle or sensor.
+        uvnav.scenarios.ScenarioError: the scene breaks the law's assumption.
     """
-    from uvnav.controllers.base import controller_info, make_controller
-    from uvnav.controllers.base3d import make_controller3d
-    from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
+    from pydantic import BaseModel
 
-    builders = {
-        "unicycle": make_controller,
-        "vehicle3d": make_controller3d,
-        "uuv2d": make_uuv2d_controller,
-    }
-    return builders[controller_info(name).vehicle](name, **params)
+    from uvnav.scenarios.catalog import Resolved, infer_kind, kinds
+    from uvnav.scenarios.episodes import check_law
+
+    scenario = getattr(getattr(env, "unwrapped", env), "scenario", None)
+    if not isinstance(scenario, BaseModel):
+        return
+    kind = kinds()[infer_kind(scenario)]
+    check_law(Resolved(kind, scenario, str(getattr(scenario, "name", "env")), None), name)
 
 
-def as_policy(controller: Any, seed: int = 0, **params: Any) -> ControllerPolicy:
+def as_policy(
+    controller: Any, seed: int = 0, *, env: Any = None, **params: Any
+) -> ControllerPolicy:
     """``policy(obs, info) -> action`` driven by ``controller`` (an instance, or a registered
-    name — 2D, 3D or Chapter-4 UUV law — with ``params``)."""
+    name of any vehicle's law with ``params``).  With ``env``, a named law is first checked
+    against the env's scene (:func:`check_env_law`)."""
     if isinstance(controller, str):
-        controller = make_any_controller(controller, **params)
+        from uvnav.controllers.base import make_law
+
+        if env is not None:
+            check_env_law(env, controller)
+        controller = make_law(controller, **params)
     return ControllerPolicy(controller, seed)
