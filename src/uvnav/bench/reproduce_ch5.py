@@ -372,9 +372,14 @@ class Ch5Job:
 
 
 def checkpoint_digest(path: Path) -> str:
-    """First 16 hex digits of the SHA-256 of a checkpoint's weights file."""
+    """First 16 hex digits of the SHA-256 of a checkpoint's weights: its arrays serialised
+    without the header (what the weights file was before the header moved into it), so the
+    digest, and the closed-loop episodes keyed on it, do not change with the format or the
+    training record."""
+    from safetensors.numpy import load_file, save
+
     st = Path(path).with_suffix(".safetensors")
-    return hashlib.sha256(st.read_bytes()).hexdigest()[:16]
+    return hashlib.sha256(save(load_file(str(st)))).hexdigest()[:16]
 
 
 _MODEL_CACHE: dict[str, TrainedBPNN] = {}
