@@ -922,7 +922,7 @@ def reproduce_ch5(
         },
     }
     summary.json_path = results_dir / "ch5.json"
-    summary.json_path.write_text(json.dumps(out, indent=1, default=_json_default))
+    write_atomic(summary.json_path, json.dumps(out, indent=1, default=_json_default))
     if render is not None and report_dir is not None:
         summary.figures = list(render(summary, Path(report_dir)))
     return summary
