@@ -29,7 +29,7 @@ DESIGN_LAYERS = [
     {"uvnav.sensors", "uvnav.prediction"},
     {"uvnav.dynamics", "uvnav.obstacles"},
     {"uvnav.geometry"},
-    {"uvnav.core"},  # issue 16: the contract every layer reads
+    {"uvnav.core", "uvnav.stages"},  # issue 16: the contract every layer reads; the stage cache
 ]
 
 
@@ -101,6 +101,7 @@ LOW_LAYERS = [
     "uvnav.prediction",
     "uvnav.planners",
     "uvnav.sim",
+    "uvnav.stages",
 ]
 
 

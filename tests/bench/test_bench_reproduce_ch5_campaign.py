@@ -108,8 +108,8 @@ def test_network_jobs_key_on_the_checkpoint_digest() -> None:
 
 def test_cached_dataset_resumes_the_same_data_and_random_stream(tmp_path: Path) -> None:
     ds, rng = cached_dataset(4, 123, tmp_path)
-    files = sorted(p.name for p in tmp_path.iterdir())
-    assert files == ["data_n4_r123.npz", "data_n4_r123.rng.json"]
+    files = sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*"))
+    assert files == ["data_n4_r123.npz", "stages", "stages/data_n4_r123.json"]
     again, rng2 = cached_dataset(4, 123, tmp_path)  # read back, nothing sampled
     np.testing.assert_array_equal(again.ranges, ds.ranges)
     np.testing.assert_array_equal(again.target_index, ds.target_index)
@@ -120,6 +120,42 @@ def test_cached_dataset_resumes_the_same_data_and_random_stream(tmp_path: Path) 
     expect = ref_rng.random(3)
     np.testing.assert_array_equal(rng.random(3), expect)
     np.testing.assert_array_equal(rng2.random(3), expect)
+
+
+def test_learning_rows_are_stages_built_on_their_data_and_test_set(tmp_path: Path) -> None:
+    pytest.importorskip("torch")
+    from uvnav.learning.bpnn import BPNNConfig
+    from uvnav.stages import Stages
+
+    cfg = BPNNConfig(max_epochs=3)
+    test, _ = cached_dataset(6, 7, tmp_path)
+    row, model, _ = r5.learning_row(12, 0, test, cfg, cache=tmp_path)
+    assert (tmp_path / "model_n12_s0_plain.safetensors").is_file()
+    st = Stages(tmp_path / "stages")
+    again, back, _ = r5.learning_row(12, 0, test, cfg, cache=tmp_path, stages=st)
+    assert st.reused == ["data_n12_r10000", "row_n12_s0_plain"]  # nothing trained again
+    assert again == json.loads(json.dumps(row, default=r5._json_default))
+    np.testing.assert_array_equal(back.predict(test.inputs), model.predict(test.inputs))
+    # another independent test set: the row is measured again on the same data
+    other, _ = cached_dataset(6, 8, tmp_path)
+    st = Stages(tmp_path / "stages")
+    r5.learning_row(12, 0, other, cfg, cache=tmp_path, stages=st)
+    assert st.reused == ["data_n12_r10000"]
+    # the data set sampled again (its stage lost): the row built on it is recomputed too
+    (tmp_path / "stages" / "data_n12_r10000.json").unlink()
+    st = Stages(tmp_path / "stages")
+    r5.learning_row(12, 0, other, cfg, cache=tmp_path, stages=st)
+    assert st.reused == []
+
+
+def test_a_cache_of_the_older_layout_is_dropped(tmp_path: Path) -> None:
+    cache = tmp_path / "ch5" / "cache"
+    cache.mkdir(parents=True)
+    (cache / "row_n50_s0_plain.json").write_text("{}")
+    (cache / "data_n4_r123.rng.json").write_text("{}")
+    with pytest.raises(TypeError):  # stop right after the cache is prepared
+        r5.reproduce_ch5(tmp_path, sizes=(50,), n_test="x", progress=False)  # type: ignore[arg-type]
+    assert sorted(p.name for p in cache.iterdir()) == ["stages"]
 
 
 def test_ch5_section_shows_the_animation_and_names_failures(tmp_path: Path) -> None:

@@ -96,7 +96,7 @@ def test_drive_evaluate_refuses_a_model_with_nan_weights(tmp_path: Path) -> None
     state = {k: v.detach().clone().contiguous() for k, v in net.state_dict().items()}
     name = next(k for k in state if k.endswith("weight"))
     state[name].view(-1)[0] = torch.nan
-    header = {"format": FORMAT, "config": cfg.to_dict(), "record": {}}
+    header = {"format": FORMAT, "kind": "pilotnet", "config": cfg.to_dict(), "record": {}}
     model = tmp_path / "m.safetensors"
     save_file(state, str(model), metadata={"uvnav": json.dumps(header)})
     r = runner.invoke(app, ["drive", "evaluate", str(model), "--seeds", "1000", "--json"])
@@ -137,6 +137,7 @@ def test_sonar_train_refuses_a_dataset_with_one_nan(tmp_path: Path) -> None:
 
 def test_sonar_evaluate_refuses_a_checkpoint_with_nan_scaling(tmp_path: Path) -> None:
     pytest.importorskip("torch")
+    from safetensors import safe_open
     from safetensors.numpy import load_file, save_file
 
     data = tmp_path / "d.npz"
@@ -145,9 +146,11 @@ def test_sonar_evaluate_refuses_a_checkpoint_with_nan_scaling(tmp_path: Path) ->
         app, ["sonar", "train", str(data), "--out", str(tmp_path / "m"), "--max-epochs", "3"]
     )
     assert r.exit_code == 0, r.output
+    with safe_open(str(tmp_path / "m.safetensors"), framework="numpy") as fh:
+        meta = fh.metadata()  # the header: kept, only a scaling value is changed
     arrays = load_file(str(tmp_path / "m.safetensors"))
     arrays["y_hi"][0] = np.nan
-    save_file(arrays, str(tmp_path / "m.safetensors"))
+    save_file(arrays, str(tmp_path / "m.safetensors"), metadata=meta)
     for args in (
         ["sonar", "evaluate", str(tmp_path / "m"), str(data)],
         ["sonar", "simulate", "thesis-ch5-scene1", "--locator", "network", "--model",

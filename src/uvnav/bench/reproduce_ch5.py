@@ -27,9 +27,14 @@ obstacles, whether Scene 2's inner space was entered) go to ``effective_params``
 
 **Resumable.**  Nothing measured is lost when a run is interrupted: every sampled data set (with
 the generator state after sampling, so training continues exactly as in one go), every learning
-row and its trained network are cached under ``results_dir/ch5/cache`` as they finish, and every
-random-campaign episode is one transaction of the store; a re-run skips what is there (``fresh``
-drops the cache; stored episodes are never deleted or replaced by a later run).
+row and its trained network are cached under ``results_dir/ch5/cache`` as they finish — stages of
+:class:`uvnav.stages.Stages` in ``ch5/cache/stages/``, the files written atomically; a row is
+built on its data set's stage and names the independent test set, so new data retrain it — and
+every random-campaign episode is one transaction of the store; a re-run skips what is there
+(``fresh`` drops the cache; stored episodes are never deleted or replaced by a later run).  A
+cache written before the stage cache (``row_*.json``, ``data_*.rng.json``, no ``stages/``) is
+dropped and recomputed from the same seeds (the same data; a network trained again to the same
+weights keeps its digest, which covers the weights only, and so its stored episodes).
 ``results_dir/ch5.json`` (rows, table, per-group summary, failures) and the table
 "thesis reported vs uvnav measured" are computed from the measured rows only.  Figures are drawn
 by a renderer the caller injects (``bench`` may not import ``viz``, DESIGN §1).
@@ -40,11 +45,10 @@ from __future__ import annotations
 import hashlib
 import json
 import math
-import os
 import shutil
 import time
 from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -86,6 +90,7 @@ from uvnav.scenarios.ch5 import (
 from uvnav.sensors.sonar_dataset import SonarDataset, sample_sonar_dataset
 from uvnav.sim.episode_uuv3d import UUV3DResult, run_uuv3d_episode
 from uvnav.sim.metrics import METRIC_NAMES
+from uvnav.stages import Stages, write_atomic
 
 QUICK_SIZES: tuple[int, ...] = (50, 150)
 FULL_SIZES: tuple[int, ...] = (50, 150, 500, 5000)
@@ -136,6 +141,8 @@ DENSE_CAMPAIGN = "ch5-dense"
 CAMPAIGNS: tuple[str, ...] = (SCENES_CAMPAIGN, RANDOM_CAMPAIGN, NOISE_CAMPAIGN, DENSE_CAMPAIGN)
 #: seed of the closed-loop network's data and of the independent test set
 CLOSED_LOOP_SEED, TEST_SEED = 100, 999_999
+#: the resume cache's stage records (:class:`uvnav.stages.Stages`), in ``ch5/cache``
+STAGES_DIR = "stages"
 
 
 def make_locator(
@@ -191,13 +198,13 @@ class Ch5Summary:
 # ------------------------------------------------------------------------------------- learning
 
 
-def _write_atomic(path: Path, write: Callable[[Any], None], mode: str = "wb") -> None:
-    """Write ``path`` through a temporary file and rename it (an interrupted write leaves no
-    half file that a resumed run would trust)."""
-    tmp = path.with_name(path.name + ".part")
-    with open(tmp, mode) as fh:
-        write(fh)
-    os.replace(tmp, path)
+def _dataset_stage(n: int, rng_seed: int) -> tuple[str, dict[str, Any]]:
+    """Stage name and key of a sampled data set."""
+    return f"data_n{n}_r{rng_seed}", {
+        "n": n,
+        "rng_seed": rng_seed,
+        "subdivisions": DATA_SUBDIVISIONS,
+    }
 
 
 def cached_dataset(
@@ -205,31 +212,48 @@ def cached_dataset(
     rng_seed: int,
     cache: Path | None = None,
     on_sample: Callable[[int], None] | None = None,
+    *,
+    stages: Stages | None = None,
 ) -> tuple[SonarDataset, np.random.Generator]:
     """``n`` samples drawn with ``default_rng(rng_seed)`` and that generator *after* sampling.
 
-    With ``cache`` the data set and the generator's state are read from / written to
-    ``cache/data_n<n>_r<rng_seed>.npz`` (+ ``.rng.json``), so a resumed run trains on the same
-    data with the same random stream as an uninterrupted one.
+    With ``cache`` the data set is read from / written to ``cache/data_n<n>_r<rng_seed>.npz``
+    and the generator's state is the value of the stage ``data_n<n>_r<rng_seed>`` of ``stages``
+    (default ``Stages(cache / "stages")``), so a resumed run trains on the same data with the same
+    random stream as an uninterrupted one.
     """
     rng = np.random.default_rng(rng_seed)
-    f = st = None
-    if cache is not None:
-        cache.mkdir(parents=True, exist_ok=True)
-        f = cache / f"data_n{n}_r{rng_seed}.npz"
-        st = cache / f"data_n{n}_r{rng_seed}.rng.json"
-        if f.is_file() and st.is_file():
+    if cache is None:
+        return sample_sonar_dataset(
+            n, rng, subdivisions=DATA_SUBDIVISIONS, on_sample=on_sample
+        ), rng
+    stages = stages if stages is not None else Stages(cache / STAGES_DIR)
+    name, key = _dataset_stage(n, rng_seed)
+    f = cache / f"{name}.npz"
+    state = stages.get(name, key, (f,))
+    if state is not None:
+        try:
             with np.load(f, allow_pickle=False) as z:
                 ds = SonarDataset.from_arrays({k: z[k] for k in z.files})
-            rng.bit_generator.state = json.loads(st.read_text())
+            rng.bit_generator.state = state
             return ds, rng
+        except (OSError, ValueError, KeyError, TypeError):
+            stages.reused.remove(name)  # an unreadable file: sample again
+            rng = np.random.default_rng(rng_seed)
     ds = sample_sonar_dataset(n, rng, subdivisions=DATA_SUBDIVISIONS, on_sample=on_sample)
-    if f is not None and st is not None:
-        arrays: dict[str, Any] = ds.arrays()
-        _write_atomic(f, lambda fh: np.savez(fh, **arrays))
-        state = json.dumps(rng.bit_generator.state)
-        _write_atomic(st, lambda fh: fh.write(state), "w")
+    arrays: dict[str, Any] = ds.arrays()
+    write_atomic(f, lambda fh: np.savez(fh, **arrays))
+    stages.put(name, key, rng.bit_generator.state)
     return ds, rng
+
+
+def _dataset_digest(ds: SonarDataset) -> str:
+    """First 16 hex digits of the SHA-256 of a data set's arrays."""
+    h = hashlib.sha256()
+    for k, a in sorted(ds.arrays().items()):
+        h.update(k.encode())
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()[:16]
 
 
 def learning_row(
@@ -240,21 +264,32 @@ def learning_row(
     *,
     cache: Path | None = None,
     on_sample: Callable[[int], None] | None = None,
+    stages: Stages | None = None,
 ) -> tuple[dict[str, Any], TrainedBPNN, SonarDataset]:
     """Train on ``n`` fresh samples (seed ``seed``) and measure errors (module docstring).
 
-    With ``cache`` the data set, the row and the trained network are kept there and reused by a
-    later call with the same ``(n, seed, variant)`` (resume).
+    With ``cache`` the data set, the row and the trained network are kept there (the row is the
+    stage ``row_n<n>_s<seed>_<variant>`` of ``stages``, default ``Stages(cache / "stages")``,
+    the network ``cache/model_n<n>_s<seed>_<variant>``) and reused by a later call with the same
+    settings, the same data set stage and the same independent test set (resume).
     """
     cfg = config or BPNNConfig()
     variant = cfg.variant
-    ds, rng = cached_dataset(n, 10_000 + seed, cache, on_sample)
-    key = f"n{n}_s{seed}_{variant}"
-    if cache is not None:
-        row_f = cache / f"row_{key}.json"
-        model_base = cache / f"model_{key}"
-        if row_f.is_file() and model_base.with_suffix(".safetensors").is_file():
-            return json.loads(row_f.read_text()), load_checkpoint(model_base), ds
+    if cache is not None and stages is None:
+        stages = Stages(cache / STAGES_DIR)
+    ds, rng = cached_dataset(n, 10_000 + seed, cache, on_sample, stages=stages)
+    name = f"row_n{n}_s{seed}_{variant}"
+    key: dict[str, Any] = {}
+    if cache is not None and stages is not None:
+        model_base = cache / f"model_n{n}_s{seed}_{variant}"
+        key = {
+            "config": asdict(cfg),
+            "data": stages.ref(_dataset_stage(n, 10_000 + seed)[0]),
+            "test": _dataset_digest(test),
+        }
+        row = stages.get(name, key, (model_base.with_suffix(".safetensors"),))
+        if row is not None:
+            return row, load_checkpoint(model_base), ds
     tic = time.perf_counter()
     model = train_bpnn(ds.inputs, ds.targets(), rng, cfg, offset=ds.baseline())
     train_s = time.perf_counter() - tic
@@ -276,10 +311,9 @@ def learning_row(
         "independent": ind,
         "test_group_beam_ties": beam_ties(ds, grp, pred_grp),
     }
-    if cache is not None:
-        save_checkpoint(model, cache / f"model_{key}")
-        text = json.dumps(row, default=_json_default)
-        _write_atomic(cache / f"row_{key}.json", lambda fh: fh.write(text), "w")
+    if cache is not None and stages is not None:
+        save_checkpoint(model, model_base)
+        stages.put(name, key, json.loads(json.dumps(row, default=_json_default)))
     return row, model, ds
 
 
@@ -338,9 +372,14 @@ class Ch5Job:
 
 
 def checkpoint_digest(path: Path) -> str:
-    """First 16 hex digits of the SHA-256 of a checkpoint's weights file."""
+    """First 16 hex digits of the SHA-256 of a checkpoint's weights: its arrays serialised
+    without the header (what the weights file was before the header moved into it), so the
+    digest, and the closed-loop episodes keyed on it, do not change with the format or the
+    training record."""
+    from safetensors.numpy import load_file, save
+
     st = Path(path).with_suffix(".safetensors")
-    return hashlib.sha256(st.read_bytes()).hexdigest()[:16]
+    return hashlib.sha256(save(load_file(str(st)))).hexdigest()[:16]
 
 
 _MODEL_CACHE: dict[str, TrainedBPNN] = {}
@@ -743,8 +782,9 @@ def reproduce_ch5(
     results_dir.mkdir(parents=True, exist_ok=True)
     cache = results_dir / "ch5" / "cache"
     db_path = results_dir / DB_NAME
-    if fresh and cache.exists():
-        shutil.rmtree(cache)
+    if cache.exists() and (fresh or not (cache / STAGES_DIR).is_dir()):
+        shutil.rmtree(cache)  # asked for, or a cache of the older layout (recomputed cleanly)
+    stages = Stages(cache / STAGES_DIR)
     sizes = tuple(sizes) if sizes is not None else (FULL_SIZES if full else QUICK_SIZES)
     seeds = n_seeds if n_seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
     n_rand = n_random if n_random is not None else (FULL_RANDOM if full else QUICK_RANDOM)
@@ -773,13 +813,13 @@ def reproduce_ch5(
             prog.reset(sampling, total=n, visible=True, description=f"Ch5 sampling {n}")
             return lambda k: prog.update(sampling, completed=k)
 
-        test, _ = cached_dataset(n_test, TEST_SEED, cache, sampler(n_test))
+        test, _ = cached_dataset(n_test, TEST_SEED, cache, sampler(n_test), stages=stages)
         summary.datasets["independent_test"] = test
         for n in sizes:
             for s in range(seeds):
                 for cfg in variants:
                     row, model, ds = learning_row(
-                        n, s, test, cfg, cache=cache, on_sample=sampler(n)
+                        n, s, test, cfg, cache=cache, on_sample=sampler(n), stages=stages
                     )
                     summary.learning.append(row)
                     if s == 0:
@@ -795,6 +835,7 @@ def reproduce_ch5(
             variants[1],
             cache=cache,
             on_sample=sampler(closed_loop_samples),
+            stages=stages,
         )
         prog.update(sampling, visible=False)
         summary.learning.append(cl_row)
@@ -881,7 +922,7 @@ def reproduce_ch5(
         },
     }
     summary.json_path = results_dir / "ch5.json"
-    summary.json_path.write_text(json.dumps(out, indent=1, default=_json_default))
+    write_atomic(summary.json_path, json.dumps(out, indent=1, default=_json_default))
     if render is not None and report_dir is not None:
         summary.figures = list(render(summary, Path(report_dir)))
     return summary

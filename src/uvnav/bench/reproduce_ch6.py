@@ -37,7 +37,8 @@ Resumable: the collection skips recorded episodes, and every stage (training, re
 round, each closed loop) writes its checkpoint and ``stages/<stage>.json`` as it finishes; a rerun
 with the same settings skips finished stages (``fresh=True`` reruns them; the recorded episodes
 are kept).  A stage is reused only when its settings, and those of the stages it builds on, are
-the same as recorded.
+the same as recorded (:class:`uvnav.stages.Stages`, the cache every reproduction uses; a
+``stages/`` folder written before it has the same layout and is reused, its checkpoints too).
 
 Figures are drawn by the caller from the returned :class:`Ch6Summary`
 (:func:`uvnav.viz.figures_ch6.render_ch6`), since figures live in the ``viz`` layer.
@@ -55,6 +56,8 @@ from typing import Any
 
 import numpy as np
 from numpy.typing import NDArray
+
+from uvnav.stages import Stages, write_atomic
 
 THESIS_VAL_MSE = 0.05
 THESIS_FRAMES = 17592
@@ -149,48 +152,6 @@ def augmentation_examples(
 
 
 STAGES_DIR = "stages"
-
-
-class _Stages:
-    """Finished stages of a run: ``stages/<name>.json`` = ``{"key", "id", "value"}``.
-
-    A stage is reused when its file exists, its recorded settings equal ``key`` (JSON-normalised)
-    and its files (checkpoints) exist.  Each computed stage gets a new ``id``; a stage built on
-    another puts :meth:`ref` of it in its key, so recomputing a stage invalidates every stage
-    built on it.
-    """
-
-    def __init__(self, out: Path, *, fresh: bool) -> None:
-        self.dir = out / STAGES_DIR
-        if fresh and self.dir.exists():
-            shutil.rmtree(self.dir)
-        self.dir.mkdir(parents=True, exist_ok=True)
-        self.reused: list[str] = []
-        self.ids: dict[str, str] = {}
-
-    def get(self, name: str, key: dict[str, Any], files: tuple[Path, ...] = ()) -> Any:
-        path = self.dir / f"{name}.json"
-        if not path.is_file() or not all(f.is_file() for f in files):
-            return None
-        try:
-            stored = json.loads(path.read_text())
-        except json.JSONDecodeError:
-            return None
-        if stored.get("key") != json.loads(json.dumps(key)):
-            return None
-        self.reused.append(name)
-        self.ids[name] = str(stored.get("id"))
-        return stored["value"]
-
-    def put(self, name: str, key: dict[str, Any], value: Any) -> None:
-        self.ids[name] = f"{time.time_ns():x}"
-        tmp = self.dir / f".{name}.json.tmp"
-        tmp.write_text(json.dumps({"key": key, "id": self.ids[name], "value": value}, indent=2))
-        tmp.replace(self.dir / f"{name}.json")
-
-    def ref(self, name: str) -> dict[str, str]:
-        """What a stage built on ``name`` puts in its key."""
-        return {"stage": name, "id": self.ids[name]}
 
 
 def _log_rows(root: Path) -> int:
@@ -321,7 +282,7 @@ def reproduce_ch6(
     say = progress or (lambda s: None)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    stages = _Stages(out, fresh=fresh)
+    stages = Stages(out / STAGES_DIR, fresh=fresh)
     cp = (
         CollectParams(max_steps=c_steps)
         if noise_sigma is None
@@ -476,7 +437,8 @@ def reproduce_ch6(
     examples = augmentation_examples(data.train[0][k], float(data.train[1][k]))
     table = _table(data, record, records, rows, size, head=head, full=full, tracks=tracks)
     wall = time.perf_counter() - tic
-    (out / "ch6.json").write_text(
+    write_atomic(
+        out / "ch6.json",
         json.dumps(
             {
                 "closed_loop": rows,
@@ -491,7 +453,7 @@ def reproduce_ch6(
                 "wall_s": wall,
             },
             indent=2,
-        )
+        ),
     )
     return Ch6Summary(
         table=table,

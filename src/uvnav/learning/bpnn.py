@@ -18,10 +18,13 @@ Levenberg-Marquardt; here the default is full-batch L-BFGS with a strong-Wolfe l
 regime — and Adam is an option.  Weights are initialised from the caller's
 ``numpy.random.Generator`` (Glorot-uniform), so the same seed gives the same network.
 
-Checkpoints are a ``.safetensors`` file of the weights and normalisation arrays plus a ``.json``
-file of the configuration and the training history: loading parses data only and can never
-execute code (a pickle is refused with :class:`CheckpointError`).  The forward pass of a trained
-model is plain numpy (:meth:`TrainedBPNN.predict`), so the navigation law can use it without torch.
+Checkpoints are the one format of :mod:`uvnav.learning.checkpoint` (also the CNN's): a
+``.safetensors`` file of the weights and normalisation arrays with a JSON header (the
+configuration and the training history) in its metadata, plus a ``.json`` copy of the header;
+loading parses data only and can never execute code (a pickle is refused with
+:class:`CheckpointError`), and older ``uvnav-bpnn-v1`` checkpoints still load.  The forward pass
+of a trained model is plain numpy (:meth:`TrainedBPNN.predict`), so the navigation law can use
+it without torch.
 
 torch is imported inside the functions that need it (extra ``learning``), with at most 2 threads.
 """
@@ -29,7 +32,6 @@ torch is imported inside the functions that need it (extra ``learning``), with a
 from __future__ import annotations
 
 import itertools
-import json
 import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -38,6 +40,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
+from uvnav.learning.checkpoint import CheckpointError, first_non_finite
 from uvnav.learning.runtime import require_torch
 
 #: the thesis's reported test-error ranges (target - output), Ch. 5 §5.4
@@ -53,24 +56,8 @@ MAX_THREADS = 2
 MAX_HIDDEN = 10_000
 
 
-class CheckpointError(ValueError):
-    """A model file that is not a valid uvnav BPNN checkpoint (one-line message)."""
-
-
 class NonFiniteError(ValueError):
     """A NaN or ±inf where a finite number is meant: in the data, the loss or the weights."""
-
-
-def first_non_finite(arrays: dict[str, Any]) -> str | None:
-    """Where the first NaN/±inf of some named arrays is (``"name[i, j] = nan"``), or ``None``."""
-    for name, value in arrays.items():
-        a = np.asarray(value, dtype=float)
-        bad = np.argwhere(~np.isfinite(a))
-        if len(bad):
-            where = tuple(int(i) for i in bad[0])
-            index = ", ".join(str(i) for i in where)
-            return f"{name}[{index}] = {float(a[where])}" if where else f"{name} = {float(a)}"
-    return None
 
 
 def _model_arrays(model: TrainedBPNN) -> dict[str, Any]:
@@ -437,7 +424,10 @@ def error_table(
 
 
 def save_checkpoint(model: TrainedBPNN, path: Path) -> tuple[Path, Path]:
-    """Write ``<path>.safetensors`` (weights, scaling) and ``<path>.json`` (config, history).
+    """Write ``<path>.safetensors`` (weights and min/max scaling as float64 arrays, the header in
+    its metadata) and ``<path>.json`` (the header's copy), in the one checkpoint format of
+    :mod:`uvnav.learning.checkpoint` (kind ``bpnn``; the record holds the history, best epoch,
+    stop reason and division).
 
     Returns:
         The two paths written.
@@ -445,72 +435,55 @@ def save_checkpoint(model: TrainedBPNN, path: Path) -> tuple[Path, Path]:
     Raises:
         NonFiniteError: a weight or scaling value is NaN/±inf (nothing is written).
     """
-    from safetensors.numpy import save_file
+    from uvnav.learning.checkpoint import write_checkpoint
 
-    from uvnav.learning.checkpoint import json_safe
-
-    tensors = {k: np.ascontiguousarray(v) for k, v in _model_arrays(model).items()}
-    bad = first_non_finite(tensors)
+    arrays = {k: np.asarray(v, dtype=np.float64) for k, v in _model_arrays(model).items()}
+    bad = first_non_finite(arrays)
     if bad is not None:
         raise NonFiniteError(f"{path}: refusing to save a network with {bad}")
     base = Path(path)
     if base.suffix in (".safetensors", ".json"):
         base = base.with_suffix("")
-    base.parent.mkdir(parents=True, exist_ok=True)
-    st_path = base.with_suffix(".safetensors")
-    save_file({k: np.asarray(v, dtype=np.float64) for k, v in tensors.items()}, str(st_path))
-    meta = {
-        "format": "uvnav-bpnn-v1",
-        "config": asdict(model.config),
-        "n_layers": len(model.weights),
+    record = {
         "history": model.history,
         "best_epoch": model.best_epoch,
         "stop_reason": model.stop_reason,
         "split": {k: [int(i) for i in v] for k, v in model.split.items()},
     }
-    js_path = base.with_suffix(".json")
-    js_path.write_text(json.dumps(json_safe(meta), indent=1, allow_nan=False))
-    return st_path, js_path
+    st_path = write_checkpoint(
+        base.with_suffix(".safetensors"),
+        arrays,
+        kind="bpnn",
+        config=asdict(model.config),
+        record=record,
+    )
+    return st_path, st_path.with_suffix(".json")
 
 
 def load_checkpoint(path: Path) -> TrainedBPNN:
-    """Read a checkpoint written by :func:`save_checkpoint` (either file's path, or the stem).
+    """Read a BPNN checkpoint (either file's path, or the stem): the one format of
+    :mod:`uvnav.learning.checkpoint`, or a legacy ``uvnav-bpnn-v1`` one (its reader is there).
 
-    Only data are parsed (safetensors header + raw arrays, and JSON); nothing is unpickled.
+    Only data are parsed (safetensors header + raw arrays, and JSON); nothing is unpickled, and
+    torch is not needed.
 
     Raises:
-        CheckpointError: missing file, a file that is not safetensors (e.g. a pickle),
-            missing/inconsistent arrays, or a weight or scaling value that is NaN/±inf — one
-            line naming the file and the problem.
+        CheckpointError: missing file, a file that is not safetensors (e.g. a pickle), another
+            format or kind, missing/inconsistent arrays, or a weight or scaling value that is
+            NaN/±inf — one line naming the file and the problem.
     """
-    from safetensors import SafetensorError
-    from safetensors.numpy import load_file
+    from uvnav.learning.checkpoint import read_checkpoint, weights_path
 
-    base = Path(path)
-    if base.suffix in (".safetensors", ".json"):
-        base = base.with_suffix("")
-    st_path, js_path = base.with_suffix(".safetensors"), base.with_suffix(".json")
-    for p in (st_path, js_path):
-        if not p.is_file():
-            raise CheckpointError(f"{p}: checkpoint file not found")
+    st_path = weights_path(path)
+    if not st_path.is_file():
+        raise CheckpointError(f"{st_path}: checkpoint file not found")
     try:
-        tensors = load_file(str(st_path))
-    except (SafetensorError, OSError, ValueError) as exc:
-        first = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise CheckpointError(f"{st_path}: not a safetensors checkpoint ({first})") from exc
+        tensors, header = read_checkpoint(st_path, "bpnn")
+    except FileNotFoundError as exc:  # the legacy JSON vanished meanwhile
+        raise CheckpointError(f"{exc.filename}: checkpoint file not found") from None
+    record = dict(header.get("record") or {})
     try:
-        meta = json.loads(js_path.read_text())
-    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
-        raise CheckpointError(f"{js_path}: not valid JSON ({exc.__class__.__name__})") from exc
-    if not isinstance(meta, dict) or meta.get("format") != "uvnav-bpnn-v1":
-        raise CheckpointError(f"{js_path}: field 'format' must be 'uvnav-bpnn-v1'")
-    cfg_d = meta.get("config")
-    if not isinstance(cfg_d, dict):
-        raise CheckpointError(
-            f"{js_path}: config: must be a mapping (got {type(cfg_d).__name__}: {cfg_d!r:.40})"
-        )
-    try:
-        cfg_d = dict(cfg_d)
+        cfg_d = dict(header["config"])
         for key in ("hidden", "fractions"):
             value = cfg_d.get(key)
             if not isinstance(value, list | tuple) or any(isinstance(v, bool | str) for v in value):
@@ -518,33 +491,30 @@ def load_checkpoint(path: Path) -> TrainedBPNN:
             cfg_d[key] = tuple(value)
         cfg = BPNNConfig(**cfg_d)
     except (TypeError, ValueError) as exc:
-        raise CheckpointError(f"{js_path}: config: {exc}") from None
+        raise CheckpointError(f"{st_path}: config: {exc}") from None
     try:
-        n_layers = int(meta["n_layers"])
+        n_layers = len(cfg.hidden) + 1
         weights = [
             (tensors[f"layer{k}.weight"], tensors[f"layer{k}.bias"]) for k in range(n_layers)
         ]
         scal = {k: tensors[k] for k in ("x_lo", "x_hi", "y_lo", "y_hi")}
     except (KeyError, TypeError, ValueError) as exc:
-        raise CheckpointError(f"{base}: incomplete checkpoint ({exc})") from exc
+        raise CheckpointError(f"{st_path}: incomplete checkpoint ({exc})") from exc
     for k in range(1, n_layers):
         if weights[k][0].shape[1] != weights[k - 1][0].shape[0]:
             raise CheckpointError(f"{st_path}: layer{k}.weight does not fit layer{k - 1}")
     sizes = [int(w.shape[0]) for w, _ in weights[:-1]]
     if sizes != [int(h) for h in cfg.hidden]:
         raise CheckpointError(
-            f"{js_path}: config.hidden {list(cfg.hidden)} does not match the weights' hidden "
-            f"layer sizes {sizes} in {st_path.name}"
+            f"{st_path}: config.hidden {list(cfg.hidden)} does not match the weights' hidden "
+            f"layer sizes {sizes}"
         )
-    bad = first_non_finite(tensors)
-    if bad is not None:
-        raise CheckpointError(f"{st_path}: {bad} is not a finite number (a diverged network)")
     return TrainedBPNN(
         config=cfg,
         weights=weights,
-        history=dict(meta.get("history", {})),
-        best_epoch=int(meta.get("best_epoch", 0)),
-        stop_reason=str(meta.get("stop_reason", "")),
-        split={k: np.asarray(v, dtype=np.int64) for k, v in dict(meta.get("split", {})).items()},
+        history=dict(record.get("history", {})),
+        best_epoch=int(record.get("best_epoch", 0)),
+        stop_reason=str(record.get("stop_reason", "")),
+        split={k: np.asarray(v, dtype=np.int64) for k, v in dict(record.get("split", {})).items()},
         **scal,
     )
