@@ -33,8 +33,9 @@ This module imports nothing from uvnav: it is the bottom layer.
 from __future__ import annotations
 
 import time as _time
-from collections.abc import Sequence
+from collections.abc import Collection, Sequence
 from dataclasses import dataclass, field
+from importlib.metadata import entry_points
 from typing import Any, ClassVar, Protocol, TypeVar, runtime_checkable
 
 import numpy as np
@@ -218,3 +219,18 @@ def run_loop(
     for p in probes:
         p.on_end(world, laws)
     return logs
+
+
+def load_plugins(group: str, taken: Collection[str] = (), what: str = "plug-in") -> dict[str, Any]:
+    """The objects of the entry points of ``group`` by name (third-party laws' siblings: scene
+    generators, motion models, sensors).
+
+    Raises:
+        RuntimeError: a plug-in takes a name in ``taken`` (the built-ins') or another plug-in's.
+    """
+    found: dict[str, Any] = {}
+    for ep in entry_points(group=group):
+        if ep.name in taken or ep.name in found:
+            raise RuntimeError(f"{what} {ep.name!r} of {ep.value} is already registered")
+        found[ep.name] = ep.load()
+    return found

@@ -8,6 +8,7 @@ from typing import Any
 
 import pytest
 
+import uvnav.core as core
 import uvnav.scenarios.catalog as catalog
 from uvnav.scenarios.errors import ScenarioError
 from uvnav.scenarios.generators import random_ch2_scenario
@@ -25,7 +26,9 @@ class FakeEntryPoint:
 def plugins(monkeypatch: pytest.MonkeyPatch) -> Any:
     def install(**objs: Any) -> None:
         eps = [FakeEntryPoint(n.replace("_", "-"), o) for n, o in objs.items()]
-        monkeypatch.setattr(catalog, "entry_points", lambda group: eps)
+        monkeypatch.setattr(
+            core, "entry_points", lambda group: eps if group == catalog.GENERATOR_GROUP else []
+        )
         monkeypatch.setattr(catalog, "_PLUGINS", None)
 
     yield install

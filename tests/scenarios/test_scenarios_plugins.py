@@ -9,6 +9,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+import uvnav.core as core
 import uvnav.obstacles.motion as motion
 import uvnav.sensors.plugins as sensors
 from uvnav.obstacles.motion import ObstacleState
@@ -57,8 +58,7 @@ def plugins(monkeypatch: pytest.MonkeyPatch) -> Any:
         motion.MOTION_GROUP: [FakeEntryPoint("circling", Circling)],
         sensors.SENSOR_GROUP: [FakeEntryPoint("gap", nearest_gap)],
     }
-    monkeypatch.setattr(motion, "entry_points", lambda group: groups.get(group, []))
-    monkeypatch.setattr(sensors, "entry_points", lambda group: groups.get(group, []))
+    monkeypatch.setattr(core, "entry_points", lambda group: groups.get(group, []))
     monkeypatch.setattr(motion, "_PLUGINS", None)
     monkeypatch.setattr(sensors, "_PLUGINS", None)
     return groups

@@ -16,11 +16,11 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from importlib.metadata import entry_points
 from typing import Any, Protocol
 
 import numpy as np
 
+from uvnav.core import load_plugins
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 
 
@@ -73,12 +73,7 @@ def motion_plugins() -> dict[str, Callable[..., Any]]:
     """
     global _PLUGINS
     if _PLUGINS is None:
-        found: dict[str, Callable[..., Any]] = {}
-        for ep in entry_points(group=MOTION_GROUP):
-            if ep.name in BUILTIN_MOTIONS or ep.name in found:
-                raise RuntimeError(f"motion {ep.name!r} of {ep.value} is already registered")
-            found[ep.name] = ep.load()
-        _PLUGINS = found
+        _PLUGINS = load_plugins(MOTION_GROUP, BUILTIN_MOTIONS, "motion")
     return _PLUGINS
 
 

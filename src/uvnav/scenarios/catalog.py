@@ -29,13 +29,13 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
-from importlib.metadata import entry_points
 from pathlib import Path
 from typing import Annotated, Any, Union
 
 import numpy as np
 from pydantic import Discriminator, Tag, TypeAdapter
 
+from uvnav.core import load_plugins
 from uvnav.scenarios.errors import ScenarioError
 
 
@@ -259,21 +259,15 @@ def plugin_generators() -> dict[str, Callable[..., Any]]:
     """The generators of the :data:`GENERATOR_GROUP` entry points (loaded once)."""
     global _PLUGINS
     if _PLUGINS is None:
-        plugins: dict[str, Callable[..., Any]] = {}
         builtin = {g for k in kinds().values() for g in k.generators}
-        for ep in entry_points(group=GENERATOR_GROUP):
-            if ep.name in builtin or ep.name in plugins:
-                raise RuntimeError(
-                    f"scene generator {ep.name!r} of {ep.value} is already registered"
-                )
-            fn = ep.load()
+        plugins = load_plugins(GENERATOR_GROUP, builtin, "scene generator")
+        for name, fn in plugins.items():
             kind = getattr(fn, "scene_kind", "nav2d")
             if kind not in KINDS:
                 raise RuntimeError(
-                    f"scene generator {ep.name!r}: unknown scene_kind {kind!r}; "
+                    f"scene generator {name!r}: unknown scene_kind {kind!r}; "
                     f"known: {', '.join(KINDS)}"
                 )
-            plugins[ep.name] = fn
         _PLUGINS = plugins
     return _PLUGINS
 

@@ -28,7 +28,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_valida
 from uvnav.dynamics.vehicle3d import Vehicle3DSpec
 from uvnav.obstacles.deforming3d import CompoundBody, as_compound, horseshoe, random_star
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import check_episode_steps, check_magnitudes
+from uvnav.scenarios.limits import check_magnitudes, check_timing
 from uvnav.scenarios.loader import builtin_yaml_files, parse_yaml
 from uvnav.sensors.sonar_array import SonarArray
 from uvnav.sim.episode_uuv3d import UUV3DSetup
@@ -137,13 +137,7 @@ class Scenario5(_Model):
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario5:
-        check_episode_steps(self.t_max, self.dt)
-        ratio = self.control_period / self.dt
-        if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
-            raise FieldError(
-                "control_period",
-                f"must be a positive multiple of dt={self.dt:g} s (got {self.control_period:g})",
-            )
+        check_timing(self.t_max, self.dt, self.control_period)
         r = self.robot
         start, goal = np.asarray(r.start, float), np.asarray(r.goal, float)
         if float(np.linalg.norm(goal - start)) <= self.goal_tolerance:

@@ -42,6 +42,23 @@ def check_episode_steps(t_max: float, dt: float) -> None:
         )
 
 
+def check_timing(t_max: float, dt: float, control_period: float) -> None:
+    """The timing of every scene kind: at most :data:`MAX_EPISODE_STEPS` integration steps, and
+    a decision period that is a positive whole multiple of ``dt`` (within 1e-9 relative, as
+    :func:`uvnav.sim.episode.decision_ratio` requires).
+
+    Raises:
+        FieldError: on ``dt`` or ``control_period``.
+    """
+    check_episode_steps(t_max, dt)
+    ratio = control_period / dt
+    if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
+        raise FieldError(
+            "control_period",
+            f"must be a positive multiple of dt={dt:g} s (got {control_period:g})",
+        )
+
+
 #: largest magnitude of a number in a 3D scene file (coordinates [m], sizes [m], speeds [m/s]):
 #: beyond it squared distances overflow float64 in the mesh geometry; seeds are exempt
 MAX_MAGNITUDE = 1e9

@@ -30,7 +30,7 @@ from pydantic import Field, PrivateAttr, ValidationError, model_validator
 
 from uvnav.controllers.base import make_controller
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import check_episode_steps
+from uvnav.scenarios.limits import check_timing
 from uvnav.scenarios.schema import (
     MOTION_TYPES,
     ControllerSpec,
@@ -82,13 +82,7 @@ class MultiScenario(_Model):
 
     @model_validator(mode="after")
     def _consistent(self) -> MultiScenario:
-        check_episode_steps(self.t_max, self.dt)
-        ratio = self.control_period / self.dt
-        if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
-            raise FieldError(
-                "control_period",
-                f"must be a positive multiple of dt={self.dt:g} s (got {self.control_period:g})",
-            )
+        check_timing(self.t_max, self.dt, self.control_period)
         starts = np.array([r.start for r in self.robots], dtype=float)
         goals = np.array([r.goal for r in self.robots], dtype=float)
         radii = np.array([r.radius for r in self.robots], dtype=float)

@@ -46,7 +46,7 @@ from uvnav.obstacles import (
 from uvnav.obstacles.motion import motion_plugins
 from uvnav.scenarios import pedestrians
 from uvnav.scenarios.errors import FieldError, ScenarioError
-from uvnav.scenarios.limits import check_episode_steps
+from uvnav.scenarios.limits import check_timing
 from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sim import LidarConfig, SensingConfig
 
@@ -623,13 +623,7 @@ class Scenario(_Model):
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario:
-        check_episode_steps(self.t_max, self.dt)
-        ratio = self.control_period / self.dt
-        if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
-            raise FieldError(
-                "control_period",
-                f"must be a positive multiple of dt={self.dt:g} s (got {self.control_period:g})",
-            )
+        check_timing(self.t_max, self.dt, self.control_period)
         rng = np.random.default_rng(0)
         obstacles = [o.to_obstacle(rng, self.dt, j) for j, o in enumerate(self.obstacles)]
         if obstacles:

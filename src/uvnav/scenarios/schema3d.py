@@ -42,7 +42,7 @@ from uvnav.obstacles.motion3d import (
     Waypoints3D,
 )
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import check_episode_steps, check_magnitudes
+from uvnav.scenarios.limits import check_magnitudes, check_timing
 from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, clearance3d
 
 Point3 = Annotated[tuple[float, float, float], Field(description="[x, y, z] [m]")]
@@ -297,10 +297,7 @@ class Scenario3D(_Model):
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario3D:
-        check_episode_steps(self.t_max, self.dt)
-        ratio = self.control_period / self.dt
-        if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
-            raise FieldError("control_period", f"must be a positive multiple of dt={self.dt:g} s")
+        check_timing(self.t_max, self.dt, self.control_period)
         for j, ob in enumerate(self.obstacles):
             v_b, u_b = ob.motion.bounds()
             if v_b >= self.robot.v_max:

@@ -33,7 +33,7 @@ from uvnav.obstacles.deforming import (
     trap_polygon,
 )
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import check_episode_steps
+from uvnav.scenarios.limits import check_timing
 from uvnav.scenarios.loader import builtin_yaml_files, natural_key, parse_yaml
 from uvnav.sensors.sonar2d import SonarConfig
 from uvnav.sim.episode_uuv2d import Uuv2dSetup, clearance_of, inside_any
@@ -191,13 +191,7 @@ class Uuv2dScenario(_Model):
 
     @model_validator(mode="after")
     def _consistent(self) -> Uuv2dScenario:
-        check_episode_steps(self.t_max, self.dt)
-        ratio = self.control_period / self.dt
-        if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
-            raise FieldError(
-                "control_period",
-                f"must be a positive multiple of dt={self.dt:g} s (got {self.control_period:g})",
-            )
+        check_timing(self.t_max, self.dt, self.control_period)
         shapes = [o.to_shape() for o in self.obstacles]
         outlines = [s.outline(0.0) for s in shapes]
         gap, j = clearance_of(self.vehicle.start, outlines, self.vehicle.radius)

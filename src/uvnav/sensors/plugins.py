@@ -12,8 +12,9 @@ built-in sensors (exact readings, lidar) are not plug-ins and their names are re
 from __future__ import annotations
 
 from collections.abc import Callable
-from importlib.metadata import entry_points
 from typing import Any
+
+from uvnav.core import load_plugins
 
 SENSOR_GROUP = "uvnav.sensors"
 #: names of the built-in sensors (a plug-in may not take them)
@@ -30,12 +31,7 @@ def sensor_plugins() -> dict[str, Callable[..., Any]]:
     """
     global _PLUGINS
     if _PLUGINS is None:
-        found: dict[str, Callable[..., Any]] = {}
-        for ep in entry_points(group=SENSOR_GROUP):
-            if ep.name in BUILTIN_SENSORS or ep.name in found:
-                raise RuntimeError(f"sensor {ep.name!r} of {ep.value} is already registered")
-            found[ep.name] = ep.load()
-        _PLUGINS = found
+        _PLUGINS = load_plugins(SENSOR_GROUP, BUILTIN_SENSORS, "sensor")
     return _PLUGINS
 
 
