@@ -245,3 +245,34 @@ def test_real_interruptions_then_resume_equal_an_uninterrupted_run(
     assert run_in_process(db, campaign_file)
     assert_same_rows(db, reference)
 
+
+# A worker killed while it writes a result left the pool's manager thread blocked reading the rest
+# of the message, and Python joins that thread at exit: Ctrl-C hung.  Results of 40 MB keep the
+# second worker writing when the first result interrupts the pool.
+MID_WRITE = """\
+import concurrent.futures.process as cfp
+from uvnav.bench.campaign import run_in_workers
+
+def stop(result):
+    raise KeyboardInterrupt
+
+if __name__ == "__main__":
+    try:
+        run_in_workers([40_000_000] * 8, bytes, stop, workers=2)
+    except KeyboardInterrupt:
+        pass
+    threads = list(cfp._threads_wakeups)
+    for t in threads:
+        t.join(10)
+    print("stuck:", sum(t.is_alive() for t in threads))
+"""
+
+
+def test_interrupt_while_a_worker_writes_its_result_does_not_hang(tmp_path: Path) -> None:
+    script = tmp_path / "mid_write.py"
+    script.write_text(MID_WRITE)
+    done = subprocess.run(
+        [sys.executable, str(script)], capture_output=True, text=True, timeout=30, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "stuck: 0", done.stdout + done.stderr
