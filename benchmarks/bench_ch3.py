@@ -19,8 +19,9 @@ and with ``--against DIR`` also for another uvnav source tree (e.g. the commit b
 this checkout; the ratios are what to compare on a busy machine.  Each timing is also taken in
 the process's own CPU time (``time.thread_time`` / ``process_time``; ``cpu_*`` keys), which on a
 machine shared with other jobs is close to what the wall time would be on an idle one.  The
-targets are checked on the compiled path (this checkout's default with the ``fast`` extra), in
-wall time (``pass``) and in CPU time (``pass_cpu``).
+targets are checked on the compiled path (this checkout's default with the ``fast`` extra) and
+judged on CPU time (``measured``/``pass``, also ``measured_cpu``/``pass_cpu``); the wall-time
+verdict is reported beside it (``measured_wall``/``pass_wall``).
 """
 
 from __future__ import annotations
@@ -272,23 +273,27 @@ def run(quick: bool, against: Path | None = None, rounds: int | None = None) -> 
         "targets": {
             "ch3_decision_us_median_10": {
                 "benchmark": "ch3",
-                "what": "zhang2020-3d-v1 median decision time, 10 mesh obstacles in range [µs]",
+                "what": "zhang2020-3d-v1 median decision CPU time, 10 mesh obstacles in range [µs]",
                 "limit": TARGETS["decision_us_median_10"],
                 "direction": "<=",
-                "measured": dec_med,
-                "pass": dec_med <= TARGETS["decision_us_median_10"],
+                "measured": dec_cpu,  # judged on CPU time
+                "pass": dec_cpu <= TARGETS["decision_us_median_10"],
                 "measured_cpu": dec_cpu,
                 "pass_cpu": dec_cpu <= TARGETS["decision_us_median_10"],
+                "measured_wall": dec_med,
+                "pass_wall": dec_med <= TARGETS["decision_us_median_10"],
             },
             "ch3_world_steps_per_s_10": {
                 "benchmark": "ch3",
-                "what": "run_episode3d steps per second, 10 moving mesh obstacles",
+                "what": "run_episode3d steps per CPU second, 10 moving mesh obstacles",
                 "limit": TARGETS["world_steps_per_s_10"],
                 "direction": ">=",
-                "measured": sps_med,
-                "pass": sps_med >= TARGETS["world_steps_per_s_10"],
+                "measured": sps_cpu,  # judged on CPU time
+                "pass": sps_cpu >= TARGETS["world_steps_per_s_10"],
                 "measured_cpu": sps_cpu,
                 "pass_cpu": sps_cpu >= TARGETS["world_steps_per_s_10"],
+                "measured_wall": sps_med,
+                "pass_wall": sps_med >= TARGETS["world_steps_per_s_10"],
             },
         },
     }

@@ -8,7 +8,12 @@ the targets.  Numbers that are compared are measured side by side in the same ru
 
 Benchmarks:
 
-* ``decision_time``: wall time of one ``Controller.act`` call [µs] (median, p99) for every
+Every timing is CPU time (``time.thread_time_ns`` around a single-threaded call, ``process_time``
+around an episode; ``cpu_*`` keys, first in the tables) with wall time beside it, and every
+target is judged on CPU time, so that a loaded machine's pre-emptions do not fail it; warm-up
+calls (imports, JIT compilation) run before the clock starts and are discarded.
+
+* ``decision_time``: CPU and wall time of one ``Controller.act`` call [µs] (median, p99) for every
   registered controller with 1, 10, 100 obstacles in sensing range (random non-convex polygons,
   moving and rotating, sensed with :func:`uvnav.sensors.sense_obstacles`).
 * ``world_steps``: integration steps per second of :func:`uvnav.sim.run_episode` (robot step,
@@ -34,6 +39,7 @@ machine.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import cProfile
 import io
 import json
@@ -75,19 +81,19 @@ WORLD_COUNTS = (10, 100)
 TARGETS = {
     "zhang2019_decision_us_median_10": {
         "benchmark": "decision_time",
-        "what": "zhang2019-v1 median decision time with 10 obstacles in sensing range [µs]",
+        "what": "zhang2019-v1 median decision CPU time with 10 obstacles in sensing range [µs]",
         "limit": 100.0,
         "direction": "<=",
     },
     "world_steps_per_s_10": {
         "benchmark": "world_steps",
-        "what": "run_episode integration steps per second with 10 moving non-convex polygons",
+        "what": "run_episode integration steps per CPU second with 10 moving non-convex polygons",
         "limit": 5000.0,
         "direction": ">=",
     },
     "ch4_decision_us_median": {
         "benchmark": "ch4_decision",
-        "what": "zhang2022-uuv2d-v1 median decision time, 0.05 m AMAPS grid over 10x10 m [µs]",
+        "what": "zhang2022-uuv2d-v1 median decision CPU time, 0.05 m AMAPS grid over 10x10 m [µs]",
         "limit": 500.0,
         "direction": "<=",
     },
@@ -289,27 +295,32 @@ def bench_decision(quick: bool) -> dict[str, Any]:
                 ctrl = make_controller(name)
                 ctrl.reset(CH2_SPEC, observations[0].goal, np.random.default_rng(0))
                 samples: list[float] = []
-                perf = time.perf_counter_ns
+                cpu_samples: list[float] = []
+                perf, cpu = time.perf_counter_ns, time.thread_time_ns
                 start = time.perf_counter()
                 warm = True
                 for i, obs in enumerate(observations):
-                    tic = perf()
+                    tic, cpu_tic = perf(), cpu()
                     ctrl.act(obs)
-                    toc = perf()
+                    cpu_toc, toc = cpu(), perf()
                     now = time.perf_counter()
                     if warm:  # warm up for `warmup` calls or 10 % of the budget, at least 3 calls
                         warm = i + 1 < 3 or (i + 1 < warmup and now - start < 0.1 * budget_s)
                         continue
                     samples.append((toc - tic) / 1000.0)
+                    cpu_samples.append((cpu_toc - cpu_tic) / 1000.0)
                     if len(samples) >= min_calls and now - start > budget_s:
                         break
             except Exception as exc:
                 per_n[str(n)] = _error(exc)
                 continue
-            arr = np.asarray(samples)
+            arr, cpu_arr = np.asarray(samples), np.asarray(cpu_samples)
             per_n[str(n)] = {
                 "calls": len(arr),
                 "obstacles_in_range": len(observations[0].obstacles),
+                "cpu_median_us": float(np.median(cpu_arr)),
+                "cpu_p99_us": float(np.percentile(cpu_arr, 99)),
+                "cpu_mean_us": float(cpu_arr.mean()),
                 "median_us": float(np.median(arr)),
                 "p99_us": float(np.percentile(arr, 99)),
                 "mean_us": float(arr.mean()),
@@ -325,16 +336,17 @@ def bench_decision(quick: bool) -> dict[str, Any]:
             ref = base.get(n) if isinstance(base, dict) else None
             if (
                 isinstance(row, dict)
-                and "median_us" in row
+                and "cpu_median_us" in row
                 and isinstance(ref, dict)
-                and "median_us" in ref
+                and "cpu_median_us" in ref
             ):
-                row["median_vs_straight"] = row["median_us"] / ref["median_us"]
+                row["median_vs_straight"] = row["cpu_median_us"] / ref["cpu_median_us"]
     zhang = results.get("zhang2019-v1", {}).get("10", {})
-    measured = zhang.get("median_us") if isinstance(zhang, dict) else None
+    measured = zhang.get("cpu_median_us") if isinstance(zhang, dict) else None  # judged on CPU
     return {
         "benchmark": "decision_time",
-        "description": "Controller.act wall time per decision (obstacles from sense_obstacles)",
+        "description": "Controller.act time per decision: this thread's CPU time (cpu_*, judged) "
+        "and wall time (obstacles from sense_obstacles)",
         "params": {
             "obstacle_counts": OBSTACLE_COUNTS,
             "max_calls": n_calls,
@@ -365,12 +377,13 @@ def _target(key: str, measured: float | None) -> dict[str, Any]:
 
 def _time_episode(
     setup_fn: Callable[[], EpisodeSetup], controller: str, seed: int, record: bool
-) -> tuple[float, Any]:
+) -> tuple[float, Any, float]:
+    """(wall s, result, CPU s of this process) of one episode; setup untimed."""
     setup = setup_fn()
     ctrl = make_controller(controller)
-    tic = time.perf_counter()
+    tic, cpu = time.perf_counter(), time.process_time()
     res = run_episode(setup, ctrl, np.random.default_rng(seed), record=record)
-    return time.perf_counter() - tic, res
+    return time.perf_counter() - tic, res, time.process_time() - cpu
 
 
 def bench_world(quick: bool) -> dict[str, Any]:
@@ -379,12 +392,15 @@ def bench_world(quick: bool) -> dict[str, Any]:
     results: dict[str, Any] = {}
     for n in WORLD_COUNTS:
         row: dict[str, Any] = {}
+        # warm-up, discarded: first calls import, compile and fill caches (errors: timed runs)
+        with contextlib.suppress(Exception):
+            _time_episode(lambda n=n: world_setup(n, 20, seed=99), "straight-v1", 99, False)
         for record in (False, True):
-            best = math.inf
+            best = best_cpu = math.inf
             status = None
             for r in range(repeats if not record else 1):
                 try:
-                    wall, res = _time_episode(
+                    wall, res, cpu = _time_episode(
                         lambda n=n, r=r: world_setup(n, n_steps, seed=r), "straight-v1", r, record
                     )
                 except Exception as exc:
@@ -396,9 +412,13 @@ def bench_world(quick: bool) -> dict[str, Any]:
                         f"episode ended early ({res.status}); steps/s is not comparable"
                     )
                 best = min(best, wall)
+                best_cpu = min(best_cpu, cpu)
             else:
                 row["record" if record else "no_record"] = {
                     "steps": n_steps,
+                    "best_cpu_s": best_cpu,
+                    "cpu_steps_per_s": n_steps / best_cpu,
+                    "cpu_us_per_step": 1e6 * best_cpu / n_steps,
                     "best_wall_s": best,
                     "steps_per_s": n_steps / best,
                     "us_per_step": 1e6 * best / n_steps,
@@ -407,12 +427,13 @@ def bench_world(quick: bool) -> dict[str, Any]:
         results[str(n)] = row
     ten = results.get("10", {}).get("no_record", {})
     hundred = results.get("100", {}).get("no_record", {})
-    if "steps_per_s" in ten and "steps_per_s" in hundred:
-        results["cost_ratio_100_vs_10"] = ten["steps_per_s"] / hundred["steps_per_s"]
-    measured = ten.get("steps_per_s") if isinstance(ten, dict) else None
+    if "cpu_steps_per_s" in ten and "cpu_steps_per_s" in hundred:
+        results["cost_ratio_100_vs_10"] = ten["cpu_steps_per_s"] / hundred["cpu_steps_per_s"]
+    measured = ten.get("cpu_steps_per_s") if isinstance(ten, dict) else None  # judged on CPU
     return {
         "benchmark": "world_steps",
-        "description": "run_episode(straight-v1) steps per second, random_turn non-convex polygons",
+        "description": "run_episode(straight-v1) steps per CPU second (cpu_*, judged) and per "
+        "wall second, random_turn non-convex polygons; a short warm-up episode discarded",
         "params": {
             "obstacle_counts": WORLD_COUNTS,
             "steps": n_steps,
@@ -431,18 +452,22 @@ def bench_episodes(quick: bool) -> dict[str, Any]:
     names, missing = _controller_names()
     results: dict[str, Any] = {}
     for name in names:
-        walls, statuses = [], {"success": 0, "collision": 0, "timeout": 0}
+        walls, cpus, statuses = [], [], {"success": 0, "collision": 0, "timeout": 0}
         try:
+            _time_episode(lambda: ch2_setup(0), name, 0, False)  # warm-up, discarded
             for seed in range(n_episodes):
-                wall, res = _time_episode(lambda seed=seed: ch2_setup(seed), name, seed, False)
+                wall, res, cpu = _time_episode(lambda seed=seed: ch2_setup(seed), name, seed, False)
                 walls.append(wall)
+                cpus.append(cpu)
                 statuses[res.status] += 1
         except Exception as exc:
             results[name] = _error(exc)
             continue
-        total = float(sum(walls))
+        total, total_cpu = float(sum(walls)), float(sum(cpus))
         results[name] = {
             "episodes": n_episodes,
+            "cpu_episodes_per_s": n_episodes / total_cpu if total_cpu > 0 else math.inf,
+            "cpu_median_episode_ms": 1e3 * float(np.median(cpus)),
             "episodes_per_s": n_episodes / total,
             "median_episode_ms": 1e3 * float(np.median(walls)),
             "statuses": statuses,
@@ -451,7 +476,8 @@ def bench_episodes(quick: bool) -> dict[str, Any]:
         results[name] = {"error": why}
     return {
         "benchmark": "episodes",
-        "description": "Episodes per second, thesis Ch. 2 one random-turn obstacle scene",
+        "description": "Episodes per CPU second (cpu_*) and per wall second, thesis Ch. 2 "
+        "one random-turn obstacle scene (one warm-up episode per law discarded)",
         "params": {
             "episodes": n_episodes,
             "I": [0, 0],
@@ -571,13 +597,13 @@ def profile_world(quick: bool, top: int = 25) -> dict[str, Any]:
 
 
 def _world_job(job: dict[str, Any]) -> dict[str, Any]:
-    wall, res = _time_episode(
+    wall, res, cpu = _time_episode(
         lambda: world_setup(int(job["n"]), int(job["steps"]), seed=int(job["seed"])),
         "straight-v1",
         int(job["seed"]),
         bool(job.get("record", False)),
     )
-    return {"wall": wall, "status": res.status}
+    return {"wall": wall, "cpu": cpu, "status": res.status}
 
 
 _HERE_SRC = Path(__file__).resolve().parents[1] / "src"
@@ -607,6 +633,7 @@ def bench_world_ab(quick: bool, against: Path) -> dict[str, Any]:
         for n in WORLD_COUNTS:
             n_steps = steps.get(n, 1000)
             walls: dict[str, list[float]] = {name: [] for name in sides}
+            cpus: dict[str, list[float]] = {name: [] for name in sides}
             statuses: dict[str, set[str]] = {name: set() for name in sides}
             errors: dict[str, str] = {}
             for r in range(rounds):
@@ -617,11 +644,14 @@ def bench_world_ab(quick: bool, against: Path) -> dict[str, Any]:
                         errors[name] = out["error"]
                         continue
                     walls[name].append(out["wall"])
+                    cpus[name].append(out["cpu"])
                     statuses[name].add(out["status"])
             row: dict[str, Any] = {"steps": n_steps, "rounds": rounds}
             for name, w in walls.items():
                 if w:
                     row[name] = {
+                        "best_cpu_steps_per_s": n_steps / min(cpus[name]),
+                        "median_cpu_steps_per_s": n_steps / float(np.median(cpus[name])),
                         "best_steps_per_s": n_steps / min(w),
                         "median_steps_per_s": n_steps / float(np.median(w)),
                         "us_per_step_best": 1e6 * min(w) / n_steps,
@@ -631,6 +661,7 @@ def bench_world_ab(quick: bool, against: Path) -> dict[str, Any]:
                 row["errors"] = errors
             b, c = walls["baseline"], walls["current"]
             if b and c:
+                row["speedup_best_cpu"] = min(cpus["baseline"]) / min(cpus["current"])
                 row["speedup_best"] = min(b) / min(c)
                 if len(b) == len(c):
                     row["speedup_median_of_rounds"] = float(
@@ -663,7 +694,7 @@ def bench_ch4_decision(quick: bool) -> dict[str, Any]:
 
     n = 60 if quick else 400
     decision = bench_ch4.bench_decision(n)
-    measured = decision["zhang2022-uuv2d-v1"]["wall_us_median"]
+    measured = decision["zhang2022-uuv2d-v1"]["cpu_us_median"]  # judged on CPU time
     return {
         "decision_time": decision,
         "amaps_update": bench_ch4.bench_amaps_update(n),
@@ -677,7 +708,7 @@ def print_tables(reports: dict[str, dict[str, Any]]) -> None:
 
     console = Console()
     if "decision_time" in reports:
-        t = Table(title="decision time per Controller.act [µs] (median / p99)")
+        t = Table(title="decision time per Controller.act [µs]: CPU median / p99 (wall median)")
         t.add_column("controller")
         for n in OBSTACLE_COUNTS:
             t.add_column(f"{n} obstacles", justify="right")
@@ -685,8 +716,11 @@ def print_tables(reports: dict[str, dict[str, Any]]) -> None:
             cells = []
             for n in OBSTACLE_COUNTS:
                 row = per_n.get(str(n), per_n) if isinstance(per_n, dict) else {}
-                if "median_us" in row:
-                    cells.append(f"{row['median_us']:.1f} / {row['p99_us']:.1f}")
+                if "cpu_median_us" in row:
+                    cells.append(
+                        f"{row['cpu_median_us']:.1f} / {row['cpu_p99_us']:.1f} "
+                        f"({row['median_us']:.1f})"
+                    )
                 else:
                     cells.append(f"[red]{str(row.get('error', '?'))[:40]}[/red]")
             t.add_row(name, *cells)
@@ -695,9 +729,10 @@ def print_tables(reports: dict[str, dict[str, Any]]) -> None:
         t = Table(title="world steps per second (run_episode, straight-v1)")
         for col in (
             "obstacles",
-            "steps/s (record off)",
-            "µs/step",
-            "steps/s (record on)",
+            "CPU steps/s (record off)",
+            "CPU µs/step",
+            "wall steps/s",
+            "CPU steps/s (record on)",
             "status",
         ):
             t.add_column(col, justify="right")
@@ -706,16 +741,24 @@ def print_tables(reports: dict[str, dict[str, Any]]) -> None:
             a, b = row.get("no_record", {}), row.get("record", {})
             t.add_row(
                 str(n),
+                f"{a.get('cpu_steps_per_s', float('nan')):,.0f}",
+                f"{a.get('cpu_us_per_step', float('nan')):.1f}",
                 f"{a.get('steps_per_s', float('nan')):,.0f}",
-                f"{a.get('us_per_step', float('nan')):.1f}",
-                f"{b.get('steps_per_s', float('nan')):,.0f}",
+                f"{b.get('cpu_steps_per_s', float('nan')):,.0f}",
                 str(a.get("status", a.get("error", "?"))),
             )
         console.print(t)
     if "world_steps_ab" in reports:
         ab = reports["world_steps_ab"]
-        t = Table(title="world steps per second, side by side (best / median of rounds)")
-        for col in ("obstacles", "baseline", "current", "speed-up (best)", "speed-up (median)"):
+        t = Table(title="world CPU steps per second, side by side (best / median of rounds)")
+        for col in (
+            "obstacles",
+            "baseline",
+            "current",
+            "speed-up (best CPU)",
+            "speed-up (best wall)",
+            "speed-up (median wall)",
+        ):
             t.add_column(col, justify="right")
         for n in WORLD_COUNTS:
             row = ab["results"].get(str(n), {})
@@ -723,31 +766,39 @@ def print_tables(reports: dict[str, dict[str, Any]]) -> None:
             for side in ("baseline", "current"):
                 r = row.get(side, {})
                 cells.append(
-                    f"{r.get('best_steps_per_s', float('nan')):,.0f} / "
-                    f"{r.get('median_steps_per_s', float('nan')):,.0f}"
+                    f"{r.get('best_cpu_steps_per_s', float('nan')):,.0f} / "
+                    f"{r.get('median_cpu_steps_per_s', float('nan')):,.0f}"
                 )
             t.add_row(
                 str(n),
                 *cells,
+                f"{row.get('speedup_best_cpu', float('nan')):.2f}x",
                 f"{row.get('speedup_best', float('nan')):.2f}x",
                 f"{row.get('speedup_median_of_rounds', float('nan')):.2f}x",
             )
         console.print(t)
     if "episodes" in reports:
         t = Table(title="episodes per second, Ch. 2 one-obstacle scene")
-        for col in ("controller", "episodes/s", "median ms", "success / collision / timeout"):
+        for col in (
+            "controller",
+            "episodes/CPU s",
+            "CPU median ms",
+            "episodes/s (wall)",
+            "success / collision / timeout",
+        ):
             t.add_column(col, justify="right")
         for name, row in reports["episodes"]["results"].items():
             if "episodes_per_s" in row:
                 s = row["statuses"]
                 t.add_row(
                     name,
+                    f"{row['cpu_episodes_per_s']:.2f}",
+                    f"{row['cpu_median_episode_ms']:.1f}",
                     f"{row['episodes_per_s']:.2f}",
-                    f"{row['median_episode_ms']:.1f}",
                     f"{s['success']} / {s['collision']} / {s['timeout']}",
                 )
             else:
-                t.add_row(name, f"[red]{str(row.get('error'))[:50]}[/red]", "", "")
+                t.add_row(name, f"[red]{str(row.get('error'))[:50]}[/red]", "", "", "")
         console.print(t)
     targets = [tg for r in reports.values() for tg in r.get("targets", {}).values()]
     if targets:

@@ -517,6 +517,8 @@ def sigterm_as_interrupt() -> Iterator[None]:
 
 #: how often a worker checks that the campaign's main process is still there [s]
 WATCHDOG_PERIOD = 0.5
+#: how long an interrupted campaign waits for each killed worker to be gone [s]
+WORKER_EXIT_TIMEOUT = 5.0
 
 
 def _process_alive(pid: int) -> bool:
@@ -552,17 +554,30 @@ def _worker_init(main_pid: int) -> None:
 
 
 def _stop_workers(executor: ProcessPoolExecutor) -> None:
-    """Cancel queued jobs and end the workers now: their episodes are lost anyway on interrupt."""
-    terminate = getattr(executor, "terminate_workers", None)  # Python >= 3.14
-    if callable(terminate):
-        terminate()
-        return
-    # best effort before 3.14: the executor keeps its processes in a private mapping
+    """Cancel queued jobs and end the workers now: their episodes are lost anyway on interrupt.
+
+    A worker killed while it writes a result leaves part of a message in the result pipe, and the
+    executor's manager thread blocked in ``Connection.recv`` waiting for the rest: Python joins
+    that thread at exit, so the process hung after Ctrl-C.  Once the workers are dead, this
+    process holds the pipe's last write end; closing it turns the blocked read into an EOF, the
+    manager thread sees a broken pool and ends.
+    """
+    # the executor keeps its processes and queues in private attributes (Python >= 3.14 also has
+    # ``terminate_workers``); they are read before ``shutdown`` forgets them
     procs = list((getattr(executor, "_processes", None) or {}).values())
+    writer = getattr(getattr(executor, "_result_queue", None), "_writer", None)
+    terminate = getattr(executor, "terminate_workers", None)
+    if not procs and callable(terminate):
+        terminate()  # no private mapping to read (a future Python)
+        return
     executor.shutdown(wait=False, cancel_futures=True)
     for proc in procs:
         if proc.is_alive():
-            proc.terminate()
+            proc.kill()  # SIGKILL: a worker's own code cannot delay it
+    for proc in procs:
+        proc.join(timeout=WORKER_EXIT_TIMEOUT)
+    if writer is not None and all(not proc.is_alive() for proc in procs):
+        writer.close()
 
 
 def run_in_workers(
