@@ -54,6 +54,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from uvnav.scenarios.errors import ScenarioError
 from uvnav.scenarios.loader import scenario_from_dict
 from uvnav.scenarios.schema import Scenario
 
@@ -216,8 +217,14 @@ def crowdnav_scenario(
     if not time_limit - 1.0 > 0:
         raise ValueError(f"time_limit must be > 1 s (got {time_limit})")
     seed = PHASE_OFFSET[phase] + case
+    short = "circle" if rule == "circle_crossing" else "square"
     if seed >= 2**32:  # numpy's legacy seeds are 32-bit
-        raise ValueError(f"case must be below {2**32 - PHASE_OFFSET[phase]} (got {case})")
+        raise ScenarioError(
+            f"crowdnav-{short}:{case}",
+            "seed",
+            f"CrowdNav's cases are numpy legacy seeds {PHASE_OFFSET[phase]} + case < 2**32: the "
+            f"case must be below {2**32 - PHASE_OFFSET[phase]} (got {case})",
+        )
     rs = np.random.RandomState(seed)
     robot: _Agent = (0.0, -circle_radius, 0.0, circle_radius, robot_radius)
     if rule == "circle_crossing":
@@ -246,7 +253,6 @@ def crowdnav_scenario(
     ]
     if controller_params is None:
         controller_params = dict(CROWDNAV_ORCA_PARAMS) if controller == "orca-holonomic-v1" else {}
-    short = "circle" if rule == "circle_crossing" else "square"
     data: dict[str, Any] = {
         "name": f"crowdnav-{short}-{case}",
         "description": (
