@@ -8,6 +8,7 @@ from uvnav.obstacles.bodies import (
     radial_profile,
     rotation_boundary_growth,
 )
+from uvnav.obstacles.crowd import Crowd, OrcaPedestrian, join_crowds
 from uvnav.obstacles.motion import (
     ConstantVelocity,
     MotionModel,
@@ -21,6 +22,7 @@ from uvnav.obstacles.obstacle import FieldTemplate, NearestQuery, Obstacle, Obst
 __all__ = [
     "Body",
     "ConstantVelocity",
+    "Crowd",
     "DiscBody",
     "FieldTemplate",
     "MotionModel",
@@ -29,10 +31,12 @@ __all__ = [
     "ObstacleBatch",
     "ObstacleField",
     "ObstacleState",
+    "OrcaPedestrian",
     "PolygonBody",
     "RandomTurn",
     "Replay",
     "Waypoints",
+    "join_crowds",
     "radial_profile",
     "rotation_boundary_growth",
 ]

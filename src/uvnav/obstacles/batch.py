@@ -9,8 +9,9 @@ and advances the common motion models in vectorised form:
   (obstacles in index order), and the course, arena steering and pose updates done with the same
   floating-point operations, element by element;
 * a model class with a ``batch_group(models)`` classmethod (for instance the pedestrian replays
-  of :mod:`uvnav.scenarios.pedestrians`): one :class:`~uvnav.obstacles.motion.MotionGroup` call
-  per class and step;
+  of :mod:`uvnav.scenarios.pedestrians` and the ORCA pedestrians of :mod:`uvnav.obstacles.crowd`,
+  joined into their crowds here by :func:`~uvnav.obstacles.crowd.join_crowds`): one
+  :class:`~uvnav.obstacles.motion.MotionGroup` call per class and step;
 * any other model (``Waypoints``, ``Replay``, third-party models): its own
   ``step(state, t, dt)``, called per obstacle.
 
@@ -31,6 +32,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.obstacles.crowd import join_crowds
 from uvnav.obstacles.motion import (
     ConstantVelocity,
     MotionGroup,
@@ -208,6 +210,7 @@ class ObstacleBatch:
 
     def __init__(self, obstacles: Sequence[Obstacle]) -> None:
         self.obstacles = list(obstacles)
+        join_crowds(self.obstacles)  # ORCA pedestrians not yet in a crowd: one per crowd id
         k = len(self.obstacles)
         # rows: x, y, heading, course (random-turn obstacles only, else 0)
         x = np.zeros((4, k))

@@ -61,7 +61,14 @@ class MotionModel(Protocol):
 #: params: {...}}``.
 MOTION_GROUP = "uvnav.motions"
 #: motion types of the scenario schema (a plug-in may not take these names)
-BUILTIN_MOTIONS: tuple[str, ...] = ("constant", "random_turn", "waypoints", "replay", "plugin")
+BUILTIN_MOTIONS: tuple[str, ...] = (
+    "constant",
+    "random_turn",
+    "waypoints",
+    "replay",
+    "orca_crowd",
+    "plugin",
+)
 _PLUGINS: dict[str, Callable[..., Any]] | None = None
 
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from uvnav.geometry.polygons import polygon_area, polygon_centroid
 from uvnav.scenarios.build import obstacle_bounds
+from uvnav.scenarios.crowdnav import crowdnav_circle, crowdnav_square
 from uvnav.scenarios.loader import scenario_from_dict
 from uvnav.scenarios.schema import ObstacleSpec, Scenario
 
@@ -365,6 +366,8 @@ GENERATORS: dict[str, Callable[..., Scenario]] = {
     "crowd-eth": partial(crowd_crossing_scenario, dataset="eth"),
     "crowd-hotel": partial(crowd_crossing_scenario, dataset="hotel"),
     "random-ch3": _random_ch3,
+    "crowdnav-circle": crowdnav_circle,
+    "crowdnav-square": crowdnav_square,
 }
 
 

@@ -38,11 +38,13 @@ from uvnav.obstacles import (
     Obstacle,
     ObstacleField,
     ObstacleState,
+    OrcaPedestrian,
     PolygonBody,
     RandomTurn,
     Replay,
     Waypoints,
 )
+from uvnav.obstacles import crowd as orca_crowd
 from uvnav.obstacles.motion import motion_plugins
 from uvnav.scenarios import pedestrians
 from uvnav.scenarios.errors import FieldError, ScenarioError
@@ -329,6 +331,62 @@ class ReplayMotion(_Model):
         return Replay(np.asarray(self.times, dtype=float), np.asarray(self.positions, dtype=float))
 
 
+class OrcaCrowdMotion(_Model):
+    """A pedestrian walking to ``goal`` by its own ORCA policy (:mod:`uvnav.obstacles.crowd`).
+
+    The scene's ``orca_crowd`` pedestrians with the same ``crowd`` id form one crowd, simulated
+    together by one RVO2 simulator (``pyrvo``): each avoids the others reciprocally.  The robot is
+    invisible to them (CrowdNav's protocol).  At its goal a pedestrian stops but keeps stepping
+    aside for the others.  Defaults are CrowdNav's (Chen et al., ICRA 2019).  The body must be a
+    disc; the pedestrian starts at rest, and may start on the robot's goal (it walks on).
+    """
+
+    type: Literal["orca_crowd"]
+    goal: Point2 = Field(description="where the pedestrian walks to [m]")
+    v_pref: float = Field(
+        orca_crowd.V_PREF, gt=0, description="preferred (and largest) speed [m/s]"
+    )
+    crowd: str = Field(
+        orca_crowd.DEFAULT_CROWD,
+        min_length=1,
+        description="crowd id: pedestrians with the same id are simulated together",
+    )
+    neighbor_dist: float = Field(
+        orca_crowd.NEIGHBOR_DIST, gt=0, description="RVO2 neighbour distance, centre to centre [m]"
+    )
+    max_neighbors: int = Field(orca_crowd.MAX_NEIGHBORS, ge=1, description="RVO2 max neighbours")
+    time_horizon: float = Field(
+        orca_crowd.TIME_HORIZON, gt=0, description="ORCA horizon for other pedestrians [s]"
+    )
+    time_horizon_obst: float = Field(
+        orca_crowd.TIME_HORIZON_OBST, gt=0, description="ORCA horizon for static obstacles [s]"
+    )
+    safety_margin: float = Field(
+        orca_crowd.SAFETY_MARGIN, ge=0, description="added to the body radius for RVO2 [m]"
+    )
+    period: float | None = Field(
+        None,
+        gt=0,
+        description="decision period of the crowd [s] (omitted = every integration step dt); "
+        "the same for every pedestrian of a crowd",
+    )
+
+    def to_model(self, rng: np.random.Generator) -> OrcaPedestrian:
+        """The motion model (``rng`` unused: ORCA is deterministic); joined to its crowd when the
+        episode's obstacles are batched (:func:`uvnav.obstacles.crowd.join_crowds`)."""
+        return OrcaPedestrian(
+            goal=np.asarray(self.goal, dtype=float),
+            v_pref=float(self.v_pref),
+            crowd_id=self.crowd,
+            neighbor_dist=float(self.neighbor_dist),
+            max_neighbors=int(self.max_neighbors),
+            time_horizon=float(self.time_horizon),
+            time_horizon_obst=float(self.time_horizon_obst),
+            safety_margin=float(self.safety_margin),
+            period=None if self.period is None else float(self.period),
+        )
+
+
 class PluginMotion(_Model):
     """A third-party motion model (entry-point group ``uvnav.motions``, see
     :data:`uvnav.obstacles.motion.MOTION_GROUP`), built from its keyword ``params``."""
@@ -360,7 +418,12 @@ class PluginMotion(_Model):
 
 
 MotionSpec = Annotated[
-    ConstantMotion | RandomTurnMotion | WaypointsMotion | ReplayMotion | PluginMotion,
+    ConstantMotion
+    | RandomTurnMotion
+    | WaypointsMotion
+    | ReplayMotion
+    | OrcaCrowdMotion
+    | PluginMotion,
     Field(discriminator="type"),
 ]
 """One of the motion specs, chosen by its ``type`` field."""
@@ -370,6 +433,7 @@ MOTION_TYPES: dict[str, type[_Model]] = {
     "random_turn": RandomTurnMotion,
     "waypoints": WaypointsMotion,
     "replay": ReplayMotion,
+    "orca_crowd": OrcaCrowdMotion,
     "plugin": PluginMotion,
 }
 
@@ -393,6 +457,8 @@ class ObstacleSpec(_Model):
         m = self.motion
         if self.start is None and not isinstance(m, WaypointsMotion | ReplayMotion):
             raise FieldError("start", f"required for motion type {m.type!r}")
+        if isinstance(m, OrcaCrowdMotion) and self.body.disc is None:
+            raise FieldError("body", "an orca_crowd pedestrian is a disc (give 'disc: RADIUS')")
         if self.start is not None and isinstance(m, ReplayMotion):
             at0 = m.to_model(np.random.default_rng(0)).position_at(0.0)
             if float(np.hypot(*(np.asarray(self.start.position) - at0))) > 1e-6:
@@ -444,7 +510,7 @@ class ObstacleSpec(_Model):
                 velocity=np.asarray(m.velocity, dtype=float),
                 angular_velocity=float(m.angular_velocity),
             )
-        if isinstance(m, PluginMotion):  # at rest until its first step sets its rates
+        if isinstance(m, PluginMotion | OrcaCrowdMotion):  # at rest until its first step
             return ObstacleState(position=pos, heading=heading)
         speed = 0.5 * (m.speed[0] + m.speed[1])
         vel = speed * np.array([np.cos(heading), np.sin(heading)])
@@ -629,6 +695,9 @@ class Scenario(_Model):
         if obstacles:
             field = ObstacleField.from_obstacles(obstacles)
             _, _, inside = field.nearest(np.asarray(self.robot.goal, dtype=float))
+            # ORCA pedestrians walk on (CrowdNav's square crossing may start one on the goal)
+            walking = np.array([isinstance(o.motion, OrcaPedestrian) for o in obstacles])
+            inside = inside & ~walking
             if inside.any():
                 j = int(np.argmax(inside))
                 raise FieldError(

@@ -1,0 +1,255 @@
+"""Validation against CrowdNav's ORCA row (issue 18): ``orca-holonomic-v1`` on ``crowdnav-circle``.
+
+Run: ``PYTHONPATH=src .venv/bin/python benchmarks/bench_crowdnav.py --cases 500`` (``--out DIR``
+writes ``DIR/crowdnav.json``).
+
+The paper: Chen, Liu, Kreiss, Alahi, "Crowd-robot interaction: crowd-aware robot navigation with
+attention-based deep reinforcement learning", ICRA 2019 (arXiv:1809.08835), Table I (invisible
+robot, 5 ORCA humans, circle crossing, 500 test cases): ORCA success 0.43, collision 0.57, time
+to goal 10.86 s.  Here: the same 500 test cases (``crowdnav-circle:0`` ... ``:499`` are CrowdSim's
+test cases, :mod:`uvnav.scenarios.crowdnav`), the robot driven by ``orca-holonomic-v1`` with the
+robot ORCA of CrowdNav (time horizon 5 s, neighbour distance 10 m, at most 10 neighbours,
+reciprocal responsibility 0.5, combined radius 0.62 m: ``safety_margin`` 0.02).  Reported:
+success / collision / timeout rates with 95 % Wilson intervals, the mean time to goal of the
+successes, the CPU time, and PASS when the paper's success rate 0.43 lies inside our interval.
+
+Options for the protocol study (defaults = the reproduction):
+
+* ``--substeps K``: integrate every 0.25/K s (collision checked at every integration step; the
+  robot and the crowd still decide every 0.25 s); CrowdNav checks the swept relative segment.
+* ``--outcome crowdnav``: judge each episode as ``CrowdSim.step`` does, by a probe watching every
+  decision: collision when the relative position swept over the step (the human's *previous*
+  velocity against the robot's new one, from the positions at the step's start) comes within the
+  radius sum; else success when the robot's position after the step is strictly within its
+  radius of the goal; else on; the first of these events wins (the world's own end comes at or
+  after it: a discrete overlap is a collision at CrowdSim's next step, whose swept segment starts
+  inside; the time limit a timeout).  Needs ``--substeps 1``.
+* ``--pref crowdnav``: the robot's preferred velocity as CrowdNav's ORCA sets it (1 m/s toward
+  the goal beyond 1 m, the gap within) instead of ``orca-holonomic-v1``'s (V_max, lowered to
+  ``dist / period`` on the last step).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import sys
+import time
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from uvnav.controllers.base import make_law
+from uvnav.controllers.holonomic import OrcaHolonomic
+from uvnav.controllers.orca import orca_velocity
+from uvnav.core import BaseProbe
+from uvnav.dynamics.omni import VelocityCommand
+from uvnav.scenarios.build import build_episode
+from uvnav.scenarios.catalog import kinds
+from uvnav.scenarios.crowdnav import CROWDNAV_ORCA_PARAMS, TIME_STEP, crowdnav_scenario
+from uvnav.sensors.observation import Observation
+from uvnav.sim.episode import run_episode
+
+#: Chen et al. ICRA 2019, Table I, ORCA (invisible robot)
+PAPER = {"success": 0.43, "collision": 0.57, "time_to_goal": 10.86}
+Z95 = 1.959963984540054
+
+
+def wilson(k: int, n: int, z: float = Z95) -> tuple[float, float]:
+    """95 % Wilson score interval of the proportion ``k / n``."""
+    if n == 0:
+        return 0.0, 1.0
+    p = k / n
+    denom = 1.0 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+class CrowdNavPrefOrca(OrcaHolonomic):
+    """``orca-holonomic-v1`` with CrowdNav's preferred velocity (``ORCA.predict``: the unit
+    vector toward the goal beyond 1 m, the gap within); otherwise the same query."""
+
+    def act(self, obs: Observation) -> VelocityCommand:
+        period = self.decision_period(obs.time)
+        spec = self._spec
+        pos = np.asarray(obs.position, dtype=float)
+        gap = self._goal - pos
+        d = float(np.hypot(*gap))
+        pref = gap / d if d > 1.0 else gap
+        query = orca_velocity(
+            pos, self.current_velocity(obs), pref, obs.obstacles,
+            radius=spec.radius + self.params.safety_margin, max_speed=spec.v_max,
+            period=period, params=self.params,
+        )  # fmt: skip
+        self.last_query = query
+        self._mode = "M1" if float(np.hypot(*(query.velocity - pref))) < 1e-6 else "M2"
+        return VelocityCommand(float(query.velocity[0]), float(query.velocity[1])).clipped(spec)
+
+
+def _segment_distance(px: float, py: float, ex: float, ey: float) -> float:
+    """Distance from the origin to the segment (px, py)-(ex, ey) [m]."""
+    dx, dy = ex - px, ey - py
+    dd = dx * dx + dy * dy
+    s = 0.0 if dd == 0.0 else min(max(-(px * dx + py * dy) / dd, 0.0), 1.0)
+    return math.hypot(px + s * dx, py + s * dy)
+
+
+class CrowdSimOutcome(BaseProbe):
+    """The outcome ``CrowdSim.step`` would give (``--outcome crowdnav``, module docstring)."""
+
+    def __init__(self) -> None:
+        self.status: str | None = None
+        self.at: float | None = None
+
+    def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
+        if self.status is not None:
+            return
+        x, y, dt = world.x, world.y, world.dt
+        vx, vy = float(applied.vx), float(applied.vy)
+        r = float(world.spec.radius)
+        pos, vel = world.batch.positions, world.batch.velocities
+        for j, ob in enumerate(world.obstacles):
+            px, py = float(pos[j, 0]) - x, float(pos[j, 1]) - y
+            ex = px + (float(vel[j, 0]) - vx) * dt
+            ey = py + (float(vel[j, 1]) - vy) * dt
+            if _segment_distance(px, py, ex, ey) - float(ob.body.bounding_radius) - r < 0:
+                self.status, self.at = "collision", world.t + dt
+                return
+        gx, gy = float(world.goal[0]), float(world.goal[1])
+        if math.hypot(x + vx * dt - gx, y + vy * dt - gy) < r:
+            self.status, self.at = "success", world.t + dt
+
+
+def run(
+    cases: int, *, rule: str, substeps: int, pref: str, outcome: str = "uvnav", first: int = 0
+) -> dict[str, Any]:
+    """Run the cases; returns the counts, rates, intervals and times."""
+    rng_of = kinds()["nav2d"].episode_rng
+    counts = {"success": 0, "collision": 0, "timeout": 0}
+    times: list[float] = []
+    statuses: list[str] = []
+    cpu0, wall0 = time.process_time(), time.perf_counter()
+    for case in range(first, first + cases):
+        scn = crowdnav_scenario(case, rule=rule, dt=TIME_STEP / substeps)  # type: ignore[arg-type]
+        setup = build_episode(scn, case)
+        law: Any
+        if pref == "crowdnav":
+            law = CrowdNavPrefOrca()
+            law.params = type(law.params)(**CROWDNAV_ORCA_PARAMS)
+        else:
+            law = make_law("orca-holonomic-v1", **CROWDNAV_ORCA_PARAMS)
+        probe = CrowdSimOutcome()
+        probes: list[Any] = [probe] if outcome == "crowdnav" else []
+        res = run_episode(
+            setup, law, rng_of(case), record=False, vehicle="holonomic", probes=probes
+        )
+        status, arrival = res.status, res.metrics.time_to_goal
+        if outcome == "crowdnav":
+            # no event before the world's end: a discrete overlap is a collision in CrowdSim's
+            # next step (its swept segment starts inside), the time limit a timeout
+            status = probe.status or res.status
+            arrival = probe.at if probe.status == "success" else arrival
+        counts[status] += 1
+        statuses.append(status)
+        if status == "success" and arrival is not None:
+            times.append(float(arrival))
+    cpu, wall = time.process_time() - cpu0, time.perf_counter() - wall0
+    rates: dict[str, dict[str, Any]] = {}
+    for key, k in counts.items():
+        lo, hi = wilson(k, cases)
+        rates[key] = {"count": k, "rate": k / cases, "ci95": [lo, hi]}
+    lo, hi = wilson(counts["success"], cases)
+    return {
+        "cases": cases,
+        "first_case": first,
+        "rule": rule,
+        "substeps": substeps,
+        "dt": TIME_STEP / substeps,
+        "pref": pref,
+        "outcome": outcome,
+        "law": "orca-holonomic-v1",
+        "params": dict(CROWDNAV_ORCA_PARAMS),
+        "rates": rates,
+        "time_to_goal_mean": float(np.mean(times)) if times else None,
+        "cpu_s": cpu,
+        "wall_s": wall,
+        "cpu_ms_per_episode": 1000.0 * cpu / max(cases, 1),
+        "paper": PAPER,
+        "pass": bool(lo <= PAPER["success"] <= hi),
+        "statuses": statuses,
+    }
+
+
+def report(r: dict[str, Any]) -> str:
+    lines = [
+        f"crowdnav-{r['rule'].split('_')[0]} cases {r['first_case']}.."
+        f"{r['first_case'] + r['cases'] - 1} ({r['cases']}), orca-holonomic-v1 {r['params']}, "
+        f"dt {r['dt']:g} s, pref {r['pref']}, outcome {r['outcome']}",
+    ]
+    for key in ("success", "collision", "timeout"):
+        x = r["rates"][key]
+        lo, hi = x["ci95"]
+        paper = f"   paper {PAPER[key]:.2f}" if key in PAPER else ""
+        lines.append(
+            f"  {key:<9} {x['count']:4d}  {x['rate']:.3f}  95% [{lo:.3f}, {hi:.3f}]{paper}"
+        )
+    ttg = r["time_to_goal_mean"]
+    lines.append(
+        f"  time to goal (successes) {ttg:.2f} s   paper {PAPER['time_to_goal']:.2f} s"
+        if ttg is not None
+        else "  time to goal: no success"
+    )
+    lines.append(
+        f"  CPU {r['cpu_s']:.1f} s ({r['cpu_ms_per_episode']:.1f} ms/episode), "
+        f"wall {r['wall_s']:.1f} s"
+    )
+    verdict = "PASS" if r["pass"] else "FAIL"
+    lines.append(f"  {verdict}: paper's ORCA success 0.43 {'inside' if r['pass'] else 'outside'} "
+                 "our 95 % interval")  # fmt: skip
+    return "\n".join(lines)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--cases", type=int, default=500, help="number of test cases (default 500)")
+    ap.add_argument("--first", type=int, default=0, help="first case number (default 0)")
+    ap.add_argument("--rule", choices=("circle_crossing", "square_crossing"),
+                    default="circle_crossing")  # fmt: skip
+    ap.add_argument("--substeps", type=int, default=1, help="integration steps per 0.25 s")
+    ap.add_argument("--pref", choices=("uvnav", "crowdnav"), default="uvnav",
+                    help="robot's preferred velocity (default: orca-holonomic-v1's)")  # fmt: skip
+    ap.add_argument("--outcome", choices=("uvnav", "crowdnav"), default="uvnav",
+                    help="judge episodes by the world (default) or as CrowdSim.step")  # fmt: skip
+    ap.add_argument("--out", type=Path, default=None, help="write crowdnav.json here")
+    args = ap.parse_args(argv)
+    if args.cases < 1 or args.substeps < 1:
+        ap.error("--cases and --substeps must be >= 1")
+    if args.outcome == "crowdnav" and args.substeps != 1:
+        ap.error("--outcome crowdnav judges 0.25 s steps: use --substeps 1")
+    r = run(
+        args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
+        outcome=args.outcome, first=args.first,
+    )  # fmt: skip
+    print(report(r))
+    if args.out is not None:
+        args.out.mkdir(parents=True, exist_ok=True)
+        r["machine"] = {
+            "cpus": os.cpu_count(),
+            "load": os.getloadavg(),
+            "python": sys.version.split()[0],
+            "platform": platform.platform(),
+            "numpy": np.__version__,
+            "time": datetime.now(UTC).isoformat(timespec="seconds"),
+        }
+        (args.out / "crowdnav.json").write_text(json.dumps(r, indent=1))
+    return 0 if r["pass"] else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

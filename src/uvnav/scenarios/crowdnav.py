@@ -1,0 +1,294 @@
+"""CrowdNav's test scenes as generators: ``crowdnav-circle:<case>`` and ``crowdnav-square:<case>``.
+
+The crowd-navigation benchmark of Chen, Liu, Kreiss, Alahi, "Crowd-robot interaction: crowd-aware
+robot navigation with attention-based deep reinforcement learning", ICRA 2019 (arXiv:1809.08835),
+simulated by CrowdSim (https://github.com/vita-epfl/CrowdNav, studied for this module, not
+copied).  Scene number ``case`` is CrowdNav's test case ``case``: the humans are drawn exactly as
+CrowdSim draws them, from numpy's legacy global generator seeded ``1000 + case`` in the test
+phase (``CrowdSim.reset``: ``np.random.seed(counter_offset[phase] + case_counter[phase])`` with
+``counter_offset['test'] = case_capacity['val'] = 1000``), here a ``RandomState`` of that seed, with
+the same calls in the same order.  So ``crowdnav-circle:0`` ... ``crowdnav-circle:499`` are the
+500 cases of ``python test.py --policy orca`` (``test_size = 500``).
+
+The set-up, with its source (``crowd_nav/configs/env.config`` unless said otherwise):
+
+* humans: ``human_num = 5`` (``n_humans``), radius 0.3 m, ``v_pref`` 1 m/s, policy ORCA, each an
+  ``orca_crowd`` pedestrian of one crowd (:mod:`uvnav.obstacles.crowd`: CrowdNav's ORCA
+  parameters, decision period = the time step);
+* circle crossing (``CrowdSim.generate_circle_crossing_human``): angle uniform in [0, 2 pi), the
+  start ``circle_radius`` (4 m) from the origin at that angle plus a noise uniform in
+  ``[-v_pref/2, v_pref/2)`` on each axis, the goal the start's opposite ``-start``; a draw is
+  redone while the start is within ``r_human + r_other + discomfort_dist`` (0.3 + 0.3 + 0.2 m) of
+  another agent's start or goal (robot included);
+* square crossing (``generate_square_crossing_human``): a side ``sign`` (+1 or -1, even odds),
+  start uniform in ``[0, square_width/2) sign`` x ``[-square_width/2, square_width/2)``
+  (``square_width`` 10 m), goal likewise on the other side; a start is redrawn while within the
+  same distance of another agent's start, a goal while within it of another agent's goal;
+* robot (``CrowdSim.reset``): from (0, -circle_radius) to (0, circle_radius), heading pi/2, at
+  rest, radius 0.3 m, ``v_pref`` 1 m/s (here V_max), invisible to the humans (``visible =
+  false``), seeing every human (``sensor = coordinates``: the sensing range here is 20 m);
+* time (``[env]``): time step 0.25 s (the robot's decision period and the crowd's); the time
+  limit 25 s acts as 24 s, because ``CrowdSim.step`` ends the episode as a timeout once
+  ``global_time >= time_limit - 1``, before looking at the step: ``t_max = time_limit - 1``;
+* success (``CrowdSim.step``): the robot's position after the step within its radius of the goal
+  (``goal_tolerance`` = robot radius);
+* collision: the robot's disc touching a human's (radius sum 0.6 m).  CrowdNav tests the segment
+  the relative position would sweep over the step with the human's *previous* velocity; here
+  the world checks the exact positions after every integration step ``dt`` (0.25 s by default;
+  give a smaller ``dt`` for a nearly continuous check, the crowd still deciding every 0.25 s);
+* randomised attributes (``randomize_attributes = false``): off by default; when on, each human
+  draws ``v_pref`` in [0.5, 1.5) and radius in [0.3, 0.5) first, as ``sample_random_attributes``.
+
+The scene's own law is ``orca-holonomic-v1`` with the robot's ORCA of CrowdNav (``ORCA`` policy
+with ``safety_space`` 0, ``crowd_nav/test.py``): time horizon 5 s, neighbour distance 10 m, at most
+10 neighbours, reciprocal responsibility 0.5 (RVO2's own), and a combined radius 0.62 m (CrowdNav
+adds 0.01 m to the robot's and to each human's radius: ``safety_margin`` 0.02 on the robot here).
+The law picks the robot: a holonomic law drives the holonomic disc robot, a unicycle law the
+unicycle (``u_max`` pi rad/s: CrowdNav's unicycle turns at most pi/4 per 0.25 s step).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Literal
+
+import numpy as np
+
+from uvnav.scenarios.errors import ScenarioError
+from uvnav.scenarios.loader import scenario_from_dict
+from uvnav.scenarios.schema import Scenario
+
+#: CrowdNav's ``env.config``
+CIRCLE_RADIUS = 4.0  # [m]
+SQUARE_WIDTH = 10.0  # [m]
+N_HUMANS = 5
+HUMAN_RADIUS = 0.3  # [m]
+HUMAN_V_PREF = 1.0  # [m/s]
+ROBOT_RADIUS = 0.3  # [m]
+ROBOT_V_PREF = 1.0  # [m/s]
+TIME_STEP = 0.25  # [s]
+TIME_LIMIT = 25.0  # [s]
+DISCOMFORT_DIST = 0.2  # [m]
+#: seed offsets of the phases (``CrowdSim.reset``: ``counter_offset``)
+PHASE_OFFSET: dict[str, int] = {"val": 0, "test": 1000, "train": 2000}
+#: the robot's ORCA in CrowdNav (``crowd_sim/envs/policy/orca.py``, ``test.py``)
+CROWDNAV_ORCA_PARAMS: dict[str, Any] = {
+    "time_horizon": 5.0,
+    "time_horizon_obst": 5.0,
+    "neighbor_dist": 10.0,
+    "max_neighbors": 10,
+    "responsibility": 0.5,
+    "safety_margin": 0.02,
+}
+#: the unicycle variant's U_max (CrowdNav's unicycle: rotations within +-pi/4 per 0.25 s step)
+UNICYCLE_U_MAX = math.pi  # [rad/s]
+SENSING_RANGE = 20.0  # [m]
+
+_Agent = tuple[float, float, float, float, float]  # px, py, gx, gy, radius
+
+
+def _norm(dx: float, dy: float) -> float:
+    return float(np.linalg.norm((dx, dy)))
+
+
+def _attributes(rs: np.random.RandomState, randomize: bool) -> tuple[float, float]:
+    """``(v_pref, radius)`` of a new human (``Agent.sample_random_attributes`` when on)."""
+    if not randomize:
+        return HUMAN_V_PREF, HUMAN_RADIUS
+    v_pref = float(rs.uniform(0.5, 1.5))
+    radius = float(rs.uniform(0.3, 0.5))
+    return v_pref, radius
+
+
+def circle_crossing_humans(
+    rs: np.random.RandomState,
+    n: int,
+    *,
+    circle_radius: float = CIRCLE_RADIUS,
+    robot: _Agent = (0.0, -CIRCLE_RADIUS, 0.0, CIRCLE_RADIUS, ROBOT_RADIUS),
+    randomize_attributes: bool = False,
+) -> list[tuple[_Agent, float]]:
+    """CrowdNav's circle-crossing humans: ``[((px, py, gx, gy, radius), v_pref), ...]`` (module
+    docstring), drawn from ``rs`` with CrowdSim's calls in CrowdSim's order."""
+    agents: list[_Agent] = [robot]
+    out: list[tuple[_Agent, float]] = []
+    for _ in range(n):
+        v_pref, radius = _attributes(rs, randomize_attributes)
+        while True:
+            angle = rs.random_sample() * np.pi * 2
+            px_noise = (rs.random_sample() - 0.5) * v_pref
+            py_noise = (rs.random_sample() - 0.5) * v_pref
+            px = float(circle_radius * np.cos(angle) + px_noise)
+            py = float(circle_radius * np.sin(angle) + py_noise)
+            if not any(
+                _norm(px - a[0], py - a[1]) < radius + a[4] + DISCOMFORT_DIST
+                or _norm(px - a[2], py - a[3]) < radius + a[4] + DISCOMFORT_DIST
+                for a in agents
+            ):
+                break
+        human = (px, py, -px, -py, radius)
+        agents.append(human)
+        out.append((human, v_pref))
+    return out
+
+
+def square_crossing_humans(
+    rs: np.random.RandomState,
+    n: int,
+    *,
+    square_width: float = SQUARE_WIDTH,
+    robot: _Agent = (0.0, -CIRCLE_RADIUS, 0.0, CIRCLE_RADIUS, ROBOT_RADIUS),
+    randomize_attributes: bool = False,
+) -> list[tuple[_Agent, float]]:
+    """CrowdNav's square-crossing humans (module docstring), as :func:`circle_crossing_humans`."""
+    agents: list[_Agent] = [robot]
+    out: list[tuple[_Agent, float]] = []
+    for _ in range(n):
+        v_pref, radius = _attributes(rs, randomize_attributes)
+        sign = -1.0 if rs.random_sample() > 0.5 else 1.0
+        while True:
+            px = float(rs.random_sample() * square_width * 0.5 * sign)
+            py = float((rs.random_sample() - 0.5) * square_width)
+            if not any(
+                _norm(px - a[0], py - a[1]) < radius + a[4] + DISCOMFORT_DIST for a in agents
+            ):
+                break
+        while True:
+            gx = float(rs.random_sample() * square_width * 0.5 * -sign)
+            gy = float((rs.random_sample() - 0.5) * square_width)
+            if not any(
+                _norm(gx - a[2], gy - a[3]) < radius + a[4] + DISCOMFORT_DIST for a in agents
+            ):
+                break
+        human = (px, py, gx, gy, radius)
+        agents.append(human)
+        out.append((human, v_pref))
+    return out
+
+
+def crowdnav_scenario(
+    case: int,
+    *,
+    rule: Literal["circle_crossing", "square_crossing"] = "circle_crossing",
+    n_humans: int = N_HUMANS,
+    circle_radius: float = CIRCLE_RADIUS,
+    square_width: float = SQUARE_WIDTH,
+    phase: Literal["test", "val", "train"] = "test",
+    randomize_attributes: bool = False,
+    dt: float = TIME_STEP,
+    time_step: float = TIME_STEP,
+    time_limit: float = TIME_LIMIT,
+    robot_radius: float = ROBOT_RADIUS,
+    v_pref: float = ROBOT_V_PREF,
+    u_max: float = UNICYCLE_U_MAX,
+    sensing_range: float = SENSING_RANGE,
+    controller: str = "orca-holonomic-v1",
+    controller_params: dict[str, Any] | None = None,
+) -> Scenario:
+    """CrowdNav's test case ``case`` of ``rule`` (module docstring for every choice and source).
+
+    Args:
+        case: the case number (numpy legacy seed ``PHASE_OFFSET[phase] + case``), >= 0.
+        rule: ``circle_crossing`` or ``square_crossing``.
+        n_humans: number of humans.
+        circle_radius: radius of the humans' circle, and the robot's start/goal distance [m].
+        square_width: side of the square crossing [m].
+        phase: CrowdNav's phase whose seeds are used (``test``: 1000 + case).
+        randomize_attributes: humans draw their ``v_pref`` and radius.
+        dt: integration step [s] (a divisor of ``time_step``; smaller = finer collision checks).
+        time_step: the robot's and the crowd's decision period [s].
+        time_limit: CrowdNav's time limit [s]; the episode lasts ``time_limit - 1``.
+        robot_radius: robot disc radius [m] (also the goal tolerance).
+        v_pref: robot V_max [m/s].
+        u_max: U_max of the unicycle variant [rad/s].
+        sensing_range: the robot sees humans within this [m].
+        controller: the scene's own law.
+        controller_params: its parameters (``orca-holonomic-v1``: CrowdNav's robot ORCA).
+    """
+    case = int(case)
+    if case < 0:
+        raise ValueError(f"case must be >= 0 (got {case})")
+    if rule not in ("circle_crossing", "square_crossing"):
+        raise ValueError(f"rule must be circle_crossing or square_crossing (got {rule!r})")
+    if phase not in PHASE_OFFSET:
+        raise ValueError(f"phase must be one of {', '.join(PHASE_OFFSET)} (got {phase!r})")
+    if int(n_humans) < 0:
+        raise ValueError(f"n_humans must be >= 0 (got {n_humans})")
+    if not time_limit - 1.0 > 0:
+        raise ValueError(f"time_limit must be > 1 s (got {time_limit})")
+    seed = PHASE_OFFSET[phase] + case
+    short = "circle" if rule == "circle_crossing" else "square"
+    if seed >= 2**32:  # numpy's legacy seeds are 32-bit
+        raise ScenarioError(
+            f"crowdnav-{short}:{case}",
+            "seed",
+            f"CrowdNav's cases are numpy legacy seeds {PHASE_OFFSET[phase]} + case < 2**32: the "
+            f"case must be below {2**32 - PHASE_OFFSET[phase]} (got {case})",
+        )
+    rs = np.random.RandomState(seed)
+    robot: _Agent = (0.0, -circle_radius, 0.0, circle_radius, robot_radius)
+    if rule == "circle_crossing":
+        humans = circle_crossing_humans(
+            rs, int(n_humans), circle_radius=circle_radius, robot=robot,
+            randomize_attributes=randomize_attributes,
+        )  # fmt: skip
+    else:
+        humans = square_crossing_humans(
+            rs, int(n_humans), square_width=square_width, robot=robot,
+            randomize_attributes=randomize_attributes,
+        )  # fmt: skip
+    obstacles = [
+        {
+            "name": f"human-{i}",
+            "body": {"disc": radius},
+            "start": {"position": [px, py], "heading": 0.0},
+            "motion": {
+                "type": "orca_crowd",
+                "goal": [gx, gy],
+                "v_pref": hv,
+                "period": time_step,
+            },
+        }
+        for i, ((px, py, gx, gy, radius), hv) in enumerate(humans)
+    ]
+    if controller_params is None:
+        controller_params = dict(CROWDNAV_ORCA_PARAMS) if controller == "orca-holonomic-v1" else {}
+    data: dict[str, Any] = {
+        "name": f"crowdnav-{short}-{case}",
+        "description": (
+            f"CrowdNav {rule.replace('_', ' ')} ({phase} case {case}, numpy seed {seed}; Chen et "
+            f"al., ICRA 2019): {len(humans)} ORCA humans that do not see the robot; robot from "
+            f"(0, {-circle_radius:g}) to (0, {circle_radius:g}), time limit {time_limit:g} s "
+            f"(acting as {time_limit - 1:g} s, as in CrowdSim)."
+        ),
+        "dim": 2,
+        "dt": dt,
+        "control_period": time_step,
+        "t_max": time_limit - 1.0,
+        "goal_tolerance": robot_radius,
+        "robot": {
+            "model": "unicycle",
+            "start": [0.0, -circle_radius],
+            "heading": math.pi / 2,
+            "goal": [0.0, circle_radius],
+            "v_max": v_pref,
+            "u_max": u_max,
+            "radius": robot_radius,
+        },
+        "sensing": {"range": sensing_range, "velocities": "known", "position_noise": 0.0},
+        "obstacles": obstacles,
+        "controller": {"name": controller, "params": dict(controller_params)},
+    }
+    return scenario_from_dict(data, source=f"crowdnav-{short}:{case}")
+
+
+def crowdnav_circle(seed: int, **params: Any) -> Scenario:
+    """``crowdnav-circle:<case>``: CrowdNav's circle-crossing test case
+    (:func:`crowdnav_scenario`)."""
+    return crowdnav_scenario(seed, rule="circle_crossing", **params)
+
+
+def crowdnav_square(seed: int, **params: Any) -> Scenario:
+    """``crowdnav-square:<case>``: CrowdNav's square-crossing test case
+    (:func:`crowdnav_scenario`)."""
+    return crowdnav_scenario(seed, rule="square_crossing", **params)
