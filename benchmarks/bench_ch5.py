@@ -1,8 +1,10 @@
 """Chapter 5 speed benchmarks (run: ``.venv/bin/python benchmarks/bench_ch5.py --out DIR``).
 
-Writes ``<out>/ch5.json`` with the machine, the parameters and:
+Writes ``<out>/ch5.json`` with the machine, the parameters and, all in CPU time of the process
+(every thread; the targets are judged on it, so a loaded machine does not fail them), with the
+training's wall time beside it:
 
-* ``train_150``: wall time [s] of training the BPNN (plain and residual, L-BFGS, 2 torch threads)
+* ``train_150``: CPU time [s] of training the BPNN (plain and residual, L-BFGS, 2 torch threads)
   on 150 samples — the issue's target: "training 150 samples takes seconds on 2 CPU cores"
   (target < 10 s, ``pass`` flag);
 * ``sonar_scan``: one R(t) of the nine-sonar array against a 1280-triangle deforming star [ms];
@@ -29,11 +31,12 @@ TARGET_TRAIN_S = 10.0
 
 
 def _median_time(fn: Any, repeat: int) -> float:
+    """Median CPU time [s] of ``fn()`` (the process's, every thread: judged, immune to load)."""
     times = []
     for _ in range(repeat):
-        tic = time.perf_counter()
+        tic = time.process_time()
         fn()
-        times.append(time.perf_counter() - tic)
+        times.append(time.process_time() - tic)
     return float(np.median(times))
 
 
@@ -61,15 +64,20 @@ def main() -> None:
     train = {}
     models = {}
     for name, cfg in (("plain", BPNNConfig()), ("residual", BPNNConfig(residual=True))):
-        secs = []
+        secs, walls = [], []
         for s in range(repeat):
-            tic = time.perf_counter()
+            tic, cpu0 = time.perf_counter(), time.process_time()
             m = train_bpnn(
                 ds.inputs, ds.targets(), np.random.default_rng(s), cfg, offset=ds.baseline()
             )
-            secs.append(time.perf_counter() - tic)
+            secs.append(time.process_time() - cpu0)
+            walls.append(time.perf_counter() - tic)
         models[name] = m
-        train[name] = {"median_s": float(np.median(secs)), "max_s": float(np.max(secs))}
+        train[name] = {
+            "median_s": float(np.median(secs)),  # CPU time, every thread (judged)
+            "max_s": float(np.max(secs)),
+            "wall_median_s": float(np.median(walls)),
+        }
     worst = max(v["max_s"] for v in train.values())
     star = random_star(np.random.default_rng(1), np.zeros(3), 2.0, subdivisions=3)
     tri = star.triangles(0.0)
@@ -102,14 +110,14 @@ def main() -> None:
     from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
     from uvnav.viz.figures_ch5 import save_animation3d
 
-    tic = time.perf_counter()
+    tic = time.process_time()
     _, res = run_ch5_job(Ch5Job("thesis-ch5-scene3", "geometric", 0), record=True)
-    episode_s = time.perf_counter() - tic
+    episode_s = time.process_time() - tic
     setup = build_uuv3d(load_ch5_scenario("thesis-ch5-scene3"))
     with tempfile.TemporaryDirectory() as tmp:
-        tic = time.perf_counter()
+        tic = time.process_time()
         save_animation3d(res, setup.obstacles, setup.goal, Path(tmp) / "a.gif")
-        animation_s = time.perf_counter() - tic
+        animation_s = time.process_time() - tic
     out = {
         "machine": {
             "platform": platform.platform(),

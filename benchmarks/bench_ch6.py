@@ -17,7 +17,10 @@ Writes ``ch6.json`` with the machine, the parameters and:
 
 Targets (issue 7; a prototype measured about 190 img/s training and about 2 ms inference on 2 CPU
 threads) are reported beside the measurement with a ``pass`` flag; the numbers move with the load
-of the machine (the load averages at the start and the end are recorded).
+of the machine (the load averages at the start and the end are recorded).  These are the only
+targets of the benchmarks judged on wall time: they are throughputs and latencies of a program
+running 2 threads at once, which CPU time (the sum over the threads) does not measure; the
+training's CPU-time rate is reported beside it (``train_images_per_cpu_s_*``).
 """
 
 from __future__ import annotations

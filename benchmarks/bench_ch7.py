@@ -67,9 +67,9 @@ def run(out: Path, *, quick: bool, ref_seconds: float) -> dict[str, Any]:
     for kind, side, R in experiments:
         terrain, area = experiment_terrain(kind, side)
         cfg = ReconConfig(footprint_radius=R, uavs=2, r_min=min(15.0, 0.5 * R))
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         plan = plan_recon(terrain, area, cfg)
-        wall = time.perf_counter() - t0
+        wall, cpu = time.perf_counter() - t0, time.process_time() - c0
         s = plan.summary()
         tours = []
         for u in [*plan.uavs, *([plan.integrated] if plan.integrated is not None else [])]:
@@ -93,7 +93,8 @@ def run(out: Path, *, quick: bool, ref_seconds: float) -> dict[str, Any]:
                 "side": side,
                 "R": R,
                 "n_waypoints": s["n_waypoints"],
-                "planning_time_s": wall,
+                "planning_time_s": cpu,  # CPU time of the process, every thread (judged)
+                "planning_wall_s": wall,
                 "timings": s["timings"],
                 "coverage_visible": s["coverage_visible"],
                 "max_curvature": s["max_curvature"],
@@ -101,12 +102,12 @@ def run(out: Path, *, quick: bool, ref_seconds: float) -> dict[str, Any]:
                 "max_waypoint_distance": s["max_waypoint_distance"],
                 "delta": s["delta"],
                 "tours": tours,
-                "time_pass": wall <= TIME_LIMIT_S if side == 600.0 else None,
+                "time_pass": cpu <= TIME_LIMIT_S if side == 600.0 else None,
             }
         )
         print(
-            f"{kind} {side:.0f} m R={R:.0f}: N={s['n_waypoints']} planned in {wall:.1f} s; "
-            + ", ".join(f"tour {t['ratio']:.3f}x ref" for t in tours),
+            f"{kind} {side:.0f} m R={R:.0f}: N={s['n_waypoints']} planned in {cpu:.1f} CPU s "
+            f"({wall:.1f} s wall); " + ", ".join(f"tour {t['ratio']:.3f}x ref" for t in tours),
             flush=True,
         )
     doc = {
