@@ -268,7 +268,7 @@ def run_job(job: Job) -> JobOutcome:
     Jobs with a scene (any kind) run through :func:`uvnav.scenarios.episodes.run_scene`, the
     path of ``uvnav simulate``; jobs with a ``setup_factory`` run the 2D loop directly.
     """
-    from uvnav.scenarios.errors import ScenarioError
+    from uvnav.scenarios.episodes import AssumptionError, LawMismatchError
 
     tic = time.perf_counter()
     params: dict[str, Any] = job.params_dict
@@ -291,7 +291,7 @@ def run_job(job: Job) -> JobOutcome:
                     use_scene_params=job.use_scenario_params,
                     beyond_assumptions=job.beyond_assumptions,
                 )  # fmt: skip
-            except ScenarioError as exc:  # the law's assumption does not hold on this scene
+            except (AssumptionError, LawMismatchError) as exc:  # the law is refused here
                 return JobOutcome(
                     job, STATUS_REFUSED, None, exc.problem, time.perf_counter() - tic, None,
                     params,

@@ -28,6 +28,10 @@ class LawMismatchError(ScenarioError):
     """The law cannot drive the scene (another vehicle or another sensor)."""
 
 
+class AssumptionError(ScenarioError):
+    """The scene breaks an assumption the law declares (thesis (2.6)): the law is refused."""
+
+
 @dataclass
 class Outcome:
     """One episode's result in a kind-independent form.
@@ -69,7 +73,7 @@ def check_law(resolved: Resolved, law: str, *, assumptions: bool = True) -> Cont
     Raises:
         UnknownControllerError: no such law.
         LawMismatchError: the law drives another vehicle or reads another sensor.
-        ScenarioError: the scene breaks an assumption the law declares (thesis (2.6)).
+        AssumptionError: the scene breaks an assumption the law declares (thesis (2.6)).
     """
     info = controller_info(law)
     kind = resolved.kind
@@ -83,7 +87,10 @@ def check_law(resolved: Resolved, law: str, *, assumptions: bool = True) -> Cont
     if assumptions and kind.name == "nav2d":
         from uvnav.scenarios.build import validate_for_controller
 
-        validate_for_controller(resolved.scenario, law)
+        try:
+            validate_for_controller(resolved.scenario, law)
+        except ScenarioError as exc:
+            raise AssumptionError(exc.source, exc.path, exc.problem) from None
     return info
 
 
@@ -121,7 +128,8 @@ def run_scene(
     assumption it declares (a deliberate experiment; never the default).
 
     Raises:
-        UnknownControllerError, ControllerParamsError, LawMismatchError, ScenarioError: as above.
+        UnknownControllerError, ControllerParamsError, LawMismatchError, AssumptionError: as
+            above; ScenarioError: a seed that contradicts a ``generator:seed`` spec.
     """
     own, own_params = default_law(resolved)
     name = law or own
