@@ -1,4 +1,5 @@
-"""Layer 4: the world, the step loop, collision checks, termination, recorder and metrics."""
+"""Layer 4: the worlds of every vehicle (stepped by :func:`uvnav.core.run_loop`), collision checks,
+termination, recorder probes and metrics."""
 
 from uvnav.sim.episode import EpisodeResult, EpisodeSetup, LidarConfig, SensingConfig, run_episode
 from uvnav.sim.metrics import METRIC_NAMES, EpisodeMetrics

@@ -1,14 +1,18 @@
-"""The 2D step loop: sensing, decisions, exact integration, collision checks, metrics (DESIGN §2,
-§4).
+"""The 2D worlds (thesis Ch. 2; DESIGN §2, §4): sensing, exact integration, collision checks and
+metrics of one robot among moving bodies, stepped by the one loop :func:`uvnav.core.run_loop`.
 
-Decision rate and integration rate are separate: the controller is asked every ``control_period``
-[s] (a whole multiple of ``dt``, else :func:`run_episode` raises ``ValueError``); robot and
-obstacles are integrated every ``dt`` [s] with the last command held.  Collisions are checked at
-*every* integration step, exactly (robot disc against disc or polygon sets, see
+:class:`UnicycleWorld` holds the thesis's unicycle, :class:`HolonomicWorld` the holonomic disc
+robot of the crowd benchmarks (the law's vehicle picks the world: :data:`WORLDS_2D`);
+:func:`run_episode` runs one episode with either.
+
+Decision rate and integration rate are separate: the law is asked every ``control_period`` [s]
+(a whole multiple of ``dt``, else :func:`run_episode` raises ``ValueError``); robot and obstacles
+are integrated every ``dt`` [s] with the last command held.  Collisions are checked at *every*
+integration step, exactly (robot disc against disc or polygon sets, see
 :meth:`uvnav.obstacles.ObstacleField.query`; the kernel is property-tested against shapely).
 
-The simulator clips nothing silently: a command outside the limits (2.4) is saturated to what the
-vehicle can physically do *and* counted in ``limit_violations``.
+The simulator clips nothing silently: a command outside the limits ((2.4), or the V_max disc) is
+saturated to what the vehicle can physically do *and* counted in ``limit_violations``.
 
 Speed (``benchmarks/``): the obstacles are advanced together by
 :class:`uvnav.obstacles.ObstacleBatch` (bit for bit their models' own ``step``), each step's
