@@ -178,3 +178,58 @@ def test_cli_simulate_json() -> None:
     data = json.loads(res.stdout)
     assert data["scenario"] == "crowdnav-circle-3" and data["controller"] == "orca-holonomic-v1"
     assert data["status"] in ("success", "collision", "timeout")
+
+
+class _Standing:
+    """A robot that stays where it is (a zero velocity command)."""
+
+    name = "standing"
+    oracle = False
+    mode = "M1"
+
+    def reset(self, spec: Any, goal: np.ndarray, rng: np.random.Generator) -> None:
+        pass
+
+    def act(self, obs: Any) -> Any:
+        from uvnav.dynamics.omni import VelocityCommand
+
+        return VelocityCommand(0.0, 0.0)
+
+
+def _closest_pedestrian(case: int, visible: bool) -> tuple[float, np.ndarray, str]:
+    """Smallest centre distance [m] from any pedestrian to a robot standing on the first
+    pedestrian's way (a quarter of its straight path), and the pedestrians' positions, for
+    CrowdNav circle case ``case``."""
+    from uvnav.scenarios.catalog import kinds
+    from uvnav.sim.episode import run_episode
+
+    scn = crowdnav_scenario(case, robot_visible=visible)
+    setup = build_episode(scn, case)
+    first = setup.obstacles[0]
+    spot = first.state.position + 0.25 * (first.motion.goal - first.state.position)  # type: ignore[attr-defined]
+    setup.start = np.array([spot[0], spot[1], 0.0])
+    log = _PedestrianLog()
+    res = run_episode(
+        setup, _Standing(), kinds()["nav2d"].episode_rng(case), record=False,
+        vehicle="holonomic", probes=[log],
+    )  # fmt: skip
+    rows = np.array(log.rows)
+    gap = float(np.hypot(rows[:, :, 0] - spot[0], rows[:, :, 1] - spot[1]).min())
+    return gap, rows, res.status
+
+
+def test_a_visible_robot_is_avoided_an_invisible_one_is_not() -> None:
+    runs = {v: [_closest_pedestrian(c, v) for c in range(6)] for v in (False, True)}
+    # invisible: the first pedestrian walks into the robot standing on its way
+    assert all(status == "collision" for _, _, status in runs[False])
+    # visible: every pedestrian keeps ORCA's distance from it (radii 0.3 + 0.3 m + margins)
+    assert all(status == "timeout" for _, _, status in runs[True])
+    assert all(gap >= 0.6 for gap, _, _ in runs[True]), [g for g, _, _ in runs[True]]
+
+
+def test_visible_robot_changes_the_crowd_only_through_the_robot() -> None:
+    _, a, _ = _closest_pedestrian(2, True)
+    _, b, _ = _closest_pedestrian(2, True)
+    assert np.array_equal(a, b)  # deterministic
+    _, invisible, _ = _closest_pedestrian(2, False)
+    assert not np.array_equal(a[: len(invisible)], invisible)

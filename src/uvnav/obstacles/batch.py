@@ -32,7 +32,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-from uvnav.obstacles.crowd import join_crowds
+from uvnav.obstacles.crowd import crowds_seeing_robot, join_crowds
 from uvnav.obstacles.motion import (
     ConstantVelocity,
     MotionGroup,
@@ -194,6 +194,7 @@ class ObstacleBatch:
 
     __slots__ = (
         "_const",
+        "_crowds",
         "_dt",
         "_groups",
         "_inc",
@@ -211,6 +212,7 @@ class ObstacleBatch:
     def __init__(self, obstacles: Sequence[Obstacle]) -> None:
         self.obstacles = list(obstacles)
         join_crowds(self.obstacles)  # ORCA pedestrians not yet in a crowd: one per crowd id
+        self._crowds = crowds_seeing_robot(self.obstacles)
         k = len(self.obstacles)
         # rows: x, y, heading, course (random-turn obstacles only, else 0)
         x = np.zeros((4, k))
@@ -308,6 +310,17 @@ class ObstacleBatch:
         self._dt = dt
         self._inc = inc
         self._omega_base = omega
+
+    @property
+    def sees_robot(self) -> bool:
+        """Whether some obstacle reacts to the robot (a crowd with a visible robot)."""
+        return bool(self._crowds)
+
+    def see_robot(self, position: FloatArray, velocity: FloatArray, radius: float) -> None:
+        """Tell the obstacles that react to the robot where it is: position [m], velocity
+        [m/s], disc radius [m] (the world calls it before every :meth:`step`)."""
+        for crowd in self._crowds:
+            crowd.see_robot(position, velocity, radius)
 
     def step(self, t: float, dt: float) -> None:
         """Advance every obstacle from time ``t`` [s] by ``dt`` [s]."""

@@ -8,9 +8,15 @@ period the crowd's velocities are chosen by ORCA (van den Berg, Guy, Lin, Manoch
 through RVO2 (``pyrvo``), each pedestrian avoiding the others reciprocally, and held over the
 period.
 
-**The robot is invisible** (CrowdNav's test protocol, ``[robot] visible = false`` in its
-``env.config``): pedestrians react to each other only.  That is what lets a crowd be an ordinary
-obstacle motion model: its step needs only the pedestrians' own states, never the robot's.
+**The robot is invisible by default** (CrowdNav's test protocol, ``[robot] visible = false`` in
+its ``env.config``): pedestrians react to each other only, and a crowd is an ordinary obstacle
+motion model.  **A visible robot** (``sees_robot``, CrowdNav's ``visible = true``): the world
+tells the crowd where the robot is before every step (:meth:`Crowd.see_robot`, through
+:meth:`uvnav.obstacles.ObstacleBatch.see_robot`), and at each decision the robot is one more RVO2
+agent at its position with its velocity as current and preferred velocity (its new velocity is
+discarded: the law moves it), so the pedestrians avoid it as CrowdNav's ORCA humans avoid a
+visible robot, reciprocally (they take half of each avoidance, expecting the robot to take the
+other half).  A crowd sees the robot when any of its members is set to.
 
 What is implemented, with its source in CrowdNav (``crowd_sim/envs/policy/orca.py``,
 ``crowd_sim/envs/crowd_sim.py``, ``crowd_sim/envs/utils/agent.py``):
@@ -126,6 +132,7 @@ class OrcaPedestrian:
         time_horizon_obst: ORCA's horizon for static obstacles [s] (none here).
         safety_margin: added to the body radius for RVO2 [m].
         period: decision period [s] (every integration step when ``None``); one value per crowd.
+        sees_robot: the robot is an agent of the crowd's ORCA (module docstring).
     """
 
     goal: FloatArray
@@ -137,6 +144,7 @@ class OrcaPedestrian:
     time_horizon_obst: float = TIME_HORIZON_OBST
     safety_margin: float = SAFETY_MARGIN
     period: float | None = None
+    sees_robot: bool = False
     crowd: Crowd | None = field(default=None, init=False, repr=False)
     index: int = field(default=-1, init=False, repr=False)
 
@@ -209,6 +217,19 @@ class Crowd:
         self._dt: float | None = None
         self._sim: Any = None
         self.decisions = 0
+        self.sees_robot = any(m.sees_robot for m in self.members)
+        #: the robot as last seen: (position (2,), velocity (2,), radius) [m, m/s, m]
+        self.robot: tuple[FloatArray, FloatArray, float] | None = None
+        self._robot_agent = -1
+
+    def see_robot(self, position: FloatArray, velocity: FloatArray, radius: float) -> None:
+        """The robot's state now (a visible robot is an agent at the next decision)."""
+        if self.sees_robot:
+            self.robot = (
+                np.array(position[:2], dtype=float),
+                np.array(velocity[:2], dtype=float),
+                float(radius),
+            )
 
     def __len__(self) -> int:
         return len(self.members)
@@ -229,6 +250,12 @@ class Crowd:
                     float(m.v_pref),
                     (float(self.velocity[i, 0]), float(self.velocity[i, 1])),
                 )
+            if self.sees_robot:
+                m0 = self.members[0] if self.members else OrcaPedestrian(np.zeros(2))
+                self._robot_agent = sim.add_agent(
+                    (0.0, 0.0), float(m0.neighbor_dist), int(m0.max_neighbors),
+                    float(m0.time_horizon), float(m0.time_horizon_obst), 0.0, 1.0, (0.0, 0.0),
+                )  # fmt: skip
             self._sim = sim
         elif self._sim.get_time_step() != np.float32(period):
             self._sim.set_time_step(float(period))
@@ -242,14 +269,32 @@ class Crowd:
             sim.set_agent_position(i, (float(pos[i, 0]), float(pos[i, 1])))
             sim.set_agent_velocity(i, (float(vel[i, 0]), float(vel[i, 1])))
             sim.set_agent_pref_velocity(i, preferred_velocity(pos[i], m.goal, float(m.v_pref)))
+        if self._robot_agent >= 0:
+            self._place_robot(sim)
         sim.do_step()
         held = np.empty_like(self._held)
-        for i in range(len(self.members)):
+        for i in range(len(self.members)):  # (the robot's own agent is read by nobody)
             v = sim.get_agent_velocity(i)
             held[i, 0] = float(v.x)
             held[i, 1] = float(v.y)
         self._held = held
         self.decisions += 1
+
+    def _place_robot(self, sim: Any) -> None:
+        """The robot's agent at its last seen state (far away and still before it is seen)."""
+        k = self._robot_agent
+        if self.robot is None:
+            sim.set_agent_position(k, (1e6, 1e6))
+            sim.set_agent_velocity(k, (0.0, 0.0))
+            sim.set_agent_pref_velocity(k, (0.0, 0.0))
+            return
+        p, v, r = self.robot
+        speed = max(float(math.hypot(v[0], v[1])), 1e-6)
+        sim.set_agent_radius(k, r + float(self.members[0].safety_margin if self.members else 0.0))
+        sim.set_agent_max_speed(k, speed)
+        sim.set_agent_position(k, (float(p[0]), float(p[1])))
+        sim.set_agent_velocity(k, (float(v[0]), float(v[1])))
+        sim.set_agent_pref_velocity(k, (float(v[0]), float(v[1])))
 
     def advance(self, t: float, dt: float) -> None:
         """Advance the crowd from ``t`` [s] by ``dt`` [s], once: later calls for the same step
@@ -325,4 +370,15 @@ def join_crowds(obstacles: Sequence[Obstacle]) -> list[Crowd]:
             m.crowd = crowd
             m.index = i
         out.append(crowd)
+    return out
+
+
+def crowds_seeing_robot(obstacles: Sequence[Obstacle]) -> list[Crowd]:
+    """The crowds of ``obstacles`` (joined) that see the robot, each once, in obstacle order."""
+    out: list[Crowd] = []
+    for ob in obstacles:
+        m = ob.motion
+        crowd = m.crowd if isinstance(m, OrcaPedestrian) else None
+        if crowd is not None and crowd.sees_robot and not any(c is crowd for c in out):
+            out.append(crowd)
     return out

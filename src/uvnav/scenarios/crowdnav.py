@@ -184,6 +184,7 @@ def crowdnav_scenario(
     sensing_range: float = SENSING_RANGE,
     controller: str = "orca-holonomic-v1",
     controller_params: dict[str, Any] | None = None,
+    robot_visible: bool = False,
 ) -> Scenario:
     """CrowdNav's test case ``case`` of ``rule`` (module docstring for every choice and source).
 
@@ -197,6 +198,8 @@ def crowdnav_scenario(
         randomize_attributes: humans draw their ``v_pref`` and radius.
         dt: integration step [s] (a divisor of ``time_step``; smaller = finer collision checks).
         time_step: the robot's and the crowd's decision period [s].
+        robot_visible: the humans see the robot and avoid it (CrowdNav's ``visible = true``);
+            the test protocol's robot is invisible.
         time_limit: CrowdNav's time limit [s]; the episode lasts ``time_limit - 1``.
         robot_radius: robot disc radius [m] (also the goal tolerance).
         v_pref: robot V_max [m/s].
@@ -247,17 +250,19 @@ def crowdnav_scenario(
                 "goal": [gx, gy],
                 "v_pref": hv,
                 "period": time_step,
+                "sees_robot": bool(robot_visible),
             },
         }
         for i, ((px, py, gx, gy, radius), hv) in enumerate(humans)
     ]
     if controller_params is None:
         controller_params = dict(CROWDNAV_ORCA_PARAMS) if controller == "orca-holonomic-v1" else {}
+    sees = "see" if robot_visible else "do not see"
     data: dict[str, Any] = {
         "name": f"crowdnav-{short}-{case}",
         "description": (
             f"CrowdNav {rule.replace('_', ' ')} ({phase} case {case}, numpy seed {seed}; Chen et "
-            f"al., ICRA 2019): {len(humans)} ORCA humans that do not see the robot; robot from "
+            f"al., ICRA 2019): {len(humans)} ORCA humans that {sees} the robot; robot from "
             f"(0, {-circle_radius:g}) to (0, {circle_radius:g}), time limit {time_limit:g} s "
             f"(acting as {time_limit - 1:g} s, as in CrowdSim)."
         ),

@@ -370,6 +370,11 @@ class OrcaCrowdMotion(_Model):
         description="decision period of the crowd [s] (omitted = every integration step dt); "
         "the same for every pedestrian of a crowd",
     )
+    sees_robot: bool = Field(
+        False,
+        description="the robot is an agent of the crowd's ORCA: the pedestrians avoid it "
+        "(CrowdNav's visible robot); false = invisible (CrowdNav's test protocol)",
+    )
 
     def to_model(self, rng: np.random.Generator) -> OrcaPedestrian:
         """The motion model (``rng`` unused: ORCA is deterministic); joined to its crowd when the
@@ -384,6 +389,7 @@ class OrcaCrowdMotion(_Model):
             time_horizon_obst=float(self.time_horizon_obst),
             safety_margin=float(self.safety_margin),
             period=None if self.period is None else float(self.period),
+            sees_robot=bool(self.sees_robot),
         )
 
 

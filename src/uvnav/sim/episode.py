@@ -345,6 +345,11 @@ class UnicycleWorld:
         self.applied = new
         return new
 
+    def velocity(self) -> tuple[float, float]:
+        """The robot's world-frame velocity now [m/s]."""
+        v = float(self.applied.v)
+        return v * math.cos(self.th), v * math.sin(self.th)
+
     def _move(self, dt: float) -> tuple[float, float]:
         """Integrate the robot over ``dt`` [s] (exact); returns the new position, updates the
         heading and the turn part of the control effort."""
@@ -357,6 +362,8 @@ class UnicycleWorld:
         """One step ``dt``: robot (exact), obstacles, clearance, collision and arrival."""
         dt = self.dt
         x, y = self.x, self.y
+        if self.batch.sees_robot:  # bodies that react to the robot see it as it starts the step
+            self.batch.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
         nx, ny = self._move(dt)
         self.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
@@ -429,6 +436,9 @@ class HolonomicWorld(UnicycleWorld):
     def command_pair(self) -> tuple[float, float]:
         """``(vx, vy)`` [m/s]."""
         return self.applied.vx, self.applied.vy
+
+    def velocity(self) -> tuple[float, float]:
+        return float(self.applied.vx), float(self.applied.vy)
 
     def _speed_change(self, new: Any) -> float:
         return float((new.vx - self.applied.vx) ** 2 + (new.vy - self.applied.vy) ** 2)
