@@ -18,6 +18,7 @@ from uvnav.obstacles.motion import (
     Waypoints,
 )
 from uvnav.obstacles.obstacle import FieldTemplate, NearestQuery, Obstacle, ObstacleField
+from uvnav.obstacles.social_force import SocialForcePedestrian, join_force_crowds
 
 __all__ = [
     "Body",
@@ -35,8 +36,10 @@ __all__ = [
     "PolygonBody",
     "RandomTurn",
     "Replay",
+    "SocialForcePedestrian",
     "Waypoints",
     "join_crowds",
+    "join_force_crowds",
     "radial_profile",
     "rotation_boundary_growth",
 ]

@@ -41,6 +41,7 @@ from uvnav.obstacles.motion import (
     uniform_draw,
 )
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
+from uvnav.obstacles.social_force import join_force_crowds
 
 _Rows = slice | np.ndarray
 #: at most this many obstacles outside their arena are steered one by one, more in array form
@@ -212,6 +213,7 @@ class ObstacleBatch:
     def __init__(self, obstacles: Sequence[Obstacle]) -> None:
         self.obstacles = list(obstacles)
         join_crowds(self.obstacles)  # ORCA pedestrians not yet in a crowd: one per crowd id
+        join_force_crowds(self.obstacles)  # the same for social-force pedestrians
         self._crowds = crowds_seeing_robot(self.obstacles)
         k = len(self.obstacles)
         # rows: x, y, heading, course (random-turn obstacles only, else 0)

@@ -373,12 +373,12 @@ def join_crowds(obstacles: Sequence[Obstacle]) -> list[Crowd]:
     return out
 
 
-def crowds_seeing_robot(obstacles: Sequence[Obstacle]) -> list[Crowd]:
-    """The crowds of ``obstacles`` (joined) that see the robot, each once, in obstacle order."""
-    out: list[Crowd] = []
+def crowds_seeing_robot(obstacles: Sequence[Obstacle]) -> list[Any]:
+    """The crowds of ``obstacles`` (joined; ORCA or social force: any shared ``crowd`` with
+    ``sees_robot`` and ``see_robot``) that see the robot, each once, in obstacle order."""
+    out: list[Any] = []
     for ob in obstacles:
-        m = ob.motion
-        crowd = m.crowd if isinstance(m, OrcaPedestrian) else None
-        if crowd is not None and crowd.sees_robot and not any(c is crowd for c in out):
+        crowd = getattr(ob.motion, "crowd", None)
+        if getattr(crowd, "sees_robot", False) and not any(c is crowd for c in out):
             out.append(crowd)
     return out

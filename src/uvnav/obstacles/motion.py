@@ -67,6 +67,7 @@ BUILTIN_MOTIONS: tuple[str, ...] = (
     "waypoints",
     "replay",
     "orca_crowd",
+    "social_force",
     "plugin",
 )
 _PLUGINS: dict[str, Callable[..., Any]] | None = None

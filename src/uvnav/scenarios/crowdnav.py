@@ -185,6 +185,7 @@ def crowdnav_scenario(
     controller: str = "orca-holonomic-v1",
     controller_params: dict[str, Any] | None = None,
     robot_visible: bool = False,
+    human_policy: Literal["orca", "social_force"] = "orca",
 ) -> Scenario:
     """CrowdNav's test case ``case`` of ``rule`` (module docstring for every choice and source).
 
@@ -200,6 +201,9 @@ def crowdnav_scenario(
         time_step: the robot's and the crowd's decision period [s].
         robot_visible: the humans see the robot and avoid it (CrowdNav's ``visible = true``);
             the test protocol's robot is invisible.
+        human_policy: the humans' policy: ``orca`` (CrowdNav's test protocol) or ``social_force``
+            (Helbing and Molnár's model, :mod:`uvnav.obstacles.social_force`; CrowdNav offers a
+            social-force policy too, through another implementation).
         time_limit: CrowdNav's time limit [s]; the episode lasts ``time_limit - 1``.
         robot_radius: robot disc radius [m] (also the goal tolerance).
         v_pref: robot V_max [m/s].
@@ -208,6 +212,8 @@ def crowdnav_scenario(
         controller: the scene's own law.
         controller_params: its parameters (``orca-holonomic-v1``: CrowdNav's robot ORCA).
     """
+    if human_policy not in ("orca", "social_force"):
+        raise ValueError(f"human_policy must be 'orca' or 'social_force' (got {human_policy!r})")
     case = int(case)
     if case < 0:
         raise ValueError(f"case must be >= 0 (got {case})")
@@ -245,24 +251,34 @@ def crowdnav_scenario(
             "name": f"human-{i}",
             "body": {"disc": radius},
             "start": {"position": [px, py], "heading": 0.0},
-            "motion": {
-                "type": "orca_crowd",
-                "goal": [gx, gy],
-                "v_pref": hv,
-                "period": time_step,
-                "sees_robot": bool(robot_visible),
-            },
+            "motion": (
+                {
+                    "type": "orca_crowd",
+                    "goal": [gx, gy],
+                    "v_pref": hv,
+                    "period": time_step,
+                    "sees_robot": bool(robot_visible),
+                }
+                if human_policy == "orca"
+                else {
+                    "type": "social_force",
+                    "goal": [gx, gy],
+                    "v_pref": hv,
+                    "sees_robot": bool(robot_visible),
+                }
+            ),
         }
         for i, ((px, py, gx, gy, radius), hv) in enumerate(humans)
     ]
     if controller_params is None:
         controller_params = dict(CROWDNAV_ORCA_PARAMS) if controller == "orca-holonomic-v1" else {}
     sees = "see" if robot_visible else "do not see"
+    policy = "ORCA" if human_policy == "orca" else "social-force"
     data: dict[str, Any] = {
         "name": f"crowdnav-{short}-{case}",
         "description": (
             f"CrowdNav {rule.replace('_', ' ')} ({phase} case {case}, numpy seed {seed}; Chen et "
-            f"al., ICRA 2019): {len(humans)} ORCA humans that {sees} the robot; robot from "
+            f"al., ICRA 2019): {len(humans)} {policy} humans that {sees} the robot; robot from "
             f"(0, {-circle_radius:g}) to (0, {circle_radius:g}), time limit {time_limit:g} s "
             f"(acting as {time_limit - 1:g} s, as in CrowdSim)."
         ),

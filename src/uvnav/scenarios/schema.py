@@ -43,9 +43,11 @@ from uvnav.obstacles import (
     RandomTurn,
     Replay,
     Waypoints,
+    social_force,
 )
 from uvnav.obstacles import crowd as orca_crowd
 from uvnav.obstacles.motion import motion_plugins
+from uvnav.obstacles.social_force import SocialForcePedestrian
 from uvnav.scenarios import pedestrians
 from uvnav.scenarios.errors import FieldError, ScenarioError
 from uvnav.scenarios.limits import check_timing
@@ -393,6 +395,33 @@ class OrcaCrowdMotion(_Model):
         )
 
 
+class SocialForceMotion(_Model):
+    """A pedestrian walking by the social force model (Helbing and Molnár 1995;
+    :mod:`uvnav.obstacles.social_force`); the scene's ``social_force`` pedestrians with the same
+    ``crowd`` id form one crowd.  The body must be a disc."""
+
+    type: Literal["social_force"]
+    goal: Point2 = Field(description="where the pedestrian walks to [m]")
+    v_pref: float = Field(1.0, gt=0, description="preferred speed v0 [m/s]")
+    crowd: str = Field(social_force.DEFAULT_CROWD, min_length=1, description="crowd id")
+    tau: float = Field(social_force.TAU, gt=0, description="relaxation time [s]")
+    strength: float = Field(social_force.STRENGTH, gt=0, description="repulsion A [m/s^2]")
+    range: float = Field(social_force.RANGE, gt=0, description="repulsion range B [m]")
+    goal_radius: float = Field(
+        social_force.GOAL_RADIUS, ge=0, description="it stops within this of its goal [m]"
+    )
+    sees_robot: bool = Field(False, description="a visible robot repels it too")
+
+    def to_model(self, rng: np.random.Generator) -> SocialForcePedestrian:
+        """The motion model (``rng`` unused: the model is deterministic)."""
+        return SocialForcePedestrian(
+            goal=np.asarray(self.goal, dtype=float), v_pref=float(self.v_pref),
+            crowd_id=self.crowd, tau=float(self.tau), strength=float(self.strength),
+            range=float(self.range), goal_radius=float(self.goal_radius),
+            sees_robot=bool(self.sees_robot),
+        )  # fmt: skip
+
+
 class PluginMotion(_Model):
     """A third-party motion model (entry-point group ``uvnav.motions``, see
     :data:`uvnav.obstacles.motion.MOTION_GROUP`), built from its keyword ``params``."""
@@ -429,6 +458,7 @@ MotionSpec = Annotated[
     | WaypointsMotion
     | ReplayMotion
     | OrcaCrowdMotion
+    | SocialForceMotion
     | PluginMotion,
     Field(discriminator="type"),
 ]
@@ -440,6 +470,7 @@ MOTION_TYPES: dict[str, type[_Model]] = {
     "waypoints": WaypointsMotion,
     "replay": ReplayMotion,
     "orca_crowd": OrcaCrowdMotion,
+    "social_force": SocialForceMotion,
     "plugin": PluginMotion,
 }
 
@@ -463,8 +494,8 @@ class ObstacleSpec(_Model):
         m = self.motion
         if self.start is None and not isinstance(m, WaypointsMotion | ReplayMotion):
             raise FieldError("start", f"required for motion type {m.type!r}")
-        if isinstance(m, OrcaCrowdMotion) and self.body.disc is None:
-            raise FieldError("body", "an orca_crowd pedestrian is a disc (give 'disc: RADIUS')")
+        if isinstance(m, OrcaCrowdMotion | SocialForceMotion) and self.body.disc is None:
+            raise FieldError("body", f"a {m.type} pedestrian is a disc (give 'disc: RADIUS')")
         if self.start is not None and isinstance(m, ReplayMotion):
             at0 = m.to_model(np.random.default_rng(0)).position_at(0.0)
             if float(np.hypot(*(np.asarray(self.start.position) - at0))) > 1e-6:
@@ -516,7 +547,7 @@ class ObstacleSpec(_Model):
                 velocity=np.asarray(m.velocity, dtype=float),
                 angular_velocity=float(m.angular_velocity),
             )
-        if isinstance(m, PluginMotion | OrcaCrowdMotion):  # at rest until its first step
+        if isinstance(m, PluginMotion | OrcaCrowdMotion | SocialForceMotion):  # at rest until
             return ObstacleState(position=pos, heading=heading)
         speed = 0.5 * (m.speed[0] + m.speed[1])
         vel = speed * np.array([np.cos(heading), np.sin(heading)])
@@ -702,7 +733,9 @@ class Scenario(_Model):
             field = ObstacleField.from_obstacles(obstacles)
             _, _, inside = field.nearest(np.asarray(self.robot.goal, dtype=float))
             # ORCA pedestrians walk on (CrowdNav's square crossing may start one on the goal)
-            walking = np.array([isinstance(o.motion, OrcaPedestrian) for o in obstacles])
+            walking = np.array(
+                [isinstance(o.motion, OrcaPedestrian | SocialForcePedestrian) for o in obstacles]
+            )
             inside = inside & ~walking
             if inside.any():
                 j = int(np.argmax(inside))
