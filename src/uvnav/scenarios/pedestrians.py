@@ -514,6 +514,11 @@ class PedestrianReplayGroup:
     def _present(self, t: float) -> np.ndarray:
         return (self._first <= t) & (t <= self._end)
 
+    def present(self, t: float) -> np.ndarray:
+        """(m,) whether each pedestrian is on the scene at ``t`` [s]
+        (:meth:`PedestrianReplay.present`, element by element)."""
+        return self._present(t)
+
     def step(
         self, position: FloatArray, heading: FloatArray, t: float, dt: float
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
