@@ -19,12 +19,13 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from pydantic import ValidationError
 
 from uvnav.geometry.polygons import polygon_area, polygon_centroid
 from uvnav.scenarios import pedestrians
 from uvnav.scenarios.build import obstacle_bounds
 from uvnav.scenarios.crowdnav import crowdnav_circle, crowdnav_square
-from uvnav.scenarios.errors import ScenarioError
+from uvnav.scenarios.errors import ScenarioError, from_validation_error
 from uvnav.scenarios.loader import scenario_from_dict
 from uvnav.scenarios.schema import CrowdSpec, ObstacleSpec, Scenario
 
@@ -495,7 +496,7 @@ def crowd_file_scenario(
         raise ScenarioError(source, "params", f"min_near must be >= 0 (got {min_near})")
     file = Path(str(path)).expanduser()
     if not file.is_file():
-        raise ScenarioError(str(path), "", "no such file")
+        raise ScenarioError(source, "params", f"path: no such file {str(path)!r}")
     crowd: dict[str, Any] = {
         "dataset": str(file.resolve()),
         "format": format,
@@ -507,6 +508,10 @@ def crowd_file_scenario(
         "region": None if region is None else list(region),
     }
     crowd = {k: v for k, v in crowd.items() if v is not None}
+    try:  # the file's own problems first: one line naming it and the line
+        pedestrians.load_tracks(crowd["dataset"], format, frame_rate=frame_rate)
+    except ScenarioError as exc:
+        raise ScenarioError(source, "params", f"path: {exc}") from None
     try:
         found = _crowd_crossing(
             seed, crowd, what=file.name, v_max=v_max, radius=radius, robot_radius=robot_radius,
@@ -515,12 +520,9 @@ def crowd_file_scenario(
             goal=None if goal is None else np.asarray(goal, dtype=float),
             min_near=int(min_near),
         )  # fmt: skip
-    except ScenarioError as exc:
-        if exc.path.startswith("crowd"):  # the crowd spec's validation: the file's own line
-            raise ScenarioError(
-                exc.source if exc.source != "<dict>" else source, exc.path, exc.problem
-            ) from None
-        raise
+    except ValidationError as exc:  # scale, offset, frame_rate, region ...
+        err = from_validation_error(exc, source)
+        raise ScenarioError(source, "params", f"{err.path}: {err.problem}") from None
     except RuntimeError as exc:
         raise ScenarioError(source, "", str(exc)) from None
     start_, goal_, t0, near, length, horizon = found
