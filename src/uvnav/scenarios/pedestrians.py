@@ -31,13 +31,16 @@ annotation period of :data:`ANNOTATION_PERIOD` = 0.4 s (2.5 Hz): seq_eth steps b
 
 Replay (:class:`PedestrianReplay`): a pedestrian is present from its first to its last annotation
 and its position is interpolated linearly in between (piecewise-constant velocity).  Outside that
-interval it is *absent*: parked at a distant point (:data:`ABSENT_DISTANCE` = 1 km from the
-recording's centre, each pedestrian at its own spot) with zero velocity, so it neither collides
-with nor is sensed by the robot (sensing ranges are metres), and no phantom obstacle blocks the
-scene.  It appears and disappears instantaneously; the step on which it appears reports the
-velocity of its first track segment, not the jump from the parking spot (simulation collision
-checks are made at integration steps, so the jump itself cannot collide).  Pedestrians do not
-react to the robot: the recording is replayed as it was.
+interval it is *absent*: :meth:`PedestrianReplay.present` (and the batched
+:meth:`PedestrianReplayGroup.present`) is false, and the obstacle field leaves it out of every
+collision, clearance, sensing and ray-casting query (:class:`~uvnav.obstacles.ObstacleField`), so
+it is never sensed, never counted in the clearance and blocks nothing.  Its stored pose is parked
+at a distant point (:data:`ABSENT_DISTANCE` = 1 km from the recording's centre, each pedestrian at
+its own spot) with zero velocity, which only recorded trajectories and plots see.  It appears
+and disappears instantaneously; the step on which it appears reports the velocity of its first
+track segment, not the jump from the parking spot (simulation collision checks are made at
+integration steps, so the jump itself cannot collide).  Pedestrians do not react to the robot:
+the recording is replayed as it was.
 """
 
 from __future__ import annotations
@@ -68,7 +71,8 @@ ANNOTATION_PERIOD = 0.4
 DATASETS: dict[str, float] = {"eth": 15.0, "hotel": 25.0}
 #: default pedestrian disc radius [m]
 DEFAULT_RADIUS = 0.3
-#: absent pedestrians are parked this far from the recording's centre [m]
+#: absent pedestrians are parked this far from the recording's centre [m] (their pose only: no
+#: query sees an absent body)
 ABSENT_DISTANCE = 1000.0
 #: tolerance on the presence interval [s] (simulation times are sums of dt)
 _TIME_EPS = 1e-9
