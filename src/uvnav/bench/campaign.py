@@ -227,7 +227,13 @@ def job_scene(job: Job) -> Any:
     """The job's scene (a :class:`uvnav.scenarios.catalog.Resolved`; runs in the worker)."""
     if job.scenario is not None:
         return _resolved(job.scenario)
-    scene = _generated(job.generator, int(job.generator_seed or 0), job.generator_params)
+    key = (job.generator, int(job.generator_seed or 0), job.generator_params)
+    try:
+        hash(key)
+    except TypeError:  # list or mapping parameters (crowd-file's start: [x, y]): not cached
+        scene = _generated.__wrapped__(*key)
+    else:
+        scene = _generated(*key)
     if scene.seed != job.seed:  # a scene drawn with one seed, run with another
         scene = dataclasses.replace(scene, seed=None)
     return scene

@@ -249,8 +249,9 @@ class EnvWorld:
         tpl, keep = self._lidar_fields[i]
         f = w.field
         return tpl.field(
-            f.centres[keep], f.headings[keep], f.velocities[keep], f.angular_velocities[keep]
-        )
+            f.centres[keep], f.headings[keep], f.velocities[keep], f.angular_velocities[keep],
+            None if f.present is None else f.present[keep],
+        )  # fmt: skip
 
     def command(self, i: int, action: np.ndarray) -> UnicycleCommand:
         """The unicycle command of an action: ``(v, u)`` itself with ``raw_commands``, else the

@@ -19,6 +19,9 @@ The result is bit for bit what calling ``obstacle.motion.step`` on every obstacl
 suite checks it), at a cost that hardly grows with the number of obstacles.  Each step makes new
 arrays (a field built from them is a snapshot), and :meth:`ObstacleBatch.write_back` puts the final
 states and the models' internal state back on the :class:`~uvnav.obstacles.Obstacle` objects.
+Presence: a model (or :class:`~uvnav.obstacles.motion.MotionGroup`) with a ``present(t)`` method
+says when its body exists; :attr:`ObstacleBatch.present` holds the answers for the current time and
+:meth:`ObstacleBatch.field` hands them to the field, whose queries skip absent bodies.
 One caveat: models that share one generator are advanced group by group (random-turn obstacles
 first), so their draws interleave differently from the per-obstacle loop; give every obstacle its
 own generator, as :func:`uvnav.scenarios.build_episode` does.
@@ -40,7 +43,7 @@ from uvnav.obstacles.motion import (
     RandomTurn,
     uniform_draw,
 )
-from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
+from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField, model_present
 from uvnav.obstacles.social_force import join_force_crowds
 
 _Rows = slice | np.ndarray
@@ -189,6 +192,7 @@ class ObstacleBatch:
         positions: (k, 2) mass centres [m].
         headings: (k,) body rotations [rad].
         velocities: (k, 2) [m/s] and angular_velocities (k,) [rad/s] used over the last step.
+        present: (k,) bool, the bodies that exist now, or ``None`` when no model can be absent.
 
     The arrays are views of storage that :meth:`step` replaces, never modifies.
     """
@@ -202,6 +206,9 @@ class ObstacleBatch:
         "_omega",
         "_omega_base",
         "_other",
+        "_present",
+        "_present_groups",
+        "_present_other",
         "_random",
         "_states",
         "_stepped",
@@ -210,7 +217,8 @@ class ObstacleBatch:
         "obstacles",
     )
 
-    def __init__(self, obstacles: Sequence[Obstacle]) -> None:
+    def __init__(self, obstacles: Sequence[Obstacle], *, t: float = 0.0) -> None:
+        """Batch ``obstacles`` in their current states, which are those of time ``t`` [s]."""
         self.obstacles = list(obstacles)
         join_crowds(self.obstacles)  # ORCA pedestrians not yet in a crowd: one per crowd id
         join_force_crowds(self.obstacles)  # the same for social-force pedestrians
@@ -267,6 +275,15 @@ class ObstacleBatch:
             (np.array(idx, dtype=np.intp), kind.batch_group([obs[j].motion for j in idx]))  # type: ignore[attr-defined]
             for kind, idx in grouped.items()
         ]
+        self._present_groups = [
+            (idx, group) for idx, group in self._groups if callable(getattr(group, "present", None))
+        ]
+        self._present_other = [
+            j for j in other if callable(getattr(obs[j].motion, "present", None))
+        ]
+        self._present: np.ndarray | None = None
+        if self._present_groups or self._present_other:
+            self._present = np.array([model_present(o.motion, t) for o in obs], dtype=bool)
         self._stepped = False
         self._dt = math.nan
         self._inc = np.zeros((2, k))
@@ -294,6 +311,21 @@ class ObstacleBatch:
     @property
     def angular_velocities(self) -> FloatArray:
         return self._omega
+
+    @property
+    def present(self) -> np.ndarray | None:
+        return self._present
+
+    def _update_presence(self, t: float) -> None:
+        """:attr:`present` at ``t`` [s] from the models (and groups) that can be absent."""
+        if self._present is None:
+            return
+        pres = np.ones(len(self.obstacles), dtype=bool)
+        for idx, group in self._present_groups:
+            pres[idx] = group.present(t)  # type: ignore[attr-defined]
+        for j in self._present_other:
+            pres[j] = model_present(self.obstacles[j].motion, t)
+        self._present = pres
 
     def _refresh(self, dt: float) -> None:
         """Per-step increments of heading and course, and rotation rates, for the current draws."""
@@ -382,6 +414,7 @@ class ObstacleBatch:
         self._x = xn
         self._v = v
         self._omega = omega
+        self._update_presence(t + dt)
 
     def field(self, template: FieldTemplate | None = None) -> ObstacleField:
         """The :class:`ObstacleField` of the current state (shares this step's arrays)."""
@@ -390,7 +423,9 @@ class ObstacleBatch:
             if template is not None
             else FieldTemplate.from_bodies([o.body for o in self.obstacles])
         )
-        return tpl.field(self.positions, self.headings, self.velocities, self.angular_velocities)
+        return tpl.field(
+            self.positions, self.headings, self.velocities, self.angular_velocities, self._present
+        )
 
     def state(self, j: int) -> ObstacleState:
         """Current state of obstacle ``j`` as an :class:`ObstacleState`."""

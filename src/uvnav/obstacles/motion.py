@@ -6,6 +6,12 @@ the ``numpy.random.Generator`` handed to it, so the same seed replays the same m
 ``step(state, t, dt)`` returns the state after ``dt`` [s] and sets ``velocity`` [m/s] and
 ``angular_velocity`` [rad/s] to the values used over that step.
 
+A model may also say when its body exists: ``present(t) -> bool`` (optional; a model without it
+is always present).  A body that is not present at ``t`` (a replayed pedestrian outside its
+recorded interval) is left out of every query of the :class:`~uvnav.obstacles.ObstacleField` of
+that instant: collision, clearance, sensing and ray casting never see it.  A
+:class:`MotionGroup` says it with ``present(t) -> (m,) bool``.
+
 ``step`` is the reference definition of each model.  The simulator advances all obstacles of an
 episode at once with :class:`uvnav.obstacles.batch.ObstacleBatch`, which reproduces it bit for bit
 (vectorised for :class:`ConstantVelocity` and :class:`RandomTurn`, by calling ``step`` otherwise).

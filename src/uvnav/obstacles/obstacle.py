@@ -11,6 +11,11 @@ exact kernels on the obstacles that can matter.  The cull is conservative (a mar
 relative plus 1e-9 m absolute covers the rounding of the bound), so what it returns is bit for bit
 what the unculled computation gives for those obstacles, and the obstacles it leaves out are
 provably farther than everything it reports.
+
+A field may mark some bodies absent (``present``, from the motion models' optional
+``present(t)``: a replayed pedestrian outside its recorded interval).  Absent bodies take part in
+no query: :meth:`ObstacleField.query` (hence collision, clearance and sensing), :meth:`nearest`
+and :meth:`ray_hits` skip them, whatever their stored pose.
 """
 
 from __future__ import annotations
@@ -40,6 +45,13 @@ _CULL_REL = 1e-9
 _CULL_ABS = 1e-9
 _X_AXIS = np.array([1.0, 0.0])
 _NO_RINGS = np.zeros((2, 0, 1))
+
+
+def model_present(model: object, t: float) -> bool:
+    """Whether a body moved by ``model`` exists at ``t`` [s]: its ``present(t)`` when it has one,
+    else always (see :mod:`uvnav.obstacles.motion`)."""
+    present = getattr(model, "present", None)
+    return True if present is None else bool(present(t))
 
 
 @dataclass
@@ -165,6 +177,8 @@ class ObstacleField:
         polygons: tuple of (n_j, 2) world vertices for every obstacle (``None`` for discs),
             built on first access.
         template: the packed body geometry.
+        present: (k,) bool, False for a body that does not exist at this instant (skipped by
+            every query), or ``None`` when every body is present.
 
     A field is a snapshot: it never changes its arrays, and callers must not either.
     """
@@ -176,6 +190,7 @@ class ObstacleField:
         "angular_velocities",
         "centres",
         "headings",
+        "present",
         "template",
         "velocities",
     )
@@ -187,8 +202,10 @@ class ObstacleField:
         headings: FloatArray,
         velocities: FloatArray,
         angular_velocities: FloatArray,
+        present: np.ndarray | None = None,
     ) -> None:
         self.template = template
+        self.present = None if present is None or bool(np.all(present)) else present
         self.centres = centres
         self.headings = headings
         self.velocities = velocities
@@ -199,11 +216,16 @@ class ObstacleField:
 
     @classmethod
     def from_obstacles(
-        cls, obstacles: Sequence[Obstacle], template: FieldTemplate | None = None
+        cls,
+        obstacles: Sequence[Obstacle],
+        template: FieldTemplate | None = None,
+        *,
+        t: float | None = None,
     ) -> ObstacleField:
         """Snapshot of ``obstacles``.
 
-        Pass the episode's :class:`FieldTemplate` to skip re-packing the bodies.
+        Pass the episode's :class:`FieldTemplate` to skip re-packing the bodies.  With a time
+        ``t`` [s], bodies whose motion model says it is not ``present(t)`` are marked absent.
         """
         tpl = (
             template
@@ -221,7 +243,10 @@ class ObstacleField:
             velocities[j] = st.velocity
             omegas[j] = st.angular_velocity
             headings[j] = st.heading
-        return tpl.field(centres, headings, velocities, omegas)
+        present = None
+        if t is not None:
+            present = np.array([model_present(ob.motion, t) for ob in obstacles], dtype=bool)
+        return tpl.field(centres, headings, velocities, omegas, present)
 
     def __len__(self) -> int:
         return len(self.centres)
@@ -320,7 +345,15 @@ class ObstacleField:
         if k:
             dc = np.hypot(cen[:, 0] - px, cen[:, 1] - py)
             lower = dc - tpl.bounding_radii
+            if self.present is not None:  # absent bodies: beyond any radius
+                lower = np.where(self.present, lower, math.inf)
             j0 = int(lower.argmin())
+            if math.isinf(lower[j0]):  # nobody present
+                e = np.zeros(0)
+                return NearestQuery(
+                    self, (px, py), radius, with_nearest, np.zeros(0, dtype=np.intp), e,
+                    np.zeros((0, 2)), np.zeros(0, bool), e, _NO_RINGS, None, bounds,
+                )  # fmt: skip
             slack = _CULL_ABS * (1.0 + abs(px) + abs(py))
             # containment is possible only inside an obstacle's bounding disc
             maybe_inside = bool(lower[j0] <= 2.0 * slack)
@@ -338,6 +371,8 @@ class ObstacleField:
                 ids = (lower <= limit).nonzero()[0]
                 if len(ids) == k:
                     ids = None
+            elif self.present is not None:
+                ids = self.present.nonzero()[0]
         if ids is None:
             ids = tpl.all_ids
         m = len(ids)
@@ -412,11 +447,21 @@ class ObstacleField:
 
         Returns ``(distance (k,), nearest (k, 2), inside (k,))``.  ``distance`` is 0 for a point
         inside an obstacle (the thesis's d_i of eq. (2.5) is a distance to the set), while
-        ``nearest`` is still the closest boundary point.  Use :meth:`query` when only the
-        obstacles within some radius (or the nearest one) are needed.
+        ``nearest`` is still the closest boundary point.  An absent body reads distance ``inf``,
+        nearest point NaN and not inside.  Use :meth:`query` when only the obstacles within some
+        radius (or the nearest one) are needed.
         """
         q = self.query(point, math.inf)
-        return q.distance.copy(), q.nearest.copy(), q.inside.copy()
+        if self.present is None:
+            return q.distance.copy(), q.nearest.copy(), q.inside.copy()
+        k = len(self)
+        dist = np.full(k, math.inf)
+        near = np.full((k, 2), math.nan)
+        inside = np.zeros(k, dtype=bool)
+        dist[q.ids] = q.distance
+        near[q.ids] = q.nearest
+        inside[q.ids] = q.inside
+        return dist, near, inside
 
     def ray_hits(
         self, origin: FloatArray, directions: FloatArray, *, max_range: float = math.inf
@@ -424,7 +469,8 @@ class ObstacleField:
         """(R, k) distance [m] along each unit ray to each obstacle's boundary, ``inf`` on a miss.
 
         With a finite ``max_range`` [m], obstacles whose bounding disc lies entirely beyond it are
-        not ray-cast and read ``inf`` (their hits, if any, are farther than ``max_range``).
+        not ray-cast and read ``inf`` (their hits, if any, are farther than ``max_range``).  Absent
+        bodies read ``inf``.
         """
         tpl = self.template
         ox = float(origin[0])
@@ -439,6 +485,8 @@ class ObstacleField:
             slack = _CULL_ABS * (1.0 + abs(ox) + abs(oy))
             limit = max_range * (1.0 + _CULL_REL) + slack
             ids = (dc - tpl.bounding_radii <= limit).nonzero()[0]
+        if self.present is not None:
+            ids = ids[self.present.take(ids)]
         is_disc = tpl.poly_row.take(ids) < 0
         dids = ids[is_disc]
         pids = ids[~is_disc]
@@ -522,14 +570,20 @@ class FieldTemplate:
         )
 
     def field(
-        self, centres: FloatArray, headings: FloatArray, velocities: FloatArray, omegas: FloatArray
+        self,
+        centres: FloatArray,
+        headings: FloatArray,
+        velocities: FloatArray,
+        omegas: FloatArray,
+        present: np.ndarray | None = None,
     ) -> ObstacleField:
         """The :class:`ObstacleField` for obstacles at ``centres`` (k, 2) [m], ``headings`` (k,)
-        [rad], moving at ``velocities`` (k, 2) [m/s] and ``omegas`` (k,) [rad/s].
+        [rad], moving at ``velocities`` (k, 2) [m/s] and ``omegas`` (k,) [rad/s]; ``present``
+        (k,) bool marks the bodies that exist (``None``: all).
 
         The arrays are kept, not copied: do not change them afterwards.
         """
-        return ObstacleField(self, centres, headings, velocities, omegas)
+        return ObstacleField(self, centres, headings, velocities, omegas, present)
 
     def __len__(self) -> int:
         return len(self.radii)

@@ -15,15 +15,19 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from functools import partial
+from pathlib import Path
 from typing import Any
 
 import numpy as np
+from pydantic import ValidationError
 
 from uvnav.geometry.polygons import polygon_area, polygon_centroid
+from uvnav.scenarios import pedestrians
 from uvnav.scenarios.build import obstacle_bounds
 from uvnav.scenarios.crowdnav import crowdnav_circle, crowdnav_square
+from uvnav.scenarios.errors import ScenarioError, from_validation_error
 from uvnav.scenarios.loader import scenario_from_dict
-from uvnav.scenarios.schema import ObstacleSpec, Scenario
+from uvnav.scenarios.schema import CrowdSpec, ObstacleSpec, Scenario
 
 CH2_START = (0.0, 0.0)
 CH2_GOAL = (10.0, 10.0)
@@ -272,29 +276,124 @@ def crowd_crossing_scenario(
         controller: default controller of the scene.
         controller_params: its parameters.
     """
-    from uvnav.scenarios import pedestrians
+    crowd: dict[str, Any] = {"dataset": dataset}
+    found = _crowd_crossing(
+        seed, crowd, what=dataset, v_max=v_max, radius=radius, robot_radius=robot_radius,
+        t_max=t_max, t_start=t_start,
+    )  # fmt: skip
+    start, goal, t0, near, length, horizon = found
+    data: dict[str, Any] = {
+        "name": f"crowd-{dataset}-seed{seed}",
+        "description": (
+            f"Crossing the {dataset} walkway (ETH pedestrian recordings, Pellegrini et al. ICCV "
+            f"2009; seed {seed}): {near} real pedestrians pass near the {length:.1f} m crossing "
+            f"in its first {horizon:.0f} s. Pedestrians do not react to the robot (replayed "
+            f"recording). V_max {v_max:g} m/s; pedestrians may be faster, so the thesis's "
+            "(2.6)-(2.8) do not hold for all of them."
+        ),
+        **_crowd_scene_body(
+            start, goal, crowd, t0, radius, v_max=v_max, u_max=u_max, robot_radius=robot_radius,
+            t_max=t_max, dt=dt, controller=controller, controller_params=controller_params,
+        ),
+    }  # fmt: skip
+    return scenario_from_dict(data, source=f"crowd-{dataset}:{seed}")
 
-    rng = np.random.default_rng(seed)
-    tracks = pedestrians.load_dataset(dataset)
-    centre, along, across = pedestrians.walkway_axes(tracks)
-    pts = pedestrians.all_positions(tracks)
-    spread = float(np.std((pts - centre) @ along))
+
+def _crowd_scene_body(
+    start: np.ndarray,
+    goal: np.ndarray,
+    crowd: dict[str, Any],
+    t0: float,
+    radius: float,
+    *,
+    v_max: float,
+    u_max: float,
+    robot_radius: float,
+    t_max: float,
+    dt: float,
+    controller: str,
+    controller_params: dict[str, Any] | None,
+) -> dict[str, Any]:
+    return {
+        "dim": 2,
+        "dt": dt,
+        "control_period": dt,
+        "t_max": t_max,
+        "goal_tolerance": 0.2,
+        "robot": {
+            "model": "unicycle",
+            "start": start.tolist(),
+            "goal": goal.tolist(),
+            "v_max": v_max,
+            "u_max": u_max,
+            "radius": robot_radius,
+        },
+        "sensing": {"range": 5.0, "velocities": "known", "position_noise": 0.0},
+        "crowd": {**crowd, "t_start": t0, "radius": radius},
+        "controller": {"name": controller, "params": dict(controller_params or {})},
+    }
+
+
+def _crowd_crossing(
+    seed: int,
+    crowd: dict[str, Any],
+    *,
+    what: str,
+    v_max: float,
+    radius: float,
+    robot_radius: float,
+    t_max: float,
+    t_start: float | None,
+    start: np.ndarray | None = None,
+    goal: np.ndarray | None = None,
+    min_near: int = _MIN_NEAR,
+) -> tuple[np.ndarray, np.ndarray, float, int, float, float]:
+    """Draw a clear, busy crossing of the crowd ``crowd`` (a :class:`CrowdSpec` mapping without
+    ``t_start``) from ``default_rng(seed)``: ``(start, goal, t_start, near, length, horizon)``.
+
+    The draws, in order, per try: the recording time of t = 0 (unless ``t_start``), then, unless
+    ``start`` and ``goal`` are given, the offset along the walkway axis, the crossing length and
+    the side (see :func:`crowd_crossing_scenario`).
+    """
+    spec = CrowdSpec.model_validate({**crowd, "radius": radius})
+    tracks = spec.tracks()
+    fixed = start is not None and goal is not None
+    if fixed:
+        assert start is not None and goal is not None
+        start = np.round(np.asarray(start, dtype=float), 3)
+        goal = np.round(np.asarray(goal, dtype=float), 3)
+        length = float(np.hypot(*(goal - start)))
+        if length <= 0.0:
+            raise ValueError("start and goal must differ")
+    else:
+        centre, along, across = pedestrians.walkway_axes(tracks)
+        pts = pedestrians.all_positions(tracks)
+        spread = float(np.std((pts - centre) @ along))
     t_first = min(float(t.times[0]) for t in tracks.values())
     t_last = max(float(t.times[-1]) for t in tracks.values())
+    if t_start is None and t_last - t_max < t_first:
+        raise ValueError(
+            f"the recording lasts {t_last - t_first:.1f} s, shorter than t_max = {t_max:g} s"
+        )
     clear = robot_radius + radius + _CLEAR_MARGIN
+    rng = np.random.default_rng(seed)
     for _ in range(_MAX_TRIES):
         t0 = (
             round(float(rng.uniform(t_first, t_last - t_max)), 1)
             if t_start is None
             else float(t_start)
         )
-        offset = float(rng.uniform(-spread, spread))
-        length = float(rng.uniform(*_CROSSING_LENGTH))
-        side = 1.0 if rng.random() < 0.5 else -1.0
-        mid = centre + offset * along
-        start = np.round(mid - side * 0.5 * length * across, 3)
-        goal = np.round(mid + side * 0.5 * length * across, 3)
-        pieces = pedestrians.episode_tracks(tracks, t_start=t0, duration=t_max)
+        if not fixed:
+            offset = float(rng.uniform(-spread, spread))
+            length = float(rng.uniform(*_CROSSING_LENGTH))
+            side = 1.0 if rng.random() < 0.5 else -1.0
+            mid = centre + offset * along
+            start = np.round(mid - side * 0.5 * length * across, 3)
+            goal = np.round(mid + side * 0.5 * length * across, 3)
+        assert start is not None and goal is not None
+        pieces = pedestrians.episode_tracks(
+            tracks, t_start=t0, duration=t_max, region=spec.region, at_rest=spec.at_rest
+        )
         now = [p for p in pieces if p.times[0] <= 1e-9 <= p.times[-1] + 1e-9]
         at0 = np.array(
             [
@@ -317,39 +416,131 @@ def crowd_crossing_scenario(
                 _NEAR_CROSSING
             ):
                 near += 1
-        if near < _MIN_NEAR:
+        if near < min_near:
             continue
-        break
-    else:
-        raise RuntimeError(f"no busy, clear crossing found in {dataset} (seed {seed})")
+        return start, goal, t0, near, length, horizon
+    raise RuntimeError(f"no busy, clear crossing found in {what} (seed {seed})")
 
-    data: dict[str, Any] = {
-        "name": f"crowd-{dataset}-seed{seed}",
-        "description": (
-            f"Crossing the {dataset} walkway (ETH pedestrian recordings, Pellegrini et al. ICCV "
-            f"2009; seed {seed}): {near} real pedestrians pass near the {length:.1f} m crossing "
-            f"in its first {horizon:.0f} s. Pedestrians do not react to the robot (replayed "
-            f"recording). V_max {v_max:g} m/s; pedestrians may be faster, so the thesis's "
-            "(2.6)-(2.8) do not hold for all of them."
-        ),
-        "dim": 2,
-        "dt": dt,
-        "control_period": dt,
-        "t_max": t_max,
-        "goal_tolerance": 0.2,
-        "robot": {
-            "model": "unicycle",
-            "start": start.tolist(),
-            "goal": goal.tolist(),
-            "v_max": v_max,
-            "u_max": u_max,
-            "radius": robot_radius,
-        },
-        "sensing": {"range": 5.0, "velocities": "known", "position_noise": 0.0},
-        "crowd": {"dataset": dataset, "t_start": t0, "radius": radius},
-        "controller": {"name": controller, "params": dict(controller_params or {})},
+
+CROWD_FILE_FORMATS = pedestrians.FORMATS
+
+
+def crowd_file_scenario(
+    seed: int,
+    *,
+    path: str | None = None,
+    format: str = "obsmat",
+    frame_rate: float | None = None,
+    scale: float = 1.0,
+    offset: tuple[float, float] | list[float] = (0.0, 0.0),
+    start: tuple[float, float] | list[float] | None = None,
+    goal: tuple[float, float] | list[float] | None = None,
+    stitch: bool = True,
+    at_rest: bool = False,
+    region: tuple[float, float, float, float] | list[float] | None = None,
+    min_near: int = _MIN_NEAR,
+    v_max: float = CROWD_V_MAX,
+    u_max: float = CROWD_U_MAX,
+    radius: float = 0.3,
+    robot_radius: float = CROWD_ROBOT_RADIUS,
+    t_max: float = CROWD_T_MAX,
+    dt: float = 0.1,
+    t_start: float | None = None,
+    controller: str = "zhang2019-v1",
+    controller_params: dict[str, Any] | None = None,
+) -> Scenario:
+    """A robot crossing the crowd of any trajectory file (``crowd-file:<seed>``), seeded.
+
+    The file (``path``, relative to the current folder; ``.gz`` read transparently) is read as
+    ``format`` ``obsmat`` (ETH), ``xy4`` (``frame id x y``, ``?`` for hidden positions) or
+    ``trajnet`` (TrajNet++ ndjson), at ``frame_rate`` frames/s (inferred from a 0.4 s annotation
+    period when omitted), positions ``scale * p + offset`` [m].  Hidden positions are skipped with
+    a warning; a malformed file is one :class:`ScenarioError` line naming the file and the line.
+    With ``stitch`` (default on) a track that ends where another starts, at most one annotation
+    step later and within 1 m, is one person (:func:`~uvnav.scenarios.pedestrians.stitch_tracks`);
+    with ``at_rest`` people whose track starts after t = 0 wait at rest at their first position.
+
+    The crossing line:
+
+    * default: across the walkway axis estimated from the tracks (the principal axis of every
+      annotated position), exactly as :func:`crowd_crossing_scenario` draws it for the ETH
+      recordings (crossing point, 8-12 m length and side drawn from the seed);
+    * ``start`` and ``goal`` [m] given: that line, only the recording time of t = 0 is drawn.
+
+    Either way a draw is kept when nobody is within ``robot_radius + radius + 0.5`` m of the start
+    or the goal at t = 0 and at least ``min_near`` people pass within 1.5 m of the line while the
+    robot could be crossing (0 accepts any time); ``t_start`` fixes the recording time of t = 0.
+    The other arguments are those of :func:`crowd_crossing_scenario`.
+
+    Raises:
+        ScenarioError: no ``path``, an unreadable or malformed file, or bad parameters.
+    """
+    source = f"crowd-file:{seed}"
+    if path is None:
+        raise ScenarioError(
+            source,
+            "params",
+            "crowd-file needs params: path (and format: obsmat | xy4 | trajnet); give them in a "
+            "campaign entry (generator: crowd-file, params: {path: ...}) or write a scene with "
+            "a crowd: section",
+        )
+    if format not in CROWD_FILE_FORMATS:
+        raise ScenarioError(
+            source,
+            "params",
+            f"format must be one of {', '.join(CROWD_FILE_FORMATS)} (got {format!r})",
+        )
+    if (start is None) != (goal is None):
+        raise ScenarioError(source, "params", "give both start and goal, or neither")
+    if int(min_near) < 0:
+        raise ScenarioError(source, "params", f"min_near must be >= 0 (got {min_near})")
+    file = Path(str(path)).expanduser()
+    if not file.is_file():
+        raise ScenarioError(source, "params", f"path: no such file {str(path)!r}")
+    crowd: dict[str, Any] = {
+        "dataset": str(file.resolve()),
+        "format": format,
+        "frame_rate": frame_rate,
+        "scale": scale,
+        "offset": list(offset),
+        "stitch": bool(stitch),
+        "at_rest": bool(at_rest),
+        "region": None if region is None else list(region),
     }
-    return scenario_from_dict(data, source=f"crowd-{dataset}:{seed}")
+    crowd = {k: v for k, v in crowd.items() if v is not None}
+    try:  # the file's own problems first: one line naming it and the line
+        pedestrians.load_tracks(crowd["dataset"], format, frame_rate=frame_rate)
+    except ScenarioError as exc:
+        raise ScenarioError(source, "params", f"path: {exc}") from None
+    try:
+        found = _crowd_crossing(
+            seed, crowd, what=file.name, v_max=v_max, radius=radius, robot_radius=robot_radius,
+            t_max=t_max, t_start=t_start,
+            start=None if start is None else np.asarray(start, dtype=float),
+            goal=None if goal is None else np.asarray(goal, dtype=float),
+            min_near=int(min_near),
+        )  # fmt: skip
+    except ValidationError as exc:  # scale, offset, frame_rate, region ...
+        err = from_validation_error(exc, source)
+        raise ScenarioError(source, "params", f"{err.path}: {err.problem}") from None
+    except RuntimeError as exc:
+        raise ScenarioError(source, "", str(exc)) from None
+    start_, goal_, t0, near, length, horizon = found
+    data: dict[str, Any] = {
+        "name": f"crowd-file-{file.stem.split('.')[0]}-seed{seed}",
+        "description": (
+            f"Crossing the crowd of {file.name} (seed {seed}): {near} recorded pedestrians pass "
+            f"near the {length:.1f} m crossing in its first {horizon:.0f} s. Pedestrians do not "
+            f"react to the robot (replayed recording). V_max {v_max:g} m/s; pedestrians may be "
+            "faster, so the thesis's (2.6)-(2.8) do not hold for all of them."
+        ),
+        **_crowd_scene_body(
+            start_, goal_, crowd, t0, radius, v_max=v_max, u_max=u_max,
+            robot_radius=robot_radius, t_max=t_max, dt=dt, controller=controller,
+            controller_params=controller_params,
+        ),
+    }  # fmt: skip
+    return scenario_from_dict(data, source=source)
 
 
 def _random_ch3(seed: int, **params: Any) -> Any:
@@ -365,6 +556,7 @@ GENERATORS: dict[str, Callable[..., Scenario]] = {
     "random-ch2": random_ch2_scenario,
     "crowd-eth": partial(crowd_crossing_scenario, dataset="eth"),
     "crowd-hotel": partial(crowd_crossing_scenario, dataset="hotel"),
+    "crowd-file": crowd_file_scenario,
     "random-ch3": _random_ch3,
     "crowdnav-circle": crowdnav_circle,
     "crowdnav-square": crowdnav_square,

@@ -5,13 +5,24 @@ behavior for multi-target tracking", ICCV 2009; sequences ``seq_eth`` and ``seq_
 redistributed in OpenTraj, shipped as package data under ``uvnav/scenarios/data/pedestrians/``
 (see the ``README.md`` there for attribution and checksums).  Research use; cite the paper.
 
-Two text formats are read, both one row per (frame, person), whitespace (or comma) separated:
+Three formats are read, all one annotation per (frame, person):
 
 * ``obsmat`` (the ETH files): ``frame id pos_x pos_z pos_y v_x v_z v_y`` in [m] and [m/s], world
-  frame; ``pos_z``/``v_z`` are the (always zero) vertical axis.  Only the planar positions
-  ``(pos_x, pos_y)`` are used: velocities are re-derived from the positions so that the replayed
-  motion and its reported velocity agree.
+  frame, whitespace (or comma) separated; ``pos_z``/``v_z`` are the (always zero) vertical axis.
+  Only the planar positions ``(pos_x, pos_y)`` are used: velocities are re-derived from the
+  positions so that the replayed motion and its reported velocity agree.
 * ``xy4`` (the common ``frame id x y`` files of Social-LSTM/Social-GAN/TrajNet): positions [m].
+* ``trajnet`` (TrajNet++ ``.ndjson``): one JSON object a line, ``{"scene": {...}}`` (ignored) or
+  ``{"track": {"f": frame, "p": id, "x": x, "y": y, ...}}``.
+
+A hidden position (``?`` in a text file, as in TrajNet's test files, or ``null`` in ndjson) is
+skipped: the file's hidden lines are counted and reported in one :class:`HiddenPositionsWarning`
+naming the file, not an error.  Any other malformed line is a :class:`ScenarioError` naming the
+file, the line and the problem.
+
+After reading, :func:`shape_tracks` may scale and shift the positions (a file in pixels or in
+another frame) and stitch broken tracks (:func:`stitch_tracks`: a track that ends where another
+starts one annotation later is one person whose id the tracker lost).
 
 Times are ``frame / frame_rate`` [s].  When ``frame_rate`` is not given it is inferred from the
 most common frame step between consecutive annotations of one person, assuming the ETH/UCY
@@ -20,13 +31,16 @@ annotation period of :data:`ANNOTATION_PERIOD` = 0.4 s (2.5 Hz): seq_eth steps b
 
 Replay (:class:`PedestrianReplay`): a pedestrian is present from its first to its last annotation
 and its position is interpolated linearly in between (piecewise-constant velocity).  Outside that
-interval it is *absent*: parked at a distant point (:data:`ABSENT_DISTANCE` = 1 km from the
-recording's centre, each pedestrian at its own spot) with zero velocity, so it neither collides
-with nor is sensed by the robot (sensing ranges are metres), and no phantom obstacle blocks the
-scene.  It appears and disappears instantaneously; the step on which it appears reports the
-velocity of its first track segment, not the jump from the parking spot (simulation collision
-checks are made at integration steps, so the jump itself cannot collide).  Pedestrians do not
-react to the robot: the recording is replayed as it was.
+interval it is *absent*: :meth:`PedestrianReplay.present` (and the batched
+:meth:`PedestrianReplayGroup.present`) is false, and the obstacle field leaves it out of every
+collision, clearance, sensing and ray-casting query (:class:`~uvnav.obstacles.ObstacleField`), so
+it is never sensed, never counted in the clearance and blocks nothing.  Its stored pose is parked
+at a distant point (:data:`ABSENT_DISTANCE` = 1 km from the recording's centre, each pedestrian at
+its own spot) with zero velocity, which only recorded trajectories and plots see.  It appears
+and disappears instantaneously; the step on which it appears reports the velocity of its first
+track segment, not the jump from the parking spot (simulation collision checks are made at
+integration steps, so the jump itself cannot collide).  Pedestrians do not react to the robot:
+the recording is replayed as it was.
 """
 
 from __future__ import annotations
@@ -34,7 +48,9 @@ from __future__ import annotations
 import bisect
 import gzip
 import itertools
+import json
 import math
+import warnings
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -55,13 +71,21 @@ ANNOTATION_PERIOD = 0.4
 DATASETS: dict[str, float] = {"eth": 15.0, "hotel": 25.0}
 #: default pedestrian disc radius [m]
 DEFAULT_RADIUS = 0.3
-#: absent pedestrians are parked this far from the recording's centre [m]
+#: absent pedestrians are parked this far from the recording's centre [m] (their pose only: no
+#: query sees an absent body)
 ABSENT_DISTANCE = 1000.0
 #: tolerance on the presence interval [s] (simulation times are sums of dt)
 _TIME_EPS = 1e-9
 
-FORMATS = ("obsmat", "xy4")
+FORMATS = ("obsmat", "xy4", "trajnet")
 _COLUMNS = {"obsmat": 8, "xy4": 4}
+#: default largest gap [m] between the end of a track and the start of the next for stitching
+STITCH_DISTANCE = 1.0
+
+
+class HiddenPositionsWarning(UserWarning):
+    """A track file holds hidden positions (``?``), which were skipped."""
+
 
 _DATA_PACKAGE = "uvnav.scenarios"
 _DATA_DIR = "data/pedestrians"
@@ -98,42 +122,38 @@ class Track:
 # ------------------------------------------------------------------------------------------ parsing
 
 
+_Row = tuple[float, float, float, int]  # frame, x, y, line
+
+
 def _parse(text: str, source: str, fmt: str, frame_rate: float | None) -> dict[int, Track]:
-    if fmt not in _COLUMNS:
-        raise ScenarioError(source, "", f"unknown track format {fmt!r} (one of: obsmat, xy4)")
+    if fmt not in FORMATS:
+        raise ScenarioError(
+            source, "", f"unknown track format {fmt!r} (one of: {', '.join(FORMATS)})"
+        )
     if frame_rate is not None and not (math.isfinite(frame_rate) and frame_rate > 0):
         raise ScenarioError(source, "", f"frame_rate must be > 0 (got {frame_rate})")
-    ncol = _COLUMNS[fmt]
-    rows: dict[int, list[tuple[float, float, float, int]]] = {}
+    rows: dict[int, list[_Row]] = {}
     seen: set[tuple[float, int]] = set()
-    for lineno, raw in enumerate(text.splitlines(), start=1):
-        line = raw.split("#", 1)[0].replace(",", " ").strip()
-        if not line:
+    hidden: list[int] = []
+    entries = _json_rows(text, source) if fmt == "trajnet" else _text_rows(text, source, fmt)
+    for lineno, frame, pid, x, y in entries:
+        if x is None or y is None:
+            hidden.append(lineno)
             continue
-        parts = line.split()
-        where = f"line {lineno}"
-        if len(parts) != ncol:
-            raise ScenarioError(
-                source, where, f"expected {ncol} columns for {fmt} (got {len(parts)})"
-            )
-        try:
-            values = [float(p) for p in parts]
-        except ValueError:
-            bad = next(p for p in parts if not _is_float(p))
-            raise ScenarioError(source, where, f"not a number: {bad!r}") from None
-        if not all(math.isfinite(v) for v in values):
-            raise ScenarioError(source, where, "non-finite number")
-        frame, pid = values[0], values[1]
-        if not pid.is_integer():
-            raise ScenarioError(source, where, f"person id must be an integer (got {parts[1]})")
-        x, y = (values[2], values[4]) if fmt == "obsmat" else (values[2], values[3])
-        key = (frame, int(pid))
+        key = (frame, pid)
         if key in seen:
             raise ScenarioError(
-                source, where, f"person {int(pid)} annotated twice in frame {parts[0]}"
+                source, f"line {lineno}", f"person {pid} annotated twice in frame {frame:g}"
             )
         seen.add(key)
-        rows.setdefault(int(pid), []).append((frame, x, y, lineno))
+        rows.setdefault(pid, []).append((frame, x, y, lineno))
+    if hidden:
+        warnings.warn(
+            f"{source}: {len(hidden)} line(s) with a hidden position ('?') skipped "
+            f"(first: line {hidden[0]})",
+            HiddenPositionsWarning,
+            stacklevel=2,
+        )
     if not rows:
         raise ScenarioError(source, "", "no annotations")
     for r in rows.values():
@@ -149,15 +169,94 @@ def _parse(text: str, source: str, fmt: str, frame_rate: float | None) -> dict[i
     }
 
 
-def _is_float(text: str) -> bool:
+_Entry = tuple[int, float, int, float | None, float | None]  # line, frame, id, x, y (None: hidden)
+
+
+def _number(text: str, source: str, where: str, what: str) -> float:
     try:
-        float(text)
+        value = float(text)
     except ValueError:
-        return False
-    return True
+        raise ScenarioError(source, where, f"not a number: {text!r} ({what})") from None
+    if not math.isfinite(value):
+        raise ScenarioError(source, where, f"non-finite number {text!r} ({what})")
+    return value
 
 
-def _infer_frame_rate(rows: dict[int, list[tuple[float, float, float, int]]], source: str) -> float:
+def _person(value: float, text: str, source: str, where: str) -> int:
+    if not value.is_integer():
+        raise ScenarioError(source, where, f"person id must be an integer (got {text})")
+    return int(value)
+
+
+def _text_rows(text: str, source: str, fmt: str) -> list[_Entry]:
+    ncol = _COLUMNS[fmt]
+    xcol, ycol = (2, 4) if fmt == "obsmat" else (2, 3)
+    out: list[_Entry] = []
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split("#", 1)[0].replace(",", " ").strip()
+        if not line:
+            continue
+        parts = line.split()
+        where = f"line {lineno}"
+        if len(parts) != ncol:
+            raise ScenarioError(
+                source, where, f"expected {ncol} columns for {fmt} (got {len(parts)})"
+            )
+        frame = _number(parts[0], source, where, "frame")
+        pid = _person(_number(parts[1], source, where, "person id"), parts[1], source, where)
+        if parts[xcol] == "?" or parts[ycol] == "?":
+            out.append((lineno, frame, pid, None, None))
+            continue
+        for j, p in enumerate(parts[2:], start=2):
+            if p != "?":
+                _number(p, source, where, f"column {j + 1}")
+        x = _number(parts[xcol], source, where, "x")
+        y = _number(parts[ycol], source, where, "y")
+        out.append((lineno, frame, pid, x, y))
+    return out
+
+
+def _json_rows(text: str, source: str) -> list[_Entry]:
+    out: list[_Entry] = []
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = raw.strip()
+        if not line:
+            continue
+        where = f"line {lineno}"
+        try:
+            obj = json.loads(line)
+        except json.JSONDecodeError as exc:
+            raise ScenarioError(
+                source, where, f"not JSON: {exc.msg} (column {exc.colno})"
+            ) from None
+        if not isinstance(obj, dict) or not ({"scene", "track"} & set(obj)):
+            raise ScenarioError(
+                source, where, 'expected {"scene": {...}} or {"track": {...}} (TrajNet++ ndjson)'
+            )
+        if "track" not in obj:
+            continue
+        tr = obj["track"]
+        if not isinstance(tr, dict):
+            raise ScenarioError(source, where, "track must be an object {f, p, x, y}")
+        missing = [k for k in ("f", "p", "x", "y") if k not in tr]
+        if missing:
+            raise ScenarioError(source, where, f"track lacks {', '.join(missing)}")
+        vals: list[float | None] = []
+        for k in ("f", "p", "x", "y"):
+            v = tr[k]
+            if k in "xy" and (v is None or v == "?"):
+                vals.append(None)
+            elif isinstance(v, bool) or not isinstance(v, int | float | str):
+                raise ScenarioError(source, where, f"track.{k} is not a number: {v!r}")
+            else:
+                vals.append(_number(str(v), source, where, f"track.{k}"))
+        frame, pid = vals[0], vals[1]
+        assert frame is not None and pid is not None
+        out.append((lineno, frame, _person(pid, str(tr["p"]), source, where), vals[2], vals[3]))
+    return out
+
+
+def _infer_frame_rate(rows: dict[int, list[_Row]], source: str) -> float:
     steps: Counter[float] = Counter()
     for r in rows.values():
         steps.update(round(b[0] - a[0], 6) for a, b in itertools.pairwise(r))
@@ -196,10 +295,18 @@ def parse_xy4(
     return _parse(text, source, "xy4", frame_rate)
 
 
+def parse_trajnet(
+    text: str, source: str = "<text>", *, frame_rate: float | None = None
+) -> dict[int, Track]:
+    """Tracks of a TrajNet++ ``.ndjson`` text; see :func:`parse_obsmat`."""
+    return _parse(text, source, "trajnet", frame_rate)
+
+
 def read_tracks(
     path: str | Path, fmt: str = "obsmat", *, frame_rate: float | None = None
 ) -> dict[int, Track]:
-    """Tracks of a file in format ``fmt`` (``obsmat`` or ``xy4``); ``.gz`` files are decompressed.
+    """Tracks of a file in format ``fmt`` (``obsmat``, ``xy4`` or ``trajnet``); ``.gz`` files are
+    decompressed.
 
     Raises:
         ScenarioError: missing/unreadable file or bad contents (one line).
@@ -246,25 +353,139 @@ def _cached_file(
 
 
 def load_tracks(
-    dataset: str, fmt: str = "obsmat", *, frame_rate: float | None = None
+    dataset: str,
+    fmt: str = "obsmat",
+    *,
+    frame_rate: float | None = None,
+    scale: float = 1.0,
+    offset: tuple[float, float] = (0.0, 0.0),
+    stitch: bool = False,
 ) -> dict[int, Track]:
     """Tracks of a shipped dataset name (``eth``, ``hotel``) or of a file path (cached by path,
-    modification time and size).  A shipped name ignores ``fmt``; ``frame_rate`` overrides its
-    rate when given."""
+    modification time and size), shaped by :func:`shape_tracks` (``scale``, ``offset``,
+    ``stitch``).  A shipped name ignores ``fmt``; ``frame_rate`` overrides its rate when given."""
     if dataset in DATASETS:
-        if frame_rate is None or frame_rate == DATASETS[dataset]:
-            return load_dataset(dataset)
+        stamp = None
+    else:
+        p = Path(dataset)
+        try:
+            st = p.stat()
+        except OSError:
+            raise ScenarioError(
+                dataset, "", f"no such file or shipped dataset ({', '.join(DATASETS)})"
+            ) from None
+        dataset = str(p.resolve())
+        stamp = (st.st_mtime_ns, st.st_size)
+    off = (float(offset[0]), float(offset[1]))
+    return _shaped(dataset, fmt, frame_rate, float(scale), off, bool(stitch), stamp)
+
+
+@cache
+def _shaped(
+    dataset: str,
+    fmt: str,
+    frame_rate: float | None,
+    scale: float,
+    offset: tuple[float, float],
+    stitch: bool,
+    stamp: tuple[int, int] | None,
+) -> dict[int, Track]:
+    if stamp is None:  # shipped
         base = load_dataset(dataset)
-        scale = DATASETS[dataset] / frame_rate
-        return {k: Track(k, t.times * scale, t.positions) for k, t in base.items()}
-    p = Path(dataset)
-    try:
-        st = p.stat()
-    except OSError:
-        raise ScenarioError(
-            dataset, "", f"no such file or shipped dataset ({', '.join(DATASETS)})"
-        ) from None
-    return _cached_file(str(p.resolve()), fmt, frame_rate, (st.st_mtime_ns, st.st_size))
+        if frame_rate is not None and frame_rate != DATASETS[dataset]:
+            k = DATASETS[dataset] / frame_rate
+            base = {i: Track(i, t.times * k, t.positions) for i, t in base.items()}
+    else:
+        base = _cached_file(dataset, fmt, frame_rate, stamp)
+    return shape_tracks(base, scale=scale, offset=offset, stitch=stitch)
+
+
+def shape_tracks(
+    tracks: dict[int, Track],
+    *,
+    scale: float = 1.0,
+    offset: tuple[float, float] = (0.0, 0.0),
+    stitch: bool = False,
+) -> dict[int, Track]:
+    """``tracks`` with positions ``scale * p + offset`` [m] and, with ``stitch``, broken tracks
+    joined (:func:`stitch_tracks`).  The defaults return ``tracks`` itself."""
+    if not (math.isfinite(scale) and scale > 0):
+        raise ScenarioError("", "scale", f"must be > 0 (got {scale})")
+    out = tracks
+    if scale != 1.0 or offset != (0.0, 0.0):
+        shift = np.asarray(offset, dtype=float)
+        out = {i: Track(i, t.times, t.positions * scale + shift) for i, t in out.items()}
+    if stitch:
+        out = stitch_tracks(out)
+    return out
+
+
+def annotation_step(tracks: dict[int, Track]) -> float:
+    """The most common time between consecutive annotations of one person [s] (the recording's
+    annotation period; :data:`ANNOTATION_PERIOD` when no track has two samples)."""
+    steps: Counter[float] = Counter()
+    for t in tracks.values():
+        steps.update(np.round(np.diff(t.times), 9).tolist())
+    return float(steps.most_common(1)[0][0]) if steps else ANNOTATION_PERIOD
+
+
+def stitch_tracks(
+    tracks: dict[int, Track],
+    *,
+    max_gap: float | None = None,
+    max_distance: float = STITCH_DISTANCE,
+) -> dict[int, Track]:
+    """Join the pieces of one person that a tracker gave several ids.
+
+    Track B continues track A when B starts after A ends by at most ``max_gap`` [s] (default: one
+    annotation step, :func:`annotation_step`, i.e. B starts at most one annotated frame after A's
+    last) and within ``max_distance`` [m] of A's last position.  Candidate pairs are taken
+    closest first; each track continues at most one and is continued by at most one, so chains
+    A -> B -> C become one track.  The joined track keeps the first piece's id and is
+    interpolated across the gap, so the person neither vanishes nor pops up beside the robot.
+
+    Returns:
+        ``{id: Track}`` sorted by id (the continued ids are gone).
+    """
+    gap = annotation_step(tracks) if max_gap is None else float(max_gap)
+    eps = 1e-9 * max(1.0, gap)
+    by_start = sorted(tracks.values(), key=lambda t: (float(t.times[0]), t.ped_id))
+    starts = [float(t.times[0]) for t in by_start]
+    pairs: list[tuple[float, float, int, int]] = []
+    for a in tracks.values():
+        end = float(a.times[-1])
+        lo = bisect.bisect_right(starts, end + eps)
+        hi = bisect.bisect_right(starts, end + gap + eps)
+        for b in by_start[lo:hi]:
+            if b.ped_id == a.ped_id:
+                continue
+            d = float(np.hypot(*(b.positions[0] - a.positions[-1])))
+            if d <= max_distance:
+                pairs.append((d, float(b.times[0]) - end, a.ped_id, b.ped_id))
+    nxt: dict[int, int] = {}
+    prev: dict[int, int] = {}
+    for _, _, a_id, b_id in sorted(pairs):
+        if a_id not in nxt and b_id not in prev:
+            nxt[a_id] = b_id
+            prev[b_id] = a_id
+    if not nxt:
+        return tracks
+    out: dict[int, Track] = {}
+    for pid in sorted(tracks):
+        if pid in prev:
+            continue
+        chain = [tracks[pid]]
+        while chain[-1].ped_id in nxt:
+            chain.append(tracks[nxt[chain[-1].ped_id]])
+        if len(chain) == 1:
+            out[pid] = chain[0]
+        else:
+            out[pid] = Track(
+                pid,
+                np.concatenate([c.times for c in chain]),
+                np.concatenate([c.positions for c in chain]),
+            )
+    return out
 
 
 # ---------------------------------------------------------------------------------------- geometry
@@ -396,6 +617,7 @@ def episode_tracks(
     t_start: float,
     duration: float,
     region: tuple[float, float, float, float] | None = None,
+    at_rest: bool = False,
 ) -> list[Track]:
     """The pieces of ``tracks`` seen in the episode window, times shifted so ``t_start`` is 0.
 
@@ -404,6 +626,10 @@ def episode_tracks(
     (a pedestrian seen once has no motion to replay).  A piece is kept when its time span overlaps
     ``[0, duration]``; samples outside the window are kept too, so the interpolation at the window
     edges uses the real neighbouring annotations.
+
+    With ``at_rest`` a person whose first piece starts after t = 0 waits at rest (present, zero
+    velocity) at that piece's first position from t = 0 on, instead of appearing out of nowhere
+    when its annotations begin (a sample at t = 0 is prepended).
     """
     out: list[Track] = []
     for pid, tr in tracks.items():
@@ -418,13 +644,19 @@ def episode_tracks(
             inside = (pos[:, 0] >= x0) & (pos[:, 0] <= x1) & (pos[:, 1] >= y0) & (pos[:, 1] <= y1)
             idx = np.flatnonzero(inside)
             runs = np.split(idx, np.flatnonzero(np.diff(idx) > 1) + 1) if idx.size else []
+        first = True
         for run in runs:
             if len(run) < 2:
                 continue
             tt = times[run]
             if tt[-1] < -_TIME_EPS or tt[0] > duration + _TIME_EPS:
                 continue
-            out.append(Track(ped_id=pid, times=tt, positions=pos[run]))
+            pp = pos[run]
+            if at_rest and first and tt[0] > _TIME_EPS:
+                tt = np.concatenate(([0.0], tt))
+                pp = np.concatenate((pp[:1], pp))
+            first = False
+            out.append(Track(ped_id=pid, times=tt, positions=pp))
     return out
 
 
@@ -513,6 +745,11 @@ class PedestrianReplayGroup:
 
     def _present(self, t: float) -> np.ndarray:
         return (self._first <= t) & (t <= self._end)
+
+    def present(self, t: float) -> np.ndarray:
+        """(m,) whether each pedestrian is on the scene at ``t`` [s]
+        (:meth:`PedestrianReplay.present`, element by element)."""
+        return self._present(t)
 
     def step(
         self, position: FloatArray, heading: FloatArray, t: float, dt: float

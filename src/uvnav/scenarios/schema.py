@@ -583,8 +583,9 @@ class CrowdSpec(_Model):
 
     At build time every pedestrian whose track overlaps the episode window becomes a disc obstacle
     of ``radius`` replaying its annotations (linear interpolation between them, times shifted so
-    that ``t_start`` of the recording is t = 0).  Outside its track a pedestrian is parked 1 km
-    away (absent: not sensed, cannot collide).  Pedestrians do not react to the robot.  They are
+    that ``t_start`` of the recording is t = 0).  Outside its track a pedestrian is absent: it
+    takes part in no collision or clearance query and is never sensed (its motion model reports
+    ``present(t)``).  Pedestrians do not react to the robot.  They are
     not bound by the thesis's (2.6)-(2.8): :func:`~uvnav.scenarios.check_constraints` reports them
     as warnings only.
     """
@@ -594,10 +595,10 @@ class CrowdSpec(_Model):
         description="shipped sequence 'eth' or 'hotel', or a path to a track file "
         "(relative paths are taken from the scenario file's folder)",
     )
-    format: Literal["obsmat", "xy4"] = Field(
+    format: Literal["obsmat", "xy4", "trajnet"] = Field(
         "obsmat",
-        description="file format: ETH 'obsmat' (frame id x z y vx vz vy) or 'xy4' (frame id x y); "
-        "ignored for the shipped sequences",
+        description="file format: ETH 'obsmat' (frame id x z y vx vz vy), 'xy4' (frame id x y) or "
+        "'trajnet' (TrajNet++ ndjson); ignored for the shipped sequences",
     )
     t_start: float = Field(0.0, description="recording time that becomes t = 0 [s]")
     duration: float | None = Field(
@@ -612,6 +613,22 @@ class CrowdSpec(_Model):
     )
     region: tuple[float, float, float, float] | None = Field(
         None, description="optional crop [xmin, ymin, xmax, ymax] [m]: samples outside are absent"
+    )
+    scale: float = Field(
+        1.0,
+        gt=0,
+        description="file positions are multiplied by this to give metres (before offset)",
+    )
+    offset: Point2 = Field((0.0, 0.0), description="added to the scaled positions [m]")
+    stitch: bool = Field(
+        False,
+        description="join a track that ends where another starts (at most one annotation step "
+        "later, within 1 m) into one person",
+    )
+    at_rest: bool = Field(
+        False,
+        description="a person whose track starts after t = 0 waits at rest at its first position "
+        "from t = 0 instead of appearing then",
     )
 
     @field_validator("dataset")
@@ -644,7 +661,14 @@ class CrowdSpec(_Model):
 
     def tracks(self) -> dict[int, pedestrians.Track]:
         """All tracks of the recording (recording times) [s], [m]."""
-        return pedestrians.load_tracks(self.dataset, self.format, frame_rate=self.frame_rate)
+        return pedestrians.load_tracks(
+            self.dataset,
+            self.format,
+            frame_rate=self.frame_rate,
+            scale=self.scale,
+            offset=(float(self.offset[0]), float(self.offset[1])),
+            stitch=self.stitch,
+        )
 
     def window(self, t_max: float) -> float:
         """Length of the replayed window [s]: ``duration`` or the scene's ``t_max``."""
@@ -653,7 +677,11 @@ class CrowdSpec(_Model):
     def pieces(self, t_max: float) -> list[pedestrians.Track]:
         """Episode-time track pieces, :func:`uvnav.scenarios.pedestrians.episode_tracks`."""
         return pedestrians.episode_tracks(
-            self.tracks(), t_start=self.t_start, duration=self.window(t_max), region=self.region
+            self.tracks(),
+            t_start=self.t_start,
+            duration=self.window(t_max),
+            region=self.region,
+            at_rest=self.at_rest,
         )
 
     def to_obstacles(self, t_max: float) -> list[Obstacle]:

@@ -401,7 +401,7 @@ class UnicycleWorld:
             shortest=shortest,
             straight_time=shortest / spec.v_max if spec.v_max > 0 else 0.0,
             reached_at=self.reached_at,
-            min_clearance=float(self.min_clear) if self.obstacles else None,
+            min_clearance=float(self.min_clear) if math.isfinite(self.min_clear) else None,
             control_effort=self.effort,
             limit_violations=self.violations,
             mode_switches=log.mode_switches,

@@ -313,6 +313,7 @@ class MultiUnicycleWorld:
             np.concatenate((b.headings, state[:, 2])),
             np.vstack((b.velocities, vel)),
             np.concatenate((b.angular_velocities, omegas)),
+            None if b.present is None else np.concatenate((b.present, np.ones(n, dtype=bool))),
         )
 
     def start(self, oracles: Sequence[bool]) -> None:
