@@ -6,7 +6,7 @@ import math
 import sqlite3
 from collections.abc import Iterator
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 import pandas as pd
@@ -276,3 +276,91 @@ def test_unknown_metric_is_rejected(store: ResultsStore) -> None:
             status="success",
             metrics={"speed_of_light": 3e8},
         )
+
+
+def _crowd_collision() -> EpisodeResult:
+    """A pedestrian walks into a standing robot: every social metric has a value."""
+    from uvnav.dynamics import UnicycleCommand
+
+    class Stand:
+        name: ClassVar[str] = "stand"
+        oracle = False
+
+        @property
+        def mode(self) -> str:
+            return ""
+
+        def reset(self, spec: Any, goal: np.ndarray, rng: np.random.Generator) -> None:
+            pass
+
+        def act(self, obs: Any) -> UnicycleCommand:
+            return UnicycleCommand(0.0, 0.0)
+
+    setup = EpisodeSetup(
+        spec=UnicycleSpec(1.0, 1.0, 0.2),
+        start=np.array([0.0, 0.0, 0.0]),
+        goal=np.array([5.0, 5.0]),
+        obstacles=[Obstacle.moving_disc((-2.0, 0.1), 0.3, (1.0, 0.0))],
+        dt=0.25,
+        control_period=0.25,
+        t_max=10.0,
+    )
+    return run_episode(setup, Stand(), np.random.default_rng(0), record=False)
+
+
+def test_social_metrics_round_trip(store: ResultsStore) -> None:
+    result = _crowd_collision()
+    m = result.metrics
+    assert m.collision_by == "pedestrian" and m.min_separation is not None
+    assert m.too_close_time is not None and m.too_close_time > 0
+    eid = store.add_episode(
+        store.campaign("c"), scenario="crowd", controller="stand", seed=0, status=result.status,
+        metrics=m,
+    )  # fmt: skip
+    assert store.episode_result(eid).metrics == m
+    conn = sqlite3.connect(store.path)
+    types = {row[1]: row[2] for row in conn.execute("PRAGMA table_info(episodes)")}
+    conn.close()
+    assert types["collision_by"] == "TEXT" and types["min_separation"] == "REAL"
+    row = store.episodes_frame("c").iloc[0]
+    assert row["collision_by"] == "pedestrian"
+    assert row["intrusion_time"] == m.intrusion_time
+
+
+SOCIAL = (
+    "min_separation",
+    "too_close_time",
+    "too_close_frequency",
+    "intrusion_time",
+    "path_irregularity",
+    "collision_by",
+)
+
+
+def test_database_without_social_columns_reads_and_upgrades(tmp_path: Path) -> None:
+    db = tmp_path / "old.sqlite"
+    with ResultsStore(db) as store:
+        old = run_tiny(1, record=False)
+        eid = store.add_episode(
+            store.campaign("c"), scenario="tiny", controller="straight-v1", seed=1,
+            status=old.status, metrics=old.metrics,
+        )  # fmt: skip
+    with sqlite3.connect(db) as conn:  # an older database: no social columns
+        for name in SOCIAL:
+            conn.execute(f"ALTER TABLE episodes DROP COLUMN {name}")
+    with ResultsStore(db, readonly=True) as store:  # read as it is, not migrated
+        df = store.episodes_frame("c")
+        assert all(df[name].isna().all() for name in SOCIAL)
+        back = store.episode_result(eid).metrics
+        assert all(getattr(back, name) is None for name in SOCIAL)
+        assert back.min_clearance == old.metrics.min_clearance
+    with sqlite3.connect(db) as conn:
+        assert not set(SOCIAL) & {row[1] for row in conn.execute("PRAGMA table_info(episodes)")}
+    with ResultsStore(db) as store:  # opened for writing: the columns are added
+        new = _crowd_collision()
+        nid = store.add_episode(
+            store.campaign("c"), scenario="crowd", controller="stand", seed=0,
+            status=new.status, metrics=new.metrics,
+        )  # fmt: skip
+        assert store.episode_result(nid).metrics == new.metrics
+        assert store.episode_result(eid).metrics.collision_by is None

@@ -17,10 +17,20 @@ from typing import Any
 import numpy as np
 
 TIMING = ("decision_us_median", "decision_us_p99")
+#: metrics added after the references were written (issue 18: uvnav.sim.social); they have no
+#: reference, and the metrics that do must stay as they were
+LATER = (
+    "min_separation",
+    "too_close_time",
+    "too_close_frequency",
+    "intrusion_time",
+    "path_irregularity",
+    "collision_by",
+)
 
 
 def _metrics(m: Any) -> dict[str, Any]:
-    return {k: v for k, v in m.to_dict().items() if k not in TIMING}
+    return {k: v for k, v in m.to_dict().items() if k not in TIMING and k not in LATER}
 
 
 def _summary(arr: Any) -> list[float]:

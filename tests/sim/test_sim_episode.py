@@ -62,10 +62,16 @@ def _setup(obstacles: list[Obstacle], **kw: Any) -> EpisodeSetup:
     return EpisodeSetup(**args)
 
 
+RESPONSIBLE = ("robot", "pedestrian", "obstacle")
+
+
 def _metrics_are_clean(res: EpisodeResult) -> None:
     d = res.metrics.to_dict()
     assert tuple(d) == METRIC_NAMES
     for name, value in d.items():
+        if name == "collision_by":
+            assert value in ((None,) if not res.metrics.collision else RESPONSIBLE), value
+            continue
         assert value is None or isinstance(value, bool | int) or math.isfinite(value), (
             f"{name} = {value!r}"
         )

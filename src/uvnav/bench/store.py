@@ -28,7 +28,9 @@ Design choices, after what sweep tools such as Optuna's RDB storage and Sacred's
 * An ``error`` row may be overwritten by a later retry of the same key; a finished (non-error)
   episode never is, so a resumed campaign cannot duplicate or silently change results.
 * Opening an older database adds any metric column it lacks (``ALTER TABLE ADD COLUMN``), so
-  adding a metric to :data:`~uvnav.sim.METRIC_NAMES` does not break existing result files.
+  adding a metric to :data:`~uvnav.sim.METRIC_NAMES` does not break existing result files (the
+  social metrics of :mod:`uvnav.sim.social` came so; their episodes read NULL there).  Opened
+  read-only, such a file is not changed, and its missing columns read as missing values.
 * One campaign writer per database: :meth:`ResultsStore.writer_lease` holds an exclusive
   ``flock`` on ``<db>.lock`` beside the file (with the holder's pid in it) while a campaign
   runs, so a second ``uvnav bench`` on the same database refuses at once
@@ -60,8 +62,9 @@ from uvnav.sim import METRIC_NAMES, EpisodeMetrics, EpisodeResult, Trajectory
 if TYPE_CHECKING:
     import pandas as pd
 
-#: Metrics stored as SQL INTEGER (booleans as 0/1); every other metric is REAL.
+#: Metrics stored as SQL INTEGER (booleans as 0/1) and as TEXT; every other metric is REAL.
 _INTEGER_METRICS = frozenset({"success", "collision", "limit_violations", "mode_switches"})
+_TEXT_METRICS = frozenset({"collision_by"})
 _BOOLEAN_METRICS = ("success", "collision")
 
 #: Resume key of an episode inside one campaign: (scenario, controller, params_hash, seed).
@@ -73,6 +76,8 @@ STATUS_REFUSED = "refused"
 
 
 def _metric_sql_type(name: str) -> str:
+    if name in _TEXT_METRICS:
+        return "TEXT"
     return "INTEGER" if name in _INTEGER_METRICS else "REAL"
 
 
@@ -103,9 +108,12 @@ def params_hash(params: Mapping[str, Any] | None) -> str:
 
 
 def _sql_value(value: Any) -> Any:
-    """A metric value as SQLite will store it: NaN/inf and None become NULL, bools 0/1."""
+    """A metric value as SQLite will store it: NaN/inf and None become NULL, bools 0/1, text
+    (``collision_by``) as it is."""
     if value is None:
         return None
+    if isinstance(value, str):
+        return value
     if isinstance(value, bool | np.bool_):
         return int(value)
     if isinstance(value, int | np.integer):

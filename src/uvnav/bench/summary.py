@@ -10,6 +10,18 @@ One row per (controller, parameter set), over every stored episode of the campai
     the smallest ``min_clearance`` of any episode — the worst case, the safety number.
 ``detour_ratio``, ``time_ratio``
     means over the successful episodes (path length / straight distance; time / (distance/V_max)).
+``min_separation`` [m]
+    the smallest ``min_separation`` (robot to pedestrian, :mod:`uvnav.sim.social`) of any
+    episode, like ``min_clearance``; ``None`` when no episode had a pedestrian.
+``too_close_frequency``, ``intrusion_time`` [s]
+    means over the episodes with pedestrians (share of decisions closer than 0.2 m, CrowdNav's
+    discomfort frequency; time closer than 0.45 m).
+``path_irregularity`` [rad/m]
+    mean over the episodes that have it (2D episodes in which the robot moved).
+``pedestrian_collision_share``
+    share of the collisions in which the pedestrian closed the gap (``collision_by`` is
+    ``pedestrian``): with replayed or robot-blind pedestrians part of the collisions are people
+    walking into the robot.  ``None`` without collision with a known ``collision_by``.
 ``decision_us_median``, ``decision_us_p99`` [µs]
     medians over episodes of each episode's median and p99 decision time (wall-clock: the only
     columns that differ between two runs of the same campaign).
@@ -40,6 +52,11 @@ SUMMARY_COLUMNS = (
     "min_clearance",
     "detour_ratio",
     "time_ratio",
+    "min_separation",
+    "too_close_frequency",
+    "intrusion_time",
+    "path_irregularity",
+    "pedestrian_collision_share",
     "decision_us_median",
     "decision_us_p99",
 )
@@ -95,12 +112,31 @@ def controller_summary(store: ResultsStore, campaign: int | str) -> list[dict[st
                 "min_clearance": _num(ok["min_clearance"].min()) if n else None,
                 "detour_ratio": _num(wins["detour_ratio"].mean()) if len(wins) else None,
                 "time_ratio": _num(wins["time_ratio"].mean()) if len(wins) else None,
+                **_social(ok),
                 "decision_us_median": _num(ok["decision_us_median"].median()) if n else None,
                 "decision_us_p99": _num(ok["decision_us_p99"].median()) if n else None,
             }
         )
     rows.sort(key=lambda r: (r["controller"], r["params"]))
     return rows
+
+
+def _social(ok: Any) -> dict[str, float | None]:
+    """The social columns of one summary row from its non-error episodes (a DataFrame)."""
+
+    def mean(name: str) -> float | None:
+        col = ok[name].dropna()
+        return _num(col.astype(float).mean()) if len(col) else None
+
+    sep = ok["min_separation"].dropna()
+    by = ok.loc[ok["collision"].fillna(False).astype(bool), "collision_by"].dropna()
+    return {
+        "min_separation": _num(sep.astype(float).min()) if len(sep) else None,
+        "too_close_frequency": mean("too_close_frequency"),
+        "intrusion_time": mean("intrusion_time"),
+        "path_irregularity": mean("path_irregularity"),
+        "pedestrian_collision_share": _num((by == "pedestrian").mean()) if len(by) else None,
+    }
 
 
 def outcome_stats(rows: list[dict[str, Any]]) -> dict[str, Any]:

@@ -50,6 +50,7 @@ from uvnav.scenarios import (
     check_constraints,
 )
 from uvnav.sim import METRIC_NAMES
+from uvnav.sim.social import SOCIAL_METRIC_NAMES
 
 # ---------------------------------------------------------------------------------- error handling
 # One path for every command (see uvnav.cli.errors): user errors are one ``error:`` line and exit
@@ -199,6 +200,10 @@ _METRIC_UNITS = {
     "control_effort": "rad²/s + m²/s³",
     "decision_us_median": "µs",
     "decision_us_p99": "µs",
+    "min_separation": "m",
+    "too_close_time": "s",
+    "intrusion_time": "s",
+    "path_irregularity": "rad/m",
 }
 
 
@@ -292,6 +297,8 @@ def simulate(
     table.add_column("value", justify="right")
     table.add_column("unit")
     for key in METRIC_NAMES:
+        if key in SOCIAL_METRIC_NAMES and out.kind != "nav2d":
+            continue  # only the 2D worlds have them (uvnav.sim.social); JSON keeps them as null
         table.add_row(key, _fmt(out.metrics[key]), _METRIC_UNITS.get(key, ""))
     for key, value in out.extra.items():
         if not isinstance(value, dict | list):

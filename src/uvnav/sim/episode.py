@@ -38,7 +38,7 @@ from uvnav.controllers.base import Controller
 from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
 from uvnav.dynamics.omni import OmniSpec, VelocityCommand, omni_advance
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
-from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
@@ -47,6 +47,7 @@ from uvnav.sensors.observation import Observation
 from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
+from uvnav.sim.social import SocialTracker, collision_by, pedestrian_ids
 
 
 @dataclass(frozen=True)
@@ -209,8 +210,9 @@ def decision_ratio(control_period: float, dt: float) -> int:
 class UnicycleWorld:
     """The Chapter-2 world: one unicycle among rigid moving bodies (:class:`uvnav.core.World`).
 
-    Bookkeeping (path, effort, limit violations, clearance, status) lives here, so
-    :func:`run_episode` and the Gymnasium env ``uvnav/Nav2D-v0`` get the same numbers.  Without
+    Bookkeeping (path, effort, limit violations, clearance, status, the social metrics of
+    :mod:`uvnav.sim.social`) lives here, so :func:`run_episode` and the Gymnasium env
+    ``uvnav/Nav2D-v0`` get the same numbers.  Without
     ``exact`` the minimum clearance is tracked by :class:`_MinClearance` (the same minimum, and
     the per-step ``clearance`` only exact when it can matter).
 
@@ -242,6 +244,7 @@ class UnicycleWorld:
         self.batch = ObstacleBatch(self.obstacles)
         self.field = self.batch.field(self.template)
         self.sensing_range = float(setup.sensing.sensing_range)
+        self.pedestrians = pedestrian_ids(self.obstacles)
         self.exact = exact
         self.t = 0.0
         self.done = False
@@ -282,6 +285,15 @@ class UnicycleWorld:
             else None
         )
         self.start_dist = math.hypot(self.goal[0] - self.x, self.goal[1] - self.y)
+        self.social: SocialTracker | None = None
+        if len(self.pedestrians):
+            radius = float(self.spec.radius)
+            self.social = SocialTracker(
+                self.pedestrians, self.template.radii, radius, self.dt, self.ratio
+            )
+            self.social.observe(self.field, self.x, self.y, 0)
+        self.collision_by: str | None = None
+        self.turn = 0.0  # total absolute heading change [rad]
         self.path = 0.0
         self.effort = 0.0
         self.violations = 0
@@ -291,6 +303,7 @@ class UnicycleWorld:
         self.step_index = 0
         if self.clearance < 0:
             self.status, self.done = "collision", True
+            self.collision_by = self._collision_by()
         elif self.start_dist <= float(self.setup.goal_tolerance):
             self.status, self.reached_at, self.done = "success", 0.0, True
         self.done = self.done or self.n_steps <= 0
@@ -326,6 +339,15 @@ class UnicycleWorld:
         """The robot's speed now [m/s] (its applied command's)."""
         return float(self.applied.v)
 
+    def velocity(self) -> tuple[float, float]:
+        """The robot's velocity now [m/s]: its applied speed along its heading."""
+        v = float(self.applied.v)
+        return v * math.cos(self.th), v * math.sin(self.th)
+
+    def _collision_by(self) -> str:
+        """Who closed the gap at the collision now (:func:`uvnav.sim.social.collision_by`)."""
+        return collision_by(self.field, self.x, self.y, self.velocity(), self.pedestrians)
+
     def command_pair(self) -> tuple[float, float]:
         """The applied command as two numbers for the trajectory: ``(V_R, u_R)``."""
         return self.applied.v, self.applied.u
@@ -355,6 +377,7 @@ class UnicycleWorld:
         heading and the turn part of the control effort."""
         v, u = self.applied.v, self.applied.u
         self.effort += u**2 * dt
+        self.turn += abs(u) * dt
         nx, ny, self.th = unicycle_advance(self.x, self.y, self.th, v, u, dt)
         return nx, ny
 
@@ -377,8 +400,11 @@ class UnicycleWorld:
             self.min_clear = min(self.min_clear, self.clearance)
         else:
             self.clearance = self.tracker.step(self.field, nx, ny, radius)
+        if self.social is not None:
+            self.social.observe(self.field, nx, ny, i)
         if self.clearance < 0:
             self.status, self.done = "collision", True
+            self.collision_by = self._collision_by()
         elif math.hypot(self.goal[0] - nx, self.goal[1] - ny) <= float(self.setup.goal_tolerance):
             self.status, self.reached_at, self.done = "success", self.t, True
         elif i >= self.n_steps:
@@ -406,7 +432,22 @@ class UnicycleWorld:
             limit_violations=self.violations,
             mode_switches=log.mode_switches,
             decision_us=log.timed_us,
+            path_irregularity=self.turn / self.path if self.path > 0 else None,
+            collision_by=self.collision_by,
+            **self._social_metrics(len(log.decision_us)),
         )
+
+    def _social_metrics(self, decisions: int) -> dict[str, float]:
+        """The pedestrian metrics (:mod:`uvnav.sim.social`); none without pedestrians."""
+        soc = self.social
+        if soc is None:
+            return {}
+        return {
+            "min_separation": soc.min_separation,
+            "too_close_time": soc.too_close_time,
+            "too_close_frequency": soc.too_close_frequency(decisions),
+            "intrusion_time": soc.intrusion_time,
+        }
 
 
 class HolonomicWorld(UnicycleWorld):
@@ -433,6 +474,10 @@ class HolonomicWorld(UnicycleWorld):
     def speed(self) -> float:
         return float(self.applied.speed)
 
+    def velocity(self) -> tuple[float, float]:
+        """``(vx, vy)`` [m/s]."""
+        return float(self.applied.vx), float(self.applied.vy)
+
     def command_pair(self) -> tuple[float, float]:
         """``(vx, vy)`` [m/s]."""
         return self.applied.vx, self.applied.vy
@@ -446,7 +491,10 @@ class HolonomicWorld(UnicycleWorld):
     def _move(self, dt: float) -> tuple[float, float]:
         vx, vy = self.applied.vx, self.applied.vy
         if vx != 0.0 or vy != 0.0:
-            self.th = math.atan2(vy, vx)
+            th = math.atan2(vy, vx)
+            if th != self.th:
+                self.turn += abs(wrap_scalar(th - self.th))
+            self.th = th
         return omni_advance(self.x, self.y, vx, vy, dt)
 
 

@@ -3,10 +3,15 @@
 Names are the snake_case column names used in JSON, the results database and the report.  Metrics
 that do not exist for an episode (time to goal of a failed run, minimum clearance in a world
 without obstacles) are ``None``, never NaN or infinite.
+
+The social metrics (:data:`uvnav.sim.social.SOCIAL_METRIC_NAMES`, defined in
+:mod:`uvnav.sim.social`) come last; only the 2D worlds compute them, every other vehicle kind
+leaves them ``None``.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
@@ -26,6 +31,13 @@ METRIC_NAMES: tuple[str, ...] = (
     "mode_switches",
     "decision_us_median",
     "decision_us_p99",
+    # social metrics (uvnav.sim.social): 2D worlds only
+    "min_separation",
+    "too_close_time",
+    "too_close_frequency",
+    "intrusion_time",
+    "path_irregularity",
+    "collision_by",
 )
 
 
@@ -50,6 +62,18 @@ class EpisodeMetrics:
             (:func:`time.thread_time_ns`), the first decision (warm-up) left out when there are
             several (:attr:`uvnav.core.AgentLog.timed_us`).
         decision_us_p99: 99th percentile of the same [µs].
+        min_separation: smallest gap between the robot's disc and a pedestrian's [m]; ``None``
+            without pedestrians or outside the 2D worlds (this and the fields below:
+            :mod:`uvnav.sim.social`).
+        too_close_time: time with a pedestrian closer than 0.2 m (CrowdNav's discomfort
+            distance) [s].
+        too_close_frequency: share of the decisions whose period had a pedestrian closer than
+            0.2 m (CrowdNav's discomfort frequency).
+        intrusion_time: time with a pedestrian closer than 0.45 m (Hall's intimate zone) [s].
+        path_irregularity: total absolute heading change per metre of path [rad/m] (every 2D
+            episode that moved).
+        collision_by: who closed the gap at the collision: ``"robot"``, ``"pedestrian"`` or
+            ``"obstacle"`` (a body that is not a pedestrian); ``None`` without collision.
     """
 
     success: bool
@@ -64,6 +88,12 @@ class EpisodeMetrics:
     mode_switches: int
     decision_us_median: float
     decision_us_p99: float
+    min_separation: float | None = None
+    too_close_time: float | None = None
+    too_close_frequency: float | None = None
+    intrusion_time: float | None = None
+    path_irregularity: float | None = None
+    collision_by: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -81,6 +111,12 @@ def episode_metrics(
     limit_violations: int,
     mode_switches: int,
     decision_us: Sequence[float] | np.ndarray,
+    min_separation: float | None = None,
+    too_close_time: float | None = None,
+    too_close_frequency: float | None = None,
+    intrusion_time: float | None = None,
+    path_irregularity: float | None = None,
+    collision_by: str | None = None,
 ) -> EpisodeMetrics:
     """The DESIGN §4 metrics of one finished episode, the same way for every simulator.
 
@@ -98,6 +134,9 @@ def episode_metrics(
         limit_violations: decisions whose command was outside the limits.
         mode_switches: changes of the controller's reported mode.
         decision_us: controller compute time of every decision [µs] (empty: no decision).
+        min_separation, too_close_time, too_close_frequency, intrusion_time, path_irregularity,
+        collision_by: the social metrics of a 2D world (:mod:`uvnav.sim.social`), ``None``
+            where they do not apply.
     """
     dec = np.asarray(decision_us, dtype=float) if len(decision_us) else np.zeros(1)
     success = status == "success"
@@ -116,4 +155,18 @@ def episode_metrics(
         mode_switches=int(mode_switches),
         decision_us_median=float(np.median(dec)),
         decision_us_p99=float(np.percentile(dec, 99)),
+        min_separation=_opt(min_separation),
+        too_close_time=_opt(too_close_time),
+        too_close_frequency=_opt(too_close_frequency),
+        intrusion_time=_opt(intrusion_time),
+        path_irregularity=_opt(path_irregularity),
+        collision_by=collision_by,
     )
+
+
+def _opt(value: float | None) -> float | None:
+    """``value`` as a float; ``None`` for missing or non-finite."""
+    if value is None:
+        return None
+    v = float(value)
+    return v if math.isfinite(v) else None

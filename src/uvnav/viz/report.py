@@ -90,6 +90,15 @@ def _rate(hits: pd.Series) -> str:
     return f"{k / n:.1%} [{lo:.1%}, {hi:.1%}]" if n else "–"
 
 
+#: social metric columns of the summary: (label, episodes column, digits)
+_SOCIAL_COLUMNS = (
+    ("min_separation [m]", "min_separation", 3),
+    ("too_close_frequency", "too_close_frequency", 3),
+    ("intrusion_time [s]", "intrusion_time", 2),
+    ("path_irregularity [rad/m]", "path_irregularity", 3),
+)
+
+
 def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
     """Per (family, controller) summary rows of an episodes frame, formatted for display.
 
@@ -100,7 +109,10 @@ def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
         One dict per group, keys in display order: ``family``, ``controller``, ``episodes``,
         ``success rate`` and ``collision rate`` (with 95 % Wilson intervals), ``timeout rate``,
         ``errors``, and "mean [95 % CI] / median" strings of ``min_clearance [m]``,
-        ``path_length [m]``, ``detour_ratio``, ``time_ratio``, ``control_effort``,
+        ``path_length [m]``, ``detour_ratio``, ``time_ratio``, ``control_effort``, then the
+        social metrics (:mod:`uvnav.sim.social`) the frame has values of — ``min_separation
+        [m]``, ``too_close_frequency``, ``intrusion_time [s]`` when some episode had a
+        pedestrian, ``path_irregularity [rad/m]`` when some 2D episode moved — and
         ``decision_us_median [µs]`` and ``decision_us_p99 [µs]``.
     """
     if df.empty:
@@ -108,6 +120,11 @@ def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
     frame = df.copy()
     if "family" not in frame.columns:
         frame["family"] = frame["scenario"]
+    social = [
+        (label, name, digits)
+        for label, name, digits in _SOCIAL_COLUMNS
+        if name in frame.columns and frame[name].notna().any()
+    ]
     rows: list[dict[str, Any]] = []
     for (family, controller), g in frame.groupby(["family", "controller"], sort=True):
         n = len(g)
@@ -127,6 +144,7 @@ def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
                 "detour_ratio": _mean_median(g.loc[ok, "detour_ratio"]),
                 "time_ratio": _mean_median(g.loc[ok, "time_ratio"]),
                 "control_effort": _mean_median(g["control_effort"], 2),
+                **{label: _mean_median(g[name], digits) for label, name, digits in social},
                 "decision_us_median [µs]": _mean_median(g["decision_us_median"], 1),
                 "decision_us_p99 [µs]": _mean_median(g["decision_us_p99"], 1),
             }

@@ -1,0 +1,214 @@
+"""Social metrics of a 2D episode: how the robot treats the pedestrians of a crowd scene.
+
+Crowd-navigation papers report, beside success and collisions, how close the robot came to people
+and how often it made them uncomfortable.  The 2D worlds (:class:`uvnav.sim.episode.UnicycleWorld`
+and :class:`~uvnav.sim.episode.HolonomicWorld`) keep the numbers below with :class:`SocialTracker`
+at every integration step; every other vehicle kind reports them as ``None``.
+
+**Who is a pedestrian.**  The scene schema has no pedestrian flag, so the rule is structural: a
+pedestrian is an obstacle whose body is a *disc* and whose motion model can move it
+(``motion.speed_bound() > 0``) — :func:`pedestrian_ids`.  That covers the two kinds of people the
+scenes hold: replayed ETH/UCY walkers (``crowd:`` section, :mod:`uvnav.scenarios.pedestrians`) and
+CrowdNav's ORCA humans (``orca_crowd`` motion, :mod:`uvnav.obstacles.crowd`); moving discs of other
+scenes count too (they are the same thing to the robot), static discs and polygons never do.  A
+replayed pedestrian outside its track is parked 1 km away and so never comes close.
+
+**Gap.**  The gap to a pedestrian is the distance between the robot's disc and the pedestrian's
+disc, ``|c - p| - r_ped - R`` [m] (negative on overlap), evaluated in the same floating-point order
+as the collision check, so in a scene whose only bodies are pedestrians ``min_separation`` equals
+``min_clearance`` bit for bit.
+
+Metrics (``None`` in a scene without pedestrians, except where said):
+
+``min_separation`` [m]
+    smallest gap to any pedestrian over every integration step of the episode, the initial state
+    included (CrowdNav's "minimum separation distance"; Chen et al., ICRA 2019).
+``too_close_time`` [s]
+    ``dt`` times the number of integration steps whose end state has a gap < 0.2 m,
+    CrowdNav's discomfort distance (``discomfort_dist = 0.2`` in its ``env.config``).
+``too_close_frequency``
+    share of the episode's decisions whose decision period (the integration steps the decision's
+    command is held over) holds a state with a gap < 0.2 m: CrowdNav's per-step discomfort count
+    ("frequency of being in danger") divided by the number of decision steps.  An overlap
+    (collision) counts as too close.
+``intrusion_time`` [s]
+    ``dt`` times the number of integration steps whose end state has a gap < 0.45 m, the outer
+    edge of Hall's intimate zone (E. T. Hall, *The Hidden Dimension*, 1966: intimate distance up to
+    18 in ≈ 0.45 m) — time with a pedestrian inside the robot's personal space.
+``path_irregularity`` [rad/m]
+    total absolute heading change divided by the path length: ``sum_k |Δθ_k| / L`` over the
+    integration steps (unicycle: ``sum |u_R| dt``, the exact rotation of each step; holonomic
+    robot: the wrapped change of the direction of motion each time it changes).  Defined for every
+    2D episode (with or without pedestrians); ``None`` when the robot did not move.  This is the
+    "path irregularity" of Guzzi et al. (ICRA 2013, "Human-friendly robot navigation in dynamic
+    environments") *without* their subtraction of the rotation needed to face the target, so it
+    is never negative and needs no goal.
+``collision_by``
+    at a collision, who closed the gap: ``"robot"`` when the robot's velocity component toward
+    the body it touches is larger than the body's velocity component toward the robot at that
+    step, else ``"pedestrian"`` (or ``"obstacle"`` when the body is not a pedestrian); ``None``
+    without collision.  The direction is from the robot's centre to the body's centre (disc) or to
+    its nearest boundary point (polygon); the body's velocity is that of its touching point
+    (translation plus rotation).  Set for every 2D scene, with or without pedestrians.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+
+from uvnav.obstacles.bodies import DiscBody
+from uvnav.obstacles.obstacle import Obstacle, ObstacleField
+
+#: CrowdNav's discomfort distance [m] (gap below which the robot is "too close")
+DISCOMFORT_DISTANCE = 0.2
+#: Hall's intimate distance [m] (gap below which a pedestrian intrudes on the robot's space)
+INTIMATE_DISTANCE = 0.45
+
+#: the social metrics, in the order of :data:`uvnav.sim.metrics.METRIC_NAMES`
+SOCIAL_METRIC_NAMES: tuple[str, ...] = (
+    "min_separation",
+    "too_close_time",
+    "too_close_frequency",
+    "intrusion_time",
+    "path_irregularity",
+    "collision_by",
+)
+
+
+def pedestrian_ids(obstacles: Sequence[Obstacle]) -> np.ndarray:
+    """Indices of the pedestrians of ``obstacles``: disc bodies whose motion can move them
+    (``speed_bound() > 0``; see the module docstring)."""
+    ids = [
+        j
+        for j, ob in enumerate(obstacles)
+        if isinstance(ob.body, DiscBody) and float(ob.motion.speed_bound()) > 0.0
+    ]
+    return np.asarray(ids, dtype=np.intp)
+
+
+class SocialTracker:
+    """Gap to the nearest pedestrian at every integration step of a 2D episode.
+
+    Args:
+        ids: the pedestrians' indices among the field's obstacles (:func:`pedestrian_ids`,
+            not empty).
+        radii: (k,) disc radius of every obstacle [m] (``FieldTemplate.radii``).
+        robot_radius: the robot's radius [m].
+        dt: integration step [s].
+        ratio: integration steps per decision.
+    """
+
+    __slots__ = (
+        "_all",
+        "_close_periods",
+        "_close_steps",
+        "_ids",
+        "_intrusion_steps",
+        "_last_period",
+        "_radii",
+        "_radius",
+        "dt",
+        "min_separation",
+        "ratio",
+    )
+
+    def __init__(
+        self,
+        ids: np.ndarray,
+        radii: np.ndarray,
+        robot_radius: float,
+        dt: float,
+        ratio: int,
+    ) -> None:
+        self._ids = ids
+        self._all = len(ids) == len(radii)
+        self._radii = radii if self._all else radii.take(ids)
+        self._radius = float(robot_radius)
+        self.dt = float(dt)
+        self.ratio = int(ratio)
+        self.min_separation = math.inf
+        self._close_steps = 0
+        self._intrusion_steps = 0
+        self._close_periods = 0
+        self._last_period = -1
+
+    def gap(self, fld: ObstacleField, px: float, py: float) -> float:
+        """Smallest gap [m] between the robot's disc at ``(px, py)`` and a pedestrian's."""
+        c = fld.centres if self._all else fld.centres.take(self._ids, axis=0)
+        # the collision check's order: (|p - c| - r_ped) - R
+        g = np.hypot(px - c[:, 0], py - c[:, 1]) - self._radii - self._radius
+        return float(g.min())
+
+    def observe(self, fld: ObstacleField, px: float, py: float, step: int) -> None:
+        """Account for the state after integration step ``step`` (0: the initial state, which
+        counts for the minimum only)."""
+        g = self.gap(fld, px, py)
+        if g < self.min_separation:
+            self.min_separation = g
+        if step > 0 and g < INTIMATE_DISTANCE:
+            self._intrusion_steps += 1
+            if g < DISCOMFORT_DISTANCE:
+                self._close_steps += 1
+                period = (step - 1) // self.ratio
+                if period != self._last_period:
+                    self._last_period = period
+                    self._close_periods += 1
+
+    @property
+    def too_close_time(self) -> float:
+        """Time with a gap < :data:`DISCOMFORT_DISTANCE` [s]."""
+        return self._close_steps * self.dt
+
+    @property
+    def intrusion_time(self) -> float:
+        """Time with a gap < :data:`INTIMATE_DISTANCE` [s]."""
+        return self._intrusion_steps * self.dt
+
+    def too_close_frequency(self, decisions: int) -> float:
+        """Share of ``decisions`` whose period held a gap < :data:`DISCOMFORT_DISTANCE`."""
+        return min(self._close_periods / decisions, 1.0) if decisions > 0 else 0.0
+
+
+def collision_by(
+    fld: ObstacleField,
+    px: float,
+    py: float,
+    robot_velocity: tuple[float, float],
+    pedestrians: np.ndarray,
+) -> str:
+    """Who closed the gap at a collision of the robot at ``(px, py)`` (module docstring).
+
+    Args:
+        fld: the field at the collision step.
+        robot_velocity: the robot's velocity ``(vx, vy)`` [m/s] at that step.
+        pedestrians: indices of the pedestrians (:func:`pedestrian_ids`).
+
+    Returns:
+        ``"robot"``, ``"pedestrian"`` or ``"obstacle"``.
+    """
+    q = fld.query((px, py), 0.0, nearest=True)
+    j = int(q.signed.argmin())
+    body = int(q.ids[j])
+    cx, cy = float(fld.centres[body, 0]), float(fld.centres[body, 1])
+    # the touching point: a disc's centre (its rotation moves its boundary tangentially, never
+    # along the normal), a polygon's nearest boundary point
+    disc = bool(fld.template.radii[body] > 0)
+    tx, ty = (cx, cy) if disc else (float(q.nearest[j, 0]), float(q.nearest[j, 1]))
+    nx, ny = tx - px, ty - py
+    if q.inside[j] and not disc:
+        nx, ny = -nx, -ny  # the robot's centre is inside: the body lies behind the boundary
+    norm = math.hypot(nx, ny)
+    if norm == 0.0:  # no direction to close along (centre on the boundary or the centre)
+        nx, ny, norm = cx - px, cy - py, max(math.hypot(cx - px, cy - py), 1.0)
+    nx, ny = nx / norm, ny / norm
+    omega = float(fld.angular_velocities[body])
+    bvx = float(fld.velocities[body, 0]) - omega * (ty - cy)
+    bvy = float(fld.velocities[body, 1]) + omega * (tx - cx)
+    robot_in = robot_velocity[0] * nx + robot_velocity[1] * ny
+    body_in = -(bvx * nx + bvy * ny)
+    if robot_in > body_in:
+        return "robot"
+    return "pedestrian" if bool(np.isin(body, pedestrians)) else "obstacle"

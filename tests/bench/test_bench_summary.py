@@ -1,0 +1,55 @@
+"""The campaign summary's social columns (:func:`uvnav.bench.summary.controller_summary`)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from uvnav.bench.store import ResultsStore
+from uvnav.bench.summary import SUMMARY_COLUMNS, controller_summary
+
+
+def _metrics(status: str, **social: Any) -> dict[str, Any]:
+    return {
+        "success": status == "success", "collision": status == "collision",
+        "min_clearance": 0.1, "path_length": 5.0, "control_effort": 0.0,
+        "limit_violations": 0, "mode_switches": 0, "decision_us_median": 1.0,
+        "decision_us_p99": 2.0, **social,
+    }  # fmt: skip
+
+
+def test_social_columns(tmp_path: Path) -> None:
+    episodes: list[tuple[str, dict[str, Any]]] = [
+        ("success", {"min_separation": 0.3, "too_close_frequency": 0.0, "intrusion_time": 1.0,
+                     "path_irregularity": 0.2}),
+        ("collision", {"min_separation": -0.05, "too_close_frequency": 0.5, "intrusion_time": 2.0,
+                       "path_irregularity": 0.4, "collision_by": "pedestrian"}),
+        ("collision", {"min_separation": 0.2, "too_close_frequency": 0.1, "intrusion_time": 0.0,
+                       "path_irregularity": 0.6, "collision_by": "robot"}),
+        ("collision", {"min_separation": -0.01, "too_close_frequency": 0.2, "intrusion_time": 3.0,
+                       "path_irregularity": None, "collision_by": "pedestrian"}),
+        ("success", {"path_irregularity": 0.3}),  # a scene without pedestrians
+    ]  # fmt: skip
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        cid = store.campaign("c")
+        for seed, (status, social) in enumerate(episodes):
+            store.add_episode(
+                cid, scenario="s", controller="law", seed=seed, status=status,
+                metrics=_metrics(status, **social),
+            )  # fmt: skip
+        store.add_episode(cid, scenario="s", controller="other", seed=0, status="success",
+                          metrics=_metrics("success"))  # fmt: skip
+        rows = {r["controller"]: r for r in controller_summary(store, "c")}
+    assert all(tuple(r) == SUMMARY_COLUMNS for r in rows.values())
+    law = rows["law"]
+    assert law["min_separation"] == -0.05
+    assert law["too_close_frequency"] == pytest.approx(0.8 / 4)
+    assert law["intrusion_time"] == pytest.approx(6.0 / 4)
+    assert law["path_irregularity"] == pytest.approx(1.5 / 4)
+    assert law["pedestrian_collision_share"] == pytest.approx(2 / 3)
+    other = rows["other"]  # no pedestrian, no turn recorded, no collision
+    for col in ("min_separation", "too_close_frequency", "intrusion_time", "path_irregularity",
+                "pedestrian_collision_share"):  # fmt: skip
+        assert other[col] is None
