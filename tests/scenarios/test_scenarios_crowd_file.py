@@ -277,4 +277,5 @@ def test_campaign_with_crowd_file_runs(tmp_path: Path) -> None:
     # the empty-walkway crossing (nobody there while the robot crosses) has no clearance
     empty = df[df["scenario"].str.contains("t_start")]
     assert len(empty) == 1 and empty["min_clearance"].isna().all()
+    assert empty["min_separation"].isna().all()  # nor a pedestrian separation (nobody is there)
     assert all(c is None or np.isnan(c) or c < 50.0 for c in clear)

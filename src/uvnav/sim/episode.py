@@ -367,11 +367,6 @@ class UnicycleWorld:
         self.applied = new
         return new
 
-    def velocity(self) -> tuple[float, float]:
-        """The robot's world-frame velocity now [m/s]."""
-        v = float(self.applied.v)
-        return v * math.cos(self.th), v * math.sin(self.th)
-
     def _move(self, dt: float) -> tuple[float, float]:
         """Integrate the robot over ``dt`` [s] (exact); returns the new position, updates the
         heading and the turn part of the control effort."""
@@ -481,9 +476,6 @@ class HolonomicWorld(UnicycleWorld):
     def command_pair(self) -> tuple[float, float]:
         """``(vx, vy)`` [m/s]."""
         return self.applied.vx, self.applied.vy
-
-    def velocity(self) -> tuple[float, float]:
-        return float(self.applied.vx), float(self.applied.vy)
 
     def _speed_change(self, new: Any) -> float:
         return float((new.vx - self.applied.vx) ** 2 + (new.vy - self.applied.vy) ** 2)

@@ -140,7 +140,10 @@ class SocialTracker:
         c = fld.centres if self._all else fld.centres.take(self._ids, axis=0)
         # the collision check's order: (|p - c| - r_ped) - R
         g = np.hypot(px - c[:, 0], py - c[:, 1]) - self._radii - self._radius
-        return float(g.min())
+        present = fld.present
+        if present is not None:  # an absent pedestrian is nobody (not a parked one 1 km away)
+            g = np.where(present if self._all else present.take(self._ids), g, np.inf)
+        return float(g.min()) if len(g) else math.inf
 
     def observe(self, fld: ObstacleField, px: float, py: float, step: int) -> None:
         """Account for the state after integration step ``step`` (0: the initial state, which
