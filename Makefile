@@ -58,6 +58,7 @@ bench: $(STAMP_RUN)
 	$(PY) benchmarks/run_benchmarks.py --out benchmarks/results
 	$(PY) benchmarks/bench_multi.py --out benchmarks/results
 	$(PY) benchmarks/bench_ch7.py --out benchmarks/results
+	$(PY) benchmarks/bench_crowdnav.py --cases 500 --out benchmarks/results
 
 clean:
 	rm -rf $(VENV) results report .pytest_cache .mypy_cache .ruff_cache
