@@ -102,9 +102,7 @@ class CrowdsSummary:
     wall_time: float = 0.0
 
 
-def crowd_jobs(
-    laws: Sequence[str], cases: range, *, beyond_assumptions: bool = False
-) -> list[Job]:
+def crowd_jobs(laws: Sequence[str], cases: range, *, beyond_assumptions: bool = False) -> list[Job]:
     """One job per scene, case and law (episode seed = case, as CrowdNav's test case)."""
     return [
         Job(
@@ -158,7 +156,7 @@ def reproduce_crowds(
     n = cases if cases is not None else (FULL_CASES if full else QUICK_CASES)
     run_cases = range(start_case, start_case + n)
     fp = code_fingerprint()
-    plans = [
+    plans: list[tuple[str, dict[str, Any], list[Job]]] = [
         (
             CAMPAIGN,
             {"generators": list(GENERATORS), "controllers": main, "fingerprint": fp},
