@@ -171,3 +171,28 @@ def test_report_rebuilds_the_chapter_sections_it_can(tmp_path: Path) -> None:
         assert f'id="section-{key}"' in html
     assert "15.00 m" in html or "15.0" in html
     assert db.read_bytes() == before  # the report only reads
+
+
+def test_reproduce_crowds_runs_the_crowd_section(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from uvnav.bench import reproduce_crowds as rc
+
+    # two laws instead of every 2D law (the rest of the run is real: 2 cases per scene)
+    monkeypatch.setattr(rc, "crowd_laws", lambda: (["orca-holonomic-v1", "zhang2019-v1"], []))
+    res, rep = tmp_path / "res", tmp_path / "rep"
+    args = ["reproduce", "crowds", "--seeds", "2", "--workers", "1"]
+    result = runner.invoke(
+        app, [*args, "--results", str(res), "--report", str(rep)], env={"COLUMNS": "250"}
+    )
+    assert result.exit_code == 0, result.output
+    assert "CrowdNav circle crossing" in result.stdout and "refused (2/2" in result.stdout
+    html = (rep / "index.html").read_text(encoding="utf-8")
+    assert 'id="section-crowds"' in html and "0.43" in html
+    with ResultsStore(res / "uvnav.sqlite") as store:
+        assert store.count(rc.CAMPAIGN) == 2 * 2 * 2
+    # a second call adds nothing
+    again = runner.invoke(app, [*args, "--results", str(res), "--report", str(rep)])
+    assert again.exit_code == 0, again.output
+    with ResultsStore(res / "uvnav.sqlite") as store:
+        assert store.count(rc.CAMPAIGN) == 2 * 2 * 2

@@ -1,7 +1,8 @@
 """One chapter's reproduction at a time: the job behind ``uvnav reproduce CHAPTER``.
 
-:func:`reproduce_chapter` runs one of :data:`CHAPTERS` — a thesis chapter ``ch2`` … ``ch7`` or
-``beyond`` (the experiments beyond the thesis: planners, office floor, multi-robot swap) — into
+:func:`reproduce_chapter` runs one of :data:`CHAPTERS` — a thesis chapter ``ch2`` … ``ch7``,
+``beyond`` (the experiments beyond the thesis: planners, office floor, multi-robot swap) or
+``crowds`` (every 2D law on CrowdNav's crowds, :mod:`uvnav.bench.reproduce_crowds`) — into
 the results store ``results_dir/uvnav.sqlite`` (and the chapter's own files under
 ``results_dir``), draws its figures with the injected renderers
 (:class:`~uvnav.bench.sections.ChapterRenderers`) into ``report_dir/<chapter>``, and saves its
@@ -9,7 +10,8 @@ report section in ``results_dir/sections/<chapter>.json`` (:func:`~uvnav.bench.s
 save_section`), so the report shows it beside the sections of the chapters run before.
 
 ``uvnav run`` (:func:`uvnav.bench.reproduce.reproduce`) calls the same per-chapter runners
-(:func:`run_ch3` … :func:`run_beyond`), so the two entry points run the same experiments.
+(:func:`run_ch3` … :func:`run_beyond`, :func:`run_crowds`), so the two entry points run the same
+experiments.
 
 Every chapter adds to the store: stored episodes are skipped (resume) and never deleted or
 replaced by a later run; a campaign that cannot be resumed (stored by other code) is refused with
@@ -18,7 +20,8 @@ replaced by a later run; a campaign that cannot be resumed (stored by other code
 ``seeds`` and ``start_seed`` (chapters with random scenes, :data:`SEEDED`) choose the random
 scenes: ``seeds`` scenes from ``start_seed`` (Ch. 2: the random and baseline campaigns; Ch. 3: the
 random-ch3 scenes; Ch. 4: every family — random-ch4, the noise sweep, random-ch4-hard; Ch. 5: the
-random-ch5 closed-loop scenes).
+random-ch5 closed-loop scenes; crowds: CrowdNav's test cases ``start_seed`` ..
+``start_seed + seeds - 1`` of each scene).
 """
 
 from __future__ import annotations
@@ -32,9 +35,9 @@ from typing import Any
 from uvnav.bench.sections import SECTIONS_DIR, ChapterRenderers, ChapterSection, save_section
 
 #: What ``uvnav reproduce`` accepts (``all`` is ``uvnav run``).
-CHAPTERS: tuple[str, ...] = ("ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "beyond")
+CHAPTERS: tuple[str, ...] = ("ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "beyond", "crowds")
 #: Chapters that run random seeds (``seeds`` / ``start_seed`` apply).
-SEEDED: frozenset[str] = frozenset({"ch2", "ch3", "ch4", "ch5"})
+SEEDED: frozenset[str] = frozenset({"ch2", "ch3", "ch4", "ch5", "crowds"})
 DB_NAME = "uvnav.sqlite"
 
 
@@ -217,6 +220,31 @@ def run_beyond(
     return sec.beyond_section(rows, figs, full=full), rows
 
 
+def run_crowds(
+    results_dir: Path,
+    *,
+    full: bool,
+    workers: int,
+    seeds: int | None = None,
+    start_seed: int = 0,
+    progress: bool = False,
+) -> tuple[ChapterSection, Any]:
+    """Every 2D law on CrowdNav's crowds (:func:`uvnav.bench.reproduce_crowds.reproduce_crowds`:
+    ``seeds`` test cases per scene from ``start_seed``) and its section."""
+    from uvnav.bench import sections as sec
+    from uvnav.bench.reproduce_crowds import reproduce_crowds
+
+    sc = reproduce_crowds(
+        results_dir,
+        full=full,
+        workers=workers,
+        cases=seeds,
+        start_case=start_seed,
+        progress=progress,
+    )
+    return sec.crowds_section(sc), sc
+
+
 # ------------------------------------------------------------------------------- the dispatcher
 
 
@@ -333,6 +361,15 @@ def reproduce_chapter(
         )
     elif chapter == "ch7":
         section, summary = run_ch7(results_dir, report_dir, full=full, renderers=rend)
+    elif chapter == "crowds":
+        section, summary = run_crowds(
+            results_dir,
+            full=full,
+            workers=workers,
+            seeds=seeds,
+            start_seed=start_seed,
+            progress=progress,
+        )
     else:
         section, summary = run_beyond(report_dir, full=full, renderers=rend)
     path = save_section(section, results_dir / SECTIONS_DIR)
@@ -354,7 +391,8 @@ _FILE_CHAPTERS = {"ch6": ("ch6", "ch6-quick"), "ch7": ("ch7",)}
 
 
 def _rerun_section(key: str, why: str) -> ChapterSection:
-    name = "the experiments beyond the thesis" if key == "beyond" else f"Chapter {key[2:]}"
+    names = {"beyond": "the experiments beyond the thesis", "crowds": "CrowdNav's crowds"}
+    name = names.get(key, f"Chapter {key[2:]}")
     return ChapterSection(
         key=key,
         title=f"{name[0].upper()}{name[1:]}",
@@ -410,13 +448,29 @@ def _ch4_from_store(store: Any) -> ChapterSection:
     )
 
 
+def _crowds_from_store(store: Any) -> ChapterSection:
+    from uvnav.bench import reproduce_crowds as rc
+    from uvnav.bench.sections import rows_of
+
+    return ChapterSection(
+        key="crowds",
+        title="Beyond the thesis — CrowdNav's crowds, every 2D law",
+        intro="Rebuilt from the episodes stored in the database (campaigns "
+        f"{', '.join(rc.CAMPAIGNS)}: every stored test case of CrowdNav's circle and square "
+        "crossing; success and collision with 95 % Wilson intervals, the paper's ORCA figure, "
+        "social metrics in the notes).",
+        rows=rows_of(rc.crowd_rows(store)),
+    )
+
+
 def report_sections(db_path: Path) -> list[ChapterSection]:
     """The chapter sections of the report of a results database (``uvnav report DB``).
 
     A section saved by the last run of its chapter (``DB folder/sections``) is used as it is;
-    otherwise Chapters 2 and 4, whose tables are computed from stored rows only, are rebuilt from
-    the database's episodes; a chapter with stored campaigns or result files but no saved
-    section gets a section that says to rerun ``uvnav reproduce CH``.  The database is only read.
+    otherwise Chapters 2 and 4 and the crowd section, whose tables are computed from stored rows
+    only, are rebuilt from the database's episodes; a chapter with stored campaigns or result
+    files but no saved section gets a section that says to rerun ``uvnav reproduce CH``.  The
+    database is only read.
     """
     from uvnav.bench.sections import SECTION_ORDER, load_sections
     from uvnav.bench.store import ResultsStore
@@ -430,13 +484,20 @@ def report_sections(db_path: Path) -> list[ChapterSection]:
             if key in saved:
                 out.append(saved[key])
                 continue
-            stored = any(n.startswith(f"{key}-") for n in names)
+            if key == "crowds":  # its campaigns are CrowdNav's ("crowds-eth" is Chapter 2's)
+                from uvnav.bench.reproduce_crowds import CAMPAIGNS
+
+                stored = any(n in CAMPAIGNS for n in names)
+            else:
+                stored = any(n.startswith(f"{key}-") for n in names)
             files = any((db_path.parent / d).is_dir() for d in _FILE_CHAPTERS.get(key, ()))
             section: ChapterSection | None = None
             if key == "ch2" and stored:
                 section = _ch2_from_store(store)
             elif key == "ch4" and stored:
                 section = _ch4_from_store(store)
+            elif key == "crowds" and stored:
+                section = _crowds_from_store(store)
             if section is None and (stored or files):
                 what = "campaigns are stored" if stored else "result files exist"
                 section = _rerun_section(
@@ -462,4 +523,5 @@ __all__ = [
     "run_ch5",
     "run_ch6",
     "run_ch7",
+    "run_crowds",
 ]

@@ -8,7 +8,9 @@
 2. a random campaign on ``random_ch2_scenario(seed)`` for seeds ``0..199`` (``1000`` with
    ``full=True``) with both laws — campaign ``ch2-random``;
 
-and, in a real run (``n_random`` not given), the other chapters' reproductions (Chapter 6, the
+and, in a real run (``n_random`` not given), the crowd section (every 2D law on CrowdNav's
+crowds, :mod:`uvnav.bench.reproduce_crowds`, after Chapter 2's ETH crowds) and the other
+chapters' reproductions (Chapter 6, the
 CNN that drives: at :data:`uvnav.bench.reproduce_ch6.RUN_QUICK`'s size in quick mode, the
 thesis size with ``full=True``; in ``results_dir/ch6-quick`` and ``results_dir/ch6``);
 
@@ -465,6 +467,7 @@ def reproduce(
     ch5_render: Callable[..., list[Path]] | None = None,
     renderers: ChapterRenderers | None = None,
     save_sections: bool = True,
+    crowds: bool | None = None,
 ) -> ReproductionSummary:
     """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
 
@@ -496,6 +499,9 @@ def reproduce(
             ``renderers.ch5`` is used when ``ch5_render`` is not given.
         save_sections: save every section in ``results_dir/sections`` (so ``uvnav report`` and
             ``uvnav reproduce CH`` show them beside later single-chapter runs).
+        crowds: also run every 2D law on CrowdNav's crowds (campaigns ``crowdnav`` and
+            ``crowdnav-beyond``, :mod:`uvnav.bench.reproduce_crowds`; quick or full size), its
+            section after Chapter 2's; ``None`` = in a real run with baselines.
 
     Returns:
         The summary: table, database and report paths, random-campaign failures.
@@ -659,6 +665,10 @@ def reproduce(
     by_key: dict[str, ChapterSection] = {}
     from uvnav.bench import chapters
 
+    if crowds if crowds is not None else (baselines and real_run):  # after the ETH crowds
+        sec_c, _ = chapters.run_crowds(results_dir, full=full, workers=workers, progress=progress)
+        table += sec_c.rows
+        sections.append(sec_c)
     if baselines and real_run:  # beyond the thesis (a real run, not a quick look)
         sec_b, rows_b = chapters.run_beyond(report_dir, full=full, renderers=rend)
         table += rows_b

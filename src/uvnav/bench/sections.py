@@ -499,10 +499,56 @@ def beyond_section(
     return sec
 
 
+# ----------------------------------------------------------------------------- CrowdNav's crowds
+
+
+def crowds_section(summary: Any) -> ChapterSection:
+    """The crowd section (issue 18) from a :class:`uvnav.bench.reproduce_crowds.CrowdsSummary`."""
+    from uvnav.bench import reproduce_crowds as rc
+
+    first, last = summary.start_case, summary.start_case + summary.cases - 1
+    size = (
+        f"{summary.cases} test cases per scene (cases {first}–{last}"
+        + (
+            f"; the quick size, CrowdNav's test set is {rc.FULL_CASES} cases: --full"
+            if not summary.full and summary.cases < rc.FULL_CASES
+            else ""
+        )
+        + ")"
+    )
+    intro = (
+        f"CrowdNav's crowds ({mode_text(summary.full)}): every 2D law on CrowdNav's circle and "
+        f"square crossing (Chen, Liu, Kreiss, Alahi, ICRA 2019; five ORCA pedestrians at 1 m/s "
+        f"who do not see the robot, robot V_max 1 m/s, 24 s), {size}: "
+        f"{', '.join(summary.laws)}. Success and collision rates with 95 % Wilson intervals; "
+        "the paper's ORCA figure stands beside orca-holonomic-v1 on circle crossing (CrowdNav's "
+        "robot ORCA). The notes give the social metrics: mean share of decisions closer than "
+        "0.2 m, mean time closer than 0.45 m, min separation, and the share of the collisions a "
+        "pedestrian closed (these pedestrians do not avoid the robot). Laws that assume "
+        "obstacles slower than the robot (thesis (2.6)) are refused here, and shown as refused: "
+        "the pedestrians walk at the robot's speed, so their guarantees do not apply."
+    )
+    if summary.beyond:
+        intro += (
+            f" Because the thesis's laws are this library's subject, {', '.join(summary.beyond)} "
+            "also ran beyond that assumption, as a separate row group ('beyond assumption "
+            "(2.6)', campaign crowdnav-beyond), as in the ETH crowd campaign of Chapter 2; "
+            "hybrid-v1 belongs there because it drives with zhang2019-v1 inside and does not "
+            "check that law's assumption."
+        )
+    return ChapterSection(
+        key="crowds",
+        title="Beyond the thesis — CrowdNav's crowds, every 2D law",
+        intro=intro,
+        rows=rows_of(summary.table),
+    )
+
+
 # ------------------------------------------------------------------------- sections on disk
 
-#: Every section key in report order: the thesis chapters, then what goes beyond the thesis.
-SECTION_ORDER: tuple[str, ...] = ("ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "beyond")
+#: Every section key in report order: the thesis chapters (the crowd section after Chapter 2's
+#: ETH crowds), then what goes beyond the thesis.
+SECTION_ORDER: tuple[str, ...] = ("ch2", "crowds", "ch3", "ch4", "ch5", "ch6", "ch7", "beyond")
 #: Folder, next to the results database, of the last section each chapter's run produced.
 SECTIONS_DIR = "sections"
 

@@ -29,7 +29,7 @@ def reproduce_cmd(
         str,
         typer.Argument(
             help="ch2, ch3, ch4, ch5, ch6, ch7, beyond (planners, office floor, multi-robot), "
-            "or all (= uvnav run)."
+            "crowds (every 2D law on CrowdNav's crowds), or all (= uvnav run)."
         ),
     ],
     full: Annotated[
@@ -44,12 +44,15 @@ def reproduce_cmd(
         int | None,
         typer.Option(
             min=1,
-            help="Random scenes to run (ch2-ch5; default: the chapter's quick or full size).",
+            help="Random scenes to run (ch2-ch5; crowds: CrowdNav test cases per scene; default: "
+            "the chapter's quick or full size).",
         ),
     ] = None,
     start_seed: Annotated[
         int,
-        typer.Option("--start-seed", min=0, help="First random scene (ch2-ch5): seeds S .. S+N-1."),
+        typer.Option(
+            "--start-seed", min=0, help="First random scene (ch2-ch5, crowds): seeds S .. S+N-1."
+        ),
     ] = 0,
 ) -> None:
     """Reproduce one chapter into the results store and its report section.
@@ -60,7 +63,9 @@ def reproduce_cmd(
     chapter = chapter.strip().lower()
     if chapter == "all":
         if seeds is not None or start_seed:
-            raise CliError("reproduce all: --seeds/--start-seed apply to one chapter (ch2-ch5)")
+            raise CliError(
+                "reproduce all: --seeds/--start-seed apply to one chapter (ch2-ch5, crowds)"
+            )
         from uvnav.cli.app import run
 
         run(full=full, workers=workers, results=results, report=report)

@@ -1,0 +1,328 @@
+"""CrowdNav's crowds for every 2D law: the ``crowds`` section of ``uvnav run`` (issue 18).
+
+:func:`reproduce_crowds` runs every registered 2D law — the unicycle laws and the holonomic ones
+(:func:`uvnav.controllers.base.available_controllers`) — on CrowdNav's test cases of circle and
+square crossing (``crowdnav-circle:<case>``, ``crowdnav-square:<case>``,
+:mod:`uvnav.scenarios.crowdnav`: five ORCA pedestrians at 1 m/s who do not see the robot, robot
+V_max 1 m/s, 24 s), cases ``start .. start + n - 1`` (:data:`QUICK_CASES` quick, :data:`FULL_CASES`
+with ``full``: CrowdNav's whole test set), and builds one table: per scene and law the success and
+collision rates with 95 % Wilson intervals, the timeouts, the mean time to goal of the successes,
+and the social metrics (:mod:`uvnav.sim.social`: mean too-close frequency, mean intrusion time,
+min separation, share of the collisions a pedestrian closed), beside the paper's ORCA figure
+(:data:`PAPER_ORCA`: Chen, Liu, Kreiss, Alahi, ICRA 2019, Table I) on the row of
+``orca-holonomic-v1`` on circle crossing, the paper's configuration.
+
+Laws whose assumptions the scene breaks (``zhang2019-v1`` and ``savkin-wang2013-v1`` assume
+obstacles slower than the robot, thesis (2.6); these pedestrians walk at the robot's V_max) are
+stored and shown as ``refused`` in campaign :data:`CAMPAIGN`: that is the honest result of the
+laws as specified.  Because the thesis's laws are the library's subject, they are *also* run
+beyond that assumption, in a separate campaign :data:`BEYOND_CAMPAIGN` whose rows are labelled so
+(the ETH crowd campaign of Ch. 2 does the same); ``hybrid-v1`` goes there too, since it follows
+its waypoints with ``zhang2019-v1`` inside and does not check that law's assumption.
+
+Both campaigns live in the results store ``results_dir/uvnav.sqlite``, carry the Ch. 2 code
+fingerprint (:func:`uvnav.bench.reproduce.code_fingerprint`) and only add: a second run skips every
+stored episode; a campaign stored by other code is refused
+(:class:`~uvnav.bench.store.StaleCampaignError`).  The table shows the run's own cases (those it
+ran or found stored); ``uvnav report`` rebuilds it from every stored case (:func:`crowd_rows`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from uvnav.bench.campaign import Job, run_campaign
+from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
+
+CAMPAIGN = "crowdnav"
+BEYOND_CAMPAIGN = "crowdnav-beyond"
+CAMPAIGNS: tuple[str, ...] = (CAMPAIGN, BEYOND_CAMPAIGN)
+GENERATORS: tuple[str, ...] = ("crowdnav-circle", "crowdnav-square")
+SCENE_NAMES = {"crowdnav-circle": "circle crossing", "crowdnav-square": "square crossing"}
+#: Test cases per scene: quick (``uvnav run``) and full (``--full``: CrowdNav's test set).
+QUICK_CASES, FULL_CASES = 100, 500
+#: Laws run beyond the scene's assumptions besides the refused ones (their inner law is refused).
+WRAPPERS: tuple[str, ...] = ("hybrid-v1",)
+#: Chen, Liu, Kreiss, Alahi, ICRA 2019 (arXiv:1809.08835), Table I: ORCA, invisible robot,
+#: 5 ORCA humans, circle crossing, 500 test cases.
+PAPER_ORCA = {"success": 0.43, "collision": 0.57, "time_to_goal": 10.86}
+PAPER_LAW, PAPER_SCENE = "orca-holonomic-v1", "crowdnav-circle"
+Z95 = 1.959963984540054
+
+
+def wilson(k: int, n: int, z: float = Z95) -> tuple[float, float]:
+    """95 % Wilson score interval of the proportion ``k / n`` (``(0, 1)`` for ``n = 0``)."""
+    if n <= 0:
+        return 0.0, 1.0
+    p = k / n
+    denom = 1.0 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def crowd_laws() -> tuple[list[str], list[str]]:
+    """``(laws, beyond)``: every registered 2D law (unicycle, then holonomic) of the main campaign,
+    and the laws also run beyond the scene's assumptions (those that require slower obstacles)
+    with :data:`WRAPPERS` (which run such a law inside, in the beyond campaign only)."""
+    from uvnav.controllers.base import available_controllers
+
+    infos = {**available_controllers("unicycle"), **available_controllers("holonomic")}
+    laws = [n for n in infos if n not in WRAPPERS]
+    beyond = [n for n in infos if infos[n].requires_slower_obstacles]
+    return laws, beyond + [w for w in WRAPPERS if w in infos]
+
+
+@dataclass
+class CrowdsSummary:
+    """Outcome of :func:`reproduce_crowds`.
+
+    Attributes:
+        table: rows ``{"quantity", "thesis", "measured", "note"}``, measured from the store.
+        db_path: the results database.
+        laws: laws of the main campaign; beyond: laws of the beyond campaign.
+        cases: test cases per scene; start_case: the first.
+        campaigns: per campaign: ``jobs``, ``ran``, ``skipped``, ``errors``, ``wall_time`` [s].
+        wall_time: total elapsed time [s].
+    """
+
+    table: list[dict[str, str]]
+    db_path: Path
+    laws: list[str]
+    beyond: list[str]
+    cases: int
+    start_case: int
+    full: bool
+    campaigns: dict[str, dict[str, Any]] = field(default_factory=dict)
+    wall_time: float = 0.0
+
+
+def crowd_jobs(laws: Sequence[str], cases: range, *, beyond_assumptions: bool = False) -> list[Job]:
+    """One job per scene, case and law (episode seed = case, as CrowdNav's test case)."""
+    return [
+        Job(
+            controller=c,
+            seed=g,
+            generator=gen,
+            generator_seed=g,
+            beyond_assumptions=beyond_assumptions,
+        )
+        for gen in GENERATORS
+        for g in cases
+        for c in laws
+    ]
+
+
+def reproduce_crowds(
+    results_dir: Path,
+    *,
+    full: bool = False,
+    workers: int = 2,
+    cases: int | None = None,
+    start_case: int = 0,
+    laws: Sequence[str] | None = None,
+    beyond: Sequence[str] | None = None,
+    progress: bool = False,
+) -> CrowdsSummary:
+    """Run the crowd campaigns into ``results_dir/uvnav.sqlite`` and build the table.
+
+    Args:
+        results_dir: folder of the results database (created).
+        full: CrowdNav's 500 test cases per scene instead of :data:`QUICK_CASES`.
+        workers: worker processes (1 = in-process).
+        cases: test cases per scene (overrides the quick/full size).
+        start_case: first test case.
+        laws: laws of the main campaign (default :func:`crowd_laws`).
+        beyond: laws run beyond the scene's assumptions (default :func:`crowd_laws`; empty: none).
+        progress: rich progress bars on stderr.
+
+    Raises:
+        StaleCampaignError: a stored crowd campaign was made by other code.
+    """
+    from uvnav.bench.reproduce import DB_NAME, _check_campaigns, code_fingerprint
+
+    tic = time.perf_counter()
+    results_dir = Path(results_dir)
+    results_dir.mkdir(parents=True, exist_ok=True)
+    db_path = results_dir / DB_NAME
+    default_laws, default_beyond = crowd_laws()
+    main = list(default_laws if laws is None else laws)
+    over = list(default_beyond if beyond is None else beyond)
+    n = cases if cases is not None else (FULL_CASES if full else QUICK_CASES)
+    run_cases = range(start_case, start_case + n)
+    fp = code_fingerprint()
+    plans: list[tuple[str, dict[str, Any], list[Job]]] = [
+        (
+            CAMPAIGN,
+            {"generators": list(GENERATORS), "controllers": main, "fingerprint": fp},
+            crowd_jobs(main, run_cases),
+        )
+    ]
+    if over:
+        plans.append(
+            (
+                BEYOND_CAMPAIGN,
+                {
+                    "generators": list(GENERATORS),
+                    "controllers": over,
+                    "beyond_assumptions": True,
+                    "fingerprint": fp,
+                },
+                crowd_jobs(over, run_cases, beyond_assumptions=True),
+            )
+        )
+    done: dict[str, dict[str, Any]] = {}
+    with ResultsStore(db_path) as store:
+        _check_campaigns(store, {name: cfg for name, cfg, _ in plans})
+        for name, cfg, jobs in plans:
+            run = run_campaign(store, name, jobs, config=cfg, workers=workers, progress=progress)
+            done[name] = {
+                "jobs": run.total,
+                "ran": run.ran,
+                "skipped": run.skipped,
+                "errors": run.errors,
+                "wall_time": round(run.wall_time, 2),
+            }
+        table = crowd_rows(store, cases=run_cases, laws=main, beyond=over)
+    return CrowdsSummary(
+        table=table,
+        db_path=db_path,
+        laws=main,
+        beyond=over,
+        cases=n,
+        start_case=start_case,
+        full=full,
+        campaigns=done,
+        wall_time=time.perf_counter() - tic,
+    )
+
+
+# ------------------------------------------------------------------------------------ the table
+
+
+def _rate(k: int, n: int) -> str:
+    lo, hi = wilson(k, n)
+    return f"{k / n:.2f} [{lo:.2f}, {hi:.2f}]"
+
+
+def _mean(g: Any, name: str) -> float | None:
+    col = g[name].dropna().astype(float)
+    return float(col.mean()) if len(col) else None
+
+
+def _social_note(ok: Any) -> str:
+    parts = []
+    freq = _mean(ok, "too_close_frequency")
+    if freq is not None:
+        parts.append(f"too close {freq:.1%} of decisions")
+    intr = _mean(ok, "intrusion_time")
+    if intr is not None:
+        parts.append(f"intrusion {intr:.1f} s")
+    sep = ok["min_separation"].dropna().astype(float)
+    if len(sep):
+        parts.append(f"min separation mean {sep.mean():.2f} m, worst {sep.min():.2f} m")
+    by = ok.loc[ok["collision"].fillna(False).astype(bool), "collision_by"].dropna()
+    if len(by):
+        parts.append(f"collisions closed by a pedestrian {float((by == 'pedestrian').mean()):.0%}")
+    return "; ".join(parts)
+
+
+def _row(gen: str, law: str, g: Any, *, beyond: bool) -> dict[str, str]:
+    scene = f"CrowdNav {SCENE_NAMES.get(gen, gen)}"
+    quantity = f"{scene}, {law}" + (", beyond assumption (2.6)" if beyond else "")
+    paper = law == PAPER_LAW and gen == PAPER_SCENE
+    thesis = (
+        f"paper's ORCA: success {PAPER_ORCA['success']:.2f}, collision "
+        f"{PAPER_ORCA['collision']:.2f}, time {PAPER_ORCA['time_to_goal']:.2f} s "
+        "(Chen et al. ICRA 2019, Table I, 500 cases)"
+        if paper
+        else "not reported (beyond the thesis)"
+    )
+    status = g["status"].astype(str)
+    refused = int((status == STATUS_REFUSED).sum())
+    errors = int((status == STATUS_ERROR).sum())
+    ok = g[~status.isin((STATUS_REFUSED, STATUS_ERROR))]
+    n = len(ok)
+    if n == 0:
+        if refused:
+            why = str(g.loc[status == STATUS_REFUSED, "error"].dropna().iloc[0])
+            measured = f"refused ({refused}/{len(g)} cases)"
+            note = f"the law's assumption does not hold: {why}"
+        else:
+            measured, note = f"errors only ({errors})", ""
+        return {"quantity": quantity, "thesis": thesis, "measured": measured, "note": note}
+    st = ok["status"].astype(str)
+    k_ok, k_hit = int((st == "success").sum()), int((st == "collision").sum())
+    k_out = int((st == "timeout").sum())
+    wins = ok[st == "success"]
+    ttg = _mean(wins, "time_to_goal") if len(wins) else None
+    measured = (
+        f"success {_rate(k_ok, n)}, collision {_rate(k_hit, n)}, timeout {k_out / n:.2f} "
+        f"(n={n}); time to goal {'n/a' if ttg is None else f'{ttg:.2f} s'}"
+    )
+    extra = []
+    if paper:
+        lo, hi = wilson(k_ok, n)
+        inside = lo <= PAPER_ORCA["success"] <= hi
+        extra.append(
+            f"paper's success {PAPER_ORCA['success']:.2f} {'inside' if inside else 'outside'} "
+            "the 95 % interval"
+        )
+    if refused:
+        extra.append(f"refused {refused}")
+    if errors:
+        extra.append(f"errors {errors}")
+    note = "; ".join([*extra, _social_note(ok)] if _social_note(ok) else extra)
+    return {"quantity": quantity, "thesis": thesis, "measured": measured, "note": note}
+
+
+def crowd_rows(
+    store: ResultsStore,
+    *,
+    cases: range | None = None,
+    laws: Sequence[str] | None = None,
+    beyond: Sequence[str] | None = None,
+) -> list[dict[str, str]]:
+    """The crowd table read from the store: per campaign (main, then beyond), scene and law one
+    row (module docstring).  ``cases``: only those test cases (default every stored one);
+    ``laws`` / ``beyond``: only those laws of each campaign, in that order (default all stored,
+    sorted)."""
+    rows: list[dict[str, str]] = []
+    for name, chosen in ((CAMPAIGN, laws), (BEYOND_CAMPAIGN, beyond)):
+        df = store.episodes_frame(name)
+        if df.empty:
+            continue
+        if cases is not None:
+            labels = {f"{gen}/{g:04d}" for gen in GENERATORS for g in cases}
+            df = df[df["scenario"].astype(str).isin(labels)]
+        family = df["family"].astype(str)
+        ctrl = df["controller"].astype(str)
+        order = list(chosen) if chosen is not None else sorted(set(ctrl))
+        for gen in GENERATORS:
+            for law in order:
+                g = df[(family == gen) & (ctrl == law)]
+                if len(g):
+                    rows.append(_row(gen, law, g, beyond=name == BEYOND_CAMPAIGN))
+    return rows
+
+
+__all__ = [
+    "BEYOND_CAMPAIGN",
+    "CAMPAIGN",
+    "CAMPAIGNS",
+    "FULL_CASES",
+    "GENERATORS",
+    "PAPER_ORCA",
+    "QUICK_CASES",
+    "CrowdsSummary",
+    "crowd_jobs",
+    "crowd_laws",
+    "crowd_rows",
+    "reproduce_crowds",
+    "wilson",
+]
