@@ -44,6 +44,9 @@ BEYOND_CAMPAIGN = "crowdnav-beyond"
 CAMPAIGNS: tuple[str, ...] = (CAMPAIGN, BEYOND_CAMPAIGN)
 GENERATORS: tuple[str, ...] = ("crowdnav-circle", "crowdnav-square")
 SCENE_NAMES = {"crowdnav-circle": "circle crossing", "crowdnav-square": "square crossing"}
+#: the Chapter 2 campaign of real pedestrians (ETH ``eth`` and ``hotel``) tabulated beside them
+ETH_CAMPAIGN = "crowds-eth"
+ETH_NAMES = {"crowd-eth": "ETH eth walkway", "crowd-hotel": "ETH hotel walkway"}
 #: Test cases per scene: quick (``uvnav run``) and full (``--full``: CrowdNav's test set).
 QUICK_CASES, FULL_CASES = 100, 500
 #: Laws run beyond the scene's assumptions besides the refused ones (their inner law is refused).
@@ -233,7 +236,8 @@ def _social_note(ok: Any) -> str:
 
 
 def _row(gen: str, law: str, g: Any, *, beyond: bool) -> dict[str, str]:
-    scene = f"CrowdNav {SCENE_NAMES.get(gen, gen)}"
+    base = gen.split("[", 1)[0]
+    scene = ETH_NAMES[base] if base in ETH_NAMES else f"CrowdNav {SCENE_NAMES.get(gen, gen)}"
     quantity = f"{scene}, {law}" + (", beyond assumption (2.6)" if beyond else "")
     paper = law == PAPER_LAW and gen == PAPER_SCENE
     thesis = (
@@ -308,6 +312,29 @@ def crowd_rows(
                 g = df[(family == gen) & (ctrl == law)]
                 if len(g):
                     rows.append(_row(gen, law, g, beyond=name == BEYOND_CAMPAIGN))
+    return rows + eth_rows(store)
+
+
+def eth_rows(store: ResultsStore) -> list[dict[str, str]]:
+    """Rows of the ETH crowd campaign of Chapter 2 (:data:`ETH_CAMPAIGN`, real pedestrians
+    replayed; every law runs beyond (2.6) there on purpose), in the crowd table's form, when the
+    store holds it: one row per walkway and law."""
+    if store.campaign_id(ETH_CAMPAIGN) is None:
+        return []
+    df = store.episodes_frame(ETH_CAMPAIGN)
+    rows: list[dict[str, str]] = []
+    if df.empty:
+        return rows
+    family = df["family"].astype(str)
+    ctrl = df["controller"].astype(str)
+    for fam in sorted(set(family)):
+        if fam.split("[", 1)[0] not in ETH_NAMES:
+            continue
+        for law in sorted(set(ctrl[family == fam])):
+            g = df[(family == fam) & (ctrl == law)]
+            row = _row(fam, law, g, beyond=False)
+            row["thesis"] = "not reported (real pedestrians, who do not react to the robot)"
+            rows.append(row)
     return rows
 
 
@@ -323,6 +350,7 @@ __all__ = [
     "crowd_jobs",
     "crowd_laws",
     "crowd_rows",
+    "eth_rows",
     "reproduce_crowds",
     "wilson",
 ]

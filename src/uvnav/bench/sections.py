@@ -524,7 +524,9 @@ def crowds_section(summary: Any) -> ChapterSection:
         "the paper's ORCA figure stands beside orca-holonomic-v1 on circle crossing (CrowdNav's "
         "robot ORCA). The notes give the social metrics: mean share of decisions closer than "
         "0.2 m, mean time closer than 0.45 m, min separation, and the share of the collisions a "
-        "pedestrian closed (these pedestrians do not avoid the robot). Laws that assume "
+        "pedestrian closed (these pedestrians do not avoid the robot). When the store holds the "
+        "ETH crowd campaign of Chapter 2 (real pedestrians, replayed), its walkways follow in the "
+        "same form. Laws that assume "
         "obstacles slower than the robot (thesis (2.6)) are refused here, and shown as refused: "
         "the pedestrians walk at the robot's speed, so their guarantees do not apply."
     )
