@@ -44,52 +44,27 @@ from typing import Any
 
 import numpy as np
 
+from uvnav.bench.summary import wilson_interval
 from uvnav.controllers.base import make_law
 from uvnav.controllers.holonomic import OrcaHolonomic
-from uvnav.controllers.orca import orca_velocity
 from uvnav.core import BaseProbe
-from uvnav.dynamics.omni import VelocityCommand
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.catalog import kinds
 from uvnav.scenarios.crowdnav import CROWDNAV_ORCA_PARAMS, TIME_STEP, crowdnav_scenario
-from uvnav.sensors.observation import Observation
 from uvnav.sim.episode import run_episode
 
 #: Chen et al. ICRA 2019, Table I, ORCA (invisible robot)
 PAPER = {"success": 0.43, "collision": 0.57, "time_to_goal": 10.86}
-Z95 = 1.959963984540054
-
-
-def wilson(k: int, n: int, z: float = Z95) -> tuple[float, float]:
-    """95 % Wilson score interval of the proportion ``k / n``."""
-    if n == 0:
-        return 0.0, 1.0
-    p = k / n
-    denom = 1.0 + z * z / n
-    centre = (p + z * z / (2 * n)) / denom
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
-    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 class CrowdNavPrefOrca(OrcaHolonomic):
     """``orca-holonomic-v1`` with CrowdNav's preferred velocity (``ORCA.predict``: the unit
     vector toward the goal beyond 1 m, the gap within); otherwise the same query."""
 
-    def act(self, obs: Observation) -> VelocityCommand:
-        period = self.decision_period(obs.time)
-        spec = self._spec
-        pos = np.asarray(obs.position, dtype=float)
-        gap = self._goal - pos
+    def preferred_velocity(self, position: np.ndarray, period: float) -> np.ndarray:
+        gap = self._goal - position
         d = float(np.hypot(*gap))
-        pref = gap / d if d > 1.0 else gap
-        query = orca_velocity(
-            pos, self.current_velocity(obs), pref, obs.obstacles,
-            radius=spec.radius + self.params.safety_margin, max_speed=spec.v_max,
-            period=period, params=self.params,
-        )  # fmt: skip
-        self.last_query = query
-        self._mode = "M1" if float(np.hypot(*(query.velocity - pref))) < 1e-6 else "M2"
-        return VelocityCommand(float(query.velocity[0]), float(query.velocity[1])).clipped(spec)
+        return np.asarray(gap / d if d > 1.0 else gap, dtype=float)
 
 
 def _segment_distance(px: float, py: float, ex: float, ey: float) -> float:
@@ -162,9 +137,9 @@ def run(
     cpu, wall = time.process_time() - cpu0, time.perf_counter() - wall0
     rates: dict[str, dict[str, Any]] = {}
     for key, k in counts.items():
-        lo, hi = wilson(k, cases)
+        lo, hi = wilson_interval(k, cases)
         rates[key] = {"count": k, "rate": k / cases, "ci95": [lo, hi]}
-    lo, hi = wilson(counts["success"], cases)
+    lo, hi = wilson_interval(counts["success"], cases)
     return {
         "cases": cases,
         "first_case": first,

@@ -29,7 +29,6 @@ ran or found stored); ``uvnav report`` rebuilds it from every stored case (:func
 
 from __future__ import annotations
 
-import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -38,6 +37,7 @@ from typing import Any
 
 from uvnav.bench.campaign import Job, run_campaign
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
+from uvnav.bench.summary import wilson_interval
 
 CAMPAIGN = "crowdnav"
 BEYOND_CAMPAIGN = "crowdnav-beyond"
@@ -55,18 +55,6 @@ WRAPPERS: tuple[str, ...] = ("hybrid-v1",)
 #: 5 ORCA humans, circle crossing, 500 test cases.
 PAPER_ORCA = {"success": 0.43, "collision": 0.57, "time_to_goal": 10.86}
 PAPER_LAW, PAPER_SCENE = "orca-holonomic-v1", "crowdnav-circle"
-Z95 = 1.959963984540054
-
-
-def wilson(k: int, n: int, z: float = Z95) -> tuple[float, float]:
-    """95 % Wilson score interval of the proportion ``k / n`` (``(0, 1)`` for ``n = 0``)."""
-    if n <= 0:
-        return 0.0, 1.0
-    p = k / n
-    denom = 1.0 + z * z / n
-    centre = (p + z * z / (2 * n)) / denom
-    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
-    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def crowd_laws() -> tuple[list[str], list[str]]:
@@ -209,7 +197,7 @@ def reproduce_crowds(
 
 
 def _rate(k: int, n: int) -> str:
-    lo, hi = wilson(k, n)
+    lo, hi = wilson_interval(k, n)
     return f"{k / n:.2f} [{lo:.2f}, {hi:.2f}]"
 
 
@@ -271,7 +259,7 @@ def _row(gen: str, law: str, g: Any, *, beyond: bool) -> dict[str, str]:
     )
     extra = []
     if paper:
-        lo, hi = wilson(k_ok, n)
+        lo, hi = wilson_interval(k_ok, n)
         inside = lo <= PAPER_ORCA["success"] <= hi
         extra.append(
             f"paper's success {PAPER_ORCA['success']:.2f} {'inside' if inside else 'outside'} "
@@ -352,5 +340,4 @@ __all__ = [
     "crowd_rows",
     "eth_rows",
     "reproduce_crowds",
-    "wilson",
 ]

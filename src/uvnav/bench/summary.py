@@ -164,3 +164,23 @@ def outcome_stats(rows: list[dict[str, Any]]) -> dict[str, Any]:
         ),
         "decision_us_median": median("decision_us_median"),
     }
+
+
+#: the 97.5 % quantile of the standard normal (two-sided 95 % intervals)
+Z95 = 1.959963984540054
+
+
+def wilson_interval(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
+    """95 % Wilson score interval of the proportion ``successes / n`` (well-behaved at 0 % and
+    100 %; ``(0, 1)`` for ``n = 0``).
+
+    >>> [round(x, 4) for x in wilson_interval(43, 100)]
+    [0.3373, 0.5278]
+    """
+    if n <= 0:
+        return 0.0, 1.0
+    p = successes / n
+    denom = 1.0 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)

@@ -95,6 +95,10 @@ class OrcaHolonomic(HolonomicLaw):
         _import_pyrvo()  # fail at reset, with the extra's name, not in the middle of an episode
         self.last_query = None
 
+    def preferred_velocity(self, position: FloatArray, period: float) -> FloatArray:
+        """V_max toward the goal, lowered to ``dist / period`` near it [m/s]."""
+        return toward_goal(position, self._goal, self._spec.v_max, period)
+
     def act(self, obs: Observation) -> VelocityCommand:
         period = self.decision_period(obs.time)
         spec = self._spec
@@ -102,7 +106,7 @@ class OrcaHolonomic(HolonomicLaw):
         if not np.all(np.isfinite(pos)):
             self._mode = "M1"
             return VelocityCommand(0.0, 0.0)
-        pref = toward_goal(pos, self._goal, spec.v_max, period)
+        pref = self.preferred_velocity(pos, period)
         query = orca_velocity(
             pos, self.current_velocity(obs), pref, obs.obstacles,
             radius=spec.radius + self.params.safety_margin, max_speed=spec.v_max,

@@ -32,6 +32,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from uvnav.bench.summary import wilson_interval
+
 if TYPE_CHECKING:
     import pandas as pd
 
@@ -71,17 +73,6 @@ def _mean_median(values: pd.Series, digits: int = 3) -> str:
     half = float(stats.t.ppf(0.975, len(v) - 1) * np.std(v, ddof=1) / np.sqrt(len(v)))
     ci = f"[{_fmt(mean - half, digits)}, {_fmt(mean + half, digits)}]"
     return f"{_fmt(mean, digits)} {ci} / {_fmt(median, digits)}"
-
-
-def wilson_interval(successes: int, n: int, z: float = 1.959963984540054) -> tuple[float, float]:
-    """95 % Wilson score interval of a proportion (well-behaved at 0 % and 100 %)."""
-    if n == 0:
-        return 0.0, 1.0
-    p = successes / n
-    denom = 1.0 + z * z / n
-    centre = (p + z * z / (2 * n)) / denom
-    half = z * np.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
-    return max(0.0, centre - half), min(1.0, centre + half)
 
 
 def _rate(hits: pd.Series) -> str:
