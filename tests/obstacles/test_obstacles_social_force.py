@@ -9,10 +9,9 @@ from typing import Any
 import numpy as np
 import pytest
 
-from uvnav.obstacles import DiscBody, Obstacle, ObstacleBatch, ObstacleState
+from uvnav.obstacles import DiscBody, Obstacle, ObstacleBatch, ObstacleState, join_crowds
 from uvnav.obstacles.social_force import (
     SocialForcePedestrian,
-    join_force_crowds,
     social_acceleration,
 )
 from uvnav.scenarios import build_episode
@@ -39,7 +38,7 @@ def _run(obstacles: list[Obstacle], steps: int, batched: bool) -> np.ndarray:
             batch.step(i * 0.1, 0.1)
             rows.append(batch.positions.copy())
         return np.array(rows)
-    join_force_crowds(obstacles)
+    join_crowds(obstacles)
     for i in range(steps):
         for ob in obstacles:
             ob.state = ob.motion.step(ob.state, i * 0.1, 0.1)

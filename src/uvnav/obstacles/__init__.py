@@ -18,7 +18,7 @@ from uvnav.obstacles.motion import (
     Waypoints,
 )
 from uvnav.obstacles.obstacle import FieldTemplate, NearestQuery, Obstacle, ObstacleField
-from uvnav.obstacles.social_force import SocialForcePedestrian, join_force_crowds
+from uvnav.obstacles.social_force import SocialForcePedestrian
 
 __all__ = [
     "Body",
@@ -39,7 +39,6 @@ __all__ = [
     "SocialForcePedestrian",
     "Waypoints",
     "join_crowds",
-    "join_force_crowds",
     "radial_profile",
     "rotation_boundary_growth",
 ]

@@ -44,7 +44,6 @@ from uvnav.obstacles.motion import (
     uniform_draw,
 )
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField, model_present
-from uvnav.obstacles.social_force import join_force_crowds
 
 _Rows = slice | np.ndarray
 #: at most this many obstacles outside their arena are steered one by one, more in array form
@@ -220,8 +219,7 @@ class ObstacleBatch:
     def __init__(self, obstacles: Sequence[Obstacle], *, t: float = 0.0) -> None:
         """Batch ``obstacles`` in their current states, which are those of time ``t`` [s]."""
         self.obstacles = list(obstacles)
-        join_crowds(self.obstacles)  # ORCA pedestrians not yet in a crowd: one per crowd id
-        join_force_crowds(self.obstacles)  # the same for social-force pedestrians
+        join_crowds(self.obstacles)  # crowd pedestrians not yet in a crowd: one per crowd id
         self._crowds = crowds_seeing_robot(self.obstacles)
         k = len(self.obstacles)
         # rows: x, y, heading, course (random-turn obstacles only, else 0)

@@ -66,7 +66,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -118,8 +118,57 @@ def preferred_velocity(
     return gx, gy
 
 
+class CrowdMember:
+    """What every pedestrian of a crowd shares, whatever the crowd's policy (ORCA here, social
+    force in :mod:`uvnav.obstacles.social_force`): a reference to its crowd and its row there,
+    a ``step`` that advances the crowd once per time step and reads the row, and the batched
+    group.  A subclass is a dataclass with the fields ``crowd_id``, ``crowd`` and ``index`` and a
+    classmethod :meth:`make_crowd`."""
+
+    crowd_id: str
+    crowd: Any
+    index: int
+
+    @classmethod
+    def make_crowd(
+        cls,
+        members: Sequence[Any],
+        positions: FloatArray,
+        velocities: FloatArray,
+        radii: Sequence[float],
+    ) -> Any:
+        """The shared state of a crowd of ``members`` (from their obstacles' states)."""
+        raise NotImplementedError
+
+    def step(self, state: ObstacleState, t: float, dt: float) -> ObstacleState:
+        crowd = self.crowd
+        if crowd is None:
+            raise RuntimeError(
+                f"{type(self).__name__} not in a crowd: call "
+                "uvnav.obstacles.crowd.join_crowds(obstacles) before stepping the models one by "
+                "one (ObstacleBatch does it)"
+            )
+        crowd.advance(t, dt)
+        i = self.index
+        return ObstacleState(
+            position=crowd.position[i].copy(),
+            heading=state.heading,
+            velocity=crowd.velocity[i].copy(),
+            angular_velocity=0.0,
+        )
+
+    def turn_bound(self) -> float:
+        """0: a disc pedestrian does not rotate."""
+        return 0.0
+
+    @classmethod
+    def batch_group(cls, models: Sequence[Any]) -> CrowdGroup:
+        """The pedestrians advanced together (:class:`~uvnav.obstacles.motion.MotionGroup`)."""
+        return CrowdGroup(models)
+
+
 @dataclass
-class OrcaPedestrian:
+class OrcaPedestrian(CrowdMember):
     """One pedestrian of an ORCA crowd (module docstring).
 
     Attributes:
@@ -155,34 +204,19 @@ class OrcaPedestrian:
         if self.period is not None and not (math.isfinite(self.period) and self.period > 0):
             raise ValueError(f"period must be > 0 (got {self.period!r})")
 
-    def step(self, state: ObstacleState, t: float, dt: float) -> ObstacleState:
-        crowd = self.crowd
-        if crowd is None:
-            raise RuntimeError(
-                "orca pedestrian not in a crowd: call uvnav.obstacles.crowd.join_crowds(obstacles)"
-                " before stepping the models one by one (ObstacleBatch does it)"
-            )
-        crowd.advance(t, dt)
-        i = self.index
-        return ObstacleState(
-            position=crowd.position[i].copy(),
-            heading=state.heading,
-            velocity=crowd.velocity[i].copy(),
-            angular_velocity=0.0,
-        )
-
     def speed_bound(self) -> float:
         """``v_pref``: RVO2's maximum speed."""
         return float(self.v_pref)
 
-    def turn_bound(self) -> float:
-        """0: a disc pedestrian does not rotate."""
-        return 0.0
-
     @classmethod
-    def batch_group(cls, models: Sequence[OrcaPedestrian]) -> CrowdGroup:
-        """The pedestrians advanced together (:class:`~uvnav.obstacles.motion.MotionGroup`)."""
-        return CrowdGroup(models)
+    def make_crowd(
+        cls,
+        members: Sequence[Any],
+        positions: FloatArray,
+        velocities: FloatArray,
+        radii: Sequence[float],
+    ) -> Crowd:
+        return Crowd(members, positions, velocities, radii)
 
 
 class Crowd:
@@ -315,17 +349,16 @@ class Crowd:
 
 
 class CrowdGroup:
-    """The :class:`OrcaPedestrian` obstacles of an :class:`~uvnav.obstacles.ObstacleBatch`: each
-    crowd advanced once per step, every member's row read (bit for bit the models' ``step``)."""
+    """The crowd pedestrians of an :class:`~uvnav.obstacles.ObstacleBatch`: each crowd advanced
+    once per step, every member's row read (bit for bit the models' ``step``)."""
 
-    def __init__(self, models: Sequence[OrcaPedestrian]) -> None:
+    def __init__(self, models: Sequence[CrowdMember]) -> None:
         for m in models:
             if m.crowd is None:
-                raise RuntimeError("orca pedestrian not in a crowd: call join_crowds(obstacles)")
+                raise RuntimeError("pedestrian not in a crowd: call join_crowds(obstacles)")
         self.models = list(models)
-        self.crowds: list[Crowd] = []
+        self.crowds: list[Any] = []
         for m in self.models:
-            assert m.crowd is not None
             if not any(c is m.crowd for c in self.crowds):
                 self.crowds.append(m.crowd)
         self.rows = [
@@ -348,27 +381,28 @@ class CrowdGroup:
         return pos, np.array(heading, dtype=float), vel, np.zeros(m)
 
 
-def join_crowds(obstacles: Sequence[Obstacle]) -> list[Crowd]:
-    """Gather the :class:`OrcaPedestrian` obstacles not yet in a crowd by crowd id, in obstacle
-    order, and give each group its shared :class:`Crowd` (from the obstacles' current states and
-    body radii).  Pedestrians already in a crowd keep it.  Returns the new crowds."""
-    groups: dict[str, list[Obstacle]] = {}
+def join_crowds(obstacles: Sequence[Obstacle]) -> list[Any]:
+    """Gather the crowd pedestrians (:class:`CrowdMember`) not yet in a crowd by policy and
+    crowd id, in obstacle order, and give each group its shared crowd (its class's
+    :meth:`~CrowdMember.make_crowd`, from the obstacles' current states and body radii).
+    Pedestrians already in a crowd keep it.  Returns the new crowds."""
+    groups: dict[tuple[type[CrowdMember], str], list[Obstacle]] = {}
     for ob in obstacles:
         m = ob.motion
-        if isinstance(m, OrcaPedestrian) and m.crowd is None:
-            groups.setdefault(m.crowd_id, []).append(ob)
-    out: list[Crowd] = []
-    for members in groups.values():
-        models: list[OrcaPedestrian] = [ob.motion for ob in members]  # type: ignore[misc]
-        crowd = Crowd(
+        if isinstance(m, CrowdMember) and m.crowd is None:
+            groups.setdefault((type(m), m.crowd_id), []).append(ob)
+    out: list[Any] = []
+    for (kind, _), members in groups.items():
+        models = [cast(CrowdMember, ob.motion) for ob in members]
+        crowd = kind.make_crowd(
             models,
             np.array([ob.state.position for ob in members], dtype=float),
             np.array([ob.state.velocity for ob in members], dtype=float),
             [float(ob.body.bounding_radius) for ob in members],
         )
-        for i, m in enumerate(models):
-            m.crowd = crowd
-            m.index = i
+        for i, member in enumerate(models):
+            member.crowd = crowd
+            member.index = i
         out.append(crowd)
     return out
 

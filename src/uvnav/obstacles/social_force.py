@@ -1,4 +1,4 @@
-"""Pedestrians that walk by the social force model (Helbing and Molnár).
+r"""Pedestrians that walk by the social force model (Helbing and Molnár).
 
 Reference: D. Helbing, P. Molnár, "Social force model for pedestrian dynamics", *Physical Review
 E* 51 (1995) 4282-4286: eq. (1) the driving term, eqs. (3)-(4) the repulsion of other
@@ -21,10 +21,11 @@ with the new velocity); forces come from the state at the start of the step, for
 at once.  Nothing is random: the same start gives the same trajectory.
 
 A crowd is one shared state (:class:`ForceCrowd`) that advances once per time step whichever
-member is stepped first, so the per-model ``step`` and the batched group agree bit for bit (the
-pattern of :mod:`uvnav.obstacles.crowd`).  **A visible robot** (``sees_robot``) repels the
-pedestrians like one more pedestrian, at the position and radius the world reports before every
-step (:meth:`ForceCrowd.see_robot`).
+member is stepped first, so the per-model ``step`` and the batched group agree bit for bit: the
+members are :class:`~uvnav.obstacles.crowd.CrowdMember`\ s, joined by
+:func:`~uvnav.obstacles.crowd.join_crowds` like the ORCA pedestrians.  **A visible robot**
+(``sees_robot``) repels the pedestrians like one more pedestrian, at the position and radius the
+world reports before every step (:meth:`ForceCrowd.see_robot`).
 
 Why not the ``pysocialforce`` package: its last release is from 2020, it steps a whole scene of
 its own (state arrays, groups, wall lines, a TOML configuration) with no way to take one
@@ -37,12 +38,12 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
-from uvnav.obstacles.motion import ObstacleState
-from uvnav.obstacles.obstacle import Obstacle
+from uvnav.obstacles.crowd import CrowdMember
 
 TAU = 0.5  # relaxation time [s] (Helbing and Molnár 1995)
 STRENGTH = 7.0  # A = V0 / sigma = 2.1 / 0.3 [m/s^2]
@@ -54,7 +55,7 @@ DEFAULT_CROWD = "social"
 
 
 @dataclass
-class SocialForcePedestrian:
+class SocialForcePedestrian(CrowdMember):
     """One pedestrian of a social-force crowd (module docstring).
 
     Attributes:
@@ -88,34 +89,19 @@ class SocialForcePedestrian:
         if not (math.isfinite(self.goal_radius) and self.goal_radius >= 0):
             raise ValueError(f"goal_radius must be >= 0 (got {self.goal_radius!r})")
 
-    def step(self, state: ObstacleState, t: float, dt: float) -> ObstacleState:
-        crowd = self.crowd
-        if crowd is None:
-            raise RuntimeError(
-                "social-force pedestrian not in a crowd: call join_force_crowds(obstacles) before "
-                "stepping the models one by one (ObstacleBatch does it)"
-            )
-        crowd.advance(t, dt)
-        i = self.index
-        return ObstacleState(
-            position=crowd.position[i].copy(),
-            heading=state.heading,
-            velocity=crowd.velocity[i].copy(),
-            angular_velocity=0.0,
-        )
-
     def speed_bound(self) -> float:
         """The speed cap 1.3 v0 [m/s]."""
         return SPEED_CAP * float(self.v_pref)
 
-    def turn_bound(self) -> float:
-        """0: a disc pedestrian does not rotate."""
-        return 0.0
-
     @classmethod
-    def batch_group(cls, models: Sequence[SocialForcePedestrian]) -> ForceGroup:
-        """The pedestrians advanced together (:class:`~uvnav.obstacles.motion.MotionGroup`)."""
-        return ForceGroup(models)
+    def make_crowd(
+        cls,
+        members: Sequence[Any],
+        positions: FloatArray,
+        velocities: FloatArray,
+        radii: Sequence[float],
+    ) -> ForceCrowd:
+        return ForceCrowd(members, positions, velocities, radii)
 
 
 def social_acceleration(
@@ -207,54 +193,3 @@ class ForceCrowd:
         self.velocity = vel
         self.position = self.position + vel * dt
         self._from, self._dt = t, dt
-
-
-class ForceGroup:
-    """The social-force pedestrians of an :class:`~uvnav.obstacles.ObstacleBatch`, each crowd
-    advanced once per step (bit for bit the models' ``step``)."""
-
-    def __init__(self, models: Sequence[SocialForcePedestrian]) -> None:
-        self.models = list(models)
-        self.crowds: list[ForceCrowd] = []
-        for m in self.models:
-            if m.crowd is None:
-                raise RuntimeError("social-force pedestrian not in a crowd: join_force_crowds")
-            if not any(c is m.crowd for c in self.crowds):
-                self.crowds.append(m.crowd)
-
-    def step(
-        self, position: FloatArray, heading: FloatArray, t: float, dt: float
-    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        for c in self.crowds:
-            c.advance(t, dt)
-        m = len(self.models)
-        pos, vel = np.empty((2, m)), np.empty((2, m))
-        for j, model in enumerate(self.models):
-            assert model.crowd is not None
-            pos[:, j] = model.crowd.position[model.index]
-            vel[:, j] = model.crowd.velocity[model.index]
-        return pos, np.array(heading, dtype=float), vel, np.zeros(m)
-
-
-def join_force_crowds(obstacles: Sequence[Obstacle]) -> list[ForceCrowd]:
-    """Gather the social-force pedestrians not yet in a crowd by crowd id and give each group its
-    shared :class:`ForceCrowd` (from the obstacles' current states and body radii)."""
-    groups: dict[str, list[Obstacle]] = {}
-    for ob in obstacles:
-        m = ob.motion
-        if isinstance(m, SocialForcePedestrian) and m.crowd is None:
-            groups.setdefault(m.crowd_id, []).append(ob)
-    out: list[ForceCrowd] = []
-    for members in groups.values():
-        models: list[SocialForcePedestrian] = [ob.motion for ob in members]  # type: ignore[misc]
-        crowd = ForceCrowd(
-            models,
-            np.array([ob.state.position for ob in members], dtype=float),
-            np.array([ob.state.velocity for ob in members], dtype=float),
-            [float(ob.body.bounding_radius) for ob in members],
-        )
-        for i, m in enumerate(models):
-            m.crowd = crowd
-            m.index = i
-        out.append(crowd)
-    return out
