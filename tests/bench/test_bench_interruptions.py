@@ -26,6 +26,7 @@ import pandas as pd
 import pytest
 
 import uvnav.bench.campaign as campaign_mod
+from processes import stored_episodes as stored
 from uvnav.bench.spec import load_campaign, run_campaign_spec
 from uvnav.bench.store import ResultsStore
 
@@ -51,16 +52,6 @@ def rows(db: Path) -> pd.DataFrame:
     with ResultsStore(db) as store:
         df = store.episodes_frame("fifty")
     return df.drop(columns=VOLATILE).sort_values(KEY).reset_index(drop=True)
-
-
-def stored(db: Path) -> int:
-    if not db.exists():
-        return 0
-    try:
-        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=5) as conn:
-            return int(conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0])
-    except sqlite3.Error:
-        return 0
 
 
 @pytest.fixture(scope="module")

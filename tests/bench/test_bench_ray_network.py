@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pytest
 
+from processes import descendants
 from uvnav.bench.campaign import Job, run_campaign
 from uvnav.bench.ray_engine import is_loopback
 from uvnav.bench.store import ResultsStore
@@ -20,25 +21,6 @@ from uvnav.bench.store import ResultsStore
 ray = pytest.importorskip("ray")
 
 _TCP_LISTEN = "0A"
-
-
-def _proc_children(pid: int) -> list[int]:
-    out: list[int] = []
-    for task in Path(f"/proc/{pid}/task").glob("*"):
-        try:
-            out += [int(c) for c in (task / "children").read_text().split()]
-        except OSError:
-            continue
-    return out
-
-
-def _process_tree(root: int) -> list[int]:
-    tree, todo = [], [root]
-    while todo:
-        pid = todo.pop()
-        tree.append(pid)
-        todo += _proc_children(pid)
-    return tree
 
 
 def _proc_address(hex_addr: str) -> str:
@@ -58,7 +40,7 @@ def _listening_proc(root: int) -> list[tuple[str, int]]:
             if fields[3] == _TCP_LISTEN:
                 listening[fields[9]] = _proc_address(fields[1])
     found = []
-    for pid in _process_tree(root):
+    for pid in [root, *descendants(root)]:
         for fd in Path(f"/proc/{pid}/fd").glob("*"):
             try:
                 target = os.readlink(fd)

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import os
 import signal
-import sqlite3
 import subprocess
 import sys
 import time
@@ -14,6 +13,8 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
+from processes import LINUX_PROC, descendants, running, stored_episodes
 
 # 400 episodes (~0.1-0.2 s each) on two workers: far from done when Ctrl-C comes
 CAMPAIGN = """\
@@ -31,47 +32,7 @@ EXIT_WITHIN = 5.0
 #: how long the workers' watchdogs and the fork server may take to follow [s]
 TREE_GONE_WITHIN = 3.0
 
-pytestmark = pytest.mark.skipif(
-    not Path("/proc/self/task").is_dir(), reason="reads the process tree from Linux /proc"
-)
-
-
-def _children(pid: int) -> list[int]:
-    out: list[int] = []
-    for task in Path(f"/proc/{pid}/task").glob("*"):
-        try:
-            out += [int(c) for c in (task / "children").read_text().split()]
-        except OSError:
-            continue
-    return out
-
-
-def _descendants(pid: int) -> list[int]:
-    found, todo = [], _children(pid)
-    while todo:
-        p = todo.pop()
-        found.append(p)
-        todo += _children(p)
-    return found
-
-
-def _running(pid: int) -> bool:
-    """Whether ``pid`` exists and is not a zombie."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except (OSError, IndexError):
-        return False
-    return state != "Z"
-
-
-def _stored(db: Path) -> int:
-    if not db.exists():
-        return 0
-    try:
-        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=5) as conn:
-            return int(conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0])
-    except sqlite3.Error:
-        return 0
+pytestmark = pytest.mark.skipif(not LINUX_PROC, reason="reads the process tree from Linux /proc")
 
 
 def _ctrl_c_once(tmp_path: Path, delay: float, k: int) -> tuple[int, float, str, list[int]]:
@@ -94,16 +55,16 @@ def _ctrl_c_once(tmp_path: Path, delay: float, k: int) -> tuple[int, float, str,
     try:
         deadline = time.monotonic() + 60
         while proc.poll() is None and time.monotonic() < deadline:
-            tree.update(_descendants(proc.pid))
-            if _stored(db) >= 1 and len(tree) >= 3:  # fork server and two busy workers
+            tree.update(descendants(proc.pid))
+            if stored_episodes(db) >= 1 and len(tree) >= 3:  # fork server and two busy workers
                 break
             time.sleep(0.02)
         end = time.monotonic() + delay
         while time.monotonic() < end:
-            tree.update(_descendants(proc.pid))
+            tree.update(descendants(proc.pid))
             time.sleep(0.01)
         assert proc.poll() is None, "the campaign ended before it could be interrupted"
-        tree.update(_descendants(proc.pid))
+        tree.update(descendants(proc.pid))
         os.killpg(proc.pid, signal.SIGINT)
         tic = time.monotonic()
         try:
@@ -112,15 +73,15 @@ def _ctrl_c_once(tmp_path: Path, delay: float, k: int) -> tuple[int, float, str,
             code = -999  # hung
         took = time.monotonic() - tic
         deadline = time.monotonic() + TREE_GONE_WITHIN
-        while any(_running(p) for p in tree) and time.monotonic() < deadline:
+        while any(running(p) for p in tree) and time.monotonic() < deadline:
             time.sleep(0.05)
-        survivors = sorted(p for p in tree if _running(p))
+        survivors = sorted(p for p in tree if running(p))
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
         for p in tree:  # only processes this test started
-            if _running(p):
+            if running(p):
                 os.kill(p, signal.SIGKILL)
     return code, took, err.read_text(), survivors
 

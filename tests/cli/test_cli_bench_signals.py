@@ -4,13 +4,14 @@ from __future__ import annotations
 
 import os
 import signal
-import sqlite3
 import subprocess
 import sys
 import time
 from pathlib import Path
 
 import pytest
+
+from processes import LINUX_PROC, descendants, running, stored_episodes
 
 # 400 episodes on two workers: far from done when the signal comes
 CAMPAIGN = """\
@@ -23,47 +24,7 @@ controllers:
   - name: savkin-wang2013-v1
 """
 
-pytestmark = pytest.mark.skipif(
-    not Path("/proc/self/task").is_dir(), reason="reads the process tree from Linux /proc"
-)
-
-
-def _children(pid: int) -> list[int]:
-    out: list[int] = []
-    for task in Path(f"/proc/{pid}/task").glob("*"):
-        try:
-            out += [int(c) for c in (task / "children").read_text().split()]
-        except OSError:
-            continue
-    return out
-
-
-def _descendants(pid: int) -> list[int]:
-    found, todo = [], _children(pid)
-    while todo:
-        p = todo.pop()
-        found.append(p)
-        todo += _children(p)
-    return found
-
-
-def _running(pid: int) -> bool:
-    """Whether ``pid`` exists and is not a zombie."""
-    try:
-        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-    except (OSError, IndexError):
-        return False
-    return state != "Z"
-
-
-def _stored(db: Path) -> int:
-    if not db.exists():
-        return 0
-    try:
-        with sqlite3.connect(f"file:{db}?mode=ro", uri=True, timeout=5) as conn:
-            return int(conn.execute("SELECT COUNT(*) FROM episodes").fetchone()[0])
-    except sqlite3.Error:
-        return 0
+pytestmark = pytest.mark.skipif(not LINUX_PROC, reason="reads the process tree from Linux /proc")
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["SIGTERM", "SIGKILL"])
@@ -79,27 +40,27 @@ def test_no_worker_survives_the_campaign_process(tmp_path: Path, sig: signal.Sig
     try:
         deadline = time.monotonic() + 60
         while proc.poll() is None and time.monotonic() < deadline:
-            tree.update(_descendants(proc.pid))
-            if _stored(db) >= 2 and len(tree) >= 3:  # fork server and two busy workers
+            tree.update(descendants(proc.pid))
+            if stored_episodes(db) >= 2 and len(tree) >= 3:  # fork server and two busy workers
                 break
             time.sleep(0.05)
         assert proc.poll() is None, "the campaign ended before it could be interrupted"
-        tree.update(_descendants(proc.pid))
+        tree.update(descendants(proc.pid))
         proc.send_signal(sig)
         code = proc.wait(timeout=60)
         deadline = time.monotonic() + 10  # workers check their main process twice a second
-        while any(_running(p) for p in tree) and time.monotonic() < deadline:
+        while any(running(p) for p in tree) and time.monotonic() < deadline:
             time.sleep(0.1)
-        survivors = sorted(p for p in tree if _running(p))
+        survivors = sorted(p for p in tree if running(p))
         assert survivors == [], f"processes of the campaign survived it: {survivors}"
     finally:
         if proc.poll() is None:
             proc.kill()
             proc.wait()
         for p in tree:
-            if _running(p):
+            if running(p):
                 os.kill(p, signal.SIGKILL)
-    stored = _stored(db)
+    stored = stored_episodes(db)
     assert 2 <= stored < 400
     if sig == signal.SIGTERM:  # handled as Ctrl-C: a clean stop with the resume hint
         assert code == 130
