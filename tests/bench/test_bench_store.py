@@ -17,6 +17,7 @@ from uvnav.controllers import make_controller
 from uvnav.dynamics import UnicycleSpec
 from uvnav.obstacles import DiscBody, Obstacle, ObstacleState, PolygonBody, RandomTurn
 from uvnav.sim import METRIC_NAMES, EpisodeResult, EpisodeSetup, run_episode
+from uvnav.sim.metrics import SOCIAL_METRIC_NAMES
 
 
 def tiny_setup(seed: int) -> EpisodeSetup:
@@ -327,14 +328,7 @@ def test_social_metrics_round_trip(store: ResultsStore) -> None:
     assert row["intrusion_time"] == m.intrusion_time
 
 
-SOCIAL = (
-    "min_separation",
-    "too_close_time",
-    "too_close_frequency",
-    "intrusion_time",
-    "path_irregularity",
-    "collision_by",
-)
+SOCIAL = SOCIAL_METRIC_NAMES
 
 
 def test_database_without_social_columns_reads_and_upgrades(tmp_path: Path) -> None:

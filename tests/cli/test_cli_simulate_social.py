@@ -7,7 +7,7 @@ import json
 from typer.testing import CliRunner
 
 from uvnav.cli.app import app
-from uvnav.sim.social import SOCIAL_METRIC_NAMES
+from uvnav.sim.metrics import SOCIAL_METRIC_NAMES
 
 runner = CliRunner()
 

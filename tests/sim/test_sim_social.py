@@ -16,13 +16,8 @@ from uvnav.dynamics.omni import VelocityCommand
 from uvnav.obstacles import ConstantVelocity, Obstacle, ObstacleState, PolygonBody
 from uvnav.sensors import Observation
 from uvnav.sim import EpisodeSetup, run_episode
-from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
-from uvnav.sim.social import (
-    DISCOMFORT_DISTANCE,
-    INTIMATE_DISTANCE,
-    SOCIAL_METRIC_NAMES,
-    pedestrian_ids,
-)
+from uvnav.sim.metrics import SOCIAL_METRIC_NAMES, EpisodeMetrics, episode_metrics
+from uvnav.sim.social import DISCOMFORT_DISTANCE, INTIMATE_DISTANCE, pedestrian_ids
 
 ROBOT_R = 0.2
 PED_R = 0.3

@@ -50,7 +50,7 @@ from uvnav.scenarios import (
     check_constraints,
 )
 from uvnav.sim import METRIC_NAMES
-from uvnav.sim.social import SOCIAL_METRIC_NAMES
+from uvnav.sim.metrics import SOCIAL_METRIC_NAMES
 
 # ---------------------------------------------------------------------------------- error handling
 # One path for every command (see uvnav.cli.errors): user errors are one ``error:`` line and exit

@@ -18,6 +18,16 @@ from typing import Any
 
 import numpy as np
 
+#: the social metrics (:mod:`uvnav.sim.social`), last in :data:`METRIC_NAMES`: 2D worlds only
+SOCIAL_METRIC_NAMES: tuple[str, ...] = (
+    "min_separation",
+    "too_close_time",
+    "too_close_frequency",
+    "intrusion_time",
+    "path_irregularity",
+    "collision_by",
+)
+
 METRIC_NAMES: tuple[str, ...] = (
     "success",
     "collision",
@@ -31,13 +41,7 @@ METRIC_NAMES: tuple[str, ...] = (
     "mode_switches",
     "decision_us_median",
     "decision_us_p99",
-    # social metrics (uvnav.sim.social): 2D worlds only
-    "min_separation",
-    "too_close_time",
-    "too_close_frequency",
-    "intrusion_time",
-    "path_irregularity",
-    "collision_by",
+    *SOCIAL_METRIC_NAMES,
 )
 
 

@@ -67,16 +67,6 @@ DISCOMFORT_DISTANCE = 0.2
 #: Hall's intimate distance [m] (gap below which a pedestrian intrudes on the robot's space)
 INTIMATE_DISTANCE = 0.45
 
-#: the social metrics, in the order of :data:`uvnav.sim.metrics.METRIC_NAMES`
-SOCIAL_METRIC_NAMES: tuple[str, ...] = (
-    "min_separation",
-    "too_close_time",
-    "too_close_frequency",
-    "intrusion_time",
-    "path_irregularity",
-    "collision_by",
-)
-
 
 def pedestrian_ids(obstacles: Sequence[Obstacle]) -> np.ndarray:
     """Indices of the pedestrians of ``obstacles``: disc bodies whose motion can move them
