@@ -17,8 +17,9 @@ obstacles slower than the robot, thesis (2.6); these pedestrians walk at the rob
 stored and shown as ``refused`` in campaign :data:`CAMPAIGN`: that is the honest result of the
 laws as specified.  Because the thesis's laws are the library's subject, they are *also* run
 beyond that assumption, in a separate campaign :data:`BEYOND_CAMPAIGN` whose rows are labelled so
-(the ETH crowd campaign of Ch. 2 does the same); ``hybrid-v1`` goes there too, since it follows
-its waypoints with ``zhang2019-v1`` inside and does not check that law's assumption.
+(the ETH crowd campaign of Ch. 2 does the same).  ``hybrid-v1`` follows its waypoints with
+``zhang2019-v1`` inside and inherits that law's assumption (``ControllerInfo.inner_law``), so it is
+refused and run beyond like it.
 
 Both campaigns live in the results store ``results_dir/uvnav.sqlite``, carry the Ch. 2 code
 fingerprint (:func:`uvnav.bench.reproduce.code_fingerprint`) and only add: a second run skips every
@@ -49,8 +50,6 @@ ETH_CAMPAIGN = "crowds-eth"
 ETH_NAMES = {"crowd-eth": "ETH eth walkway", "crowd-hotel": "ETH hotel walkway"}
 #: Test cases per scene: quick (``uvnav run``) and full (``--full``: CrowdNav's test set).
 QUICK_CASES, FULL_CASES = 100, 500
-#: Laws run beyond the scene's assumptions besides the refused ones (their inner law is refused).
-WRAPPERS: tuple[str, ...] = ("hybrid-v1",)
 #: Chen, Liu, Kreiss, Alahi, ICRA 2019 (arXiv:1809.08835), Table I: ORCA, invisible robot,
 #: 5 ORCA humans, circle crossing, 500 test cases.
 PAPER_ORCA = {"success": 0.43, "collision": 0.57, "time_to_goal": 10.86}
@@ -59,14 +58,13 @@ PAPER_LAW, PAPER_SCENE = "orca-holonomic-v1", "crowdnav-circle"
 
 def crowd_laws() -> tuple[list[str], list[str]]:
     """``(laws, beyond)``: every registered 2D law (unicycle, then holonomic) of the main campaign,
-    and the laws also run beyond the scene's assumptions (those that require slower obstacles)
-    with :data:`WRAPPERS` (which run such a law inside, in the beyond campaign only)."""
-    from uvnav.controllers.base import available_controllers
+    and the laws also run beyond the scene's assumptions: those that require slower obstacles,
+    themselves or through the law they run inside (``hybrid-v1``)."""
+    from uvnav.controllers.base import available_controllers, requires_slower_obstacles
 
     infos = {**available_controllers("unicycle"), **available_controllers("holonomic")}
-    laws = [n for n in infos if n not in WRAPPERS]
-    beyond = [n for n in infos if infos[n].requires_slower_obstacles]
-    return laws, beyond + [w for w in WRAPPERS if w in infos]
+    laws = list(infos)
+    return laws, [n for n in laws if requires_slower_obstacles(n)]
 
 
 @dataclass

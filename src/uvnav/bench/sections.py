@@ -534,9 +534,8 @@ def crowds_section(summary: Any) -> ChapterSection:
         intro += (
             f" Because the thesis's laws are this library's subject, {', '.join(summary.beyond)} "
             "also ran beyond that assumption, as a separate row group ('beyond assumption "
-            "(2.6)', campaign crowdnav-beyond), as in the ETH crowd campaign of Chapter 2; "
-            "hybrid-v1 belongs there because it drives with zhang2019-v1 inside and does not "
-            "check that law's assumption."
+            "(2.6)', campaign crowdnav-beyond), as in the ETH crowd campaign of Chapter 2 "
+            "(hybrid-v1 drives with zhang2019-v1 inside and inherits its assumption)."
         )
     return ChapterSection(
         key="crowds",

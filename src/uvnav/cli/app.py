@@ -453,7 +453,7 @@ def scenarios_validate(
             [f"{item}: {w}" for w in check_constraints(sc)] if res.kind.name == "nav2d" else []
         )
         try:
-            check_law(res, sc.controller.name)
+            check_law(res, sc.controller.name, params=dict(getattr(sc.controller, "params", {})))
         except ScenarioError as exc:
             typer.echo(f"error: {item}: {exc.path}: {exc.problem}", err=True)
             invalid += 1

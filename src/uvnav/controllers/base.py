@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import import_module
 from importlib.metadata import entry_points
@@ -71,6 +71,9 @@ class ControllerInfo:
     sensing: str = "exact"
     #: the vehicle the law drives, one of :data:`VEHICLES`
     vehicle: str = "unicycle"
+    #: the parameter naming a law this one runs inside (``hybrid-v1``'s ``law``; its parameters
+    #: in ``<name>_params``): that law's assumptions are this law's too
+    inner_law: str = ""
 
 
 #: Vehicle kinds of the registry (:data:`uvnav.core.VEHICLES`): the Ch. 2 unicycle
@@ -220,6 +223,23 @@ def make_controller(name: str, *, oracle: bool = False, **params: Any) -> Contro
         **params: fields of the controller's ``Params`` dataclass.
     """
     return cast(Controller, make_law(name, vehicle="unicycle", oracle=oracle, **params))
+
+
+def requires_slower_obstacles(name: str, params: Mapping[str, Any] | None = None) -> bool:
+    """Whether the law ``name`` with ``params`` assumes obstacles slower than the robot (thesis
+    (2.6)): its own declaration, or that of the law it runs inside
+    (:attr:`ControllerInfo.inner_law`: the parameter's value or its default)."""
+    info = controller_info(name)
+    if info.requires_slower_obstacles:
+        return True
+    if not info.inner_law:
+        return False
+    given = dict(params or {})
+    inner = given.get(info.inner_law)
+    if inner is None and info.params_type is not None:
+        fields = {f.name: f for f in dataclasses.fields(info.params_type)}
+        inner = fields[info.inner_law].default
+    return requires_slower_obstacles(str(inner), given.get(f"{info.inner_law}_params"))
 
 
 def make_law(name: str, *, vehicle: str | None = None, oracle: bool = False, **params: Any) -> Any:

@@ -293,5 +293,6 @@ register(
         summary="Global + local: D* Lite path on an occupancy grid (map learned from sensed static "
         "obstacles, optional a-priori map) followed with any registered reactive law.",
         reference="Thesis Ch. 8 and Ch. 1 §1.2; Koenig & Likhachev, IEEE T-RO 2005 (D* Lite)",
+        inner_law="law",
     )
 )

@@ -24,10 +24,12 @@ invalid one.
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
+from typing import Any
 
 import numpy as np
 
-from uvnav.controllers.base import controller_info
+from uvnav.controllers.base import requires_slower_obstacles
 from uvnav.obstacles import MotionModel, rotation_boundary_growth
 from uvnav.scenarios.errors import ScenarioError
 from uvnav.scenarios.pedestrians import crowd_speed_stats
@@ -176,8 +178,12 @@ def crowd_warnings(scenario: Scenario) -> list[str]:
     return lines
 
 
-def validate_for_controller(scenario: Scenario, controller_name: str) -> None:
-    """Check that ``scenario`` satisfies the assumptions ``controller_name`` declares.
+def validate_for_controller(
+    scenario: Scenario, controller_name: str, params: Mapping[str, Any] | None = None
+) -> None:
+    """Check that ``scenario`` satisfies the assumptions ``controller_name`` (with ``params``)
+    declares, or the law it runs inside declares
+    (:func:`uvnav.controllers.base.requires_slower_obstacles`).
 
     Raises:
         ScenarioError: the controller requires obstacles slower than the robot (thesis (2.6)) and an
@@ -191,8 +197,7 @@ def validate_for_controller(scenario: Scenario, controller_name: str) -> None:
     V_max (some jog, most are faster for a moment) are a documented departure, reported by
     :func:`check_constraints` as warnings.
     """
-    info = controller_info(controller_name)
-    if not info.requires_slower_obstacles:
+    if not requires_slower_obstacles(controller_name, params):
         return
     v_max = scenario.robot.v_max
     for j, spec in enumerate(scenario.obstacles):

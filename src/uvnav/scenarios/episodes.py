@@ -66,9 +66,15 @@ def default_law(resolved: Resolved) -> tuple[str, dict[str, Any]]:
     return str(ctrl.name), dict(getattr(ctrl, "params", {}) or {})
 
 
-def check_law(resolved: Resolved, law: str, *, assumptions: bool = True) -> ControllerInfo:
+def check_law(
+    resolved: Resolved,
+    law: str,
+    *,
+    assumptions: bool = True,
+    params: dict[str, Any] | None = None,
+) -> ControllerInfo:
     """The registry entry of ``law`` if it fits ``resolved``'s scene (and, with
-    ``assumptions``, if the scene keeps the assumptions the law declares).
+    ``assumptions``, if the scene keeps the assumptions the law, with ``params``, declares).
 
     Raises:
         UnknownControllerError: no such law.
@@ -88,7 +94,7 @@ def check_law(resolved: Resolved, law: str, *, assumptions: bool = True) -> Cont
         from uvnav.scenarios.build import validate_for_controller
 
         try:
-            validate_for_controller(resolved.scenario, law)
+            validate_for_controller(resolved.scenario, law, params)
         except ScenarioError as exc:
             raise AssumptionError(exc.source, exc.path, exc.problem) from None
     return info
@@ -135,7 +141,7 @@ def run_scene(
     name = law or own
     merged = dict(own_params) if name == own and use_scene_params else {}
     merged.update(params or {})
-    check_law(resolved, name, assumptions=not beyond_assumptions)
+    check_law(resolved, name, assumptions=not beyond_assumptions, params=merged)
     s = episode_seed(resolved, seed)
     runner = _RUNNERS[resolved.kind.name]
     try:
