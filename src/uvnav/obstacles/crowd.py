@@ -361,23 +361,25 @@ class CrowdGroup:
         for m in self.models:
             if not any(c is m.crowd for c in self.crowds):
                 self.crowds.append(m.crowd)
+        # per crowd: the group's columns of its members and their rows in the crowd
         self.rows = [
-            (next(k for k, c in enumerate(self.crowds) if c is m.crowd), m.index)
-            for m in self.models
+            (
+                np.array([j for j, m in enumerate(self.models) if m.crowd is c], dtype=np.intp),
+                np.array([m.index for m in self.models if m.crowd is c], dtype=np.intp),
+            )
+            for c in self.crowds
         ]
 
     def step(
         self, position: FloatArray, heading: FloatArray, t: float, dt: float
     ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
-        for c in self.crowds:
-            c.advance(t, dt)
         m = len(self.models)
         pos = np.empty((2, m))
         vel = np.empty((2, m))
-        for j, (k, i) in enumerate(self.rows):
-            c = self.crowds[k]
-            pos[:, j] = c.position[i]
-            vel[:, j] = c.velocity[i]
+        for c, (cols, rows) in zip(self.crowds, self.rows, strict=True):
+            c.advance(t, dt)
+            pos[:, cols] = c.position[rows].T
+            vel[:, cols] = c.velocity[rows].T
         return pos, np.array(heading, dtype=float), vel, np.zeros(m)
 
 
