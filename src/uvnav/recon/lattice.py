@@ -28,6 +28,11 @@ Counting uses the separating-axis theorem (exact for convex pieces; a non-convex
 triangles by ``shapely.constrained_delaunay_triangles``), with the hexagon shrunk by 1e-9 so that
 touching does not count; the tests compare it with shapely's own intersection areas.
 
+The "naive" baseline the counts are compared with is the axis-aligned lattice (λ = 0) with a
+vertex at the lower-left corner of D's bounding box: it moves with D, so the same area gives the
+same count wherever it sits (anchored at the world origin it did not: 600 m square, R = 50 m,
+68 naive waypoints with D's corner at the origin, 67 centred on it, 78 centred at (397.3, 494.1)).
+
 The thesis's (7.1) asks waypoints to lie in D; a vertex whose cell meets D can lie up to R outside
 D.  It is kept there (moving it would break the covering) and :class:`LatticeSolution` reports
 how many such vertices there are.
@@ -60,7 +65,7 @@ class LatticeSolution:
         R: Footprint radius [m] (triangle side √3·R).
         xy: Waypoints (N, 2) [m]: the vertices whose Voronoi cell meets D.
         n: N.
-        n_naive: Count of the naive lattice λ = x0 = y0 = 0.
+        n_naive: Count of the naive lattice (λ = 0, vertex at D's lower-left corner).
         bound_disc: A / (π R²), the area bound (no covering by discs can use fewer).
         bound_kershner: A / (1.5·√3·R²), Kershner's asymptotic minimum for discs of radius R.
         n_outside: Waypoints lying outside D (allowed, see module doc).
@@ -369,9 +374,15 @@ def aligned_angles(area: Polygon) -> FloatArray:
     return np.unique(np.round(lam, 12))
 
 
+def naive_anchor(area: Polygon) -> FloatArray:
+    """The naive lattice's vertex (2,) [m]: the lower-left corner of D's bounding box."""
+    xmin, ymin, _, _ = area.bounds
+    return np.array([xmin, ymin])
+
+
 def naive_count(area: Polygon, R: float) -> int:
-    """Count of the naive lattice λ = x0 = y0 = 0 (world origin)."""
-    return int(count_cells(np.zeros((1, 2)), area, 0.0, R)[0])
+    """Count of the naive lattice: λ = 0, a vertex at D's lower-left corner (module doc)."""
+    return int(count_cells(naive_anchor(area)[None, :], area, 0.0, R)[0])
 
 
 def optimal_lattice(
@@ -426,7 +437,7 @@ def optimal_lattice(
     c_best, o_best = results[lam_best]
     n_naive = naive_count(area, R)
     if n_naive < c_best:  # the naive lattice is one candidate of the search space
-        lam_best, c_best, o_best = 0.0, n_naive, np.zeros(2)
+        lam_best, c_best, o_best = 0.0, n_naive, naive_anchor(area)
     xy = lattice_waypoints(area, lam_best, float(o_best[0]), float(o_best[1]), R)
     A = float(area.area)
     outside = ~(
@@ -449,8 +460,9 @@ def optimal_lattice(
 
 
 def naive_lattice(area: Polygon, R: float) -> FloatArray:
-    """Waypoints (N, 2) [m] of the naive lattice λ = x0 = y0 = 0."""
-    return lattice_waypoints(area, 0.0, 0.0, 0.0, R)
+    """Waypoints (N, 2) [m] of the naive lattice (:func:`naive_count`)."""
+    x0, y0 = naive_anchor(area)
+    return lattice_waypoints(area, 0.0, float(x0), float(y0), R)
 
 
 def check_margins(R: float, delta: float, c1: float, c2: float) -> None:

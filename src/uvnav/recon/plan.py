@@ -40,6 +40,13 @@ from uvnav.recon.checks import (
     check_margins_measured,
     check_trajectory,
 )
+from uvnav.recon.coverage import (
+    PointCoverage,
+    PolygonCoverage,
+    check_coverage_polygons,
+    check_grid,
+    check_random,
+)
 from uvnav.recon.lattice import LatticeSolution, check_margins, optimal_lattice
 from uvnav.recon.terrain import Terrain, check_area_inside
 from uvnav.recon.tour import cluster_tours, kmeans_clusters, merge_tours, tour_length
@@ -68,6 +75,9 @@ class ReconConfig:
         lattice_pairs: Lattice vectors paired with the edge-aligned lines in that search.
         tsp: OR-Tools metaheuristic, "greedy" (reproducible) or "gls".
         tsp_time_limit: Cap on each TSP solve [s].
+        check_step: Spacing [m] of the independent coverage grid (None: no grid check).
+        check_points: Seeded uniform random points of the independent check (0: none).
+        check_polygons: Run the shapely footprint-polygon check.
     """
 
     theta: float = math.radians(90.0)
@@ -85,6 +95,9 @@ class ReconConfig:
     lattice_pairs: int = 60
     tsp: str = "greedy"
     tsp_time_limit: float = 20.0
+    check_step: float | None = 0.5
+    check_points: int = 200_000
+    check_polygons: bool = True
 
 
 @dataclass
@@ -111,6 +124,7 @@ class ReconPlan:
     z_min: float
     z_max: float
     coverage: CoverageCheck
+    ground: GroundCoverage
     uavs: list[UavPlan]
     integrated: UavPlan | None
     min_waypoint_separation: float
@@ -137,6 +151,7 @@ class ReconPlan:
             "coverage_all": self.coverage.coverage_all,
             "coverage_visible": self.coverage.coverage_visible,
             "ground_nodes": self.coverage.nodes,
+            **self.ground.summary(),
             "min_waypoint_separation": self.min_waypoint_separation,
             "min_waypoint_terrain": self.min_waypoint_terrain,
             "uavs": len(self.uavs),
@@ -159,6 +174,48 @@ class ReconPlan:
             out["integrated_max_curvature"] = self.integrated.check.max_curvature
             out["integrated_max_waypoint_distance"] = self.integrated.check.max_waypoint_distance
         return out
+
+
+@dataclass(frozen=True)
+class GroundCoverage:
+    """The independent coverage checks of :mod:`.coverage` (``None`` where not run)."""
+
+    grid: PointCoverage | None
+    grid_step: float | None
+    random: PointCoverage | None
+    polygons: PolygonCoverage | None
+
+    def summary(self) -> dict[str, Any]:
+        """Flat JSON-friendly figures (NaN where a check was not run)."""
+        nan = float("nan")
+        g, r, p = self.grid, self.random, self.polygons
+        return {
+            "check_grid_step": nan if self.grid_step is None else self.grid_step,
+            "check_grid_points": 0 if g is None else g.points,
+            "coverage_grid_all": nan if g is None else g.coverage_all,
+            "coverage_grid_visible": nan if g is None else g.coverage_visible,
+            "grid_unseen_visible": 0 if g is None else g.visible_at_zmax - g.seen_of_visible,
+            "check_random_points": 0 if r is None else r.points,
+            "coverage_random_all": nan if r is None else r.coverage_all,
+            "coverage_random_visible": nan if r is None else r.coverage_visible,
+            "coverage_polygon": nan if p is None else p.coverage,
+            "polygon_uncovered_m2": nan if p is None else p.uncovered_area,
+            "polygon_largest_gap_m": nan if p is None else p.largest_gap,
+            "polygon_cells_not_seen": -1 if p is None else p.cells_not_seen,
+        }
+
+
+def ground_truth_coverage(
+    terrain: Terrain, area: Polygon, W: FloatArray, cfg: ReconConfig, z_max: float
+) -> GroundCoverage:
+    """Run the independent coverage checks that ``cfg`` asks for on waypoints W (N, 3)."""
+    step = cfg.check_step
+    grid = None if step is None else check_grid(terrain, W, area, cfg.theta, z_max, step=step)
+    rnd = None
+    if cfg.check_points > 0:
+        rnd = check_random(terrain, W, area, cfg.theta, z_max, n=cfg.check_points, seed=cfg.seed)
+    poly = check_coverage_polygons(terrain, W, area, cfg.theta) if cfg.check_polygons else None
+    return GroundCoverage(grid, step, rnd, poly)
 
 
 def validate_inputs(terrain: Terrain, area: Polygon, cfg: ReconConfig) -> tuple[float, float]:
@@ -219,7 +276,7 @@ def plan_recon(
 
     t = time.perf_counter()
     nodes = terrain.nodes_in(area)
-    z, _info = assign_altitudes(terrain, lat.xy, nodes, cfg.theta, z_min, z_max, cfg.c2)
+    z, _info = assign_altitudes(terrain, lat.xy, area, cfg.theta, z_min, z_max, cfg.c2)
     W = np.column_stack([lat.xy, z])
     timings["altitudes"] = time.perf_counter() - t
 
@@ -266,6 +323,7 @@ def plan_recon(
     timings["total"] = time.perf_counter() - t_all
 
     coverage = check_coverage(terrain, nodes, W, cfg.theta, z_max)
+    ground = ground_truth_coverage(terrain, area, W, cfg, z_max)
     qij, qi = check_margins_measured(terrain, W, search=2 * cfg.c2)
     timings["checks"] = time.perf_counter() - t_all - timings["total"]
     return ReconPlan(
@@ -278,6 +336,7 @@ def plan_recon(
         z_min=z_min,
         z_max=z_max,
         coverage=coverage,
+        ground=ground,
         uavs=uavs,
         integrated=integrated,
         min_waypoint_separation=qij,

@@ -35,10 +35,17 @@ import math
 
 import numpy as np
 
+from shapely.geometry import Polygon
+
+from uvnav.recon.cells import clipped_cells, sample_polygon
 from uvnav.recon.terrain import Terrain
 
 FloatArray = np.ndarray
 LOS_EPS = 1e-3
+#: Spacing [m] of the samples of a waypoint's cell (edges and interior) in :func:`assign_altitudes`.
+CELL_STEP = 0.5
+#: How far [m] past its cell's farthest sample a footprint reaches (:func:`assign_altitudes`).
+FOOTPRINT_MARGIN = 0.01
 
 
 def check_theta(theta: float) -> None:
@@ -242,79 +249,113 @@ def seen_by_any(terrain: Terrain, cams: FloatArray, pts: FloatArray, theta: floa
 def assign_altitudes(
     terrain: Terrain,
     xy: FloatArray,
-    nodes: FloatArray,
+    area: Polygon,
     theta: float,
     z_min: float,
     z_max: float,
     c2: float,
     *,
+    step: float = CELL_STEP,
     tol: float = 0.25,
-    max_repairs: int = 8,
+    margin: float = FOOTPRINT_MARGIN,
 ) -> tuple[FloatArray, dict[str, float]]:
-    """Stage 1's altitudes: the lowest z_i per waypoint that sees its cell (thesis §7.3.1).
+    """Stage 1's altitudes: the lowest z_i per waypoint that sees its whole clipped cell (§7.3.1).
 
-    1. Each ground node of D (``nodes`` (m, 3)) belongs to its nearest waypoint (its Voronoi cell).
+    1. Each waypoint's cell is its Voronoi cell clipped to D (:func:`.cells.clipped_cells`),
+       sampled by its corners, its edges every ``step`` and the grid ``step·(i, j)`` inside it
+       (:func:`.cells.sample_polygon`) — not the DEM nodes: the cell's corners and edges are
+       where the footprint must reach.
     2. z_i starts at ``max(z_min, clearance_altitude(xy_i, c2))`` (waypoint–terrain margin (7.4)).
-    3. z_i = the lowest altitude that sees every node of its cell that is visible from
-       ``(x_i, y_i, z_max)`` (bisection, :func:`lowest_altitude`).
-    4. Repair: a node visible from some waypoint at ``z_max`` but seen by none at the chosen
-       altitudes (occluded from its own waypoint) is handed to the nearest waypoint that sees it
-       at ``z_max``, whose altitude is raised by bisection; repeated until none is left.
+    3. z_i = the lowest altitude that sees every sample of its cell that is visible from
+       ``(x_i, y_i, z_max)`` (bisection, :func:`lowest_altitude`; the cone bound is exact, so on
+       flat ground z_i = z_g + (distance to the cell's farthest corner)/tan(θ/2)), then raised by
+       ``margin``/tan(θ/2) (the footprint reaches ``margin`` past the corners; capped at z_max).
+    4. Orphans — samples occluded from their own waypoint at ``z_max`` and seen by no camera at
+       the altitudes of step 3 — go to the nearest waypoint that sees them from ``z_max``, which
+       is raised to see them too.  Raising a camera only adds ground it sees (module doc), so
+       one pass leaves every sample seen that some waypoint sees from ``z_max``.
 
     Returns:
-        (z (N,), info) with ``visible_at_zmax`` and ``seen`` node counts and ``repairs``.
+        (z (N,), info) with counts of ``samples``, ``orphans``, ``visible_at_zmax`` (samples seen
+        from some waypoint at z_max), ``seen`` and ``raised`` (waypoints raised in step 4).
 
     Raises:
         ValueError: if ``z_max`` cannot give the clearance c2 at some waypoint.
     """
-    from scipy.spatial import cKDTree
-
     xy = np.asarray(xy, dtype=float)
     n = len(xy)
-    owner = cKDTree(xy).query(nodes[:, :2])[1] if n else np.zeros(0, dtype=np.intp)
-    z_floor = np.empty(n)
-    for i in range(n):
-        zc = max(z_min, clearance_altitude(terrain, xy[i], c2))
-        if zc > z_max:
-            raise ValueError(
-                f"z_max: {z_max:.1f} m is below the terrain clearance {zc:.1f} m (c2 = {c2:g} m) "
-                f"needed at waypoint {i} ({xy[i, 0]:.1f}, {xy[i, 1]:.1f})"
-            )
-        z_floor[i] = zc
+    lift = margin / math.tan(theta / 2.0)
+    z_floor = np.array([_floor_altitude(terrain, xy[i], i, z_min, z_max, c2) for i in range(n)])
+    cells = clipped_cells(xy, area) if n else []
     targets: list[FloatArray] = []
+    orphans: list[FloatArray] = []
     z = np.empty(n)
-    for i in range(n):
-        mine = nodes[owner == i]
-        cam = np.array([xy[i, 0], xy[i, 1], z_max])
-        vis = visible(terrain, cam, mine, theta) if len(mine) else np.zeros(0, bool)
+    for i, cell in enumerate(cells):
+        p = sample_polygon(cell, step)
+        mine = np.column_stack([p, terrain.height(p[:, 0], p[:, 1])])
+        vis = visible(terrain, np.array([xy[i, 0], xy[i, 1], z_max]), mine, theta)
         targets.append(mine[vis])
-        z[i] = lowest_altitude(terrain, xy[i], targets[i], theta, z_floor[i], z_max, tol=tol)
-    cams_max = np.column_stack([xy, np.full(n, z_max)])
-    vis_max = seen_by_any(terrain, cams_max, nodes, theta)
-    repairs = 0
-    for _ in range(max_repairs):
-        seen = seen_by_any(terrain, np.column_stack([xy, z]), nodes, theta)
-        missing = np.flatnonzero(vis_max & ~seen)
-        if len(missing) == 0:
-            break
-        dist = np.linalg.norm(xy[:, None, :] - nodes[missing][None, :, :2], axis=2)  # (N, K)
-        order = np.argsort(dist, axis=0)
-        extra: dict[int, list[int]] = {}
-        for col, m in enumerate(missing):
-            for j in order[:, col]:
-                if visible(terrain, cams_max[j], nodes[m : m + 1], theta)[0]:
-                    extra.setdefault(int(j), []).append(int(m))
-                    break
-        for j, ms in extra.items():
-            targets[j] = np.vstack([targets[j], nodes[ms]])
-            z[j] = lowest_altitude(terrain, xy[j], targets[j], theta, z[j], z_max, tol=tol)
-            repairs += 1
-    seen = seen_by_any(terrain, np.column_stack([xy, z]), nodes, theta)
+        orphans.append(mine[~vis])
+        z_i = lowest_altitude(terrain, xy[i], targets[i], theta, z_floor[i], z_max, tol=tol)
+        z[i] = min(z_i + lift, z_max)
+    lost = np.vstack(orphans) if n else np.zeros((0, 3))
+    raised = _adopt_orphans(terrain, xy, z, targets, lost, theta, z_max, tol, lift)
+    seen = seen_by_any(terrain, np.column_stack([xy, z]), lost, theta)
     info = {
-        "nodes": float(len(nodes)),
-        "visible_at_zmax": float(vis_max.sum()),
-        "seen": float(seen.sum()),
-        "seen_of_visible": float((seen & vis_max).sum()),
-        "repairs": float(repairs),
+        "samples": float(sum(len(t) for t in targets) + len(lost)),
+        "orphans": float(len(lost)),
+        "visible_at_zmax": float(sum(len(t) for t in targets) + raised[1]),
+        "seen": float(sum(len(t) for t in targets) + seen.sum()),
+        "raised": float(raised[0]),
     }
     return z, info
+
+
+def _floor_altitude(
+    terrain: Terrain, xy: FloatArray, i: int, z_min: float, z_max: float, c2: float
+) -> float:
+    """max(z_min, clearance altitude) at waypoint ``i``; ``ValueError`` if above z_max."""
+    zc = max(z_min, clearance_altitude(terrain, xy, c2))
+    if zc > z_max:
+        raise ValueError(
+            f"z_max: {z_max:.1f} m is below the terrain clearance {zc:.1f} m (c2 = {c2:g} m) "
+            f"needed at waypoint {i} ({xy[0]:.1f}, {xy[1]:.1f})"
+        )
+    return zc
+
+
+def _adopt_orphans(
+    terrain: Terrain,
+    xy: FloatArray,
+    z: FloatArray,
+    targets: list[FloatArray],
+    lost: FloatArray,
+    theta: float,
+    z_max: float,
+    tol: float,
+    lift: float,
+) -> tuple[int, int]:
+    """Step 4 of :func:`assign_altitudes`, in place on ``z`` and ``targets``.
+
+    Returns (waypoints raised, orphans visible from some waypoint at z_max).
+    """
+    n = len(xy)
+    if len(lost) == 0 or n == 0:
+        return 0, 0
+    from scipy.spatial import cKDTree
+
+    seen = seen_by_any(terrain, np.column_stack([xy, z]), lost, theta)
+    todo = np.flatnonzero(~seen)
+    k = min(n, 24)  # the cone at z_max reaches ~2R: the 19 lattice points within 2R, and more
+    near = cKDTree(xy).query(lost[todo, :2], k=k)[1].reshape(len(todo), k)
+    owner = np.full(len(todo), -1)
+    for rank in range(k):
+        for j in np.unique(near[owner < 0, rank]):
+            idx = np.flatnonzero((owner < 0) & (near[:, rank] == j))
+            cam = np.array([xy[j, 0], xy[j, 1], z_max])
+            owner[idx[visible(terrain, cam, lost[todo[idx]], theta)]] = j
+    for j in np.unique(owner[owner >= 0]):
+        targets[j] = np.vstack([targets[j], lost[todo[owner == j]]])
+        z_j = lowest_altitude(terrain, xy[j], targets[j], theta, z[j] - lift, z_max, tol=tol)
+        z[j] = min(max(z_j + lift, z[j]), z_max)
+    return len(np.unique(owner[owner >= 0])), int(seen.sum() + (owner >= 0).sum())
