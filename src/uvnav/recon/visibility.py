@@ -34,7 +34,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-
 from shapely.geometry import Polygon
 
 from uvnav.recon.cells import clipped_cells, sample_polygon
