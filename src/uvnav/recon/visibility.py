@@ -282,16 +282,60 @@ def assign_altitudes(
         ValueError: if ``z_max`` cannot give the clearance c2 at some waypoint.
     """
     xy = np.asarray(xy, dtype=float)
+    samples = []
+    for cell in clipped_cells(xy, area) if len(xy) else []:
+        p = sample_polygon(cell, step)
+        samples.append(np.column_stack([p, terrain.height(p[:, 0], p[:, 1])]))
+    return altitudes_for_samples(
+        terrain, xy, samples, theta, z_min, z_max, c2, tol=tol, margin=margin
+    )
+
+
+def node_altitudes(
+    terrain: Terrain,
+    xy: FloatArray,
+    nodes: FloatArray,
+    theta: float,
+    z_min: float,
+    z_max: float,
+    c2: float,
+    *,
+    tol: float = 0.25,
+) -> tuple[FloatArray, dict[str, float]]:
+    """The earlier rule, kept as the baseline: each waypoint sees the DEM nodes (m, 3) nearest it.
+
+    Same steps as :func:`assign_altitudes` with the cell's samples replaced by the DEM nodes of
+    D nearest the waypoint and no margin.  On flat ground it stops at the farthest *node* of the
+    cell, short of the cell's corners: the independent checks of :mod:`.coverage` find the gaps.
+    """
+    from scipy.spatial import cKDTree
+
+    xy = np.asarray(xy, dtype=float)
+    owner = cKDTree(xy).query(nodes[:, :2])[1] if len(xy) else np.zeros(0, dtype=np.intp)
+    samples = [nodes[owner == i] for i in range(len(xy))]
+    return altitudes_for_samples(terrain, xy, samples, theta, z_min, z_max, c2, tol=tol, margin=0.0)
+
+
+def altitudes_for_samples(
+    terrain: Terrain,
+    xy: FloatArray,
+    samples: list[FloatArray],
+    theta: float,
+    z_min: float,
+    z_max: float,
+    c2: float,
+    *,
+    tol: float,
+    margin: float,
+) -> tuple[FloatArray, dict[str, float]]:
+    """Steps 2–4 of :func:`assign_altitudes` for given ground samples (m_i, 3) per waypoint."""
     n = len(xy)
     lift = margin / math.tan(theta / 2.0)
     z_floor = np.array([_floor_altitude(terrain, xy[i], i, z_min, z_max, c2) for i in range(n)])
-    cells = clipped_cells(xy, area) if n else []
     targets: list[FloatArray] = []
     orphans: list[FloatArray] = []
     z = np.empty(n)
-    for i, cell in enumerate(cells):
-        p = sample_polygon(cell, step)
-        mine = np.column_stack([p, terrain.height(p[:, 0], p[:, 1])])
+    for i, mine in enumerate(samples):
         vis = visible(terrain, np.array([xy[i, 0], xy[i, 1], z_max]), mine, theta)
         targets.append(mine[vis])
         orphans.append(mine[~vis])
@@ -300,11 +344,12 @@ def assign_altitudes(
     lost = np.vstack(orphans) if n else np.zeros((0, 3))
     raised = _adopt_orphans(terrain, xy, z, targets, lost, theta, z_max, tol, lift)
     seen = seen_by_any(terrain, np.column_stack([xy, z]), lost, theta)
+    owned = sum(len(t) for t in targets) - raised[1]  # adopted orphans were appended
     info = {
-        "samples": float(sum(len(t) for t in targets) + len(lost)),
+        "samples": float(owned + len(lost)),
         "orphans": float(len(lost)),
-        "visible_at_zmax": float(sum(len(t) for t in targets) + raised[1]),
-        "seen": float(sum(len(t) for t in targets) + seen.sum()),
+        "visible_at_zmax": float(owned + raised[2]),
+        "seen": float(owned + seen.sum()),
         "raised": float(raised[0]),
     }
     return z, info
@@ -333,14 +378,14 @@ def _adopt_orphans(
     z_max: float,
     tol: float,
     lift: float,
-) -> tuple[int, int]:
+) -> tuple[int, int, int]:
     """Step 4 of :func:`assign_altitudes`, in place on ``z`` and ``targets``.
 
-    Returns (waypoints raised, orphans visible from some waypoint at z_max).
+    Returns (waypoints raised, orphans adopted, orphans visible from some waypoint at z_max).
     """
     n = len(xy)
     if len(lost) == 0 or n == 0:
-        return 0, 0
+        return 0, 0, 0
     from scipy.spatial import cKDTree
 
     seen = seen_by_any(terrain, np.column_stack([xy, z]), lost, theta)
@@ -357,4 +402,5 @@ def _adopt_orphans(
         targets[j] = np.vstack([targets[j], lost[todo[owner == j]]])
         z_j = lowest_altitude(terrain, xy[j], targets[j], theta, z[j] - lift, z_max, tol=tol)
         z[j] = min(max(z_j + lift, z[j]), z_max)
-    return len(np.unique(owner[owner >= 0])), int(seen.sum() + (owner >= 0).sum())
+    adopted = int((owner >= 0).sum())
+    return len(np.unique(owner[owner >= 0])), adopted, int(seen.sum()) + adopted
