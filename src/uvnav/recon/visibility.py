@@ -269,10 +269,12 @@ def assign_altitudes(
        ``(x_i, y_i, z_max)`` (bisection, :func:`lowest_altitude`; the cone bound is exact, so on
        flat ground z_i = z_g + (distance to the cell's farthest corner)/tan(θ/2)), then raised by
        ``margin``/tan(θ/2) (the footprint reaches ``margin`` past the corners; capped at z_max).
-    4. Orphans — samples occluded from their own waypoint at ``z_max`` and seen by no camera at
-       the altitudes of step 3 — go to the nearest waypoint that sees them from ``z_max``, which
-       is raised to see them too.  Raising a camera only adds ground it sees (module doc), so
-       one pass leaves every sample seen that some waypoint sees from ``z_max``.
+    4. Orphans — samples occluded from their own waypoint at ``z_max`` — go to the nearest camera
+       that sees them at its step-3 altitude, else to the nearest that sees them from ``z_max``,
+       with the samples within 1.5·``step`` around them (the band where the ground changes
+       hands); that camera is raised to see them all.  Raising a camera only adds ground it sees
+       (module doc), so one pass leaves every sample seen that some waypoint sees from
+       ``z_max``.
 
     Returns:
         (z (N,), info) with counts of ``samples``, ``orphans``, ``visible_at_zmax`` (samples seen
@@ -287,7 +289,7 @@ def assign_altitudes(
         p = sample_polygon(cell, step)
         samples.append(np.column_stack([p, terrain.height(p[:, 0], p[:, 1])]))
     return altitudes_for_samples(
-        terrain, xy, samples, theta, z_min, z_max, c2, tol=tol, margin=margin
+        terrain, xy, samples, theta, z_min, z_max, c2, tol=tol, margin=margin, ring=1.5 * step
     )
 
 
@@ -313,7 +315,9 @@ def node_altitudes(
     xy = np.asarray(xy, dtype=float)
     owner = cKDTree(xy).query(nodes[:, :2])[1] if len(xy) else np.zeros(0, dtype=np.intp)
     samples = [nodes[owner == i] for i in range(len(xy))]
-    return altitudes_for_samples(terrain, xy, samples, theta, z_min, z_max, c2, tol=tol, margin=0.0)
+    return altitudes_for_samples(
+        terrain, xy, samples, theta, z_min, z_max, c2, tol=tol, margin=0.0, ring=0.0
+    )
 
 
 def altitudes_for_samples(
@@ -327,8 +331,10 @@ def altitudes_for_samples(
     *,
     tol: float,
     margin: float,
+    ring: float,
 ) -> tuple[FloatArray, dict[str, float]]:
-    """Steps 2–4 of :func:`assign_altitudes` for given ground samples (m_i, 3) per waypoint."""
+    """Steps 2–4 of :func:`assign_altitudes` for given ground samples (m_i, 3) per waypoint;
+    ``ring`` [m]: the band of samples around an orphan that its new camera must see too."""
     n = len(xy)
     lift = margin / math.tan(theta / 2.0)
     z_floor = np.array([_floor_altitude(terrain, xy[i], i, z_min, z_max, c2) for i in range(n)])
@@ -342,15 +348,20 @@ def altitudes_for_samples(
         z_i = lowest_altitude(terrain, xy[i], targets[i], theta, z_floor[i], z_max, tol=tol)
         z[i] = min(z_i + lift, z_max)
     lost = np.vstack(orphans) if n else np.zeros((0, 3))
-    raised = _adopt_orphans(terrain, xy, z, targets, lost, theta, z_max, tol, lift)
-    seen = seen_by_any(terrain, np.column_stack([xy, z]), lost, theta)
-    owned = sum(len(t) for t in targets) - raised[1]  # adopted orphans were appended
+    owned = sum(len(t) for t in targets)
+    every = np.vstack(samples) if n else np.zeros((0, 3))
+    cams = np.column_stack([xy, z])
+    raised, found = _adopt_orphans(
+        terrain, cams, targets, lost, every, theta, z_max, tol=tol, lift=lift, ring=ring
+    )
+    z = cams[:, 2]
+    seen = seen_by_any(terrain, cams, lost, theta)
     info = {
         "samples": float(owned + len(lost)),
         "orphans": float(len(lost)),
-        "visible_at_zmax": float(owned + raised[2]),
+        "visible_at_zmax": float(owned + found),
         "seen": float(owned + seen.sum()),
-        "raised": float(raised[0]),
+        "raised": float(raised),
     }
     return z, info
 
@@ -370,37 +381,53 @@ def _floor_altitude(
 
 def _adopt_orphans(
     terrain: Terrain,
-    xy: FloatArray,
-    z: FloatArray,
+    cams: FloatArray,
     targets: list[FloatArray],
     lost: FloatArray,
+    every: FloatArray,
     theta: float,
     z_max: float,
+    *,
     tol: float,
     lift: float,
-) -> tuple[int, int, int]:
-    """Step 4 of :func:`assign_altitudes`, in place on ``z`` and ``targets``.
+    ring: float,
+) -> tuple[int, int]:
+    """Step 4 of :func:`assign_altitudes`, in place on ``cams`` (N, 3) and ``targets``.
 
-    Returns (waypoints raised, orphans adopted, orphans visible from some waypoint at z_max).
+    Every orphan (m, 3) goes to the nearest camera that sees it at its current altitude, else to
+    the nearest that sees it from ``z_max``, together with the samples of ``every`` within
+    ``ring`` [m] of it that this camera sees from ``z_max``: between an orphan and its neighbours
+    the ground changes hands, and a camera seeing both sides leaves no sliver unseen.  The camera
+    is raised until it sees all of them.  Returns (cameras raised, orphans visible at z_max).
     """
-    n = len(xy)
+    n = len(cams)
     if len(lost) == 0 or n == 0:
-        return 0, 0, 0
+        return 0, 0
     from scipy.spatial import cKDTree
 
-    seen = seen_by_any(terrain, np.column_stack([xy, z]), lost, theta)
-    todo = np.flatnonzero(~seen)
     k = min(n, 24)  # the cone at z_max reaches ~2R: the 19 lattice points within 2R, and more
-    near = cKDTree(xy).query(lost[todo, :2], k=k)[1].reshape(len(todo), k)
-    owner = np.full(len(todo), -1)
-    for rank in range(k):
-        for j in np.unique(near[owner < 0, rank]):
-            idx = np.flatnonzero((owner < 0) & (near[:, rank] == j))
-            cam = np.array([xy[j, 0], xy[j, 1], z_max])
-            owner[idx[visible(terrain, cam, lost[todo[idx]], theta)]] = j
+    near = cKDTree(cams[:, :2]).query(lost[:, :2], k=k)[1].reshape(len(lost), k)
+    owner = np.full(len(lost), -1)
+    for at_max in (False, True):
+        for rank in range(k):
+            for j in np.unique(near[owner < 0, rank]):
+                idx = np.flatnonzero((owner < 0) & (near[:, rank] == j))
+                cam = np.array([cams[j, 0], cams[j, 1], z_max if at_max else cams[j, 2]])
+                owner[idx[visible(terrain, cam, lost[idx], theta)]] = j
+    tree = cKDTree(every[:, :2]) if ring > 0 else None
+    raised = 0
     for j in np.unique(owner[owner >= 0]):
-        targets[j] = np.vstack([targets[j], lost[todo[owner == j]]])
-        z_j = lowest_altitude(terrain, xy[j], targets[j], theta, z[j] - lift, z_max, tol=tol)
-        z[j] = min(max(z_j + lift, z[j]), z_max)
-    adopted = int((owner >= 0).sum())
-    return len(np.unique(owner[owner >= 0])), adopted, int(seen.sum()) + adopted
+        mine = lost[owner == j]
+        cam_top = np.array([cams[j, 0], cams[j, 1], z_max])
+        if tree is not None:
+            hits = tree.query_ball_point(mine[:, :2], ring)
+            band = every[np.unique(np.concatenate([np.asarray(h, dtype=np.intp) for h in hits]))]
+            mine = np.vstack([mine, band[visible(terrain, cam_top, band, theta)]])
+        targets[j] = np.vstack([targets[j], mine])
+        z_j = lowest_altitude(
+            terrain, cams[j, :2], targets[j], theta, cams[j, 2] - lift, z_max, tol=tol
+        )
+        z_new = min(max(z_j + lift, cams[j, 2]), z_max)
+        raised += int(z_new > cams[j, 2])
+        cams[j, 2] = z_new
+    return raised, int((owner >= 0).sum())
