@@ -148,8 +148,14 @@ def test_footprint_polygon_and_cells() -> None:
 # Stage 1 is verified optimal: the altitude rule and the checks must not change its counts
 @pytest.mark.parametrize(
     "side,R,n,n_naive",
-    [(300.0, 20.0, 104, 105), (300.0, 30.0, 45, 52), (300.0, 50.0, 20, 20)]
-    + [(600.0, 20.0, 378, 378), (600.0, 30.0, 175, 175), (600.0, 50.0, 67, 68)],
+    [
+        (300.0, 20.0, 104, 105),
+        (300.0, 30.0, 45, 52),
+        (300.0, 50.0, 20, 20),
+        (600.0, 20.0, 378, 378),
+        (600.0, 30.0, 175, 175),
+        (600.0, 50.0, 67, 68),
+    ],
 )
 def test_stage1_counts_unchanged(side: float, R: float, n: int, n_naive: int) -> None:
     for centre in [(0.5 * side, 0.5 * side), (0.0, 0.0), (397.3, 494.1)]:

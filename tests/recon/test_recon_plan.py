@@ -18,7 +18,9 @@ def terrain():  # type: ignore[no-untyped-def]
     return fractal_terrain((320.0, 320.0), cell=5.0, seed=7, origin=(-60.0, -60.0), n_blocks=6)
 
 
-CFG = ReconConfig(footprint_radius=30.0, uavs=2, n_lambda=8, r_min=12.0)
+CFG = ReconConfig(
+    footprint_radius=30.0, uavs=2, n_lambda=8, r_min=12.0, check_step=1.0, check_points=20_000
+)
 
 
 @pytest.fixture(scope="module")
@@ -29,6 +31,10 @@ def plan(terrain):  # type: ignore[no-untyped-def]
 def test_plan_meets_every_claim(plan) -> None:  # type: ignore[no-untyped-def]
     s = plan.summary()
     assert s["coverage_visible"] == 1.0
+    # on ground truth, apart from the planning samples: 1 m grid, random points, polygons
+    assert s["coverage_grid_visible"] == 1.0 and s["grid_unseen_visible"] == 0
+    assert s["coverage_random_visible"] == 1.0 and s["check_random_points"] == 20_000
+    assert s["polygon_uncovered_m2"] == 0.0
     assert s["n_waypoints"] <= s["n_naive"]
     assert s["n_waypoints"] >= s["bound_disc"]
     assert s["max_waypoint_distance"] <= CFG.delta
@@ -69,6 +75,8 @@ def test_plan_is_deterministic(terrain, plan) -> None:  # type: ignore[no-untype
         ({"footprint_radius": -1.0}, "radius"),
         ({"uavs": 0}, "uavs"),
         ({"z_max": 20.0}, "z_max"),
+        ({"check_step": 0.0}, "check_step"),
+        ({"check_points": -1}, "check_points"),
     ],
 )
 def test_invalid_inputs_rejected(terrain, change: dict, field: str) -> None:  # type: ignore[no-untyped-def]

@@ -228,6 +228,12 @@ def validate_inputs(terrain: Terrain, area: Polygon, cfg: ReconConfig) -> tuple[
     check_area_inside(terrain, area)
     check_margins(cfg.footprint_radius, cfg.delta, cfg.c1, cfg.c2)
     check_turn_radius(cfg.r_min, cfg.delta)
+    if cfg.check_step is not None and not cfg.check_step > 0:
+        raise ValueError(
+            f"check_step: the coverage grid spacing must be > 0 m, got {cfg.check_step}"
+        )
+    if cfg.check_points < 0:
+        raise ValueError(f"check_points: must be >= 0, got {cfg.check_points}")
     if cfg.uavs < 1:
         raise ValueError(f"uavs: need at least 1, got {cfg.uavs}")
     z_min = 0.0 if cfg.z_min is None else float(cfg.z_min)
