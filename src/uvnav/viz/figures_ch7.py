@@ -104,8 +104,8 @@ def plot_fig7_4(plan: ReconPlan, path: str | Path | None = None) -> Figure:
         )
     )
     ax.set_title(
-        f"(b) δ = {plan.config.delta:g} m balls, footprints; "
-        f"coverage {100 * s['coverage_visible']:.1f} %"
+        f"(b) δ = {plan.config.delta:g} m balls, footprints; coverage "
+        f"{100 * s['coverage_grid_visible']:.2f} % ({s['check_grid_step']:g} m grid)"
     )
     ax = axs[1, 0]
     _background(ax, plan, shade)
