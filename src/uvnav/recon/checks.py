@@ -6,7 +6,9 @@ of D at the lowest altitude, a trajectory through every waypoint's δ-neighbourh
 on a plan, independently of how the plan was built:
 
 * coverage: fraction of D's DEM nodes seen by at least one waypoint camera at its altitude, over
-  (a) all nodes and (b) the nodes visible from some waypoint at Z_max ("visible at all");
+  (a) all nodes and (b) the nodes visible from some waypoint at Z_max ("visible at all") — a
+  coarse figure; the ground-truth checks (finer grid, random points, footprint polygons) are in
+  :mod:`.coverage`;
 * max distance waypoint → trajectory (dense samples of τ, an upper bound of the true distance);
 * max horizontal curvature of τ (analytic Bézier derivatives at dense samples) vs 1/r_min;
 * max tangent-angle jump at the Bézier joints [rad];

@@ -4,10 +4,7 @@ Thesis: Y. Zhang, Ch. 7 (J. Zhang and Y. Zhang, ICCAR 2020): after Stage 1 "the 
 covered completely" by the cameras at the waypoints' lowest altitudes.  The camera model is the
 one of :mod:`.visibility` ((7.2) with the height above the seen point, plus line of sight).
 
-The clipped cell of a waypoint is its Voronoi cell among the waypoints intersected with D; on the
-lattice of :mod:`.lattice` it is the hexagon of circumradius R around the vertex clipped to D (a
-point of D lies in a hexagon whose vertex is a waypoint, because that hexagon meets D).  The cells
-partition D, so D is covered when every cell is seen.
+The clipped cells of :mod:`.cells` partition D, so D is covered when every cell is seen.
 
 Two checks that share nothing with the planner's samples:
 
@@ -22,6 +19,12 @@ Two checks that share nothing with the planner's samples:
   seeded uniform random points in D, each tested against every camera in cone *and* line of sight
   over the DEM; reported against all points and against those seen from some waypoint at Z_max
   (the ground a camera can see at all).
+
+Measured (``uvnav run``'s Chapter 7 rows, :func:`uvnav.bench.reproduce_ch7.coverage_rows`; 300 m
+and 600 m squares, R = 20/30/50 m, θ = 90°): altitudes that see the 5 m DEM nodes of each cell
+(:func:`.visibility.node_altitudes`) leave 0.64–1.51 % of flat ground unseen on the 0.5 m grid
+(largest gap 2.0–2.6 m past a footprint) and 0.61–8.01 % of the Jacksboro crop; the cell rule
+(:func:`.visibility.assign_altitudes`) reads 100.00 % on all three checks for both terrains.
 
 Units: lengths [m], areas [m²], angles [rad].
 """

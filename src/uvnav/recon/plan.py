@@ -9,12 +9,15 @@ Environments" (J. Zhang and Y. Zhang, ICCAR 2020), eqs. (7.1)–(7.4), Figs. 7.1
    c1 > 2δ > 0, c2 > δ, lattice spacing √3·R ≥ c1, r_min small enough for δ) — each failure is a
    ``ValueError`` whose message starts with the offending field;
 2. Stage 1: the optimal triangular lattice for footprint radius R (:mod:`.lattice`), then the
-   lowest altitude per waypoint with occlusion and terrain clearance c2 (:mod:`.visibility`);
+   lowest altitude per waypoint that sees its whole clipped cell (corners and edges included),
+   with occlusion and terrain clearance c2 (:mod:`.visibility`);
 3. Stage 2: k-means clusters (one per UAV) or given labels; per cluster a closed tour by the TSP
    (OR-Tools) and by the spiral order (both measured); the smooth Bézier trajectory τ of each UAV
    on its TSP tour (:mod:`.bezier`); with several UAVs also the thesis's second scenario — one
    UAV flying the merged tour (Fig. 7.4(d));
-4. the checks of :mod:`.checks` and the stage timings.
+4. the checks of :mod:`.checks`, the coverage on ground truth of :mod:`.coverage` (footprint
+   polygons, a 0.5 m grid and random points apart from every planning sample; see
+   ``ReconConfig.check_*``) and the stage timings.
 
 Altitudes Z_min, Z_max and waypoint z are absolute [m] in the DEM's datum; defaults (``None``)
 are Z_min = 0 and Z_max = the highest terrain under D (buffered by R) + 2·R/tan(θ/2).
