@@ -166,25 +166,29 @@ def lowest_altitude(
     if len(targets) == 0:
         return float(z_lo)
 
-    def sees(z: float) -> bool:
-        cam = np.array([xy[0], xy[1], z])
-        return bool(visible(terrain, cam, targets, theta).all())
+    def missed(z: float, idx: FloatArray) -> FloatArray:
+        """Indices of ``targets[idx]`` not seen from altitude z."""
+        return idx[~visible(terrain, np.array([xy[0], xy[1], z]), targets[idx], theta)]
 
-    if not sees(z_hi):
-        raise ValueError(f"lowest_altitude: targets not all visible from z_hi = {z_hi:.2f} m")
     # the cone alone needs z >= z_g + d / tan(θ/2) for every target: an exact lower bound
     d = np.hypot(targets[:, 0] - xy[0], targets[:, 1] - xy[1])
     z_cone = float(np.max(targets[:, 2] + d / math.tan(theta / 2.0)))
     lo = min(max(float(z_lo), z_cone), float(z_hi))
-    if sees(lo):
+    # monotone in altitude (module doc): what is seen from lo is seen from every z above it, so
+    # only the targets missed at the highest failing altitude are tested again
+    pending = missed(lo, np.arange(len(targets)))
+    if len(pending) == 0:
         return lo
     hi = float(z_hi)
+    if len(missed(hi, pending)):
+        raise ValueError(f"lowest_altitude: targets not all visible from z_hi = {z_hi:.2f} m")
     while hi - lo > tol:
         mid = 0.5 * (lo + hi)
-        if sees(mid):
+        still = missed(mid, pending)
+        if len(still) == 0:
             hi = mid
         else:
-            lo = mid
+            lo, pending = mid, still
     return hi
 
 
