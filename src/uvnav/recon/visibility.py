@@ -24,7 +24,14 @@ reference (tests assert < 1 % of rays on fractal and urban terrain; the note rec
 
 Visibility is monotone in altitude (raising the camera keeps the cone's footprint growing, and it
 lifts every point of the segment above the same ground abscissa), so the lowest altitude in
-``[z_lo, z_hi]`` that sees a whole target set is found by bisection (:func:`lowest_altitude`).
+``[z_lo, z_hi]`` that sees a whole target set is found by bisection (:func:`lowest_altitude`,
+which re-tests only the targets missed at the highest failing altitude).
+
+Stage 1's altitudes (:func:`assign_altitudes`) make each waypoint see its *whole* clipped cell —
+corners, edges and interior sampled every 0.5 m — not only the DEM nodes in it: on flat ground
+the node rule (:func:`node_altitudes`, kept as the baseline) flew at 16.0–19.5 m for R = 20 m and
+left 0.64–1.51 % of the ground unseen; the cell rule flies at R + 1 cm and leaves none
+(:mod:`.coverage` has the checks and the figures).
 
 Units: lengths [m], angles [rad].
 """
