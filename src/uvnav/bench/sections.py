@@ -430,8 +430,10 @@ def ch7_section(summary: Any, *, full: bool) -> ChapterSection:
     radii = "/".join(f"{r:.0f}" for r in r7.RADII)
     intro = (
         f"UAV reconnaissance of a terrain ({mode_text(full)}). Stage 1 lattice counts for "
-        f"{sizes} m squares and R = {radii} m; full plans (lattice, lowest altitudes, tours, "
-        f"Bézier paths) for {plans}."
+        f"{sizes} m squares and R = {radii} m; coverage on ground truth (a "
+        f"{r7.CHECK_STEP:g} m grid, random points and footprint polygons, none of them a planning "
+        f"sample) for {' and '.join(r7.COVERAGE_KINDS)} terrain, with the altitude it costs; "
+        f"full plans (lattice, lowest altitudes, tours, Bézier paths) for {plans}."
     )
     sec = ChapterSection(
         key="ch7",
