@@ -54,14 +54,17 @@ def ch2(scene: str, law: str, seed: int, record: bool) -> dict[str, Any]:
 
 
 def ch3(scene: str, law: str, seed: int, known: bool) -> dict[str, Any]:
-    from uvnav.controllers.base3d import make_controller3d
+    from uvnav.controllers.base import make_law
     from uvnav.scenarios import load_scenario
     from uvnav.sim.episode3d import run_episode3d
 
     sc: Any = load_scenario(scene)
     setup = sc.build(seed, velocities="known" if known else "estimated")
     res, traj = run_episode3d(
-        setup, make_controller3d(law, oracle=known), np.random.default_rng(seed), record=True
+        setup,
+        make_law(law, vehicle="vehicle3d", oracle=known),
+        np.random.default_rng(seed),
+        record=True,
     )
     assert traj is not None
     return {

@@ -48,7 +48,7 @@ import pandas as pd
 from uvnav.bench.campaign import run_in_workers
 from uvnav.bench.store import ResultsStore, params_hash
 from uvnav.bench.summary import outcome_stats
-from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
+from uvnav.controllers.base import make_law
 from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin, load_uuv2d_scenario
 from uvnav.sim.episode_uuv2d import Uuv2dResult, run_uuv2d_episode
 from uvnav.sim.metrics import METRIC_NAMES
@@ -94,7 +94,7 @@ def run_ch4_job(job: Ch4Job, *, record: bool = False) -> tuple[dict[str, Any], U
         sc = load_uuv2d_scenario(job.scene)
     res = run_uuv2d_episode(
         sc.to_setup(),
-        make_uuv2d_controller(job.law),
+        make_law(job.law, vehicle="uuv2d"),
         np.random.default_rng(job.seed),
         record=record,
     )
