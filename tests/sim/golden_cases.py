@@ -77,9 +77,9 @@ def ch3(scene: str, law: str, seed: int, known: bool) -> dict[str, Any]:
 
 
 def ch4(scene: str, law: str, seed: int, noise: float) -> dict[str, Any]:
-    from uvnav.bench.reproduce_ch4 import Ch4Job, run_ch4_job
+    from uvnav.bench.reproduce_ch4 import ch4_job, run_ch4_job
 
-    _row, res = run_ch4_job(Ch4Job(scene, law, seed, noise_std=noise), record=True)
+    _row, res = run_ch4_job(ch4_job(scene, law, seed, noise_std=noise), record=True)
     tr = res.trajectory
     assert tr is not None
     return {
