@@ -93,9 +93,9 @@ def ch4(scene: str, law: str, seed: int, noise: float) -> dict[str, Any]:
 
 
 def ch5(scene: str, locator: str, seed: int, noise: float) -> dict[str, Any]:
-    from uvnav.bench.reproduce_ch5 import Ch5Job, run_ch5_job
+    from uvnav.bench.reproduce_ch5 import ch5_job, run_ch5_job
 
-    _, res = run_ch5_job(Ch5Job(scene, locator, seed, noise_std=noise), record=True)
+    _, res = run_ch5_job(ch5_job(scene, locator, seed, noise_std=noise), record=True)
     return {
         "status": res.status,
         "metrics": _metrics(res.metrics),
