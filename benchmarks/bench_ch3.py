@@ -41,7 +41,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from ab_worker import SourceTreeWorker, serve, source_dir
 
-from uvnav.controllers.base3d import make_controller3d
+from uvnav.controllers.base import make_law
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
 from uvnav.obstacles.bodies3d import StarBody
 from uvnav.obstacles.motion3d import ARMotion3D, Obstacle3D, ObstacleState3D
@@ -73,7 +73,7 @@ def bench_decision(n_decisions: int) -> dict[str, Any]:
     res: dict[str, Any] = {}
     for mode in ("oracle", "ar"):
         world = _obstacles(10, 1, np.array([0.0, 4.0, 0.0]), 1.5)
-        c = make_controller3d("zhang2020-3d-v1", oracle=mode == "oracle")
+        c = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=mode == "oracle")
         c.reset(spec, goal, np.random.default_rng(0))
         est = FiniteDifference3D(np.random.default_rng(0))
         times, cpu_times = [], []

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 import uvnav.controllers.zhang2022_uuv2d as z22
-from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
+from uvnav.controllers.base import make_law
 from uvnav.dynamics.holonomic import HolonomicSpec
 from uvnav.obstacles.deforming import DeformingStar
 from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
@@ -115,7 +115,7 @@ def _time_law(
     and the opening detector's pair search)."""
     spec = HolonomicSpec(1.0, 2.0, 0.2)
     goal = np.array([10.0, 10.0])
-    ctrl = make_uuv2d_controller(name)
+    ctrl = make_law(name, vehicle="uuv2d")
     ctrl.reset(spec, goal, np.random.default_rng(0))
     if engine is not None:
         p = ctrl.params  # type: ignore[attr-defined]

@@ -106,12 +106,12 @@ def main() -> None:
         dec[name] = _median_time(lambda c=ctrl: c.act(obs), repeat * 20) * 1e6
     import tempfile
 
-    from uvnav.bench.reproduce_ch5 import Ch5Job, run_ch5_job
+    from uvnav.bench.reproduce_ch5 import ch5_job, run_ch5_job
     from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
     from uvnav.viz.figures_ch5 import save_animation3d
 
     tic = time.process_time()
-    _, res = run_ch5_job(Ch5Job("thesis-ch5-scene3", "geometric", 0), record=True)
+    _, res = run_ch5_job(ch5_job("thesis-ch5-scene3", "geometric", 0), record=True)
     episode_s = time.process_time() - tic
     setup = build_uuv3d(load_ch5_scenario("thesis-ch5-scene3"))
     with tempfile.TemporaryDirectory() as tmp:

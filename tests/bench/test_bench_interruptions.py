@@ -159,7 +159,7 @@ def in_process_interrupt(rng: np.random.Generator) -> tuple[str, Any]:
     if kind == "after-episode":
         return kind, raising_on_call(campaign_mod, "run_job", n, after=True)
     if kind == "after-store":
-        return kind, raising_on_call(campaign_mod, "_store_outcome", n, after=True)
+        return kind, raising_on_call(campaign_mod, "store_outcome", n, after=True)
     if kind == "in-transaction":
         return kind, interrupting_transaction(n)
     return kind, timer_interrupt(float(rng.uniform(0.001, 0.08)))

@@ -6,7 +6,7 @@ from pathlib import Path
 
 from uvnav.bench.reproduce_ch4 import (
     HARD_CAMPAIGN,
-    Ch4Job,
+    ch4_job,
     failures,
     run_jobs,
     stored_rows,
@@ -18,8 +18,8 @@ from uvnav.sim.metrics import METRIC_NAMES
 
 def test_jobs_are_stored_resumed_and_summarised(tmp_path: Path) -> None:
     jobs = [
-        Ch4Job("random-ch4:1", "zhang2022-uuv2d-v1", 1),
-        Ch4Job("random-ch4:1", "apf-uuv2d-v1", 1, noise_std=0.05),
+        ch4_job("random-ch4:1", "zhang2022-uuv2d-v1", 1),
+        ch4_job("random-ch4:1", "apf-uuv2d-v1", 1, noise_std=0.05),
     ]
     with ResultsStore(tmp_path / "uvnav.sqlite") as store:
         rows = run_jobs(jobs[:1], store, "ch4-random")
@@ -27,14 +27,19 @@ def test_jobs_are_stored_resumed_and_summarised(tmp_path: Path) -> None:
         calls: list[tuple[int, int]] = []
         rows = run_jobs(jobs, store, "ch4-random", progress=lambda k, n: calls.append((k, n)))
         assert calls == [(1, 1)]  # only the missing job ran
-        assert store.count("ch4-random") == 2 and [r["law"] for r in rows] == [j.law for j in jobs]
+        assert store.count("ch4-random") == 2 and [r["law"] for r in rows] == [
+            j.controller for j in jobs
+        ]
         # the store's own columns: controller = law, params = the sensing level, family
         frame = store.episodes_frame("ch4-random")
         assert list(frame["controller"]) == ["zhang2022-uuv2d-v1", "apf-uuv2d-v1"]
         assert set(frame["family"]) == {"random-ch4"}
         assert '"noise_std":0.05' in frame["params"].iloc[1]
         again = stored_rows(store, "ch4-random")
-    assert [r["key"] for r in again] == [j.key for j in jobs]
+    assert [(r["scene"], r["law"], r["seed"]) for r in again] == [
+        (j.label, j.controller, j.seed) for j in jobs
+    ]
+    assert again[1]["key"] == "random-ch4:1|apf-uuv2d-v1|1|0.05|0"
     assert again[1]["noise_std"] == 0.05 and again[0]["n_obstacles"] >= 1
     assert again[0]["status"] == rows[0]["status"]
     assert again[0]["path_length"] == rows[0]["path_length"]
@@ -52,3 +57,29 @@ def test_jobs_are_stored_resumed_and_summarised(tmp_path: Path) -> None:
 def test_a_missing_campaign_has_no_rows(tmp_path: Path) -> None:
     with ResultsStore(tmp_path / "uvnav.sqlite") as store:
         assert stored_rows(store, HARD_CAMPAIGN) == []
+
+
+def test_a_store_written_by_the_chapter_s_former_job_type_is_resumed(tmp_path: Path) -> None:
+    """Rows as the former ``Ch4Job``/``store_row`` wrote them: scenario = the scene label,
+    params = the sensing level; the same episodes are skipped, not run again."""
+    old_params = {"noise_std": 0.05, "dropout": 0.0}
+    with ResultsStore(tmp_path / "uvnav.sqlite") as store:
+        cid = store.campaign("ch4-noise", {"chapter": 4})
+        store.add_episode(
+            cid,
+            scenario="random-ch4:3",
+            controller="apf-uuv2d-v1",
+            seed=3,
+            status="timeout",
+            params=old_params,
+            metrics={m: None for m in METRIC_NAMES} | {"success": False, "collision": False},
+            family="random-ch4",
+            effective_params={**old_params, "n_obstacles": 4, "entered_forbidden": False},
+            wall_time=1.5,
+        )
+        calls: list[tuple[int, int]] = []
+        job = ch4_job("random-ch4:3", "apf-uuv2d-v1", 3, noise_std=0.05)
+        rows = run_jobs([job], store, "ch4-noise", progress=lambda k, n: calls.append((k, n)))
+        assert calls == [] and store.count("ch4-noise") == 1
+    assert rows[0]["status"] == "timeout" and rows[0]["n_obstacles"] == 4
+    assert rows[0]["key"] == "random-ch4:3|apf-uuv2d-v1|3|0.05|0"

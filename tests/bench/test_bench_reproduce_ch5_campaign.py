@@ -12,8 +12,8 @@ import pytest
 from uvnav.bench import reproduce_ch5 as r5
 from uvnav.bench.reproduce_ch5 import (
     LAW,
-    Ch5Job,
     cached_dataset,
+    ch5_job,
     run_jobs,
     stored_rows,
     summarise,
@@ -50,7 +50,7 @@ class _KilledError(Exception):
 def test_campaign_rows_are_stored_and_an_interrupted_campaign_resumes(
     tmp_path: Path, short_scene: str
 ) -> None:
-    jobs = [Ch5Job(short_scene, "geometric", 0), Ch5Job(short_scene, "oracle", 0, 0.05)]
+    jobs = [ch5_job(short_scene, "geometric", 0), ch5_job(short_scene, "oracle", 0, 0.05)]
     db = tmp_path / "uvnav.sqlite"
 
     def stop_after_first() -> None:
@@ -66,7 +66,7 @@ def test_campaign_rows_are_stored_and_an_interrupted_campaign_resumes(
             scenario=short_scene,
             controller=LAW,
             seed=0,
-            params=jobs[0].params,
+            params=jobs[0].store_params,
         )
         rows = run_jobs(jobs, store, r5.RANDOM_CAMPAIGN)
         assert store.count(r5.RANDOM_CAMPAIGN) == 2  # only the missing episode ran
@@ -75,7 +75,7 @@ def test_campaign_rows_are_stored_and_an_interrupted_campaign_resumes(
             scenario=short_scene,
             controller=LAW,
             seed=0,
-            params=jobs[0].params,
+            params=jobs[0].store_params,
         )
         assert again == first_id
         frame = store.episodes_frame(r5.RANDOM_CAMPAIGN)
@@ -95,15 +95,15 @@ def test_campaign_rows_are_stored_and_an_interrupted_campaign_resumes(
 
 
 def test_network_jobs_key_on_the_checkpoint_digest() -> None:
-    a = Ch5Job("random-ch5:1", "network", 1, 0.0, "m", "aaaa")
-    b = Ch5Job("random-ch5:1", "network", 1, 0.0, "m", "bbbb")
-    g1 = Ch5Job("random-ch5:1", "geometric", 1, 0.0, None, "")
-    g2 = Ch5Job("random-ch5:1", "geometric", 1, 0.0, "m", "cccc")
+    a = ch5_job("random-ch5:1", "network", 1, 0.0, "m", "aaaa")
+    b = ch5_job("random-ch5:1", "network", 1, 0.0, "m", "bbbb")
+    g1 = ch5_job("random-ch5:1", "geometric", 1, 0.0, None, "")
+    g2 = ch5_job("random-ch5:1", "geometric", 1, 0.0, "m", "cccc")
     assert a.key != b.key  # another network: the episode runs again
     assert g1.key == g2.key  # the digest means nothing to the other locators
     # random scenes carry the generator's version: a store of older scenes is not reused
-    assert g1.params["generator"] == RANDOM_CH5_VERSION
-    assert "generator" not in Ch5Job("thesis-ch5-scene1", "geometric", 0).params
+    assert g1.store_params["generator"] == RANDOM_CH5_VERSION
+    assert "generator" not in ch5_job("thesis-ch5-scene1", "geometric", 0).store_params
 
 
 def test_cached_dataset_resumes_the_same_data_and_random_stream(tmp_path: Path) -> None:
@@ -208,8 +208,8 @@ def test_dense_jobs_form_their_own_campaign_and_table_rows() -> None:
     jobs = r5._campaign_jobs(2, (0.0, 0.05), Path("m"), "digest", n_dense=1)
     assert len(jobs[r5.RANDOM_CAMPAIGN]) == len(jobs[r5.NOISE_CAMPAIGN]) == 2 * len(r5.LOCATORS)
     dense = jobs[r5.DENSE_CAMPAIGN]
-    assert [j.scene for j in dense] == ["random-ch5-dense:0"] * len(r5.LOCATORS)
-    assert all(j.noise_std == 0.0 and "generator" in j.params for j in dense)
+    assert [j.label for j in dense] == ["random-ch5-dense:0"] * len(r5.LOCATORS)
+    assert all(j.store_params["noise_std"] == 0.0 and "generator" in dict(j.tags) for j in dense)
     row = {"locator": "geometric", "noise_std": 0.0, "success": True, "entered_inner_space": False}
     summary = r5.Ch5Summary(db_path=Path("x"))
     summary.closed_loop = [
@@ -237,3 +237,32 @@ def test_model_keys_name_every_variant_and_nothing_else() -> None:
 
     caption = _ch5_caption(Path("ch5_errors_n150h_independent.png"))
     assert "150-sample residual (Huber loss) network on the independent test set" in caption
+
+
+def test_a_store_written_by_the_chapter_s_former_job_type_is_resumed(
+    tmp_path: Path, short_scene: str
+) -> None:
+    """A row as the former ``Ch5Job``/``store_row`` wrote it (params = locator + noise) is the
+    same episode: not run again, read back as it was stored."""
+    from uvnav.sim.metrics import METRIC_NAMES
+
+    old_params = {"locator": "oracle", "noise_std": 0.05}
+    with ResultsStore(tmp_path / "uvnav.sqlite") as store:
+        cid = store.campaign(r5.NOISE_CAMPAIGN, {"chapter": 5})
+        store.add_episode(
+            cid,
+            scenario=short_scene,
+            controller=LAW,
+            seed=0,
+            status="collision",
+            params=old_params,
+            metrics={m: None for m in METRIC_NAMES} | {"success": False, "collision": True},
+            family=short_scene,
+            effective_params={**old_params, "n_obstacles": 1, "entered_inner_space": True},
+        )
+        calls: list[int] = []
+        job = ch5_job(short_scene, "oracle", 0, 0.05)
+        rows = run_jobs([job], store, r5.NOISE_CAMPAIGN, on_episode=lambda: calls.append(1))
+        assert calls == [1] and store.count(r5.NOISE_CAMPAIGN) == 1
+    assert rows[0]["status"] == "collision" and rows[0]["entered_inner_space"] is True
+    assert (rows[0]["locator"], rows[0]["noise_std"], rows[0]["model"]) == ("oracle", 0.05, "")

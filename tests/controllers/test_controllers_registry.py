@@ -29,15 +29,13 @@ def test_unknown_name_lists_the_known_ones() -> None:
 
 
 def test_one_registry_views_each_vehicle_apart() -> None:
-    from uvnav.controllers.base import ControllerInfo, register
-    from uvnav.controllers.base3d import available_controllers3d, make_controller3d
-    from uvnav.controllers.zhang2022_uuv2d import available_uuv2d_controllers
+    from uvnav.controllers.base import ControllerInfo, available_controllers, make_law, register
 
     unicycle = available_controllers()
     everything = available_controllers(None)
     assert {i.vehicle for i in unicycle.values()} == {"unicycle"}
     holonomic = available_controllers("holonomic")
-    assert set(available_controllers3d()) | set(available_uuv2d_controllers()) | set(
+    assert set(available_controllers("vehicle3d")) | set(available_controllers("uuv2d")) | set(
         unicycle
     ) | set(holonomic) == set(everything)
     assert "zhang2020-3d-v1" not in unicycle and "zhang2020-3d-v1" in everything
@@ -45,7 +43,7 @@ def test_one_registry_views_each_vehicle_apart() -> None:
     with pytest.raises(UnknownControllerError, match="drives the vehicle3d vehicle"):
         make_controller("zhang2020-3d-v1")
     with pytest.raises(UnknownControllerError, match="drives the unicycle vehicle"):
-        make_controller3d("zhang2019-v1")
+        make_law("zhang2019-v1", vehicle="vehicle3d")
     with pytest.raises(ValueError, match="unknown vehicle 'boat'"):
         register(ControllerInfo("boat-v1", object, None, "", vehicle="boat"))
     assert "boat-v1" not in available_controllers(None)

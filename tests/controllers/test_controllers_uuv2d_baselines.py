@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
+from uvnav.controllers.base import make_law
 from uvnav.controllers.uuv2d_baselines import reading_from_points
-from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
 from uvnav.scenarios.uuv2d import load_uuv2d_scenario
 from uvnav.sim.episode_uuv2d import run_uuv2d_episode
 
@@ -17,7 +17,7 @@ from uvnav.sim.episode_uuv2d import run_uuv2d_episode
 def test_baseline_runs_within_the_limits_and_avoids_the_fig_4_7_obstacle(name: str) -> None:
     sc = load_uuv2d_scenario("thesis-ch4-fig4-7-approach")
     res = run_uuv2d_episode(
-        sc.to_setup(), make_uuv2d_controller(name), np.random.default_rng(0), record=False
+        sc.to_setup(), make_law(name, vehicle="uuv2d"), np.random.default_rng(0), record=False
     )
     assert res.metrics.limit_violations == 0
     assert res.status == "success"

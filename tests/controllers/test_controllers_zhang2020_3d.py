@@ -9,8 +9,12 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from uvnav.controllers.base import ControllerParamsError, UnknownControllerError
-from uvnav.controllers.base3d import available_controllers3d, make_controller3d
+from uvnav.controllers.base import (
+    ControllerParamsError,
+    UnknownControllerError,
+    available_controllers,
+    make_law,
+)
 from uvnav.dynamics.vehicle3d import Vehicle3DSpec
 from uvnav.geometry.frames3d import online_frame
 from uvnav.obstacles.bodies3d import SphereBody, StarBody
@@ -20,7 +24,7 @@ from uvnav.sensors.sensing3d import Observation3D, sense_obstacles3d
 SPEC = Vehicle3DSpec(v_max=1.0, u_max=1.0, radius=0.1)
 GOAL = np.array([0.0, 20.0, 0.0])
 # the laws that read exact 3D readings (the Ch. 5 sonar law has its own tests)
-LAWS3D = sorted(n for n, i in available_controllers3d().items() if i.sensing == "exact")
+LAWS3D = sorted(n for n, i in available_controllers("vehicle3d").items() if i.sensing == "exact")
 
 
 def _obs(world: list[Obstacle3D], pos=None, heading=None, t: float = 0.0) -> Observation3D:
@@ -31,7 +35,7 @@ def _obs(world: list[Obstacle3D], pos=None, heading=None, t: float = 0.0) -> Obs
 
 
 def test_m1_goes_straight_at_vmax_without_turning() -> None:
-    c = make_controller3d("zhang2020-3d-v1")
+    c = make_law("zhang2020-3d-v1", vehicle="vehicle3d")
     c.reset(SPEC, GOAL, np.random.default_rng(0))
     cmd = c.act(_obs([]))
     assert cmd.v == 1.0 and np.allclose(cmd.u, 0.0) and c.mode == "M1"
@@ -43,7 +47,7 @@ def test_fig_3_5_single_cycle_avoids_on_the_tagged_side_with_a_valid_command() -
     world = [Obstacle3D(body, ConstantMotion3D(np.array([0.5, 0.5, 0.0])),
                         ObstacleState3D(np.array([-0.8, 2.2, 0.0]),
                                         velocity=np.array([0.5, 0.5, 0.0])))]  # fmt: skip
-    c = make_controller3d("zhang2020-3d-v1", oracle=True)
+    c = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=True)
     c.reset(SPEC, GOAL, np.random.default_rng(0))
     obs = _obs(world)
     frame = online_frame(obs.position, GOAL)
@@ -61,7 +65,7 @@ def test_fig_3_5_single_cycle_avoids_on_the_tagged_side_with_a_valid_command() -
 def test_obstacle_beside_the_path_does_not_trigger_avoidance() -> None:
     world = [Obstacle3D(SphereBody(0.5), ConstantMotion3D(np.zeros(3)),
                         ObstacleState3D(np.array([4.0, 2.0, 0.0])))]  # fmt: skip
-    c = make_controller3d("zhang2020-3d-v1", oracle=True)
+    c = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=True)
     c.reset(SPEC, GOAL, np.random.default_rng(0))
     c.act(_obs(world, pos=[0.0, 0.5, 0.0]))
     assert c.mode == "M1"
@@ -69,11 +73,11 @@ def test_obstacle_beside_the_path_does_not_trigger_avoidance() -> None:
 
 def test_registry_errors_are_clear() -> None:
     with pytest.raises(UnknownControllerError, match=r"unknown controller 'nope-v1'; known: apf3d"):
-        make_controller3d("nope-v1")
+        make_law("nope-v1", vehicle="vehicle3d")
     with pytest.raises(ControllerParamsError, match="alpha0"):
-        make_controller3d("zhang2020-3d-v1", alpha0=-1.0)
+        make_law("zhang2020-3d-v1", vehicle="vehicle3d", alpha0=-1.0)
     with pytest.raises(ControllerParamsError, match="unknown parameter"):
-        make_controller3d("zhang2020-3d-v1", bogus=1)
+        make_law("zhang2020-3d-v1", vehicle="vehicle3d", bogus=1)
 
 
 coords = st.floats(-2.0, 2.0, allow_nan=False)
@@ -93,7 +97,7 @@ def test_3d_commands_are_finite_within_limits_and_orthogonal(
     pos = {"boundary": centre + np.array([0.8, 0, 0]), "centre": centre, "goal": GOAL,
            "near": centre + np.array([0, -1.0, 0])}[where]  # fmt: skip
     heading = np.array([math.cos(th), math.sin(th), 0.0])
-    c = make_controller3d(name, oracle=True)
+    c = make_law(name, vehicle="vehicle3d", oracle=True)
     c.reset(SPEC, GOAL, np.random.default_rng(0))
     for k in range(3):
         cmd = c.act(_obs(world, pos=pos, heading=heading, t=0.1 * k))
@@ -110,7 +114,7 @@ def test_a_group_is_passed_on_one_side(seed: int, motion: str) -> None:
     from uvnav.sim.episode3d import run_episode3d
 
     setup = load_scenario(f"random-ch3:{seed}").build(seed, velocities=motion)
-    law = make_controller3d("zhang2020-3d-v1", oracle=motion == "known")
+    law = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=motion == "known")
     res, _ = run_episode3d(setup, law, np.random.default_rng(seed))
     assert res.status == "success"
     assert res.metrics.min_clearance > 0.05

@@ -10,11 +10,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from uvnav.controllers.zhang2022_uuv2d import (
-    Zhang2022Uuv2dController,
-    available_uuv2d_controllers,
-    make_uuv2d_controller,
-)
+from uvnav.controllers.base import available_controllers, make_law
+from uvnav.controllers.zhang2022_uuv2d import Zhang2022Uuv2dController
 from uvnav.dynamics.holonomic import HolonomicSpec
 from uvnav.obstacles.deforming import DeformingStar
 from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
@@ -34,10 +31,10 @@ def observe(pose: np.ndarray, outlines: list[np.ndarray], centres: np.ndarray, t
 
 def test_registry_holds_the_law_and_both_baselines() -> None:
     assert {"zhang2022-uuv2d-v1", "apf-uuv2d-v1", "zhang2019-uuv2d-v1"} <= set(
-        available_uuv2d_controllers()
+        available_controllers("uuv2d")
     )
     with pytest.raises(KeyError):
-        make_uuv2d_controller("nope")
+        make_law("nope", vehicle="uuv2d")
 
 
 def test_direction_tag_is_the_side_of_the_mass_centre() -> None:
@@ -51,7 +48,7 @@ def test_avoidance_waypoint_is_a_tangent_away_from_the_mass_centre(outer: bool) 
     # a disc-like body centred right of the I->E line, its near side across the line
     body = DeformingStar.create((2.4, 2.0), math.pi * 0.8**2, np.zeros((1, 2)), max_rate=0.0)
     outline = body.outline(0.0)
-    ctrl = make_uuv2d_controller("zhang2022-uuv2d-v1", outer_tangent=outer)
+    ctrl = make_law("zhang2022-uuv2d-v1", vehicle="uuv2d", outer_tangent=outer)
     ctrl.reset(SPEC, GOAL, np.random.default_rng(0))
     pose = np.array([1.0, 1.0, math.pi / 4])
     cmd = ctrl.act(observe(pose, [outline], np.array([[2.4, 2.0]])))
@@ -84,7 +81,7 @@ def test_avoidance_waypoint_is_a_tangent_away_from_the_mass_centre(outer: bool) 
 
 def test_count_and_forecast_radius_follow_4_11_and_4_12() -> None:
     body = DeformingStar.create((3.0, 3.0), math.pi * 0.8**2, np.zeros((1, 2)), max_rate=0.0)
-    ctrl = make_uuv2d_controller("zhang2022-uuv2d-v1")
+    ctrl = make_law("zhang2022-uuv2d-v1", vehicle="uuv2d")
     ctrl.reset(SPEC, GOAL, np.random.default_rng(0))
     centres = np.array([[3.0, 3.0]])
     path = [np.array([1.55, 1.55]), np.array([1.6, 1.5]), np.array([1.7, 1.45])]
@@ -110,7 +107,7 @@ def test_count_and_forecast_radius_follow_4_11_and_4_12() -> None:
 )
 def test_commands_stay_within_the_limits(x: float, y: float, th: float, seed: int) -> None:
     body = DeformingStar.random(np.random.default_rng(seed), (3.0, 3.0), 2.0, max_rate=0.2)
-    ctrl = make_uuv2d_controller("zhang2022-uuv2d-v1")
+    ctrl = make_law("zhang2022-uuv2d-v1", vehicle="uuv2d")
     ctrl.reset(SPEC, GOAL, np.random.default_rng(0))
     pose = np.array([x, y, th])
     for k in range(3):
@@ -125,7 +122,7 @@ def test_fig_4_7_target_approaching_for_t_0_to_4() -> None:
     setup = sc.to_setup()
     setup.t_max = 4.2
     res = run_uuv2d_episode(
-        setup, make_uuv2d_controller(sc.controller.name), np.random.default_rng(0)
+        setup, make_law(sc.controller.name, vehicle="uuv2d"), np.random.default_rng(0)
     )
     tr = res.trajectory
     assert tr is not None and res.status == "timeout"
@@ -143,7 +140,7 @@ def test_decisions_are_the_same_with_either_amaps_engine() -> None:
     centres = np.array([[5.0, 5.0]])
     seen: dict[str, list[tuple[object, ...]]] = {}
     for engine in ("numpy", "numba"):
-        ctrl = make_uuv2d_controller("zhang2022-uuv2d-v1")
+        ctrl = make_law("zhang2022-uuv2d-v1", vehicle="uuv2d")
         ctrl.reset(SPEC, GOAL, np.random.default_rng(0))
         assert isinstance(ctrl, Zhang2022Uuv2dController)
         ctrl.grid = AmapsGrid.covering(
@@ -196,7 +193,7 @@ def test_the_passing_side_is_kept_when_r_min_moves_to_another_body(seed: int) ->
 
     sc = random_ch4_hard_scenario(seed)
     res = run_uuv2d_episode(
-        sc.to_setup(), make_uuv2d_controller("zhang2022-uuv2d-v1"), np.random.default_rng(seed)
+        sc.to_setup(), make_law("zhang2022-uuv2d-v1", vehicle="uuv2d"), np.random.default_rng(seed)
     )
     assert res.status == "success"
     assert res.metrics.min_clearance > 0.05

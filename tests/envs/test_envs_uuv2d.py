@@ -10,7 +10,7 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 import uvnav.envs
-from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
+from uvnav.controllers.base import make_law
 from uvnav.dynamics.holonomic import HolonomicSpec
 from uvnav.envs import as_policy
 from uvnav.envs.uuv2d import Uuv2DEnv, action_of, command_of
@@ -97,7 +97,7 @@ def test_zhang2022_as_policy_reaches_the_goal_like_in_the_simulator(scene: str) 
     assert info["clearance"] > 0 and not info["entered_forbidden"]
     sim = run_uuv2d_episode(
         load_uuv2d_scenario(scene).to_setup(),
-        make_uuv2d_controller("zhang2022-uuv2d-v1"),
+        make_law("zhang2022-uuv2d-v1", vehicle="uuv2d"),
         np.random.default_rng(0),
         record=False,
     )

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
+from uvnav.controllers.base import make_law
 from uvnav.scenarios.errors import ScenarioError
 from uvnav.scenarios.uuv2d import (
     UUV2D_GENERATORS,
@@ -37,7 +37,7 @@ def test_thesis_scene_is_collision_free_and_reaches_e(name: str) -> None:
     sc = load_uuv2d_scenario(name)
     res = run_uuv2d_episode(
         sc.to_setup(),
-        make_uuv2d_controller(sc.controller.name),
+        make_law(sc.controller.name, vehicle="uuv2d"),
         np.random.default_rng(0),
         record=False,
     )
@@ -56,7 +56,7 @@ def test_trap_scene_is_a_real_trap_and_is_never_entered() -> None:
     inner = setup.forbidden[0]
     assert np.hypot(*(inner.mean(axis=0) - np.array([5.0, 5.0]))) < 1e-9
     res = run_uuv2d_episode(
-        setup, make_uuv2d_controller("zhang2022-uuv2d-v1"), np.random.default_rng(1)
+        setup, make_law("zhang2022-uuv2d-v1", vehicle="uuv2d"), np.random.default_rng(1)
     )
     assert res.trajectory is not None
     poses = res.trajectory.poses[:, :2]

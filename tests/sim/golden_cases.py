@@ -54,14 +54,17 @@ def ch2(scene: str, law: str, seed: int, record: bool) -> dict[str, Any]:
 
 
 def ch3(scene: str, law: str, seed: int, known: bool) -> dict[str, Any]:
-    from uvnav.controllers.base3d import make_controller3d
+    from uvnav.controllers.base import make_law
     from uvnav.scenarios import load_scenario
     from uvnav.sim.episode3d import run_episode3d
 
     sc: Any = load_scenario(scene)
     setup = sc.build(seed, velocities="known" if known else "estimated")
     res, traj = run_episode3d(
-        setup, make_controller3d(law, oracle=known), np.random.default_rng(seed), record=True
+        setup,
+        make_law(law, vehicle="vehicle3d", oracle=known),
+        np.random.default_rng(seed),
+        record=True,
     )
     assert traj is not None
     return {
@@ -74,9 +77,9 @@ def ch3(scene: str, law: str, seed: int, known: bool) -> dict[str, Any]:
 
 
 def ch4(scene: str, law: str, seed: int, noise: float) -> dict[str, Any]:
-    from uvnav.bench.reproduce_ch4 import Ch4Job, run_ch4_job
+    from uvnav.bench.reproduce_ch4 import ch4_job, run_ch4_job
 
-    _row, res = run_ch4_job(Ch4Job(scene, law, seed, noise_std=noise), record=True)
+    _row, res = run_ch4_job(ch4_job(scene, law, seed, noise_std=noise), record=True)
     tr = res.trajectory
     assert tr is not None
     return {
@@ -90,9 +93,9 @@ def ch4(scene: str, law: str, seed: int, noise: float) -> dict[str, Any]:
 
 
 def ch5(scene: str, locator: str, seed: int, noise: float) -> dict[str, Any]:
-    from uvnav.bench.reproduce_ch5 import Ch5Job, run_ch5_job
+    from uvnav.bench.reproduce_ch5 import ch5_job, run_ch5_job
 
-    _, res = run_ch5_job(Ch5Job(scene, locator, seed, noise_std=noise), record=True)
+    _, res = run_ch5_job(ch5_job(scene, locator, seed, noise_std=noise), record=True)
     return {
         "status": res.status,
         "metrics": _metrics(res.metrics),

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from uvnav.controllers.base3d import make_controller3d
+from uvnav.controllers.base import make_law
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
 from uvnav.geometry.mesh3d import box_mesh
 from uvnav.obstacles.bodies3d import MeshBody, SphereBody
@@ -61,7 +61,7 @@ def test_unrecorded_and_recorded_runs_give_identical_metrics() -> None:
     def run(record: bool) -> dict:
         ob = Obstacle3D(SphereBody(1.0), ConstantMotion3D(np.array([0.0, 0.2, 0.0])),
                         ObstacleState3D(np.array([5.0, -1.5, 0.3])))  # fmt: skip
-        c = make_controller3d("zhang2020-3d-v1", oracle=True)
+        c = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=True)
         res, _ = run_episode3d(_setup([ob]), c, np.random.default_rng(1), record=record)
         d = res.metrics.to_dict()
         d.pop("decision_us_median"), d.pop("decision_us_p99")
@@ -83,7 +83,7 @@ def test_zhang2020_3d_reaches_e_without_collision_on_the_thesis_scenes(
 ) -> None:
     sc = load_scenario(scene)
     setup = sc.build(0, velocities=velocities)
-    c = make_controller3d("zhang2020-3d-v1", oracle=velocities == "known")
+    c = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=velocities == "known")
     res, _ = run_episode3d(setup, c, np.random.default_rng(0), record=False)
     assert res.status == "success"
     assert res.metrics.min_clearance > 0.1
@@ -108,7 +108,7 @@ def test_compiled_kernels_and_numpy_fallback_give_the_same_episode(
         sc = random_ch3_scenario(3)
         setup = sc.build(3, velocities="known")
         setup.t_max = 15.0
-        c = make_controller3d("zhang2020-3d-v1", oracle=True)
+        c = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=True)
         res, _ = run_episode3d(setup, c, np.random.default_rng(3), record=False)
         out.append(res)
     a, b = out

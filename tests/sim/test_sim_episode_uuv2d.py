@@ -8,7 +8,7 @@ from typing import ClassVar
 import numpy as np
 import shapely
 
-from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
+from uvnav.controllers.base import make_law
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec
 from uvnav.scenarios.uuv2d import load_uuv2d_scenario, random_ch4_scenario
 from uvnav.sensors.sonar2d import SonarObservation
@@ -56,10 +56,10 @@ def test_straight_run_collides_exactly_when_the_disc_touches_the_body() -> None:
 def test_same_seed_same_run_with_a_noisy_sonar() -> None:
     sc = random_ch4_scenario(5, noise_std=0.05, dropout=0.1)
     a = run_uuv2d_episode(
-        sc.to_setup(), make_uuv2d_controller("zhang2022-uuv2d-v1"), np.random.default_rng(9)
+        sc.to_setup(), make_law("zhang2022-uuv2d-v1", vehicle="uuv2d"), np.random.default_rng(9)
     )
     b = run_uuv2d_episode(
-        sc.to_setup(), make_uuv2d_controller("zhang2022-uuv2d-v1"), np.random.default_rng(9)
+        sc.to_setup(), make_law("zhang2022-uuv2d-v1", vehicle="uuv2d"), np.random.default_rng(9)
     )
     assert a.trajectory is not None and b.trajectory is not None
     assert np.array_equal(a.trajectory.poses, b.trajectory.poses)

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 
-from uvnav.controllers.base3d import make_controller3d
+from uvnav.controllers.base import make_law
 from uvnav.dynamics.vehicle3d import Vehicle3DSpec
 from uvnav.geometry.mesh3d import box_mesh
 from uvnav.obstacles.bodies3d import MeshBody
@@ -23,7 +23,7 @@ def test_render_ch3_writes_every_figure(tmp_path: Path) -> None:
                            heading=np.array([1.0, 0, 0]), goal=np.array([6.0, 0, 0]),
                            obstacles=[ob], t_max=12.0,
                            sensing=Sensing3DConfig(velocities="known"))  # fmt: skip
-    res, tr = run_episode3d(setup, make_controller3d("zhang2020-3d-v1", oracle=True),
+    res, tr = run_episode3d(setup, make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=True),
                             np.random.default_rng(0))  # fmt: skip
     assert res.status == "success" and tr is not None
     assert np.isfinite(tr.predicted_velocity).any()  # the law's predictions were recorded

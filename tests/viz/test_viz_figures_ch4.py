@@ -6,7 +6,7 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 
-from uvnav.bench.reproduce_ch4 import Ch4Job, run_ch4_job
+from uvnav.bench.reproduce_ch4 import ch4_job, run_ch4_job
 from uvnav.viz.figures_ch4 import (
     first_avoidance,
     plot_amaps,
@@ -18,7 +18,7 @@ from uvnav.viz.figures_ch4 import (
 
 def test_figures_of_the_thesis_scenes(tmp_path: Path) -> None:
     scene = "thesis-ch4-fig4-8-decision"
-    res = run_ch4_job(Ch4Job(scene, "zhang2022-uuv2d-v1", 0), record=True)[1]
+    res = run_ch4_job(ch4_job(scene, "zhang2022-uuv2d-v1", 0), record=True)[1]
     traj = res.trajectory
     assert traj is not None
     k = first_avoidance(traj)

@@ -126,10 +126,10 @@ def test_add_files_sorts_images_and_links(tmp_path: Path) -> None:
 
 def test_ch4_section_from_a_real_recorded_run(tmp_path: Path) -> None:
     """Chapter 4: one real thesis-scene run drawn by the CLI's renderer, then the section."""
-    from uvnav.bench.reproduce_ch4 import LAW, Ch4Job, _table, run_ch4_job
+    from uvnav.bench.reproduce_ch4 import LAW, _table, ch4_job, run_ch4_job
 
     scene = "thesis-ch4-fig4-7-approach"
-    r, res = run_ch4_job(Ch4Job(scene, LAW, 0), record=True)
+    r, res = run_ch4_job(ch4_job(scene, LAW, 0), record=True)
     renderers = chapter_renderers()
     assert renderers.ch4 is not None
     figs = renderers.ch4(tmp_path / "report" / "ch4", {(scene, LAW): res})

@@ -59,6 +59,8 @@ T = TypeVar("T")
 R = TypeVar("R")
 
 SetupFactory = Callable[[int], EpisodeSetup]
+#: what a job's ``runner`` returns: status, metrics, trajectory (or ``None``), facts to store
+EpisodeRun = tuple[str, dict[str, Any], Any, dict[str, Any]]
 
 
 def _freeze(
@@ -72,7 +74,8 @@ def _freeze(
 class Job:
     """One episode to run: where the scene comes from, which controller, which seed.
 
-    Exactly one scene source must be given: ``scenario``, ``generator_seed`` or ``setup_factory``.
+    Exactly one scene source must be given: ``scenario``, ``generator_seed``, ``setup_factory``
+    or ``runner``.
 
     Attributes:
         controller: registry name, e.g. ``"zhang2019-v1"``.
@@ -96,6 +99,12 @@ class Job:
         record: keep the trajectory and store it (for figures; costs memory and disk).
         beyond_assumptions: run the law even where the scene breaks an assumption it declares
             (thesis (2.6)); by default such an episode is stored as ``refused``.
+        tags: what identifies the episode beyond the controller parameters (a chapter's sensing
+            level, locator, ...): stored with them in the ``params`` column and part of the
+            resume key, never passed to the law (a mapping is frozen to sorted pairs).
+        runner: a *module-level* (picklable) function ``job -> (status, metrics, trajectory,
+            facts)`` running a chapter's own episode of ``label`` (a chapter's world set-up);
+            ``facts`` are stored in ``effective_params`` after the tags.
     """
 
     controller: str
@@ -111,17 +120,21 @@ class Job:
     use_scenario_params: bool = True
     record: bool = False
     beyond_assumptions: bool = False
+    tags: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
+    runner: Callable[[Job], EpisodeRun] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", _freeze(self.params))
         object.__setattr__(self, "generator_params", _freeze(self.generator_params))
-        sources = sum(
-            x is not None for x in (self.scenario, self.generator_seed, self.setup_factory)
-        )
+        object.__setattr__(self, "tags", _freeze(self.tags))
+        own = (self.setup_factory, self.runner)
+        sources = sum(x is not None for x in (self.scenario, self.generator_seed, *own))
         if sources != 1:
-            raise ValueError("a Job needs exactly one of scenario, generator_seed, setup_factory")
-        if self.setup_factory is not None and self.label is None:
-            raise ValueError("a Job with a setup_factory needs a label")
+            raise ValueError(
+                "a Job needs exactly one of scenario, generator_seed, setup_factory, runner"
+            )
+        if any(x is not None for x in own) and self.label is None:
+            raise ValueError("a Job with a setup_factory or a runner needs a label")
         if self.generator_seed is not None:
             from uvnav.scenarios.catalog import generators  # layer 5, imported when needed
 
@@ -137,6 +150,12 @@ class Job:
     def params_dict(self) -> dict[str, Any]:
         """The controller parameters as a dict."""
         return dict(self.params)
+
+    @property
+    def store_params(self) -> dict[str, Any]:
+        """What the store's ``params`` column holds and the resume key hashes: the controller
+        parameters and the :attr:`tags`."""
+        return {**dict(self.params), **dict(self.tags)}
 
     @property
     def generator_label(self) -> str:
@@ -172,7 +191,12 @@ class Job:
     @property
     def key(self) -> EpisodeKey:
         """Resume key ``(scenario, controller, params_hash, seed)``."""
-        return (self.scenario_label, self.controller, params_hash(self.params_dict), int(self.seed))
+        return (
+            self.scenario_label,
+            self.controller,
+            params_hash(self.store_params),
+            int(self.seed),
+        )
 
 
 @dataclass
@@ -186,7 +210,9 @@ class JobOutcome:
         error: ``"ExceptionType: message"`` for an error, else ``None``.
         wall_time: time spent in the worker, building included [s].
         trajectory: recorded trajectory when ``job.record``.
-        effective_params: parameters the controller was built with.
+        effective_params: parameters the controller was built with (a ``runner``'s job: its
+            tags and facts).
+        result: a ``runner``'s own result when ``job.record`` (for figures; never stored).
     """
 
     job: Job
@@ -196,6 +222,7 @@ class JobOutcome:
     wall_time: float
     trajectory: Trajectory | None = None
     effective_params: dict[str, Any] = field(default_factory=dict)
+    result: Any = None
 
 
 def _plain(params: Any) -> dict[str, Any]:
@@ -272,14 +299,18 @@ def run_job(job: Job) -> JobOutcome:
     scene that breaks an assumption the law declares a ``refused`` one.
 
     Jobs with a scene (any kind) run through :func:`uvnav.scenarios.episodes.run_scene`, the
-    path of ``uvnav simulate``; jobs with a ``setup_factory`` run the 2D loop directly.
+    path of ``uvnav simulate``; jobs with a ``setup_factory`` run the 2D loop directly, jobs with
+    a ``runner`` their chapter's own episode.
     """
     from uvnav.scenarios.episodes import AssumptionError, LawMismatchError
 
     tic = time.perf_counter()
     params: dict[str, Any] = job.params_dict
     try:
-        if job.setup_factory is not None:
+        if job.runner is not None:
+            status, metrics, traj, facts = job.runner(job)
+            params = {**job.store_params, **facts}
+        elif job.setup_factory is not None:
             from uvnav.controllers import make_controller
 
             setup = job.setup_factory(int(job.seed))
@@ -313,6 +344,7 @@ def run_job(job: Job) -> JobOutcome:
         wall_time=time.perf_counter() - tic,
         trajectory=traj if job.record and isinstance(traj, Trajectory) else None,
         effective_params=params,
+        result=traj if job.record and job.runner is not None else None,
     )
 
 
@@ -341,14 +373,14 @@ class CampaignRun:
     wall_time: float = 0.0
 
 
-def _store_outcome(store: ResultsStore, campaign_id: int, out: JobOutcome) -> int:
+def store_outcome(store: ResultsStore, campaign_id: int, out: JobOutcome) -> int:
     job = out.job
     return store.add_episode(
         campaign_id,
         scenario=job.scenario_label,
         family=job.family_label,
         controller=job.controller,
-        params=job.params_dict,
+        params=job.store_params,
         effective_params=out.effective_params,
         seed=job.seed,
         status=out.status,
@@ -357,6 +389,101 @@ def _store_outcome(store: ResultsStore, campaign_id: int, out: JobOutcome) -> in
         wall_time=out.wall_time,
         trajectory=out.trajectory,
     )
+
+
+def _value(v: Any) -> Any:
+    """A stored value as plain Python (missing -> None, numpy scalars -> Python)."""
+    import numpy as np
+    import pandas as pd
+
+    if v is None or (not isinstance(v, str) and pd.isna(v)):
+        return None
+    return v.item() if isinstance(v, np.generic) else v
+
+
+def outcome_record(out: JobOutcome) -> dict[str, Any]:
+    """An outcome as :func:`stored_records` reads it back once stored (``params_hash`` left out).
+
+    Raises:
+        RuntimeError: the job failed (its error message).
+    """
+    if out.error is not None:
+        raise RuntimeError(f"{out.job.scenario_label} {out.job.controller}: {out.error}")
+    job = out.job
+    return {
+        "scenario": job.scenario_label,
+        "controller": job.controller,
+        "seed": int(job.seed),
+        "status": out.status,
+        "params": job.store_params,
+        "effective_params": out.effective_params,
+        "wall_time": out.wall_time,
+        **(out.metrics or {}),
+    }
+
+
+def stored_records(store: ResultsStore, campaign: str) -> list[dict[str, Any]]:
+    """A campaign's episodes as plain dicts, in store order: ``scenario``, ``controller``,
+    ``seed``, ``status``, ``params`` and ``effective_params`` (dicts), ``params_hash``,
+    ``wall_time`` [s] and every
+    metric of :data:`~uvnav.sim.metrics.METRIC_NAMES` (``None`` where missing); ``[]`` for a
+    campaign not in the store."""
+    import json
+
+    from uvnav.sim.metrics import METRIC_NAMES
+
+    if store.campaign_id(campaign) is None:
+        return []
+    return [
+        {
+            "scenario": rec["scenario"],
+            "controller": rec["controller"],
+            "seed": int(rec["seed"]),
+            "status": rec["status"],
+            "params": json.loads(rec["params"]),
+            "params_hash": rec["params_hash"],
+            "effective_params": json.loads(rec["effective_params"] or "{}"),
+            "wall_time": _value(rec["wall_time"]),
+            **{m: _value(rec[m]) for m in METRIC_NAMES},
+        }
+        for rec in store.episodes_frame(campaign).to_dict("records")
+    ]
+
+
+def run_stored(
+    store: ResultsStore,
+    name: str,
+    jobs: Sequence[Job],
+    *,
+    config: Mapping[str, Any],
+    workers: int = 1,
+    on_outcome: Callable[[JobOutcome, int], None] | None = None,
+) -> list[dict[str, Any]]:
+    """Run ``jobs`` as campaign ``name`` (:func:`run_campaign`: each episode stored as it
+    finishes, stored ones skipped) and return the :func:`stored_records` of the jobs, in job
+    order: the chapters' campaigns.
+
+    Raises:
+        RuntimeError: a job failed (stored with status ``error``; a later run retries it).
+    """
+    errors: list[str] = []
+
+    def seen(out: JobOutcome, episode_id: int) -> None:
+        if out.error is not None:
+            errors.append(f"{out.job.scenario_label} {out.job.controller}: {out.error}")
+        if on_outcome is not None:
+            on_outcome(out, episode_id)
+
+    run_campaign(
+        store, name, jobs, config=config, workers=workers, retry_errors=True, on_outcome=seen
+    )
+    if errors:
+        raise RuntimeError(f"{name}: {len(errors)} episode(s) failed, first {errors[0]}")
+    by_key = {
+        (r["scenario"], r["controller"], r["params_hash"], r["seed"]): r
+        for r in stored_records(store, name)
+    }
+    return [by_key[j.key] for j in jobs if j.key in by_key]
 
 
 def default_mp_context() -> mp.context.BaseContext:
@@ -467,7 +594,7 @@ def _run_campaign(
     bar = _ProgressBar(name, len(todo), run.skipped) if progress and todo else None
 
     def handle(out: JobOutcome) -> None:
-        episode_id = _store_outcome(store, campaign_id, out)
+        episode_id = store_outcome(store, campaign_id, out)
         run.ran += 1
         run.errors += out.status == STATUS_ERROR
         run.statuses[out.status] = run.statuses.get(out.status, 0) + 1

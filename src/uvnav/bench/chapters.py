@@ -308,70 +308,26 @@ def reproduce_chapter(
 
         n = seeds if seeds is not None else (rp.FULL_SEEDS if full else rp.QUICK_SEEDS)
         summary = rp.reproduce(
-            results_dir,
-            report_dir,
-            full=full,
-            workers=workers,
-            progress=progress,
-            n_random=n,
-            start_seed=start_seed,
-            n_baseline_seeds=seeds,
-            render=render,
-            ch7=False,
-            ch5=False,
+            results_dir, report_dir, full=full, workers=workers, progress=progress, n_random=n,
+            start_seed=start_seed, n_baseline_seeds=seeds, render=render, ch7=False, ch5=False,
             save_sections=False,
-        )
+        )  # fmt: skip
         section = next(s for s in summary.sections if s.key == "ch2")
         report_path = summary.report_path
-    elif chapter == "ch3":
-        section, summary = run_ch3(
-            results_dir,
-            report_dir,
-            full=full,
-            workers=workers,
-            renderers=rend,
-            seeds=seeds,
-            start_seed=start_seed,
-            progress=False,
-        )
-    elif chapter == "ch4":
-        section, summary = run_ch4(
-            results_dir,
-            report_dir,
-            full=full,
-            workers=workers,
-            renderers=rend,
-            seeds=seeds,
-            start_seed=start_seed,
-        )
-    elif chapter == "ch5":
-        section, summary = run_ch5(
-            results_dir,
-            report_dir,
-            full=full,
-            workers=workers,
-            renderers=rend,
-            seeds=seeds,
-            start_seed=start_seed,
-            progress=progress,
-        )
-    elif chapter == "ch6":
-        section, summary = run_ch6(
-            results_dir, report_dir, full=full, renderers=rend, progress=progress
-        )
-    elif chapter == "ch7":
-        section, summary = run_ch7(results_dir, report_dir, full=full, renderers=rend)
-    elif chapter == "crowds":
-        section, summary = run_crowds(
-            results_dir,
-            full=full,
-            workers=workers,
-            seeds=seeds,
-            start_seed=start_seed,
-            progress=progress,
-        )
     else:
-        section, summary = run_beyond(report_dir, full=full, renderers=rend)
+        dirs = (results_dir, report_dir)
+        seeded: dict[str, Any] = {"full": full, "workers": workers, "seeds": seeds}
+        seeded["start_seed"] = start_seed
+        runs: dict[str, Callable[[], tuple[ChapterSection, Any]]] = {
+            "ch3": lambda: run_ch3(*dirs, **seeded, renderers=rend, progress=False),
+            "ch4": lambda: run_ch4(*dirs, **seeded, renderers=rend),
+            "ch5": lambda: run_ch5(*dirs, **seeded, renderers=rend, progress=progress),
+            "ch6": lambda: run_ch6(*dirs, full=full, renderers=rend, progress=progress),
+            "ch7": lambda: run_ch7(*dirs, full=full, renderers=rend),
+            "crowds": lambda: run_crowds(results_dir, **seeded, progress=progress),
+            "beyond": lambda: run_beyond(report_dir, full=full, renderers=rend),
+        }
+        section, summary = runs[chapter]()
     path = save_section(section, results_dir / SECTIONS_DIR)
     return ChapterRun(
         chapter=chapter,

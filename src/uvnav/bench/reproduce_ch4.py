@@ -15,18 +15,20 @@
    narrower gaps; :func:`~uvnav.scenarios.uuv2d.random_ch4_hard_scenario`) with the three laws
    (quick: 4 seeds; ``full``: 100) — campaign ``ch4-hard``.
 
-Every episode is a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
+Every episode is an ordinary campaign job (:class:`~uvnav.bench.campaign.Job` with this chapter's
+runner, :func:`ch4_job`; run, stored and resumed by :func:`~uvnav.bench.campaign.run_campaign`) and
+a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
 ``results_dir/uvnav.sqlite``, the database ``uvnav run`` and Chapter 3 use, DESIGN §5): the
-``controller`` column holds the law, ``params`` the sensing level (``{"noise_std", "dropout"}``,
-part of the resume key), ``family`` the generator (``random-ch4``, ``random-ch4-hard``) or the
-scene, the metrics of :data:`~uvnav.sim.metrics.METRIC_NAMES` their own columns; the two facts
-the store has no column for, the number of obstacles and whether a forbidden region (the
-Fig. 4.2(b) inner space) was entered, are kept in ``effective_params``.  Campaigns resume (a
-re-run skips the stored episodes) and only add to the store: no run deletes or replaces another
-run's episodes.  The summary (``results_dir/ch4/summary.json``)
-and the table "thesis reported vs uvnav measured" are computed from the stored rows, never typed
-in.  The thesis reports no numbers for Chapter 4 (only Figs. 4.7-4.9: the vehicle reaches E
-without collision), so the table's thesis column states that.
+``controller`` column holds the law, ``params`` the sensing level (the job's tags: ``{"noise_std",
+"dropout"}``, part of the resume key), ``family`` the generator (``random-ch4``,
+``random-ch4-hard``) or the scene, the metrics of :data:`~uvnav.sim.metrics.METRIC_NAMES` their own
+columns; the two facts the store has no column for, the number of obstacles and whether a forbidden
+region (the Fig. 4.2(b) inner space) was entered, are kept in ``effective_params``. Campaigns
+resume (a re-run skips the stored episodes) and only add to the store: no run deletes or replaces
+another run's episodes. The summary (``results_dir/ch4/summary.json``) and the table "thesis
+reported vs uvnav measured" are computed from the stored rows, never typed in. The thesis reports
+no numbers for Chapter 4 (only Figs. 4.7-4.9: the vehicle reaches E without collision), so the
+table's thesis column states that.
 
 Figures are made by a renderer injected by the caller (``render=``; the CLI passes
 :func:`uvnav.viz.figures_ch4.render_ch4`), because ``bench`` (layer 6) must not import ``viz``.
@@ -34,21 +36,28 @@ Figures are made by a renderer injected by the caller (``render=``; the CLI pass
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
-import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
-from uvnav.bench.campaign import run_in_workers
-from uvnav.bench.store import ResultsStore, params_hash
+from uvnav.bench.campaign import (
+    EpisodeRun,
+    Job,
+    outcome_record,
+    run_job,
+    run_stored,
+    store_outcome,
+    stored_records,
+)
+from uvnav.bench.store import ResultsStore
 from uvnav.bench.summary import outcome_stats
-from uvnav.controllers.zhang2022_uuv2d import make_uuv2d_controller
+from uvnav.controllers.base import make_law
 from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin, load_uuv2d_scenario
 from uvnav.sim.episode_uuv2d import Uuv2dResult, run_uuv2d_episode
 from uvnav.sim.metrics import METRIC_NAMES
@@ -70,122 +79,67 @@ HARD_CAMPAIGN = "ch4-hard"
 CAMPAIGNS: tuple[str, ...] = (RANDOM_CAMPAIGN, NOISE_CAMPAIGN, HARD_CAMPAIGN)
 
 
-@dataclass(frozen=True)
-class Ch4Job:
-    """One episode: a scene (built-in name or ``random-ch4:<seed>``), a law, a seed, noise."""
-
-    scene: str
-    law: str
-    seed: int
-    noise_std: float = 0.0
-    dropout: float = 0.0
-
-    @property
-    def key(self) -> str:
-        return f"{self.scene}|{self.law}|{self.seed}|{self.noise_std:g}|{self.dropout:g}"
+def ch4_job(scene: str, law: str, seed: int, noise_std: float = 0.0, dropout: float = 0.0) -> Job:
+    """One episode as a campaign job: a scene (built-in name or ``random-ch4:<seed>``), a law,
+    a seed and the sonar's sensing level (the job's tags: the store's ``params``, part of the
+    resume key, as the chapter's own job type stored them)."""
+    tags = {"noise_std": float(noise_std), "dropout": float(dropout)}
+    family = scene.split(":", 1)[0]
+    return Job(law, int(seed), label=scene, family=family, tags=tags, runner=_run_job)
 
 
-def run_ch4_job(job: Ch4Job, *, record: bool = False) -> tuple[dict[str, Any], Uuv2dResult]:
-    """Run one job; returns its JSON row and the full result."""
-    family, _, number = job.scene.partition(":")
+def run_ch4_job(job: Job, *, record: bool = False) -> tuple[dict[str, Any], Uuv2dResult]:
+    """Run one job in this process; returns its row (as :func:`stored_rows` reads it back) and
+    the full result.
+
+    Raises:
+        RuntimeError: the episode failed.
+    """
+    out = run_job(dataclasses.replace(job, record=record))
+    return _row(outcome_record(out)), out.result
+
+
+def _run_job(job: Job) -> EpisodeRun:
+    """The campaign's runner: the scene with the job's sensing level, the law, the episode."""
+    scene = str(job.label)
+    family, _, number = scene.partition(":")
     if number and family in UUV2D_GENERATORS:
-        sc = UUV2D_GENERATORS[family](int(number), noise_std=job.noise_std, dropout=job.dropout)
+        sc = UUV2D_GENERATORS[family](int(number), **dict(job.tags))
     else:
-        sc = load_uuv2d_scenario(job.scene)
-    res = run_uuv2d_episode(
-        sc.to_setup(),
-        make_uuv2d_controller(job.law),
-        np.random.default_rng(job.seed),
-        record=record,
-    )
-    row: dict[str, Any] = {
-        "key": job.key,
-        "scene": job.scene,
-        "law": job.law,
-        "seed": job.seed,
-        "noise_std": job.noise_std,
-        "dropout": job.dropout,
-        "n_obstacles": len(sc.obstacles),
-        "status": res.status,
-        "entered_forbidden": res.entered_forbidden,
-    }
-    row.update(res.metrics.to_dict())
-    return row, res
+        sc = load_uuv2d_scenario(scene)
+    law = make_law(job.controller, vehicle="uuv2d")
+    rng = np.random.default_rng(job.seed)
+    res = run_uuv2d_episode(sc.to_setup(), law, rng, record=job.record)
+    facts = {"n_obstacles": len(sc.obstacles), "entered_forbidden": bool(res.entered_forbidden)}
+    return res.status, res.metrics.to_dict(), res, facts
 
 
-def _row_only(job: Ch4Job) -> dict[str, Any]:
-    tic = time.perf_counter()
-    row = run_ch4_job(job)[0]
-    row["wall_time"] = time.perf_counter() - tic
-    return row
-
-
-def _params(job_or_row: Ch4Job | dict[str, Any]) -> dict[str, float]:
-    """The job identity beyond scene/law/seed: the sensing level (the store's ``params``)."""
-    if isinstance(job_or_row, Ch4Job):
-        return {"noise_std": job_or_row.noise_std, "dropout": job_or_row.dropout}
-    return {"noise_std": job_or_row["noise_std"], "dropout": job_or_row["dropout"]}
-
-
-def store_row(store: ResultsStore, campaign_id: int, row: dict[str, Any]) -> int:
-    """Write one episode row to the store: controller = the law, params = the sensing level,
-    family = the scene's generator (or the scene), metrics in their columns; what the store has
-    no column for (``n_obstacles``, ``entered_forbidden``) goes into ``effective_params``."""
-    return store.add_episode(
-        campaign_id,
-        scenario=row["scene"],
-        controller=row["law"],
-        seed=int(row["seed"]),
-        status=row["status"],
-        params=_params(row),
-        metrics={m: row.get(m) for m in METRIC_NAMES},
-        family=row["scene"].split(":", 1)[0],
-        effective_params={
-            **_params(row),
-            "n_obstacles": int(row["n_obstacles"]),
-            "entered_forbidden": bool(row["entered_forbidden"]),
-        },
-        wall_time=row.get("wall_time"),
-    )
+def _row(rec: dict[str, Any]) -> dict[str, Any]:
+    """A stored record (:func:`~uvnav.bench.campaign.stored_records`) as this chapter's row."""
+    extra = rec["effective_params"]
+    return {
+        "scene": rec["scenario"],
+        "law": rec["controller"],
+        "seed": int(rec["seed"]),
+        "noise_std": float(extra.get("noise_std", 0.0)),
+        "dropout": float(extra.get("dropout", 0.0)),
+        "n_obstacles": int(extra.get("n_obstacles", 0)),
+        "status": rec["status"],
+        "entered_forbidden": bool(extra.get("entered_forbidden", False)),
+        "wall_time": rec.get("wall_time"),
+        **{m: rec.get(m) for m in METRIC_NAMES},
+        "key": "|".join((rec["scenario"], rec["controller"], str(int(rec["seed"])),
+                         f"{extra.get('noise_std', 0.0):g}", f"{extra.get('dropout', 0.0):g}")),
+    }  # fmt: skip
 
 
 def stored_rows(store: ResultsStore, campaign: str) -> list[dict[str, Any]]:
-    """The episode rows of a campaign, as :func:`run_ch4_job` makes them (store order)."""
-    if store.campaign_id(campaign) is None:
-        return []
-    frame = store.episodes_frame(campaign)
-    rows: list[dict[str, Any]] = []
-    for rec in frame.to_dict("records"):
-        params = json.loads(rec["params"])
-        extra = json.loads(rec["effective_params"] or "{}")
-        row: dict[str, Any] = {
-            "scene": rec["scenario"],
-            "law": rec["controller"],
-            "seed": int(rec["seed"]),
-            "noise_std": float(params.get("noise_std", 0.0)),
-            "dropout": float(params.get("dropout", 0.0)),
-            "n_obstacles": int(extra.get("n_obstacles", 0)),
-            "status": rec["status"],
-            "entered_forbidden": bool(extra.get("entered_forbidden", False)),
-            "wall_time": _value(rec["wall_time"]),
-        }
-        for m in METRIC_NAMES:
-            row[m] = _value(rec[m])
-        row["key"] = Ch4Job(row["scene"], row["law"], row["seed"], row["noise_std"],
-                            row["dropout"]).key  # fmt: skip
-        rows.append(row)
-    return rows
-
-
-def _value(v: Any) -> Any:
-    """A stored value as plain Python (missing -> None, numpy scalars -> Python)."""
-    if v is None or pd.isna(v):
-        return None
-    return v.item() if isinstance(v, np.generic) else v
+    """The episode rows of a campaign (store order)."""
+    return [_row(r) for r in stored_records(store, campaign)]
 
 
 def run_jobs(
-    jobs: Iterable[Ch4Job],
+    jobs: Iterable[Job],
     store: ResultsStore,
     campaign: str,
     *,
@@ -193,43 +147,38 @@ def run_jobs(
     progress: Callable[[int, int], None] | None = None,
     config: dict[str, Any] | None = None,
 ) -> list[dict[str, Any]]:
-    """Run the jobs of ``campaign`` not yet in the store (one transaction per finished episode,
-    written by this process; workers only compute), so an interrupted campaign resumes.
+    """Run the jobs of ``campaign`` not yet in the store (a campaign: one transaction per
+    finished episode, so an interrupted campaign resumes); ``progress(done, total)`` after each
+    episode run.
 
     Returns:
         The rows of all requested jobs (stored and new), in job order.
     """
     jobs = list(jobs)
-    cid = store.campaign(campaign, config or {"chapter": 4})
-    done_keys = store.done_keys(cid)
-    todo = [
-        j for j in jobs
-        if (j.scene, j.law, params_hash(_params(j)), j.seed) not in done_keys
-    ]  # fmt: skip
-    total = len(todo)
+    cfg = config or {"chapter": 4}
+    total = len({j.key for j in jobs} - store.done_keys(store.campaign(campaign, cfg)))
     done = 0
 
-    def write(row: dict[str, Any]) -> None:
+    def advance(_out: Any, _episode: int) -> None:
         nonlocal done
-        store_row(store, cid, row)
         done += 1
         if progress is not None:
             progress(done, total)
 
-    run_in_workers(todo, _row_only, write, workers=workers)
-    by_key = {r["key"]: r for r in stored_rows(store, campaign)}
-    return [by_key[j.key] for j in jobs if j.key in by_key]
+    recs = run_stored(store, campaign, jobs, config=cfg, workers=workers, on_outcome=advance)
+    return [_row(r) for r in recs]
 
 
 def campaign_jobs(
     seeds: int, noise_seeds: int, laws: Iterable[str] = LAWS, start: int = 0
-) -> tuple[list[Ch4Job], list[Ch4Job]]:
+) -> tuple[list[Job], list[Job]]:
     """Jobs of the random campaign (noise-free) and of the sensor-noise sweep (seeds ``start``
     onwards)."""
     laws = tuple(laws)
-    clean = [Ch4Job(f"random-ch4:{s}", law, s) for law in laws for s in range(start, start + seeds)]
+    seed_range = range(start, start + seeds)
+    clean = [ch4_job(f"random-ch4:{s}", law, s) for law in laws for s in seed_range]
     noisy = [
-        Ch4Job(f"random-ch4:{s}", law, s, noise, drop)
+        ch4_job(f"random-ch4:{s}", law, s, noise, drop)
         for noise, drop in NOISE_LEVELS
         for law in laws
         for s in range(start, start + noise_seeds)
@@ -237,10 +186,10 @@ def campaign_jobs(
     return clean, noisy
 
 
-def hard_jobs(seeds: int, laws: Iterable[str] = LAWS, start: int = 0) -> list[Ch4Job]:
+def hard_jobs(seeds: int, laws: Iterable[str] = LAWS, start: int = 0) -> list[Job]:
     """Jobs of the harder family ``random-ch4-hard`` (noise-free), seed by seed from ``start``."""
     return [
-        Ch4Job(f"{HARD_FAMILY}:{s}", law, s) for s in range(start, start + seeds) for law in laws
+        ch4_job(f"{HARD_FAMILY}:{s}", law, s) for s in range(start, start + seeds) for law in laws
     ]
 
 
@@ -374,13 +323,12 @@ def reproduce_ch4(
         stored = store.done_keys(cid)
         for scene in list_uuv2d_builtin():
             for law in LAWS:
-                job = Ch4Job(scene, law, 0)
-                tic = time.perf_counter()
-                row, res = run_ch4_job(job, record=True)  # for the figures' trajectories
-                row["wall_time"] = time.perf_counter() - tic
-                if (scene, law, params_hash(_params(job)), 0) not in stored:
-                    store_row(store, cid, row)
-                scene_results[(scene, law)] = res
+                job = ch4_job(scene, law, 0)
+                out = run_job(dataclasses.replace(job, record=True))  # the figures' trajectories
+                outcome_record(out)  # raises for a failed episode
+                if job.key not in stored:
+                    store_outcome(store, cid, out)
+                scene_results[(scene, law)] = out.result
         scene_rows = [
             r
             for r in stored_rows(store, SCENES_CAMPAIGN)
@@ -425,9 +373,9 @@ def reproduce_ch4(
 __all__ = [
     "LAWS",
     "METRIC_NAMES",
-    "Ch4Job",
     "Ch4Summary",
     "campaign_jobs",
+    "ch4_job",
     "failures",
     "hard_jobs",
     "reproduce_ch4",

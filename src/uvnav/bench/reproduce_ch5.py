@@ -18,11 +18,13 @@ the baseline), network (the BPNN) and oracle (true geometry) locators:
 3. on the same scenes with sonar range noise :data:`NOISE_STD` (quick: none; ``full``: 300) —
    campaign ``ch5-noise``.
 
-Every episode is a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
+Every episode is an ordinary campaign job (:func:`ch5_job`: a :class:`~uvnav.bench.campaign.Job`
+with this chapter's runner, run, stored and resumed by :func:`~uvnav.bench.campaign.run_campaign`)
+and a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
 ``results_dir/uvnav.sqlite``, the database of ``uvnav run``, DESIGN §5), as Chapter 4 does: the
-``controller`` column holds the law, ``params`` the locator and the noise level (plus, for the
-network, a digest of its checkpoint: part of the resume key, so a different network re-runs),
-``family`` the generator or the scene; the facts the store has no column for (number of
+``controller`` column holds the law, ``params`` (the job's tags) the locator and the noise level
+(plus, for the network, a digest of its checkpoint: part of the resume key, so a different network
+re-runs), ``family`` the generator or the scene; the facts the store has no column for (number of
 obstacles, whether Scene 2's inner space was entered) go to ``effective_params``.
 
 **Resumable.**  Nothing measured is lost when a run is interrupted: every sampled data set (with
@@ -42,6 +44,8 @@ by a renderer the caller injects (``bench`` may not import ``viz``, DESIGN §1).
 
 from __future__ import annotations
 
+import dataclasses
+import functools
 import hashlib
 import json
 import math
@@ -53,10 +57,17 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
 
-from uvnav.bench.campaign import run_in_workers
-from uvnav.bench.store import ResultsStore, params_hash
+from uvnav.bench.campaign import (
+    EpisodeRun,
+    Job,
+    outcome_record,
+    run_job,
+    run_stored,
+    store_outcome,
+    stored_records,
+)
+from uvnav.bench.store import EpisodeKey, ResultsStore
 from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.zhang_uuv3d import (
     NAME as LAW,
@@ -342,33 +353,29 @@ def beam_ties(ds: SonarDataset, group: np.ndarray, predicted: np.ndarray) -> dic
 # ---------------------------------------------------------------------------------- closed loop
 
 
-@dataclass(frozen=True)
-class Ch5Job:
-    """One closed-loop episode: a scene (built-in or ``random-ch5:<seed>``), a locator, a seed,
-    the sonar range noise [m]; ``model`` is the network's checkpoint (``network`` only) and
-    ``model_id`` its digest (part of the resume key, as is the random generator's version)."""
+def ch5_job(
+    scene: str,
+    locator: str,
+    seed: int,
+    noise_std: float = 0.0,
+    model: str | TrainedBPNN | None = None,
+    model_id: str = "",
+) -> Job:
+    """One closed-loop episode as a campaign job: a scene (built-in or ``random-ch5:<seed>``), a
+    locator, a seed, the sonar range noise [m]; ``model`` is the network (a checkpoint path, or
+    the trained network itself in this process; ``network`` only) and ``model_id`` its digest.
 
-    scene: str
-    locator: str
-    seed: int
-    noise_std: float = 0.0
-    model: str | None = None
-    model_id: str = ""
-
-    @property
-    def params(self) -> dict[str, Any]:
-        """The store's ``params`` (hashed into the resume key)."""
-        p: dict[str, Any] = {"locator": self.locator, "noise_std": float(self.noise_std)}
-        if self.locator == "network":
-            p["model"] = self.model_id
-        if self.scene.startswith((GENERATOR_CH5 + ":", GENERATOR_CH5_DENSE + ":")):
-            # a newer generator re-runs its scenes
-            p["generator"] = RANDOM_CH5_VERSION
-        return p
-
-    @property
-    def key(self) -> tuple[str, str, str, int]:
-        return (self.scene, LAW, params_hash(self.params), int(self.seed))
+    The job's tags (the store's ``params``, hashed into the resume key, as the chapter's former
+    job type stored them) are the locator and the noise, the digest for ``network`` and, for a
+    random scene, the generator's version (a newer generator re-runs its scenes).
+    """
+    tags: dict[str, Any] = {"locator": locator, "noise_std": float(noise_std)}
+    if locator == "network":
+        tags["model"] = model_id
+    if scene.startswith((GENERATOR_CH5 + ":", GENERATOR_CH5_DENSE + ":")):
+        tags["generator"] = RANDOM_CH5_VERSION
+    runner = _run_job if model is None else functools.partial(_run_job, model=model)
+    return Job(LAW, int(seed), label=scene, family=scene.split(":", 1)[0], tags=tags, runner=runner)
 
 
 def checkpoint_digest(path: Path) -> str:
@@ -385,120 +392,60 @@ def checkpoint_digest(path: Path) -> str:
 _MODEL_CACHE: dict[str, TrainedBPNN] = {}
 
 
-def _job_locator(job: Ch5Job, model: TrainedBPNN | None) -> Locator:
-    if job.locator == "network" and model is None:
-        if job.model is None:
-            raise ValueError("a 'network' job needs a checkpoint (Ch5Job.model)")
-        if job.model not in _MODEL_CACHE:  # once per worker process
-            _MODEL_CACHE[job.model] = load_checkpoint(Path(job.model))
-        model = _MODEL_CACHE[job.model]
-    return make_locator(job.locator, model=model)
-
-
-def run_ch5_job(
-    job: Ch5Job, *, record: bool = False, model: TrainedBPNN | None = None
-) -> tuple[dict[str, Any], UUV3DResult]:
-    """Run one job (``model`` overrides the job's checkpoint); returns its row and result."""
-    tic = time.perf_counter()
-    scn = load_ch5_scenario(job.scene)
-    setup = build_uuv3d(scn, noise_std=job.noise_std)
+def _run_job(job: Job, *, model: str | TrainedBPNN | None = None) -> EpisodeRun:
+    """The campaign's runner: the scene with the job's noise, the law with its locator."""
+    tags = dict(job.tags)
+    if isinstance(model, str):
+        if tags["locator"] == "network" and model not in _MODEL_CACHE:  # once per worker process
+            _MODEL_CACHE[model] = load_checkpoint(Path(model))
+        model = _MODEL_CACHE.get(model)
+    scn = load_ch5_scenario(str(job.label))
+    setup = build_uuv3d(scn, noise_std=tags["noise_std"])
     params = ZhangUUV3DParams(**scn.controller.params)  # type: ignore[arg-type]
-    law = ZhangUUV3D(params, _job_locator(job, model))
-    res = run_uuv3d_episode(setup, law, np.random.default_rng(job.seed), record=record)
-    row = _episode_row(job.scene, job.locator, job.noise_std, job.seed, res)
-    row["n_obstacles"] = len(scn.obstacles)
-    row["model"] = job.model_id if job.locator == "network" else ""
-    row["wall_time"] = time.perf_counter() - tic
-    return row, res
+    law = ZhangUUV3D(params, make_locator(tags["locator"], model=model))
+    res = run_uuv3d_episode(setup, law, np.random.default_rng(job.seed), record=job.record)
+    facts = {
+        "n_obstacles": len(scn.obstacles),
+        "entered_inner_space": bool(res.entered_inner_space),
+    }
+    return res.status, res.metrics.to_dict(), res, facts
 
 
-def _row_only(job: Ch5Job) -> dict[str, Any]:
-    return run_ch5_job(job)[0]
+def run_ch5_job(job: Job, *, record: bool = False) -> tuple[dict[str, Any], UUV3DResult]:
+    """Run one job in this process; returns its row (as :func:`stored_rows` reads it back) and
+    its result.
+
+    Raises:
+        RuntimeError: the episode failed.
+    """
+    out = run_job(dataclasses.replace(job, record=record))
+    return _row(outcome_record(out)), out.result
 
 
-def _episode_row(
-    scene: str, locator: str, noise: float, seed: int, res: UUV3DResult
-) -> dict[str, Any]:
+def _row(rec: dict[str, Any]) -> dict[str, Any]:
+    """A stored record (:func:`~uvnav.bench.campaign.stored_records`) as this chapter's row."""
+    params, extra = rec["params"], rec["effective_params"]
     return {
-        "scene": scene,
-        "locator": locator,
-        "noise_std": noise,
-        "seed": seed,
-        "status": res.status,
-        "entered_inner_space": res.entered_inner_space,
-        **res.metrics.to_dict(),
+        "scene": rec["scenario"],
+        "locator": params["locator"],
+        "noise_std": float(params.get("noise_std", 0.0)),
+        "seed": int(rec["seed"]),
+        "status": rec["status"],
+        "entered_inner_space": bool(extra.get("entered_inner_space", False)),
+        "n_obstacles": int(extra.get("n_obstacles", 0)),
+        "model": str(params.get("model", "")),
+        "wall_time": rec.get("wall_time"),
+        **{m: rec.get(m) for m in METRIC_NAMES},
     }
 
 
-def _row_job(row: dict[str, Any]) -> Ch5Job:
-    """The job of a row (its resume key is the store's)."""
-    return Ch5Job(
-        row["scene"],
-        row["locator"],
-        int(row["seed"]),
-        float(row["noise_std"]),
-        None,
-        str(row.get("model", "")),
-    )
-
-
-def store_row(store: ResultsStore, campaign_id: int, row: dict[str, Any]) -> int:
-    """Write one episode row: controller = the law, params = locator + noise (+ model digest),
-    family = the generator or the scene, metrics in their columns; ``n_obstacles`` and
-    ``entered_inner_space`` (no column) in ``effective_params``."""
-    job = _row_job(row)
-    return store.add_episode(
-        campaign_id,
-        scenario=row["scene"],
-        controller=LAW,
-        seed=int(row["seed"]),
-        status=row["status"],
-        params=job.params,
-        metrics={m: row.get(m) for m in METRIC_NAMES},
-        family=str(row["scene"]).split(":", 1)[0],
-        effective_params={
-            **job.params,
-            "n_obstacles": int(row.get("n_obstacles", 0)),
-            "entered_inner_space": bool(row["entered_inner_space"]),
-        },
-        wall_time=row.get("wall_time"),
-    )
-
-
-def _value(v: Any) -> Any:
-    """A stored value as plain Python (missing -> None, numpy scalars -> Python)."""
-    if v is None or (not isinstance(v, str) and pd.isna(v)):
-        return None
-    return v.item() if isinstance(v, np.generic) else v
-
-
 def stored_rows(store: ResultsStore, campaign: str) -> list[dict[str, Any]]:
-    """The episode rows of a campaign, as :func:`run_ch5_job` makes them (store order)."""
-    if store.campaign_id(campaign) is None:
-        return []
-    rows: list[dict[str, Any]] = []
-    for rec in store.episodes_frame(campaign).to_dict("records"):
-        params = json.loads(rec["params"])
-        extra = json.loads(rec["effective_params"] or "{}")
-        row: dict[str, Any] = {
-            "scene": rec["scenario"],
-            "locator": params["locator"],
-            "noise_std": float(params.get("noise_std", 0.0)),
-            "seed": int(rec["seed"]),
-            "status": rec["status"],
-            "entered_inner_space": bool(extra.get("entered_inner_space", False)),
-            "n_obstacles": int(extra.get("n_obstacles", 0)),
-            "model": str(params.get("model", "")),
-            "wall_time": _value(rec["wall_time"]),
-        }
-        for m in METRIC_NAMES:
-            row[m] = _value(rec[m])
-        rows.append(row)
-    return rows
+    """The episode rows of a campaign (store order)."""
+    return [_row(r) for r in stored_records(store, campaign)]
 
 
 def run_jobs(
-    jobs: Iterable[Ch5Job],
+    jobs: Iterable[Job],
     store: ResultsStore,
     campaign: str,
     *,
@@ -506,61 +453,23 @@ def run_jobs(
     on_episode: Callable[[], None] | None = None,
     config: dict[str, Any] | None = None,
 ) -> list[dict[str, Any]]:
-    """Run the jobs of ``campaign`` not yet in the store (one transaction per finished episode,
-    written by this process; workers only compute), so an interrupted campaign resumes.
+    """Run the jobs of ``campaign`` not yet in the store (a campaign: one transaction per
+    finished episode, so an interrupted campaign resumes); ``on_episode()`` once per job, the
+    stored ones first.
 
     Returns:
         The rows of all requested jobs (stored and new), in job order.
     """
     jobs = list(jobs)
-    cid = store.campaign(campaign, config or {"chapter": 5})
-    done = store.done_keys(cid)
-    todo = [j for j in jobs if j.key not in done]
-    for _ in range(len(jobs) - len(todo)):
-        if on_episode is not None:
-            on_episode()
-
-    def write(row: dict[str, Any]) -> None:
-        store_row(store, cid, row)
-        if on_episode is not None:
-            on_episode()
-
-    run_in_workers(todo, _row_only, write, workers=workers)
-    by_key: dict[tuple[str, str, str, int], dict[str, Any]] = {}
-    for r in stored_rows(store, campaign):
-        j = Ch5Job(r["scene"], r["locator"], r["seed"], r["noise_std"], None, r["model"])
-        by_key[j.key] = r
-    return [by_key[j.key] for j in jobs if j.key in by_key]
-
-
-def run_closed_loop(
-    scenes: Sequence[str],
-    locators: dict[str, Locator],
-    *,
-    noises: Sequence[float] = (0.0,),
-    seed: int = 0,
-    on_episode: Callable[[], None] | None = None,
-    record: bool = False,
-) -> tuple[list[dict[str, Any]], dict[tuple[str, str, float], UUV3DResult]]:
-    """Every scene x locator x noise once with ``seed`` (in-process, not stored); rows and (when
-    ``record``) results."""
-    rows: list[dict[str, Any]] = []
-    kept: dict[tuple[str, str, float], UUV3DResult] = {}
-    for scene in scenes:
-        scn = load_ch5_scenario(scene)
-        for noise in noises:
-            setup = build_uuv3d(scn, noise_std=noise)
-            for name, loc in locators.items():
-                params = ZhangUUV3DParams(**scn.controller.params)  # type: ignore[arg-type]
-                res = run_uuv3d_episode(
-                    setup, ZhangUUV3D(params, loc), np.random.default_rng(seed), record=record
-                )
-                rows.append(_episode_row(scene, name, noise, seed, res))
-                if record:
-                    kept[(scene, name, noise)] = res
-                if on_episode is not None:
-                    on_episode()
-    return rows, kept
+    cfg = config or {"chapter": 5}
+    done = store.done_keys(store.campaign(campaign, cfg))
+    for _ in range(sum(j.key in done for j in jobs) if on_episode is not None else 0):
+        on_episode()  # type: ignore[misc]
+    recs = run_stored(
+        store, campaign, jobs, config=cfg, workers=workers,
+        on_outcome=None if on_episode is None else (lambda _o, _e: on_episode()),
+    )  # fmt: skip
+    return [_row(r) for r in recs]
 
 
 def _family(row: dict[str, Any]) -> str:
@@ -702,11 +611,11 @@ def _campaign_jobs(
     model_id: str,
     n_dense: int = 0,
     start: int = 0,
-) -> dict[str, list[Ch5Job]]:
+) -> dict[str, list[Job]]:
     """The random-scene jobs of each campaign (noise 0: ``ch5-random``; else ``ch5-noise``;
     the dense family, noise 0: ``ch5-dense``), scene by scene (all locators of a scene
     together)."""
-    out: dict[str, list[Ch5Job]] = {RANDOM_CAMPAIGN: [], NOISE_CAMPAIGN: [], DENSE_CAMPAIGN: []}
+    out: dict[str, list[Job]] = {RANDOM_CAMPAIGN: [], NOISE_CAMPAIGN: [], DENSE_CAMPAIGN: []}
     plan = [(RANDOM_CAMPAIGN if noise == 0 else NOISE_CAMPAIGN, GENERATOR_CH5, noise, n_rand)
             for noise in noises]  # fmt: skip
     plan.append((DENSE_CAMPAIGN, GENERATOR_CH5_DENSE, 0.0, n_dense))
@@ -715,7 +624,7 @@ def _campaign_jobs(
             for loc in LOCATORS:
                 net = loc == "network"
                 out[name].append(
-                    Ch5Job(
+                    ch5_job(
                         f"{generator}:{g}",
                         loc,
                         g,
@@ -855,27 +764,24 @@ def reproduce_ch5(
         with ResultsStore(db_path) as store:
             cid = store.campaign(SCENES_CAMPAIGN, {**base_cfg, "noises": list(noise_list)})
             stored = store.done_keys(cid)
-            wanted: set[tuple[str, str, str, int]] = set()
+            wanted: set[EpisodeKey] = set()
             for scene in scene_list:
                 for noise in noise_list:
                     for loc in LOCATORS:
-                        job = Ch5Job(
-                            scene,
-                            loc,
-                            0,
-                            float(noise),
-                            str(model_path),
-                            model_id if loc == "network" else "",
-                        )
+                        job = ch5_job(scene, loc, 0, float(noise), cl_model,
+                                      model_id if loc == "network" else "")  # fmt: skip
                         # run again for the figures' trajectories; stored only when missing
-                        row, res = run_ch5_job(job, record=True, model=cl_model)
+                        done = run_job(dataclasses.replace(job, record=True))
+                        outcome_record(done)  # raises for a failed episode
                         if job.key not in stored:
-                            store_row(store, cid, row)
+                            store_outcome(store, cid, done)
                         wanted.add(job.key)
-                        kept[(scene, loc, float(noise))] = res
+                        kept[(scene, loc, float(noise))] = done.result
                         prog.advance(task2)
             scene_rows = [
-                r for r in stored_rows(store, SCENES_CAMPAIGN) if _row_job(r).key in wanted
+                _row(r)
+                for r in stored_records(store, SCENES_CAMPAIGN)
+                if (r["scenario"], r["controller"], r["params_hash"], r["seed"]) in wanted
             ]
             rand_rows: list[dict[str, Any]] = []
             for name, js in jobs.items():
@@ -884,7 +790,7 @@ def reproduce_ch5(
                 cfg_c = {
                     **base_cfg,
                     "seeds": len({j.seed for j in js}),
-                    "noise_std": js[0].noise_std,
+                    "noise_std": dict(js[0].tags)["noise_std"],
                 }
                 rand_rows += run_jobs(
                     js,
@@ -939,10 +845,10 @@ def _json_default(x: Any) -> Any:
 __all__ = [
     "CAMPAIGNS",
     "LAW",
-    "Ch5Job",
     "Ch5Summary",
     "build_ch5_table",
     "cached_dataset",
+    "ch5_job",
     "checkpoint_digest",
     "failures",
     "learning_row",
@@ -950,7 +856,6 @@ __all__ = [
     "random_ch5_scenario",
     "reproduce_ch5",
     "run_ch5_job",
-    "run_closed_loop",
     "run_jobs",
     "stored_rows",
     "summarise",

@@ -19,8 +19,8 @@ from typing import Any, ClassVar, cast
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, check_params
-from uvnav.controllers.base3d import Vehicle3DController, register3d
+from uvnav.controllers.base import ControllerInfo, check_params, register
+from uvnav.controllers.base3d import Vehicle3DController
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand
 from uvnav.sensors.sensing3d import Observation3D
 
@@ -84,12 +84,13 @@ class APF3D(Vehicle3DController):
         return self.steer(obs, direction, v, period)
 
 
-register3d(
+register(
     ControllerInfo(
         name=APF3D.name,
-        factory=cast("Callable[..., Any]", APF3D),  # a 3D law (base3d registry)
+        factory=cast("Callable[..., Any]", APF3D),
         params_type=APF3DParams,
         summary="3D artificial potential field with tangential sliding (baseline)",
         reference="Khatib, IJRR 1986",
+        vehicle="vehicle3d",
     )
 )

@@ -10,7 +10,7 @@ There is one registry for every vehicle.  Each entry says which vehicle it drive
 (:data:`VEHICLES`: the command it returns and the observation it reads) and what it senses;
 :func:`available_controllers` lists one vehicle's laws (the unicycle's by default, the contract the
 2D simulator and campaigns use) or all of them, and :func:`make_controller` builds unicycle laws
-(``make_controller3d`` and ``make_uuv2d_controller`` the others).
+(:func:`make_law` builds any vehicle's).
 
 Parameters are a frozen dataclass (``Params``) whose field docs carry units;
 ``make_controller`` builds

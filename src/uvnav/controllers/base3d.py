@@ -4,27 +4,20 @@ A 3D law is reset with the vehicle's limits (:class:`~uvnav.dynamics.vehicle3d.V
 the goal and a generator, and asked for a :class:`~uvnav.dynamics.vehicle3d.Vehicle3DCommand`
 ``(V_R, u_R)`` with nothing but an :class:`~uvnav.sensors.sensing3d.Observation3D`.
 
-3D laws live in the one registry of :mod:`uvnav.controllers.base` with ``vehicle="vehicle3d"``;
-``available_controllers3d`` / ``make_controller3d`` are its views for this vehicle (the unicycle
-views leave them out: a 3D law cannot take a 2D observation).
+3D laws live in the one registry of :mod:`uvnav.controllers.base` with ``vehicle="vehicle3d"``
+(``register``, ``make_law``, ``available_controllers("vehicle3d")``; the unicycle views leave
+them out: a 3D law cannot take a 2D observation).
 """
 
 from __future__ import annotations
 
-import dataclasses
+import functools
 import math
-from typing import Any, ClassVar, Protocol, cast, runtime_checkable
+from typing import ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from uvnav.controllers.base import (
-    ControllerInfo,
-    LawState,
-    available_controllers,
-    build_params,
-    controller_info,
-    register,
-)
+from uvnav.controllers.base import LawState, make_law
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.frames3d import turn_toward
@@ -46,23 +39,8 @@ class Controller3D(Protocol):
     def mode(self) -> str: ...
 
 
-def register3d(info: ControllerInfo) -> ControllerInfo:
-    """Register a 3D law (``info`` with ``vehicle="vehicle3d"``)."""
-    return register(dataclasses.replace(info, vehicle="vehicle3d"))
-
-
-def available_controllers3d() -> dict[str, ControllerInfo]:
-    """All registered 3D laws by name."""
-    return available_controllers("vehicle3d")
-
-
-def make_controller3d(name: str, *, oracle: bool = False, **params: Any) -> Controller3D:
-    """Build a registered 3D law by name with keyword parameters (see ``make_controller``)."""
-    info = controller_info(name, "vehicle3d")
-    p = build_params(info.params_type, params)
-    ctrl = info.factory(p) if info.params_type is not None else info.factory()
-    ctrl.oracle = oracle
-    return cast(Controller3D, ctrl)
+#: kept for callers of the former per-vehicle builder: ``make_law(name, vehicle="vehicle3d")``
+make_controller3d = functools.partial(make_law, vehicle="vehicle3d")
 
 
 class Vehicle3DController(LawState[Vehicle3DSpec]):

@@ -28,9 +28,8 @@ from typing import Any, ClassVar
 import numpy as np
 
 from uvnav.controllers.apf import ApfController, ApfParams
-from uvnav.controllers.base import ControllerInfo, UnicycleController
+from uvnav.controllers.base import ControllerInfo, UnicycleController, register
 from uvnav.controllers.zhang2019 import Zhang2019Controller, Zhang2019Params
-from uvnav.controllers.zhang2022_uuv2d import register_uuv2d
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec
 from uvnav.dynamics.unicycle import UnicycleSpec
 from uvnav.geometry.angles import FloatArray
@@ -220,21 +219,25 @@ class Zhang2019Uuv2dController(_UnicycleOnUuv):
         return tuple(out)
 
 
-register_uuv2d(
+register(
     ControllerInfo(
         name=ApfUuv2dController.name,
         factory=ApfUuv2dController,
         params_type=ApfParams,
         summary="baseline: apf-v1 on the current sonar sweep",
         reference="Khatib 1986 (see apf-v1)",
+        vehicle="uuv2d",
+        sensing="sonar-fan",
     )
 )
-register_uuv2d(
+register(
     ControllerInfo(
         name=Zhang2019Uuv2dController.name,
         factory=Zhang2019Uuv2dController,
         params_type=Zhang2019Uuv2dParams,
         summary="baseline: zhang2019-v1 fed with AMAPS nearest squares and outlines",
         reference="thesis Ch. 2 law on the Ch. 4 AMAPS grid",
+        vehicle="uuv2d",
+        sensing="sonar-fan",
     )
 )

@@ -24,8 +24,8 @@ from typing import Any, ClassVar, cast
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, check_params
-from uvnav.controllers.base3d import Vehicle3DController, register3d
+from uvnav.controllers.base import ControllerInfo, check_params, register
+from uvnav.controllers.base3d import Vehicle3DController
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand
 from uvnav.geometry.angles import FloatArray
 from uvnav.sensors.sensing3d import Observation3D
@@ -132,12 +132,13 @@ class VO3D(Vehicle3DController):
         return self.steer(obs, v, float(np.linalg.norm(v)), period)
 
 
-register3d(
+register(
     ControllerInfo(
         name=VO3D.name,
-        factory=cast("Callable[..., Any]", VO3D),  # a 3D law (base3d registry)
+        factory=cast("Callable[..., Any]", VO3D),
         params_type=VO3DParams,
         summary="3D velocity obstacles by sampling, bounding spheres (baseline)",
         reference="Fiorini & Shiller, IJRR 1998",
+        vehicle="vehicle3d",
     )
 )

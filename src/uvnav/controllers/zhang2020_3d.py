@@ -73,8 +73,8 @@ from typing import Any, ClassVar, Literal, NamedTuple, cast
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, check_params
-from uvnav.controllers.base3d import Vehicle3DController, register3d
+from uvnav.controllers.base import ControllerInfo, check_params, register
+from uvnav.controllers.base3d import Vehicle3DController
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.frames3d import OnlineFrame, online_frame, rotation_from_vector
@@ -422,13 +422,14 @@ class Zhang2020Law(Vehicle3DController):
         return min(vmax, max(vmax * max(cos_b, 0.0), floor))
 
 
-register3d(
+register(
     ControllerInfo(
         name=Zhang2020Law.name,
-        factory=cast("Callable[..., Any]", Zhang2020Law),  # a 3D law (base3d registry)
+        factory=cast("Callable[..., Any]", Zhang2020Law),
         params_type=Zhang2020Params,
         summary="Thesis Ch. 3: sliding-mode law in the on-line frame with AR prediction (3D)",
         reference="Zhang, thesis Ch. 3 §3.3, eqs. (3.11)-(3.22); ICCAR 2020",
         requires_slower_obstacles=True,
+        vehicle="vehicle3d",
     )
 )

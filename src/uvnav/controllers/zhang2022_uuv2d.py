@@ -61,20 +61,16 @@ How the text is read (docs/thesis-notes.md, Chapter 4, gives the reasons at more
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections import deque
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Protocol, cast, runtime_checkable
+from typing import Any, ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
 from uvnav.controllers.base import (
     ControllerInfo,
-    available_controllers,
-    build_params,
     check_params,
-    controller_info,
     register,
 )
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec, velocity_toward
@@ -98,33 +94,6 @@ class Uuv2dController(Protocol):
 
     @property
     def mode(self) -> str: ...
-
-
-def register_uuv2d(info: ControllerInfo) -> ControllerInfo:
-    """Register a Chapter-4 law (``info`` with ``vehicle="uuv2d"`` and planar-sonar sensing).
-
-    The laws join the one registry of :mod:`uvnav.controllers.base`; the unicycle views leave them
-    out because they take a different observation and command.
-    """
-    return register(dataclasses.replace(info, vehicle="uuv2d", sensing="sonar-fan"))
-
-
-def available_uuv2d_controllers() -> dict[str, ControllerInfo]:
-    """All Chapter-4 laws (the thesis's and the adapted baselines)."""
-    return available_controllers("uuv2d")
-
-
-def make_uuv2d_controller(name: str, **params: Any) -> Uuv2dController:
-    """Build a Chapter-4 law by name with keyword parameters.
-
-    Raises:
-        uvnav.controllers.UnknownControllerError: unknown name (a ``KeyError``).
-        uvnav.controllers.ControllerParamsError: unknown or invalid parameters.
-    """
-    info = controller_info(name, "uuv2d")
-    p = build_params(info.params_type, params)
-    law = info.factory(p) if info.params_type is not None else info.factory()
-    return cast(Uuv2dController, law)
 
 
 @dataclass(frozen=True)
@@ -448,7 +417,7 @@ class Zhang2022Uuv2dController:
         return base_r + max(-math.pi, min(math.pi, extreme))
 
 
-register_uuv2d(
+register(
     ControllerInfo(
         name=Zhang2022Uuv2dController.name,
         factory=Zhang2022Uuv2dController,
@@ -456,5 +425,7 @@ register_uuv2d(
         summary="thesis Ch. 4: AMAPS nearest square, forecast circle (4.11)-(4.12), tangent "
         "waypoints (4.13)",
         reference="Zhang & Zhang, ICCAE 2022; thesis Ch. 4 §4.3",
+        vehicle="uuv2d",
+        sensing="sonar-fan",
     )
 )

@@ -50,8 +50,8 @@ from typing import Any, ClassVar, Protocol
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo
-from uvnav.controllers.base3d import Vehicle3DController, register3d
+from uvnav.controllers.base import ControllerInfo, register
+from uvnav.controllers.base3d import Vehicle3DController
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.frames3d import horizontal_perpendicular
@@ -348,7 +348,7 @@ class ZhangUUV3D(Vehicle3DController):
         return self.steer(obs, direction, self._spec.v_max, period)
 
 
-register3d(
+register(
     ControllerInfo(
         name=NAME,
         factory=ZhangUUV3D,
@@ -357,5 +357,6 @@ register3d(
         "tangent avoidance in the plane through the vehicle, B and the point",
         reference="Y. Zhang, J. Zhang, ICCAE 2022; thesis Ch. 5 (and Ch. 4 §4.3)",
         sensing="sonar-array",
+        vehicle="vehicle3d",
     )
 )

@@ -23,12 +23,12 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
 
 from uvnav.dynamics.vehicle3d import Vehicle3DSpec
 from uvnav.obstacles.deforming3d import CompoundBody, as_compound, horseshoe, random_star
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import check_magnitudes, check_timing
+from uvnav.scenarios.limits import FileModel, SceneModel, check_magnitudes, check_timing
 from uvnav.scenarios.loader import builtin_yaml_files, parse_yaml
 from uvnav.sensors.sonar_array import SonarArray
 from uvnav.sim.episode_uuv3d import UUV3DSetup
@@ -41,8 +41,7 @@ Vec3 = Annotated[list[float], Field(min_length=3, max_length=3)]
 Pos = Annotated[float, Field(gt=0)]
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+_Model = FileModel
 
 
 class Robot5(_Model):
@@ -114,7 +113,7 @@ class Controller5(_Model):
     params: dict[str, float] = Field(default_factory=dict)
 
 
-class Scenario5(_Model):
+class Scenario5(SceneModel):
     """A Chapter 5 scenario (module docstring)."""
 
     name: str

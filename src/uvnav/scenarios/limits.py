@@ -18,7 +18,27 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from pydantic import BaseModel, ConfigDict, PrivateAttr
+
 from uvnav.scenarios.errors import FieldError
+
+
+class FileModel(BaseModel):
+    """Base of every scene file's models: unknown keys refused, no inf/nan, frozen."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+
+
+class SceneModel(FileModel):
+    """Base of a whole scene of any kind: ``source``, where it was read from (not a field)."""
+
+    _source: str = PrivateAttr(default="<dict>")
+
+    @property
+    def source(self) -> str:
+        """The file (or ``"<dict>"``) this scenario was read from, for error messages."""
+        return self._source
+
 
 #: most integration steps ``t_max / dt`` of one episode
 MAX_EPISODE_STEPS = 10_000_000

@@ -26,18 +26,17 @@ from typing import Any
 
 import numpy as np
 import yaml
-from pydantic import Field, PrivateAttr, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
 
 from uvnav.controllers.base import make_controller
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import check_timing
+from uvnav.scenarios.limits import SceneModel, check_timing
 from uvnav.scenarios.schema import (
     MOTION_TYPES,
     ControllerSpec,
     ObstacleSpec,
     RobotSpec,
     SensingSpec,
-    _Model,
 )
 from uvnav.sim.multi import MultiSetup, RobotSetup
 from uvnav.sim.seeding import world_rng
@@ -55,7 +54,7 @@ class MultiRobotSpec(RobotSpec):
     )
 
 
-class MultiScenario(_Model):
+class MultiScenario(SceneModel):
     """A multi-robot scenario: robots, shared obstacles, timing, defaults."""
 
     name: str = Field(min_length=1, description="scenario name")
@@ -73,12 +72,6 @@ class MultiScenario(_Model):
     sensing: SensingSpec = Field(default_factory=lambda: SensingSpec.model_validate({}))
     controller: ControllerSpec = Field(default_factory=lambda: ControllerSpec.model_validate({}))
     obstacles: list[ObstacleSpec] = Field(default_factory=list)
-
-    _source: str = PrivateAttr(default="<dict>")
-
-    @property
-    def source(self) -> str:
-        return self._source
 
     @model_validator(mode="after")
     def _consistent(self) -> MultiScenario:

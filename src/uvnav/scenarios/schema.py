@@ -20,10 +20,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
-    BaseModel,
-    ConfigDict,
     Field,
-    PrivateAttr,
     ValidationInfo,
     field_validator,
     model_validator,
@@ -50,7 +47,7 @@ from uvnav.obstacles.motion import motion_plugins
 from uvnav.obstacles.social_force import SocialForcePedestrian
 from uvnav.scenarios import pedestrians
 from uvnav.scenarios.errors import FieldError, ScenarioError
-from uvnav.scenarios.limits import check_timing
+from uvnav.scenarios.limits import FileModel, SceneModel, check_timing
 from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sim import LidarConfig, SensingConfig
 
@@ -58,8 +55,7 @@ Point2 = Annotated[tuple[float, float], Field(description="[x, y] [m]")]
 """A planar point ``[x, y]`` [m]."""
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+_Model = FileModel
 
 
 def _heading_of(vector: np.ndarray, default: float) -> float:
@@ -706,7 +702,7 @@ class ControllerSpec(_Model):
 # ---------------------------------------------------------------------------------------- scenario
 
 
-class Scenario(_Model):
+class Scenario(SceneModel):
     """A complete scenario (DESIGN §3): robot, sensing, obstacles, timing and default controller."""
 
     name: str = Field(min_length=1, description="scenario name, e.g. thesis-ch2-one-obstacle")
@@ -727,13 +723,6 @@ class Scenario(_Model):
         None, description="real pedestrians replayed as moving discs (appended after obstacles)"
     )
     controller: ControllerSpec = Field(default_factory=lambda: ControllerSpec.model_validate({}))
-
-    _source: str = PrivateAttr(default="<dict>")
-
-    @property
-    def source(self) -> str:
-        """The file (or ``"<dict>"``) this scenario was read from, for error messages."""
-        return self._source
 
     def __eq__(self, other: object) -> bool:
         """Equal when every field is equal; where the scenario was read from does not count."""

@@ -27,7 +27,7 @@ import math
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, model_validator
+from pydantic import BaseModel, Field, ValidationError, model_validator
 
 from uvnav.dynamics.vehicle3d import Vehicle3DSpec
 from uvnav.geometry.frames3d import rotation_from_vector
@@ -42,15 +42,14 @@ from uvnav.obstacles.motion3d import (
     Waypoints3D,
 )
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import check_magnitudes, check_timing
+from uvnav.scenarios.limits import FileModel, SceneModel, check_magnitudes, check_timing
 from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, clearance3d
 
 Point3 = Annotated[tuple[float, float, float], Field(description="[x, y, z] [m]")]
 Vec3 = tuple[float, float, float]
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+_Model = FileModel
 
 
 class Robot3DSpec(_Model):
@@ -258,7 +257,7 @@ class Controller3DSpec(_Model):
     params: dict[str, Any] = Field(default_factory=dict, description="the law's parameters")
 
 
-class Scenario3D(_Model):
+class Scenario3D(SceneModel):
     """A complete 3D scenario."""
 
     name: str = Field(min_length=1)
@@ -274,12 +273,6 @@ class Scenario3D(_Model):
     controller: Controller3DSpec = Field(
         default_factory=lambda: Controller3DSpec.model_validate({})
     )
-
-    _source: str = PrivateAttr(default="<dict>")
-
-    @property
-    def source(self) -> str:
-        return self._source
 
     def __eq__(self, other: object) -> bool:
         """Equal when every field is equal; where the scenario was read from does not count."""

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import BaseModel, ConfigDict, Field, PrivateAttr, ValidationError, model_validator
+from pydantic import Field, ValidationError, model_validator
 
 from uvnav.dynamics.holonomic import HolonomicSpec
 from uvnav.obstacles.deforming import (
@@ -33,7 +33,7 @@ from uvnav.obstacles.deforming import (
     trap_polygon,
 )
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import check_timing
+from uvnav.scenarios.limits import FileModel, SceneModel, check_timing
 from uvnav.scenarios.loader import builtin_yaml_files, natural_key, parse_yaml
 from uvnav.sensors.sonar2d import SonarConfig
 from uvnav.sim.episode_uuv2d import Uuv2dSetup, clearance_of, inside_any
@@ -42,8 +42,7 @@ Point2 = Annotated[tuple[float, float], Field(description="[x, y] [m]")]
 BUILTIN_SUBDIR = "ch4"  # of the built-in scenario folder
 
 
-class _Model(BaseModel):
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, frozen=True)
+_Model = FileModel
 
 
 class VehicleSpec(_Model):
@@ -165,7 +164,7 @@ class ControllerChoice(_Model):
     params: dict[str, Any] = Field(default_factory=dict)
 
 
-class Uuv2dScenario(_Model):
+class Uuv2dScenario(SceneModel):
     """A Chapter-4 scene: vehicle, sonar, shape-changing obstacles, timing, default law."""
 
     kind: Literal["uuv2d"] = Field(description="marks a Chapter-4 UUV scene")
@@ -182,12 +181,6 @@ class Uuv2dScenario(_Model):
     controller: ControllerChoice = Field(
         default_factory=lambda: ControllerChoice.model_validate({})
     )
-
-    _source: str = PrivateAttr(default="<dict>")
-
-    @property
-    def source(self) -> str:
-        return self._source
 
     @model_validator(mode="after")
     def _consistent(self) -> Uuv2dScenario:
