@@ -69,9 +69,11 @@ from uvnav.controllers.holonomic import HolonomicLaw, toward_goal
 from uvnav.dynamics.omni import VelocityCommand
 from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.geometry.contact import candidate_risk, candidate_risk_compiled
+from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.sensors.observation import Observation, ObstacleReading
 
-_DISC_SAMPLES = 1  # a disc body is its own boundary disc
+IntArray = np.ndarray
 
 
 @dataclass(frozen=True)
@@ -105,9 +107,9 @@ class Zhang2019V2Params:
     min_ttc: float = 3.0
     spacing: float = 0.25
     max_tangent_bodies: int = 12
-    comfort: float = 0.2
+    comfort: float = 0.3
     comfort_horizon: float = 1.0
-    w_comfort: float = 5.0
+    w_comfort: float = 10.0
 
     def __post_init__(self) -> None:
         check_params(
@@ -121,32 +123,26 @@ class Zhang2019V2Params:
                 raise ValueError(f"{name} must be an integer >= 0 (got {value!r})")
         levels = tuple(self.speed_levels)
         if not levels or not all(isinstance(s, int | float) and 0 < s <= 1 for s in levels):
-            raise ValueError(f"speed_levels must be fractions in (0, 1] (got {self.speed_levels!r})")
+            raise ValueError(
+                f"speed_levels must be fractions in (0, 1] (got {self.speed_levels!r})"
+            )
 
 
 # -- pure functions ----------------------------------------------------------------------------
 
 
-def _polygon_samples(outline: FloatArray, spacing: float) -> FloatArray:
-    """Points along a closed polygon's edges, no two neighbours farther apart than ``spacing``
-    [m]: the vertices and evenly spaced points between them."""
-    start = np.asarray(outline, dtype=float)
-    end = np.roll(start, -1, axis=0)
-    edge = end - start
-    n_sub = np.maximum(np.ceil(np.hypot(edge[:, 0], edge[:, 1]) / spacing).astype(int), 1)
-    idx = np.repeat(np.arange(len(start)), n_sub)
-    frac = np.concatenate([np.arange(k) / k for k in n_sub])
-    return np.asarray(start[idx] + frac[:, None] * edge[idx], dtype=float)
-
-
 def boundary_discs(
     readings: tuple[ObstacleReading, ...], spacing: float
-) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+) -> tuple[FloatArray, FloatArray, FloatArray, IntArray, FloatArray]:
     """Every body as discs on its boundary: centres (M, 2) [m], velocities (M, 2) [m/s], radii
-    (M,) [m] and the index of the body (M,).
+    (M,) [m], the index of the body (M,), and per body (N, 6) its first and end disc index, its
+    centre and velocity (the rows of :func:`uvnav.geometry.contact.candidate_risk_compiled`, less
+    the reach).
 
-    A disc body is one disc; a polygon's boundary samples (:func:`_polygon_samples`) carry discs
-    of radius ``spacing / 2``, which cover its edges, each moving with ``v_i + u_i x (q - c_i)``.
+    A disc body is one disc; a polygon's edges are sampled so that no two neighbouring samples are
+    farther apart than ``spacing`` (the vertices and evenly spaced points between them), each
+    sample a disc of radius ``spacing / 2`` (which covers the edges) moving with
+    ``v_i + u_i x (q - c_i)``.  One pass over all edges of all bodies.
 
     >>> from uvnav.sensors.observation import ObstacleReading
     >>> z = np.zeros(2)
@@ -155,107 +151,67 @@ def boundary_discs(
     >>> boundary_discs((rd,), 0.5)[0].shape
     (8, 2)
     """
-    if not readings:
-        empty = np.zeros((0, 2))
-        return empty, empty, np.zeros(0), np.zeros(0, dtype=int)
-    points, vels, radii, owner = [], [], [], []
-    for k, rd in enumerate(readings):
-        if rd.is_disc:
-            q = np.asarray(rd.centre, dtype=float)[None, :]
-            r = np.array([rd.radius])
-        else:
-            q = _polygon_samples(rd.outline, spacing)
-            r = np.full(len(q), 0.5 * spacing)
-        rel = q - np.asarray(rd.centre, dtype=float)
-        w = np.asarray(rd.velocity, dtype=float) + rd.angular_velocity * np.column_stack(
-            [-rel[:, 1], rel[:, 0]]
-        )
-        points.append(q)
-        vels.append(w)
-        radii.append(r)
-        owner.append(np.full(len(q), k))
-    return (
-        np.concatenate(points),
-        np.concatenate(vels),
-        np.concatenate(radii),
-        np.concatenate(owner),
-    )
-
-
-def first_contact(
-    rel_pos: FloatArray, rel_vel: FloatArray, reach: FloatArray, horizon: float
-) -> FloatArray:
-    """First time [s] in [0, horizon] at which ``|rel_pos - rel_vel t| <= reach``; inf if never.
-
-    ``rel_pos`` (..., 2) is a body's position relative to the robot, ``rel_vel`` (..., 2) the
-    robot's velocity relative to the body, ``reach`` the radius sum (broadcast).  A pair already
-    in contact reads 0 while it closes in and inf while it opens.
-
-    >>> first_contact(np.array([2.0, 0.0]), np.array([1.0, 0.0]), np.array(1.0), 5.0).item()
-    1.0
-    >>> first_contact(np.array([2.0, 0.0]), np.array([-1.0, 0.0]), np.array(1.0), 5.0).item()
-    inf
-    >>> first_contact(np.array([0.5, 0.0]), np.array([1.0, 0.0]), np.array(1.0), 5.0).item()
-    0.0
-    """
-    a = np.einsum("...i,...i->...", rel_vel, rel_vel)
-    b = np.einsum("...i,...i->...", rel_pos, rel_vel)
-    c = np.einsum("...i,...i->...", rel_pos, rel_pos) - reach * reach
-    disc = b * b - a * c
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = (b - np.sqrt(np.maximum(disc, 0.0))) / a
-    hit = (disc >= 0.0) & (b > 0.0) & (a > 1e-12) & (t <= horizon)
-    out = np.where(hit, np.maximum(t, 0.0), np.inf)
-    return np.where(c <= 0.0, np.where(b > 0.0, 0.0, np.inf), out)
-
-
-def closest_gap(
-    rel_pos: FloatArray, rel_vel: FloatArray, reach: FloatArray, horizon: float
-) -> FloatArray:
-    """Smallest ``|rel_pos - rel_vel t| - reach`` over t in [0, horizon] [m] (negative: overlap).
-
-    >>> closest_gap(np.array([2.0, 1.0]), np.array([1.0, 0.0]), np.array(0.5), 5.0).item()
-    0.5
-    """
-    a = np.einsum("...i,...i->...", rel_vel, rel_vel)
-    b = np.einsum("...i,...i->...", rel_pos, rel_vel)
-    t = np.clip(b / np.maximum(a, 1e-12), 0.0, horizon)
-    gap = rel_pos - rel_vel * t[..., None]
-    return np.asarray(np.hypot(gap[..., 0], gap[..., 1]) - reach, dtype=float)
+    n = len(readings)
+    centre = np.array([rd.centre for rd in readings], dtype=float).reshape(n, 2)
+    vel = np.array([rd.velocity for rd in readings], dtype=float).reshape(n, 2)
+    omega = np.array([rd.angular_velocity for rd in readings], dtype=float)
+    disc_r = np.array([rd.radius for rd in readings], dtype=float)
+    rings = [np.asarray(rd.outline, dtype=float).reshape(-1, 2) if rd.radius <= 0.0
+             else centre[k : k + 1] for k, rd in enumerate(readings)]  # fmt: skip
+    sizes = np.array([len(x) for x in rings], dtype=int)
+    start = np.concatenate(rings) if n else np.zeros((0, 2))
+    first = np.repeat(np.cumsum(sizes) - sizes, sizes)
+    nxt = np.arange(len(start)) + 1
+    nxt = np.where(nxt - first >= np.repeat(sizes, sizes), first, nxt)
+    edge = np.where(np.repeat(disc_r > 0.0, sizes)[:, None], 0.0, start[nxt] - start)
+    n_sub = np.maximum(np.ceil(np.hypot(edge[:, 0], edge[:, 1]) / spacing).astype(int), 1)
+    idx = np.repeat(np.arange(len(start)), n_sub)
+    frac = np.arange(len(idx)) - np.repeat(np.cumsum(n_sub) - n_sub, n_sub)
+    q = start[idx] + (frac / n_sub[idx])[:, None] * edge[idx]
+    owner = np.repeat(np.repeat(np.arange(n), sizes), n_sub)
+    rel = q - centre[owner]
+    w = vel[owner] + omega[owner, None] * np.column_stack([-rel[:, 1], rel[:, 0]])
+    r = np.where(disc_r[owner] > 0.0, disc_r[owner], 0.5 * spacing)
+    counts = np.bincount(owner, minlength=n)
+    ends = np.cumsum(counts)
+    bodies = np.column_stack([ends - counts, ends, centre, vel]).astype(float)
+    return q, w, r, owner, bodies
 
 
 def tangent_directions(
-    position: FloatArray,
-    centres: FloatArray,
-    radii: FloatArray,
-    owner: FloatArray,
-    n_bodies: int,
+    position: FloatArray, centres: FloatArray, radii: FloatArray, owner: IntArray
 ) -> FloatArray:
     """Per body, the outermost tangent direction [rad] on each side over the circles
-    (``centres``, ``radii``) of that body (v1's note 3): at most ``2 n_bodies`` angles.
+    (``centres``, ``radii``) of that body (v1's note 3): two angles per body (``owner``: the
+    body of each circle, non-decreasing).
 
     A circle that holds the robot gives the directions perpendicular to its radius.
 
     >>> t = tangent_directions(np.zeros(2), np.array([[2.0, 0.0]]), np.array([1.0]),
-    ...                        np.array([0]), 1)
+    ...                        np.array([0]))
     >>> np.round(np.degrees(t), 6).tolist()
     [-30.0, 30.0]
     """
+    if not len(centres):
+        return np.zeros(0)
     d = centres - position
     dist = np.hypot(d[:, 0], d[:, 1])
     base = np.arctan2(d[:, 1], d[:, 0])
-    half = np.where(dist > radii, np.arcsin(np.minimum(radii / np.maximum(dist, 1e-12), 1.0)),
-                    0.5 * np.pi)  # fmt: skip
-    out = []
-    for k in range(n_bodies):
-        sel = owner == k
-        if not np.any(sel):
-            continue
-        ref = base[sel][int(np.argmin(dist[sel]))]
-        rel = (base[sel] - ref + np.pi) % (2.0 * np.pi) - np.pi
-        out.append(ref + float(np.min(rel - half[sel])))
-        out.append(ref + float(np.max(rel + half[sel])))
-    return np.asarray(out, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        half = np.where(dist > radii, np.arcsin(np.minimum(radii / dist, 1.0)), 0.5 * np.pi)
+    starts = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+    ends = np.r_[starts[1:], len(owner)]
+    nearest = np.minimum.reduceat(dist, starts)
+    ref_idx = starts + np.array(
+        [np.argmax(dist[a:b] == m) for a, b, m in zip(starts, ends, nearest, strict=True)]
+    )
+    ref = base[ref_idx]
+    rel = (base - ref[np.repeat(np.arange(len(starts)), ends - starts)] + np.pi) % (
+        2 * np.pi
+    ) - np.pi
+    lo = ref + np.minimum.reduceat(rel - half, starts)
+    hi = ref + np.maximum.reduceat(rel + half, starts)
+    return np.concatenate([lo, hi])
 
 
 @dataclass(frozen=True)
@@ -274,8 +230,7 @@ def choose_velocity(
     v_prev: FloatArray,
     headings: FloatArray,
     v_max: float,
-    discs: tuple[FloatArray, FloatArray, FloatArray],
-    robot_radius: float,
+    discs: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
     params: Zhang2019V2Params,
     *,
     heading: float | None = None,
@@ -283,6 +238,8 @@ def choose_velocity(
 ) -> Choice:
     """The candidate velocity of least cost (module docstring, steps 2-4).
 
+    ``discs``: boundary discs (centres, velocities, radius sums with the robot's disc and margin)
+    and the bodies' rows (:func:`boundary_discs` with the bounding reach appended).
     ``headings`` [rad] are the candidate directions, each tried at every speed level.  With
     ``heading`` [rad] given (a unicycle turning at most ``u_max`` [rad/s]) a candidate is checked
     as the robot will drive it: first the turn, ``|beta| / u_max`` seconds along the chord's
@@ -296,33 +253,21 @@ def choose_velocity(
     spd = np.append(np.tile(speeds, len(headings)), math.hypot(pref[0], pref[1]))
     ang, spd = np.append(ang, ang[-1]), np.append(spd, 0.0)  # standing still
     cand = spd[:, None] * np.column_stack([np.cos(ang), np.sin(ang)])
-    q, w, r = discs
-    ttc = np.full(len(cand), np.inf)
-    gap = np.full(len(cand), np.inf)
-    if len(q):
-        reach = (r + robot_radius + p.safety_margin)[None, :]
-        rel = (q - position)[None, :, :]
-        near = cand
-        if heading is None:
-            ttc = first_contact(rel, cand[:, None, :] - w[None, :, :], reach, p.horizon).min(1)
-        else:
-            beta = (ang - heading + np.pi) % (2.0 * np.pi) - np.pi
-            tau = np.minimum(np.abs(beta) / u_max, p.horizon)
-            mid = heading + 0.5 * beta
-            s1 = spd * np.maximum(np.cos(0.5 * beta), 0.0)
-            turn = s1[:, None] * np.column_stack([np.cos(mid), np.sin(mid)])
-            t1 = first_contact(rel, turn[:, None, :] - w[None, :, :], reach, 1.0)
-            t1 = np.where(t1 <= tau[:, None], t1, np.inf).min(1)
-            rel2 = rel + (w[None, :, :] - turn[:, None, :]) * tau[:, None, None]
-            t2 = first_contact(rel2, cand[:, None, :] - w[None, :, :], reach, p.horizon).min(1)
-            t2 = np.where(tau + t2 <= p.horizon, tau + t2, np.inf)
-            ttc = np.minimum(t1, t2)
-            near = turn
-        gap = closest_gap(rel, near[:, None, :] - w[None, :, :], reach, p.comfort_horizon).min(1)
+    turn, tau = cand, np.zeros(len(cand))
+    if heading is not None:
+        beta = (ang - heading + np.pi) % (2.0 * np.pi) - np.pi
+        tau = np.minimum(np.abs(beta) / u_max, p.horizon)
+        mid = heading + 0.5 * beta
+        s1 = spd * np.maximum(np.cos(0.5 * beta), 0.0)
+        turn = s1[:, None] * np.column_stack([np.cos(mid), np.sin(mid)])
+    q, w, reach, bodies = discs
+    args = (p.horizon, p.comfort, p.comfort_horizon)
+    if numba_enabled():
+        ttc, pen = candidate_risk_compiled(position, cand, turn, tau, (q, w, reach), bodies, *args)
+    else:
+        ttc, pen = candidate_risk(position, cand, turn, tau, (q, w, reach), *args)
     cost = np.hypot(*(cand - pref).T) + p.w_change * np.hypot(*(cand - v_prev).T)
-    with np.errstate(divide="ignore"):
-        cost = cost + p.w_ttc / np.maximum(ttc, 1e-3)
-    cost = cost + p.w_comfort * np.clip(p.comfort - gap, 0.0, None)
+    cost = cost + p.w_ttc / np.maximum(ttc, 1e-3) + p.w_comfort * pen
     safe = ttc > p.min_ttc
     if np.any(safe):
         cost = np.where(safe, cost, np.inf)
@@ -331,15 +276,20 @@ def choose_velocity(
 
 
 def reachable(
-    readings: tuple[ObstacleReading, ...], position: FloatArray, v_max: float, horizon: float
+    readings: tuple[ObstacleReading, ...], v_max: float, horizon: float
 ) -> tuple[ObstacleReading, ...]:
     """The bodies that can come into contact with the robot within ``horizon`` [s]."""
-    out = []
-    for rd in readings:
-        bound = rd.speed + abs(rd.angular_velocity) * rd.bounding_radius
-        if rd.distance <= (v_max + bound) * horizon:
-            out.append(rd)
-    return tuple(out)
+    return tuple(
+        rd
+        for rd in readings
+        if rd.distance
+        <= (
+            v_max
+            + math.hypot(rd.velocity[0], rd.velocity[1])
+            + abs(rd.angular_velocity) * rd.bounding_radius
+        )
+        * horizon  # fmt: skip
+    )
 
 
 def plan(
@@ -358,19 +308,24 @@ def plan(
     p = params
     pos = np.asarray(obs.position, dtype=float)
     v_pref = toward_goal(pos, goal, v_max, period)
-    near = reachable(obs.obstacles, pos, v_max, p.horizon)
+    near = reachable(obs.obstacles, v_max, p.horizon)
     if not near:
         return Choice(v_pref, math.inf, True)
-    q, w, r, owner = boundary_discs(near, p.spacing)
-    n_t = min(len(near), p.max_tangent_bodies)
-    grow = (r + robot_radius + p.safety_margin) + np.hypot(w[:, 0], w[:, 1]) * p.forecast_horizon
-    tangents = tangent_directions(pos, q[owner < n_t], grow[owner < n_t], owner[owner < n_t], n_t)
+    q, w, r, owner, rows = boundary_discs(near, p.spacing)
+    pad = robot_radius + p.safety_margin
+    reach = r + pad
+    sample_r = np.array([0.0 if rd.radius > 0.0 else 0.5 * p.spacing for rd in near])
+    bound = np.array([rd.bounding_radius for rd in near]) + sample_r + pad
+    bodies = np.column_stack([rows, bound])
+    few = owner < p.max_tangent_bodies  # readings come nearest first
+    grow = reach + np.hypot(w[:, 0], w[:, 1]) * p.forecast_horizon
+    tangents = tangent_directions(pos, q[few], grow[few], owner[few])
     spread = 2.0 * np.pi * np.arange(p.n_headings) / max(p.n_headings, 1)
     extra = [math.atan2(v_pref[1], v_pref[0])]
     if float(np.hypot(*v_prev)) > 1e-9:
         extra.append(math.atan2(v_prev[1], v_prev[0]))
     headings = np.concatenate([tangents, spread, np.asarray(extra)])
-    return choose_velocity(pos, v_pref, v_prev, headings, v_max, (q, w, r), robot_radius, p,
+    return choose_velocity(pos, v_pref, v_prev, headings, v_max, (q, w, reach, bodies), p,
                            heading=heading, u_max=u_max)  # fmt: skip
 
 
