@@ -31,17 +31,19 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 
-from run_benchmarks import CH2_SPEC, decision_observations, machine_info  # noqa: E402
+from run_benchmarks import CH2_SPEC, decision_observations, machine_info
 
-from uvnav.controllers.base import make_controller  # noqa: E402
-from uvnav.geometry.kernels3d import use_compiled  # noqa: E402
-from uvnav.sensors.observation import Observation, ObstacleReading  # noqa: E402
+from uvnav.controllers.base import make_controller
+from uvnav.geometry.kernels3d import use_compiled
+from uvnav.sensors.observation import Observation, ObstacleReading
 
 TARGET_US = 200.0
 COUNTS = (10, 100)
 
 
-def crowd_observations(n: int, n_calls: int, *, n_poses: int = 16, seed: int = 0) -> list[Observation]:
+def crowd_observations(
+    n: int, n_calls: int, *, n_poses: int = 16, seed: int = 0
+) -> list[Observation]:
     """``n`` walking pedestrians within 8 m of the robot, seen exactly (discs, nearest first)."""
     rng = np.random.default_rng(seed)
     out = []

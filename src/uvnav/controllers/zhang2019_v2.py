@@ -200,15 +200,10 @@ def tangent_directions(
     with np.errstate(divide="ignore", invalid="ignore"):
         half = np.where(dist > radii, np.arcsin(np.minimum(radii / dist, 1.0)), 0.5 * np.pi)
     starts = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
-    ends = np.r_[starts[1:], len(owner)]
-    nearest = np.minimum.reduceat(dist, starts)
-    ref_idx = starts + np.array(
-        [np.argmax(dist[a:b] == m) for a, b, m in zip(starts, ends, nearest, strict=True)]
-    )
-    ref = base[ref_idx]
-    rel = (base - ref[np.repeat(np.arange(len(starts)), ends - starts)] + np.pi) % (
-        2 * np.pi
-    ) - np.pi
+    group = np.repeat(np.arange(len(starts)), np.diff(np.r_[starts, len(owner)]))
+    order = np.lexsort((dist, group))  # by body, nearest first
+    ref = base[order[starts]]
+    rel = (base - ref[group] + np.pi) % (2.0 * np.pi) - np.pi
     lo = ref + np.minimum.reduceat(rel - half, starts)
     hi = ref + np.maximum.reduceat(rel + half, starts)
     return np.concatenate([lo, hi])
@@ -279,17 +274,14 @@ def reachable(
     readings: tuple[ObstacleReading, ...], v_max: float, horizon: float
 ) -> tuple[ObstacleReading, ...]:
     """The bodies that can come into contact with the robot within ``horizon`` [s]."""
-    return tuple(
-        rd
-        for rd in readings
-        if rd.distance
-        <= (
-            v_max
-            + math.hypot(rd.velocity[0], rd.velocity[1])
-            + abs(rd.angular_velocity) * rd.bounding_radius
-        )
-        * horizon  # fmt: skip
+    if not readings:
+        return ()
+    facts = np.array(
+        [(rd.distance, *rd.velocity, rd.angular_velocity, rd.bounding_radius) for rd in readings]
     )
+    bound = np.hypot(facts[:, 1], facts[:, 2]) + np.abs(facts[:, 3]) * facts[:, 4]
+    keep = np.flatnonzero(facts[:, 0] <= (v_max + bound) * horizon)
+    return tuple(readings[k] for k in keep)
 
 
 def plan(
