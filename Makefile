@@ -59,6 +59,9 @@ bench: $(STAMP_RUN)
 	$(PY) benchmarks/bench_multi.py --out benchmarks/results
 	$(PY) benchmarks/bench_ch7.py --out benchmarks/results
 	$(PY) benchmarks/bench_crowdnav.py --cases 500 --out benchmarks/results
+	$(PY) benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-holonomic-v2 --out benchmarks/results
+	$(PY) benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-v2 --out benchmarks/results
+	$(PY) benchmarks/bench_zhang2019_v2.py --out benchmarks/results
 
 clean:
 	rm -rf $(VENV) results report .pytest_cache .mypy_cache .ruff_cache

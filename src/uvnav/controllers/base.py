@@ -85,6 +85,7 @@ _REGISTRY: dict[str, ControllerInfo] = {}
 #: Modules of ``uvnav.controllers`` that register built-in unicycle laws when imported.
 BUILTIN_MODULES: tuple[str, ...] = (
     "zhang2019",
+    "zhang2019_v2",
     "savkin_wang2013",
     "straight",
     "orca",
@@ -97,7 +98,7 @@ BUILTIN_MODULES_BY_VEHICLE: dict[str, tuple[str, ...]] = {
     "unicycle": BUILTIN_MODULES,
     "vehicle3d": ("zhang2020_3d", "apf3d", "vo3d", "zhang_uuv3d"),
     "uuv2d": ("zhang2022_uuv2d", "uuv2d_baselines"),
-    "holonomic": ("holonomic",),
+    "holonomic": ("holonomic", "zhang2019_v2"),
 }
 _ENTRY_POINTS_LOADED = False
 

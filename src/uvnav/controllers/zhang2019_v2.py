@@ -1,0 +1,406 @@
+"""``zhang2019-v2`` / ``zhang2019-holonomic-v2``: the thesis's forecast-circle tangent law extended
+to every body that can reach the robot — a law for crowds.
+
+Reference: Y. Zhang, *Algorithms of Real-Time Navigation and Control of Autonomous Unmanned
+Vehicles*, UNSW — Chapter 2, §2.3: the forecast circle (2.11), its tangent lines and forecast
+vectors (2.12)-(2.13), the sliding-mode heading law (2.15) and the target-approaching mode (2.16).
+``zhang2019-v1`` (:mod:`uvnav.controllers.zhang2019`) is that law as the chapter states it and
+stays unchanged for the reproduction.
+
+**What it keeps from Chapter 2.**
+
+* The forecast circle: where a boundary point of a body may be one forecast time T_f from now —
+  centred at the point, radius ``(||v_i|| + |u_i| R_i) T_f`` grown by the robot's radius and a
+  margin (v1's note 2).
+* The tangent lines from the robot to the forecast circles as the directions worth steering along
+  (2.12)-(2.13); per body the outermost tangent on each side over the forecast circles of all its
+  boundary points (v1's note 3), so a non-convex body is passed, not grazed.
+* The sliding-mode heading law with its boundary layer, ``u = U_max sat(beta / (U_max T_c))``
+  (2.15; v1's note 5), and slowing by cos(beta) while turning (v1's note 7), for the unicycle.
+* M1 (2.16): V_max toward T when nothing can reach the robot; the speed lowered near T.
+
+**What it adds, and why.**  Measured on crowds (issue 19: CrowdNav circle crossing, ETH
+recordings) v1 fails because it avoids the *one* nearest obstacle (or group) in its way, turns
+into the next stream of people, and never slows down, waits or backs off.  v2 therefore
+
+1. takes the tangent directions of *all* forecast circles of bodies that can reach the robot within
+   the ``horizon`` H (plus the goal direction, the previous choice and ``n_headings`` evenly spread
+   directions, so that a way out exists when every tangent is blocked) — no grouping of
+   neighbours is needed, because every candidate is checked against every body;
+2. pairs each direction with several speeds (``speed_levels`` x V_max, and standing still) and
+   checks every candidate velocity against every predicted body over H: the first time of contact
+   of the robot's disc (radius + margin) with each body's boundary discs under constant
+   velocities (the bodies' velocities as observed; a rotating body's boundary points move with
+   ``v_i + u_i x (q - c_i)``), in closed form;
+3. chooses the candidate of least cost ``||v - v_pref|| + w_ttc / t_c`` (v_pref: V_max toward T;
+   t_c: the first contact time, infinite when none within H), among the candidates whose first
+   contact is later than ``min_ttc`` when there is one — so the robot keeps its speed where that is
+   safe, slows down or stops where only that is safe, and backs away (a direction with a negative
+   component toward T) where even standing still is not;
+4. holds its choice: a small cost ``w_change ||v - v_prev||`` keeps it from switching sides between
+   decisions (the role of v1's direction tag).
+
+The holonomic robot takes the chosen velocity as it is; the unicycle steers toward the chosen
+direction with the sliding-mode law at the chosen speed times cos(beta) (its candidates are
+checked at the speed it will actually have, so a direction behind it counts as standing still
+while it turns).
+
+Everything is vectorised over candidates x boundary discs in numpy (one array expression for the
+contact times), so one decision with 100 pedestrians in range costs about a hundred microseconds
+(``benchmarks/bench_zhang2019_v2.py``).  Units: metres, seconds, radians.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import ClassVar
+
+import numpy as np
+
+from uvnav.controllers.base import (
+    ControllerInfo,
+    UnicycleController,
+    check_params,
+    heading_rate_toward,
+    register,
+)
+from uvnav.controllers.holonomic import HolonomicLaw, toward_goal
+from uvnav.dynamics.omni import VelocityCommand
+from uvnav.dynamics.unicycle import UnicycleCommand
+from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.geometry.contact import candidate_risk, candidate_risk_compiled
+from uvnav.geometry.kernels3d import numba_enabled
+from uvnav.sensors.observation import Observation, ObstacleReading
+
+IntArray = np.ndarray
+
+
+@dataclass(frozen=True)
+class Zhang2019V2Params:
+    """Parameters of ``zhang2019-v2`` and ``zhang2019-holonomic-v2``.
+
+    Attributes:
+        horizon: H [s], how far ahead every candidate is checked against every body.
+        forecast_horizon: T_f [s] of the forecast circles (thesis: 1 s).
+        safety_margin: clearance [m] kept beyond the robot's radius.
+        n_headings: evenly spread extra directions (a way out when every tangent is blocked).
+        speed_levels: fractions of V_max tried with every direction (standing still is always
+            tried).
+        w_ttc: weight [m] of the collision term ``w_ttc / t_c``.
+        w_change: weight of ``||v - v_prev||`` (holding the choice between decisions).
+        min_ttc: first contact [s] a candidate must clear when any candidate does.
+        spacing: largest distance [m] between boundary samples of a polygon body.
+        max_tangent_bodies: the nearest bodies whose tangents become candidates (all bodies are
+            still checked against every candidate).
+        comfort: clearance [m] beyond the margin below which a candidate pays
+            ``w_comfort`` [1/s] per metre, by its smallest clearance over ``comfort_horizon`` [s].
+    """
+
+    horizon: float = 4.0
+    forecast_horizon: float = 1.0
+    safety_margin: float = 0.05
+    n_headings: int = 16
+    speed_levels: tuple[float, ...] = (1.0, 0.6, 0.3)
+    w_ttc: float = 1.0
+    w_change: float = 0.1
+    min_ttc: float = 3.0
+    spacing: float = 0.25
+    max_tangent_bodies: int = 12
+    comfort: float = 0.3
+    comfort_horizon: float = 1.0
+    w_comfort: float = 10.0
+
+    def __post_init__(self) -> None:
+        check_params(
+            self,
+            positive=("horizon", "forecast_horizon", "spacing", "min_ttc", "comfort_horizon"),
+            non_negative=("safety_margin", "w_ttc", "w_change", "comfort", "w_comfort"),
+        )
+        for name in ("n_headings", "max_tangent_bodies"):
+            value = getattr(self, name)
+            if not isinstance(value, int) or isinstance(value, bool) or value < 0:
+                raise ValueError(f"{name} must be an integer >= 0 (got {value!r})")
+        levels = tuple(self.speed_levels)
+        if not levels or not all(isinstance(s, int | float) and 0 < s <= 1 for s in levels):
+            raise ValueError(
+                f"speed_levels must be fractions in (0, 1] (got {self.speed_levels!r})"
+            )
+
+
+# -- pure functions ----------------------------------------------------------------------------
+
+
+def boundary_discs(
+    readings: tuple[ObstacleReading, ...], spacing: float
+) -> tuple[FloatArray, FloatArray, FloatArray, IntArray, FloatArray]:
+    """Every body as discs on its boundary: centres (M, 2) [m], velocities (M, 2) [m/s], radii
+    (M,) [m], the index of the body (M,), and per body (N, 6) its first and end disc index, its
+    centre and velocity (the rows of :func:`uvnav.geometry.contact.candidate_risk_compiled`, less
+    the reach).
+
+    A disc body is one disc; a polygon's edges are sampled so that no two neighbouring samples are
+    farther apart than ``spacing`` (the vertices and evenly spaced points between them), each
+    sample a disc of radius ``spacing / 2`` (which covers the edges) moving with
+    ``v_i + u_i x (q - c_i)``.  One pass over all edges of all bodies.
+
+    >>> from uvnav.sensors.observation import ObstacleReading
+    >>> z = np.zeros(2)
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> rd = ObstacleReading(0, 1.0, z, np.array([0.5, 0.5]), z, 0.0, sq, 0.0, 0.71)
+    >>> boundary_discs((rd,), 0.5)[0].shape
+    (8, 2)
+    """
+    n = len(readings)
+    centre = np.array([rd.centre for rd in readings], dtype=float).reshape(n, 2)
+    vel = np.array([rd.velocity for rd in readings], dtype=float).reshape(n, 2)
+    omega = np.array([rd.angular_velocity for rd in readings], dtype=float)
+    disc_r = np.array([rd.radius for rd in readings], dtype=float)
+    rings = [np.asarray(rd.outline, dtype=float).reshape(-1, 2) if rd.radius <= 0.0
+             else centre[k : k + 1] for k, rd in enumerate(readings)]  # fmt: skip
+    sizes = np.array([len(x) for x in rings], dtype=int)
+    start = np.concatenate(rings) if n else np.zeros((0, 2))
+    first = np.repeat(np.cumsum(sizes) - sizes, sizes)
+    nxt = np.arange(len(start)) + 1
+    nxt = np.where(nxt - first >= np.repeat(sizes, sizes), first, nxt)
+    edge = np.where(np.repeat(disc_r > 0.0, sizes)[:, None], 0.0, start[nxt] - start)
+    n_sub = np.maximum(np.ceil(np.hypot(edge[:, 0], edge[:, 1]) / spacing).astype(int), 1)
+    idx = np.repeat(np.arange(len(start)), n_sub)
+    frac = np.arange(len(idx)) - np.repeat(np.cumsum(n_sub) - n_sub, n_sub)
+    q = start[idx] + (frac / n_sub[idx])[:, None] * edge[idx]
+    owner = np.repeat(np.repeat(np.arange(n), sizes), n_sub)
+    rel = q - centre[owner]
+    w = vel[owner] + omega[owner, None] * np.column_stack([-rel[:, 1], rel[:, 0]])
+    r = np.where(disc_r[owner] > 0.0, disc_r[owner], 0.5 * spacing)
+    counts = np.bincount(owner, minlength=n)
+    ends = np.cumsum(counts)
+    bodies = np.column_stack([ends - counts, ends, centre, vel]).astype(float)
+    return q, w, r, owner, bodies
+
+
+def tangent_directions(
+    position: FloatArray, centres: FloatArray, radii: FloatArray, owner: IntArray
+) -> FloatArray:
+    """Per body, the outermost tangent direction [rad] on each side over the circles
+    (``centres``, ``radii``) of that body (v1's note 3): two angles per body (``owner``: the
+    body of each circle, non-decreasing).
+
+    A circle that holds the robot gives the directions perpendicular to its radius.
+
+    >>> t = tangent_directions(np.zeros(2), np.array([[2.0, 0.0]]), np.array([1.0]),
+    ...                        np.array([0]))
+    >>> np.round(np.degrees(t), 6).tolist()
+    [-30.0, 30.0]
+    """
+    if not len(centres):
+        return np.zeros(0)
+    d = centres - position
+    dist = np.hypot(d[:, 0], d[:, 1])
+    base = np.arctan2(d[:, 1], d[:, 0])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        half = np.where(dist > radii, np.arcsin(np.minimum(radii / dist, 1.0)), 0.5 * np.pi)
+    starts = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
+    group = np.repeat(np.arange(len(starts)), np.diff(np.r_[starts, len(owner)]))
+    order = np.lexsort((dist, group))  # by body, nearest first
+    ref = base[order[starts]]
+    rel = (base - ref[group] + np.pi) % (2.0 * np.pi) - np.pi
+    lo = ref + np.minimum.reduceat(rel - half, starts)
+    hi = ref + np.maximum.reduceat(rel + half, starts)
+    return np.concatenate([lo, hi])
+
+
+@dataclass(frozen=True)
+class Choice:
+    """The chosen velocity [m/s] (2,), its first contact time [s] and whether it is the
+    preferred one (M1)."""
+
+    velocity: FloatArray
+    ttc: float
+    preferred: bool
+
+
+def choose_velocity(
+    position: FloatArray,
+    v_pref: FloatArray,
+    v_prev: FloatArray,
+    headings: FloatArray,
+    v_max: float,
+    discs: tuple[FloatArray, FloatArray, FloatArray, FloatArray],
+    params: Zhang2019V2Params,
+    *,
+    heading: float | None = None,
+    u_max: float = math.inf,
+) -> Choice:
+    """The candidate velocity of least cost (module docstring, steps 2-4).
+
+    ``discs``: boundary discs (centres, velocities, radius sums with the robot's disc and margin)
+    and the bodies' rows (:func:`boundary_discs` with the bounding reach appended).
+    ``headings`` [rad] are the candidate directions, each tried at every speed level.  With
+    ``heading`` [rad] given (a unicycle turning at most ``u_max`` [rad/s]) a candidate is checked
+    as the robot will drive it: first the turn, ``|beta| / u_max`` seconds along the chord's
+    direction ``heading + beta / 2`` at ``s cos(beta / 2)`` (0 for a turn past pi), then straight
+    at ``s`` (the turn slowdown of v1's note 7, averaged over the turn).
+    """
+    p = params
+    speeds = v_max * np.asarray(p.speed_levels, dtype=float)
+    pref = np.asarray(v_pref, dtype=float)
+    ang = np.append(np.repeat(headings, len(speeds)), math.atan2(pref[1], pref[0]))
+    spd = np.append(np.tile(speeds, len(headings)), math.hypot(pref[0], pref[1]))
+    ang, spd = np.append(ang, ang[-1]), np.append(spd, 0.0)  # standing still
+    cand = spd[:, None] * np.column_stack([np.cos(ang), np.sin(ang)])
+    turn, tau = cand, np.zeros(len(cand))
+    if heading is not None:
+        beta = (ang - heading + np.pi) % (2.0 * np.pi) - np.pi
+        tau = np.minimum(np.abs(beta) / u_max, p.horizon)
+        mid = heading + 0.5 * beta
+        s1 = spd * np.maximum(np.cos(0.5 * beta), 0.0)
+        turn = s1[:, None] * np.column_stack([np.cos(mid), np.sin(mid)])
+    q, w, reach, bodies = discs
+    args = (p.horizon, p.comfort, p.comfort_horizon)
+    if numba_enabled():
+        ttc, pen = candidate_risk_compiled(position, cand, turn, tau, (q, w, reach), bodies, *args)
+    else:
+        ttc, pen = candidate_risk(position, cand, turn, tau, (q, w, reach), *args)
+    cost = np.hypot(*(cand - pref).T) + p.w_change * np.hypot(*(cand - v_prev).T)
+    cost = cost + p.w_ttc / np.maximum(ttc, 1e-3) + p.w_comfort * pen
+    safe = ttc > p.min_ttc
+    if np.any(safe):
+        cost = np.where(safe, cost, np.inf)
+    k = int(np.argmin(cost))
+    return Choice(cand[k], float(ttc[k]), bool(k == len(cand) - 2 and np.isinf(ttc[k])))
+
+
+def reachable(
+    readings: tuple[ObstacleReading, ...], v_max: float, horizon: float
+) -> tuple[ObstacleReading, ...]:
+    """The bodies that can come into contact with the robot within ``horizon`` [s]."""
+    if not readings:
+        return ()
+    facts = np.array(
+        [(rd.distance, *rd.velocity, rd.angular_velocity, rd.bounding_radius) for rd in readings]
+    )
+    bound = np.hypot(facts[:, 1], facts[:, 2]) + np.abs(facts[:, 3]) * facts[:, 4]
+    keep = np.flatnonzero(facts[:, 0] <= (v_max + bound) * horizon)
+    return tuple(readings[k] for k in keep)
+
+
+def plan(
+    obs: Observation,
+    goal: FloatArray,
+    v_max: float,
+    robot_radius: float,
+    period: float,
+    v_prev: FloatArray,
+    params: Zhang2019V2Params,
+    *,
+    heading: float | None = None,
+    u_max: float = math.inf,
+) -> Choice:
+    """One decision of v2 for a robot at ``obs.position`` (both vehicles)."""
+    p = params
+    pos = np.asarray(obs.position, dtype=float)
+    v_pref = toward_goal(pos, goal, v_max, period)
+    near = reachable(obs.obstacles, v_max, p.horizon)
+    if not near:
+        return Choice(v_pref, math.inf, True)
+    q, w, r, owner, rows = boundary_discs(near, p.spacing)
+    pad = robot_radius + p.safety_margin
+    reach = r + pad
+    sample_r = np.array([0.0 if rd.radius > 0.0 else 0.5 * p.spacing for rd in near])
+    bound = np.array([rd.bounding_radius for rd in near]) + sample_r + pad
+    bodies = np.column_stack([rows, bound])
+    few = owner < p.max_tangent_bodies  # readings come nearest first
+    grow = reach + np.hypot(w[:, 0], w[:, 1]) * p.forecast_horizon
+    tangents = tangent_directions(pos, q[few], grow[few], owner[few])
+    spread = 2.0 * np.pi * np.arange(p.n_headings) / max(p.n_headings, 1)
+    extra = [math.atan2(v_pref[1], v_pref[0])]
+    if float(np.hypot(*v_prev)) > 1e-9:
+        extra.append(math.atan2(v_prev[1], v_prev[0]))
+    headings = np.concatenate([tangents, spread, np.asarray(extra)])
+    return choose_velocity(pos, v_pref, v_prev, headings, v_max, (q, w, reach, bodies), p,
+                           heading=heading, u_max=u_max)  # fmt: skip
+
+
+# -- the two laws -----------------------------------------------------------------------------
+
+
+class Zhang2019HolonomicV2(HolonomicLaw):
+    """v2 on the holonomic robot: the chosen velocity as it is."""
+
+    name: ClassVar[str] = "zhang2019-holonomic-v2"
+
+    def __init__(self, params: Zhang2019V2Params | None = None) -> None:
+        super().__init__()
+        self.params = params or Zhang2019V2Params()
+        self.last_choice: Choice | None = None
+
+    def act(self, obs: Observation) -> VelocityCommand:
+        period = self.decision_period(obs.time)
+        spec = self._spec
+        if not np.all(np.isfinite(obs.position)):
+            return VelocityCommand(0.0, 0.0)
+        choice = plan(obs, self._goal, spec.v_max, spec.radius, period,
+                      self.current_velocity(obs), self.params)  # fmt: skip
+        self.last_choice = choice
+        self._mode = "M1" if choice.preferred else "M2"
+        return VelocityCommand(float(choice.velocity[0]), float(choice.velocity[1])).clipped(spec)
+
+
+class Zhang2019V2(UnicycleController):
+    """v2 on the unicycle: sliding-mode turn toward the chosen direction (2.15)."""
+
+    name: ClassVar[str] = "zhang2019-v2"
+
+    def __init__(self, params: Zhang2019V2Params | None = None) -> None:
+        super().__init__()
+        self.params = params or Zhang2019V2Params()
+        self.last_choice: Choice | None = None
+        self._aim = np.zeros(2)
+
+    def _reset_law(self, rng: np.random.Generator) -> None:
+        self.last_choice = None
+        self._aim = np.zeros(2)
+
+    def act(self, obs: Observation) -> UnicycleCommand:
+        period = self.decision_period(obs.time)
+        spec = self._spec
+        if not (np.all(np.isfinite(obs.position)) and math.isfinite(obs.heading)):
+            return UnicycleCommand(0.0, 0.0)
+        choice = plan(obs, self._goal, spec.v_max, spec.radius, period, self._aim, self.params,
+                      heading=obs.heading, u_max=spec.u_max)  # fmt: skip
+        self.last_choice = choice
+        self._mode = "M1" if choice.preferred else "M2"
+        v = choice.velocity
+        speed = float(np.hypot(v[0], v[1]))
+        self._aim = np.asarray(v, dtype=float)
+        if speed < 1e-9:  # standing still: face the target meanwhile
+            gap = self._goal - obs.position
+            aim = math.atan2(float(gap[1]), float(gap[0]))
+        else:
+            aim = math.atan2(float(v[1]), float(v[0]))
+        beta = wrap_scalar(aim - obs.heading)
+        speed *= max(math.cos(beta), 0.0)  # v1's turn slowdown (note 7)
+        return UnicycleCommand(speed, heading_rate_toward(beta, spec.u_max, period)).clipped(spec)
+
+
+_REFERENCE = "Y. Zhang, thesis Ch. 2, eqs. (2.11)-(2.16), extended to crowds (module docstring)"
+register(
+    ControllerInfo(
+        name="zhang2019-v2",
+        factory=Zhang2019V2,
+        params_type=Zhang2019V2Params,
+        summary="Thesis Ch. 2 tangent law for crowds: forecast-circle tangents of every body, each "
+        "candidate checked against all, speed chosen with the heading.",
+        reference=_REFERENCE,
+    )
+)
+register(
+    ControllerInfo(
+        name="zhang2019-holonomic-v2",
+        factory=Zhang2019HolonomicV2,
+        params_type=Zhang2019V2Params,
+        summary="zhang2019-v2 on the holonomic robot: the chosen velocity applied as it is.",
+        reference=_REFERENCE,
+        vehicle="holonomic",
+    )
+)

@@ -1,0 +1,247 @@
+"""``zhang2019-v2`` / ``zhang2019-holonomic-v2``: the contact kernels (numpy vs compiled, against
+brute-force sampling), the choice (keeps speed when free, slows, stops or backs away when boxed
+in, safe when a safe candidate exists), both vehicles on real scenes, and v1 left as it was."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from uvnav.controllers import make_controller
+from uvnav.controllers.base import controller_info, make_law, requires_slower_obstacles
+from uvnav.controllers.zhang2019_v2 import (
+    Zhang2019V2Params,
+    boundary_discs,
+    plan,
+    tangent_directions,
+)
+from uvnav.dynamics import UnicycleSpec
+from uvnav.dynamics.omni import OmniSpec
+from uvnav.geometry.contact import (
+    candidate_risk,
+    candidate_risk_compiled,
+    candidate_risk_py,
+    closest_gap,
+    first_contact,
+)
+from uvnav.geometry.kernels3d import numba_available, use_compiled
+from uvnav.scenarios.catalog import resolve
+from uvnav.scenarios.episodes import run_scene
+from uvnav.sensors.observation import Observation, ObstacleReading
+
+GOAL = np.array([10.0, 0.0])
+PARAMS = Zhang2019V2Params()
+coord = st.floats(-6.0, 6.0, allow_nan=False)
+speed = st.floats(-1.5, 1.5, allow_nan=False)
+
+
+def pedestrian(k: int, x: float, y: float, vx: float = 0.0, vy: float = 0.0) -> ObstacleReading:
+    """A disc of radius 0.3 m seen from the origin."""
+    c = np.array([x, y])
+    d = float(np.hypot(x, y))
+    return ObstacleReading(
+        obstacle_id=k,
+        distance=max(d - 0.3, 0.0),
+        nearest_point=c * (1.0 - 0.3 / max(d, 1e-9)),
+        centre=c,
+        velocity=np.array([vx, vy]),
+        angular_velocity=0.0,
+        outline=np.zeros((0, 2)),
+        radius=0.3,
+        bounding_radius=0.3,
+    )
+
+
+def observe(*readings: ObstacleReading, heading: float = 0.0) -> Observation:
+    order = sorted(readings, key=lambda rd: rd.distance)
+    return Observation(
+        time=1.0, pose=np.array([0.0, 0.0, heading]), speed=0.0, goal=GOAL, obstacles=tuple(order)
+    )
+
+
+# -- kernels --------------------------------------------------------------------------------
+
+
+@settings(max_examples=200, deadline=None)
+@given(px=coord, py=coord, vx=speed, vy=speed, reach=st.floats(0.1, 1.0))
+def test_first_contact_is_the_first_sampled_contact(
+    px: float, py: float, vx: float, vy: float, reach: float
+) -> None:
+    """The closed form against sampling: no contact before it, contact at it."""
+    p, v, horizon = np.array([px, py]), np.array([vx, vy]), 4.0
+    t = float(first_contact(p, v, np.array(reach), horizon))
+    ts = np.linspace(0.0, horizon, 4001)
+    dist = np.hypot(*(p[None, :] - ts[:, None] * v[None, :]).T)
+    inside_now = float(np.hypot(px, py)) <= reach
+    if inside_now:
+        closing = float(np.dot(p, v)) > 0.0
+        assert t == (0.0 if closing else math.inf)
+        return
+    if math.isinf(t):
+        assert np.all(dist > reach - 1e-3)
+    else:
+        assert abs(float(np.hypot(*(p - t * v))) - reach) < 1e-6
+        assert np.all(dist[ts < t - 1e-3] > reach - 1e-6)
+    gap = float(closest_gap(p, v, np.array(reach), horizon))
+    assert gap == pytest.approx(float(dist.min()) - reach, abs=1e-3)
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 12), unicycle=st.booleans())
+def test_compiled_and_numpy_paths_agree(seed: int, n: int, unicycle: bool) -> None:
+    """The culled loop gives the numpy reference's numbers (the cull drops only far pairs)."""
+    rng = np.random.default_rng(seed)
+    readings = tuple(
+        pedestrian(k, *rng.uniform(-5, 5, 2), *rng.uniform(-1.2, 1.2, 2)) for k in range(n)
+    )
+    q, w, r, _, rows = boundary_discs(readings, 0.25)
+    reach = r + 0.35
+    bodies = np.column_stack([rows, np.full(n, 0.3 + 0.35)])
+    k = 40
+    ang = rng.uniform(-np.pi, np.pi, k)
+    spd = rng.uniform(0.0, 1.0, k)
+    cand = spd[:, None] * np.column_stack([np.cos(ang), np.sin(ang)])
+    tau = rng.uniform(0.0, 1.5, k) if unicycle else np.zeros(k)
+    turn = cand * rng.uniform(0.3, 1.0, (k, 1)) if unicycle else cand
+    args = (4.0, 0.3, 1.0)
+    ref = candidate_risk(np.zeros(2), cand, turn, tau, (q, w, reach), *args)
+    got = candidate_risk_compiled(np.zeros(2), cand, turn, tau, (q, w, reach), bodies, *args)
+    ttc_py, pen_py = np.empty(k), np.empty(k)
+    candidate_risk_py(np.zeros(2), cand, turn, tau, q, w, reach, bodies, *args, ttc_py, pen_py)
+    for a, b in ((ref, got), (ref, (ttc_py, pen_py))):
+        np.testing.assert_allclose(a[0], b[0], rtol=0, atol=1e-12)
+        np.testing.assert_allclose(a[1], b[1], rtol=0, atol=1e-12)
+
+
+def test_polygon_boundary_discs_cover_the_edges_and_rotate() -> None:
+    square = np.array([[1.0, -0.5], [2.0, -0.5], [2.0, 0.5], [1.0, 0.5]])
+    rd = ObstacleReading(0, 1.0, np.array([1.0, 0.0]), np.array([1.5, 0.0]), np.zeros(2), 1.0,
+                         square, 0.0, 0.71)  # fmt: skip
+    q, w, r, owner, rows = boundary_discs((rd,), 0.3)
+    assert np.all(owner == 0) and rows[0, :2].tolist() == [0.0, len(q)]
+    gaps = np.hypot(*np.diff(np.vstack([q, q[:1]]), axis=0).T)
+    assert gaps.max() <= 0.3 + 1e-12 and np.all(r == 0.15)
+    # rotation at 1 rad/s about the centre: w = u x (q - c)
+    np.testing.assert_allclose(w, np.column_stack([-(q[:, 1] - 0.0), q[:, 0] - 1.5]))
+
+
+def test_tangents_bound_the_body_on_both_sides() -> None:
+    t = tangent_directions(np.zeros(2), np.array([[2.0, 0.0], [2.0, 1.0]]), np.array([0.5, 0.5]),
+                           np.array([0, 0]))  # fmt: skip
+    assert t[0] == pytest.approx(-math.asin(0.25))
+    assert t[1] == pytest.approx(math.atan2(1.0, 2.0) + math.asin(0.5 / math.sqrt(5.0)))
+
+
+# -- the choice -----------------------------------------------------------------------------
+
+
+def _holonomic_plan(obs: Observation) -> np.ndarray:
+    return plan(obs, GOAL, 1.0, 0.3, 0.25, np.zeros(2), PARAMS).velocity
+
+
+def test_free_floor_full_speed_to_the_goal() -> None:
+    v = _holonomic_plan(observe())
+    np.testing.assert_allclose(v, [1.0, 0.0])
+
+
+def test_head_on_pedestrian_is_passed_not_met() -> None:
+    """A pedestrian walking straight at the robot: the robot steps aside at speed."""
+    v = _holonomic_plan(observe(pedestrian(0, 3.0, 0.0, -1.0, 0.0)))
+    assert abs(v[1]) > 0.2 and float(np.hypot(*v)) > 0.5
+
+
+def test_boxed_in_robot_backs_away() -> None:
+    """A wall of pedestrians walking at the robot from the goal side: no way forward is safe, and
+    standing still is not either; the robot moves away from them."""
+    wall = [pedestrian(k, 1.2, y, -1.0, 0.0) for k, y in enumerate(np.linspace(-3.0, 3.0, 9))]
+    v = _holonomic_plan(observe(*wall))
+    assert v[0] < 0.0
+
+
+def test_crossing_stream_slows_or_waits() -> None:
+    """A dense stream crossing just ahead: the robot does not drive into it at full speed."""
+    stream = [pedestrian(k, 1.2, y, 0.0, 1.0) for k, y in enumerate(np.arange(-6.0, 6.1, 0.8))]
+    v = _holonomic_plan(observe(*stream))
+    assert v[0] < 0.5
+
+
+@settings(max_examples=60, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 8))
+def test_choice_is_clear_of_every_body_for_min_ttc(seed: int, n: int) -> None:
+    """When the chosen velocity's first contact is later than ``min_ttc``, brute-force sampling of
+    every body's constant-velocity motion finds no contact before then."""
+    rng = np.random.default_rng(seed)
+    readings = []
+    for k in range(n):
+        x, y = rng.uniform(-6, 6, 2)
+        if math.hypot(x, y) < 1.0:
+            continue
+        readings.append(pedestrian(k, x, y, *rng.uniform(-1.0, 1.0, 2)))
+    obs = observe(*readings)
+    choice = plan(obs, GOAL, 1.0, 0.3, 0.25, np.zeros(2), PARAMS)
+    if choice.ttc <= PARAMS.min_ttc:
+        return
+    ts = np.linspace(0.0, PARAMS.min_ttc, 301)
+    robot = ts[:, None] * choice.velocity[None, :]
+    for rd in readings:
+        body = rd.centre[None, :] + ts[:, None] * rd.velocity[None, :]
+        gap = np.hypot(*(robot - body).T) - (0.3 + 0.3 + PARAMS.safety_margin)
+        assert gap.min() > -1e-9
+
+
+def test_same_observation_same_command() -> None:
+    obs = observe(pedestrian(0, 2.0, 0.5, -0.5, 0.0), pedestrian(1, 3.0, -1.0, 0.0, 0.4))
+    a, b = make_controller("zhang2019-v2"), make_controller("zhang2019-v2")
+    for law in (a, b):
+        law.reset(UnicycleSpec(1.0, math.pi, 0.3), GOAL, np.random.default_rng(0))
+    assert a.act(obs) == b.act(obs)
+
+
+@pytest.mark.parametrize("value", [{"horizon": 0.0}, {"n_headings": -1}, {"speed_levels": ()}])
+def test_bad_parameters_are_refused(value: dict[str, object]) -> None:
+    with pytest.raises(ValueError):
+        Zhang2019V2Params(**value)  # type: ignore[arg-type]
+
+
+# -- registry and scenes --------------------------------------------------------------------
+
+
+def test_both_vehicles_registered_without_the_slower_obstacle_assumption() -> None:
+    assert controller_info("zhang2019-v2").vehicle == "unicycle"
+    assert controller_info("zhang2019-holonomic-v2").vehicle == "holonomic"
+    assert not requires_slower_obstacles("zhang2019-v2")
+    assert not requires_slower_obstacles("zhang2019-holonomic-v2")
+    law = make_law("zhang2019-holonomic-v2", vehicle="holonomic")
+    law.reset(OmniSpec(1.0, 0.3), GOAL, np.random.default_rng(0))
+    assert law.act(observe()).vx == pytest.approx(1.0)
+
+
+@pytest.mark.parametrize("law", ["zhang2019-v2", "zhang2019-holonomic-v2"])
+def test_crowdnav_case_is_crossed(law: str) -> None:
+    """CrowdNav's first test case: v2 gets across where v1 is refused (1 m/s pedestrians)."""
+    out = run_scene(resolve("crowdnav-circle:1"), law)
+    assert out.status == "success"
+
+
+def test_fig_2_10_path_no_longer_than_v1() -> None:
+    """Issue 19's no-regression target on the thesis's comparison scene."""
+    scene = resolve("thesis-ch2-fig2-10-comparison")
+    v1, v2 = run_scene(scene, "zhang2019-v1"), run_scene(scene, "zhang2019-v2")
+    assert v1.status == v2.status == "success"
+    assert v2.metrics["path_length"] <= v1.metrics["path_length"]
+
+
+@pytest.mark.skipif(not numba_available(), reason="needs numba (the fast extra)")
+def test_law_gives_the_same_commands_on_both_paths() -> None:
+    obs = observe(*(pedestrian(k, 1.0 + 0.7 * k, (-1) ** k * 0.6, -0.8, 0.1) for k in range(6)))
+    previous = use_compiled(False)
+    try:
+        slow = plan(obs, GOAL, 1.0, 0.3, 0.25, np.zeros(2), PARAMS, heading=0.2, u_max=math.pi)
+    finally:
+        use_compiled(previous)
+    fast = plan(obs, GOAL, 1.0, 0.3, 0.25, np.zeros(2), PARAMS, heading=0.2, u_max=math.pi)
+    np.testing.assert_allclose(fast.velocity, slow.velocity, atol=1e-12)
