@@ -21,7 +21,13 @@ from typing import ClassVar
 import numpy as np
 
 from uvnav.controllers.base import ControllerInfo, LawState, register
-from uvnav.controllers.orca import OrcaParams, OrcaQuery, _import_pyrvo, orca_velocity
+from uvnav.controllers.orca import (
+    OrcaCrowdNavParams,
+    OrcaParams,
+    OrcaQuery,
+    _import_pyrvo,
+    orca_velocity,
+)
 from uvnav.dynamics.omni import OmniSpec, VelocityCommand
 from uvnav.geometry.angles import FloatArray
 from uvnav.sensors.observation import Observation
@@ -86,7 +92,7 @@ class OrcaHolonomic(HolonomicLaw):
 
     name: ClassVar[str] = "orca-holonomic-v1"
 
-    def __init__(self, params: OrcaHolonomicParams | None = None) -> None:
+    def __init__(self, params: OrcaParams | None = None) -> None:
         super().__init__()
         self.params = params or OrcaHolonomicParams()
         self.last_query: OrcaQuery | None = None
@@ -134,6 +140,28 @@ register(
         summary="ORCA (RVO2 via pyrvo) with full responsibility; the holonomic robot takes its "
         "velocity as it is.",
         reference="J. van den Berg, S. J. Guy, M. Lin, D. Manocha, ISRR 2009 (STAR 70, 2011)",
+        vehicle="holonomic",
+    )
+)
+
+
+class OrcaCrowdNavHolonomic(OrcaHolonomic):
+    """``orca-holonomic-v1`` with CrowdNav's parameters (:data:`~uvnav.controllers.orca.
+    CROWDNAV_ORCA`): CrowdNav's own robot ORCA, the paper's ORCA row."""
+
+    name: ClassVar[str] = "orca-crowdnav-holonomic-v1"
+
+    def __init__(self, params: OrcaParams | None = None) -> None:
+        super().__init__(params or OrcaCrowdNavParams())
+
+
+register(
+    ControllerInfo(
+        name="orca-crowdnav-holonomic-v1",
+        factory=OrcaCrowdNavHolonomic,
+        params_type=OrcaCrowdNavParams,
+        summary="orca-holonomic-v1 with CrowdNav's ORCA parameters: the paper's ORCA row.",
+        reference="Chen, Liu, Kreiss, Alahi, ICRA 2019 (CrowdNav); van den Berg et al., ISRR 2009",
         vehicle="holonomic",
     )
 )

@@ -54,6 +54,7 @@ from typing import Any, Literal
 
 import numpy as np
 
+from uvnav.controllers.orca import CROWDNAV_ORCA
 from uvnav.scenarios.errors import ScenarioError
 from uvnav.scenarios.loader import scenario_from_dict
 from uvnav.scenarios.schema import Scenario
@@ -72,14 +73,7 @@ DISCOMFORT_DIST = 0.2  # [m]
 #: seed offsets of the phases (``CrowdSim.reset``: ``counter_offset``)
 PHASE_OFFSET: dict[str, int] = {"val": 0, "test": 1000, "train": 2000}
 #: the robot's ORCA in CrowdNav (``crowd_sim/envs/policy/orca.py``, ``test.py``)
-CROWDNAV_ORCA_PARAMS: dict[str, Any] = {
-    "time_horizon": 5.0,
-    "time_horizon_obst": 5.0,
-    "neighbor_dist": 10.0,
-    "max_neighbors": 10,
-    "responsibility": 0.5,
-    "safety_margin": 0.02,
-}
+CROWDNAV_ORCA_PARAMS: dict[str, Any] = dict(CROWDNAV_ORCA)
 #: the unicycle variant's U_max (CrowdNav's unicycle: rotations within +-pi/4 per 0.25 s step)
 UNICYCLE_U_MAX = math.pi  # [rad/s]
 SENSING_RANGE = 20.0  # [m]
