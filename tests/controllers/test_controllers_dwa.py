@@ -133,3 +133,50 @@ def test_prediction_avoids_a_crossing_obstacle_that_a_static_window_would_hit() 
 def test_bad_parameters_are_rejected_with_the_field_name(bad: dict[str, Any], message: str) -> None:
     with pytest.raises(ControllerParamsError, match=message):
         make_controller("dwa-v1", **bad)
+
+
+EMPTY_FLOOR = """\
+name: empty-floor
+dim: 2
+dt: 0.1
+control_period: 0.1
+t_max: 60
+goal_tolerance: 0.1
+robot: {model: unicycle, start: [0, 0], heading: 0.0, goal: [GOAL, 0], v_max: 0.707,
+        u_max: 1.414, radius: 0.1}
+sensing: {range: 5.0, velocities: known, position_noise: 0.0}
+obstacles: []
+controller: {name: dwa-v1, params: {}}
+"""
+
+
+def _floor(tmp_path: Any, goal: float) -> Any:
+    from uvnav.scenarios.catalog import resolve
+
+    path = tmp_path / "floor.yaml"
+    path.write_text(EMPTY_FLOOR.replace("GOAL", str(goal)))
+    return resolve(str(path))
+
+
+def test_empty_floor_is_crossed_within_a_tenth_of_the_straight_line_time(tmp_path: Any) -> None:
+    """Issue 19: with the heading term evaluated past T the robot slowed from 2 m before T on
+    (17.9 s for 7.7 m against straight-v1's 10.8 s); now within 1.1 x."""
+    from uvnav.scenarios.episodes import run_scene
+
+    scene = _floor(tmp_path, 7.7)
+    dwa, straight = run_scene(scene, "dwa-v1"), run_scene(scene, "straight-v1")
+    assert dwa.status == straight.status == "success"
+    assert dwa.metrics["time_to_goal"] <= 1.1 * straight.metrics["time_to_goal"]
+
+
+@pytest.mark.parametrize("seed", [11, 12])
+def test_random_ch2_episodes_that_parked_short_of_the_goal_now_arrive(seed: int) -> None:
+    """Issue 19's stopping bug: on these scenes the robot stopped next to T (a timeout), because
+    every rollout that drives onto T faces away from it 3 s later, so standing still scored
+    best.  Both arrive now, in about the straight-line time (20.4 s, 20.5 s)."""
+    from uvnav.scenarios.catalog import resolve
+    from uvnav.scenarios.episodes import run_scene
+
+    out = run_scene(resolve(f"random-ch2:{seed}"), "dwa-v1")
+    assert out.status == "success"
+    assert out.metrics["time_to_goal"] < 25.0

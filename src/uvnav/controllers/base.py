@@ -364,3 +364,25 @@ def heading_rate_toward(angle_error: float, u_max: float, period: float) -> floa
     if period <= 0:
         return float(u_max * np.sign(angle_error))
     return saturate(angle_error / period, u_max)
+
+
+def approach_speed(v_max: float, u_max: float, dist: float, beta: float) -> float:
+    """The target-approach speed [m/s] of a unicycle ``dist`` [m] from T, T at angle ``beta``
+    [rad] from its heading: V_max, lowered where T lies inside the minimum turning circle (radius
+    V / U_max) to the largest speed whose turning circle passes through T,
+    ``U_max dist / (2 sin|beta|)``, and to ``U_max dist / 2`` with T behind — so that the robot does
+    not orbit T (``zhang2019-v1``'s note 10; ``savkin-wang2013-v1``'s M1, issue 19).
+
+    >>> approach_speed(1.0, 1.0, 10.0, 0.5)
+    1.0
+    >>> round(approach_speed(1.0, 1.0, 0.5, 1.2), 4)
+    0.2681
+    """
+    v = v_max
+    sin_b = abs(np.sin(beta))
+    if sin_b > 1e-9:
+        v = min(v, u_max * dist / (2.0 * sin_b))
+    if abs(beta) > 0.5 * np.pi:  # target behind: the tightest circle through it
+        v = min(v, u_max * dist / 2.0)
+    return float(v)
+

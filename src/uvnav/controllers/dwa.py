@@ -366,10 +366,7 @@ class DwaController(UnicycleController):
         room = np.maximum(arc - v * period, 0.0)
         admissible = v <= np.sqrt(2.0 * p.brake_accel * room) + 1e-12
         goal = self._goal
-        k_h = int(np.clip(np.searchsorted(times, p.heading_time - 1e-9), 0, len(times) - 1))
-        gx, gy = goal[0] - xs[:, k_h], goal[1] - ys[:, k_h]
-        err = np.angle(np.exp(1j * (np.arctan2(gy, gx) - ths[:, k_h])))
-        heading = 1.0 - np.abs(err) / math.pi
+        heading = heading_term(xs, ys, ths, times, goal, p.heading_time, v * p.rollout_dt)
         # Fox's dist(v, w): arc length to the first predicted contact (the cap when none)
         clearance = np.minimum(np.where(np.isfinite(arc), arc, p.clearance_cap), p.clearance_cap)
         clearance = clearance / p.clearance_cap
@@ -392,6 +389,44 @@ class DwaController(UnicycleController):
         self._last_u = cmd_u
         self.last_samples = (v, u)
         return UnicycleCommand(cmd_v, cmd_u)
+
+
+def heading_term(
+    xs: FloatArray,
+    ys: FloatArray,
+    ths: FloatArray,
+    times: FloatArray,
+    goal: FloatArray,
+    heading_time: float,
+    step: FloatArray,
+) -> FloatArray:
+    """Fox's heading term, 1 - |angle to T| / pi, per sample (rows of the rollout poses
+    ``xs``, ``ys``, ``ths`` at ``times``) [0, 1].
+
+    Evaluated at ``heading_time`` — or, where the rollout passes T before then, at its point
+    nearest T, and 1 (less 0.01 d / ``step``, so that the nearest pass wins) where that point
+    is within the sample's rollout ``step`` [m] of T (it reaches T).  Evaluated past T, a
+    rollout that drives onto T would face away from it and score worst, so that standing still
+    short of T scored best: the robot parked 0.13 m from T (issue 19).
+
+    >>> t = np.array([1.0, 2.0, 3.0])
+    >>> xs = np.array([[0.5, 1.0, 1.5], [0.0, 0.0, 0.0]]); z = np.zeros_like(xs)
+    >>> heading_term(xs, z, z, t, np.array([1.0, 0.0]), 3.0, np.array([0.5, 0.0])).tolist()
+    [1.0, 1.0]
+    >>> h = heading_term(xs, z + 0.1, z, t, np.array([1.0, 0.0]), 3.0, np.array([0.5, 0.5]))
+    >>> h.round(3).tolist()  # a pass 0.1 m off T; a robot at rest 0.1 rad off its bearing
+    [0.998, 0.968]
+    """
+    k_h = int(np.clip(np.searchsorted(times, heading_time - 1e-9), 0, len(times) - 1))
+    d = np.hypot(goal[0] - xs[:, : k_h + 1], goal[1] - ys[:, : k_h + 1])
+    k = np.argmin(d, axis=1)
+    rows = np.arange(len(xs))
+    gx, gy = goal[0] - xs[rows, k], goal[1] - ys[rows, k]
+    err = np.angle(np.exp(1j * (np.arctan2(gy, gx) - ths[rows, k])))
+    heading = 1.0 - np.abs(err) / math.pi
+    reach = np.maximum(step, 1e-9)
+    passing = 1.0 - 0.01 * d[rows, k] / reach  # the nearest pass first
+    return np.asarray(np.where(d[rows, k] <= reach, passing, heading), dtype=float)
 
 
 register(

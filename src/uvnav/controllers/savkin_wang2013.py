@@ -28,6 +28,11 @@ reconstruction in docs/thesis-notes.md):
   target* at V_max, relative to the obstacle, points into the widened cone (a collision course).
 * *Leave* avoidance (back to pure pursuit of the target at V_max) when that relative velocity no
   longer points into the widened cone — heading to the target has become safe.
+* *Pure pursuit slows near T* (:func:`~uvnav.controllers.base.approach_speed`): at V_max a
+  unicycle whose target lies inside its minimum turning circle (radius V_max / U_max) circles it
+  for ever (measured: whole episodes at V_max round T, issue 19); the speed is lowered to the
+  largest one whose turning circle passes through T — the same rule as the thesis law's M1
+  (``zhang2019-v1``, note 10), so the comparison does not turn on it.
 * ``V`` is set to ``||v_obs||`` (the smallest value allowed), which gives the largest relative
   speed ``V_max - ||v_obs||`` along the cone boundary.
 * Non-disc obstacles are replaced by their bounding disc about the mass centre (the law assumes
@@ -46,6 +51,7 @@ import numpy as np
 from uvnav.controllers.base import (
     ControllerInfo,
     UnicycleController,
+    approach_speed,
     check_params,
     heading_rate_toward,
     register,
@@ -164,9 +170,9 @@ class SavkinWang2013Controller(UnicycleController):
             self._mode, self._target_id, self._side = "M1", None, 0
             to_goal = self._goal - pos
             beta = wrap_scalar(math.atan2(to_goal[1], to_goal[0]) - heading)
-            return UnicycleCommand(
-                self._spec.v_max, heading_rate_toward(beta, self._spec.u_max, period)
-            )
+            dist = math.hypot(to_goal[0], to_goal[1])
+            v = approach_speed(self._spec.v_max, self._spec.u_max, dist, beta)
+            return UnicycleCommand(v, heading_rate_toward(beta, self._spec.u_max, period))
         reading, b1, b2 = avoiding
         candidates = (self.desired_velocity(reading, b1), self.desired_velocity(reading, b2))
         if self._mode != "M2" or reading.obstacle_id != self._target_id:

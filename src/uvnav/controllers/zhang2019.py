@@ -83,6 +83,7 @@ import numpy as np
 from uvnav.controllers.base import (
     ControllerInfo,
     UnicycleController,
+    approach_speed,
     check_params,
     heading_rate_toward,
     register,
@@ -458,12 +459,7 @@ class Zhang2019Controller(UnicycleController):
         to_goal = self._goal - obs.position
         dist = float(np.hypot(*to_goal))
         beta = wrap_scalar(float(np.arctan2(to_goal[1], to_goal[0])) - obs.heading)
-        v = self._spec.v_max
-        sin_b = abs(np.sin(beta))
-        if sin_b > 1e-9:
-            v = min(v, self._spec.u_max * dist / (2.0 * sin_b))
-        if abs(beta) > 0.5 * np.pi:  # target behind: the tightest circle through it
-            v = min(v, self._spec.u_max * dist / 2.0)
+        v = approach_speed(self._spec.v_max, self._spec.u_max, dist, beta)
         return UnicycleCommand(v, heading_rate_toward(beta, self._spec.u_max, period))
 
     # -- the switching law ---------------------------------------------------------------------
