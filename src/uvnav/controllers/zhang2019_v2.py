@@ -156,6 +156,10 @@ def boundary_discs(
     vel = np.array([rd.velocity for rd in readings], dtype=float).reshape(n, 2)
     omega = np.array([rd.angular_velocity for rd in readings], dtype=float)
     disc_r = np.array([rd.radius for rd in readings], dtype=float)
+    if n and bool(np.all(disc_r > 0.0)):  # discs only (a crowd): each body is its own disc
+        idx = np.arange(n)
+        rows = np.column_stack([idx, idx + 1, centre, vel]).astype(float)
+        return centre, vel, disc_r, idx, rows
     rings = [np.asarray(rd.outline, dtype=float).reshape(-1, 2) if rd.radius <= 0.0
              else centre[k : k + 1] for k, rd in enumerate(readings)]  # fmt: skip
     sizes = np.array([len(x) for x in rings], dtype=int)
@@ -276,11 +280,11 @@ def reachable(
     """The bodies that can come into contact with the robot within ``horizon`` [s]."""
     if not readings:
         return ()
-    facts = np.array(
-        [(rd.distance, *rd.velocity, rd.angular_velocity, rd.bounding_radius) for rd in readings]
-    )
-    bound = np.hypot(facts[:, 1], facts[:, 2]) + np.abs(facts[:, 3]) * facts[:, 4]
-    keep = np.flatnonzero(facts[:, 0] <= (v_max + bound) * horizon)
+    dist = np.array([rd.distance for rd in readings])
+    vel = np.array([rd.velocity for rd in readings], dtype=float).reshape(len(readings), 2)
+    spin = np.array([abs(rd.angular_velocity) * rd.bounding_radius for rd in readings])
+    bound = np.hypot(vel[:, 0], vel[:, 1]) + spin
+    keep = np.flatnonzero(dist <= (v_max + bound) * horizon)
     return tuple(readings[k] for k in keep)
 
 
@@ -306,8 +310,9 @@ def plan(
     q, w, r, owner, rows = boundary_discs(near, p.spacing)
     pad = robot_radius + p.safety_margin
     reach = r + pad
-    sample_r = np.array([0.0 if rd.radius > 0.0 else 0.5 * p.spacing for rd in near])
-    bound = np.array([rd.bounding_radius for rd in near]) + sample_r + pad
+    half = 0.5 * p.spacing  # a polygon's boundary discs reach this far past its bounding disc
+    bound = np.array([rd.bounding_radius + (0.0 if rd.radius > 0.0 else half) for rd in near])
+    bound = bound + pad
     bodies = np.column_stack([rows, bound])
     few = owner < p.max_tangent_bodies  # readings come nearest first
     grow = reach + np.hypot(w[:, 0], w[:, 1]) * p.forecast_horizon

@@ -122,6 +122,15 @@ def _gap_scalar(px: float, py: float, vx: float, vy: float, reach: float, h: flo
     return math.hypot(px - vx * t, py - vy * t) - reach
 
 
+def _clear_scalar(px: float, py: float, vx: float, vy: float, lim: float, h: float) -> bool:
+    """``|p - v t| > lim`` for every t in [0, h] (squared distances: no square root)."""
+    a = vx * vx + vy * vy
+    b = px * vx + py * vy
+    t = min(max(b / max(a, 1e-12), 0.0), h)
+    dx, dy = px - vx * t, py - vy * t
+    return dx * dx + dy * dy > lim * lim
+
+
 def candidate_risk_py(
     position: FloatArray,
     cand: FloatArray,
@@ -149,10 +158,11 @@ def candidate_risk_py(
             bx, by = bodies[b, 2] - px, bodies[b, 3] - py
             ux, uy = turn[k, 0] - bodies[b, 4], turn[k, 1] - bodies[b, 5]
             lim = bodies[b, 6] + comfort
-            near = _gap_scalar(bx, by, ux, uy, lim, max(tk, comfort_horizon))
             bx2, by2 = bx - ux * tk, by - uy * tk
             cx, cy = cand[k, 0] - bodies[b, 4], cand[k, 1] - bodies[b, 5]
-            if near > 0.0 and _gap_scalar(bx2, by2, cx, cy, lim, horizon - tk) > 0.0:
+            if _clear(bx, by, ux, uy, lim, max(tk, comfort_horizon)) and _clear(
+                bx2, by2, cx, cy, lim, horizon - tk
+            ):
                 continue  # the bounding disc stays clear: so does every boundary disc
             for j in range(int(bodies[b, 0]), int(bodies[b, 1])):
                 rx, ry = q[j, 0] - px, q[j, 1] - py
@@ -173,17 +183,20 @@ def candidate_risk_py(
 _COMPILED: dict[str, Callable[..., Any]] = {}
 _contact: Callable[..., float] = _contact_scalar
 _gap: Callable[..., float] = _gap_scalar
+_clear: Callable[..., bool] = _clear_scalar
 
 
 def _kernel() -> Callable[..., Any]:
     """The numba-compiled loop (compiled, or loaded from numba's cache, on the first call)."""
-    global _contact, _gap
+    global _contact, _gap, _clear
     if not _COMPILED:
         import numba
 
         _contact = numba.njit(cache=True, nogil=True)(_contact_scalar)
         _gap = numba.njit(cache=True, nogil=True)(_gap_scalar)
+        _clear = numba.njit(cache=True, nogil=True)(_clear_scalar)
         globals()["_contact_scalar"], globals()["_gap_scalar"] = _contact, _gap
+        globals()["_clear_scalar"] = _clear
         _COMPILED["risk"] = numba.njit(cache=True, nogil=True)(candidate_risk_py)
     return _COMPILED["risk"]
 
