@@ -76,9 +76,13 @@ def _mean_median(values: pd.Series, digits: int = 3) -> str:
 
 
 def _rate(hits: pd.Series) -> str:
+    """``"87.0% [80.1%, 91.8%]"``, flagged ``⚠`` when on fewer than SMALL_SAMPLE episodes."""
+    from uvnav.bench.regime import SMALL_SAMPLE
+
     k, n = int(hits.sum()), len(hits)
     lo, hi = wilson_interval(k, n)
-    return f"{k / n:.1%} [{lo:.1%}, {hi:.1%}]" if n else "–"
+    flag = f" ⚠ n={n}" if n < SMALL_SAMPLE else ""
+    return f"{k / n:.1%} [{lo:.1%}, {hi:.1%}]{flag}" if n else "–"
 
 
 #: social metric columns of the summary: (label, episodes column, digits)
@@ -371,6 +375,7 @@ def write_report(
     import jinja2
 
     from uvnav import __version__
+    from uvnav.bench.regime import SMALL_SAMPLE
     from uvnav.bench.store import ResultsStore
 
     db_path = Path(db_path)
@@ -426,15 +431,18 @@ def write_report(
         for r in errors_df.head(_MAX_ERRORS).itertuples()
     ]
 
+    from uvnav.viz.interactive import ANIMATIONS_GLOBAL, PLOTLY_JS, write_plotly_js
+
     anim_sections: list[dict[str, str]] = []
     if animations > 0:
-        from uvnav.viz.interactive import PLOTLY_JS, animation_sections, write_plotly_js
+        from uvnav.viz.interactive import animation_sections
 
-        anim_sections = animation_sections(db_path, limit=animations)
-        if anim_sections:
-            write_plotly_js(out_dir)
-    else:
-        PLOTLY_JS = ""
+        anim_sections = animation_sections(db_path, limit=animations, out_dir=out_dir)
+    from uvnav.viz.regime import SMALL_MARK, decision_view
+
+    decision = decision_view(db_path)
+    if anim_sections or decision["heatmaps"]:
+        write_plotly_js(out_dir)
 
     template_text = files("uvnav.viz").joinpath("templates/report.html").read_text(encoding="utf-8")
     env = jinja2.Environment(
@@ -457,6 +465,10 @@ def write_report(
         sections=chapter_rows,
         errors=errors,
         animations=anim_sections,
+        animations_global=ANIMATIONS_GLOBAL,
+        decision=decision,
+        small_mark=SMALL_MARK,
+        small_sample=SMALL_SAMPLE,
         plotly_js=PLOTLY_JS,
         errors_truncated=max(0, len(errors_df) - _MAX_ERRORS),
     )
