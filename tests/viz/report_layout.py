@@ -63,12 +63,12 @@ def chromium() -> str | None:
 
 
 def inline_animation_bytes(index: Path) -> int:
-    """Bytes of the page source inside its animation sections (``<section class="animation...">``
-    ... ``</section>``): the frames a page carries inline rather than loading on demand."""
+    """Bytes of the page source inside its inline animation sections (``<section
+    class="animation">`` ... ``</section>``, the frames carried by the page itself; a ``lazy``
+    section holds only the button that loads its side file)."""
     text = Path(index).read_bytes()
-    return sum(
-        len(m) for m in re.findall(rb'<section class="animation[^"]*".*?</section>', text, re.S)
-    )
+    pattern = rb'<section class="animation">.*?</section>'
+    return sum(len(m) for m in re.findall(pattern, text, re.S))
 
 
 def measure(page: Any, index: Path) -> dict[str, Any]:

@@ -413,7 +413,9 @@ def write_report(
     figure_rows = _copy_figures(figure_specs, out_dir)
     chapter_rows = section_rows(list(sections or []), out_dir)
 
-    table_rows = [dict(r) for r in (table or [])]
+    in_sections = [dict(r) for sec in sections or [] for r in sec.rows]
+    # a row a section shows is not repeated in the global table (which keeps the others)
+    table_rows = [dict(r) for r in (table or []) if dict(r) not in in_sections]
     table_columns = list(_TABLE_ORDER) if table_rows else []
     for r in table_rows:
         table_columns += [k for k in r if k not in table_columns]
