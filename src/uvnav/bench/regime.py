@@ -46,8 +46,9 @@ from uvnav.bench.summary import wilson_interval
 
 CAMPAIGN = "regime-map"
 GENERATOR = "crowdnav-circle"
-#: humans on CrowdNav's 4 m circle (about 0.08, 0.16, 0.24 humans per m^2 of the disc)
-DENSITIES: tuple[int, ...] = (4, 8, 12)
+#: humans on CrowdNav's 4 m circle (about 0.08, 0.14, 0.20 humans per m^2 of the disc; 12
+#: slow humans cannot always be placed apart on the circle, CrowdSim's placement rule)
+DENSITIES: tuple[int, ...] = (4, 7, 10)
 #: humans' preferred speed / robot V_max
 SPEED_RATIOS: tuple[float, ...] = (0.5, 1.0, 1.5)
 VISIBLE: tuple[bool, ...] = (False, True)

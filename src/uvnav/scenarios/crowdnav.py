@@ -85,6 +85,16 @@ UNICYCLE_U_MAX = math.pi  # [rad/s]
 SENSING_RANGE = 20.0  # [m]
 
 _Agent = tuple[float, float, float, float, float]  # px, py, gx, gy, radius
+#: draws per human before a scene is refused as unplaceable (CrowdSim redraws forever: 12 humans
+#: at v_pref 0.5 on the 4 m circle never fit for some cases; a placeable scene takes far fewer)
+MAX_DRAWS = 20_000
+
+
+def _give_up(i: int, n: int) -> ValueError:
+    return ValueError(
+        f"cannot place human {i + 1} of {n} apart from the others after {MAX_DRAWS} draws: too "
+        "many humans for the circle or square (lower n_humans)"
+    )
 
 
 def _norm(dx: float, dy: float) -> float:
@@ -116,9 +126,9 @@ def circle_crossing_humans(
     docstring), drawn from ``rs`` with CrowdSim's calls in CrowdSim's order."""
     agents: list[_Agent] = [robot]
     out: list[tuple[_Agent, float]] = []
-    for _ in range(n):
+    for i in range(n):
         v_pref, radius = _attributes(rs, randomize_attributes, human_v_pref)
-        while True:
+        for _ in range(MAX_DRAWS):
             angle = rs.random_sample() * np.pi * 2
             px_noise = (rs.random_sample() - 0.5) * v_pref
             py_noise = (rs.random_sample() - 0.5) * v_pref
@@ -130,6 +140,8 @@ def circle_crossing_humans(
                 for a in agents
             ):
                 break
+        else:
+            raise _give_up(i, n)
         human = (px, py, -px, -py, radius)
         agents.append(human)
         out.append((human, v_pref))
@@ -148,27 +160,57 @@ def square_crossing_humans(
     """CrowdNav's square-crossing humans (module docstring), as :func:`circle_crossing_humans`."""
     agents: list[_Agent] = [robot]
     out: list[tuple[_Agent, float]] = []
-    for _ in range(n):
+    for i in range(n):
         v_pref, radius = _attributes(rs, randomize_attributes, human_v_pref)
         sign = -1.0 if rs.random_sample() > 0.5 else 1.0
-        while True:
+        for _ in range(MAX_DRAWS):
             px = float(rs.random_sample() * square_width * 0.5 * sign)
             py = float((rs.random_sample() - 0.5) * square_width)
             if not any(
                 _norm(px - a[0], py - a[1]) < radius + a[4] + DISCOMFORT_DIST for a in agents
             ):
                 break
-        while True:
+        else:
+            raise _give_up(i, n)
+        for _ in range(MAX_DRAWS):
             gx = float(rs.random_sample() * square_width * 0.5 * -sign)
             gy = float((rs.random_sample() - 0.5) * square_width)
             if not any(
                 _norm(gx - a[2], gy - a[3]) < radius + a[4] + DISCOMFORT_DIST for a in agents
             ):
                 break
+        else:
+            raise _give_up(i, n)
         human = (px, py, gx, gy, radius)
         agents.append(human)
         out.append((human, v_pref))
     return out
+
+
+def _draw_humans(
+    rs: np.random.RandomState,
+    rule: str,
+    n: int,
+    circle_radius: float,
+    square_width: float,
+    robot: _Agent,
+    randomize_attributes: bool,
+    human_v_pref: float,
+) -> list[tuple[_Agent, float]]:
+    """The humans of ``rule`` (``circle_crossing`` or ``square_crossing``), drawn from ``rs``.
+
+    Raises:
+        ValueError: a human cannot be placed in :data:`MAX_DRAWS` draws.
+    """
+    if rule == "circle_crossing":
+        return circle_crossing_humans(
+            rs, n, circle_radius=circle_radius, robot=robot,
+            randomize_attributes=randomize_attributes, human_v_pref=human_v_pref,
+        )  # fmt: skip
+    return square_crossing_humans(
+        rs, n, square_width=square_width, robot=robot,
+        randomize_attributes=randomize_attributes, human_v_pref=human_v_pref,
+    )  # fmt: skip
 
 
 def crowdnav_scenario(
@@ -259,16 +301,13 @@ def crowdnav_scenario(
         )
     rs = np.random.RandomState(seed)
     robot: _Agent = (0.0, -circle_radius, 0.0, circle_radius, robot_radius)
-    if rule == "circle_crossing":
-        humans = circle_crossing_humans(
-            rs, int(n_humans), circle_radius=circle_radius, robot=robot,
-            randomize_attributes=randomize_attributes, human_v_pref=human_v_pref,
+    try:
+        humans = _draw_humans(
+            rs, rule, int(n_humans), circle_radius, square_width, robot, randomize_attributes,
+            human_v_pref,
         )  # fmt: skip
-    else:
-        humans = square_crossing_humans(
-            rs, int(n_humans), square_width=square_width, robot=robot,
-            randomize_attributes=randomize_attributes, human_v_pref=human_v_pref,
-        )  # fmt: skip
+    except ValueError as exc:
+        raise ScenarioError(f"crowdnav-{short}:{case}", "n_humans", str(exc)) from None
     obstacles = [
         {
             "name": f"human-{i}",

@@ -1,22 +1,28 @@
 """The HTML report of a results database (DESIGN §5–6: ``uvnav report DB`` and ``uvnav run``).
 
 :func:`write_report` renders ``out_dir/index.html`` from the Jinja2 template
-``uvnav/viz/templates/report.html`` with
+``uvnav/viz/templates/report.html``, a decision tool first and a record second (issue 19):
 
-* the table "thesis reported vs uvnav measured" (rows given by the caller, e.g.
-  :func:`uvnav.bench.reproduce.reproduce`, whose measured values come from the runs),
-* a metric summary per scenario family and controller computed from the ``episodes`` table
-  (episodes, success/collision/timeout rates, errors, mean / median of the distance metrics),
+* **first screen, "which law, where"** (:func:`uvnav.viz.regime.decision_view`, read from the
+  store): the regime map's heat maps of success and of robot-driven collisions per law, a
+  recommendation per regime generated from the numbers, and the law x scene-family table at equal
+  seeds with 95 % intervals; rates on fewer than ``SMALL_SAMPLE`` episodes carry a ⚠ marker;
 * one section per chapter (:class:`uvnav.bench.sections.ChapterSection`): heading, what was
-  run, that chapter's rows of the table, its figures with captions and links to its other files
-  (interactive views, JSON), every file linked relatively — a file already inside ``out_dir`` is
-  linked where it is, one outside is copied into ``out_dir/<section key>/``,
-* the other figures, copied next to ``index.html`` and linked relatively,
-* the episodes that raised errors, and the campaigns with their configs,
-* a note that the Chapter 2 obstacles are simulated.
+  run, that chapter's rows of the "thesis reported vs uvnav measured" table (folded in a
+  ``<details>`` when longer than 12 rows), its figures as a grid of thumbnails each linking to the
+  full-size file, links to its other files — every file linked relatively: a file already inside
+  ``out_dir`` is linked where it is, one outside is copied into ``out_dir/<section key>/``;
+  rows of ``table`` that no section shows get a table of their own;
+* a metric summary per campaign, scenario family and controller computed from the ``episodes``
+  table (folded, in horizontal scroll containers), the other figures, the episodes that raised
+  errors, and the campaigns with their configs;
+* animated trajectory views whose frames are side files ``anim/anim-<id>.js``
+  (:func:`uvnav.viz.interactive.write_animation_file`) loaded when the reader presses a button, so
+  the page carries none of them.
 
-The page is self-contained: inline CSS, no scripts, no external URL — it opens offline and can be
-zipped or published as is.
+Every table fits the text column (fixed layout with wrapping, or a scroll container).  The page
+works offline: inline CSS, plotly loaded from ``plotly.min.js`` next to ``index.html`` (only when
+the page has a heat map or an animation), no external URL.
 """
 
 from __future__ import annotations
