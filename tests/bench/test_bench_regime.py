@@ -31,6 +31,7 @@ def test_a_clearly_best_law_is_named() -> None:
     text = rg.recommend("8 humans", stats)
     assert text.startswith("8 humans: use a-law.")
     assert "runner-up, b-law" in text and "the lead is real" in text
+    assert "Clearly below: c-law 12%." in text
     assert "cannot separate" not in text and "Small sample" not in text
 
 
@@ -40,7 +41,7 @@ def test_overlapping_intervals_cannot_be_separated() -> None:
     assert [s.law for s in best] == ["a-law", "b-law"] and [s.law for s in rest] == ["c-law"]
     text = rg.recommend("dense", stats)
     assert "cannot separate a-law from b-law" in text and "use " not in text
-    assert "c-law" not in text  # clearly below: not among the inseparable
+    assert text.endswith("Clearly below: c-law 5%.")  # not among the inseparable
     assert "b-law drives into people least" in text  # the safer of the inseparable
 
 

@@ -117,7 +117,7 @@ def test_human_speed_and_sensing_noise_params() -> None:
 
 def test_an_unplaceable_crowd_is_refused_not_drawn_forever() -> None:
     # 40 humans cannot stand 0.8 m apart from each other's starts and goals on a 4 m circle
-    with pytest.raises(ScenarioError, match="cannot place human .* of 40"):
+    with pytest.raises(ScenarioError, match=r"cannot place human .* of 40"):
         crowdnav_scenario(0, n_humans=40)
     with pytest.raises(ScenarioError, match="cannot place human"):
         crowdnav_scenario(0, rule="square_crossing", n_humans=400)

@@ -394,6 +394,10 @@ def recommend(regime_label: str, stats: Sequence[CellStats]) -> str:
                 f" Among them {_name(safest)} drives into people least "
                 f"({_pct(safest.robot_collision)} robot-driven collisions)."
             )
+    below = [s for s in rest if s is not (rest[0] if len(best) == 1 else None)]
+    if below:
+        listed = ", ".join(f"{_name(s)} {s.success.p:.0%}" for s in below)
+        text += f" Clearly below: {listed}."
     if n < SMALL_SAMPLE:
         text += f" Small sample ({n} episodes per law): run more seeds (--full) to narrow this."
     return text
