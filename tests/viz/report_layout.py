@@ -5,7 +5,8 @@ widest table as shown (a table inside a horizontal scroll container counts as wi
 container) against the width of the text column, the page's bytes and the share of them that are
 inline animation frames, and where the regime map sits.  The browser test asserts on it; run this
 module as a script to measure a real report:
-``python tests/viz/report_layout.py REPORT/index.html``.
+``python tests/viz/report_layout.py REPORT/index.html`` (``OPEN_DETAILS=1``: with every
+``<details>`` unfolded).
 """
 
 from __future__ import annotations
@@ -95,6 +96,8 @@ def main(argv: list[str]) -> int:
             page = browser.new_page(viewport=VIEWPORT)
             page.goto(index.as_uri(), wait_until="load")
             page.wait_for_timeout(int(os.environ.get("SETTLE_MS", "1500")))
+            if os.environ.get("OPEN_DETAILS"):  # every folded table unfolded
+                page.evaluate("() => document.querySelectorAll('details').forEach(d => d.open = 1)")
             print(json.dumps(measure(page, index), indent=1))
         finally:
             browser.close()
