@@ -671,10 +671,9 @@ def reproduce(
         table += sec_c.rows
         sections.append(sec_c)
     if regime if regime is not None else (baselines and real_run):  # "which law, where"
-        from uvnav.bench.regime import run_regime_map
-
-        rm = run_regime_map(results_dir, full=full, workers=workers, progress=progress)
+        sec_r, rm = chapters.run_regime(results_dir, full=full, workers=workers, progress=progress)
         summary_campaigns["regime-map"] = rm.campaign
+        sections.append(sec_r)
     if baselines and real_run:  # beyond the thesis (a real run, not a quick look)
         sec_b, rows_b = chapters.run_beyond(report_dir, full=full, renderers=rend)
         table += rows_b
