@@ -99,6 +99,30 @@ def test_generator_params() -> None:
         crowdnav_scenario(2**32)
 
 
+def test_human_speed_and_sensing_noise_params() -> None:
+    default = crowdnav_scenario(4)
+    fast = crowdnav_scenario(4, human_v_pref=1.5, velocities="estimated", position_noise=0.1)
+    assert {o.motion.v_pref for o in default.obstacles} == {1.0}
+    assert {o.motion.v_pref for o in fast.obstacles} == {1.5}
+    assert default.sensing.velocities == "known" and default.sensing.position_noise == 0.0
+    assert fast.sensing.velocities == "estimated" and fast.sensing.position_noise == 0.1
+    # CrowdSim scales the circle-crossing start noise with v_pref: other starts, same draws
+    assert not np.allclose(_humans(default)[0], _humans(fast)[0])
+    assert np.allclose(_humans(default)[0], _humans(crowdnav_scenario(4, human_v_pref=1.0))[0])
+    with pytest.raises(ValueError, match="position_noise needs velocities='estimated'"):
+        crowdnav_scenario(4, position_noise=0.1)
+    with pytest.raises(ValueError, match="human_v_pref"):
+        crowdnav_scenario(4, human_v_pref=0.0)
+
+
+def test_an_unplaceable_crowd_is_refused_not_drawn_forever() -> None:
+    # 40 humans cannot stand 0.8 m apart from each other's starts and goals on a 4 m circle
+    with pytest.raises(ScenarioError, match=r"cannot place human .* of 40"):
+        crowdnav_scenario(0, n_humans=40)
+    with pytest.raises(ScenarioError, match="cannot place human"):
+        crowdnav_scenario(0, rule="square_crossing", n_humans=400)
+
+
 class _PedestrianLog(BaseProbe):
     def __init__(self) -> None:
         self.rows: list[np.ndarray] = []

@@ -116,9 +116,9 @@ def test_summary_table_values(db: Path) -> None:
         rows = summary_table(store.episodes_frame())
     by_family = {r["family"]: r for r in rows}
     assert by_family["small-family"]["episodes"] == 8
-    # 4 of 8, with the 95 % Wilson interval [21.5 %, 78.5 %]
-    assert by_family["small-family"]["success rate"] == "50.0% [21.5%, 78.5%]"
-    assert by_family["small-family"]["collision rate"] == "50.0% [21.5%, 78.5%]"
+    # 4 of 8, with the 95 % Wilson interval [21.5 %, 78.5 %], flagged as a small sample
+    assert by_family["small-family"]["success rate"] == "50.0% [21.5%, 78.5%] ⚠ n=8"
+    assert by_family["small-family"]["collision rate"] == "50.0% [21.5%, 78.5%] ⚠ n=8"
     assert by_family["broken"]["errors"] == 1
     assert by_family["broken"]["min_clearance [m]"] == "–"
 

@@ -2,7 +2,8 @@
 
 :func:`reproduce_chapter` runs one of :data:`CHAPTERS` — a thesis chapter ``ch2`` … ``ch7``,
 ``beyond`` (the experiments beyond the thesis: planners, office floor, multi-robot swap) or
-``crowds`` (every 2D law on CrowdNav's crowds, :mod:`uvnav.bench.reproduce_crowds`) — into
+``crowds`` (every 2D law on CrowdNav's crowds, :mod:`uvnav.bench.reproduce_crowds`) or
+``regime`` (the regime map, :mod:`uvnav.bench.regime`) — into
 the results store ``results_dir/uvnav.sqlite`` (and the chapter's own files under
 ``results_dir``), draws its figures with the injected renderers
 (:class:`~uvnav.bench.sections.ChapterRenderers`) into ``report_dir/<chapter>``, and saves its
@@ -21,7 +22,7 @@ replaced by a later run; a campaign that cannot be resumed (stored by other code
 scenes: ``seeds`` scenes from ``start_seed`` (Ch. 2: the random and baseline campaigns; Ch. 3: the
 random-ch3 scenes; Ch. 4: every family — random-ch4, the noise sweep, random-ch4-hard; Ch. 5: the
 random-ch5 closed-loop scenes; crowds: CrowdNav's test cases ``start_seed`` ..
-``start_seed + seeds - 1`` of each scene).
+``start_seed + seeds - 1`` of each scene; regime: the seeds of every regime).
 """
 
 from __future__ import annotations
@@ -35,9 +36,19 @@ from typing import Any
 from uvnav.bench.sections import SECTIONS_DIR, ChapterRenderers, ChapterSection, save_section
 
 #: What ``uvnav reproduce`` accepts (``all`` is ``uvnav run``).
-CHAPTERS: tuple[str, ...] = ("ch2", "ch3", "ch4", "ch5", "ch6", "ch7", "beyond", "crowds")
+CHAPTERS: tuple[str, ...] = (
+    "ch2",
+    "ch3",
+    "ch4",
+    "ch5",
+    "ch6",
+    "ch7",
+    "beyond",
+    "crowds",
+    "regime",
+)
 #: Chapters that run random seeds (``seeds`` / ``start_seed`` apply).
-SEEDED: frozenset[str] = frozenset({"ch2", "ch3", "ch4", "ch5", "crowds"})
+SEEDED: frozenset[str] = frozenset({"ch2", "ch3", "ch4", "ch5", "crowds", "regime"})
 DB_NAME = "uvnav.sqlite"
 
 
@@ -245,6 +256,31 @@ def run_crowds(
     return sec.crowds_section(sc), sc
 
 
+def run_regime(
+    results_dir: Path,
+    *,
+    full: bool,
+    workers: int,
+    seeds: int | None = None,
+    start_seed: int = 0,
+    progress: bool = False,
+) -> tuple[ChapterSection, Any]:
+    """The regime map (:func:`uvnav.bench.regime.run_regime_map`: ``seeds`` seeds per regime and
+    law from ``start_seed``) and its section."""
+    from uvnav.bench import sections as sec
+    from uvnav.bench.regime import run_regime_map
+
+    rm = run_regime_map(
+        results_dir,
+        full=full,
+        workers=workers,
+        seeds=seeds,
+        start_seed=start_seed,
+        progress=progress,
+    )
+    return sec.regime_section(rm, full=full), rm
+
+
 # ------------------------------------------------------------------------------- the dispatcher
 
 
@@ -325,6 +361,7 @@ def reproduce_chapter(
             "ch6": lambda: run_ch6(*dirs, full=full, renderers=rend, progress=progress),
             "ch7": lambda: run_ch7(*dirs, full=full, renderers=rend),
             "crowds": lambda: run_crowds(results_dir, **seeded, progress=progress),
+            "regime": lambda: run_regime(results_dir, **seeded, progress=progress),
             "beyond": lambda: run_beyond(report_dir, full=full, renderers=rend),
         }
         section, summary = runs[chapter]()
@@ -454,6 +491,10 @@ def report_sections(db_path: Path) -> list[ChapterSection]:
                 section = _ch4_from_store(store)
             elif key == "crowds" and stored:
                 section = _crowds_from_store(store)
+            elif key == "regime" and stored:
+                from uvnav.bench.sections import regime_section
+
+                section = regime_section(None, full=False)
             if section is None and (stored or files):
                 what = "campaigns are stored" if stored else "result files exist"
                 section = _rerun_section(
@@ -480,4 +521,5 @@ __all__ = [
     "run_ch6",
     "run_ch7",
     "run_crowds",
+    "run_regime",
 ]

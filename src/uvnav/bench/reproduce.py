@@ -9,7 +9,8 @@
    ``full=True``) with both laws — campaign ``ch2-random``;
 
 and, in a real run (``n_random`` not given), the crowd section (every 2D law on CrowdNav's
-crowds, :mod:`uvnav.bench.reproduce_crowds`, after Chapter 2's ETH crowds) and the other
+crowds, :mod:`uvnav.bench.reproduce_crowds`, after Chapter 2's ETH crowds), the regime map
+(:mod:`uvnav.bench.regime`, the report's first screen) and the other
 chapters' reproductions (Chapter 6, the
 CNN that drives: at :data:`uvnav.bench.reproduce_ch6.RUN_QUICK`'s size in quick mode, the
 thesis size with ``full=True``; in ``results_dir/ch6-quick`` and ``results_dir/ch6``);
@@ -57,7 +58,6 @@ CROWD_CAMPAIGN = "crowds-eth"
 #: above the recordings' typical pedestrian speed (eth about 1.4 m/s, hotel about 1.0 m/s).
 CROWD_GENERATORS: tuple[str, ...] = ("crowd-eth", "crowd-hotel")
 CROWD_V_MAX = 1.5
-QUICK_BASELINE_SEEDS, FULL_BASELINE_SEEDS = 30, 200
 QUICK_CROWD_SEEDS, FULL_CROWD_SEEDS = 8, 50
 THESIS_PREFIX = "thesis-ch2-"
 COMPARISON_SCENE = "thesis-ch2-fig2-10-comparison"
@@ -468,6 +468,7 @@ def reproduce(
     renderers: ChapterRenderers | None = None,
     save_sections: bool = True,
     crowds: bool | None = None,
+    regime: bool | None = None,
 ) -> ReproductionSummary:
     """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
 
@@ -483,7 +484,8 @@ def reproduce(
         baselines: classical controllers run beside the thesis's two laws: on the thesis scenes
             and a subset of the random seeds (campaign ``ch2-baselines``), and with the two laws
             on crowd crossings of the ETH recordings (campaign ``crowds-eth``); empty to skip both.
-        n_baseline_seeds: random seeds for the baselines (default 30 quick, 200 full).
+        n_baseline_seeds: random seeds for the baselines (default the random campaign's: the
+            baselines and the thesis's laws are compared on the same seeds).
         n_crowd_seeds: seeds per crowd generator (default 8 quick, 50 full).
         controllers: laws to run (default both Ch. 2 laws).
         render: renderer callable (e.g. ``uvnav.viz.reproduction.render_reproduction``);
@@ -502,6 +504,9 @@ def reproduce(
         crowds: also run every 2D law on CrowdNav's crowds (campaigns ``crowdnav`` and
             ``crowdnav-beyond``, :mod:`uvnav.bench.reproduce_crowds`; quick or full size), its
             section after Chapter 2's; ``None`` = in a real run with baselines.
+        regime: also run the regime map (:mod:`uvnav.bench.regime`: every 2D law over crowd
+            density x pedestrian speed x visibility x sensing noise, quick or full size; the
+            report's first screen); ``None`` = in a real run with baselines.
 
     Returns:
         The summary: table, database and report paths, random-campaign failures.
@@ -556,11 +561,7 @@ def reproduce(
                 ],
             ),
         ]
-        n_base = (
-            n_baseline_seeds
-            if n_baseline_seeds is not None
-            else (FULL_BASELINE_SEEDS if full else QUICK_BASELINE_SEEDS)
-        )
+        n_base = n_baseline_seeds if n_baseline_seeds is not None else n_seeds
         n_crowd = (
             n_crowd_seeds
             if n_crowd_seeds is not None
@@ -669,6 +670,10 @@ def reproduce(
         sec_c, _ = chapters.run_crowds(results_dir, full=full, workers=workers, progress=progress)
         table += sec_c.rows
         sections.append(sec_c)
+    if regime if regime is not None else (baselines and real_run):  # "which law, where"
+        sec_r, rm = chapters.run_regime(results_dir, full=full, workers=workers, progress=progress)
+        summary_campaigns["regime-map"] = rm.campaign
+        sections.append(sec_r)
     if baselines and real_run:  # beyond the thesis (a real run, not a quick look)
         sec_b, rows_b = chapters.run_beyond(report_dir, full=full, renderers=rend)
         table += rows_b

@@ -547,11 +547,59 @@ def crowds_section(summary: Any) -> ChapterSection:
     )
 
 
+# ---------------------------------------------------------------------------- the regime map
+
+
+def regime_section(summary: Any | None, *, full: bool) -> ChapterSection:
+    """The regime map's section (issue 19) from a :class:`uvnav.bench.regime.RegimeSummary`
+    (``None``: rebuilt from the store, what was run unknown).  Its numbers are the report's first
+    screen ("Which law, where", drawn from the store), so the section only says what ran."""
+    from uvnav.bench import regime as rg
+
+    if summary is None:
+        ran = "every stored cell and law"
+    else:
+        dens = ", ".join(str(d) for d in sorted({c.n_humans for c in summary.cells}))
+        speeds = ", ".join(f"{v:g}" for v in sorted({c.speed_ratio for c in summary.cells}))
+        noises = ", ".join(f"{z:g}" for z in sorted({c.noise for c in summary.cells}))
+        ran = (
+            f"{len(summary.cells)} regimes ({dens} humans; speed {speeds} x V_max; robot "
+            f"invisible and visible; sensing noise {noises} m), {summary.seeds} "
+            f"seed{'' if summary.seeds == 1 else 's'} per regime "
+            f"and law ({mode_text(full)}), laws {', '.join(summary.laws)}"
+        )
+    return ChapterSection(
+        key="regime",
+        title="Beyond the thesis — where each law wins (regime map)",
+        intro=(
+            f"Every 2D law on CrowdNav's circle crossing over crowd density x pedestrian speed / "
+            f"V_max x robot visible or not x sensing noise (campaign {rg.CAMPAIGN}): {ran}. Every "
+            "law runs in every regime, beyond its declared assumption where the regime breaks it "
+            "(marked †)."
+        ),
+        notes=[
+            "The heat maps, the recommendation per regime and every cell's rates with 95 % "
+            "intervals are the first screen of this report ('Which law, where'), read from the "
+            "store."
+        ],
+    )
+
+
 # ------------------------------------------------------------------------- sections on disk
 
 #: Every section key in report order: the thesis chapters (the crowd section after Chapter 2's
 #: ETH crowds), then what goes beyond the thesis.
-SECTION_ORDER: tuple[str, ...] = ("ch2", "crowds", "ch3", "ch4", "ch5", "ch6", "ch7", "beyond")
+SECTION_ORDER: tuple[str, ...] = (
+    "ch2",
+    "crowds",
+    "regime",
+    "ch3",
+    "ch4",
+    "ch5",
+    "ch6",
+    "ch7",
+    "beyond",
+)
 #: Folder, next to the results database, of the last section each chapter's run produced.
 SECTIONS_DIR = "sections"
 

@@ -29,7 +29,8 @@ def reproduce_cmd(
         str,
         typer.Argument(
             help="ch2, ch3, ch4, ch5, ch6, ch7, beyond (planners, office floor, multi-robot), "
-            "crowds (every 2D law on CrowdNav's crowds), or all (= uvnav run)."
+            "crowds (every 2D law on CrowdNav's crowds), regime (where each law wins: the "
+            "regime map), or all (= uvnav run)."
         ),
     ],
     full: Annotated[
@@ -44,14 +45,16 @@ def reproduce_cmd(
         int | None,
         typer.Option(
             min=1,
-            help="Random scenes to run (ch2-ch5; crowds: CrowdNav test cases per scene; default: "
-            "the chapter's quick or full size).",
+            help="Random scenes to run (ch2-ch5; crowds: CrowdNav test cases per scene; "
+            "regime: seeds per regime; default: the chapter's quick or full size).",
         ),
     ] = None,
     start_seed: Annotated[
         int,
         typer.Option(
-            "--start-seed", min=0, help="First random scene (ch2-ch5, crowds): seeds S .. S+N-1."
+            "--start-seed",
+            min=0,
+            help="First random scene (ch2-ch5, crowds, regime): seeds S .. S+N-1.",
         ),
     ] = 0,
 ) -> None:
@@ -64,7 +67,7 @@ def reproduce_cmd(
     if chapter == "all":
         if seeds is not None or start_seed:
             raise CliError(
-                "reproduce all: --seeds/--start-seed apply to one chapter (ch2-ch5, crowds)"
+                "reproduce all: --seeds/--start-seed apply to one chapter (ch2-ch5, crowds, regime)"
             )
         from uvnav.cli.app import run
 

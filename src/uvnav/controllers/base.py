@@ -385,4 +385,3 @@ def approach_speed(v_max: float, u_max: float, dist: float, beta: float) -> floa
     if abs(beta) > 0.5 * np.pi:  # target behind: the tightest circle through it
         v = min(v, u_max * dist / 2.0)
     return float(v)
-

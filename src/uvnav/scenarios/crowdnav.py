@@ -12,9 +12,9 @@ the same calls in the same order.  So ``crowdnav-circle:0`` ... ``crowdnav-circl
 
 The set-up, with its source (``crowd_nav/configs/env.config`` unless said otherwise):
 
-* humans: ``human_num = 5`` (``n_humans``), radius 0.3 m, ``v_pref`` 1 m/s, policy ORCA, each an
-  ``orca_crowd`` pedestrian of one crowd (:mod:`uvnav.obstacles.crowd`: CrowdNav's ORCA
-  parameters, decision period = the time step);
+* humans: ``human_num = 5`` (``n_humans``), radius 0.3 m, ``v_pref`` 1 m/s (``human_v_pref``),
+  policy ORCA, each an ``orca_crowd`` pedestrian of one crowd (:mod:`uvnav.obstacles.crowd`:
+  CrowdNav's ORCA parameters, decision period = the time step);
 * circle crossing (``CrowdSim.generate_circle_crossing_human``): angle uniform in [0, 2 pi), the
   start ``circle_radius`` (4 m) from the origin at that angle plus a noise uniform in
   ``[-v_pref/2, v_pref/2)`` on each axis, the goal the start's opposite ``-start``; a draw is
@@ -79,16 +79,29 @@ UNICYCLE_U_MAX = math.pi  # [rad/s]
 SENSING_RANGE = 20.0  # [m]
 
 _Agent = tuple[float, float, float, float, float]  # px, py, gx, gy, radius
+#: draws per human before a scene is refused as unplaceable (CrowdSim redraws forever: 12 humans
+#: at v_pref 0.5 on the 4 m circle never fit for some cases; a placeable scene takes far fewer)
+MAX_DRAWS = 20_000
+
+
+def _give_up(i: int, n: int) -> ValueError:
+    return ValueError(
+        f"cannot place human {i + 1} of {n} apart from the others after {MAX_DRAWS} draws: too "
+        "many humans for the circle or square (lower n_humans)"
+    )
 
 
 def _norm(dx: float, dy: float) -> float:
     return float(np.linalg.norm((dx, dy)))
 
 
-def _attributes(rs: np.random.RandomState, randomize: bool) -> tuple[float, float]:
-    """``(v_pref, radius)`` of a new human (``Agent.sample_random_attributes`` when on)."""
+def _attributes(
+    rs: np.random.RandomState, randomize: bool, v_pref: float = HUMAN_V_PREF
+) -> tuple[float, float]:
+    """``(v_pref, radius)`` of a new human (``Agent.sample_random_attributes`` when on; ``v_pref``
+    [m/s] otherwise, CrowdNav's ``humans.v_pref``)."""
     if not randomize:
-        return HUMAN_V_PREF, HUMAN_RADIUS
+        return v_pref, HUMAN_RADIUS
     v_pref = float(rs.uniform(0.5, 1.5))
     radius = float(rs.uniform(0.3, 0.5))
     return v_pref, radius
@@ -101,14 +114,15 @@ def circle_crossing_humans(
     circle_radius: float = CIRCLE_RADIUS,
     robot: _Agent = (0.0, -CIRCLE_RADIUS, 0.0, CIRCLE_RADIUS, ROBOT_RADIUS),
     randomize_attributes: bool = False,
+    human_v_pref: float = HUMAN_V_PREF,
 ) -> list[tuple[_Agent, float]]:
     """CrowdNav's circle-crossing humans: ``[((px, py, gx, gy, radius), v_pref), ...]`` (module
     docstring), drawn from ``rs`` with CrowdSim's calls in CrowdSim's order."""
     agents: list[_Agent] = [robot]
     out: list[tuple[_Agent, float]] = []
-    for _ in range(n):
-        v_pref, radius = _attributes(rs, randomize_attributes)
-        while True:
+    for i in range(n):
+        v_pref, radius = _attributes(rs, randomize_attributes, human_v_pref)
+        for _ in range(MAX_DRAWS):
             angle = rs.random_sample() * np.pi * 2
             px_noise = (rs.random_sample() - 0.5) * v_pref
             py_noise = (rs.random_sample() - 0.5) * v_pref
@@ -120,6 +134,8 @@ def circle_crossing_humans(
                 for a in agents
             ):
                 break
+        else:
+            raise _give_up(i, n)
         human = (px, py, -px, -py, radius)
         agents.append(human)
         out.append((human, v_pref))
@@ -133,31 +149,62 @@ def square_crossing_humans(
     square_width: float = SQUARE_WIDTH,
     robot: _Agent = (0.0, -CIRCLE_RADIUS, 0.0, CIRCLE_RADIUS, ROBOT_RADIUS),
     randomize_attributes: bool = False,
+    human_v_pref: float = HUMAN_V_PREF,
 ) -> list[tuple[_Agent, float]]:
     """CrowdNav's square-crossing humans (module docstring), as :func:`circle_crossing_humans`."""
     agents: list[_Agent] = [robot]
     out: list[tuple[_Agent, float]] = []
-    for _ in range(n):
-        v_pref, radius = _attributes(rs, randomize_attributes)
+    for i in range(n):
+        v_pref, radius = _attributes(rs, randomize_attributes, human_v_pref)
         sign = -1.0 if rs.random_sample() > 0.5 else 1.0
-        while True:
+        for _ in range(MAX_DRAWS):
             px = float(rs.random_sample() * square_width * 0.5 * sign)
             py = float((rs.random_sample() - 0.5) * square_width)
             if not any(
                 _norm(px - a[0], py - a[1]) < radius + a[4] + DISCOMFORT_DIST for a in agents
             ):
                 break
-        while True:
+        else:
+            raise _give_up(i, n)
+        for _ in range(MAX_DRAWS):
             gx = float(rs.random_sample() * square_width * 0.5 * -sign)
             gy = float((rs.random_sample() - 0.5) * square_width)
             if not any(
                 _norm(gx - a[2], gy - a[3]) < radius + a[4] + DISCOMFORT_DIST for a in agents
             ):
                 break
+        else:
+            raise _give_up(i, n)
         human = (px, py, gx, gy, radius)
         agents.append(human)
         out.append((human, v_pref))
     return out
+
+
+def _draw_humans(
+    rs: np.random.RandomState,
+    rule: str,
+    n: int,
+    circle_radius: float,
+    square_width: float,
+    robot: _Agent,
+    randomize_attributes: bool,
+    human_v_pref: float,
+) -> list[tuple[_Agent, float]]:
+    """The humans of ``rule`` (``circle_crossing`` or ``square_crossing``), drawn from ``rs``.
+
+    Raises:
+        ValueError: a human cannot be placed in :data:`MAX_DRAWS` draws.
+    """
+    if rule == "circle_crossing":
+        return circle_crossing_humans(
+            rs, n, circle_radius=circle_radius, robot=robot,
+            randomize_attributes=randomize_attributes, human_v_pref=human_v_pref,
+        )  # fmt: skip
+    return square_crossing_humans(
+        rs, n, square_width=square_width, robot=robot,
+        randomize_attributes=randomize_attributes, human_v_pref=human_v_pref,
+    )  # fmt: skip
 
 
 def crowdnav_scenario(
@@ -180,6 +227,9 @@ def crowdnav_scenario(
     controller_params: dict[str, Any] | None = None,
     robot_visible: bool = False,
     human_policy: Literal["orca", "social_force"] = "orca",
+    human_v_pref: float = HUMAN_V_PREF,
+    velocities: Literal["known", "estimated"] = "known",
+    position_noise: float = 0.0,
 ) -> Scenario:
     """CrowdNav's test case ``case`` of ``rule`` (module docstring for every choice and source).
 
@@ -205,6 +255,13 @@ def crowdnav_scenario(
         sensing_range: the robot sees humans within this [m].
         controller: the scene's own law.
         controller_params: its parameters (``orca-holonomic-v1``: CrowdNav's robot ORCA).
+        human_v_pref: the humans' preferred speed [m/s] (CrowdNav's ``humans.v_pref``, 1 m/s; it
+            also scales the circle-crossing start noise, as in CrowdSim); ignored when
+            ``randomize_attributes`` draws it.
+        velocities: what the robot knows of the humans' velocities (the scene's sensing block):
+            ``known`` (CrowdNav's ``coordinates`` sensor, exact) or ``estimated`` (finite
+            differences of the sensed centres, :mod:`uvnav.prediction.finite_difference`).
+        position_noise: std of the Gaussian noise on the sensed centres [m] when ``estimated``.
     """
     if human_policy not in ("orca", "social_force"):
         raise ValueError(f"human_policy must be 'orca' or 'social_force' (got {human_policy!r})")
@@ -217,6 +274,14 @@ def crowdnav_scenario(
         raise ValueError(f"phase must be one of {', '.join(PHASE_OFFSET)} (got {phase!r})")
     if int(n_humans) < 0:
         raise ValueError(f"n_humans must be >= 0 (got {n_humans})")
+    if not (math.isfinite(human_v_pref) and human_v_pref > 0):
+        raise ValueError(f"human_v_pref must be > 0 m/s (got {human_v_pref})")
+    if velocities not in ("known", "estimated"):
+        raise ValueError(f"velocities must be 'known' or 'estimated' (got {velocities!r})")
+    if not (math.isfinite(position_noise) and position_noise >= 0):
+        raise ValueError(f"position_noise must be >= 0 m (got {position_noise})")
+    if position_noise > 0 and velocities == "known":
+        raise ValueError("position_noise needs velocities='estimated' (known velocities are exact)")
     if not time_limit - 1.0 > 0:
         raise ValueError(f"time_limit must be > 1 s (got {time_limit})")
     seed = PHASE_OFFSET[phase] + case
@@ -230,16 +295,13 @@ def crowdnav_scenario(
         )
     rs = np.random.RandomState(seed)
     robot: _Agent = (0.0, -circle_radius, 0.0, circle_radius, robot_radius)
-    if rule == "circle_crossing":
-        humans = circle_crossing_humans(
-            rs, int(n_humans), circle_radius=circle_radius, robot=robot,
-            randomize_attributes=randomize_attributes,
+    try:
+        humans = _draw_humans(
+            rs, rule, int(n_humans), circle_radius, square_width, robot, randomize_attributes,
+            human_v_pref,
         )  # fmt: skip
-    else:
-        humans = square_crossing_humans(
-            rs, int(n_humans), square_width=square_width, robot=robot,
-            randomize_attributes=randomize_attributes,
-        )  # fmt: skip
+    except ValueError as exc:
+        raise ScenarioError(f"crowdnav-{short}:{case}", "n_humans", str(exc)) from None
     obstacles = [
         {
             "name": f"human-{i}",
@@ -290,7 +352,11 @@ def crowdnav_scenario(
             "u_max": u_max,
             "radius": robot_radius,
         },
-        "sensing": {"range": sensing_range, "velocities": "known", "position_noise": 0.0},
+        "sensing": {
+            "range": sensing_range,
+            "velocities": velocities,
+            "position_noise": float(position_noise),
+        },
         "obstacles": obstacles,
         "controller": {"name": controller, "params": dict(controller_params)},
     }

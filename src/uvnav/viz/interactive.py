@@ -6,10 +6,14 @@ range, every obstacle's outline at that instant, start and goal — with play / 
 time slider.  :func:`animation_sections` collects one such view per recorded episode of a results
 database, as HTML ``<div>`` fragments that load ``plotly.min.js`` from the report folder
 (:func:`write_plotly_js` puts it there), so the report works from ``file://`` with no network.
+In the report each view's frames live in a side file ``anim/anim-<id>.js``
+(:func:`write_animation_file`) that the page loads only when the reader asks for that view, so the
+page itself carries no frames.
 """
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -234,11 +238,42 @@ def write_plotly_js(out_dir: Path) -> Path:
     return path
 
 
-def animation_sections(db_path: Path, *, limit: int = 12) -> list[dict[str, str]]:
+#: Folder, next to ``index.html``, of the animations' frame files (loaded on demand).
+ANIMATIONS_DIR = "anim"
+#: The global object each frame file registers its figure in (``window.uvnavAnimations[id]``).
+ANIMATIONS_GLOBAL = "uvnavAnimations"
+
+
+def write_animation_file(fig: go.Figure, out_dir: Path, div_id: str) -> Path:
+    """Write one figure (data, layout, frames) as ``out_dir/anim/<div_id>.js``, a script that
+    registers it in ``window.uvnavAnimations``: the report loads it only when asked (a
+    ``<script>`` element works from ``file://``, where fetching JSON does not)."""
+    folder = Path(out_dir) / ANIMATIONS_DIR
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / f"{div_id}.js"
+    g = ANIMATIONS_GLOBAL
+    path.write_text(
+        f"(window.{g} = window.{g} || {{}})[{json.dumps(div_id)}] = {fig.to_json()};\n",
+        encoding="utf-8",
+    )
+    return path
+
+
+def animation_sections(
+    db_path: Path, *, limit: int = 12, out_dir: Path | None = None
+) -> list[dict[str, str]]:
     """One animated view per recorded episode of ``db_path`` (at most ``limit``).
 
+    Args:
+        db_path: the results database (only read).
+        limit: at most this many views.
+        out_dir: the report folder: each view's frames go to a side file
+            (:func:`write_animation_file`) loaded on demand; ``None``: inline ``<div>`` fragments.
+
     Returns:
-        ``[{"title": ..., "html": <div> fragment}]``; empty when nothing was recorded.
+        ``[{"title", "id", "src", "html"}]`` (``src``: the side file relative to ``out_dir``,
+        ``html`` empty; without ``out_dir``: ``src`` empty and ``html`` the fragment); empty when
+        nothing was recorded.
     """
     from contextlib import closing
 
@@ -276,8 +311,14 @@ def animation_sections(db_path: Path, *, limit: int = 12) -> list[dict[str, str]
             fig = trajectory_animation(
                 traj, goal=goal, robot_radius=radius, sensing_range=sensing, title=title
             )
+            div_id = f"anim-{ep_id}"
+            if out_dir is not None:
+                src = write_animation_file(fig, out_dir, div_id)
+                rel = src.relative_to(Path(out_dir)).as_posix()
+                sections.append({"title": title, "id": div_id, "src": rel, "html": ""})
+                continue
             html = fig.to_html(
-                full_html=False, include_plotlyjs=False, div_id=f"anim-{ep_id}", auto_play=False
+                full_html=False, include_plotlyjs=False, div_id=div_id, auto_play=False
             )
-            sections.append({"title": title, "html": html})
+            sections.append({"title": title, "id": div_id, "src": "", "html": html})
     return sections

@@ -1,22 +1,28 @@
 """The HTML report of a results database (DESIGN §5–6: ``uvnav report DB`` and ``uvnav run``).
 
 :func:`write_report` renders ``out_dir/index.html`` from the Jinja2 template
-``uvnav/viz/templates/report.html`` with
+``uvnav/viz/templates/report.html``, a decision tool first and a record second (issue 19):
 
-* the table "thesis reported vs uvnav measured" (rows given by the caller, e.g.
-  :func:`uvnav.bench.reproduce.reproduce`, whose measured values come from the runs),
-* a metric summary per scenario family and controller computed from the ``episodes`` table
-  (episodes, success/collision/timeout rates, errors, mean / median of the distance metrics),
+* **first screen, "which law, where"** (:func:`uvnav.viz.regime.decision_view`, read from the
+  store): the regime map's heat maps of success and of robot-driven collisions per law, a
+  recommendation per regime generated from the numbers, and the law x scene-family table at equal
+  seeds with 95 % intervals; rates on fewer than ``SMALL_SAMPLE`` episodes carry a ⚠ marker;
 * one section per chapter (:class:`uvnav.bench.sections.ChapterSection`): heading, what was
-  run, that chapter's rows of the table, its figures with captions and links to its other files
-  (interactive views, JSON), every file linked relatively — a file already inside ``out_dir`` is
-  linked where it is, one outside is copied into ``out_dir/<section key>/``,
-* the other figures, copied next to ``index.html`` and linked relatively,
-* the episodes that raised errors, and the campaigns with their configs,
-* a note that the Chapter 2 obstacles are simulated.
+  run, that chapter's rows of the "thesis reported vs uvnav measured" table (folded in a
+  ``<details>`` when longer than 12 rows), its figures as a grid of thumbnails each linking to the
+  full-size file, links to its other files — every file linked relatively: a file already inside
+  ``out_dir`` is linked where it is, one outside is copied into ``out_dir/<section key>/``;
+  rows of ``table`` that no section shows get a table of their own;
+* a metric summary per campaign, scenario family and controller computed from the ``episodes``
+  table (folded, in horizontal scroll containers), the other figures, the episodes that raised
+  errors, and the campaigns with their configs;
+* animated trajectory views whose frames are side files ``anim/anim-<id>.js``
+  (:func:`uvnav.viz.interactive.write_animation_file`) loaded when the reader presses a button, so
+  the page carries none of them.
 
-The page is self-contained: inline CSS, no scripts, no external URL — it opens offline and can be
-zipped or published as is.
+Every table fits the text column (fixed layout with wrapping, or a scroll container).  The page
+works offline: inline CSS, plotly loaded from ``plotly.min.js`` next to ``index.html`` (only when
+the page has a heat map or an animation), no external URL.
 """
 
 from __future__ import annotations
@@ -76,9 +82,13 @@ def _mean_median(values: pd.Series, digits: int = 3) -> str:
 
 
 def _rate(hits: pd.Series) -> str:
+    """``"87.0% [80.1%, 91.8%]"``, flagged ``⚠`` when on fewer than SMALL_SAMPLE episodes."""
+    from uvnav.bench.regime import SMALL_SAMPLE
+
     k, n = int(hits.sum()), len(hits)
     lo, hi = wilson_interval(k, n)
-    return f"{k / n:.1%} [{lo:.1%}, {hi:.1%}]" if n else "–"
+    flag = f" ⚠ n={n}" if n < SMALL_SAMPLE else ""
+    return f"{k / n:.1%} [{lo:.1%}, {hi:.1%}]{flag}" if n else "–"
 
 
 #: social metric columns of the summary: (label, episodes column, digits)
@@ -371,6 +381,7 @@ def write_report(
     import jinja2
 
     from uvnav import __version__
+    from uvnav.bench.regime import SMALL_SAMPLE
     from uvnav.bench.store import ResultsStore
 
     db_path = Path(db_path)
@@ -408,12 +419,18 @@ def write_report(
     figure_rows = _copy_figures(figure_specs, out_dir)
     chapter_rows = section_rows(list(sections or []), out_dir)
 
-    table_rows = [dict(r) for r in (table or [])]
+    in_sections = [dict(r) for sec in sections or [] for r in sec.rows]
+    # a row a section shows is not repeated in the global table (which keeps the others)
+    table_rows = [dict(r) for r in (table or []) if dict(r) not in in_sections]
     table_columns = list(_TABLE_ORDER) if table_rows else []
     for r in table_rows:
         table_columns += [k for k in r if k not in table_columns]
 
-    summaries = campaign_summaries(df)
+    from uvnav.bench.regime import CAMPAIGN as REGIME_CAMPAIGN
+
+    # the regime map's cells (36 families x every law) are tabulated, with intervals, on the
+    # first screen: not again here
+    summaries = [c for c in campaign_summaries(df) if c["campaign"] != REGIME_CAMPAIGN]
     errors_df = df[df["status"] == "error"] if not df.empty else df
     errors = [
         {
@@ -426,15 +443,18 @@ def write_report(
         for r in errors_df.head(_MAX_ERRORS).itertuples()
     ]
 
+    from uvnav.viz.interactive import ANIMATIONS_GLOBAL, PLOTLY_JS, write_plotly_js
+
     anim_sections: list[dict[str, str]] = []
     if animations > 0:
-        from uvnav.viz.interactive import PLOTLY_JS, animation_sections, write_plotly_js
+        from uvnav.viz.interactive import animation_sections
 
-        anim_sections = animation_sections(db_path, limit=animations)
-        if anim_sections:
-            write_plotly_js(out_dir)
-    else:
-        PLOTLY_JS = ""
+        anim_sections = animation_sections(db_path, limit=animations, out_dir=out_dir)
+    from uvnav.viz.regime import SMALL_MARK, decision_view
+
+    decision = decision_view(db_path)
+    if anim_sections or decision["heatmaps"]:
+        write_plotly_js(out_dir)
 
     template_text = files("uvnav.viz").joinpath("templates/report.html").read_text(encoding="utf-8")
     env = jinja2.Environment(
@@ -457,6 +477,10 @@ def write_report(
         sections=chapter_rows,
         errors=errors,
         animations=anim_sections,
+        animations_global=ANIMATIONS_GLOBAL,
+        decision=decision,
+        small_mark=SMALL_MARK,
+        small_sample=SMALL_SAMPLE,
         plotly_js=PLOTLY_JS,
         errors_truncated=max(0, len(errors_df) - _MAX_ERRORS),
     )

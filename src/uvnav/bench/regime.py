@@ -1,0 +1,503 @@
+"""Where each law wins: the regime map campaign and its generated recommendations (issue 19).
+
+The regime map runs every registered 2D law (:func:`uvnav.bench.reproduce_crowds.crowd_laws`: the
+unicycle laws and the holonomic ones, so laws registered later join by themselves) on CrowdNav's
+circle crossing (:mod:`uvnav.scenarios.crowdnav`: humans on a 4 m circle walking to the opposite
+point, the robot from (0, -4) to (0, 4) at V_max 1 m/s, 24 s) over a grid of regimes
+
+* crowd density: :data:`DENSITIES` humans on the circle (``n_humans``);
+* pedestrian speed / V_max: :data:`SPEED_RATIOS` (the humans' preferred speed ``human_v_pref``;
+  the robot's V_max is CrowdNav's 1 m/s, so the ratio is the speed in m/s);
+* the robot invisible to the humans (CrowdNav's test protocol) or visible (they avoid it);
+* sensing: exact (velocities known) or noisy (velocities estimated by finite differences of
+  centres sensed with Gaussian noise of :data:`NOISES` std, :mod:`uvnav.prediction`),
+
+with the same ``seeds`` test cases in every cell (:data:`QUICK_SEEDS` in ``uvnav run``,
+:data:`FULL_SEEDS` with ``--full``), in one campaign :data:`CAMPAIGN` of the results store (the
+campaign machinery: resumable, fingerprinted like Chapter 2's).  Every law runs in every cell,
+beyond its declared assumption where the cell breaks it (the thesis's laws assume obstacles slower
+than the robot, (2.6)): the map is a measurement of where each law works, and each such cell says
+so (:attr:`CellStats.beyond`).
+
+Per cell and law: success rate and *robot-driven* collision rate (a collision whose gap the robot
+closed, ``collision_by == "robot"``, :mod:`uvnav.sim.social`), each with its 95 % Wilson interval
+(:func:`uvnav.bench.summary.wilson_interval`).  :func:`recommend` turns one regime's numbers into a
+paragraph: the best law by success, ties decided by overlapping intervals (every law whose interval
+overlaps the best one's cannot be told apart from it on this evidence, and the text says so).
+
+:func:`family_table` is the law x scene-family view of the report's first screen: for every 2D
+scene family in the store, each law's success and collision rates on the *same* seeds (the scenes
+every law of that family ran), so no law is compared on more or easier scenes than another.
+
+Everything here reads the store or pure numbers; drawing is :mod:`uvnav.viz.regime`'s.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from uvnav.bench.campaign import Job, run_campaign
+from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
+from uvnav.bench.summary import wilson_interval
+
+CAMPAIGN = "regime-map"
+GENERATOR = "crowdnav-circle"
+#: humans on CrowdNav's 4 m circle (about 0.08, 0.14, 0.20 humans per m^2 of the disc; 12
+#: slow humans cannot always be placed apart on the circle, CrowdSim's placement rule)
+DENSITIES: tuple[int, ...] = (4, 7, 10)
+#: humans' preferred speed / robot V_max
+SPEED_RATIOS: tuple[float, ...] = (0.5, 1.0, 1.5)
+VISIBLE: tuple[bool, ...] = (False, True)
+#: std of the noise on sensed centres [m]; 0 = exact sensing (velocities known)
+NOISES: tuple[float, ...] = (0.0, 0.1)
+#: the robot's V_max in these scenes [m/s] (CrowdNav's robot ``v_pref``)
+V_MAX = 1.0
+QUICK_SEEDS, FULL_SEEDS = 15, 60
+#: a rate on fewer episodes than this is flagged as a small sample
+SMALL_SAMPLE = 30
+
+
+@dataclass(frozen=True, order=True)
+class Regime:
+    """One cell of the grid: humans, their speed / V_max, robot visible, sensing noise [m]."""
+
+    n_humans: int
+    speed_ratio: float
+    visible: bool
+    noise: float
+
+    def generator_params(self) -> dict[str, Any]:
+        """Keyword arguments of the ``crowdnav-circle`` generator for this cell."""
+        p: dict[str, Any] = {
+            "n_humans": int(self.n_humans),
+            "human_v_pref": float(self.speed_ratio) * V_MAX,
+            "robot_visible": bool(self.visible),
+        }
+        if self.noise > 0:
+            p.update(velocities="estimated", position_noise=float(self.noise))
+        return p
+
+    @property
+    def family(self) -> str:
+        """The scenario family its episodes are stored under (the generator label)."""
+        return Job(
+            controller="straight-v1",
+            seed=0,
+            generator=GENERATOR,
+            generator_seed=0,
+            generator_params=self.generator_params(),
+        ).family_label
+
+    @property
+    def sensing(self) -> str:
+        return "exact sensing" if self.noise == 0 else f"noise {self.noise:g} m"
+
+    @property
+    def label(self) -> str:
+        """``"8 humans, speed 1.5 V_max, invisible robot, exact sensing"``."""
+        seen = "visible" if self.visible else "invisible"
+        return (
+            f"{self.n_humans} humans, speed {self.speed_ratio:g} V_max, {seen} robot, "
+            f"{self.sensing}"
+        )
+
+
+def regimes(
+    densities: Sequence[int] = DENSITIES,
+    speed_ratios: Sequence[float] = SPEED_RATIOS,
+    visible: Sequence[bool] = VISIBLE,
+    noises: Sequence[float] = NOISES,
+) -> list[Regime]:
+    """The grid, visible and noise outermost (the report's panels), then speed, then density."""
+    return [
+        Regime(int(n), float(s), bool(v), float(z))
+        for v in visible
+        for z in noises
+        for s in speed_ratios
+        for n in densities
+    ]
+
+
+def regime_jobs(laws: Sequence[str], cells: Sequence[Regime], seeds: range) -> list[Job]:
+    """One job per cell, seed and law; every law beyond its assumptions (module docstring)."""
+    return [
+        Job(
+            controller=law,
+            seed=g,
+            generator=GENERATOR,
+            generator_seed=g,
+            generator_params=cell.generator_params(),
+            beyond_assumptions=True,
+        )
+        for cell in cells
+        for g in seeds
+        for law in laws
+    ]
+
+
+@dataclass
+class RegimeSummary:
+    """What :func:`run_regime_map` ran: laws, cells, seeds per cell, campaign counts."""
+
+    db_path: Path
+    laws: list[str]
+    cells: list[Regime]
+    seeds: int
+    full: bool
+    campaign: dict[str, Any] = field(default_factory=dict)
+    wall_time: float = 0.0
+
+
+def run_regime_map(
+    results_dir: Path,
+    *,
+    full: bool = False,
+    workers: int = 2,
+    seeds: int | None = None,
+    start_seed: int = 0,
+    laws: Sequence[str] | None = None,
+    cells: Sequence[Regime] | None = None,
+    progress: bool = False,
+) -> RegimeSummary:
+    """Run the regime map into ``results_dir/uvnav.sqlite`` (stored episodes are skipped).
+
+    Args:
+        results_dir: folder of the results database (created).
+        full: :data:`FULL_SEEDS` seeds per cell instead of :data:`QUICK_SEEDS`.
+        workers: worker processes (1 = in-process).
+        seeds: seeds (CrowdNav test cases) per cell, overriding the quick/full size.
+        start_seed: the first seed.
+        laws: laws to run (default every registered 2D law).
+        cells: the grid (default :func:`regimes`).
+        progress: rich progress bars on stderr.
+
+    Raises:
+        StaleCampaignError: the stored campaign was made by other code.
+    """
+    from uvnav.bench.reproduce import DB_NAME, _check_campaigns, code_fingerprint
+    from uvnav.bench.reproduce_crowds import crowd_laws
+
+    tic = time.perf_counter()
+    results_dir = Path(results_dir)
+    results_dir.mkdir(parents=True, exist_ok=True)
+    db_path = results_dir / DB_NAME
+    run_laws = list(crowd_laws()[0] if laws is None else laws)
+    grid = list(regimes() if cells is None else cells)
+    n = seeds if seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
+    cfg = {
+        "generator": GENERATOR,
+        "controllers": run_laws,
+        "cells": [[c.n_humans, c.speed_ratio, c.visible, c.noise] for c in grid],
+        "v_max": V_MAX,
+        "beyond_assumptions": True,
+        "fingerprint": code_fingerprint(),
+    }
+    jobs = regime_jobs(run_laws, grid, range(start_seed, start_seed + n))
+    with ResultsStore(db_path) as store:
+        _check_campaigns(store, {CAMPAIGN: cfg})
+        run = run_campaign(store, CAMPAIGN, jobs, config=cfg, workers=workers, progress=progress)
+    return RegimeSummary(
+        db_path=db_path,
+        laws=run_laws,
+        cells=grid,
+        seeds=n,
+        full=full,
+        campaign={
+            "jobs": run.total,
+            "ran": run.ran,
+            "skipped": run.skipped,
+            "errors": run.errors,
+            "wall_time": round(run.wall_time, 2),
+        },
+        wall_time=time.perf_counter() - tic,
+    )
+
+
+# ----------------------------------------------------------------------------- cells from the store
+
+
+@dataclass(frozen=True)
+class Rate:
+    """``k`` of ``n`` with its 95 % Wilson interval."""
+
+    k: int
+    n: int
+
+    @property
+    def p(self) -> float:
+        return self.k / self.n if self.n else 0.0
+
+    @property
+    def interval(self) -> tuple[float, float]:
+        return wilson_interval(self.k, self.n)
+
+    @property
+    def small(self) -> bool:
+        """Fewer episodes than :data:`SMALL_SAMPLE`."""
+        return self.n < SMALL_SAMPLE
+
+    def text(self, digits: int = 2) -> str:
+        """``"0.87 [0.62, 0.96]"``, with ``" n=15 (small)"`` for a small sample."""
+        if self.n == 0:
+            return "no episodes"
+        lo, hi = self.interval
+        out = f"{self.p:.{digits}f} [{lo:.{digits}f}, {hi:.{digits}f}]"
+        return out + (f" n={self.n} (small)" if self.small else "")
+
+
+@dataclass(frozen=True)
+class CellStats:
+    """One law in one regime: success and robot-driven collision (and all collisions)."""
+
+    law: str
+    success: Rate
+    robot_collision: Rate
+    collision: Rate
+    beyond: bool = False
+    errors: int = 0
+
+
+def _rates(g: Any) -> tuple[Rate, Rate, Rate, int]:
+    status = g["status"].astype(str)
+    errors = int((status == STATUS_ERROR).sum())
+    ok = g[~status.isin((STATUS_ERROR, STATUS_REFUSED))]
+    n = len(ok)
+    st = ok["status"].astype(str)
+    hit = st == "collision"
+    by = ok["collision_by"].astype(object).where(hit, None)
+    return (
+        Rate(int((st == "success").sum()), n),
+        Rate(int((by == "robot").sum()), n),
+        Rate(int(hit.sum()), n),
+        errors,
+    )
+
+
+def cell_stats(store: ResultsStore) -> dict[Regime, list[CellStats]]:
+    """Per regime of the stored campaign, one :class:`CellStats` per law (laws sorted), on the
+    seeds every law of that cell ran (equal samples); empty when the campaign is not stored."""
+    from uvnav.controllers.base import UnknownControllerError, requires_slower_obstacles
+
+    camp = next((c for c in store.campaigns() if c["name"] == CAMPAIGN), None)
+    if camp is None:
+        return {}
+    df = store.episodes_frame(CAMPAIGN)
+    if df.empty:
+        return {}
+    cells = [Regime(int(n), float(s), bool(v), float(z)) for n, s, v, z in camp["config"]["cells"]]
+    out: dict[Regime, list[CellStats]] = {}
+    for cell in cells:
+        g = equal_seeds(df[df["family"].astype(str) == cell.family])
+        if g.empty:
+            continue
+        stats = []
+        for law, gl in g.groupby("controller", sort=True):
+            try:
+                slower = requires_slower_obstacles(str(law))
+            except UnknownControllerError:  # a law stored by a plug-in no longer installed
+                slower = False
+            s, rc, c, err = _rates(gl)
+            beyond = slower and cell.speed_ratio >= 1.0
+            stats.append(CellStats(str(law), s, rc, c, beyond=beyond, errors=err))
+        out[cell] = stats
+    return out
+
+
+def equal_seeds(df: Any) -> Any:
+    """The rows of ``df`` (an episodes frame) on the scenes every controller in it ran, refused
+    and error episodes aside: each law is then measured on the same scenes."""
+    status = df["status"].astype(str)
+    ok = df[~status.isin((STATUS_ERROR, STATUS_REFUSED))]
+    if ok.empty:
+        return ok
+    keys = ok["scenario"].astype(str) + "#" + ok["seed"].astype(str)
+    per_law = [set(keys[ok["controller"] == c]) for c in ok["controller"].unique()]
+    common = set.intersection(*per_law)
+    return ok[keys.isin(common)]
+
+
+# ------------------------------------------------------------------------ the recommendation
+
+
+def _overlap(a: tuple[float, float], b: tuple[float, float]) -> bool:
+    return a[0] <= b[1] and b[0] <= a[1]
+
+
+def ranking(stats: Sequence[CellStats]) -> tuple[list[CellStats], list[CellStats]]:
+    """``(best, rest)``: the laws ordered by success (then fewer robot-driven collisions, then
+    name); ``best`` is the top law and every law whose success interval overlaps its interval
+    (the evidence cannot separate them), ``rest`` the laws clearly below."""
+    ordered = sorted(
+        (s for s in stats if s.success.n > 0),
+        key=lambda s: (-s.success.p, s.robot_collision.p, s.law),
+    )
+    if not ordered:
+        return [], []
+    top = ordered[0].success.interval
+    best = [s for s in ordered if _overlap(s.success.interval, top)]
+    rest = [s for s in ordered if s not in best]
+    return best, rest
+
+
+def _pct(r: Rate) -> str:
+    lo, hi = r.interval
+    return f"{r.p:.0%} [{lo:.0%}, {hi:.0%}]"
+
+
+#: the mark of a law run beyond the assumption it declares (thesis (2.6)) in that cell
+BEYOND_MARK = "†"
+
+
+def _name(s: CellStats) -> str:
+    return s.law + (BEYOND_MARK if s.beyond else "")
+
+
+def recommend(regime_label: str, stats: Sequence[CellStats]) -> str:
+    """One paragraph for one regime, generated from the numbers (module docstring).
+
+    Names the best law by success with its interval and robot-driven collision rate; when other
+    laws' success intervals overlap the best one's it says the evidence cannot separate them;
+    flags small samples and cells where no law succeeds.
+    """
+    best, rest = ranking(stats)
+    if not best:
+        return f"{regime_label}: no episodes stored."
+    n = min(s.success.n for s in best + rest)
+    top = best[0]
+    if top.success.k == 0:
+        text = f"{regime_label}: no law reached the goal in {n} episodes each; none can be "
+        return text + "recommended here."
+    lead = (
+        f"{_name(top)} succeeds most often: {_pct(top.success)}, robot-driven collisions "
+        f"{_pct(top.robot_collision)}."
+    )
+    if len(best) == 1:
+        runner = (
+            f" The runner-up, {_name(rest[0])}, reaches {_pct(rest[0].success)}" if rest else ""
+        )
+        text = f"{regime_label}: use {top.law}. {lead}{runner}" + (
+            "; the intervals do not overlap, so the lead is real." if rest else "."
+        )
+    else:
+        others = ", ".join(f"{_name(s)} {s.success.p:.0%}" for s in best[1:])
+        safest = min(best, key=lambda s: (s.robot_collision.p, -s.success.p, s.law))
+        text = (
+            f"{regime_label}: the evidence cannot separate {_name(top)} from {others} (success "
+            f"intervals overlap its own). {lead}"
+        )
+        if safest is not top:
+            text += (
+                f" Among them {_name(safest)} drives into people least "
+                f"({_pct(safest.robot_collision)} robot-driven collisions)."
+            )
+    below = [s for s in rest if s is not (rest[0] if len(best) == 1 else None)]
+    if below:
+        listed = ", ".join(f"{_name(s)} {s.success.p:.0%}" for s in below)
+        text += f" Clearly below: {listed}."
+    if n < SMALL_SAMPLE:
+        text += f" Small sample ({n} episodes per law): run more seeds (--full) to narrow this."
+    return text
+
+
+# --------------------------------------------------------------------- law x scene family
+
+
+#: campaigns whose laws that assume slower obstacles ran beyond that assumption
+_BEYOND_CAMPAIGNS = frozenset({"crowdnav-beyond", "crowds-eth"})
+#: campaigns the family table leaves out (the regime map has its own view; 3D/UUV are other
+#: vehicles' families, kept apart by their chapters)
+_OTHER_CAMPAIGNS = frozenset({CAMPAIGN})
+
+
+@dataclass(frozen=True)
+class FamilyCell:
+    """One law on one scene family, on the seeds every law of the family ran."""
+
+    family: str
+    law: str
+    success: Rate
+    collision: Rate
+    beyond: bool
+    ran: int  # episodes of this law on the family before equalising
+
+
+def family_table(store: ResultsStore, *, families: Sequence[str] | None = None) -> list[FamilyCell]:
+    """Law x scene family at equal seeds, for every 2D family of the store (or ``families``):
+    per family the scenes every law of it ran (refused and error episodes aside; a law refused
+    everywhere in a campaign but run in its ``-beyond`` twin counts with those episodes)."""
+    from uvnav.controllers.base import available_controllers
+
+    laws2d = set(available_controllers("unicycle")) | set(available_controllers("holonomic"))
+    df = store.episodes_frame()
+    if df.empty:
+        return []
+    df = df[~df["campaign"].astype(str).isin(_OTHER_CAMPAIGNS)]
+    df = df[df["controller"].astype(str).isin(laws2d)]
+    df = df[~df["scenario"].astype(str).str.startswith("thesis-")]  # one scene each: no rate
+    df = df[~df["status"].astype(str).isin((STATUS_ERROR, STATUS_REFUSED))]
+    if df.empty:
+        return []
+    fam = df["family"].astype(str).str.split("[", n=1).str[0]
+    df = df.assign(family_base=fam)
+    out: list[FamilyCell] = []
+    chosen = sorted(set(fam)) if families is None else list(families)
+    for family in chosen:
+        g = df[df["family_base"] == family]
+        if g.empty:
+            continue
+        g = g.drop_duplicates(["scenario", "controller", "seed"])
+        ran = g.groupby("controller").size().to_dict()
+        eq = equal_seeds(g)
+        for law, gl in eq.groupby("controller", sort=True):
+            st = gl["status"].astype(str)
+            n = len(gl)
+            beyond = bool(gl["campaign"].astype(str).isin(_BEYOND_CAMPAIGNS).any())
+            out.append(
+                FamilyCell(
+                    family=family,
+                    law=str(law),
+                    success=Rate(int((st == "success").sum()), n),
+                    collision=Rate(int((st == "collision").sum()), n),
+                    beyond=beyond and _slower(str(law)),
+                    ran=int(ran.get(law, n)),
+                )
+            )
+    return out
+
+
+def _slower(law: str) -> bool:
+    from uvnav.controllers.base import UnknownControllerError, requires_slower_obstacles
+
+    try:
+        return requires_slower_obstacles(law)
+    except UnknownControllerError:
+        return False
+
+
+__all__ = [
+    "CAMPAIGN",
+    "DENSITIES",
+    "FULL_SEEDS",
+    "NOISES",
+    "QUICK_SEEDS",
+    "SMALL_SAMPLE",
+    "SPEED_RATIOS",
+    "VISIBLE",
+    "CellStats",
+    "FamilyCell",
+    "Rate",
+    "Regime",
+    "RegimeSummary",
+    "cell_stats",
+    "equal_seeds",
+    "family_table",
+    "ranking",
+    "recommend",
+    "regime_jobs",
+    "regimes",
+    "run_regime_map",
+]
