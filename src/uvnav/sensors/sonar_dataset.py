@@ -17,6 +17,13 @@ The baseline the network must beat is kept beside them: ``min_i R_i`` and ``argm
 Every reading is ``>= d*`` (a sensor sits on the hull), with equality only when ``q*`` lies in a
 beam, so the baseline is biased high by the array's angular gaps.
 
+The thesis's own targets are kept too (``targets("readings")``, :func:`reading_targets`): the
+minimum of the network's nine inputs and the 1-based number of the input that holds it — a label
+computed from the inputs themselves, as §5.4 describes ("the outputs are minimum distance among the
+nine sensors and the sensor ... which achieved the minimum distance").  The inputs are the adapted
+readings ``k_i R_i``, so these differ from the raw min/argmin baseline where the coefficient
+reorders the readings.
+
 Sampling (pure numpy, one seeded Generator): an obstacle from
 :func:`~uvnav.obstacles.deforming3d.random_star` (base radius, reference shape and a deformation of
 at most 10 %, a random time), a vehicle at a random direction and hull gap from it, its heading
@@ -66,6 +73,18 @@ class SonarSampling:
     time_range: tuple[float, float] = (0.0, 60.0)
 
 
+#: what the network is trained to output: ``"geometry"`` (the true nearest distance and the beam
+#: nearest to it, ours) or ``"readings"`` (min/argmin of the network's own inputs, the thesis's)
+TARGET_KINDS: tuple[str, ...] = ("geometry", "readings")
+
+
+def reading_targets(inputs: FloatArray) -> FloatArray:
+    """The thesis's targets (§5.4, Fig. 5.4) of inputs ``(n, 9)``: ``(n, 2)`` — the least input
+    [m] and the 1-based number of the input that holds it (the first one on a tie)."""
+    x = np.atleast_2d(np.asarray(inputs, dtype=float))
+    return np.stack([x.min(axis=1), np.argmin(x, axis=1) + 1.0], axis=1)
+
+
 @dataclass(frozen=True)
 class SonarDataset:
     """Samples as arrays (n rows).
@@ -89,8 +108,20 @@ class SonarDataset:
     def __len__(self) -> int:
         return int(self.ranges.shape[0])
 
-    def targets(self) -> FloatArray:
-        """(n, 2): distance [m] and sensor index, the network's outputs (Fig. 5.4)."""
+    def targets(self, kind: str = "geometry") -> FloatArray:
+        """(n, 2): distance [m] and sensor index, the network's outputs (Fig. 5.4).
+
+        Args:
+            kind: ``"geometry"`` (the true nearest distance and sensor) or ``"readings"``
+                (min/argmin of :attr:`inputs`, the thesis's set-up; :data:`TARGET_KINDS`).
+
+        Raises:
+            ValueError: another ``kind``.
+        """
+        if kind == "readings":
+            return reading_targets(self.inputs)
+        if kind != "geometry":
+            raise ValueError(f"targets: {kind!r} (must be one of {', '.join(TARGET_KINDS)})")
         return np.stack([self.target_distance, self.target_index.astype(float)], axis=1)
 
     def baseline(self) -> FloatArray:
