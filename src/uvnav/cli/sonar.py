@@ -5,9 +5,12 @@ Commands (thin: they parse, call the library, print):
 * ``dataset`` — sample R(t) with true-geometry targets (:mod:`uvnav.sensors.sonar_dataset`) into
   an ``.npz`` file (plain arrays; read back with ``allow_pickle=False``);
 * ``train`` — train the BPNN (:mod:`uvnav.learning.bpnn`) with a random train/validation/test
-  division and early stopping, write a safetensors checkpoint + JSON;
-* ``evaluate`` — errors target - output of a checkpoint on a dataset, beside the min/argmin
-  baseline and the thesis's ranges;
+  division and early stopping, write a safetensors checkpoint + JSON; ``--variant`` picks the
+  network (``plain``: the thesis's; ``residual``; ``residual-huber``) and ``--targets`` what it
+  learns (``geometry``: the true nearest distance and sensor; ``readings``: min/argmin of its own
+  inputs, the thesis's set-up) — every variant the Chapter 5 report shows;
+* ``evaluate`` — errors target - output of a checkpoint (any variant, on the targets it was
+  trained for) on a dataset, beside the min/argmin baseline and the thesis's ranges;
 * ``simulate`` — one closed-loop episode of ``zhang2022-uuv3d-v1`` on a Chapter 5 scenario.
 
 The chapter's reproduction (BPNN experiment + closed-loop campaigns) is ``uvnav reproduce ch5``.
@@ -114,32 +117,73 @@ def train_cmd(
         int, typer.Option("--seed", min=0, help="Seed of the division and the initial weights.")
     ] = 0,
     max_epochs: Annotated[int, typer.Option(min=1, help="Largest number of epochs.")] = 1000,
+    variant: Annotated[
+        str, typer.Option(help="Network: plain (the thesis's), residual or residual-huber.")
+    ] = "plain",
+    targets: Annotated[
+        str,
+        typer.Option(
+            help="What it learns: geometry (true nearest distance and sensor) or readings "
+            "(min/argmin of its inputs, the thesis's set-up)."
+        ),
+    ] = "geometry",
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object instead of the table.")
     ] = False,
 ) -> None:
     """Train the BPNN with a random division and early stopping; write a safe checkpoint."""
-    from uvnav.learning.bpnn import BPNNConfig, error_table, save_checkpoint, train_bpnn
+    from uvnav.learning.bpnn import (
+        VARIANTS,
+        error_table,
+        save_checkpoint,
+        train_bpnn,
+        variant_config,
+    )
+    from uvnav.sensors.sonar_dataset import TARGET_KINDS
 
-    ds = _load_dataset(data)
+    if variant not in VARIANTS:
+        raise CliError(f"--variant: {variant!r} (must be one of {', '.join(VARIANTS)})")
+    if targets not in TARGET_KINDS:
+        raise CliError(f"--targets: {targets!r} (must be one of {', '.join(TARGET_KINDS)})")
     try:
         sizes = tuple(int(h) for h in hidden.split(","))
-        cfg = BPNNConfig(hidden=sizes, optimizer=optimizer, max_epochs=max_epochs)
+    except ValueError as exc:
+        raise CliError(f"--hidden: {exc}") from None
+    try:
+        cfg = variant_config(variant, hidden=sizes, optimizer=optimizer, max_epochs=max_epochs)
     except ValueError as exc:
         raise CliError(f"--hidden/--optimizer: {exc}") from None
+    ds = _load_dataset(data)
+    y = ds.targets(targets)
     try:
-        model = train_bpnn(ds.inputs, ds.targets(), np.random.default_rng(seed), cfg)
+        model = train_bpnn(
+            ds.inputs,
+            y,
+            np.random.default_rng(seed),
+            cfg,
+            offset=ds.baseline(),
+            target_kind=targets,
+        )
     except ValueError as exc:
         raise CliError(f"{data}: {exc}") from None
     st, js = save_checkpoint(model, out)
     test = model.split["test"]
-    table = error_table(model.predict(ds.inputs[test]), ds.targets()[test], ds.baseline()[test])
+    pred = model.predict(ds.inputs[test], ds.baseline()[test])
+    table = error_table(pred, y[test], ds.baseline()[test])
     if as_json:
         typer.echo(
-            dumps({"test": table, "best_epoch": model.best_epoch, "stop_reason": model.stop_reason})
+            dumps(
+                {
+                    "variant": model.variant,
+                    "targets": model.target_kind,
+                    "test": table,
+                    "best_epoch": model.best_epoch,
+                    "stop_reason": model.stop_reason,
+                }
+            )
         )
     else:
-        _print_table(table, len(ds), f"test group ({len(test)} samples)")
+        _print_table(table, len(ds), f"test group ({len(test)} samples), {_what(model)}")
         typer.echo(f"stopped: {model.stop_reason} (best epoch {model.best_epoch})")
     typer.echo(f"wrote {st} and {js}", err=as_json)  # --json: stdout holds the JSON alone
 
@@ -164,18 +208,24 @@ def evaluate_cmd(
         raise CliError(
             f"{data}: {ds.inputs.shape[1]} inputs per sample, the model takes {model.n_inputs}"
         )
-    table = error_table(model.predict(ds.inputs), ds.targets(), ds.baseline())
+    y = ds.targets(model.target_kind)
+    table = error_table(model.predict(ds.inputs, ds.baseline()), y, ds.baseline())
     if as_json:
-        typer.echo(dumps(table))
+        typer.echo(dumps({"variant": model.variant, "targets": model.target_kind, **table}))
     else:
-        _print_table(table, None, f"{data} ({len(ds)} samples)")
+        _print_table(table, None, f"{data} ({len(ds)} samples), {_what(model)}")
+
+
+def _what(model: Any) -> str:
+    """``"variant plain, targets readings"``: what a network is, for table titles."""
+    return f"variant {model.variant}, targets {model.target_kind}"
 
 
 def _print_table(table: dict[str, Any], n_train: int | None, title: str) -> None:
     from rich.console import Console
     from rich.table import Table
 
-    from uvnav.learning.bpnn import THESIS_ERROR_RANGES
+    from uvnav.learning.bpnn import THESIS_ACCEPTED, THESIS_ERROR_RANGES
 
     t = Table(title=f"errors target - output, {title}")
     for col in ("who", "distance range [m]", "distance MAE [m]", "index range", "index right"):
@@ -192,7 +242,10 @@ def _print_table(table: dict[str, Any], n_train: int | None, title: str) -> None
     for n, ref in THESIS_ERROR_RANGES.items():
         if n_train is None or n_train == n:
             d, i = ref["distance"], ref["index"]
-            t.add_row(f"thesis ({n} samples)", f"[{d[0]}, {d[1]}]", "", f"[{i[0]}, {i[1]}]", "")
+            verdict = "accepted" if THESIS_ACCEPTED[n] else "a failure"
+            t.add_row(
+                f"thesis ({n} samples, {verdict})", f"[{d[0]}, {d[1]}]", "", f"[{i[0]}, {i[1]}]", ""
+            )
     Console().print(t)
 
 
