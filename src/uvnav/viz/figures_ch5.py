@@ -118,7 +118,9 @@ def fig_errors(
 
 def fig_learning_curve(rows: Sequence[dict[str, Any]]) -> Figure:
     """Median MAE on the independent test set vs sample count, network (plain thesis-style and
-    residual) and baseline."""
+    residual) and baseline, for the true-geometry targets (the literal experiment's rows, trained
+    on min/argmin of the inputs, are another task and stay in the table)."""
+    rows = [r for r in rows if r.get("targets", "geometry") == "geometry"]
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     for j, out in enumerate(("distance", "index")):
         for variant, style in zip(VARIANT_LABELS, ("o-", "^-", "D-", "v-"), strict=True):
