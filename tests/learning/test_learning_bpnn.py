@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import pickle
 from pathlib import Path
 
@@ -11,14 +12,22 @@ import pytest
 pytest.importorskip("torch")
 pytest.importorskip("safetensors")
 
+from hypothesis import given
+from hypothesis import strategies as st
+
+from uvnav.learning import bpnn
 from uvnav.learning.bpnn import (
+    HUBER_DELTA,
+    VARIANTS,
     BPNNConfig,
     CheckpointError,
     error_table,
     load_checkpoint,
     save_checkpoint,
     split_indices,
+    split_sizes,
     train_bpnn,
+    variant_config,
 )
 from uvnav.sensors.sonar_dataset import SonarDataset, sample_sonar_dataset
 
@@ -35,6 +44,36 @@ def test_split_is_random_disjoint_and_complete() -> None:
     tr, va, te = split_indices(50, np.random.default_rng(0), (0.7, 0.15, 0.15))
     assert (len(tr), len(va), len(te)) == (34, 8, 8)
     assert sorted(np.concatenate([tr, va, te]).tolist()) == list(range(50))
+
+
+def test_split_proportions_are_the_toolboxs_dividerand() -> None:
+    # MATLAB's dividerand: round(0.15 n) for validation and test, halves away from zero
+    # (150 -> 22.5 -> 23; Python's round would give 22), training the rest
+    assert split_sizes(50, (0.7, 0.15, 0.15)) == (34, 8, 8)
+    assert split_sizes(150, (0.7, 0.15, 0.15)) == (104, 23, 23)
+    assert split_sizes(500, (0.7, 0.15, 0.15)) == (350, 75, 75)
+    assert BPNNConfig().fractions == (0.7, 0.15, 0.15)  # the toolbox's default the thesis used
+    tr, va, te = split_indices(150, np.random.default_rng(1), (0.7, 0.15, 0.15))
+    assert (len(tr), len(va), len(te)) == (104, 23, 23)
+    with pytest.raises(ValueError, match="too few samples"):
+        split_sizes(2, (0.7, 0.15, 0.15))
+
+
+@given(st.integers(3, 10_000))
+def test_split_sizes_round_each_group_to_its_share(n: int) -> None:
+    n_train, n_val, n_test = split_sizes(n, (0.7, 0.15, 0.15))
+    assert n_train + n_val + n_test == n
+    for k in (n_val, n_test):
+        assert k >= 1 and (abs(k - 0.15 * n) < 0.5 or k - 0.15 * n == 0.5 or k == 1)
+
+
+def test_variants_by_name() -> None:
+    assert [variant_config(v).variant for v in VARIANTS] == list(VARIANTS)
+    assert variant_config("residual-huber").huber_delta == HUBER_DELTA > 0
+    assert not variant_config("plain").residual
+    assert variant_config("residual", max_epochs=3).max_epochs == 3
+    with pytest.raises(ValueError, match="variant: 'deep'"):
+        variant_config("deep")
 
 
 def test_network_learns_a_smooth_map_far_below_its_initial_error() -> None:
@@ -106,12 +145,42 @@ def test_adam_option_trains(data: tuple[SonarDataset, SonarDataset]) -> None:
 def test_checkpoint_round_trip(tmp_path: Path, data: tuple[SonarDataset, SonarDataset]) -> None:
     ds, _ = data
     m = train_bpnn(ds.inputs, ds.targets(), np.random.default_rng(0), BPNNConfig(max_epochs=5))
-    st, js = save_checkpoint(m, tmp_path / "net")
-    assert st.suffix == ".safetensors" and js.suffix == ".json"
-    back = load_checkpoint(st)
+    path, js = save_checkpoint(m, tmp_path / "net")
+    assert path.suffix == ".safetensors" and js.suffix == ".json"
+    back = load_checkpoint(path)
     np.testing.assert_array_equal(back.predict(ds.inputs), m.predict(ds.inputs))
     assert back.config == m.config
+    assert back.target_kind == "geometry"
     np.testing.assert_array_equal(back.split["test"], m.split["test"])
+
+
+def test_a_checkpoint_keeps_what_its_network_learnt(
+    tmp_path: Path, data: tuple[SonarDataset, SonarDataset]
+) -> None:
+    ds, _ = data
+    cfg = variant_config("residual-huber", max_epochs=3)
+    y = ds.targets("readings")
+    m = train_bpnn(
+        ds.inputs, y, np.random.default_rng(0), cfg, offset=ds.baseline(), target_kind="readings"
+    )
+    back = load_checkpoint(save_checkpoint(m, tmp_path / "net")[0])
+    assert (back.variant, back.target_kind) == ("residual-huber", "readings")
+    np.testing.assert_array_equal(
+        back.predict(ds.inputs, ds.baseline()), m.predict(ds.inputs, ds.baseline())
+    )
+    header = json.loads((tmp_path / "net.json").read_text())
+    header["record"]["target_kind"] = "vibes"
+    from uvnav.learning.checkpoint import write_checkpoint
+
+    arrays = {k: np.asarray(v) for k, v in bpnn._model_arrays(m).items()}
+    write_checkpoint(
+        tmp_path / "bad.safetensors", arrays, kind="bpnn", config=header["config"],
+        record=header["record"],
+    )  # fmt: skip
+    with pytest.raises(CheckpointError, match="target_kind 'vibes'"):
+        load_checkpoint(tmp_path / "bad.safetensors")
+    with pytest.raises(ValueError, match="target_kind"):
+        train_bpnn(ds.inputs, y, np.random.default_rng(0), cfg, target_kind="vibes")
 
 
 class _Evil:

@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import hypothesis.extra.numpy as hnp
+import hypothesis.strategies as st
 import numpy as np
 import pytest
+from hypothesis import given, settings
 
 from uvnav.sensors.sonar_array import SonarArray, adapted_ranges
-from uvnav.sensors.sonar_dataset import SonarDataset, sample_sonar_dataset
+from uvnav.sensors.sonar_dataset import SonarDataset, reading_targets, sample_sonar_dataset
 
 
 @pytest.fixture(scope="module")
@@ -48,3 +51,33 @@ def test_round_trip_and_bad_arrays(ds: SonarDataset) -> None:
         SonarDataset.from_arrays(bad)
     with pytest.raises(ValueError, match=">= 1"):
         sample_sonar_dataset(0, np.random.default_rng(0))
+
+
+def test_thesis_targets_are_min_and_argmin_of_the_networks_own_inputs(ds: SonarDataset) -> None:
+    y = ds.targets("readings")
+    assert y.shape == (40, 2)
+    # the label is a function of the inputs alone: the least input and the number holding it
+    np.testing.assert_array_equal(y[:, 0], ds.inputs.min(axis=1))
+    np.testing.assert_array_equal(y[:, 1], ds.inputs.argmin(axis=1) + 1)
+    np.testing.assert_array_equal(ds.inputs[np.arange(40), y[:, 1].astype(int) - 1], y[:, 0])
+    # the inputs are the adapted readings, so these are not the raw min/argmin everywhere
+    assert np.any(y[:, 0] != ds.baseline_distance)
+    assert not np.array_equal(y, ds.targets("geometry"))
+    with pytest.raises(ValueError, match="targets: 'truth'"):
+        ds.targets("truth")
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    hnp.arrays(
+        np.float64,
+        hnp.array_shapes(min_dims=2, max_dims=2, min_side=1, max_side=12).map(lambda s: (s[0], 9)),
+        elements=st.floats(0.0, 8.0),
+    )
+)
+def test_reading_targets_pick_the_first_least_input(x: np.ndarray) -> None:
+    y = reading_targets(x)
+    for row, (d, i) in zip(x, y, strict=True):
+        k = int(i) - 1
+        assert 0 <= k < 9 and row[k] == d == row.min()
+        assert np.all(row[:k] > d)  # the first input holding the least value (ties: the lowest)
