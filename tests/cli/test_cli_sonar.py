@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 from typer.testing import CliRunner
 
@@ -40,6 +41,45 @@ def test_dataset_train_evaluate(tmp_path: Path) -> None:
     assert table["network"]["distance"]["n"] == 30
 
 
+@pytest.mark.parametrize("targets", ["geometry", "readings"])
+def test_every_variant_trains_to_a_loadable_checkpoint_and_evaluates(
+    tmp_path: Path, targets: str
+) -> None:
+    from uvnav.learning.bpnn import VARIANTS, load_checkpoint
+    from uvnav.sensors.sonar_dataset import SonarDataset
+
+    data = tmp_path / "d.npz"
+    r = runner.invoke(
+        app,
+        ["sonar", "dataset", "-n", "30", "--seed", "2", "--subdivisions", "1", "--out", str(data)],
+    )
+    assert r.exit_code == 0, r.output
+    with np.load(data) as z:
+        ds = SonarDataset.from_arrays({k: z[k] for k in z.files})
+    for variant in VARIANTS:
+        out = tmp_path / f"m_{variant}"
+        args = ["sonar", "train", str(data), "--out", str(out), "--max-epochs", "3", "--json"]
+        r = runner.invoke(app, [*args, "--variant", variant, "--targets", targets])
+        assert r.exit_code == 0, r.output
+        assert (json.loads(r.stdout)["variant"], json.loads(r.stdout)["targets"]) == (
+            variant,
+            targets,
+        )
+        model = load_checkpoint(out)  # the one checkpoint format, either kind of network
+        assert (model.variant, model.target_kind) == (variant, targets)
+        assert model.config.residual == (variant != "plain")
+        r = runner.invoke(
+            app, ["sonar", "evaluate", str(out) + ".safetensors", str(data), "--json"]
+        )
+        assert r.exit_code == 0, r.output
+        table = json.loads(r.stdout)
+        assert (table["variant"], table["targets"]) == (variant, targets)
+        # errors against the targets the network learnt, not the other kind
+        expect = ds.targets(targets)[:, 0] - model.predict(ds.inputs, ds.baseline())[:, 0]
+        assert table["network"]["distance"]["lo"] == pytest.approx(expect.min())
+        assert table["network"]["distance"]["hi"] == pytest.approx(expect.max())
+
+
 def test_bad_inputs_are_one_line_errors(tmp_path: Path) -> None:
     junk = tmp_path / "junk.npz"
     junk.write_text("not a zip")
@@ -49,6 +89,8 @@ def test_bad_inputs_are_one_line_errors(tmp_path: Path) -> None:
         ["sonar", "evaluate", str(tmp_path / "nomodel"), str(junk)],
         ["sonar", "simulate", "random-ch5:x"],
         ["sonar", "simulate", "thesis-ch5-scene1", "--locator", "network"],
+        ["sonar", "train", str(junk), "--variant", "deep"],
+        ["sonar", "train", str(junk), "--targets", "truth"],
     ):
         r = runner.invoke(app, args)
         assert r.exit_code == 2, (args, r.output)
