@@ -148,6 +148,32 @@ def test_learning_rows_are_stages_built_on_their_data_and_test_set(tmp_path: Pat
     assert st.reused == []
 
 
+def test_the_literal_experiments_rows_are_stages_of_their_own(tmp_path: Path) -> None:
+    pytest.importorskip("torch")
+    from uvnav.learning.bpnn import BPNNConfig
+    from uvnav.stages import Stages
+
+    cfg = BPNNConfig(max_epochs=3)
+    test, _ = cached_dataset(6, 7, tmp_path)
+    geo, _, _ = r5.learning_row(20, 0, test, cfg, cache=tmp_path)
+    st = Stages(tmp_path / "stages")
+    row, model, ds = r5.learning_row(20, 0, test, cfg, cache=tmp_path, stages=st,
+                                     target_kind="readings")  # fmt: skip
+    assert st.reused == ["data_n20_r10000"]  # the same data, a new row (its own stage)
+    assert (tmp_path / "model_n20_s0_plain_readings.safetensors").is_file()
+    assert (row["targets"], model.target_kind, geo["targets"]) == ("readings",) * 2 + ("geometry",)
+    assert row["division"] == [14, 3, 3]  # dividerand: round(0.15 * 20) = 3
+    # its errors are against min/argmin of the inputs
+    grp = model.split["test"]
+    err = ds.inputs[grp].min(axis=1) - model.predict(ds.inputs[grp])[:, 0]
+    assert row["test_group"]["network"]["distance"]["lo"] == pytest.approx(err.min())
+    st = Stages(tmp_path / "stages")
+    r5.learning_row(20, 0, test, cfg, cache=tmp_path, stages=st, target_kind="readings")
+    r5.learning_row(20, 0, test, cfg, cache=tmp_path, stages=st)
+    assert st.reused == ["data_n20_r10000", "row_n20_s0_plain_readings", "data_n20_r10000",
+                         "row_n20_s0_plain"]  # fmt: skip
+
+
 def test_a_cache_of_the_older_layout_is_dropped(tmp_path: Path) -> None:
     cache = tmp_path / "ch5" / "cache"
     cache.mkdir(parents=True)
