@@ -332,8 +332,9 @@ def scenarios_list(
         bool, typer.Option("--json", help="Print one JSON array instead of the table.")
     ] = False,
 ) -> None:
-    """List the built-in scenes of every kind (thesis experiments first) and the generators."""
-    from uvnav.scenarios.catalog import builtin_names, generators
+    """List the built-in scenes of every kind (thesis experiments first) and the generators
+    (one line each with its parameters' names; 'uvnav scenarios show GENERATOR' describes them)."""
+    from uvnav.scenarios.catalog import builtin_names, generator_params, generators
 
     rows: list[dict[str, Any]] = []
     for name, kind in builtin_names():
@@ -349,11 +350,14 @@ def scenarios_list(
         )
     for gen, kind in generators().items():
         number = "<seed>" if kind.spec_is_seed else "<robots>"
+        names = [p.name for p in generator_params(gen)] if kind.spec_is_seed else []
         rows.append(
             {
                 "name": f"{gen}:{number}",
                 "kind": kind.name,
-                "description": f"generator of {kind.summary} scenes",
+                "description": f"generator of {kind.summary} scenes"
+                + (f" (params: {', '.join(names)})" if names else ""),
+                "params": names,
                 "obstacles": None,
                 "controller": None,
             }
@@ -365,7 +369,8 @@ def scenarios_list(
     cols = shutil.get_terminal_size().columns if sys.stdout.isatty() else None
     typer.echo(f"{'name':<{width}}  {'kind':<7}  description ('uvnav scenarios show NAME')")
     for row in rows:
-        line = f"{row['name']:<{width}}  {row['kind']:<7}  {_first_sentence(row['description'])}"
+        text = row["description"] if row.get("params") else _first_sentence(row["description"])
+        line = f"{row['name']:<{width}}  {row['kind']:<7}  {text}"
         if cols is not None and len(line) > cols:
             line = line[: cols - 1] + "…"
         typer.echo(line.rstrip())
@@ -382,20 +387,61 @@ def _model_yaml(model: Any) -> str:
     return str(yaml.safe_dump(model.model_dump(mode="json"), sort_keys=False))
 
 
+def _show_generator_params(name: str) -> None:
+    """The parameter table of seed generator ``name``."""
+    from uvnav.scenarios.catalog import generator_params
+
+    params = generator_params(name)
+    typer.echo(f"{name}:SEED parameters (--param KEY=VALUE; params: in a campaign entry)")
+    if not params:
+        typer.echo("  (none)")
+    width = max((len(p.name) for p in params), default=0)
+    for p in params:
+        bounds = f", {p.bounds}" if p.bounds else ""
+        text = f"  {p.name:<{width}}  {p.type} = {p.default!r}{bounds}"
+        typer.echo(f"{text}  {p.description}".rstrip())
+
+
 @scenarios_app.command("show")
 def scenarios_show(
-    name: Annotated[str, typer.Argument(help="Built-in name, YAML file, or GENERATOR:SEED.")],
+    name: Annotated[
+        str,
+        typer.Argument(
+            help="Built-in name, YAML file, GENERATOR:SEED, or a GENERATOR (its parameters)."
+        ),
+    ],
     resolved: Annotated[
         bool,
         typer.Option(
             "--resolved", help="Print the validated scenario with every default filled in."
         ),
     ] = False,
+    param: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--param",
+            help="Generator parameter KEY=VALUE (repeatable) for GENERATOR:SEED, e.g. "
+            "speed_ratio_max=0.9; 'uvnav scenarios show GENERATOR' lists them.",
+        ),
+    ] = None,
 ) -> None:
     """Print a scenario as YAML (the file as written; a generated one, or --resolved, with
-    every default filled in)."""
-    from uvnav.scenarios.catalog import resolve
+    every default filled in), or a generator's parameters."""
+    from uvnav.scenarios.catalog import generate, generators, resolve
 
+    by_gen = generators()
+    if name in by_gen and by_gen[name].spec_is_seed:
+        _show_generator_params(name)
+        return
+    params = parse_params(param)
+    gen, sep, number = name.partition(":")
+    if params:
+        if not (sep and gen in by_gen and by_gen[gen].spec_is_seed):
+            raise CliError(f"--param: only a GENERATOR:SEED scene takes parameters (got {name!r})")
+        if not number.isdigit():
+            raise CliError(f"{name}: seed: must be a non-negative integer (got {number!r})")
+        typer.echo(_model_yaml(generate(gen, int(number), params).scenario), nl=False)
+        return
     res = resolve(name)
     if resolved or res.spec.partition(":")[1]:
         typer.echo(_model_yaml(res.scenario), nl=False)

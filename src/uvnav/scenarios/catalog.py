@@ -164,6 +164,38 @@ def _generate(name: str, seed: int, params: Mapping[str, Any]) -> Any:
     return random_ch5_scenario(seed, dense=name == GENERATOR_CH5_DENSE, **params)
 
 
+def generator_function(name: str) -> Callable[..., Any]:
+    """The callable ``f(seed, **params)`` of the seed generator ``name`` (any kind).
+
+    Raises:
+        KeyError: ``name`` is not a seed generator.
+    """
+    from uvnav.scenarios.ch5 import GENERATOR_CH5, GENERATOR_CH5_DENSE, random_ch5_scenario
+    from uvnav.scenarios.generators import GENERATORS
+    from uvnav.scenarios.uuv2d import UUV2D_GENERATORS
+
+    table: dict[str, Callable[..., Any]] = {
+        **GENERATORS,
+        **UUV2D_GENERATORS,
+        GENERATOR_CH5: random_ch5_scenario,
+        GENERATOR_CH5_DENSE: functools.partial(random_ch5_scenario, dense=True),
+        **plugin_generators(),
+    }
+    return table[name]
+
+
+def generator_params(name: str) -> list[Any]:
+    """The keyword parameters of seed generator ``name``
+    (:class:`uvnav.scenarios.params.ParamInfo`: name, type, default, bounds, description)."""
+    from uvnav.scenarios.crowdnav import crowdnav_scenario
+    from uvnav.scenarios.params import describe_params
+
+    rules = {"crowdnav-circle": "circle_crossing", "crowdnav-square": "square_crossing"}
+    if name in rules:  # f(seed, **params) passing them on
+        return describe_params(functools.partial(crowdnav_scenario, rule=rules[name]))
+    return describe_params(generator_function(name))
+
+
 def _uuv3d_load(spec: str) -> Any:
     from uvnav.scenarios.ch5 import load_ch5_scenario
 

@@ -26,8 +26,9 @@ from uvnav.scenarios import pedestrians
 from uvnav.scenarios.build import obstacle_bounds
 from uvnav.scenarios.crowdnav import crowdnav_circle, crowdnav_square
 from uvnav.scenarios.errors import PlacementError, ScenarioError, from_validation_error
+from uvnav.scenarios.generators3d import random_ch3_scenario
 from uvnav.scenarios.loader import scenario_from_dict
-from uvnav.scenarios.params import typed_generator
+from uvnav.scenarios.params import generator_variant, typed_generator
 from uvnav.scenarios.schema import CrowdSpec, ObstacleSpec, Scenario
 
 CH2_START = (0.0, 0.0)
@@ -107,6 +108,14 @@ def random_star_polygon(
 #: defaults of :func:`random_ch2_scenario`'s envelope (the family as it always was)
 CH2_SPEED_RATIO = 0.5  # largest obstacle speed / V_max
 CH2_TURN_RATIO = 0.3 / CH2_U_MAX  # largest course turn rate / U_max (0.3 rad/s; 0.21 U_max)
+#: ``random-ch2-edge``: random-ch2 at the edge of (2.6)-(2.7) (issue 19): 8 fast, fast-turning
+#: discs (discs: a polygon that fast and turning that fast breaks (2.8))
+CH2_EDGE: dict[str, Any] = {
+    "n_obstacles": 8,
+    "speed_ratio_max": 0.95,
+    "turn_rate_ratio_max": 0.95,
+    "body": "disc",
+}
 #: crowd id of the bodies that avoid each other (``mutual_avoidance``)
 CH2_AVOID_CROWD = "bodies"
 
@@ -203,7 +212,10 @@ def _ch2_obstacles(
             break
         else:
             raise PlacementError(
-                source, j, n, f"{_MAX_TRIES} draws of body {j} obeyed (2.6)-(2.8) nowhere clear"
+                source,
+                j,
+                n,
+                f"no clear place for body {j} that obeys (2.6)-(2.8) in {_MAX_TRIES} draws",
             )
     return obstacles
 
@@ -301,9 +313,9 @@ def _ch2_description(
     seed: int, n: int, speed_ratio: float, turn_ratio: float, body: str, avoid: bool
 ) -> str:
     what = "non-convex obstacle(s)" if body == "polygon" else "disc obstacle(s)"
-    moving = "steering around each other" if avoid else "randomly turning"
+    bodies = f"{n} {what} steering around each other" if avoid else f"{n} randomly turning {what}"
     text = (
-        f"Random Chapter-2 scene (seed {seed}): {n} {moving} {what} "
+        f"Random Chapter-2 scene (seed {seed}): {bodies} "
         "near the straight path I->T, all obeying (2.6)-(2.8)."
     )
     if (speed_ratio, turn_ratio, body, avoid) == (
@@ -641,21 +653,15 @@ def crowd_file_scenario(
     return scenario_from_dict(data, source=source)
 
 
-def _random_ch3(seed: int, **params: Any) -> Any:
-    """3D scenes of thesis Ch. 3 (:func:`uvnav.scenarios.generators3d.random_ch3_scenario`)."""
-    from uvnav.scenarios.generators3d import random_ch3_scenario
-
-    return random_ch3_scenario(seed, **params)
-
-
 #: Seeded scenario generators by name: ``GENERATORS[name](seed, **params) -> Scenario``.
 #: ``load_scenario("<name>:<seed>")`` and campaign files refer to them by these names.
 GENERATORS: dict[str, Callable[..., Scenario]] = {
     "random-ch2": random_ch2_scenario,
+    "random-ch2-edge": generator_variant("random-ch2-edge", random_ch2_scenario, **CH2_EDGE),
     "crowd-eth": partial(crowd_crossing_scenario, dataset="eth"),
     "crowd-hotel": partial(crowd_crossing_scenario, dataset="hotel"),
     "crowd-file": crowd_file_scenario,
-    "random-ch3": _random_ch3,
+    "random-ch3": random_ch3_scenario,
     "crowdnav-circle": crowdnav_circle,
     "crowdnav-square": crowdnav_square,
 }

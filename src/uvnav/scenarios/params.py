@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import functools
 import inspect
+import types
 import typing
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -53,6 +54,24 @@ def typed_generator(name: str) -> Callable[[F], F]:
     return wrap
 
 
+def generator_variant(name: str, fn: Callable[..., Any], **defaults: Any) -> Callable[..., Any]:
+    """The generator ``name``: ``fn`` with other ``defaults`` (each still a parameter, checked as
+    ``fn`` checks it); its errors name ``name``."""
+    part = functools.partial(fn, **defaults)
+
+    @functools.wraps(fn)
+    def run(seed: int, **params: Any) -> Any:
+        try:
+            return part(seed, **params)
+        except ScenarioError as exc:
+            exc.source = f"{name}:{seed}"
+            raise
+
+    run.__signature__ = inspect.signature(part)  # type: ignore[attr-defined]
+    run.variant_of = part  # type: ignore[attr-defined]
+    return run
+
+
 @dataclass(frozen=True)
 class ParamInfo:
     """One generator parameter: ``name``, ``type`` (as written), ``default``, ``bounds`` (e.g.
@@ -80,19 +99,32 @@ def _bounds(info: FieldInfo | None) -> str:
 
 
 def _type_text(hint: Any) -> str:
-    text = str(hint).replace("typing.", "")
-    return text[8:-2] if text.startswith("<class '") else text
+    """``float``, ``int | None``, ``tuple[float, float]``, ``'polygon' | 'disc'``."""
+    origin, args = typing.get_origin(hint), typing.get_args(hint)
+    if origin is typing.Annotated:
+        return _type_text(args[0])
+    if origin is typing.Literal:
+        return " | ".join(repr(a) for a in args)
+    if origin in (typing.Union, types.UnionType):
+        return " | ".join(_type_text(a) for a in args)
+    if origin is not None and args:
+        name = getattr(origin, "__name__", str(origin))
+        return f"{name}[{', '.join(_type_text(a) for a in args)}]"
+    if hint is type(None):
+        return "None"
+    return str(getattr(hint, "__name__", hint)).replace("typing.", "")
 
 
 def describe_params(fn: Callable[..., Any]) -> list[ParamInfo]:
-    """The keyword parameters of generator ``fn`` (a function or a ``functools.partial`` of one;
-    those a partial fixes are left out), in signature order."""
+    """The parameters of generator ``fn`` after its seed (a function or a ``functools.partial``
+    of one, whose keywords are then the defaults), in signature order."""
+    fn = getattr(fn, "variant_of", fn)
     base = fn.func if isinstance(fn, functools.partial) else fn
-    fixed = fn.keywords if isinstance(fn, functools.partial) else {}
     hints = typing.get_type_hints(inspect.unwrap(base), include_extras=True)
     out: list[ParamInfo] = []
-    for p in inspect.signature(fn).parameters.values():
-        if p.kind is not inspect.Parameter.KEYWORD_ONLY or p.name in fixed:
+    named = (inspect.Parameter.KEYWORD_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
+    for p in list(inspect.signature(fn).parameters.values())[1:]:
+        if p.kind not in named:
             continue
         hint = hints.get(p.name, Any)
         info = None
