@@ -30,7 +30,7 @@ import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Union
+from typing import Annotated, Any, Literal, Union
 
 import numpy as np
 from pydantic import Discriminator, Tag, TypeAdapter
@@ -190,9 +190,12 @@ def generator_params(name: str) -> list[Any]:
     from uvnav.scenarios.crowdnav import crowdnav_scenario
     from uvnav.scenarios.params import describe_params
 
-    rules = {"crowdnav-circle": "circle_crossing", "crowdnav-square": "square_crossing"}
-    if name in rules:  # f(seed, **params) passing them on
-        return describe_params(functools.partial(crowdnav_scenario, rule=rules[name]))
+    if name in ("crowdnav-circle", "crowdnav-square"):  # f(seed, **params) passing them on
+        circle = name == "crowdnav-circle"
+        rule: Literal["circle_crossing", "square_crossing"] = (
+            "circle_crossing" if circle else "square_crossing"
+        )
+        return describe_params(functools.partial(crowdnav_scenario, rule=rule))
     return describe_params(generator_function(name))
 
 

@@ -655,7 +655,7 @@ def crowd_file_scenario(
 
 #: Seeded scenario generators by name: ``GENERATORS[name](seed, **params) -> Scenario``.
 #: ``load_scenario("<name>:<seed>")`` and campaign files refer to them by these names.
-GENERATORS: dict[str, Callable[..., Scenario]] = {
+GENERATORS: dict[str, Callable[..., Any]] = {
     "random-ch2": random_ch2_scenario,
     "random-ch2-edge": generator_variant("random-ch2-edge", random_ch2_scenario, **CH2_EDGE),
     "crowd-eth": partial(crowd_crossing_scenario, dataset="eth"),

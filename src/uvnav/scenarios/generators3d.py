@@ -56,7 +56,7 @@ CH3_TURN_RATIO = 0.3  # largest body rotation rate / U_max
 #: a placement (400 draws) that leaves the scene short is followed by up to this many fresh ones
 #: from the same generator (9 of seeds 0-199 were short after the first); a scene complete after
 #: the first is drawn as it always was
-_RETRY_ROUNDS = 30
+_RETRY_ROUNDS = 10
 
 
 def _ch3_round(

@@ -46,8 +46,7 @@ def typed_generator(name: str) -> Callable[[F], F]:
             try:
                 return checked(seed, **params)
             except ValidationError as exc:
-                err = from_validation_error(exc, f"{name}:{seed}")
-                raise ScenarioError(err.source, f"params.{err.path}", err.problem) from None
+                raise _params_error(name, seed, fn, exc) from None
 
         return typing.cast(F, run)
 
@@ -70,6 +69,22 @@ def generator_variant(name: str, fn: Callable[..., Any], **defaults: Any) -> Cal
     run.__signature__ = inspect.signature(part)  # type: ignore[attr-defined]
     run.variant_of = part  # type: ignore[attr-defined]
     return run
+
+
+def _params_error(
+    name: str, seed: int, fn: Callable[..., Any], exc: ValidationError
+) -> ScenarioError:
+    """One line: an unknown parameter with the known ones, else the first refused value."""
+    source = f"{name}:{seed}"
+    unknown = [e for e in exc.errors() if e.get("type") == "unexpected_keyword_argument"]
+    if unknown:
+        known = ", ".join(list(inspect.signature(fn).parameters)[1:])
+        key = str(unknown[0]["loc"][-1])
+        return ScenarioError(
+            source, "params", f"{name}: unknown parameter {key!r} (known: {known})"
+        )
+    err = from_validation_error(exc, source)
+    return ScenarioError(source, f"params.{err.path}", err.problem)
 
 
 @dataclass(frozen=True)
