@@ -229,10 +229,18 @@ def test_cli_shows_parameters_and_refuses_with_exit_2() -> None:
     assert "speed_ratio_max" in table.stdout and "< 1" in table.stdout
     scene = runner.invoke(
         app,
-        ["scenarios", "show", "random-ch2:4", "--param", "body=disc", "--param", "n_obstacles=2"],
+        [
+            "scenarios",
+            "show",
+            "random-ch2:4",
+            "--gen-param",
+            "body=disc",
+            "--gen-param",
+            "n_obstacles=2",
+        ],
     )
     assert scene.exit_code == 0 and scene.stdout.count("disc:") == 2
-    short = runner.invoke(app, ["scenarios", "show", "random-ch3:0", "--param", "n_obstacles=12"])
+    short = runner.invoke(app, ["simulate", "random-ch3:0", "--gen-param", "n_obstacles=12"])
     assert short.exit_code == 2
     assert short.stderr.strip().startswith("error: random-ch3:0: placement: placed")
     listing = runner.invoke(app, ["scenarios", "list"])
