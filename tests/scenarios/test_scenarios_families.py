@@ -6,6 +6,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from uvnav.bench.campaign import Job, run_job
+from uvnav.bench.spec import load_campaign
 from uvnav.bench.store import STATUS_REFUSED
 from uvnav.cli.app import app
 from uvnav.obstacles import ObstacleState, OrcaWanderer, RandomTurn
@@ -246,3 +248,14 @@ def test_cli_shows_parameters_and_refuses_with_exit_2() -> None:
     listing = runner.invoke(app, ["scenarios", "list"])
     line = next(ln for ln in listing.stdout.splitlines() if ln.startswith("random-ch2:<seed>"))
     assert "mutual_avoidance" in line
+
+
+def test_a_campaign_whose_first_scene_cannot_be_placed_still_loads(tmp_path: Path) -> None:
+    """Valid parameters: the file loads, and each episode of a refused scene is stored refused."""
+    path = tmp_path / "c.yaml"
+    path.write_text(
+        "name: x\nscenarios:\n  - generator: random-ch3\n    seeds: [0, 2]\n"
+        "    params: {n_obstacles: 12}\ncontrollers:\n  - name: zhang2020-3d-v1\n"
+    )
+    jobs = load_campaign(path).jobs()
+    assert [j.generator_seed for j in jobs] == [0, 1]

@@ -155,7 +155,7 @@ class ScenarioEntry(_Strict):
             except PlacementError:  # valid parameters; that seed's episodes are stored refused
                 self._kind = generators()[self.generator]
             except ScenarioError as exc:
-                if exc.path in ("generator", "params"):
+                if exc.path in ("generator", "params") or exc.path.startswith("params."):
                     raise FieldError(exc.path, exc.problem) from None
                 problem = f"{self.generator}: {exc.path}: {exc.problem}"
                 raise FieldError("params", problem) from None
