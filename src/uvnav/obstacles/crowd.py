@@ -55,6 +55,11 @@ states bit for bit.  RVO2 draws nothing at random: the same start gives the same
 The crowd owns its pedestrians' positions: the ``state`` handed to ``step`` supplies only the
 heading (kept: a disc pedestrian does not rotate, ``angular_velocity`` 0).
 
+:class:`OrcaWanderer` is a crowd member without a goal: its preferred velocity is what a
+:class:`~uvnav.obstacles.motion.RandomTurn` wandering takes from its actual state, so randomly
+wandering bodies (any body: ORCA sees its bounding disc) avoid each other (``random-ch2``'s
+``mutual_avoidance``); each member's :meth:`OrcaPedestrian.preferred` gives its preferred velocity.
+
 Models are built unattached (:meth:`OrcaPedestrian`), then :func:`join_crowds` gathers the
 pedestrians of an obstacle list by crowd id and builds their shared crowd from the obstacles'
 initial states and body radii; :class:`~uvnav.obstacles.ObstacleBatch` calls it, and a per-model
