@@ -177,7 +177,7 @@ def generator_function(name: str) -> Callable[..., Any]:
     table: dict[str, Callable[..., Any]] = {
         **GENERATORS,
         **UUV2D_GENERATORS,
-        GENERATOR_CH5: random_ch5_scenario,
+        GENERATOR_CH5: functools.partial(random_ch5_scenario, dense=False),
         GENERATOR_CH5_DENSE: functools.partial(random_ch5_scenario, dense=True),
         **plugin_generators(),
     }

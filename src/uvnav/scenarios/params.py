@@ -131,15 +131,18 @@ def _type_text(hint: Any) -> str:
 
 
 def describe_params(fn: Callable[..., Any]) -> list[ParamInfo]:
-    """The parameters of generator ``fn`` after its seed (a function or a ``functools.partial``
-    of one, whose keywords are then the defaults), in signature order."""
-    fn = getattr(fn, "variant_of", fn)
+    """The parameters of generator ``fn`` after its seed, in signature order: of a function, of a
+    :func:`generator_variant` (its defaults), or of a ``functools.partial`` (less the keywords it
+    fixes: ``crowd-eth`` is the ETH walkway)."""
+    variant = getattr(fn, "variant_of", None)
+    fixed = set(fn.keywords) if isinstance(fn, functools.partial) else set()
+    fn = variant if variant is not None else fn
     base = fn.func if isinstance(fn, functools.partial) else fn
     hints = typing.get_type_hints(inspect.unwrap(base), include_extras=True)
     out: list[ParamInfo] = []
     named = (inspect.Parameter.KEYWORD_ONLY, inspect.Parameter.POSITIONAL_OR_KEYWORD)
     for p in list(inspect.signature(fn).parameters.values())[1:]:
-        if p.kind not in named:
+        if p.kind not in named or p.name in fixed:
             continue
         hint = hints.get(p.name, Any)
         info = None
