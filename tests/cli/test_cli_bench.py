@@ -171,8 +171,9 @@ def test_bad_generator_parameters_stop_the_campaign_before_it_runs(tmp_path: Pat
     db = tmp_path / "b.sqlite"
     res = invoke("bench", str(path), "--db", str(db), "--workers", "1")
     assert res.exit_code == 2, res.output
-    assert res.output.count("\n") == 1 and "scenarios.0.params" in res.output
-    assert "n_obstacles must be >= 0" in res.output and not db.exists()
+    assert res.output.count("\n") == 1
+    assert "scenarios.0.params.n_obstacles: must be >= 0 (got -3)" in res.output
+    assert not db.exists()
 
 
 def test_errored_episodes_exit_non_zero_with_the_first_error(

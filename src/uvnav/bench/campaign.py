@@ -296,13 +296,16 @@ def _error(job: Job, exc: BaseException, tic: float, params: dict[str, Any]) -> 
 
 def run_job(job: Job) -> JobOutcome:
     """Build and run one job; any exception becomes an ``error`` outcome (never raises it), a
-    scene that breaks an assumption the law declares a ``refused`` one.
+    scene that breaks an assumption the law declares a ``refused`` one, and so does a generated
+    scene whose bodies cannot all be placed (:class:`~uvnav.scenarios.errors.PlacementError`,
+    its one line as the reason).
 
     Jobs with a scene (any kind) run through :func:`uvnav.scenarios.episodes.run_scene`, the
     path of ``uvnav simulate``; jobs with a ``setup_factory`` run the 2D loop directly, jobs with
     a ``runner`` their chapter's own episode.
     """
     from uvnav.scenarios.episodes import AssumptionError, LawMismatchError
+    from uvnav.scenarios.errors import PlacementError
 
     tic = time.perf_counter()
     params: dict[str, Any] = job.params_dict
@@ -334,6 +337,10 @@ def run_job(job: Job) -> JobOutcome:
                     params,
                 )  # fmt: skip
             status, metrics, traj, params = out.status, out.metrics, out.trajectory, out.params
+    except PlacementError as exc:  # the scene cannot be built: refused, with the generator's line
+        return JobOutcome(
+            job, STATUS_REFUSED, None, str(exc), time.perf_counter() - tic, None, params
+        )
     except Exception as exc:  # a failing job is data, not a crash of the campaign
         return _error(job, exc, tic, params)
     return JobOutcome(

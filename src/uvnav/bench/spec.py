@@ -30,8 +30,9 @@ controller parameters are checked against the controller's ``Params``, generator
 drawing the entry's first scene (names, types and ranges, as the generator checks them), and every
 controller must fit at least one scenario entry and every entry at least one controller, so a typo
 stops the campaign before it starts rather than filling the database with ``error`` rows.  An
-episode whose scene breaks an assumption the law declares (thesis (2.6)) is stored as ``refused``
-with the reason, not run.
+episode whose scene breaks an assumption the law declares (thesis (2.6)), or whose generated
+scene cannot place the bodies it drew (a first seed refused so does not stop the campaign), is
+stored as ``refused`` with the reason, not run.
 
 The schema is pydantic v2 with ``extra="forbid"`` (DESIGN §3); :func:`load_campaign` turns every
 problem into one :class:`CampaignError` line ``FILE: FIELD: PROBLEM``.
@@ -139,7 +140,8 @@ class ScenarioEntry(_Strict):
 
     @model_validator(mode="after")
     def _check(self, info: ValidationInfo) -> ScenarioEntry:
-        from uvnav.scenarios.catalog import builtin_names, generate, resolve
+        from uvnav.scenarios.catalog import builtin_names, generate, generators, resolve
+        from uvnav.scenarios.errors import PlacementError
 
         sources = ("generator", "builtin", "file", "scene")
         given = [k for k in sources if getattr(self, k) is not None]
@@ -150,8 +152,10 @@ class ScenarioEntry(_Strict):
         if self.generator is not None:
             try:  # names, types and ranges, as the generator itself checks them
                 self._kind = generate(self.generator, seeds[0], self.params).kind
+            except PlacementError:  # valid parameters; that seed's episodes are stored refused
+                self._kind = generators()[self.generator]
             except ScenarioError as exc:
-                if exc.path in ("generator", "params"):
+                if exc.path in ("generator", "params") or exc.path.startswith("params."):
                     raise FieldError(exc.path, exc.problem) from None
                 problem = f"{self.generator}: {exc.path}: {exc.problem}"
                 raise FieldError("params", problem) from None

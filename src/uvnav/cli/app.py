@@ -171,7 +171,7 @@ def _optional(module: str, attr: str, what: str) -> Any:
 _PARAM_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
 
 
-def parse_params(items: list[str] | None) -> dict[str, Any]:
+def parse_params(items: list[str] | None, option: str = "--param") -> dict[str, Any]:
     """``["alpha0=0.1", "mode=fast"]`` -> ``{"alpha0": 0.1, "mode": "fast"}`` (values read as YAML).
 
     Raises:
@@ -183,12 +183,12 @@ def parse_params(items: list[str] | None) -> dict[str, Any]:
         key = key.strip()
         if not sep or not _PARAM_KEY.match(key):
             raise CliError(
-                f"--param {item!r}: expected KEY=VALUE with an identifier KEY (e.g. alpha0=0.1)"
+                f"{option} {item!r}: expected KEY=VALUE with an identifier KEY (e.g. alpha0=0.1)"
             )
         try:
             value = yaml.safe_load(raw) if raw.strip() else ""
         except yaml.YAMLError:
-            raise CliError(f"--param {item!r}: value is not a valid YAML scalar or list") from None
+            raise CliError(f"{option} {item!r}: value is not a valid YAML scalar or list") from None
         params[key] = value
     return params
 
@@ -212,6 +212,35 @@ def _make_controller(name: str, params: dict[str, Any]) -> Any:
         return make_controller(name, **params)
     except ControllerParamsError as exc:
         raise ControllerParamsError(f"controller {name}: {exc}") from None
+
+
+GenParamOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--gen-param",
+        metavar="KEY=VALUE",
+        help="Generator parameter KEY=VALUE of a GENERATOR:SEED scene (repeatable; value read "
+        "as YAML), e.g. speed_ratio_max=0.9; 'uvnav scenarios show GENERATOR' lists them.",
+    ),
+]
+
+
+def resolve_scene(spec: str, gen_param: list[str] | None) -> Any:
+    """The scene ``spec`` names (:func:`uvnav.scenarios.catalog.resolve`), drawn with the
+    ``--gen-param`` values when there are any (a ``GENERATOR:SEED`` spec only)."""
+    from uvnav.scenarios.catalog import generate, generators, resolve
+
+    items = parse_params(gen_param, "--gen-param").items()
+    if not items:
+        return resolve(spec)
+    params = dict(items)
+    by_gen = generators()
+    gen, sep, number = spec.partition(":")
+    if not (sep and gen in by_gen and by_gen[gen].spec_is_seed):
+        raise CliError(f"--gen-param: only a GENERATOR:SEED scene takes them (got {spec!r})")
+    if not number.isdigit():
+        raise CliError(f"{spec}: seed: must be a non-negative integer (got {number!r})")
+    return generate(gen, int(number), params)
 
 
 # ---------------------------------------------------------------------------------------- simulate
@@ -253,6 +282,7 @@ def simulate(
     plot: Annotated[
         Path | None, typer.Option(help="Also draw the episode into this image file.")
     ] = None,
+    gen_param: GenParamOption = None,
 ) -> None:
     """Run one episode of SCENARIO (any vehicle) and print its metrics.
 
@@ -260,10 +290,9 @@ def simulate(
     override them.  With another --controller only --param values apply.  A law that drives
     another vehicle or reads another sensor than the scene's is refused.
     """
-    from uvnav.scenarios.catalog import resolve
     from uvnav.scenarios.episodes import run_scene
 
-    resolved = resolve(scenario)
+    resolved = resolve_scene(scenario, gen_param)
     plot_outcome = (
         _optional("uvnav.viz.episode", "plot_outcome", "plotting (--plot)") if plot else None
     )
@@ -332,8 +361,9 @@ def scenarios_list(
         bool, typer.Option("--json", help="Print one JSON array instead of the table.")
     ] = False,
 ) -> None:
-    """List the built-in scenes of every kind (thesis experiments first) and the generators."""
-    from uvnav.scenarios.catalog import builtin_names, generators
+    """List the built-in scenes of every kind (thesis experiments first) and the generators
+    (one line each with its parameters' names; 'uvnav scenarios show GENERATOR' describes them)."""
+    from uvnav.scenarios.catalog import builtin_names, generator_params, generators
 
     rows: list[dict[str, Any]] = []
     for name, kind in builtin_names():
@@ -349,11 +379,14 @@ def scenarios_list(
         )
     for gen, kind in generators().items():
         number = "<seed>" if kind.spec_is_seed else "<robots>"
+        names = [p.name for p in generator_params(gen)] if kind.spec_is_seed else []
         rows.append(
             {
                 "name": f"{gen}:{number}",
                 "kind": kind.name,
-                "description": f"generator of {kind.summary} scenes",
+                "description": f"generator of {kind.summary} scenes"
+                + (f" (params: {', '.join(names)})" if names else ""),
+                "params": names,
                 "obstacles": None,
                 "controller": None,
             }
@@ -365,7 +398,8 @@ def scenarios_list(
     cols = shutil.get_terminal_size().columns if sys.stdout.isatty() else None
     typer.echo(f"{'name':<{width}}  {'kind':<7}  description ('uvnav scenarios show NAME')")
     for row in rows:
-        line = f"{row['name']:<{width}}  {row['kind']:<7}  {_first_sentence(row['description'])}"
+        text = row["description"] if row.get("params") else _first_sentence(row["description"])
+        line = f"{row['name']:<{width}}  {row['kind']:<7}  {text}"
         if cols is not None and len(line) > cols:
             line = line[: cols - 1] + "…"
         typer.echo(line.rstrip())
@@ -382,21 +416,49 @@ def _model_yaml(model: Any) -> str:
     return str(yaml.safe_dump(model.model_dump(mode="json"), sort_keys=False))
 
 
+def _show_generator_params(name: str) -> None:
+    """The parameter table of seed generator ``name``."""
+    from uvnav.scenarios.catalog import generator_params
+
+    params = generator_params(name)
+    typer.echo(f"{name}:SEED parameters (--param KEY=VALUE; params: in a campaign entry)")
+    if not params:
+        typer.echo("  (none)")
+    width = max((len(p.name) for p in params), default=0)
+    for p in params:
+        bounds = f", {p.bounds}" if p.bounds else ""
+        text = f"  {p.name:<{width}}  {p.type} = {p.default!r}{bounds}"
+        typer.echo(f"{text}  {p.description}".rstrip())
+
+
 @scenarios_app.command("show")
 def scenarios_show(
-    name: Annotated[str, typer.Argument(help="Built-in name, YAML file, or GENERATOR:SEED.")],
+    name: Annotated[
+        str,
+        typer.Argument(
+            help="Built-in name, YAML file, GENERATOR:SEED, or a GENERATOR (its parameters)."
+        ),
+    ],
     resolved: Annotated[
         bool,
         typer.Option(
             "--resolved", help="Print the validated scenario with every default filled in."
         ),
     ] = False,
+    gen_param: GenParamOption = None,
 ) -> None:
     """Print a scenario as YAML (the file as written; a generated one, or --resolved, with
-    every default filled in)."""
-    from uvnav.scenarios.catalog import resolve
+    every default filled in), or a generator's parameters."""
+    from uvnav.scenarios.catalog import generators
 
-    res = resolve(name)
+    by_gen = generators()
+    if name in by_gen and by_gen[name].spec_is_seed:
+        _show_generator_params(name)
+        return
+    res = resolve_scene(name, gen_param)
+    if gen_param:
+        typer.echo(_model_yaml(res.scenario), nl=False)
+        return
     if resolved or res.spec.partition(":")[1]:
         typer.echo(_model_yaml(res.scenario), nl=False)
         return

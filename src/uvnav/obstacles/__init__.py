@@ -8,7 +8,7 @@ from uvnav.obstacles.bodies import (
     radial_profile,
     rotation_boundary_growth,
 )
-from uvnav.obstacles.crowd import Crowd, OrcaPedestrian, join_crowds
+from uvnav.obstacles.crowd import Crowd, OrcaPedestrian, OrcaWanderer, join_crowds
 from uvnav.obstacles.motion import (
     ConstantVelocity,
     MotionModel,
@@ -33,6 +33,7 @@ __all__ = [
     "ObstacleField",
     "ObstacleState",
     "OrcaPedestrian",
+    "OrcaWanderer",
     "PolygonBody",
     "RandomTurn",
     "Replay",

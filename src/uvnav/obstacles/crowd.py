@@ -55,6 +55,11 @@ states bit for bit.  RVO2 draws nothing at random: the same start gives the same
 The crowd owns its pedestrians' positions: the ``state`` handed to ``step`` supplies only the
 heading (kept: a disc pedestrian does not rotate, ``angular_velocity`` 0).
 
+:class:`OrcaWanderer` is a crowd member without a goal: its preferred velocity is what a
+:class:`~uvnav.obstacles.motion.RandomTurn` wandering takes from its actual state, so randomly
+wandering bodies (any body: ORCA sees its bounding disc) avoid each other (``random-ch2``'s
+``mutual_avoidance``); each member's :meth:`OrcaPedestrian.preferred` gives its preferred velocity.
+
 Models are built unattached (:meth:`OrcaPedestrian`), then :func:`join_crowds` gathers the
 pedestrians of an obstacle list by crowd id and builds their shared crowd from the obstacles'
 initial states and body radii; :class:`~uvnav.obstacles.ObstacleBatch` calls it, and a per-model
@@ -71,7 +76,7 @@ from typing import Any, cast
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
-from uvnav.obstacles.motion import ObstacleState
+from uvnav.obstacles.motion import ObstacleState, RandomTurn
 from uvnav.obstacles.obstacle import Obstacle
 
 #: CrowdNav's ORCA defaults (``crowd_sim/envs/policy/orca.py``)
@@ -208,6 +213,13 @@ class OrcaPedestrian(CrowdMember):
         """``v_pref``: RVO2's maximum speed."""
         return float(self.v_pref)
 
+    def preferred(
+        self, position: FloatArray, velocity: FloatArray, t: float, period: float
+    ) -> tuple[float, float]:
+        """The preferred velocity [m/s] at ``t`` [s] for the next ``period`` [s]: toward the
+        goal (:func:`preferred_velocity`)."""
+        return preferred_velocity(position, self.goal, float(self.v_pref))
+
     @classmethod
     def make_crowd(
         cls,
@@ -217,6 +229,37 @@ class OrcaPedestrian(CrowdMember):
         radii: Sequence[float],
     ) -> Crowd:
         return Crowd(members, positions, velocities, radii)
+
+
+@dataclass
+class OrcaWanderer(OrcaPedestrian):
+    """A body of a crowd that wanders instead of walking to a goal: its preferred velocity is
+    the velocity a :class:`~uvnav.obstacles.motion.RandomTurn` would take from the body's actual
+    position and velocity (a speed and a course turn rate drawn every ``change_period``, the
+    course turned back inside the arena), and ORCA (RVO2, reciprocal, on the bodies' bounding
+    discs) bends it so that the bodies of the crowd do not collide.  The body does not rotate
+    (``u_i`` = 0).  ``v_pref`` is the largest wandering speed.
+
+    Attributes:
+        wander: the wandering that proposes the preferred velocity (draws from its own ``rng``).
+    """
+
+    wander: RandomTurn | None = None
+
+    def __post_init__(self) -> None:
+        super().__post_init__()
+        if self.wander is None:
+            raise ValueError("an orca wanderer needs its wander (a RandomTurn)")
+
+    def preferred(
+        self, position: FloatArray, velocity: FloatArray, t: float, period: float
+    ) -> tuple[float, float]:
+        """The wandering's velocity over the next ``period`` [s] from the state at ``t`` [s]."""
+        assert self.wander is not None
+        state = ObstacleState(position=np.array(position, dtype=float), heading=0.0,
+                              velocity=np.array(velocity, dtype=float))  # fmt: skip
+        v = self.wander.step(state, t, period).velocity
+        return float(v[0]), float(v[1])
 
 
 class Crowd:
@@ -295,14 +338,15 @@ class Crowd:
             self._sim.set_time_step(float(period))
         return self._sim
 
-    def _decide(self, period: float) -> None:
-        """Every pedestrian's ORCA velocity for the state now (all from the same state)."""
+    def _decide(self, t: float, period: float) -> None:
+        """Every pedestrian's ORCA velocity for the state at ``t`` [s] (all from the same
+        state)."""
         sim = self._simulator(period)
         pos, vel = self.position, self.velocity
         for i, m in enumerate(self.members):
             sim.set_agent_position(i, (float(pos[i, 0]), float(pos[i, 1])))
             sim.set_agent_velocity(i, (float(vel[i, 0]), float(vel[i, 1])))
-            sim.set_agent_pref_velocity(i, preferred_velocity(pos[i], m.goal, float(m.v_pref)))
+            sim.set_agent_pref_velocity(i, m.preferred(pos[i], vel[i], t, period))
         if self._robot_agent >= 0:
             self._place_robot(sim)
         sim.do_step()
@@ -337,7 +381,7 @@ class Crowd:
             return
         period = dt if self.period is None else self.period
         if self.members and t >= self._next_decision - _TIME_EPS:
-            self._decide(period)
+            self._decide(t, period)
             base = t if self._next_decision == -math.inf else self._next_decision
             self._next_decision = base + period
             while self._next_decision <= t + _TIME_EPS:  # a step longer than the period

@@ -30,7 +30,7 @@ import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Union
+from typing import Annotated, Any, Literal, Union
 
 import numpy as np
 from pydantic import Discriminator, Tag, TypeAdapter
@@ -162,6 +162,41 @@ def _generate(name: str, seed: int, params: Mapping[str, Any]) -> Any:
     if name in UUV2D_GENERATORS:
         return UUV2D_GENERATORS[name](seed, **params)
     return random_ch5_scenario(seed, dense=name == GENERATOR_CH5_DENSE, **params)
+
+
+def generator_function(name: str) -> Callable[..., Any]:
+    """The callable ``f(seed, **params)`` of the seed generator ``name`` (any kind).
+
+    Raises:
+        KeyError: ``name`` is not a seed generator.
+    """
+    from uvnav.scenarios.ch5 import GENERATOR_CH5, GENERATOR_CH5_DENSE, random_ch5_scenario
+    from uvnav.scenarios.generators import GENERATORS
+    from uvnav.scenarios.uuv2d import UUV2D_GENERATORS
+
+    table: dict[str, Callable[..., Any]] = {
+        **GENERATORS,
+        **UUV2D_GENERATORS,
+        GENERATOR_CH5: functools.partial(random_ch5_scenario, dense=False),
+        GENERATOR_CH5_DENSE: functools.partial(random_ch5_scenario, dense=True),
+        **plugin_generators(),
+    }
+    return table[name]
+
+
+def generator_params(name: str) -> list[Any]:
+    """The keyword parameters of seed generator ``name``
+    (:class:`uvnav.scenarios.params.ParamInfo`: name, type, default, bounds, description)."""
+    from uvnav.scenarios.crowdnav import crowdnav_scenario
+    from uvnav.scenarios.params import describe_params
+
+    if name in ("crowdnav-circle", "crowdnav-square"):  # f(seed, **params) passing them on
+        circle = name == "crowdnav-circle"
+        rule: Literal["circle_crossing", "square_crossing"] = (
+            "circle_crossing" if circle else "square_crossing"
+        )
+        return describe_params(functools.partial(crowdnav_scenario, rule=rule))
+    return describe_params(generator_function(name))
 
 
 def _uuv3d_load(spec: str) -> Any:

@@ -178,3 +178,21 @@ def from_validation_error(
     if len(errors) > 1:
         problem += f" (and {len(errors) - 1} more error{'s' if len(errors) > 2 else ''})"
     return ScenarioError(source, path or "<root>", problem)
+
+
+class PlacementError(ScenarioError):
+    """A generator could not place the bodies it drew: the scene is refused, not built short.
+
+    ``str()`` is one line ``GENERATOR:SEED: placement: placed K of N bodies (...)``; a campaign
+    stores the episode as ``refused`` with that line, the command line exits 2.
+
+    Attributes:
+        placed: bodies placed.
+        wanted: bodies drawn (or asked for).
+    """
+
+    def __init__(self, source: str, placed: int, wanted: int, why: str = "") -> None:
+        self.placed = int(placed)
+        self.wanted = int(wanted)
+        detail = f" ({why})" if why else ""
+        super().__init__(source, "placement", f"placed {placed} of {wanted} bodies{detail}")

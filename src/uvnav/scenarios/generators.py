@@ -16,17 +16,19 @@ import math
 from collections.abc import Callable
 from functools import partial
 from pathlib import Path
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import ValidationError
+from pydantic import Field, ValidationError
 
 from uvnav.geometry.polygons import polygon_area, polygon_centroid
 from uvnav.scenarios import pedestrians
 from uvnav.scenarios.build import obstacle_bounds
 from uvnav.scenarios.crowdnav import crowdnav_circle, crowdnav_square
-from uvnav.scenarios.errors import ScenarioError, from_validation_error
+from uvnav.scenarios.errors import PlacementError, ScenarioError, from_validation_error
+from uvnav.scenarios.generators3d import random_ch3_scenario
 from uvnav.scenarios.loader import scenario_from_dict
+from uvnav.scenarios.params import generator_variant, typed_generator
 from uvnav.scenarios.schema import CrowdSpec, ObstacleSpec, Scenario
 
 CH2_START = (0.0, 0.0)
@@ -103,85 +105,104 @@ def random_star_polygon(
     raise RuntimeError("could not draw a star-shaped non-convex polygon")  # pragma: no cover
 
 
-def _random_motion(rng: np.random.Generator) -> dict[str, Any]:
-    lo = float(rng.uniform(0.05, 0.2))
-    hi = float(rng.uniform(lo, 0.5 * CH2_V_MAX))
-    w = float(rng.uniform(0.05, 0.3))
-    return {
-        "type": "random_turn",
+#: defaults of :func:`random_ch2_scenario`'s envelope (the family as it always was)
+CH2_SPEED_RATIO = 0.5  # largest obstacle speed / V_max
+CH2_TURN_RATIO = 0.3 / CH2_U_MAX  # largest course turn rate / U_max (0.3 rad/s; 0.21 U_max)
+#: ``random-ch2-edge``: random-ch2 at the edge of (2.6)-(2.7) (issue 19): 8 fast, fast-turning
+#: discs (discs: a polygon that fast and turning that fast breaks (2.8))
+CH2_EDGE: dict[str, Any] = {
+    "n_obstacles": 8,
+    "speed_ratio_max": 0.95,
+    "turn_rate_ratio_max": 0.95,
+    "body": "disc",
+}
+#: crowd id of the bodies that avoid each other (``mutual_avoidance``)
+CH2_AVOID_CROWD = "bodies"
+
+
+def _random_motion(
+    rng: np.random.Generator,
+    v_hi: float = CH2_SPEED_RATIO * CH2_V_MAX,
+    w_hi: float = CH2_TURN_RATIO * CH2_U_MAX,
+    avoid: bool = False,
+) -> dict[str, Any]:
+    """A ``random_turn`` motion (``orca_wander`` with ``avoid``): speeds within [lo, hi] with lo
+    in [0.05, min(0.2, v_hi)] and hi in [lo, v_hi] [m/s], turn rates within +-w, w in
+    [0.05, w_hi] [rad/s].  The defaults draw exactly what the family always drew."""
+    lo = float(rng.uniform(0.05, min(0.2, v_hi)))
+    hi = float(rng.uniform(lo, v_hi))
+    w = float(rng.uniform(0.05, w_hi))
+    motion: dict[str, Any] = {
+        "type": "orca_wander" if avoid else "random_turn",
         "speed": [round(lo, 4), round(hi, 4)],
         "turn_rate": [round(-w, 4), round(w, 4)],
         "change_period": round(float(rng.uniform(1.0, 3.0)), 3),
         "arena": list(CH2_ARENA),
     }
+    if avoid:
+        motion["crowd"] = CH2_AVOID_CROWD
+    return motion
 
 
-def random_ch2_scenario(
-    seed: int,
-    *,
-    n_obstacles: int | None = None,
-    controller: str = "zhang2019-v1",
-    controller_params: dict[str, Any] | None = None,
-    dt: float = 0.1,
-    t_max: float = 120.0,
-) -> Scenario:
-    """A random Chapter-2 scene, deterministic in ``seed``.
+def _random_body(rng: np.random.Generator, body: str) -> tuple[dict[str, Any], float]:
+    """A body spec and its bounding radius [m]: a star polygon, or a disc of radius 0.3-0.9 m."""
+    if body == "disc":
+        r = round(float(rng.uniform(*_RADIUS_RANGE)), 3)
+        return {"disc": r}, r
+    verts = random_star_polygon(rng)
+    return {"polygon": verts.tolist()}, float(
+        np.max(np.hypot(*(verts - polygon_centroid(verts)).T))
+    )
 
-    Robot: I = [0, 0], T = [10, 10], heading toward T, V_max 0.707 m/s, U_max 1.414 rad/s, radius
-    0.1 m.  Obstacles: non-convex star-shaped polygons (5-9 vertices at 0.3-0.9 m from the
-    centroid) centred near the I->T line (2-12 m along it, up to +-2 m across), clear of each other
-    (0.3 m between bounding discs) and of the start and goal (1.5 m from the bounding disc), moving
-    with ``random_turn`` (speeds within [0.05, 0.5 V_max] m/s, turn rates within +-0.3 rad/s, arena
-    [-3, -3, 13, 13] m) and obeying the thesis's (2.6)-(2.8).
 
-    Args:
-        seed: the only source of randomness.
-        n_obstacles: number of obstacles; drawn in 1..6 when ``None``.
-        controller: default controller of the scene.
-        controller_params: its parameters (controller defaults when ``None``).
-        dt: integration and decision step [s].
-        t_max: time limit [s].
-    """
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(1, 7)) if n_obstacles is None else int(n_obstacles)
-    if n < 0:
-        raise ValueError(f"n_obstacles must be >= 0 (got {n})")
-    start = np.asarray(CH2_START)
-    goal = np.asarray(CH2_GOAL)
+def _place_centre(
+    rng: np.random.Generator,
+    bound: float,
+    placed: list[tuple[np.ndarray, float]],
+    start: np.ndarray,
+    goal: np.ndarray,
+) -> np.ndarray | None:
+    """A centre near the I->T line clear of I, T and the placed bodies, or ``None``."""
     along = (goal - start) / np.hypot(*(goal - start))
     across = np.array([-along[1], along[0]])
+    for _ in range(_MAX_TRIES):
+        c = start + rng.uniform(*_ALONG_TRACK) * along + rng.uniform(-_LATERAL, _LATERAL) * across
+        c = np.round(c, 3)
+        if np.hypot(*(c - start)) - bound < _END_CLEARANCE:
+            continue
+        if np.hypot(*(c - goal)) - bound < _END_CLEARANCE:
+            continue
+        if any(np.hypot(*(c - pc)) < bound + pb + _GAP for pc, pb in placed):
+            continue
+        return c
+    return None
 
+
+def _ch2_obstacles(
+    rng: np.random.Generator, n: int, source: str, *, v_hi: float, w_hi: float, body: str,
+    avoid: bool,
+) -> list[dict[str, Any]]:  # fmt: skip
+    """``n`` obstacles of :func:`random_ch2_scenario` drawn from ``rng``.
+
+    Raises:
+        PlacementError: a body that obeys (2.6)-(2.8) and fits could not be drawn.
+    """
+    start, goal = np.asarray(CH2_START), np.asarray(CH2_GOAL)
     obstacles: list[dict[str, Any]] = []
     placed: list[tuple[np.ndarray, float]] = []  # (centre, bounding radius)
     for j in range(n):
         for _ in range(_MAX_TRIES):
-            verts = random_star_polygon(rng)
+            shape, bound = _random_body(rng, body)
             spec: dict[str, Any] = {
-                "name": f"polygon-{j}",
-                "body": {"polygon": verts.tolist()},
+                "name": f"{'disc' if body == 'disc' else 'polygon'}-{j}",
+                "body": shape,
                 "start": {"position": [0.0, 0.0], "heading": 0.0},
-                "motion": _random_motion(rng),
+                "motion": _random_motion(rng, v_hi, w_hi, avoid),
             }
             speed, turn, growth = obstacle_bounds(ObstacleSpec.model_validate(spec))
             if not (speed < CH2_V_MAX and turn < CH2_U_MAX and growth < CH2_V_MAX - speed):
                 continue
-            bound = float(np.max(np.hypot(*(verts - polygon_centroid(verts)).T)))
-            centre = None
-            for _ in range(_MAX_TRIES):
-                c = (
-                    start
-                    + rng.uniform(*_ALONG_TRACK) * along
-                    + rng.uniform(-_LATERAL, _LATERAL) * across
-                )
-                c = np.round(c, 3)
-                if np.hypot(*(c - start)) - bound < _END_CLEARANCE:
-                    continue
-                if np.hypot(*(c - goal)) - bound < _END_CLEARANCE:
-                    continue
-                if any(np.hypot(*(c - pc)) < bound + pb + _GAP for pc, pb in placed):
-                    continue
-                centre = c
-                break
+            centre = _place_centre(rng, bound, placed, start, goal)
             if centre is None:
                 continue
             heading = round(float(rng.uniform(-math.pi, math.pi)), 4)
@@ -189,15 +210,83 @@ def random_ch2_scenario(
             placed.append((centre, bound))
             obstacles.append(spec)
             break
-        else:  # pragma: no cover - the strip has room for far more than 6 obstacles
-            raise RuntimeError(f"could not place obstacle {j} of {n} (seed {seed})")
+        else:
+            raise PlacementError(
+                source,
+                j,
+                n,
+                f"no clear place for body {j} that obeys (2.6)-(2.8) in {_MAX_TRIES} draws",
+            )
+    return obstacles
 
+
+@typed_generator("random-ch2")
+def random_ch2_scenario(
+    seed: int,
+    *,
+    n_obstacles: Annotated[
+        int | None, Field(ge=0, le=30, description="number of bodies (drawn in 1..6 when null)")
+    ] = None,
+    speed_ratio_max: Annotated[
+        float,
+        Field(ge=0.1, lt=1.0, description="largest body speed / V_max ((2.6): below 1)"),
+    ] = CH2_SPEED_RATIO,
+    turn_rate_ratio_max: Annotated[
+        float,
+        Field(ge=0.05, lt=1.0, description="largest course turn rate / U_max ((2.7): below 1)"),
+    ] = CH2_TURN_RATIO,
+    body: Annotated[
+        Literal["polygon", "disc"],
+        Field(description="non-convex star polygons, or discs (no (2.8) growth: fast bodies)"),
+    ] = "polygon",
+    mutual_avoidance: Annotated[
+        bool,
+        Field(description="bodies steer around each other (ORCA, motion orca_wander)"),
+    ] = False,
+    controller: Annotated[str, Field(description="default law of the scene")] = "zhang2019-v1",
+    controller_params: Annotated[dict[str, Any] | None, Field(description="its parameters")] = None,
+    dt: Annotated[float, Field(gt=0, description="integration and decision step [s]")] = 0.1,
+    t_max: Annotated[float, Field(gt=0, description="time limit [s]")] = 120.0,
+) -> Scenario:
+    """A random Chapter-2 scene, deterministic in ``seed``.
+
+    Robot: I = [0, 0], T = [10, 10], heading toward T, V_max 0.707 m/s, U_max 1.414 rad/s, radius
+    0.1 m.  Obstacles (defaults): non-convex star-shaped polygons (5-9 vertices at 0.3-0.9 m from
+    the centroid) centred near the I->T line (2-12 m along it, up to +-2 m across), clear of each
+    other (0.3 m between bounding discs) and of the start and goal (1.5 m from the bounding disc),
+    moving with ``random_turn`` (speeds within [0.05, 0.5 V_max] m/s, turn rates within +-0.3
+    rad/s, arena [-3, -3, 13, 13] m) and obeying the thesis's (2.6)-(2.8): a drawn body that does
+    not is redrawn.
+
+    The parameters widen the family up to the edge of (2.6)-(2.7): the largest speed is
+    ``speed_ratio_max`` V_max, the largest turn rate ``turn_rate_ratio_max`` U_max (with
+    polygons, (2.8) then rejects the fast, fast-turning draws; discs have no rotation growth);
+    ``mutual_avoidance`` drives the bodies as one ORCA crowd whose preferred velocities wander as
+    ``random_turn`` does (motion ``orca_wander``: their bounding discs avoid each other, the
+    bodies do not rotate).  The defaults draw exactly the scenes the family always drew.
+
+    Args:
+        seed: the only source of randomness.
+
+    Raises:
+        ScenarioError: a parameter out of range (one line).
+        PlacementError: the bodies drawn cannot all be placed (e.g. too many for the strip).
+    """
+    source = f"random-ch2:{seed}"
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 7)) if n_obstacles is None else int(n_obstacles)
+    obstacles = _ch2_obstacles(
+        rng, n, source, v_hi=speed_ratio_max * CH2_V_MAX, w_hi=turn_rate_ratio_max * CH2_U_MAX,
+        body=body, avoid=mutual_avoidance,
+    )  # fmt: skip
+    start = np.asarray(CH2_START)
+    goal = np.asarray(CH2_GOAL)
+    along = (goal - start) / np.hypot(*(goal - start))
     heading = float(np.arctan2(along[1], along[0]))
     data: dict[str, Any] = {
         "name": f"random-ch2-{seed}",
-        "description": (
-            f"Random Chapter-2 scene (seed {seed}): {n} randomly turning non-convex obstacle(s) "
-            "near the straight path I->T, all obeying (2.6)-(2.8)."
+        "description": _ch2_description(
+            seed, n, speed_ratio_max, turn_rate_ratio_max, body, mutual_avoidance
         ),
         "dim": 2,
         "dt": dt,
@@ -217,7 +306,28 @@ def random_ch2_scenario(
         "obstacles": obstacles,
         "controller": {"name": controller, "params": dict(controller_params or {})},
     }
-    return scenario_from_dict(data, source=f"random-ch2:{seed}")
+    return scenario_from_dict(data, source=source)
+
+
+def _ch2_description(
+    seed: int, n: int, speed_ratio: float, turn_ratio: float, body: str, avoid: bool
+) -> str:
+    what = "non-convex obstacle(s)" if body == "polygon" else "disc obstacle(s)"
+    bodies = f"{n} {what} steering around each other" if avoid else f"{n} randomly turning {what}"
+    text = (
+        f"Random Chapter-2 scene (seed {seed}): {bodies} "
+        "near the straight path I->T, all obeying (2.6)-(2.8)."
+    )
+    if (speed_ratio, turn_ratio, body, avoid) == (
+        CH2_SPEED_RATIO,
+        CH2_TURN_RATIO,
+        "polygon",
+        False,
+    ):
+        return text
+    return text + (
+        f" Speeds up to {speed_ratio:g} V_max, course turn rates up to {turn_ratio:.3g} U_max."
+    )
 
 
 # ----------------------------------------------------------------------------------- crowd crossing
@@ -543,21 +653,15 @@ def crowd_file_scenario(
     return scenario_from_dict(data, source=source)
 
 
-def _random_ch3(seed: int, **params: Any) -> Any:
-    """3D scenes of thesis Ch. 3 (:func:`uvnav.scenarios.generators3d.random_ch3_scenario`)."""
-    from uvnav.scenarios.generators3d import random_ch3_scenario
-
-    return random_ch3_scenario(seed, **params)
-
-
 #: Seeded scenario generators by name: ``GENERATORS[name](seed, **params) -> Scenario``.
 #: ``load_scenario("<name>:<seed>")`` and campaign files refer to them by these names.
-GENERATORS: dict[str, Callable[..., Scenario]] = {
+GENERATORS: dict[str, Callable[..., Any]] = {
     "random-ch2": random_ch2_scenario,
+    "random-ch2-edge": generator_variant("random-ch2-edge", random_ch2_scenario, **CH2_EDGE),
     "crowd-eth": partial(crowd_crossing_scenario, dataset="eth"),
     "crowd-hotel": partial(crowd_crossing_scenario, dataset="hotel"),
     "crowd-file": crowd_file_scenario,
-    "random-ch3": _random_ch3,
+    "random-ch3": random_ch3_scenario,
     "crowdnav-circle": crowdnav_circle,
     "crowdnav-square": crowdnav_square,
 }

@@ -15,10 +15,13 @@ start at least 3 m apart surface to surface (the thesis excludes narrow gaps, Fi
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from pydantic import Field
 
+from uvnav.scenarios.errors import PlacementError
+from uvnav.scenarios.params import typed_generator
 from uvnav.scenarios.schema3d import Scenario3D, scenario3d_from_dict
 
 V_MAX = 1.0
@@ -47,47 +50,42 @@ def _star(rng: np.random.Generator) -> tuple[dict[str, Any], float]:
     return {"star": {"radius": round(r0, 3), "bumps": bumps, "subdivisions": 2}}, r0 * bound
 
 
-def random_ch3_scenario(
-    seed: int,
-    *,
-    n_obstacles: int | None = None,
-    velocities: str = "estimated",
-    t_max: float = 90.0,
-) -> Scenario3D:
-    """Random 3D scene number ``seed`` (see the module docstring).
+#: defaults of :func:`random_ch3_scenario`'s envelope (the family as it always was)
+CH3_SPEED_RATIO = 0.5  # largest body speed / V_max
+CH3_TURN_RATIO = 0.3  # largest body rotation rate / U_max
+#: a placement (400 draws) that leaves the scene short is followed by up to this many fresh ones
+#: from the same generator (9 of seeds 0-199 were short after the first); a scene complete after
+#: the first is drawn as it always was
+_RETRY_ROUNDS = 10
 
-    Args:
-        seed: the scene's seed (the same seed gives the same scene).
-        n_obstacles: number of obstacles (default: 2-4 drawn from the seed).
-        velocities: ``"estimated"`` (finite differences, AR-predicted by the law) or ``"known"``.
-        t_max: time limit [s].
-    """
-    rng = np.random.default_rng(seed)
-    n = int(n_obstacles) if n_obstacles is not None else int(rng.integers(2, 5))
-    start = np.array([0.0, 0.0, 5.0])
-    heading = rng.uniform(0, 2 * math.pi)
-    length = float(rng.uniform(20.0, 26.0))
-    climb = float(rng.uniform(-6.0, 6.0))
-    horiz = math.sqrt(max(length * length - climb * climb, 1.0))
-    goal = start + np.array([horiz * math.cos(heading), horiz * math.sin(heading), climb])
-    axis = (goal - start) / np.linalg.norm(goal - start)
-    side = np.cross(axis, [0.0, 0.0, 1.0])
-    side /= np.linalg.norm(side)
-    up = np.cross(side, axis)
+
+def _ch3_round(
+    rng: np.random.Generator,
+    n: int,
+    frame: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float],
+    speed_ratio_max: float,
+    turn_rate_ratio_max: float,
+) -> list[dict[str, Any]]:
+    """One placement of :func:`random_ch3_scenario`'s bodies on the line S-E (``frame`` = S, E,
+    the unit vectors across it and the drawn length [m]): up to ``n`` bodies in 400 draws from
+    ``rng``."""
+    start, goal, side, up, length = frame
     placed: list[tuple[np.ndarray, float]] = []
     obstacles: list[dict[str, Any]] = []
     tries = 0
+    v_scale = speed_ratio_max / CH3_SPEED_RATIO  # 1.0 by default: the draws as they were
+    u_scale = turn_rate_ratio_max / CH3_TURN_RATIO
     while len(obstacles) < n and tries < 400:
         tries += 1
         body, bound = _star(rng)
         frac = float(rng.uniform(0.25, 0.8))
-        speed = float(rng.uniform(0.1, 0.4))
+        speed = float(rng.uniform(0.1, 0.4 * v_scale))
         vdir = rng.normal(size=3)
         vdir[2] *= 0.3
         vdir /= np.linalg.norm(vdir)
         v_mean = speed * vdir
         u_mean = rng.normal(size=3)
-        u_mean *= float(rng.uniform(0.0, 0.2)) / np.linalg.norm(u_mean)
+        u_mean *= float(rng.uniform(0.0, 0.2 * u_scale)) / np.linalg.norm(u_mean)
         meet = start + frac * (goal - start)
         meet = meet + side * rng.uniform(-1.2, 1.2) + up * rng.uniform(-1.2, 1.2)
         t_meet = frac * length / V_MAX
@@ -112,13 +110,74 @@ def random_ch3_scenario(
                     "phi": [0.6, 0.25],
                     "v_sigma": 0.04,
                     "v_min": 0.02,
-                    "v_max": 0.5 * V_MAX,
+                    "v_max": speed_ratio_max * V_MAX,
                     "u_mean": [round(float(x), 4) for x in u_mean],
                     "u_sigma": 0.02,
-                    "u_max": 0.3 * U_MAX,
+                    "u_max": turn_rate_ratio_max * U_MAX,
                     "period": 1.0,
                 },
             }
+        )
+    return obstacles
+
+
+@typed_generator("random-ch3")
+def random_ch3_scenario(
+    seed: int,
+    *,
+    n_obstacles: Annotated[
+        int | None, Field(ge=1, le=12, description="number of bodies (drawn in 2..4 when null)")
+    ] = None,
+    speed_ratio_max: Annotated[
+        float, Field(ge=0.25, lt=1.0, description="largest body speed / V_max ((3.9): below 1)")
+    ] = CH3_SPEED_RATIO,
+    turn_rate_ratio_max: Annotated[
+        float,
+        Field(ge=0.05, lt=1.0, description="largest rotation rate / U_max ((3.10): below 1)"),
+    ] = CH3_TURN_RATIO,
+    velocities: Annotated[
+        Literal["estimated", "known"],
+        Field(description="obstacle velocities sensed by finite differences, or known"),
+    ] = "estimated",
+    t_max: Annotated[float, Field(gt=0, description="time limit [s]")] = 90.0,
+) -> Scenario3D:
+    """Random 3D scene number ``seed`` (see the module docstring).
+
+    ``speed_ratio_max`` and ``turn_rate_ratio_max`` widen the family up to the edge of
+    (3.9)-(3.10): the AR motion's bounds become ``speed_ratio_max`` V_max and
+    ``turn_rate_ratio_max`` U_max, and the drawn mean speed (0.1-0.4 m/s by default) and mean
+    rotation rate (0-0.2 rad/s) scale with them.  The defaults draw the family as it always was.
+
+    Args:
+        seed: the scene's seed (the same seed gives the same scene).
+
+    Raises:
+        ScenarioError: a parameter out of range (one line).
+        PlacementError: the bodies drawn cannot all be placed 3 m apart.
+    """
+    rng = np.random.default_rng(seed)
+    n = int(n_obstacles) if n_obstacles is not None else int(rng.integers(2, 5))
+    start = np.array([0.0, 0.0, 5.0])
+    heading = rng.uniform(0, 2 * math.pi)
+    length = float(rng.uniform(20.0, 26.0))
+    climb = float(rng.uniform(-6.0, 6.0))
+    horiz = math.sqrt(max(length * length - climb * climb, 1.0))
+    goal = start + np.array([horiz * math.cos(heading), horiz * math.sin(heading), climb])
+    axis = (goal - start) / np.linalg.norm(goal - start)
+    side = np.cross(axis, [0.0, 0.0, 1.0])
+    side /= np.linalg.norm(side)
+    up = np.cross(side, axis)
+    frame = (start, goal, side, up, length)
+    obstacles = _ch3_round(rng, n, frame, speed_ratio_max, turn_rate_ratio_max)
+    best = len(obstacles)
+    for _ in range(_RETRY_ROUNDS):  # only a scene the family's own draws leave short
+        if len(obstacles) == n:
+            break
+        obstacles = _ch3_round(rng, n, frame, speed_ratio_max, turn_rate_ratio_max)
+        best = max(best, len(obstacles))
+    if len(obstacles) < n:
+        raise PlacementError(
+            f"random-ch3:{seed}", best, n, f"{1 + _RETRY_ROUNDS} placements of 400 draws each"
         )
     data = {
         "name": f"random-ch3:{seed}",

@@ -36,6 +36,7 @@ from uvnav.obstacles import (
     ObstacleField,
     ObstacleState,
     OrcaPedestrian,
+    OrcaWanderer,
     PolygonBody,
     RandomTurn,
     Replay,
@@ -391,6 +392,47 @@ class OrcaCrowdMotion(_Model):
         )
 
 
+class OrcaWanderMotion(RandomTurnMotion):
+    """Random wandering (as ``random_turn``) of bodies that avoid each other by ORCA
+    (:class:`~uvnav.obstacles.crowd.OrcaWanderer`).
+
+    The ``orca_wander`` bodies with the same ``crowd`` id form one crowd, simulated together by one
+    RVO2 simulator (``pyrvo``): every step each body's preferred velocity is the one its
+    wandering proposes (speed and course turn rate drawn from ``speed`` and ``turn_rate`` every
+    ``change_period``, turned back inside ``arena``), and ORCA changes it as little as it can so
+    that no two bounding discs collide.  The body may be a polygon (its bounding disc is what the
+    others avoid); it does not rotate (``spin`` must be 0).  The robot is invisible to the
+    bodies.  ORCA's parameters are CrowdNav's (:class:`OrcaCrowdMotion`).
+    """
+
+    type: Literal["orca_wander"]  # type: ignore[assignment]
+    crowd: str = Field(
+        orca_crowd.DEFAULT_CROWD,
+        min_length=1,
+        description="crowd id: bodies with the same id avoid each other",
+    )
+    safety_margin: float = Field(
+        orca_crowd.SAFETY_MARGIN, ge=0, description="added to the bounding radius for RVO2 [m]"
+    )
+
+    @field_validator("spin")
+    @classmethod
+    def _no_spin(cls, value: float) -> float:
+        if value != 0.0:
+            raise ValueError("an orca_wander body does not rotate (spin must be 0)")
+        return value
+
+    def to_model(self, rng: np.random.Generator) -> OrcaWanderer:  # type: ignore[override]
+        """The motion model; its wandering draws from ``rng`` (the obstacle's own generator)."""
+        return OrcaWanderer(
+            goal=np.zeros(2),
+            v_pref=max(float(self.speed[1]), 1e-9),
+            crowd_id=self.crowd,
+            safety_margin=float(self.safety_margin),
+            wander=super().to_model(rng),
+        )
+
+
 class SocialForceMotion(_Model):
     """A pedestrian walking by the social force model (Helbing and Molnár 1995;
     :mod:`uvnav.obstacles.social_force`); the scene's ``social_force`` pedestrians with the same
@@ -454,6 +496,7 @@ MotionSpec = Annotated[
     | WaypointsMotion
     | ReplayMotion
     | OrcaCrowdMotion
+    | OrcaWanderMotion
     | SocialForceMotion
     | PluginMotion,
     Field(discriminator="type"),
@@ -466,6 +509,7 @@ MOTION_TYPES: dict[str, type[_Model]] = {
     "waypoints": WaypointsMotion,
     "replay": ReplayMotion,
     "orca_crowd": OrcaCrowdMotion,
+    "orca_wander": OrcaWanderMotion,
     "social_force": SocialForceMotion,
     "plugin": PluginMotion,
 }
@@ -563,6 +607,8 @@ class ObstacleSpec(_Model):
         motion: MotionModel = self.motion.to_model(rng)
         if isinstance(motion, RandomTurn):
             motion.course = float(state.heading)
+        elif isinstance(motion, OrcaWanderer) and motion.wander is not None:
+            motion.wander.course = float(state.heading)
         return Obstacle(
             body=self.body.to_body(),
             state=state,

@@ -21,7 +21,7 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import numpy as np
-from pydantic import Field, ValidationError, model_validator
+from pydantic import AfterValidator, Field, ValidationError, model_validator
 
 from uvnav.dynamics.holonomic import HolonomicSpec
 from uvnav.obstacles.deforming import (
@@ -32,9 +32,15 @@ from uvnav.obstacles.deforming import (
     trap_inner_space,
     trap_polygon,
 )
-from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
+from uvnav.scenarios.errors import (
+    FieldError,
+    PlacementError,
+    ScenarioError,
+    from_validation_error,
+)
 from uvnav.scenarios.limits import FileModel, SceneModel, check_timing
 from uvnav.scenarios.loader import builtin_yaml_files, natural_key, parse_yaml
+from uvnav.scenarios.params import typed_generator
 from uvnav.sensors.sonar2d import SonarConfig
 from uvnav.sim.episode_uuv2d import Uuv2dSetup, clearance_of, inside_any
 
@@ -299,13 +305,40 @@ CH4_U_MAX = 2.0  # [rad/s]
 CH4_RADIUS = 0.2  # [m]
 
 
+#: placement attempts per body asked for (random-ch4): the family always made 200; a scene
+#: complete within them is drawn as it always was, the further ones run only for a scene that
+#: would otherwise be short (none of seeds 0-199 is)
+_MORE_TRIES = 400
+#: random-ch4-hard: a placement (40 draws per body) that leaves the scene short is followed by
+#: up to this many fresh ones from the same generator (24 of seeds 0-199 were short after the
+#: first); a scene complete after the first is drawn as it always was
+_RETRY_ROUNDS = 10
+
+_Rate = Annotated[float, Field(gt=0, lt=CH4_V_MAX)]
+
+
+def _rate_range(value: tuple[float, float]) -> tuple[float, float]:
+    if value[0] > value[1]:
+        raise ValueError(f"need min <= max (got {list(value)})")
+    return value
+
+
+RateRange = Annotated[tuple[_Rate, _Rate], AfterValidator(_rate_range)]
+
+
+@typed_generator("random-ch4")
 def random_ch4_scenario(
     seed: int,
     *,
-    n_obstacles: int | None = None,
-    noise_std: float = 0.0,
-    dropout: float = 0.0,
-    max_rate: tuple[float, float] = (0.05, 0.3),
+    n_obstacles: Annotated[
+        int | None, Field(ge=1, le=10, description="number of bodies (drawn in 1..5 when null)")
+    ] = None,
+    noise_std: Annotated[float, Field(ge=0, description="sonar range noise [m]")] = 0.0,
+    dropout: Annotated[float, Field(ge=0, le=1, description="sonar dropout probability")] = 0.0,
+    max_rate: Annotated[
+        RateRange,
+        Field(description="range of the bodies' deformation rate bound [m/s] (below V_max)"),
+    ] = (0.05, 0.3),
 ) -> Uuv2dScenario:
     """A random Chapter-4 scene within the chapter's assumptions (seeded).
 
@@ -317,17 +350,18 @@ def random_ch4_scenario(
     body with a narrow inner space (Fig. 4.2(b), excluded).  At least one body lies across the
     I-E line.
 
+    ``n_obstacles`` may ask for up to 10 bodies and ``max_rate`` for deformation rates up to
+    (below) V_max, the chapter's assumption.
+
     Args:
         seed: scene number.
-        n_obstacles: force the count (1-5); drawn uniformly otherwise.
-        noise_std: sonar range noise [m].
-        dropout: sonar dropout probability.
-        max_rate: range of the obstacles' deformation rate bound [m/s].
+
+    Raises:
+        ScenarioError: a parameter out of range (one line).
+        PlacementError: the bodies drawn cannot all be placed.
     """
     rng = np.random.default_rng(seed)
     n = int(rng.integers(1, 6)) if n_obstacles is None else int(n_obstacles)
-    if not 1 <= n <= 5:
-        raise ValueError("n_obstacles must be in 1..5")
     start = np.array(CH4_START)
     goal = np.array(CH4_GOAL)
     u = (goal - start) / np.hypot(*(goal - start))
@@ -335,7 +369,7 @@ def random_ch4_scenario(
     gap = 2.0 * (CH4_RADIUS + 0.3)
     placed: list[tuple[np.ndarray, float]] = []
     specs: list[dict[str, Any]] = []
-    for _ in range(200 * n):
+    for _ in range(_MORE_TRIES * n):
         if len(specs) == n:
             break
         area = float(rng.uniform(0.5, 4.0))
@@ -362,6 +396,8 @@ def random_ch4_scenario(
             continue
         placed.append((c, br))
         specs.append(spec)
+    if len(specs) < n:
+        raise PlacementError(f"random-ch4:{seed}", len(specs), n, f"{_MORE_TRIES * n} draws")
     data = {
         "kind": "uuv2d",
         "name": f"random-ch4:{seed}",
@@ -394,45 +430,11 @@ HARD_GAP_MARGIN = 0.05  # bounding discs at least 2 (radius + this) apart [m]
 HARD_T_MAX = 30.0  # time limit [s] (the straight run takes 10 s); every check covers it
 
 
-def random_ch4_hard_scenario(
-    seed: int,
-    *,
-    n_obstacles: int | None = None,
-    noise_std: float = 0.0,
-    dropout: float = 0.0,
-) -> Uuv2dScenario:
-    """A harder random Chapter-4 scene: faster, translating bodies, narrow gaps (seeded).
-
-    ``random-ch4-hard:<seed>``, still within the chapter's assumptions as
-    :func:`random_ch4_scenario` reads them.
-
-    What is harder: 2-6 bodies; deformation at the top of the rate range (boundary speed bound
-    drawn from ``HARD_RATE`` = 0.3-0.6 m/s, against 0.05-0.3 m/s); every body but possibly the
-    first translates (mass-centre speed up to ``HARD_SPEED`` = 0.3 m/s) roughly *across* the I-E
-    line, timed to cross it near when the vehicle (sqrt(2) V_max along the diagonal) gets there;
-    and the bounding discs of two bodies may come as close as 2 (vehicle radius + 0.05 m) — a gap
-    the vehicle fits through with 5 cm on each side — instead of 2 (radius + 0.3 m).
-
-    Assumptions kept (the chapter's): each body is one star-shaped, closed, smooth outline of fixed
-    area whose mass centre is known to the vehicle (§4.2); its boundary moves slower than the
-    vehicle (deformation rate + translation speed <= 0.9 m/s < V_max = 1 m/s per component);
-    bodies never touch one another (the closest approach of their bounding discs over the whole
-    episode, t_max = ``HARD_T_MAX`` = 30 s, computed from their constant velocities, is at least
-    the gap above, so no two bodies merge into a non-star body with a narrow inner space,
-    Fig. 4.2(b)); I and E stay clear (every bounding disc stays 1.0 m from both over t_max); at
-    least one body starts across the I-E line.  The time limit is 30 s (3 times the straight
-    run): a translating body may drift onto E after that.
-
-    Args:
-        seed: scene number.
-        n_obstacles: force the count (2-6); drawn uniformly otherwise.
-        noise_std: sonar range noise [m].
-        dropout: sonar dropout probability.
-    """
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(2, 7)) if n_obstacles is None else int(n_obstacles)
-    if not 2 <= n <= 6:
-        raise ValueError("n_obstacles must be in 2..6")
+def _hard_round(
+    rng: np.random.Generator, n: int, rate: tuple[float, float], speed_max: float
+) -> list[dict[str, Any]]:
+    """One placement of :func:`random_ch4_hard_scenario`'s bodies: up to ``n`` bodies in
+    ``40 n`` draws from ``rng`` (fewer when the first placed leave no room)."""
     horizon = HARD_T_MAX
     start = np.array(CH4_START)
     goal = np.array(CH4_GOAL)
@@ -447,14 +449,14 @@ def random_ch4_hard_scenario(
             break
         area = float(rng.uniform(0.5, 4.0))
         shape_seed = int(rng.integers(0, 2**31 - 1))
-        rate = float(rng.uniform(*HARD_RATE))
+        body_rate = float(rng.uniform(*rate))
         br = DeformingStar.random(
-            np.random.default_rng(shape_seed), (0.0, 0.0), area, max_rate=rate, calibrate=False
+            np.random.default_rng(shape_seed), (0.0, 0.0), area, max_rate=body_rate, calibrate=False
         ).bounding_radius
         for _ in range(25):  # places for this body (its bounding radius is costly to compute)
             along = float(rng.uniform(2.5, 11.6))
             lateral = float(rng.uniform(-0.3, 0.3)) if not specs else float(rng.uniform(-1.5, 1.5))
-            speed = 0.0 if not specs else float(rng.uniform(0.0, HARD_SPEED))
+            speed = 0.0 if not specs else float(rng.uniform(0.0, speed_max))
             # across the line (within 45 degrees of its normal), either way
             tilt = float(rng.uniform(-math.pi / 4, math.pi / 4))
             side = 1.0 if rng.random() < 0.5 else -1.0
@@ -477,12 +479,84 @@ def random_ch4_hard_scenario(
                     "type": "deforming",
                     "centre": [float(c[0]), float(c[1])],
                     "area": round(area, 3),
-                    "max_rate": round(rate, 3),
+                    "max_rate": round(body_rate, 3),
                     "shape_seed": shape_seed,
                     "velocity": [float(vel[0]), float(vel[1])],
                 }
             )
             break
+    return specs
+
+
+@typed_generator("random-ch4-hard")
+def random_ch4_hard_scenario(
+    seed: int,
+    *,
+    n_obstacles: Annotated[
+        int | None, Field(ge=2, le=10, description="number of bodies (drawn in 2..6 when null)")
+    ] = None,
+    noise_std: Annotated[float, Field(ge=0, description="sonar range noise [m]")] = 0.0,
+    dropout: Annotated[float, Field(ge=0, le=1, description="sonar dropout probability")] = 0.0,
+    rate: Annotated[
+        RateRange, Field(description="range of the deformation rate bound [m/s]")
+    ] = HARD_RATE,
+    speed_max: Annotated[
+        float,
+        Field(ge=0, lt=CH4_V_MAX, description="largest mass-centre speed [m/s]; rate max + this "
+              "must stay below V_max"),
+    ] = HARD_SPEED,
+) -> Uuv2dScenario:  # fmt: skip
+    """A harder random Chapter-4 scene: faster, translating bodies, narrow gaps (seeded).
+
+    ``random-ch4-hard:<seed>``, still within the chapter's assumptions as
+    :func:`random_ch4_scenario` reads them.
+
+    What is harder: 2-6 bodies; deformation at the top of the rate range (boundary speed bound
+    drawn from ``HARD_RATE`` = 0.3-0.6 m/s, against 0.05-0.3 m/s); every body but possibly the
+    first translates (mass-centre speed up to ``HARD_SPEED`` = 0.3 m/s) roughly *across* the I-E
+    line, timed to cross it near when the vehicle (sqrt(2) V_max along the diagonal) gets there;
+    and the bounding discs of two bodies may come as close as 2 (vehicle radius + 0.05 m) — a gap
+    the vehicle fits through with 5 cm on each side — instead of 2 (radius + 0.3 m).
+
+    Assumptions kept (the chapter's): each body is one star-shaped, closed, smooth outline of fixed
+    area whose mass centre is known to the vehicle (§4.2); its boundary moves slower than the
+    vehicle (deformation rate + translation speed <= 0.9 m/s < V_max = 1 m/s per component);
+    bodies never touch one another (the closest approach of their bounding discs over the whole
+    episode, t_max = ``HARD_T_MAX`` = 30 s, computed from their constant velocities, is at least
+    the gap above, so no two bodies merge into a non-star body with a narrow inner space,
+    Fig. 4.2(b)); I and E stay clear (every bounding disc stays 1.0 m from both over t_max); at
+    least one body starts across the I-E line.  The time limit is 30 s (3 times the straight
+    run): a translating body may drift onto E after that.
+
+    ``rate`` and ``speed_max`` widen the family up to the edge of the chapter's assumption: the
+    boundary's speed bound, deformation rate + translation speed, stays below V_max.
+
+    Args:
+        seed: scene number.
+
+    Raises:
+        ScenarioError: a parameter out of range (one line).
+        PlacementError: the bodies drawn cannot all be placed.
+    """
+    source = f"random-ch4-hard:{seed}"
+    if not rate[1] + speed_max < CH4_V_MAX:
+        raise ScenarioError(
+            source, "params.speed_max", f"rate max + speed_max = {rate[1] + speed_max:g} m/s is "
+            f"not below V_max = {CH4_V_MAX:g} m/s (the chapter's assumption)",
+        )  # fmt: skip
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(2, 7)) if n_obstacles is None else int(n_obstacles)
+    specs = _hard_round(rng, n, rate, speed_max)
+    best = len(specs)
+    for _ in range(_RETRY_ROUNDS):  # only a scene the family's own draws leave short
+        if len(specs) == n:
+            break
+        specs = _hard_round(rng, n, rate, speed_max)
+        best = max(best, len(specs))
+    if len(specs) < n:
+        raise PlacementError(
+            source, best, n, f"{1 + _RETRY_ROUNDS} placements of {40 * n} draws each"
+        )
     data = {
         "kind": "uuv2d",
         "name": f"random-ch4-hard:{seed}",
