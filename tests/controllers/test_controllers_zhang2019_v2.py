@@ -90,6 +90,33 @@ def test_first_contact_is_the_first_sampled_contact(
     assert gap == pytest.approx(float(dist.min()) - reach, abs=1e-3)
 
 
+@settings(max_examples=200, deadline=None)
+@given(px=coord, py=coord, vx=speed, vy=speed, reach=st.floats(0.3, 1.0),
+       margin=st.floats(0.01, 0.2))  # fmt: skip
+def test_inside_the_margin_contact_is_measured_to_the_bodies(
+    px: float, py: float, vx: float, vy: float, reach: float, margin: float
+) -> None:
+    """Within ``reach`` and closing, the first contact is the sampled first contact with
+    ``reach - margin``; elsewhere the margin changes nothing."""
+    p, v, horizon = np.array([px, py]), np.array([vx, vy]), 4.0
+    t = float(first_contact(p, v, np.array(reach), horizon, margin))
+    plain = float(first_contact(p, v, np.array(reach), horizon))
+    dist0 = float(np.hypot(px, py))
+    if dist0 > reach or float(np.dot(p, v)) <= 0.0:
+        assert t == plain
+        return
+    inner = reach - margin
+    ts = np.linspace(0.0, horizon, 4001)
+    dist = np.hypot(*(p[None, :] - ts[:, None] * v[None, :]).T)
+    if dist0 <= inner:
+        assert t == 0.0
+    elif math.isinf(t):
+        assert np.all(dist > inner - 1e-3)
+    else:
+        assert abs(float(np.hypot(*(p - t * v))) - inner) < 1e-6
+        assert np.all(dist[ts < t - 1e-3] > inner - 1e-6)
+
+
 @settings(max_examples=60, deadline=None)
 @given(seed=st.integers(0, 10_000), n=st.integers(1, 12), unicycle=st.booleans())
 def test_compiled_and_numpy_paths_agree(seed: int, n: int, unicycle: bool) -> None:
@@ -107,7 +134,7 @@ def test_compiled_and_numpy_paths_agree(seed: int, n: int, unicycle: bool) -> No
     cand = spd[:, None] * np.column_stack([np.cos(ang), np.sin(ang)])
     tau = rng.uniform(0.0, 1.5, k) if unicycle else np.zeros(k)
     turn = cand * rng.uniform(0.3, 1.0, (k, 1)) if unicycle else cand
-    args = (4.0, 0.3, 1.0)
+    args = (4.0, 0.3, 1.0, 0.05)
     ref = candidate_risk(np.zeros(2), cand, turn, tau, (q, w, reach), *args)
     got = candidate_risk_compiled(np.zeros(2), cand, turn, tau, (q, w, reach), bodies, *args)
     ttc_py, pen_py = np.empty(k), np.empty(k)

@@ -284,7 +284,7 @@ def choose_velocity(
         s1 = spd * np.maximum(np.cos(0.5 * beta), 0.0)
         turn = s1[:, None] * np.column_stack([np.cos(mid), np.sin(mid)])
     q, w, reach, bodies = discs
-    args = (p.horizon, p.comfort, p.comfort_horizon)
+    args = (p.horizon, p.comfort, p.comfort_horizon, p.safety_margin)
     if numba_enabled():
         ttc, pen = candidate_risk_compiled(position, cand, turn, tau, (q, w, reach), bodies, *args)
     else:
@@ -356,7 +356,7 @@ def plan(
                           v_pref[0], v_pref[1], v_prev[0], v_prev[1]])  # fmt: skip
         weights = np.array([p.horizon, p.comfort, p.comfort_horizon, p.w_ttc, p.w_change,
                             p.w_comfort, p.min_ttc, pad, p.forecast_horizon,
-                            p.max_tangent_bodies])  # fmt: skip
+                            p.max_tangent_bodies, p.safety_margin])  # fmt: skip
         if discs_only:
             discs = (centre, vel, scal[:, 2], np.arange(len(scal)))
         else:

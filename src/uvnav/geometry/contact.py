@@ -35,13 +35,20 @@ IntArray = np.ndarray
 
 
 def first_contact(
-    rel_pos: FloatArray, rel_vel: FloatArray, reach: FloatArray, horizon: float | FloatArray
+    rel_pos: FloatArray,
+    rel_vel: FloatArray,
+    reach: FloatArray,
+    horizon: float | FloatArray,
+    margin: float = 0.0,
 ) -> FloatArray:
     """First time [s] in [0, horizon] at which ``|rel_pos - rel_vel t| <= reach``; inf if never.
 
     ``rel_pos`` (..., 2): a body relative to the robot; ``rel_vel`` (..., 2): the robot's velocity
     relative to the body; ``reach``: the radius sum (broadcast).  A pair already in contact reads 0
-    while it closes in and inf while it opens.
+    while it closes in and inf while it opens.  With a ``margin`` [m] (``reach`` = the bodies'
+    radius sum + ``margin``), a pair already within ``reach`` and closing reads its first contact
+    with ``reach - margin`` instead (the bodies themselves touching), 0 when that too is reached:
+    inside the margin, candidates are told apart by how soon they would really touch.
 
     >>> first_contact(np.array([2.0, 0.0]), np.array([1.0, 0.0]), np.array(1.0), 5.0).item()
     1.0
@@ -49,10 +56,23 @@ def first_contact(
     inf
     >>> first_contact(np.array([0.5, 0.0]), np.array([1.0, 0.0]), np.array(1.0), 5.0).item()
     0.0
+    >>> first_contact(np.array([0.875, 0.0]), np.array([0.5, 0.0]), np.array(1.0), 5.0, 0.25).item()
+    0.25
     """
     a = np.einsum("...i,...i->...", rel_vel, rel_vel)
     b = np.einsum("...i,...i->...", rel_pos, rel_vel)
-    c = np.einsum("...i,...i->...", rel_pos, rel_pos) - reach * reach
+    pp = np.einsum("...i,...i->...", rel_pos, rel_pos)
+    c = pp - reach * reach
+    out = _roots(a, b, c, horizon)
+    if margin > 0.0:
+        inner = reach - margin
+        out = np.where((c <= 0.0) & (b > 0.0), _roots(a, b, pp - inner * inner, horizon), out)
+    return np.asarray(out, dtype=float)
+
+
+def _roots(a: FloatArray, b: FloatArray, c: FloatArray, horizon: float | FloatArray) -> FloatArray:
+    """First root in [0, horizon] of ``a t^2 - 2 b t + c`` (0 when ``c <= 0`` and closing, inf
+    when ``c <= 0`` and opening, or no root)."""
     disc = b * b - a * c
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (b - np.sqrt(np.maximum(disc, 0.0))) / a
@@ -85,17 +105,19 @@ def candidate_risk(
     horizon: float,
     comfort: float,
     comfort_horizon: float,
+    margin: float = 0.0,
 ) -> tuple[FloatArray, FloatArray]:
-    """``(ttc, pen)`` per candidate (module docstring), numpy over K x M."""
+    """``(ttc, pen)`` per candidate (module docstring), numpy over K x M; ``margin``: that of
+    :func:`first_contact`."""
     q, w, reach = discs
     if not len(q):
         return np.full(len(cand), np.inf), np.zeros(len(cand))
     rel = (q - position)[None, :, :]
     r = reach[None, :]
     turn_rel = turn[:, None, :] - w[None, :, :]
-    t1 = first_contact(rel, turn_rel, r, tau[:, None])
+    t1 = first_contact(rel, turn_rel, r, tau[:, None], margin)
     rel2 = rel - turn_rel * tau[:, None, None]
-    t2 = first_contact(rel2, cand[:, None, :] - w[None, :, :], r, (horizon - tau)[:, None])
+    t2 = first_contact(rel2, cand[:, None, :] - w[None, :, :], r, (horizon - tau)[:, None], margin)
     ttc = np.minimum(t1, tau[:, None] + t2).min(axis=1)
     gap = closest_gap(rel, turn_rel, r, comfort_horizon)
     pen = np.clip(comfort - gap, 0.0, None).max(axis=1)
@@ -105,13 +127,21 @@ def candidate_risk(
 # -- the compiled path ------------------------------------------------------------------------
 
 
-def _contact_scalar(px: float, py: float, vx: float, vy: float, reach: float, h: float) -> float:
+def _contact_scalar(
+    px: float, py: float, vx: float, vy: float, reach: float, h: float, margin: float
+) -> float:
     """:func:`first_contact` for one pair, on floats."""
     a = vx * vx + vy * vy
     b = px * vx + py * vy
-    c = px * px + py * py - reach * reach
+    pp = px * px + py * py
+    c = pp - reach * reach
     if c <= 0.0:
-        return 0.0 if b > 0.0 else math.inf
+        if b <= 0.0:
+            return math.inf
+        inner = reach - margin
+        c = pp - inner * inner
+        if margin <= 0.0 or c <= 0.0:
+            return 0.0
     disc = b * b - a * c
     if disc < 0.0 or b <= 0.0 or a <= 1e-12:
         return math.inf
@@ -151,6 +181,7 @@ def risk_one(
     horizon: float,
     comfort: float,
     comfort_horizon: float,
+    margin: float,
 ) -> tuple[float, float]:
     """``(ttc, pen)`` of one candidate (velocity ``(tx, ty)`` for ``tk`` s, then ``(cx, cy)``)
     for a robot at ``(px, py)``, with the bounding-disc cull (compiled by numba; plain Python
@@ -172,9 +203,9 @@ def risk_one(
         for j in range(int(bodies[b, 0]), int(bodies[b, 1])):
             rx, ry = q[j, 0] - px, q[j, 1] - py
             ax, ay = tx - w[j, 0], ty - w[j, 1]
-            t = _contact(rx, ry, ax, ay, reach[j], tk)
+            t = _contact(rx, ry, ax, ay, reach[j], tk, margin)
             t2 = _contact(rx - ax * tk, ry - ay * tk, cx - w[j, 0], cy - w[j, 1], reach[j],
-                          horizon - tk)  # fmt: skip
+                          horizon - tk, margin)  # fmt: skip
             t = min(t, tk + t2)
             if t < best_t:
                 best_t = t
@@ -196,6 +227,7 @@ def candidate_risk_py(
     horizon: float,
     comfort: float,
     comfort_horizon: float,
+    margin: float,
     ttc: FloatArray,
     pen: FloatArray,
 ) -> None:
@@ -204,7 +236,7 @@ def candidate_risk_py(
     for k in range(cand.shape[0]):
         ttc[k], pen[k] = _risk_one(position[0], position[1], cand[k, 0], cand[k, 1], turn[k, 0],
                                    turn[k, 1], tau[k], q, w, reach, bodies, horizon, comfort,
-                                   comfort_horizon)  # fmt: skip
+                                   comfort_horizon, margin)  # fmt: skip
 
 
 def tangents_py(
@@ -274,7 +306,8 @@ def decide_py(
     ``state``: robot x, y, heading [rad], U_max [rad/s] (heading NaN: a holonomic robot), the
     preferred velocity x, y, the previous choice x, y; ``weights``: horizon, comfort,
     comfort horizon, w_ttc, w_change, w_comfort, min_ttc, the robot's radius plus margin,
-    forecast time T_f, the number of nearest bodies whose tangents are candidates.
+    forecast time T_f, the number of nearest bodies whose tangents are candidates, the margin
+    (:func:`first_contact`).
 
     The same candidates, costs and first-index tie-break as
     :func:`uvnav.controllers.zhang2019_v2.choose_velocity`, but branch-and-bound: candidates are
@@ -286,7 +319,7 @@ def decide_py(
     fx, fy, ox, oy = state[4], state[5], state[6], state[7]
     horizon, comfort, c_h = weights[0], weights[1], weights[2]
     w_ttc, w_change, w_comfort, min_ttc = weights[3], weights[4], weights[5], weights[6]
-    pad, t_f, n_tan = weights[7], weights[8], weights[9]
+    pad, t_f, n_tan, margin = weights[7], weights[8], weights[9], weights[10]
     reach, grow = r + pad, np.empty(q.shape[0])
     bodies = np.empty((centre.shape[0], 7))
     n_few = 0
@@ -331,7 +364,7 @@ def decide_py(
             s1 = spd[k] * max(math.cos(0.5 * beta), 0.0)
             tx, ty = s1 * math.cos(hd + 0.5 * beta), s1 * math.sin(hd + 0.5 * beta)
         ttc, pen = _risk_one(px, py, cand[k, 0], cand[k, 1], tx, ty, tk, q, w, reach, bodies,
-                             horizon, comfort, c_h)  # fmt: skip
+                             horizon, comfort, c_h, margin)  # fmt: skip
         cost = bound[k] + w_ttc / max(ttc, 1e-3) + w_comfort * pen
         if cost < best[0] or (cost == best[0] and k < best[1]):
             best[0], best[1], best[4] = cost, k, ttc
@@ -378,6 +411,7 @@ def candidate_risk_compiled(
     horizon: float,
     comfort: float,
     comfort_horizon: float,
+    margin: float = 0.0,
 ) -> tuple[FloatArray, FloatArray]:
     """:func:`candidate_risk` with the bounding-disc cull, compiled (module docstring)."""
     q, w, reach = discs
@@ -387,7 +421,8 @@ def candidate_risk_compiled(
     fn(np.ascontiguousarray(position, dtype=float), np.ascontiguousarray(cand),
        np.ascontiguousarray(turn), np.ascontiguousarray(tau), np.ascontiguousarray(q),
        np.ascontiguousarray(w), np.ascontiguousarray(reach), np.ascontiguousarray(bodies),
-       float(horizon), float(comfort), float(comfort_horizon), ttc, pen)  # fmt: skip
+       float(horizon), float(comfort), float(comfort_horizon), float(margin), ttc,
+       pen)  # fmt: skip
     return ttc, pen
 
 
