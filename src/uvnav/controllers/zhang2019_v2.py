@@ -39,6 +39,9 @@ into the next stream of people, and never slows down, waits or backs off.  v2 th
    component toward T) where even standing still is not;
 4. holds its choice: a small cost ``w_change ||v - v_prev||`` keeps it from switching sides between
    decisions (the role of v1's direction tag).
+5. inside the safety margin (the robot already within radius sum + margin of a body) judges a
+   closing candidate by when the bodies themselves would touch, not 0 for all of them, so that
+   it still tells stepping toward a passing pedestrian from standing still.
 
 The holonomic robot takes the chosen velocity as it is; the unicycle steers toward the chosen
 direction with the sliding-mode law at the chosen speed times cos(beta) (its candidates are
