@@ -90,6 +90,33 @@ def test_first_contact_is_the_first_sampled_contact(
     assert gap == pytest.approx(float(dist.min()) - reach, abs=1e-3)
 
 
+@settings(max_examples=200, deadline=None)
+@given(px=coord, py=coord, vx=speed, vy=speed, reach=st.floats(0.3, 1.0),
+       margin=st.floats(0.01, 0.2))  # fmt: skip
+def test_inside_the_margin_contact_is_measured_to_the_bodies(
+    px: float, py: float, vx: float, vy: float, reach: float, margin: float
+) -> None:
+    """Within ``reach`` and closing, the first contact is the sampled first contact with
+    ``reach - margin``; elsewhere the margin changes nothing."""
+    p, v, horizon = np.array([px, py]), np.array([vx, vy]), 4.0
+    t = float(first_contact(p, v, np.array(reach), horizon, margin))
+    plain = float(first_contact(p, v, np.array(reach), horizon))
+    dist0 = float(np.hypot(px, py))
+    if dist0 > reach or float(np.dot(p, v)) <= 0.0:
+        assert t == plain
+        return
+    inner = reach - margin
+    ts = np.linspace(0.0, horizon, 4001)
+    dist = np.hypot(*(p[None, :] - ts[:, None] * v[None, :]).T)
+    if dist0 <= inner:
+        assert t == 0.0
+    elif math.isinf(t):
+        assert np.all(dist > inner - 1e-3)
+    else:
+        assert abs(float(np.hypot(*(p - t * v))) - inner) < 1e-6
+        assert np.all(dist[ts < t - 1e-3] > inner - 1e-6)
+
+
 @settings(max_examples=60, deadline=None)
 @given(seed=st.integers(0, 10_000), n=st.integers(1, 12), unicycle=st.booleans())
 def test_compiled_and_numpy_paths_agree(seed: int, n: int, unicycle: bool) -> None:
@@ -107,7 +134,7 @@ def test_compiled_and_numpy_paths_agree(seed: int, n: int, unicycle: bool) -> No
     cand = spd[:, None] * np.column_stack([np.cos(ang), np.sin(ang)])
     tau = rng.uniform(0.0, 1.5, k) if unicycle else np.zeros(k)
     turn = cand * rng.uniform(0.3, 1.0, (k, 1)) if unicycle else cand
-    args = (4.0, 0.3, 1.0)
+    args = (4.0, 0.3, 1.0, 0.05)
     ref = candidate_risk(np.zeros(2), cand, turn, tau, (q, w, reach), *args)
     got = candidate_risk_compiled(np.zeros(2), cand, turn, tau, (q, w, reach), bodies, *args)
     ttc_py, pen_py = np.empty(k), np.empty(k)
@@ -245,3 +272,68 @@ def test_law_gives_the_same_commands_on_both_paths() -> None:
         use_compiled(previous)
     fast = plan(obs, GOAL, 1.0, 0.3, 0.25, np.zeros(2), PARAMS, heading=0.2, u_max=math.pi)
     np.testing.assert_allclose(fast.velocity, slow.velocity, atol=1e-12)
+
+
+# -- the one-loop decision (branch-and-bound) against the numpy reference ----------------------
+
+
+def square_body(k: int, x: float, y: float, vx: float, vy: float, spin: float) -> ObstacleReading:
+    """A 1 m square centred at (x, y), moving and rotating, seen from the origin."""
+    c = np.array([x, y])
+    outline = c + np.array([[-0.5, -0.5], [0.5, -0.5], [0.5, 0.5], [-0.5, 0.5]])
+    d = max(float(np.hypot(x, y)) - 0.71, 0.0)
+    return ObstacleReading(k, d, c * 0.5, c, np.array([vx, vy]), spin, outline, 0.0, 0.71)
+
+
+def _random_scene(seed: int, n: int, polygons: bool) -> tuple[Observation, np.ndarray]:
+    rng = np.random.default_rng(seed)
+    readings = []
+    for k in range(n):
+        x, y = rng.uniform(-6.0, 6.0, 2)
+        if math.hypot(x, y) < 1.2:
+            continue
+        vx, vy = rng.uniform(-1.2, 1.2, 2)
+        make_polygon = polygons and k % 3 == 0
+        readings.append(
+            square_body(k, x, y, vx, vy, rng.uniform(-0.5, 0.5))
+            if make_polygon
+            else pedestrian(k, x, y, vx, vy)
+        )
+    return observe(*readings, heading=rng.uniform(-np.pi, np.pi)), rng.uniform(-1.0, 1.0, 2)
+
+
+@settings(max_examples=80, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(0, 14), unicycle=st.booleans(),
+       polygons=st.booleans())  # fmt: skip
+def test_loop_chooses_what_the_numpy_reference_chooses(
+    seed: int, n: int, unicycle: bool, polygons: bool
+) -> None:
+    """Branch-and-bound visits only candidates that can still win: the loop (plain Python here,
+    compiled in the law) and the exhaustive numpy reference pick the same velocity."""
+    obs, v_prev = _random_scene(seed, n, polygons)
+    kw = {"heading": obs.heading, "u_max": math.pi} if unicycle else {}
+    args = (obs, GOAL, 1.0, 0.3, 0.25, v_prev, PARAMS)
+    previous = use_compiled(False)
+    try:
+        ref = plan(*args, loop=False, **kw)  # type: ignore[arg-type]
+        got = plan(*args, loop=True, **kw)  # type: ignore[arg-type]
+    finally:
+        use_compiled(previous)
+    np.testing.assert_allclose(got.velocity, ref.velocity, atol=1e-9)
+    assert got.ttc == pytest.approx(ref.ttc, abs=1e-9) or got.ttc == ref.ttc
+    assert got.preferred == ref.preferred
+
+
+@pytest.mark.skipif(not numba_available(), reason="needs numba (the fast extra)")
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(1, 14), polygons=st.booleans())
+def test_compiled_loop_chooses_what_plain_python_chooses(seed: int, n: int, polygons: bool) -> None:
+    obs, v_prev = _random_scene(seed, n, polygons)
+    args = (obs, GOAL, 1.0, 0.3, 0.25, v_prev, PARAMS)
+    fast = plan(*args, loop=True, heading=obs.heading, u_max=math.pi)
+    previous = use_compiled(False)
+    try:
+        slow = plan(*args, loop=True, heading=obs.heading, u_max=math.pi)
+    finally:
+        use_compiled(previous)
+    np.testing.assert_allclose(fast.velocity, slow.velocity, atol=1e-9)

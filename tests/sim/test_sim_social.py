@@ -13,7 +13,8 @@ import pytest
 from uvnav.controllers import make_controller
 from uvnav.dynamics import UnicycleCommand, UnicycleSpec
 from uvnav.dynamics.omni import VelocityCommand
-from uvnav.obstacles import ConstantVelocity, Obstacle, ObstacleState, PolygonBody
+from uvnav.obstacles import ConstantVelocity, DiscBody, Obstacle, ObstacleState, PolygonBody
+from uvnav.scenarios.pedestrians import PedestrianReplay
 from uvnav.sensors import Observation
 from uvnav.sim import EpisodeSetup, run_episode
 from uvnav.sim.metrics import SOCIAL_METRIC_NAMES, EpisodeMetrics, episode_metrics
@@ -141,6 +142,26 @@ def test_robot_driving_into_a_standing_body(record: bool) -> None:
 def test_robot_catching_up_with_a_slower_pedestrian() -> None:
     slow = Obstacle.moving_disc((3.0, 0.0), PED_R, (0.3, 0.0))  # walking away at 0.3 m/s
     res = _run(_setup([slow]), make_controller("straight-v1"))
+    assert res.status == "collision" and res.metrics.collision_by == "robot"
+
+
+def _appearing(t0: float) -> Obstacle:
+    """A replayed pedestrian whose track starts at ``t0`` [s] at (1.3, 0), walking +y at 1 m/s
+    (across the robot's path, not toward it)."""
+    track = np.array([[1.3, 0.0], [1.3, 4.0]])
+    motion = PedestrianReplay(np.array([t0, t0 + 4.0]), track)
+    return Obstacle(DiscBody(PED_R), motion.initial_state(0.0), motion)
+
+
+def test_pedestrian_appearing_in_contact_is_not_the_robots_doing() -> None:
+    """straight-v1 drives along y = 0 at 1 m/s, at x = 1.0 at t = 1 s: a track starting then at
+    (1.3, 0) overlaps it on the step it appears.  By velocities alone the robot closed the gap
+    (it drives at the body, which walks across); but the body did not exist one step before."""
+    res = _run(_setup([_appearing(1.0)]), make_controller("straight-v1"))
+    assert res.status == "collision" and res.metrics.collision_by == "pedestrian"
+    # the same body on the scene from the start and met at the same place: the robot's doing
+    present = Obstacle.moving_disc((1.3, -1.0), PED_R, (0.0, 1.0))
+    res = _run(_setup([present]), make_controller("straight-v1"))
     assert res.status == "collision" and res.metrics.collision_by == "robot"
 
 

@@ -14,7 +14,9 @@ then ``cand[k]`` (a holonomic robot: ``tau = 0``).  A boundary disc j (centre ``
 extra) :func:`candidate_risk_compiled` runs one compiled loop that first tests each body's
 bounding disc (``bodies``: index ranges of its discs, centre, velocity and reach), skipping bodies
 no candidate comes near — the same numbers (tests compare the two to 1e-12), at a fraction of
-the cost with 100 bodies.  Units: metres, seconds.
+the cost with 100 bodies.  :func:`decide_compiled` goes one step further for ``zhang2019-v2``:
+the candidates, their costs and the choice in the same loop, branch-and-bound (:func:`decide_py`).
+Units: metres, seconds.
 """
 
 from __future__ import annotations
@@ -28,15 +30,25 @@ import numpy as np
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import numba_enabled
 
+#: integer arrays (indices)
+IntArray = np.ndarray
+
 
 def first_contact(
-    rel_pos: FloatArray, rel_vel: FloatArray, reach: FloatArray, horizon: float | FloatArray
+    rel_pos: FloatArray,
+    rel_vel: FloatArray,
+    reach: FloatArray,
+    horizon: float | FloatArray,
+    margin: float = 0.0,
 ) -> FloatArray:
     """First time [s] in [0, horizon] at which ``|rel_pos - rel_vel t| <= reach``; inf if never.
 
     ``rel_pos`` (..., 2): a body relative to the robot; ``rel_vel`` (..., 2): the robot's velocity
     relative to the body; ``reach``: the radius sum (broadcast).  A pair already in contact reads 0
-    while it closes in and inf while it opens.
+    while it closes in and inf while it opens.  With a ``margin`` [m] (``reach`` = the bodies'
+    radius sum + ``margin``), a pair already within ``reach`` and closing reads its first contact
+    with ``reach - margin`` instead (the bodies themselves touching), 0 when that too is reached:
+    inside the margin, candidates are told apart by how soon they would really touch.
 
     >>> first_contact(np.array([2.0, 0.0]), np.array([1.0, 0.0]), np.array(1.0), 5.0).item()
     1.0
@@ -44,10 +56,23 @@ def first_contact(
     inf
     >>> first_contact(np.array([0.5, 0.0]), np.array([1.0, 0.0]), np.array(1.0), 5.0).item()
     0.0
+    >>> first_contact(np.array([0.875, 0.0]), np.array([0.5, 0.0]), np.array(1.0), 5.0, 0.25).item()
+    0.25
     """
     a = np.einsum("...i,...i->...", rel_vel, rel_vel)
     b = np.einsum("...i,...i->...", rel_pos, rel_vel)
-    c = np.einsum("...i,...i->...", rel_pos, rel_pos) - reach * reach
+    pp = np.einsum("...i,...i->...", rel_pos, rel_pos)
+    c = pp - reach * reach
+    out = _roots(a, b, c, horizon)
+    if margin > 0.0:
+        inner = reach - margin
+        out = np.where((c <= 0.0) & (b > 0.0), _roots(a, b, pp - inner * inner, horizon), out)
+    return np.asarray(out, dtype=float)
+
+
+def _roots(a: FloatArray, b: FloatArray, c: FloatArray, horizon: float | FloatArray) -> FloatArray:
+    """First root in [0, horizon] of ``a t^2 - 2 b t + c`` (0 when ``c <= 0`` and closing, inf
+    when ``c <= 0`` and opening, or no root)."""
     disc = b * b - a * c
     with np.errstate(divide="ignore", invalid="ignore"):
         t = (b - np.sqrt(np.maximum(disc, 0.0))) / a
@@ -80,17 +105,19 @@ def candidate_risk(
     horizon: float,
     comfort: float,
     comfort_horizon: float,
+    margin: float = 0.0,
 ) -> tuple[FloatArray, FloatArray]:
-    """``(ttc, pen)`` per candidate (module docstring), numpy over K x M."""
+    """``(ttc, pen)`` per candidate (module docstring), numpy over K x M; ``margin``: that of
+    :func:`first_contact`."""
     q, w, reach = discs
     if not len(q):
         return np.full(len(cand), np.inf), np.zeros(len(cand))
     rel = (q - position)[None, :, :]
     r = reach[None, :]
     turn_rel = turn[:, None, :] - w[None, :, :]
-    t1 = first_contact(rel, turn_rel, r, tau[:, None])
+    t1 = first_contact(rel, turn_rel, r, tau[:, None], margin)
     rel2 = rel - turn_rel * tau[:, None, None]
-    t2 = first_contact(rel2, cand[:, None, :] - w[None, :, :], r, (horizon - tau)[:, None])
+    t2 = first_contact(rel2, cand[:, None, :] - w[None, :, :], r, (horizon - tau)[:, None], margin)
     ttc = np.minimum(t1, tau[:, None] + t2).min(axis=1)
     gap = closest_gap(rel, turn_rel, r, comfort_horizon)
     pen = np.clip(comfort - gap, 0.0, None).max(axis=1)
@@ -100,13 +127,21 @@ def candidate_risk(
 # -- the compiled path ------------------------------------------------------------------------
 
 
-def _contact_scalar(px: float, py: float, vx: float, vy: float, reach: float, h: float) -> float:
+def _contact_scalar(
+    px: float, py: float, vx: float, vy: float, reach: float, h: float, margin: float
+) -> float:
     """:func:`first_contact` for one pair, on floats."""
     a = vx * vx + vy * vy
     b = px * vx + py * vy
-    c = px * px + py * py - reach * reach
+    pp = px * px + py * py
+    c = pp - reach * reach
     if c <= 0.0:
-        return 0.0 if b > 0.0 else math.inf
+        if b <= 0.0:
+            return math.inf
+        inner = reach - margin
+        c = pp - inner * inner
+        if margin <= 0.0 or c <= 0.0:
+            return 0.0
     disc = b * b - a * c
     if disc < 0.0 or b <= 0.0 or a <= 1e-12:
         return math.inf
@@ -131,6 +166,55 @@ def _clear_scalar(px: float, py: float, vx: float, vy: float, lim: float, h: flo
     return dx * dx + dy * dy > lim * lim
 
 
+def risk_one(
+    px: float,
+    py: float,
+    cx: float,
+    cy: float,
+    tx: float,
+    ty: float,
+    tk: float,
+    q: FloatArray,
+    w: FloatArray,
+    reach: FloatArray,
+    bodies: FloatArray,
+    horizon: float,
+    comfort: float,
+    comfort_horizon: float,
+    margin: float,
+) -> tuple[float, float]:
+    """``(ttc, pen)`` of one candidate (velocity ``(tx, ty)`` for ``tk`` s, then ``(cx, cy)``)
+    for a robot at ``(px, py)``, with the bounding-disc cull (compiled by numba; plain Python
+    otherwise).
+
+    ``bodies`` (N, 7): first disc index, end index, centre x, y, velocity x, y, bounding reach.
+    """
+    best_t, best_p = math.inf, 0.0
+    for b in range(bodies.shape[0]):
+        bx, by = bodies[b, 2] - px, bodies[b, 3] - py
+        ux, uy = tx - bodies[b, 4], ty - bodies[b, 5]
+        lim = bodies[b, 6] + comfort
+        bx2, by2 = bx - ux * tk, by - uy * tk
+        vx, vy = cx - bodies[b, 4], cy - bodies[b, 5]
+        if _clear(bx, by, ux, uy, lim, max(tk, comfort_horizon)) and _clear(
+            bx2, by2, vx, vy, lim, horizon - tk
+        ):
+            continue  # the bounding disc stays clear: so does every boundary disc
+        for j in range(int(bodies[b, 0]), int(bodies[b, 1])):
+            rx, ry = q[j, 0] - px, q[j, 1] - py
+            ax, ay = tx - w[j, 0], ty - w[j, 1]
+            t = _contact(rx, ry, ax, ay, reach[j], tk, margin)
+            t2 = _contact(rx - ax * tk, ry - ay * tk, cx - w[j, 0], cy - w[j, 1], reach[j],
+                          horizon - tk, margin)  # fmt: skip
+            t = min(t, tk + t2)
+            if t < best_t:
+                best_t = t
+            g = comfort - _gap(rx, ry, ax, ay, reach[j], comfort_horizon)
+            if g > best_p:
+                best_p = g
+    return best_t, best_p
+
+
 def candidate_risk_py(
     position: FloatArray,
     cand: FloatArray,
@@ -143,52 +227,165 @@ def candidate_risk_py(
     horizon: float,
     comfort: float,
     comfort_horizon: float,
+    margin: float,
     ttc: FloatArray,
     pen: FloatArray,
 ) -> None:
-    """The loop of :func:`candidate_risk_compiled` (compiled by numba; plain Python otherwise).
-
-    ``bodies`` (N, 7): first disc index, end index, centre x, y, velocity x, y, bounding reach.
-    """
-    px, py = position[0], position[1]
+    """The loop of :func:`candidate_risk_compiled`: :func:`risk_one` per candidate, written into
+    ``ttc`` and ``pen``."""
     for k in range(cand.shape[0]):
-        best_t, best_p = math.inf, 0.0
-        tk = tau[k]
-        for b in range(bodies.shape[0]):
-            bx, by = bodies[b, 2] - px, bodies[b, 3] - py
-            ux, uy = turn[k, 0] - bodies[b, 4], turn[k, 1] - bodies[b, 5]
-            lim = bodies[b, 6] + comfort
-            bx2, by2 = bx - ux * tk, by - uy * tk
-            cx, cy = cand[k, 0] - bodies[b, 4], cand[k, 1] - bodies[b, 5]
-            if _clear(bx, by, ux, uy, lim, max(tk, comfort_horizon)) and _clear(
-                bx2, by2, cx, cy, lim, horizon - tk
-            ):
-                continue  # the bounding disc stays clear: so does every boundary disc
-            for j in range(int(bodies[b, 0]), int(bodies[b, 1])):
-                rx, ry = q[j, 0] - px, q[j, 1] - py
-                ax, ay = turn[k, 0] - w[j, 0], turn[k, 1] - w[j, 1]
-                t = _contact_scalar(rx, ry, ax, ay, reach[j], tk)
-                t2 = _contact_scalar(rx - ax * tk, ry - ay * tk, cand[k, 0] - w[j, 0],
-                                     cand[k, 1] - w[j, 1], reach[j], horizon - tk)  # fmt: skip
-                t = min(t, tk + t2)
-                if t < best_t:
-                    best_t = t
-                g = comfort - _gap_scalar(rx, ry, ax, ay, reach[j], comfort_horizon)
-                if g > best_p:
-                    best_p = g
-        ttc[k] = best_t
-        pen[k] = best_p
+        ttc[k], pen[k] = _risk_one(position[0], position[1], cand[k, 0], cand[k, 1], turn[k, 0],
+                                   turn[k, 1], tau[k], q, w, reach, bodies, horizon, comfort,
+                                   comfort_horizon, margin)  # fmt: skip
+
+
+def tangents_py(
+    px: float,
+    py: float,
+    q: FloatArray,
+    grow: FloatArray,
+    owner: FloatArray,
+    n: int,
+    out: FloatArray,
+) -> int:
+    """Per body among the first ``n`` circles (centres ``q``, radii ``grow``, ``owner``
+    non-decreasing), the outermost tangent direction [rad] on each side, written into ``out`` as
+    all the lower ones, then all the upper ones; returns the number of bodies (the loop of
+    :func:`uvnav.controllers.zhang2019_v2.tangent_directions`)."""
+    n_bodies = 0
+    for i in range(n):
+        if i == 0 or owner[i] != owner[i - 1]:
+            n_bodies += 1
+    b, i = 0, 0
+    while i < n:
+        end = i
+        while end < n and owner[end] == owner[i]:
+            end += 1
+        near, near_d = i, math.inf
+        for j in range(i, end):
+            d = math.hypot(q[j, 0] - px, q[j, 1] - py)
+            if d < near_d:
+                near, near_d = j, d
+        ref = math.atan2(q[near, 1] - py, q[near, 0] - px)
+        lo, hi = math.inf, -math.inf
+        for j in range(i, end):
+            dx, dy = q[j, 0] - px, q[j, 1] - py
+            d = math.hypot(dx, dy)
+            half = math.asin(min(grow[j] / d, 1.0)) if d > grow[j] else 0.5 * math.pi
+            rel = (math.atan2(dy, dx) - ref + math.pi) % (2.0 * math.pi) - math.pi
+            lo = min(lo, rel - half)
+            hi = max(hi, rel + half)
+        out[b], out[n_bodies + b] = ref + lo, ref + hi
+        b += 1
+        i = end
+    return 2 * n_bodies
+
+
+def decide_py(
+    state: FloatArray,
+    extra: FloatArray,
+    speeds: FloatArray,
+    q: FloatArray,
+    w: FloatArray,
+    r: FloatArray,
+    owner: IntArray,
+    centre: FloatArray,
+    vel: FloatArray,
+    body_r: FloatArray,
+    weights: FloatArray,
+    out: FloatArray,
+) -> None:
+    """One whole choice of ``zhang2019-v2`` in one loop (compiled by numba): the candidate
+    headings (the forecast circles' tangents of the nearest bodies, then ``extra``), every heading
+    at every speed in ``speeds``, the preferred velocity and standing still; the least-cost one
+    written into ``out``: velocity x, y [m/s], its first contact [s], 1.0 when it is the preferred
+    one.
+
+    Bodies: boundary discs ``q``, ``w``, ``r`` (M,) of the bodies ``owner`` (non-decreasing), and
+    per body (N,) its ``centre``, ``vel`` and bounding radius ``body_r`` (the discs included).
+    ``state``: robot x, y, heading [rad], U_max [rad/s] (heading NaN: a holonomic robot), the
+    preferred velocity x, y, the previous choice x, y; ``weights``: horizon, comfort,
+    comfort horizon, w_ttc, w_change, w_comfort, min_ttc, the robot's radius plus margin,
+    forecast time T_f, the number of nearest bodies whose tangents are candidates, the margin
+    (:func:`first_contact`).
+
+    The same candidates, costs and first-index tie-break as
+    :func:`uvnav.controllers.zhang2019_v2.choose_velocity`, but branch-and-bound: candidates are
+    visited by their cost without the risk terms (a lower bound: the risk terms are >= 0), and
+    the visit stops once a safe candidate costs no more than the next bound, so candidates that
+    cannot win are never checked against the bodies.
+    """
+    px, py, hd, u_max = state[0], state[1], state[2], state[3]
+    fx, fy, ox, oy = state[4], state[5], state[6], state[7]
+    horizon, comfort, c_h = weights[0], weights[1], weights[2]
+    w_ttc, w_change, w_comfort, min_ttc = weights[3], weights[4], weights[5], weights[6]
+    pad, t_f, n_tan, margin = weights[7], weights[8], weights[9], weights[10]
+    reach, grow = r + pad, np.empty(q.shape[0])
+    bodies = np.empty((centre.shape[0], 7))
+    n_few = 0
+    for j in range(q.shape[0]):
+        grow[j] = reach[j] + math.hypot(w[j, 0], w[j, 1]) * t_f
+        if owner[j] < n_tan:
+            n_few = j + 1
+        if j == 0 or owner[j] != owner[j - 1]:
+            bodies[owner[j], 0] = j
+        bodies[owner[j], 1] = j + 1
+    for b in range(centre.shape[0]):
+        bodies[b, 2], bodies[b, 3] = centre[b, 0], centre[b, 1]
+        bodies[b, 4], bodies[b, 5] = vel[b, 0], vel[b, 1]
+        bodies[b, 6] = body_r[b] + pad
+    tang = np.empty(2 * n_few + 1)
+    n_t = _tangents(px, py, q, grow, owner, n_few, tang)
+    n_s = speeds.shape[0]
+    n_h = n_t + extra.shape[0]
+    n_c = n_h * n_s + 2
+    ang, spd = np.empty(n_c), np.empty(n_c)
+    for h in range(n_h):
+        a = tang[h] if h < n_t else extra[h - n_t]
+        for s in range(n_s):
+            ang[h * n_s + s], spd[h * n_s + s] = a, speeds[s]
+    ang[n_c - 2] = ang[n_c - 1] = math.atan2(fy, fx)
+    spd[n_c - 2], spd[n_c - 1] = math.hypot(fx, fy), 0.0
+    cand = np.empty((n_c, 2))
+    bound = np.empty(n_c)
+    for k in range(n_c):
+        cand[k, 0], cand[k, 1] = spd[k] * math.cos(ang[k]), spd[k] * math.sin(ang[k])
+        bound[k] = math.hypot(cand[k, 0] - fx, cand[k, 1] - fy) + w_change * math.hypot(
+            cand[k, 0] - ox, cand[k, 1] - oy
+        )
+    best = np.array([math.inf, -1.0, math.inf, -1.0, math.inf, math.inf])  # all, safe: cost, k, ttc
+    for k in np.argsort(bound, kind="mergesort"):
+        if best[3] >= 0.0 and bound[k] > best[2]:
+            break
+        tx, ty, tk = cand[k, 0], cand[k, 1], 0.0
+        if not math.isnan(hd):
+            beta = (ang[k] - hd + math.pi) % (2.0 * math.pi) - math.pi
+            tk = min(abs(beta) / u_max, horizon)
+            s1 = spd[k] * max(math.cos(0.5 * beta), 0.0)
+            tx, ty = s1 * math.cos(hd + 0.5 * beta), s1 * math.sin(hd + 0.5 * beta)
+        ttc, pen = _risk_one(px, py, cand[k, 0], cand[k, 1], tx, ty, tk, q, w, reach, bodies,
+                             horizon, comfort, c_h, margin)  # fmt: skip
+        cost = bound[k] + w_ttc / max(ttc, 1e-3) + w_comfort * pen
+        if cost < best[0] or (cost == best[0] and k < best[1]):
+            best[0], best[1], best[4] = cost, k, ttc
+        if ttc > min_ttc and (cost < best[2] or (cost == best[2] and k < best[3])):
+            best[2], best[3], best[5] = cost, k, ttc
+    pick, t_pick = (int(best[3]), best[5]) if best[3] >= 0.0 else (int(best[1]), best[4])
+    out[0], out[1], out[2] = cand[pick, 0], cand[pick, 1], t_pick
+    out[3] = 1.0 if pick == n_c - 2 and math.isinf(t_pick) else 0.0
 
 
 _COMPILED: dict[str, Callable[..., Any]] = {}
 _contact: Callable[..., float] = _contact_scalar
 _gap: Callable[..., float] = _gap_scalar
 _clear: Callable[..., bool] = _clear_scalar
+_risk_one: Callable[..., tuple[float, float]] = risk_one
+_tangents: Callable[..., int] = tangents_py
 
 
 def _kernel() -> Callable[..., Any]:
     """The numba-compiled loop (compiled, or loaded from numba's cache, on the first call)."""
-    global _contact, _gap, _clear
+    global _contact, _gap, _clear, _risk_one, _tangents
     if not _COMPILED:
         import numba
 
@@ -197,6 +394,9 @@ def _kernel() -> Callable[..., Any]:
         _clear = numba.njit(cache=True, nogil=True)(_clear_scalar)
         globals()["_contact_scalar"], globals()["_gap_scalar"] = _contact, _gap
         globals()["_clear_scalar"] = _clear
+        _risk_one = numba.njit(cache=True, nogil=True)(risk_one)
+        _tangents = numba.njit(cache=True, nogil=True)(tangents_py)
+        _COMPILED["decide"] = numba.njit(cache=True, nogil=True)(decide_py)
         _COMPILED["risk"] = numba.njit(cache=True, nogil=True)(candidate_risk_py)
     return _COMPILED["risk"]
 
@@ -211,6 +411,7 @@ def candidate_risk_compiled(
     horizon: float,
     comfort: float,
     comfort_horizon: float,
+    margin: float = 0.0,
 ) -> tuple[FloatArray, FloatArray]:
     """:func:`candidate_risk` with the bounding-disc cull, compiled (module docstring)."""
     q, w, reach = discs
@@ -220,5 +421,33 @@ def candidate_risk_compiled(
     fn(np.ascontiguousarray(position, dtype=float), np.ascontiguousarray(cand),
        np.ascontiguousarray(turn), np.ascontiguousarray(tau), np.ascontiguousarray(q),
        np.ascontiguousarray(w), np.ascontiguousarray(reach), np.ascontiguousarray(bodies),
-       float(horizon), float(comfort), float(comfort_horizon), ttc, pen)  # fmt: skip
+       float(horizon), float(comfort), float(comfort_horizon), float(margin), ttc,
+       pen)  # fmt: skip
     return ttc, pen
+
+
+def decide_compiled(
+    state: FloatArray,
+    extra: FloatArray,
+    speeds: FloatArray,
+    discs: tuple[FloatArray, FloatArray, FloatArray, IntArray],
+    bodies: tuple[FloatArray, FloatArray, FloatArray],
+    weights: FloatArray,
+) -> FloatArray:
+    """:func:`decide_py`, compiled when numba is enabled: ``(vx, vy, ttc, preferred)``.
+
+    ``discs``: centres, velocities, radii and owners of the boundary discs; ``bodies``: centres,
+    velocities and bounding radii of the bodies.
+    """
+    q, w, r, owner = discs
+    centre, vel, body_r = bodies
+    out = np.empty(4)
+    fn = decide_py
+    if numba_enabled():
+        _kernel()
+        fn = _COMPILED["decide"]
+    c = np.ascontiguousarray
+    fn(c(state, dtype=float), c(extra, dtype=float), c(speeds, dtype=float), c(q, dtype=float),
+       c(w, dtype=float), c(r, dtype=float), c(owner, dtype=np.int64), c(centre, dtype=float),
+       c(vel, dtype=float), c(body_r, dtype=float), c(weights, dtype=float), out)  # fmt: skip
+    return out

@@ -344,9 +344,11 @@ class UnicycleWorld:
         v = float(self.applied.v)
         return v * math.cos(self.th), v * math.sin(self.th)
 
-    def _collision_by(self) -> str:
-        """Who closed the gap at the collision now (:func:`uvnav.sim.social.collision_by`)."""
-        return collision_by(self.field, self.x, self.y, self.velocity(), self.pedestrians)
+    def _collision_by(self, was_present: np.ndarray | None = None) -> str:
+        """Who closed the gap at the collision now (:func:`uvnav.sim.social.collision_by`);
+        ``was_present``: the bodies that existed one step before."""
+        return collision_by(self.field, self.x, self.y, self.velocity(), self.pedestrians,
+                            was_present=was_present)  # fmt: skip
 
     def command_pair(self) -> tuple[float, float]:
         """The applied command as two numbers for the trajectory: ``(V_R, u_R)``."""
@@ -388,6 +390,7 @@ class UnicycleWorld:
         self.batch.step(self.t, dt)
         self.step_index = i = self.step_index + 1
         self.t = i * dt
+        was_present = self.field.present
         self.field = self.batch.field(self.template)
         radius = self.sensing_range if i % self.ratio == 0 else 0.0
         if self.tracker is None:
@@ -399,7 +402,7 @@ class UnicycleWorld:
             self.social.observe(self.field, nx, ny, i)
         if self.clearance < 0:
             self.status, self.done = "collision", True
-            self.collision_by = self._collision_by()
+            self.collision_by = self._collision_by(was_present)
         elif math.hypot(self.goal[0] - nx, self.goal[1] - ny) <= float(self.setup.goal_tolerance):
             self.status, self.reached_at, self.done = "success", self.t, True
         elif i >= self.n_steps:

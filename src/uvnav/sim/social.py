@@ -49,7 +49,10 @@ Metrics (``None`` in a scene without pedestrians, except where said):
     step, else ``"pedestrian"`` (or ``"obstacle"`` when the body is not a pedestrian); ``None``
     without collision.  The direction is from the robot's centre to the body's centre (disc) or to
     its nearest boundary point (polygon); the body's velocity is that of its touching point
-    (translation plus rotation).  Set for every 2D scene, with or without pedestrians.
+    (translation plus rotation).  A body that did not exist one step before (a replayed
+    pedestrian whose recorded track starts in contact with the robot) closed the gap by
+    appearing: ``"pedestrian"`` (``"obstacle"``), whatever the velocities.  Set for every 2D
+    scene, with or without pedestrians.
 """
 
 from __future__ import annotations
@@ -171,6 +174,8 @@ def collision_by(
     py: float,
     robot_velocity: tuple[float, float],
     pedestrians: np.ndarray,
+    *,
+    was_present: np.ndarray | None = None,
 ) -> str:
     """Who closed the gap at a collision of the robot at ``(px, py)`` (module docstring).
 
@@ -178,6 +183,7 @@ def collision_by(
         fld: the field at the collision step.
         robot_velocity: the robot's velocity ``(vx, vy)`` [m/s] at that step.
         pedestrians: indices of the pedestrians (:func:`pedestrian_ids`).
+        was_present: per body, whether it existed one step before (``None``: all did).
 
     Returns:
         ``"robot"``, ``"pedestrian"`` or ``"obstacle"``.
@@ -202,6 +208,7 @@ def collision_by(
     bvy = float(fld.velocities[body, 1]) + omega * (tx - cx)
     robot_in = robot_velocity[0] * nx + robot_velocity[1] * ny
     body_in = -(bvx * nx + bvy * ny)
-    if robot_in > body_in:
+    appeared = was_present is not None and not bool(was_present[body])
+    if robot_in > body_in and not appeared:
         return "robot"
     return "pedestrian" if bool(np.isin(body, pedestrians)) else "obstacle"
