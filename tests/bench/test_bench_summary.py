@@ -8,7 +8,7 @@ from typing import Any
 import pytest
 
 from uvnav.bench.store import ResultsStore
-from uvnav.bench.summary import SUMMARY_COLUMNS, controller_summary
+from uvnav.bench.summary import FAILURE_COLUMNS, SUMMARY_COLUMNS, controller_summary, failure_rows
 
 
 def _metrics(status: str, **social: Any) -> dict[str, Any]:
@@ -53,3 +53,30 @@ def test_social_columns(tmp_path: Path) -> None:
     for col in ("min_separation", "too_close_frequency", "intrusion_time", "path_irregularity",
                 "pedestrian_collision_share"):  # fmt: skip
         assert other[col] is None
+
+
+def test_failure_rows_give_seed_and_cause(tmp_path: Path) -> None:
+    """Every episode that did not succeed, sorted by its key, with who closed the gap or why."""
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        cid = store.campaign("c")
+        add = store.add_episode
+        add(cid, scenario="s/0003", controller="law", seed=3, status="collision",
+            metrics=_metrics("collision", collision_by="robot"))  # fmt: skip
+        add(cid, scenario="s/0001", controller="law", seed=1, status="success",
+            metrics=_metrics("success"))  # fmt: skip
+        add(cid, scenario="s/0002", controller="law", seed=2, status="collision",
+            metrics=_metrics("collision", collision_by="pedestrian"))  # fmt: skip
+        add(cid, scenario="s/0004", controller="law", seed=4, status="timeout",
+            metrics=_metrics("timeout"))  # fmt: skip
+        add(cid, scenario="s/0005", controller="law", seed=5, status="refused",
+            error="speed bound 2 m/s >= V_max 1 m/s\nmore")  # fmt: skip
+        rows = failure_rows(store, "c")
+        assert failure_rows(store, "nothing") == []
+    assert all(tuple(r) == FAILURE_COLUMNS for r in rows)
+    assert [(r["seed"], r["cause"]) for r in rows] == [
+        (2, "pedestrian-driven"),
+        (3, "robot-driven"),
+        (4, "timeout"),
+        (5, "refused: speed bound 2 m/s >= V_max 1 m/s"),
+    ]
+    assert rows[0]["min_clearance"] == 0.1 and rows[-1]["min_clearance"] is None

@@ -88,6 +88,35 @@ def test_bench_prints_the_per_controller_table(campaign: Path, tmp_path: Path) -
     assert rows[1]["detour_ratio"] >= 1.0 and rows[1]["decision_us_median"] > 0
 
 
+def test_bench_failures_lists_each_failed_episode(tmp_path: Path) -> None:
+    """--failures: one row per episode that did not succeed, with its seed and cause; also in
+    the JSON record, and from a finished campaign with --resume (nothing runs again)."""
+    path = tmp_path / "c.yaml"
+    path.write_text(CAMPAIGN.replace("cli-small", "fails").replace("[0, 2]", "[0, 4]"))
+    db = tmp_path / "r.sqlite"
+    res = runner.invoke(
+        app, ["bench", str(path), "--db", str(db), "--workers", "1", "--failures"],
+        env={"COLUMNS": "160"},
+    )  # fmt: skip
+    assert res.exit_code == 0, res.output
+    fresh = invoke("bench", str(path), "--db", str(db), "--resume", "--failures", "--json")
+    record = json.loads(fresh.stdout)
+    assert record["ran"] == 0
+    failed = record["failures"]
+    assert failed, "straight-v1 collides on random-ch2 seeds 0-3"
+    assert {f["controller"] for f in failed} == {"straight-v1"}
+    for f in failed:
+        assert f["status"] in ("collision", "timeout")
+        assert f["cause"] in ("robot-driven", "obstacle-driven", "timeout")
+    assert f"{len(failed)} episode(s) did not succeed" in res.stdout
+    lines = res.stdout.splitlines()
+    for f in failed:
+        assert any(f["scenario"] in ln and f["cause"] in ln for ln in lines), f
+    assert "failures" not in json.loads(
+        invoke("bench", str(path), "--db", str(db), "--resume", "--json").stdout
+    )
+
+
 def assert_one_line_error(result: Any, code: int, *fragments: str) -> str:
     assert result.exit_code == code, result.output
     lines = result.stderr.strip().splitlines()

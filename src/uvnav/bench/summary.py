@@ -28,6 +28,11 @@ One row per (controller, parameter set), over every stored episode of the campai
 
 The rows are computed from the episodes sorted by their resume key, so the same stored episodes give
 bit-identical numbers whatever order the engine finished them in.
+
+:func:`failure_rows` lists the episodes that did not succeed, one row each with its seed and cause
+(``uvnav bench --failures``): a collision's cause is who closed the gap (``robot-driven``,
+``pedestrian-driven``, ``obstacle-driven``, :mod:`uvnav.sim.social`), else the status
+(``timeout``, ``refused``, ``error``) with the stored reason.
 """
 
 from __future__ import annotations
@@ -119,6 +124,46 @@ def controller_summary(store: ResultsStore, campaign: int | str) -> list[dict[st
         )
     rows.sort(key=lambda r: (r["controller"], r["params"]))
     return rows
+
+
+#: Columns of a failure row, in display order.
+FAILURE_COLUMNS = ("controller", "params", "scenario", "seed", "status", "cause", "min_clearance")
+
+
+def _cause(row: Any) -> str:
+    """Why one stored episode failed: who closed the gap at a collision, else its status and the
+    stored reason (refused, error)."""
+    status = str(row["status"])
+    if status == "collision":
+        by = row["collision_by"]
+        return f"{by}-driven" if isinstance(by, str) and by else "collision"
+    reason = row["error"]
+    if isinstance(reason, str) and reason.strip():
+        return f"{status}: {reason.strip().splitlines()[0]}"
+    return status
+
+
+def failure_rows(store: ResultsStore, campaign: int | str) -> list[dict[str, Any]]:
+    """Every episode of one campaign that did not succeed, sorted by controller, params,
+    scenario and seed: the keys of :data:`FAILURE_COLUMNS` (``min_clearance`` [m], ``None``
+    where the episode did not run)."""
+    df = store.episodes_frame(campaign)
+    if df.empty:
+        return []
+    bad = df[~df["success"].fillna(False).astype(bool)]
+    bad = bad.sort_values(["controller", "params_hash", "scenario", "seed"], kind="mergesort")
+    return [
+        {
+            "controller": str(r["controller"]),
+            "params": params_text(str(r["params"])),
+            "scenario": str(r["scenario"]),
+            "seed": int(r["seed"]),
+            "status": str(r["status"]),
+            "cause": _cause(r),
+            "min_clearance": _num(r["min_clearance"]),
+        }
+        for _, r in bad.iterrows()
+    ]
 
 
 def _social(ok: Any) -> dict[str, float | None]:

@@ -867,6 +867,15 @@ def bench(
             "--json", help="Print one JSON object (the run and the summary) instead of the table."
         ),
     ] = False,
+    failures: Annotated[
+        bool,
+        typer.Option(
+            "--failures",
+            help="Also list every episode that did not succeed: seed and cause (who closed the "
+            "gap at a collision, or timeout / refused / error).  With --resume on a finished "
+            "campaign: only the listing.",
+        ),
+    ] = False,
 ) -> None:
     """Run a benchmark campaign into a results database, then print a per-controller summary.
 
@@ -880,7 +889,7 @@ def bench(
     from uvnav.bench.ray_engine import EngineUnavailableError, import_ray
     from uvnav.bench.spec import load_campaign, run_campaign_spec
     from uvnav.bench.store import ResultsStore, StoreInUseError
-    from uvnav.bench.summary import SUMMARY_COLUMNS, controller_summary
+    from uvnav.bench.summary import SUMMARY_COLUMNS, controller_summary, failure_rows
 
     if engine not in ENGINES:
         raise CliError(f"--engine {engine!r}: expected one of {', '.join(ENGINES)}")
@@ -927,6 +936,7 @@ def bench(
             raise typer.Exit(130) from None
         elapsed = time.perf_counter() - tic
         rows = controller_summary(store, spec.name)
+        failed = failure_rows(store, spec.name) if failures else []
         first_error = _first_error(store, spec.name) if result.errors else None
     rate = result.ran / elapsed if result.ran and elapsed > 0 else None
     if json_out:
@@ -944,6 +954,8 @@ def bench(
             "controllers": rows,
             "first_error": first_error,
         }
+        if failures:
+            record["failures"] = failed
         typer.echo(_dumps(record))
         _fail_on_errors(result.errors, first_error)
         return
@@ -970,12 +982,36 @@ def bench(
         )
         table.add_row(_text(label), *(_text(c) for c in r))
     _console().print(table)
+    if failures:
+        _print_failures(failed)
     speed = f", {rate:.2f} episodes/s" if rate is not None else ""
     typer.echo(
         f"ran {result.ran} episode(s) ({result.errors} error(s)), skipped {result.skipped} already "
         f"stored, in {elapsed:.1f} s{speed} on {engine} × {n_workers}; results in {db}"
     )
     _fail_on_errors(result.errors, first_error)
+
+
+def _print_failures(rows: list[dict[str, Any]]) -> None:
+    """The episodes that did not succeed, one line each (``uvnav bench --failures``)."""
+    from rich import box
+    from rich.table import Table
+
+    table = Table(
+        title=f"{len(rows)} episode(s) did not succeed",
+        box=box.SIMPLE_HEAD,
+        pad_edge=False,
+        collapse_padding=True,
+    )
+    for head in ("controller", "scenario", "seed"):
+        table.add_column(head, overflow="fold")
+    table.add_column("cause", overflow="fold", ratio=1)
+    table.add_column("clearance\n[m]", justify="right", no_wrap=True)
+    for r in rows:
+        law = r["controller"] if r["params"] == "-" else f"{r['controller']} {r['params']}"
+        gap = "-" if r["min_clearance"] is None else f"{r['min_clearance']:.3f}"
+        table.add_row(*(_text(x) for x in (law, r["scenario"], str(r["seed"]), r["cause"], gap)))
+    _console().print(table)
 
 
 def _first_error(store: Any, campaign: str) -> str | None:
