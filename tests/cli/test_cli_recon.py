@@ -44,6 +44,18 @@ def test_recon_plan_writes_plan_files(tmp_path: Path) -> None:
     gj = json.loads((out / "trajectory.geojson").read_text())
     assert {f["properties"]["uav"] for f in gj["features"]} == {0, 1, 2}
     assert json.loads((out / "plan.json").read_text())["n_waypoints"] == s["n_waypoints"]
+    assert s["coverage_grid_visible"] == 1.0 and s["check_grid_step"] == 0.5
+
+
+def test_recon_plan_table_quotes_the_independent_check(tmp_path: Path) -> None:
+    """The summary table quotes the 0.5 m ground-truth grid, not the planning DEM nodes."""
+    args = ["recon", "plan", "--synthetic", "2", "--area", "150", "--radius", "30"]
+    res = runner.invoke(app, [*args, "--out", str(tmp_path), "--no-figures"],
+                        env={"COLUMNS": "100"})  # fmt: skip
+    assert res.exit_code == 0, res.output
+    line = next(ln for ln in res.output.splitlines() if "0.5 m grid" in ln)
+    assert "100.00 %" in line and "nodes" not in res.output
+    assert "ground outside every footprint" in res.output
 
 
 def test_recon_plan_figures(tmp_path: Path) -> None:

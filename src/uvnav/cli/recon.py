@@ -296,8 +296,12 @@ def plan_cmd(
             f"{s['altitude_min']:.1f} / {s['altitude_mean']:.1f} / {s['altitude_max']:.1f}",
         ),
         (
-            "coverage of visible / of all nodes",
-            f"{100 * s['coverage_visible']:.2f} % / {100 * s['coverage_all']:.2f} %",
+            f"coverage, {s['check_grid_step']:g} m grid (visible at Z_max / all)",
+            f"{100 * s['coverage_grid_visible']:.2f} % / {100 * s['coverage_grid_all']:.2f} %",
+        ),
+        (
+            "ground outside every footprint [m²]",
+            f"{s['polygon_uncovered_m2']:.2f}",
         ),
         (
             "TSP / spiral tour length [m]",
