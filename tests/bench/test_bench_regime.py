@@ -111,6 +111,20 @@ def test_cells_from_the_store(small_map: Path) -> None:
             assert s.beyond == (s.law == "zhang2019-v1" and c.speed_ratio >= 1.0)
 
 
+def test_leaders_name_the_best_law_per_regime(small_map: Path) -> None:
+    with ResultsStore(small_map, readonly=True) as store:
+        stats = rg.cell_stats(store)
+    rows = rg.leaders(stats)
+    assert [r["regime"] for r in rows] == [
+        "4 × 0.5 V_max, invisible, exact sensing",
+        "4 × 1.5 V_max, invisible, exact sensing",
+    ]
+    for r, laws in zip(rows, stats.values(), strict=True):
+        best, _ = rg.ranking(laws)
+        assert r["best"] == rg._name(best[0]) and r["tied"] == str(len(best) - 1)
+        assert r["success"].startswith(f"{best[0].success.p:.0%} [")
+
+
 def test_family_table_compares_laws_on_equal_seeds(tmp_path: Path) -> None:
     db = tmp_path / "uvnav.sqlite"
     jobs = [Job(controller="straight-v1", seed=g, generator_seed=g) for g in range(6)]

@@ -403,6 +403,31 @@ def recommend(regime_label: str, stats: Sequence[CellStats]) -> str:
     return text
 
 
+def leaders(stats_by_cell: dict[Regime, list[CellStats]]) -> list[dict[str, str]]:
+    """One short row per regime for a console: the regime, the law that succeeds most often
+    with its rate and 95 % interval, and how many other laws the evidence cannot separate from
+    it (:func:`ranking`); the paragraphs of :func:`recommend` are the report's."""
+    rows = []
+    for cell, stats in stats_by_cell.items():
+        best, _ = ranking(stats)
+        if not best:
+            continue
+        top = best[0]
+        rows.append(
+            {
+                "regime": (
+                    f"{cell.n_humans} × {cell.speed_ratio:g} V_max, "
+                    f"{'visible' if cell.visible else 'invisible'}, {cell.sensing}"
+                ),
+                "best": _name(top),
+                "success": _pct(top.success),
+                "robot_driven": f"{top.robot_collision.p:.0%}",
+                "tied": str(len(best) - 1),
+            }
+        )
+    return rows
+
+
 # --------------------------------------------------------------------- law x scene family
 
 
@@ -495,6 +520,7 @@ __all__ = [
     "cell_stats",
     "equal_seeds",
     "family_table",
+    "leaders",
     "ranking",
     "recommend",
     "regime_jobs",

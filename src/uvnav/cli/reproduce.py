@@ -110,12 +110,15 @@ def reproduce_cmd(
         report_path = _write_report(out.db_path, report, load_sections(saved))
     from rich.table import Table
 
-    table = Table(title=f"{out.section.title}: thesis reported vs uvnav measured")
-    for col in _COLUMNS:
-        table.add_column(col, justify="right" if col in ("thesis", "measured") else "left")
-    for row in out.section.rows:
-        table.add_row(*(_text(_fmt(row.get(col))) for col in _COLUMNS))
-    _console().print(table)
+    if out.section.rows:
+        table = Table(title=f"{out.section.title}: thesis reported vs uvnav measured")
+        for col in _COLUMNS:
+            table.add_column(col, justify="right" if col in ("thesis", "measured") else "left")
+        for row in out.section.rows:
+            table.add_row(*(_text(_fmt(row.get(col))) for col in _COLUMNS))
+        _console().print(table)
+    if chapter == "regime":
+        _print_regime_leaders(out.db_path)
     for f in out.failures[:20]:
         typer.echo(f"failure: {f}")
     if len(out.failures) > 20:
@@ -123,6 +126,35 @@ def reproduce_cmd(
     n_files = len(out.section.figures) + len(out.section.links)
     typer.echo(f"wrote {out.db_path}")
     typer.echo(f"wrote {report_path} ({n_files} file(s) in the {chapter} section)")
+
+
+def _print_regime_leaders(db: Path) -> None:
+    """The regime map on one screen: per regime the law that succeeds most often."""
+    from rich import box
+    from rich.table import Table
+
+    from uvnav.bench.regime import cell_stats, leaders
+    from uvnav.bench.store import ResultsStore
+
+    with ResultsStore(db, readonly=True) as store:
+        rows = leaders(cell_stats(store))
+    table = Table(
+        title="Where each law wins: the best success per regime (95 % interval)",
+        caption="tied: other laws whose interval overlaps the best one's; "
+        "the report gives each regime's paragraph and heat maps",
+        box=box.SIMPLE_HEAD,
+        pad_edge=False,
+        collapse_padding=True,
+    )
+    table.add_column("humans × speed, robot, sensing", overflow="fold", ratio=1)
+    table.add_column("best law", overflow="fold")
+    table.add_column("success", no_wrap=True, justify="right")
+    table.add_column("robot-\ndriven", justify="right")
+    table.add_column("tied", justify="right")
+    for r in rows:
+        cells = (r["regime"], r["best"], r["success"], r["robot_driven"], r["tied"])
+        table.add_row(*(_text(c) for c in cells))
+    _console().print(table)
 
 
 def _write_report(db: Path, report: Path, sections: list[Any]) -> Path:
