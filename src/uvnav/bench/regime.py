@@ -40,7 +40,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.campaign import Job, run_campaign
+from uvnav.bench.campaign import Job
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
 
@@ -178,7 +178,7 @@ def run_regime_map(
     Raises:
         StaleCampaignError: the stored campaign was made by other code.
     """
-    from uvnav.bench.reproduce import DB_NAME, _check_campaigns, code_fingerprint
+    from uvnav.bench.reproduce import DB_NAME, code_fingerprint, run_checked
     from uvnav.bench.reproduce_crowds import crowd_laws
 
     tic = time.perf_counter()
@@ -198,21 +198,14 @@ def run_regime_map(
     }
     jobs = regime_jobs(run_laws, grid, range(start_seed, start_seed + n))
     with ResultsStore(db_path) as store:
-        _check_campaigns(store, {CAMPAIGN: cfg})
-        run = run_campaign(store, CAMPAIGN, jobs, config=cfg, workers=workers, progress=progress)
+        done = run_checked(store, [(CAMPAIGN, cfg, jobs)], workers=workers, progress=progress)
     return RegimeSummary(
         db_path=db_path,
         laws=run_laws,
         cells=grid,
         seeds=n,
         full=full,
-        campaign={
-            "jobs": run.total,
-            "ran": run.ran,
-            "skipped": run.skipped,
-            "errors": run.errors,
-            "wall_time": round(run.wall_time, 2),
-        },
+        campaign=done[CAMPAIGN],
         wall_time=time.perf_counter() - tic,
     )
 

@@ -251,6 +251,29 @@ def _check_campaigns(store: ResultsStore, configs: dict[str, dict[str, Any]]) ->
         )
 
 
+def run_checked(
+    store: ResultsStore,
+    plans: Sequence[tuple[str, dict[str, Any], list[Job]]],
+    *,
+    workers: int,
+    progress: bool,
+    statuses: bool = False,
+) -> dict[str, dict[str, Any]]:
+    """Check the stored campaigns of ``plans`` ((name, config, jobs); :func:`_check_campaigns`),
+    then run each; returns name -> its counts: jobs, ran, skipped, errors, the status counts (with
+    ``statuses``) and the wall time [s]."""
+    _check_campaigns(store, {name: cfg for name, cfg, _ in plans})
+    out: dict[str, dict[str, Any]] = {}
+    for name, cfg, jobs in plans:
+        run = run_campaign(store, name, jobs, config=cfg, workers=workers, progress=progress)
+        counts: dict[str, Any] = {"jobs": run.total, "ran": run.ran, "skipped": run.skipped}
+        counts["errors"] = run.errors
+        if statuses:
+            counts["statuses"] = dict(run.statuses)
+        out[name] = {**counts, "wall_time": round(run.wall_time, 2)}
+    return out
+
+
 def _fmt_m(x: Any, digits: int = 2) -> str:
     if x is None or not np.isfinite(float(x)):
         return "n/a"
@@ -616,17 +639,9 @@ def reproduce(
                     ],
                 )
             )
-        _check_campaigns(store, {name: cfg for name, cfg, _ in plans})
-        for name, cfg, jobs in plans:
-            run = run_campaign(store, name, jobs, config=cfg, workers=workers, progress=progress)
-            summary_campaigns[name] = {
-                "jobs": run.total,
-                "ran": run.ran,
-                "skipped": run.skipped,
-                "errors": run.errors,
-                "statuses": dict(run.statuses),
-                "wall_time": round(run.wall_time, 2),
-            }
+        summary_campaigns.update(
+            run_checked(store, plans, workers=workers, progress=progress, statuses=True)
+        )
 
         straight: float | None = None
         if COMPARISON_SCENE in scenes:

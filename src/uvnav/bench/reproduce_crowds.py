@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.campaign import Job, run_campaign
+from uvnav.bench.campaign import Job
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
 
@@ -133,7 +133,7 @@ def reproduce_crowds(
     Raises:
         StaleCampaignError: a stored crowd campaign was made by other code.
     """
-    from uvnav.bench.reproduce import DB_NAME, _check_campaigns, code_fingerprint
+    from uvnav.bench.reproduce import DB_NAME, code_fingerprint, run_checked
 
     tic = time.perf_counter()
     results_dir = Path(results_dir)
@@ -165,18 +165,8 @@ def reproduce_crowds(
                 crowd_jobs(over, run_cases, beyond_assumptions=True),
             )
         )
-    done: dict[str, dict[str, Any]] = {}
     with ResultsStore(db_path) as store:
-        _check_campaigns(store, {name: cfg for name, cfg, _ in plans})
-        for name, cfg, jobs in plans:
-            run = run_campaign(store, name, jobs, config=cfg, workers=workers, progress=progress)
-            done[name] = {
-                "jobs": run.total,
-                "ran": run.ran,
-                "skipped": run.skipped,
-                "errors": run.errors,
-                "wall_time": round(run.wall_time, 2),
-            }
+        done = run_checked(store, plans, workers=workers, progress=progress)
         table = crowd_rows(store, cases=run_cases, laws=main, beyond=over)
     return CrowdsSummary(
         table=table,
