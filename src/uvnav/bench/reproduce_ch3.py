@@ -218,6 +218,39 @@ def horizon_errors(
     return out
 
 
+def ar_usage(family: str, seeds: Sequence[int]) -> dict[str, float]:
+    """How often ``PREDICTION_LAW`` with AR prediction actually used an AR model: over its
+    decisions on ``family:<seed>`` (rates estimated) that predicted a body's motion (M2), the
+    share whose velocity prediction came from AR fits (``"ar"`` or ``"mixed"``) rather than the
+    constant-velocity fallback (fewer than ``min_samples`` samples of the body, or rejected fits).
+
+    Returns:
+        ``{"decisions": count, "ar_share": fraction (nan for none)}``."""
+    from uvnav.controllers.base3d import make_controller3d
+    from uvnav.core import BaseProbe
+    from uvnav.scenarios import load_scenario
+    from uvnav.sim.episode3d import run_episode3d
+
+    class _Use(BaseProbe):
+        def __init__(self) -> None:
+            self.total = 0
+            self.ar = 0
+
+        def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
+            for _v, _u, model in (getattr(law, "predictions", None) or {}).values():
+                self.total += 1
+                self.ar += model in ("ar", "mixed")
+
+    use = _Use()
+    for g in seeds:
+        sc: Any = load_scenario(f"{family}:{g}")
+        setup = sc.build(g, velocities="estimated")
+        law = make_controller3d(PREDICTION_LAW)
+        run_episode3d(setup, law, np.random.default_rng(g), record=False, probes=(use,))
+    share = use.ar / use.total if use.total else float("nan")
+    return {"decisions": float(use.total), "ar_share": share}
+
+
 def prediction_jobs(n_seeds: int, start_seed: int = 0) -> list[tuple[str, str, int, str, bool]]:
     """The ``ch3-prediction`` episodes: every family x arm x seed, ``PREDICTION_LAW``."""
     return [
@@ -253,13 +286,19 @@ def prediction_study(
 ) -> dict[str, Any]:
     """What prediction buys (module docstring, item 4): the ``ch3-prediction`` episodes the
     store lacks are run and stored; returns ``{"errors": {family: horizon_errors},
-    "closed_loop": closed_loop_rates, "seeds": n}``."""
+    "closed_loop": closed_loop_rates, "usage": {family: ar_usage}, "seeds": n}`` (the usage
+    episodes run again every call: their counts are not stored)."""
     jobs = prediction_jobs(n_seeds, start_seed)
     config = {"chapter": 3, "law": PREDICTION_LAW, "seeds": n_seeds}
     _store_jobs(store, PREDICTION_CAMPAIGN, config, jobs, workers, progress)
     frame = _requested(store.episodes_frame(PREDICTION_CAMPAIGN), jobs)
     errors = {fam: horizon_errors(motion) for fam, motion in PREDICTION_FAMILIES.items()}
-    return {"errors": errors, "closed_loop": closed_loop_rates(frame), "seeds": n_seeds}
+    seeds = range(start_seed, start_seed + n_seeds)
+    usage = {fam: ar_usage(fam, seeds) for fam in PREDICTION_FAMILIES}
+    return {
+        "errors": errors, "closed_loop": closed_loop_rates(frame), "usage": usage,
+        "seeds": n_seeds,
+    }  # fmt: skip
 
 
 def prediction_rows(study: dict[str, Any]) -> list[dict[str, str]]:
@@ -298,6 +337,15 @@ def prediction_rows(study: dict[str, Any]) -> list[dict[str, str]]:
             "measured": f"{' / '.join(parts)} of {n}",
             "note": f"mean min clearance: {clear}",
         })  # fmt: skip
+        use = study.get("usage", {}).get(fam)
+        if use is not None:
+            rows.append({
+                "quantity": f"{fam}: M2 predictions made by AR fits (not the fallback)",
+                "thesis": "",
+                "measured": f"{100 * use['ar_share']:.1f}% of {int(use['decisions'])}",
+                "note": "the rest: constant velocity (under 12 samples of the body, or "
+                        "fits rejected)",
+            })  # fmt: skip
     return rows
 
 
@@ -317,6 +365,11 @@ def prediction_finding(study: dict[str, Any]) -> str:
         gains.append(ar - cv)
         succ.append(f"{100 * ar:.1f}% / {100 * cv:.1f}% / {100 * orc:.1f}% on {fam}")
     n = int(study.get("seeds", 0))
+    usage = study.get("usage", {})
+    used = ""
+    if usage:
+        shares = "; ".join(f"{100 * u['ar_share']:.0f}% on {f}" for f, u in usage.items())
+        used = f" (AR fits made only {shares} of its M2 predictions, the rest constant velocity)"
     if all(abs(g) < 0.5 / max(n, 1) for g in gains):
         verdict = "so in closed loop AR prediction buys nothing measurable"
     elif all(g >= 0 for g in gains):
@@ -326,7 +379,7 @@ def prediction_finding(study: dict[str, Any]) -> str:
     return (
         f"AR prediction cuts the one-step velocity error against constant velocity by "
         f"{' and '.join(cuts)}, but {PREDICTION_LAW} succeeds in {'; '.join(succ)} of {n} "
-        f"seeds each (AR / constant velocity / oracle), {verdict}."
+        f"seeds each (AR / constant velocity / oracle){used}, {verdict}."
     )
 
 
