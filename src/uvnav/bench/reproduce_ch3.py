@@ -350,16 +350,23 @@ def prediction_rows(study: dict[str, Any]) -> list[dict[str, str]]:
 
 
 def prediction_finding(study: dict[str, Any]) -> str:
-    """One sentence from :func:`prediction_study`'s numbers: how much AR cuts the one-step
-    velocity error on each family, and whether that shows in the closed-loop success."""
+    """One sentence from :func:`prediction_study`'s numbers: AR's one-step velocity error as a
+    share of constant velocity's on each family, the closed-loop success of the three arms, how
+    often the law's AR fits were used, and whether AR changed the success rate."""
     errors, cl = study["errors"], study["closed_loop"]
-    cuts = []
+    fams = list(errors)
+
+    def both(parts: list[str]) -> str:
+        return " and ".join(parts)
+
+    shares = []
     for fam, e in errors.items():
         ratio = e["v1_ar"] / e["v1_cv"] if e["v1_cv"] > 0 else float("nan")
-        cuts.append(f"{100 * (1 - ratio):.0f}% on {fam}")
+        whose = "" if shares else " of constant velocity's"
+        shares.append(f"{100 * ratio:.0f}%{whose} on {fam}")
     succ = []
     gains = []
-    for fam in errors:
+    for fam in fams:
         ar, cv, orc = (cl.get(f"{fam}|{a}", {}).get("success", float("nan"))
                        for a in ("predicted", "constant", "known"))  # fmt: skip
         gains.append(ar - cv)
@@ -368,18 +375,21 @@ def prediction_finding(study: dict[str, Any]) -> str:
     usage = study.get("usage", {})
     used = ""
     if usage:
-        shares = "; ".join(f"{100 * u['ar_share']:.0f}% on {f}" for f, u in usage.items())
-        used = f" (AR fits made only {shares} of its M2 predictions, the rest constant velocity)"
+        pct = both([f"{100 * usage[f]['ar_share']:.0f}%" for f in fams if f in usage])
+        used = (
+            f", its AR fits making {pct} of its M2 predictions (the rest fell back to constant "
+            "velocity)"
+        )
     if all(abs(g) < 0.5 / max(n, 1) for g in gains):
-        verdict = "so in closed loop AR prediction buys nothing measurable"
+        conj, verdict = "yet", "in closed loop AR prediction buys nothing measurable"
     elif all(g >= 0 for g in gains):
-        verdict = "and in closed loop AR prediction raises the success rate"
+        conj, verdict = "and", "AR prediction raises the closed-loop success rate"
     else:
-        verdict = "and in closed loop AR prediction does not consistently help"
+        conj, verdict = "and", "AR prediction does not consistently help in closed loop"
     return (
-        f"AR prediction cuts the one-step velocity error against constant velocity by "
-        f"{' and '.join(cuts)}, but {PREDICTION_LAW} succeeds in {'; '.join(succ)} of {n} "
-        f"seeds each (AR / constant velocity / oracle){used}, {verdict}."
+        f"AR prediction's one-step velocity error is {both(shares)}, {conj} {PREDICTION_LAW} "
+        f"(AR / constant velocity / oracle, {n} seeds per family) succeeds in {both(succ)}"
+        f"{used}: {verdict}."
     )
 
 
