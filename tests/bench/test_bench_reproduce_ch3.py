@@ -46,7 +46,7 @@ def test_the_finding_is_one_sentence_from_the_numbers() -> None:
     assert "is 50% of constant velocity's on random-ch3 and 50% on random-ch3-periodic" in same
     assert "95.0% / 95.0% / 100.0% on random-ch3 and" in same
     assert "buys nothing measurable" in same and "making 10% and 10% of its M2" in same
-    assert "raises the success rate" in r3.prediction_finding(_study(1.0, 0.9, 1.0))
+    assert "raises the closed-loop success rate" in r3.prediction_finding(_study(1.0, 0.9, 1.0))
     assert "does not consistently help" in r3.prediction_finding(_study(0.9, 1.0, 1.0))
     rows = r3.prediction_rows(_study(0.95, 0.9, 1.0))
     succ = [r for r in rows if "success by prediction" in r["quantity"]]
