@@ -359,13 +359,13 @@ def prediction_finding(study: dict[str, Any]) -> str:
     def both(parts: list[str]) -> str:
         return " and ".join(parts)
 
-    shares = []
+    shares: list[str] = []
     for fam, e in errors.items():
         ratio = e["v1_ar"] / e["v1_cv"] if e["v1_cv"] > 0 else float("nan")
         whose = "" if shares else " of constant velocity's"
         shares.append(f"{100 * ratio:.0f}%{whose} on {fam}")
-    succ = []
-    gains = []
+    succ: list[str] = []
+    gains: list[float] = []
     for fam in fams:
         ar, cv, orc = (cl.get(f"{fam}|{a}", {}).get("success", float("nan"))
                        for a in ("predicted", "constant", "known"))  # fmt: skip
