@@ -14,9 +14,11 @@ from uvnav.bench.store import ResultsStore
 
 @pytest.fixture
 def no_prediction(monkeypatch: pytest.MonkeyPatch) -> None:
-    """Chapter 3's AR-vs-constant prediction errors take seconds and touch no store."""
+    """Chapter 3's AR-vs-constant prediction errors and the what-prediction-buys comparison
+    take seconds to minutes (tested in test_bench_reproduce_ch3)."""
     fake = {"ar_rms": 1.0, "constant_rms": 2.0, "series": 1.0, "ratio": 0.5}
     monkeypatch.setattr(r3, "prediction_errors", lambda: fake)
+    monkeypatch.setattr(r3, "prediction_study", lambda store, **kw: {})
 
 
 def _keys(db: Path, campaign: str) -> set[tuple[str, str, str, int]]:

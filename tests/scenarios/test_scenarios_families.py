@@ -147,6 +147,8 @@ def test_random_ch4_hard_speeds_and_counts_follow_the_parameters(
         ("random-ch2", {"nobstacles": 3}, "unknown parameter 'nobstacles' (known: n_obstacles"),
         ("random-ch2-edge", {"speed_ratio_max": 1.5}, "random-ch2-edge:0: params."),
         ("random-ch3", {"speed_ratio_max": 1.0}, "params.speed_ratio_max: must be < 1"),
+        ("random-ch3", {"motion": "sinusoidal"}, "params.motion"),
+        ("random-ch3-periodic", {"motion": 3}, "random-ch3-periodic:0: params.motion"),
         ("random-ch4", {"max_rate": [0.3, 0.1]}, "params.max_rate: need min <= max"),
         ("random-ch4-hard", {"rate": [0.3, 0.8], "speed_max": 0.3}, "not below V_max"),
     ],

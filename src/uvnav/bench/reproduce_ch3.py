@@ -11,10 +11,19 @@
    ``zhang2020-3d-v1``; the baselines use the finite differences as they are) — campaign
    ``ch3-random``; quick mode ``QUICK_SEEDS`` seeds, ``full=True`` ``FULL_SEEDS``;
 3. the one-step velocity prediction error of the AR models against constant velocity on the AR
-   motion of the random scenes' obstacles (sampled every T_s = 1 s).
+   motion of the random scenes' obstacles (sampled every T_s = 1 s);
+4. *what prediction buys* (issue 21): on the default family (``random-ch3``, slowly varying AR
+   motion) and on the periodic one (``random-ch3-periodic``, weaving / circling bodies whose
+   velocity is a noise-driven oscillator), the AR models' k-step velocity and position errors
+   against constant velocity (:func:`horizon_errors`), and ``zhang2020-3d-v1`` closed loop with
+   AR prediction (``prediction="ar"``), constant velocity (``prediction="last"``: the sensed rates
+   as they are) and the oracle (true rates) — campaign ``ch3-prediction``, at least
+   ``PREDICTION_MIN_SEEDS`` seeds per family; :func:`prediction_finding` turns the numbers into
+   the section's one sentence.
 
 Every episode is stored in the results database (SQLite, :class:`ResultsStore`), the controller
-column holding the law and ``params`` the motion knowledge (``{"motion": "known"|"predicted"}``);
+column holding the law and ``params`` the motion knowledge (``{"motion": "known"|"predicted"}``,
+and ``"constant"`` in ``ch3-prediction``);
 the table "thesis reported vs uvnav measured" is read back from the stored rows.  Figures are made
 by an injected renderer (``render=``; the CLI passes :func:`uvnav.viz.figures3d.render_ch3`), so
 this module never imports ``viz`` (DESIGN §1 layers).
@@ -44,6 +53,18 @@ RANDOM_FAMILY = "random-ch3"
 QUICK_SEEDS = 2
 FULL_SEEDS = 500
 MOTIONS: tuple[str, ...] = ("known", "predicted")
+PREDICTION_CAMPAIGN = "ch3-prediction"
+#: the law whose prediction is compared, the families (label prefix, ``motion`` of random-ch3)
+#: and the motion knowledge of each arm: AR prediction, constant velocity, oracle
+PREDICTION_LAW = "zhang2020-3d-v1"
+PREDICTION_FAMILIES: dict[str, str] = {"random-ch3": "ar", "random-ch3-periodic": "periodic"}
+PREDICTION_ARMS: dict[str, str] = {
+    "predicted": "AR prediction", "constant": "constant velocity", "known": "oracle",
+}  # fmt: skip
+#: the comparison runs at least this many seeds per family (more when the run asks for more)
+PREDICTION_MIN_SEEDS = 20
+#: horizons [periods T_s] of :func:`horizon_errors`
+HORIZONS: tuple[int, ...] = (1, 3)
 DB_NAME = "uvnav.sqlite"
 
 #: What the thesis reports for its Chapter 3 experiments (§3.4).
@@ -64,13 +85,20 @@ class Ch3Summary:
     prediction: dict[str, float]
     figures: list[Path] = field(default_factory=list)
     wall_time: float = 0.0
+    #: what prediction buys: :func:`horizon_errors` by family and closed-loop rates by
+    #: (family, arm), see :func:`prediction_study`
+    study: dict[str, Any] = field(default_factory=dict)
+    #: the one sentence of :func:`prediction_finding`
+    finding: str = ""
 
 
 Renderer = Callable[[Path, Path, list[tuple[str, str, Any]]], list[Path]]
 
 
 def run_one(job: tuple[str, str, int, str, bool]) -> dict[str, Any]:
-    """One episode: ``(scene name or generator label, controller, seed, motion, record)``.
+    """One episode: ``(scene name or generator label, controller, seed, motion, record)``;
+    ``motion`` is ``"known"`` (oracle), ``"predicted"`` (estimated rates, the law's own
+    prediction) or ``"constant"`` (estimated rates used as they are, ``prediction="last"``).
 
     Returns a row with the metrics, status, wall time and (when recorded) the trajectory."""
     from uvnav.controllers.base3d import make_controller3d
@@ -80,7 +108,9 @@ def run_one(job: tuple[str, str, int, str, bool]) -> dict[str, Any]:
     scene, ctrl, seed, motion, record = job
     sc: Any = load_scenario(scene)
     setup = sc.build(seed, velocities="known" if motion == "known" else "estimated")
-    c = make_controller3d(ctrl, oracle=motion == "known")
+    # "constant": the sensed (estimated) rates as they are, no AR models (zhang2020-3d-v1 only)
+    extra = {"prediction": "last"} if motion == "constant" else {}
+    c = make_controller3d(ctrl, oracle=motion == "known", **extra)
     tic = time.perf_counter()
     res, traj = run_episode3d(setup, c, np.random.default_rng(seed), record=record)
     return {
@@ -129,6 +159,238 @@ def prediction_errors(n_series: int = 20, length: int = 120) -> dict[str, float]
     ar = rms(np.concatenate(e_ar))
     cv = rms(np.concatenate(e_cv))
     return {"ar_rms": ar, "constant_rms": cv, "series": float(len(e_ar)), "ratio": ar / cv}
+
+
+def horizon_errors(
+    motion: str = "ar",
+    n_series: int = 20,
+    length: int = 120,
+    horizons: Sequence[int] = HORIZONS,
+    period: float = 1.0,
+) -> dict[str, float]:
+    """k-step prediction RMS errors of the AR models and of constant velocity on the bodies of
+    the ``random-ch3`` scenes with ``motion`` (one series per body of scenes 0, 1, ... until
+    ``n_series``, each ``length`` samples of the true velocity taken every ``period`` T_s [s],
+    the predictor of :func:`prediction_errors`).
+
+    After each sample v_i (from the predictor's ``min_samples`` on) both predict v_{i+k}: AR by
+    iterating (3.13), constant velocity by v_i.  A sample is held over its period, so the body
+    moves T_s (v_i + v_{i+1} + ... + v_{i+k-1}) in k periods; the position forecasts put the
+    predicted samples in that sum (v_i is known), so the k = 1 position error is 0.
+
+    Returns:
+        ``v{k}_ar``, ``v{k}_cv`` [m/s] and ``p{k}_ar``, ``p{k}_cv`` [m] for each k, and
+        ``series``."""
+    from uvnav.obstacles.motion3d import ObstacleState3D
+    from uvnav.prediction.autoregressive import ARPredictor, rms
+    from uvnav.scenarios.generators3d import random_ch3_scenario
+
+    kmax = max(horizons)
+    err: dict[str, list[np.ndarray]] = {
+        f"{q}{k}_{m}": [] for q in ("v", "p") for k in horizons for m in ("ar", "cv")
+    }
+    series = 0
+    seed = 0
+    while series < n_series:
+        setup = random_ch3_scenario(seed, motion=motion).build(seed)  # type: ignore[arg-type]
+        for ob in setup.obstacles:
+            st = ObstacleState3D(np.zeros(3))
+            y = np.array([ob.motion.rates(k * period, st)[0] for k in range(length)])
+            pred = ARPredictor(dim=3, max_lag=3, period=period)
+            for i in range(length - 1):
+                pred.observe(i * period, y[i])
+                if pred.n_samples < pred.min_samples:
+                    continue
+                ahead = pred.predict(kmax).mean  # (kmax, 3): v_{i+1} .. v_{i+kmax}
+                for k in horizons:
+                    if i + k >= length:
+                        continue
+                    truth = y[i + 1 : i + k + 1]
+                    err[f"v{k}_ar"].append(ahead[k - 1] - y[i + k])
+                    err[f"v{k}_cv"].append(y[i] - y[i + k])
+                    # positions: the first k - 1 predicted samples against the true ones
+                    err[f"p{k}_ar"].append(period * (ahead[: k - 1] - truth[: k - 1]).sum(0))
+                    err[f"p{k}_cv"].append(period * (y[i] - truth[: k - 1]).sum(0))
+            series += 1
+        seed += 1
+    out = {key: rms(np.array(v).reshape(-1, 3)) for key, v in err.items()}
+    out["series"] = float(series)
+    return out
+
+
+def ar_usage(family: str, seeds: Sequence[int]) -> dict[str, float]:
+    """How often ``PREDICTION_LAW`` with AR prediction actually used an AR model: over its
+    decisions on ``family:<seed>`` (rates estimated) that predicted a body's motion (M2), the
+    share whose velocity prediction came from AR fits (``"ar"`` or ``"mixed"``) rather than the
+    constant-velocity fallback (fewer than ``min_samples`` samples of the body, or rejected fits).
+
+    Returns:
+        ``{"decisions": count, "ar_share": fraction (nan for none)}``."""
+    from uvnav.controllers.base3d import make_controller3d
+    from uvnav.core import BaseProbe
+    from uvnav.scenarios import load_scenario
+    from uvnav.sim.episode3d import run_episode3d
+
+    class _Use(BaseProbe):
+        def __init__(self) -> None:
+            self.total = 0
+            self.ar = 0
+
+        def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
+            for _v, _u, model in (getattr(law, "predictions", None) or {}).values():
+                self.total += 1
+                self.ar += model in ("ar", "mixed")
+
+    use = _Use()
+    for g in seeds:
+        sc: Any = load_scenario(f"{family}:{g}")
+        setup = sc.build(g, velocities="estimated")
+        law = make_controller3d(PREDICTION_LAW)
+        run_episode3d(setup, law, np.random.default_rng(g), record=False, probes=(use,))
+    share = use.ar / use.total if use.total else float("nan")
+    return {"decisions": float(use.total), "ar_share": share}
+
+
+def prediction_jobs(n_seeds: int, start_seed: int = 0) -> list[tuple[str, str, int, str, bool]]:
+    """The ``ch3-prediction`` episodes: every family x arm x seed, ``PREDICTION_LAW``."""
+    return [
+        (f"{fam}:{g}", PREDICTION_LAW, g, arm, False)
+        for fam in PREDICTION_FAMILIES for g in range(start_seed, start_seed + n_seeds)
+        for arm in PREDICTION_ARMS
+    ]  # fmt: skip
+
+
+def closed_loop_rates(frame: Any) -> dict[str, dict[str, float]]:
+    """Success / collision rates and mean min clearance by ``"family|arm"`` of stored
+    ``ch3-prediction`` episodes (``frame`` from :meth:`ResultsStore.episodes_frame`)."""
+    out: dict[str, dict[str, float]] = {}
+    fam = frame["scenario"].astype(str).str.split(":").str[0]
+    arm = frame["params"].map(lambda p: json.loads(str(p)).get("motion", ""))
+    for (f, a), grp in frame.groupby([fam, arm]):
+        out[f"{f}|{a}"] = {
+            "n": float(len(grp)),
+            "success": float(grp["success"].astype(float).mean()),
+            "collision": float(grp["collision"].astype(float).mean()),
+            "min_clearance": float(grp["min_clearance"].astype(float).mean()),
+        }
+    return out
+
+
+def prediction_study(
+    store: ResultsStore,
+    *,
+    n_seeds: int,
+    start_seed: int = 0,
+    workers: int = 1,
+    progress: bool = False,
+) -> dict[str, Any]:
+    """What prediction buys (module docstring, item 4): the ``ch3-prediction`` episodes the
+    store lacks are run and stored; returns ``{"errors": {family: horizon_errors},
+    "closed_loop": closed_loop_rates, "usage": {family: ar_usage}, "seeds": n}`` (the usage
+    episodes run again every call: their counts are not stored)."""
+    jobs = prediction_jobs(n_seeds, start_seed)
+    config = {"chapter": 3, "law": PREDICTION_LAW, "seeds": n_seeds}
+    _store_jobs(store, PREDICTION_CAMPAIGN, config, jobs, workers, progress)
+    frame = _requested(store.episodes_frame(PREDICTION_CAMPAIGN), jobs)
+    errors = {fam: horizon_errors(motion) for fam, motion in PREDICTION_FAMILIES.items()}
+    seeds = range(start_seed, start_seed + n_seeds)
+    usage = {fam: ar_usage(fam, seeds) for fam in PREDICTION_FAMILIES}
+    return {
+        "errors": errors, "closed_loop": closed_loop_rates(frame), "usage": usage,
+        "seeds": n_seeds,
+    }  # fmt: skip
+
+
+def prediction_rows(study: dict[str, Any]) -> list[dict[str, str]]:
+    """The table rows of :func:`prediction_study`'s result."""
+    rows: list[dict[str, str]] = []
+    for fam, e in study["errors"].items():
+        for k in HORIZONS:
+            rows.append({
+                "quantity": f"{fam}: {k}-step velocity prediction RMS error [m/s]",
+                "thesis": "AR model (3.13)-(3.14), no numbers",
+                "measured": f"AR {e[f'v{k}_ar']:.4f} vs constant velocity {e[f'v{k}_cv']:.4f}",
+                "note": f"{int(e['series'])} body series, T_s = 1 s, true velocities",
+            })  # fmt: skip
+        k = max(HORIZONS)
+        rows.append({
+            "quantity": f"{fam}: {k} s position prediction RMS error [m]",
+            "thesis": "",
+            "measured": f"AR {e[f'p{k}_ar']:.4f} vs constant velocity {e[f'p{k}_cv']:.4f}",
+            "note": "positions from the predicted velocity samples",
+        })  # fmt: skip
+    cl = study["closed_loop"]
+    for fam in study["errors"]:
+        parts = []
+        for arm, label in PREDICTION_ARMS.items():
+            r = cl.get(f"{fam}|{arm}")
+            if r is not None:
+                parts.append(f"{label} {100 * r['success']:.1f}%")
+        n = int(next((r["n"] for key, r in cl.items() if key.startswith(f"{fam}|")), 0))
+        clear = ", ".join(
+            f"{PREDICTION_ARMS[a]} {cl[f'{fam}|{a}']['min_clearance']:.3f} m"
+            for a in PREDICTION_ARMS if f"{fam}|{a}" in cl
+        )  # fmt: skip
+        rows.append({
+            "quantity": f"{fam}: {PREDICTION_LAW} success by prediction",
+            "thesis": "",
+            "measured": f"{' / '.join(parts)} of {n}",
+            "note": f"mean min clearance: {clear}",
+        })  # fmt: skip
+        use = study.get("usage", {}).get(fam)
+        if use is not None:
+            rows.append({
+                "quantity": f"{fam}: M2 predictions made by AR fits (not the fallback)",
+                "thesis": "",
+                "measured": f"{100 * use['ar_share']:.1f}% of {int(use['decisions'])}",
+                "note": "the rest: constant velocity (under 12 samples of the body, or "
+                        "fits rejected)",
+            })  # fmt: skip
+    return rows
+
+
+def prediction_finding(study: dict[str, Any]) -> str:
+    """One sentence from :func:`prediction_study`'s numbers: AR's one-step velocity error as a
+    share of constant velocity's on each family, the closed-loop success of the three arms, how
+    often the law's AR fits were used, and whether AR changed the success rate."""
+    errors, cl = study["errors"], study["closed_loop"]
+    fams = list(errors)
+
+    def both(parts: list[str]) -> str:
+        return " and ".join(parts)
+
+    shares: list[str] = []
+    for fam, e in errors.items():
+        ratio = e["v1_ar"] / e["v1_cv"] if e["v1_cv"] > 0 else float("nan")
+        whose = "" if shares else " of constant velocity's"
+        shares.append(f"{100 * ratio:.0f}%{whose} on {fam}")
+    succ: list[str] = []
+    gains: list[float] = []
+    for fam in fams:
+        ar, cv, orc = (cl.get(f"{fam}|{a}", {}).get("success", float("nan"))
+                       for a in ("predicted", "constant", "known"))  # fmt: skip
+        gains.append(ar - cv)
+        succ.append(f"{100 * ar:.1f}% / {100 * cv:.1f}% / {100 * orc:.1f}% on {fam}")
+    n = int(study.get("seeds", 0))
+    usage = study.get("usage", {})
+    used = ""
+    if usage:
+        pct = both([f"{100 * usage[f]['ar_share']:.0f}%" for f in fams if f in usage])
+        used = (
+            f", its AR fits making {pct} of its M2 predictions (the rest fell back to constant "
+            "velocity)"
+        )
+    if all(abs(g) < 0.5 / max(n, 1) for g in gains):
+        conj, verdict = "yet", "in closed loop AR prediction buys nothing measurable"
+    elif all(g >= 0 for g in gains):
+        conj, verdict = "and", "AR prediction raises the closed-loop success rate"
+    else:
+        conj, verdict = "and", "AR prediction does not consistently help in closed loop"
+    return (
+        f"AR prediction's one-step velocity error is {both(shares)}, {conj} {PREDICTION_LAW} "
+        f"(AR / constant velocity / oracle, {n} seeds per family) succeeds in {both(succ)}"
+        f"{used}: {verdict}."
+    )
 
 
 def _job_key(job: tuple[str, str, int, str, bool]) -> tuple[str, str, str, int]:
@@ -192,6 +454,7 @@ def reproduce_ch3(
     start_seed: int = 0,
     controllers: Sequence[str] = CONTROLLERS_3D,
     render: Renderer | None = None,
+    prediction_seeds: int | None = None,
 ) -> Ch3Summary:
     """Chapter 3 scenes, random campaign (known vs predicted motion), prediction errors, table.
 
@@ -205,6 +468,8 @@ def reproduce_ch3(
         start_seed: first random scene (scenes ``start_seed .. start_seed + n - 1``).
         controllers: the 3D laws to compare.
         render: figure renderer ``(db_path, report_dir, recorded) -> figure paths``.
+        prediction_seeds: seeds per family of the prediction comparison (default: the random
+            campaign's, at least ``PREDICTION_MIN_SEEDS``); 0 skips it.
 
     Resumable and additive: episodes already in the store are not run again (the thesis scenes
     run again only for the figures' trajectories), and another run's episodes (other
@@ -234,6 +499,15 @@ def reproduce_ch3(
                     progress)  # fmt: skip
         frame = _requested(store.episodes_frame(RANDOM_CAMPAIGN), rand_jobs)
         scene_frame = _requested(store.episodes_frame(SCENES_CAMPAIGN), scene_jobs)
+        n_pred = (
+            prediction_seeds if prediction_seeds is not None
+            else max(n_seeds, PREDICTION_MIN_SEEDS)
+        )  # fmt: skip
+        study = (
+            prediction_study(store, n_seeds=n_pred, start_seed=start_seed, workers=workers,
+                             progress=progress)
+            if n_pred > 0 else {}
+        )  # fmt: skip
     pred = prediction_errors()
     table: list[dict[str, str]] = []
     for _, row in scene_frame.iterrows():
@@ -273,8 +547,14 @@ def reproduce_ch3(
         "measured": f"AR {pred['ar_rms']:.4f} vs constant velocity {pred['constant_rms']:.4f}",
         "note": f"{int(pred['series'])} obstacle series of the random scenes",
     })  # fmt: skip
+    finding = ""
+    if study:
+        table += prediction_rows(study)
+        finding = prediction_finding(study)
     figures: list[Path] = []
     if render is not None:
         recorded = [(r["scene"], r["controller"], r["trajectory"]) for r in scene_rows]
         figures = render(db_path, Path(report_dir), recorded)
-    return Ch3Summary(table, db_path, failures, pred, figures, time.perf_counter() - tic)
+    return Ch3Summary(
+        table, db_path, failures, pred, figures, time.perf_counter() - tic, study, finding
+    )

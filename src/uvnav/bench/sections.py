@@ -192,12 +192,23 @@ def ch3_section(
         f"each law, obstacle motion known (oracle) and predicted; the AR one-step velocity "
         "prediction is compared with constant velocity."
     )
+    study = getattr(summary, "study", None) or {}
+    if study:
+        intro += (
+            f" What prediction buys: on random-ch3 and random-ch3-periodic (weaving / circling "
+            f"bodies), AR vs constant-velocity k-step errors, and {r3.PREDICTION_LAW} with AR "
+            f"prediction, constant velocity and the oracle on {int(study.get('seeds', 0))} seeds "
+            "per family."
+        )
     sec = ChapterSection(
         key="ch3",
         title="Chapter 3 — a 3D flying robot with AR prediction",
         intro=intro,
         rows=rows_of(summary.table),
     )
+    finding = getattr(summary, "finding", "")
+    if finding:
+        sec.notes.append(finding)
     sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch3_caption))
     if not sec.figures:
         sec.notes.append("No figures: the run had no Chapter 3 renderer.")

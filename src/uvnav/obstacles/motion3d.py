@@ -10,6 +10,12 @@ and rotates about its mass centre with rotation vector u_i(t), subject to (3.9)
   the thesis) around a mean, held constant within a period, with their norms kept in the bounds
   of (3.9)-(3.10) (a draw outside is scaled back to the bound): the "slowly varying" motion the
   AR predictor of :mod:`uvnav.prediction.autoregressive` is built for;
+* :class:`PeriodicMotion3D` — weaving or circling about a mean velocity,
+  sampled every ``period`` T_s and held within it like the AR motion, its norm kept below the
+  bound of (3.9): the oscillation o_k = v_k - v_mean follows o_k = 2 r cos(w T_s) o_{k-1} -
+  r^2 o_{k-2} + sigma e_k — a sinusoid for r = 1, sigma = 0, else an oscillator driven by noise
+  (an AR(2) process with complex roots) — the case where (3.13)-(3.14) should beat constant
+  velocity;
 * :class:`Waypoints3D` — a scripted path through points at a fixed speed, with a fixed spin.
 
 Integration of one step ``dt`` with (v, u) held is exact: ``c += v dt``,
@@ -132,6 +138,91 @@ class ARMotion3D:
             if len(self._v_hist) > 16:
                 del self._v_hist[0], self._u_hist[0]
         return self._v_hist[-1], self._u_hist[-1]
+
+
+@dataclass
+class PeriodicMotion3D:
+    """Weaving / circling motion about a mean velocity, sampled every ``period`` T_s.
+
+    The sample of period k (from ``t_k = k T_s``) is ``v_k = v_mean + o_k`` with the oscillation
+
+        o_k = 2 r cos(w T_s) o_{k-1} - r^2 o_{k-2} + v_sigma e_k,    w = 2 pi / osc_period,
+
+    e_k standard normal (3,), started on ``o(t) = amp_cos cos(w t + phase) + amp_sin sin(w t +
+    phase)`` at t = 0 and t = -T_s.  With ``damping`` r = 1 and ``v_sigma`` = 0 this is that
+    sinusoid exactly (its samples obey the recursion); r < 1 and v_sigma > 0 make it an
+    oscillator driven by noise, an AR(2) process with complex roots r exp(+-i w T_s).  A sample is
+    scaled back to ``v_max`` by norm when above it (3.9) and held within its period, as
+    :class:`ARMotion3D` holds its samples; the rotation ``rotation_rate`` is constant.  With
+    ``v_sigma = 0`` no random draws are made.
+
+    Attributes:
+        v_mean: mean velocity [m/s], (3,).
+        amp_cos, amp_sin: initial oscillation amplitudes [m/s], (3,) each; one of them zero gives
+            a weave along a line, two orthogonal ones of equal norm a circle (a helix about
+            ``v_mean``).
+        osc_period: period of the oscillation [s].
+        phase: phase at t = 0 [rad].
+        v_max: bound on ||v_i|| [m/s] ((3.9)).
+        rotation_rate: u_i [rad/s], (3,), world frame.
+        period: sampling period T_s [s].
+        damping: r in (0, 1], the modulus of the recursion's roots.
+        v_sigma: std of the innovation e_k's scale [m/s] (needs ``rng`` when > 0).
+        rng: the generator of the innovations.
+    """
+
+    v_mean: FloatArray
+    amp_cos: FloatArray
+    amp_sin: FloatArray
+    osc_period: float
+    phase: float = 0.0
+    v_max: float = 0.5
+    rotation_rate: FloatArray = field(default_factory=lambda: np.zeros(3))
+    period: float = 1.0
+    damping: float = 1.0
+    v_sigma: float = 0.0
+    rng: np.random.Generator | None = None
+    _k: int = field(default=-1, init=False)
+    _osc: tuple[FloatArray, FloatArray] = field(
+        default_factory=lambda: (np.zeros(3), np.zeros(3)), init=False
+    )
+    _v: FloatArray = field(default_factory=lambda: np.zeros(3), init=False)
+
+    def __post_init__(self) -> None:
+        if self.v_sigma > 0 and self.rng is None:
+            raise ValueError("v_sigma > 0 needs an rng")
+        if not 0.0 < self.damping <= 1.0:
+            raise ValueError(f"damping must be in (0, 1] (got {self.damping!r})")
+
+    def _sinusoid(self, t: float) -> FloatArray:
+        a = 2.0 * math.pi / self.osc_period * t + self.phase
+        return np.asarray(
+            math.cos(a) * np.asarray(self.amp_cos, float)
+            + math.sin(a) * np.asarray(self.amp_sin, float)
+        )
+
+    def _next(self) -> FloatArray:
+        """The oscillation o_k of the next period (advances the recursion)."""
+        self._k += 1
+        if self._k == 0:
+            o = self._sinusoid(0.0)
+            self._osc = (o, self._sinusoid(-self.period))
+            return o
+        prev, prev2 = self._osc
+        c = math.cos(2.0 * math.pi / self.osc_period * self.period)
+        r = self.damping
+        o = 2.0 * r * c * prev - r * r * prev2
+        if self.v_sigma > 0 and self.rng is not None:
+            o = o + self.v_sigma * self.rng.standard_normal(3)
+        self._osc = (o, prev)
+        return np.asarray(o)
+
+    def rates(self, t: float, state: ObstacleState3D) -> tuple[FloatArray, FloatArray]:
+        k = math.floor(t / self.period + 1e-9)
+        while self._k < k:  # one sample per period, in order, whatever the step
+            o = self._next()
+            self._v = _clip_norm(np.asarray(self.v_mean, float) + o, 0.0, self.v_max)
+        return self._v, np.asarray(self.rotation_rate, float)
 
 
 @dataclass

@@ -662,6 +662,9 @@ GENERATORS: dict[str, Callable[..., Any]] = {
     "crowd-hotel": partial(crowd_crossing_scenario, dataset="hotel"),
     "crowd-file": crowd_file_scenario,
     "random-ch3": random_ch3_scenario,
+    "random-ch3-periodic": generator_variant(
+        "random-ch3-periodic", random_ch3_scenario, motion="periodic"
+    ),
     "crowdnav-circle": crowdnav_circle,
     "crowdnav-square": crowdnav_square,
 }

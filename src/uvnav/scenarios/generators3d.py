@@ -10,6 +10,19 @@ gets there (lateral and vertical offsets within +-1.2 m): they are in the way.  
 ||v_i|| <= 0.5 V_max and ||u_i|| <= 0.3 U_max, so (3.9)-(3.10) hold with room to spare.  Bodies
 start at least 3 m apart surface to surface (the thesis excludes narrow gaps, Fig. 3.1(c)) and
 3 m from S and E.  Everything is drawn from ``np.random.default_rng(seed)``.
+
+``motion="periodic"`` (generator ``random-ch3-periodic``) keeps every draw above — the same bodies,
+start poses, mean velocities and rotations — and makes each body weave or circle about its mean
+velocity (:class:`~uvnav.obstacles.motion3d.PeriodicMotion3D`): oscillation period 6-12 s, an
+initial amplitude of 0.12-0.3 m/s perpendicular to the mean velocity (a weave along one direction,
+or a circle of that radius, 50/50), capped at 95% of sqrt((``speed_ratio_max`` V_max)^2 -
+||v_mean||^2) so that the undisturbed speed stays below the bound; the oscillation, sampled every
+T_s = 1 s, is driven by noise: o_k = 2 r cos(w T_s) o_{k-1} - r^2 o_{k-2} + sigma e_k with r = 0.98,
+sigma = 0.015 m/s (e_k from the episode's generator, as the AR noise is) — an AR(2) process with
+complex roots, the motion AR prediction (3.13)-(3.14) is built for and constant velocity lags
+behind.  A sample above ``speed_ratio_max`` V_max is scaled back to it (3.9); the rotation is the
+constant mean one (3.10).  The family's own draws come from a second generator,
+``np.random.default_rng([seed, 1])``, so the default family's stream is untouched.
 """
 
 from __future__ import annotations
@@ -57,6 +70,48 @@ CH3_TURN_RATIO = 0.3  # largest body rotation rate / U_max
 #: from the same generator (9 of seeds 0-199 were short after the first); a scene complete after
 #: the first is drawn as it always was
 _RETRY_ROUNDS = 10
+
+
+#: ``motion`` values of :func:`random_ch3_scenario`
+CH3_MOTIONS: tuple[str, ...] = ("ar", "periodic")
+#: periodic family: oscillation period range [s] and amplitude range [m/s] (at the default
+#: ``speed_ratio_max``; scaled with it)
+CH3_OSC_PERIOD = (6.0, 12.0)
+CH3_OSC_AMPLITUDE = (0.12, 0.3)
+#: periodic family: the oscillator's root modulus and innovation std [m/s] (per 1 s sample)
+CH3_OSC_DAMPING = 0.98
+CH3_OSC_SIGMA = 0.015
+
+
+def _periodic(
+    rng: np.random.Generator, motion: dict[str, Any], speed_ratio_max: float
+) -> dict[str, Any]:
+    """The periodic variant of one body's AR ``motion`` entry: the same mean velocity and
+    rotation, a weave or a circle perpendicular to the mean velocity (module docstring)."""
+    v_mean = np.array(motion["v_mean"], float)
+    v_bound = speed_ratio_max * V_MAX
+    axis = v_mean / max(float(np.linalg.norm(v_mean)), 1e-12)
+    e1 = np.cross(axis, rng.normal(size=3))
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(axis, e1)
+    scale = speed_ratio_max / CH3_SPEED_RATIO
+    amp = float(rng.uniform(*CH3_OSC_AMPLITUDE)) * scale
+    room = math.sqrt(max(v_bound**2 - float(v_mean @ v_mean), 0.0))
+    amp = min(amp, 0.95 * room)
+    circle = bool(rng.random() < 0.5)
+    return {
+        "type": "periodic",
+        "v_mean": motion["v_mean"],
+        "amp_cos": [round(float(x), 4) for x in amp * e1],
+        "amp_sin": [round(float(x), 4) for x in (amp * e2 if circle else np.zeros(3))],
+        "osc_period": round(float(rng.uniform(*CH3_OSC_PERIOD)), 3),
+        "phase": round(float(rng.uniform(-math.pi, math.pi)), 4),
+        "v_max": v_bound,
+        "rotation_rate": motion["u_mean"],
+        "period": motion["period"],
+        "damping": CH3_OSC_DAMPING,
+        "v_sigma": CH3_OSC_SIGMA,
+    }
 
 
 def _ch3_round(
@@ -140,6 +195,10 @@ def random_ch3_scenario(
         Field(description="obstacle velocities sensed by finite differences, or known"),
     ] = "estimated",
     t_max: Annotated[float, Field(gt=0, description="time limit [s]")] = 90.0,
+    motion: Annotated[
+        Literal["ar", "periodic"],
+        Field(description="bodies' motion: slowly varying AR(2), or weaving/circling (periodic)"),
+    ] = "ar",
 ) -> Scenario3D:
     """Random 3D scene number ``seed`` (see the module docstring).
 
@@ -147,6 +206,8 @@ def random_ch3_scenario(
     (3.9)-(3.10): the AR motion's bounds become ``speed_ratio_max`` V_max and
     ``turn_rate_ratio_max`` U_max, and the drawn mean speed (0.1-0.4 m/s by default) and mean
     rotation rate (0-0.2 rad/s) scale with them.  The defaults draw the family as it always was.
+    ``motion="periodic"`` turns the same scene's bodies into weaving / circling ones (module
+    docstring); the scene is then named ``random-ch3-periodic:<seed>``.
 
     Args:
         seed: the scene's seed (the same seed gives the same scene).
@@ -179,9 +240,17 @@ def random_ch3_scenario(
         raise PlacementError(
             f"random-ch3:{seed}", best, n, f"{1 + _RETRY_ROUNDS} placements of 400 draws each"
         )
+    name = f"random-ch3:{seed}"
+    description = "random 3D scene of thesis Ch. 3 (moving, rotating non-convex bodies)"
+    if motion == "periodic":
+        osc = np.random.default_rng([seed, 1])
+        for ob in obstacles:
+            ob["motion"] = _periodic(osc, ob["motion"], speed_ratio_max)
+        name = f"random-ch3-periodic:{seed}"
+        description = "random 3D scene of thesis Ch. 3 with weaving / circling bodies"
     data = {
-        "name": f"random-ch3:{seed}",
-        "description": "random 3D scene of thesis Ch. 3 (moving, rotating non-convex bodies)",
+        "name": name,
+        "description": description,
         "dim": 3,
         "dt": 0.05,
         "control_period": 0.1,
@@ -198,4 +267,4 @@ def random_ch3_scenario(
         "obstacles": obstacles,
         "controller": {"name": "zhang2020-3d-v1"},
     }
-    return scenario3d_from_dict(data, f"random-ch3:{seed}")
+    return scenario3d_from_dict(data, name)

@@ -39,6 +39,7 @@ from uvnav.obstacles.motion3d import (
     MotionModel3D,
     Obstacle3D,
     ObstacleState3D,
+    PeriodicMotion3D,
     Waypoints3D,
 )
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
@@ -208,6 +209,34 @@ class ARMotion3DSpec(_Model):
         )  # fmt: skip
 
 
+class PeriodicMotion3DSpec(_Model):
+    """Weaving / circling motion about a mean velocity, sampled every ``period`` (see
+    :class:`PeriodicMotion3D`)."""
+
+    type: Literal["periodic"]
+    v_mean: Vec3 = Field(description="mean velocity [m/s]")
+    amp_cos: Vec3 = Field((0.0, 0.0, 0.0), description="cosine amplitude of v_i [m/s]")
+    amp_sin: Vec3 = Field((0.0, 0.0, 0.0), description="sine amplitude of v_i [m/s]")
+    osc_period: float = Field(gt=0, description="period of the oscillation [s]")
+    phase: float = Field(0.0, description="phase at t = 0 [rad]")
+    v_max: float = Field(0.5, gt=0, description="upper bound of ||v_i|| [m/s]")
+    rotation_rate: Vec3 = Field((0.0, 0.0, 0.0), description="u_i [rad/s]")
+    period: float = Field(1.0, gt=0, description="sampling period T_s [s]")
+    damping: float = Field(1.0, gt=0, le=1, description="modulus r of the oscillator's roots")
+    v_sigma: float = Field(0.0, ge=0, description="innovation std of the oscillation [m/s]")
+
+    def bounds(self) -> tuple[float, float]:
+        return self.v_max, float(np.linalg.norm(self.rotation_rate))
+
+    def build(self, rng: np.random.Generator) -> MotionModel3D:
+        return PeriodicMotion3D(
+            v_mean=np.array(self.v_mean, float), amp_cos=np.array(self.amp_cos, float),
+            amp_sin=np.array(self.amp_sin, float), osc_period=self.osc_period, phase=self.phase,
+            v_max=self.v_max, rotation_rate=np.array(self.rotation_rate, float),
+            period=self.period, damping=self.damping, v_sigma=self.v_sigma, rng=rng,
+        )  # fmt: skip
+
+
 class Waypoints3DSpec(_Model):
     type: Literal["waypoints"]
     points: list[Point3] = Field(min_length=1, description="waypoints [m]")
@@ -226,11 +255,13 @@ class Waypoints3DSpec(_Model):
 
 
 Motion3DSpec = Annotated[
-    ConstantMotion3DSpec | ARMotion3DSpec | Waypoints3DSpec, Field(discriminator="type")
+    ConstantMotion3DSpec | ARMotion3DSpec | PeriodicMotion3DSpec | Waypoints3DSpec,
+    Field(discriminator="type"),
 ]
 MOTION3D_TYPES: dict[str, type[BaseModel]] = {
     "constant": ConstantMotion3DSpec,
     "ar": ARMotion3DSpec,
+    "periodic": PeriodicMotion3DSpec,
     "waypoints": Waypoints3DSpec,
 }
 
