@@ -13,7 +13,7 @@ STAMP_TEST := $(VENV)/.installed-test
 # Debian's Chromium for the report's browser test (playwright drives it; no browser download)
 CHROMIUM   ?= chromium
 
-.PHONY: run test fuzz bench lint clean venv browser
+.PHONY: run test fuzz bench lint clean venv browser evidence
 
 $(PY):
 	$(PYTHON) -m venv $(VENV) || python3 -m venv $(VENV)
@@ -53,6 +53,10 @@ lint: $(STAMP_TEST)
 	$(VENV)/bin/ruff format --check src tests benchmarks
 	$(VENV)/bin/mypy
 	$(VENV)/bin/lint-imports
+
+# every measured figure quoted in docs/thesis-notes.md, regenerated (both sizes) into the record
+evidence: $(STAMP_RUN)
+	$(PY) -m uvnav.bench.evidence --write docs/evidence.json
 
 bench: $(STAMP_RUN)
 	$(PY) benchmarks/run_benchmarks.py --out benchmarks/results

@@ -2,18 +2,49 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
+
+import numpy as np
 
 from uvnav.bench.reproduce_ch4 import (
     HARD_CAMPAIGN,
+    _table,
     ch4_job,
     failures,
     run_jobs,
     stored_rows,
     summarise,
+    target_approach_check,
 )
 from uvnav.bench.store import ResultsStore
+from uvnav.sim.episode_uuv2d import Uuv2dTrajectory
 from uvnav.sim.metrics import METRIC_NAMES
+
+
+def _run(modes: list[str]) -> Uuv2dTrajectory:
+    """A straight run along y = x at 1 m/s, one decision every second with ``modes``."""
+    t = np.arange(0.0, 6.01, 0.5)
+    poses = np.column_stack([t / math.sqrt(2), t / math.sqrt(2), np.full_like(t, math.pi / 4)])
+    return Uuv2dTrajectory(
+        times=t, poses=poses, clearance=10.0 - t, decision_times=np.arange(0.0, 6.0, 1.0),
+        outlines=[], commands=np.zeros((6, 2)), modes=modes, decisions=[],
+    )  # fmt: skip
+
+
+def test_fig47_target_approach_check_and_its_row() -> None:
+    held = target_approach_check(_run(["M1"] * 5 + ["M2"]))
+    assert held["target_approach"] == 1.0 and held["first_avoidance_s"] == 5.0
+    assert held["x_m"] == held["y_m"] == 4.0 / math.sqrt(2) and held["clearance_m"] == 6.0
+    broken = target_approach_check(_run(["M1", "M1", "M2", "M1", "M1", "M1"]))
+    assert broken["target_approach"] == 0.0 and broken["first_avoidance_s"] == 2.0
+    never = target_approach_check(_run(["M1"] * 6))
+    assert math.isnan(never["first_avoidance_s"])
+    (row,) = _table([], [], held)
+    assert row["thesis"] == "t = 0...4 in target approach"
+    assert row["measured"].startswith("held; at (2.83, 2.83) m at t = 4 s")
+    assert _table([], [], broken)[0]["measured"].startswith("NOT held")
+    assert _table([], []) == []
 
 
 def test_jobs_are_stored_resumed_and_summarised(tmp_path: Path) -> None:

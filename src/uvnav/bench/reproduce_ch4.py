@@ -28,7 +28,8 @@ resume (a re-run skips the stored episodes) and only add to the store: no run de
 another run's episodes. The summary (``results_dir/ch4/summary.json``) and the table "thesis
 reported vs uvnav measured" are computed from the stored rows, never typed in. The thesis reports
 no numbers for Chapter 4 (only Figs. 4.7-4.9: the vehicle reaches E without collision), so the
-table's thesis column states that.
+table's thesis column states that; Fig. 4.7's one checkable statement, "t = 0...4 in target
+approach", is a row of its own (:func:`target_approach_check` on the recorded run).
 
 Figures are made by a renderer injected by the caller (``render=``; the CLI passes
 :func:`uvnav.viz.figures_ch4.render_ch4`), because ``bench`` (layer 6) must not import ``viz``.
@@ -59,10 +60,12 @@ from uvnav.bench.store import ResultsStore
 from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.base import make_law
 from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin, load_uuv2d_scenario
-from uvnav.sim.episode_uuv2d import Uuv2dResult, run_uuv2d_episode
+from uvnav.sim.episode_uuv2d import Uuv2dResult, Uuv2dTrajectory, run_uuv2d_episode
 from uvnav.sim.metrics import METRIC_NAMES
 
 LAW = "zhang2022-uuv2d-v1"
+#: Fig. 4.7's scene and the end [s] of its "t = 0...4 in target approach"
+FIG47_SCENE, FIG47_UNTIL = "thesis-ch4-fig4-7-approach", 4.0
 BASELINES: tuple[str, ...] = ("apf-uuv2d-v1", "zhang2019-uuv2d-v1")
 LAWS: tuple[str, ...] = (LAW, *BASELINES)
 #: (range noise std [m], dropout probability) levels of the sweep
@@ -245,10 +248,44 @@ class Ch4Summary:
     hard_failures: list[dict[str, Any]] = field(default_factory=list)
 
 
+def target_approach_check(traj: Uuv2dTrajectory, until: float = FIG47_UNTIL) -> dict[str, float]:
+    """Fig. 4.7's claim on a recorded run: whether every decision up to ``until`` [s] was target
+    approach (mode ``M1``), where the vehicle is at ``until`` (``x_m``, ``y_m`` [m]), its
+    clearance there [m] and the time of its first avoidance decision [s] (NaN: none)."""
+    times = np.asarray(traj.decision_times, dtype=float)
+    early = [m for m, t in zip(traj.modes, times, strict=True) if t <= until + 1e-9]
+    later = [t for m, t in zip(traj.modes, times, strict=True) if m != "M1"]
+    i = min(int(np.searchsorted(traj.times, until - 1e-9)), len(traj.times) - 1)
+    return {
+        "target_approach": float(all(m == "M1" for m in early)),
+        "x_m": float(traj.poses[i, 0]),
+        "y_m": float(traj.poses[i, 1]),
+        "clearance_m": float(traj.clearance[i]),
+        "first_avoidance_s": float(later[0]) if later else math.nan,
+    }
+
+
+def _fig47_row(check: dict[str, float]) -> dict[str, Any]:
+    held = "held" if check["target_approach"] else "NOT held"
+    return {
+        "quantity": f"Ch.4 Fig. 4.7: target approach for t = 0...{FIG47_UNTIL:g} s",
+        "thesis": f"t = 0...{FIG47_UNTIL:g} in target approach",
+        "measured": (
+            f"{held}; at ({check['x_m']:.2f}, {check['y_m']:.2f}) m at t = {FIG47_UNTIL:g} s"
+        ),
+        "note": (
+            f"{LAW}; clearance {check['clearance_m']:.2f} m there; first avoidance decision at "
+            f"t = {check['first_avoidance_s']:.1f} s"
+        ),
+    }
+
+
 def _table(
-    scene_rows: list[dict[str, Any]], campaign: list[dict[str, Any]]
+    scene_rows: list[dict[str, Any]],
+    campaign: list[dict[str, Any]],
+    fig47: dict[str, float] | None = None,
 ) -> list[dict[str, Any]]:
-    table: list[dict[str, Any]] = []
+    table: list[dict[str, Any]] = [] if fig47 is None else [_fig47_row(fig47)]
     for r in scene_rows:
         if r["law"] != LAW:
             continue
@@ -346,7 +383,9 @@ def reproduce_ch4(
     campaign = summarise(rows)
     fails = failures(rows_random)
     hard_fails = failures(rows_hard, law=None)
-    table = _table(scene_rows, campaign)
+    fig = scene_results.get((FIG47_SCENE, LAW))
+    traj = None if fig is None else fig.trajectory
+    table = _table(scene_rows, campaign, None if traj is None else target_approach_check(traj))
     summary_path = out_dir / "summary.json"
     summary_path.write_text(
         json.dumps(
@@ -383,4 +422,5 @@ __all__ = [
     "run_jobs",
     "stored_rows",
     "summarise",
+    "target_approach_check",
 ]

@@ -49,10 +49,13 @@ in docs/thesis-notes.md, where the reasons are given at more length):
    on the passing side), tilted outward in proportion to the penetration.
 7. *Speed.* The literal law is V_R = ||l_J|| / T_f with ||l_J||^2 = d_min^2 - (||v_i|| T_f)^2 (the
    identity below (2.15)), bounded below by ``min_speed`` and by 1.05 ||v_i|| (constraint (2.6)
-   needs the robot faster than the obstacle) and above by V_max: ``speed_law="tangent"``.  Measured
-   on the built-in scenes, it lets the robot crawl at the speed floor next to an obstacle that moves
-   the way it passes (Fig. 2.10 scene: 18.2 m and 35.7 s against 14.5 m and 20.5 s), and it is
-   less safe on the random Chapter-2 scenes (docs/thesis-notes.md), so the default is
+   needs the robot faster than the obstacle) and above by V_max: ``speed_law="tangent"``.  On the
+   Fig. 2.10 scene, whose disc moves the way the robot passes, it collides after
+   8.42 m [ev:ch2-notes.fig210_tangent_path_m] of path where the default arrives after
+   14.46 m [ev:ch2-notes.fig210_default_path_m], and it is less safe on the random Chapter-2
+   scenes (97.5 % [ev:ch2-notes.random_tangent_pct] success against
+   99 % [ev:ch2-notes.random_default_pct], seeds 0-199; ``python -m uvnav.bench.evidence``
+   regenerates these figures, docs/thesis-notes.md), so the default is
    ``speed_law="max"`` — V_max in M2 as in M1 — with ``turn_slowdown``: V_R scaled by cos(beta_J)
    (a unicycle cannot follow a direction change faster than U_max; slowing while turning keeps the
    turning radius V_R / U_max small), never below the same floor.
