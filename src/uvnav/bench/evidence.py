@@ -268,6 +268,70 @@ def _ch4_fig47(quick: bool) -> Figures:
     return target_approach_check(out.result.trajectory)
 
 
+@claim("ch5-literal", "the thesis's own Ch. 5 set-up, 50 and 150 samples (thesis-notes Ch. 5)")
+def _ch5_literal(quick: bool) -> Figures:
+    import numpy as np
+
+    from uvnav.bench.reproduce_ch5 import (
+        ACCEPTED_SAMPLES,
+        TEST_SEED,
+        THESIS_ERROR_RANGES,
+        _inside,
+        cached_dataset,
+        learning_row,
+        seed_succeeds,
+    )
+    from uvnav.learning.bpnn import BPNNConfig
+
+    test, _ = cached_dataset(500, TEST_SEED, None, None)
+    seeds = range(3 if quick else 50)
+    ref = THESIS_ERROR_RANGES[ACCEPTED_SAMPLES]
+    out: Figures = {"seeds": float(len(seeds))}
+    for n in (50, 150):
+        rows = [learning_row(n, s, test, BPNNConfig(), target_kind="readings")[0] for s in seeds]
+        net = [r["test_group"]["network"] for r in rows]
+        out[f"n{n}_succeed"] = float(sum(seed_succeeds(r) for r in rows))
+        for o in ("distance", "index"):
+            out[f"n{n}_{o}_lo_median"] = float(np.median([x[o]["lo"] for x in net]))
+            out[f"n{n}_{o}_hi_median"] = float(np.median([x[o]["hi"] for x in net]))
+            out[f"n{n}_{o}_inside"] = float(sum(_inside(x[o], ref[o]) for x in net))
+        ind = [r["independent"]["network"] for r in rows]
+        out[f"n{n}_independent_distance_mae"] = float(
+            np.median([x["distance"]["mae"] for x in ind])
+        )
+        out[f"n{n}_independent_index_right_pct"] = 100.0 * float(
+            np.median([x["index_accuracy"] for x in ind])
+        )
+    return out
+
+
+@claim("ch5-geometry", "Ch. 5 networks on the true geometry, 20 seeds (thesis-notes Ch. 5)")
+def _ch5_geometry(quick: bool) -> Figures:
+    import numpy as np
+
+    from uvnav.bench.reproduce_ch5 import TEST_SEED, cached_dataset, learning_row, seed_succeeds
+    from uvnav.learning.bpnn import VARIANTS, variant_config
+
+    test, _ = cached_dataset(500, TEST_SEED, None, None)
+    seeds = range(2 if quick else 20)
+    out: Figures = {"seeds": float(len(seeds))}
+    for variant in VARIANTS:
+        tag = variant.replace("-", "_")
+        for n in (50, 150):
+            rows = [learning_row(n, s, test, variant_config(variant))[0] for s in seeds]
+            ind = [r["independent"] for r in rows]
+            out[f"{tag}_n{n}_succeed"] = float(sum(seed_succeeds(r) for r in rows))
+            for who in ("network", "baseline"):
+                pre = f"{tag}_n{n}" if who == "network" else f"baseline_n{n}"
+                med = {
+                    "index_mae": np.median([x[who]["index"]["mae"] for x in ind]),
+                    "distance_mae": np.median([x[who]["distance"]["mae"] for x in ind]),
+                    "index_right_pct": 100.0 * np.median([x[who]["index_accuracy"] for x in ind]),
+                }
+                out.update({f"{pre}_{k}": float(v) for k, v in med.items()})
+    return out
+
+
 @claim("ch7-coverage", "Ch. 7 coverage on ground truth and Stage 1 counts (thesis-notes Ch. 7)")
 def _ch7_coverage(quick: bool) -> Figures:
     from uvnav.bench.reproduce_ch7 import RADII, SIZES, coverage_case
