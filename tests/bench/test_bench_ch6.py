@@ -35,7 +35,8 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     # the target-speed head drives DAgger with its own learned-speed throttle
     assert set(s.closed_loop) == {"cnn-learned-speed", "cnn-pi", "dagger1-learned-speed", "expert"}
     assert s.record["second_output"] == "target_speed" and s.record["val_target_speed_rmse"]
-    assert "target speed RMSE" in s.table[3]["note"]
+    two = next(r for r in s.table if r["quantity"].startswith("Ch6 validation MSE (steering +"))
+    assert "target speed RMSE" in two["note"]
     assert not list(tmp_path.glob("*.train-state.safetensors"))  # removed once models are saved
     # every closed-loop row keeps each track's metrics, and the means are theirs
     for name, row in s.closed_loop.items():
@@ -43,7 +44,7 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
         assert [t["seed"] for t in per] == [1000]
         assert row["return"] == pytest.approx(np.mean([t["return"] for t in per]))
     # the steering row compares eq. (6.1) with the thesis, by camera, with exact side labels
-    steer_row = s.table[2]
+    steer_row = next(r for r in s.table if "MSE of the steering, eq. (6.1)" in r["quantity"])
     assert steer_row["measured"] == f"{s.record['val_steering_mse'][-1]:.4f}"
     assert "side-image labels: exact" in steer_row["note"]
     assert set(s.record["val_steering_mse_by_camera"]) <= {"centre", "left", "right"}
@@ -56,6 +57,11 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     assert all(0.0 <= r["autonomy"] <= 1.0 for r in s.closed_loop.values())
     assert next(r["quantity"] for r in s.table).startswith("Ch6 frames before balancing")
     assert all("[quick size]" in r["quantity"] for r in s.table)
+    steer = next(r for r in s.table if "steering over all frames" in r["quantity"])
+    assert steer["thesis"] == "-1 / 1 / -0.009 / 0.204"
+    lo, hi, mean, std = (float(x) for x in steer["measured"].split(" / "))
+    assert lo == pytest.approx(s.steering_all.min(), abs=0.005) and lo <= mean <= hi and std >= 0
+    assert steer["note"].startswith(f"{s.steering_all.size} frames")
     assert (tmp_path / "ch6.json").is_file() and s.model_path.is_file()
     names = [name for name, *_ in s.augment_examples]
     assert names == ["flip", "brightness", "zoom"]

@@ -62,6 +62,8 @@ from uvnav.stages import Stages, write_atomic
 THESIS_VAL_MSE = 0.05
 THESIS_FRAMES = 17592
 THESIS_TRAIN, THESIS_VAL = 1199, 300
+#: the thesis's statistics of the recorded steering angle (§6.3, Fig. 6.4): min, max, mean, std
+THESIS_STEERING = (-1.0, 1.0, -0.009, 0.204)
 #: DAgger rounds of the full run: one, driven with the learned-speed throttle (measured on the 20
 #: held-out tracks from a 12-episode network: the readout alone 0.947 autonomy, after one round
 #: 1.00, and 1.00 on 20 more unseen tracks; in the 20-episode ``--full`` runs the readout alone
@@ -474,6 +476,24 @@ def reproduce_ch6(
     )
 
 
+def steering_row(steering: NDArray[np.float64], tag: str = "") -> dict[str, str]:
+    """Fig. 6.4's statistics of the recorded steering (normalised to [-1, 1]) beside the
+    thesis's, and the share of frames within 0.05 of straight (its "majority ... 0 degree")."""
+    st = np.asarray(steering, dtype=float)
+    if st.size == 0:
+        stats, near = "no frames", ""
+    else:
+        stats = f"{st.min():.2f} / {st.max():.2f} / {st.mean():.3f} / {st.std():.3f}"
+        near = f"; {100 * float(np.mean(np.abs(st) <= 0.05)):.1f} % of frames within 0.05 of 0"
+    lo, hi, mean, std = THESIS_STEERING
+    return {
+        "quantity": "Ch6 steering over all frames: min / max / mean / std (Fig. 6.4)" + tag,
+        "thesis": f"{lo:g} / {hi:g} / {mean:g} / {std:g}",
+        "measured": stats,
+        "note": f"{st.size} frames, before balancing{near}",
+    }
+
+
 def _table(
     data: Any,
     record: dict[str, Any],
@@ -500,6 +520,7 @@ def _table(
             "measured": str(data.n_frames),
             "note": f"CarRacing-v3 + forward camera, 3 cameras, {size['episodes']} episodes",
         },
+        steering_row(data.steering_all, tag),
         {
             "quantity": "Ch6 training / validation images" + tag,
             "thesis": f"{THESIS_TRAIN} / {THESIS_VAL}",
