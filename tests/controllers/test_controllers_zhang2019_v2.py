@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from uvnav.controllers import make_controller
@@ -305,6 +305,9 @@ def _random_scene(seed: int, n: int, polygons: bool) -> tuple[Observation, np.nd
 @settings(max_examples=80, deadline=None)
 @given(seed=st.integers(0, 10_000), n=st.integers(0, 14), unicycle=st.booleans(),
        polygons=st.booleans())  # fmt: skip
+# a square spinning at 0.45 rad/s: its linearly moving boundary points leave the bounding disc
+# over the horizon, and the loop's cull once skipped the contact the reference found at 3.996 s
+@example(seed=6129, n=1, unicycle=True, polygons=True)
 def test_loop_chooses_what_the_numpy_reference_chooses(
     seed: int, n: int, unicycle: bool, polygons: bool
 ) -> None:
@@ -337,3 +340,32 @@ def test_compiled_loop_chooses_what_plain_python_chooses(seed: int, n: int, poly
     finally:
         use_compiled(previous)
     np.testing.assert_allclose(fast.velocity, slow.velocity, atol=1e-9)
+
+
+def _noisy_crossing(seed: int) -> object:
+    from uvnav.scenarios.catalog import generate
+
+    params = {"n_humans": 10, "human_v_pref": 1.0, "robot_visible": False,
+              "velocities": "estimated", "position_noise": 0.1}  # fmt: skip
+    return generate("crowdnav-circle", seed, params)
+
+
+def test_tracker_leaves_exact_sensing_alone_and_helps_under_noise() -> None:
+    """With known rates the tracker changes nothing (the same episode, metric for metric); with
+    rates estimated from centres sensed with 0.1 m noise it filters them, and on the same ten
+    noisy crossings the tracked law reaches the goal more often."""
+    exact = resolve("crowdnav-circle:4")
+    law = "zhang2019-holonomic-v2"
+    on, off = (run_scene(exact, law, {"track_estimates": t}) for t in (True, False))
+    timing = ("decision_us_median", "decision_us_p99")
+    same = {k: v for k, v in on.metrics.items() if k not in timing}
+    assert on.status == off.status and same == {k: off.metrics[k] for k in same}
+    wins = {
+        t: sum(
+            run_scene(_noisy_crossing(s), law, {"track_estimates": t},  # type: ignore[arg-type]
+                      beyond_assumptions=True).status == "success"
+            for s in range(10)
+        )
+        for t in (False, True)
+    }  # fmt: skip
+    assert wins[True] > wins[False]

@@ -194,6 +194,29 @@ def _crowd_law(quick: bool) -> Figures:
     return out
 
 
+@claim("v2-tracking", "zhang2019-v2 with and without its tracker under noisy sensing (issue 19)")
+def _v2_tracking(quick: bool) -> Figures:
+    from uvnav.scenarios.catalog import generate
+    from uvnav.scenarios.episodes import run_scene
+
+    n = 10 if quick else 60
+    out: Figures = {"seeds": float(n)}
+    for speed in (0.5, 1.0, 1.5):
+        params = {"n_humans": 10, "human_v_pref": speed, "robot_visible": False,
+                  "velocities": "estimated", "position_noise": 0.1}  # fmt: skip
+        scenes = [generate("crowdnav-circle", s, params) for s in range(n)]
+        for track in (False, True):
+            runs = [
+                run_scene(r, "zhang2019-holonomic-v2", {"track_estimates": track},
+                          beyond_assumptions=True)
+                for r in scenes
+            ]  # fmt: skip
+            tag = f"speed{speed:g}".replace(".", "_") + ("_tracked" if track else "_raw")
+            out[f"{tag}_success"] = _count(runs, "success")
+            out[f"{tag}_collision"] = _count(runs, "collision")
+    return out
+
+
 def _eth_specs(n: int) -> list[Any]:
     """The ETH crossings at V_max 1.2 m/s, seeds 0..n-1 of ``crowd-eth`` and ``crowd-hotel``
     (recorded people outrun the robot at times: every law runs beyond (2.6), as in

@@ -376,7 +376,7 @@ def approach_speed(v_max: float, u_max: float, dist: float, beta: float) -> floa
     >>> approach_speed(1.0, 1.0, 10.0, 0.5)
     1.0
     >>> round(approach_speed(1.0, 1.0, 0.5, 1.2), 4)
-    0.2681
+    0.2682
     """
     v = v_max
     sin_b = abs(np.sin(beta))

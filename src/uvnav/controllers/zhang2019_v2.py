@@ -62,6 +62,7 @@ about a third of it reading the observation's readings into arrays
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from dataclasses import dataclass
 from itertools import chain
@@ -83,6 +84,7 @@ from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.contact import candidate_risk, candidate_risk_compiled, decide_compiled
 from uvnav.geometry.kernels3d import numba_enabled
+from uvnav.prediction.tracking import CentreTracker
 from uvnav.sensors.observation import Observation, ObstacleReading
 
 IntArray = np.ndarray
@@ -107,6 +109,12 @@ class Zhang2019V2Params:
             still checked against every candidate).
         comfort: clearance [m] beyond the margin below which a candidate pays
             ``w_comfort`` [1/s] per metre, by its smallest clearance over ``comfort_horizon`` [s].
+        track_estimates: where the bodies' rates are *estimated* (finite differences of sensed
+            centres), plan on the centres and velocities of a constant-velocity Kalman filter per
+            body (:class:`uvnav.prediction.tracking.CentreTracker`); readings with known rates
+            are used as they are.
+        track_position_std: the filter's assumed centre noise [m].
+        track_accel_std: the filter's assumed white-noise acceleration of a body [m/s^2].
     """
 
     horizon: float = 4.0
@@ -122,11 +130,22 @@ class Zhang2019V2Params:
     comfort: float = 0.3
     comfort_horizon: float = 1.0
     w_comfort: float = 10.0
+    track_estimates: bool = True
+    track_position_std: float = 0.1
+    track_accel_std: float = 1.0
 
     def __post_init__(self) -> None:
         check_params(
             self,
-            positive=("horizon", "forecast_horizon", "spacing", "min_ttc", "comfort_horizon"),
+            positive=(
+                "horizon",
+                "forecast_horizon",
+                "spacing",
+                "min_ttc",
+                "comfort_horizon",
+                "track_position_std",
+                "track_accel_std",
+            ),
             non_negative=("safety_margin", "w_ttc", "w_change", "comfort", "w_comfort"),
         )
         for name in ("n_headings", "max_tangent_bodies"):
@@ -351,8 +370,11 @@ def plan(
     near = () if discs_only else tuple(obs.obstacles[k] for k in keep)
     headings = extra_headings(p.n_headings, v_pref, v_prev)
     pad = robot_radius + p.safety_margin
-    # a polygon's boundary discs reach half a spacing past its bounding disc
-    body_r = scal[:, 3] + np.where(scal[:, 2] > 0.0, 0.0, 0.5 * p.spacing)
+    # a polygon's boundary discs reach half a spacing past its bounding disc; a rotating one's
+    # move along straight lines (v_i + u_i x (q - c_i)), so over H a point at rho from the centre
+    # drifts out to rho sqrt(1 + (u_i H)^2): the cull's disc must hold that too
+    spin = np.sqrt(1.0 + (scal[:, 1] * p.horizon) ** 2)
+    body_r = np.where(scal[:, 2] > 0.0, scal[:, 3], scal[:, 3] * spin + 0.5 * p.spacing)
     use_loop = numba_enabled() if loop is None else loop
     if use_loop:
         state = np.array([pos[0], pos[1], math.nan if heading is None else heading, u_max,
@@ -380,6 +402,21 @@ def plan(
 # -- the two laws -----------------------------------------------------------------------------
 
 
+def _tracker(p: Zhang2019V2Params) -> CentreTracker | None:
+    if not p.track_estimates:
+        return None
+    return CentreTracker(p.track_position_std, p.track_accel_std)
+
+
+def tracked(obs: Observation, tracker: CentreTracker | None) -> Observation:
+    """``obs`` with the tracker's centres and velocities for the bodies whose rates were
+    estimated (the same object when nothing was estimated or there is no tracker)."""
+    if tracker is None or not any(r.velocity_source == "estimated" for r in obs.obstacles):
+        return obs
+    pos = np.asarray(obs.position, dtype=float)
+    return dataclasses.replace(obs, obstacles=tracker.update(obs.time, obs.obstacles, pos))
+
+
 class Zhang2019HolonomicV2(HolonomicLaw):
     """v2 on the holonomic robot: the chosen velocity as it is."""
 
@@ -389,12 +426,18 @@ class Zhang2019HolonomicV2(HolonomicLaw):
         super().__init__()
         self.params = params or Zhang2019V2Params()
         self.last_choice: Choice | None = None
+        self._tracker = _tracker(self.params)
+
+    def _reset_law(self, rng: np.random.Generator) -> None:
+        self.last_choice = None
+        self._tracker = _tracker(self.params)
 
     def act(self, obs: Observation) -> VelocityCommand:
         period = self.decision_period(obs.time)
         spec = self._spec
         if not np.all(np.isfinite(obs.position)):
             return VelocityCommand(0.0, 0.0)
+        obs = tracked(obs, self._tracker)
         choice = plan(obs, self._goal, spec.v_max, spec.radius, period,
                       self.current_velocity(obs), self.params)  # fmt: skip
         self.last_choice = choice
@@ -412,16 +455,19 @@ class Zhang2019V2(UnicycleController):
         self.params = params or Zhang2019V2Params()
         self.last_choice: Choice | None = None
         self._aim = np.zeros(2)
+        self._tracker = _tracker(self.params)
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
         self._aim = np.zeros(2)
+        self._tracker = _tracker(self.params)
 
     def act(self, obs: Observation) -> UnicycleCommand:
         period = self.decision_period(obs.time)
         spec = self._spec
         if not (np.all(np.isfinite(obs.position)) and math.isfinite(obs.heading)):
             return UnicycleCommand(0.0, 0.0)
+        obs = tracked(obs, self._tracker)
         choice = plan(obs, self._goal, spec.v_max, spec.radius, period, self._aim, self.params,
                       heading=obs.heading, u_max=spec.u_max)  # fmt: skip
         self.last_choice = choice
