@@ -101,7 +101,7 @@ def run_one(job: tuple[str, str, int, str, bool]) -> dict[str, Any]:
     prediction) or ``"constant"`` (estimated rates used as they are, ``prediction="last"``).
 
     Returns a row with the metrics, status, wall time and (when recorded) the trajectory."""
-    from uvnav.controllers.base3d import make_controller3d
+    from uvnav.controllers.base import make_law
     from uvnav.scenarios import load_scenario
     from uvnav.sim.episode3d import run_episode3d
 
@@ -110,7 +110,7 @@ def run_one(job: tuple[str, str, int, str, bool]) -> dict[str, Any]:
     setup = sc.build(seed, velocities="known" if motion == "known" else "estimated")
     # "constant": the sensed (estimated) rates as they are, no AR models (zhang2020-3d-v1 only)
     extra = {"prediction": "last"} if motion == "constant" else {}
-    c = make_controller3d(ctrl, oracle=motion == "known", **extra)
+    c = make_law(ctrl, vehicle="vehicle3d", oracle=motion == "known", **extra)
     tic = time.perf_counter()
     res, traj = run_episode3d(setup, c, np.random.default_rng(seed), record=record)
     return {
@@ -226,7 +226,7 @@ def ar_usage(family: str, seeds: Sequence[int]) -> dict[str, float]:
 
     Returns:
         ``{"decisions": count, "ar_share": fraction (nan for none)}``."""
-    from uvnav.controllers.base3d import make_controller3d
+    from uvnav.controllers.base import make_law
     from uvnav.core import BaseProbe
     from uvnav.scenarios import load_scenario
     from uvnav.sim.episode3d import run_episode3d
@@ -245,7 +245,7 @@ def ar_usage(family: str, seeds: Sequence[int]) -> dict[str, float]:
     for g in seeds:
         sc: Any = load_scenario(f"{family}:{g}")
         setup = sc.build(g, velocities="estimated")
-        law = make_controller3d(PREDICTION_LAW)
+        law = make_law(PREDICTION_LAW, vehicle="vehicle3d")
         run_episode3d(setup, law, np.random.default_rng(g), record=False, probes=(use,))
     share = use.ar / use.total if use.total else float("nan")
     return {"decisions": float(use.total), "ar_share": share}

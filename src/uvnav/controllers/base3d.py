@@ -11,13 +11,12 @@ them out: a 3D law cannot take a 2D observation).
 
 from __future__ import annotations
 
-import functools
 import math
 from typing import ClassVar, Protocol, runtime_checkable
 
 import numpy as np
 
-from uvnav.controllers.base import LawState, make_law
+from uvnav.controllers.base import LawState
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.frames3d import turn_toward
@@ -37,10 +36,6 @@ class Controller3D(Protocol):
 
     @property
     def mode(self) -> str: ...
-
-
-#: kept for callers of the former per-vehicle builder: ``make_law(name, vehicle="vehicle3d")``
-make_controller3d = functools.partial(make_law, vehicle="vehicle3d")
 
 
 class Vehicle3DController(LawState[Vehicle3DSpec]):
