@@ -96,3 +96,7 @@ def test_cli_check_and_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert "bad.md: 1.2 [ev:c.x] but the figure is 1.26" in out.out
     assert evidence.main(["--only", "nope"]) == 2
     assert "error: --only: unknown evidence claim(s): nope" in capsys.readouterr().err
+    assert evidence.main(["--check", str(good), "--record", str(tmp_path / "none.json")]) == 2
+    assert "error: --record" in capsys.readouterr().err
+    assert evidence.main(["--check", str(tmp_path / "none.md"), "--record", str(rec)]) == 2
+    assert "none.md: no such file" in capsys.readouterr().err

@@ -485,7 +485,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = ap.parse_args(argv)
     echo = (lambda s: print(s, file=sys.stderr)) if not args.json else None
     if args.check is not None:
-        return _check_files(args.check or _default_files(), read_record(args.record)["full"])
+        try:
+            recorded = read_record(args.record)["full"]
+        except (OSError, ValueError, KeyError) as exc:
+            print(f"error: --record {args.record}: not an evidence record ({exc})", file=sys.stderr)
+            return 2
+        files = args.check or _default_files()
+        missing = [f for f in files if not f.is_file()]
+        if missing:
+            print(f"error: --check {missing[0]}: no such file", file=sys.stderr)
+            return 2
+        return _check_files(files, recorded)
     try:
         if args.write is not None:
             full = run_claims(args.only, quick=False, echo=echo)
