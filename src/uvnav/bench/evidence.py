@@ -24,7 +24,7 @@ Command line::
     python -m uvnav.bench.evidence [--quick] [--only CLAIM ...] [--json] [--write FILE]
     python -m uvnav.bench.evidence --check [--record FILE] [FILE ...]
 
-Figures that cannot be re-run in minutes (the Chapter 6 training runs, the Chapter 5 network
+Figures that cannot be re-run in minutes (the Chapter 6 training runs, the Chapter 5 closed-loop
 campaigns) are not claims here: their paragraphs in the notes name the command that produced them
 and say that they were measured once.
 
