@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from uvnav.bench.campaign import Job, JobOutcome, grid_jobs, run_campaign, run_job
+from uvnav.bench.campaign import Job, JobOutcome, grid_jobs, run_campaign, run_job, scene_groups
 from uvnav.bench.store import ResultsStore
 from uvnav.dynamics import UnicycleSpec
 from uvnav.obstacles import ConstantVelocity, DiscBody, Obstacle, ObstacleState
@@ -189,3 +189,37 @@ def test_run_in_workers_hands_every_result_to_this_process() -> None:
     in_order: list[float] = []
     run_in_workers(items, math.sqrt, in_order.append, workers=1)
     assert in_order == [math.sqrt(x) for x in items]  # in-process keeps the order
+
+
+def test_scene_groups_keep_one_scene_and_seed_together() -> None:
+    laws = ("straight-v1", "zhang2019-v1")
+    jobs = [Job(controller=c, seed=g, generator_seed=g) for g in (3, 1) for c in laws]
+    jobs += [Job(controller=c, seed=s, scenario="thesis-ch2-one-obstacle") for s in (0, 1)
+             for c in laws]  # fmt: skip
+    jobs.append(Job(controller="straight-v1", seed=3, generator_seed=3,
+                    generator_params={"n_obstacles": 2}))  # fmt: skip
+    groups = scene_groups(jobs)
+    assert [[j.controller for j in g] for g in groups] == [list(laws)] * 4 + [["straight-v1"]]
+    assert [(g[0].scenario_label, g[0].seed) for g in groups] == [
+        ("random-ch2/0003", 3), ("random-ch2/0001", 1), ("thesis-ch2-one-obstacle", 0),
+        ("thesis-ch2-one-obstacle", 1), ("random-ch2[n_obstacles=2]/0003", 3),
+    ]  # fmt: skip
+    assert sorted(j.key for g in groups for j in g) == sorted(j.key for j in jobs)
+
+
+def test_a_batch_stores_all_or_nothing(tmp_path: Path) -> None:
+    ok = {m: 0.0 for m in ("min_clearance", "path_length", "control_effort")}
+    with ResultsStore(tmp_path / "r.sqlite") as store:
+        cid = store.campaign("c")
+        with store.batch():
+            for s in range(3):
+                store.add_episode(cid, scenario="s", controller="x", seed=s, status="timeout",
+                                  metrics=ok)  # fmt: skip
+        assert store.count("c") == 3
+        with pytest.raises(KeyboardInterrupt), store.batch():
+            store.add_episode(cid, scenario="s", controller="x", seed=7, status="timeout",
+                              metrics=ok)  # fmt: skip
+            raise KeyboardInterrupt
+        assert store.count("c") == 3
+        store.add_episode(cid, scenario="s", controller="x", seed=8, status="timeout", metrics=ok)
+        assert store.count("c") == 4  # outside a batch: a write is its own transaction again

@@ -20,7 +20,10 @@ SQLite connection is unsafe, and the fork server preloads uvnav once so workers 
 most ``2 × workers`` jobs are submitted ahead, which bounds memory for large campaigns.  With
 ``workers=1`` everything runs in-process (no pool; easiest to debug and profile).  ``engine="ray"``
 runs the same jobs as Ray tasks instead (:mod:`uvnav.bench.ray_engine`); results still come back to
-this process, which alone writes the store.  As with any
+this process, which alone writes the store.  On the local pool the jobs of one scene (the laws and
+parameter sets run on one generated scene) travel together (:func:`scene_groups`): one worker
+builds the scene once for all of them, and their episodes are stored in one transaction when the
+group finishes, so an interrupt loses at most the groups in flight.  As with any
 ``spawn``/``forkserver`` pool, a *script* that starts a campaign with ``workers > 1`` must do so
 under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already do), and a
 ``setup_factory`` must be importable (defined at module level, not in a notebook cell); pass
@@ -283,6 +286,29 @@ def build_job(job: Job) -> tuple[EpisodeSetup, dict[str, Any]]:
     ):
         params = {**_plain(getattr(ctrl, "params", None)), **params}
     return scenarios.build_episode(scenario, int(job.seed)), params
+
+
+def _scene_key(job: Job) -> tuple[Any, ...]:
+    """What identifies a job's episode set-up but for the law: the scene and the episode seed
+    (jobs with their own set-up or runner are their own)."""
+    if job.scenario is not None:
+        return ("scenario", job.scenario, int(job.seed))
+    if job.generator_seed is not None:
+        return ("generator", job.generator_label, int(job.generator_seed), int(job.seed))
+    return ("job", job.key)
+
+
+def scene_groups(jobs: Sequence[Job]) -> list[list[Job]]:
+    """``jobs`` grouped by scene, groups in the order of their first job, jobs in their order."""
+    groups: dict[tuple[Any, ...], list[Job]] = {}
+    for job in jobs:
+        groups.setdefault(_scene_key(job), []).append(job)
+    return list(groups.values())
+
+
+def run_job_group(jobs: Sequence[Job]) -> list[JobOutcome]:
+    """:func:`run_job` on each job of one scene group, in one worker (the scene is built once)."""
+    return [run_job(job) for job in jobs]
 
 
 def _error(job: Job, exc: BaseException, tic: float, params: dict[str, Any]) -> JobOutcome:
@@ -623,7 +649,14 @@ def _run_campaign(
             for job in todo:
                 handle(run_job(job))
         elif todo:
-            _run_pool(todo, run_job, handle, workers, mp_context or default_mp_context())
+
+            def handle_group(outs: list[JobOutcome]) -> None:
+                with store.batch():  # the group's episodes in one transaction
+                    for out in outs:
+                        handle(out)
+
+            ctx = mp_context or default_mp_context()
+            _run_pool(scene_groups(todo), run_job_group, handle_group, workers, ctx)
     finally:
         if bar is not None:
             bar.stop()

@@ -401,6 +401,9 @@ class ResultsStore:
 
     @contextmanager
     def _transaction(self) -> Iterator[sqlite3.Connection]:
+        if self._conn.in_transaction:  # inside batch(): its transaction holds this write
+            yield self._conn
+            return
         self._conn.execute("BEGIN IMMEDIATE")
         try:
             yield self._conn
@@ -408,6 +411,13 @@ class ResultsStore:
             self._conn.execute("ROLLBACK")
             raise
         self._conn.execute("COMMIT")
+
+    @contextmanager
+    def batch(self) -> Iterator[None]:
+        """Every write inside the block in one transaction: all of it is stored, or (on an
+        exception, Ctrl-C included) none of it."""
+        with self._transaction():
+            yield
 
     def _create_schema(self) -> None:
         metric_cols = ",\n".join(f"    {m} {_metric_sql_type(m)}" for m in METRIC_NAMES)
