@@ -11,6 +11,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from shapely.geometry import LineString, Point, Polygon
 
+from uvnav.geometry.kernels3d import numba_available, use_compiled
 from uvnav.geometry.polygons import (
     angular_extent,
     closed_rings,
@@ -284,6 +285,29 @@ def test_ring_kernels_equal_edge_soup_kernels_bit_for_bit(
     dirs = np.array([[math.cos(angle + a), math.sin(angle + a)] for a in (0.0, 1.0, 2.5, -2.0)])
     soup_hits = np.minimum.reduceat(rays_segments_hit(p, dirs, starts, ends), offsets[:-1], axis=1)
     assert np.array_equal(soup_hits, rays_rings_hit(p, dirs, rings))
+
+
+@pytest.mark.skipif(not numba_available(), reason="needs numba (the fast extra)")
+@SETTINGS
+@given(st.lists(star_polygons(max_n=9), min_size=1, max_size=6), small, small,
+       st.sampled_from([None, 0, 1]))  # fmt: skip
+def test_compiled_rings_nearest_equals_the_array_version_bit_for_bit(
+    polys: list[np.ndarray], x: float, y: float, on_vertex: int | None
+) -> None:
+    """The compiled loop of :func:`rings_nearest` gives the array version's numbers exactly, also
+    on a vertex and with the zero-length edges of the padding."""
+    rings, _ = closed_rings(polys)
+    p = (x, y) if on_vertex is None else tuple(polys[0][on_vertex])
+    previous = use_compiled(False)
+    try:
+        ref = [rings_nearest(p, rings, parity=par) for par in (True, False)]
+        use_compiled(True)
+        got = [rings_nearest(p, rings, parity=par) for par in (True, False)]
+    finally:
+        use_compiled(previous)
+    for (d0, n0, i0), (d1, n1, i1) in zip(ref, got, strict=True):
+        assert np.array_equal(d0, d1) and np.array_equal(n0, n1)
+        assert (i0 is None and i1 is None) or np.array_equal(i0, i1)
 
 
 @SETTINGS

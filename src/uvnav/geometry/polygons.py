@@ -12,11 +12,14 @@ Units: lengths [m], angles [rad].
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.kernels3d import numba_enabled
 
 _EPS = 1e-12
 
@@ -345,6 +348,12 @@ def rings_nearest(
     """
     px = float(point[0])
     py = float(point[1])
+    if numba_enabled() and rings.shape[1] and rings.shape[2] > 1:
+        m = rings.shape[1]
+        dist, nearest, inside = np.empty(m), np.empty((2, m)), np.empty(m, dtype=np.bool_)
+        _rings_kernel()(px, py, np.ascontiguousarray(rings, dtype=float), parity, dist, nearest,
+                        inside)  # fmt: skip
+        return dist, nearest, (inside if parity else None)
     p = np.array((px, py)).reshape(2, 1, 1)
     starts = rings[:, :, :-1]
     e = rings[:, :, 1:] - starts
@@ -368,6 +377,57 @@ def rings_nearest(
     x_cross = starts[0] + (py - sy) * e[0] / np.where(straddles, e[1], 1.0)
     crossings = np.count_nonzero(straddles & (x_cross > px), axis=1)
     return dist, nearest, (crossings % 2) == 1
+
+
+def rings_nearest_py(
+    px: float,
+    py: float,
+    rings: FloatArray,
+    parity: bool,
+    dist: FloatArray,
+    nearest: FloatArray,
+    inside: np.ndarray,
+) -> None:
+    """:func:`rings_nearest` as one loop over the rings' edges, writing ``dist`` (m,),
+    ``nearest`` (2, m) and, with ``parity``, ``inside`` (m,) (compiled by numba when it is
+    enabled).  The same operations in the same order as the array version, so the same numbers
+    bit for bit (NaN included: the first NaN distance wins, as ``argmin`` picks it)."""
+    for i in range(rings.shape[1]):
+        best, bx, by, seen_nan = math.inf, math.nan, math.nan, False
+        crossings = 0
+        for j in range(rings.shape[2] - 1):
+            sx, sy = rings[0, i, j], rings[1, i, j]
+            ex, ey = rings[0, i, j + 1] - sx, rings[1, i, j + 1] - sy
+            ee = ex * ex + ey * ey
+            if not ee >= _EPS and ee == ee:  # np.maximum(ee, EPS), NaN kept
+                ee = _EPS
+            t = ((px - sx) * ex + (py - sy) * ey) / ee
+            if t < 0.0:
+                t = 0.0
+            if t > 1.0:
+                t = 1.0
+            qx, qy = sx + t * ex, sy + t * ey
+            dx, dy = qx - px, qy - py
+            d = math.sqrt(dx * dx + dy * dy)
+            if not seen_nan and (d != d or d < best or j == 0):
+                best, bx, by, seen_nan = d, qx, qy, d != d
+            straddles = (sy > py) != (rings[1, i, j + 1] > py)
+            if parity and straddles and sx + (py - sy) * ex / ey > px:
+                crossings += 1
+        dist[i], nearest[0, i], nearest[1, i] = best, bx, by
+        inside[i] = crossings % 2 == 1
+
+
+_RINGS: list[Callable[..., Any]] = []
+
+
+def _rings_kernel() -> Callable[..., Any]:
+    """:func:`rings_nearest_py`, compiled on the first call (or loaded from numba's cache)."""
+    if not _RINGS:
+        import numba
+
+        _RINGS.append(numba.njit(cache=True, nogil=True)(rings_nearest_py))
+    return _RINGS[0]
 
 
 def rays_rings_hit(
