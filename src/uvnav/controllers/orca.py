@@ -92,6 +92,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from itertools import pairwise
 from typing import Any, ClassVar
 
 import numpy as np
@@ -366,7 +367,8 @@ class RvoPool:
         self._key: tuple[float, float, float] | None = None
         self._slots = 0  # obstacle agents in the simulator (in use or parked)
         self._used = 0  # obstacle agents in use at the last decision
-        self._period: float | None = None
+        self._radii: list[float] = []  # each agent's radius as set [m]
+        self.max_speed = 0.0  # the robot agent's speed limit as set [m/s]
         self.reused = 0
         self.fresh = 0
 
@@ -383,12 +385,15 @@ class RvoPool:
                 key[0], key[1], 0.0, 0.0, (0.0, 0.0),
             )  # fmt: skip
             self._slots = self._used = 0
+            self._radii = [0.0]
+            self.max_speed = 0.0
         elif key[2] != self._key[2]:
             self._sim.set_time_step(float(period))
         self._key = key
         sim = self._sim
         while self._slots < n_agents:
             sim.add_agent((_PARKED, _PARKED), 0.0, 0, key[0], key[1], 0.0, 0.0, (0.0, 0.0))
+            self._radii.append(0.0)
             self._slots += 1
         for k in range(n_agents + 1, self._used + 1):  # no longer needed: parked, still
             sim.set_agent_position(k, (_PARKED + k, _PARKED))
@@ -396,6 +401,12 @@ class RvoPool:
             sim.set_agent_pref_velocity(k, (0.0, 0.0))
         self._used = n_agents
         return sim
+
+    def set_radius(self, agent: int, radius: float) -> None:
+        """Agent ``agent``'s radius [m] (set in the simulator only when it changes)."""
+        if self._radii[agent] != radius:
+            self._sim.set_agent_radius(agent, radius)
+            self._radii[agent] = radius
 
     def one_leaf(self, n_agents: int) -> bool:
         """Whether the kept simulator, grown to ``n_agents`` obstacle agents, has at most
@@ -405,14 +416,15 @@ class RvoPool:
 
 
 def _distinct_ranges(agents: Sequence[tuple[float, ...]]) -> bool:
-    """Whether RVO2's squared centre distances (float32, robot at the origin) of ``agents`` are
-    clearly distinct (relative gap > 1e-6): then its neighbour order does not depend on its
-    k-d tree, so a reused simulator orders the half-planes as a fresh one does (note 11)."""
+    """Whether RVO2's squared centre distances of ``agents`` (robot at the origin) are certainly
+    distinct: the float64 ones differ by more than 1e-6 relative, far above the rounding of
+    RVO2's float32 ones (coordinates, products and sum: below 3e-7 relative), so its float32
+    values are distinct and in the same order.  Its neighbour order then does not depend on its
+    k-d tree, and a reused simulator orders the half-planes as a fresh one does (note 11)."""
     if len(agents) < 2:
         return True
-    c = np.array([(a[0], a[1]) for a in agents], dtype=np.float32)
-    d = np.sort((c[:, 0] * c[:, 0] + c[:, 1] * c[:, 1]).astype(float))
-    return bool(np.all(np.diff(d) > 1e-6 * d[1:]))
+    d = sorted(a[0] * a[0] + a[1] * a[1] for a in agents)
+    return all(hi - lo > 1e-6 * hi for lo, hi in pairwise(d))
 
 
 def orca_velocity(
@@ -470,15 +482,18 @@ def orca_velocity(
         sim = pool.simulator(float(period), p, n_agents)
         sim.set_agent_position(0, (0.0, 0.0))
         sim.set_agent_velocity(0, vel)
-        sim.set_agent_radius(0, float(radius))
-        sim.set_agent_max_speed(0, float(max_speed))
         sim.set_agent_pref_velocity(0, pref)
-        for idx, (cx, cy, r_obs, vx, vy, speed) in enumerate(agents, start=1):
+        pool.set_radius(0, float(radius))
+        if pool.max_speed != float(max_speed):
+            sim.set_agent_max_speed(0, float(max_speed))
+            pool.max_speed = float(max_speed)
+        # the robot's half-planes read only its neighbours' positions, velocities and radii (its
+        # neighbours' own new velocities, from their speed limits and preferred velocities, are
+        # never read): those three are set
+        for idx, (cx, cy, r_obs, vx, vy, _) in enumerate(agents, start=1):
             sim.set_agent_position(idx, (cx, cy))
             sim.set_agent_velocity(idx, (vx, vy))
-            sim.set_agent_radius(idx, r_obs)
-            sim.set_agent_max_speed(idx, speed)
-            sim.set_agent_pref_velocity(idx, (vx, vy))
+            pool.set_radius(idx, r_obs)
     else:
         if pool is not None:
             pool.fresh += 1
