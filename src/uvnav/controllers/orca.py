@@ -328,17 +328,17 @@ def _ccw(outline: FloatArray) -> FloatArray:
 
 def _finite_reading(rd: ObstacleReading) -> bool:
     c, v = rd.centre, rd.velocity
-    values = (
-        rd.distance,
-        rd.bounding_radius,
-        rd.radius,
-        rd.angular_velocity,
-        c[0],
-        c[1],
-        v[0],
-        v[1],
-    )
-    if not all(math.isfinite(float(x)) for x in values):
+    isf = math.isfinite
+    if not (
+        isf(rd.distance)
+        and isf(rd.bounding_radius)
+        and isf(rd.radius)
+        and isf(rd.angular_velocity)
+        and isf(c[0])
+        and isf(c[1])
+        and isf(v[0])
+        and isf(v[1])
+    ):
         return False
     return rd.is_disc or bool(np.isfinite(rd.outline).all())
 
@@ -542,9 +542,11 @@ def orca_velocity(
         if k >= n_obst:  # agent line: point = v_A + u / 2 -> v_A + responsibility * u
             qx = vel[0] + scale * (qx - vel[0])
             qy = vel[1] + scale * (qy - vel[1])
-        line = ((float(qx), float(qy)), (float(dx), float(dy)))
-        if not all(math.isfinite(c) for c in (*line[0], *line[1])):
+        qx, qy, dx, dy = float(qx), float(qy), float(dx), float(dy)
+        isf = math.isfinite
+        if not (isf(qx) and isf(qy) and isf(dx) and isf(dy)):
             continue  # note 8
+        line = ((qx, qy), (dx, dy))
         if k < n_obst:
             kept_obst += 1
         lines.append(line)
