@@ -237,7 +237,7 @@ class SharedOrca:
         self._v_max = np.zeros(n)
         self._u_max = np.zeros(n)
         for j, law in enumerate(laws):
-            if isinstance(law, OrcaShared):
+            if getattr(law, "group_key", None) == (OrcaShared.name, self.params):
                 self._goals[j] = law._goal
                 self._v_max[j] = law._spec.v_max
                 self._u_max[j] = law._spec.u_max
