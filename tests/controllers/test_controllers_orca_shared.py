@@ -28,8 +28,9 @@ def shared_setup(n: int, **params: Any) -> MultiSetup:
     return setup
 
 
-def test_antipodal_10_swaps_without_collision_or_deadlock() -> None:
-    res = run_multi(shared_setup(10), np.random.default_rng(0), record=False)
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_antipodal_10_swaps_without_collision_or_deadlock(seed: int) -> None:
+    res = run_multi(shared_setup(10), np.random.default_rng(seed), record=False)
     assert res.group.all_arrived
     assert res.group.robot_collisions == 0 and res.group.deadlocks == 0
 
