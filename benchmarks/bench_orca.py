@@ -2,7 +2,9 @@
 and navground 0.7's C++ beside them when it can be imported (issue 20, item 2).
 
 Run: ``.venv/bin/python benchmarks/bench_orca.py --out benchmarks/results`` (``--quick``: fewer
-steps and repeats).  Writes ``<out>/orca.json`` and prints target / measured / ratio / pass-fail.
+steps and repeats; ``--outcomes K``: also K whole episodes per side and N, seeds 0..K-1, with
+their outcome: arrivals, collided pairs, deadlocks, makespan, minimum clearance).  Writes
+``<out>/orca.json`` and prints target / measured / ratio / pass-fail.
 
 Scene: the antipodal swap ``antipodal:N`` (N = 10, 100; :func:`uvnav.scenarios.multi.
 antipodal_scenario`), every robot on the same law, ``--steps`` integration steps (dt = control
@@ -85,6 +87,28 @@ def uvnav_run(n: int, law: str, params: dict[str, Any], steps: int) -> dict[str,
     }
 
 
+def uvnav_episode(n: int, law: str, params: dict[str, Any], seed: int) -> dict[str, Any]:
+    """One whole episode of ``antipodal:n`` (to arrival, collision or t_max): the outcome."""
+    from uvnav.scenarios.multi import antipodal_scenario, build_multi
+    from uvnav.sim.multi import run_multi
+
+    setup = build_multi(antipodal_scenario(n), seed, controller=law, params=params)
+    cpu0 = time.thread_time()
+    res = run_multi(setup, np.random.default_rng(seed), record=False)
+    cpu = time.thread_time() - cpu0
+    g = res.group
+    clear = [m.min_clearance for m in res.robots if m.min_clearance is not None]
+    return {
+        "seed": seed,
+        "arrived": g.arrived,
+        "robot_collisions": g.robot_collisions,
+        "deadlocks": g.deadlocks,
+        "makespan_s": g.makespan,
+        "min_clearance_m": min(clear) if clear else None,
+        "cpu_s": cpu,
+    }
+
+
 def navground_available() -> str | None:
     """navground's version, or ``None`` when ``navground.sim`` cannot be imported."""
     try:
@@ -147,6 +171,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--steps", type=int, default=None, help="integration steps per run")
     ap.add_argument("--repeats", type=int, default=None, help="runs per cell (best kept)")
     ap.add_argument("--counts", type=str, default=None, help="robot counts, e.g. 10,100")
+    ap.add_argument(
+        "--outcomes", type=int, default=0, help="also run this many whole episodes (seeds 0..)"
+    )
     args = ap.parse_args(argv)
     steps = args.steps or (50 if args.quick else 150)
     repeats = args.repeats or (1 if args.quick else 3)
@@ -188,6 +215,11 @@ def main(argv: list[str] | None = None) -> int:
             if not label.startswith("navground"):
                 cell["sides"][label]["speedup_vs_orca_v1"] = base / best[label]["us_per_step"]
         cells.append(cell)
+    outcomes: list[dict[str, Any]] = []
+    for n in counts if args.outcomes else ():
+        for label, law, params in SIDES:
+            for seed in range(args.outcomes):
+                outcomes.append({"robots": n, "side": label} | uvnav_episode(n, law, params, seed))
     out = {
         "benchmark": "orca",
         "what": f"antipodal:N, {steps} steps, CPU µs per step (thread time), best of {repeats}",
@@ -198,6 +230,7 @@ def main(argv: list[str] | None = None) -> int:
         "steps": steps,
         "repeats": repeats,
         "cells": cells,
+        "outcomes": outcomes,
     }
     args.out.mkdir(parents=True, exist_ok=True)
     (args.out / "orca.json").write_text(json.dumps(out, indent=2), encoding="utf-8")
@@ -228,6 +261,15 @@ def main(argv: list[str] | None = None) -> int:
                 f" {tgt} {ratio_s} {ok_s}  {outcome}"
             )
         print(f"     navground reference: {cell['navground_source']}")
+    for o in outcomes:
+        ms = f"{o['makespan_s']:.1f} s" if o["makespan_s"] is not None else "-"
+        mc = o["min_clearance_m"]
+        print(
+            f"whole episode antipodal:{o['robots']} seed {o['seed']} {o['side']:22} arrived "
+            f"{o['arrived']}/{o['robots']}, collided pairs {o['robot_collisions']}, deadlocks "
+            f"{o['deadlocks']}, makespan {ms}, min clearance "
+            f"{mc if mc is None else round(mc, 4)} m, CPU {o['cpu_s']:.2f} s"
+        )
     print(f"wrote {args.out / 'orca.json'}")
     return 0
 
