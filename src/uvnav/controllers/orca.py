@@ -372,6 +372,15 @@ class RvoPool:
         self.reused = 0
         self.fresh = 0
 
+    def __getstate__(self) -> dict[str, Any]:
+        """Copied or pickled, a pool starts empty (RVO2's simulator cannot be copied; the
+        decisions do not depend on it)."""
+        return {"reused": self.reused, "fresh": self.fresh}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__()  # type: ignore[misc]
+        self.reused, self.fresh = state["reused"], state["fresh"]
+
     def simulator(self, period: float, params: OrcaParams, n_agents: int) -> Any:
         """The kept simulator with room for ``n_agents`` obstacle agents, its time step
         ``period`` [s]; the agents of the previous decision beyond ``n_agents`` parked."""
