@@ -173,6 +173,9 @@ class SharedOrca:
     (module docstring).
 
     Attributes:
+        last_velocities: (m, 2) the members' new velocities at the last step [m/s] (rows in the
+            order of the members who decided).
+        last_preferred: (m, 2) their (perturbed) preferred velocities [m/s].
         steps: shared RVO2 steps taken.
         corrected: member decisions recomputed with ``responsibility`` (not 0.5).
         alone: member decisions taken alone (a world without :class:`~uvnav.core.DiscAgents`).
@@ -184,6 +187,8 @@ class SharedOrca:
         self._set: list[tuple[float, float, int, float]] = []  # radius, max speed, k, range
         self._members: tuple[int, ...] | None = None  # the members of the last step
         self._period: float | None = None
+        self.last_velocities = np.zeros((0, 2))
+        self.last_preferred = np.zeros((0, 2))
         self.steps = 0
         self.corrected = 0
         self.alone = 0
@@ -206,9 +211,7 @@ class SharedOrca:
             self._period = float(period)
         return self._sim
 
-    def _roles(
-        self, sim: Any, members: tuple[int, ...], st: DiscAgents, laws: Sequence[Any]
-    ) -> None:
+    def _roles(self, sim: Any, members: tuple[int, ...], st: DiscAgents) -> None:
         """Set every agent's role for the members ``members``: a member avoids (radius + half
         the margin, V_max, ``max_neighbors`` within its range); any other robot is a disc that
         does not decide (radius + half the margin, no neighbours; its own RVO2 velocity is never
@@ -285,7 +288,7 @@ class SharedOrca:
         sim = self._simulator(n, float(periods[0]))
         key = tuple(idx)
         if key != self._members:  # who decides changed: each agent's role (radius, range, ...)
-            self._roles(sim, key, st, laws)
+            self._roles(sim, key, st)
         rel = (st.positions - pos.mean(axis=0)).tolist()
         vel = st.velocities.tolist()
         for j, pj in zip(idx, pref.tolist(), strict=True):
