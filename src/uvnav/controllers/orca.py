@@ -81,10 +81,10 @@ Choices (and why):
    never reordered: the fresh simulator's agent order) or when the distances are clearly
    distinct (relative gap > 1e-6); otherwise (ties beyond one leaf) and whenever static
    polygons are present (RVO2 cannot remove an obstacle) the decision builds a fresh simulator
-   as before.  Measured: building a simulator costs about 0.4 µs and RVO2's step about 0.5 µs
-   of a decision's ~90 µs; the rest is this module's Python (docs/design-notes.md, "Shared
-   ORCA"), so the saving is small; :mod:`uvnav.controllers.orca_shared` decides a group of
-   robots with one step.
+   as before.  Measured (``benchmarks/bench_orca.py``): building a simulator costs 0.34 µs and
+   RVO2's step 0.42 µs of a decision's ~65 µs; the rest is this module's Python
+   (docs/design-notes.md, "Shared ORCA"), so the saving is small;
+   :mod:`uvnav.controllers.orca_shared` decides a group of robots with one step.
 """
 
 from __future__ import annotations
