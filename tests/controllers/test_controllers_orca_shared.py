@@ -11,7 +11,7 @@ import pytest
 
 pytest.importorskip("pyrvo")
 
-from uvnav.controllers.base import make_law
+from uvnav.controllers.base import ControllerParamsError, make_law
 from uvnav.controllers.orca import orca_velocity
 from uvnav.controllers.orca_shared import OrcaShared, OrcaSharedParams, SharedOrca
 from uvnav.core import run_loop
@@ -127,12 +127,12 @@ def test_estimated_sensing_and_world_obstacles_are_refused() -> None:
         ]  # fmt: skip
 
     noisy = MultiSetup(robots(SensingConfig(velocities="estimated")), t_max=1.0)
-    with pytest.raises(ValueError, match="exact"):
+    with pytest.raises(ControllerParamsError, match="exact"):
         run_multi(noisy, np.random.default_rng(0))
     walled = MultiSetup(
         robots(SensingConfig()), obstacles=[Obstacle.moving_disc((3.0, 3.0), 0.3, (0.0, 0.0))]
     )
-    with pytest.raises(ValueError, match="robots only"):
+    with pytest.raises(ControllerParamsError, match="robots only"):
         run_multi(walled, np.random.default_rng(0))
 
 
