@@ -61,6 +61,7 @@ evidence: $(STAMP_RUN)
 bench: $(STAMP_RUN)
 	$(PY) benchmarks/run_benchmarks.py --out benchmarks/results
 	$(PY) benchmarks/bench_multi.py --out benchmarks/results
+	$(PY) benchmarks/bench_orca.py --out benchmarks/results
 	$(PY) benchmarks/bench_ch7.py --out benchmarks/results
 	$(PY) benchmarks/bench_campaign.py --out benchmarks/results
 	$(PY) benchmarks/bench_crowdnav.py --cases 500 --out benchmarks/results

@@ -124,3 +124,44 @@ def test_decisions_are_timed_in_cpu_time_and_the_first_is_kept_apart() -> None:
     assert min(log.decision_wall_us) >= 20_000.0
     assert max(log.decision_us) < 10_000.0  # CPU time: the sleep is not in it
     assert AgentLog(decision_us=[5.0]).timed_us == [5.0]
+
+
+class Grouped(Law):
+    """A toy law of a group keyed by ``key``: its group decides all members at once."""
+
+    def __init__(self, key: str, made: list[Any]) -> None:
+        super().__init__()
+        self.group_key = key
+        self._made = made
+
+    def make_group(self) -> Any:
+        group = Group()
+        self._made.append(group)
+        return group
+
+
+class Group:
+    def __init__(self) -> None:
+        self.calls: list[tuple[float, list[int]]] = []
+
+    def decide(self, world: Any, agents: Sequence[int], laws: Sequence[Any]) -> list[float]:
+        self.calls.append((world.t, list(agents)))
+        return [0.5 * (i + 1) for i in agents]
+
+
+def test_a_group_of_laws_decides_once_per_decision_time_before_the_others() -> None:
+    made: list[Any] = []
+    solo = Law()
+    laws = [Grouped("a", made), solo, Grouped("a", made), Grouped("b", made)]
+    world = LineWorld(4, steps=6, ratio=2)
+    probe = Events()
+    logs = run_loop(world, laws, [probe])  # type: ignore[arg-type]
+    assert len(made) == 2  # one group per key
+    a, b = made
+    assert [agents for _, agents in a.calls] == [[0, 2]] * 3
+    assert [agents for _, agents in b.calls] == [[3]] * 3
+    assert solo.calls == 3
+    assert world.cmd.tolist() == [0.5, 1.0, 1.0, 1.0]  # group commands applied, saturated
+    assert [len(log.decision_us) for log in logs] == [3, 3, 3, 3]
+    first = [e for e in probe.events if e[0] == "decide"][:4]
+    assert [agent for _, (_, agent, _) in first] == [0, 2, 3, 1]  # groups first, then the rest

@@ -22,6 +22,15 @@ PettingZoo's ``ParallelEnv`` wrap the same world step by step, so an env episode
         world.advance()                    # every dt: vehicles, bodies, clearance, status
     probes.on_end(...)                     # the final state
 
+**Group laws.**  A law whose ``group_key`` is not ``None`` belongs to a group: the laws of one
+episode with equal keys are decided together by one :class:`LawGroup` (made by the first member's
+``make_group()``), once per decision time, before the other agents: ``group.decide(world,
+members, laws)`` returns the members' commands, which are applied and recorded as the others'
+are (each member's decision time is the group's CPU and wall time divided equally among the
+members deciding; probes get ``obs=None``).  A group may read more of the world than one
+agent's observation (e.g. :class:`DiscAgents`, the state of every disc robot), so only laws that
+say so join one (``orca-shared-v1``, :mod:`uvnav.controllers.orca_shared`).
+
 Decision period and integration step are separate: a world says when a decision is due (every
 ``control_period``, a whole multiple of ``dt``).  The loop counts each agent's mode switches and
 times each decision with :func:`time.thread_time_ns` (CPU time of this thread, immune to other
@@ -33,7 +42,7 @@ This module imports nothing from uvnav: it is the bottom layer.
 from __future__ import annotations
 
 import time as _time
-from collections.abc import Collection, Sequence
+from collections.abc import Collection, Hashable, Sequence
 from dataclasses import dataclass, field
 from importlib.metadata import entry_points
 from typing import Any, ClassVar, Protocol, TypeVar, runtime_checkable
@@ -120,6 +129,42 @@ class World(Protocol[ObsT_co, CmdT]):
         ...
 
 
+@runtime_checkable
+class LawGroup(Protocol):
+    """Decides the members of a group of laws together (module docstring, "Group laws")."""
+
+    def decide(self, world: Any, agents: Sequence[int], laws: Sequence[Any]) -> Sequence[Any]:
+        """The commands of ``agents`` (members whose decision is due, in index order), one per
+        agent; ``laws`` are all the episode's laws (by agent)."""
+        ...
+
+
+@dataclass(frozen=True)
+class DiscAgents:
+    """Every agent of a world of disc robots at a decision time, as a group law reads it
+    (:meth:`~uvnav.sim.multi.MultiUnicycleWorld.disc_agents`).
+
+    Attributes:
+        time: the time now [s].
+        positions: (N, 2) centres [m].
+        headings: (N,) headings [rad] (the direction of the last velocity).
+        velocities: (N, 2) velocities [m/s] (the held commands; zero once an agent is done).
+        radii: (N,) body radii [m].
+        active: (N,) agents neither arrived nor collided.
+        sensing_range: (N,) each agent's sensing range [m].
+        exact: (N,) whether each agent senses the others exactly (true velocities, no noise).
+    """
+
+    time: float
+    positions: np.ndarray
+    headings: np.ndarray
+    velocities: np.ndarray
+    radii: np.ndarray
+    active: np.ndarray
+    sensing_range: np.ndarray
+    exact: np.ndarray
+
+
 class Probe(Protocol):
     """Watches :func:`run_loop`.  Every hook is optional (see :class:`BaseProbe`)."""
 
@@ -199,11 +244,32 @@ def run_loop(
         law.reset(spec, goal, rng)
     world.start([bool(getattr(law, "oracle", False)) for law in laws])
     logs = [AgentLog() for _ in laws]
+    keys: list[Hashable | None] = [getattr(law, "group_key", None) for law in laws]
+    groups: dict[Hashable, LawGroup] = {}
+    for law, key in zip(laws, keys, strict=True):
+        if key is not None and key not in groups:
+            groups[key] = law.make_group()  # type: ignore[attr-defined]
     for p in probes:
         p.on_start(world, laws)
     cpu_ns, wall_ns = _time.thread_time_ns, _time.perf_counter_ns
     while not world.done:
-        for i in world.acting():
+        acting = world.acting()
+        if groups and acting:
+            for key, group in groups.items():
+                members = [i for i in acting if keys[i] == key]
+                if not members:
+                    continue
+                c0, w0 = cpu_ns(), wall_ns()
+                cmds = group.decide(world, members, laws)
+                c1, w1 = cpu_ns(), wall_ns()
+                m = len(members)
+                for i, cmd in zip(members, cmds, strict=True):
+                    applied = world.apply(cmd, i)
+                    logs[i].record(laws[i].mode, (c1 - c0) // m, (w1 - w0) // m)
+                    for p in probes:
+                        p.on_decision(world, i, laws[i], None, applied)
+            acting = [i for i in acting if keys[i] is None]
+        for i in acting:
             law = laws[i]
             obs = world.observe(i)
             c0, w0 = cpu_ns(), wall_ns()

@@ -89,6 +89,7 @@ BUILTIN_MODULES: tuple[str, ...] = (
     "savkin_wang2013",
     "straight",
     "orca",
+    "orca_shared",
     "dwa",
     "apf",
     "hybrid",

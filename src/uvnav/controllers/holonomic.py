@@ -25,6 +25,7 @@ from uvnav.controllers.orca import (
     OrcaCrowdNavParams,
     OrcaParams,
     OrcaQuery,
+    RvoPool,
     _import_pyrvo,
     orca_velocity,
 )
@@ -96,10 +97,12 @@ class OrcaHolonomic(HolonomicLaw):
         super().__init__()
         self.params = params or OrcaHolonomicParams()
         self.last_query: OrcaQuery | None = None
+        self.pool = RvoPool()
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         _import_pyrvo()  # fail at reset, with the extra's name, not in the middle of an episode
         self.last_query = None
+        self.pool = RvoPool()  # one simulator kept across the episode's decisions
 
     def preferred_velocity(self, position: FloatArray, period: float) -> FloatArray:
         """V_max toward the goal, lowered to ``dist / period`` near it [m/s]."""
@@ -116,7 +119,7 @@ class OrcaHolonomic(HolonomicLaw):
         query = orca_velocity(
             pos, self.current_velocity(obs), pref, obs.obstacles,
             radius=spec.radius + self.params.safety_margin, max_speed=spec.v_max,
-            period=period, params=self.params,
+            period=period, params=self.params, pool=self.pool,
         )  # fmt: skip
         self.last_query = query
         self._mode = "M1" if float(np.hypot(*(query.velocity - pref))) < 1e-6 else "M2"

@@ -13,8 +13,9 @@ What ``pyrvo`` provides: the RVO2 ``RVOSimulator`` (agents as discs with ``neigh
 preferred velocity; static polygon obstacles; ``do_step`` computes every agent's ORCA half-planes
 and its new velocity by RVO2's incremental 2D linear programs, then moves the agents) and read
 access to each agent's ORCA lines (``get_agent_orca_line``).  It has no single-agent query, so
-one decision here is: a fresh simulator, robot = agent 0, one ``do_step`` with time step = the
-decision period, read back agent 0's ORCA lines (the simulated motion is discarded).
+one decision here is: a simulator holding the robot (agent 0) and its neighbours, one ``do_step``
+with time step = the decision period, read back agent 0's ORCA lines (the simulated motion is
+discarded); the simulator is kept between decisions (note 11).
 
 Choices (and why):
 
@@ -70,6 +71,20 @@ Choices (and why):
    (or a concave pocket) squarely across that line can stop the robot in front of it (a
    deadlock, not a collision).  No perturbation or planner is added: this baseline is ORCA
    itself, as in the literature's comparisons.
+11. *One simulator per robot* (issue 20, item 2).  A law keeps one RVO2 simulator for its
+   episode (:class:`RvoPool`): agent 0 the robot, then one agent per chosen neighbour, updated in
+   place (position, velocity, radius, speed limit, preferred velocity); agents left over from a
+   decision with more neighbours are parked far beyond any neighbour range.  The result is the
+   fresh simulator's bit for bit (property test) because RVO2's agent half-planes come in the
+   order of its neighbour list, sorted by float32 squared distance with ties in the order its
+   k-d tree meets them: the kept simulator is used when its tree is one leaf (at most 10 agents,
+   never reordered: the fresh simulator's agent order) or when the distances are clearly
+   distinct (relative gap > 1e-6); otherwise (ties beyond one leaf) and whenever static
+   polygons are present (RVO2 cannot remove an obstacle) the decision builds a fresh simulator
+   as before.  Measured (``benchmarks/bench_orca.py``): building a simulator costs 0.34 µs and
+   RVO2's step 0.42 µs of a decision's ~65 µs; the rest is this module's Python
+   (docs/design-notes.md, "Shared ORCA"), so the saving is small;
+   :mod:`uvnav.controllers.orca_shared` decides a group of robots with one step.
 """
 
 from __future__ import annotations
@@ -77,6 +92,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from itertools import pairwise
 from typing import Any, ClassVar
 
 import numpy as np
@@ -312,19 +328,112 @@ def _ccw(outline: FloatArray) -> FloatArray:
 
 def _finite_reading(rd: ObstacleReading) -> bool:
     c, v = rd.centre, rd.velocity
-    values = (
-        rd.distance,
-        rd.bounding_radius,
-        rd.radius,
-        rd.angular_velocity,
-        c[0],
-        c[1],
-        v[0],
-        v[1],
-    )
-    if not all(math.isfinite(float(x)) for x in values):
+    isf = math.isfinite
+    if not (
+        isf(rd.distance)
+        and isf(rd.bounding_radius)
+        and isf(rd.radius)
+        and isf(rd.angular_velocity)
+        and isf(c[0])
+        and isf(c[1])
+        and isf(v[0])
+        and isf(v[1])
+    ):
         return False
     return rd.is_disc or bool(np.isfinite(rd.outline).all())
+
+
+#: RVO2's ``RVO_MAX_LEAF_SIZE``: a k-d tree of at most this many agents is one leaf, scanned in
+#: agent order.
+_LEAF = 10
+
+#: Where the unused agents of a reused simulator wait [m] (robot frame): beyond any neighbour range.
+_PARKED = 1.0e7
+
+
+class RvoPool:
+    """One RVO2 simulator kept across one robot's decisions (note 11), so that a decision updates
+    agents in place instead of building a simulator.
+
+    Agent 0 is the robot; agents 1..n are the obstacle agents of the decision; the others (left
+    from decisions that had more neighbours) are parked at :data:`_PARKED` [m], still, beyond
+    every neighbour range.  :func:`orca_velocity` uses it only when the result is certainly the
+    fresh simulator's (no static polygon, no tie between neighbour distances); ``reused`` and
+    ``fresh`` count the decisions of each kind (for tests and benchmarks).
+    """
+
+    def __init__(self) -> None:
+        self._sim: Any = None
+        self._key: tuple[float, float, float] | None = None
+        self._slots = 0  # obstacle agents in the simulator (in use or parked)
+        self._used = 0  # obstacle agents in use at the last decision
+        self._radii: list[float] = []  # each agent's radius as set [m]
+        self.max_speed = 0.0  # the robot agent's speed limit as set [m/s]
+        self.reused = 0
+        self.fresh = 0
+
+    def __getstate__(self) -> dict[str, Any]:
+        """Copied or pickled, a pool starts empty (RVO2's simulator cannot be copied; the
+        decisions do not depend on it)."""
+        return {"reused": self.reused, "fresh": self.fresh}
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__init__()  # type: ignore[misc]
+        self.reused, self.fresh = state["reused"], state["fresh"]
+
+    def simulator(self, period: float, params: OrcaParams, n_agents: int) -> Any:
+        """The kept simulator with room for ``n_agents`` obstacle agents, its time step
+        ``period`` [s]; the agents of the previous decision beyond ``n_agents`` parked."""
+        key = (float(params.time_horizon), float(params.time_horizon_obst), float(period))
+        if self._sim is None or self._key is None or key[:2] != self._key[:2]:
+            pyrvo = _import_pyrvo()
+            self._sim = pyrvo.RVOSimulator()
+            self._sim.set_time_step(float(period))
+            self._sim.add_agent(
+                (0.0, 0.0), float(params.neighbor_dist), int(params.max_neighbors),
+                key[0], key[1], 0.0, 0.0, (0.0, 0.0),
+            )  # fmt: skip
+            self._slots = self._used = 0
+            self._radii = [0.0]
+            self.max_speed = 0.0
+        elif key[2] != self._key[2]:
+            self._sim.set_time_step(float(period))
+        self._key = key
+        sim = self._sim
+        while self._slots < n_agents:
+            sim.add_agent((_PARKED, _PARKED), 0.0, 0, key[0], key[1], 0.0, 0.0, (0.0, 0.0))
+            self._radii.append(0.0)
+            self._slots += 1
+        for k in range(n_agents + 1, self._used + 1):  # no longer needed: parked, still
+            sim.set_agent_position(k, (_PARKED + k, _PARKED))
+            sim.set_agent_velocity(k, (0.0, 0.0))
+            sim.set_agent_pref_velocity(k, (0.0, 0.0))
+        self._used = n_agents
+        return sim
+
+    def set_radius(self, agent: int, radius: float) -> None:
+        """Agent ``agent``'s radius [m] (set in the simulator only when it changes)."""
+        if self._radii[agent] != radius:
+            self._sim.set_agent_radius(agent, radius)
+            self._radii[agent] = radius
+
+    def one_leaf(self, n_agents: int) -> bool:
+        """Whether the kept simulator, grown to ``n_agents`` obstacle agents, has at most
+        RVO2's leaf size of agents in all: its k-d tree is then one leaf that is never reordered,
+        so the robot meets its neighbours in agent order, as in a fresh simulator."""
+        return 1 + max(self._slots, n_agents) <= _LEAF
+
+
+def _distinct_ranges(agents: Sequence[tuple[float, ...]]) -> bool:
+    """Whether RVO2's squared centre distances of ``agents`` (robot at the origin) are certainly
+    distinct: the float64 ones differ by more than 1e-6 relative, far above the rounding of
+    RVO2's float32 ones (coordinates, products and sum: below 3e-7 relative), so its float32
+    values are distinct and in the same order.  Its neighbour order then does not depend on its
+    k-d tree, and a reused simulator orders the half-planes as a fresh one does (note 11)."""
+    if len(agents) < 2:
+        return True
+    d = sorted(a[0] * a[0] + a[1] * a[1] for a in agents)
+    return all(hi - lo > 1e-6 * hi for lo, hi in pairwise(d))
 
 
 def orca_velocity(
@@ -337,6 +446,7 @@ def orca_velocity(
     max_speed: float,
     period: float,
     params: OrcaParams,
+    pool: RvoPool | None = None,
 ) -> OrcaQuery:
     """One ORCA decision for the robot through RVO2 (``pyrvo``), with the robot taking
     ``params.responsibility`` of each agent avoidance (module docstring, notes 1-3).
@@ -350,59 +460,84 @@ def orca_velocity(
         max_speed: V_max [m/s].
         period: decision period [s] (RVO2's time step, used when already overlapping).
         params: ORCA parameters.
+        pool: a simulator kept across this robot's decisions (note 11); ``None`` builds one for
+            this decision.  The result is the same bit for bit.
     """
     pyrvo = _import_pyrvo()
     p = params
     px, py = float(position[0]), float(position[1])
     vel = (float(velocity[0]), float(velocity[1]))
     pref = (float(pref_velocity[0]), float(pref_velocity[1]))
-    sim = pyrvo.RVOSimulator()
-    sim.set_time_step(float(period))
-    sim.add_agent(
-        (0.0, 0.0),
-        float(p.neighbor_dist),
-        int(p.max_neighbors),
-        float(p.time_horizon),
-        float(p.time_horizon_obst),
-        float(radius),
-        float(max_speed),
-        vel,
-    )
-    sim.set_agent_pref_velocity(0, pref)
-    has_static = False
-    n_agents = 0
+    polygons: list[list[tuple[float, float]]] = []
+    agents: list[tuple[float, float, float, float, float, float]] = []  # cx, cy, r, vx, vy, |v|
     reach = 0.0
     for rd in obstacles:
         if not _finite_reading(rd) or rd.distance > p.neighbor_dist:
             continue
         if p.static_polygons and is_static_polygon(rd, p.static_speed):
             rel = _ccw(np.asarray(rd.outline, dtype=float) - np.array([px, py]))
-            sim.add_obstacle([(float(x), float(y)) for x, y in rel])
-            has_static = True
+            polygons.append([(float(x), float(y)) for x, y in rel])
             continue
-        if n_agents >= p.max_neighbors:
+        if len(agents) >= p.max_neighbors:
             continue
-        n_agents += 1
         cx, cy = float(rd.centre[0]) - px, float(rd.centre[1]) - py
         reach = max(reach, math.hypot(cx, cy))
         r_obs = float(rd.radius if rd.is_disc else rd.bounding_radius)
-        v_obs = (float(rd.velocity[0]), float(rd.velocity[1]))
-        idx = sim.add_agent(
-            (cx, cy),
-            0.0,
-            0,
+        vx, vy = float(rd.velocity[0]), float(rd.velocity[1])
+        agents.append((cx, cy, max(r_obs, 0.0), vx, vy, float(math.hypot(vx, vy))))
+    n_agents = len(agents)
+    if pool is not None and not polygons and (pool.one_leaf(n_agents) or _distinct_ranges(agents)):
+        pool.reused += 1
+        sim = pool.simulator(float(period), p, n_agents)
+        sim.set_agent_position(0, (0.0, 0.0))
+        sim.set_agent_velocity(0, vel)
+        sim.set_agent_pref_velocity(0, pref)
+        pool.set_radius(0, float(radius))
+        if pool.max_speed != float(max_speed):
+            sim.set_agent_max_speed(0, float(max_speed))
+            pool.max_speed = float(max_speed)
+        # the robot's half-planes read only its neighbours' positions, velocities and radii (its
+        # neighbours' own new velocities, from their speed limits and preferred velocities, are
+        # never read): those three are set
+        for idx, (cx, cy, r_obs, vx, vy, _) in enumerate(agents, start=1):
+            sim.set_agent_position(idx, (cx, cy))
+            sim.set_agent_velocity(idx, (vx, vy))
+            pool.set_radius(idx, r_obs)
+    else:
+        if pool is not None:
+            pool.fresh += 1
+        sim = pyrvo.RVOSimulator()
+        sim.set_time_step(float(period))
+        sim.add_agent(
+            (0.0, 0.0),
+            float(p.neighbor_dist),
+            int(p.max_neighbors),
             float(p.time_horizon),
             float(p.time_horizon_obst),
-            max(r_obs, 0.0),
-            float(math.hypot(*v_obs)),
-            v_obs,
+            float(radius),
+            float(max_speed),
+            vel,
         )
-        sim.set_agent_pref_velocity(idx, v_obs)
+        sim.set_agent_pref_velocity(0, pref)
+        for outline in polygons:
+            sim.add_obstacle(outline)
+        for cx, cy, r_obs, vx, vy, speed in agents:
+            idx = sim.add_agent(
+                (cx, cy),
+                0.0,
+                0,
+                float(p.time_horizon),
+                float(p.time_horizon_obst),
+                r_obs,
+                speed,
+                (vx, vy),
+            )
+            sim.set_agent_pref_velocity(idx, (vx, vy))
+        if polygons:
+            sim.process_obstacles()
     # the neighbours were chosen above (surface distance, nearest first): RVO2 must keep them all
     sim.set_agent_neighbor_dist(0, float(reach + 1.0))
     sim.set_agent_max_neighbors(0, max(n_agents, 1))
-    if has_static:
-        sim.process_obstacles()
     sim.do_step()
     rv = sim.get_agent_velocity(0)
     rvo2_velocity = np.array([float(rv.x), float(rv.y)])
@@ -416,9 +551,11 @@ def orca_velocity(
         if k >= n_obst:  # agent line: point = v_A + u / 2 -> v_A + responsibility * u
             qx = vel[0] + scale * (qx - vel[0])
             qy = vel[1] + scale * (qy - vel[1])
-        line = ((float(qx), float(qy)), (float(dx), float(dy)))
-        if not all(math.isfinite(c) for c in (*line[0], *line[1])):
+        qx, qy, dx, dy = float(qx), float(qy), float(dx), float(dy)
+        isf = math.isfinite
+        if not (isf(qx) and isf(qy) and isf(dx) and isf(dy)):
             continue  # note 8
+        line = ((qx, qy), (dx, dy))
         if k < n_obst:
             kept_obst += 1
         lines.append(line)
@@ -472,6 +609,7 @@ class OrcaController(UnicycleController):
         super().__init__()
         self.params = params or OrcaParams()
         self._last_query: OrcaQuery | None = None
+        self.pool = RvoPool()
 
     @property
     def last_query(self) -> OrcaQuery | None:
@@ -481,6 +619,7 @@ class OrcaController(UnicycleController):
     def _reset_law(self, rng: np.random.Generator) -> None:
         _import_pyrvo()  # fail at reset, with the extra's name, not in the middle of an episode
         self._last_query = None
+        self.pool = RvoPool()  # one simulator per episode, kept across its decisions (note 11)
 
     def preferred_velocity(self, position: FloatArray, period: float) -> FloatArray:
         """V_max toward T, lowered to ``dist / period`` near T (note 5) [m/s]."""
@@ -512,6 +651,7 @@ class OrcaController(UnicycleController):
             max_speed=spec.v_max,
             period=period,
             params=self.params,
+            pool=self.pool,
         )
         self._last_query = query
         self._mode = "M1" if float(np.hypot(*(query.velocity - pref))) < 1e-6 else "M2"

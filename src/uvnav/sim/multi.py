@@ -47,7 +47,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from uvnav.controllers.base import Controller
-from uvnav.core import AgentLog, BaseProbe, run_loop
+from uvnav.core import AgentLog, BaseProbe, DiscAgents, run_loop
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.obstacles.batch import ObstacleBatch
@@ -415,6 +415,29 @@ class MultiUnicycleWorld:
             readings = est.update(self.t, readings)
         return Observation(
             time=self.t, pose=pose, speed=self.applied[i].v, goal=self.goals[i], obstacles=readings
+        )
+
+    def disc_agents(self) -> DiscAgents:
+        """Every robot's disc now, for a group law (:class:`uvnav.core.DiscAgents`; velocities
+        as the other robots' readings give them; ``exact`` where a robot's readings carry the
+        true velocities).
+
+        Raises:
+            ValueError: the world holds obstacles besides the robots (not covered yet).
+        """
+        if self.k:
+            raise ValueError(
+                f"a group law reads a world of robots only; this one holds {self.k} obstacle(s)"
+            )
+        return DiscAgents(
+            time=self.t,
+            positions=self.state[:, :2].copy(),
+            headings=self.state[:, 2].copy(),
+            velocities=np.array(self.field.velocities, dtype=float),
+            radii=self.radii.copy(),
+            active=self.active.copy(),
+            sensing_range=np.array([float(r.sensing.sensing_range) for r in self.robots]),
+            exact=np.array([est is None for est in self.estimators]),
         )
 
     def apply(self, cmd: UnicycleCommand, agent: int = 0) -> UnicycleCommand:
