@@ -43,13 +43,15 @@ import argparse
 import json
 import math
 import os
-import platform
+import sys
 import time
-from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from run_benchmarks import machine_info
 
 COUNTS = (10, 100)
 #: (label, law, law parameters)
@@ -212,16 +214,6 @@ def navground_run(n: int, steps: int) -> dict[str, Any]:  # pragma: no cover - o
     return {"steps": steps, "cpu_s": cpu, "wall_s": wall, "us_per_step": 1e6 * cpu / steps}
 
 
-def machine() -> dict[str, Any]:
-    return {
-        "cpus": os.cpu_count(),
-        "load_average": list(os.getloadavg()),
-        "python": platform.python_version(),
-        "numpy": np.__version__,
-        "timestamp": datetime.now(UTC).isoformat(timespec="seconds"),
-    }
-
-
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path("benchmarks/results"))
@@ -283,7 +275,7 @@ def main(argv: list[str] | None = None) -> int:
         "benchmark": "orca",
         "what": f"antipodal:N, {steps} steps, CPU µs per step (thread time), best of {repeats}",
         "navground": ng_version,
-        "machine": machine(),
+        "machine": machine_info(),
         "load_average_before": load_before,
         "load_average_after": list(os.getloadavg()),
         "steps": steps,

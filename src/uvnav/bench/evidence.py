@@ -87,20 +87,12 @@ def claim(key: str, what: str) -> Callable[[Callable[[bool], Figures]], Callable
 # -- experiments ------------------------------------------------------------------------------
 
 
-def _episodes(
-    scenes: Iterable[str],
-    law: str,
-    params: dict[str, Any] | None = None,
-    *,
-    beyond: bool = False,
-) -> list[Any]:
+def _episodes(scenes: Iterable[str], law: str, params: dict[str, Any] | None = None) -> list[Any]:
     """One episode per scene spec (``generator:seed`` or a built-in name), the scene's seed."""
     from uvnav.scenarios.catalog import resolve
     from uvnav.scenarios.episodes import run_scene
 
-    return [
-        run_scene(resolve(s), law, dict(params or {}), beyond_assumptions=beyond) for s in scenes
-    ]
+    return [run_scene(resolve(s), law, dict(params or {})) for s in scenes]
 
 
 def _count(outcomes: Sequence[Any], status: str) -> float:
@@ -115,8 +107,8 @@ def _robot_driven(outcomes: Sequence[Any]) -> float:
     return float(sum(o.metrics.get("collision_by") == "robot" for o in outcomes))
 
 
-def _seeds(generator: str, n: int, start: int = 0) -> list[str]:
-    return [f"{generator}:{s}" for s in range(start, start + n)]
+def _seeds(generator: str, n: int) -> list[str]:
+    return [f"{generator}:{s}" for s in range(n)]
 
 
 @claim("ch2-notes", "Ch. 2 notes 6 and 9 (thesis-notes table; zhang2019 docstring notes 6-7)")
@@ -299,9 +291,9 @@ def _ch5_literal(quick: bool) -> Figures:
         ACCEPTED_SAMPLES,
         TEST_SEED,
         THESIS_ERROR_RANGES,
-        _inside,
         cached_dataset,
         learning_row,
+        range_inside,
         seed_succeeds,
     )
     from uvnav.learning.bpnn import BPNNConfig
@@ -317,7 +309,7 @@ def _ch5_literal(quick: bool) -> Figures:
         for o in ("distance", "index"):
             out[f"n{n}_{o}_lo_median"] = float(np.median([x[o]["lo"] for x in net]))
             out[f"n{n}_{o}_hi_median"] = float(np.median([x[o]["hi"] for x in net]))
-            out[f"n{n}_{o}_inside"] = float(sum(_inside(x[o], ref[o]) for x in net))
+            out[f"n{n}_{o}_inside"] = float(sum(range_inside(x[o], ref[o]) for x in net))
         ind = [r["independent"]["network"] for r in rows]
         out[f"n{n}_independent_distance_mae"] = float(
             np.median([x["distance"]["mae"] for x in ind])

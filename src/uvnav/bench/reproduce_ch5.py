@@ -543,7 +543,7 @@ def _range(lo: float, hi: float) -> str:
 OUTPUTS: tuple[str, ...] = ("distance", "index")
 
 
-def _inside(summary: dict[str, Any], bounds: tuple[float, float]) -> bool:
+def range_inside(summary: dict[str, Any], bounds: tuple[float, float]) -> bool:
     """Whether an error summary's range ``[lo, hi]`` lies inside ``bounds``."""
     return bool(bounds[0] <= summary["lo"] and summary["hi"] <= bounds[1])
 
@@ -552,7 +552,7 @@ def seed_succeeds(row: dict[str, Any], group: str = "test_group") -> bool:
     """The thesis's bar of success for one learning row: the network's error ranges on ``group``
     inside the ranges the thesis accepts (its 150-sample result) for both outputs."""
     ref = THESIS_ERROR_RANGES[ACCEPTED_SAMPLES]
-    return all(_inside(row[group]["network"][o], ref[o]) for o in OUTPUTS)
+    return all(range_inside(row[group]["network"][o], ref[o]) for o in OUTPUTS)
 
 
 def thesis_statement(n: int, succeeded: int, seeds: int) -> str:
@@ -605,16 +605,18 @@ def _error_row(label: str, n: int, out: str, rs: list[dict[str, Any]]) -> dict[s
     )
     if ref is not None and THESIS_ACCEPTED[n]:
         thesis = _range(*ref[out])
-        note += f"; inside the thesis's range on {sum(_inside(x, ref[out]) for x in g)}/{k} seeds"
+        note += (
+            f"; inside the thesis's range on {sum(range_inside(x, ref[out]) for x in g)}/{k} seeds"
+        )
         alls = [r["all_samples"]["network"][out] for r in rs if "all_samples" in r]
         if alls:
-            inside_all = sum(_inside(x, ref[out]) for x in alls)
+            inside_all = sum(range_inside(x, ref[out]) for x in alls)
             note += f" (over all {n} samples, train + validation + test: {inside_all}/{len(alls)})"
     else:
         thesis = f"{_range(*ref[out])}: a failure" if ref is not None else "-"
         note += (
             f"; within the range the thesis accepts ({ACCEPTED_SAMPLES} samples, "
-            f"{_range(*accepted)}) on {sum(_inside(x, accepted) for x in g)}/{k} seeds"
+            f"{_range(*accepted)}) on {sum(range_inside(x, accepted) for x in g)}/{k} seeds"
         )
         if ref is not None:
             note += "; being inside the thesis's failed range is not agreement"

@@ -959,15 +959,7 @@ def bench(
         typer.echo(_dumps(record))
         _fail_on_errors(result.errors, first_error)
         return
-    from rich import box
-    from rich.table import Table
-
-    table = Table(
-        title=f"campaign {spec.name} ({result.total} episodes)",
-        box=box.SIMPLE_HEAD,
-        pad_edge=False,
-        collapse_padding=True,
-    )
+    table = compact_table(f"campaign {spec.name} ({result.total} episodes)")
     numeric = [c for c in SUMMARY_COLUMNS if c in _SUMMARY_HEADERS]
     table.add_column("controller\nparams", overflow="fold", ratio=1, min_width=12)
     cells = [[_summary_cell(col, row[col]) for col in numeric] for row in rows]
@@ -992,17 +984,18 @@ def bench(
     _fail_on_errors(result.errors, first_error)
 
 
-def _print_failures(rows: list[dict[str, Any]]) -> None:
-    """The episodes that did not succeed, one line each (``uvnav bench --failures``)."""
+def compact_table(title: str, caption: str | None = None) -> Any:
+    """A rich table with a rule under its header only, no outer padding: the summaries'."""
     from rich import box
     from rich.table import Table
 
-    table = Table(
-        title=f"{len(rows)} episode(s) did not succeed",
-        box=box.SIMPLE_HEAD,
-        pad_edge=False,
-        collapse_padding=True,
-    )
+    return Table(title=title, caption=caption, box=box.SIMPLE_HEAD, pad_edge=False,
+                 collapse_padding=True)  # fmt: skip
+
+
+def _print_failures(rows: list[dict[str, Any]]) -> None:
+    """The episodes that did not succeed, one line each (``uvnav bench --failures``)."""
+    table = compact_table(f"{len(rows)} episode(s) did not succeed")
     for head in ("controller", "scenario", "seed"):
         table.add_column(head, overflow="fold")
     table.add_column("cause", overflow="fold", ratio=1)

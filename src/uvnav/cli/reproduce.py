@@ -18,7 +18,7 @@ from typing import Annotated, Any
 
 import typer
 
-from uvnav.cli.app import CliError, _console, _fmt, _optional, _text
+from uvnav.cli.app import CliError, _console, _fmt, _optional, _text, compact_table
 
 _COLUMNS = ("quantity", "thesis", "measured", "note")
 _TITLE = "uvnav — reproduction of the thesis's experiments"
@@ -130,21 +130,15 @@ def reproduce_cmd(
 
 def _print_regime_leaders(db: Path) -> None:
     """The regime map on one screen: per regime the law that succeeds most often."""
-    from rich import box
-    from rich.table import Table
-
     from uvnav.bench.regime import cell_stats, leaders
     from uvnav.bench.store import ResultsStore
 
     with ResultsStore(db, readonly=True) as store:
         rows = leaders(cell_stats(store))
-    table = Table(
-        title="Where each law wins: the best success per regime (95 % interval)",
-        caption="tied: other laws whose interval overlaps the best one's; "
+    table = compact_table(
+        "Where each law wins: the best success per regime (95 % interval)",
+        "tied: other laws whose interval overlaps the best one's; "
         "the report gives each regime's paragraph and heat maps",
-        box=box.SIMPLE_HEAD,
-        pad_edge=False,
-        collapse_padding=True,
     )
     table.add_column("humans × speed, robot, sensing", overflow="fold", ratio=1)
     table.add_column("best law", overflow="fold")
