@@ -160,8 +160,8 @@ class _RandomTurnGroup:
             for i in out:
                 mid_x, mid_y, lim, spin = consts[i]
                 # the operations of RandomTurn.step, on the same values
-                to_c = np.arctan2(mid_y - p[1, i], mid_x - p[0, i])
-                e = wrap_scalar(float(to_c) - float(course[i]))
+                to_c = math.atan2(mid_y - float(p[1, i]), mid_x - float(p[0, i]))  # libm's
+                e = wrap_scalar(to_c - float(course[i]))
                 tr = min(max(e / dt, -lim), lim)  # np.clip(e / dt, -lim, lim)
                 om_i = tr + spin
                 j = i if isinstance(rows, slice) else int(rows[i])
@@ -170,7 +170,11 @@ class _RandomTurnGroup:
                 inc[1, j] = tr * dt
                 half[i] = 0.5 * tr * dt
             return inc, omega, half
-        to_centre = np.arctan2(self.mid[1] - p[1], self.mid[0] - p[0])
+        dy = self.mid[1] - p[1]
+        dx = self.mid[0] - p[0]
+        to_centre = np.zeros(m)
+        for i in out:  # libm's atan2, as RandomTurn.step
+            to_centre[i] = math.atan2(float(dy[i]), float(dx[i]))
         err = wrap_array(to_centre - course)
         steer = np.minimum(np.maximum(err / dt, -self.limit), self.limit)
         outside = np.zeros(m, dtype=bool)

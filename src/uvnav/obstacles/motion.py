@@ -197,8 +197,10 @@ class RandomTurn:
             x0, y0, x1, y1 = self.arena
             p = state.position
             if not (x0 <= p[0] <= x1 and y0 <= p[1] <= y1):
-                to_centre = np.arctan2(0.5 * (y0 + y1) - p[1], 0.5 * (x0 + x1) - p[0])
-                err = wrap_scalar(float(to_centre) - self.course)
+                # libm's atan2 (math), not numpy's: numpy dispatches arctan2 to SIMD code on
+                # some CPUs (1 ulp apart), libm is the same everywhere and in compiled kernels
+                to_centre = math.atan2(0.5 * (y0 + y1) - float(p[1]), 0.5 * (x0 + x1) - float(p[0]))
+                err = wrap_scalar(to_centre - self.course)
                 limit = max(abs(self.turn_rate[0]), abs(self.turn_rate[1]))
                 turn = float(np.clip(err / dt, -limit, limit))
         self.course = wrap_scalar(self.course + turn * dt)
