@@ -5,6 +5,9 @@
 * ``uvnav/UUV2D-v0`` (:class:`uvnav.envs.uuv2d.Uuv2DEnv`): the Chapter-4 UUV with its sonar.
 * :class:`uvnav.envs.multi_robot.MultiNav2DParallelEnv`: a PettingZoo ``ParallelEnv`` of several
   robots on a multi-robot scenario (``antipodal:4`` ...).
+* :class:`uvnav.envs.nav2d_vec.Nav2DVectorEnv`: ``uvnav/Nav2D-v0`` batched, K worlds in one
+  compiled step (``gymnasium.make_vec("uvnav/Nav2D-v0", num_envs=K,
+  vectorization_mode="vector_entry_point")``).
 * :func:`as_policy`: any uvnav controller as a policy for them.
 
 gymnasium and pettingzoo (``uvnav[envs]``) are imported only when an env class is used.
@@ -44,6 +47,7 @@ _ENTRY_POINTS = {
     "uvnav/Nav3D-v0": "uvnav.envs.nav3d:Nav3DEnv",
     "uvnav/UUV2D-v0": "uvnav.envs.uuv2d:Uuv2DEnv",
 }
+_VECTOR_ENTRY_POINTS = {"uvnav/Nav2D-v0": "uvnav.envs.nav2d_vec:Nav2DVectorEnv"}
 
 
 def register_envs() -> None:
@@ -53,7 +57,10 @@ def register_envs() -> None:
     for env_id in ENV_IDS:
         if env_id not in gymnasium.registry:
             gymnasium.register(
-                id=env_id, entry_point=_ENTRY_POINTS[env_id], disable_env_checker=False
+                id=env_id,
+                entry_point=_ENTRY_POINTS[env_id],
+                vector_entry_point=_VECTOR_ENTRY_POINTS.get(env_id),
+                disable_env_checker=False,
             )
 
 
@@ -62,6 +69,10 @@ def __getattr__(name: str) -> Any:
         from uvnav.envs.nav2d import Nav2DEnv
 
         return Nav2DEnv
+    if name == "Nav2DVectorEnv":
+        from uvnav.envs.nav2d_vec import Nav2DVectorEnv
+
+        return Nav2DVectorEnv
     if name == "Nav3DEnv":
         from uvnav.envs.nav3d import Nav3DEnv
 

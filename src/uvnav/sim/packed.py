@@ -53,6 +53,18 @@ _VELTKAMP = 134217729.0  # 2**27 + 1
 #: random numbers pre-drawn per obstacle and block
 BLOCK = 64
 
+# Columns of the (K, NW) float array of the worlds: pose [m, m, rad], held command [m/s, rad/s],
+# goal [m], robot radius [m], goal tolerance [m], dt [s], clearance now and lowest over the last
+# decision [m], V_max [m/s], U_max [rad/s].
+(W_X, W_Y, W_TH, W_V, W_U, W_GX, W_GY, W_RADIUS, W_TOL, W_DT, W_CLEAR, W_LOW, W_VMAX,
+ W_UMAX) = range(14)  # fmt: skip
+NW = 14
+# Columns of the (K, NI) int array of the worlds: step index, steps per decision, steps in the
+# episode, status code, number of obstacles, 1 when the next step() advances it.
+I_STEP, I_RATIO, I_NSTEPS, I_STATUS, I_NOBS, I_ACTIVE = range(6)
+NI = 6
+# Rows of the (K, 2, M) int array of the obstacles: motion kind, next unread pre-drawn number.
+O_KIND, O_UPOS = 0, 1
 # Parameter rows of the (K, P, M) obstacle parameter array.
 (P_VX, P_VY, P_OMEGA, P_SPEED_LO, P_SPEED_SPAN, P_TURN_LO, P_TURN_SPAN, P_PERIOD, P_SPIN,
  P_X0, P_Y0, P_X1, P_Y1, P_MIDX, P_MIDY, P_LIMIT, P_ARENA, P_BOUND) = range(18)  # fmt: skip
@@ -127,20 +139,21 @@ def wrap_angle(a: float) -> float:
     return w if w > -math.pi else math.pi
 
 
-def _obstacle_step(o: int, st: FloatArray, prm: FloatArray, kind: int, ubuf: FloatArray,
-                   upos: np.ndarray, t: float, dt: float) -> None:  # fmt: skip
-    """Advance obstacle ``o`` of one world (``st`` (S, M), ``prm`` (P, M)) from ``t`` by
-    ``dt`` [s]: :class:`ObstacleBatch`'s arithmetic for its motion ``kind``."""
+def _obstacle_step(o: int, st: FloatArray, prm: FloatArray, oi: np.ndarray, ubuf: FloatArray,
+                   t: float, dt: float) -> None:  # fmt: skip
+    """Advance obstacle ``o`` of one world (``st`` (S, M), ``prm`` (P, M), ``oi`` (2, M),
+    ``ubuf`` (M, B)) from ``t`` by ``dt`` [s]: :class:`ObstacleBatch`'s arithmetic."""
+    kind = oi[O_KIND, o]
     if kind == CONSTANT:
         st[S_HEADING, o] = wrap_angle(st[S_HEADING, o] + prm[P_OMEGA, o] * dt)
         st[S_X, o] = st[S_X, o] + prm[P_VX, o] * dt
         st[S_Y, o] = st[S_Y, o] + prm[P_VY, o] * dt
         return
     if t >= st[S_THRESHOLD, o]:  # a new speed and turn rate (RandomTurn.step's two draws)
-        p = upos[o]
+        p = oi[O_UPOS, o]
         st[S_SPEED, o] = prm[P_SPEED_LO, o] + prm[P_SPEED_SPAN, o] * ubuf[o, p]
         st[S_TURN, o] = prm[P_TURN_LO, o] + prm[P_TURN_SPAN, o] * ubuf[o, p + 1]
-        upos[o] = p + 2
+        oi[O_UPOS, o] = p + 2
         nc = t + prm[P_PERIOD, o]
         st[S_NEXT, o] = nc
         st[S_THRESHOLD, o] = nc - 1e-12
@@ -196,20 +209,19 @@ def _signed_distance(px: float, py: float, rings: FloatArray, o: int, c: float, 
     return best
 
 
-def _clearance(k: int, x: float, y: float, radius: float, n_obs: np.ndarray,
-               params: FloatArray, state: FloatArray, rings: FloatArray) -> float:  # fmt: skip
-    """World ``k``'s exact clearance [m] of the robot disc at ``(x, y)``; ``inf`` without
-    obstacles."""
+def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray,
+               st: FloatArray, rings: FloatArray) -> float:  # fmt: skip
+    """Exact clearance [m] of the robot disc at ``(x, y)`` in one world (``prm`` (P, M), ``st``
+    (S, M), ``rings`` (2, M, W)); ``inf`` without obstacles."""
     gap = math.inf
-    st = state[k]
     slack = 1e-9 * (1.0 + abs(x) + abs(y))
-    for o in range(n_obs[k]):
+    for o in range(n_obs):
         # a body whose bounding disc is farther than the gap so far cannot lower it
-        lower = math.hypot(st[S_X, o] - x, st[S_Y, o] - y) - params[k, P_BOUND, o] - radius
+        lower = math.hypot(st[S_X, o] - x, st[S_Y, o] - y) - prm[P_BOUND, o] - radius
         if lower > gap + slack:
             continue
         h = st[S_HEADING, o]
-        d = _signed_distance(x, y, rings[k], o, math.cos(h), math.sin(h), st[S_X, o], st[S_Y, o])
+        d = _signed_distance(x, y, rings, o, math.cos(h), math.sin(h), st[S_X, o], st[S_Y, o])
         g = d - radius
         if g < gap or g != g:
             gap = g
@@ -217,46 +229,35 @@ def _clearance(k: int, x: float, y: float, radius: float, n_obs: np.ndarray,
 
 
 def step_worlds_py(
-    active: np.ndarray,
-    robot: FloatArray,
-    command: FloatArray,
-    goal: FloatArray,
-    spec: FloatArray,
-    counters: np.ndarray,
-    status: np.ndarray,
-    clearance: FloatArray,
-    low: FloatArray,
-    n_obs: np.ndarray,
-    kind: np.ndarray,
+    wf: FloatArray,
+    wi: np.ndarray,
+    oi: np.ndarray,
     params: FloatArray,
     state: FloatArray,
     ubuf: FloatArray,
-    upos: np.ndarray,
     rings: FloatArray,
 ) -> None:
-    """Advance every ``active`` running world by one decision, in place.
+    """Advance every active running world by one decision (``wi[k, I_RATIO]`` integration
+    steps), in place.
 
-    Per world ``k``: ``robot[k]`` = (x, y, theta) [m, m, rad]; ``command[k]`` = the held (v, u)
-    [m/s, rad/s]; ``goal[k]`` [m]; ``spec[k]`` = (radius [m], goal tolerance [m], dt [s]);
-    ``counters[k]`` = (step index, steps per decision, steps in the episode); ``status[k]`` (a
-    code of :data:`STATUS_NAMES`); ``clearance[k]`` the last step's and ``low[k]`` the smallest
-    over this call's steps [m] (``inf`` when none ran).  Obstacles: ``n_obs[k]`` of them in the
-    first columns of ``kind`` (K, M), ``params`` (K, P, M), ``state`` (K, S, M), the pre-drawn
-    uniforms ``ubuf`` (K, M, B) read from ``upos`` (K, M), and ``rings`` (K, 2, M, W) in their
-    body frames.  The caller guarantees ``2 * steps per decision`` unread draws per obstacle.
+    The worlds' floats ``wf`` (K, NW) and ints ``wi`` (K, NI) are laid out as the ``W_*`` and
+    ``I_*`` columns say; obstacle ``o`` < ``wi[k, I_NOBS]`` of world ``k`` has its motion kind
+    and next unread draw in ``oi[k, :, o]``, its parameters ``params[k, :, o]`` (``P_*``), its
+    state ``state[k, :, o]`` (``S_*``), its pre-drawn uniforms ``ubuf[k, o]`` and its body
+    ring ``rings[k, :, o]`` (body frame).  The caller guarantees two unread draws per step.
     """
-    for k in range(robot.shape[0]):
-        low[k] = math.inf
-        if not active[k] or status[k] != RUNNING:
+    for k in range(wf.shape[0]):
+        wf[k, W_LOW] = math.inf
+        if wi[k, I_ACTIVE] == 0 or wi[k, I_STATUS] != RUNNING:
             continue
-        dt = spec[k, 2]
-        radius, tol = spec[k, 0], spec[k, 1]
-        v, u = command[k, 0], command[k, 1]
-        for _ in range(counters[k, 1]):
-            i = counters[k, 0]
+        dt = wf[k, W_DT]
+        radius, tol = wf[k, W_RADIUS], wf[k, W_TOL]
+        v, u = wf[k, W_V], wf[k, W_U]
+        for _ in range(wi[k, I_RATIO]):
+            i = wi[k, I_STEP]
             t = i * dt
             # the robot: unicycle_advance
-            x, y, th = robot[k, 0], robot[k, 1], robot[k, 2]
+            x, y, th = wf[k, W_X], wf[k, W_Y], wf[k, W_TH]
             half = 0.5 * u * dt
             sc = math.pi * (half / math.pi)
             if sc == 0.0:
@@ -264,78 +265,107 @@ def step_worlds_py(
             chord = v * dt * (math.sin(sc) / sc)
             x = x + chord * math.cos(th + half)
             y = y + chord * math.sin(th + half)
-            robot[k, 0], robot[k, 1], robot[k, 2] = x, y, wrap_angle(th + 2.0 * half)
-            for o in range(n_obs[k]):
-                _obstacle_step(o, state[k], params[k], kind[k, o], ubuf[k], upos[k], t, dt)
-            counters[k, 0] = i = i + 1
-            gap = _clearance(k, x, y, radius, n_obs, params, state, rings)
-            clearance[k] = gap
-            if gap < low[k]:
-                low[k] = gap
+            wf[k, W_X], wf[k, W_Y], wf[k, W_TH] = x, y, wrap_angle(th + 2.0 * half)
+            for o in range(wi[k, I_NOBS]):
+                _obstacle_step(o, state[k], params[k], oi[k], ubuf[k], t, dt)
+            wi[k, I_STEP] = i = i + 1
+            gap = _clearance(x, y, radius, wi[k, I_NOBS], params[k], state[k], rings[k])
+            wf[k, W_CLEAR] = gap
+            if gap < wf[k, W_LOW]:
+                wf[k, W_LOW] = gap
             if gap < 0.0:
-                status[k] = COLLISION
-            elif pyhypot(goal[k, 0] - x, goal[k, 1] - y) <= tol:
-                status[k] = SUCCESS
-            elif i >= counters[k, 2]:
-                status[k] = TIMEOUT
-            if status[k] != RUNNING:
+                wi[k, I_STATUS] = COLLISION
+            elif pyhypot(wf[k, W_GX] - x, wf[k, W_GY] - y) <= tol:
+                wi[k, I_STATUS] = SUCCESS
+            elif i >= wi[k, I_NSTEPS]:
+                wi[k, I_STATUS] = TIMEOUT
+            if wi[k, I_STATUS] != RUNNING:
                 break
 
 
-def lidar_worlds_py(
-    active: np.ndarray,
-    robot: FloatArray,
+def _lidar(
+    ox: float,
+    oy: float,
+    th: float,
     rel: FloatArray,
     max_range: float,
-    n_obs: np.ndarray,
-    params: FloatArray,
-    state: FloatArray,
+    n_obs: int,
+    prm: FloatArray,
+    st: FloatArray,
     rings: FloatArray,
     out: FloatArray,
 ) -> None:
-    """Ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) into ``out`` (K, R) for the
-    ``active`` worlds: beams at ``wrap(theta + rel)`` [rad], capped at ``max_range`` [m].  A body
-    whose bounding disc lies beyond ``max_range`` is skipped: its hits would be farther."""
-    n_rays = rel.shape[0]
-    for k in range(robot.shape[0]):
-        if not active[k]:
-            continue
-        ox, oy, th = robot[k, 0], robot[k, 1], robot[k, 2]
-        for r in range(n_rays):
-            out[k, r] = max_range
-        st = state[k]
-        for o in range(n_obs[k]):
-            cx, cy, h = st[S_X, o], st[S_Y, o], st[S_HEADING, o]
-            # the cull of ObstacleField.ray_hits (what it casts, this casts too)
-            limit = max_range * (1.0 + 1e-9) + 1e-9 * (1.0 + abs(ox) + abs(oy))
-            if math.hypot(cx - ox, cy - oy) - params[k, P_BOUND, o] > limit:
-                continue
-            c, s = math.cos(h), math.sin(h)
-            for r in range(n_rays):
-                a = wrap_angle(th + rel[r])
-                dx, dy = math.cos(a), math.sin(a)
-                best = out[k, r]
-                rx, ry = rings[k, 0, o, 0], rings[k, 1, o, 0]
-                sx, sy = c * rx + s * -ry + cx, c * ry + s * rx + cy
-                for j in range(rings.shape[3] - 1):
-                    rx, ry = rings[k, 0, o, j + 1], rings[k, 1, o, j + 1]
-                    nx, ny = c * rx + s * -ry + cx, c * ry + s * rx + cy
-                    ex, ey = nx - sx, ny - sy
-                    wx, wy = sx - ox, sy - oy
-                    den = dx * ey - dy * ex
-                    if abs(den) >= _EPS_RING:
-                        tt = (wx * ey - wy * ex) / den
-                        ss = (wx * dy - wy * dx) / den
-                        if tt >= 0.0 and ss >= 0.0 and ss <= 1.0 and tt < best:
-                            best = tt
-                    sx, sy = nx, ny
-                out[k, r] = best
+    """Ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from pose ``(ox, oy, th)`` in
+    one world into ``out`` (R,): beams at ``wrap(th + rel)`` [rad], capped at ``max_range``
+    [m].  A body is cast only where :meth:`ObstacleField.ray_hits` casts it."""
+    for r in range(rel.shape[0]):
+        out[r] = max_range
+    limit = max_range * (1.0 + 1e-9) + 1e-9 * (1.0 + abs(ox) + abs(oy))
+    for o in range(n_obs):
+        cx, cy, h = st[S_X, o], st[S_Y, o], st[S_HEADING, o]
+        if math.hypot(cx - ox, cy - oy) - prm[P_BOUND, o] > limit:
+            continue  # its hits would be beyond max_range
+        c, s = math.cos(h), math.sin(h)
+        for r in range(rel.shape[0]):
+            a = wrap_angle(th + rel[r])
+            dx, dy = math.cos(a), math.sin(a)
+            best = out[r]
+            rx, ry = rings[0, o, 0], rings[1, o, 0]
+            sx, sy = c * rx + s * -ry + cx, c * ry + s * rx + cy
+            for j in range(rings.shape[2] - 1):
+                rx, ry = rings[0, o, j + 1], rings[1, o, j + 1]
+                nx, ny = c * rx + s * -ry + cx, c * ry + s * rx + cy
+                ex, ey = nx - sx, ny - sy
+                wx, wy = sx - ox, sy - oy
+                den = dx * ey - dy * ex
+                if abs(den) >= _EPS_RING:
+                    tt = (wx * ey - wy * ex) / den
+                    ss = (wx * dy - wy * dx) / den
+                    if tt >= 0.0 and ss >= 0.0 and ss <= 1.0 and tt < best:
+                        best = tt
+                sx, sy = nx, ny
+            out[r] = best
+
+
+def observe_py(
+    wf: FloatArray,
+    wi: np.ndarray,
+    params: FloatArray,
+    state: FloatArray,
+    rings: FloatArray,
+    rel: FloatArray,
+    max_range: float,
+    goal_scale: float,
+    ranges: FloatArray,
+    out: np.ndarray,
+    dist: FloatArray,
+) -> None:
+    """``uvnav/Nav2D-v0``'s observation vectors (:meth:`uvnav.envs.core.EnvWorld.vector`) of
+    every world into ``out`` (K, 4 + R) float32, their lidar ranges [m] into ``ranges`` (K, R)
+    and goal distances [m] into ``dist`` (K,): goal distance / ``goal_scale`` capped at 1, cos
+    and sin of the goal bearing in the robot frame, speed / V_max in [0, 1] (0 once arrived or
+    collided), ranges / ``max_range`` in [0, 1] (beams at heading + ``rel`` [rad])."""
+    for k in range(wf.shape[0]):
+        x, y, th = wf[k, W_X], wf[k, W_Y], wf[k, W_TH]
+        _lidar(x, y, th, rel, max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ranges[k])
+        gx, gy = wf[k, W_GX] - x, wf[k, W_GY] - y
+        d = pyhypot(gx, gy)
+        dist[k] = d
+        bearing = math.atan2(gy, gx) - th
+        out[k, 0] = min(d / goal_scale, 1.0)
+        out[k, 1] = math.cos(bearing)
+        out[k, 2] = math.sin(bearing)
+        status = wi[k, I_STATUS]
+        speed = 0.0 if status in (SUCCESS, COLLISION) else wf[k, W_V]
+        out[k, 3] = min(max(speed / wf[k, W_VMAX], 0.0), 1.0)
+        for r in range(ranges.shape[1]):
+            out[k, 4 + r] = min(max(ranges[k, r] / max_range, 0.0), 1.0)
 
 
 _KERNELS: dict[str, Callable[..., Any]] = {}
 #: the functions compiled, callees before callers
 _COMPILED = ("pyhypot", "wrap_angle", "_obstacle_step", "_signed_distance", "_clearance",
-             "step_worlds_py", "lidar_worlds_py")  # fmt: skip
+             "_lidar", "step_worlds_py", "observe_py")  # fmt: skip
 
 
 def _compile() -> None:
@@ -348,18 +378,23 @@ def _compile() -> None:
         f = globals()[name]
         copy = types.FunctionType(f.__code__, env, name, f.__defaults__, f.__closure__)
         env[name] = numba.njit(cache=True, nogil=True)(copy)
-    _KERNELS["step"] = env["step_worlds_py"]
-    _KERNELS["lidar"] = env["lidar_worlds_py"]
+    for name in _PUBLIC.values():
+        _KERNELS[name] = env[name]
+
+
+#: the kernels by short name
+_PUBLIC = {"step": "step_worlds_py", "observe": "observe_py"}
 
 
 def kernel(name: str) -> Callable[..., Any]:
-    """``"step"`` (:func:`step_worlds_py`) or ``"lidar"`` (:func:`lidar_worlds_py`), compiled by
+    """``"step"`` (:func:`step_worlds_py`) or ``"observe"`` (:func:`observe_py`), compiled by
     numba on first use when it is enabled (:func:`numba_enabled`), else the Python functions."""
+    full = _PUBLIC[name]
     if not numba_enabled():
-        return step_worlds_py if name == "step" else lidar_worlds_py
+        return globals()[full]  # type: ignore[no-any-return]
     if not _KERNELS:
         _compile()
-    return _KERNELS[name]
+    return _KERNELS[full]
 
 
 def pack_check(setup: EpisodeSetup) -> str | None:
@@ -380,54 +415,84 @@ def pack_check(setup: EpisodeSetup) -> str | None:
 
 class PackedWorlds:
     """``k`` slots of packed worlds (module docstring); :meth:`load` an episode into a slot,
-    :meth:`step` all running ones by one decision.
+    :meth:`step` the running ones by one decision, :meth:`observe` them.
 
-    The arrays are public and are the state (see :func:`step_worlds_py` for their layout); a
-    slot's obstacles keep their generators, read ahead by up to :data:`BLOCK` numbers, so the
-    :class:`RandomTurn` models are not written back (unlike :meth:`UnicycleWorld.close`).
+    The arrays are the state (:func:`step_worlds_py` gives their layout; :attr:`robot`,
+    :attr:`command`, :attr:`status`... are views of them).  A slot's random-turn obstacles keep
+    their generators, read ahead by up to :data:`BLOCK` numbers: the models are not written
+    back (unlike :meth:`UnicycleWorld.close <uvnav.sim.episode.UnicycleWorld.close>`).
     """
 
     def __init__(self, k: int) -> None:
         self.k = int(k)
-        self.robot = np.zeros((k, 3))
-        self.command = np.zeros((k, 2))
-        self.goal = np.zeros((k, 2))
-        self.spec = np.zeros((k, 3))
-        self.limits = np.zeros((k, 2))  # v_max [m/s], u_max [rad/s]
-        self.counters = np.zeros((k, 3), dtype=np.int64)
-        self.status = np.full(k, TIMEOUT, dtype=np.int64)
-        self.clearance = np.full(k, math.inf)
-        self.low = np.full(k, math.inf)
-        self.n_obs = np.zeros(k, dtype=np.int64)
+        self.wf = np.zeros((k, NW))
+        self.wi = np.zeros((k, NI), dtype=np.int64)
+        self.wi[:, I_STATUS] = TIMEOUT
+        self.wi[:, I_ACTIVE] = 1
+        self.wf[:, W_CLEAR] = self.wf[:, W_LOW] = math.inf
         self.rngs: list[list[np.random.Generator | None]] = [[] for _ in range(k)]
+        self._safe_calls = 0  # step() calls before a refill may be needed
         self._alloc(0, 2)
+
+    # views of the state, by meaning
+    @property
+    def robot(self) -> FloatArray:
+        """(k, 3) poses ``(x, y, theta)`` [m, m, rad]."""
+        return self.wf[:, W_X : W_TH + 1]
+
+    @property
+    def command(self) -> FloatArray:
+        """(k, 2) held commands ``(v, u)`` [m/s, rad/s], used as given (saturate them first)."""
+        return self.wf[:, W_V : W_U + 1]
+
+    @property
+    def limits(self) -> FloatArray:
+        """(k, 2) ``(V_max [m/s], U_max [rad/s])``."""
+        return self.wf[:, W_VMAX : W_UMAX + 1]
+
+    @property
+    def clearance(self) -> FloatArray:
+        """(k,) exact clearance after the last step [m] (``inf`` without obstacles)."""
+        return self.wf[:, W_CLEAR]
+
+    @property
+    def low(self) -> FloatArray:
+        """(k,) lowest clearance over the last :meth:`step` [m] (``inf`` where none ran)."""
+        return self.wf[:, W_LOW]
+
+    @property
+    def status(self) -> np.ndarray:
+        """(k,) status codes (:data:`STATUS_NAMES`)."""
+        return self.wi[:, I_STATUS]
+
+    @property
+    def time(self) -> FloatArray:
+        """(k,) simulated time [s] (step index x dt, as the loop world counts it)."""
+        return self.wi[:, I_STEP] * self.wf[:, W_DT]
 
     def _alloc(self, m: int, w: int) -> None:
         """(Re)allocate the obstacle arrays for ``m`` obstacles of ``w``-column rings, keeping
         what the slots hold."""
         k = self.k
-        old = getattr(self, "kind", None)
-        kind = np.full((k, m), EMPTY, dtype=np.int64)
+        oi = np.zeros((k, 2, m), dtype=np.int64)
+        oi[:, O_KIND] = EMPTY
         params = np.zeros((k, N_PARAMS, m))
         state = np.zeros((k, N_STATE, m))
         ubuf = np.zeros((k, m, BLOCK))
-        upos = np.zeros((k, m), dtype=np.int64)
         rings = np.zeros((k, 2, m, w))
-        if old is not None:
+        if hasattr(self, "oi"):
             m0, w0 = self.rings.shape[2], self.rings.shape[3]
-            kind[:, :m0] = self.kind
+            oi[:, :, :m0] = self.oi
             params[:, :, :m0] = self.params
             state[:, :, :m0] = self.state
             ubuf[:, :m0] = self.ubuf
-            upos[:, :m0] = self.upos
             rings[:, :, :m0, :w0] = self.rings
             rings[:, :, :m0, w0:] = self.rings[:, :, :, :1]  # more copies of the first vertex
-        self.kind, self.params, self.state = kind, params, state
-        self.ubuf, self.upos, self.rings = ubuf, upos, rings
+        self.oi, self.params, self.state, self.ubuf, self.rings = oi, params, state, ubuf, rings
 
     def load(self, slot: int, setup: EpisodeSetup) -> None:
-        """Put ``setup``'s episode in ``slot`` as :meth:`UnicycleWorld.start` begins it (status,
-        clearance at t = 0).
+        """Put ``setup``'s episode in ``slot`` as :meth:`UnicycleWorld.start
+        <uvnav.sim.episode.UnicycleWorld.start>` begins it (status and clearance at t = 0).
 
         Raises:
             ValueError: the episode cannot be packed (:func:`pack_check`).
@@ -441,35 +506,37 @@ class PackedWorlds:
         w = tpl.rings.shape[2] if m else 2
         if m > self.rings.shape[2] or w > self.rings.shape[3]:
             self._alloc(max(m, self.rings.shape[2]), max(w, self.rings.shape[3]))
-        spec = setup.spec
-        dt = float(setup.dt)
-        self.robot[slot] = np.asarray(setup.start, dtype=float)[:3]
-        self.command[slot] = 0.0
-        self.goal[slot] = np.asarray(setup.goal, dtype=float)[:2]
-        self.spec[slot] = (float(spec.radius), float(setup.goal_tolerance), dt)
-        self.limits[slot] = (float(spec.v_max), float(spec.u_max))
+        spec, dt = setup.spec, float(setup.dt)
+        x, y, th = (float(c) for c in np.asarray(setup.start, dtype=float)[:3])
+        gx, gy = (float(c) for c in np.asarray(setup.goal, dtype=float)[:2])
+        wf, wi = self.wf[slot], self.wi[slot]
+        wf[:] = 0.0
+        wf[[W_X, W_Y, W_TH, W_GX, W_GY]] = (x, y, th, gx, gy)
+        wf[[W_RADIUS, W_TOL, W_DT]] = (float(spec.radius), float(setup.goal_tolerance), dt)
+        wf[[W_VMAX, W_UMAX]] = (float(spec.v_max), float(spec.u_max))
         n_steps = round(setup.t_max / dt)
-        self.counters[slot] = (0, decision_ratio(float(setup.control_period), dt), n_steps)
-        self.n_obs[slot] = m
-        self.kind[slot] = EMPTY
+        wi[[I_STEP, I_RATIO, I_NSTEPS, I_NOBS]] = (
+            0, decision_ratio(float(setup.control_period), dt), n_steps, m,
+        )  # fmt: skip
+        self.oi[slot, O_KIND] = EMPTY
         self.rings[slot] = 0.0
         if m:
             self.rings[slot, :, :m, :w] = tpl.rings
             self.rings[slot, :, :m, w:] = tpl.rings[:, :, :1]
         self.rngs[slot] = [self._pack_obstacle(slot, o, ob) for o, ob in enumerate(obstacles)]
         self.params[slot, P_BOUND, :m] = tpl.bounding_radii
-        x, y = float(self.robot[slot, 0]), float(self.robot[slot, 1])
-        gap = _clearance(slot, x, y, float(spec.radius), self.n_obs, self.params, self.state,
-                         self.rings)  # fmt: skip
-        self.clearance[slot] = gap
+        gap = _clearance(x, y, float(spec.radius), m, self.params[slot], self.state[slot],
+                         self.rings[slot])  # fmt: skip
+        wf[W_CLEAR], wf[W_LOW] = gap, math.inf
         status = RUNNING
         if gap < 0:
             status = COLLISION
-        elif math.hypot(self.goal[slot, 0] - x, self.goal[slot, 1] - y) <= setup.goal_tolerance:
+        elif math.hypot(gx - x, gy - y) <= setup.goal_tolerance:
             status = SUCCESS
         elif n_steps <= 0:
             status = TIMEOUT
-        self.status[slot] = status
+        wi[I_STATUS] = status
+        self._safe_calls = 0
 
     def _pack_obstacle(self, slot: int, o: int, ob: Obstacle) -> np.random.Generator | None:
         """Obstacle ``o`` of ``slot``: its state, parameters and first block of draws."""
@@ -477,15 +544,16 @@ class PackedWorlds:
         state = ob.state
         st[:, o] = 0.0
         prm[:, o] = 0.0
+        self.oi[slot, O_UPOS, o] = 0
         st[S_X, o], st[S_Y, o] = state.position
         st[S_HEADING, o] = state.heading
         if isinstance(mod, ConstantVelocity):
-            self.kind[slot, o] = CONSTANT
+            self.oi[slot, O_KIND, o] = CONSTANT
             prm[P_VX, o], prm[P_VY, o] = np.asarray(mod.velocity, dtype=float)
             prm[P_OMEGA, o] = float(mod.angular_velocity)
             return None
         assert isinstance(mod, RandomTurn)
-        self.kind[slot, o] = RANDOM_TURN
+        self.oi[slot, O_KIND, o] = RANDOM_TURN
         if mod.course is None:  # as ObstacleBatch does
             vel = state.velocity
             course = float(np.arctan2(vel[1], vel[0])) if np.hypot(*vel) > 0 else state.heading
@@ -513,40 +581,40 @@ class PackedWorlds:
             prm[P_X0, o], prm[P_Y0, o], prm[P_X1, o], prm[P_Y1, o] = x0, y0, x1, y1
             prm[P_MIDX, o], prm[P_MIDY, o] = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
         self.ubuf[slot, o] = mod.rng.random(BLOCK)
-        self.upos[slot, o] = 0
         return mod.rng
 
     def refill(self) -> None:
-        """Top up the draws of every obstacle that may need more in the next decision (two per
-        integration step): the unread ones move to the front, the rest are drawn."""
-        need = 2 * self.counters[:, 1:2]
-        for slot, o in zip(*(self.upos + need > BLOCK).nonzero(), strict=True):
+        """Top up the draws of every obstacle that may run out in the coming decisions (two
+        per integration step): the unread ones move to the front, the rest are drawn.  Sets how
+        many :meth:`step` calls are safe before the next top-up."""
+        need = 2 * self.wi[:, I_RATIO, None]
+        upos = self.oi[:, O_UPOS]
+        for slot, o in zip(*(upos + need > BLOCK).nonzero(), strict=True):
             rng = self.rngs[slot][o]
             if rng is None:
                 continue
-            p = int(self.upos[slot, o])
+            p = int(upos[slot, o])
             left = BLOCK - p
             self.ubuf[slot, o, :left] = self.ubuf[slot, o, p:]
             self.ubuf[slot, o, left:] = rng.random(p)
-            self.upos[slot, o] = 0
+            upos[slot, o] = 0
+        spare = (BLOCK - upos) // np.maximum(need, 1)
+        self._safe_calls = int(spare.min()) if spare.size else 1 << 30
 
     def step(self, active: np.ndarray | None = None) -> None:
         """Advance every running world (of the ``active`` (k,) bool slots) by one decision with
-        the commands in :attr:`command` ((v, u) [m/s, rad/s], held as given)."""
-        if active is None:
-            active = np.ones(self.k, dtype=np.bool_)
-        self.refill()
-        kernel("step")(
-            active, self.robot, self.command, self.goal, self.spec, self.counters, self.status,
-            self.clearance, self.low, self.n_obs, self.kind, self.params, self.state, self.ubuf,
-            self.upos, self.rings,
-        )  # fmt: skip
+        the commands in :attr:`command`."""
+        if active is not None:
+            self.wi[:, I_ACTIVE] = active
+        if self._safe_calls <= 0:
+            self.refill()
+        self._safe_calls -= 1
+        kernel("step")(self.wf, self.wi, self.oi, self.params, self.state, self.ubuf, self.rings)
+        if active is not None:
+            self.wi[:, I_ACTIVE] = 1
 
-    def lidar(self, rel: FloatArray, max_range: float, out: FloatArray) -> FloatArray:
-        """The noise-free lidar ranges [m] of every slot into ``out`` (k, len(rel)): beams at
-        heading + ``rel`` [rad] (:func:`uvnav.sensors.lidar_scan`'s)."""
-        kernel("lidar")(
-            np.ones(self.k, dtype=np.bool_), self.robot, rel, float(max_range), self.n_obs,
-            self.params, self.state, self.rings, out,
-        )  # fmt: skip
-        return out
+    def observe(self, rel: FloatArray, max_range: float, goal_scale: float, ranges: FloatArray,
+                out: np.ndarray, dist: FloatArray) -> None:  # fmt: skip
+        """:func:`observe_py` on every slot (lidar beams at heading + ``rel`` [rad])."""
+        kernel("observe")(self.wf, self.wi, self.params, self.state, self.rings, rel,
+                          float(max_range), float(goal_scale), ranges, out, dist)  # fmt: skip

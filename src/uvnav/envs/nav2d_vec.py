@@ -1,0 +1,182 @@
+"""``uvnav/Nav2D-v0`` batched: K worlds stepped by one compiled call, a Gymnasium ``VectorEnv``.
+
+``gymnasium.make_vec("uvnav/Nav2D-v0", num_envs=K, vectorization_mode="vector_entry_point")``
+gives :class:`Nav2DVectorEnv`.  Its K sub-environments are :class:`uvnav.envs.nav2d.Nav2DEnv`'s,
+number for number: the same observation vector (goal distance, goal bearing, speed, lidar), the
+same actions, rewards, terminations and truncations, and the same episodes for the same seeds
+(``reset(seed=s)`` seeds sub-environment ``i`` with ``s + i``, as ``SyncVectorEnv`` does), with
+Gymnasium's default ``NEXT_STEP`` autoreset.  The test suite checks equality with a
+``SyncVectorEnv`` of ``Nav2DEnv`` s, not closeness.
+
+The worlds live in :class:`uvnav.sim.packed.PackedWorlds` (compiled with numba when it is
+installed, the plain Python loops otherwise: the same numbers, far slower), so only scenes whose
+obstacles are polygons moving with constant velocity or random turns can be batched (the
+``random-ch2`` generator and the thesis's Ch. 2 scenes); another scene is refused with the reason.
+What the single env has and this one has not: rendering, and ``info["uvnav"]`` (the
+:class:`~uvnav.sensors.Observation` a uvnav law would get), which needs the per-step objects that
+batching removes.  ``info`` holds ``status``, ``distance`` [m], ``clearance`` [m] and ``time`` [s]
+per sub-environment.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from uvnav.envs.core import RewardConfig
+from uvnav.envs.nav2d import act_space, episode_seed, obs_space, reward_config
+from uvnav.scenarios.build import build_episode
+from uvnav.scenarios.loader import load_scenario
+from uvnav.scenarios.schema import Scenario
+from uvnav.sim.packed import COLLISION, STATUS_NAMES, SUCCESS, TIMEOUT, PackedWorlds
+
+try:
+    import gymnasium as gym
+    from gymnasium.utils import seeding
+    from gymnasium.vector.utils import batch_space
+except ImportError as exc:  # pragma: no cover - exercised only without the extra
+    raise ImportError("uvnav.envs needs gymnasium: pip install 'uvnav[envs]'") from exc
+
+
+class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
+    """K ``uvnav/Nav2D-v0`` worlds in one (module docstring).
+
+    Args:
+        num_envs: K.
+        scenario: as :class:`~uvnav.envs.nav2d.Nav2DEnv`'s (built-in name, YAML path,
+            ``generator:seed`` or a :class:`~uvnav.scenarios.Scenario`).
+        n_rays, max_range, goal_scale, reward, raw_commands: as
+            :class:`~uvnav.envs.nav2d.Nav2DEnv`'s.
+
+    Raises:
+        ValueError: the scene cannot be batched (its reason, one line).
+    """
+
+    metadata: dict[str, Any] = {"autoreset_mode": gym.vector.AutoresetMode.NEXT_STEP}  # noqa: RUF012 - gymnasium declares it an instance variable
+
+    def __init__(
+        self,
+        num_envs: int = 8,
+        scenario: str | Scenario = "thesis-ch2-one-obstacle",
+        *,
+        n_rays: int = 32,
+        max_range: float = 5.0,
+        goal_scale: float | None = None,
+        reward: RewardConfig | dict[str, float] | None = None,
+        raw_commands: bool = False,
+        render_mode: None = None,
+    ) -> None:
+        if num_envs < 1:
+            raise ValueError(f"num_envs must be at least 1 (got {num_envs})")
+        if render_mode is not None:
+            raise ValueError("the batched Nav2D env does not render; use Nav2DEnv")
+        self.num_envs = k = int(num_envs)
+        self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+        r = self.scenario.robot
+        dist = float(np.hypot(r.goal[0] - r.start[0], r.goal[1] - r.start[1]))
+        self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
+        self.n_rays = int(n_rays)
+        self.max_range = float(max_range)
+        self.reward_config = reward_config(reward)
+        self.raw_commands = raw_commands
+        self.single_observation_space = obs_space(self.n_rays)
+        self.single_action_space = act_space(r.v_max, r.u_max, raw=raw_commands)
+        self.observation_space = batch_space(self.single_observation_space, k)
+        self.action_space = batch_space(self.single_action_space, k)
+        self.render_mode = None
+        self.worlds = PackedWorlds(k)
+        self._rel = np.linspace(-np.pi, np.pi, self.n_rays, endpoint=False)
+        self._ranges = np.empty((k, self.n_rays))
+        self._obs = np.empty((k, 4 + self.n_rays), dtype=np.float32)
+        self._dist = np.zeros(k)
+        self._clear = np.zeros(k)
+        self._rngs: list[np.random.Generator | None] = [None] * k
+        self._autoreset = np.zeros(k, dtype=np.bool_)
+        self.episode_seeds = np.zeros(k, dtype=np.int64)
+
+    def _load(self, i: int, options: dict[str, Any] | None) -> None:
+        """Start sub-environment ``i``'s next episode (its generator picks the seed)."""
+        rng = self._rngs[i]
+        if rng is None:
+            rng = self._rngs[i] = seeding.np_random()[0]
+        self.episode_seeds[i] = k = episode_seed(rng, options)
+        self.worlds.load(i, build_episode(self.scenario, k))
+        c = float(self.worlds.clearance[i])
+        self._clear[i] = c if np.isfinite(c) else self.max_range
+
+    def _observe(self) -> None:
+        """Observation vectors and goal distances of every sub-environment."""
+        self.worlds.observe(self._rel, self.max_range, self.goal_scale, self._ranges, self._obs,
+                            self._dist)  # fmt: skip
+
+    def _infos(self) -> dict[str, Any]:
+        w = self.worlds
+        status = np.array(STATUS_NAMES, dtype=object)[w.status]
+        ones = np.ones(self.num_envs, dtype=np.bool_)
+        return {
+            "status": status, "_status": ones,
+            "distance": self._dist.copy(), "_distance": ones,
+            "clearance": self._clear.copy(), "_clearance": ones,
+            "time": w.time, "_time": ones,
+        }  # fmt: skip
+
+    def reset(
+        self, *, seed: int | list[int | None] | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        """Start every sub-environment's next episode; ``seed`` (an int ``s``: ``s + i`` for
+        sub-environment ``i``, or one per sub-environment) re-seeds their generators."""
+        seeds = [seed + i for i in range(self.num_envs)] if isinstance(seed, int) else seed
+        if seeds is not None and len(seeds) != self.num_envs:
+            raise ValueError(f"reset: {len(seeds)} seeds for {self.num_envs} environments")
+        for i in range(self.num_envs):
+            if seeds is not None and seeds[i] is not None:
+                self._rngs[i] = seeding.np_random(seeds[i])[0]
+            self._load(i, options)
+        self._autoreset[:] = False
+        self._observe()
+        return self._obs.copy(), self._infos()
+
+    def _commands(self, actions: np.ndarray, acting: np.ndarray) -> None:
+        """The ``acting`` worlds' actions to held commands: :meth:`EnvWorld.command
+        <uvnav.envs.core.EnvWorld.command>`, then the saturation of
+        :meth:`UnicycleCommand.clipped <uvnav.dynamics.unicycle.UnicycleCommand.clipped>`."""
+        a = np.asarray(actions, dtype=float).reshape(self.num_envs, 2)
+        vmax, umax = self.worlds.limits[:, 0], self.worlds.limits[:, 1]
+        if self.raw_commands:
+            v, u = a[:, 0], a[:, 1]
+        else:
+            a = np.clip(a, -1.0, 1.0)
+            a = np.where(np.isfinite(a), a, 0.0)
+            v, u = 0.5 * (a[:, 0] + 1.0) * vmax, a[:, 1] * umax
+        v = np.where(np.isfinite(v), np.minimum(np.maximum(v, 0.0), vmax), 0.0)
+        u = np.where(np.isfinite(u), np.minimum(np.maximum(u, -umax), umax), 0.0)
+        self.worlds.command[acting, 0] = v[acting]
+        self.worlds.command[acting, 1] = u[acting]
+
+    def step(
+        self, actions: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
+        """One decision in every sub-environment (those that ended last step restart instead,
+        ignoring their action)."""
+        w = self.worlds
+        restart = self._autoreset.copy()
+        for i in restart.nonzero()[0].tolist():
+            self._load(i, None)
+        running = ~restart & (w.status != SUCCESS) & (w.status != COLLISION)
+        before = self._dist.copy()
+        self._commands(actions, running & (w.status != TIMEOUT))
+        w.step(~restart)
+        clear = np.where(np.isfinite(w.low), w.low, self.max_range)
+        self._clear = np.where(running & np.isfinite(w.low), clear, self._clear)
+        self._observe()
+        cfg = self.reward_config
+        r = cfg.progress * (before - self._dist) - cfg.time
+        r = r - cfg.clearance * np.maximum(0.0, cfg.clearance_margin - self._clear)
+        r = np.where(w.status == SUCCESS, r + cfg.success, r)
+        r = np.where(w.status == COLLISION, r - cfg.collision, r)
+        rewards = np.where(running, r, 0.0)
+        terminated = ~restart & ((w.status == SUCCESS) | (w.status == COLLISION))
+        truncated = ~restart & (w.status == TIMEOUT)
+        self._autoreset = terminated | truncated
+        return self._obs.copy(), rewards, terminated, truncated, self._infos()
