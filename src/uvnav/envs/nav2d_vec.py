@@ -29,7 +29,14 @@ from uvnav.envs.nav2d import act_space, episode_seed, obs_space, reward_config
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.scenarios.schema import Scenario
-from uvnav.sim.packed import COLLISION, STATUS_NAMES, SUCCESS, TIMEOUT, PackedWorlds
+from uvnav.sim.packed import (
+    COLLISION,
+    STATUS_NAMES,
+    SUCCESS,
+    TIMEOUT,
+    PackedWorlds,
+    pack_check,
+)
 
 try:
     import gymnasium as gym
@@ -73,6 +80,10 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             raise ValueError("the batched Nav2D env does not render; use Nav2DEnv")
         self.num_envs = k = int(num_envs)
         self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
+        why = pack_check(build_episode(self.scenario, 0))
+        if why is not None:
+            name = getattr(self.scenario, "name", None) or "the scene"
+            raise ValueError(f"{name} cannot be batched: {why}")
         r = self.scenario.robot
         dist = float(np.hypot(r.goal[0] - r.start[0], r.goal[1] - r.start[1]))
         self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)

@@ -391,7 +391,7 @@ def kernel(name: str) -> Callable[..., Any]:
     numba on first use when it is enabled (:func:`numba_enabled`), else the Python functions."""
     full = _PUBLIC[name]
     if not numba_enabled():
-        return globals()[full]  # type: ignore[no-any-return]
+        return globals()[full]
     if not _KERNELS:
         _compile()
     return _KERNELS[full]
@@ -422,6 +422,12 @@ class PackedWorlds:
     their generators, read ahead by up to :data:`BLOCK` numbers: the models are not written
     back (unlike :meth:`UnicycleWorld.close <uvnav.sim.episode.UnicycleWorld.close>`).
     """
+
+    oi: np.ndarray
+    params: FloatArray
+    state: FloatArray
+    ubuf: FloatArray
+    rings: FloatArray
 
     def __init__(self, k: int) -> None:
         self.k = int(k)

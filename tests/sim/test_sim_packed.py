@@ -1,0 +1,190 @@
+"""Packed worlds (uvnav.sim.packed) against the loop world they reproduce, bit for bit."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from contextlib import contextmanager
+
+import numpy as np
+import pytest
+from hypothesis import example, given
+from hypothesis import strategies as st
+
+from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
+from uvnav.geometry.kernels3d import numba_available, use_compiled
+from uvnav.obstacles import Obstacle, ObstacleState
+from uvnav.obstacles.bodies import DiscBody, PolygonBody
+from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
+from uvnav.scenarios.build import build_episode
+from uvnav.scenarios.loader import load_scenario
+from uvnav.sensors.exact import lidar_scan
+from uvnav.sim.episode import EpisodeSetup, UnicycleWorld
+from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, pack_check, pyhypot
+from uvnav.sim.seeding import run_rng
+
+REL = np.linspace(-np.pi, np.pi, 16, endpoint=False)
+SPEC = UnicycleSpec(v_max=0.8, u_max=1.2, radius=0.2)
+SQUARE = np.array([[-0.4, -0.3], [0.4, -0.3], [0.4, 0.3], [-0.4, 0.3]])
+
+
+@contextmanager
+def kernels(compiled: bool) -> Iterator[None]:
+    if compiled and not numba_available():
+        pytest.skip("needs numba (the fast extra)")
+    previous = use_compiled(compiled)
+    try:
+        yield
+    finally:
+        use_compiled(previous)
+
+
+finite = st.floats(-1e300, 1e300, allow_nan=False)
+
+
+@given(finite, finite)
+@example(3.0, 4.0)
+@example(1e-310, 3e-320)
+@example(0.0, -0.0)
+@example(1e300, 1e300)
+@example(math.inf, math.nan)
+@example(math.nan, 1.0)
+def test_pyhypot_is_cpythons_hypot(x: float, y: float) -> None:
+    want = math.hypot(x, y)
+    got = pyhypot(x, y)
+    assert got == want or (math.isnan(got) and math.isnan(want))
+
+
+def mixed_setup(seed: int, n: int = 12, t_max: float = 30.0) -> EpisodeSetup:
+    """Random-turn polygons in an arena (some outside it, some spinning) and constant-velocity
+    ones, around a robot crossing them."""
+    rng = np.random.default_rng(seed)
+    obstacles = []
+    for j in range(n):
+        pos = rng.uniform(-1.0, 9.0, 2)
+        body = PolygonBody.from_vertices(SQUARE * rng.uniform(0.5, 1.5))
+        state = ObstacleState(position=pos, heading=float(rng.uniform(-3, 3)))
+        motion: ConstantVelocity | RandomTurn
+        if j % 3 == 0:
+            motion = ConstantVelocity(rng.uniform(-0.3, 0.3, 2), float(rng.uniform(-0.5, 0.5)))
+        else:
+            motion = RandomTurn(speed=(0.1, 0.5), turn_rate=(-0.4, 0.4), rng=rng.spawn(1)[0],
+                                change_period=float(rng.uniform(0.3, 2.0)),
+                                spin=0.1 * (j % 2), arena=(1.0, 1.0, 7.0, 7.0))  # fmt: skip
+        obstacles.append(Obstacle(body, state, motion))
+    return EpisodeSetup(spec=SPEC, start=np.array([-2.0, -2.0, 0.7]), goal=np.array([10.0, 9.0]),
+                        obstacles=obstacles, dt=0.05, control_period=0.15, t_max=t_max)  # fmt: skip
+
+
+def run_both(make: object, seed: int, max_decisions: int = 10**6) -> tuple[str, int]:
+    """Drive the loop world and a packed world with the same random commands; every decision
+    the pose, clearance, status and lidar must be equal.  Returns (status, decisions)."""
+    ref = UnicycleWorld(make(), run_rng(seed), exact=True)  # type: ignore[operator]
+    ref.start([False])
+    packed = PackedWorlds(1)
+    packed.load(0, make())  # type: ignore[operator]
+    rng = np.random.default_rng(seed)
+    ranges, out, dist = (
+        np.empty((1, len(REL))),
+        np.empty((1, 4 + len(REL)), np.float32),
+        np.empty(1),
+    )
+    n = 0
+    while not ref.done and n < max_decisions:
+        v, u = rng.uniform(-0.1, 1.1) * SPEC.v_max, rng.uniform(-1.1, 1.1) * SPEC.u_max
+        cmd = ref.apply(UnicycleCommand(v, u))
+        packed.command[0] = (cmd.v, cmd.u)
+        while True:
+            ref.advance()
+            if ref.done or ref.acting():
+                break
+        packed.step()
+        n += 1
+        assert tuple(packed.robot[0]) == tuple(ref.pose)
+        assert packed.clearance[0] == ref.clearance
+        status = STATUS_NAMES[packed.status[0]]
+        assert status == (ref.status if ref.done else "running")
+        packed.observe(REL, 3.0, 10.0, ranges, out, dist)
+        scan = lidar_scan(ref.pose, ref.field, n_rays=len(REL), max_range=3.0).ranges
+        assert np.array_equal(ranges[0], scan)
+        assert dist[0] == math.hypot(*(ref.goal - ref.pose[:2]))
+    return ref.status, n
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_packed_equals_the_loop_world_on_random_ch2(compiled: bool) -> None:
+    statuses = set()
+    with kernels(compiled):
+        for seed in range(3 if compiled else 1):
+            scene = load_scenario(f"random-ch2:{seed}")
+            status, _ = run_both(lambda s=seed, sc=scene: build_episode(sc, s), seed)
+            statuses.add(status)
+    assert statuses
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_packed_equals_the_loop_world_with_arenas_spin_and_constant_motion(seed: int) -> None:
+    with kernels(numba_available()):
+        run_both(lambda: mixed_setup(seed), seed)
+
+
+def test_pre_drawn_numbers_are_the_generators_stream_across_refills() -> None:
+    def far_wanderer() -> EpisodeSetup:
+        setup = mixed_setup(9, n=1)
+        motion = RandomTurn(speed=(0.1, 0.5), turn_rate=(-1.0, 1.0),
+                            rng=np.random.default_rng(4), change_period=0.05)  # fmt: skip
+        far = ObstacleState(position=np.array([50.0, 50.0]))
+        setup.obstacles[0] = Obstacle(PolygonBody.from_vertices(SQUARE), far, motion)
+        return setup
+
+    with kernels(numba_available()):
+        _, decisions = run_both(far_wanderer, 0, max_decisions=150)
+    assert decisions == 150  # 2 draws per step, 3 steps a decision: 900 numbers, 14 blocks
+    assert 6 * decisions > 10 * BLOCK
+
+
+def test_a_slot_keeps_its_world_when_a_bigger_one_is_loaded_beside_it() -> None:
+    with kernels(numba_available()):
+        alone = PackedWorlds(1)
+        alone.load(0, mixed_setup(5, n=3))
+        both = PackedWorlds(2)
+        both.load(0, mixed_setup(5, n=3))
+        both.step()
+        alone.step()
+        both.load(1, mixed_setup(6, n=20))  # grows the obstacle arrays
+        for _ in range(40):
+            alone.step()
+            both.step()
+        assert np.array_equal(alone.wf[0], both.wf[0])
+        assert np.array_equal(alone.state[0], both.state[0, :, :3])
+
+
+def test_episodes_that_end_at_the_start() -> None:
+    base = mixed_setup(0, n=1)
+    base.obstacles[0].state = ObstacleState(position=np.array([-2.0, -2.0]))
+    packed = PackedWorlds(3)
+    packed.load(0, base)
+    packed.load(1, EpisodeSetup(spec=SPEC, start=np.array([1.0, 1.0, 0.0]),
+                                goal=np.array([1.0, 1.1]), obstacles=[]))  # fmt: skip
+    packed.load(2, EpisodeSetup(spec=SPEC, start=np.zeros(3), goal=np.ones(2), obstacles=[],
+                                t_max=0.0))  # fmt: skip
+    assert [STATUS_NAMES[s] for s in packed.status] == ["collision", "success", "timeout"]
+    before = packed.wf.copy()
+    packed.step()
+    assert np.array_equal(packed.wf[:, :3], before[:, :3])  # nothing moves
+    assert np.isinf(packed.low).all()
+
+
+def test_unpackable_scenes_are_refused_with_the_reason() -> None:
+    setup = mixed_setup(0, n=2)
+    setup.obstacles[1] = Obstacle(DiscBody(0.3), ObstacleState(position=np.zeros(2)),
+                                  ConstantVelocity(np.zeros(2)))  # fmt: skip
+    assert pack_check(setup) == "obstacle 1 is a DiscBody, packed worlds hold polygons"
+    setup.obstacles[1] = Obstacle(
+        PolygonBody.from_vertices(SQUARE),
+        ObstacleState(position=np.zeros(2)),
+        Waypoints(points=np.ones((2, 2)), speed=0.1),
+    )
+    with pytest.raises(ValueError, match="obstacle 1 moves by Waypoints"):
+        PackedWorlds(1).load(0, setup)
+    assert pack_check(mixed_setup(0)) is None
