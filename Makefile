@@ -64,6 +64,7 @@ bench: $(STAMP_RUN)
 	$(PY) benchmarks/bench_orca.py --out benchmarks/results
 	$(PY) benchmarks/bench_ch7.py --out benchmarks/results
 	$(PY) benchmarks/bench_campaign.py --out benchmarks/results
+	$(PY) benchmarks/bench_packed.py --out benchmarks/results
 	$(PY) benchmarks/bench_crowdnav.py --cases 500 --out benchmarks/results
 	$(PY) benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-holonomic-v2 --out benchmarks/results
 	$(PY) benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-v2 --out benchmarks/results

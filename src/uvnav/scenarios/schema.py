@@ -204,11 +204,26 @@ class BodySpec(_Model):
         return self
 
     def to_body(self) -> Body:
-        """A :class:`~uvnav.obstacles.PolygonBody` (centred on its centroid) or a disc."""
+        """A :class:`~uvnav.obstacles.PolygonBody` (centred on its centroid) or a disc.
+
+        Built once per spec and shared by the episodes (bodies are frozen, and re-centring a
+        polygon costs more than the rest of an episode's set-up)."""
+        hit = _BODIES.get(id(self))
+        if hit is not None and hit[0] is self:
+            return hit[1]
         if self.polygon is not None:
-            return PolygonBody.from_vertices(np.asarray(self.polygon, dtype=float))
-        assert self.disc is not None
-        return DiscBody(float(self.disc))
+            body: Body = PolygonBody.from_vertices(np.asarray(self.polygon, dtype=float))
+        else:
+            assert self.disc is not None
+            body = DiscBody(float(self.disc))
+        if len(_BODIES) >= 4096:
+            _BODIES.clear()
+        _BODIES[id(self)] = (self, body)
+        return body
+
+
+#: :meth:`BodySpec.to_body`'s bodies by spec (the spec is kept, so its id stays its own)
+_BODIES: dict[int, tuple[BodySpec, Body]] = {}
 
 
 class ObstacleStart(_Model):

@@ -438,6 +438,7 @@ class PackedWorlds:
         self.wf[:, W_CLEAR] = self.wf[:, W_LOW] = math.inf
         self.rngs: list[list[np.random.Generator | None]] = [[] for _ in range(k)]
         self._safe_calls = 0  # step() calls before a refill may be needed
+        self._templates: dict[tuple[int, ...], tuple[FieldTemplate, list[Any]]] = {}
         self._alloc(0, 2)
 
     # views of the state, by meaning
@@ -508,7 +509,7 @@ class PackedWorlds:
             raise ValueError(why)
         obstacles = setup.obstacles
         m = len(obstacles)
-        tpl = FieldTemplate.from_bodies([o.body for o in obstacles])
+        tpl = self._template([o.body for o in obstacles])
         w = tpl.rings.shape[2] if m else 2
         if m > self.rings.shape[2] or w > self.rings.shape[3]:
             self._alloc(max(m, self.rings.shape[2]), max(w, self.rings.shape[3]))
@@ -543,6 +544,17 @@ class PackedWorlds:
             status = TIMEOUT
         wi[I_STATUS] = status
         self._safe_calls = 0
+
+    def _template(self, bodies: list[Any]) -> FieldTemplate:
+        """The bodies' packed geometry, kept for the episodes that share the body objects (the
+        scenario's, see :meth:`BodySpec.to_body <uvnav.scenarios.schema.BodySpec.to_body>`)."""
+        key = tuple(map(id, bodies))
+        hit = self._templates.get(key)
+        if hit is None:
+            if len(self._templates) >= 64:
+                self._templates.clear()
+            hit = self._templates[key] = (FieldTemplate.from_bodies(bodies), bodies)
+        return hit[0]
 
     def _pack_obstacle(self, slot: int, o: int, ob: Obstacle) -> np.random.Generator | None:
         """Obstacle ``o`` of ``slot``: its state, parameters and first block of draws."""
