@@ -95,12 +95,7 @@ class VehicleWorldEnv(gym.Env[np.ndarray, np.ndarray]):
     """The decision loop of ``uvnav/Nav3D-v0`` and ``uvnav/UUV2D-v0`` over the simulator's own
     vehicle world: one env step applies the action's command and advances the world
     ``ratio`` integration steps (or until the episode ends), keeping the smallest clearance
-    over them for the reward (:class:`~uvnav.envs.core.RewardConfig`).
-
-    A subclass builds the world (:meth:`_new_world`), maps an action to a command
-    (:meth:`_command`), measures the distance to the goal (:meth:`_distance`) and makes the
-    observation vector and the ``info`` (:meth:`_vector`, :meth:`_info`).
-    """
+    over them for the reward (:class:`~uvnav.envs.core.RewardConfig`)."""
 
     scenario: Any
 
@@ -130,16 +125,15 @@ class VehicleWorldEnv(gym.Env[np.ndarray, np.ndarray]):
         self._clearance = math.inf
         return first
 
+    # the subclass's: the started world of one episode of ``scene``, the vehicle command of an
+    # action, the distance [m] to the goal now, the observation vector and the info
     def _new_world(self, scene: Any, episode_seed: int) -> Any:
-        """The started world of one episode of ``scene``."""
         raise NotImplementedError
 
     def _command(self, action: np.ndarray) -> Any:
-        """The vehicle command of ``action`` in the world now."""
         raise NotImplementedError
 
     def _distance(self) -> float:
-        """Distance [m] from the vehicle to its goal now."""
         raise NotImplementedError
 
     def _vector(self) -> np.ndarray:
