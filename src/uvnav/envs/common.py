@@ -14,7 +14,8 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.envs.core import RewardConfig, reward_config
+from uvnav.envs.core import RewardConfig
+from uvnav.envs.nav2d import reward_config
 
 try:
     import gymnasium as gym

@@ -39,7 +39,7 @@ the robot's disc to an obstacle or another robot over the decision's integration
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -300,22 +300,6 @@ class EnvWorld:
         self.world.close()
 
 
-def reward_config(reward: RewardConfig | dict[str, float] | None) -> RewardConfig:
-    """A :class:`RewardConfig` from a config, a dict of its fields, or ``None`` (defaults)."""
-    if reward is None:
-        return RewardConfig()
-    if isinstance(reward, RewardConfig):
-        return reward
-    return replace(RewardConfig(), **reward)
-
-
-def episode_seed(rng: np.random.Generator, options: dict[str, Any] | None) -> int:
-    """``options["episode_seed"]`` when given, else one drawn from ``rng``."""
-    if options and options.get("episode_seed") is not None:
-        return int(options["episode_seed"])
-    return int(rng.integers(2**31 - 1))
-
-
 class EnvWorldEnv:
     """What ``uvnav/Nav2D-v0`` and the multi-robot env (:mod:`uvnav.envs.multi_robot`) share
     over their :class:`EnvWorld`: the lidar, reward and action options, opening a world at reset,
@@ -329,13 +313,13 @@ class EnvWorldEnv:
         render_mode: str | None,
         n_rays: int,
         max_range: float,
-        reward: RewardConfig | dict[str, float] | None,
+        reward: RewardConfig,
         raw_commands: bool,
     ) -> None:
         self.render_mode = render_mode
         self.n_rays = int(n_rays)
         self.max_range = float(max_range)
-        self.reward_config = reward_config(reward)
+        self.reward_config = reward
         self.raw_commands = raw_commands
         self._world: EnvWorld | None = None
         self._bounds = (0.0, 0.0, 1.0, 1.0)

@@ -32,11 +32,12 @@ generator :func:`uvnav.sim.run_rng` ``(k)`` (the law's generator is ``env.world.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig, episode_seed
+from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.scenarios.schema import Scenario
@@ -48,6 +49,15 @@ try:
     from gymnasium import spaces
 except ImportError as exc:  # pragma: no cover - exercised only without the extra
     raise ImportError("uvnav.envs needs gymnasium: pip install 'uvnav[envs]'") from exc
+
+
+def reward_config(reward: RewardConfig | dict[str, float] | None) -> RewardConfig:
+    """A :class:`RewardConfig` from a config, a dict of its fields, or ``None`` (defaults)."""
+    if reward is None:
+        return RewardConfig()
+    if isinstance(reward, RewardConfig):
+        return reward
+    return replace(RewardConfig(), **reward)
 
 
 def obs_space(n_rays: int) -> spaces.Box:
@@ -63,6 +73,13 @@ def act_space(v_max: float = 1.0, u_max: float = 1.0, *, raw: bool = False) -> s
             low=np.array([0.0, -u_max]), high=np.array([v_max, u_max]), dtype=np.float64
         )
     return spaces.Box(low=-1.0, high=1.0, shape=(2,), dtype=np.float32)
+
+
+def episode_seed(rng: np.random.Generator, options: dict[str, Any] | None) -> int:
+    """``options["episode_seed"]`` when given, else one drawn from ``rng``."""
+    if options and options.get("episode_seed") is not None:
+        return int(options["episode_seed"])
+    return int(rng.integers(2**31 - 1))
 
 
 class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
@@ -98,7 +115,7 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         r = self.scenario.robot
         dist = float(np.hypot(r.goal[0] - r.start[0], r.goal[1] - r.start[1]))
         self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
-        self._configure(render_mode, n_rays, max_range, reward, raw_commands)
+        self._configure(render_mode, n_rays, max_range, reward_config(reward), raw_commands)
         self.observation_space = obs_space(self.n_rays)
         self.action_space = act_space(r.v_max, r.u_max, raw=raw_commands)
 
