@@ -463,13 +463,6 @@ def comparison_rows(store: ResultsStore) -> list[dict[str, str]]:
     return rows
 
 
-def _say_ch6(message: str) -> None:
-    """Chapter 6's stage messages on stderr (its training takes minutes)."""
-    import sys
-
-    print(f"ch6: {message}", file=sys.stderr, flush=True)
-
-
 def reproduce(
     results_dir: Path,
     report_dir: Path,

@@ -38,11 +38,9 @@ from uvnav.cli.recon import recon_app
 from uvnav.cli.sonar import sonar_app
 from uvnav.controllers import (
     ControllerInfo,
-    ControllerParamsError,
     UnknownControllerError,
     available_controllers,
     controller_info,
-    make_controller,
 )
 from uvnav.controllers.base import VEHICLES
 from uvnav.scenarios import (
@@ -205,13 +203,6 @@ _METRIC_UNITS = {
     "intrusion_time": "s",
     "path_irregularity": "rad/m",
 }
-
-
-def _make_controller(name: str, params: dict[str, Any]) -> Any:
-    try:
-        return make_controller(name, **params)
-    except ControllerParamsError as exc:
-        raise ControllerParamsError(f"controller {name}: {exc}") from None
 
 
 GenParamOption = Annotated[

@@ -302,11 +302,6 @@ class Zhang2019Controller(UnicycleController):
         self._tag = 1
 
     @property
-    def target_ids(self) -> frozenset[int]:
-        """Ids of the obstacles avoided in M2 (empty in M1)."""
-        return self._group_ids
-
-    @property
     def direction(self) -> int:
         """Current direction tag: +1 ('+', counter-clockwise round the obstacle) or -1."""
         return self._tag

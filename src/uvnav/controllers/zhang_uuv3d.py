@@ -270,11 +270,6 @@ class ZhangUUV3D(Vehicle3DController):
         self._memory: FloatArray | None = None
         self.last_located: Located | None = None
 
-    def set_locator(self, locator: Locator) -> None:
-        """Use ``locator`` from the next decision on (oracle flag follows it)."""
-        self.locator = locator
-        self.oracle = bool(getattr(locator, "oracle", False))
-
     def _reset_law(self, rng: np.random.Generator) -> None:
         self._history = []
         self._normal = np.array([0.0, 0.0, 1.0])

@@ -1,17 +1,26 @@
 """Pieces shared by the Chapter 3 and Chapter 4 environments (``uvnav/Nav3D-v0``,
-``uvnav/UUV2D-v0``): comparing observations by content, the generic :class:`SimView` of
-``info["uvnav"]``, loading a scene or a per-episode random scene, and painting polygons into an
-RGB frame.  No gymnasium import here.
+``uvnav/UUV2D-v0``): their decision loop (:class:`VehicleWorldEnv`), comparing observations by
+content, the generic :class:`SimView` of ``info["uvnav"]``, loading a scene or a per-episode
+random scene, and painting polygons into an RGB frame.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+
+from uvnav.envs.core import RewardConfig
+from uvnav.envs.nav2d import reward_config
+
+try:
+    import gymnasium as gym
+except ImportError as exc:  # pragma: no cover - exercised only without the extra
+    raise ImportError("uvnav.envs needs gymnasium: pip install 'uvnav[envs]'") from exc
 
 
 def content_equal(a: Any, b: Any) -> bool:
@@ -83,6 +92,96 @@ def scene_for_episode(
     return scenario
 
 
+class VehicleWorldEnv(gym.Env[np.ndarray, np.ndarray]):
+    """The decision loop of ``uvnav/Nav3D-v0`` and ``uvnav/UUV2D-v0`` over the simulator's own
+    vehicle world: one env step applies the action's command and advances the world
+    ``ratio`` integration steps (or until the episode ends), keeping the smallest clearance
+    over them for the reward (:class:`~uvnav.envs.core.RewardConfig`)."""
+
+    scenario: Any
+
+    def _configure(
+        self,
+        scenario: Any,
+        generators: Mapping[str, Callable[[int], Any]],
+        load: Callable[[Any], Any],
+        render_mode: str | None,
+        reward: RewardConfig | dict[str, float] | None,
+    ) -> Any:
+        """Set the scene (a generator's name, or anything ``load`` turns into a scene), the
+        render mode and the reward; the scene of the first episode is returned (the generator's
+        scene 0 for a generator)."""
+        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
+            raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
+        self._generators = dict(generators)
+        if isinstance(scenario, str) and scenario in self._generators:
+            self.scenario = scenario
+            first = self._generators[scenario](0)
+        else:
+            self.scenario = first = load(scenario)
+        self.render_mode = render_mode
+        self.reward_config = reward_config(reward)
+        self._world: Any = None
+        self._obs: Any = None
+        self._clearance = math.inf
+        return first
+
+    # the subclass's: the started world of one episode of ``scene``, the vehicle command of an
+    # action, the distance [m] to the goal now, the observation vector and the info
+    def _new_world(self, scene: Any, episode_seed: int) -> Any:
+        raise NotImplementedError
+
+    def _command(self, action: np.ndarray) -> Any:
+        raise NotImplementedError
+
+    def _distance(self) -> float:
+        raise NotImplementedError
+
+    def _vector(self) -> np.ndarray:
+        raise NotImplementedError
+
+    def _info(self) -> dict[str, Any]:
+        raise NotImplementedError
+
+    def reset(
+        self, *, seed: int | None = None, options: dict[str, Any] | None = None
+    ) -> tuple[np.ndarray, dict[str, Any]]:
+        super().reset(seed=seed)
+        episode_seed = int(self.np_random.integers(2**31 - 1))
+        sc = scene_for_episode(self.scenario, self._generators, episode_seed)
+        self._world = world = self._new_world(sc, episode_seed)
+        self._clearance = world.clearance
+        self._obs = world.observe()
+        return self._vector(), self._info()
+
+    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
+        world = self._world
+        if world is None:
+            raise RuntimeError("call reset() before step()")
+        if world.done:
+            raise RuntimeError("the episode is over: call reset()")
+        rw = self.reward_config
+        before = self._distance()
+        world.apply(self._command(action))
+        low = math.inf
+        for _ in range(world.ratio):
+            world.advance()
+            low = min(low, world.clearance)
+            if world.done:
+                break
+        self._clearance = low
+        after = self._distance()
+        terminated = world.done and world.status in ("success", "collision")
+        truncated = world.done and not terminated
+        reward = rw.reward(before - after, low, world.status if terminated else "running")
+        self._obs = world.observe()
+        return self._vector(), float(reward), terminated, truncated, self._info()
+
+    def close(self) -> None:
+        self._world = None
+        self._obs = None
+
+
 def fill_polygon(
     img: np.ndarray,
     polygon: np.ndarray,
@@ -106,25 +205,3 @@ def fill_polygon(
     inside = np.zeros(gx.shape, dtype=bool)
     inside[box] = shapely.contains_xy(poly, gx[box], gy[box])
     img[inside] = colour
-
-
-def pixel_grid(
-    bounds: tuple[float, float, float, float], width: int, height: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """Pixel-centre coordinates [m] of a ``height`` x ``width`` frame over ``bounds``
-    ``(xmin, ymin, xmax, ymax)``, y up."""
-    xmin, ymin, xmax, ymax = bounds
-    xs = xmin + (np.arange(width) + 0.5) * (xmax - xmin) / width
-    ys = ymax - (np.arange(height) + 0.5) * (ymax - ymin) / height
-    gx, gy = np.meshgrid(xs, ys)
-    return gx, gy
-
-
-def square_bounds(points: np.ndarray, margin: float) -> tuple[float, float, float, float]:
-    """The smallest square ``(xmin, ymin, xmax, ymax)`` [m] around ``points`` (n, 2), grown by
-    ``margin`` [m]."""
-    lo = points.min(axis=0) - margin
-    hi = points.max(axis=0) + margin
-    side = float(max(hi - lo))
-    mid = 0.5 * (lo + hi)
-    return (mid[0] - side / 2, mid[1] - side / 2, mid[0] + side / 2, mid[1] + side / 2)

@@ -40,6 +40,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -299,6 +300,71 @@ class EnvWorld:
         self.world.close()
 
 
+class EnvWorldEnv:
+    """What ``uvnav/Nav2D-v0`` and the multi-robot env (:mod:`uvnav.envs.multi_robot`) share
+    over their :class:`EnvWorld`: the lidar, reward and action options, opening a world at reset,
+    robot i's ``info``, rendering and closing."""
+
+    render_mode: str | None
+    goal_scale: float
+
+    def _configure(
+        self,
+        render_mode: str | None,
+        n_rays: int,
+        max_range: float,
+        reward: RewardConfig,
+        raw_commands: bool,
+    ) -> None:
+        self.render_mode = render_mode
+        self.n_rays = int(n_rays)
+        self.max_range = float(max_range)
+        self.reward_config = reward
+        self.raw_commands = raw_commands
+        self._world: EnvWorld | None = None
+        self._bounds = (0.0, 0.0, 1.0, 1.0)
+        self.episode_seed: int | None = None
+
+    def _open(self, world: UnicycleWorld | MultiUnicycleWorld) -> EnvWorld:
+        """Step ``world`` (fresh, of the episode ``reset`` starts) from now on."""
+        self._world = w = EnvWorld(
+            world,
+            n_rays=self.n_rays,
+            max_range=self.max_range,
+            goal_scale=self.goal_scale,
+            reward=self.reward_config,
+            raw_commands=self.raw_commands,
+        )
+        self._bounds = scene_bounds(w)
+        return w
+
+    def _loop_world(self) -> UnicycleWorld | MultiUnicycleWorld:
+        if self._world is None:
+            raise RuntimeError("call reset() first")
+        return self._world.world
+
+    def _info(self, i: int) -> dict[str, Any]:
+        w = self._world
+        assert w is not None
+        return {
+            "status": w.status(i),
+            "distance": w.distance(i),
+            "clearance": float(w.clearance[i]),
+            "time": w.world.t,
+            "uvnav": w.view(i),
+        }
+
+    def render(self) -> np.ndarray | None:
+        if self.render_mode != "rgb_array" or self._world is None:
+            return None
+        return render_frame(self._world, self._bounds)
+
+    def close(self) -> None:
+        if self._world is not None:
+            self._world.close()
+            self._world = None
+
+
 def scene_bounds(world: EnvWorld, margin: float = 1.5) -> tuple[float, float, float, float]:
     """A box [m] around the robots' starts and goals and the obstacles' initial bounding discs
     (pedestrians parked far away are left out), grown by ``margin``; call it at reset."""
@@ -310,12 +376,29 @@ def scene_bounds(world: EnvWorld, margin: float = 1.5) -> tuple[float, float, fl
         near = np.hypot(*(c - starts[0]).T) < 100.0
         if near.any():
             pts += [c[near] - rad[near, None], c[near] + rad[near, None]]
-    allp = np.vstack(pts)
-    lo = allp.min(axis=0) - margin
-    hi = allp.max(axis=0) + margin
+    return square_bounds(np.vstack(pts), margin)
+
+
+def square_bounds(points: np.ndarray, margin: float) -> tuple[float, float, float, float]:
+    """The smallest square ``(xmin, ymin, xmax, ymax)`` [m] around ``points`` (n, 2), grown by
+    ``margin`` [m]."""
+    lo = points.min(axis=0) - margin
+    hi = points.max(axis=0) + margin
     side = float(max(hi - lo))
     mid = 0.5 * (lo + hi)
     return (mid[0] - side / 2, mid[1] - side / 2, mid[0] + side / 2, mid[1] + side / 2)
+
+
+def pixel_grid(
+    bounds: tuple[float, float, float, float], width: int, height: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel-centre coordinates [m] of a ``height`` x ``width`` frame over ``bounds``
+    ``(xmin, ymin, xmax, ymax)``, y up."""
+    xmin, ymin, xmax, ymax = bounds
+    xs = xmin + (np.arange(width) + 0.5) * (xmax - xmin) / width
+    ys = ymax - (np.arange(height) + 0.5) * (ymax - ymin) / height
+    gx, gy = np.meshgrid(xs, ys)
+    return gx, gy
 
 
 ROBOT_COLOURS = np.array(
@@ -342,9 +425,7 @@ def render_frame(
 
     xmin, ymin, xmax, ymax = bounds
     img = np.full((size, size, 3), 255, dtype=np.uint8)
-    xs = xmin + (np.arange(size) + 0.5) * (xmax - xmin) / size
-    ys = ymax - (np.arange(size) + 0.5) * (ymax - ymin) / size
-    gx, gy = np.meshgrid(xs, ys)
+    gx, gy = pixel_grid(bounds, size, size)
     f = world.field
     for j in range(world.k):
         c = f.centres[j]

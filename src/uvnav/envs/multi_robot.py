@@ -22,7 +22,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.envs.core import TERMINAL, EnvWorld, RewardConfig, render_frame, scene_bounds
+from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig
 from uvnav.envs.nav2d import act_space, episode_seed, obs_space, reward_config
 from uvnav.scenarios.multi import MultiScenario, build_multi, load_multi_scenario
 from uvnav.sim.multi import MultiUnicycleWorld
@@ -37,7 +37,7 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
     ) from exc
 
 
-class MultiNav2DParallelEnv(ParallelEnv):
+class MultiNav2DParallelEnv(EnvWorldEnv, ParallelEnv):
     """PettingZoo ParallelEnv of a multi-robot scenario (module docstring).
 
     Args:
@@ -74,29 +74,20 @@ class MultiNav2DParallelEnv(ParallelEnv):
         self.scenario = (
             scenario if isinstance(scenario, MultiScenario) else load_multi_scenario(scenario)
         )
-        self.render_mode = render_mode
-        self.n_rays = int(n_rays)
-        self.max_range = float(max_range)
         starts = np.array([r.start for r in self.scenario.robots])
         goals = np.array([r.goal for r in self.scenario.robots])
         longest = float(np.hypot(*(goals - starts).T).max())
         self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * longest, 1.0)
-        self.reward_config = reward_config(reward)
-        self.raw_commands = raw_commands
+        self._configure(render_mode, n_rays, max_range, reward_config(reward), raw_commands)
         self.possible_agents = [f"robot_{i}" for i in range(len(self.scenario.robots))]
         self.agents: list[str] = []
         self._index = {a: i for i, a in enumerate(self.possible_agents)}
-        self._world: EnvWorld | None = None
-        self._bounds = (0.0, 0.0, 1.0, 1.0)
         self._rng = np.random.default_rng()
-        self.episode_seed: int | None = None
 
     @property
     def world(self) -> MultiUnicycleWorld:
         """The loop world of the current episode (metrics, ``law_setup``...)."""
-        if self._world is None:
-            raise RuntimeError("call reset() first")
-        world = self._world.world
+        world = self._loop_world()
         assert isinstance(world, MultiUnicycleWorld)
         return world
 
@@ -109,17 +100,6 @@ class MultiNav2DParallelEnv(ParallelEnv):
         r = self.scenario.robots[self._index[agent]]
         return act_space(r.v_max, r.u_max, raw=self.raw_commands)
 
-    def _info(self, i: int) -> dict[str, Any]:
-        w = self._world
-        assert w is not None
-        return {
-            "status": w.status(i),
-            "distance": w.distance(i),
-            "clearance": float(w.clearance[i]),
-            "time": w.world.t,
-            "uvnav": w.view(i),
-        }
-
     def reset(
         self, seed: int | None = None, options: dict[str, Any] | None = None
     ) -> tuple[dict[str, np.ndarray], dict[str, dict[str, Any]]]:
@@ -128,17 +108,9 @@ class MultiNav2DParallelEnv(ParallelEnv):
         if self._world is not None:
             self._world.close()
         self.episode_seed = k = episode_seed(self._rng, options)
-        self._world = EnvWorld(
-            MultiUnicycleWorld(build_multi(self.scenario, k), run_rng(k)),
-            n_rays=self.n_rays,
-            max_range=self.max_range,
-            goal_scale=self.goal_scale,
-            reward=self.reward_config,
-            raw_commands=self.raw_commands,
-        )
-        self._bounds = scene_bounds(self._world)
-        self.agents = [a for a in self.possible_agents if self._world.running(self._index[a])]
-        obs = {a: self._world.vector(self._index[a]) for a in self.agents}
+        w = self._open(MultiUnicycleWorld(build_multi(self.scenario, k), run_rng(k)))
+        self.agents = [a for a in self.possible_agents if w.running(self._index[a])]
+        obs = {a: w.vector(self._index[a]) for a in self.agents}
         infos = {a: self._info(self._index[a]) for a in self.agents}
         return obs, infos
 
@@ -169,13 +141,3 @@ class MultiNav2DParallelEnv(ParallelEnv):
                 infos[a]["status"] = "timeout"
         self.agents = [a for a in live if not (terms[a] or truncs[a])]
         return obs, rewards, terms, truncs, infos
-
-    def render(self) -> np.ndarray | None:
-        if self.render_mode != "rgb_array" or self._world is None:
-            return None
-        return render_frame(self._world, self._bounds)
-
-    def close(self) -> None:
-        if self._world is not None:
-            self._world.close()
-            self._world = None

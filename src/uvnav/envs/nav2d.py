@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.envs.core import TERMINAL, EnvWorld, RewardConfig, render_frame, scene_bounds
+from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.scenarios.schema import Scenario
@@ -82,7 +82,7 @@ def episode_seed(rng: np.random.Generator, options: dict[str, Any] | None) -> in
     return int(rng.integers(2**31 - 1))
 
 
-class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
+class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
     """``uvnav/Nav2D-v0`` (module docstring).
 
     Args:
@@ -112,39 +112,19 @@ class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
         self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
-        self.render_mode = render_mode
-        self.n_rays = int(n_rays)
-        self.max_range = float(max_range)
         r = self.scenario.robot
         dist = float(np.hypot(r.goal[0] - r.start[0], r.goal[1] - r.start[1]))
         self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
-        self.reward_config = reward_config(reward)
+        self._configure(render_mode, n_rays, max_range, reward_config(reward), raw_commands)
         self.observation_space = obs_space(self.n_rays)
-        self.raw_commands = raw_commands
         self.action_space = act_space(r.v_max, r.u_max, raw=raw_commands)
-        self._world: EnvWorld | None = None
-        self._bounds = (0.0, 0.0, 1.0, 1.0)
-        self.episode_seed: int | None = None
 
     @property
     def world(self) -> UnicycleWorld:
         """The loop world of the current episode (metrics, ``law_setup``...)."""
-        if self._world is None:
-            raise RuntimeError("call reset() first")
-        world = self._world.world
+        world = self._loop_world()
         assert isinstance(world, UnicycleWorld)
         return world
-
-    def _info(self) -> dict[str, Any]:
-        w = self._world
-        assert w is not None
-        return {
-            "status": w.status(0),
-            "distance": w.distance(0),
-            "clearance": float(w.clearance[0]),
-            "time": w.world.t,
-            "uvnav": w.view(0),
-        }
 
     def reset(
         self, *, seed: int | None = None, options: dict[str, Any] | None = None
@@ -153,16 +133,8 @@ class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
         if self._world is not None:
             self._world.close()
         self.episode_seed = k = episode_seed(self.np_random, options)
-        self._world = EnvWorld(
-            UnicycleWorld(build_episode(self.scenario, k), run_rng(k), exact=True),
-            n_rays=self.n_rays,
-            max_range=self.max_range,
-            goal_scale=self.goal_scale,
-            reward=self.reward_config,
-            raw_commands=self.raw_commands,
-        )
-        self._bounds = scene_bounds(self._world)
-        return self._world.vector(0), self._info()
+        w = self._open(UnicycleWorld(build_episode(self.scenario, k), run_rng(k), exact=True))
+        return w.vector(0), self._info(0)
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         w = self._world
@@ -171,17 +143,7 @@ class Nav2DEnv(gym.Env[np.ndarray, np.ndarray]):
         reward = float(w.step({0: np.asarray(action)})[0])
         terminated = w.status(0) in TERMINAL
         truncated = not terminated and w.world.done
-        info = self._info()
+        info = self._info(0)
         if truncated:
             info["status"] = "timeout"
         return w.vector(0), reward, terminated, truncated, info
-
-    def render(self) -> np.ndarray | None:
-        if self.render_mode != "rgb_array" or self._world is None:
-            return None
-        return render_frame(self._world, self._bounds)
-
-    def close(self) -> None:
-        if self._world is not None:
-            self._world.close()
-            self._world = None

@@ -56,20 +56,17 @@ same episode.
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import numpy as np
 
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand
-from uvnav.envs.common import SimView, fill_polygon, pixel_grid, scene_for_episode, square_bounds
-from uvnav.envs.core import ROBOT_COLOURS, RewardConfig
-from uvnav.envs.nav2d import reward_config
+from uvnav.envs.common import SimView, VehicleWorldEnv, fill_polygon
+from uvnav.envs.core import ROBOT_COLOURS, RewardConfig, pixel_grid, square_bounds
 from uvnav.sensors.sensing3d import Observation3D
 from uvnav.sim.episode3d import Vehicle3DWorld
 
 try:
-    import gymnasium as gym
     from gymnasium import spaces
 except ImportError as exc:  # pragma: no cover - exercised only without the extra
     raise ImportError("uvnav.envs needs gymnasium: pip install 'uvnav[envs]'") from exc
@@ -144,7 +141,7 @@ def observation_vector(
     return out
 
 
-class Nav3DEnv(gym.Env[np.ndarray, np.ndarray]):
+class Nav3DEnv(VehicleWorldEnv):
     """``uvnav/Nav3D-v0`` (module docstring).
 
     Args:
@@ -159,6 +156,8 @@ class Nav3DEnv(gym.Env[np.ndarray, np.ndarray]):
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 10}  # noqa: RUF012 - gymnasium declares it an instance variable
+    _world: Vehicle3DWorld | None
+    _obs: Observation3D | None
 
     def __init__(
         self,
@@ -174,37 +173,46 @@ class Nav3DEnv(gym.Env[np.ndarray, np.ndarray]):
         from uvnav.scenarios.generators3d import random_ch3_scenario
         from uvnav.scenarios.schema3d import Scenario3D
 
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
-        if int(n_obstacles) < 1:
-            raise ValueError(f"n_obstacles must be >= 1 (got {n_obstacles})")
-        self._generators = {"random-ch3": random_ch3_scenario}
-        if isinstance(scenario, str) and scenario in self._generators:
-            self.scenario: Any = scenario
-            first = random_ch3_scenario(0)
-        else:
+        def load(scenario: Any) -> Scenario3D:
             sc = scenario if isinstance(scenario, Scenario3D) else load_scenario(scenario)
             if not isinstance(sc, Scenario3D):
                 raise ValueError(f"{scenario!r} is not a Chapter-3 (dim: 3) scene")
-            self.scenario = first = sc
-        self.render_mode = render_mode
+            return sc
+
+        if int(n_obstacles) < 1:
+            raise ValueError(f"n_obstacles must be >= 1 (got {n_obstacles})")
+        first = self._configure(
+            scenario, {"random-ch3": random_ch3_scenario}, load, render_mode, reward
+        )
         self.n_obstacles = int(n_obstacles)
         self.oracle = bool(oracle)
         r = first.robot
         dist = float(np.linalg.norm(np.subtract(r.goal, r.start)))
         self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
-        self.reward_config = reward_config(reward)
         low = np.zeros(5 + SLOT * self.n_obstacles, dtype=np.float32)
         low[1:4] = -1.0
         for j in range(self.n_obstacles):
             low[5 + SLOT * j + 2 : 5 + SLOT * j + 8] = -1.0
         self.observation_space = spaces.Box(low=low, high=np.ones_like(low), dtype=np.float32)
         self.action_space = spaces.Box(low=-1.0, high=1.0, shape=(3,), dtype=np.float32)
-        self._world: Vehicle3DWorld | None = None
-        self._obs: Observation3D | None = None
-        self._clearance = math.inf
 
     # ------------------------------------------------------------------------------ helpers
+    def _new_world(self, scene: Any, episode_seed: int) -> Vehicle3DWorld:
+        velocities = "known" if self.oracle else "estimated"
+        setup = scene.build(episode_seed, velocities=velocities)
+        world = Vehicle3DWorld(setup, np.random.default_rng(episode_seed), exact=True)
+        world.start([self.oracle])
+        return world
+
+    def _command(self, action: np.ndarray) -> Vehicle3DCommand:
+        world = self._world
+        assert world is not None
+        return command_of(action, world.a, world.spec.v_max, world.spec.u_max)
+
+    def _distance(self) -> float:
+        assert self._world is not None
+        return float(np.linalg.norm(self._world.goal - self._world.pos))
+
     def _vector(self) -> np.ndarray:
         world, obs = self._world, self._obs
         assert world is not None and obs is not None
@@ -226,58 +234,16 @@ class Nav3DEnv(gym.Env[np.ndarray, np.ndarray]):
 
         return {
             "status": world.status if world.done else "running",
-            "distance": float(np.linalg.norm(world.goal - world.pos)),
+            "distance": self._distance(),
             "clearance": float(self._clearance),
             "time": world.t,
             "uvnav": SimView(obs, spec, to_action),
         }
 
-    # --------------------------------------------------------------------------------- API
-    def reset(
-        self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[np.ndarray, dict[str, Any]]:
-        super().reset(seed=seed)
-        episode_seed = int(self.np_random.integers(2**31 - 1))
-        sc = scene_for_episode(self.scenario, self._generators, episode_seed)
-        velocities = "known" if self.oracle else "estimated"
-        setup = sc.build(episode_seed, velocities=velocities)
-        self._world = world = Vehicle3DWorld(setup, np.random.default_rng(episode_seed), exact=True)
-        world.start([self.oracle])
-        self._clearance = world.clearance
-        self._obs = world.observe()
-        return self._vector(), self._info()
-
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        world = self._world
-        if world is None:
-            raise RuntimeError("call reset() before step()")
-        if world.done:
-            raise RuntimeError("the episode is over: call reset()")
-        rw = self.reward_config
-        before = float(np.linalg.norm(world.goal - world.pos))
-        world.apply(command_of(action, world.a, world.spec.v_max, world.spec.u_max))
-        low = math.inf
-        for _ in range(world.ratio):
-            world.advance()
-            low = min(low, world.clearance)
-            if world.done:
-                break
-        self._clearance = low
-        after = float(np.linalg.norm(world.goal - world.pos))
-        terminated = world.done and world.status in ("success", "collision")
-        truncated = world.done and not terminated
-        reward = rw.reward(before - after, low, world.status if terminated else "running")
-        self._obs = world.observe()
-        return self._vector(), float(reward), terminated, truncated, self._info()
-
     def render(self) -> np.ndarray | None:
         if self.render_mode != "rgb_array" or self._world is None:
             return None
         return render_frame3d(self._world)
-
-    def close(self) -> None:
-        self._world = None
-        self._obs = None
 
 
 def render_frame3d(world: Vehicle3DWorld, size: int = 256) -> np.ndarray:

@@ -55,15 +55,13 @@ from typing import Any
 import numpy as np
 
 from uvnav.dynamics.holonomic import SPEED_EPS, HolonomicCommand, max_speed_along
-from uvnav.envs.common import SimView, fill_polygon, pixel_grid, scene_for_episode, square_bounds
-from uvnav.envs.core import ROBOT_COLOURS, RewardConfig
-from uvnav.envs.nav2d import reward_config
+from uvnav.envs.common import SimView, VehicleWorldEnv, fill_polygon
+from uvnav.envs.core import ROBOT_COLOURS, RewardConfig, pixel_grid, square_bounds
 from uvnav.geometry.angles import wrap_scalar
 from uvnav.sensors.sonar2d import SonarObservation
 from uvnav.sim.episode_uuv2d import Uuv2dWorld
 
 try:
-    import gymnasium as gym
     from gymnasium import spaces
 except ImportError as exc:  # pragma: no cover - exercised only without the extra
     raise ImportError("uvnav.envs needs gymnasium: pip install 'uvnav[envs]'") from exc
@@ -111,7 +109,7 @@ def observation_vector(obs: SonarObservation, *, v_max: float, goal_scale: float
     return out
 
 
-class Uuv2DEnv(gym.Env[np.ndarray, np.ndarray]):
+class Uuv2DEnv(VehicleWorldEnv):
     """``uvnav/UUV2D-v0`` (module docstring).
 
     Args:
@@ -124,6 +122,8 @@ class Uuv2DEnv(gym.Env[np.ndarray, np.ndarray]):
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 5}  # noqa: RUF012 - gymnasium declares it an instance variable
+    _world: Uuv2dWorld | None
+    _obs: SonarObservation | None
 
     def __init__(
         self,
@@ -135,29 +135,36 @@ class Uuv2DEnv(gym.Env[np.ndarray, np.ndarray]):
     ) -> None:
         from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, Uuv2dScenario, load_uuv2d_scenario
 
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
-        self._generators = dict(UUV2D_GENERATORS)
-        if isinstance(scenario, str) and scenario in self._generators:
-            self.scenario: Any = scenario
-            first = self._generators[scenario](0)
-        else:
-            sc = scenario if isinstance(scenario, Uuv2dScenario) else load_uuv2d_scenario(scenario)
-            self.scenario = first = sc
-        self.render_mode = render_mode
+        def load(scenario: Any) -> Uuv2dScenario:
+            return (
+                scenario if isinstance(scenario, Uuv2dScenario) else load_uuv2d_scenario(scenario)
+            )
+
+        first = self._configure(scenario, UUV2D_GENERATORS, load, render_mode, reward)
         v = first.vehicle
         dist = float(math.hypot(v.goal[0] - v.start[0], v.goal[1] - v.start[1]))
         self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
-        self.reward_config = reward_config(reward)
         n = first.sonar.to_config().n_beams
         low = np.zeros(4 + n, dtype=np.float32)
         low[1:3] = -1.0
         self.observation_space = spaces.Box(low=low, high=np.ones_like(low), dtype=np.float32)
         self.action_space = spaces.Box(low=-1.0, high=1.0, shape=(2,), dtype=np.float32)
         self._n_beams = n
-        self._world: Uuv2dWorld | None = None
-        self._obs: SonarObservation | None = None
-        self._clearance = math.inf
+
+    def _new_world(self, scene: Any, episode_seed: int) -> Uuv2dWorld:
+        world = Uuv2dWorld(scene.to_setup(), np.random.default_rng(episode_seed))
+        world.start()
+        return world
+
+    def _command(self, action: np.ndarray) -> HolonomicCommand:
+        world = self._world
+        assert world is not None
+        spec = world.spec
+        return command_of(action, float(world.state[2]), spec.v_max, spec.u_max, world.period)
+
+    def _distance(self) -> float:
+        assert self._world is not None
+        return float(math.hypot(*(self._world.goal - self._world.state[:2])))
 
     def _vector(self) -> np.ndarray:
         world, obs = self._world, self._obs
@@ -180,57 +187,17 @@ class Uuv2DEnv(gym.Env[np.ndarray, np.ndarray]):
 
         return {
             "status": world.status if world.done else "running",
-            "distance": float(math.hypot(*(world.goal - world.state[:2]))),
+            "distance": self._distance(),
             "clearance": float(self._clearance),
             "time": world.t,
             "entered_forbidden": bool(world.entered),
             "uvnav": SimView(obs, spec, to_action),
         }
 
-    def reset(
-        self, *, seed: int | None = None, options: dict[str, Any] | None = None
-    ) -> tuple[np.ndarray, dict[str, Any]]:
-        super().reset(seed=seed)
-        episode_seed = int(self.np_random.integers(2**31 - 1))
-        sc = scene_for_episode(self.scenario, self._generators, episode_seed)
-        self._world = world = Uuv2dWorld(sc.to_setup(), np.random.default_rng(episode_seed))
-        world.start()
-        self._clearance = world.clearance
-        self._obs = world.observe()
-        return self._vector(), self._info()
-
-    def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
-        world = self._world
-        if world is None:
-            raise RuntimeError("call reset() before step()")
-        if world.done:
-            raise RuntimeError("the episode is over: call reset()")
-        rw = self.reward_config
-        before = float(math.hypot(*(world.goal - world.state[:2])))
-        spec = world.spec
-        world.apply(command_of(action, float(world.state[2]), spec.v_max, spec.u_max, world.period))
-        low = math.inf
-        for _ in range(world.ratio):
-            world.advance()
-            low = min(low, world.clearance)
-            if world.done:
-                break
-        self._clearance = low
-        after = float(math.hypot(*(world.goal - world.state[:2])))
-        terminated = world.done and world.status in ("success", "collision")
-        truncated = world.done and not terminated
-        reward = rw.reward(before - after, low, world.status if terminated else "running")
-        self._obs = world.observe()
-        return self._vector(), float(reward), terminated, truncated, self._info()
-
     def render(self) -> np.ndarray | None:
         if self.render_mode != "rgb_array" or self._world is None:
             return None
         return render_frame_uuv2d(self._world, self._obs)
-
-    def close(self) -> None:
-        self._world = None
-        self._obs = None
 
 
 def render_frame_uuv2d(

@@ -255,8 +255,3 @@ def _radial_hits(dirs: FloatArray, verts: FloatArray, faces: np.ndarray) -> Floa
 
 Body3D = MeshBody | SphereBody
 """The bodies the 3D world simulates (a :class:`StarBody` enters through its mesh)."""
-
-
-def body_from_star(star: StarBody, subdivisions: int = 2) -> MeshBody:
-    """The mesh of an analytic star-shaped body (see :meth:`StarBody.to_mesh`)."""
-    return star.to_mesh(subdivisions)

@@ -145,9 +145,6 @@ class DStarLite:
         r, c = divmod(self._goal, self.cols)
         return (r, c)
 
-    def is_free(self, cell: Cell) -> bool:
-        return self._free[self._flat(cell)]
-
     def occupancy(self) -> np.ndarray:
         """The current (rows, cols) bool occupancy."""
         return ~np.asarray(self._free, dtype=bool).reshape(self.rows, self.cols)

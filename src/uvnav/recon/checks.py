@@ -23,7 +23,7 @@ Units: lengths [m], angles [rad], curvature [1/m].
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -45,10 +45,6 @@ class TrajectoryCheck:
     max_tangent_jump: float  # [rad]
     min_clearance: float  # vertical, above terrain [m]
     n_pieces: int
-
-    def as_dict(self) -> dict[str, float]:
-        """Plain dict for JSON/CSV."""
-        return {k: float(v) for k, v in asdict(self).items()}
 
 
 def check_trajectory(

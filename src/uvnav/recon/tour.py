@@ -24,8 +24,6 @@ Distances are 3D Euclidean between waypoints [m].
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import shapely
 
@@ -237,14 +235,3 @@ def cluster_tours(
             raise ValueError(f"tour method: unknown {method!r} (use 'tsp' or 'spiral')")
         tours.append(idx[o])
     return tours
-
-
-def max_turn(pts: FloatArray, order: IntArray) -> float:
-    """Largest heading change [rad] at a waypoint along the closed tour (xy)."""
-    p = np.asarray(pts, dtype=float)[np.asarray(order)][:, :2]
-    if len(p) < 3:
-        return math.pi
-    v_in = p - np.roll(p, 1, axis=0)
-    v_out = np.roll(p, -1, axis=0) - p
-    a = np.arctan2(v_out[:, 1], v_out[:, 0]) - np.arctan2(v_in[:, 1], v_in[:, 0])
-    return float(np.max(np.abs((a + math.pi) % (2 * math.pi) - math.pi)))

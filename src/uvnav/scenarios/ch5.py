@@ -28,7 +28,7 @@ from pydantic import Field, ValidationError, model_validator
 from uvnav.dynamics.vehicle3d import Vehicle3DSpec
 from uvnav.obstacles.deforming3d import CompoundBody, as_compound, horseshoe, random_star
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import FileModel, SceneModel, check_magnitudes, check_timing
+from uvnav.scenarios.limits import BoundedScene, FileModel, check_timing
 from uvnav.scenarios.loader import builtin_yaml_files, parse_yaml
 from uvnav.sensors.sonar_array import SonarArray
 from uvnav.sim.episode_uuv3d import UUV3DSetup
@@ -113,7 +113,7 @@ class Controller5(_Model):
     params: dict[str, float] = Field(default_factory=dict)
 
 
-class Scenario5(SceneModel):
+class Scenario5(BoundedScene):
     """A Chapter 5 scenario (module docstring)."""
 
     name: str
@@ -127,12 +127,6 @@ class Scenario5(SceneModel):
     sonar: Sonar5 = Sonar5()
     obstacles: list[Obstacle5Spec] = Field(default_factory=list)
     controller: Controller5 = Controller5()
-
-    @model_validator(mode="before")
-    @classmethod
-    def _bounded(cls, data: Any) -> Any:
-        check_magnitudes(data)
-        return data
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario5:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from pydantic import BaseModel, ConfigDict, PrivateAttr
+from pydantic import BaseModel, ConfigDict, PrivateAttr, model_validator
 
 from uvnav.scenarios.errors import FieldError
 
@@ -38,6 +38,28 @@ class SceneModel(FileModel):
     def source(self) -> str:
         """The file (or ``"<dict>"``) this scenario was read from, for error messages."""
         return self._source
+
+
+class FieldEqualScene(SceneModel):
+    """A scene equal to another when every field is equal: where it was read from does not
+    count."""
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, type(self)):
+            return NotImplemented
+        return self.__dict__ == other.__dict__
+
+    __hash__ = None  # type: ignore[assignment]  # lists inside: not hashable
+
+
+class BoundedScene(SceneModel):
+    """A scene whose numbers are refused above :data:`MAX_MAGNITUDE` (:func:`check_magnitudes`)."""
+
+    @model_validator(mode="before")
+    @classmethod
+    def _bounded(cls, data: Any) -> Any:
+        check_magnitudes(data)
+        return data
 
 
 #: most integration steps ``t_max / dt`` of one episode

@@ -268,40 +268,6 @@ def _infer_frame_rate(rows: dict[int, list[_Row]], source: str) -> float:
     return step / ANNOTATION_PERIOD
 
 
-def parse_obsmat(
-    text: str, source: str = "<text>", *, frame_rate: float | None = None
-) -> dict[int, Track]:
-    """Tracks of an ETH ``obsmat.txt``: ``frame id pos_x pos_z pos_y v_x v_z v_y`` per row.
-
-    Args:
-        text: the file's contents.
-        source: file name for error messages.
-        frame_rate: frames per second [1/s]; inferred (0.4 s annotation period) when ``None``.
-
-    Returns:
-        ``{person id: Track}`` with times ``frame / frame_rate`` [s] and positions ``(pos_x,
-        pos_y)`` [m], sorted by time.
-
-    Raises:
-        ScenarioError: one line naming ``source``, the line and the problem.
-    """
-    return _parse(text, source, "obsmat", frame_rate)
-
-
-def parse_xy4(
-    text: str, source: str = "<text>", *, frame_rate: float | None = None
-) -> dict[int, Track]:
-    """Tracks of a ``frame id x y`` file (Social-GAN/TrajNet style); see :func:`parse_obsmat`."""
-    return _parse(text, source, "xy4", frame_rate)
-
-
-def parse_trajnet(
-    text: str, source: str = "<text>", *, frame_rate: float | None = None
-) -> dict[int, Track]:
-    """Tracks of a TrajNet++ ``.ndjson`` text; see :func:`parse_obsmat`."""
-    return _parse(text, source, "trajnet", frame_rate)
-
-
 def read_tracks(
     path: str | Path, fmt: str = "obsmat", *, frame_rate: float | None = None
 ) -> dict[int, Track]:

@@ -20,6 +20,7 @@ from typing import Annotated, Any, Literal
 
 import numpy as np
 from pydantic import (
+    AfterValidator,
     Field,
     ValidationInfo,
     field_validator,
@@ -48,7 +49,7 @@ from uvnav.obstacles.motion import motion_plugins
 from uvnav.obstacles.social_force import SocialForcePedestrian
 from uvnav.scenarios import pedestrians
 from uvnav.scenarios.errors import FieldError, ScenarioError
-from uvnav.scenarios.limits import FileModel, SceneModel, check_timing
+from uvnav.scenarios.limits import FieldEqualScene, FileModel, check_timing
 from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sim import LidarConfig, SensingConfig
 
@@ -57,6 +58,16 @@ Point2 = Annotated[tuple[float, float], Field(description="[x, y] [m]")]
 
 
 _Model = FileModel
+
+
+def _ordered_box(value: tuple[float, float, float, float]) -> tuple[float, float, float, float]:
+    if not (value[0] < value[2] and value[1] < value[3]):
+        raise ValueError(f"need xmin < xmax and ymin < ymax (got {list(value)})")
+    return value
+
+
+#: a box ``[xmin, ymin, xmax, ymax]`` [m] with xmin < xmax and ymin < ymax
+Box = Annotated[tuple[float, float, float, float], AfterValidator(_ordered_box)]
 
 
 def _heading_of(vector: np.ndarray, default: float) -> float:
@@ -262,7 +273,7 @@ class RandomTurnMotion(_Model):
         1.0, gt=0, description="a new speed and turn rate are drawn this often [s]"
     )
     spin: float = Field(0.0, description="extra constant rotation of the body [rad/s]")
-    arena: tuple[float, float, float, float] | None = Field(
+    arena: Box | None = Field(
         None, description="[xmin, ymin, xmax, ymax] [m]; outside it the course turns back"
     )
 
@@ -271,15 +282,6 @@ class RandomTurnMotion(_Model):
     def _ordered(cls, value: tuple[float, float]) -> tuple[float, float]:
         if value[0] > value[1]:
             raise ValueError(f"min {value[0]} > max {value[1]}")
-        return value
-
-    @field_validator("arena")
-    @classmethod
-    def _box(
-        cls, value: tuple[float, float, float, float] | None
-    ) -> tuple[float, float, float, float] | None:
-        if value is not None and not (value[0] < value[2] and value[1] < value[3]):
-            raise ValueError(f"need xmin < xmax and ymin < ymax (got {list(value)})")
         return value
 
     def to_model(self, rng: np.random.Generator) -> RandomTurn:
@@ -668,7 +670,7 @@ class CrowdSpec(_Model):
         description="frames per second of the file [1/s]; omitted = the sequence's own (eth 15, "
         "hotel 25) or, for a file, inferred from a 0.4 s annotation period",
     )
-    region: tuple[float, float, float, float] | None = Field(
+    region: Box | None = Field(
         None, description="optional crop [xmin, ymin, xmax, ymax] [m]: samples outside are absent"
     )
     scale: float = Field(
@@ -698,15 +700,6 @@ class CrowdSpec(_Model):
         if not path.is_absolute() and base is not None:
             path = Path(base) / path
         return str(path)
-
-    @field_validator("region")
-    @classmethod
-    def _box(
-        cls, value: tuple[float, float, float, float] | None
-    ) -> tuple[float, float, float, float] | None:
-        if value is not None and not (value[0] < value[2] and value[1] < value[3]):
-            raise ValueError(f"need xmin < xmax and ymin < ymax (got {list(value)})")
-        return value
 
     @model_validator(mode="after")
     def _readable(self) -> CrowdSpec:
@@ -763,7 +756,7 @@ class ControllerSpec(_Model):
 # ---------------------------------------------------------------------------------------- scenario
 
 
-class Scenario(SceneModel):
+class Scenario(FieldEqualScene):
     """A complete scenario (DESIGN §3): robot, sensing, obstacles, timing and default controller."""
 
     name: str = Field(min_length=1, description="scenario name, e.g. thesis-ch2-one-obstacle")
@@ -784,14 +777,6 @@ class Scenario(SceneModel):
         None, description="real pedestrians replayed as moving discs (appended after obstacles)"
     )
     controller: ControllerSpec = Field(default_factory=lambda: ControllerSpec.model_validate({}))
-
-    def __eq__(self, other: object) -> bool:
-        """Equal when every field is equal; where the scenario was read from does not count."""
-        if not isinstance(other, Scenario):
-            return NotImplemented
-        return self.__dict__ == other.__dict__
-
-    __hash__ = None  # type: ignore[assignment]  # lists inside: not hashable
 
     @model_validator(mode="before")
     @classmethod

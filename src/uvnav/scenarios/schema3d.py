@@ -43,7 +43,7 @@ from uvnav.obstacles.motion3d import (
     Waypoints3D,
 )
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import FileModel, SceneModel, check_magnitudes, check_timing
+from uvnav.scenarios.limits import BoundedScene, FieldEqualScene, FileModel, check_timing
 from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, clearance3d
 
 Point3 = Annotated[tuple[float, float, float], Field(description="[x, y, z] [m]")]
@@ -288,7 +288,7 @@ class Controller3DSpec(_Model):
     params: dict[str, Any] = Field(default_factory=dict, description="the law's parameters")
 
 
-class Scenario3D(SceneModel):
+class Scenario3D(BoundedScene, FieldEqualScene):
     """A complete 3D scenario."""
 
     name: str = Field(min_length=1)
@@ -304,20 +304,6 @@ class Scenario3D(SceneModel):
     controller: Controller3DSpec = Field(
         default_factory=lambda: Controller3DSpec.model_validate({})
     )
-
-    def __eq__(self, other: object) -> bool:
-        """Equal when every field is equal; where the scenario was read from does not count."""
-        if not isinstance(other, Scenario3D):
-            return NotImplemented
-        return self.__dict__ == other.__dict__
-
-    __hash__ = None  # type: ignore[assignment]  # lists inside: not hashable
-
-    @model_validator(mode="before")
-    @classmethod
-    def _bounded(cls, data: Any) -> Any:
-        check_magnitudes(data)
-        return data
 
     @model_validator(mode="after")
     def _consistent(self) -> Scenario3D:

@@ -185,13 +185,6 @@ def fig_trajectory3d(
     return fig
 
 
-def _draw_bodies(ax: Any, obstacles: Sequence[CompoundBody], t: float, **kw: Any) -> None:
-    for ob in obstacles:
-        for part in ob.parts:
-            v = part.vertices(t)
-            ax.plot_trisurf(v[:, 0], v[:, 1], v[:, 2], triangles=part.faces, linewidth=0, **kw)
-
-
 def _sphere(centre: FloatArray, radius: float, n: int = 10) -> tuple[Any, Any, Any]:
     u, v = np.mgrid[0 : 2 * np.pi : complex(0, n), 0 : np.pi : complex(0, n // 2 + 1)]
     return (
