@@ -297,18 +297,30 @@ def _lidar(
 ) -> None:
     """Ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from pose ``(ox, oy, th)`` in
     one world into ``out`` (R,): beams at ``wrap(th + rel)`` [rad], capped at ``max_range``
-    [m].  A body is cast only where :meth:`ObstacleField.ray_hits` casts it."""
-    for r in range(rel.shape[0]):
+    [m].  A body is cast where :meth:`ObstacleField.ray_hits` casts it, and only by the beams
+    that meet its bounding disc (the others cannot hit it: the same ranges, far fewer edges)."""
+    n_rays = rel.shape[0]
+    dirs = np.empty((2, n_rays))
+    for r in range(n_rays):
         out[r] = max_range
-    limit = max_range * (1.0 + 1e-9) + 1e-9 * (1.0 + abs(ox) + abs(oy))
+        a = wrap_angle(th + rel[r])
+        dirs[0, r], dirs[1, r] = math.cos(a), math.sin(a)
+    slack = 1e-9 * (1.0 + abs(ox) + abs(oy))
+    limit = max_range * (1.0 + 1e-9) + slack
     for o in range(n_obs):
         cx, cy, h = st[S_X, o], st[S_Y, o], st[S_HEADING, o]
-        if math.hypot(cx - ox, cy - oy) - prm[P_BOUND, o] > limit:
+        bound = prm[P_BOUND, o]
+        if math.hypot(cx - ox, cy - oy) - bound > limit:
             continue  # its hits would be beyond max_range
+        reach = bound * (1.0 + 1e-9) + slack
         c, s = math.cos(h), math.sin(h)
-        for r in range(rel.shape[0]):
-            a = wrap_angle(th + rel[r])
-            dx, dy = math.cos(a), math.sin(a)
+        for r in range(n_rays):
+            dx, dy = dirs[0, r], dirs[1, r]
+            # a beam that passes outside the bounding disc, or starts beyond it, cannot hit
+            if abs(dx * (cy - oy) - dy * (cx - ox)) > reach:
+                continue
+            if dx * (cx - ox) + dy * (cy - oy) < -reach:
+                continue
             best = out[r]
             rx, ry = rings[0, o, 0], rings[1, o, 0]
             sx, sy = c * rx + s * -ry + cx, c * ry + s * rx + cy
