@@ -1,4 +1,4 @@
-"""World steps per second: ir-sim (optional peer) side by side with uvnav, in one run.
+"""World steps per CPU second: ir-sim (optional peer) side by side with uvnav, in one run.
 
 Scene: one unicycle / diff-drive robot driving straight along +x plus N moving non-convex polygon
 obstacles wandering in an arena beside its path (N = 10 and 100), dt = 0.1 s.  The uvnav side is
@@ -11,13 +11,21 @@ headless (``headless=True``: no figure, no rendering, no animation saving, no pa
 
 Run (from the repository root)::
 
-    MPLBACKEND=Agg .venv/bin/python benchmarks/peers/irsim_steps.py
+    .venv/bin/python benchmarks/peers/irsim_steps.py             # ~1.5 min
+    .venv/bin/python benchmarks/peers/irsim_steps.py --quick     # smoke run, indicative only
 
-Writes ``benchmarks/results/peers.json`` (``--out`` to change the folder) and prints a table.
-Both sides: best wall time of 3 runs, interleaved (uvnav: 3000 steps, as ``run_benchmarks.py``;
-ir-sim: fewer steps because it is much slower, 1000 with N = 10 and 300 with N = 100, or
-``--irsim-steps``), steps/s = steps / best wall time.  Both worlds are built from the 3000-step
-``world_setup`` (same arena length, same obstacle density); the ir-sim robot just drives less far.
+Writes ``benchmarks/results/peers_irsim.json`` (``--out`` to change the folder) and prints a
+table.  Timing: CPU time of the process (:func:`time.process_time`) around each episode's step
+loop (building the world is not timed; a warm-up episode / step of each side is discarded);
+``--repeats`` runs per side (default 5, seeds 0..), uvnav and ir-sim alternating run by run; the
+figure of a side is the median over its runs of CPU µs per step.  uvnav runs 3000 steps an
+episode, ir-sim fewer because it is much slower (2000 with N = 10, 800 with N = 100, or
+``--irsim-steps``); both worlds are built from the 3000-step ``world_setup`` (same arena, same
+obstacle density), the ir-sim robot just drives less far.
+
+Targets (issue 20): a uvnav world step with 100 polygons <= 15 µs CPU and >= 1,000x ir-sim's
+steps/s; with 10 polygons <= 3 µs.  Without ir-sim the script says so in one line and records
+``"available": false`` (the uvnav side is still measured: the absolute targets do not need ir-sim).
 """
 
 from __future__ import annotations
@@ -27,17 +35,20 @@ import math
 import os
 import sys
 import tempfile
-import time
 from pathlib import Path
 from typing import Any
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
-import numpy as np
-
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))  # benchmarks/ -> run_benchmarks
+sys.path.insert(0, str(HERE))  # peerstats
 
+import peerstats  # noqa: E402
+
+peerstats.single_threaded()
+
+import numpy as np  # noqa: E402
 from run_benchmarks import (  # noqa: E402
     CH2_SPEC,
     WORLD_COUNTS,
@@ -47,10 +58,18 @@ from run_benchmarks import (  # noqa: E402
     write_json,
 )
 
-REPEATS = 3
+REPEATS = peerstats.MIN_REPEATS
 UVNAV_STEPS = 3000
 DT = 0.1
-IRSIM_STEPS = {10: 1000, 100: 300}
+IRSIM_STEPS = {10: 2000, 100: 800}
+#: --quick: steps per episode (uvnav, ir-sim) and repeats
+QUICK = {"uvnav_steps": 500, "irsim_steps": 50, "repeats": 2}
+#: issue 20's world-step targets: key -> (obstacles, what, limit, direction)
+TARGETS: dict[str, tuple[int, str, float, str]] = {
+    "world_step_us_100": (100, "uvnav CPU µs per world step, 100 polygons", 15.0, "<="),
+    "world_step_us_10": (10, "uvnav CPU µs per world step, 10 polygons", 3.0, "<="),
+    "vs_irsim_100": (100, "uvnav steps/s over ir-sim's, 100 polygons", 1000.0, ">="),
+}
 
 
 # --------------------------------------------------------------------------------------------
@@ -107,6 +126,7 @@ def irsim_world_yaml(n_obstacles: int, n_steps: int, seed: int) -> str:
 def time_irsim(
     n_obstacles: int, n_steps: int, scene_steps: int, seed: int, tmp: Path
 ) -> dict[str, Any]:
+    """One ir-sim episode of ``n_steps`` steps: CPU s of the step loop and the end state."""
     import irsim
 
     path = tmp / f"irsim_{n_obstacles}_{seed}.yaml"
@@ -117,11 +137,11 @@ def time_irsim(
     try:
         n_obs = len(env.obstacle_list)
         action = np.array([[CH2_SPEC.v_max], [0.0]])
-        env.step(action)  # warm-up (first-call imports, caches)
-        tic = time.perf_counter()
+        env.step(action)  # warm-up (first-call imports, caches), not timed
+        cpu0 = peerstats.cpu_s()
         for _ in range(n_steps):
             env.step(action)
-        wall = time.perf_counter() - tic
+        cpu = peerstats.cpu_s() - cpu0
         robot = env.robot
         status = {
             "robot_x": float(robot.state[0, 0]),
@@ -138,14 +158,30 @@ def time_irsim(
         }
     finally:
         env.end(0)
-    return {"wall": wall, **status}
+    return {"seed": seed, "steps": n_steps, "cpu_s": cpu, **status}
 
 
 def time_uvnav(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
-    wall, res = _time_episode(
-        lambda: world_setup(n_obstacles, n_steps, seed=seed), "straight-v1", seed, False
+    """One uvnav episode of ``n_steps`` steps (``straight-v1``, record off): CPU s, status."""
+    wall, res, cpu = _time_episode(
+        lambda: world_setup(n_obstacles, n_steps, seed), "straight-v1", seed, False
     )
-    return {"wall": wall, "status": res.status}
+    return {"seed": seed, "steps": n_steps, "cpu_s": cpu, "wall_s": wall, "status": res.status}
+
+
+def targets(results: dict[str, Any]) -> dict[str, Any]:
+    """Issue 20's world-step targets judged on the medians in ``results`` (keyed by N)."""
+    out: dict[str, Any] = {}
+    for key, (n, what, limit, direction) in TARGETS.items():
+        row = results.get(str(n), {})
+        if key.startswith("vs_irsim"):
+            measured = row.get("ratio_uvnav_over_irsim")
+        else:
+            measured = row.get("uvnav", {}).get("median_us_per_step")
+        out[key] = {"what": what, **peerstats.judge(measured, limit, direction)}
+        if measured is None and key.startswith("vs_irsim"):
+            out[key]["note"] = "ir-sim not available: not measured"
+    return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -154,48 +190,50 @@ def time_uvnav(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", type=Path, default=HERE.parent / "results")
-    ap.add_argument("--irsim-steps", type=int, default=None, help="default: 1000 / 300 steps")
-    ap.add_argument("--uvnav-steps", type=int, default=UVNAV_STEPS)
+    ap.add_argument("--irsim-steps", type=int, default=None, help="default: 2000 / 800 steps")
+    ap.add_argument("--uvnav-steps", type=int, default=None, help=f"default: {UVNAV_STEPS}")
+    ap.add_argument("--repeats", type=int, default=None, help=f"runs per side (default {REPEATS})")
+    ap.add_argument("--quick", action="store_true", help="short smoke run, indicative only")
     args = ap.parse_args(argv)
-
-    try:
-        import irsim
-    except ImportError:
-        print("ir-sim is not installed (install the 'bench' extra: pyrvo pulls it in)")
-        return 1
+    uv_steps = args.uvnav_steps or (QUICK["uvnav_steps"] if args.quick else UVNAV_STEPS)
+    repeats = args.repeats or (QUICK["repeats"] if args.quick else REPEATS)
 
     info = machine_info()
-    info["irsim"] = irsim.__version__
+    try:
+        import irsim
+
+        info["irsim"] = irsim.__version__
+        available = True
+    except ImportError:
+        print("ir-sim is not installed: its side is not measured (pip install -e '.[peers]')")
+        available = False
+
     results: dict[str, Any] = {}
     with tempfile.TemporaryDirectory(prefix="uvnav_peers_") as tmpdir:
         tmp = Path(tmpdir)
         for n in WORLD_COUNTS:
-            ir_steps = args.irsim_steps or IRSIM_STEPS.get(n, 300)
-            ir_runs, uv_runs = [], []
-            for r in range(REPEATS):  # interleaved so drifting machine load hits both sides
-                ir_runs.append(time_irsim(n, ir_steps, args.uvnav_steps, r, tmp))
-                uv_runs.append(time_uvnav(n, args.uvnav_steps, r))
-            ir_best = min(x["wall"] for x in ir_runs)
-            uv_best = min(x["wall"] for x in uv_runs)
-            ir_sps = ir_steps / ir_best
-            uv_sps = args.uvnav_steps / uv_best
-            row: dict[str, Any] = {
-                "irsim": {
-                    "steps": ir_steps,
-                    "best_wall_s": ir_best,
-                    "steps_per_s": ir_sps,
-                    "us_per_step": 1e6 * ir_best / ir_steps,
-                    "runs": ir_runs,
-                },
-                "uvnav": {
-                    "steps": args.uvnav_steps,
-                    "best_wall_s": uv_best,
-                    "steps_per_s": uv_sps,
-                    "us_per_step": 1e6 * uv_best / args.uvnav_steps,
-                    "runs": uv_runs,
-                },
-                "ratio_uvnav_over_irsim": uv_sps / ir_sps,
-            }
+            ir_steps = args.irsim_steps or (
+                QUICK["irsim_steps"] if args.quick else IRSIM_STEPS.get(n, 300)
+            )
+            time_uvnav(n, 20, 99)  # warm-up episode, discarded
+            ir_runs: list[dict[str, Any]] = []
+            uv_runs: list[dict[str, Any]] = []
+            for r in range(repeats):  # interleaved so drifting machine load hits both sides
+                if available:
+                    ir_runs.append(time_irsim(n, ir_steps, uv_steps, r, tmp))
+                uv_runs.append(time_uvnav(n, uv_steps, r))
+            uv = {"steps": uv_steps, **peerstats.summarize(uv_runs), "runs": uv_runs}
+            row: dict[str, Any] = {"uvnav": uv}
+            if available:
+                ir = {"steps": ir_steps, **peerstats.summarize(ir_runs), "runs": ir_runs}
+                row["irsim"] = ir
+                row["ratio_uvnav_over_irsim"] = peerstats.ratio(
+                    ir["median_us_per_step"], uv["median_us_per_step"]
+                )
+                row["ratio_by_round"] = [
+                    peerstats.ratio(peerstats.us_per_step(a), peerstats.us_per_step(b))
+                    for a, b in zip(ir_runs, uv_runs, strict=True)
+                ]
             warnings = [
                 f"uvnav run {i} ended early ({x['status']})"
                 for i, x in enumerate(uv_runs)
@@ -210,17 +248,21 @@ def main(argv: list[str] | None = None) -> int:
                 row["warnings"] = warnings
             results[str(n)] = row
 
+    judged = targets(results)
     payload = {
-        "benchmark": "peers_world_steps",
-        "description": "world steps per second, 1 robot + N moving non-convex polygons, dt 0.1 s: "
-        "ir-sim EnvBase.step (headless) vs uvnav run_episode (straight-v1, record off)",
+        "benchmark": "peers_irsim",
+        "description": "world steps per CPU second, 1 robot + N moving non-convex polygons, "
+        "dt 0.1 s: ir-sim EnvBase.step (headless) vs uvnav run_episode (straight-v1, record off)",
+        "available": available,
+        "irsim": info.get("irsim"),
+        "quick": args.quick,
         "machine": info,
         "params": {
             "dt": DT,
             "obstacle_counts": WORLD_COUNTS,
-            "repeats": REPEATS,
-            "measure": "best of repeats",
-            "seeds": list(range(REPEATS)),
+            "repeats": repeats,
+            "statistic": "median over runs of CPU µs per step (time.process_time)",
+            "seeds": list(range(repeats)),
         },
         "per_step": {
             "irsim": "behaviour velocity (dash to a wander goal) + kinematics for every obstacle, "
@@ -233,19 +275,31 @@ def main(argv: list[str] | None = None) -> int:
             "straight-v1 decision every step",
         },
         "results": results,
+        "targets": judged,
     }
-    path = write_json(args.out, "peers", payload)
+    path = write_json(args.out, "peers_irsim", payload)
 
-    print(f"{'N':>5} {'ir-sim steps/s':>15} {'uvnav steps/s':>15} {'uvnav/ir-sim':>13}")
+    print(f"world step, CPU time, median of {repeats} runs" + (" (quick)" if args.quick else ""))
+    print(f"{'N':>4} {'ir-sim µs/step':>15} {'uvnav µs/step':>14} {'uvnav/ir-sim':>13}")
     for n, row in results.items():
+        ir_us = row.get("irsim", {}).get("median_us_per_step")
+        ratio = row.get("ratio_uvnav_over_irsim")
         print(
-            f"{n:>5} {row['irsim']['steps_per_s']:>15.0f} {row['uvnav']['steps_per_s']:>15.0f}"
-            f" {row['ratio_uvnav_over_irsim']:>13.2f}"
+            f"{n:>4} {_num(ir_us, 15, 1)} {_num(row['uvnav']['median_us_per_step'], 14, 1)}"
+            f" {_num(ratio, 12, 2)}x"
         )
         for w in row.get("warnings", []):
             print(f"      warning: {w}")
+    for key, t in judged.items():
+        verdict = {True: "PASS", False: "FAIL", None: "not measured"}[t["pass"]]
+        print(f"target {key}: {t['direction']} {t['limit']:g}, measured {_num(t['measured'], 0, 2)}"
+              f" -> {verdict}")  # fmt: skip
     print(f"wrote {path}")
     return 0
+
+
+def _num(x: float | None, width: int, digits: int) -> str:
+    return f"{x:{width}.{digits}f}" if x is not None and math.isfinite(x) else f"{'-':>{width}}"
 
 
 if __name__ == "__main__":
