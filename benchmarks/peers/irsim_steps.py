@@ -14,7 +14,7 @@ Run (from the repository root)::
     .venv/bin/python benchmarks/peers/irsim_steps.py             # ~1.5 min
     .venv/bin/python benchmarks/peers/irsim_steps.py --quick     # smoke run, indicative only
 
-Writes ``benchmarks/results/peers_irsim.json`` (``--out`` to change the folder) and prints a
+Writes ``benchmarks/results/peers.json`` (``--out`` to change the folder) and prints a
 table.  Timing: CPU time of the process (:func:`time.process_time`) around each episode's step
 loop (building the world is not timed; a warm-up episode / step of each side is discarded);
 ``--repeats`` runs per side (default 5, seeds 0..), uvnav and ir-sim alternating run by run; the
@@ -45,6 +45,7 @@ sys.path.insert(0, str(HERE.parent))  # benchmarks/ -> run_benchmarks
 sys.path.insert(0, str(HERE))  # peerstats
 
 import peerstats  # noqa: E402
+from peerstats import fmt  # noqa: E402
 
 peerstats.single_threaded()
 
@@ -223,7 +224,7 @@ def main(argv: list[str] | None = None) -> int:
                     ir_runs.append(time_irsim(n, ir_steps, uv_steps, r, tmp))
                 uv_runs.append(time_uvnav(n, uv_steps, r))
             uv = {"steps": uv_steps, **peerstats.summarize(uv_runs), "runs": uv_runs}
-            row: dict[str, Any] = {"uvnav": uv}
+            row: dict[str, Any] = {"uvnav": uv, "irsim": {"available": False}}
             if available:
                 ir = {"steps": ir_steps, **peerstats.summarize(ir_runs), "runs": ir_runs}
                 row["irsim"] = ir
@@ -277,7 +278,7 @@ def main(argv: list[str] | None = None) -> int:
         "results": results,
         "targets": judged,
     }
-    path = write_json(args.out, "peers_irsim", payload)
+    path = write_json(args.out, "peers", payload)
 
     print(f"world step, CPU time, median of {repeats} runs" + (" (quick)" if args.quick else ""))
     print(f"{'N':>4} {'ir-sim µs/step':>15} {'uvnav µs/step':>14} {'uvnav/ir-sim':>13}")
@@ -285,21 +286,17 @@ def main(argv: list[str] | None = None) -> int:
         ir_us = row.get("irsim", {}).get("median_us_per_step")
         ratio = row.get("ratio_uvnav_over_irsim")
         print(
-            f"{n:>4} {_num(ir_us, 15, 1)} {_num(row['uvnav']['median_us_per_step'], 14, 1)}"
-            f" {_num(ratio, 12, 2)}x"
+            f"{n:>4} {fmt(ir_us, 15, 1)} {fmt(row['uvnav']['median_us_per_step'], 14, 1)}"
+            f" {fmt(ratio, 12, 2)}x"
         )
         for w in row.get("warnings", []):
             print(f"      warning: {w}")
     for key, t in judged.items():
         verdict = {True: "PASS", False: "FAIL", None: "not measured"}[t["pass"]]
-        print(f"target {key}: {t['direction']} {t['limit']:g}, measured {_num(t['measured'], 0, 2)}"
-              f" -> {verdict}")  # fmt: skip
+        measured = fmt(t["measured"], 0, 2)
+        print(f"target {key}: {t['direction']} {t['limit']:g}, measured {measured} -> {verdict}")
     print(f"wrote {path}")
     return 0
-
-
-def _num(x: float | None, width: int, digits: int) -> str:
-    return f"{x:{width}.{digits}f}" if x is not None and math.isfinite(x) else f"{'-':>{width}}"
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ Pure helpers, no timing of their own beyond :func:`cpu_s` (unit-tested in
 
 from __future__ import annotations
 
+import math
 import os
 import statistics
 import time
@@ -103,3 +104,10 @@ def judge(measured: float | None, limit: float, direction: str) -> dict[str, Any
         "ratio": ratio(measured, limit),
         "pass": ok,
     }
+
+
+def fmt(x: float | None, width: int, digits: int) -> str:
+    """``x`` right-aligned in ``width`` with ``digits`` decimals, ``-`` when missing."""
+    if x is None or not math.isfinite(x):
+        return f"{'-':>{width}}"
+    return f"{x:{width}.{digits}f}"
