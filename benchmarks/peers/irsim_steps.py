@@ -11,7 +11,7 @@ headless (``headless=True``: no figure, no rendering, no animation saving, no pa
 
 Run (from the repository root)::
 
-    .venv/bin/python benchmarks/peers/irsim_steps.py             # ~1.5 min
+    .venv/bin/python benchmarks/peers/irsim_steps.py             # ~1 min
     .venv/bin/python benchmarks/peers/irsim_steps.py --quick     # smoke run, indicative only
 
 Writes ``benchmarks/results/peers.json`` (``--out`` to change the folder) and prints a
@@ -19,9 +19,9 @@ table.  Timing: CPU time of the process (:func:`time.process_time`) around each 
 loop (building the world is not timed; a warm-up episode / step of each side is discarded);
 ``--repeats`` runs per side (default 5, seeds 0..), uvnav and ir-sim alternating run by run; the
 figure of a side is the median over its runs of CPU µs per step.  uvnav runs 3000 steps an
-episode, ir-sim fewer because it is much slower (2000 with N = 10, 800 with N = 100, or
-``--irsim-steps``); both worlds are built from the 3000-step ``world_setup`` (same arena, same
-obstacle density), the ir-sim robot just drives less far.
+episode; ir-sim 3000 with N = 10 and 1000 with N = 100, where it is slowest (``--irsim-steps`` to
+change).  Both worlds are built from the 3000-step ``world_setup`` (same arena, same obstacle
+density); with fewer steps the ir-sim robot just drives less far.
 
 Targets (issue 20): a uvnav world step with 100 polygons <= 15 µs CPU and >= 1,000x ir-sim's
 steps/s; with 10 polygons <= 3 µs.  Without ir-sim the script says so in one line and records
@@ -62,7 +62,7 @@ from run_benchmarks import (  # noqa: E402
 REPEATS = peerstats.MIN_REPEATS
 UVNAV_STEPS = 3000
 DT = 0.1
-IRSIM_STEPS = {10: 2000, 100: 800}
+IRSIM_STEPS = {10: 3000, 100: 1000}
 #: --quick: steps per episode (uvnav, ir-sim) and repeats
 QUICK = {"uvnav_steps": 500, "irsim_steps": 50, "repeats": 2}
 #: issue 20's world-step targets: key -> (obstacles, what, limit, direction)
@@ -191,7 +191,7 @@ def targets(results: dict[str, Any]) -> dict[str, Any]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", type=Path, default=HERE.parent / "results")
-    ap.add_argument("--irsim-steps", type=int, default=None, help="default: 2000 / 800 steps")
+    ap.add_argument("--irsim-steps", type=int, default=None, help="default: 3000 / 1000 steps")
     ap.add_argument("--uvnav-steps", type=int, default=None, help=f"default: {UVNAV_STEPS}")
     ap.add_argument("--repeats", type=int, default=None, help=f"runs per side (default {REPEATS})")
     ap.add_argument("--quick", action="store_true", help="short smoke run, indicative only")
