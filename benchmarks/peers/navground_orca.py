@@ -35,7 +35,7 @@ line, records ``"available": false`` and judges nothing (no reference figure is 
 Run (from the repository root)::
 
     .venv/bin/pip install -e '.[peers]'                  # navground and ir-sim
-    .venv/bin/python benchmarks/peers/navground_orca.py  # ~2.5 min; writes peers_orca.json
+    .venv/bin/python benchmarks/peers/navground_orca.py  # ~3 min; writes peers_orca.json
     .venv/bin/python benchmarks/peers/navground_orca.py --quick --counts 10
 """
 
