@@ -9,8 +9,8 @@ the JSON files the benchmarks wrote there; it measures nothing:
   (``orca-shared-v1``) on ``antipodal:10`` / ``antipodal:100``, its CPU time per step over
   navground's (within 2x = at most 2);
 * ``campaign.json`` (``benchmarks/bench_campaign.py``): 10,000 episodes in <= 120 s wall;
-* ``vector_env.json``: the vector env's targets, once a benchmark writes them ("not measured"
-  until then);
+* ``packed.json`` (``benchmarks/bench_packed.py``, where it exists): the vector env's target,
+  env steps per CPU second ("not measured" until a benchmark writes it);
 * ``summary.json`` (``benchmarks/run_benchmarks.py``): a closing line with how many of its own
   targets pass.
 
@@ -137,20 +137,28 @@ def campaign_row(results: Path) -> Row:
 
 
 def vector_env_rows(results: Path) -> list[Row]:
-    """The vector env's targets from ``vector_env.json``; one "not measured" row without it."""
-    data = load(results, "vector_env.json")
+    """The vector env's targets from ``packed.json`` (``bench_packed.py``: rows named
+    ``vector env...``); one "not measured" row without them."""
+    data = load(results, "packed.json")
     targets = data.get("targets") if data else None
-    if not isinstance(targets, dict) or not targets:
+    found = [
+        t
+        for t in (targets if isinstance(targets, list) else [])
+        if isinstance(t, dict) and str(t.get("name", "")).startswith("vector env")
+    ]
+    if not found:
         return [Row("vector env", "issue 20", "-", "-", "not measured")]
-    rows = []
-    for key, record in targets.items():
-        if not isinstance(record, dict):
-            continue
-        target = f"{record.get('direction', '')} {number(record.get('limit'))}".strip()
-        rows.append(
-            judged_row(f"vector env {key}"[:31], target, record, "", bool(data.get("quick")))
+    quick = bool(data.get("quick")) if data else False
+    return [
+        Row(
+            str(t["name"]),
+            str(t.get("target", "")),
+            str(t.get("measured", "-")),
+            number(t.get("ratio")),
+            verdict(t.get("pass"), quick),
         )
-    return rows
+        for t in found
+    ]
 
 
 def summary_line(results: Path) -> str | None:

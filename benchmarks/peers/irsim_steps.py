@@ -1,13 +1,17 @@
 """World steps per CPU second: ir-sim (optional peer) side by side with uvnav, in one run.
 
 Scene: one unicycle / diff-drive robot driving straight along +x plus N moving non-convex polygon
-obstacles wandering in an arena beside its path (N = 10 and 100), dt = 0.1 s.  The uvnav side is
-``benchmarks/run_benchmarks.py``'s ``world_setup`` run by ``uvnav.sim.run_episode`` with
-``straight-v1`` and ``record=False``; the ir-sim side is a YAML world generated at run time with
-*the same polygons* (same seed, same ``random_nonconvex`` bodies and start poses), the robot
-driven by a constant action ``[0.707, 0]`` and the obstacles on ir-sim's own ``dash`` + ``wander``
-behavior (drive to a random goal in the same arena, draw a new one on arrival).  ir-sim runs
-headless (``headless=True``: no figure, no rendering, no animation saving, no pauses).
+obstacles wandering in an arena beside its path (N = 10 and 100), dt = 0.1 s, built by
+``benchmarks/run_benchmarks.py``'s ``world_setup``.  uvnav runs it two ways, side by side: the
+packed world step (``uvnav.sim.packed.PackedWorlds``, one compiled call a step, the robot on a
+constant command; the side judged against the targets, when this uvnav has it) and the one loop
+(``uvnav.sim.run_episode`` with ``straight-v1`` and ``record=False``: sensing and a decision every
+step on top; judged when there is no packed step).  The ir-sim side is a YAML world generated
+at run time with *the same polygons* (same seed, same ``random_nonconvex`` bodies and start
+poses), the robot driven by a constant action ``[0.707, 0]`` and the obstacles on ir-sim's own
+``dash`` + ``wander`` behavior (drive to a random goal in the same arena, draw a new one on
+arrival).  ir-sim runs headless (``headless=True``: no figure, no rendering, no animation
+saving, no pauses).
 
 Run (from the repository root)::
 
@@ -61,6 +65,9 @@ from run_benchmarks import (  # noqa: E402
 
 REPEATS = peerstats.MIN_REPEATS
 UVNAV_STEPS = 3000
+#: the uvnav sides: the packed world step (judged, when this uvnav has it) and the one loop
+PACKED = "packed world step (uvnav.sim.packed.PackedWorlds, constant command)"
+LOOP = "run_episode (straight-v1, record off)"
 DT = 0.1
 IRSIM_STEPS = {10: 3000, 100: 1000}
 #: --quick: steps per episode (uvnav, ir-sim) and repeats
@@ -170,6 +177,33 @@ def time_uvnav(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
     return {"seed": seed, "steps": n_steps, "cpu_s": cpu, "wall_s": wall, "status": res.status}
 
 
+def packed_available() -> bool:
+    """Whether this uvnav has the compiled packed world step (:mod:`uvnav.sim.packed`)."""
+    try:
+        from uvnav.sim.packed import PackedWorlds  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def time_packed(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
+    """One packed world (:class:`uvnav.sim.packed.PackedWorlds`, one slot) of the same scene,
+    the robot on a constant command (0.707 m/s straight ahead), ``n_steps`` steps: CPU s of the
+    step loop (the first step, which compiles or loads the kernels, is not timed), status."""
+    from uvnav.sim.packed import STATUS_NAMES, PackedWorlds
+
+    worlds = PackedWorlds(1)
+    worlds.load(0, world_setup(n_obstacles, n_steps, seed))
+    worlds.command[0] = (CH2_SPEC.v_max, 0.0)
+    worlds.step()  # not timed: compiles (or loads the cache)
+    cpu0 = peerstats.cpu_s()
+    for _ in range(n_steps - 1):
+        worlds.step()
+    cpu = peerstats.cpu_s() - cpu0
+    status = STATUS_NAMES[int(worlds.status[0])]
+    return {"seed": seed, "steps": n_steps - 1, "cpu_s": cpu, "status": status}
+
+
 def targets(results: dict[str, Any]) -> dict[str, Any]:
     """Issue 20's world-step targets judged on the medians in ``results`` (keyed by N)."""
     out: dict[str, Any] = {}
@@ -208,6 +242,7 @@ def main(argv: list[str] | None = None) -> int:
     except ImportError:
         print("ir-sim is not installed: its side is not measured (pip install -e '.[peers]')")
         available = False
+    packed = packed_available()
 
     results: dict[str, Any] = {}
     with tempfile.TemporaryDirectory(prefix="uvnav_peers_") as tmpdir:
@@ -216,15 +251,28 @@ def main(argv: list[str] | None = None) -> int:
             ir_steps = args.irsim_steps or (
                 QUICK["irsim_steps"] if args.quick else IRSIM_STEPS.get(n, 300)
             )
-            time_uvnav(n, 20, 99)  # warm-up episode, discarded
+            time_uvnav(n, 20, 99)  # warm-up episodes, discarded
+            if packed:
+                time_packed(n, 20, 99)
             ir_runs: list[dict[str, Any]] = []
-            uv_runs: list[dict[str, Any]] = []
-            for r in range(repeats):  # interleaved so drifting machine load hits both sides
+            loop_runs: list[dict[str, Any]] = []
+            packed_runs: list[dict[str, Any]] = []
+            for r in range(repeats):  # interleaved so drifting machine load hits every side
                 if available:
                     ir_runs.append(time_irsim(n, ir_steps, uv_steps, r, tmp))
-                uv_runs.append(time_uvnav(n, uv_steps, r))
-            uv = {"steps": uv_steps, **peerstats.summarize(uv_runs), "runs": uv_runs}
-            row: dict[str, Any] = {"uvnav": uv, "irsim": {"available": False}}
+                if packed:
+                    packed_runs.append(time_packed(n, uv_steps, r))
+                loop_runs.append(time_uvnav(n, uv_steps, r))
+            loop = {"side": LOOP, **peerstats.summarize(loop_runs), "runs": loop_runs}
+            row: dict[str, Any] = {"irsim": {"available": False}}
+            if packed:
+                row["uvnav"] = {"side": PACKED, **peerstats.summarize(packed_runs)}
+                row["uvnav"]["runs"] = packed_runs
+                row["uvnav_loop"] = loop
+            else:
+                row["uvnav"] = loop
+            uv = row["uvnav"]
+            judged_runs = packed_runs or loop_runs
             if available:
                 ir = {"steps": ir_steps, **peerstats.summarize(ir_runs), "runs": ir_runs}
                 row["irsim"] = ir
@@ -233,11 +281,15 @@ def main(argv: list[str] | None = None) -> int:
                 )
                 row["ratio_by_round"] = [
                     peerstats.ratio(peerstats.us_per_step(a), peerstats.us_per_step(b))
-                    for a, b in zip(ir_runs, uv_runs, strict=True)
+                    for a, b in zip(ir_runs, judged_runs, strict=True)
                 ]
+                if packed:
+                    row["ratio_loop_over_irsim"] = peerstats.ratio(
+                        ir["median_us_per_step"], loop["median_us_per_step"]
+                    )
             warnings = [
                 f"uvnav run {i} ended early ({x['status']})"
-                for i, x in enumerate(uv_runs)
+                for i, x in enumerate(packed_runs + loop_runs)
                 if x["status"] != "timeout"
             ]
             warnings += [
@@ -253,8 +305,10 @@ def main(argv: list[str] | None = None) -> int:
     payload = {
         "benchmark": "peers_irsim",
         "description": "world steps per CPU second, 1 robot + N moving non-convex polygons, "
-        "dt 0.1 s: ir-sim EnvBase.step (headless) vs uvnav run_episode (straight-v1, record off)",
+        "dt 0.1 s: ir-sim EnvBase.step (headless) vs uvnav's packed world step (judged, when this "
+        "uvnav has uvnav.sim.packed) and run_episode (straight-v1, record off)",
         "available": available,
+        "uvnav_judged": PACKED if packed else LOOP,
         "irsim": info.get("irsim"),
         "quick": args.quick,
         "machine": info,
@@ -271,7 +325,10 @@ def main(argv: list[str] | None = None) -> int:
             "step (none configured), one batched all-pairs shapely intersects query (collision "
             "status of every object; mode unobstructed_obstacles: only the robot stops), "
             "arrival/status bookkeeping",
-            "uvnav": "obstacle motion (RandomTurn) for every obstacle, ObstacleField rebuild, "
+            "uvnav packed": "one compiled call: obstacle motion (random turn, arena steering, "
+            "spin) for every obstacle, robot unicycle step, exact clearance, arrival and "
+            "collision tests; no sensing, no controller (a constant command)",
+            "uvnav loop": "obstacle motion (RandomTurn) for every obstacle, ObstacleField rebuild, "
             "robot unicycle step, robot clearance/collision check, sensing within 8 m and a "
             "straight-v1 decision every step",
         },
@@ -281,14 +338,20 @@ def main(argv: list[str] | None = None) -> int:
     path = write_json(args.out, "peers", payload)
 
     print(f"world step, CPU time, median of {repeats} runs" + (" (quick)" if args.quick else ""))
-    print(f"{'N':>4} {'ir-sim µs/step':>15} {'uvnav µs/step':>14} {'uvnav/ir-sim':>13}")
+    print(f"uvnav judged: {PACKED if packed else LOOP}")
+    head = f"{'N':>4} {'ir-sim µs/step':>15} {'uvnav µs/step':>14} {'uvnav/ir-sim':>13}"
+    print(head + (f" {'loop µs/step':>13} {'loop/ir-sim':>12}" if packed else ""))
     for n, row in results.items():
         ir_us = row.get("irsim", {}).get("median_us_per_step")
         ratio = row.get("ratio_uvnav_over_irsim")
-        print(
-            f"{n:>4} {fmt(ir_us, 15, 1)} {fmt(row['uvnav']['median_us_per_step'], 14, 1)}"
+        line = (
+            f"{n:>4} {fmt(ir_us, 15, 1)} {fmt(row['uvnav']['median_us_per_step'], 14, 2)}"
             f" {fmt(ratio, 12, 2)}x"
         )
+        if packed:
+            loop_us = row["uvnav_loop"]["median_us_per_step"]
+            line += f" {fmt(loop_us, 13, 1)} {fmt(row.get('ratio_loop_over_irsim'), 11, 2)}x"
+        print(line)
         for w in row.get("warnings", []):
             print(f"      warning: {w}")
     for key, t in judged.items():

@@ -133,6 +133,10 @@ def test_summary_table(tmp_path: Path) -> None:
     )  # fmt: skip
     _write(tmp_path, "campaign.json", {"wall_s_per_10000": 90.0, "pass": True, "quick": False})
     _write(tmp_path, "summary.json", {"targets": {"a": {"pass": True}, "b": {"pass": False}}})
+    vec = {"name": "vector env, K = 256", "target": ">= 100,000/s", "measured": "110,066/s",
+           "ratio": 1.1007, "pass": True}  # fmt: skip
+    world = {"name": "world step, 10 obstacles", "ratio": 1.5, "pass": False}
+    _write(tmp_path, "packed.json", {"quick": True, "targets": [world, vec]})
     rows = summary.build_rows(tmp_path)
     got = {r.name.strip(): (r.measured, r.ratio, r.result) for r in rows}
     assert got["world step, 100 polygons"] == ("150 µs", "10.0", "FAIL")
@@ -141,6 +145,8 @@ def test_summary_table(tmp_path: Path) -> None:
     assert got["ORCA antipodal:10 vs navground"] == ("46.0x", "23.0", "FAIL*")
     assert got["ORCA antipodal:100 vs navground"][2] == "not run"
     assert got["campaign, 10,000 episodes"] == ("90.0 s", "0.75", "PASS")
+    assert got["vector env, K = 256"] == ("110,066/s", "1.10", "PASS*")
+    assert len(rows) == 7
     text = summary.render(rows, ["footer", summary.summary_line(tmp_path) or ""])
     assert max(len(line) for line in text.splitlines()) <= summary.WIDTH
     assert "* quick (smoke) run" in text and "1 of 2 pass" in text
