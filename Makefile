@@ -10,10 +10,13 @@ TORCH_PIN  ?= torch==2.13.0
 STAMP_TORCH := $(VENV)/.installed-torch
 STAMP_RUN  := $(VENV)/.installed-run
 STAMP_TEST := $(VENV)/.installed-test
+# peer simulators for benchmarks/peers/ (ir-sim, navground): `make bench` only, never `make test`
+STAMP_PEERS := $(VENV)/.installed-peers
+BENCH_OUT  ?= benchmarks/results
 # Debian's Chromium for the report's browser test (playwright drives it; no browser download)
 CHROMIUM   ?= chromium
 
-.PHONY: run test fuzz bench lint clean venv browser evidence
+.PHONY: run test fuzz bench peers lint clean venv browser evidence
 
 $(PY):
 	$(PYTHON) -m venv $(VENV) || python3 -m venv $(VENV)
@@ -58,17 +61,35 @@ lint: $(STAMP_TEST)
 evidence: $(STAMP_RUN)
 	$(PY) -m uvnav.bench.evidence --write docs/evidence.json
 
-bench: $(STAMP_RUN)
-	$(PY) benchmarks/run_benchmarks.py --out benchmarks/results
-	$(PY) benchmarks/bench_multi.py --out benchmarks/results
-	$(PY) benchmarks/bench_orca.py --out benchmarks/results
-	$(PY) benchmarks/bench_ch7.py --out benchmarks/results
-	$(PY) benchmarks/bench_campaign.py --out benchmarks/results
-	$(PY) benchmarks/bench_packed.py --out benchmarks/results
-	$(PY) benchmarks/bench_crowdnav.py --cases 500 --out benchmarks/results
-	$(PY) benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-holonomic-v2 --out benchmarks/results
-	$(PY) benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-v2 --out benchmarks/results
-	$(PY) benchmarks/bench_zhang2019_v2.py --out benchmarks/results
+# a peer that does not install is not fatal: its script records "available": false
+$(STAMP_PEERS): pyproject.toml $(STAMP_RUN) | $(PY)
+	@if $(PY) -m pip install --quiet -e ".[peers]"; then touch $@; \
+	else echo "note: the peers extra did not install; peer rows read 'no peer'"; fi
+
+peers: $(STAMP_PEERS)
+
+# every benchmark runs (one failing does not stop the others), then issue 20's summary table;
+# the exit status is 1 when any benchmark failed
+BENCH_RUNS = \
+	benchmarks/run_benchmarks.py \
+	benchmarks/bench_multi.py \
+	benchmarks/bench_orca.py \
+	benchmarks/bench_ch7.py \
+	benchmarks/bench_campaign.py \
+	benchmarks/bench_packed.py \
+	"benchmarks/bench_crowdnav.py --cases 500" \
+	"benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-holonomic-v2" \
+	"benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-v2" \
+	benchmarks/bench_zhang2019_v2.py \
+	benchmarks/peers/irsim_steps.py \
+	benchmarks/peers/navground_orca.py \
+	benchmarks/peers/navground_crowd.py
+
+bench: $(STAMP_RUN) peers
+	@status=0; for run in $(BENCH_RUNS); do \
+	  echo "== $$run"; $(PY) $$run --out $(BENCH_OUT) || { status=1; echo "FAILED: $$run"; }; \
+	done; \
+	echo; $(PY) benchmarks/summary.py --results $(BENCH_OUT); exit $$status
 
 clean:
 	rm -rf $(VENV) results report .pytest_cache .mypy_cache .ruff_cache

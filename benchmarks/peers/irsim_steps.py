@@ -1,23 +1,35 @@
-"""World steps per second: ir-sim (optional peer) side by side with uvnav, in one run.
+"""World steps per CPU second: ir-sim (optional peer) side by side with uvnav, in one run.
 
 Scene: one unicycle / diff-drive robot driving straight along +x plus N moving non-convex polygon
-obstacles wandering in an arena beside its path (N = 10 and 100), dt = 0.1 s.  The uvnav side is
-``benchmarks/run_benchmarks.py``'s ``world_setup`` run by ``uvnav.sim.run_episode`` with
-``straight-v1`` and ``record=False``; the ir-sim side is a YAML world generated at run time with
-*the same polygons* (same seed, same ``random_nonconvex`` bodies and start poses), the robot
-driven by a constant action ``[0.707, 0]`` and the obstacles on ir-sim's own ``dash`` + ``wander``
-behavior (drive to a random goal in the same arena, draw a new one on arrival).  ir-sim runs
-headless (``headless=True``: no figure, no rendering, no animation saving, no pauses).
+obstacles wandering in an arena beside its path (N = 10 and 100), dt = 0.1 s, built by
+``benchmarks/run_benchmarks.py``'s ``world_setup``.  uvnav runs it two ways, side by side: the
+packed world step (``uvnav.sim.packed.PackedWorlds``, one compiled call a step, the robot on a
+constant command; the side judged against the targets, when this uvnav has it) and the one loop
+(``uvnav.sim.run_episode`` with ``straight-v1`` and ``record=False``: sensing and a decision every
+step on top; judged when there is no packed step).  The ir-sim side is a YAML world generated
+at run time with *the same polygons* (same seed, same ``random_nonconvex`` bodies and start
+poses), the robot driven by a constant action ``[0.707, 0]`` and the obstacles on ir-sim's own
+``dash`` + ``wander`` behavior (drive to a random goal in the same arena, draw a new one on
+arrival).  ir-sim runs headless (``headless=True``: no figure, no rendering, no animation
+saving, no pauses).
 
 Run (from the repository root)::
 
-    MPLBACKEND=Agg .venv/bin/python benchmarks/peers/irsim_steps.py
+    .venv/bin/python benchmarks/peers/irsim_steps.py             # ~1 min
+    .venv/bin/python benchmarks/peers/irsim_steps.py --quick     # smoke run, indicative only
 
-Writes ``benchmarks/results/peers.json`` (``--out`` to change the folder) and prints a table.
-Both sides: best wall time of 3 runs, interleaved (uvnav: 3000 steps, as ``run_benchmarks.py``;
-ir-sim: fewer steps because it is much slower, 1000 with N = 10 and 300 with N = 100, or
-``--irsim-steps``), steps/s = steps / best wall time.  Both worlds are built from the 3000-step
-``world_setup`` (same arena length, same obstacle density); the ir-sim robot just drives less far.
+Writes ``benchmarks/results/peers.json`` (``--out`` to change the folder) and prints a
+table.  Timing: CPU time of the process (:func:`time.process_time`) around each episode's step
+loop (building the world is not timed; a warm-up episode / step of each side is discarded);
+``--repeats`` runs per side (default 5, seeds 0..), uvnav and ir-sim alternating run by run; the
+figure of a side is the median over its runs of CPU µs per step.  uvnav runs 3000 steps an
+episode; ir-sim 3000 with N = 10 and 1000 with N = 100, where it is slowest (``--irsim-steps`` to
+change).  Both worlds are built from the 3000-step ``world_setup`` (same arena, same obstacle
+density); with fewer steps the ir-sim robot just drives less far.
+
+Targets (issue 20): a uvnav world step with 100 polygons <= 15 µs CPU and >= 1,000x ir-sim's
+steps/s; with 10 polygons <= 3 µs.  Without ir-sim the script says so in one line and records
+``"available": false`` (the uvnav side is still measured: the absolute targets do not need ir-sim).
 """
 
 from __future__ import annotations
@@ -27,17 +39,21 @@ import math
 import os
 import sys
 import tempfile
-import time
 from pathlib import Path
 from typing import Any
 
 os.environ.setdefault("MPLBACKEND", "Agg")
 
-import numpy as np
-
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent))  # benchmarks/ -> run_benchmarks
+sys.path.insert(0, str(HERE))  # peerstats
 
+import peerstats  # noqa: E402
+from peerstats import fmt  # noqa: E402
+
+peerstats.single_threaded()
+
+import numpy as np  # noqa: E402
 from run_benchmarks import (  # noqa: E402
     CH2_SPEC,
     WORLD_COUNTS,
@@ -47,10 +63,21 @@ from run_benchmarks import (  # noqa: E402
     write_json,
 )
 
-REPEATS = 3
+REPEATS = peerstats.MIN_REPEATS
 UVNAV_STEPS = 3000
+#: the uvnav sides: the packed world step (judged, when this uvnav has it) and the one loop
+PACKED = "packed world step (uvnav.sim.packed.PackedWorlds, constant command)"
+LOOP = "run_episode (straight-v1, record off)"
 DT = 0.1
-IRSIM_STEPS = {10: 1000, 100: 300}
+IRSIM_STEPS = {10: 3000, 100: 1000}
+#: --quick: steps per episode (uvnav, ir-sim) and repeats
+QUICK = {"uvnav_steps": 500, "irsim_steps": 50, "repeats": 2}
+#: issue 20's world-step targets: key -> (obstacles, what, limit, direction)
+TARGETS: dict[str, tuple[int, str, float, str]] = {
+    "world_step_us_100": (100, "uvnav CPU µs per world step, 100 polygons", 15.0, "<="),
+    "world_step_us_10": (10, "uvnav CPU µs per world step, 10 polygons", 3.0, "<="),
+    "vs_irsim_100": (100, "uvnav steps/s over ir-sim's, 100 polygons", 1000.0, ">="),
+}
 
 
 # --------------------------------------------------------------------------------------------
@@ -107,6 +134,7 @@ def irsim_world_yaml(n_obstacles: int, n_steps: int, seed: int) -> str:
 def time_irsim(
     n_obstacles: int, n_steps: int, scene_steps: int, seed: int, tmp: Path
 ) -> dict[str, Any]:
+    """One ir-sim episode of ``n_steps`` steps: CPU s of the step loop and the end state."""
     import irsim
 
     path = tmp / f"irsim_{n_obstacles}_{seed}.yaml"
@@ -117,11 +145,11 @@ def time_irsim(
     try:
         n_obs = len(env.obstacle_list)
         action = np.array([[CH2_SPEC.v_max], [0.0]])
-        env.step(action)  # warm-up (first-call imports, caches)
-        tic = time.perf_counter()
+        env.step(action)  # warm-up (first-call imports, caches), not timed
+        cpu0 = peerstats.cpu_s()
         for _ in range(n_steps):
             env.step(action)
-        wall = time.perf_counter() - tic
+        cpu = peerstats.cpu_s() - cpu0
         robot = env.robot
         status = {
             "robot_x": float(robot.state[0, 0]),
@@ -138,14 +166,57 @@ def time_irsim(
         }
     finally:
         env.end(0)
-    return {"wall": wall, **status}
+    return {"seed": seed, "steps": n_steps, "cpu_s": cpu, **status}
 
 
 def time_uvnav(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
-    wall, res = _time_episode(
-        lambda: world_setup(n_obstacles, n_steps, seed=seed), "straight-v1", seed, False
+    """One uvnav episode of ``n_steps`` steps (``straight-v1``, record off): CPU s, status."""
+    wall, res, cpu = _time_episode(
+        lambda: world_setup(n_obstacles, n_steps, seed), "straight-v1", seed, False
     )
-    return {"wall": wall, "status": res.status}
+    return {"seed": seed, "steps": n_steps, "cpu_s": cpu, "wall_s": wall, "status": res.status}
+
+
+def packed_available() -> bool:
+    """Whether this uvnav has the compiled packed world step (:mod:`uvnav.sim.packed`)."""
+    try:
+        from uvnav.sim.packed import PackedWorlds  # noqa: F401
+    except ImportError:
+        return False
+    return True
+
+
+def time_packed(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
+    """One packed world (:class:`uvnav.sim.packed.PackedWorlds`, one slot) of the same scene,
+    the robot on a constant command (0.707 m/s straight ahead), ``n_steps`` steps: CPU s of the
+    step loop (the first step, which compiles or loads the kernels, is not timed), status."""
+    from uvnav.sim.packed import STATUS_NAMES, PackedWorlds
+
+    worlds = PackedWorlds(1)
+    worlds.load(0, world_setup(n_obstacles, n_steps, seed))
+    worlds.command[0] = (CH2_SPEC.v_max, 0.0)
+    worlds.step()  # not timed: compiles (or loads the cache)
+    cpu0 = peerstats.cpu_s()
+    for _ in range(n_steps - 1):
+        worlds.step()
+    cpu = peerstats.cpu_s() - cpu0
+    status = STATUS_NAMES[int(worlds.status[0])]
+    return {"seed": seed, "steps": n_steps - 1, "cpu_s": cpu, "status": status}
+
+
+def targets(results: dict[str, Any]) -> dict[str, Any]:
+    """Issue 20's world-step targets judged on the medians in ``results`` (keyed by N)."""
+    out: dict[str, Any] = {}
+    for key, (n, what, limit, direction) in TARGETS.items():
+        row = results.get(str(n), {})
+        if key.startswith("vs_irsim"):
+            measured = row.get("ratio_uvnav_over_irsim")
+        else:
+            measured = row.get("uvnav", {}).get("median_us_per_step")
+        out[key] = {"what": what, **peerstats.judge(measured, limit, direction)}
+        if measured is None and key.startswith("vs_irsim"):
+            out[key]["note"] = "ir-sim not available: not measured"
+    return out
 
 
 # --------------------------------------------------------------------------------------------
@@ -154,51 +225,71 @@ def time_uvnav(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", type=Path, default=HERE.parent / "results")
-    ap.add_argument("--irsim-steps", type=int, default=None, help="default: 1000 / 300 steps")
-    ap.add_argument("--uvnav-steps", type=int, default=UVNAV_STEPS)
+    ap.add_argument("--irsim-steps", type=int, default=None, help="default: 3000 / 1000 steps")
+    ap.add_argument("--uvnav-steps", type=int, default=None, help=f"default: {UVNAV_STEPS}")
+    ap.add_argument("--repeats", type=int, default=None, help=f"runs per side (default {REPEATS})")
+    ap.add_argument("--quick", action="store_true", help="short smoke run, indicative only")
     args = ap.parse_args(argv)
-
-    try:
-        import irsim
-    except ImportError:
-        print("ir-sim is not installed (install the 'bench' extra: pyrvo pulls it in)")
-        return 1
+    uv_steps = args.uvnav_steps or (QUICK["uvnav_steps"] if args.quick else UVNAV_STEPS)
+    repeats = args.repeats or (QUICK["repeats"] if args.quick else REPEATS)
 
     info = machine_info()
-    info["irsim"] = irsim.__version__
+    try:
+        import irsim
+
+        info["irsim"] = irsim.__version__
+        available = True
+    except ImportError:
+        print("ir-sim is not installed: its side is not measured (pip install -e '.[peers]')")
+        available = False
+    packed = packed_available()
+
     results: dict[str, Any] = {}
     with tempfile.TemporaryDirectory(prefix="uvnav_peers_") as tmpdir:
         tmp = Path(tmpdir)
         for n in WORLD_COUNTS:
-            ir_steps = args.irsim_steps or IRSIM_STEPS.get(n, 300)
-            ir_runs, uv_runs = [], []
-            for r in range(REPEATS):  # interleaved so drifting machine load hits both sides
-                ir_runs.append(time_irsim(n, ir_steps, args.uvnav_steps, r, tmp))
-                uv_runs.append(time_uvnav(n, args.uvnav_steps, r))
-            ir_best = min(x["wall"] for x in ir_runs)
-            uv_best = min(x["wall"] for x in uv_runs)
-            ir_sps = ir_steps / ir_best
-            uv_sps = args.uvnav_steps / uv_best
-            row: dict[str, Any] = {
-                "irsim": {
-                    "steps": ir_steps,
-                    "best_wall_s": ir_best,
-                    "steps_per_s": ir_sps,
-                    "us_per_step": 1e6 * ir_best / ir_steps,
-                    "runs": ir_runs,
-                },
-                "uvnav": {
-                    "steps": args.uvnav_steps,
-                    "best_wall_s": uv_best,
-                    "steps_per_s": uv_sps,
-                    "us_per_step": 1e6 * uv_best / args.uvnav_steps,
-                    "runs": uv_runs,
-                },
-                "ratio_uvnav_over_irsim": uv_sps / ir_sps,
-            }
+            ir_steps = args.irsim_steps or (
+                QUICK["irsim_steps"] if args.quick else IRSIM_STEPS.get(n, 300)
+            )
+            time_uvnav(n, 20, 99)  # warm-up episodes, discarded
+            if packed:
+                time_packed(n, 20, 99)
+            ir_runs: list[dict[str, Any]] = []
+            loop_runs: list[dict[str, Any]] = []
+            packed_runs: list[dict[str, Any]] = []
+            for r in range(repeats):  # interleaved so drifting machine load hits every side
+                if available:
+                    ir_runs.append(time_irsim(n, ir_steps, uv_steps, r, tmp))
+                if packed:
+                    packed_runs.append(time_packed(n, uv_steps, r))
+                loop_runs.append(time_uvnav(n, uv_steps, r))
+            loop = {"side": LOOP, **peerstats.summarize(loop_runs), "runs": loop_runs}
+            row: dict[str, Any] = {"irsim": {"available": False}}
+            if packed:
+                row["uvnav"] = {"side": PACKED, **peerstats.summarize(packed_runs)}
+                row["uvnav"]["runs"] = packed_runs
+                row["uvnav_loop"] = loop
+            else:
+                row["uvnav"] = loop
+            uv = row["uvnav"]
+            judged_runs = packed_runs or loop_runs
+            if available:
+                ir = {"steps": ir_steps, **peerstats.summarize(ir_runs), "runs": ir_runs}
+                row["irsim"] = ir
+                row["ratio_uvnav_over_irsim"] = peerstats.ratio(
+                    ir["median_us_per_step"], uv["median_us_per_step"]
+                )
+                row["ratio_by_round"] = [
+                    peerstats.ratio(peerstats.us_per_step(a), peerstats.us_per_step(b))
+                    for a, b in zip(ir_runs, judged_runs, strict=True)
+                ]
+                if packed:
+                    row["ratio_loop_over_irsim"] = peerstats.ratio(
+                        ir["median_us_per_step"], loop["median_us_per_step"]
+                    )
             warnings = [
                 f"uvnav run {i} ended early ({x['status']})"
-                for i, x in enumerate(uv_runs)
+                for i, x in enumerate(packed_runs + loop_runs)
                 if x["status"] != "timeout"
             ]
             warnings += [
@@ -210,17 +301,23 @@ def main(argv: list[str] | None = None) -> int:
                 row["warnings"] = warnings
             results[str(n)] = row
 
+    judged = targets(results)
     payload = {
-        "benchmark": "peers_world_steps",
-        "description": "world steps per second, 1 robot + N moving non-convex polygons, dt 0.1 s: "
-        "ir-sim EnvBase.step (headless) vs uvnav run_episode (straight-v1, record off)",
+        "benchmark": "peers_irsim",
+        "description": "world steps per CPU second, 1 robot + N moving non-convex polygons, "
+        "dt 0.1 s: ir-sim EnvBase.step (headless) vs uvnav's packed world step (judged, when this "
+        "uvnav has uvnav.sim.packed) and run_episode (straight-v1, record off)",
+        "available": available,
+        "uvnav_judged": PACKED if packed else LOOP,
+        "irsim": info.get("irsim"),
+        "quick": args.quick,
         "machine": info,
         "params": {
             "dt": DT,
             "obstacle_counts": WORLD_COUNTS,
-            "repeats": REPEATS,
-            "measure": "best of repeats",
-            "seeds": list(range(REPEATS)),
+            "repeats": repeats,
+            "statistic": "median over runs of CPU µs per step (time.process_time)",
+            "seeds": list(range(repeats)),
         },
         "per_step": {
             "irsim": "behaviour velocity (dash to a wander goal) + kinematics for every obstacle, "
@@ -228,22 +325,39 @@ def main(argv: list[str] | None = None) -> int:
             "step (none configured), one batched all-pairs shapely intersects query (collision "
             "status of every object; mode unobstructed_obstacles: only the robot stops), "
             "arrival/status bookkeeping",
-            "uvnav": "obstacle motion (RandomTurn) for every obstacle, ObstacleField rebuild, "
+            "uvnav packed": "one compiled call: obstacle motion (random turn, arena steering, "
+            "spin) for every obstacle, robot unicycle step, exact clearance, arrival and "
+            "collision tests; no sensing, no controller (a constant command)",
+            "uvnav loop": "obstacle motion (RandomTurn) for every obstacle, ObstacleField rebuild, "
             "robot unicycle step, robot clearance/collision check, sensing within 8 m and a "
             "straight-v1 decision every step",
         },
         "results": results,
+        "targets": judged,
     }
     path = write_json(args.out, "peers", payload)
 
-    print(f"{'N':>5} {'ir-sim steps/s':>15} {'uvnav steps/s':>15} {'uvnav/ir-sim':>13}")
+    print(f"world step, CPU time, median of {repeats} runs" + (" (quick)" if args.quick else ""))
+    print(f"uvnav judged: {PACKED if packed else LOOP}")
+    head = f"{'N':>4} {'ir-sim µs/step':>15} {'uvnav µs/step':>14} {'uvnav/ir-sim':>13}"
+    print(head + (f" {'loop µs/step':>13} {'loop/ir-sim':>12}" if packed else ""))
     for n, row in results.items():
-        print(
-            f"{n:>5} {row['irsim']['steps_per_s']:>15.0f} {row['uvnav']['steps_per_s']:>15.0f}"
-            f" {row['ratio_uvnav_over_irsim']:>13.2f}"
+        ir_us = row.get("irsim", {}).get("median_us_per_step")
+        ratio = row.get("ratio_uvnav_over_irsim")
+        line = (
+            f"{n:>4} {fmt(ir_us, 15, 1)} {fmt(row['uvnav']['median_us_per_step'], 14, 2)}"
+            f" {fmt(ratio, 12, 2)}x"
         )
+        if packed:
+            loop_us = row["uvnav_loop"]["median_us_per_step"]
+            line += f" {fmt(loop_us, 13, 1)} {fmt(row.get('ratio_loop_over_irsim'), 11, 2)}x"
+        print(line)
         for w in row.get("warnings", []):
             print(f"      warning: {w}")
+    for key, t in judged.items():
+        verdict = {True: "PASS", False: "FAIL", None: "not measured"}[t["pass"]]
+        measured = fmt(t["measured"], 0, 2)
+        print(f"target {key}: {t['direction']} {t['limit']:g}, measured {measured} -> {verdict}")
     print(f"wrote {path}")
     return 0
 

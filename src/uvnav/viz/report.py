@@ -181,7 +181,8 @@ def benchmark_tables(bench_dir: Path) -> list[dict[str, Any]]:
     * ``summary.json`` (``make bench``): each target, its limit and the measured value;
     * ``peers.json`` (``benchmarks/peers/irsim_steps.py``): world steps/s, uvnav vs ir-sim;
     * ``peers_navground.json`` (``benchmarks/peers/navground_crowd.py``): µs per step and decision
-      cost on crowd crossings, uvnav vs navground, with each run's outcome.
+      cost on crowd crossings, uvnav vs navground, with each run's outcome (skipped when it
+      records ``"available": false``: navground was not installed).
 
     Raises:
         ValueError: a file is not the JSON its writer makes (names the file and the key).
@@ -238,7 +239,7 @@ def benchmark_tables(bench_dir: Path) -> list[dict[str, Any]]:
             tables.append(
                 {"title": "World stepping: uvnav vs ir-sim", "note": machine(data), "rows": rows}
             )
-        if (data := load("peers_navground.json")) is not None:
+        if (data := load("peers_navground.json")) is not None and data.get("available", True):
             rows = []
             for scene, r in data["scenes"].items():
                 for run, v in r["runs"].items():
