@@ -9,7 +9,7 @@ the JSON files the benchmarks wrote there; it measures nothing:
   (``orca-shared-v1``) on ``antipodal:10`` / ``antipodal:100``, its CPU time per step over
   navground's (within 2x = at most 2);
 * ``campaign.json`` (``benchmarks/bench_campaign.py``): 10,000 episodes in <= 120 s wall;
-* ``packed.json`` (``benchmarks/bench_packed.py``, where it exists): the vector env's target,
+* ``vector_env.json`` (``benchmarks/bench_vector_env.py``): the vector env's target,
   env steps per CPU second ("not measured" until a benchmark writes it);
 * ``summary.json`` (``benchmarks/run_benchmarks.py``): a closing line with how many of its own
   targets pass.
@@ -137,9 +137,9 @@ def campaign_row(results: Path) -> Row:
 
 
 def vector_env_rows(results: Path) -> list[Row]:
-    """The vector env's targets from ``packed.json`` (``bench_packed.py``: rows named
+    """The vector env's targets from ``vector_env.json`` (``bench_vector_env.py``: rows named
     ``vector env...``); one "not measured" row without them."""
-    data = load(results, "packed.json")
+    data = load(results, "vector_env.json")
     targets = data.get("targets") if data else None
     found = [
         t

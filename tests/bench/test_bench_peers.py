@@ -136,7 +136,7 @@ def test_summary_table(tmp_path: Path) -> None:
     vec = {"name": "vector env, K = 256", "target": ">= 100,000/s", "measured": "110,066/s",
            "ratio": 1.1007, "pass": True}  # fmt: skip
     world = {"name": "world step, 10 obstacles", "ratio": 1.5, "pass": False}
-    _write(tmp_path, "packed.json", {"quick": True, "targets": [world, vec]})
+    _write(tmp_path, "vector_env.json", {"quick": True, "targets": [world, vec]})
     rows = summary.build_rows(tmp_path)
     got = {r.name.strip(): (r.measured, r.ratio, r.result) for r in rows}
     assert got["world step, 100 polygons"] == ("150 µs", "10.0", "FAIL")

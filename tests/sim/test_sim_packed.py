@@ -113,13 +113,10 @@ def run_both(make: object, seed: int, max_decisions: int = 10**6) -> tuple[str, 
 
 @pytest.mark.parametrize("compiled", [True, False])
 def test_packed_equals_the_loop_world_on_random_ch2(compiled: bool) -> None:
-    statuses = set()
     with kernels(compiled):
         for seed in range(3 if compiled else 1):
             scene = load_scenario(f"random-ch2:{seed}")
-            status, _ = run_both(lambda s=seed, sc=scene: build_episode(sc, s), seed)
-            statuses.add(status)
-    assert statuses
+            run_both(lambda s=seed, sc=scene: build_episode(sc, s), seed)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])

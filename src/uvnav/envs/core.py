@@ -365,6 +365,12 @@ class EnvWorldEnv:
             self._world = None
 
 
+def goal_scale_for(distance: float, goal_scale: float | None) -> float:
+    """The distance [m] an observation maps to 1: ``goal_scale`` when given, else 1.5 x the
+    scene's start-goal ``distance`` [m] (at least 1 m), the default of every uvnav env."""
+    return float(goal_scale) if goal_scale else max(1.5 * distance, 1.0)
+
+
 def scene_bounds(world: EnvWorld, margin: float = 1.5) -> tuple[float, float, float, float]:
     """A box [m] around the robots' starts and goals and the obstacles' initial bounding discs
     (pedestrians parked far away are left out), grown by ``margin``; call it at reset."""

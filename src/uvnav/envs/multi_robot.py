@@ -22,7 +22,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig
+from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig, goal_scale_for
 from uvnav.envs.nav2d import act_space, episode_seed, obs_space, reward_config
 from uvnav.scenarios.multi import MultiScenario, build_multi, load_multi_scenario
 from uvnav.sim.multi import MultiUnicycleWorld
@@ -77,7 +77,7 @@ class MultiNav2DParallelEnv(EnvWorldEnv, ParallelEnv):
         starts = np.array([r.start for r in self.scenario.robots])
         goals = np.array([r.goal for r in self.scenario.robots])
         longest = float(np.hypot(*(goals - starts).T).max())
-        self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * longest, 1.0)
+        self.goal_scale = goal_scale_for(longest, goal_scale)
         self._configure(render_mode, n_rays, max_range, reward_config(reward), raw_commands)
         self.possible_agents = [f"robot_{i}" for i in range(len(self.scenario.robots))]
         self.agents: list[str] = []

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig
+from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig, goal_scale_for
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.scenarios.schema import Scenario
@@ -114,7 +114,7 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
         r = self.scenario.robot
         dist = float(np.hypot(r.goal[0] - r.start[0], r.goal[1] - r.start[1]))
-        self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
+        self.goal_scale = goal_scale_for(dist, goal_scale)
         self._configure(render_mode, n_rays, max_range, reward_config(reward), raw_commands)
         self.observation_space = obs_space(self.n_rays)
         self.action_space = act_space(r.v_max, r.u_max, raw=raw_commands)

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.envs.core import RewardConfig
+from uvnav.envs.core import RewardConfig, goal_scale_for
 from uvnav.envs.nav2d import act_space, episode_seed, obs_space, reward_config
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
@@ -86,7 +86,7 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             raise ValueError(f"{name} cannot be batched: {why}")
         r = self.scenario.robot
         dist = float(np.hypot(r.goal[0] - r.start[0], r.goal[1] - r.start[1]))
-        self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
+        self.goal_scale = goal_scale_for(dist, goal_scale)
         self.n_rays = int(n_rays)
         self.max_range = float(max_range)
         self.reward_config = reward_config(reward)

@@ -62,7 +62,7 @@ import numpy as np
 
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand
 from uvnav.envs.common import SimView, VehicleWorldEnv, fill_polygon
-from uvnav.envs.core import ROBOT_COLOURS, RewardConfig, pixel_grid, square_bounds
+from uvnav.envs.core import ROBOT_COLOURS, RewardConfig, goal_scale_for, pixel_grid, square_bounds
 from uvnav.sensors.sensing3d import Observation3D
 from uvnav.sim.episode3d import Vehicle3DWorld
 
@@ -188,7 +188,7 @@ class Nav3DEnv(VehicleWorldEnv):
         self.oracle = bool(oracle)
         r = first.robot
         dist = float(np.linalg.norm(np.subtract(r.goal, r.start)))
-        self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
+        self.goal_scale = goal_scale_for(dist, goal_scale)
         low = np.zeros(5 + SLOT * self.n_obstacles, dtype=np.float32)
         low[1:4] = -1.0
         for j in range(self.n_obstacles):

@@ -56,7 +56,7 @@ import numpy as np
 
 from uvnav.dynamics.holonomic import SPEED_EPS, HolonomicCommand, max_speed_along
 from uvnav.envs.common import SimView, VehicleWorldEnv, fill_polygon
-from uvnav.envs.core import ROBOT_COLOURS, RewardConfig, pixel_grid, square_bounds
+from uvnav.envs.core import ROBOT_COLOURS, RewardConfig, goal_scale_for, pixel_grid, square_bounds
 from uvnav.geometry.angles import wrap_scalar
 from uvnav.sensors.sonar2d import SonarObservation
 from uvnav.sim.episode_uuv2d import Uuv2dWorld
@@ -143,7 +143,7 @@ class Uuv2DEnv(VehicleWorldEnv):
         first = self._configure(scenario, UUV2D_GENERATORS, load, render_mode, reward)
         v = first.vehicle
         dist = float(math.hypot(v.goal[0] - v.start[0], v.goal[1] - v.start[1]))
-        self.goal_scale = float(goal_scale) if goal_scale else max(1.5 * dist, 1.0)
+        self.goal_scale = goal_scale_for(dist, goal_scale)
         n = first.sonar.to_config().n_beams
         low = np.zeros(4 + n, dtype=np.float32)
         low[1:3] = -1.0

@@ -32,7 +32,8 @@ from __future__ import annotations
 import importlib.util
 import math
 import os
-from collections.abc import Callable
+import types
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -43,6 +44,23 @@ from uvnav.geometry.angles import FloatArray
 _HAVE_NUMBA = importlib.util.find_spec("numba") is not None
 #: the compiled kernels are used (see :func:`use_compiled`)
 _ENABLED = _HAVE_NUMBA and os.environ.get("UVNAV_NO_NUMBA", "") != "1"
+
+
+def compile_family(functions: Sequence[Callable[..., Any]]) -> dict[str, Callable[..., Any]]:
+    """numba-compiled copies of ``functions`` (callees before callers), by name.
+
+    Each copy runs in its own module's globals with the names of the functions compiled before it
+    bound to their compiled copies, so a compiled kernel calls compiled callees while the Python
+    functions stay untouched: they remain the reference path of :func:`use_compiled` (False).
+    """
+    import numba
+
+    done: dict[str, Callable[..., Any]] = {}
+    for f in functions:
+        env = {**f.__globals__, **done}
+        copy = types.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
+        done[f.__name__] = numba.njit(cache=True, nogil=True)(copy)
+    return done
 
 
 def numba_available() -> bool:

@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
-from uvnav.geometry.kernels3d import numba_enabled
+from uvnav.geometry.kernels3d import compile_family, numba_enabled
 
 _EPS = 1e-12
 
@@ -379,6 +379,36 @@ def rings_nearest(
     return dist, nearest, (crossings % 2) == 1
 
 
+def ring_nearest_py(
+    px: float, py: float, xs: FloatArray, ys: FloatArray, parity: bool
+) -> tuple[float, float, float, bool]:
+    """One closed ring (``xs``, ``ys``: its padded vertices [m]) of :func:`rings_nearest_py`:
+    ``(distance to the boundary, nearest x, nearest y, inside)`` from ``(px, py)``; ``inside``
+    is the even-odd test, False without ``parity``."""
+    best, bx, by, seen_nan = math.inf, math.nan, math.nan, False
+    crossings = 0
+    for j in range(xs.shape[0] - 1):
+        sx, sy = xs[j], ys[j]
+        ex, ey = xs[j + 1] - sx, ys[j + 1] - sy
+        ee = ex * ex + ey * ey
+        if not ee >= _EPS and ee == ee:  # np.maximum(ee, EPS), NaN kept
+            ee = _EPS
+        t = ((px - sx) * ex + (py - sy) * ey) / ee
+        if t < 0.0:
+            t = 0.0
+        if t > 1.0:
+            t = 1.0
+        qx, qy = sx + t * ex, sy + t * ey
+        dx, dy = qx - px, qy - py
+        d = math.sqrt(dx * dx + dy * dy)
+        if not seen_nan and (d != d or d < best or j == 0):
+            best, bx, by, seen_nan = d, qx, qy, d != d
+        straddles = (sy > py) != (ys[j + 1] > py)
+        if parity and straddles and sx + (py - sy) * ex / ey > px:
+            crossings += 1
+    return best, bx, by, crossings % 2 == 1
+
+
 def rings_nearest_py(
     px: float,
     py: float,
@@ -388,34 +418,14 @@ def rings_nearest_py(
     nearest: FloatArray,
     inside: np.ndarray,
 ) -> None:
-    """:func:`rings_nearest` as one loop over the rings' edges, writing ``dist`` (m,),
-    ``nearest`` (2, m) and, with ``parity``, ``inside`` (m,) (compiled by numba when it is
-    enabled).  The same operations in the same order as the array version, so the same numbers
-    bit for bit (NaN included: the first NaN distance wins, as ``argmin`` picks it)."""
+    """:func:`rings_nearest` as one loop over the rings' edges (:func:`ring_nearest_py` per
+    ring), writing ``dist`` (m,), ``nearest`` (2, m) and, with ``parity``, ``inside`` (m,)
+    (compiled by numba when it is enabled).  The same operations in the same order as the array
+    version, so the same numbers bit for bit (NaN included: the first NaN distance wins, as
+    ``argmin`` picks it)."""
     for i in range(rings.shape[1]):
-        best, bx, by, seen_nan = math.inf, math.nan, math.nan, False
-        crossings = 0
-        for j in range(rings.shape[2] - 1):
-            sx, sy = rings[0, i, j], rings[1, i, j]
-            ex, ey = rings[0, i, j + 1] - sx, rings[1, i, j + 1] - sy
-            ee = ex * ex + ey * ey
-            if not ee >= _EPS and ee == ee:  # np.maximum(ee, EPS), NaN kept
-                ee = _EPS
-            t = ((px - sx) * ex + (py - sy) * ey) / ee
-            if t < 0.0:
-                t = 0.0
-            if t > 1.0:
-                t = 1.0
-            qx, qy = sx + t * ex, sy + t * ey
-            dx, dy = qx - px, qy - py
-            d = math.sqrt(dx * dx + dy * dy)
-            if not seen_nan and (d != d or d < best or j == 0):
-                best, bx, by, seen_nan = d, qx, qy, d != d
-            straddles = (sy > py) != (rings[1, i, j + 1] > py)
-            if parity and straddles and sx + (py - sy) * ex / ey > px:
-                crossings += 1
-        dist[i], nearest[0, i], nearest[1, i] = best, bx, by
-        inside[i] = crossings % 2 == 1
+        d, qx, qy, ins = ring_nearest_py(px, py, rings[0, i], rings[1, i], parity)
+        dist[i], nearest[0, i], nearest[1, i], inside[i] = d, qx, qy, ins
 
 
 _RINGS: list[Callable[..., Any]] = []
@@ -424,10 +434,28 @@ _RINGS: list[Callable[..., Any]] = []
 def _rings_kernel() -> Callable[..., Any]:
     """:func:`rings_nearest_py`, compiled on the first call (or loaded from numba's cache)."""
     if not _RINGS:
-        import numba
-
-        _RINGS.append(numba.njit(cache=True, nogil=True)(rings_nearest_py))
+        _RINGS.append(compile_family([ring_nearest_py, rings_nearest_py])["rings_nearest_py"])
     return _RINGS[0]
+
+
+def ray_ring_hit_py(
+    ox: float, oy: float, dx: float, dy: float, xs: FloatArray, ys: FloatArray
+) -> float:
+    """:func:`rays_rings_hit` for one unit ray from ``(ox, oy)`` along ``(dx, dy)`` and one
+    closed ring (``xs``, ``ys`` [m]) as a loop: the distance [m] to its first crossing, ``inf``
+    on a miss (the same operations, for compiled callers)."""
+    best = math.inf
+    for j in range(xs.shape[0] - 1):
+        sx, sy = xs[j], ys[j]
+        ex, ey = xs[j + 1] - sx, ys[j + 1] - sy
+        wx, wy = sx - ox, sy - oy
+        den = dx * ey - dy * ex
+        if abs(den) >= _EPS:
+            t = (wx * ey - wy * ex) / den
+            s = (wx * dy - wy * dx) / den
+            if t >= 0.0 and s >= 0.0 and s <= 1.0 and t < best:
+                best = t
+    return best
 
 
 def rays_rings_hit(

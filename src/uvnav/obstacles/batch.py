@@ -243,12 +243,7 @@ class ObstacleBatch:
             kind = type(ob.motion)
             if kind is RandomTurn:
                 mod: RandomTurn = ob.motion  # type: ignore[assignment]
-                if mod.course is None:  # as RandomTurn.step does on its first call
-                    vel = st.velocity
-                    course = float(np.arctan2(vel[1], vel[0])) if np.hypot(*vel) > 0 else st.heading
-                else:
-                    course = mod.course
-                x[3, j] = course
+                x[3, j] = mod.course_at(st)
                 rt.append(j)
             elif kind is ConstantVelocity:
                 cv.append(j)

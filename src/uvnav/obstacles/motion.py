@@ -186,8 +186,7 @@ class RandomTurn:
 
     def step(self, state: ObstacleState, t: float, dt: float) -> ObstacleState:
         if self.course is None:
-            v = state.velocity
-            self.course = float(np.arctan2(v[1], v[0])) if np.hypot(*v) > 0 else state.heading
+            self.course = self.course_at(state)
         if t >= self._next_change - 1e-12:
             self._speed = uniform_draw(self.rng, self.speed)
             self._turn = uniform_draw(self.rng, self.turn_rate)
@@ -207,6 +206,14 @@ class RandomTurn:
         mid = self.course - 0.5 * turn * dt
         velocity = self._speed * np.array([np.cos(mid), np.sin(mid)])
         return _advance(state, velocity, turn + self.spin, dt)
+
+    def course_at(self, state: ObstacleState) -> float:
+        """The course [rad] a step from ``state`` starts on: the model's, or before its first
+        step the direction of the state's velocity (its heading when at rest)."""
+        if self.course is not None:
+            return self.course
+        v = state.velocity
+        return float(np.arctan2(v[1], v[0])) if np.hypot(*v) > 0 else state.heading
 
     def speed_bound(self) -> float:
         return float(max(abs(self.speed[0]), abs(self.speed[1])))

@@ -27,18 +27,18 @@ Only these motions and polygon bodies are packed; :func:`pack_check` says why a 
 from __future__ import annotations
 
 import math
-import types
 from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 
-from uvnav.dynamics.unicycle import UnicycleSpec
-from uvnav.geometry.angles import FloatArray
-from uvnav.geometry.kernels3d import numba_enabled
+from uvnav.dynamics.unicycle import UnicycleSpec, unicycle_advance
+from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.geometry.kernels3d import compile_family, numba_enabled
+from uvnav.geometry.polygons import ray_ring_hit_py, ring_nearest_py
 from uvnav.obstacles.bodies import PolygonBody
 from uvnav.obstacles.motion import ConstantVelocity, RandomTurn
-from uvnav.obstacles.obstacle import FieldTemplate, Obstacle
+from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
 from uvnav.sim.episode import EpisodeSetup, decision_ratio
 
 #: status codes of a packed world
@@ -46,8 +46,6 @@ RUNNING, SUCCESS, COLLISION, TIMEOUT = 0, 1, 2, 3
 STATUS_NAMES = ("running", "success", "collision", "timeout")
 #: motion kinds of a packed obstacle (-1: an empty slot)
 EMPTY, CONSTANT, RANDOM_TURN = -1, 0, 1
-_EPS_UNI = float(np.finfo(float).eps)  # unicycle_advance's sinc guard
-_EPS_RING = 1e-12  # the rings kernels' degenerate-edge guard
 _DBL_MIN = 2.2250738585072014e-308
 _VELTKAMP = 134217729.0  # 2**27 + 1
 #: random numbers pre-drawn per obstacle and block
@@ -131,21 +129,13 @@ def pyhypot(x: float, y: float) -> float:
     return outer * (h / scale)
 
 
-def wrap_angle(a: float) -> float:
-    """:func:`uvnav.geometry.angles.wrap_scalar` (to (-pi, pi] [rad]) for compiled code."""
-    if -math.pi < a <= math.pi:
-        return a
-    w = math.pi - (math.pi - a) % (2.0 * math.pi)
-    return w if w > -math.pi else math.pi
-
-
 def _obstacle_step(o: int, st: FloatArray, prm: FloatArray, oi: np.ndarray, ubuf: FloatArray,
                    t: float, dt: float) -> None:  # fmt: skip
     """Advance obstacle ``o`` of one world (``st`` (S, M), ``prm`` (P, M), ``oi`` (2, M),
     ``ubuf`` (M, B)) from ``t`` by ``dt`` [s]: :class:`ObstacleBatch`'s arithmetic."""
     kind = oi[O_KIND, o]
     if kind == CONSTANT:
-        st[S_HEADING, o] = wrap_angle(st[S_HEADING, o] + prm[P_OMEGA, o] * dt)
+        st[S_HEADING, o] = wrap_scalar(st[S_HEADING, o] + prm[P_OMEGA, o] * dt)
         st[S_X, o] = st[S_X, o] + prm[P_VX, o] * dt
         st[S_Y, o] = st[S_Y, o] + prm[P_VY, o] * dt
         return
@@ -164,10 +154,10 @@ def _obstacle_step(o: int, st: FloatArray, prm: FloatArray, oi: np.ndarray, ubuf
     ):  # outside its arena: turn back toward the centre at the largest rate
         to_c = math.atan2(prm[P_MIDY, o] - py, prm[P_MIDX, o] - px)
         lim = prm[P_LIMIT, o]
-        turn = min(max(wrap_angle(to_c - st[S_COURSE, o]) / dt, -lim), lim)
+        turn = min(max(wrap_scalar(to_c - st[S_COURSE, o]) / dt, -lim), lim)
     om = turn + prm[P_SPIN, o]
-    course = wrap_angle(st[S_COURSE, o] + turn * dt)
-    st[S_HEADING, o] = wrap_angle(st[S_HEADING, o] + om * dt)
+    course = wrap_scalar(st[S_COURSE, o] + turn * dt)
+    st[S_HEADING, o] = wrap_scalar(st[S_HEADING, o] + om * dt)
     st[S_COURSE, o] = course
     mid = course - 0.5 * turn * dt
     speed = st[S_SPEED, o]
@@ -175,44 +165,22 @@ def _obstacle_step(o: int, st: FloatArray, prm: FloatArray, oi: np.ndarray, ubuf
     st[S_Y, o] = py + math.sin(mid) * speed * dt
 
 
-def _signed_distance(px: float, py: float, rings: FloatArray, o: int, c: float, s: float,
-                     cx: float, cy: float) -> float:  # fmt: skip
-    """Signed distance [m] from ``(px, py)`` to polygon ``o`` of ``rings`` (2, M, W) turned by
-    (``c``, ``s``) = (cos, sin) of its heading and moved to ``(cx, cy)``: the nearest boundary
-    distance outside, minus it inside (:meth:`ObstacleField.query`'s ``signed``)."""
-    best, bx, by, seen_nan = math.inf, math.nan, math.nan, False
-    crossings = 0
-    rx, ry = rings[0, o, 0], rings[1, o, 0]
-    sx, sy = c * rx + s * -ry + cx, c * ry + s * rx + cy
-    for j in range(rings.shape[2] - 1):
-        rx, ry = rings[0, o, j + 1], rings[1, o, j + 1]
-        nx, ny = c * rx + s * -ry + cx, c * ry + s * rx + cy
-        ex, ey = nx - sx, ny - sy
-        ee = ex * ex + ey * ey
-        if not ee >= _EPS_RING and ee == ee:
-            ee = _EPS_RING
-        u = ((px - sx) * ex + (py - sy) * ey) / ee
-        if u < 0.0:
-            u = 0.0
-        if u > 1.0:
-            u = 1.0
-        qx, qy = sx + u * ex, sy + u * ey
-        dx, dy = qx - px, qy - py
-        d = math.sqrt(dx * dx + dy * dy)
-        if not seen_nan and (d != d or d < best or j == 0):
-            best, bx, by, seen_nan = d, qx, qy, d != d
-        if (sy > py) != (ny > py) and sx + (py - sy) * ex / ey > px:
-            crossings += 1
-        sx, sy = nx, ny
-    if crossings % 2 == 1:
-        return -math.hypot(bx - px, by - py)
-    return best
+def _transform_ring(rings: FloatArray, o: int, c: float, s: float, cx: float, cy: float,
+                    out: FloatArray) -> None:  # fmt: skip
+    """Ring ``o`` of ``rings`` (2, M, W) turned by (``c``, ``s``) = (cos, sin) of its heading and
+    moved to ``(cx, cy)`` [m], into ``out`` (2, W): :func:`transform_rings`'s operations."""
+    for j in range(rings.shape[2]):
+        rx, ry = rings[0, o, j], rings[1, o, j]
+        out[0, j] = c * rx + s * -ry + cx
+        out[1, j] = c * ry + s * rx + cy
 
 
 def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray,
-               st: FloatArray, rings: FloatArray) -> float:  # fmt: skip
+               st: FloatArray, rings: FloatArray, ring: FloatArray) -> float:  # fmt: skip
     """Exact clearance [m] of the robot disc at ``(x, y)`` in one world (``prm`` (P, M), ``st``
-    (S, M), ``rings`` (2, M, W)); ``inf`` without obstacles."""
+    (S, M), ``rings`` (2, M, W); ``ring`` (2, W) scratch): the signed distance of
+    :meth:`ObstacleField.query` (boundary distance outside, minus it inside) minus the radius;
+    ``inf`` without obstacles."""
     gap = math.inf
     slack = 1e-9 * (1.0 + abs(x) + abs(y))
     for o in range(n_obs):
@@ -221,7 +189,10 @@ def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray,
         if lower > gap + slack:
             continue
         h = st[S_HEADING, o]
-        d = _signed_distance(x, y, rings, o, math.cos(h), math.sin(h), st[S_X, o], st[S_Y, o])
+        _transform_ring(rings, o, math.cos(h), math.sin(h), st[S_X, o], st[S_Y, o], ring)
+        d, qx, qy, inside = ring_nearest_py(x, y, ring[0], ring[1], True)
+        if inside:
+            d = -math.hypot(qx - x, qy - y)
         g = d - radius
         if g < gap or g != g:
             gap = g
@@ -246,6 +217,7 @@ def step_worlds_py(
     state ``state[k, :, o]`` (``S_*``), its pre-drawn uniforms ``ubuf[k, o]`` and its body
     ring ``rings[k, :, o]`` (body frame).  The caller guarantees two unread draws per step.
     """
+    ring = np.empty((2, rings.shape[3]))
     for k in range(wf.shape[0]):
         wf[k, W_LOW] = math.inf
         if wi[k, I_ACTIVE] == 0 or wi[k, I_STATUS] != RUNNING:
@@ -256,20 +228,12 @@ def step_worlds_py(
         for _ in range(wi[k, I_RATIO]):
             i = wi[k, I_STEP]
             t = i * dt
-            # the robot: unicycle_advance
-            x, y, th = wf[k, W_X], wf[k, W_Y], wf[k, W_TH]
-            half = 0.5 * u * dt
-            sc = math.pi * (half / math.pi)
-            if sc == 0.0:
-                sc = _EPS_UNI
-            chord = v * dt * (math.sin(sc) / sc)
-            x = x + chord * math.cos(th + half)
-            y = y + chord * math.sin(th + half)
-            wf[k, W_X], wf[k, W_Y], wf[k, W_TH] = x, y, wrap_angle(th + 2.0 * half)
+            x, y, th = unicycle_advance(wf[k, W_X], wf[k, W_Y], wf[k, W_TH], v, u, dt)
+            wf[k, W_X], wf[k, W_Y], wf[k, W_TH] = x, y, th
             for o in range(wi[k, I_NOBS]):
                 _obstacle_step(o, state[k], params[k], oi[k], ubuf[k], t, dt)
             wi[k, I_STEP] = i = i + 1
-            gap = _clearance(x, y, radius, wi[k, I_NOBS], params[k], state[k], rings[k])
+            gap = _clearance(x, y, radius, wi[k, I_NOBS], params[k], state[k], rings[k], ring)
             wf[k, W_CLEAR] = gap
             if gap < wf[k, W_LOW]:
                 wf[k, W_LOW] = gap
@@ -293,17 +257,19 @@ def _lidar(
     prm: FloatArray,
     st: FloatArray,
     rings: FloatArray,
+    ring: FloatArray,
     out: FloatArray,
 ) -> None:
     """Ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from pose ``(ox, oy, th)`` in
     one world into ``out`` (R,): beams at ``wrap(th + rel)`` [rad], capped at ``max_range``
-    [m].  A body is cast where :meth:`ObstacleField.ray_hits` casts it, and only by the beams
-    that meet its bounding disc (the others cannot hit it: the same ranges, far fewer edges)."""
+    [m] (``ring`` (2, W): scratch).  A body is cast where :meth:`ObstacleField.ray_hits` casts
+    it, and only by the beams that meet its bounding disc (the others cannot hit it: the same
+    ranges, far fewer edges)."""
     n_rays = rel.shape[0]
     dirs = np.empty((2, n_rays))
     for r in range(n_rays):
         out[r] = max_range
-        a = wrap_angle(th + rel[r])
+        a = wrap_scalar(th + rel[r])
         dirs[0, r], dirs[1, r] = math.cos(a), math.sin(a)
     slack = 1e-9 * (1.0 + abs(ox) + abs(oy))
     limit = max_range * (1.0 + 1e-9) + slack
@@ -313,7 +279,7 @@ def _lidar(
         if math.hypot(cx - ox, cy - oy) - bound > limit:
             continue  # its hits would be beyond max_range
         reach = bound * (1.0 + 1e-9) + slack
-        c, s = math.cos(h), math.sin(h)
+        _transform_ring(rings, o, math.cos(h), math.sin(h), cx, cy, ring)
         for r in range(n_rays):
             dx, dy = dirs[0, r], dirs[1, r]
             # a beam that passes outside the bounding disc, or starts beyond it, cannot hit
@@ -321,22 +287,7 @@ def _lidar(
                 continue
             if dx * (cx - ox) + dy * (cy - oy) < -reach:
                 continue
-            best = out[r]
-            rx, ry = rings[0, o, 0], rings[1, o, 0]
-            sx, sy = c * rx + s * -ry + cx, c * ry + s * rx + cy
-            for j in range(rings.shape[2] - 1):
-                rx, ry = rings[0, o, j + 1], rings[1, o, j + 1]
-                nx, ny = c * rx + s * -ry + cx, c * ry + s * rx + cy
-                ex, ey = nx - sx, ny - sy
-                wx, wy = sx - ox, sy - oy
-                den = dx * ey - dy * ex
-                if abs(den) >= _EPS_RING:
-                    tt = (wx * ey - wy * ex) / den
-                    ss = (wx * dy - wy * dx) / den
-                    if tt >= 0.0 and ss >= 0.0 and ss <= 1.0 and tt < best:
-                        best = tt
-                sx, sy = nx, ny
-            out[r] = best
+            out[r] = min(out[r], ray_ring_hit_py(ox, oy, dx, dy, ring[0], ring[1]))
 
 
 def observe_py(
@@ -357,9 +308,11 @@ def observe_py(
     and goal distances [m] into ``dist`` (K,): goal distance / ``goal_scale`` capped at 1, cos
     and sin of the goal bearing in the robot frame, speed / V_max in [0, 1] (0 once arrived or
     collided), ranges / ``max_range`` in [0, 1] (beams at heading + ``rel`` [rad])."""
+    ring = np.empty((2, rings.shape[3]))
     for k in range(wf.shape[0]):
         x, y, th = wf[k, W_X], wf[k, W_Y], wf[k, W_TH]
-        _lidar(x, y, th, rel, max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ranges[k])
+        _lidar(x, y, th, rel, max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ring,
+               ranges[k])  # fmt: skip
         gx, gy = wf[k, W_GX] - x, wf[k, W_GY] - y
         d = pyhypot(gx, gy)
         dist[k] = d
@@ -374,39 +327,22 @@ def observe_py(
             out[k, 4 + r] = min(max(ranges[k, r] / max_range, 0.0), 1.0)
 
 
-_KERNELS: dict[str, Callable[..., Any]] = {}
-#: the functions compiled, callees before callers
-_COMPILED = ("pyhypot", "wrap_angle", "_obstacle_step", "_signed_distance", "_clearance",
-             "_lidar", "step_worlds_py", "observe_py")  # fmt: skip
-
-
-def _compile() -> None:
-    """Compile the kernels: copies of the Python functions whose globals name the compiled
-    callees (the Python functions stay as they are, the reference)."""
-    import numba
-
-    env = dict(globals())
-    for name in _COMPILED:
-        f = globals()[name]
-        copy = types.FunctionType(f.__code__, env, name, f.__defaults__, f.__closure__)
-        env[name] = numba.njit(cache=True, nogil=True)(copy)
-    for name in _PUBLIC.values():
-        _KERNELS[name] = env[name]
-
-
-#: the kernels by short name
+#: the kernels by short name, and everything they call (callees first)
 _PUBLIC = {"step": "step_worlds_py", "observe": "observe_py"}
+_KERNELS: dict[str, Callable[..., Any]] = {}
 
 
 def kernel(name: str) -> Callable[..., Any]:
     """``"step"`` (:func:`step_worlds_py`) or ``"observe"`` (:func:`observe_py`), compiled by
     numba on first use when it is enabled (:func:`numba_enabled`), else the Python functions."""
-    full = _PUBLIC[name]
     if not numba_enabled():
-        return globals()[full]
+        return step_worlds_py if name == "step" else observe_py
     if not _KERNELS:
-        _compile()
-    return _KERNELS[full]
+        _KERNELS.update(compile_family([
+            wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py, ray_ring_hit_py,
+            _transform_ring, _obstacle_step, _clearance, _lidar, step_worlds_py, observe_py,
+        ]))  # fmt: skip
+    return _KERNELS[_PUBLIC[name]]
 
 
 def pack_check(setup: EpisodeSetup) -> str | None:
@@ -544,8 +480,10 @@ class PackedWorlds:
             self.rings[slot, :, :m, w:] = tpl.rings[:, :, :1]
         self.rngs[slot] = [self._pack_obstacle(slot, o, ob) for o, ob in enumerate(obstacles)]
         self.params[slot, P_BOUND, :m] = tpl.bounding_radii
-        gap = _clearance(x, y, float(spec.radius), m, self.params[slot], self.state[slot],
-                         self.rings[slot])  # fmt: skip
+        gap = math.inf  # at t = 0 as UnicycleWorld.start measures it
+        if m:
+            field = ObstacleField.from_obstacles(obstacles, tpl)
+            gap = float((field.query((x, y), 0.0, nearest=True).signed - spec.radius).min())
         wf[W_CLEAR], wf[W_LOW] = gap, math.inf
         status = RUNNING
         if gap < 0:
@@ -584,12 +522,7 @@ class PackedWorlds:
             return None
         assert isinstance(mod, RandomTurn)
         self.oi[slot, O_KIND, o] = RANDOM_TURN
-        if mod.course is None:  # as ObstacleBatch does
-            vel = state.velocity
-            course = float(np.arctan2(vel[1], vel[0])) if np.hypot(*vel) > 0 else state.heading
-        else:
-            course = mod.course
-        st[S_COURSE, o] = course
+        st[S_COURSE, o] = mod.course_at(state)
         st[S_SPEED, o], st[S_TURN, o] = mod._speed, mod._turn
         st[S_NEXT, o] = mod._next_change
         st[S_THRESHOLD, o] = mod._next_change - 1e-12
