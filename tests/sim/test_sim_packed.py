@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.geometry.kernels3d import numba_available, use_compiled
+from uvnav.geometry.small import pyhypot
 from uvnav.obstacles import Obstacle, ObstacleState
 from uvnav.obstacles.bodies import DiscBody, PolygonBody
 from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
@@ -20,7 +21,7 @@ from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.sensors.exact import lidar_scan
 from uvnav.sim.episode import EpisodeSetup, UnicycleWorld
-from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, pack_check, pyhypot
+from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, pack_check
 from uvnav.sim.seeding import run_rng
 
 REL = np.linspace(-np.pi, np.pi, 16, endpoint=False)

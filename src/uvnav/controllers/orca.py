@@ -105,12 +105,10 @@ from uvnav.controllers.base import (
     is_number,
     register,
 )
+from uvnav.controllers.orca_kernels import solve_orca_lines
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.sensors.observation import Observation, ObstacleReading
-
-#: RVO2's RVO_EPSILON.
-_EPS = 1e-5
 
 #: An ORCA half-plane: (point, direction); feasible side is left of the direction.
 Line = tuple[tuple[float, float], tuple[float, float]]
@@ -182,112 +180,17 @@ class OrcaParams:
             raise ValueError(f"static_polygons must be a bool (got {self.static_polygons!r})")
 
 
-# -- RVO2's linear programs, in float64 (port of Agent.cc linearProgram1-3) -------------------
-
-
-def _det(ax: float, ay: float, bx: float, by: float) -> float:
-    return ax * by - ay * bx
-
-
-def _lp1(
-    lines: Sequence[Line], no: int, radius: float, opt: tuple[float, float], direction_opt: bool
-) -> tuple[float, float] | None:
-    (px, py), (dx, dy) = lines[no]
-    dot = px * dx + py * dy
-    disc = dot * dot + radius * radius - (px * px + py * py)
-    if disc < 0.0:  # the max-speed circle fully invalidates line ``no``
-        return None
-    sq = math.sqrt(disc)
-    t_left, t_right = -dot - sq, -dot + sq
-    for i in range(no):
-        (qx, qy), (ex, ey) = lines[i]
-        denom = _det(dx, dy, ex, ey)
-        numer = _det(ex, ey, px - qx, py - qy)
-        if abs(denom) <= _EPS:  # (almost) parallel
-            if numer < 0.0:
-                return None
-            continue
-        t = numer / denom
-        if denom >= 0.0:
-            t_right = min(t_right, t)
-        else:
-            t_left = max(t_left, t)
-        if t_left > t_right:
-            return None
-    if direction_opt:
-        t = t_right if opt[0] * dx + opt[1] * dy > 0.0 else t_left
-    else:
-        t = dx * (opt[0] - px) + dy * (opt[1] - py)
-        t = min(max(t, t_left), t_right)
-    return (px + t * dx, py + t * dy)
-
-
-def _lp2(
-    lines: Sequence[Line], radius: float, opt: tuple[float, float], direction_opt: bool
-) -> tuple[int, tuple[float, float]]:
-    ox, oy = opt
-    if direction_opt:
-        result = (ox * radius, oy * radius)
-    elif ox * ox + oy * oy > radius * radius:
-        n = math.hypot(ox, oy)
-        result = (ox / n * radius, oy / n * radius)
-    else:
-        result = (ox, oy)
-    for i, ((px, py), (dx, dy)) in enumerate(lines):
-        if _det(dx, dy, px - result[0], py - result[1]) > 0.0:
-            new = _lp1(lines, i, radius, opt, direction_opt)
-            if new is None:
-                return i, result
-            result = new
-    return len(lines), result
-
-
-def _lp3(
-    lines: Sequence[Line],
-    n_obst: int,
-    begin: int,
-    radius: float,
-    result: tuple[float, float],
-) -> tuple[float, float]:
-    distance = 0.0
-    for i in range(begin, len(lines)):
-        (pi_x, pi_y), (di_x, di_y) = lines[i]
-        if _det(di_x, di_y, pi_x - result[0], pi_y - result[1]) > distance:
-            proj: list[Line] = list(lines[:n_obst])
-            for j in range(n_obst, i):
-                (pj_x, pj_y), (dj_x, dj_y) = lines[j]
-                determinant = _det(di_x, di_y, dj_x, dj_y)
-                if abs(determinant) <= _EPS:
-                    if di_x * dj_x + di_y * dj_y > 0.0:
-                        continue
-                    point = (0.5 * (pi_x + pj_x), 0.5 * (pi_y + pj_y))
-                else:
-                    s = _det(dj_x, dj_y, pi_x - pj_x, pi_y - pj_y) / determinant
-                    point = (pi_x + s * di_x, pi_y + s * di_y)
-                nx, ny = dj_x - di_x, dj_y - di_y
-                norm = math.hypot(nx, ny)
-                if norm <= 0.0:
-                    continue
-                proj.append((point, (nx / norm, ny / norm)))
-            fail, new = _lp2(proj, radius, (-di_y, di_x), True)
-            if fail >= len(proj):  # else: floating-point trouble, keep the current result
-                result = new
-            distance = _det(di_x, di_y, pi_x - result[0], pi_y - result[1])
-    return result
-
-
 def solve_orca_lp(
     lines: Sequence[Line], n_obst: int, max_speed: float, pref: tuple[float, float]
 ) -> tuple[float, float]:
     """The ORCA velocity [m/s]: closest to ``pref`` in the ``max_speed`` disc on the feasible side
     (left of each line's direction) of every half-plane; when infeasible, the velocity that
     minimises the largest violation of lines ``n_obst:`` while keeping lines ``:n_obst`` (static
-    obstacles).  RVO2's ``linearProgram2``/``linearProgram3`` in float64.
+    obstacles).  RVO2's ``linearProgram2``/``linearProgram3`` in float64
+    (:func:`uvnav.controllers.orca_kernels.solve_orca_lines`).
     """
-    fail, result = _lp2(lines, max_speed, pref, False)
-    if fail < len(lines):
-        result = _lp3(lines, n_obst, fail, max_speed, result)
-    return result
+    rows = np.array([(p[0], p[1], d[0], d[1]) for p, d in lines], dtype=float).reshape(-1, 4)
+    return solve_orca_lines(rows, n_obst, max_speed, pref)
 
 
 # -- one ORCA query through RVO2 --------------------------------------------------------------

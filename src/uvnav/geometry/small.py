@@ -16,6 +16,66 @@ from collections.abc import Sequence
 
 Point = Sequence[float]
 
+_DBL_MIN = 2.2250738585072014e-308
+_VELTKAMP = 134217729.0  # 2**27 + 1
+
+
+def pyhypot(x: float, y: float) -> float:
+    """CPython's ``math.hypot(x, y)`` (its ``vector_norm``: scaled, error-free squares and sums,
+    one differential correction), operation for operation, so compiled code gets its numbers.
+
+    libm's ``hypot`` (numpy's, numba's) differs from it in the last bit for about 0.6 % of
+    inputs; the simulator's arrival test and the env's distances use ``math.hypot``.
+
+    >>> import math
+    >>> pyhypot(3.0, 4.0), pyhypot(-0.0, 0.0), pyhypot(1e-310, 0.0) == math.hypot(1e-310, 0.0)
+    (5.0, 0.0, True)
+    >>> pyhypot(math.inf, math.nan), math.isnan(pyhypot(1.0, math.nan))
+    (inf, True)
+    """
+    x = abs(x)
+    y = abs(y)
+    if math.isinf(x) or math.isinf(y):
+        return math.inf
+    if x != x or y != y:
+        return math.nan
+    big = x if x > y else y
+    if big == 0.0:
+        return big
+    outer = 1.0
+    _, e = math.frexp(big)
+    if e < -1021:  # subnormal: scaled up first, as CPython does
+        x /= _DBL_MIN
+        y /= _DBL_MIN
+        outer = _DBL_MIN
+        _, e = math.frexp(x if x > y else y)
+    scale = math.ldexp(1.0, -e)
+    csum, frac1, frac2 = 1.0, 0.0, 0.0
+    for v in (x * scale, y * scale):
+        t = v * _VELTKAMP  # Dekker's exact square v * v = z + zz
+        hi = t - (t - v)
+        lo = v - hi
+        p, q = hi * hi, hi * lo + lo * hi
+        z = p + q
+        zz = p - z + q + lo * lo
+        s = csum + z  # exact sum csum + z = s + (csum - s) + z
+        frac1 += zz
+        frac2 += (csum - s) + z
+        csum = s
+    h = math.sqrt(csum - 1.0 + (frac1 + frac2))
+    t, t2 = -h * _VELTKAMP, h * _VELTKAMP  # exact product -h * h
+    hi, hi2 = t - (t + h), t2 - (t2 - h)
+    lo, lo2 = -h - hi, h - hi2
+    p, q = hi * hi2, hi * lo2 + lo * hi2
+    z = p + q
+    zz = p - z + q + lo * lo2
+    s = csum + z
+    frac1 += zz
+    frac2 += (csum - s) + z
+    csum = s
+    h += (csum - 1.0 + (frac1 + frac2)) / (2.0 * h)
+    return outer * (h / scale)
+
 
 def wrap(angle: float) -> float:
     """``angle`` [rad] wrapped to (-pi, pi]."""

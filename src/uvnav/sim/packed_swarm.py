@@ -1,0 +1,361 @@
+"""Packed swarms: N unicycles deciding by ``orca-shared-v1``, stepped in one compiled call.
+
+The multi-robot world of :mod:`uvnav.sim.multi` (thesis Ch. 8's robots that avoid each other;
+unicycles (2.1)-(2.4) with disc bodies) for the case that needs speed more than generality: every
+robot on ``orca-shared-v1`` with the same parameters (ORCA, van den Berg et al., ISRR 2009:
+:mod:`uvnav.controllers.orca_shared`), exact sensing with known velocities, no obstacle besides
+the robots.  The whole step — the group decision
+(:func:`uvnav.controllers.orca_kernels.decide_group_py`), the commands held and saturated, the
+unicycles, the robot-pair checks, arrivals and the time limit — is :func:`swarm_step_py`, one
+loop over preallocated arrays, compiled by numba when it is enabled; the Python function is the
+reference and the fallback.
+
+It is :func:`uvnav.core.run_loop` over :class:`~uvnav.sim.multi.MultiUnicycleWorld` bit for bit
+(the tests compare every pose, status, clearance and collided pair at every step):
+
+* decisions: the group law's own kernel; each robot's decision clock is its law's
+  (``FIRST_PERIOD`` at the first decision, then the time since the last, at least 1 ms); the
+  perturbation's draws come from each law's generator (child 2i of the episode generator, as
+  :meth:`MultiUnicycleWorld.law_setup` gives it), pre-drawn in blocks
+  (``Generator.random(n)`` gives the numbers of ``n`` single draws);
+* commands: :meth:`~uvnav.dynamics.unicycle.UnicycleCommand.clipped`;
+* motion: :func:`~uvnav.dynamics.unicycle.unicycle_advance`; the path with
+  :func:`~uvnav.geometry.small.pyhypot` (CPython's ``math.hypot``);
+* pairs: the arithmetic of :class:`uvnav.sim.multi._DiscPairs` with numpy's ``hypot`` (libm's,
+  not CPython's) where it uses it.
+
+Not kept here: control effort, limit violations, mode switches, decision times and the deadlock
+window (the loop world's metrics); :class:`PackedSwarm` is for stepping fast, the loop world for
+the record.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from uvnav.controllers.base import LawState
+from uvnav.controllers.orca_kernels import FAMILY, decide_group_py
+from uvnav.controllers.orca_shared import OrcaShared, group_geometry, group_scratch
+from uvnav.dynamics.unicycle import unicycle_advance
+from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.kernels3d import compile_family, numba_enabled
+from uvnav.geometry.small import pyhypot
+from uvnav.obstacles.bodies import DiscBody
+from uvnav.obstacles.obstacle import _CULL_ABS, _CULL_REL, _X_AXIS, FieldTemplate
+from uvnav.sim.episode import decision_ratio
+from uvnav.sim.multi import MultiSetup
+
+#: status codes of a packed robot (those of :mod:`uvnav.sim.packed`)
+RUNNING, SUCCESS, COLLISION, TIMEOUT = 0, 1, 2, 3
+STATUS_NAMES = ("running", "success", "collision", "timeout")
+#: perturbation draws pre-drawn per robot and block (two per decision)
+BLOCK = 64
+# Columns of the (N, NR) float array of the robots: pose [m, m, rad], held command [m/s, rad/s],
+# velocity [m/s, m/s], goal [m], body radius [m], collision reach [m], ORCA radius [m], ORCA
+# neighbour range [m], V_max [m/s], U_max [rad/s], disc radius and bounding radius of the body
+# in the field [m], time reached [s] (NaN: not yet), path [m], clearance now and lowest [m],
+# time of the last decision [s] (NaN: none yet).
+(R_X, R_Y, R_TH, R_V, R_U, R_VX, R_VY, R_GX, R_GY, R_RADIUS, R_REACH, R_ORAD, R_OREACH, R_VMAX,
+ R_UMAX, R_DISC, R_BOUND, R_REACHED, R_PATH, R_CLEAR, R_LOW, R_LAST_T) = range(22)  # fmt: skip
+NR = 22
+# Entries of the int array of the swarm: step index, steps per decision, steps in the episode,
+# 1 when the episode is over, max_neighbors.
+(I_STEP, I_RATIO, I_NSTEPS, I_DONE, I_MAXNB) = range(5)
+# Entries of the float array of the swarm: dt [s], goal tolerance [m], perturbation [m/s], time
+# horizon [s], responsibility, first decision period [s].
+(F_DT, F_TOL, F_EPS, F_TAU, F_RESP, F_FIRST) = range(6)
+
+
+def swarm_check(setup: MultiSetup) -> str | None:
+    """Why ``setup`` cannot be packed (one line), or None: no obstacle besides the robots, every
+    robot on ``orca-shared-v1`` with the same parameters and exact sensing (velocities known)."""
+    if setup.obstacles:
+        return f"the world holds {len(setup.obstacles)} obstacle(s) besides the robots"
+    keys = set()
+    for i, r in enumerate(setup.robots):
+        if not isinstance(r.controller, OrcaShared):
+            return f"robot {i} is driven by {r.controller.name}, packed swarms hold orca-shared-v1"
+        if r.sensing.velocities != "known":
+            return f"robot {i} estimates velocities, packed swarms sense exactly"
+        keys.add(r.controller.group_key)
+    if len(keys) > 1:
+        return "the robots' orca-shared-v1 parameters differ (more than one group)"
+    return None
+
+
+def _pair_check(rob: FloatArray, status: np.ndarray, pairs: np.ndarray) -> None:
+    """Clearances and collisions of the active robots (:meth:`MultiUnicycleWorld._check` with
+    :class:`~uvnav.sim.multi._DiscPairs`' arithmetic); a robot that collided stops."""
+    n = rob.shape[0]
+    for i in range(n):
+        if status[i] != RUNNING:
+            rob[i, R_CLEAR] = math.inf
+            continue
+        px, py = rob[i, R_X], rob[i, R_Y]
+        limit = rob[i, R_REACH] * (1.0 + _CULL_REL) + _CULL_ABS * (1.0 + abs(px) + abs(py))
+        low = math.inf
+        seen = False
+        for j in range(n):
+            if j == i:
+                continue
+            cx, cy = rob[j, R_X], rob[j, R_Y]
+            if not (math.isinf(limit) or np.hypot(cx - px, cy - py) - rob[j, R_BOUND] <= limit):
+                continue
+            rad = rob[j, R_DISC]
+            offx, offy = px - cx, py - cy
+            r = np.hypot(offx, offy)
+            if r > 0:
+                ux, uy = offx / r, offy / r
+            else:
+                ux, uy = _X_AXIS[0], _X_AXIS[1]
+            if r < rad:
+                signed = -np.hypot(cx + ux * rad - px, cy + uy * rad - py)
+            else:
+                signed = max(r - rad, 0.0)
+            gap = signed - rob[i, R_RADIUS]
+            seen = True
+            if gap < low:
+                low = gap
+            if gap < 0:
+                pairs[min(i, j), max(i, j)] = 1
+                status[i] = COLLISION
+        rob[i, R_CLEAR] = low
+        if seen and low < rob[i, R_LOW]:
+            rob[i, R_LOW] = low
+
+
+def _arrivals(rob: FloatArray, status: np.ndarray, t: float, tol: float) -> None:
+    """Robots within ``tol`` of their goals arrive at ``t``."""
+    for i in range(rob.shape[0]):
+        if status[i] == RUNNING and pyhypot(rob[i, R_GX] - rob[i, R_X], rob[i, R_GY] - rob[i, R_Y]) <= tol:  # fmt: skip
+            status[i], rob[i, R_REACHED] = SUCCESS, t
+
+
+def swarm_step_py(
+    rob: FloatArray, status: np.ndarray, pairs: np.ndarray, ints: np.ndarray, flt: FloatArray,
+    draws: FloatArray, upos: np.ndarray, scratch: FloatArray, idx: np.ndarray,
+    members: np.ndarray, periods: FloatArray, pick: FloatArray, out: FloatArray,
+) -> int:  # fmt: skip
+    """One iteration of the loop (decisions when due, one step ``dt``, checks); returns 1 when
+    the episode is over.  ``draws`` (N, 2 BLOCK) holds each robot's pre-drawn numbers from
+    ``upos[i]`` on; the other arrays are the swarm's (:class:`PackedSwarm`)."""
+    n = rob.shape[0]
+    dt = flt[F_DT]
+    step = ints[I_STEP]
+    t = step * dt
+    if step % ints[I_RATIO] == 0:
+        m = 0
+        for i in range(n):
+            if status[i] == RUNNING:
+                members[m] = i
+                last = rob[i, R_LAST_T]
+                if last != last:
+                    periods[m] = flt[F_FIRST]
+                else:
+                    period = t - last
+                    periods[m] = period if not (1e-3 > period) else 1e-3
+                rob[i, R_LAST_T] = t
+                if flt[F_EPS] > 0.0:
+                    pick[m, 0], pick[m, 1] = draws[i, upos[i]], draws[i, upos[i] + 1]
+                    upos[i] += 2
+                m += 1
+        if m:
+            decide_group_py(
+                members[:m], rob[:, R_X:R_Y + 1], rob[:, R_TH], rob[:, R_VX:R_VY + 1],
+                rob[:, R_ORAD], rob[:, R_OREACH], rob[:, R_GX:R_GY + 1], rob[:, R_VMAX],
+                rob[:, R_UMAX], periods[:m], pick[:m], flt[F_EPS], ints[I_MAXNB], flt[F_TAU],
+                flt[F_RESP], scratch, idx, out[:m],
+            )  # fmt: skip
+            for k in range(m):
+                i = members[k]
+                v, u = out[k, 0], out[k, 1]
+                vmax, umax = rob[i, R_VMAX], rob[i, R_UMAX]
+                if math.isfinite(v):
+                    v = 0.0 if 0.0 > v else v
+                    v = vmax if vmax < v else v
+                else:
+                    v = 0.0
+                if math.isfinite(u):
+                    u = -umax if -umax > u else u
+                    u = umax if umax < u else u
+                else:
+                    u = 0.0
+                rob[i, R_V], rob[i, R_U] = v, u
+    for i in range(n):
+        if status[i] != RUNNING:
+            rob[i, R_VX] = rob[i, R_VY] = 0.0
+            continue
+        x, y = rob[i, R_X], rob[i, R_Y]
+        nx, ny, nth = unicycle_advance(x, y, rob[i, R_TH], rob[i, R_V], rob[i, R_U], dt)
+        rob[i, R_PATH] += pyhypot(nx - x, ny - y)
+        rob[i, R_X], rob[i, R_Y], rob[i, R_TH] = nx, ny, nth
+        rob[i, R_VX] = rob[i, R_V] * math.cos(nth)
+        rob[i, R_VY] = rob[i, R_V] * math.sin(nth)
+    step += 1
+    ints[I_STEP] = step
+    t = step * dt
+    _pair_check(rob, status, pairs)
+    _arrivals(rob, status, t, flt[F_TOL])
+    running = False
+    for i in range(n):
+        if status[i] == RUNNING:
+            running = True
+    done = 1 if (not running or step >= ints[I_NSTEPS]) else 0
+    ints[I_DONE] = done
+    return done
+
+
+_KERNELS: dict[str, Callable[..., Any]] = {}
+
+
+def _step_kernel() -> Callable[..., Any]:
+    if not numba_enabled():
+        return swarm_step_py
+    if not _KERNELS:
+        _KERNELS.update(
+            compile_family((*FAMILY, unicycle_advance, _pair_check, _arrivals, swarm_step_py))
+        )
+    return _KERNELS["swarm_step_py"]
+
+
+class PackedSwarm:
+    """One multi-robot episode of ``orca-shared-v1`` robots in packed arrays (module docstring).
+
+    Args:
+        setup: the scene (:func:`swarm_check` must pass); its laws' parameters are read, the
+            laws themselves are not called.
+        rng: the episode generator, spawned as :class:`~uvnav.sim.multi.MultiUnicycleWorld`
+            spawns it (robot i's law draws from child 2i).
+
+    Attributes:
+        rob: (N, NR) the robots (``R_*`` columns).
+        status: (N,) status codes (``RUNNING`` until arrival or collision; ``TIMEOUT`` at the end).
+        pairs: (N, N) 1 where robots i < j overlapped at some step.
+
+    Raises:
+        ValueError: the scene cannot be packed (the reason in one line), or ``control_period``
+            is not a whole multiple of ``dt``.
+    """
+
+    def __init__(self, setup: MultiSetup, rng: np.random.Generator) -> None:
+        reason = swarm_check(setup)
+        if reason is not None:
+            raise ValueError(f"cannot pack this swarm: {reason}")
+        robots = setup.robots
+        n = len(robots)
+        if n == 0:
+            raise ValueError("a multi-robot episode needs at least one robot")
+        law: Any = robots[0].controller
+        p = law.params
+        dt = float(setup.dt)
+        self.n = n
+        self.dt = dt
+        self._rngs = rng.spawn(2 * n)[0::2]  # each law's generator (child 2i)
+        radii = np.array([float(r.spec.radius) for r in robots])
+        sensing = np.array([float(r.sensing.sensing_range) for r in robots])
+        template = FieldTemplate.from_bodies([DiscBody(max(r, 1e-6)) for r in radii])
+        orad, oreach = group_geometry(p, radii, sensing)
+        rob = np.zeros((n, NR))
+        rob[:, R_X:R_TH + 1] = [np.asarray(r.start, dtype=float)[:3] for r in robots]
+        rob[:, R_GX:R_GY + 1] = [np.asarray(r.goal, dtype=float)[:2] for r in robots]
+        rob[:, R_RADIUS] = radii
+        floor = 4.0 * float(radii.max()) + 1.0
+        rob[:, R_REACH] = [max(s, floor) for s in sensing.tolist()]
+        rob[:, R_ORAD], rob[:, R_OREACH] = orad, oreach
+        rob[:, R_VMAX] = [float(r.spec.v_max) for r in robots]
+        rob[:, R_UMAX] = [float(r.spec.u_max) for r in robots]
+        rob[:, R_DISC], rob[:, R_BOUND] = template.radii, template.bounding_radii
+        rob[:, R_REACHED] = rob[:, R_LAST_T] = np.nan
+        rob[:, R_CLEAR] = rob[:, R_LOW] = np.inf
+        self.rob = rob
+        self.status = np.zeros(n, dtype=np.int64)
+        self.pairs = np.zeros((n, n), dtype=np.uint8)
+        self.ints = np.array(
+            [0, decision_ratio(float(setup.control_period), dt), round(setup.t_max / dt), 0,
+             int(p.max_neighbors)], dtype=np.int64,
+        )  # fmt: skip
+        self.flt = np.array(
+            [dt, float(setup.goal_tolerance), float(p.perturbation), float(p.time_horizon),
+             float(p.responsibility), float(LawState.FIRST_PERIOD)],
+        )  # fmt: skip
+        self.draws = np.zeros((n, 2 * BLOCK))
+        self.upos = np.full(n, 2 * BLOCK, dtype=np.int64)
+        self._safe = 0  # steps that cannot run out of pre-drawn numbers
+        self._scratch, self._idx = group_scratch(p)
+        self._members = np.zeros(n, dtype=np.int64)
+        self._periods = np.zeros(n)
+        self._pick = np.zeros((n, 2))
+        self._out = np.zeros((n, 7))
+        self._start()
+
+    def _start(self) -> None:
+        """Checks and arrivals at t = 0 (:meth:`MultiUnicycleWorld.start`)."""
+        rob, status = self.rob, self.status
+        _pair_check(rob, status, self.pairs)
+        start_dist = np.hypot(rob[:, R_GX] - rob[:, R_X], rob[:, R_GY] - rob[:, R_Y])
+        for i in range(self.n):
+            if status[i] == RUNNING and start_dist[i] <= self.flt[F_TOL]:
+                status[i], rob[i, R_REACHED] = SUCCESS, 0.0
+        over = not bool(np.any(status == RUNNING)) or self.ints[I_NSTEPS] <= 0
+        self.ints[I_DONE] = int(over)
+        self._finish()
+
+    def _refill(self) -> None:
+        """Every robot's unread numbers moved to the front, the rest drawn from its generator."""
+        if self.flt[F_EPS] > 0.0:
+            for i, g in enumerate(self._rngs):
+                rest = self.draws[i, self.upos[i] :].copy()
+                self.draws[i, : len(rest)] = rest
+                self.draws[i, len(rest) :] = g.random(2 * BLOCK - len(rest))
+        self.upos[:] = 0
+        self._safe = BLOCK
+
+    def _finish(self) -> None:
+        if self.ints[I_DONE]:
+            self.status[self.status == RUNNING] = TIMEOUT
+
+    @property
+    def done(self) -> bool:
+        """The episode is over (every robot arrived or collided, or the time limit)."""
+        return bool(self.ints[I_DONE])
+
+    @property
+    def step_index(self) -> int:
+        return int(self.ints[I_STEP])
+
+    @property
+    def t(self) -> float:
+        """Time now [s]."""
+        return self.step_index * self.dt
+
+    def step(self) -> bool:
+        """One step ``dt`` (decisions first when due); returns :attr:`done`."""
+        if self.ints[I_DONE]:
+            return True
+        if self._safe == 0:
+            self._refill()
+        self._safe -= 1
+        done = _step_kernel()(
+            self.rob, self.status, self.pairs, self.ints, self.flt, self.draws, self.upos,
+            self._scratch, self._idx, self._members, self._periods, self._pick, self._out,
+        )  # fmt: skip
+        if done:
+            self._finish()
+        return bool(done)
+
+    def run(self) -> None:
+        """Step to the end."""
+        while not self.step():
+            pass
+
+    def statuses(self) -> list[str]:
+        """Each robot's status name (``running`` while the episode goes on)."""
+        return [STATUS_NAMES[s] for s in self.status.tolist()]
+
+    def collided_pairs(self) -> list[tuple[int, int]]:
+        """The robot pairs (i < j) that overlapped."""
+        return [(int(i), int(j)) for i, j in zip(*np.nonzero(self.pairs), strict=True)]
