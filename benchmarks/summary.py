@@ -5,8 +5,8 @@ the JSON files the benchmarks wrote there; it measures nothing:
 
 * ``peers.json`` (``benchmarks/peers/irsim_steps.py``): the world step with 100 and 10 moving
   polygons [CPU µs, median] and its speed over ir-sim's;
-* ``peers_orca.json`` (``benchmarks/peers/navground_orca.py``): multi-robot ORCA
-  (``orca-shared-v1``) on ``antipodal:10`` / ``antipodal:100``, its CPU time per step over
+* ``peers_orca.json`` (``benchmarks/peers/navground_orca.py``): multi-robot ORCA (the packed
+  ``orca-shared-v1`` swarm) on ``antipodal:10`` / ``antipodal:100``, its CPU time per step over
   navground's (within 2x = at most 2);
 * ``campaign.json`` (``benchmarks/bench_campaign.py``): 10,000 episodes in <= 120 s wall;
 * ``vector_env.json`` (``benchmarks/bench_vector_env.py``): the vector env's target,

@@ -84,7 +84,7 @@ Choices (and why):
    as before.  Measured (``benchmarks/bench_orca.py``): building a simulator costs 0.34 µs and
    RVO2's step 0.42 µs of a decision's ~65 µs; the rest is this module's Python
    (docs/design-notes.md, "Shared ORCA"), so the saving is small;
-   :mod:`uvnav.controllers.orca_shared` decides a group of robots with one step.
+   :mod:`uvnav.controllers.orca_shared` decides a group of robots in one compiled call.
 """
 
 from __future__ import annotations

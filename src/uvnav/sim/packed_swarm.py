@@ -260,8 +260,8 @@ class PackedSwarm:
         template = FieldTemplate.from_bodies([DiscBody(max(r, 1e-6)) for r in radii])
         orad, oreach = group_geometry(p, radii, sensing)
         rob = np.zeros((n, NR))
-        rob[:, R_X:R_TH + 1] = [np.asarray(r.start, dtype=float)[:3] for r in robots]
-        rob[:, R_GX:R_GY + 1] = [np.asarray(r.goal, dtype=float)[:2] for r in robots]
+        rob[:, R_X : R_TH + 1] = [np.asarray(r.start, dtype=float)[:3] for r in robots]
+        rob[:, R_GX : R_GY + 1] = [np.asarray(r.goal, dtype=float)[:2] for r in robots]
         rob[:, R_RADIUS] = radii
         floor = 4.0 * float(radii.max()) + 1.0
         rob[:, R_REACH] = [max(s, floor) for s in sensing.tolist()]
