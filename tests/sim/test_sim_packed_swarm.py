@@ -16,7 +16,7 @@ from uvnav.geometry.kernels3d import numba_available, use_compiled
 from uvnav.obstacles import Obstacle
 from uvnav.scenarios.multi import antipodal_scenario, build_multi
 from uvnav.sim import SensingConfig
-from uvnav.sim.multi import MultiSetup, MultiUnicycleWorld, RobotSetup
+from uvnav.sim.multi import MultiSetup, MultiUnicycleWorld, RobotSetup, run_multi
 from uvnav.sim.packed_swarm import (
     BLOCK,
     R_CLEAR,
@@ -135,3 +135,27 @@ def test_what_cannot_be_packed_is_refused_with_its_reason() -> None:
     setup.obstacles = [Obstacle.moving_disc((0.0, 0.0), 0.3, (0.0, 0.0))]
     with pytest.raises(ValueError, match="1 obstacle"):
         PackedSwarm(setup, np.random.default_rng(0))
+
+
+@pytest.mark.parametrize("use_numba", KERNELS)
+@pytest.mark.parametrize("case", sorted(CASES))
+def test_run_multi_gives_the_loop_worlds_result_through_the_swarm(
+    case: str, use_numba: bool
+) -> None:
+    """run_multi runs these scenes as a packed swarm: its whole result (per-robot metrics, group
+    metrics, recorded poses) is the loop world's, decision times apart."""
+    with compiled(use_numba):
+        loop = run_multi(CASES[case](), np.random.default_rng(9), vectorised=False)
+        packed = run_multi(CASES[case](), np.random.default_rng(9))
+    timing = {"decision_us_median", "decision_us_p99"}
+    for a, b in zip(loop.robots, packed.robots, strict=True):
+        da, db = a.to_dict(), b.to_dict()
+        assert {k: da[k] for k in da if k not in timing} == {
+            k: db[k] for k in db if k not in timing
+        }
+    assert any(m.mode_switches for m in loop.robots) and any(m.control_effort for m in loop.robots)
+    assert loop.group == packed.group and loop.statuses == packed.statuses
+    assert loop.collided_pairs == packed.collided_pairs
+    assert loop.poses.tobytes() == packed.poses.tobytes()
+    assert loop.times.tobytes() == packed.times.tobytes()
+    assert all(m.decision_us_p99 > 0 for m in packed.robots)

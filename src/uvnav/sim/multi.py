@@ -488,45 +488,72 @@ class MultiUnicycleWorld:
     def metrics(self, log: AgentLog, agent: int) -> EpisodeMetrics:
         """Robot ``agent``'s metrics (the names of a single-robot episode's)."""
         i = agent
-        spec = self.robots[i].spec
-        shortest = max(float(self.start_dist[i]) - self.tol, 0.0)
-        return episode_metrics(
-            status=self.status[i],
-            path_length=float(self.path[i]),
-            shortest=shortest,
-            straight_time=shortest / spec.v_max if spec.v_max > 0 else 0.0,
-            reached_at=self.reached[i],
-            min_clearance=float(self.min_clear[i]) if math.isfinite(self.min_clear[i]) else None,
-            control_effort=float(self.effort[i]),
-            limit_violations=int(self.violations[i]),
-            mode_switches=log.mode_switches,
-            decision_us=log.timed_us,
-        )
+        return robot_metrics(
+            self.robots[i].spec, float(self.start_dist[i]), self.tol, self.status[i],
+            float(self.path[i]), self.reached[i], float(self.min_clear[i]), float(self.effort[i]),
+            int(self.violations[i]), log,
+        )  # fmt: skip
 
     def group_metrics(self) -> GroupMetrics:
-        """The group's outcome (module docstring); a robot is stuck when it moved less than
-        ``deadlock_distance`` between the start of the deadlock window and now."""
-        n, status, setup = self.n_agents, self.status, self.setup
-        arrived = sum(s == "success" for s in status)
-        all_arrived = arrived == n
-        arrival_times = [a for a in self.reached if a is not None]
-        moved = np.hypot(*(self.state[:, :2] - self.history[0]).T) if self.history else np.zeros(n)
-        stuck = sum(
-            1
-            for i in range(n)
-            if status[i] == "timeout"
-            and self.t >= setup.deadlock_window
-            and moved[i] < setup.deadlock_distance
-        )
-        return GroupMetrics(
-            all_arrived=all_arrived,
-            arrived=int(arrived),
-            robot_collisions=len(self.pairs),
-            obstacle_collisions=int(self.obstacle_hits),
-            makespan=max(arrival_times) if all_arrived else None,
-            sum_of_times=float(sum(arrival_times)) if all_arrived else None,
-            deadlocks=int(stuck),
-        )
+        """The group's outcome (module docstring, :func:`group_outcome`)."""
+        return group_outcome(
+            self.setup, self.status, self.reached, self.state[:, :2],
+            self.history[0] if self.history else None, self.t, len(self.pairs),
+            self.obstacle_hits,
+        )  # fmt: skip
+
+
+def robot_metrics(
+    spec: UnicycleSpec, start_dist: float, tol: float, status: str, path: float,
+    reached: float | None, min_clear: float, effort: float, violations: int, log: AgentLog,
+) -> EpisodeMetrics:  # fmt: skip
+    """One robot's metrics (the names of a single-robot episode's) from its bookkeeping: the
+    distance to its goal at the start [m], path [m], arrival time [s], lowest clearance [m]
+    (``inf``: nothing ever within reach), effort, violations and the loop's log."""
+    shortest = max(start_dist - tol, 0.0)
+    return episode_metrics(
+        status=status,
+        path_length=path,
+        shortest=shortest,
+        straight_time=shortest / spec.v_max if spec.v_max > 0 else 0.0,
+        reached_at=reached,
+        min_clearance=min_clear if math.isfinite(min_clear) else None,
+        control_effort=effort,
+        limit_violations=violations,
+        mode_switches=log.mode_switches,
+        decision_us=log.timed_us,
+    )
+
+
+def group_outcome(
+    setup: MultiSetup, status: Sequence[str], reached: Sequence[float | None], xy: FloatArray,
+    window_start: FloatArray | None, t: float, robot_collisions: int, obstacle_collisions: int,
+) -> GroupMetrics:  # fmt: skip
+    """The group's outcome (module docstring) from every robot's status, arrival time and
+    position now [m], the positions at the start of the deadlock window (None: no step yet),
+    the time [s] and the collision counts; a robot is stuck when it moved less than
+    ``deadlock_distance`` since the window's start."""
+    n = len(status)
+    arrived = sum(s == "success" for s in status)
+    all_arrived = arrived == n
+    arrival_times = [a for a in reached if a is not None]
+    moved = np.hypot(*(xy - window_start).T) if window_start is not None else np.zeros(n)
+    stuck = sum(
+        1
+        for i in range(n)
+        if status[i] == "timeout"
+        and t >= setup.deadlock_window
+        and moved[i] < setup.deadlock_distance
+    )
+    return GroupMetrics(
+        all_arrived=all_arrived,
+        arrived=int(arrived),
+        robot_collisions=robot_collisions,
+        obstacle_collisions=obstacle_collisions,
+        makespan=max(arrival_times) if all_arrived else None,
+        sum_of_times=float(sum(arrival_times)) if all_arrived else None,
+        deadlocks=int(stuck),
+    )
 
 
 class PosesProbe(BaseProbe):
@@ -558,12 +585,18 @@ def run_multi(
         setup: the instantiated scene; its obstacles are advanced in place.
         rng: episode generator; each robot gets independent children for its law and sensors.
         record: keep every robot's pose at every integration step (figures).
-        vectorised: check and sense all robots at once when the world holds only robots
-            (identical results; ``False`` forces one field query per robot).
+        vectorised: check and sense all robots at once when the world holds only robots, and
+            run a swarm of ``orca-shared-v1`` robots as a
+            :class:`~uvnav.sim.packed_swarm.PackedSwarm` (identical results, decision times
+            apart; ``False`` forces the loop world with one field query per robot).
 
     Raises:
         ValueError: ``control_period`` is not a whole multiple of ``dt``, or no robot.
     """
+    from uvnav.sim.packed_swarm import run_swarm, swarm_check
+
+    if vectorised and swarm_check(setup) is None:
+        return run_swarm(setup, rng, record=record)
     world = MultiUnicycleWorld(setup, rng, vectorised=vectorised)
     rec = PosesProbe() if record else None
     try:

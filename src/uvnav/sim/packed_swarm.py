@@ -1,38 +1,43 @@
-"""Packed swarms: N unicycles deciding by ``orca-shared-v1``, stepped in one compiled call.
+"""Packed swarms: N unicycles deciding by ``orca-shared-v1``, stepped in two compiled calls a step.
 
 The multi-robot world of :mod:`uvnav.sim.multi` (thesis Ch. 8's robots that avoid each other;
 unicycles (2.1)-(2.4) with disc bodies) for the case that needs speed more than generality: every
 robot on ``orca-shared-v1`` with the same parameters (ORCA, van den Berg et al., ISRR 2009:
 :mod:`uvnav.controllers.orca_shared`), exact sensing with known velocities, no obstacle besides
-the robots.  The whole step — the group decision
-(:func:`uvnav.controllers.orca_kernels.decide_group_py`), the commands held and saturated, the
-unicycles, the robot-pair checks, arrivals and the time limit — is :func:`swarm_step_py`, one
-loop over preallocated arrays, compiled by numba when it is enabled; the Python function is the
-reference and the fallback.
+the robots.  A step is :func:`swarm_decide_py` (the group decision,
+:func:`uvnav.controllers.orca_kernels.decide_group_py`, when one is due, and the commands held)
+then :func:`swarm_advance_py` (the unicycles, robot-pair checks, arrivals, time limit): loops over
+preallocated arrays, compiled by numba when it is enabled; the Python functions are the reference
+and the fallback.  Two calls, not one, so that the decisions are timed as the one loop times a
+group's (:func:`uvnav.core.run_loop`: CPU and wall time divided among the members).
 
 It is :func:`uvnav.core.run_loop` over :class:`~uvnav.sim.multi.MultiUnicycleWorld` bit for bit
-(the tests compare every pose, status, clearance and collided pair at every step):
+(the tests compare every pose, status, clearance and collided pair at every step, and the whole
+:class:`~uvnav.sim.multi.MultiResult`), so :func:`~uvnav.sim.multi.run_multi` runs such scenes
+here (:func:`run_swarm`; campaigns and ``uvnav simulate`` with them):
 
 * decisions: the group law's own kernel; each robot's decision clock is its law's
   (``FIRST_PERIOD`` at the first decision, then the time since the last, at least 1 ms); the
   perturbation's draws come from each law's generator (child 2i of the episode generator, as
   :meth:`MultiUnicycleWorld.law_setup` gives it), pre-drawn in blocks
   (``Generator.random(n)`` gives the numbers of ``n`` single draws);
-* commands: :meth:`~uvnav.dynamics.unicycle.UnicycleCommand.clipped`;
+* commands: :meth:`MultiUnicycleWorld.apply` (violations counted, effort of the speed change,
+  :meth:`~uvnav.dynamics.unicycle.UnicycleCommand.clipped`); modes counted as
+  :class:`uvnav.core.AgentLog` counts them;
 * motion: :func:`~uvnav.dynamics.unicycle.unicycle_advance`; the path with
-  :func:`~uvnav.geometry.small.pyhypot` (CPython's ``math.hypot``);
+  :func:`~uvnav.geometry.small.pyhypot` (CPython's ``math.hypot``); the deadlock window's
+  positions in a ring;
 * pairs: the arithmetic of :class:`uvnav.sim.multi._DiscPairs` with numpy's ``hypot`` (libm's,
   not CPython's) where it uses it.
 
-Not kept here: control effort, limit violations, mode switches, decision times and the deadlock
-window (the loop world's metrics); :class:`PackedSwarm` is for stepping fast, the loop world for
-the record.
+Decision times are measured, so they differ from run to run, as the loop's do.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+import time as _time
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -40,6 +45,7 @@ import numpy as np
 from uvnav.controllers.base import LawState
 from uvnav.controllers.orca_kernels import FAMILY, decide_group_py
 from uvnav.controllers.orca_shared import OrcaShared, group_geometry, group_scratch
+from uvnav.core import AgentLog
 from uvnav.dynamics.unicycle import unicycle_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
@@ -47,7 +53,7 @@ from uvnav.geometry.small import pyhypot
 from uvnav.obstacles.bodies import DiscBody
 from uvnav.obstacles.obstacle import _CULL_ABS, _CULL_REL, _X_AXIS, FieldTemplate
 from uvnav.sim.episode import decision_ratio
-from uvnav.sim.multi import MultiSetup
+from uvnav.sim.multi import MultiResult, MultiSetup, group_outcome, robot_metrics
 
 #: status codes of a packed robot (those of :mod:`uvnav.sim.packed`)
 RUNNING, SUCCESS, COLLISION, TIMEOUT = 0, 1, 2, 3
@@ -58,13 +64,15 @@ BLOCK = 64
 # velocity [m/s, m/s], goal [m], body radius [m], collision reach [m], ORCA radius [m], ORCA
 # neighbour range [m], V_max [m/s], U_max [rad/s], disc radius and bounding radius of the body
 # in the field [m], time reached [s] (NaN: not yet), path [m], clearance now and lowest [m],
-# time of the last decision [s] (NaN: none yet).
+# time of the last decision [s] (NaN: none yet), control effort, commands outside the limits,
+# decisions taken, mode switches, last mode (-1: none yet, 0: M1, 1: M2).
 (R_X, R_Y, R_TH, R_V, R_U, R_VX, R_VY, R_GX, R_GY, R_RADIUS, R_REACH, R_ORAD, R_OREACH, R_VMAX,
- R_UMAX, R_DISC, R_BOUND, R_REACHED, R_PATH, R_CLEAR, R_LOW, R_LAST_T) = range(22)  # fmt: skip
-NR = 22
+ R_UMAX, R_DISC, R_BOUND, R_REACHED, R_PATH, R_CLEAR, R_LOW, R_LAST_T, R_EFFORT, R_VIOL, R_NDEC,
+ R_SWITCH, R_MODE) = range(27)  # fmt: skip
+NR = 27
 # Entries of the int array of the swarm: step index, steps per decision, steps in the episode,
-# 1 when the episode is over, max_neighbors.
-(I_STEP, I_RATIO, I_NSTEPS, I_DONE, I_MAXNB) = range(5)
+# 1 when the episode is over, max_neighbors, next slot and length of the position history.
+(I_STEP, I_RATIO, I_NSTEPS, I_DONE, I_MAXNB, I_HNEXT, I_HLEN) = range(7)
 # Entries of the float array of the swarm: dt [s], goal tolerance [m], perturbation [m/s], time
 # horizon [s], responsibility, first decision period [s].
 (F_DT, F_TOL, F_EPS, F_TAU, F_RESP, F_FIRST) = range(6)
@@ -131,75 +139,113 @@ def _pair_check(rob: FloatArray, status: np.ndarray, pairs: np.ndarray) -> None:
 def _arrivals(rob: FloatArray, status: np.ndarray, t: float, tol: float) -> None:
     """Robots within ``tol`` of their goals arrive at ``t``."""
     for i in range(rob.shape[0]):
-        if status[i] == RUNNING and pyhypot(rob[i, R_GX] - rob[i, R_X], rob[i, R_GY] - rob[i, R_Y]) <= tol:  # fmt: skip
+        if status[i] != RUNNING:
+            continue
+        if pyhypot(rob[i, R_GX] - rob[i, R_X], rob[i, R_GY] - rob[i, R_Y]) <= tol:
             status[i], rob[i, R_REACHED] = SUCCESS, t
 
 
-def swarm_step_py(
-    rob: FloatArray, status: np.ndarray, pairs: np.ndarray, ints: np.ndarray, flt: FloatArray,
-    draws: FloatArray, upos: np.ndarray, scratch: FloatArray, idx: np.ndarray,
-    members: np.ndarray, periods: FloatArray, pick: FloatArray, out: FloatArray,
+def swarm_decide_py(
+    rob: FloatArray, status: np.ndarray, ints: np.ndarray, flt: FloatArray, draws: FloatArray,
+    upos: np.ndarray, scratch: FloatArray, idx: np.ndarray, members: np.ndarray,
+    periods: FloatArray, pick: FloatArray, out: FloatArray,
 ) -> int:  # fmt: skip
-    """One iteration of the loop (decisions when due, one step ``dt``, checks); returns 1 when
-    the episode is over.  ``draws`` (N, 2 BLOCK) holds each robot's pre-drawn numbers from
-    ``upos[i]`` on; the other arrays are the swarm's (:class:`PackedSwarm`)."""
+    """The decisions of the running robots when one is due (every ``ratio`` steps), held as
+    :meth:`MultiUnicycleWorld.apply` holds them (limit violations counted, effort of the speed
+    change, saturated; the mode of each decision counted as :class:`uvnav.core.AgentLog` counts
+    it); returns how many robots decided.  ``draws`` (N, 2 BLOCK) holds each robot's pre-drawn
+    numbers from ``upos[i]`` on; the other arrays are the swarm's (:class:`PackedSwarm`)."""
     n = rob.shape[0]
     dt = flt[F_DT]
     step = ints[I_STEP]
+    if step % ints[I_RATIO] != 0:
+        return 0
     t = step * dt
-    if step % ints[I_RATIO] == 0:
-        m = 0
-        for i in range(n):
-            if status[i] == RUNNING:
-                members[m] = i
-                last = rob[i, R_LAST_T]
-                if last != last:
-                    periods[m] = flt[F_FIRST]
-                else:
-                    period = t - last
-                    periods[m] = period if not (1e-3 > period) else 1e-3
-                rob[i, R_LAST_T] = t
-                if flt[F_EPS] > 0.0:
-                    pick[m, 0], pick[m, 1] = draws[i, upos[i]], draws[i, upos[i] + 1]
-                    upos[i] += 2
-                m += 1
-        if m:
-            decide_group_py(
-                members[:m], rob[:, R_X:R_Y + 1], rob[:, R_TH], rob[:, R_VX:R_VY + 1],
-                rob[:, R_ORAD], rob[:, R_OREACH], rob[:, R_GX:R_GY + 1], rob[:, R_VMAX],
-                rob[:, R_UMAX], periods[:m], pick[:m], flt[F_EPS], ints[I_MAXNB], flt[F_TAU],
-                flt[F_RESP], scratch, idx, out[:m],
-            )  # fmt: skip
-            for k in range(m):
-                i = members[k]
-                v, u = out[k, 0], out[k, 1]
-                vmax, umax = rob[i, R_VMAX], rob[i, R_UMAX]
-                if math.isfinite(v):
-                    v = 0.0 if 0.0 > v else v
-                    v = vmax if vmax < v else v
-                else:
-                    v = 0.0
-                if math.isfinite(u):
-                    u = -umax if -umax > u else u
-                    u = umax if umax < u else u
-                else:
-                    u = 0.0
-                rob[i, R_V], rob[i, R_U] = v, u
+    m = 0
+    for i in range(n):
+        if status[i] == RUNNING:
+            members[m] = i
+            last = rob[i, R_LAST_T]
+            if last != last:
+                periods[m] = flt[F_FIRST]
+            else:
+                period = t - last
+                periods[m] = period if not (period < 1e-3) else 1e-3
+            rob[i, R_LAST_T] = t
+            if flt[F_EPS] > 0.0:
+                pick[m, 0], pick[m, 1] = draws[i, upos[i]], draws[i, upos[i] + 1]
+                upos[i] += 2
+            m += 1
+    if m == 0:
+        return 0
+    decide_group_py(
+        members[:m], rob[:, R_X:R_Y + 1], rob[:, R_TH], rob[:, R_VX:R_VY + 1], rob[:, R_ORAD],
+        rob[:, R_OREACH], rob[:, R_GX:R_GY + 1], rob[:, R_VMAX], rob[:, R_UMAX], periods[:m],
+        pick[:m], flt[F_EPS], ints[I_MAXNB], flt[F_TAU], flt[F_RESP], scratch, idx, out[:m],
+    )  # fmt: skip
+    for k in range(m):
+        i = members[k]
+        v, u = out[k, 0], out[k, 1]
+        vmax, umax = rob[i, R_VMAX], rob[i, R_UMAX]
+        if v < -1e-9 or v > vmax + 1e-9 or abs(u) > umax + 1e-9:
+            rob[i, R_VIOL] += 1.0
+        if math.isfinite(v):
+            v = 0.0 if v < 0.0 else v
+            v = vmax if vmax < v else v
+        else:
+            v = 0.0
+        if math.isfinite(u):
+            u = -umax if -umax > u else u
+            u = umax if umax < u else u
+        else:
+            u = 0.0
+        if step:
+            rob[i, R_EFFORT] += ((v - rob[i, R_V]) ** 2) / (ints[I_RATIO] * dt)
+        else:
+            rob[i, R_EFFORT] += 0.0
+        rob[i, R_V], rob[i, R_U] = v, u
+        mode = out[k, 6]
+        if rob[i, R_NDEC] > 0.0 and mode != rob[i, R_MODE]:
+            rob[i, R_SWITCH] += 1.0
+        rob[i, R_MODE] = mode
+        rob[i, R_NDEC] += 1.0
+    return m
+
+
+def swarm_advance_py(
+    rob: FloatArray,
+    status: np.ndarray,
+    pairs: np.ndarray,
+    ints: np.ndarray,
+    flt: FloatArray,
+    hist: FloatArray,
+) -> int:
+    """One step ``dt`` (:meth:`MultiUnicycleWorld.advance`): the positions into the deadlock
+    window's ring ``hist`` (W + 1, N, 2), the running robots moved, then pairs, clearances,
+    collisions, arrivals and the time limit; returns 1 when the episode is over."""
+    n = rob.shape[0]
+    dt = flt[F_DT]
+    slot = ints[I_HNEXT]
+    for i in range(n):
+        hist[slot, i, 0], hist[slot, i, 1] = rob[i, R_X], rob[i, R_Y]
+    ints[I_HNEXT] = (slot + 1) % hist.shape[0]
+    if ints[I_HLEN] < hist.shape[0]:
+        ints[I_HLEN] += 1
     for i in range(n):
         if status[i] != RUNNING:
             rob[i, R_VX] = rob[i, R_VY] = 0.0
             continue
-        x, y = rob[i, R_X], rob[i, R_Y]
-        nx, ny, nth = unicycle_advance(x, y, rob[i, R_TH], rob[i, R_V], rob[i, R_U], dt)
+        x, y, u = rob[i, R_X], rob[i, R_Y], rob[i, R_U]
+        rob[i, R_EFFORT] += u * u * dt
+        nx, ny, nth = unicycle_advance(x, y, rob[i, R_TH], rob[i, R_V], u, dt)
         rob[i, R_PATH] += pyhypot(nx - x, ny - y)
         rob[i, R_X], rob[i, R_Y], rob[i, R_TH] = nx, ny, nth
         rob[i, R_VX] = rob[i, R_V] * math.cos(nth)
         rob[i, R_VY] = rob[i, R_V] * math.sin(nth)
-    step += 1
+    step = ints[I_STEP] + 1
     ints[I_STEP] = step
-    t = step * dt
     _pair_check(rob, status, pairs)
-    _arrivals(rob, status, t, flt[F_TOL])
+    _arrivals(rob, status, step * dt, flt[F_TOL])
     running = False
     for i in range(n):
         if status[i] == RUNNING:
@@ -212,14 +258,15 @@ def swarm_step_py(
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
 
-def _step_kernel() -> Callable[..., Any]:
+def _kernels() -> tuple[Callable[..., Any], Callable[..., Any]]:
+    """:func:`swarm_decide_py` and :func:`swarm_advance_py`, compiled when numba is enabled."""
     if not numba_enabled():
-        return swarm_step_py
+        return swarm_decide_py, swarm_advance_py
     if not _KERNELS:
-        _KERNELS.update(
-            compile_family((*FAMILY, unicycle_advance, _pair_check, _arrivals, swarm_step_py))
-        )
-    return _KERNELS["swarm_step_py"]
+        _KERNELS.update(compile_family(
+            (*FAMILY, unicycle_advance, _pair_check, _arrivals, swarm_decide_py, swarm_advance_py)
+        ))  # fmt: skip
+    return _KERNELS["swarm_decide_py"], _KERNELS["swarm_advance_py"]
 
 
 class PackedSwarm:
@@ -235,6 +282,7 @@ class PackedSwarm:
         rob: (N, NR) the robots (``R_*`` columns).
         status: (N,) status codes (``RUNNING`` until arrival or collision; ``TIMEOUT`` at the end).
         pairs: (N, N) 1 where robots i < j overlapped at some step.
+        start_dist: (N,) each robot's distance to its goal at the start [m].
 
     Raises:
         ValueError: the scene cannot be packed (the reason in one line), or ``control_period``
@@ -252,6 +300,7 @@ class PackedSwarm:
         law: Any = robots[0].controller
         p = law.params
         dt = float(setup.dt)
+        self.setup = setup
         self.n = n
         self.dt = dt
         self._rngs = rng.spawn(2 * n)[0::2]  # each law's generator (child 2i)
@@ -271,17 +320,20 @@ class PackedSwarm:
         rob[:, R_DISC], rob[:, R_BOUND] = template.radii, template.bounding_radii
         rob[:, R_REACHED] = rob[:, R_LAST_T] = np.nan
         rob[:, R_CLEAR] = rob[:, R_LOW] = np.inf
+        rob[:, R_MODE] = -1.0
         self.rob = rob
         self.status = np.zeros(n, dtype=np.int64)
         self.pairs = np.zeros((n, n), dtype=np.uint8)
         self.ints = np.array(
             [0, decision_ratio(float(setup.control_period), dt), round(setup.t_max / dt), 0,
-             int(p.max_neighbors)], dtype=np.int64,
+             int(p.max_neighbors), 0, 0], dtype=np.int64,
         )  # fmt: skip
         self.flt = np.array(
             [dt, float(setup.goal_tolerance), float(p.perturbation), float(p.time_horizon),
              float(p.responsibility), float(LawState.FIRST_PERIOD)],
         )  # fmt: skip
+        window = max(1, round(setup.deadlock_window / dt))
+        self.hist = np.zeros((window + 1, n, 2))  # the last window + 1 positions before a step
         self.draws = np.zeros((n, 2 * BLOCK))
         self.upos = np.full(n, 2 * BLOCK, dtype=np.int64)
         self._safe = 0  # steps that cannot run out of pre-drawn numbers
@@ -290,15 +342,17 @@ class PackedSwarm:
         self._periods = np.zeros(n)
         self._pick = np.zeros((n, 2))
         self._out = np.zeros((n, 7))
+        self._cpu_ns: list[int] = []  # each group decision's CPU and wall time per member [ns]
+        self._wall_ns: list[int] = []
         self._start()
 
     def _start(self) -> None:
         """Checks and arrivals at t = 0 (:meth:`MultiUnicycleWorld.start`)."""
         rob, status = self.rob, self.status
         _pair_check(rob, status, self.pairs)
-        start_dist = np.hypot(rob[:, R_GX] - rob[:, R_X], rob[:, R_GY] - rob[:, R_Y])
+        self.start_dist = np.hypot(*(rob[:, R_GX : R_GY + 1] - rob[:, R_X : R_Y + 1]).T)
         for i in range(self.n):
-            if status[i] == RUNNING and start_dist[i] <= self.flt[F_TOL]:
+            if status[i] == RUNNING and self.start_dist[i] <= self.flt[F_TOL]:
                 status[i], rob[i, R_REACHED] = SUCCESS, 0.0
         over = not bool(np.any(status == RUNNING)) or self.ints[I_NSTEPS] <= 0
         self.ints[I_DONE] = int(over)
@@ -333,16 +387,25 @@ class PackedSwarm:
         return self.step_index * self.dt
 
     def step(self) -> bool:
-        """One step ``dt`` (decisions first when due); returns :attr:`done`."""
+        """One iteration of the loop: the decisions when due (their CPU and wall time kept, as
+        :func:`uvnav.core.run_loop` keeps a group's), then one step ``dt``; returns
+        :attr:`done`."""
         if self.ints[I_DONE]:
             return True
         if self._safe == 0:
             self._refill()
         self._safe -= 1
-        done = _step_kernel()(
-            self.rob, self.status, self.pairs, self.ints, self.flt, self.draws, self.upos,
-            self._scratch, self._idx, self._members, self._periods, self._pick, self._out,
+        decide, advance = _kernels()
+        c0, w0 = _time.thread_time_ns(), _time.perf_counter_ns()
+        m = decide(
+            self.rob, self.status, self.ints, self.flt, self.draws, self.upos, self._scratch,
+            self._idx, self._members, self._periods, self._pick, self._out,
         )  # fmt: skip
+        if m:
+            c1, w1 = _time.thread_time_ns(), _time.perf_counter_ns()
+            self._cpu_ns.append((c1 - c0) // m)
+            self._wall_ns.append((w1 - w0) // m)
+        done = advance(self.rob, self.status, self.pairs, self.ints, self.flt, self.hist)
         if done:
             self._finish()
         return bool(done)
@@ -359,3 +422,65 @@ class PackedSwarm:
     def collided_pairs(self) -> list[tuple[int, int]]:
         """The robot pairs (i < j) that overlapped."""
         return [(int(i), int(j)) for i, j in zip(*np.nonzero(self.pairs), strict=True)]
+
+    def logs(self) -> list[AgentLog]:
+        """Each robot's :class:`~uvnav.core.AgentLog`: its mode switches, and its share of every
+        group decision it took (a robot decides at every decision time from the start until it
+        arrives or collides, so its decisions are the first ``R_NDEC`` of the group's)."""
+        out = []
+        for i in range(self.n):
+            k = int(self.rob[i, R_NDEC])
+            mode = int(self.rob[i, R_MODE])
+            out.append(AgentLog(
+                mode_switches=int(self.rob[i, R_SWITCH]),
+                decision_us=[c / 1000.0 for c in self._cpu_ns[:k]],
+                decision_wall_us=[w / 1000.0 for w in self._wall_ns[:k]],
+                last_mode="" if mode < 0 else ("M2" if mode else "M1"),
+                _decided=k > 0,
+            ))  # fmt: skip
+        return out
+
+    def result(self, poses: Sequence[FloatArray] = (), times: Sequence[float] = ()) -> MultiResult:
+        """The episode's :class:`~uvnav.sim.multi.MultiResult` (``poses`` / ``times``: the
+        recorded poses before each step and at the end, as :class:`PosesProbe` records them)."""
+        rob, setup = self.rob, self.setup
+        status = self.statuses()
+        reached = [None if r != r else float(r) for r in rob[:, R_REACHED].tolist()]
+        hlen, cap = int(self.ints[I_HLEN]), self.hist.shape[0]
+        start = self.hist[(int(self.ints[I_HNEXT]) - hlen) % cap] if hlen else None
+        pairs = self.collided_pairs()
+        logs = self.logs()
+        tol = float(self.flt[F_TOL])
+        robots = []
+        for i in range(self.n):
+            robots.append(robot_metrics(
+                setup.robots[i].spec, float(self.start_dist[i]), tol, status[i],
+                float(rob[i, R_PATH]), reached[i], float(rob[i, R_LOW]), float(rob[i, R_EFFORT]),
+                int(rob[i, R_VIOL]), logs[i],
+            ))  # fmt: skip
+        return MultiResult(
+            robots=robots,
+            statuses=status,
+            group=group_outcome(
+                setup, status, reached, rob[:, R_X : R_Y + 1], start, self.t, len(pairs), 0
+            ),
+            times=np.asarray(times) if len(times) else np.zeros(0),
+            poses=np.asarray(poses) if len(poses) else np.zeros((0, self.n, 3)),
+            collided_pairs=pairs,
+        )
+
+
+def run_swarm(setup: MultiSetup, rng: np.random.Generator, *, record: bool = True) -> MultiResult:
+    """:func:`uvnav.sim.multi.run_multi`'s episode in a :class:`PackedSwarm` (the same result,
+    decision times apart); ``record`` keeps every robot's pose at every step."""
+    swarm = PackedSwarm(setup, rng)
+    poses: list[FloatArray] = []
+    times: list[float] = []
+    while True:
+        if record:
+            times.append(swarm.t)
+            poses.append(swarm.rob[:, R_X : R_TH + 1].copy())
+        if swarm.done:
+            break
+        swarm.step()
+    return swarm.result(poses, times)
