@@ -5,8 +5,6 @@ at responsibility 0.5 is RVO2's own step up to RVO2's float32 rounding."""
 from __future__ import annotations
 
 import math
-from collections.abc import Iterator
-from contextlib import contextmanager
 
 import numpy as np
 import pytest
@@ -16,20 +14,11 @@ from hypothesis import strategies as st
 from uvnav.controllers.orca import track_velocity
 from uvnav.controllers.orca_kernels import kernel, solve_orca_lines
 from uvnav.dynamics.unicycle import UnicycleSpec
-from uvnav.geometry.kernels3d import numba_available, use_compiled
+from uvnav.geometry.kernels3d import compiled, numba_available
 
 coord = st.floats(-5.0, 5.0, allow_nan=False)
 angle = st.floats(-math.pi, math.pi, allow_nan=False)
 line = st.tuples(coord, coord, angle)
-
-
-@contextmanager
-def compiled(on: bool) -> Iterator[None]:
-    before = use_compiled(on)
-    try:
-        yield
-    finally:
-        use_compiled(before)
 
 
 def as_lines(rows: list[tuple[float, float, float]]) -> np.ndarray:

@@ -28,7 +28,7 @@ from uvnav.geometry.contact import (
     closest_gap,
     first_contact,
 )
-from uvnav.geometry.kernels3d import numba_available, use_compiled
+from uvnav.geometry.kernels3d import compiled, numba_available
 from uvnav.scenarios.catalog import resolve
 from uvnav.scenarios.episodes import run_scene
 from uvnav.sensors.observation import Observation, ObstacleReading
@@ -265,11 +265,8 @@ def test_fig_2_10_path_no_longer_than_v1() -> None:
 @pytest.mark.skipif(not numba_available(), reason="needs numba (the fast extra)")
 def test_law_gives_the_same_commands_on_both_paths() -> None:
     obs = observe(*(pedestrian(k, 1.0 + 0.7 * k, (-1) ** k * 0.6, -0.8, 0.1) for k in range(6)))
-    previous = use_compiled(False)
-    try:
+    with compiled(False):
         slow = plan(obs, GOAL, 1.0, 0.3, 0.25, np.zeros(2), PARAMS, heading=0.2, u_max=math.pi)
-    finally:
-        use_compiled(previous)
     fast = plan(obs, GOAL, 1.0, 0.3, 0.25, np.zeros(2), PARAMS, heading=0.2, u_max=math.pi)
     np.testing.assert_allclose(fast.velocity, slow.velocity, atol=1e-12)
 
@@ -316,12 +313,9 @@ def test_loop_chooses_what_the_numpy_reference_chooses(
     obs, v_prev = _random_scene(seed, n, polygons)
     kw = {"heading": obs.heading, "u_max": math.pi} if unicycle else {}
     args = (obs, GOAL, 1.0, 0.3, 0.25, v_prev, PARAMS)
-    previous = use_compiled(False)
-    try:
+    with compiled(False):
         ref = plan(*args, loop=False, **kw)  # type: ignore[arg-type]
         got = plan(*args, loop=True, **kw)  # type: ignore[arg-type]
-    finally:
-        use_compiled(previous)
     np.testing.assert_allclose(got.velocity, ref.velocity, atol=1e-9)
     assert got.ttc == pytest.approx(ref.ttc, abs=1e-9) or got.ttc == ref.ttc
     assert got.preferred == ref.preferred
@@ -334,11 +328,8 @@ def test_compiled_loop_chooses_what_plain_python_chooses(seed: int, n: int, poly
     obs, v_prev = _random_scene(seed, n, polygons)
     args = (obs, GOAL, 1.0, 0.3, 0.25, v_prev, PARAMS)
     fast = plan(*args, loop=True, heading=obs.heading, u_max=math.pi)
-    previous = use_compiled(False)
-    try:
+    with compiled(False):
         slow = plan(*args, loop=True, heading=obs.heading, u_max=math.pi)
-    finally:
-        use_compiled(previous)
     np.testing.assert_allclose(fast.velocity, slow.velocity, atol=1e-9)
 
 

@@ -11,7 +11,7 @@ import pytest
 import uvnav.envs
 from uvnav.envs.nav2d import Nav2DEnv
 from uvnav.envs.nav2d_vec import Nav2DVectorEnv
-from uvnav.geometry.kernels3d import numba_available, use_compiled
+from uvnav.geometry.kernels3d import compiled, numba_available
 
 gym.register_envs(uvnav.envs)
 
@@ -58,11 +58,8 @@ def test_equal_with_raw_commands_and_a_short_lidar() -> None:
 
 @pytest.mark.skipif(not numba_available(), reason="needs numba (the fast extra)")
 def test_python_kernels_give_the_same_numbers() -> None:
-    previous = use_compiled(False)
-    try:
+    with compiled(False):
         assert_same_run("random-ch2:2", 2, 40)
-    finally:
-        use_compiled(previous)
 
 
 def test_seeds_per_env_and_episode_seed_option() -> None:

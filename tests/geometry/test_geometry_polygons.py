@@ -11,7 +11,7 @@ from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from shapely.geometry import LineString, Point, Polygon
 
-from uvnav.geometry.kernels3d import numba_available, use_compiled
+from uvnav.geometry.kernels3d import compiled, numba_available
 from uvnav.geometry.polygons import (
     angular_extent,
     closed_rings,
@@ -298,13 +298,10 @@ def test_compiled_rings_nearest_equals_the_array_version_bit_for_bit(
     on a vertex and with the zero-length edges of the padding."""
     rings, _ = closed_rings(polys)
     p = (x, y) if on_vertex is None else tuple(polys[0][on_vertex])
-    previous = use_compiled(False)
-    try:
+    with compiled(False):
         ref = [rings_nearest(p, rings, parity=par) for par in (True, False)]
-        use_compiled(True)
+    with compiled(True):
         got = [rings_nearest(p, rings, parity=par) for par in (True, False)]
-    finally:
-        use_compiled(previous)
     for (d0, n0, i0), (d1, n1, i1) in zip(ref, got, strict=True):
         assert np.array_equal(d0, d1) and np.array_equal(n0, n1)
         assert (i0 is None and i1 is None) or np.array_equal(i0, i1)

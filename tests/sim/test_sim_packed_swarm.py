@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterator
-from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -12,7 +10,7 @@ import pytest
 from uvnav.controllers.base import make_law
 from uvnav.core import BaseProbe, run_loop
 from uvnav.dynamics import UnicycleSpec
-from uvnav.geometry.kernels3d import numba_available, use_compiled
+from uvnav.geometry.kernels3d import compiled, numba_available
 from uvnav.obstacles import Obstacle
 from uvnav.scenarios.multi import antipodal_scenario, build_multi
 from uvnav.sim import SensingConfig
@@ -31,15 +29,6 @@ from uvnav.sim.packed_swarm import (
 
 KERNELS = [False, pytest.param(True, marks=pytest.mark.skipif(
     not numba_available(), reason="numba is not installed"))]  # fmt: skip
-
-
-@contextmanager
-def compiled(on: bool) -> Iterator[None]:
-    before = use_compiled(on)
-    try:
-        yield
-    finally:
-        use_compiled(before)
 
 
 class Rows(BaseProbe):

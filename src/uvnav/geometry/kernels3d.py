@@ -33,7 +33,8 @@ import importlib.util
 import math
 import os
 import types
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from typing import Any
 
 import numpy as np
@@ -82,6 +83,16 @@ def use_compiled(enabled: bool) -> bool:
     previous = _ENABLED
     _ENABLED = bool(enabled) and _HAVE_NUMBA
     return previous
+
+
+@contextmanager
+def compiled(enabled: bool) -> Iterator[None]:
+    """:func:`use_compiled` for the ``with`` block only (the setting before it is restored)."""
+    previous = use_compiled(enabled)
+    try:
+        yield
+    finally:
+        use_compiled(previous)
 
 
 def closest_barycentric_scalar(
