@@ -185,3 +185,32 @@ def test_unpackable_scenes_are_refused_with_the_reason() -> None:
     with pytest.raises(ValueError, match="obstacle 1 moves by Waypoints"):
         PackedWorlds(1).load(0, setup)
     assert pack_check(mixed_setup(0)) is None
+
+
+def test_decisions_that_read_more_than_a_row_of_pre_drawn_numbers() -> None:
+    def long_decisions() -> EpisodeSetup:
+        setup = mixed_setup(9, n=1)
+        motion = RandomTurn(speed=(0.1, 0.5), turn_rate=(-1.0, 1.0),
+                            rng=np.random.default_rng(4), change_period=0.05)  # fmt: skip
+        far = ObstacleState(position=np.array([50.0, 50.0]))
+        setup.obstacles[0] = Obstacle(PolygonBody.from_vertices(SQUARE), far, motion)
+        setup.control_period = 0.05 * (3 * BLOCK)  # 6 blocks of draws a decision
+        return setup
+
+    with kernels(numba_available()):
+        _, decisions = run_both(long_decisions, 0, max_decisions=6)
+        assert decisions == 4  # 30 s at 9.6 s a decision
+
+        alone = PackedWorlds(1)
+        alone.load(0, mixed_setup(5, n=3))
+        both = PackedWorlds(2)
+        both.load(0, mixed_setup(5, n=3))
+        for _ in range(30):
+            alone.step()
+            both.step()
+        both.load(1, long_decisions())  # lengthens the rows of pre-drawn numbers
+        for _ in range(150):
+            alone.step()
+            both.step()
+        assert np.array_equal(alone.wf[0], both.wf[0])
+        assert np.array_equal(alone.state[0], both.state[0, :, :3])

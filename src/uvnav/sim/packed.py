@@ -48,8 +48,10 @@ STATUS_NAMES = ("running", "success", "collision", "timeout")
 EMPTY, CONSTANT, RANDOM_TURN = -1, 0, 1
 _DBL_MIN = 2.2250738585072014e-308
 _VELTKAMP = 134217729.0  # 2**27 + 1
-#: random numbers pre-drawn per obstacle and block
+#: random numbers are pre-drawn per obstacle in rows of ROW_BLOCKS blocks of BLOCK (longer rows
+#: where one decision may need more); a row is topped up once half of it has been read
 BLOCK = 64
+ROW_BLOCKS = 4
 
 # Columns of the (K, NW) float array of the worlds: pose [m, m, rad], held command [m/s, rad/s],
 # goal [m], robot radius [m], goal tolerance [m], dt [s], clearance now and lowest over the last
@@ -371,8 +373,10 @@ class PackedWorlds:
 
     The arrays are the state (:func:`step_worlds_py` gives their layout; :attr:`robot`,
     :attr:`command`, :attr:`status`... are views of them).  A slot's random-turn obstacles keep
-    their generators, read ahead by up to :data:`BLOCK` numbers: the models are not written
-    back (unlike :meth:`UnicycleWorld.close <uvnav.sim.episode.UnicycleWorld.close>`).
+    their generators, read ahead by up to a row of pre-drawn numbers (:data:`ROW_BLOCKS` x
+    :data:`BLOCK`, more where a decision has over :data:`BLOCK` integration steps): the models
+    are not written back (unlike :meth:`UnicycleWorld.close
+    <uvnav.sim.episode.UnicycleWorld.close>`).
     """
 
     oi: np.ndarray
@@ -391,7 +395,7 @@ class PackedWorlds:
         self.rngs: list[list[np.random.Generator | None]] = [[] for _ in range(k)]
         self._safe_calls = 0  # step() calls before a refill may be needed
         self._templates: dict[tuple[int, ...], tuple[FieldTemplate, list[Any]]] = {}
-        self._alloc(0, 2)
+        self._alloc(0, 2, ROW_BLOCKS * BLOCK)
 
     # views of the state, by meaning
     @property
@@ -429,22 +433,24 @@ class PackedWorlds:
         """(k,) simulated time [s] (step index x dt, as the loop world counts it)."""
         return self.wi[:, I_STEP] * self.wf[:, W_DT]
 
-    def _alloc(self, m: int, w: int) -> None:
-        """(Re)allocate the obstacle arrays for ``m`` obstacles of ``w``-column rings, keeping
-        what the slots hold."""
+    def _alloc(self, m: int, w: int, b: int) -> None:
+        """(Re)allocate the obstacle arrays for ``m`` obstacles of ``w``-column rings and ``b``
+        pre-drawn numbers, keeping what the slots hold (the unread numbers move to the end of
+        the longer rows, the next top-up fills the rest)."""
         k = self.k
         oi = np.zeros((k, 2, m), dtype=np.int64)
         oi[:, O_KIND] = EMPTY
         params = np.zeros((k, N_PARAMS, m))
         state = np.zeros((k, N_STATE, m))
-        ubuf = np.zeros((k, m, BLOCK))
+        ubuf = np.zeros((k, m, b))
         rings = np.zeros((k, 2, m, w))
         if hasattr(self, "oi"):
-            m0, w0 = self.rings.shape[2], self.rings.shape[3]
+            m0, w0, b0 = self.rings.shape[2], self.rings.shape[3], self.ubuf.shape[2]
             oi[:, :, :m0] = self.oi
+            oi[:, O_UPOS, :m0] += b - b0
             params[:, :, :m0] = self.params
             state[:, :, :m0] = self.state
-            ubuf[:, :m0] = self.ubuf
+            ubuf[:, :m0, b - b0 :] = self.ubuf
             rings[:, :, :m0, :w0] = self.rings
             rings[:, :, :m0, w0:] = self.rings[:, :, :, :1]  # more copies of the first vertex
         self.oi, self.params, self.state, self.ubuf, self.rings = oi, params, state, ubuf, rings
@@ -463,9 +469,11 @@ class PackedWorlds:
         m = len(obstacles)
         tpl = self._template([o.body for o in obstacles])
         w = tpl.rings.shape[2] if m else 2
-        if m > self.rings.shape[2] or w > self.rings.shape[3]:
-            self._alloc(max(m, self.rings.shape[2]), max(w, self.rings.shape[3]))
         spec, dt = setup.spec, float(setup.dt)
+        ratio = decision_ratio(float(setup.control_period), dt)
+        b = max(self.ubuf.shape[2], 4 * ratio)  # half a row: a decision's draws, 2 a step
+        if m > self.rings.shape[2] or w > self.rings.shape[3] or b > self.ubuf.shape[2]:
+            self._alloc(max(m, self.rings.shape[2]), max(w, self.rings.shape[3]), b)
         x, y, th = (float(c) for c in np.asarray(setup.start, dtype=float)[:3])
         gx, gy = (float(c) for c in np.asarray(setup.goal, dtype=float)[:2])
         wf, wi = self.wf[slot], self.wi[slot]
@@ -474,10 +482,9 @@ class PackedWorlds:
         wf[[W_RADIUS, W_TOL, W_DT]] = (float(spec.radius), float(setup.goal_tolerance), dt)
         wf[[W_VMAX, W_UMAX]] = (float(spec.v_max), float(spec.u_max))
         n_steps = round(setup.t_max / dt)
-        wi[[I_STEP, I_RATIO, I_NSTEPS, I_NOBS]] = (
-            0, decision_ratio(float(setup.control_period), dt), n_steps, m,
-        )  # fmt: skip
+        wi[[I_STEP, I_RATIO, I_NSTEPS, I_NOBS]] = (0, ratio, n_steps, m)
         self.oi[slot, O_KIND] = EMPTY
+        self.oi[slot, O_UPOS] = 0
         self.rings[slot] = 0.0
         if m:
             self.rings[slot, :, :m, :w] = tpl.rings
@@ -497,7 +504,8 @@ class PackedWorlds:
         elif n_steps <= 0:
             status = TIMEOUT
         wi[I_STATUS] = status
-        self._safe_calls = 0
+        # the slot's rows are full: a top-up is due no sooner for it than for the others
+        self._safe_calls = min(self._safe_calls, b // (2 * ratio))
 
     def _template(self, bodies: list[Any]) -> FieldTemplate:
         """The bodies' packed geometry, kept for the episodes that share the body objects (the
@@ -547,25 +555,31 @@ class PackedWorlds:
             prm[P_ARENA, o] = 1.0
             prm[P_X0, o], prm[P_Y0, o], prm[P_X1, o], prm[P_Y1, o] = x0, y0, x1, y1
             prm[P_MIDX, o], prm[P_MIDY, o] = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
-        self.ubuf[slot, o] = mod.rng.random(BLOCK)
+        mod.rng.random(out=self.ubuf[slot, o])
         return mod.rng
 
     def refill(self) -> None:
-        """Top up the draws of every obstacle that may run out in the coming decisions (two
-        per integration step): the unread ones move to the front, the rest are drawn.  Sets how
-        many :meth:`step` calls are safe before the next top-up."""
-        need = 2 * self.wi[:, I_RATIO, None]
+        """Top up the draws of every obstacle that has read half its row or more: the unread
+        ones move to the front, the rest are drawn.  Sets how many :meth:`step` calls are safe
+        before the next top-up (a decision reads at most two numbers per integration step, and
+        half a row holds a decision's worth: :meth:`load` sizes the rows).
+
+        Topping up every row that is half read, not only the rows that could run out in the
+        next call, and rows of four blocks, make top-ups rare: with one-block rows topped up
+        when they could run out, they cost 1.2 (10 obstacles) to 1.8 µs (100) a world step of
+        ``benchmarks/peers/irsim_steps.py``, more than the obstacles' motion."""
+        b = self.ubuf.shape[2]
         upos = self.oi[:, O_UPOS]
-        for slot, o in zip(*(upos + need > BLOCK).nonzero(), strict=True):
+        for slot, o in zip(*(upos >= b // 2).nonzero(), strict=True):
             rng = self.rngs[slot][o]
             if rng is None:
                 continue
             p = int(upos[slot, o])
-            left = BLOCK - p
-            self.ubuf[slot, o, :left] = self.ubuf[slot, o, p:]
-            self.ubuf[slot, o, left:] = rng.random(p)
+            row = self.ubuf[slot, o]
+            row[: b - p] = row[p:]
+            rng.random(out=row[b - p :])
             upos[slot, o] = 0
-        spare = (BLOCK - upos) // np.maximum(need, 1)
+        spare = (b - upos) // np.maximum(2 * self.wi[:, I_RATIO, None], 1)
         self._safe_calls = int(spare.min()) if spare.size else 1 << 30
 
     def step(self, active: np.ndarray | None = None) -> None:
