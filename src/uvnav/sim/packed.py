@@ -182,27 +182,49 @@ def _transform_ring(rings: FloatArray, o: int, c: float, s: float, cx: float, cy
         out[1, j] = c * ry + s * rx + cy
 
 
-def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray,
-               st: FloatArray, rings: FloatArray, ring: FloatArray) -> float:  # fmt: skip
+def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray, st: FloatArray,
+               rings: FloatArray, ring: FloatArray, low: FloatArray) -> float:  # fmt: skip
     """Exact clearance [m] of the robot disc at ``(x, y)`` in one world (``prm`` (P, M), ``st``
-    (S, M), ``rings`` (2, M, W); ``ring`` (2, W) scratch): the signed distance of
-    :meth:`ObstacleField.query` (boundary distance outside, minus it inside) minus the radius;
-    ``inf`` without obstacles."""
-    gap = math.inf
+    (S, M), ``rings`` (2, M, W); ``ring`` (2, W) and ``low`` (M,) scratch): the signed distance
+    of :meth:`ObstacleField.query` (boundary distance outside, minus it inside) minus the
+    radius; ``inf`` without obstacles.
+
+    A broad phase skips the bodies that cannot lower the minimum, in two passes: a lower bound
+    of every body's gap (centre distance minus bounding radius minus the robot's radius), then
+    the exact gap of the body with the lowest bound first and of every other body whose bound
+    does not exceed the gap found so far.  Starting from the likely nearest body, a step of
+    the benchmark's worlds computes about one exact gap (scanning in index order computed 3.3
+    of 10, 5.9 of 100).  A bound is ``sqrt(dx^2 + dy^2) (1 - 1e-9)``: libm's ``hypot`` costs
+    twice as much, and the relative margin covers the few ulps between them, as the absolute
+    ``slack`` covers the rounding of the transformed rings (the :meth:`ObstacleField.query`
+    cull's margins); a distance whose square is not below 1e300 takes ``hypot``.  The kept
+    bodies' gaps have the same arithmetic as before, and the first lowest one in index order
+    is returned, as the scan in index order returned it (it matters only for ``-0.0``)."""
+    if n_obs == 0:
+        return math.inf
     slack = 1e-9 * (1.0 + abs(x) + abs(y))
+    first, best = 0, math.inf
     for o in range(n_obs):
-        # a body whose bounding disc is farther than the gap so far cannot lower it
-        lower = math.hypot(st[S_X, o] - x, st[S_Y, o] - y) - prm[P_BOUND, o] - radius
-        if lower > gap + slack:
-            continue
+        dx, dy = st[S_X, o] - x, st[S_Y, o] - y
+        dd = dx * dx + dy * dy
+        dc = math.sqrt(dd) if dd < 1e300 else math.hypot(dx, dy)
+        bound = dc * (1.0 - 1e-9) - prm[P_BOUND, o] - radius
+        low[o] = bound
+        if bound < best:
+            first, best = o, bound
+    gap, at = math.inf, n_obs
+    for j in range(-1, n_obs):
+        o = first if j < 0 else j
+        if j == first or low[o] > gap + slack:
+            continue  # done first, or its bounding disc is farther than the gap so far
         h = st[S_HEADING, o]
         _transform_ring(rings, o, math.cos(h), math.sin(h), st[S_X, o], st[S_Y, o], ring)
         d, qx, qy, inside = ring_nearest_py(x, y, ring[0], ring[1], True)
         if inside:
             d = -math.hypot(qx - x, qy - y)
         g = d - radius
-        if g < gap or g != g:
-            gap = g
+        if g < gap or g != g or (g == gap and o < at):
+            gap, at = g, o
     return gap
 
 
@@ -225,6 +247,7 @@ def step_worlds_py(
     ring ``rings[k, :, o]`` (body frame).  The caller guarantees two unread draws per step.
     """
     ring = np.empty((2, rings.shape[3]))
+    low = np.empty(rings.shape[2])
     for k in range(wf.shape[0]):
         wf[k, W_LOW] = math.inf
         if wi[k, I_ACTIVE] == 0 or wi[k, I_STATUS] != RUNNING:
@@ -239,7 +262,8 @@ def step_worlds_py(
             wf[k, W_X], wf[k, W_Y], wf[k, W_TH] = x, y, th
             _move_obstacles(wi[k, I_NOBS], state[k], params[k], oi[k], ubuf[k], t, dt)
             wi[k, I_STEP] = i = i + 1
-            gap = _clearance(x, y, radius, wi[k, I_NOBS], params[k], state[k], rings[k], ring)
+            gap = _clearance(x, y, radius, wi[k, I_NOBS], params[k], state[k], rings[k], ring,
+                             low)  # fmt: skip
             wf[k, W_CLEAR] = gap
             if gap < wf[k, W_LOW]:
                 wf[k, W_LOW] = gap
