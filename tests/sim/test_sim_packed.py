@@ -203,7 +203,7 @@ def test_decisions_that_read_more_than_a_row_of_pre_drawn_numbers() -> None:
 
         alone = PackedWorlds(1)
         alone.load(0, mixed_setup(5, n=3))
-        both = PackedWorlds(2)
+        both = PackedWorlds(3)  # slot 2 is never loaded
         both.load(0, mixed_setup(5, n=3))
         for _ in range(30):
             alone.step()

@@ -236,16 +236,18 @@ def step_worlds_py(
     state: FloatArray,
     ubuf: FloatArray,
     rings: FloatArray,
-) -> None:
+) -> int:
     """Advance every active running world by one decision (``wi[k, I_RATIO]`` integration
-    steps), in place.
+    steps), in place; return how many more calls the pre-drawn numbers cover (at two a step).
 
     The worlds' floats ``wf`` (K, NW) and ints ``wi`` (K, NI) are laid out as the ``W_*`` and
     ``I_*`` columns say; obstacle ``o`` < ``wi[k, I_NOBS]`` of world ``k`` has its motion kind
     and next unread draw in ``oi[k, :, o]``, its parameters ``params[k, :, o]`` (``P_*``), its
     state ``state[k, :, o]`` (``S_*``), its pre-drawn uniforms ``ubuf[k, o]`` and its body
     ring ``rings[k, :, o]`` (body frame).  The caller guarantees two unread draws per step.
-    """
+
+    The count returned spares :meth:`PackedWorlds.step` numpy's per-call costs (about 5 µs)
+    when it asks whether a top-up is due."""
     ring = np.empty((2, rings.shape[3]))
     low = np.empty(rings.shape[2])
     for k in range(wf.shape[0]):
@@ -275,6 +277,13 @@ def step_worlds_py(
                 wi[k, I_STATUS] = TIMEOUT
             if wi[k, I_STATUS] != RUNNING:
                 break
+    safe = 1 << 40
+    for k in range(wf.shape[0]):
+        read = 0
+        for o in range(wi[k, I_NOBS]):
+            read = max(read, oi[k, O_UPOS, o])
+        safe = min(safe, (ubuf.shape[2] - read) // (2 * max(wi[k, I_RATIO], 1)))
+    return safe
 
 
 def _lidar(
@@ -471,7 +480,7 @@ class PackedWorlds:
         if hasattr(self, "oi"):
             m0, w0, b0 = self.rings.shape[2], self.rings.shape[3], self.ubuf.shape[2]
             oi[:, :, :m0] = self.oi
-            oi[:, O_UPOS, :m0] += b - b0
+            oi[:, O_UPOS, :m0] += np.where(self.oi[:, O_KIND] == RANDOM_TURN, b - b0, 0)
             params[:, :, :m0] = self.params
             state[:, :, :m0] = self.state
             ubuf[:, :m0, b - b0 :] = self.ubuf
@@ -588,21 +597,23 @@ class PackedWorlds:
         before the next top-up (a decision reads at most two numbers per integration step, and
         half a row holds a decision's worth: :meth:`load` sizes the rows).
 
-        Topping up every row that is half read, not only the rows that could run out in the
-        next call, and rows of four blocks, make top-ups rare: with one-block rows topped up
-        when they could run out, they cost 1.2 (10 obstacles) to 1.8 µs (100) a world step of
-        ``benchmarks/peers/irsim_steps.py``, more than the obstacles' motion."""
+        :meth:`step` calls it only when a row could run out in the next call (the step kernel
+        counts the safe calls), and then every half-read row is topped up, so top-ups are rare
+        and draw many numbers each: topping up one-block rows whenever one could run out cost
+        1.2 (10 obstacles) and 1.8 µs (100) of a world step in
+        ``benchmarks/peers/irsim_steps.py``, about 0.1 and 0.2 µs now (mostly the
+        generators' calls).
+        """
         b = self.ubuf.shape[2]
         upos = self.oi[:, O_UPOS]
-        for slot, o in zip(*(upos >= b // 2).nonzero(), strict=True):
+        due = (upos >= b // 2).nonzero()
+        for slot, o, p in zip(due[0].tolist(), due[1].tolist(), upos[due].tolist(), strict=True):
             rng = self.rngs[slot][o]
-            if rng is None:
-                continue
-            p = int(upos[slot, o])
-            row = self.ubuf[slot, o]
-            row[: b - p] = row[p:]
-            rng.random(out=row[b - p :])
-            upos[slot, o] = 0
+            if rng is not None:
+                row = self.ubuf[slot, o]
+                row[: b - p] = row[p:]
+                rng.random(out=row[b - p :])
+        upos[due] = 0  # (a row without a generator is never read)
         spare = (b - upos) // np.maximum(2 * self.wi[:, I_RATIO, None], 1)
         self._safe_calls = int(spare.min()) if spare.size else 1 << 30
 
@@ -613,8 +624,9 @@ class PackedWorlds:
             self.wi[:, I_ACTIVE] = active
         if self._safe_calls <= 0:
             self.refill()
-        self._safe_calls -= 1
-        kernel("step")(self.wf, self.wi, self.oi, self.params, self.state, self.ubuf, self.rings)
+        self._safe_calls = kernel("step")(
+            self.wf, self.wi, self.oi, self.params, self.state, self.ubuf, self.rings
+        )
         if active is not None:
             self.wi[:, I_ACTIVE] = 1
 
