@@ -13,7 +13,7 @@ from hypothesis import strategies as st
 
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.geometry.kernels3d import numba_available, use_compiled
-from uvnav.obstacles import Obstacle, ObstacleState
+from uvnav.obstacles import Obstacle, ObstacleField, ObstacleState
 from uvnav.obstacles.bodies import DiscBody, PolygonBody
 from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
 from uvnav.scenarios.build import build_episode
@@ -214,3 +214,43 @@ def test_decisions_that_read_more_than_a_row_of_pre_drawn_numbers() -> None:
             both.step()
         assert np.array_equal(alone.wf[0], both.wf[0])
         assert np.array_equal(alone.state[0], both.state[0, :, :3])
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_clearance_inside_a_body_is_the_fields_signed_distance(compiled: bool) -> None:
+    """Robots driven one step into (and near) static bodies: the clearance is the field's,
+    bit for bit, depth inside a body included (numpy's hypot, not CPython's)."""
+    rng = np.random.default_rng(3)
+    arrow = np.array([[-0.6, -0.4], [0.7, 0.0], [-0.6, 0.4], [-0.2, 0.0]])
+    shapes = (
+        (SQUARE, np.array([1.0, 0.5]), 0.3),
+        (arrow * 1.5, np.array([-0.5, 0.0]), 2.0),
+        (SQUARE * 0.6, np.array([0.2, -1.0]), -1.0),
+    )
+    obstacles = [
+        Obstacle(
+            PolygonBody.from_vertices(v),
+            ObstacleState(position=p, heading=h),
+            ConstantVelocity(np.zeros(2)),
+        )
+        for v, p, h in shapes
+    ]
+    field = ObstacleField.from_obstacles(obstacles)
+    k = 1500
+    with kernels(compiled):
+        worlds = PackedWorlds(k)
+        for slot in range(k):
+            worlds.load(slot, EpisodeSetup(spec=SPEC, start=np.array([0.0, 3.0, 0.0]),
+                                           goal=np.array([9.0, 9.0]), obstacles=obstacles,
+                                           dt=0.1, control_period=0.1))  # fmt: skip
+        centres = np.array([ob.state.position for ob in obstacles])
+        aim = centres[rng.integers(0, 3, k)] + rng.normal(0.0, 0.4, (k, 2)) - (0.0, 3.0)
+        worlds.robot[:, 2] = np.arctan2(aim[:, 1], aim[:, 0])
+        worlds.command[:, 0] = np.hypot(aim[:, 0], aim[:, 1]) / 0.1
+        worlds.step()
+    inside = 0
+    for slot in range(k):
+        q = field.query(tuple(worlds.robot[slot, :2]), 0.0, nearest=True)
+        assert worlds.clearance[slot] == float((q.signed - SPEC.radius).min())
+        inside += bool(q.signed.min() < 0)
+    assert inside > k // 3

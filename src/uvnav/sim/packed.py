@@ -17,8 +17,9 @@ bit (the test suite compares them):
   generator, pre-drawn in blocks (:meth:`PackedWorlds.refill`): ``Generator.random(n)`` gives the
   same numbers as ``n`` calls of ``random()``, so the stream is the one the lazy draws read;
 * clearance: the signed distance of :meth:`uvnav.obstacles.ObstacleField.query` (the loop of
-  :func:`uvnav.geometry.polygons.rings_nearest_py` on the transformed rings) minus the robot's
-  radius; arrival uses :func:`pyhypot`, CPython's ``math.hypot`` (which is not libm's ``hypot``);
+  :func:`uvnav.geometry.polygons.rings_nearest_py` on the transformed rings; the depth inside a
+  body by numpy's ``hypot``, libm's, as the field takes it) minus the robot's radius; arrival
+  uses :func:`pyhypot`, CPython's ``math.hypot`` (which is not libm's ``hypot``);
 * lidar (:func:`lidar_worlds_py`): :func:`uvnav.sensors.lidar_scan`'s beams and ray-edge test.
 
 Only these motions and polygon bodies are packed; :func:`pack_check` says why a scene is not.
@@ -221,7 +222,7 @@ def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray, s
         _transform_ring(rings, o, math.cos(h), math.sin(h), st[S_X, o], st[S_Y, o], ring)
         d, qx, qy, inside = ring_nearest_py(x, y, ring[0], ring[1], True)
         if inside:
-            d = -math.hypot(qx - x, qy - y)
+            d = -float(np.hypot(qx - x, qy - y))  # numpy's (libm's), as the field's depth
         g = d - radius
         if g < gap or g != g or (g == gap and o < at):
             gap, at = g, o
