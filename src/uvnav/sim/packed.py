@@ -14,8 +14,9 @@ bit (the test suite compares them):
 * obstacles: :class:`~uvnav.obstacles.motion.RandomTurn` and
   :class:`~uvnav.obstacles.motion.ConstantVelocity` with the operations of
   :class:`~uvnav.obstacles.batch.ObstacleBatch`.  A random-turn obstacle's draws come from its own
-  generator, pre-drawn in blocks (:meth:`PackedWorlds.refill`): ``Generator.random(n)`` gives the
-  same numbers as ``n`` calls of ``random()``, so the stream is the one the lazy draws read;
+  generator, pre-drawn in rows of blocks (:meth:`PackedWorlds.refill`): ``Generator.random(n)``
+  gives the same numbers as ``n`` calls of ``random()`` (and ``random(out=...)`` as many), so
+  the stream is the one the lazy draws read;
 * clearance: the signed distance of :meth:`uvnav.obstacles.ObstacleField.query` (the loop of
   :func:`uvnav.geometry.polygons.rings_nearest_py` on the transformed rings; the depth inside a
   body by numpy's ``hypot``, libm's, as the field takes it) minus the robot's radius; arrival
