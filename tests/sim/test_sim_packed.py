@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.geometry.kernels3d import numba_available, use_compiled
 from uvnav.geometry.small import pyhypot
-from uvnav.obstacles import Obstacle, ObstacleState
+from uvnav.obstacles import Obstacle, ObstacleField, ObstacleState
 from uvnav.obstacles.bodies import DiscBody, PolygonBody
 from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
 from uvnav.scenarios.build import build_episode
@@ -186,3 +186,72 @@ def test_unpackable_scenes_are_refused_with_the_reason() -> None:
     with pytest.raises(ValueError, match="obstacle 1 moves by Waypoints"):
         PackedWorlds(1).load(0, setup)
     assert pack_check(mixed_setup(0)) is None
+
+
+def test_decisions_that_read_more_than_a_row_of_pre_drawn_numbers() -> None:
+    def long_decisions() -> EpisodeSetup:
+        setup = mixed_setup(9, n=1)
+        motion = RandomTurn(speed=(0.1, 0.5), turn_rate=(-1.0, 1.0),
+                            rng=np.random.default_rng(4), change_period=0.05)  # fmt: skip
+        far = ObstacleState(position=np.array([50.0, 50.0]))
+        setup.obstacles[0] = Obstacle(PolygonBody.from_vertices(SQUARE), far, motion)
+        setup.control_period = 0.05 * (3 * BLOCK)  # 6 blocks of draws a decision
+        return setup
+
+    with kernels(numba_available()):
+        _, decisions = run_both(long_decisions, 0, max_decisions=6)
+        assert decisions == 4  # 30 s at 9.6 s a decision
+
+        alone = PackedWorlds(1)
+        alone.load(0, mixed_setup(5, n=3))
+        both = PackedWorlds(3)  # slot 2 is never loaded
+        both.load(0, mixed_setup(5, n=3))
+        for _ in range(30):
+            alone.step()
+            both.step()
+        both.load(1, long_decisions())  # lengthens the rows of pre-drawn numbers
+        for _ in range(150):
+            alone.step()
+            both.step()
+        assert np.array_equal(alone.wf[0], both.wf[0])
+        assert np.array_equal(alone.state[0], both.state[0, :, :3])
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_clearance_inside_a_body_is_the_fields_signed_distance(compiled: bool) -> None:
+    """Robots driven one step into (and near) static bodies: the clearance is the field's,
+    bit for bit, depth inside a body included (numpy's hypot, not CPython's)."""
+    rng = np.random.default_rng(3)
+    arrow = np.array([[-0.6, -0.4], [0.7, 0.0], [-0.6, 0.4], [-0.2, 0.0]])
+    shapes = (
+        (SQUARE, np.array([1.0, 0.5]), 0.3),
+        (arrow * 1.5, np.array([-0.5, 0.0]), 2.0),
+        (SQUARE * 0.6, np.array([0.2, -1.0]), -1.0),
+    )
+    obstacles = [
+        Obstacle(
+            PolygonBody.from_vertices(v),
+            ObstacleState(position=p, heading=h),
+            ConstantVelocity(np.zeros(2)),
+        )
+        for v, p, h in shapes
+    ]
+    field = ObstacleField.from_obstacles(obstacles)
+    k = 1500
+    with kernels(compiled):
+        worlds = PackedWorlds(k)
+        for slot in range(k):
+            worlds.load(slot, EpisodeSetup(spec=SPEC, start=np.array([0.0, 3.0, 0.0]),
+                                           goal=np.array([9.0, 9.0]), obstacles=obstacles,
+                                           dt=0.1, control_period=0.1))  # fmt: skip
+        centres = np.array([ob.state.position for ob in obstacles])
+        aim = centres[rng.integers(0, 3, k)] + rng.normal(0.0, 0.4, (k, 2)) - (0.0, 3.0)
+        worlds.robot[:, 2] = np.arctan2(aim[:, 1], aim[:, 0])
+        worlds.command[:, 0] = np.hypot(aim[:, 0], aim[:, 1]) / 0.1
+        worlds.step()
+    inside = 0
+    for slot in range(k):
+        q = field.query(tuple(worlds.robot[slot, :2]), 0.0, nearest=True)
+        assert worlds.clearance[slot] == float((q.signed - SPEC.radius).min())
+        inside += bool(q.signed.min() < 0)
+    assert inside > k // 3
