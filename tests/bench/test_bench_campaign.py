@@ -7,7 +7,16 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from uvnav.bench.campaign import Job, JobOutcome, grid_jobs, run_campaign, run_job, scene_groups
+from uvnav.bench.campaign import (
+    FORKSERVER_PRELOAD,
+    Job,
+    JobOutcome,
+    grid_jobs,
+    run_campaign,
+    run_job,
+    scene_groups,
+    warm_up,
+)
 from uvnav.bench.store import ResultsStore
 from uvnav.dynamics import UnicycleSpec
 from uvnav.obstacles import ConstantVelocity, DiscBody, Obstacle, ObstacleState
@@ -223,3 +232,16 @@ def test_a_batch_stores_all_or_nothing(tmp_path: Path) -> None:
         assert store.count("c") == 3
         store.add_episode(cid, scenario="s", controller="x", seed=8, status="timeout", metrics=ok)
         assert store.count("c") == 4  # outside a batch: a write is its own transaction again
+
+
+def test_run_job_times_its_cpu() -> None:
+    out = run_job(Job(controller="straight-v1", seed=1, generator_seed=1))
+    assert out.error is None and out.cpu_time > 0.0
+
+
+def test_fork_server_warms_up_once() -> None:
+    """The pool's fork server imports the module that runs one episode before it forks."""
+    assert FORKSERVER_PRELOAD[-1] == "uvnav.bench.forkserver_warm"
+    import uvnav.bench.forkserver_warm  # noqa: F401 - runs warm_up(): must not raise
+
+    warm_up()

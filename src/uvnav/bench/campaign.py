@@ -16,7 +16,8 @@ message; it does not stop the campaign.
 
 Workers are a :class:`concurrent.futures.ProcessPoolExecutor` started with the ``forkserver`` method
 on POSIX (``spawn`` elsewhere): forking a parent that runs a progress-bar thread and holds an open
-SQLite connection is unsafe, and the fork server preloads uvnav once so workers start quickly.  At
+SQLite connection is unsafe, and the fork server preloads uvnav and runs one short episode
+(:func:`warm_up`: lazy imports, compiled kernels loaded) once, so workers start warm.  At
 most ``2 × workers`` jobs are submitted ahead, which bounds memory for large campaigns.  With
 ``workers=1`` everything runs in-process (no pool; easiest to debug and profile).  ``engine="ray"``
 runs the same jobs as Ray tasks instead (:mod:`uvnav.bench.ray_engine`); results still come back to
@@ -43,7 +44,7 @@ import time
 import traceback
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
@@ -216,6 +217,8 @@ class JobOutcome:
         effective_params: parameters the controller was built with (a ``runner``'s job: its
             tags and facts).
         result: a ``runner``'s own result when ``job.record`` (for figures; never stored).
+        cpu_time: CPU time of the worker's thread on the job, building included [s] (never
+            stored; what a campaign's engine adds is measured against it, ``bench_ray.py``).
     """
 
     job: Job
@@ -226,6 +229,7 @@ class JobOutcome:
     trajectory: Trajectory | None = None
     effective_params: dict[str, Any] = field(default_factory=dict)
     result: Any = None
+    cpu_time: float = 0.0
 
 
 def _plain(params: Any) -> dict[str, Any]:
@@ -328,8 +332,16 @@ def run_job(job: Job) -> JobOutcome:
 
     Jobs with a scene (any kind) run through :func:`uvnav.scenarios.episodes.run_scene`, the
     path of ``uvnav simulate``; jobs with a ``setup_factory`` run the 2D loop directly, jobs with
-    a ``runner`` their chapter's own episode.
+    a ``runner`` their chapter's own episode.  The outcome's ``cpu_time`` is this thread's.
     """
+    cpu = time.thread_time()
+    out = _run_job(job)
+    out.cpu_time = time.thread_time() - cpu
+    return out
+
+
+def _run_job(job: Job) -> JobOutcome:
+    """:func:`run_job` but for its CPU time."""
     from uvnav.scenarios.episodes import AssumptionError, LawMismatchError
     from uvnav.scenarios.errors import PlacementError
 
@@ -519,13 +531,32 @@ def run_stored(
     return [by_key[j.key] for j in jobs if j.key in by_key]
 
 
+#: what the fork server imports before it forks a worker (the last one runs :func:`warm_up`)
+FORKSERVER_PRELOAD = (
+    "uvnav.bench.campaign",
+    "uvnav.scenarios",
+    "uvnav.controllers",
+    "uvnav.bench.forkserver_warm",
+)
+
+
 def default_mp_context() -> mp.context.BaseContext:
-    """``forkserver`` (uvnav preloaded) on POSIX, ``spawn`` elsewhere; see the module docstring."""
+    """``forkserver`` (uvnav preloaded and warmed up, :data:`FORKSERVER_PRELOAD`) on POSIX,
+    ``spawn`` elsewhere; see the module docstring."""
     if sys.platform != "win32" and "forkserver" in mp.get_all_start_methods():
         ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(["uvnav.bench.campaign", "uvnav.scenarios", "uvnav.controllers"])
+        ctx.set_forkserver_preload(list(FORKSERVER_PRELOAD))
         return ctx
     return mp.get_context("spawn")
+
+
+def warm_up() -> None:
+    """Run one short episode (``straight-v1`` on random-ch2 scene 0) and drop it: the lazy
+    imports and the compiled kernels' loading that a process's first episode pays are paid
+    here, once (the fork server does, :mod:`uvnav.bench.forkserver_warm`; the workers it forks
+    inherit them).  Never raises: a failure only leaves the workers to warm up themselves."""
+    with suppress(Exception):  # warming up is an optimisation, never a failure
+        run_job(Job(controller="straight-v1", seed=0, generator_seed=0))
 
 
 def run_campaign(
