@@ -21,10 +21,12 @@ SQLite connection is unsafe, and the fork server preloads uvnav and runs one sho
 most ``2 × workers`` jobs are submitted ahead, which bounds memory for large campaigns.  With
 ``workers=1`` everything runs in-process (no pool; easiest to debug and profile).  ``engine="ray"``
 runs the same jobs as Ray tasks instead (:mod:`uvnav.bench.ray_engine`); results still come back to
-this process, which alone writes the store.  On the local pool the jobs of one scene (the laws and
-parameter sets run on one generated scene) travel together (:func:`scene_groups`): one worker
-builds the scene once for all of them, and their episodes are stored in one transaction when the
-group finishes, so an interrupt loses at most the groups in flight.  As with any
+this process, which alone writes the store.  On the local pool and on Ray the jobs of one scene
+(the laws and parameter sets run on one generated scene) travel together (:func:`scene_groups`):
+one worker builds the scene once for all of them, and their episodes are stored in one transaction
+when the group finishes, so an interrupt loses at most the groups in flight.  A Ray task carries
+as many groups as run about :data:`TASK_SECONDS` (:class:`TaskSizer`; Ray's cost per task is
+fixed, a local pool's too small to matter).  As with any
 ``spawn``/``forkserver`` pool, a *script* that starts a campaign with ``workers > 1`` must do so
 under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already do), and a
 ``setup_factory`` must be importable (defined at module level, not in a notebook cell); pass
@@ -313,6 +315,42 @@ def scene_groups(jobs: Sequence[Job]) -> list[list[Job]]:
 def run_job_group(jobs: Sequence[Job]) -> list[JobOutcome]:
     """:func:`run_job` on each job of one scene group, in one worker (the scene is built once)."""
     return [run_job(job) for job in jobs]
+
+
+#: a Ray task runs about this long [s]: enough scene groups are batched into it (:class:`TaskSizer`)
+TASK_SECONDS = 0.25
+#: at most this many scene groups in one task
+MAX_GROUPS_PER_TASK = 16
+
+
+def run_group_batch(groups: Sequence[Sequence[Job]]) -> list[list[JobOutcome]]:
+    """:func:`run_job_group` on each of ``groups`` in turn, in one worker (one Ray task)."""
+    return [run_job_group(group) for group in groups]
+
+
+class TaskSizer:
+    """How many scene groups the next task gets, so that a task runs about ``seconds``.
+
+    One group while none has come back; then ``seconds`` over the mean worker time of the groups
+    that have (their outcomes' ``wall_time``), between 1 and ``limit``.  A task costs its engine
+    a fixed overhead (Ray: scheduling, two messages, the driver's bookkeeping) however long it
+    runs, so short groups are sent several at a time; the size never changes what a job stores.
+    """
+
+    def __init__(self, seconds: float = TASK_SECONDS, limit: int = MAX_GROUPS_PER_TASK) -> None:
+        self.seconds, self.limit = seconds, limit
+        self._groups, self._time = 0, 0.0
+
+    def add(self, outcomes: Sequence[JobOutcome]) -> None:
+        """Account for one finished group."""
+        self._groups += 1
+        self._time += sum(out.wall_time for out in outcomes)
+
+    def size(self) -> int:
+        """Groups for the next task."""
+        if self._groups == 0 or self._time <= 0.0:
+            return 1
+        return max(1, min(self.limit, int(self.seconds * self._groups / self._time)))
 
 
 def _error(job: Job, exc: BaseException, tic: float, params: dict[str, Any]) -> JobOutcome:
@@ -668,6 +706,11 @@ def _run_campaign(
         if on_outcome is not None:
             on_outcome(out, episode_id)
 
+    def handle_group(outs: list[JobOutcome]) -> None:
+        with store.batch():  # the group's episodes in one transaction
+            for out in outs:
+                handle(out)
+
     try:
         if bar is not None:
             bar.start()
@@ -675,17 +718,11 @@ def _run_campaign(
             if todo:
                 from uvnav.bench.ray_engine import run_ray
 
-                run_ray(todo, handle, workers=workers, address=address)
+                run_ray(scene_groups(todo), handle_group, workers=workers, address=address)
         elif workers <= 1:
             for job in todo:
                 handle(run_job(job))
         elif todo:
-
-            def handle_group(outs: list[JobOutcome]) -> None:
-                with store.batch():  # the group's episodes in one transaction
-                    for out in outs:
-                        handle(out)
-
             ctx = mp_context or default_mp_context()
             _run_pool(scene_groups(todo), run_job_group, handle_group, workers, ctx)
     finally:
