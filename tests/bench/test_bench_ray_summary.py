@@ -1,0 +1,60 @@
+"""``benchmarks/summary.py``'s Ray row and ``benchmarks/bench_ray.py``'s pure helpers (no
+benchmark is run)."""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+BENCH = Path(__file__).resolve().parents[2] / "benchmarks"
+if str(BENCH) not in sys.path:
+    sys.path.insert(0, str(BENCH))
+
+import bench_ray  # noqa: E402
+import summary  # noqa: E402
+
+
+def _write(folder: Path, payload: dict[str, Any]) -> None:
+    (folder / "ray.json").write_text(json.dumps(payload), encoding="utf-8")
+
+
+def test_ray_row(tmp_path: Path) -> None:
+    assert summary.ray_row(tmp_path).result == "not run"
+    _write(tmp_path, {"quick": False, "target": {"measured": 0.042, "limit": 0.1, "pass": True}})
+    row = summary.ray_row(tmp_path)
+    assert (row.measured, row.ratio, row.result) == ("4.20 %", "0.42", "PASS")
+    assert row.name in [r.name for r in summary.build_rows(tmp_path)]
+    _write(tmp_path, {"quick": True, "target": {"measured": 0.25, "limit": 0.1, "pass": False}})
+    assert summary.ray_row(tmp_path).result == "FAIL*"
+    _write(tmp_path, {"quick": False, "target": {"measured": None, "limit": 0.1, "pass": None,
+                                                 "note": "ray not installed"}})  # fmt: skip
+    row = summary.ray_row(tmp_path)
+    assert (row.measured, row.result) == ("-", "not measured")
+    (tmp_path / "ray.json").write_text("{not json", encoding="utf-8")
+    assert summary.ray_row(tmp_path).result == "not run"
+
+
+def test_judge_takes_the_pools_overhead_off_rays() -> None:
+    def run(overhead_ms: float, cpu: float | None = 1.0) -> dict[str, Any]:
+        return {"episodes": 100, "cpu_s": cpu, "jobs_cpu_ms_per_episode": 20.0,
+                "overhead_ms_per_episode": overhead_ms, "startup": {"cpu_s": 3.0}}  # fmt: skip
+
+    got = bench_ray.judge(run(0.2), run(0.5), run(1.5))
+    assert got["ray_added_cpu_ms"] == pytest.approx(1.0)  # Ray's overhead less the pool's
+    assert got["ray_added_vs_in_process_ms"] == pytest.approx(1.3)
+    assert got["ray_added_with_startup_ms"] == pytest.approx(1.0 + 30.0)
+    assert got["measured"] == pytest.approx(0.05) and got["pass"] is True
+    assert bench_ray.judge(run(0.2), run(0.5, None), run(1.5))["pass"] is None
+
+
+@pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="reads /proc")
+def test_tree_snapshot_sees_this_process() -> None:
+    snap = bench_ray.tree_snapshot()
+    assert snap is not None and os.getpid() in snap
+    roles = bench_ray.by_role(snap, bench_ray.tree_snapshot(), "ray")
+    assert roles is not None and roles.get("driver", 0.0) >= 0.0
