@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections import deque
 from pathlib import Path
 
 import numpy as np
@@ -17,6 +18,7 @@ from uvnav.bench.campaign import (
     run_group_batch,
     run_job,
     scene_groups,
+    sized_batches,
     warm_up,
 )
 from uvnav.bench.store import ResultsStore
@@ -258,6 +260,17 @@ def test_task_sizer_batches_short_groups_up_to_a_limit() -> None:
     fast = TaskSizer(seconds=0.25, limit=16)
     fast.add([_outcome(job, 0.0001)])
     assert fast.size() == 16
+
+
+def test_sized_batches_are_cut_when_asked_for() -> None:
+    """A task is sized when the pool asks for it, on the groups handled so far."""
+    groups = [[Job(controller="straight-v1", seed=g, generator_seed=g)] for g in range(10)]
+    sizer = TaskSizer(seconds=0.25, limit=16)
+    batches = sized_batches(deque(groups), sizer)
+    assert len(next(batches)) == 1  # nothing back yet
+    sizer.add([_outcome(groups[0][0], 0.08)])  # 0.08 s a group: 3 to a task
+    assert [len(b) for b in batches] == [3, 3, 3]
+    assert list(batches) == []
 
 
 def test_group_batch_runs_every_group_and_times_each_job() -> None:

@@ -18,18 +18,18 @@ Workers are a :class:`concurrent.futures.ProcessPoolExecutor` started with the `
 on POSIX (``spawn`` elsewhere): forking a parent that runs a progress-bar thread and holds an open
 SQLite connection is unsafe, and the fork server preloads uvnav and runs one short episode
 (:func:`warm_up`: lazy imports, compiled kernels loaded) once, so workers start warm.  At
-most ``2 × workers`` jobs are submitted ahead, which bounds memory for large campaigns.  With
+most ``2 × workers`` tasks are submitted ahead, which bounds memory for large campaigns.  With
 ``workers=1`` everything runs in-process (no pool; easiest to debug and profile).  ``engine="ray"``
 runs the same jobs as Ray tasks instead (:mod:`uvnav.bench.ray_engine`); results still come back to
 this process, which alone writes the store.  On the local pool and on Ray the jobs of one scene
 (the laws and parameter sets run on one generated scene) travel together (:func:`scene_groups`):
 one worker builds the scene once for all of them, and their episodes are stored in one transaction
-when the group finishes, so an interrupt loses at most the groups in flight.  A Ray task carries
-as many groups as run about :data:`TASK_SECONDS` (:class:`TaskSizer`; Ray's cost per task is
-fixed, a local pool's too small to matter).  As with any
-``spawn``/``forkserver`` pool, a *script* that starts a campaign with ``workers > 1`` must do so
-under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already do), and a
-``setup_factory`` must be importable (defined at module level, not in a notebook cell); pass
+when the group finishes, so an interrupt loses at most the groups in flight.  A task carries as
+many groups as run about :data:`TASK_SECONDS` (:class:`TaskSizer`: a task's cost to the engine is
+fixed), so at most ``2 × workers`` tasks in flight are about half a second of each worker's work.
+As with any ``spawn``/``forkserver`` pool, a *script* that starts a campaign with ``workers > 1``
+must do so under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already do),
+and a ``setup_factory`` must be importable (defined at module level, not in a notebook cell); pass
 ``mp_context=multiprocessing.get_context("fork")`` to lift both restrictions at fork's usual risks.
 """
 
@@ -44,6 +44,7 @@ import sys
 import threading
 import time
 import traceback
+from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from contextlib import contextmanager, suppress
@@ -317,14 +318,15 @@ def run_job_group(jobs: Sequence[Job]) -> list[JobOutcome]:
     return [run_job(job) for job in jobs]
 
 
-#: a Ray task runs about this long [s]: enough scene groups are batched into it (:class:`TaskSizer`)
+#: a task (local pool or Ray) runs about this long [s]: enough scene groups are batched into it
+#: (:class:`TaskSizer`)
 TASK_SECONDS = 0.25
 #: at most this many scene groups in one task
 MAX_GROUPS_PER_TASK = 16
 
 
 def run_group_batch(groups: Sequence[Sequence[Job]]) -> list[list[JobOutcome]]:
-    """:func:`run_job_group` on each of ``groups`` in turn, in one worker (one Ray task)."""
+    """:func:`run_job_group` on each of ``groups`` in turn, in one worker (one task)."""
     return [run_job_group(group) for group in groups]
 
 
@@ -333,8 +335,9 @@ class TaskSizer:
 
     One group while none has come back; then ``seconds`` over the mean worker time of the groups
     that have (their outcomes' ``wall_time``), between 1 and ``limit``.  A task costs its engine
-    a fixed overhead (Ray: scheduling, two messages, the driver's bookkeeping) however long it
-    runs, so short groups are sent several at a time; the size never changes what a job stores.
+    a fixed overhead however long it runs (two pickled messages and the bookkeeping of the
+    executor's or Ray's driver and workers; Ray's scheduling), so short groups are sent several
+    at a time; the size never changes what a job stores.
     """
 
     def __init__(self, seconds: float = TASK_SECONDS, limit: int = MAX_GROUPS_PER_TASK) -> None:
@@ -351,6 +354,13 @@ class TaskSizer:
         if self._groups == 0 or self._time <= 0.0:
             return 1
         return max(1, min(self.limit, int(self.seconds * self._groups / self._time)))
+
+
+def sized_batches(queue: deque[list[Job]], sizer: TaskSizer) -> Iterator[list[list[Job]]]:
+    """Tasks taken from the front of ``queue`` (scene groups) as they are asked for, each of
+    ``sizer.size()`` groups at that moment (fewer at the end)."""
+    while queue:
+        yield [queue.popleft() for _ in range(min(sizer.size(), len(queue)))]
 
 
 def _error(job: Job, exc: BaseException, tic: float, params: dict[str, Any]) -> JobOutcome:
@@ -723,8 +733,16 @@ def _run_campaign(
             for job in todo:
                 handle(run_job(job))
         elif todo:
+            sizer = TaskSizer()
+
+            def handle_batch(outs: list[list[JobOutcome]]) -> None:
+                for group in outs:
+                    sizer.add(group)
+                    handle_group(group)
+
             ctx = mp_context or default_mp_context()
-            _run_pool(scene_groups(todo), run_job_group, handle_group, workers, ctx)
+            batches = sized_batches(deque(scene_groups(todo)), sizer)
+            _run_pool(batches, run_group_batch, handle_batch, workers, ctx)
     finally:
         if bar is not None:
             bar.stop()
@@ -850,14 +868,15 @@ def run_in_workers(
 
 
 def _run_pool(
-    todo: Sequence[T],
+    todo: Iterable[T],
     compute: Callable[[T], R],
     handle: Callable[[R], None],
     workers: int,
     ctx: mp.context.BaseContext,
 ) -> None:
     """Run ``compute`` over ``todo`` on a process pool, handing each result to ``handle`` as it
-    finishes.
+    finishes.  ``todo`` is drawn from only as a worker needs more (a generator may size the next
+    item on the results handled so far).
 
     Workers ignore SIGINT, so a Ctrl-C (sent by the terminal to the whole process group) reaches
     only this process: it stops the workers at once — without waiting for the episodes in flight,
