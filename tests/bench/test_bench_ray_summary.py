@@ -39,17 +39,19 @@ def test_ray_row(tmp_path: Path) -> None:
     assert summary.ray_row(tmp_path).result == "not run"
 
 
-def test_judge_takes_the_pools_overhead_off_rays() -> None:
-    def run(overhead_ms: float, cpu: float | None = 1.0) -> dict[str, Any]:
-        return {"episodes": 100, "cpu_s": cpu, "jobs_cpu_ms_per_episode": 20.0,
+def test_judge_compares_ray_with_the_pool() -> None:
+    def run(cpu: float | None, jobs_ms: float, overhead_ms: float) -> dict[str, Any]:
+        return {"episodes": 100, "cpu_s": cpu, "jobs_cpu_ms_per_episode": jobs_ms,
                 "overhead_ms_per_episode": overhead_ms, "startup": {"cpu_s": 3.0}}  # fmt: skip
 
-    got = bench_ray.judge(run(0.2), run(0.5), run(1.5))
-    assert got["ray_added_cpu_ms"] == pytest.approx(1.0)  # Ray's overhead less the pool's
-    assert got["ray_added_vs_in_process_ms"] == pytest.approx(1.3)
+    inproc, pool = run(2.0, 20.0, 0.1), run(2.1, 20.2, 0.8)
+    got = bench_ray.judge(inproc, pool, run(2.2, 20.4, 1.6))
+    assert got["ray_added_cpu_ms"] == pytest.approx(1.0)  # (2.2 - 2.1) CPU-s over 100 episodes
+    assert got["of_which_overhead_ms"] == pytest.approx(0.8)
+    assert got["of_which_jobs_ms"] == pytest.approx(0.2)
     assert got["ray_added_with_startup_ms"] == pytest.approx(1.0 + 30.0)
     assert got["measured"] == pytest.approx(0.05) and got["pass"] is True
-    assert bench_ray.judge(run(0.2), run(0.5, None), run(1.5))["pass"] is None
+    assert bench_ray.judge(inproc, run(None, 20.0, 0.8), run(2.2, 20.4, 1.6))["pass"] is None
 
 
 @pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="reads /proc")
