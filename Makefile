@@ -76,6 +76,7 @@ BENCH_RUNS = \
 	benchmarks/bench_orca.py \
 	benchmarks/bench_ch7.py \
 	benchmarks/bench_campaign.py \
+	benchmarks/bench_ray.py \
 	benchmarks/bench_vector_env.py \
 	"benchmarks/bench_crowdnav.py --cases 500" \
 	"benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-holonomic-v2" \

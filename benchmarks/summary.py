@@ -9,6 +9,8 @@ the JSON files the benchmarks wrote there; it measures nothing:
   ``orca-shared-v1`` swarm) on ``antipodal:10`` / ``antipodal:100``, its CPU time per step over
   navground's (within 2x = at most 2);
 * ``campaign.json`` (``benchmarks/bench_campaign.py``): 10,000 episodes in <= 120 s wall;
+* ``ray.json`` (``benchmarks/bench_ray.py``): the CPU the Ray engine adds per episode, at most
+  10 % of the episode's own;
 * ``vector_env.json`` (``benchmarks/bench_vector_env.py``): the vector env's target,
   env steps per CPU second ("not measured" until a benchmark writes it);
 * ``summary.json`` (``benchmarks/run_benchmarks.py``): a closing line with how many of its own
@@ -30,6 +32,8 @@ from pathlib import Path
 from typing import Any
 
 WIDTH = 80
+#: Ray's added CPU per episode, at most this share of the episode's own (``bench_ray.py``)
+TARGET_RAY_SHARE = 0.10
 
 
 @dataclass(frozen=True)
@@ -136,6 +140,19 @@ def campaign_row(results: Path) -> Row:
     return judged_row(name, target, record, " s", bool(data.get("quick")))
 
 
+def ray_row(results: Path) -> Row:
+    """Ray's added CPU per episode, in % of the episode's own CPU, <= 10 (``ray.json``)."""
+    name, target = "Ray overhead, % episode CPU", "<= 10 %"
+    data = load(results, "ray.json")
+    record = data.get("target") if data is not None else None
+    if data is None or not isinstance(record, dict):
+        return Row(name, target)
+    share = record.get("measured")
+    if isinstance(share, int | float) and not isinstance(share, bool):
+        record = {**record, "measured": 100.0 * share, "limit": 100.0 * TARGET_RAY_SHARE}
+    return judged_row(name, target, record, " %", bool(data.get("quick")))
+
+
 def vector_env_rows(results: Path) -> list[Row]:
     """The vector env's targets from ``vector_env.json`` (``bench_vector_env.py``: rows named
     ``vector env...``); one "not measured" row without them."""
@@ -173,7 +190,12 @@ def summary_line(results: Path) -> str | None:
 
 def build_rows(results: Path) -> list[Row]:
     """Every issue-20 row, in the issue's order."""
-    return [*peer_rows(results), campaign_row(results), *vector_env_rows(results)]
+    return [
+        *peer_rows(results),
+        campaign_row(results),
+        ray_row(results),
+        *vector_env_rows(results),
+    ]
 
 
 def render(rows: Sequence[Row], footer: Sequence[str] = ()) -> str:

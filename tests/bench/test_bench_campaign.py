@@ -2,12 +2,25 @@
 
 from __future__ import annotations
 
+from collections import deque
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from uvnav.bench.campaign import Job, JobOutcome, grid_jobs, run_campaign, run_job, scene_groups
+from uvnav.bench.campaign import (
+    FORKSERVER_PRELOAD,
+    Job,
+    JobOutcome,
+    TaskSizer,
+    grid_jobs,
+    run_campaign,
+    run_group_batch,
+    run_job,
+    scene_groups,
+    sized_batches,
+    warm_up,
+)
 from uvnav.bench.store import ResultsStore
 from uvnav.dynamics import UnicycleSpec
 from uvnav.obstacles import ConstantVelocity, DiscBody, Obstacle, ObstacleState
@@ -223,3 +236,55 @@ def test_a_batch_stores_all_or_nothing(tmp_path: Path) -> None:
         assert store.count("c") == 3
         store.add_episode(cid, scenario="s", controller="x", seed=8, status="timeout", metrics=ok)
         assert store.count("c") == 4  # outside a batch: a write is its own transaction again
+
+
+def test_run_job_times_its_cpu() -> None:
+    out = run_job(Job(controller="straight-v1", seed=1, generator_seed=1))
+    assert out.error is None and out.cpu_time > 0.0
+
+
+def _outcome(job: Job, wall_time: float) -> JobOutcome:
+    return JobOutcome(job, "success", {}, None, wall_time)
+
+
+def test_task_sizer_batches_short_groups_up_to_a_limit() -> None:
+    job = Job(controller="straight-v1", seed=0, generator_seed=0)
+    sizer = TaskSizer(seconds=0.25, limit=16)
+    assert sizer.size() == 1  # nothing measured yet: one group per task
+    sizer.add([_outcome(job, 0.02), _outcome(job, 0.03)])  # a group of 0.05 s
+    assert sizer.size() == 5
+    sizer.add([_outcome(job, 0.15)])  # mean 0.1 s per group
+    assert sizer.size() == 2
+    sizer.add([_outcome(job, 2.0)])  # slow groups: still one per task
+    assert sizer.size() == 1
+    fast = TaskSizer(seconds=0.25, limit=16)
+    fast.add([_outcome(job, 0.0001)])
+    assert fast.size() == 16
+
+
+def test_sized_batches_are_cut_when_asked_for() -> None:
+    """A task is sized when the pool asks for it, on the groups handled so far."""
+    groups = [[Job(controller="straight-v1", seed=g, generator_seed=g)] for g in range(10)]
+    sizer = TaskSizer(seconds=0.25, limit=16)
+    batches = sized_batches(deque(groups), sizer)
+    assert len(next(batches)) == 1  # nothing back yet
+    sizer.add([_outcome(groups[0][0], 0.08)])  # 0.08 s a group: 3 to a task
+    assert [len(b) for b in batches] == [3, 3, 3]
+    assert list(batches) == []
+
+
+def test_group_batch_runs_every_group_and_times_each_job() -> None:
+    laws = ("straight-v1", "zhang2019-v1")
+    groups = scene_groups([Job(controller=c, seed=g, generator_seed=g) for g in (1, 2)
+                           for c in laws])  # fmt: skip
+    outs = run_group_batch(groups)
+    assert [[o.job for o in g] for g in outs] == groups
+    assert all(o.error is None and o.cpu_time > 0.0 for g in outs for o in g)
+
+
+def test_fork_server_warms_up_once() -> None:
+    """The pool's fork server imports the module that runs one episode before it forks."""
+    assert FORKSERVER_PRELOAD[-1] == "uvnav.bench.forkserver_warm"
+    import uvnav.bench.forkserver_warm  # noqa: F401 - runs warm_up(): must not raise
+
+    warm_up()

@@ -110,7 +110,7 @@ def _write(folder: Path, name: str, payload: dict[str, Any]) -> None:
 
 def test_summary_table(tmp_path: Path) -> None:
     rows = summary.build_rows(tmp_path)  # nothing run yet
-    assert [r.result for r in rows] == ["not run"] * 6 + ["not measured"]
+    assert [r.result for r in rows] == ["not run"] * 7 + ["not measured"]
     assert rows[-1].name == "vector env"
     _write(
         tmp_path,
@@ -146,7 +146,7 @@ def test_summary_table(tmp_path: Path) -> None:
     assert got["ORCA antipodal:100 vs navground"][2] == "not run"
     assert got["campaign, 10,000 episodes"] == ("90.0 s", "0.75", "PASS")
     assert got["vector env, K = 256"] == ("110,066/s", "1.10", "PASS*")
-    assert len(rows) == 7
+    assert len(rows) == 8  # the Ray row: tests/bench/test_bench_ray_summary.py
     text = summary.render(rows, ["footer", summary.summary_line(tmp_path) or ""])
     assert max(len(line) for line in text.splitlines()) <= summary.WIDTH
     assert "* quick (smoke) run" in text and "1 of 2 pass" in text

@@ -1,4 +1,5 @@
-"""The Ray engine stores the same metrics as the local engine (Ray is started once, here).
+"""The Ray engine stores the same metrics as the local engine (Ray is started once, here), and a
+task whose worker dies is run again split, so that only the job that kills its worker is an error.
 
 Skipped when Ray (extra ``uvnav[bench]``) is not installed.  Ray's start-up costs several seconds,
 so the whole module is one test: under ``pytest -n`` two tests could land in two workers and start
@@ -8,12 +9,16 @@ Ray twice.
 from __future__ import annotations
 
 import json
+import os
+import sys
 from collections.abc import Iterator
 from pathlib import Path
+from typing import Any
 
 import pytest
 from typer.testing import CliRunner
 
+from uvnav.bench.campaign import Job, run_campaign
 from uvnav.bench.ray_engine import start_local_ray
 from uvnav.bench.spec import campaign_from_dict, run_campaign_spec
 from uvnav.bench.store import ResultsStore
@@ -36,8 +41,20 @@ controllers: [{name: straight-v1}, {name: zhang2019-v1}]
 """
 
 
+CRASH_SEED = 20
+
+
+def crash_on_seed(job: Job) -> tuple[str, dict[str, Any], None, dict[str, Any]]:
+    """A chapter runner that kills its worker on :data:`CRASH_SEED` and is instant elsewhere."""
+    if job.seed == CRASH_SEED:
+        os._exit(3)
+    return "success", {}, None, {}
+
+
 @pytest.fixture(scope="module")
 def ray_instance() -> Iterator[object]:
+    # the workers cannot import this test module: its functions travel by value
+    ray.cloudpickle.register_pickle_by_value(sys.modules[__name__])
     start_local_ray(ray, 2)  # as uvnav starts it: loopback only
     yield ray
     ray.shutdown()
@@ -73,3 +90,20 @@ def test_ray_engine_matches_local_and_cli(tmp_path: Path, ray_instance: object) 
                 row.pop(col)
         tables.append(rows)
     assert tables[0] == tables[1]
+
+    check_a_dying_worker_costs_one_job(tmp_path)
+
+
+def check_a_dying_worker_costs_one_job(tmp_path: Path) -> None:
+    """Instant jobs are batched 16 to a task once the first are back; the task holding the job
+    that kills its worker fails (after Ray's retries), is run again one job per task, and only
+    that job is stored as an error."""
+    jobs = [Job(controller="x", seed=s, runner=crash_on_seed, label=f"crash/{s}")
+            for s in range(40)]  # fmt: skip
+    with ResultsStore(tmp_path / "crash.sqlite") as store:
+        run = run_campaign(store, "crash", jobs, workers=2, engine="ray")
+        df = store.episodes_frame("crash")
+    assert (run.ran, run.errors) == (40, 1)
+    bad = df[df["status"] == "error"]
+    assert list(bad["seed"]) == [CRASH_SEED]
+    assert "Error" in str(bad["error"].iloc[0])

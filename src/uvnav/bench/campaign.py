@@ -16,17 +16,20 @@ message; it does not stop the campaign.
 
 Workers are a :class:`concurrent.futures.ProcessPoolExecutor` started with the ``forkserver`` method
 on POSIX (``spawn`` elsewhere): forking a parent that runs a progress-bar thread and holds an open
-SQLite connection is unsafe, and the fork server preloads uvnav once so workers start quickly.  At
-most ``2 × workers`` jobs are submitted ahead, which bounds memory for large campaigns.  With
+SQLite connection is unsafe, and the fork server preloads uvnav and runs one short episode
+(:func:`warm_up`: lazy imports, compiled kernels loaded) once, so workers start warm.  At
+most ``2 × workers`` tasks are submitted ahead, which bounds memory for large campaigns.  With
 ``workers=1`` everything runs in-process (no pool; easiest to debug and profile).  ``engine="ray"``
 runs the same jobs as Ray tasks instead (:mod:`uvnav.bench.ray_engine`); results still come back to
-this process, which alone writes the store.  On the local pool the jobs of one scene (the laws and
-parameter sets run on one generated scene) travel together (:func:`scene_groups`): one worker
-builds the scene once for all of them, and their episodes are stored in one transaction when the
-group finishes, so an interrupt loses at most the groups in flight.  As with any
-``spawn``/``forkserver`` pool, a *script* that starts a campaign with ``workers > 1`` must do so
-under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already do), and a
-``setup_factory`` must be importable (defined at module level, not in a notebook cell); pass
+this process, which alone writes the store.  On the local pool and on Ray the jobs of one scene
+(the laws and parameter sets run on one generated scene) travel together (:func:`scene_groups`):
+one worker builds the scene once for all of them, and their episodes are stored in one transaction
+when the group finishes, so an interrupt loses at most the groups in flight.  A task carries as
+many groups as run about :data:`TASK_SECONDS` (:class:`TaskSizer`: a task's cost to the engine is
+fixed), so at most ``2 × workers`` tasks in flight are about half a second of each worker's work.
+As with any ``spawn``/``forkserver`` pool, a *script* that starts a campaign with ``workers > 1``
+must do so under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already do),
+and a ``setup_factory`` must be importable (defined at module level, not in a notebook cell); pass
 ``mp_context=multiprocessing.get_context("fork")`` to lift both restrictions at fork's usual risks.
 """
 
@@ -41,9 +44,10 @@ import sys
 import threading
 import time
 import traceback
+from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
-from contextlib import contextmanager
+from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
@@ -216,6 +220,8 @@ class JobOutcome:
         effective_params: parameters the controller was built with (a ``runner``'s job: its
             tags and facts).
         result: a ``runner``'s own result when ``job.record`` (for figures; never stored).
+        cpu_time: CPU time of the worker's thread on the job, building included [s] (never
+            stored; what a campaign's engine adds is measured against it, ``bench_ray.py``).
     """
 
     job: Job
@@ -226,6 +232,7 @@ class JobOutcome:
     trajectory: Trajectory | None = None
     effective_params: dict[str, Any] = field(default_factory=dict)
     result: Any = None
+    cpu_time: float = 0.0
 
 
 def _plain(params: Any) -> dict[str, Any]:
@@ -311,6 +318,51 @@ def run_job_group(jobs: Sequence[Job]) -> list[JobOutcome]:
     return [run_job(job) for job in jobs]
 
 
+#: a task (local pool or Ray) runs about this long [s]: enough scene groups are batched into it
+#: (:class:`TaskSizer`)
+TASK_SECONDS = 0.25
+#: at most this many scene groups in one task
+MAX_GROUPS_PER_TASK = 16
+
+
+def run_group_batch(groups: Sequence[Sequence[Job]]) -> list[list[JobOutcome]]:
+    """:func:`run_job_group` on each of ``groups`` in turn, in one worker (one task)."""
+    return [run_job_group(group) for group in groups]
+
+
+class TaskSizer:
+    """How many scene groups the next task gets, so that a task runs about ``seconds``.
+
+    One group while none has come back; then ``seconds`` over the mean worker time of the groups
+    that have (their outcomes' ``wall_time``), between 1 and ``limit``.  A task costs its engine
+    a fixed overhead however long it runs (two pickled messages and the bookkeeping of the
+    executor's or Ray's driver and workers; Ray's scheduling), so short groups are sent several
+    at a time; the size never changes what a job stores.
+    """
+
+    def __init__(self, seconds: float = TASK_SECONDS, limit: int = MAX_GROUPS_PER_TASK) -> None:
+        self.seconds, self.limit = seconds, limit
+        self._groups, self._time = 0, 0.0
+
+    def add(self, outcomes: Sequence[JobOutcome]) -> None:
+        """Account for one finished group."""
+        self._groups += 1
+        self._time += sum(out.wall_time for out in outcomes)
+
+    def size(self) -> int:
+        """Groups for the next task."""
+        if self._groups == 0 or self._time <= 0.0:
+            return 1
+        return max(1, min(self.limit, int(self.seconds * self._groups / self._time)))
+
+
+def sized_batches(queue: deque[list[Job]], sizer: TaskSizer) -> Iterator[list[list[Job]]]:
+    """Tasks taken from the front of ``queue`` (scene groups) as they are asked for, each of
+    ``sizer.size()`` groups at that moment (fewer at the end)."""
+    while queue:
+        yield [queue.popleft() for _ in range(min(sizer.size(), len(queue)))]
+
+
 def _error(job: Job, exc: BaseException, tic: float, params: dict[str, Any]) -> JobOutcome:
     tb = traceback.extract_tb(exc.__traceback__)
     where = f" (at {tb[-1].filename}:{tb[-1].lineno})" if tb else ""
@@ -328,8 +380,16 @@ def run_job(job: Job) -> JobOutcome:
 
     Jobs with a scene (any kind) run through :func:`uvnav.scenarios.episodes.run_scene`, the
     path of ``uvnav simulate``; jobs with a ``setup_factory`` run the 2D loop directly, jobs with
-    a ``runner`` their chapter's own episode.
+    a ``runner`` their chapter's own episode.  The outcome's ``cpu_time`` is this thread's.
     """
+    cpu = time.thread_time()
+    out = _run_job(job)
+    out.cpu_time = time.thread_time() - cpu
+    return out
+
+
+def _run_job(job: Job) -> JobOutcome:
+    """:func:`run_job` but for its CPU time."""
     from uvnav.scenarios.episodes import AssumptionError, LawMismatchError
     from uvnav.scenarios.errors import PlacementError
 
@@ -519,13 +579,32 @@ def run_stored(
     return [by_key[j.key] for j in jobs if j.key in by_key]
 
 
+#: what the fork server imports before it forks a worker (the last one runs :func:`warm_up`)
+FORKSERVER_PRELOAD = (
+    "uvnav.bench.campaign",
+    "uvnav.scenarios",
+    "uvnav.controllers",
+    "uvnav.bench.forkserver_warm",
+)
+
+
 def default_mp_context() -> mp.context.BaseContext:
-    """``forkserver`` (uvnav preloaded) on POSIX, ``spawn`` elsewhere; see the module docstring."""
+    """``forkserver`` (uvnav preloaded and warmed up, :data:`FORKSERVER_PRELOAD`) on POSIX,
+    ``spawn`` elsewhere; see the module docstring."""
     if sys.platform != "win32" and "forkserver" in mp.get_all_start_methods():
         ctx = mp.get_context("forkserver")
-        ctx.set_forkserver_preload(["uvnav.bench.campaign", "uvnav.scenarios", "uvnav.controllers"])
+        ctx.set_forkserver_preload(list(FORKSERVER_PRELOAD))
         return ctx
     return mp.get_context("spawn")
+
+
+def warm_up() -> None:
+    """Run one short episode (``straight-v1`` on random-ch2 scene 0) and drop it: the lazy
+    imports and the compiled kernels' loading that a process's first episode pays are paid
+    here, once (the fork server does, :mod:`uvnav.bench.forkserver_warm`; the workers it forks
+    inherit them).  Never raises: a failure only leaves the workers to warm up themselves."""
+    with suppress(Exception):  # warming up is an optimisation, never a failure
+        run_job(Job(controller="straight-v1", seed=0, generator_seed=0))
 
 
 def run_campaign(
@@ -637,6 +716,11 @@ def _run_campaign(
         if on_outcome is not None:
             on_outcome(out, episode_id)
 
+    def handle_group(outs: list[JobOutcome]) -> None:
+        with store.batch():  # the group's episodes in one transaction
+            for out in outs:
+                handle(out)
+
     try:
         if bar is not None:
             bar.start()
@@ -644,19 +728,21 @@ def _run_campaign(
             if todo:
                 from uvnav.bench.ray_engine import run_ray
 
-                run_ray(todo, handle, workers=workers, address=address)
+                run_ray(scene_groups(todo), handle_group, workers=workers, address=address)
         elif workers <= 1:
             for job in todo:
                 handle(run_job(job))
         elif todo:
+            sizer = TaskSizer()
 
-            def handle_group(outs: list[JobOutcome]) -> None:
-                with store.batch():  # the group's episodes in one transaction
-                    for out in outs:
-                        handle(out)
+            def handle_batch(outs: list[list[JobOutcome]]) -> None:
+                for group in outs:
+                    sizer.add(group)
+                    handle_group(group)
 
             ctx = mp_context or default_mp_context()
-            _run_pool(scene_groups(todo), run_job_group, handle_group, workers, ctx)
+            batches = sized_batches(deque(scene_groups(todo)), sizer)
+            _run_pool(batches, run_group_batch, handle_batch, workers, ctx)
     finally:
         if bar is not None:
             bar.stop()
@@ -782,14 +868,15 @@ def run_in_workers(
 
 
 def _run_pool(
-    todo: Sequence[T],
+    todo: Iterable[T],
     compute: Callable[[T], R],
     handle: Callable[[R], None],
     workers: int,
     ctx: mp.context.BaseContext,
 ) -> None:
     """Run ``compute`` over ``todo`` on a process pool, handing each result to ``handle`` as it
-    finishes.
+    finishes.  ``todo`` is drawn from only as a worker needs more (a generator may size the next
+    item on the results handled so far).
 
     Workers ignore SIGINT, so a Ctrl-C (sent by the terminal to the whole process group) reaches
     only this process: it stops the workers at once — without waiting for the episodes in flight,

@@ -1,16 +1,25 @@
 """Ray engine: a campaign's jobs as Ray tasks, results streamed back to the driver.
 
-The same picklable :class:`~uvnav.bench.campaign.Job` s that the local process pool runs are sent to
-:func:`~uvnav.bench.campaign.run_job` as Ray tasks (one CPU each).  Workers only compute; each
-:class:`~uvnav.bench.campaign.JobOutcome` comes back to the driver, which writes it to the SQLite
-store in its own transaction (DESIGN §5) — exactly as with the local engine, so resume, progress and
-the stored metrics are the same whatever the engine.
+The same tasks as on the local process pool — scene groups of picklable
+:class:`~uvnav.bench.campaign.Job` s (:func:`~uvnav.bench.campaign.scene_groups`: the jobs of one
+scene and seed go to one worker, which builds the scene once), as many groups to a task as run
+about :data:`~uvnav.bench.campaign.TASK_SECONDS` (a quarter of a second,
+:class:`~uvnav.bench.campaign.TaskSizer`), since each task costs Ray a fixed overhead — run
+:func:`~uvnav.bench.campaign.run_group_batch` as Ray tasks (one CPU each).  Workers only compute;
+each group's :class:`~uvnav.bench.campaign.JobOutcome` s come back to the driver, which writes
+them to the SQLite store in one transaction (DESIGN §5) — exactly as with the local engine, so
+resume, progress and the stored metrics are the same whatever the engine.
 
 Like the local pool, at most ``2 × workers`` tasks are in flight: large campaigns do not flood the
-object store, and a killed driver loses at most those episodes.  Ray is started here only when it is
-not running yet (``ray.init(address=..., num_cpus=workers)``; with no address a local instance) and
-is shut down again at the end; a caller that already called ``ray.init`` keeps its instance (tests
-start Ray once per module this way).
+object store, and a killed driver loses at most those tasks' episodes (about half a second of each
+worker's work).  Ray is started here only when it is not running yet (``ray.init(address=...,
+num_cpus=workers)``; with no address a local instance) and is shut down again at the end; a caller
+that already called ``ray.init`` keeps its instance (tests start Ray once per module this way).
+
+What Ray adds to a campaign's CPU is measured by ``benchmarks/bench_ray.py``: on 2,000
+random-ch2 episodes and 2 workers, 0.8-1.6 CPU-ms per episode over the local pool (4-7 % of an
+episode's 20-21 CPU-ms; one job per task, as before, added 5.2), and its start-up about 3 CPU-s
+per campaign.
 
 A local instance started here listens on the loopback interface only (:func:`start_local_ray`):
 its GCS server, raylet, object manager, workers and agents accept no connection from the network.
@@ -26,12 +35,20 @@ from __future__ import annotations
 import ipaddress
 import logging
 import os
+from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from types import ModuleType
 from typing import Any
 
-from uvnav.bench.campaign import Job, JobOutcome, run_job
+from uvnav.bench.campaign import (
+    TASK_SECONDS,
+    Job,
+    JobOutcome,
+    TaskSizer,
+    run_group_batch,
+    sized_batches,
+)
 from uvnav.bench.store import STATUS_ERROR
 
 
@@ -123,23 +140,45 @@ def _crash_outcome(job: Job, exc: BaseException) -> JobOutcome:
     return JobOutcome(job, STATUS_ERROR, None, f"{type(exc).__name__}: {first}", 0.0)
 
 
+Batch = list[list[Job]]
+
+
+def _split(batch: Batch) -> list[Batch] | None:
+    """A failed task's work, smaller: its groups one per task, a lone group's jobs one per task;
+    ``None`` for a lone job (it is the one that fails)."""
+    if len(batch) > 1:
+        return [[group] for group in batch]
+    if len(batch[0]) > 1:
+        return [[[job]] for job in batch[0]]
+    return None
+
+
 def run_ray(
-    todo: Sequence[Job],
-    handle: Callable[[JobOutcome], None],
+    groups: Sequence[Sequence[Job]],
+    handle: Callable[[list[JobOutcome]], None],
     *,
     workers: int = 1,
     address: str | None = None,
+    task_seconds: float = TASK_SECONDS,
 ) -> None:
-    """Run ``todo`` as Ray tasks, handing each outcome to ``handle`` (in this process) as it ends.
+    """Run ``groups`` (scene groups, :func:`~uvnav.bench.campaign.scene_groups`) as Ray tasks,
+    handing each group's outcomes to ``handle`` (in this process) as its task ends.
+
+    A task runs a batch of groups (:func:`~uvnav.bench.campaign.run_group_batch`), as many as
+    take about ``task_seconds`` (:class:`~uvnav.bench.campaign.TaskSizer`: one until the first
+    come back).  A task that Ray cannot complete (its worker died, even after Ray's retries) is
+    run again split (its groups one per task, a lone group's jobs one per task), so only the job
+    that kills its worker is stored as an error.
 
     Args:
-        todo: jobs to run.
-        handle: called with each outcome, in completion order (it stores the episode).
+        groups: the jobs, grouped by scene.
+        handle: called with each group's outcomes, in completion order (it stores them).
         workers: CPUs of the local Ray instance started here, and half the tasks kept in flight.
         address: Ray cluster to connect to (``"auto"``, ``"ray://host:10001"``...; default
             ``$RAY_ADDRESS``); none starts
             a local instance with ``num_cpus=workers`` that listens on 127.0.0.1 only
             (:func:`start_local_ray`).  Ignored when Ray is already initialised.
+        task_seconds: the worker time a task is sized to.
 
     Raises:
         EngineUnavailableError: Ray is not installed, or a local instance would not be
@@ -160,27 +199,35 @@ def run_ray(
                 logging_level=logging.WARNING,
             )
         started = True
-    remote = ray.remote(num_cpus=1, max_retries=2)(run_job)
+    remote = ray.remote(num_cpus=1, max_retries=2)(run_group_batch)
     window = 2 * max(1, workers)
-    queue = iter(todo)
-    pending: dict[Any, Job] = {}
+    sizer = TaskSizer(task_seconds)
+    queue = sized_batches(deque(list(g) for g in groups), sizer)
+    again: deque[Batch] = deque()  # the pieces of failed tasks, run first
+    pending: dict[Any, Batch] = {}
     try:
         while True:
             while len(pending) < window:
-                job = next(queue, None)
-                if job is None:
+                batch = again.popleft() if again else next(queue, None)
+                if batch is None:
                     break
-                pending[remote.remote(job)] = job
+                pending[remote.remote(batch)] = batch
             if not pending:
                 break
             ready, _ = ray.wait(list(pending), num_returns=1)
             for ref in ready:
-                job = pending.pop(ref)
+                batch = pending.pop(ref)
                 try:
-                    out = ray.get(ref)
+                    outcomes = ray.get(ref)
                 except ray.exceptions.RayError as exc:
-                    out = _crash_outcome(job, exc)
-                handle(out)
+                    pieces = _split(batch)
+                    if pieces is not None:
+                        again.extend(pieces)
+                        continue
+                    outcomes = [[_crash_outcome(batch[0][0], exc)]]
+                for group in outcomes:
+                    sizer.add(group)
+                    handle(group)
     except BaseException:
         for ref in pending:
             ray.cancel(ref, force=True)

@@ -21,7 +21,7 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import Field, ValidationError
 
-from uvnav.geometry.polygons import polygon_area, polygon_centroid
+from uvnav.geometry.polygons import cyclic_next, cyclic_prev, polygon_area, polygon_centroid
 from uvnav.scenarios import pedestrians
 from uvnav.scenarios.build import obstacle_bounds
 from uvnav.scenarios.crowdnav import crowdnav_circle, crowdnav_square
@@ -51,8 +51,8 @@ def is_convex(vertices: np.ndarray) -> bool:
     v = np.asarray(vertices, dtype=float)
     if polygon_area(v) < 0:
         v = v[::-1]
-    e_in = v - np.roll(v, 1, axis=0)
-    e_out = np.roll(v, -1, axis=0) - v
+    e_in = v - cyclic_prev(v)
+    e_out = cyclic_next(v) - v
     cross = e_in[:, 0] * e_out[:, 1] - e_in[:, 1] * e_out[:, 0]
     return bool(np.all(cross >= -1e-12))
 
@@ -64,7 +64,7 @@ def is_star_about(vertices: np.ndarray, point: np.ndarray) -> bool:
     be star-shaped with respect to ``point`` (every ray from it crosses the boundary once).
     """
     rel = np.asarray(vertices, dtype=float) - point
-    nxt = np.roll(rel, -1, axis=0)
+    nxt = cyclic_next(rel)
     return bool(np.all(rel[:, 0] * nxt[:, 1] - rel[:, 1] * nxt[:, 0] > 1e-9))
 
 

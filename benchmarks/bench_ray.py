@@ -1,0 +1,293 @@
+"""Ray's overhead: the CPU a campaign on the Ray engine adds per episode to the local engine's
+(issue 20, item 4: at most 10 % of the episode's own CPU).
+
+Run: ``PYTHONPATH=src .venv/bin/python benchmarks/bench_ray.py`` (``--seeds N``: random-ch2
+scenes, 2 episodes each, default 1000; ``--quick``: 100 seeds; ``--workers``: default 2;
+``--out DIR`` writes ``DIR/ray.json``).  Needs Ray (extra ``uvnav[bench]``) and Linux (``/proc``);
+without either it writes the record with ``pass: null`` and says why.  About 100 s on 2 idle
+cores.
+
+The same jobs (random-ch2 seeds x zhang2019-v1 and savkin-wang2013-v1, as ``bench_campaign.py``)
+run three times through :func:`uvnav.bench.campaign.run_campaign`, each into a fresh store:
+
+1. the local engine in this process (``workers=1``);
+2. the local engine's process pool (``--workers`` processes);
+3. the Ray engine on a local Ray instance of ``--workers`` CPUs, started here
+   (:func:`uvnav.bench.ray_engine.start_local_ray`, as ``uvnav bench --engine ray`` starts it).
+
+Counted, for each run: user + system CPU time, read from ``/proc/PID/stat``, of this process and
+every process below it — the fork server and pool workers; Ray's GCS server, raylet, dashboard
+and runtime-env agents, log monitor and workers — including what their exited children used
+(``cutime`` and ``cstime``: a pool worker that has exited is counted through the fork server that
+reaped it), split by process (driver, pool; Ray workers, Ray daemons).  From it is taken the
+jobs' own CPU, the sum of the outcomes' ``cpu_time`` (the worker thread's CPU time in
+:func:`~uvnav.bench.campaign.run_job`: scene, episode, metrics): what is left is the engine's
+overhead (storing, messages, scheduling, process start-up and imports, daemons).  Two processes
+busy on two cores (or on one core's two hyperthreads) each run slower than one alone, and a
+loaded machine more so, so total CPU times of runs with different parallelism are not
+comparable with each other; runs with the same parallelism are, and the overheads are.
+
+Ray's added CPU per episode = (CPU of Ray's run - CPU of the pool's run) / episodes, judged as a
+share of the episode's own CPU (the in-process run's jobs' CPU per episode).  It is reported in
+two parts: the overheads' difference, and the jobs' (Ray's workers pay the first episode's
+warm-up, about 0.65 CPU-s each, themselves; the pool's fork server pays it once before it forks;
+and whatever Ray's threads beside a task cost it).  Ray's start-up (``ray.init`` until it returns:
+GCS, raylet, agents, idle workers) is a cost per campaign, reported apart (and per episode of this
+run with it); the run after it (its daemons' CPU during the run, its workers' imports and warm-up
+included) is what the target judges.  Prints target, measured, ratio and PASS/FAIL.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+import time
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+sys.path.insert(0, str(Path(__file__).parent))
+
+from run_benchmarks import machine_info, write_json
+
+from uvnav.bench.campaign import Job, JobOutcome, run_campaign
+from uvnav.bench.store import ResultsStore
+
+LAWS = ("zhang2019-v1", "savkin-wang2013-v1")
+#: Ray's added CPU per episode, at most this share of the episode's own CPU
+TARGET_SHARE = 0.10
+#: how long to leave the fork server to reap an exited worker before its CPU is read [s]
+REAP_WAIT_S = 0.3
+
+
+def _proc_table() -> dict[int, tuple[int, str, float]] | None:
+    """Every process's ``(parent pid, name, CPU seconds)`` from ``/proc`` (user + system, its own
+    and its reaped children's), or ``None`` without ``/proc``."""
+    if not os.path.isdir("/proc/self"):
+        return None
+    tick = os.sysconf("SC_CLK_TCK")
+    table: dict[int, tuple[int, str, float]] = {}
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/stat", "rb") as fh:
+                stat = fh.read()
+        except OSError:  # gone meanwhile
+            continue
+        head, tail = stat.rsplit(b")", 1)
+        name = head.split(b"(", 1)[1].decode(errors="replace")
+        fields = tail.split()  # state ppid ... utime stime cutime cstime at 11..14
+        utime, stime, cutime, cstime = (int(x) for x in fields[11:15])
+        table[int(entry)] = (int(fields[1]), name, (utime + stime + cutime + cstime) / tick)
+    return table
+
+
+def tree_snapshot(root: int | None = None) -> dict[int, tuple[str, float]] | None:
+    """Name and CPU seconds (its reaped children's included) of process ``root`` (default: this
+    one) and each of its living descendants; ``None`` where ``/proc`` is missing."""
+    table = _proc_table()
+    if table is None:
+        return None
+    root = os.getpid() if root is None else root
+    children: dict[int, list[int]] = {}
+    for pid, (ppid, _, _) in table.items():
+        children.setdefault(ppid, []).append(pid)
+    out: dict[int, tuple[str, float]] = {}
+    todo = [root]
+    while todo:
+        pid = todo.pop()
+        if pid in table:
+            out[pid] = table[pid][1:]
+            todo.extend(children.get(pid, ()))
+    return out
+
+
+def tree_cpu(root: int | None = None) -> float | None:
+    """CPU seconds of :func:`tree_snapshot`, summed."""
+    snap = tree_snapshot(root)
+    return None if snap is None else sum(cpu for _, cpu in snap.values())
+
+
+def _role(pid: int, name: str, engine: str) -> str:
+    """Who a process of the tree is: this process (the driver, which stores), or for the local
+    engine its pool (the fork server, with the workers it reaped), for Ray a worker (named
+    ``ray::<task>`` or ``ray::IDLE``) or one of Ray's daemons (GCS server, raylet, agents,
+    monitors)."""
+    if pid == os.getpid():
+        return "driver"
+    if engine != "ray":
+        return "pool"
+    if name.startswith("ray::") and not name.startswith(("ray::Dashboard", "ray::RuntimeEnv")):
+        return "ray workers"
+    return "ray daemons"
+
+
+def by_role(
+    before: dict[int, tuple[str, float]] | None,
+    after: dict[int, tuple[str, float]] | None,
+    engine: str,
+) -> dict[str, float] | None:
+    """CPU seconds spent between two snapshots, by :func:`_role`."""
+    if before is None or after is None:
+        return None
+    roles: dict[str, float] = {}
+    for pid, (name, cpu) in after.items():
+        role = _role(pid, name, engine)
+        roles[role] = roles.get(role, 0.0) + cpu - before.get(pid, (name, 0.0))[1]
+    return dict(sorted(roles.items()))
+
+
+def campaign_jobs(seeds: int) -> list[Job]:
+    """random-ch2 seeds ``0..seeds-1`` x :data:`LAWS` (``bench_campaign.py``'s jobs)."""
+    return [Job(controller=c, seed=g, generator_seed=g) for g in range(seeds) for c in LAWS]
+
+
+def timed_campaign(
+    jobs: Sequence[Job], workers: int, engine: str, before_read: Callable[[], None] | None = None
+) -> dict[str, Any]:
+    """One campaign of ``jobs`` into a fresh store: wall time, CPU of the process tree, the jobs'
+    own CPU (their outcomes' ``cpu_time``) and what the rest costs (the engine's overhead)."""
+    jobs_cpu = [0.0]
+
+    def count(out: JobOutcome, episode_id: int) -> None:
+        jobs_cpu[0] += out.cpu_time
+
+    with tempfile.TemporaryDirectory() as tmp, ResultsStore(Path(tmp) / "r.sqlite") as store:
+        snap0, tic = tree_snapshot(), time.perf_counter()
+        run = run_campaign(
+            store, f"bench-{engine}", jobs, workers=workers, engine=engine, on_outcome=count
+        )
+        wall = time.perf_counter() - tic
+        if before_read is not None:
+            before_read()
+        snap1 = tree_snapshot()
+    roles = by_role(snap0, snap1, engine)
+    cpu = None if roles is None else sum(roles.values())
+    n = max(run.ran, 1)
+    return {
+        "engine": engine,
+        "workers": workers,
+        "episodes": run.ran,
+        "statuses": dict(sorted(run.statuses.items())),
+        "wall_s": wall,
+        "cpu_s": cpu,
+        "jobs_cpu_s": jobs_cpu[0],
+        "overhead_cpu_s": None if cpu is None else cpu - jobs_cpu[0],
+        "cpu_ms_per_episode": None if cpu is None else 1e3 * cpu / n,
+        "jobs_cpu_ms_per_episode": 1e3 * jobs_cpu[0] / n,
+        "overhead_ms_per_episode": None if cpu is None else 1e3 * (cpu - jobs_cpu[0]) / n,
+        "cpu_s_by_process": roles,
+    }
+
+
+def measure_ray(jobs: Sequence[Job], workers: int) -> dict[str, Any]:
+    """The Ray engine on a local instance started here: start-up apart, then the campaign."""
+    import ray
+
+    from uvnav.bench.ray_engine import start_local_ray
+
+    snap0, tic = tree_snapshot(), time.perf_counter()
+    start_local_ray(ray, workers)
+    wall = time.perf_counter() - tic
+    roles = by_role(snap0, tree_snapshot(), "ray")
+    startup = {
+        "wall_s": wall,
+        "cpu_s": None if roles is None else sum(roles.values()),
+        "cpu_s_by_process": roles,
+    }
+    try:
+        res = timed_campaign(jobs, workers, "ray")  # read before the shutdown: all alive
+    finally:
+        ray.shutdown()
+    return {**res, "startup": startup, "ray": ray.__version__}
+
+
+def judge(inproc: dict[str, Any], pool: dict[str, Any], ray_run: dict[str, Any]) -> dict[str, Any]:
+    """Ray's added CPU per episode (the CPU of Ray's run less the local pool's, both process
+    trees, per episode) and its share of the episode's own CPU (the in-process jobs'), with its
+    parts: the overheads' difference, and the jobs' (Ray's workers pay their first episode's
+    warm-up themselves, the pool's fork server pays it once for all its workers)."""
+    if None in (inproc["cpu_s"], pool["cpu_s"], ray_run["cpu_s"]):
+        return {"measured": None, "limit": TARGET_SHARE, "pass": None, "note": "no /proc"}
+    n = max(int(ray_run["episodes"]), 1)
+    episode_ms = inproc["jobs_cpu_ms_per_episode"]
+    added_ms = 1e3 * (ray_run["cpu_s"] - pool["cpu_s"]) / n
+    share = added_ms / episode_ms
+    startup = ray_run["startup"]["cpu_s"] or 0.0
+    return {
+        "episode_cpu_ms": episode_ms,
+        "ray_added_cpu_ms": added_ms,
+        "of_which_overhead_ms": (
+            ray_run["overhead_ms_per_episode"] - pool["overhead_ms_per_episode"]
+        ),
+        "of_which_jobs_ms": ray_run["jobs_cpu_ms_per_episode"] - pool["jobs_cpu_ms_per_episode"],
+        "ray_added_with_startup_ms": added_ms + 1e3 * startup / n,
+        "measured": share,
+        "limit": TARGET_SHARE,
+        "ratio": share / TARGET_SHARE,
+        "pass": share <= TARGET_SHARE,
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--seeds", type=int, default=1000, help="random-ch2 scenes (2 episodes each)")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--quick", action="store_true", help="100 seeds: a smoke run")
+    ap.add_argument("--out", type=Path, help="write ray.json here")
+    args = ap.parse_args()
+    seeds = 100 if args.quick else args.seeds
+    record: dict[str, Any] = {"machine": machine_info(), "quick": args.quick, "seeds": seeds}
+    try:
+        import ray  # noqa: F401
+    except ImportError as exc:
+        print(f"ray: not installed ({exc}); nothing measured")
+        record["target"] = {"measured": None, "limit": TARGET_SHARE, "pass": None,
+                            "note": "ray not installed"}  # fmt: skip
+        if args.out is not None:
+            write_json(args.out, "ray", record)
+        return
+    jobs = campaign_jobs(seeds)
+    load0 = os.getloadavg()[0]
+    inproc = timed_campaign(jobs, 1, "local")
+    pool = timed_campaign(jobs, args.workers, "local", lambda: time.sleep(REAP_WAIT_S))
+    ray_run = measure_ray(jobs, args.workers)
+    record.update(in_process=inproc, pool=pool, ray_engine=ray_run, load_before=load0,
+                  load_after=os.getloadavg()[0])  # fmt: skip
+    target = record["target"] = judge(inproc, pool, ray_run)
+    for name, res in (("in-process", inproc), (f"pool x{args.workers}", pool),
+                      (f"ray x{args.workers}", ray_run)):  # fmt: skip
+        cpu = res["cpu_s"]
+        print(f"{name:<12} {res['episodes']} episodes: {res['wall_s']:6.1f} s wall, "
+              + ("CPU not measured" if cpu is None else
+                 f"{cpu:6.1f} CPU-s; per episode: job {res['jobs_cpu_ms_per_episode']:.2f} ms, "
+                 f"the rest {res['overhead_ms_per_episode']:.2f} ms"))  # fmt: skip
+        if res["cpu_s_by_process"]:
+            print("             CPU-s by process: " + ", ".join(
+                f"{k} {v:.2f}" for k, v in res["cpu_s_by_process"].items()))  # fmt: skip
+    su = ray_run["startup"]
+    print(f"ray start-up: {su['wall_s']:.1f} s wall, {su['cpu_s'] or float('nan'):.1f} CPU-s; "
+          f"load {load0:.1f} -> {record['load_after']:.1f}")  # fmt: skip
+    if target["pass"] is None:
+        print(f"target: Ray's added CPU <= {TARGET_SHARE:.0%} of the episode's: not measured")
+    else:
+        print(
+            f"ray adds {target['ray_added_cpu_ms']:.2f} CPU-ms per episode to the pool "
+            f"(overhead {target['of_which_overhead_ms']:.2f}, jobs "
+            f"{target['of_which_jobs_ms']:.2f}; {target['ray_added_with_startup_ms']:.2f} with "
+            f"its start-up); episode {target['episode_cpu_ms']:.2f} CPU-ms"
+        )
+        print(
+            f"target: Ray's added CPU per episode <= {TARGET_SHARE:.0%} of the episode's: "
+            f"measured {target['measured']:.1%} (ratio {target['ratio']:.2f}) "
+            f"{'PASS' if target['pass'] else 'FAIL'}"
+        )
+    if args.out is not None:
+        write_json(args.out, "ray", record)
+
+
+if __name__ == "__main__":
+    main()
