@@ -1,13 +1,37 @@
-"""Shared helpers of the tests that start real processes: the process tree from Linux ``/proc``
-and the episode count of a results database read without locking it."""
+"""Shared helpers of the tests that start real processes: the process tree from Linux ``/proc``,
+the episode count of a results database read without locking it, and a child started as a
+terminal starts a foreground job."""
 
 from __future__ import annotations
 
+import signal
 import sqlite3
+import subprocess
 from pathlib import Path
+from typing import IO, Any
 
 #: ``pytestmark`` of a test module that reads ``/proc``
 LINUX_PROC = Path("/proc/self/task").is_dir()
+
+
+def _terminal_signals() -> None:
+    """In the child, before exec: Ctrl-C's default action, as a terminal's foreground job has."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
+def start_foreground(cmd: list[str], stderr: IO[Any]) -> subprocess.Popen[bytes]:
+    """Start ``cmd`` (stdout discarded) as a terminal starts a foreground job that a test will
+    press Ctrl-C on: in its own session (the signal goes to its whole process group, as a
+    terminal sends it), with SIGINT's default action whatever this process inherited.  A test
+    run started in the background of a shell without job control inherits SIGINT ignored;
+    Python then installs no ``KeyboardInterrupt`` handler in the child and the Ctrl-C is lost."""
+    return subprocess.Popen(
+        cmd,
+        stdout=subprocess.DEVNULL,
+        stderr=stderr,
+        start_new_session=True,
+        preexec_fn=_terminal_signals,
+    )
 
 
 def children(pid: int) -> list[int]:

@@ -26,6 +26,7 @@ import pandas as pd
 import pytest
 
 import uvnav.bench.campaign as campaign_mod
+from processes import start_foreground
 from processes import stored_episodes as stored
 from uvnav.bench.spec import load_campaign, run_campaign_spec
 from uvnav.bench.store import ResultsStore
@@ -187,12 +188,7 @@ def test_fifty_interruptions_then_resume_equal_an_uninterrupted_run(
 def _bench(campaign_file: Path, db: Path, err: Any) -> subprocess.Popen[bytes]:
     """``uvnav bench --resume`` in its own session: signals go to its whole process group."""
     cmd = [sys.executable, "-m", "uvnav.cli", "bench", str(campaign_file), "--db", str(db)]
-    return subprocess.Popen(
-        [*cmd, "--resume", "--workers", "2", "--json"],
-        stdout=subprocess.DEVNULL,
-        stderr=err,
-        start_new_session=True,
-    )
+    return start_foreground([*cmd, "--resume", "--workers", "2", "--json"], err)
 
 
 def interrupt_process(

@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from processes import LINUX_PROC, descendants, running, stored_episodes
+from processes import LINUX_PROC, descendants, running, start_foreground, stored_episodes
 
 # 400 episodes (~0.1-0.2 s each) on two workers: far from done when Ctrl-C comes
 CAMPAIGN = """\
@@ -45,12 +45,7 @@ def _ctrl_c_once(tmp_path: Path, delay: float, k: int) -> tuple[int, float, str,
     cmd = [sys.executable, "-m", "uvnav.cli", "bench", str(campaign), "--db", str(db)]
     with err.open("w") as fh:
         # own session: the Ctrl-C goes to the whole group, as a terminal sends it
-        proc = subprocess.Popen(
-            [*cmd, "--workers", "2", "--json"],
-            stdout=subprocess.DEVNULL,
-            stderr=fh,
-            start_new_session=True,
-        )
+        proc = start_foreground([*cmd, "--workers", "2", "--json"], fh)
     tree: set[int] = set()
     try:
         deadline = time.monotonic() + 60
