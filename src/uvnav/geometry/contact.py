@@ -28,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
-from uvnav.geometry.kernels3d import numba_enabled
+from uvnav.geometry.kernels3d import compile_family, numba_enabled
 
 #: integer arrays (indices)
 IntArray = np.ndarray
@@ -196,20 +196,20 @@ def risk_one(
         lim = bodies[b, 6] + comfort
         bx2, by2 = bx - ux * tk, by - uy * tk
         vx, vy = cx - bodies[b, 4], cy - bodies[b, 5]
-        if _clear(bx, by, ux, uy, lim, max(tk, comfort_horizon)) and _clear(
+        if _clear_scalar(bx, by, ux, uy, lim, max(tk, comfort_horizon)) and _clear_scalar(
             bx2, by2, vx, vy, lim, horizon - tk
         ):
             continue  # the bounding disc stays clear: so does every boundary disc
         for j in range(int(bodies[b, 0]), int(bodies[b, 1])):
             rx, ry = q[j, 0] - px, q[j, 1] - py
             ax, ay = tx - w[j, 0], ty - w[j, 1]
-            t = _contact(rx, ry, ax, ay, reach[j], tk, margin)
-            t2 = _contact(rx - ax * tk, ry - ay * tk, cx - w[j, 0], cy - w[j, 1], reach[j],
+            t = _contact_scalar(rx, ry, ax, ay, reach[j], tk, margin)
+            t2 = _contact_scalar(rx - ax * tk, ry - ay * tk, cx - w[j, 0], cy - w[j, 1], reach[j],
                           horizon - tk, margin)  # fmt: skip
             t = min(t, tk + t2)
             if t < best_t:
                 best_t = t
-            g = comfort - _gap(rx, ry, ax, ay, reach[j], comfort_horizon)
+            g = comfort - _gap_scalar(rx, ry, ax, ay, reach[j], comfort_horizon)
             if g > best_p:
                 best_p = g
     return best_t, best_p
@@ -234,7 +234,7 @@ def candidate_risk_py(
     """The loop of :func:`candidate_risk_compiled`: :func:`risk_one` per candidate, written into
     ``ttc`` and ``pen``."""
     for k in range(cand.shape[0]):
-        ttc[k], pen[k] = _risk_one(position[0], position[1], cand[k, 0], cand[k, 1], turn[k, 0],
+        ttc[k], pen[k] = risk_one(position[0], position[1], cand[k, 0], cand[k, 1], turn[k, 0],
                                    turn[k, 1], tau[k], q, w, reach, bodies, horizon, comfort,
                                    comfort_horizon, margin)  # fmt: skip
 
@@ -335,7 +335,7 @@ def decide_py(
         bodies[b, 4], bodies[b, 5] = vel[b, 0], vel[b, 1]
         bodies[b, 6] = body_r[b] + pad
     tang = np.empty(2 * n_few + 1)
-    n_t = _tangents(px, py, q, grow, owner, n_few, tang)
+    n_t = tangents_py(px, py, q, grow, owner, n_few, tang)
     n_s = speeds.shape[0]
     n_h = n_t + extra.shape[0]
     n_c = n_h * n_s + 2
@@ -363,7 +363,7 @@ def decide_py(
             tk = min(abs(beta) / u_max, horizon)
             s1 = spd[k] * max(math.cos(0.5 * beta), 0.0)
             tx, ty = s1 * math.cos(hd + 0.5 * beta), s1 * math.sin(hd + 0.5 * beta)
-        ttc, pen = _risk_one(px, py, cand[k, 0], cand[k, 1], tx, ty, tk, q, w, reach, bodies,
+        ttc, pen = risk_one(px, py, cand[k, 0], cand[k, 1], tx, ty, tk, q, w, reach, bodies,
                              horizon, comfort, c_h, margin)  # fmt: skip
         cost = bound[k] + w_ttc / max(ttc, 1e-3) + w_comfort * pen
         if cost < best[0] or (cost == best[0] and k < best[1]):
@@ -376,29 +376,17 @@ def decide_py(
 
 
 _COMPILED: dict[str, Callable[..., Any]] = {}
-_contact: Callable[..., float] = _contact_scalar
-_gap: Callable[..., float] = _gap_scalar
-_clear: Callable[..., bool] = _clear_scalar
-_risk_one: Callable[..., tuple[float, float]] = risk_one
-_tangents: Callable[..., int] = tangents_py
 
 
-def _kernel() -> Callable[..., Any]:
-    """The numba-compiled loop (compiled, or loaded from numba's cache, on the first call)."""
-    global _contact, _gap, _clear, _risk_one, _tangents
+def _kernels() -> dict[str, Callable[..., Any]]:
+    """The numba-compiled loops by name (compiled, or loaded from numba's cache, on the first
+    call); the Python functions stay the reference path (:func:`compile_family`)."""
     if not _COMPILED:
-        import numba
-
-        _contact = numba.njit(cache=True, nogil=True)(_contact_scalar)
-        _gap = numba.njit(cache=True, nogil=True)(_gap_scalar)
-        _clear = numba.njit(cache=True, nogil=True)(_clear_scalar)
-        globals()["_contact_scalar"], globals()["_gap_scalar"] = _contact, _gap
-        globals()["_clear_scalar"] = _clear
-        _risk_one = numba.njit(cache=True, nogil=True)(risk_one)
-        _tangents = numba.njit(cache=True, nogil=True)(tangents_py)
-        _COMPILED["decide"] = numba.njit(cache=True, nogil=True)(decide_py)
-        _COMPILED["risk"] = numba.njit(cache=True, nogil=True)(candidate_risk_py)
-    return _COMPILED["risk"]
+        _COMPILED.update(compile_family([
+            _contact_scalar, _gap_scalar, _clear_scalar, risk_one, tangents_py, decide_py,
+            candidate_risk_py,
+        ]))  # fmt: skip
+    return _COMPILED
 
 
 def candidate_risk_compiled(
@@ -417,7 +405,7 @@ def candidate_risk_compiled(
     q, w, reach = discs
     ttc = np.empty(len(cand))
     pen = np.empty(len(cand))
-    fn = _kernel() if numba_enabled() else candidate_risk_py
+    fn = _kernels()["candidate_risk_py"] if numba_enabled() else candidate_risk_py
     fn(np.ascontiguousarray(position, dtype=float), np.ascontiguousarray(cand),
        np.ascontiguousarray(turn), np.ascontiguousarray(tau), np.ascontiguousarray(q),
        np.ascontiguousarray(w), np.ascontiguousarray(reach), np.ascontiguousarray(bodies),
@@ -442,10 +430,7 @@ def decide_compiled(
     q, w, r, owner = discs
     centre, vel, body_r = bodies
     out = np.empty(4)
-    fn = decide_py
-    if numba_enabled():
-        _kernel()
-        fn = _COMPILED["decide"]
+    fn = _kernels()["decide_py"] if numba_enabled() else decide_py
     c = np.ascontiguousarray
     fn(c(state, dtype=float), c(extra, dtype=float), c(speeds, dtype=float), c(q, dtype=float),
        c(w, dtype=float), c(r, dtype=float), c(owner, dtype=np.int64), c(centre, dtype=float),

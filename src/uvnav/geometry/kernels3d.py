@@ -186,7 +186,7 @@ def nearest_triangle_py(
         a0, a1, a2 = a[j, 0], a[j, 1], a[j, 2]
         b0, b1, b2 = ab[j, 0], ab[j, 1], ab[j, 2]
         c0, c1, c2 = ac[j, 0], ac[j, 1], ac[j, 2]
-        v, w = _bary((px, py, pz), (a0, a1, a2), (b0, b1, b2), (c0, c1, c2))
+        v, w = closest_barycentric_scalar((px, py, pz), (a0, a1, a2), (b0, b1, b2), (c0, c1, c2))
         qx = a0 + b0 * v + c0 * w
         qy = a1 + b1 * v + c1 * w
         qz = a2 + b2 * v + c2 * w
@@ -228,7 +228,7 @@ def signed_nearest_world_py(
     bx = rotation[0, 0] * gx + rotation[1, 0] * gy + rotation[2, 0] * gz
     by = rotation[0, 1] * gx + rotation[1, 1] * gy + rotation[2, 1] * gz
     bz = rotation[0, 2] * gx + rotation[1, 2] * gy + rotation[2, 2] * gz
-    j, v, w, qx, qy, qz, d2 = _nearest(bx, by, bz, a, ab, ac, tri_centre, tri_radius)
+    j, v, w, qx, qy, qz, d2 = nearest_triangle_py(bx, by, bz, a, ab, ac, tri_centre, tri_radius)
     d = math.sqrt(d2)
     if d > 0.0:
         tol = 1e-12
@@ -373,7 +373,7 @@ def plane_shadow_py(
                 # asin(x) <= min(x pi / 2, tan(asin x) = x / sqrt(1 - x^2)): the second is tight
                 # for small x, where most points lie
                 bound = min(ratio * half_pi, ratio / math.sqrt(max(1.0 - ratio * ratio, 1e-300)))
-                rough = _atan2b(-q1, q2) - psi_c
+                rough = atan2_bound(-q1, q2) - psi_c
                 if rough > math.pi:
                     rough -= 2.0 * math.pi
                 elif rough < -math.pi:
@@ -396,29 +396,17 @@ def plane_shadow_py(
     return psi_c, lo, hi, inside
 
 
-# the pure-Python callees of the kernels; replaced by their compiled forms by _compiled()
-_bary: Callable[..., tuple[float, float]] = closest_barycentric_scalar
-_nearest: Callable[..., tuple[int, float, float, float, float, float, float]] = nearest_triangle_py
-_atan2b: Callable[[float, float], float] = atan2_bound
 _COMPILED: dict[str, Callable[..., Any]] = {}
 
 
 def _compiled() -> dict[str, Callable[..., Any]]:
-    """The numba-compiled kernels (imported and compiled, or loaded from numba's cache, on the
-    first call: importing uvnav does not import numba)."""
-    global _bary, _nearest, _atan2b
+    """The numba-compiled kernels by name (imported and compiled, or loaded from numba's cache,
+    on the first call: importing uvnav does not import numba)."""
     if not _COMPILED:
-        import numba
-
-        def jit(fn: Callable[..., Any]) -> Callable[..., Any]:
-            return numba.njit(cache=True, nogil=True)(fn)
-
-        # callees first: a compiled kernel resolves the module globals it calls when compiled
-        _bary = jit(closest_barycentric_scalar)
-        _nearest = jit(nearest_triangle_py)
-        _atan2b = jit(atan2_bound)
-        _COMPILED["signed"] = jit(signed_nearest_world_py)
-        _COMPILED["shadow"] = jit(plane_shadow_py)
+        _COMPILED.update(compile_family([
+            closest_barycentric_scalar, nearest_triangle_py, atan2_bound,
+            signed_nearest_world_py, plane_shadow_py,
+        ]))  # fmt: skip
     return _COMPILED
 
 
@@ -436,7 +424,7 @@ def signed_nearest_world(
     vertex: FloatArray,
 ) -> tuple[float, float, float, float, int]:
     """The compiled :func:`signed_nearest_world_py` (call only when :func:`numba_enabled`)."""
-    return _compiled()["signed"](
+    return _compiled()["signed_nearest_world_py"](
         p, centre, rotation, a, ab, ac, tri_centre, tri_radius, face, edge, vertex
     )
 
@@ -453,7 +441,7 @@ def plane_shadow(
     """The compiled :func:`plane_shadow_py` (call only when :func:`numba_enabled`); ``rotation``
     None: the points only.  The arrays must be float64 (numba compiles one version per layout)."""
     rot = _EYE if rotation is None else rotation
-    return _compiled()["shadow"](
+    return _compiled()["plane_shadow_py"](
         points, centre, rot, rotation is not None, origin, x_axis, y_axis, float(radius)
     )
 
