@@ -128,6 +128,28 @@ class ControllerView:
     __hash__ = None  # type: ignore[assignment]
 
 
+def action_commands(
+    actions: np.ndarray, v_max: np.ndarray, u_max: np.ndarray, raw: bool
+) -> tuple[np.ndarray, np.ndarray]:
+    """(n, 2) actions to unicycle commands ``(v, u)`` [m/s, rad/s], (n,) each, before the
+    world saturates them to (2.4): the actions themselves when ``raw``, else normalised actions
+    in [-1, 1]^2 (clipped; non-finite components 0) mapped onto [0, V_max] x [-U_max, U_max]
+    (``v_max``, ``u_max``: (n,) limits).  The one rule of :meth:`EnvWorld.command` and the
+    batched env.
+
+    >>> v, u = action_commands(np.array([[0.0, -1.0], [np.nan, 2.0]]), np.full(2, 1.2),
+    ...                        np.full(2, 0.8), raw=False)
+    >>> v.tolist(), u.tolist()
+    ([0.6, 0.6], [-0.8, 0.8])
+    """
+    a = np.asarray(actions, dtype=float)
+    if raw:
+        return a[:, 0], a[:, 1]
+    a = np.clip(a, -1.0, 1.0)
+    a = np.where(np.isfinite(a), a, 0.0)
+    return 0.5 * (a[:, 0] + 1.0) * v_max, a[:, 1] * u_max
+
+
 class EnvWorld:
     """A loop world stepped one decision at a time, and the env's view of it (module docstring).
 
@@ -255,15 +277,12 @@ class EnvWorld:
         )  # fmt: skip
 
     def command(self, i: int, action: np.ndarray) -> UnicycleCommand:
-        """The unicycle command of an action: ``(v, u)`` itself with ``raw_commands``, else the
-        map of a normalised action in [-1, 1]^2 (clipped; non-finite components 0)."""
-        if self.raw_commands:
-            v, u = np.asarray(action, dtype=float).reshape(2).tolist()
-            return UnicycleCommand(v, u)
-        a = np.clip(np.asarray(action, dtype=float).reshape(2), -1.0, 1.0)
-        a = np.where(np.isfinite(a), a, 0.0)
+        """The unicycle command of robot ``i``'s action (:func:`action_commands`)."""
         spec = self.spec(i)
-        return UnicycleCommand(0.5 * (a[0] + 1.0) * spec.v_max, a[1] * spec.u_max)
+        a = np.asarray(action, dtype=float).reshape(1, 2)
+        v, u = action_commands(a, np.array([spec.v_max]), np.array([spec.u_max]),
+                               self.raw_commands)  # fmt: skip
+        return UnicycleCommand(float(v[0]), float(u[0]))
 
     def step(self, actions: dict[int, np.ndarray]) -> np.ndarray:
         """One decision: the acting robots' commands (a robot without an action stands still)

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.envs.core import RewardConfig, goal_scale_for
+from uvnav.envs.core import RewardConfig, action_commands, goal_scale_for
 from uvnav.envs.nav2d import act_space, episode_seed, obs_space, reward_config
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
@@ -149,17 +149,12 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         return self._obs.copy(), self._infos()
 
     def _commands(self, actions: np.ndarray, acting: np.ndarray) -> None:
-        """The ``acting`` worlds' actions to held commands: :meth:`EnvWorld.command
-        <uvnav.envs.core.EnvWorld.command>`, then the saturation of
-        :meth:`UnicycleCommand.clipped <uvnav.dynamics.unicycle.UnicycleCommand.clipped>`."""
+        """The ``acting`` worlds' actions to held commands: :func:`action_commands
+        <uvnav.envs.core.action_commands>`, then the saturation of :meth:`UnicycleCommand.clipped
+        <uvnav.dynamics.unicycle.UnicycleCommand.clipped>` on arrays."""
         a = np.asarray(actions, dtype=float).reshape(self.num_envs, 2)
         vmax, umax = self.worlds.limits[:, 0], self.worlds.limits[:, 1]
-        if self.raw_commands:
-            v, u = a[:, 0], a[:, 1]
-        else:
-            a = np.clip(a, -1.0, 1.0)
-            a = np.where(np.isfinite(a), a, 0.0)
-            v, u = 0.5 * (a[:, 0] + 1.0) * vmax, a[:, 1] * umax
+        v, u = action_commands(a, vmax, umax, self.raw_commands)
         v = np.where(np.isfinite(v), np.minimum(np.maximum(v, 0.0), vmax), 0.0)
         u = np.where(np.isfinite(u), np.minimum(np.maximum(u, -umax), umax), 0.0)
         self.worlds.command[acting, 0] = v[acting]
