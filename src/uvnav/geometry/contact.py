@@ -204,8 +204,8 @@ def risk_one(
             rx, ry = q[j, 0] - px, q[j, 1] - py
             ax, ay = tx - w[j, 0], ty - w[j, 1]
             t = _contact_scalar(rx, ry, ax, ay, reach[j], tk, margin)
-            t2 = _contact_scalar(rx - ax * tk, ry - ay * tk, cx - w[j, 0], cy - w[j, 1], reach[j],
-                          horizon - tk, margin)  # fmt: skip
+            t2 = _contact_scalar(rx - ax * tk, ry - ay * tk, cx - w[j, 0], cy - w[j, 1],
+                                 reach[j], horizon - tk, margin)  # fmt: skip
             t = min(t, tk + t2)
             if t < best_t:
                 best_t = t
@@ -235,8 +235,8 @@ def candidate_risk_py(
     ``ttc`` and ``pen``."""
     for k in range(cand.shape[0]):
         ttc[k], pen[k] = risk_one(position[0], position[1], cand[k, 0], cand[k, 1], turn[k, 0],
-                                   turn[k, 1], tau[k], q, w, reach, bodies, horizon, comfort,
-                                   comfort_horizon, margin)  # fmt: skip
+                                  turn[k, 1], tau[k], q, w, reach, bodies, horizon, comfort,
+                                  comfort_horizon, margin)  # fmt: skip
 
 
 def tangents_py(
@@ -364,7 +364,7 @@ def decide_py(
             s1 = spd[k] * max(math.cos(0.5 * beta), 0.0)
             tx, ty = s1 * math.cos(hd + 0.5 * beta), s1 * math.sin(hd + 0.5 * beta)
         ttc, pen = risk_one(px, py, cand[k, 0], cand[k, 1], tx, ty, tk, q, w, reach, bodies,
-                             horizon, comfort, c_h, margin)  # fmt: skip
+                            horizon, comfort, c_h, margin)  # fmt: skip
         cost = bound[k] + w_ttc / max(ttc, 1e-3) + w_comfort * pen
         if cost < best[0] or (cost == best[0] and k < best[1]):
             best[0], best[1], best[4] = cost, k, ttc
