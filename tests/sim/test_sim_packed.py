@@ -2,8 +2,9 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from contextlib import contextmanager
 
 import numpy as np
@@ -11,6 +12,7 @@ import pytest
 from hypothesis import example, given
 from hypothesis import strategies as st
 
+from uvnav.controllers.base import make_law
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.geometry.kernels3d import numba_available, use_compiled
 from uvnav.geometry.small import pyhypot
@@ -20,7 +22,7 @@ from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.sensors.exact import lidar_scan
-from uvnav.sim.episode import EpisodeSetup, UnicycleWorld
+from uvnav.sim.episode import EpisodeResult, EpisodeSetup, UnicycleWorld, run_episode
 from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, pack_check
 from uvnav.sim.seeding import run_rng
 
@@ -186,6 +188,11 @@ def test_unpackable_scenes_are_refused_with_the_reason() -> None:
     with pytest.raises(ValueError, match="obstacle 1 moves by Waypoints"):
         PackedWorlds(1).load(0, setup)
     assert pack_check(mixed_setup(0)) is None
+    shared = mixed_setup(0, n=3)
+    shared.obstacles[2].motion.rng = shared.obstacles[1].motion.rng  # type: ignore[attr-defined]
+    assert pack_check(shared) == (
+        "obstacles 1 and 2 draw from one generator, packed worlds pre-draw each obstacle's numbers"
+    )
 
 
 def test_decisions_that_read_more_than_a_row_of_pre_drawn_numbers() -> None:
@@ -255,3 +262,85 @@ def test_clearance_inside_a_body_is_the_fields_signed_distance(compiled: bool) -
         assert worlds.clearance[slot] == float((q.signed - SPEC.radius).min())
         inside += bool(q.signed.min() < 0)
     assert inside > k // 3
+
+
+def episode(make: Callable[[], EpisodeSetup], law: str, seed: int, *, compiled: bool,
+            record: bool) -> tuple[EpisodeResult, list[tuple[object, ...]]]:  # fmt: skip
+    """One :func:`run_episode`; its result and what it left on the obstacles and their
+    models (states, draws, course, and the generator's next number)."""
+    vehicle = "holonomic" if "holonomic" in law else "unicycle"
+    setup = make()
+    result = run_episode(setup, make_law(law, vehicle=vehicle), run_rng(seed), record=record,
+                         compiled=compiled, vehicle=vehicle)  # fmt: skip
+    left = []
+    for ob in setup.obstacles:
+        mod, st = ob.motion, ob.state
+        extra = (
+            (mod.course, mod._speed, mod._turn, mod._next_change, mod.rng.random())
+            if isinstance(mod, RandomTurn)
+            else ()
+        )
+        left.append((*st.position, st.heading, *st.velocity, st.angular_velocity, *extra))
+    return result, left
+
+
+def same_result(a: EpisodeResult, b: EpisodeResult) -> None:
+    assert a.status == b.status
+    ma, mb = a.metrics.to_dict(), b.metrics.to_dict()
+    timed = {k for k in ma if "decision" in k}
+    assert {k: v for k, v in ma.items() if k not in timed} == {
+        k: v for k, v in mb.items() if k not in timed
+    }
+    if a.trajectory is not None:
+        assert b.trajectory is not None
+        for f in dataclasses.fields(a.trajectory):
+            va, vb = getattr(a.trajectory, f.name), getattr(b.trajectory, f.name)
+            if f.name == "obstacle_shapes":
+                assert all(np.array_equal(x, y) for x, y in zip(va, vb, strict=True))
+            elif isinstance(va, np.ndarray):
+                assert np.array_equal(va, vb, equal_nan=True), f.name
+            else:
+                assert va == vb, f.name
+
+
+LAWS = ("zhang2019-v1", "savkin-wang2013-v1")
+CASES = [
+    *[(f"random-ch2:{s}", law) for s in (0, 1, 2, 5) for law in LAWS],
+    *[(f"mixed:{s}", "zhang2019-v1") for s in (0, 1)],
+    ("random-ch2:3", "zhang2019-v2"),
+    ("random-ch2:4", "zhang2019-holonomic-v2"),
+    ("mixed:2", "orca-holonomic-v1"),
+]
+
+
+@pytest.mark.parametrize(("scene", "law"), CASES)
+@pytest.mark.parametrize("record", [False, True])
+def test_the_compiled_episode_path_equals_the_numpy_path(scene: str, law: str,
+                                                         record: bool) -> None:  # fmt: skip
+    """run_episode with the obstacles packed (PackedObstacles) gives the numpy path's episode
+    bit for bit: status, metrics, trajectory, and the obstacles and generators it leaves."""
+    if not numba_available():
+        pytest.skip("needs numba (the fast extra)")
+    kind, seed = scene.split(":")
+    s = int(seed)
+
+    def make() -> EpisodeSetup:
+        if kind == "mixed":
+            return mixed_setup(s, t_max=20.0)
+        return build_episode(load_scenario(scene), s)
+
+    ref, ref_left = episode(make, law, s, compiled=False, record=record)
+    got, got_left = episode(make, law, s, compiled=True, record=record)
+    same_result(ref, got)
+    assert got_left == ref_left
+
+
+def test_the_compiled_path_serves_the_scenes_it_can_pack() -> None:
+    scene = load_scenario("random-ch2:0")
+    assert UnicycleWorld(build_episode(scene, 0), run_rng(0), exact=False,
+                         packed=True).packed is not None  # fmt: skip
+    assert UnicycleWorld(build_episode(scene, 0), run_rng(0), exact=False).packed is None
+    setup = mixed_setup(0, n=2)
+    setup.obstacles[1] = Obstacle(DiscBody(0.3), ObstacleState(position=np.zeros(2)),
+                                  ConstantVelocity(np.zeros(2)))  # fmt: skip
+    assert UnicycleWorld(setup, run_rng(0), exact=False, packed=True).packed is None

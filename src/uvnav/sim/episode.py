@@ -39,6 +39,7 @@ from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
 from uvnav.dynamics.omni import OmniSpec, VelocityCommand, omni_advance
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
 from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
@@ -46,6 +47,7 @@ from uvnav.sensors.exact import lidar_scan, sense_obstacles
 from uvnav.sensors.observation import Observation
 from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
+from uvnav.sim.packed import PackedObstacles, pack_check
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
 from uvnav.sim.social import SocialTracker, collision_by, pedestrian_ids
 
@@ -229,7 +231,9 @@ class UnicycleWorld:
     #: what :meth:`command_pair` returns, with units
     COMMAND_NAMES: ClassVar[tuple[str, str]] = ("V_R [m/s]", "u_R [rad/s]")
 
-    def __init__(self, setup: EpisodeSetup, rng: np.random.Generator, *, exact: bool) -> None:
+    def __init__(
+        self, setup: EpisodeSetup, rng: np.random.Generator, *, exact: bool, packed: bool = False
+    ) -> None:
         self.setup = setup
         self._law_rng, self.sense_rng = rng.spawn(2)
         self.spec: Any = setup.spec  # UnicycleSpec (OmniSpec in HolonomicWorld)
@@ -242,12 +246,23 @@ class UnicycleWorld:
         self.obstacles = setup.obstacles
         self.template = FieldTemplate.from_bodies([o.body for o in self.obstacles])
         self.batch = ObstacleBatch(self.obstacles)
-        self.field = self.batch.field(self.template)
+        self._field: ObstacleField | None = self.batch.field(self.template)
+        self.packed: PackedObstacles | None = None
+        if packed and self.obstacles and pack_check(setup) is None:
+            self.packed = PackedObstacles(self.obstacles, self.template, self.ratio)
         self.sensing_range = float(setup.sensing.sensing_range)
         self.pedestrians = pedestrian_ids(self.obstacles)
         self.exact = exact
         self.t = 0.0
         self.done = False
+
+    @property
+    def field(self) -> ObstacleField:
+        """The obstacles now (built on first use at a step of the compiled path)."""
+        if self._field is None:
+            assert self.packed is not None
+            self._field = self.packed.field()
+        return self._field
 
     def law_setup(self, agent: int = 0) -> tuple[UnicycleSpec, FloatArray, np.random.Generator]:
         """The law's limits, goal and generator."""
@@ -281,7 +296,7 @@ class UnicycleWorld:
         self.min_clear = self.clearance
         self.tracker = (
             _MinClearance(float(self.spec.radius), self.clearance)
-            if self.obstacles and not self.exact
+            if self.obstacles and not self.exact and self.packed is None
             else None
         )
         self.start_dist = math.hypot(self.goal[0] - self.x, self.goal[1] - self.y)
@@ -315,7 +330,10 @@ class UnicycleWorld:
     def observe(self, agent: int = 0) -> Observation:
         """Readings within the sensing range (estimated rates unless known), the lidar scan."""
         robot = self.pose
-        readings = sense_obstacles(robot[:2], self.field, sensing_range=self.sensing_range)
+        if self.packed is not None:
+            readings = self.packed.readings(self.x, self.y, self.sensing_range)
+        else:
+            readings = sense_obstacles(robot[:2], self.field, sensing_range=self.sensing_range)
         if self.estimator is not None:
             readings = self.estimator.update(self.t, readings)
         scan = None
@@ -387,17 +405,24 @@ class UnicycleWorld:
         nx, ny = self._move(dt)
         self.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
-        self.batch.step(self.t, dt)
+        was_present = None
+        if self.packed is not None:  # compiled: the exact clearance, the field on demand
+            self.clearance, self.nearest = self.packed.step(self.t, dt, nx, ny, self.spec.radius)
+            self._field = None
+        else:
+            self.batch.step(self.t, dt)
+            was_present = self.field.present
+            self._field = self.batch.field(self.template)
         self.step_index = i = self.step_index + 1
         self.t = i * dt
-        was_present = self.field.present
-        self.field = self.batch.field(self.template)
-        radius = self.sensing_range if i % self.ratio == 0 else 0.0
+        if self.packed is None:
+            radius = self.sensing_range if i % self.ratio == 0 else 0.0
+            if self.tracker is not None:
+                self.clearance = self.tracker.step(self.field, nx, ny, radius)
+            else:
+                self.clearance, self.nearest = self._clearance(radius)
         if self.tracker is None:
-            self.clearance, self.nearest = self._clearance(radius)
             self.min_clear = min(self.min_clear, self.clearance)
-        else:
-            self.clearance = self.tracker.step(self.field, nx, ny, radius)
         if self.social is not None:
             self.social.observe(self.field, nx, ny, i)
         if self.clearance < 0:
@@ -410,7 +435,10 @@ class UnicycleWorld:
 
     def close(self) -> None:
         """Write the obstacles' states back to their models (the setup's objects)."""
-        self.batch.write_back()
+        if self.packed is not None:
+            self.packed.write_back()
+        else:
+            self.batch.write_back()
 
     def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
         """The episode's metrics (:mod:`uvnav.sim.metrics`)."""
@@ -460,8 +488,10 @@ class HolonomicWorld(UnicycleWorld):
     vehicle: ClassVar[str] = "holonomic"
     COMMAND_NAMES: ClassVar[tuple[str, str]] = ("v_x [m/s]", "v_y [m/s]")
 
-    def __init__(self, setup: EpisodeSetup, rng: np.random.Generator, *, exact: bool) -> None:
-        super().__init__(setup, rng, exact=exact)
+    def __init__(
+        self, setup: EpisodeSetup, rng: np.random.Generator, *, exact: bool, packed: bool = False
+    ) -> None:
+        super().__init__(setup, rng, exact=exact, packed=packed)
         self.spec = OmniSpec(v_max=float(setup.spec.v_max), radius=float(setup.spec.radius))
 
     def start(self, oracles: Sequence[bool] = (False,)) -> None:
@@ -537,6 +567,7 @@ def run_episode(
     record: bool = True,
     probes: Sequence[Probe] = (),
     vehicle: str = "unicycle",
+    compiled: bool | None = None,
 ) -> EpisodeResult:
     """Run one episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
     :class:`UnicycleWorld`).
@@ -549,13 +580,18 @@ def run_episode(
         record: keep the full trajectory (needed for figures; off for large campaigns).
         probes: more probes to run in the loop.
         vehicle: the robot the law drives (:data:`WORLDS_2D`: ``unicycle`` or ``holonomic``).
+        compiled: move and measure the obstacles in compiled calls where the scene allows it
+            (:class:`~uvnav.sim.packed.PackedObstacles`: the same numbers); default: when numba
+            is enabled (:func:`~uvnav.geometry.kernels3d.numba_enabled`).
 
     Raises:
         ValueError: ``setup.control_period`` is not a whole multiple of ``setup.dt``.
     """
     if vehicle not in WORLDS_2D:
         raise ValueError(f"no 2D world for vehicle {vehicle!r}; known: {', '.join(WORLDS_2D)}")
-    world = WORLDS_2D[vehicle](setup, rng, exact=record)
+    if compiled is None:
+        compiled = numba_enabled()
+    world = WORLDS_2D[vehicle](setup, rng, exact=record, packed=compiled)
     rec = TrajectoryProbe() if record else None
     try:
         (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])

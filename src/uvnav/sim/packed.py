@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -41,8 +41,11 @@ from uvnav.geometry.polygons import ray_ring_hit_py, ring_nearest_py
 from uvnav.geometry.small import pyhypot
 from uvnav.obstacles.bodies import PolygonBody
 from uvnav.obstacles.motion import ConstantVelocity, RandomTurn
-from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
-from uvnav.sim.episode import EpisodeSetup, decision_ratio
+from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField, ObstacleState
+from uvnav.sensors.observation import ObstacleReading
+
+if TYPE_CHECKING:
+    from uvnav.sim.episode import EpisodeSetup
 
 #: status codes of a packed world
 RUNNING, SUCCESS, COLLISION, TIMEOUT = 0, 1, 2, 3
@@ -70,9 +73,11 @@ O_KIND, O_UPOS = 0, 1
 (P_VX, P_VY, P_OMEGA, P_SPEED_LO, P_SPEED_SPAN, P_TURN_LO, P_TURN_SPAN, P_PERIOD, P_SPIN,
  P_X0, P_Y0, P_X1, P_Y1, P_MIDX, P_MIDY, P_LIMIT, P_ARENA, P_BOUND) = range(18)  # fmt: skip
 N_PARAMS = 18
-# State rows of the (K, S, M) obstacle state array.
-S_X, S_Y, S_HEADING, S_COURSE, S_SPEED, S_TURN, S_NEXT, S_THRESHOLD = range(8)
-N_STATE = 8
+# State rows of the (K, S, M) obstacle state array (the velocity and rotation rate are those
+# used over the last step, as :class:`ObstacleBatch` reports them).
+(S_X, S_Y, S_HEADING, S_COURSE, S_SPEED, S_TURN, S_NEXT, S_THRESHOLD, S_VX, S_VY,
+ S_OMEGA) = range(11)  # fmt: skip
+N_STATE = 11
 
 
 def _move_obstacles(n: int, st: FloatArray, prm: FloatArray, oi: np.ndarray, ubuf: FloatArray,
@@ -89,6 +94,7 @@ def _move_obstacles(n: int, st: FloatArray, prm: FloatArray, oi: np.ndarray, ubu
             st[S_HEADING, o] = wrap_scalar(st[S_HEADING, o] + prm[P_OMEGA, o] * dt)
             st[S_X, o] = st[S_X, o] + prm[P_VX, o] * dt
             st[S_Y, o] = st[S_Y, o] + prm[P_VY, o] * dt
+            st[S_VX, o], st[S_VY, o], st[S_OMEGA, o] = prm[P_VX, o], prm[P_VY, o], prm[P_OMEGA, o]
             continue
         if t >= st[S_THRESHOLD, o]:  # a new speed and turn rate (RandomTurn.step's two draws)
             p = oi[O_UPOS, o]
@@ -112,8 +118,10 @@ def _move_obstacles(n: int, st: FloatArray, prm: FloatArray, oi: np.ndarray, ubu
         st[S_COURSE, o] = course
         mid = course - 0.5 * turn * dt
         speed = st[S_SPEED, o]
-        st[S_X, o] = px + math.cos(mid) * speed * dt
-        st[S_Y, o] = py + math.sin(mid) * speed * dt
+        vx, vy = math.cos(mid) * speed, math.sin(mid) * speed
+        st[S_X, o] = px + vx * dt
+        st[S_Y, o] = py + vy * dt
+        st[S_VX, o], st[S_VY, o], st[S_OMEGA, o] = vx, vy, om
 
 
 def _transform_ring(rings: FloatArray, o: int, c: float, s: float, cx: float, cy: float,
@@ -127,11 +135,13 @@ def _transform_ring(rings: FloatArray, o: int, c: float, s: float, cx: float, cy
 
 
 def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray, st: FloatArray,
-               rings: FloatArray, ring: FloatArray, low: FloatArray) -> float:  # fmt: skip
+               rings: FloatArray, ring: FloatArray,
+               low: FloatArray) -> tuple[float, int]:  # fmt: skip
     """Exact clearance [m] of the robot disc at ``(x, y)`` in one world (``prm`` (P, M), ``st``
     (S, M), ``rings`` (2, M, W); ``ring`` (2, W) and ``low`` (M,) scratch): the signed distance
     of :meth:`ObstacleField.query` (boundary distance outside, minus it inside) minus the
-    radius; ``inf`` without obstacles.
+    radius, and the obstacle it is to (the first in index order on a tie, as the field's
+    ``argmin``); ``(inf, -1)`` without obstacles.
 
     A broad phase skips the bodies that cannot lower the minimum, in two passes: a lower bound
     of every body's gap (centre distance minus bounding radius minus the robot's radius), then
@@ -145,7 +155,7 @@ def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray, s
     bodies' gaps have the same arithmetic as before, and the first lowest one in index order
     is returned, as the scan in index order returned it (it matters only for ``-0.0``)."""
     if n_obs == 0:
-        return math.inf
+        return math.inf, -1
     slack = 1e-9 * (1.0 + abs(x) + abs(y))
     first, best = 0, math.inf
     for o in range(n_obs):
@@ -169,7 +179,7 @@ def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray, s
         g = d - radius
         if g < gap or g != g or (g == gap and o < at):
             gap, at = g, o
-    return gap
+    return gap, (at if at < n_obs else -1)
 
 
 def step_worlds_py(
@@ -208,8 +218,8 @@ def step_worlds_py(
             wf[k, W_X], wf[k, W_Y], wf[k, W_TH] = x, y, th
             _move_obstacles(wi[k, I_NOBS], state[k], params[k], oi[k], ubuf[k], t, dt)
             wi[k, I_STEP] = i = i + 1
-            gap = _clearance(x, y, radius, wi[k, I_NOBS], params[k], state[k], rings[k], ring,
-                             low)  # fmt: skip
+            gap, _ = _clearance(x, y, radius, wi[k, I_NOBS], params[k], state[k], rings[k],
+                                ring, low)  # fmt: skip
             wf[k, W_CLEAR] = gap
             if gap < wf[k, W_LOW]:
                 wf[k, W_LOW] = gap
@@ -228,6 +238,74 @@ def step_worlds_py(
             read = max(read, oi[k, O_UPOS, o])
         safe = min(safe, (ubuf.shape[2] - read) // (2 * max(wi[k, I_RATIO], 1)))
     return safe
+
+
+def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs: int,
+                   oi: np.ndarray, prm: FloatArray, st: FloatArray, ubuf: FloatArray,
+                   rings: FloatArray) -> tuple[float, int]:  # fmt: skip
+    """Move the ``n_obs`` obstacles of one world (one slot's ``oi``, ``params``, ``state``,
+    ``ubuf`` and ``rings``: :func:`step_worlds_py`'s layout) from ``t`` by ``dt`` [s], then
+    return :func:`_clearance` of the robot disc of ``radius`` [m] at ``(x, y)``: the step of
+    :class:`PackedObstacles`.  The caller guarantees two unread draws per obstacle."""
+    ring = np.empty((2, rings.shape[2]))
+    low = np.empty(rings.shape[1])
+    _move_obstacles(n_obs, st, prm, oi, ubuf, t, dt)
+    return _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)
+
+
+#: columns of :func:`sense_one_py`'s reading rows: distance [m], nearest point [m], centre [m],
+#: velocity [m/s], rotation rate [rad/s]
+R_DIST, R_NEAR, R_CENTRE, R_VEL, R_OMEGA = 0, 1, 3, 5, 7
+NR = 8
+
+
+def sense_one_py(x: float, y: float, sensing_range: float, n_obs: int, prm: FloatArray,
+                 st: FloatArray, rings: FloatArray, ids: np.ndarray, rows: FloatArray,
+                 outlines: FloatArray) -> int:  # fmt: skip
+    """The readings of :func:`uvnav.sensors.exact.sense_obstacles` in one world from
+    ``(x, y)``: their number ``m`` and, nearest first (ties in index order, NaN last, as a
+    stable ``argsort``), in the first ``m`` rows of ``ids`` (M,) the obstacles' indices, of
+    ``rows`` (M, NR) their ``R_*`` columns and of ``outlines`` (M, W, 2) their world rings.  The
+    distance to the set (0 inside) and nearest boundary point are those of
+    :meth:`ObstacleField.query`; a body whose bounding disc lies beyond ``sensing_range`` [m]
+    (with the query's cull margins) is not measured, its distance exceeding the range."""
+    slack = 1e-9 * (1.0 + abs(x) + abs(y))
+    limit = sensing_range * (1.0 + 1e-9) + slack
+    ring = np.empty((2, rings.shape[2]))
+    m = 0
+    for o in range(n_obs):
+        cx, cy = st[S_X, o], st[S_Y, o]
+        dx, dy = cx - x, cy - y
+        dd = dx * dx + dy * dy
+        dc = math.sqrt(dd) if dd < 1e300 else math.hypot(dx, dy)
+        if dc * (1.0 - 1e-9) - prm[P_BOUND, o] > limit:
+            continue
+        h = st[S_HEADING, o]
+        _transform_ring(rings, o, math.cos(h), math.sin(h), cx, cy, ring)
+        d, qx, qy, inside = ring_nearest_py(x, y, ring[0], ring[1], True)
+        if inside:
+            d = 0.0
+        if d > sensing_range:
+            continue
+        at = m  # insert after every reading nearer or as near (NaN: after all)
+        while at > 0:
+            prev = rows[at - 1, R_DIST]
+            if not (prev > d or (d == d and prev != prev)):
+                break
+            at -= 1
+        for r in range(m, at, -1):
+            ids[r] = ids[r - 1]
+            rows[r] = rows[r - 1]
+            outlines[r] = outlines[r - 1]
+        ids[at] = o
+        rows[at, R_DIST], rows[at, R_NEAR], rows[at, R_NEAR + 1] = d, qx, qy
+        rows[at, R_CENTRE], rows[at, R_CENTRE + 1] = cx, cy
+        rows[at, R_VEL], rows[at, R_VEL + 1] = st[S_VX, o], st[S_VY, o]
+        rows[at, R_OMEGA] = st[S_OMEGA, o]
+        for j in range(ring.shape[1]):
+            outlines[at, j, 0], outlines[at, j, 1] = ring[0, j], ring[1, j]
+        m += 1
+    return m
 
 
 def _lidar(
@@ -311,19 +389,26 @@ def observe_py(
 
 
 #: the kernels by short name, and everything they call (callees first)
-_PUBLIC = {"step": "step_worlds_py", "observe": "observe_py"}
+_PUBLIC = {
+    "step": "step_worlds_py",
+    "observe": "observe_py",
+    "advance_one": "advance_one_py",
+    "sense_one": "sense_one_py",
+}
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
 
 def kernel(name: str) -> Callable[..., Any]:
-    """``"step"`` (:func:`step_worlds_py`) or ``"observe"`` (:func:`observe_py`), compiled by
-    numba on first use when it is enabled (:func:`numba_enabled`), else the Python functions."""
+    """A kernel by short name (:data:`_PUBLIC`: ``"step"`` is :func:`step_worlds_py`...),
+    compiled by numba on first use when it is enabled (:func:`numba_enabled`), else the Python
+    function."""
     if not numba_enabled():
-        return step_worlds_py if name == "step" else observe_py
+        return globals()[_PUBLIC[name]]
     if not _KERNELS:
         _KERNELS.update(compile_family([
             wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py, ray_ring_hit_py,
             _transform_ring, _move_obstacles, _clearance, _lidar, step_worlds_py, observe_py,
+            advance_one_py, sense_one_py,
         ]))  # fmt: skip
     return _KERNELS[_PUBLIC[name]]
 
@@ -333,7 +418,14 @@ def pack_check(setup: EpisodeSetup) -> str | None:
     :class:`ConstantVelocity` or :class:`RandomTurn` motion."""
     if type(setup.spec) is not UnicycleSpec:
         return f"the robot is a {type(setup.spec).__name__}, packed worlds hold unicycles"
+    owner: dict[int, int] = {}
     for j, ob in enumerate(setup.obstacles):
+        rng = getattr(ob.motion, "rng", None)
+        if rng is not None and owner.setdefault(id(rng), j) != j:
+            return (
+                f"obstacles {owner[id(rng)]} and {j} draw from one generator, packed worlds "
+                "pre-draw each obstacle's numbers"
+            )
         if not isinstance(ob.body, PolygonBody):
             return f"obstacle {j} is a {type(ob.body).__name__}, packed worlds hold polygons"
         if type(ob.motion) not in (ConstantVelocity, RandomTurn):
@@ -445,12 +537,12 @@ class PackedWorlds:
         obstacles = setup.obstacles
         m = len(obstacles)
         tpl = self._template([o.body for o in obstacles])
-        w = tpl.rings.shape[2] if m else 2
+        from uvnav.sim.episode import decision_ratio  # (episode imports this module)
+
         spec, dt = setup.spec, float(setup.dt)
         ratio = decision_ratio(float(setup.control_period), dt)
         b = max(self.ubuf.shape[2], 4 * ratio)  # half a row: a decision's draws, 2 a step
-        if m > self.rings.shape[2] or w > self.rings.shape[3] or b > self.ubuf.shape[2]:
-            self._alloc(max(m, self.rings.shape[2]), max(w, self.rings.shape[3]), b)
+        self.load_obstacles(slot, obstacles, tpl, b)
         x, y, th = (float(c) for c in np.asarray(setup.start, dtype=float)[:3])
         gx, gy = (float(c) for c in np.asarray(setup.goal, dtype=float)[:2])
         wf, wi = self.wf[slot], self.wi[slot]
@@ -460,14 +552,6 @@ class PackedWorlds:
         wf[[W_VMAX, W_UMAX]] = (float(spec.v_max), float(spec.u_max))
         n_steps = round(setup.t_max / dt)
         wi[[I_STEP, I_RATIO, I_NSTEPS, I_NOBS]] = (0, ratio, n_steps, m)
-        self.oi[slot, O_KIND] = EMPTY
-        self.oi[slot, O_UPOS] = 0
-        self.rings[slot] = 0.0
-        if m:
-            self.rings[slot, :, :m, :w] = tpl.rings
-            self.rings[slot, :, :m, w:] = tpl.rings[:, :, :1]
-        self.rngs[slot] = [self._pack_obstacle(slot, o, ob) for o, ob in enumerate(obstacles)]
-        self.params[slot, P_BOUND, :m] = tpl.bounding_radii
         gap = math.inf  # at t = 0 as UnicycleWorld.start measures it
         if m:
             field = ObstacleField.from_obstacles(obstacles, tpl)
@@ -483,6 +567,24 @@ class PackedWorlds:
         wi[I_STATUS] = status
         # the slot's rows are full: a top-up is due no sooner for it than for the others
         self._safe_calls = min(self._safe_calls, b // (2 * ratio))
+
+    def load_obstacles(self, slot: int, obstacles: list[Obstacle], tpl: FieldTemplate,
+                       b: int) -> None:  # fmt: skip
+        """Put ``obstacles`` (packable: :func:`pack_check`; ``tpl`` their bodies' template) in
+        ``slot``, growing the arrays to hold them and ``b`` pre-drawn numbers a row."""
+        m = len(obstacles)
+        w = tpl.rings.shape[2] if m else 2
+        if m > self.rings.shape[2] or w > self.rings.shape[3] or b > self.ubuf.shape[2]:
+            self._alloc(max(m, self.rings.shape[2]), max(w, self.rings.shape[3]), b)
+        self.wi[slot, I_NOBS] = m
+        self.oi[slot, O_KIND] = EMPTY
+        self.oi[slot, O_UPOS] = 0
+        self.rings[slot] = 0.0
+        if m:
+            self.rings[slot, :, :m, :w] = tpl.rings
+            self.rings[slot, :, :m, w:] = tpl.rings[:, :, :1]
+        self.rngs[slot] = [self._pack_obstacle(slot, o, ob) for o, ob in enumerate(obstacles)]
+        self.params[slot, P_BOUND, :m] = tpl.bounding_radii
 
     def _template(self, bodies: list[Any]) -> FieldTemplate:
         """The bodies' packed geometry, kept for the episodes that share the body objects (the
@@ -504,6 +606,8 @@ class PackedWorlds:
         self.oi[slot, O_UPOS, o] = 0
         st[S_X, o], st[S_Y, o] = state.position
         st[S_HEADING, o] = state.heading
+        st[S_VX, o], st[S_VY, o] = state.velocity
+        st[S_OMEGA, o] = state.angular_velocity
         if isinstance(mod, ConstantVelocity):
             self.oi[slot, O_KIND, o] = CONSTANT
             prm[P_VX, o], prm[P_VY, o] = np.asarray(mod.velocity, dtype=float)
@@ -579,3 +683,130 @@ class PackedWorlds:
         """:func:`observe_py` on every slot (lidar beams at heading + ``rel`` [rad])."""
         kernel("observe")(self.wf, self.wi, self.params, self.state, self.rings, rel,
                           float(max_range), float(goal_scale), ranges, out, dist)  # fmt: skip
+
+
+class PackedObstacles:
+    """One episode's obstacles in a packed slot: :class:`UnicycleWorld
+    <uvnav.sim.episode.UnicycleWorld>`'s compiled path.  The obstacles move, the clearance is
+    measured and the exact sensor reads them in compiled calls (:func:`advance_one_py`,
+    :func:`sense_one_py`), with the numbers of :class:`ObstacleBatch` and
+    :meth:`ObstacleField.query`, bit for bit; :meth:`field` builds the field of the moment for
+    whatever reads one (lidar, plug-in sensors, the recorder, the collision's blame).
+
+    Unlike :class:`PackedWorlds`, :meth:`write_back` leaves the models exactly as the numpy
+    path does, their generators included: each is set back to its state at the start and moved
+    on by the numbers the episode read.
+
+    Args:
+        obstacles: the episode's obstacles, packable (:func:`pack_check`).
+        template: their bodies' template (the world's).
+        ratio: integration steps per decision (the rows hold a decision's draws).
+    """
+
+    def __init__(self, obstacles: list[Obstacle], template: FieldTemplate, ratio: int) -> None:
+        self.obstacles = obstacles
+        self.template = template
+        self.n = n = len(obstacles)
+        self._start = [
+            ob.motion.rng.bit_generator.state if isinstance(ob.motion, RandomTurn) else None
+            for ob in obstacles
+        ]
+        pw = PackedWorlds(1)
+        pw.load_obstacles(0, obstacles, template, max(ROW_BLOCKS * BLOCK, 4 * ratio))
+        self._rngs = pw.rngs[0]
+        self._random = [o for o, r in enumerate(self._rngs) if r is not None]
+        self._read = [0] * n  # numbers read before the last top-up, by obstacle
+        self._oi, self._prm, self._st = pw.oi[0], pw.params[0], pw.state[0]
+        self._ubuf, self._rings = pw.ubuf[0], pw.rings[0]
+        w = self._rings.shape[2]
+        self._ids = np.zeros(n, dtype=np.int64)
+        self._rows = np.zeros((n, NR))
+        self._outlines = np.zeros((n, w, 2))
+        self._counts = [int(template.counts[template.poly_row[j]]) for j in range(n)]
+        self._bounds = template.bounding_radii.tolist()
+        self._safe = 0  # steps before a top-up may be due
+        self._stepped = False
+        self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
+
+    def _refill(self) -> None:
+        """Top up every random-turn row (:meth:`PackedWorlds.refill`'s rule), counting the
+        numbers read; set how many steps (two numbers each at most) are safe."""
+        b = self._ubuf.shape[1]
+        upos = self._oi[O_UPOS]
+        safe = 1 << 30
+        for o in self._random:
+            p = int(upos[o])
+            if p >= b // 2:
+                row = self._ubuf[o]
+                row[: b - p] = row[p:]
+                self._rngs[o].random(out=row[b - p :])  # type: ignore[union-attr]
+                self._read[o] += p
+                upos[o] = p = 0
+            safe = min(safe, (b - p) // 2)
+        self._safe = safe
+
+    def step(self, t: float, dt: float, x: float, y: float, radius: float) -> tuple[float, int]:
+        """Move the obstacles from ``t`` by ``dt`` [s]; the clearance [m] of the robot disc of
+        ``radius`` [m] at ``(x, y)`` then, and its nearest obstacle (-1 without any)."""
+        if self._safe <= 0:
+            self._refill()
+        self._safe -= 1
+        self._stepped = True
+        gap, at = self._advance(x, y, radius, t, dt, self.n, self._oi, self._prm, self._st,
+                                self._ubuf, self._rings)  # fmt: skip
+        return float(gap), int(at)
+
+    def readings(self, x: float, y: float, sensing_range: float) -> tuple[ObstacleReading, ...]:
+        """:func:`uvnav.sensors.exact.sense_obstacles` from ``(x, y)``: the readings within
+        ``sensing_range`` [m], nearest first (ties in obstacle order).  Their arrays are views
+        of one block copied for this call."""
+        m = self._sense(x, y, sensing_range, self.n, self._prm, self._st, self._rings,
+                        self._ids, self._rows, self._outlines)  # fmt: skip
+        if m == 0:
+            return ()
+        rows = self._rows[:m].copy()
+        vals = rows.tolist()
+        counts, bounds = self._counts, self._bounds
+        out = []
+        for i, j in enumerate(self._ids[:m].tolist()):
+            r = rows[i]
+            reading = ObstacleReading(
+                j, vals[i][R_DIST], r[R_NEAR : R_NEAR + 2], r[R_CENTRE : R_CENTRE + 2],
+                r[R_VEL : R_VEL + 2], vals[i][R_OMEGA], self._outlines[i, : counts[j]].copy(),
+                0.0, bounds[j],
+            )  # fmt: skip
+            out.append(reading)
+        return tuple(out)
+
+    def field(self) -> ObstacleField:
+        """The :class:`ObstacleField` of now (its own arrays)."""
+        st, n = self._st, self.n
+        return self.template.field(
+            st[S_X : S_Y + 1, :n].T.copy(), st[S_HEADING, :n].copy(),
+            st[S_VX : S_VY + 1, :n].T.copy(), st[S_OMEGA, :n].copy(),
+        )  # fmt: skip
+
+    def write_back(self) -> None:
+        """Leave the obstacles and their models as :meth:`ObstacleBatch.write_back` does: the
+        states and the random-turn models' draws and course, and each generator moved on by
+        the numbers read (from its state at the start)."""
+        st, upos = self._st, self._oi[O_UPOS]
+        for o, ob in enumerate(self.obstacles):
+            rng, start = self._rngs[o], self._start[o]
+            if rng is not None and start is not None:
+                rng.bit_generator.state = start
+                rng.random(self._read[o] + int(upos[o]))
+            if not self._stepped:
+                continue
+            ob.state = ObstacleState(
+                position=np.array((st[S_X, o], st[S_Y, o])),
+                heading=float(st[S_HEADING, o]),
+                velocity=np.array((st[S_VX, o], st[S_VY, o])),
+                angular_velocity=float(st[S_OMEGA, o]),
+            )
+            mod = ob.motion
+            if isinstance(mod, RandomTurn):
+                mod.course = float(st[S_COURSE, o])
+                mod._speed = float(st[S_SPEED, o])
+                mod._turn = float(st[S_TURN, o])
+                mod._next_change = float(st[S_NEXT, o])
