@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import import_module
 from importlib.metadata import entry_points
@@ -168,14 +168,26 @@ def available_controllers(vehicle: str | None = "unicycle") -> dict[str, Control
         vehicle: only the laws driving this vehicle (one of :data:`VEHICLES`); ``None`` = all.
     """
     kinds = VEHICLES if vehicle is None else (vehicle,)
+    _import_builtins(kinds)
+    return {n: i for n, i in sorted(_REGISTRY.items()) if i.vehicle in kinds}
+
+
+#: the vehicles whose built-in law modules are imported
+_IMPORTED: set[str] = set()
+
+
+def _import_builtins(kinds: Iterable[str]) -> None:
+    """Import the built-in law modules of ``kinds`` (for their registration side effect), once,
+    and the entry points."""
     for kind in kinds:
+        if kind in _IMPORTED:
+            continue
         if kind not in BUILTIN_MODULES_BY_VEHICLE:
             raise ValueError(f"unknown vehicle {kind!r}; known: {', '.join(VEHICLES)}")
-        # import the built-in modules for their registration side effect
         for module in BUILTIN_MODULES_BY_VEHICLE[kind]:
             import_module(f"uvnav.controllers.{module}")
+        _IMPORTED.add(kind)
     _load_entry_points()
-    return {n: i for n, i in sorted(_REGISTRY.items()) if i.vehicle in kinds}
 
 
 def controller_info(name: str, vehicle: str | None = None) -> ControllerInfo:
@@ -185,11 +197,11 @@ def controller_info(name: str, vehicle: str | None = None) -> ControllerInfo:
         UnknownControllerError: not registered, or registered for another vehicle (the message
             names the vehicle it drives).
     """
-    everything = available_controllers(None)
-    if name not in everything:
+    _import_builtins(VEHICLES)
+    info = _REGISTRY.get(name)
+    if info is None:
         known = available_controllers(vehicle)
         raise UnknownControllerError(f"unknown controller {name!r}; known: {', '.join(known)}")
-    info = everything[name]
     if vehicle is not None and info.vehicle != vehicle:
         raise UnknownControllerError(
             f"controller {name!r} drives the {info.vehicle} vehicle, not the {vehicle}"

@@ -765,15 +765,15 @@ class PackedObstacles:
         if m == 0:
             return ()
         rows = self._rows[:m].copy()
+        outlines = self._outlines[:m].copy()
         vals = rows.tolist()
-        counts, bounds = self._counts, self._bounds
+        counts, bounds, make = self._counts, self._bounds, ObstacleReading.polygon
         out = []
         for i, j in enumerate(self._ids[:m].tolist()):
             r = rows[i]
-            reading = ObstacleReading(
+            reading = make(
                 j, vals[i][R_DIST], r[R_NEAR : R_NEAR + 2], r[R_CENTRE : R_CENTRE + 2],
-                r[R_VEL : R_VEL + 2], vals[i][R_OMEGA], self._outlines[i, : counts[j]].copy(),
-                0.0, bounds[j],
+                r[R_VEL : R_VEL + 2], vals[i][R_OMEGA], outlines[i, : counts[j]], bounds[j],
             )  # fmt: skip
             out.append(reading)
         return tuple(out)
