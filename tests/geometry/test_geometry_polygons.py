@@ -22,6 +22,7 @@ from uvnav.geometry.polygons import (
     polygon_area,
     polygon_centroid,
     polygon_nearest,
+    polygons_gap,
     ray_polygon_hit,
     rays_circles_hit,
     rays_rings_hit,
@@ -305,6 +306,26 @@ def test_compiled_rings_nearest_equals_the_array_version_bit_for_bit(
     for (d0, n0, i0), (d1, n1, i1) in zip(ref, got, strict=True):
         assert np.array_equal(d0, d1) and np.array_equal(n0, n1)
         assert (i0 is None and i1 is None) or np.array_equal(i0, i1)
+
+
+@pytest.mark.skipif(not numba_available(), reason="needs numba (the fast extra)")
+@SETTINGS
+@given(star_polygons(max_n=9), star_polygons(max_n=9), small, small)
+def test_compiled_polygons_gap_equals_the_array_version_bit_for_bit(
+    a: np.ndarray, b: np.ndarray, dx: float, dy: float
+) -> None:
+    """The compiled loops of :func:`polygons_gap` give the arrays' numbers exactly (also for a
+    shared vertex), and for disjoint polygons the boundaries' distance."""
+    for other in (b + np.array((dx, dy)), np.concatenate([a[:1], b[1:]])):
+        with compiled(False):
+            ref = polygons_gap(a, other)
+        with compiled(True):
+            got = polygons_gap(a, other)
+        assert got == ref
+    pa, pb = Polygon(a), Polygon(b + np.array((dx, dy)))
+    if not pa.intersects(pb):
+        want = pa.exterior.distance(pb.exterior)
+        assert polygons_gap(a, b + np.array((dx, dy))) == pytest.approx(want, abs=1e-9)
 
 
 @SETTINGS

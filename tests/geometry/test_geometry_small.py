@@ -5,15 +5,18 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 import shapely
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from uvnav.geometry.kernels3d import compiled, numba_available
 from uvnav.geometry.polygons import rays_circles_hit, rays_segments_hit
 from uvnav.geometry.small import (
     ray_circle_distance,
     ray_polygon_distance,
     segment_polygon_distance,
+    segment_ring_distance,
     wrap,
 )
 
@@ -45,6 +48,24 @@ def test_segment_polygon_distance_matches_shapely(
     )
     expected = shapely.distance(seg, poly.exterior)
     assert abs(segment_polygon_distance((ax, ay), (bx, by), ring.tolist()) - expected) < 1e-7
+
+
+@pytest.mark.skipif(not numba_available(), reason="needs numba (the fast extra)")
+@settings(max_examples=150, deadline=None)
+@given(ring=star_polygons(), ax=coord, ay=coord, bx=coord, by=coord)
+def test_compiled_segment_ring_distance_is_segment_polygon_distance(
+    ring: np.ndarray, ax: float, ay: float, bx: float, by: float
+) -> None:
+    """The compiled copy (pyhypot for math.hypot) gives the Python function's numbers exactly,
+    also from a vertex."""
+    want = segment_polygon_distance((ax, ay), (bx, by), ring.tolist())
+    with compiled(True):
+        assert segment_ring_distance(ax, ay, bx, by, ring) == want
+        vx, vy = float(ring[0, 0]), float(ring[0, 1])
+        at_vertex = segment_ring_distance(vx, vy, bx, by, ring)
+    assert at_vertex == segment_polygon_distance((vx, vy), (bx, by), ring.tolist())
+    with compiled(False):
+        assert segment_ring_distance(ax, ay, bx, by, ring) == want
 
 
 @settings(max_examples=150, deadline=None)

@@ -98,15 +98,15 @@ def widened_cone(
     inside
     the disc the cone is the half-plane facing it (half-angle pi/2).
     """
-    off = centre - position
-    dist = math.hypot(off[0], off[1])
-    base = math.atan2(off[1], off[0])
+    ox, oy = float(centre[0]) - float(position[0]), float(centre[1]) - float(position[1])
+    dist = math.hypot(ox, oy)
+    base = math.atan2(oy, ox)
     half = math.asin(min(radius / dist, 1.0)) if dist > 0 else 0.5 * math.pi
     half = min(half + alpha0, math.pi)
     return wrap_scalar(base - half), wrap_scalar(base + half)
 
 
-def in_cone(direction: FloatArray, beta1: float, beta2: float) -> bool:
+def in_cone(direction: FloatArray | tuple[float, float], beta1: float, beta2: float) -> bool:
     """True when ``direction`` points strictly inside the cone from ``beta1`` CCW to ``beta2``."""
     if math.hypot(direction[0], direction[1]) < 1e-12:
         return False
@@ -143,18 +143,24 @@ class SavkinWang2013Controller(UnicycleController):
         """Whether heading to T at V_max points into the widened cone; also (beta_1, beta_2)."""
         centre, radius = disc_of(reading)
         b1, b2 = widened_cone(position, centre, radius, self.alpha0(radius))
-        to_goal = self._goal - position
-        dist = math.hypot(to_goal[0], to_goal[1])
+        gx, gy = (
+            float(self._goal[0]) - float(position[0]),
+            float(self._goal[1]) - float(position[1]),
+        )
+        dist = math.hypot(gx, gy)
         if dist < 1e-9:
             return False, b1, b2
-        rel = self._spec.v_max * to_goal / dist - reading.velocity
+        v_max, vel = self._spec.v_max, reading.velocity
+        rel = (v_max * gx / dist - float(vel[0]), v_max * gy / dist - float(vel[1]))
         return in_cone(rel, b1, b2), b1, b2
 
-    def desired_velocity(self, reading: ObstacleReading, beta: float) -> FloatArray:
-        """v_obs + l_j with l_j = (V_max - V) [cos beta_j, sin beta_j] and V = ||v_obs||."""
+    def desired_velocity(self, reading: ObstacleReading, beta: float) -> tuple[float, float]:
+        """v_obs + l_j with l_j = (V_max - V) [cos beta_j, sin beta_j] and V = ||v_obs||
+        [m/s]."""
         speed_obs = min(reading.speed, self._spec.v_max)
-        rel = (self._spec.v_max - speed_obs) * np.array([math.cos(beta), math.sin(beta)])
-        return np.asarray(reading.velocity + rel, dtype=float)
+        scale = self._spec.v_max - speed_obs
+        vel = reading.velocity
+        return float(vel[0]) + scale * math.cos(beta), float(vel[1]) + scale * math.sin(beta)
 
     def act(self, obs: Observation) -> UnicycleCommand:
         period = self.decision_period(obs.time)
@@ -168,9 +174,9 @@ class SavkinWang2013Controller(UnicycleController):
                 avoiding = (reading, b1, b2)
         if avoiding is None:
             self._mode, self._target_id, self._side = "M1", None, 0
-            to_goal = self._goal - pos
-            beta = wrap_scalar(math.atan2(to_goal[1], to_goal[0]) - heading)
-            dist = math.hypot(to_goal[0], to_goal[1])
+            gx, gy = float(self._goal[0]) - float(pos[0]), float(self._goal[1]) - float(pos[1])
+            beta = wrap_scalar(math.atan2(gy, gx) - heading)
+            dist = math.hypot(gx, gy)
             v = approach_speed(self._spec.v_max, self._spec.u_max, dist, beta)
             return UnicycleCommand(v, heading_rate_toward(beta, self._spec.u_max, period))
         reading, b1, b2 = avoiding

@@ -93,12 +93,12 @@ from uvnav.controllers.base import (
 )
 from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-from uvnav.geometry.polygons import points_to_segments
+from uvnav.geometry.polygons import points_to_segments, polygons_gap
 from uvnav.geometry.small import (
     point_segment_distance,
     ray_circle_distance,
     ray_polygon_distance,
-    segment_polygon_distance,
+    segment_ring_distance,
     wrap,
 )
 from uvnav.sensors.observation import Observation, ObstacleReading
@@ -170,18 +170,22 @@ def run_clearance(reading: ObstacleReading, a: FloatArray, b: FloatArray, margin
     A bounding-circle test first: when even the bounding disc is farther than ``margin`` the
     (underestimated) disc distance is returned without touching the edges.
     """
+    return run_clearance_xy(reading, float(a[0]), float(a[1]), float(b[0]), float(b[1]), margin)
+
+
+def run_clearance_xy(
+    reading: ObstacleReading, ax: float, ay: float, bx: float, by: float, margin: float
+) -> float:
+    """:func:`run_clearance` of the segment ``(ax, ay)``-``(bx, by)`` [m]."""
     c = reading.centre
-    dc = point_segment_distance(
-        float(c[0]), float(c[1]), float(a[0]), float(a[1]), float(b[0]), float(b[1])
-    )
+    dc = point_segment_distance(float(c[0]), float(c[1]), ax, ay, bx, by)
     if reading.is_disc:
         return max(dc - reading.radius, 0.0)
     if dc - reading.bounding_radius > margin:
         return dc - reading.bounding_radius
     if reading.distance == 0.0:  # the robot is inside this body
         return 0.0
-    ends = ((float(a[0]), float(a[1])), (float(b[0]), float(b[1])))
-    return segment_polygon_distance(*ends, reading.outline.tolist())
+    return segment_ring_distance(ax, ay, bx, by, reading.outline)
 
 
 def body_gap(a: ObstacleReading, b: ObstacleReading) -> float:
@@ -199,12 +203,7 @@ def body_gap(a: ObstacleReading, b: ObstacleReading) -> float:
         n = len(s)
         d = points_to_segments(np.broadcast_to(disc.centre, (n, 2)), s, e)
         return max(float(d.min()) - disc.radius, 0.0)
-    sa, ea = _ring_edges(a)
-    sb, eb = _ring_edges(b)
-    na, nb = len(sa), len(sb)
-    d_ab = points_to_segments(np.repeat(sa, nb, axis=0), np.tile(sb, (na, 1)), np.tile(eb, (na, 1)))
-    d_ba = points_to_segments(np.repeat(sb, na, axis=0), np.tile(sa, (nb, 1)), np.tile(ea, (nb, 1)))
-    return float(min(d_ab.min(), d_ba.min()))
+    return polygons_gap(boundary_samples(a), boundary_samples(b))
 
 
 @dataclass(frozen=True)
@@ -349,20 +348,23 @@ class Zhang2019Controller(UnicycleController):
         """
         if reading.distance <= margin:
             return True
-        position = obs.position
-        to_goal = self._goal - position
-        dist_goal = math.hypot(to_goal[0], to_goal[1])
+        px, py = float(obs.pose[0]), float(obs.pose[1])
+        gx, gy = float(self._goal[0]) - px, float(self._goal[1]) - py
+        dist_goal = math.hypot(gx, gy)
         if dist_goal < 1e-9:
             return False
         v_max = self._spec.v_max
+        vx, vy = float(reading.velocity[0]), float(reading.velocity[1])
+        # the runs in the obstacle's frame, coordinate by coordinate (numpy's operations)
         horizon = min(self.params.threat_horizon, dist_goal / v_max)
-        goal_run = position + (v_max * to_goal / dist_goal - reading.velocity) * horizon
-        if run_clearance(reading, position, goal_run, margin) <= margin:
+        ex = px + (v_max * gx / dist_goal - vx) * horizon
+        ey = py + (v_max * gy / dist_goal - vy) * horizon
+        if run_clearance_xy(reading, px, py, ex, ey, margin) <= margin:
             return True
         ahead = min(self.params.forecast_horizon, dist_goal / v_max)
-        heading = np.array([math.cos(obs.heading), math.sin(obs.heading)])
-        head_run = position + (v_max * heading - reading.velocity) * ahead
-        return run_clearance(reading, position, head_run, margin) <= margin
+        ex = px + (v_max * math.cos(obs.heading) - vx) * ahead
+        ey = py + (v_max * math.sin(obs.heading) - vy) * ahead
+        return run_clearance_xy(reading, px, py, ex, ey, margin) <= margin
 
     def passing_points(
         self, position: FloatArray, group: ObstacleGroup, tag: int
@@ -454,9 +456,10 @@ class Zhang2019Controller(UnicycleController):
         lowered to the largest one whose turning circle passes through T,
         ``U_max d / (2 sin|beta|)``.
         """
-        to_goal = self._goal - obs.position
-        dist = float(np.hypot(*to_goal))
-        beta = wrap_scalar(float(np.arctan2(to_goal[1], to_goal[0])) - obs.heading)
+        gx = float(self._goal[0]) - float(obs.pose[0])
+        gy = float(self._goal[1]) - float(obs.pose[1])
+        dist = float(np.hypot(gx, gy))
+        beta = wrap_scalar(float(np.arctan2(gy, gx)) - obs.heading)
         v = approach_speed(self._spec.v_max, self._spec.u_max, dist, beta)
         return UnicycleCommand(v, heading_rate_toward(beta, self._spec.u_max, period))
 

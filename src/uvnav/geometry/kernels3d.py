@@ -47,20 +47,25 @@ _HAVE_NUMBA = importlib.util.find_spec("numba") is not None
 _ENABLED = _HAVE_NUMBA and os.environ.get("UVNAV_NO_NUMBA", "") != "1"
 
 
-def compile_family(functions: Sequence[Callable[..., Any]]) -> dict[str, Callable[..., Any]]:
+def compile_family(
+    functions: Sequence[Callable[..., Any] | tuple[str, Callable[..., Any]]],
+) -> dict[str, Callable[..., Any]]:
     """numba-compiled copies of ``functions`` (callees before callers), by name.
 
     Each copy runs in its own module's globals with the names of the functions compiled before it
     bound to their compiled copies, so a compiled kernel calls compiled callees while the Python
-    functions stay untouched: they remain the reference path of :func:`use_compiled` (False).
+    functions stay untouched: they remain the reference path of :func:`use_compiled` (False).  A
+    ``(name, function)`` pair binds the function's compiled copy under ``name`` (a global the
+    Python path binds to something numba cannot compile the same, e.g. ``math.hypot``).
     """
     import numba
 
     done: dict[str, Callable[..., Any]] = {}
-    for f in functions:
+    for item in functions:
+        name, f = item if isinstance(item, tuple) else (item.__name__, item)
         env = {**f.__globals__, **done}
         copy = types.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
-        done[f.__name__] = numba.njit(cache=True, nogil=True)(copy)
+        done[name] = numba.njit(cache=True, nogil=True)(copy)
     return done
 
 

@@ -269,6 +269,72 @@ def points_to_segments(points: FloatArray, starts: FloatArray, ends: FloatArray)
     return np.sqrt(np.einsum("ij,ij->i", diff, diff))
 
 
+def polygons_gap(a: FloatArray, b: FloatArray) -> float:
+    """Distance [m] between the boundaries of two polygons (vertices (n, 2) and (m, 2)): the
+    least distance from a vertex of one to an edge of the other (exact for disjoint polygons).
+
+    The numbers of :func:`points_to_segments` over every vertex-edge pair, compiled by numba when
+    it is enabled (:func:`polygons_gap_py`, the same operations), else in arrays.
+
+    Overlapping polygons give the distance of their nearest non-crossing parts, not 0:
+
+    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
+    >>> polygons_gap(sq, sq + (3.0, 0.0)), polygons_gap(sq, sq + (1.0, 0.5))
+    (2.0, 0.0)
+    >>> polygons_gap(sq, sq + 0.5)
+    0.5
+    """
+    if numba_enabled():
+        if not _GAP:
+            _GAP.append(compile_family([point_segment_np, polygons_gap_py])["polygons_gap_py"])
+        return float(_GAP[0](np.asarray(a, dtype=float), np.asarray(b, dtype=float)))
+    ea, eb = np.roll(a, -1, axis=0), np.roll(b, -1, axis=0)
+    na, nb = len(a), len(b)
+    d_ab = points_to_segments(np.repeat(a, nb, axis=0), np.tile(b, (na, 1)), np.tile(eb, (na, 1)))
+    d_ba = points_to_segments(np.repeat(b, na, axis=0), np.tile(a, (nb, 1)), np.tile(ea, (nb, 1)))
+    return float(min(d_ab.min(), d_ba.min()))
+
+
+def point_segment_np(px: float, py: float, sx: float, sy: float, ex: float, ey: float) -> float:
+    """:func:`points_to_segments` for one point and one segment, its operations in its order."""
+    dx, dy = ex - sx, ey - sy
+    len2 = dx * dx + dy * dy
+    if not len2 >= _EPS and len2 == len2:  # np.maximum(len2, EPS), NaN kept
+        len2 = _EPS
+    t = ((px - sx) * dx + (py - sy) * dy) / len2
+    if t < 0.0:  # np.clip(t, 0, 1), NaN kept
+        t = 0.0
+    if t > 1.0:
+        t = 1.0
+    qx, qy = sx + t * dx - px, sy + t * dy - py
+    return math.sqrt(qx * qx + qy * qy)
+
+
+def polygons_gap_py(a: FloatArray, b: FloatArray) -> float:
+    """:func:`polygons_gap` as loops (compiled by numba): the least vertex-edge distance each
+    way, NaN kept as ``ndarray.min`` keeps it, then the builtin ``min`` of the two."""
+    low = [math.inf, math.inf]
+    for k in range(2):
+        p, q = (a, b) if k == 0 else (b, a)
+        n = q.shape[0]
+        best = math.inf
+        for i in range(p.shape[0]):
+            for j in range(n):
+                e = j + 1 if j + 1 < n else 0
+                d = point_segment_np(p[i, 0], p[i, 1], q[j, 0], q[j, 1], q[e, 0], q[e, 1])
+                if d < best or d != d:
+                    best = d
+                if best != best:
+                    break
+            if best != best:
+                break
+        low[k] = best
+    return low[1] if low[1] < low[0] else low[0]
+
+
+_GAP: list[Callable[..., Any]] = []
+
+
 def points_to_segment(
     points: FloatArray,
     start: FloatArray | tuple[float, float],

@@ -12,9 +12,18 @@ lengths in [m], angles in [rad].
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.kernels3d import compile_family, numba_enabled
 
 Point = Sequence[float]
+
+#: the hypotenuse of :func:`point_segment_distance` (its compiled copy binds :func:`pyhypot`)
+_hypot = math.hypot
+#: the compiled kernels by name (:func:`segment_ring_distance`)
+_KERNELS: dict[str, Callable[..., Any]] = {}
 
 _DBL_MIN = 2.2250738585072014e-308
 _VELTKAMP = 134217729.0  # 2**27 + 1
@@ -92,7 +101,7 @@ def point_segment_distance(
     rx, ry = bx - ax, by - ay
     len2 = rx * rx + ry * ry
     t = 0.0 if len2 < 1e-24 else min(max(((px - ax) * rx + (py - ay) * ry) / len2, 0.0), 1.0)
-    return math.hypot(ax + t * rx - px, ay + t * ry - py)
+    return _hypot(ax + t * rx - px, ay + t * ry - py)
 
 
 def segment_polygon_distance(a: Point, b: Point, ring: Sequence[Point]) -> float:
@@ -119,6 +128,19 @@ def segment_polygon_distance(a: Point, b: Point, ring: Sequence[Point]) -> float
             point_segment_distance(sx, sy, ax, ay, bx, by),
         )
     return best
+
+
+def segment_ring_distance(ax: float, ay: float, bx: float, by: float, ring: FloatArray) -> float:
+    """:func:`segment_polygon_distance` from segment ``(ax, ay)``-``(bx, by)`` to the polygon of
+    vertices ``ring`` (n, 2) [m], compiled by numba when it is enabled (the same numbers: its
+    copy of :func:`point_segment_distance` takes :func:`pyhypot` for ``math.hypot``)."""
+    if not numba_enabled():
+        return segment_polygon_distance((ax, ay), (bx, by), ring.tolist())
+    if not _KERNELS:
+        _KERNELS.update(
+            compile_family([("_hypot", pyhypot), point_segment_distance, segment_polygon_distance])
+        )
+    return float(_KERNELS["segment_polygon_distance"]((ax, ay), (bx, by), ring))
 
 
 def ray_polygon_distance(ox: float, oy: float, angle: float, ring: Sequence[Point]) -> float:
