@@ -361,7 +361,7 @@ def check_params(
 
 def saturate(value: float, limit: float) -> float:
     """Clip ``value`` to [-limit, limit]; NaN maps to 0."""
-    if not np.isfinite(value):
+    if not math.isfinite(value):
         return 0.0
     return float(min(max(value, -limit), limit))
 

@@ -407,7 +407,10 @@ class UnicycleWorld:
         self.x, self.y = nx, ny
         was_present = None
         if self.packed is not None:  # compiled: the exact clearance, the field on demand
-            self.clearance, self.nearest = self.packed.step(self.t, dt, nx, ny, self.spec.radius)
+            sense = self.sensing_range if (self.step_index + 1) % self.ratio == 0 else -1.0
+            self.clearance, self.nearest = self.packed.step(
+                self.t, dt, nx, ny, self.spec.radius, sense
+            )
             self._field = None
         else:
             self.batch.step(self.t, dt)

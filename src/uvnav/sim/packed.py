@@ -242,15 +242,22 @@ def step_worlds_py(
 
 def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs: int,
                    oi: np.ndarray, prm: FloatArray, st: FloatArray, ubuf: FloatArray,
-                   rings: FloatArray) -> tuple[float, int]:  # fmt: skip
+                   rings: FloatArray, sensing_range: float, ids: np.ndarray, rows: FloatArray,
+                   outlines: FloatArray) -> tuple[float, int, int]:  # fmt: skip
     """Move the ``n_obs`` obstacles of one world (one slot's ``oi``, ``params``, ``state``,
-    ``ubuf`` and ``rings``: :func:`step_worlds_py`'s layout) from ``t`` by ``dt`` [s], then
-    return :func:`_clearance` of the robot disc of ``radius`` [m] at ``(x, y)``: the step of
-    :class:`PackedObstacles`.  The caller guarantees two unread draws per obstacle."""
+    ``ubuf`` and ``rings``: :func:`step_worlds_py`'s layout) from ``t`` by ``dt`` [s]; return
+    :func:`_clearance` of the robot disc of ``radius`` [m] at ``(x, y)`` then and, for a
+    ``sensing_range`` >= 0 [m], the number of readings :func:`sense_one_py` writes from there
+    (else -1): the step of :class:`PackedObstacles`, in one call.  The caller guarantees two
+    unread draws per obstacle."""
     ring = np.empty((2, rings.shape[2]))
     low = np.empty(rings.shape[1])
     _move_obstacles(n_obs, st, prm, oi, ubuf, t, dt)
-    return _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)
+    gap, at = _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)
+    m = -1
+    if sensing_range >= 0.0:
+        m = sense_one_py(x, y, sensing_range, n_obs, prm, st, rings, ids, rows, outlines)
+    return gap, at, m
 
 
 #: columns of :func:`sense_one_py`'s reading rows: distance [m], nearest point [m], centre [m],
@@ -408,7 +415,7 @@ def kernel(name: str) -> Callable[..., Any]:
         _KERNELS.update(compile_family([
             wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py, ray_ring_hit_py,
             _transform_ring, _move_obstacles, _clearance, _lidar, step_worlds_py, observe_py,
-            advance_one_py, sense_one_py,
+            sense_one_py, advance_one_py,
         ]))  # fmt: skip
     return _KERNELS[_PUBLIC[name]]
 
@@ -726,6 +733,8 @@ class PackedObstacles:
         self._bounds = template.bounding_radii.tolist()
         self._safe = 0  # steps before a top-up may be due
         self._stepped = False
+        #: ``(x, y, range, m)`` of the readings the last step took, if it took any
+        self._sensed: tuple[float, float, float, int] | None = None
         self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
 
     def _refill(self) -> None:
@@ -745,23 +754,33 @@ class PackedObstacles:
             safe = min(safe, (b - p) // 2)
         self._safe = safe
 
-    def step(self, t: float, dt: float, x: float, y: float, radius: float) -> tuple[float, int]:
+    def step(
+        self, t: float, dt: float, x: float, y: float, radius: float, sensing_range: float = -1.0
+    ) -> tuple[float, int]:
         """Move the obstacles from ``t`` by ``dt`` [s]; the clearance [m] of the robot disc of
-        ``radius`` [m] at ``(x, y)`` then, and its nearest obstacle (-1 without any)."""
+        ``radius`` [m] at ``(x, y)`` then, and its nearest obstacle (-1 without any).  With a
+        ``sensing_range`` >= 0 [m] the readings from there are taken in the same call, for
+        :meth:`readings` to return."""
         if self._safe <= 0:
             self._refill()
         self._safe -= 1
         self._stepped = True
-        gap, at = self._advance(x, y, radius, t, dt, self.n, self._oi, self._prm, self._st,
-                                self._ubuf, self._rings)  # fmt: skip
+        gap, at, m = self._advance(x, y, radius, t, dt, self.n, self._oi, self._prm, self._st,
+                                   self._ubuf, self._rings, sensing_range, self._ids,
+                                   self._rows, self._outlines)  # fmt: skip
+        self._sensed = (x, y, sensing_range, m) if m >= 0 else None
         return float(gap), int(at)
 
     def readings(self, x: float, y: float, sensing_range: float) -> tuple[ObstacleReading, ...]:
         """:func:`uvnav.sensors.exact.sense_obstacles` from ``(x, y)``: the readings within
         ``sensing_range`` [m], nearest first (ties in obstacle order).  Their arrays are views
         of one block copied for this call."""
-        m = self._sense(x, y, sensing_range, self.n, self._prm, self._st, self._rings,
-                        self._ids, self._rows, self._outlines)  # fmt: skip
+        got = self._sensed
+        if got is not None and got[:3] == (x, y, sensing_range):
+            m = got[3]
+        else:
+            m = self._sense(x, y, sensing_range, self.n, self._prm, self._st, self._rings,
+                            self._ids, self._rows, self._outlines)  # fmt: skip
         if m == 0:
             return ()
         rows = self._rows[:m].copy()
