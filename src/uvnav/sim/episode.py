@@ -223,6 +223,10 @@ class UnicycleWorld:
             :meth:`close`.
         rng: the episode generator; two independent children feed the law and the sensors.
         exact: the exact clearance and nearest obstacle at every step (recorded runs).
+        packed: keep the obstacles in a :class:`~uvnav.sim.packed.PackedObstacles` when the scene
+            packs (:func:`~uvnav.sim.packed.pack_check`): compiled motion, clearance (exact at
+            every step) and sensing, the numpy path's numbers; :attr:`field` is then built on
+            demand.
     """
 
     vehicle: ClassVar[str] = "unicycle"

@@ -422,7 +422,8 @@ def kernel(name: str) -> Callable[..., Any]:
 
 def pack_check(setup: EpisodeSetup) -> str | None:
     """Why ``setup`` cannot be packed (one line), or None: a unicycle among polygon bodies with
-    :class:`ConstantVelocity` or :class:`RandomTurn` motion."""
+    :class:`ConstantVelocity` or :class:`RandomTurn` motion, each obstacle drawing from its own
+    generator (the numbers are pre-drawn per obstacle)."""
     if type(setup.spec) is not UnicycleSpec:
         return f"the robot is a {type(setup.spec).__name__}, packed worlds hold unicycles"
     owner: dict[int, int] = {}
