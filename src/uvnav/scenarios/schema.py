@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from functools import lru_cache
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -198,14 +199,9 @@ class BodySpec(_Model):
             return value
         if len(value) < 3:
             raise ValueError(f"a polygon needs at least 3 vertices (got {len(value)})")
-        from shapely.geometry import Polygon
-        from shapely.validation import explain_validity
-
-        poly = Polygon(value)
-        if not poly.is_valid:
-            raise ValueError(f"polygon is not simple: {explain_validity(poly)}")
-        if poly.area <= 1e-12:
-            raise ValueError("polygon has zero area")
+        problem = _polygon_problem(tuple(value))
+        if problem is not None:
+            raise ValueError(problem)
         return value
 
     @model_validator(mode="after")
@@ -217,24 +213,43 @@ class BodySpec(_Model):
     def to_body(self) -> Body:
         """A :class:`~uvnav.obstacles.PolygonBody` (centred on its centroid) or a disc.
 
-        Built once per spec and shared by the episodes (bodies are frozen, and re-centring a
-        polygon costs more than the rest of an episode's set-up)."""
-        hit = _BODIES.get(id(self))
-        if hit is not None and hit[0] is self:
-            return hit[1]
-        if self.polygon is not None:
-            body: Body = PolygonBody.from_vertices(np.asarray(self.polygon, dtype=float))
-        else:
+        Built once per shape and shared by the episodes and by the specs of the same shape (bodies
+        are frozen, and re-centring a polygon costs more than the rest of an episode's set-up; a
+        generator validates each of its shapes once and builds its scene from them again)."""
+        if self.polygon is None:
             assert self.disc is not None
-            body = DiscBody(float(self.disc))
-        if len(_BODIES) >= 4096:
-            _BODIES.clear()
-        _BODIES[id(self)] = (self, body)
+            verts = np.array([float(self.disc)])
+        else:
+            verts = np.asarray(self.polygon, dtype=float)
+        key = (verts.shape, verts.tobytes())  # the very numbers, -0.0 included
+        body = _BODIES.get(key)
+        if body is None:
+            if self.polygon is None:
+                body = DiscBody(float(verts[0]))
+            else:
+                body = PolygonBody.from_vertices(verts)
+            if len(_BODIES) >= 4096:
+                _BODIES.clear()
+            _BODIES[key] = body
         return body
 
 
-#: :meth:`BodySpec.to_body`'s bodies by spec (the spec is kept, so its id stays its own)
-_BODIES: dict[int, tuple[BodySpec, Body]] = {}
+#: :meth:`BodySpec.to_body`'s bodies by their vertices' (a disc: its radius's) shape and bytes
+_BODIES: dict[tuple[tuple[int, ...], bytes], Body] = {}
+
+
+@lru_cache(maxsize=4096)
+def _polygon_problem(vertices: tuple[tuple[float, float], ...]) -> str | None:
+    """Why ``vertices`` are not a simple polygon of non-zero area (one line), or None."""
+    from shapely.geometry import Polygon
+    from shapely.validation import explain_validity
+
+    poly = Polygon(vertices)
+    if not poly.is_valid:
+        return f"polygon is not simple: {explain_validity(poly)}"
+    if poly.area <= 1e-12:
+        return "polygon has zero area"
+    return None
 
 
 class ObstacleStart(_Model):
