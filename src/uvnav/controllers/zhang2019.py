@@ -164,19 +164,15 @@ def _ring_edges(reading: ObstacleReading) -> tuple[FloatArray, FloatArray]:
     return pts, np.concatenate([pts[1:], pts[:1]])
 
 
-def run_clearance(reading: ObstacleReading, a: FloatArray, b: FloatArray, margin: float) -> float:
-    """Distance [m] from the segment ``a``-``b`` to the obstacle's body, exact up to ``margin``.
+def run_clearance(
+    reading: ObstacleReading, ax: float, ay: float, bx: float, by: float, margin: float
+) -> float:
+    """Distance [m] from the segment ``(ax, ay)``-``(bx, by)`` [m] to the obstacle's body, exact
+    up to ``margin``.
 
     A bounding-circle test first: when even the bounding disc is farther than ``margin`` the
     (underestimated) disc distance is returned without touching the edges.
     """
-    return run_clearance_xy(reading, float(a[0]), float(a[1]), float(b[0]), float(b[1]), margin)
-
-
-def run_clearance_xy(
-    reading: ObstacleReading, ax: float, ay: float, bx: float, by: float, margin: float
-) -> float:
-    """:func:`run_clearance` of the segment ``(ax, ay)``-``(bx, by)`` [m]."""
     c = reading.centre
     dc = point_segment_distance(float(c[0]), float(c[1]), ax, ay, bx, by)
     if reading.is_disc:
@@ -359,12 +355,12 @@ class Zhang2019Controller(UnicycleController):
         horizon = min(self.params.threat_horizon, dist_goal / v_max)
         ex = px + (v_max * gx / dist_goal - vx) * horizon
         ey = py + (v_max * gy / dist_goal - vy) * horizon
-        if run_clearance_xy(reading, px, py, ex, ey, margin) <= margin:
+        if run_clearance(reading, px, py, ex, ey, margin) <= margin:
             return True
         ahead = min(self.params.forecast_horizon, dist_goal / v_max)
         ex = px + (v_max * math.cos(obs.heading) - vx) * ahead
         ey = py + (v_max * math.sin(obs.heading) - vy) * ahead
-        return run_clearance_xy(reading, px, py, ex, ey, margin) <= margin
+        return run_clearance(reading, px, py, ex, ey, margin) <= margin
 
     def passing_points(
         self, position: FloatArray, group: ObstacleGroup, tag: int

@@ -156,7 +156,7 @@ def growth_py(verts: FloatArray, dirs: FloatArray, kmax: int) -> float:
             if hit and t - t == 0.0 and t > best:  # a finite hit (a miss counts as -inf)
                 best = t
         rho[r] = best
-    low = [np.inf, np.inf]  # placeholders: the two maxima
+    tops = [0.0, 0.0]  # the largest growth turning back (-k) and ahead (+k)
     for side in range(2):
         top, nan = -np.inf, False
         for k in range(1, kmax + 1):
@@ -167,9 +167,9 @@ def growth_py(verts: FloatArray, dirs: FloatArray, kmax: int) -> float:
                     nan = True
                 elif v > top:
                     top = v
-        low[side] = np.nan if nan else top
+        tops[side] = np.nan if nan else top
     out = 0.0
-    for v in low:
+    for v in tops:
         if v > out:
             out = v
     return out

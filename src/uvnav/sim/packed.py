@@ -457,6 +457,9 @@ class PackedWorlds:
     """
 
     oi: np.ndarray
+    #: (k, M) numbers of each obstacle's generator read before its row's last top-up (with
+    #: ``oi[:, O_UPOS]``: the numbers its draws have consumed)
+    read: np.ndarray
     params: FloatArray
     state: FloatArray
     ubuf: FloatArray
@@ -517,6 +520,7 @@ class PackedWorlds:
         k = self.k
         oi = np.zeros((k, 2, m), dtype=np.int64)
         oi[:, O_KIND] = EMPTY
+        read = np.zeros((k, m), dtype=np.int64)
         params = np.zeros((k, N_PARAMS, m))
         state = np.zeros((k, N_STATE, m))
         ubuf = np.zeros((k, m, b))
@@ -524,13 +528,16 @@ class PackedWorlds:
         if hasattr(self, "oi"):
             m0, w0, b0 = self.rings.shape[2], self.rings.shape[3], self.ubuf.shape[2]
             oi[:, :, :m0] = self.oi
-            oi[:, O_UPOS, :m0] += np.where(self.oi[:, O_KIND] == RANDOM_TURN, b - b0, 0)
+            moved = np.where(self.oi[:, O_KIND] == RANDOM_TURN, b - b0, 0)
+            oi[:, O_UPOS, :m0] += moved
+            read[:, :m0] = self.read - moved  # read + next unread: the numbers consumed
             params[:, :, :m0] = self.params
             state[:, :, :m0] = self.state
             ubuf[:, :m0, b - b0 :] = self.ubuf
             rings[:, :, :m0, :w0] = self.rings
             rings[:, :, :m0, w0:] = self.rings[:, :, :, :1]  # more copies of the first vertex
         self.oi, self.params, self.state, self.ubuf, self.rings = oi, params, state, ubuf, rings
+        self.read = read
 
     def load(self, slot: int, setup: EpisodeSetup) -> None:
         """Put ``setup``'s episode in ``slot`` as :meth:`UnicycleWorld.start
@@ -587,6 +594,7 @@ class PackedWorlds:
         self.wi[slot, I_NOBS] = m
         self.oi[slot, O_KIND] = EMPTY
         self.oi[slot, O_UPOS] = 0
+        self.read[slot] = 0
         self.rings[slot] = 0.0
         if m:
             self.rings[slot, :, :m, :w] = tpl.rings
@@ -669,6 +677,7 @@ class PackedWorlds:
                 row = self.ubuf[slot, o]
                 row[: b - p] = row[p:]
                 rng.random(out=row[b - p :])
+        self.read[due] += upos[due]
         upos[due] = 0  # (a row without a generator is never read)
         spare = (b - upos) // np.maximum(2 * self.wi[:, I_RATIO, None], 1)
         self._safe_calls = int(spare.min()) if spare.size else 1 << 30
@@ -719,11 +728,9 @@ class PackedObstacles:
             ob.motion.rng.bit_generator.state if isinstance(ob.motion, RandomTurn) else None
             for ob in obstacles
         ]
-        pw = PackedWorlds(1)
+        self._pw = pw = PackedWorlds(1)
         pw.load_obstacles(0, obstacles, template, max(ROW_BLOCKS * BLOCK, 4 * ratio))
-        self._rngs = pw.rngs[0]
-        self._random = [o for o, r in enumerate(self._rngs) if r is not None]
-        self._read = [0] * n  # numbers read before the last top-up, by obstacle
+        pw.wi[0, I_RATIO] = 1  # a call of step() is one integration step
         self._oi, self._prm, self._st = pw.oi[0], pw.params[0], pw.state[0]
         self._ubuf, self._rings = pw.ubuf[0], pw.rings[0]
         w = self._rings.shape[2]
@@ -732,28 +739,10 @@ class PackedObstacles:
         self._outlines = np.zeros((n, w, 2))
         self._counts = [int(template.counts[template.poly_row[j]]) for j in range(n)]
         self._bounds = template.bounding_radii.tolist()
-        self._safe = 0  # steps before a top-up may be due
         self._stepped = False
         #: ``(x, y, range, m)`` of the readings the last step took, if it took any
         self._sensed: tuple[float, float, float, int] | None = None
         self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
-
-    def _refill(self) -> None:
-        """Top up every random-turn row (:meth:`PackedWorlds.refill`'s rule), counting the
-        numbers read; set how many steps (two numbers each at most) are safe."""
-        b = self._ubuf.shape[1]
-        upos = self._oi[O_UPOS]
-        safe = 1 << 30
-        for o in self._random:
-            p = int(upos[o])
-            if p >= b // 2:
-                row = self._ubuf[o]
-                row[: b - p] = row[p:]
-                self._rngs[o].random(out=row[b - p :])  # type: ignore[union-attr]
-                self._read[o] += p
-                upos[o] = p = 0
-            safe = min(safe, (b - p) // 2)
-        self._safe = safe
 
     def step(
         self, t: float, dt: float, x: float, y: float, radius: float, sensing_range: float = -1.0
@@ -762,9 +751,10 @@ class PackedObstacles:
         ``radius`` [m] at ``(x, y)`` then, and its nearest obstacle (-1 without any).  With a
         ``sensing_range`` >= 0 [m] the readings from there are taken in the same call, for
         :meth:`readings` to return."""
-        if self._safe <= 0:
-            self._refill()
-        self._safe -= 1
+        pw = self._pw
+        if pw._safe_calls <= 0:  # PackedWorlds.refill: its rows, its accounting
+            pw.refill()
+        pw._safe_calls -= 1
         self._stepped = True
         gap, at, m = self._advance(x, y, radius, t, dt, self.n, self._oi, self._prm, self._st,
                                    self._ubuf, self._rings, sensing_range, self._ids,
@@ -810,12 +800,12 @@ class PackedObstacles:
         """Leave the obstacles and their models as :meth:`ObstacleBatch.write_back` does: the
         states and the random-turn models' draws and course, and each generator moved on by
         the numbers read (from its state at the start)."""
-        st, upos = self._st, self._oi[O_UPOS]
+        st, upos, read = self._st, self._oi[O_UPOS], self._pw.read[0]
         for o, ob in enumerate(self.obstacles):
-            rng, start = self._rngs[o], self._start[o]
+            rng, start = self._pw.rngs[0][o], self._start[o]
             if rng is not None and start is not None:
                 rng.bit_generator.state = start
-                rng.random(self._read[o] + int(upos[o]))
+                rng.random(int(read[o] + upos[o]))
             if not self._stepped:
                 continue
             ob.state = ObstacleState(
