@@ -2,10 +2,17 @@
 (issue 20, item 4: at most 10 % of the episode's own CPU).
 
 Run: ``PYTHONPATH=src .venv/bin/python benchmarks/bench_ray.py`` (``--seeds N``: random-ch2
-scenes, 2 episodes each, default 1000; ``--quick``: 100 seeds; ``--workers``: default 2;
-``--out DIR`` writes ``DIR/ray.json``).  Needs Ray (extra ``uvnav[bench]``) and Linux (``/proc``);
-without either it writes the record with ``pass: null`` and says why.  About 100 s on 2 idle
-cores.
+scenes, 2 episodes each, default 5000: the issue's 10,000-episode campaign, whose line the
+target is part of; ``--quick``: 100 seeds; ``--workers``: default 2; ``--out DIR`` writes
+``DIR/ray.json``).  Needs Ray (extra ``uvnav[bench]``) and Linux (``/proc``); without either it
+writes the record with ``pass: null`` and says why.  About 7 minutes on 2 idle cores (the
+in-process run alone takes half of it).
+
+The campaign's size matters: a Ray worker pays its imports and its first episode's warm-up
+(numba's import, loading the cached kernels, which imports scipy.linalg: over a CPU-second)
+once, where the pool's fork server pays them once for all its workers.  Over 10,000 episodes
+of about 20 CPU-ms that is about 1 % an episode; over 2,000 (this script's former default) five
+times as much.
 
 The same jobs (random-ch2 seeds x zhang2019-v1 and savkin-wang2013-v1, as ``bench_campaign.py``)
 run three times through :func:`uvnav.bench.campaign.run_campaign`, each into a fresh store:
@@ -234,7 +241,8 @@ def judge(inproc: dict[str, Any], pool: dict[str, Any], ray_run: dict[str, Any])
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=1000, help="random-ch2 scenes (2 episodes each)")
+    ap.add_argument("--seeds", type=int, default=5000,
+                    help="random-ch2 scenes (2 episodes each; 5000: the issue's campaign)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--quick", action="store_true", help="100 seeds: a smoke run")
     ap.add_argument("--out", type=Path, help="write ray.json here")
