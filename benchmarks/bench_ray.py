@@ -241,8 +241,12 @@ def judge(inproc: dict[str, Any], pool: dict[str, Any], ray_run: dict[str, Any])
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seeds", type=int, default=5000,
-                    help="random-ch2 scenes (2 episodes each; 5000: the issue's campaign)")
+    ap.add_argument(
+        "--seeds",
+        type=int,
+        default=5000,
+        help="random-ch2 scenes (2 episodes each; 5000: the issue's campaign)",
+    )
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--quick", action="store_true", help="100 seeds: a smoke run")
     ap.add_argument("--out", type=Path, help="write ray.json here")
