@@ -49,7 +49,19 @@ class UnicycleCommand:
         return bool(self.v < -tol or self.v > spec.v_max + tol or abs(self.u) > spec.u_max + tol)
 
     def clipped(self, spec: UnicycleSpec) -> UnicycleCommand:
-        """The command saturated to the limits (2.4); NaN and infinite components become 0."""
+        """The command saturated to the limits (2.4); NaN and infinite components become 0.
+
+        A command of two floats within the limits is returned as it is (the saturation would
+        give the same numbers).
+        """
+        v, u = self.v, self.u
+        if (
+            type(v) is float
+            and type(u) is float
+            and 0.0 <= v <= spec.v_max
+            and -spec.u_max <= u <= spec.u_max
+        ):
+            return self
         v = float(self.v)
         u = float(self.u)
         v = min(max(v, 0.0), float(spec.v_max)) if math.isfinite(v) else 0.0

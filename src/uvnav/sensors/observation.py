@@ -11,7 +11,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -75,10 +74,14 @@ class ObstacleReading:
     def is_disc(self) -> bool:
         return self.radius > 0.0
 
-    @cached_property
+    @property
     def speed(self) -> float:
-        """||v_i|| [m/s]."""
-        return float(np.hypot(self.velocity[0], self.velocity[1]))
+        """||v_i|| [m/s], computed once (kept in the instance's ``__dict__``, as
+        ``functools.cached_property`` would keep it, without its per-access lock)."""
+        got = self.__dict__.get("_speed")
+        if got is None:
+            got = self.__dict__["_speed"] = float(np.hypot(self.velocity[0], self.velocity[1]))
+        return got
 
 
 @dataclass(frozen=True)

@@ -347,10 +347,15 @@ class UnicycleWorld:
                 robot, self.field, self.sense_rng, n_rays=lc.n_rays, max_range=lc.max_range,
                 fov=lc.fov, noise_std=lc.noise_std, dropout=lc.dropout,
             )  # fmt: skip
-        extras = {
-            name: sensor_plugin(name)(robot, self.field, self.sense_rng, **params)
-            for name, params in self.setup.sensing.plugins
-        }
+        plugins = self.setup.sensing.plugins
+        extras = (
+            {
+                name: sensor_plugin(name)(robot, self.field, self.sense_rng, **params)
+                for name, params in plugins
+            }
+            if plugins
+            else {}
+        )
         return Observation(
             time=self.t, pose=robot, speed=self.speed, goal=self.goal, obstacles=readings,
             lidar=scan, extras=extras,
