@@ -614,27 +614,26 @@ class PackedWorlds:
         return hit[0]
 
     def _pack_obstacle(self, slot: int, o: int, ob: Obstacle) -> np.random.Generator | None:
-        """Obstacle ``o`` of ``slot``: its state, parameters and first block of draws."""
-        st, prm, mod = self.state[slot], self.params[slot], ob.motion
-        state = ob.state
-        st[:, o] = 0.0
-        prm[:, o] = 0.0
-        self.oi[slot, O_UPOS, o] = 0
-        st[S_X, o], st[S_Y, o] = state.position
-        st[S_HEADING, o] = state.heading
-        st[S_VX, o], st[S_VY, o] = state.velocity
-        st[S_OMEGA, o] = state.angular_velocity
+        """Obstacle ``o`` of ``slot``: its state, parameters and first block of draws.  The
+        columns are filled as lists and stored in one assignment each (a reset of the batched
+        env packs every obstacle of its scene)."""
+        mod, state = ob.motion, ob.state
+        st, prm = [0.0] * N_STATE, [0.0] * N_PARAMS
+        st[S_X], st[S_Y] = np.asarray(state.position, dtype=float).tolist()
+        st[S_HEADING] = state.heading
+        st[S_VX], st[S_VY] = np.asarray(state.velocity, dtype=float).tolist()
+        st[S_OMEGA] = state.angular_velocity
+        self.oi[slot, :, o] = (CONSTANT if isinstance(mod, ConstantVelocity) else RANDOM_TURN, 0)
         if isinstance(mod, ConstantVelocity):
-            self.oi[slot, O_KIND, o] = CONSTANT
-            prm[P_VX, o], prm[P_VY, o] = np.asarray(mod.velocity, dtype=float)
-            prm[P_OMEGA, o] = float(mod.angular_velocity)
+            prm[P_VX], prm[P_VY] = np.asarray(mod.velocity, dtype=float).tolist()
+            prm[P_OMEGA] = float(mod.angular_velocity)
+            self.state[slot, :, o], self.params[slot, :, o] = st, prm
             return None
         assert isinstance(mod, RandomTurn)
-        self.oi[slot, O_KIND, o] = RANDOM_TURN
-        st[S_COURSE, o] = mod.course_at(state)
-        st[S_SPEED, o], st[S_TURN, o] = mod._speed, mod._turn
-        st[S_NEXT, o] = mod._next_change
-        st[S_THRESHOLD, o] = mod._next_change - 1e-12
+        st[S_COURSE] = mod.course_at(state)
+        st[S_SPEED], st[S_TURN] = mod._speed, mod._turn
+        st[S_NEXT] = mod._next_change
+        st[S_THRESHOLD] = mod._next_change - 1e-12
         for lo_row, span_row, bounds in (
             (P_SPEED_LO, P_SPEED_SPAN, mod.speed),
             (P_TURN_LO, P_TURN_SPAN, mod.turn_rate),
@@ -643,15 +642,16 @@ class PackedWorlds:
             span = float(bounds[1]) - lo
             if not (math.isfinite(span) and span >= 0.0):
                 raise ValueError(f"random-turn bounds {tuple(bounds)} are not (low, high)")
-            prm[lo_row, o], prm[span_row, o] = lo, span
-        prm[P_PERIOD, o] = float(mod.change_period)
-        prm[P_SPIN, o] = float(mod.spin)
-        prm[P_LIMIT, o] = max(abs(mod.turn_rate[0]), abs(mod.turn_rate[1]))
+            prm[lo_row], prm[span_row] = lo, span
+        prm[P_PERIOD] = float(mod.change_period)
+        prm[P_SPIN] = float(mod.spin)
+        prm[P_LIMIT] = max(abs(mod.turn_rate[0]), abs(mod.turn_rate[1]))
         if mod.arena is not None:
             x0, y0, x1, y1 = mod.arena
-            prm[P_ARENA, o] = 1.0
-            prm[P_X0, o], prm[P_Y0, o], prm[P_X1, o], prm[P_Y1, o] = x0, y0, x1, y1
-            prm[P_MIDX, o], prm[P_MIDY, o] = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+            prm[P_ARENA] = 1.0
+            prm[P_X0], prm[P_Y0], prm[P_X1], prm[P_Y1] = x0, y0, x1, y1
+            prm[P_MIDX], prm[P_MIDY] = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+        self.state[slot, :, o], self.params[slot, :, o] = st, prm
         mod.rng.random(out=self.ubuf[slot, o])
         return mod.rng
 
