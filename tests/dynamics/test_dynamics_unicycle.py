@@ -168,3 +168,7 @@ def test_clipped_equals_numpy_clip(v: float, u: float) -> None:
     eu = 0.0 if not np.isfinite(u) else float(np.clip(u, -spec.u_max, spec.u_max))
     assert (c.v, c.u) == (ev, eu)
     assert isinstance(c.v, float) and isinstance(c.u, float)
+    # numpy scalars (a law's arithmetic) come back as Python floats, within the limits or not
+    n = UnicycleCommand(np.float64(v), np.float64(u)).clipped(spec)
+    assert (n.v, n.u) == (ev, eu)
+    assert type(n.v) is float and type(n.u) is float
