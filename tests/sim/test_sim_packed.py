@@ -225,6 +225,36 @@ def test_decisions_that_read_more_than_a_row_of_pre_drawn_numbers() -> None:
 
 
 @pytest.mark.parametrize("compiled", [True, False])
+def test_a_loaded_worlds_clearance_is_the_fields_at_the_start(compiled: bool) -> None:
+    """A world loaded with the robot in, on or near a body starts with the field's clearance,
+    bit for bit, and a robot that overlaps one starts collided."""
+    rng = np.random.default_rng(5)
+    obstacles = [
+        Obstacle(
+            PolygonBody.from_vertices(SQUARE * s),
+            ObstacleState(position=p, heading=h),
+            ConstantVelocity(np.zeros(2)),
+        )
+        for s, p, h in ((1.0, np.array([0.0, 0.0]), 0.4), (0.7, np.array([1.1, 0.3]), -1.0))
+    ]
+    field = ObstacleField.from_obstacles(obstacles)
+    starts = rng.uniform(-1.2, 2.2, (300, 2))
+    with kernels(compiled):
+        worlds = PackedWorlds(len(starts))
+        for slot, (x, y) in enumerate(starts):
+            worlds.load(slot, EpisodeSetup(spec=SPEC, start=np.array([x, y, 0.0]),
+                                           goal=np.array([9.0, 9.0]), obstacles=obstacles,
+                                           dt=0.1, control_period=0.1))  # fmt: skip
+    collided = 0
+    for slot, (x, y) in enumerate(starts):
+        want = float((field.query((x, y), 0.0, nearest=True).signed - SPEC.radius).min())
+        assert worlds.clearance[slot] == want
+        collided += STATUS_NAMES[int(worlds.status[slot])] == "collision"
+        assert (STATUS_NAMES[int(worlds.status[slot])] == "collision") == (want < 0)
+    assert 30 < collided < 270
+
+
+@pytest.mark.parametrize("compiled", [True, False])
 def test_clearance_inside_a_body_is_the_fields_signed_distance(compiled: bool) -> None:
     """Robots driven one step into (and near) static bodies: the clearance is the field's,
     bit for bit, depth inside a body included (numpy's hypot, not CPython's)."""

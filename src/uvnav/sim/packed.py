@@ -260,6 +260,17 @@ def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs
     return gap, at, m
 
 
+def clearance_one_py(x: float, y: float, radius: float, n_obs: int, prm: FloatArray,
+                     st: FloatArray, rings: FloatArray) -> float:  # fmt: skip
+    """:func:`_clearance` [m] of the robot disc of ``radius`` [m] at ``(x, y)`` among the
+    ``n_obs`` obstacles of one world as they stand (one slot's ``params``, ``state`` and
+    ``rings``), with its own scratch: :meth:`ObstacleField.query`'s signed distance minus the
+    radius, without building the field."""
+    ring = np.empty((2, rings.shape[2]))
+    low = np.empty(rings.shape[1])
+    return _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)[0]
+
+
 #: columns of :func:`sense_one_py`'s reading rows: distance [m], nearest point [m], centre [m],
 #: velocity [m/s], rotation rate [rad/s]
 R_DIST, R_NEAR, R_CENTRE, R_VEL, R_OMEGA = 0, 1, 3, 5, 7
@@ -401,6 +412,7 @@ _PUBLIC = {
     "observe": "observe_py",
     "advance_one": "advance_one_py",
     "sense_one": "sense_one_py",
+    "clearance_one": "clearance_one_py",
 }
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
@@ -415,7 +427,7 @@ def kernel(name: str) -> Callable[..., Any]:
         _KERNELS.update(compile_family([
             wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py, ray_ring_hit_py,
             _transform_ring, _move_obstacles, _clearance, _lidar, step_worlds_py, observe_py,
-            sense_one_py, advance_one_py,
+            sense_one_py, advance_one_py, clearance_one_py,
         ]))  # fmt: skip
     return _KERNELS[_PUBLIC[name]]
 
@@ -567,10 +579,9 @@ class PackedWorlds:
         wf[[W_VMAX, W_UMAX]] = (float(spec.v_max), float(spec.u_max))
         n_steps = round(setup.t_max / dt)
         wi[[I_STEP, I_RATIO, I_NSTEPS, I_NOBS]] = (0, ratio, n_steps, m)
-        gap = math.inf  # at t = 0 as UnicycleWorld.start measures it
-        if m:
-            field = ObstacleField.from_obstacles(obstacles, tpl)
-            gap = float((field.query((x, y), 0.0, nearest=True).signed - spec.radius).min())
+        # at t = 0 as UnicycleWorld.start measures it (the field's query), from the slot
+        gap = float(kernel("clearance_one")(x, y, float(spec.radius), m, self.params[slot],
+                                            self.state[slot], self.rings[slot]))  # fmt: skip
         wf[W_CLEAR], wf[W_LOW] = gap, math.inf
         status = RUNNING
         if gap < 0:
