@@ -15,7 +15,9 @@ the JSON files the benchmarks wrote there; it measures nothing:
 * ``vector_env.json`` (``benchmarks/bench_vector_env.py``): the vector env's target,
   env steps per CPU second ("not measured" until a benchmark writes it);
 * ``summary.json`` (``benchmarks/run_benchmarks.py``): a closing line with how many of its own
-  targets pass.
+  targets pass;
+* ``peers.json`` again: a last line with ir-sim's step time in the sitting (:func:`machine_line`),
+  how fast the machine ran.
 
 A missing file reads "not run", a peer that was not installed "no peer", a quick (smoke) run is
 marked with ``*``.  ``ratio`` is measured / limit (the target's direction says which side of 1
@@ -193,6 +195,26 @@ def summary_line(results: Path) -> str | None:
     return f"run_benchmarks.py targets (summary.json): {passed} of {len(targets)} pass"
 
 
+def machine_line(results: Path) -> str | None:
+    """ir-sim's median step time in this sitting (``peers.json``), or ``None`` without it.
+
+    The same pure-Python code every time, it shows how fast the machine ran: the targets with
+    absolute limits (µs, s, steps/s) move with it, the ratios against peers measured in the
+    same run do not, so sittings are compared through this line.
+    """
+    data = load(results, "peers.json")
+    res = data.get("results") if data else None
+    if not isinstance(res, dict):
+        return None
+    parts = []
+    for n in ("10", "100"):
+        irsim = res.get(n, {}).get("irsim") if isinstance(res.get(n), dict) else None
+        us = irsim.get("median_us_per_step") if isinstance(irsim, dict) else None
+        if isinstance(us, int | float) and not isinstance(us, bool) and math.isfinite(us):
+            parts.append(f"{us:,.0f} µs ({n} polygons)")
+    return "machine: ir-sim's step here " + ", ".join(parts) if parts else None
+
+
 def build_rows(results: Path) -> list[Row]:
     """Every issue-20 row, in the issue's order."""
     return [
@@ -227,8 +249,9 @@ def main(argv: list[str] | None = None) -> int:
     footer = [
         "ratio = measured / limit; not run: no result file; no peer: peer not installed",
     ]
-    if (line := summary_line(args.results)) is not None:
-        footer.append(line)
+    for line in (summary_line(args.results), machine_line(args.results)):
+        if line is not None:
+            footer.append(line)
     print(render(build_rows(args.results), footer))
     return 0
 

@@ -152,3 +152,16 @@ def test_summary_table(tmp_path: Path) -> None:
     assert "* quick (smoke) run" in text and "1 of 2 pass" in text
     (tmp_path / "campaign.json").write_text("{not json", encoding="utf-8")
     assert summary.campaign_row(tmp_path).result == "not run"
+
+
+def test_summary_machine_line(tmp_path: Path) -> None:
+    """The footer line that says how fast the machine ran: ir-sim's medians from peers.json."""
+    assert summary.machine_line(tmp_path) is None
+    _write(tmp_path, "peers.json", {"results": {
+        "10": {"irsim": {"median_us_per_step": 1762.26}},
+        "100": {"irsim": {"median_us_per_step": 22345.0}}}})  # fmt: skip
+    line = summary.machine_line(tmp_path)
+    assert line == "machine: ir-sim's step here 1,762 µs (10 polygons), 22,345 µs (100 polygons)"
+    assert len(line) <= summary.WIDTH
+    _write(tmp_path, "peers.json", {"results": {"10": {"irsim": None}}})  # no peer installed
+    assert summary.machine_line(tmp_path) is None
