@@ -21,7 +21,7 @@ Thesis ambiguities and what was chosen (also in docs/thesis-notes.md):
   the average — which made a prototype brake to a stop.  ``extra_inputs=1`` concatenates the
   car's speed (scaled) to the flattened features; ``extra_inputs=0`` is the thesis's image-only
   network.
-* The learned throttle, continued (measured in session 2: with the speed input and 30 epochs the
+* The learned throttle, continued (measured earlier: with the speed input and 30 epochs the
   throttle head's validation MSE stays at 0.16 and the car enters sharp corners at 46–52 m/s
   where the expert brakes to ~32): the expert's pedal is ``clip(k (v_target − v))``, a steep,
   often saturated function of the speed, while ``v_target`` (its corner-speed profile over the
