@@ -208,7 +208,8 @@ def machine_line(results: Path) -> str | None:
         return None
     parts = []
     for n in ("10", "100"):
-        irsim = res.get(n, {}).get("irsim") if isinstance(res.get(n), dict) else None
+        row = res.get(n)
+        irsim = row.get("irsim") if isinstance(row, dict) else None
         us = irsim.get("median_us_per_step") if isinstance(irsim, dict) else None
         if isinstance(us, int | float) and not isinstance(us, bool) and math.isfinite(us):
             parts.append(f"{us:,.0f} µs ({n} polygons)")

@@ -216,18 +216,15 @@ class BodySpec(_Model):
         Built once per shape and shared by the episodes and by the specs of the same shape (bodies
         are frozen, and re-centring a polygon costs more than the rest of an episode's set-up; a
         generator validates each of its shapes once and builds its scene from them again)."""
-        if self.polygon is None:
-            assert self.disc is not None
-            verts = np.array([float(self.disc)])
-        else:
-            verts = np.asarray(self.polygon, dtype=float)
+        verts = np.asarray(self.polygon if self.polygon is not None else [self.disc], dtype=float)
         key = (verts.shape, verts.tobytes())  # the very numbers, -0.0 included
         body = _BODIES.get(key)
         if body is None:
-            if self.polygon is None:
-                body = DiscBody(float(verts[0]))
-            else:
-                body = PolygonBody.from_vertices(verts)
+            body = (
+                PolygonBody.from_vertices(verts)
+                if self.polygon is not None
+                else DiscBody(float(verts[0]))
+            )
             if len(_BODIES) >= 4096:
                 _BODIES.clear()
             _BODIES[key] = body

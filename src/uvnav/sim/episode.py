@@ -282,6 +282,8 @@ class UnicycleWorld:
         also covers ``radius`` [m] for the sensors."""
         if not self.obstacles:
             return math.inf, -1
+        if self.packed is not None:  # the compiled measure of every later step, no field built
+            return self.packed.clearance(self.x, self.y, float(self.spec.radius))
         q = self.field.query((self.x, self.y), radius, nearest=True)
         if len(q.ids) == 0:
             return math.inf, -1

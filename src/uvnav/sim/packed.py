@@ -261,14 +261,14 @@ def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs
 
 
 def clearance_one_py(x: float, y: float, radius: float, n_obs: int, prm: FloatArray,
-                     st: FloatArray, rings: FloatArray) -> float:  # fmt: skip
-    """:func:`_clearance` [m] of the robot disc of ``radius`` [m] at ``(x, y)`` among the
-    ``n_obs`` obstacles of one world as they stand (one slot's ``params``, ``state`` and
-    ``rings``), with its own scratch: :meth:`ObstacleField.query`'s signed distance minus the
-    radius, without building the field."""
+                     st: FloatArray, rings: FloatArray) -> tuple[float, int]:  # fmt: skip
+    """:func:`_clearance` of the robot disc of ``radius`` [m] at ``(x, y)`` among the ``n_obs``
+    obstacles of one world as they stand (one slot's ``params``, ``state`` and ``rings``), with
+    its own scratch: :meth:`ObstacleField.query`'s signed distance minus the radius [m] and the
+    nearest obstacle (-1 without any), without building the field."""
     ring = np.empty((2, rings.shape[2]))
     low = np.empty(rings.shape[1])
-    return _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)[0]
+    return _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)
 
 
 #: columns of :func:`sense_one_py`'s reading rows: distance [m], nearest point [m], centre [m],
@@ -456,6 +456,33 @@ def pack_check(setup: EpisodeSetup) -> str | None:
     return None
 
 
+def _random_turn_columns(mod: RandomTurn, state: ObstacleState, st: list[float],
+                         prm: list[float]) -> None:  # fmt: skip
+    """A random-turn model's state (``S_*``: course, draws, next change) and parameters
+    (``P_*``: draw ranges, period, spin, turn limit, arena) into the column lists."""
+    st[S_COURSE] = mod.course_at(state)
+    st[S_SPEED], st[S_TURN] = mod._speed, mod._turn
+    st[S_NEXT] = mod._next_change
+    st[S_THRESHOLD] = mod._next_change - 1e-12
+    for lo_row, span_row, bounds in (
+        (P_SPEED_LO, P_SPEED_SPAN, mod.speed),
+        (P_TURN_LO, P_TURN_SPAN, mod.turn_rate),
+    ):
+        lo = float(bounds[0])
+        span = float(bounds[1]) - lo
+        if not (math.isfinite(span) and span >= 0.0):
+            raise ValueError(f"random-turn bounds {tuple(bounds)} are not (low, high)")
+        prm[lo_row], prm[span_row] = lo, span
+    prm[P_PERIOD] = float(mod.change_period)
+    prm[P_SPIN] = float(mod.spin)
+    prm[P_LIMIT] = max(abs(mod.turn_rate[0]), abs(mod.turn_rate[1]))
+    if mod.arena is not None:
+        x0, y0, x1, y1 = mod.arena
+        prm[P_ARENA] = 1.0
+        prm[P_X0], prm[P_Y0], prm[P_X1], prm[P_Y1] = x0, y0, x1, y1
+        prm[P_MIDX], prm[P_MIDY] = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+
+
 class PackedWorlds:
     """``k`` slots of packed worlds (module docstring); :meth:`load` an episode into a slot,
     :meth:`step` the running ones by one decision, :meth:`observe` them.
@@ -581,7 +608,7 @@ class PackedWorlds:
         wi[[I_STEP, I_RATIO, I_NSTEPS, I_NOBS]] = (0, ratio, n_steps, m)
         # at t = 0 as UnicycleWorld.start measures it (the field's query), from the slot
         gap = float(kernel("clearance_one")(x, y, float(spec.radius), m, self.params[slot],
-                                            self.state[slot], self.rings[slot]))  # fmt: skip
+                                            self.state[slot], self.rings[slot])[0])  # fmt: skip
         wf[W_CLEAR], wf[W_LOW] = gap, math.inf
         status = RUNNING
         if gap < 0:
@@ -625,46 +652,29 @@ class PackedWorlds:
         return hit[0]
 
     def _pack_obstacle(self, slot: int, o: int, ob: Obstacle) -> np.random.Generator | None:
-        """Obstacle ``o`` of ``slot``: its state, parameters and first block of draws.  The
-        columns are filled as lists and stored in one assignment each (a reset of the batched
-        env packs every obstacle of its scene)."""
+        """Obstacle ``o`` of ``slot``: its state, parameters and first block of draws; its
+        generator (None for constant motion).  The columns are filled as lists and stored in one
+        assignment each (a reset of the batched env packs every obstacle of its scene)."""
         mod, state = ob.motion, ob.state
         st, prm = [0.0] * N_STATE, [0.0] * N_PARAMS
         st[S_X], st[S_Y] = np.asarray(state.position, dtype=float).tolist()
         st[S_HEADING] = state.heading
         st[S_VX], st[S_VY] = np.asarray(state.velocity, dtype=float).tolist()
         st[S_OMEGA] = state.angular_velocity
-        self.oi[slot, :, o] = (CONSTANT if isinstance(mod, ConstantVelocity) else RANDOM_TURN, 0)
+        rng: np.random.Generator | None = None
         if isinstance(mod, ConstantVelocity):
+            kind = CONSTANT
             prm[P_VX], prm[P_VY] = np.asarray(mod.velocity, dtype=float).tolist()
             prm[P_OMEGA] = float(mod.angular_velocity)
-            self.state[slot, :, o], self.params[slot, :, o] = st, prm
-            return None
-        assert isinstance(mod, RandomTurn)
-        st[S_COURSE] = mod.course_at(state)
-        st[S_SPEED], st[S_TURN] = mod._speed, mod._turn
-        st[S_NEXT] = mod._next_change
-        st[S_THRESHOLD] = mod._next_change - 1e-12
-        for lo_row, span_row, bounds in (
-            (P_SPEED_LO, P_SPEED_SPAN, mod.speed),
-            (P_TURN_LO, P_TURN_SPAN, mod.turn_rate),
-        ):
-            lo = float(bounds[0])
-            span = float(bounds[1]) - lo
-            if not (math.isfinite(span) and span >= 0.0):
-                raise ValueError(f"random-turn bounds {tuple(bounds)} are not (low, high)")
-            prm[lo_row], prm[span_row] = lo, span
-        prm[P_PERIOD] = float(mod.change_period)
-        prm[P_SPIN] = float(mod.spin)
-        prm[P_LIMIT] = max(abs(mod.turn_rate[0]), abs(mod.turn_rate[1]))
-        if mod.arena is not None:
-            x0, y0, x1, y1 = mod.arena
-            prm[P_ARENA] = 1.0
-            prm[P_X0], prm[P_Y0], prm[P_X1], prm[P_Y1] = x0, y0, x1, y1
-            prm[P_MIDX], prm[P_MIDY] = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+        else:
+            assert isinstance(mod, RandomTurn)
+            kind, rng = RANDOM_TURN, mod.rng
+            _random_turn_columns(mod, state, st, prm)
+        self.oi[slot, :, o] = (kind, 0)
         self.state[slot, :, o], self.params[slot, :, o] = st, prm
-        mod.rng.random(out=self.ubuf[slot, o])
-        return mod.rng
+        if rng is not None:
+            rng.random(out=self.ubuf[slot, o])
+        return rng
 
     def refill(self) -> None:
         """Top up the draws of every obstacle that has read half its row or more: the unread
@@ -693,13 +703,20 @@ class PackedWorlds:
         spare = (b - upos) // np.maximum(2 * self.wi[:, I_RATIO, None], 1)
         self._safe_calls = int(spare.min()) if spare.size else 1 << 30
 
+    def ensure_draws(self) -> None:
+        """Top up the rows (:meth:`refill`) when the next call could run one out, and count that
+        call: :meth:`step`'s rule, for a caller that steps the slots' arrays itself (one
+        integration step a call, as :class:`PackedObstacles` does)."""
+        if self._safe_calls <= 0:
+            self.refill()
+        self._safe_calls -= 1
+
     def step(self, active: np.ndarray | None = None) -> None:
         """Advance every running world (of the ``active`` (k,) bool slots) by one decision with
         the commands in :attr:`command`."""
         if active is not None:
             self.wi[:, I_ACTIVE] = active
-        if self._safe_calls <= 0:
-            self.refill()
+        self.ensure_draws()
         self._safe_calls = kernel("step")(
             self.wf, self.wi, self.oi, self.params, self.state, self.ubuf, self.rings
         )
@@ -762,15 +779,18 @@ class PackedObstacles:
         ``radius`` [m] at ``(x, y)`` then, and its nearest obstacle (-1 without any).  With a
         ``sensing_range`` >= 0 [m] the readings from there are taken in the same call, for
         :meth:`readings` to return."""
-        pw = self._pw
-        if pw._safe_calls <= 0:  # PackedWorlds.refill: its rows, its accounting
-            pw.refill()
-        pw._safe_calls -= 1
+        self._pw.ensure_draws()
         self._stepped = True
         gap, at, m = self._advance(x, y, radius, t, dt, self.n, self._oi, self._prm, self._st,
                                    self._ubuf, self._rings, sensing_range, self._ids,
                                    self._rows, self._outlines)  # fmt: skip
         self._sensed = (x, y, sensing_range, m) if m >= 0 else None
+        return float(gap), int(at)
+
+    def clearance(self, x: float, y: float, radius: float) -> tuple[float, int]:
+        """The clearance [m] of the robot disc of ``radius`` [m] at ``(x, y)`` now, and its
+        nearest obstacle (-1 without any): :meth:`step`'s measure, without moving anything."""
+        gap, at = kernel("clearance_one")(x, y, radius, self.n, self._prm, self._st, self._rings)
         return float(gap), int(at)
 
     def readings(self, x: float, y: float, sensing_range: float) -> tuple[ObstacleReading, ...]:
