@@ -19,7 +19,7 @@ import time
 from collections.abc import Iterator
 from contextlib import contextmanager, nullcontext
 from pathlib import Path
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -62,6 +62,24 @@ def campaign_file(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
+class Timing(NamedTuple):
+    """How long an uninterrupted run takes on this machine, warm: its start (reading the file,
+    the store's resume query) and each episode [s].  Timed interruptions are drawn in these
+    units, so that a fast machine does not finish the campaign between them, nor a slow one
+    never reach an episode."""
+
+    start_s: float
+    episode_s: float
+
+
+def timed_run(db: Path, campaign_file: Path) -> float:
+    """Wall time [s] of an uninterrupted ``--resume`` run into ``db``."""
+    wall = time.perf_counter()
+    with ResultsStore(db) as store:
+        run_campaign_spec(store, load_campaign(campaign_file), resume=True, workers=1)
+    return time.perf_counter() - wall
+
+
 @pytest.fixture(scope="module")
 def reference(campaign_file: Path) -> pd.DataFrame:
     """The rows of an uninterrupted run."""
@@ -72,6 +90,16 @@ def reference(campaign_file: Path) -> pd.DataFrame:
     df = rows(db)
     assert len(df) == N_EPISODES and set(df["status"]) <= {"success", "collision", "timeout"}
     return df
+
+
+@pytest.fixture(scope="module")
+def timing(campaign_file: Path, reference: pd.DataFrame) -> Timing:
+    """:class:`Timing` of a second whole run (the first loaded the compiled kernels), its start
+    timed by a resume that finds every episode stored."""
+    db = campaign_file.parent / "timing.sqlite"
+    whole = timed_run(db, campaign_file)
+    start = min(timed_run(db, campaign_file) for _ in range(3))
+    return Timing(start, max(whole - start, 0.0) / N_EPISODES)
 
 
 def assert_same_rows(db: Path, reference: pd.DataFrame) -> None:
@@ -151,8 +179,9 @@ def run_in_process(db: Path, campaign_file: Path, interrupt: Any = None) -> bool
     return True
 
 
-def in_process_interrupt(rng: np.random.Generator) -> tuple[str, Any]:
-    """A random in-process interruption: its kind and context manager."""
+def in_process_interrupt(rng: np.random.Generator, timing: Timing) -> tuple[str, Any]:
+    """A random in-process interruption: its kind and context manager (a timer goes off
+    between the run's start and the end of its second episode)."""
     kind = str(rng.choice(IN_PROCESS_KINDS))
     n = int(rng.integers(1, 3))  # the first or the second call: about one episode per resume
     if kind == "before-episode":
@@ -163,18 +192,18 @@ def in_process_interrupt(rng: np.random.Generator) -> tuple[str, Any]:
         return kind, raising_on_call(campaign_mod, "store_outcome", n, after=True)
     if kind == "in-transaction":
         return kind, interrupting_transaction(n)
-    return kind, timer_interrupt(float(rng.uniform(0.001, 0.08)))
+    return kind, timer_interrupt(float(rng.uniform(0.0, timing.start_s + 2 * timing.episode_s)))
 
 
 def test_fifty_interruptions_then_resume_equal_an_uninterrupted_run(
-    tmp_path: Path, campaign_file: Path, reference: pd.DataFrame
+    tmp_path: Path, campaign_file: Path, reference: pd.DataFrame, timing: Timing
 ) -> None:
     rng = np.random.default_rng(2017)
     db = tmp_path / "interrupted.sqlite"
     kinds: dict[str, int] = {}
     interrupted = 0
     for _ in range(50):
-        kind, interrupt = in_process_interrupt(rng)
+        kind, interrupt = in_process_interrupt(rng, timing)
         finished = run_in_process(db, campaign_file, interrupt)
         kinds[kind] = kinds.get(kind, 0) + 1
         interrupted += not finished
@@ -216,7 +245,7 @@ def interrupt_process(
 
 @pytest.mark.slow
 def test_real_interruptions_then_resume_equal_an_uninterrupted_run(
-    tmp_path: Path, campaign_file: Path, reference: pd.DataFrame
+    tmp_path: Path, campaign_file: Path, reference: pd.DataFrame, timing: Timing
 ) -> None:
     """Ctrl-C and SIGKILL of ``uvnav bench`` on two workers, between in-process ones."""
     rng = np.random.default_rng(4242)
@@ -224,10 +253,11 @@ def test_real_interruptions_then_resume_equal_an_uninterrupted_run(
     log = tmp_path / "stderr.txt"
     real = [signal.SIGINT, signal.SIGKILL, signal.SIGINT, signal.SIGKILL]
     for sig in real:
-        code = interrupt_process(campaign_file, db, sig, float(rng.uniform(0.0, 0.1)), log)
+        delay = float(rng.uniform(0.0, 2.0)) * timing.episode_s
+        code = interrupt_process(campaign_file, db, sig, delay, log)
         assert code == (130 if sig == signal.SIGINT else -signal.SIGKILL), log.read_text()
         for _ in range(2):
-            run_in_process(db, campaign_file, in_process_interrupt(rng)[1])
+            run_in_process(db, campaign_file, in_process_interrupt(rng, timing)[1])
         assert stored(db) < N_EPISODES, "the campaign ended before all interruptions"
     assert run_in_process(db, campaign_file)
     assert_same_rows(db, reference)
