@@ -1,5 +1,5 @@
 """3D frames and rotations: exact rotation on the sphere of headings, SO(3) exp/log, the thesis's
-on-line frame, and the tangent cone to a sphere.
+on-line frame, and the turn toward a direction.
 
 Reference: Y. Zhang, *Algorithms of Real-Time Navigation and Control of Autonomous Unmanned
 Vehicles*, UNSW — Chapter 3 ("Collision-free Navigation of Flying Robots in Outdoor Environments
@@ -25,11 +25,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
-
-
-def skew(w: FloatArray) -> FloatArray:
-    """The matrix [w]x with [w]x v = w x v."""
-    return np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
 
 
 def rotation_from_vector(rotvec: FloatArray) -> FloatArray:
@@ -173,11 +168,6 @@ class OnlineFrame:
         v = np.asarray(vectors, dtype=float)
         return np.stack([v @ self.x_axis, v @ self.y_axis], axis=-1)
 
-    def plane_to_world(self, vectors2: FloatArray) -> FloatArray:
-        """(X', Y') vectors (..., 2) -> world vectors (..., 3) in the on-line plane."""
-        v = np.asarray(vectors2, dtype=float)
-        return v[..., :1] * self.x_axis + v[..., 1:2] * self.y_axis
-
 
 def online_frame(
     position: FloatArray, goal: FloatArray, previous_x: FloatArray | None = None
@@ -206,14 +196,6 @@ def online_frame(
     y = np.array([y0, y1, y2])
     z = np.array([x1 * y2 - x2 * y1, x2 * y0 - x0 * y2, x0 * y1 - x1 * y0])
     return OnlineFrame(origin=p, x_axis=x, y_axis=y, z_axis=z)
-
-
-def sphere_tangent_half_angle(distance: float, radius: float) -> float:
-    """Half-angle [rad] of the cone of tangents from a point at ``distance`` [m] from the centre
-    of a sphere of ``radius`` [m] (pi/2 when the point is inside or on the sphere)."""
-    if distance <= radius:
-        return 0.5 * math.pi
-    return math.asin(radius / distance)
 
 
 def turn_toward(a: FloatArray, direction: FloatArray, u_max: float, period: float) -> FloatArray:

@@ -324,14 +324,6 @@ def contains_points(points: FloatArray, tri: Triangles) -> np.ndarray:
     return np.asarray(winding_numbers(points, tri) > 0.5)
 
 
-def signed_distance(point: FloatArray, tri: Triangles) -> tuple[float, FloatArray]:
-    """Signed distance [m] from ``point`` to the solid (negative inside) and the nearest surface
-    point [m]."""
-    q, d, _ = nearest_on_mesh(point, tri)
-    inside = bool(contains_points(np.asarray(point, dtype=float)[None], tri)[0])
-    return (-d if inside else d), q
-
-
 def ray_triangles(
     origins: FloatArray,
     directions: FloatArray,
