@@ -398,11 +398,19 @@ def random_ch4_scenario(
         specs.append(spec)
     if len(specs) < n:
         raise PlacementError(f"random-ch4:{seed}", len(specs), n, f"{_MORE_TRIES * n} draws")
+    description = f"random Chapter-4 scene {seed}: {len(specs)} deforming obstacles"
+    return _generated(f"random-ch4:{seed}", description, 60.0, specs, noise_std, dropout)
+
+
+def _generated(name: str, description: str, t_max: float, specs: list[dict[str, Any]],
+               noise_std: float, dropout: float) -> Uuv2dScenario:  # fmt: skip
+    """A generated Chapter-4 scene ``name``: the thesis's vehicle (start, goal, limits, radius),
+    the sonar's noise ``noise_std`` and ``dropout``, and the obstacles ``specs``."""
     data = {
         "kind": "uuv2d",
-        "name": f"random-ch4:{seed}",
-        "description": f"random Chapter-4 scene {seed}: {len(specs)} deforming obstacles",
-        "t_max": 60.0,
+        "name": name,
+        "description": description,
+        "t_max": t_max,
         "vehicle": {
             "start": list(CH4_START),
             "goal": list(CH4_GOAL),
@@ -413,7 +421,7 @@ def random_ch4_scenario(
         "sonar": {"noise_std": noise_std, "dropout": dropout},
         "obstacles": specs,
     }
-    return uuv2d_from_dict(data, f"random-ch4:{seed}")
+    return uuv2d_from_dict(data, name)
 
 
 def _closest_approach(p: np.ndarray, v: np.ndarray, horizon: float) -> float:
@@ -557,23 +565,12 @@ def random_ch4_hard_scenario(
         raise PlacementError(
             source, best, n, f"{1 + _RETRY_ROUNDS} placements of {40 * n} draws each"
         )
-    data = {
-        "kind": "uuv2d",
-        "name": f"random-ch4-hard:{seed}",
-        "description": f"harder random Chapter-4 scene {seed}: {len(specs)} deforming obstacles, "
-        "fast deformation, translating, narrow gaps",
-        "t_max": HARD_T_MAX,
-        "vehicle": {
-            "start": list(CH4_START),
-            "goal": list(CH4_GOAL),
-            "v_max": CH4_V_MAX,
-            "u_max": CH4_U_MAX,
-            "radius": CH4_RADIUS,
-        },
-        "sonar": {"noise_std": noise_std, "dropout": dropout},
-        "obstacles": specs,
-    }
-    return uuv2d_from_dict(data, f"random-ch4-hard:{seed}")
+    description = (
+        f"harder random Chapter-4 scene {seed}: {len(specs)} deforming obstacles, fast "
+        "deformation, translating, narrow gaps"
+    )
+    return _generated(f"random-ch4-hard:{seed}", description, HARD_T_MAX, specs, noise_std,
+                      dropout)  # fmt: skip
 
 
 #: Seeded Chapter-4 scene generators by name (``load_uuv2d_scenario("random-ch4:7")``).
