@@ -210,9 +210,9 @@ def machine_line(results: Path) -> str | None:
     for n in ("10", "100"):
         row = res.get(n)
         irsim = row.get("irsim") if isinstance(row, dict) else None
-        us = irsim.get("median_us_per_step") if isinstance(irsim, dict) else None
-        if isinstance(us, int | float) and not isinstance(us, bool) and math.isfinite(us):
-            parts.append(f"{us:,.0f} µs ({n} polygons)")
+        us = number(irsim.get("median_us_per_step") if isinstance(irsim, dict) else None, " µs")
+        if us != "-":
+            parts.append(f"{us} ({n} polygons)")
     return "machine: ir-sim's step here " + ", ".join(parts) if parts else None
 
 

@@ -278,8 +278,9 @@ class UnicycleWorld:
         return np.array((self.x, self.y, self.th))
 
     def _clearance(self, radius: float) -> tuple[float, int]:
-        """Exact gap [m] to the nearest obstacle (negative on overlap) and its index; the query
-        also covers ``radius`` [m] for the sensors."""
+        """Exact gap [m] to the nearest obstacle (negative on overlap) and its index; the field's
+        query also covers ``radius`` [m] for the sensors, which reuse it (packed obstacles are
+        measured by their compiled kernel instead, and sensed in their own call)."""
         if not self.obstacles:
             return math.inf, -1
         if self.packed is not None:  # the compiled measure of every later step, no field built

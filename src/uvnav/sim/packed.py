@@ -716,7 +716,7 @@ class PackedWorlds:
         the commands in :attr:`command`."""
         if active is not None:
             self.wi[:, I_ACTIVE] = active
-        self.ensure_draws()
+        self.ensure_draws()  # its count is replaced by the kernel's, which knows the rows read
         self._safe_calls = kernel("step")(
             self.wf, self.wi, self.oi, self.params, self.state, self.ubuf, self.rings
         )
