@@ -231,6 +231,9 @@ def test_cli_shows_parameters_and_refuses_with_exit_2() -> None:
     table = runner.invoke(app, ["scenarios", "show", "random-ch2"])
     assert table.exit_code == 0
     assert "speed_ratio_max" in table.stdout and "< 1" in table.stdout
+    option = table.stdout.split("(", 1)[1].split()[0]  # the option the table tells one to use
+    told = runner.invoke(app, ["simulate", "random-ch2:4", option, "body=disc", "--json"])
+    assert told.exit_code == 0, told.stderr
     scene = runner.invoke(
         app,
         [

@@ -412,7 +412,7 @@ def _show_generator_params(name: str) -> None:
     from uvnav.scenarios.catalog import generator_params
 
     params = generator_params(name)
-    typer.echo(f"{name}:SEED parameters (--param KEY=VALUE; params: in a campaign entry)")
+    typer.echo(f"{name}:SEED parameters (--gen-param KEY=VALUE; params: in a campaign entry)")
     if not params:
         typer.echo("  (none)")
     width = max((len(p.name) for p in params), default=0)
