@@ -45,7 +45,6 @@ def _strict_loads(text: str) -> Any:
         ["drive", "collect", "--out", "data", "--noise", "inf"],
         ["drive", "reproduce", "--out", "data", "--noise", "inf"],
         ["sonar", "dataset", "--out", "data", "--noise", "inf"],
-        ["sonar", "simulate", "thesis-ch5-scene1", "--noise", "inf"],
     ],
 )
 def test_non_finite_numeric_options_are_usage_errors(
@@ -153,8 +152,8 @@ def test_sonar_evaluate_refuses_a_checkpoint_with_nan_scaling(tmp_path: Path) ->
     save_file(arrays, str(tmp_path / "m.safetensors"), metadata=meta)
     for args in (
         ["sonar", "evaluate", str(tmp_path / "m"), str(data)],
-        ["sonar", "simulate", "thesis-ch5-scene1", "--locator", "network", "--model",
-         str(tmp_path / "m")],
+        ["simulate", "thesis-ch5-scene1", "-p", "locator=network", "-p",
+         f"model={tmp_path / 'm'}"],
     ):  # fmt: skip
         r = runner.invoke(app, args)
         assert r.exit_code == 2, r.output

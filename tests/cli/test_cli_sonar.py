@@ -1,4 +1,5 @@
-"""``uvnav sonar``: dataset -> train -> evaluate, simulate, and one-line errors with status 2."""
+"""``uvnav sonar``: dataset -> train -> evaluate; ``uvnav simulate`` with the trained network as
+the Chapter 5 law's locator; one-line errors with status 2."""
 
 from __future__ import annotations
 
@@ -87,8 +88,9 @@ def test_bad_inputs_are_one_line_errors(tmp_path: Path) -> None:
         ["sonar", "train", str(tmp_path / "missing.npz")],
         ["sonar", "train", str(junk)],
         ["sonar", "evaluate", str(tmp_path / "nomodel"), str(junk)],
-        ["sonar", "simulate", "random-ch5:x"],
-        ["sonar", "simulate", "thesis-ch5-scene1", "--locator", "network"],
+        ["simulate", "random-ch5:x"],
+        ["simulate", "thesis-ch5-scene1", "-p", "locator=network"],
+        ["simulate", "thesis-ch5-scene1", "-p", "locator=network", "-p", "model=nothing"],
         ["sonar", "train", str(junk), "--variant", "deep"],
         ["sonar", "train", str(junk), "--targets", "truth"],
     ):
@@ -100,8 +102,33 @@ def test_bad_inputs_are_one_line_errors(tmp_path: Path) -> None:
 
 
 @pytest.mark.slow
-def test_simulate_prints_metrics(tmp_path: Path) -> None:
-    r = runner.invoke(app, ["sonar", "simulate", "thesis-ch5-scene1"])
+@pytest.mark.parametrize("locator", ["network", "oracle"])
+def test_simulate_runs_the_law_with_the_locator_its_parameters_name(
+    tmp_path: Path, locator: str
+) -> None:
+    from uvnav.controllers.zhang_uuv3d import ZhangUUV3D, make_locator
+    from uvnav.scenarios.catalog import resolve
+    from uvnav.scenarios.ch5 import build_uuv3d
+    from uvnav.sim.episode_uuv3d import run_uuv3d_episode
+
+    model = str(tmp_path / "m") if locator == "network" else ""
+    if model:
+        data = str(tmp_path / "d.npz")
+        for args in (
+            ["sonar", "dataset", "-n", "30", "--seed", "3", "--subdivisions", "1", "--out", data],
+            ["sonar", "train", data, "--out", model, "--max-epochs", "3"],
+        ):
+            assert runner.invoke(app, args).exit_code == 0
+    given = ["-p", f"locator={locator}", *(["-p", f"model={model}"] if model else [])]
+    r = runner.invoke(app, ["simulate", "thesis-ch5-scene1", *given, "--json"])
     assert r.exit_code == 0, r.output
-    out = json.loads(r.output)
-    assert out["status"] == "success" and out["success"] is True
+    out = json.loads(r.stdout)
+    scene = resolve("thesis-ch5-scene1")
+    law = ZhangUUV3D(None, make_locator(locator, model))
+    direct = run_uuv3d_episode(build_uuv3d(scene.scenario), law, scene.kind.episode_rng(0))
+    assert out["locator"] == locator and law.oracle == (locator == "oracle")
+    assert (out["status"], out["path_length"], out["min_clearance"]) == (
+        direct.status,
+        direct.metrics.path_length,
+        direct.metrics.min_clearance,
+    )

@@ -84,14 +84,7 @@ from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.zhang_uuv3d import (
     NAME as LAW,
 )
-from uvnav.controllers.zhang_uuv3d import (
-    GeometricLocator,
-    Locator,
-    ModelLocator,
-    OracleLocator,
-    ZhangUUV3D,
-    ZhangUUV3DParams,
-)
+from uvnav.controllers.zhang_uuv3d import ZhangUUV3D, ZhangUUV3DParams, make_locator
 from uvnav.learning.bpnn import (
     ACCEPTED_SAMPLES,
     HUBER_DELTA,
@@ -174,26 +167,6 @@ CAMPAIGNS: tuple[str, ...] = (SCENES_CAMPAIGN, RANDOM_CAMPAIGN, NOISE_CAMPAIGN, 
 CLOSED_LOOP_SEED, TEST_SEED = 100, 999_999
 #: the resume cache's stage records (:class:`uvnav.stages.Stages`), in ``ch5/cache``
 STAGES_DIR = "stages"
-
-
-def make_locator(
-    name: str, model_path: Path | None = None, model: TrainedBPNN | None = None
-) -> Locator:
-    """``geometric``, ``network`` (a trained model or a checkpoint path) or ``oracle``.
-
-    Raises:
-        ValueError: unknown name, or ``network`` without a model.
-        CheckpointError: the checkpoint cannot be read.
-    """
-    if name == "geometric":
-        return GeometricLocator()
-    if name == "oracle":
-        return OracleLocator()
-    if name == "network":
-        if model is None and model_path is None:
-            raise ValueError("locator 'network' needs a model (--model CHECKPOINT)")
-        return ModelLocator(model if model is not None else load_checkpoint(model_path))  # type: ignore[arg-type]
-    raise ValueError(f"unknown locator {name!r}; known: geometric, network, oracle")
 
 
 @dataclass

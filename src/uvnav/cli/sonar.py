@@ -10,10 +10,11 @@ Commands (thin: they parse, call the library, print):
   learns (``geometry``: the true nearest distance and sensor; ``readings``: min/argmin of its own
   inputs, the thesis's set-up) — every variant the Chapter 5 report shows;
 * ``evaluate`` — errors target - output of a checkpoint (any variant, on the targets it was
-  trained for) on a dataset, beside the min/argmin baseline and the thesis's ranges;
-* ``simulate`` — one closed-loop episode of ``zhang2022-uuv3d-v1`` on a Chapter 5 scenario.
+  trained for) on a dataset, beside the min/argmin baseline and the thesis's ranges.
 
-The chapter's reproduction (BPNN experiment + closed-loop campaigns) is ``uvnav reproduce ch5``.
+A closed-loop episode is ``uvnav simulate`` (``--param locator=network --param model=CKPT`` for
+the trained network).  The chapter's reproduction (BPNN experiment + closed-loop campaigns) is
+``uvnav reproduce ch5``.
 
 Bad input (missing or malformed files, bad options) prints ONE line ``error: ...`` naming the
 file and the problem, and exits with status 2.
@@ -32,7 +33,7 @@ from uvnav.cli.checks import dumps, finite
 from uvnav.cli.errors import CliError, uvnav_typer
 
 sonar_app = uvnav_typer(
-    help="Chapter 5: nine-sonar array data, the BPNN locator, closed-loop runs.",
+    help="Chapter 5: nine-sonar array data and the BPNN locator (dataset, train, evaluate).",
 )
 
 
@@ -247,54 +248,3 @@ def _print_table(table: dict[str, Any], n_train: int | None, title: str) -> None
                 f"thesis ({n} samples, {verdict})", f"[{d[0]}, {d[1]}]", "", f"[{i[0]}, {i[1]}]", ""
             )
     Console().print(t)
-
-
-@sonar_app.command("simulate")
-def simulate_cmd(
-    scenario: Annotated[
-        str,
-        typer.Argument(
-            help="thesis-ch5-scene1|2|3, random-ch5:<seed>, random-ch5-dense:<seed> or a YAML file."
-        ),
-    ],
-    locator: Annotated[
-        str, typer.Option(help="geometric, network (needs --model) or oracle.")
-    ] = "",
-    model_path: Annotated[Path | None, typer.Option("--model", help="BPNN checkpoint.")] = None,
-    seed: Annotated[int, typer.Option("--seed", min=0, help="Episode seed (sonar noise).")] = 0,
-    noise: Annotated[
-        float | None, typer.Option(min=0.0, callback=finite, help="Override sonar noise [m].")
-    ] = None,
-) -> None:
-    """Run zhang2022-uuv3d-v1 on a Chapter 5 scenario and print its metrics as JSON."""
-    from uvnav.bench.reproduce_ch5 import make_locator
-    from uvnav.learning.bpnn import CheckpointError
-    from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
-    from uvnav.scenarios.errors import ScenarioError
-    from uvnav.sim.episode_uuv3d import run_uuv3d_episode
-
-    try:
-        scn = load_ch5_scenario(scenario)
-    except ScenarioError as exc:
-        raise CliError(str(exc)) from None
-    name = locator or scn.controller.locator
-    try:
-        loc = make_locator(name, model_path)
-    except (CheckpointError, ValueError) as exc:
-        raise CliError(str(exc)) from None
-    from uvnav.controllers.zhang_uuv3d import ZhangUUV3D, ZhangUUV3DParams
-
-    try:
-        params = ZhangUUV3DParams(**scn.controller.params)  # type: ignore[arg-type]
-    except (TypeError, ValueError) as exc:
-        raise CliError(f"{scenario}: controller.params: {exc}") from None
-    ctrl = ZhangUUV3D(params, loc)
-    res = run_uuv3d_episode(build_uuv3d(scn, noise_std=noise), ctrl, np.random.default_rng(seed))
-    out = {
-        "scenario": scn.name,
-        "locator": name,
-        "status": res.status,
-        "entered_inner_space": res.entered_inner_space,
-        **res.metrics.to_dict(),
-    }
-    typer.echo(dumps(out))  # strict JSON: a missing metric is null, never NaN

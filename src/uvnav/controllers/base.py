@@ -258,7 +258,8 @@ def requires_slower_obstacles(name: str, params: Mapping[str, Any] | None = None
 
 def make_law(name: str, *, vehicle: str | None = None, oracle: bool = False, **params: Any) -> Any:
     """Build any registered law by name (of ``vehicle`` only, when given) with keyword
-    parameters; ``oracle`` lets it read ground truth.
+    parameters; ``oracle`` lets it read ground truth (a law whose parameters make it an oracle,
+    such as ``zhang2022-uuv3d-v1`` with ``locator=oracle``, stays one).
 
     Raises:
         UnknownControllerError: not registered (or another vehicle's law).
@@ -267,7 +268,7 @@ def make_law(name: str, *, vehicle: str | None = None, oracle: bool = False, **p
     info = controller_info(name, vehicle)
     p = build_params(info.params_type, params)
     law = info.factory(p) if info.params_type is not None else info.factory()
-    law.oracle = oracle
+    law.oracle = oracle or bool(getattr(law, "oracle", False))  # or an oracle by its params
     return law
 
 

@@ -46,12 +46,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Any, ClassVar, Protocol
+from pathlib import Path
+from typing import Any, ClassVar, Protocol, cast
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, register
+from uvnav.controllers.base import ControllerInfo, ControllerParamsError, register
 from uvnav.controllers.base3d import Vehicle3DController
+from uvnav.core import load_plugins
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.frames3d import horizontal_perpendicular
@@ -64,6 +66,29 @@ from uvnav.sensors.sonar_array import (
 )
 
 NAME = "zhang2022-uuv3d-v1"
+#: the built-in locators (:func:`make_locator`); others, such as ``network``, are plug-ins
+BUILTIN_LOCATORS: tuple[str, ...] = ("geometric", "oracle")
+#: entry-point group of locator plug-ins: a name -> ``factory(model: str) -> Locator``, where
+#: ``model`` is the law's ``model`` parameter (uvnav's own ``network``: the trained BPNN)
+LOCATOR_GROUP = "uvnav.locators"
+_PLUGINS: dict[str, Any] | None = None
+
+
+def locator_plugins() -> dict[str, Any]:
+    """The locator factories of the :data:`LOCATOR_GROUP` entry points by name (loaded once).
+
+    Raises:
+        RuntimeError: a plug-in takes a built-in name or another plug-in's.
+    """
+    global _PLUGINS
+    if _PLUGINS is None:
+        _PLUGINS = load_plugins(LOCATOR_GROUP, BUILTIN_LOCATORS, "locator")
+    return _PLUGINS
+
+
+def locator_names() -> tuple[str, ...]:
+    """Every locator a ``locator`` parameter may name: the built-ins, then the plug-ins."""
+    return (*BUILTIN_LOCATORS, *sorted(locator_plugins()))
 
 
 @dataclass(frozen=True)
@@ -175,6 +200,10 @@ class ZhangUUV3DParams:
         max_history: decisions kept for the forecast radius (4.11) (>= 1).
         fixed_tag: keep the side chosen at the switch for the whole avoidance (True), or re-choose
             B's side at every decision (False; it can chatter between two close points).
+        locator: what turns R(t) into the point to evade: geometric (min/argmin), network (the
+            trained BPNN in ``model``), oracle (ORACLE: the true nearest point), or another
+            plug-in of :data:`LOCATOR_GROUP`.
+        model: the learned locator's model: for network, the BPNN checkpoint (path, or stem).
     """
 
     switch_distance: float = 3.0
@@ -182,6 +211,8 @@ class ZhangUUV3DParams:
     escape_angle: float = math.radians(120.0)
     max_history: int = 20
     fixed_tag: bool = True
+    locator: str = "geometric"
+    model: str = ""
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.switch_distance) and self.switch_distance > 0):
@@ -192,6 +223,31 @@ class ZhangUUV3DParams:
             raise ValueError("escape_angle must be in [pi/2, pi] rad")
         if self.max_history < 1:
             raise ValueError("max_history must be >= 1")
+        known = locator_names()
+        if self.locator not in known:
+            raise ValueError(f"locator must be one of {', '.join(known)} (got {self.locator!r})")
+        if self.model and self.locator in BUILTIN_LOCATORS:
+            raise ValueError(f"model is read by a learned locator only (locator={self.locator})")
+
+
+def make_locator(name: str, model_path: Path | str = "", model: Predictor | None = None) -> Locator:
+    """``geometric``, ``oracle``, a learned ``model`` (:class:`ModelLocator`), or the plug-in
+    ``name`` given ``model_path`` (``network``: the BPNN checkpoint there).
+
+    Raises:
+        ValueError: unknown name, or a plug-in's refusal (``network`` without a readable
+            checkpoint: :class:`~uvnav.learning.checkpoint.CheckpointError`, one line).
+    """
+    if name == "geometric":
+        return GeometricLocator()
+    if name == "oracle":
+        return OracleLocator()
+    if model is not None:
+        return ModelLocator(model)
+    plugins = locator_plugins()
+    if name not in plugins:
+        raise ValueError(f"unknown locator {name!r}; known: {', '.join(locator_names())}")
+    return cast(Locator, plugins[name](str(model_path)))
 
 
 def fixed_tag_direction(
@@ -256,14 +312,24 @@ def tangent_direction(
 
 
 class ZhangUUV3D(Vehicle3DController):
-    """The Chapter 5 law (module docstring); the locator defaults to :class:`GeometricLocator`."""
+    """The Chapter 5 law (module docstring) with the given ``locator``, or the one its
+    parameters name (:func:`make_locator`; a ``network`` one reads its checkpoint here).
+
+    Raises:
+        ControllerParamsError: the parameters' checkpoint cannot be read (one line).
+    """
 
     name: ClassVar[str] = NAME
 
     def __init__(self, params: ZhangUUV3DParams | None = None, locator: Locator | None = None):
         super().__init__()
         self.params = params or ZhangUUV3DParams()
-        self.locator: Locator = locator or GeometricLocator()
+        if locator is None:
+            try:
+                locator = make_locator(self.params.locator, self.params.model)
+            except ValueError as exc:  # CheckpointError: a missing or unreadable file
+                raise ControllerParamsError(f"model: {exc}") from None
+        self.locator: Locator = locator
         self.oracle = bool(getattr(self.locator, "oracle", False))
         self._history: list[FloatArray] = []
         self._normal = np.array([0.0, 0.0, 1.0])

@@ -523,6 +523,23 @@ def save_checkpoint(model: TrainedBPNN, path: Path) -> tuple[Path, Path]:
     return st_path, st_path.with_suffix(".json")
 
 
+def network_locator(model: str) -> Any:
+    """The ``network`` locator of ``zhang2022-uuv3d-v1`` (its entry point in the
+    ``uvnav.locators`` group): a :class:`~uvnav.controllers.zhang_uuv3d.ModelLocator` of the BPNN
+    in the checkpoint ``model`` (either file's path, or the stem).
+
+    Raises:
+        ValueError: no checkpoint named; CheckpointError: it cannot be read (one line).
+    """
+    from uvnav.controllers.zhang_uuv3d import ModelLocator
+
+    if not model:
+        raise ValueError(
+            "no checkpoint given (the network locator reads a BPNN checkpoint: model=PATH)"
+        )
+    return ModelLocator(load_checkpoint(Path(model)))
+
+
 def load_checkpoint(path: Path) -> TrainedBPNN:
     """Read a BPNN checkpoint (either file's path, or the stem): the one format of
     :mod:`uvnav.learning.checkpoint`, or a legacy ``uvnav-bpnn-v1`` one (its reader is there).
