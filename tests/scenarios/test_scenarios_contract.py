@@ -9,8 +9,9 @@ import dataclasses
 import pytest
 
 from uvnav.controllers.base import available_controllers
-from uvnav.scenarios.catalog import KINDS, resolve
+from uvnav.scenarios.catalog import KINDS, generators, resolve
 from uvnav.scenarios.episodes import LawMismatchError, run_scene
+from uvnav.scenarios.errors import ScenarioError
 
 #: one scene of each kind, cut to a few seconds
 SCENES = {
@@ -28,6 +29,17 @@ def test_every_kind_has_a_scene_and_a_law() -> None:
     for kind in KINDS:
         k = resolve(SCENES[kind]).kind
         assert any(k.fits(i) for i in LAWS.values()), kind
+
+
+@pytest.mark.parametrize("gen", sorted(generators()))
+def test_every_generator_makes_scenes_of_the_kind_it_is_listed_under(gen: str) -> None:
+    kind = generators()[gen]
+    try:
+        scene = resolve(f"{gen}:{3 if kind.spec_is_seed else 4}")  # seed 3, or 4 robots
+    except ScenarioError as exc:  # crowd-file: it needs a recording's path
+        assert "path" in str(exc), exc
+        return
+    assert scene.kind.name == kind.name and isinstance(scene.scenario, kind.model)
 
 
 @pytest.mark.parametrize("law", sorted(LAWS))

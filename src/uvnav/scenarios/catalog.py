@@ -234,7 +234,10 @@ def _kinds() -> dict[str, SceneKind]:
     from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin
 
     models = _models()
-    gen2d = tuple(g for g in GENERATORS if g != "random-ch3")
+    gen2d, gen3d = (
+        tuple(g for g, fn in GENERATORS.items() if getattr(fn, "scene_kind", "nav2d") == kind)
+        for kind in ("nav2d", "nav3d")
+    )
     return {
         k.name: k
         for k in (
@@ -245,7 +248,7 @@ def _kinds() -> dict[str, SceneKind]:
             ),
             SceneKind(
                 "nav3d", ("vehicle3d",), "exact", "Ch. 3 flying robot among moving 3D bodies",
-                models["nav3d"], _nav3d_load, lambda: list(_builtins_of_dim(3)), ("random-ch3",),
+                models["nav3d"], _nav3d_load, lambda: list(_builtins_of_dim(3)), gen3d,
                 _plain_rng,
             ),
             SceneKind(

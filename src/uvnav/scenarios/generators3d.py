@@ -268,3 +268,7 @@ def random_ch3_scenario(
         "controller": {"name": "zhang2020-3d-v1"},
     }
     return scenario3d_from_dict(data, name)
+
+
+#: the kind of scene it makes (:mod:`uvnav.scenarios.catalog`); its variants inherit it
+random_ch3_scenario.scene_kind = "nav3d"  # type: ignore[attr-defined]
