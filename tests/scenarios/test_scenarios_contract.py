@@ -9,7 +9,7 @@ import dataclasses
 import pytest
 
 from uvnav.controllers.base import available_controllers
-from uvnav.scenarios.catalog import KINDS, generators, resolve
+from uvnav.scenarios.catalog import GENERATOR_SUMMARIES, KINDS, generators, resolve
 from uvnav.scenarios.episodes import LawMismatchError, run_scene
 from uvnav.scenarios.errors import ScenarioError
 
@@ -40,6 +40,7 @@ def test_every_generator_makes_scenes_of_the_kind_it_is_listed_under(gen: str) -
         assert "path" in str(exc), exc
         return
     assert scene.kind.name == kind.name and isinstance(scene.scenario, kind.model)
+    assert gen in GENERATOR_SUMMARIES  # its line in 'uvnav scenarios list'
 
 
 @pytest.mark.parametrize("law", sorted(LAWS))

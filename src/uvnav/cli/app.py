@@ -354,7 +354,12 @@ def scenarios_list(
 ) -> None:
     """List the built-in scenes of every kind (thesis experiments first) and the generators
     (one line each with its parameters' names; 'uvnav scenarios show GENERATOR' describes them)."""
-    from uvnav.scenarios.catalog import builtin_names, generator_params, generators
+    from uvnav.scenarios.catalog import (
+        builtin_names,
+        generator_params,
+        generator_summary,
+        generators,
+    )
 
     rows: list[dict[str, Any]] = []
     for name, kind in builtin_names():
@@ -375,7 +380,7 @@ def scenarios_list(
             {
                 "name": f"{gen}:{number}",
                 "kind": kind.name,
-                "description": f"generator of {kind.summary} scenes"
+                "description": (generator_summary(gen) or f"generator of {kind.summary} scenes")
                 + (f" (params: {', '.join(names)})" if names else ""),
                 "params": names,
                 "obstacles": None,

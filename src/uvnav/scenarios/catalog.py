@@ -184,6 +184,34 @@ def generator_function(name: str) -> Callable[..., Any]:
     return table[name]
 
 
+#: one line on each built-in generator, for listings (a plug-in's: its ``summary`` attribute)
+GENERATOR_SUMMARIES: dict[str, str] = {
+    "random-ch2": "Ch. 2: 1-6 moving, rotating non-convex bodies across I -> T, (2.6)-(2.8) kept",
+    "random-ch2-edge": "Ch. 2 at the edge of (2.6)-(2.7): 8 fast, fast-turning discs",
+    "crowd-eth": "crossing the ETH 'eth' walkway among its recorded pedestrians",
+    "crowd-hotel": "crossing the ETH 'hotel' walkway among its recorded pedestrians",
+    "crowd-file": "crossing the crowd of any trajectory file (path=...)",
+    "random-ch3": "Ch. 3: 2-4 moving, rotating 3D bodies (AR motion) between S and E",
+    "random-ch3-periodic": "random-ch3 with weaving / circling bodies",
+    "crowdnav-circle": "CrowdNav's circle-crossing test case (5 ORCA humans)",
+    "crowdnav-square": "CrowdNav's square-crossing test case (5 ORCA humans)",
+    "random-ch4": "Ch. 4: deforming bodies within the chapter's assumptions",
+    "random-ch4-hard": "Ch. 4, harder: faster, translating bodies, narrow gaps",
+    "random-ch5": "Ch. 5: deforming 3D bodies between A and B, within the assumptions",
+    "random-ch5-dense": "Ch. 5 beyond the assumptions: bodies closer than the law needs",
+    "antipodal": "N robots on a circle swap to the opposite points",
+    "crossing": "two perpendicular flows of N/2 robots each",
+    "thesis-ch2-multi": "the Fig. 2.8 six-obstacle scene with N <= 8 robots",
+}
+
+
+def generator_summary(name: str) -> str:
+    """One line on generator ``name`` (``""`` for a plug-in without a ``summary``)."""
+    if name in GENERATOR_SUMMARIES:
+        return GENERATOR_SUMMARIES[name]
+    return str(getattr(plugin_generators().get(name), "summary", "") or "")
+
+
 def generator_params(name: str) -> list[Any]:
     """The keyword parameters of seed generator ``name``
     (:class:`uvnav.scenarios.params.ParamInfo`: name, type, default, bounds, description)."""

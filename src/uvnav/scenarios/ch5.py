@@ -117,6 +117,7 @@ class Scenario5(BoundedScene):
     """A Chapter 5 scenario (module docstring)."""
 
     name: str
+    description: str = ""
     dim: Literal[3] = 3
     dt: Pos = 0.05
     control_period: Pos = 0.2
@@ -359,6 +360,10 @@ def random_ch5_scenario(
         )
     data = {
         "name": f"{generator}:{seed}",
+        "description": (
+            f"random Ch. 5 scene: {len(obstacles)} deforming bodies between A and B"
+            + (", closer than the law needs (beyond the assumptions)" if dense else "")
+        ),
         "t_max": 120.0,
         "robot": {
             "start": [0.0, 0.0, 0.0],
