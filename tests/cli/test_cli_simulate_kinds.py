@@ -4,6 +4,7 @@ runner, one-line refusals."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -95,3 +96,13 @@ def test_list_show_and_schema_cover_every_kind() -> None:
     schema = json.loads(runner.invoke(app, ["scenarios", "schema"]).stdout)
     assert len(schema["oneOf"]) == 5
     _one_line_error(runner.invoke(app, ["scenarios", "schema", "--kind", "boat"]))
+
+
+@pytest.mark.parametrize(
+    "spec", ["thesis-ch4-fig4-7-approach", "thesis-ch5-scene1", "thesis-ch2-multi:2"]
+)
+def test_plot_draws_an_episode_of_every_kind(spec: str, tmp_path: Path) -> None:
+    out = tmp_path / "episode.png"
+    res = runner.invoke(app, ["simulate", spec, "--plot", str(out)])
+    assert res.exit_code == 0, res.output
+    assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

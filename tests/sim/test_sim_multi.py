@@ -207,3 +207,18 @@ def test_disc_pairs_match_the_field_query_of_every_robot(
         np.testing.assert_array_equal(q.signed, dp.signed[i, ids])
         np.testing.assert_array_equal(q.distance, dp.dist[i, ids])
         np.testing.assert_array_equal(q.nearest, dp.near[i, ids])
+
+
+def test_a_recorded_episode_keeps_the_obstacles_paths_beside_the_robots_poses() -> None:
+    from uvnav.scenarios.multi import build_multi, load_multi_scenario
+
+    setup = build_multi(load_multi_scenario("thesis-ch2-multi:2"), 0)
+    res = run_multi(setup, np.random.default_rng(0), record=True)
+    paths = res.obstacle_paths
+    assert paths.shape == (len(res.times), len(setup.obstacles), 2)
+    assert np.all(np.ptp(paths, axis=0).max(axis=1) > 0.0)  # every body of Fig. 2.8 moves
+    ends = np.array([o.state.position for o in setup.obstacles])  # advanced in place
+    np.testing.assert_allclose(paths[-1], ends, atol=1e-12)
+    bare = run_multi(build_multi(load_multi_scenario("thesis-ch2-multi:2"), 0),
+                     np.random.default_rng(0), record=False)  # fmt: skip
+    assert bare.obstacle_paths.size == 0 and bare.group == res.group

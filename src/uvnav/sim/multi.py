@@ -152,6 +152,8 @@ class MultiResult:
         times: (n,) sample times [s] (empty when not recorded).
         poses: (n, N, 3) robot poses (empty when not recorded).
         collided_pairs: the robot index pairs that overlapped.
+        obstacle_paths: (n, K, 2) positions of the world's K obstacles [m] at the same times
+            (empty when not recorded or when there are none).
     """
 
     robots: list[EpisodeMetrics]
@@ -160,6 +162,7 @@ class MultiResult:
     times: FloatArray
     poses: FloatArray
     collided_pairs: list[tuple[int, int]]
+    obstacle_paths: FloatArray = field(default_factory=lambda: np.zeros((0, 0, 2)))
 
 
 def _robot_velocity(v: float, th: float) -> tuple[float, float]:
@@ -557,16 +560,18 @@ def group_outcome(
 
 
 class PosesProbe(BaseProbe):
-    """Records every robot's pose of a :class:`MultiUnicycleWorld` at every step and at the
-    end."""
+    """Records every robot's pose and every obstacle's position of a
+    :class:`MultiUnicycleWorld` at every step and at the end."""
 
     def __init__(self) -> None:
         self.times: list[float] = []
         self.poses: list[FloatArray] = []
+        self.obstacles: list[FloatArray] = []
 
     def on_step(self, world: Any, laws: Sequence[Any]) -> None:
         self.times.append(world.t)
         self.poses.append(world.state.copy())
+        self.obstacles.append(np.array(world.batch.positions, dtype=float).reshape(-1, 2))
 
     on_end = on_step
 
@@ -611,6 +616,7 @@ def run_multi(
         times=np.asarray(rec.times) if rec else np.zeros(0),
         poses=np.asarray(rec.poses) if rec and rec.poses else np.zeros((0, n, 3)),
         collided_pairs=sorted(world.pairs),
+        obstacle_paths=np.asarray(rec.obstacles) if rec and rec.obstacles else np.zeros((0, 0, 2)),
     )
 
 

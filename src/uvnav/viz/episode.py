@@ -6,12 +6,14 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 
 def plot_outcome(outcome: Any, path: Path) -> Path:
     """Draw ``outcome`` (a recorded :class:`uvnav.scenarios.episodes.Outcome`) into ``path``.
 
     Raises:
-        ValueError: the kind has no episode figure (multi-robot).
+        ValueError: the kind has no episode figure.
     """
     title = f"{outcome.scene} | {outcome.law} | seed {outcome.seed} | {outcome.status}"
     path = Path(path)
@@ -21,6 +23,14 @@ def plot_outcome(outcome: Any, path: Path) -> Path:
         from uvnav.viz.figures import plot_episode
 
         return plot_episode(outcome.result, outcome.setup, path, title=title)
+    if kind == "multi2d":
+        from uvnav.viz.figures_beyond import plot_swap
+
+        setup = outcome.setup  # its obstacles were advanced to the episode's end in place
+        goals = np.array([robot.goal for robot in setup.robots], dtype=float)
+        ends = [o.world_outline() for o in setup.obstacles]
+        plot_swap(outcome.result, goals, title=title, path=path, outlines=ends)
+        return path
     if kind == "nav3d":
         from uvnav.viz.figures3d import trajectory_figure
 

@@ -15,7 +15,7 @@ optionally saves to ``path``.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import numpy as np
@@ -139,13 +139,20 @@ def plot_swap(
     *,
     title: str = "",
     path: str | Path | None = None,
+    outlines: Sequence[np.ndarray] = (),
 ) -> Figure:
     """Every robot's path of a recorded multi-robot episode; start (circle), goal (star), end
-    (x for a collision, square for a timeout)."""
+    (x for a collision, square for a timeout); the world's obstacles' paths in grey and their
+    ``outlines`` [m] (at the end of the episode) filled."""
     if result.poses.size == 0:
         raise ValueError("the multi-robot episode was not recorded (run_multi(record=True))")
     fig = _figure(6.0, 6.0)
     ax = fig.add_subplot()
+    for k in range(result.obstacle_paths.shape[1]):
+        trail = result.obstacle_paths[:, k]
+        ax.plot(trail[:, 0], trail[:, 1], color="0.6", lw=0.8, ls="--")
+    for outline in outlines:
+        ax.fill(outline[:, 0], outline[:, 1], color="0.8", ec="0.4", lw=0.6)
     n = result.poses.shape[1]
     cmap = colormaps["hsv"]
     g = np.asarray(goals, dtype=float).reshape(n, 2)
