@@ -6,6 +6,7 @@ import csv
 import json
 from pathlib import Path
 
+import numpy as np
 from typer.testing import CliRunner
 
 from uvnav.cli.app import app
@@ -84,7 +85,13 @@ def test_recon_plan_figures(tmp_path: Path) -> None:
 
 
 def test_recon_plan_errors_are_one_line(tmp_path: Path) -> None:
+    (tmp_path / "text.npy").write_text("not an array")
+    np.save(tmp_path / "objects.npy", np.array([{"z": 1}], dtype=object), allow_pickle=True)
+    (tmp_path / "dem.yaml").write_text("z: 1")
     cases = [
+        (["--dem", str(tmp_path / "text.npy")], "text.npy: not a .npy array (no .npy header)"),
+        (["--dem", str(tmp_path / "objects.npy")], "objects.npy: holds pickled objects"),
+        (["--dem", str(tmp_path / "dem.yaml")], "error: " + str(tmp_path / "dem.yaml: unknown")),
         (["--theta", "180"], "--theta"),
         (["--dem", str(tmp_path / "missing.npy")], "missing.npy"),
         (["--c1", "8"], "c1"),

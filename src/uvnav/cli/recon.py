@@ -270,7 +270,8 @@ def plan_cmd(
         msg = _name_option(str(exc))
         if msg.startswith("--theta"):
             msg = f"--theta: must be in (0, 180) degrees, got {theta:g}"
-        raise CliError(msg if msg.startswith("--") else f"{source}: {msg}") from None
+        named = msg.startswith(("--", f"{source}: "))  # an option's, or the DEM reader's line
+        raise CliError(msg if named else f"{source}: {msg}") from None
     files = write_plan_files(plan, out)
     if figures:
         from uvnav.viz.figures_ch7 import plot_fig7_4, recon_3d_html

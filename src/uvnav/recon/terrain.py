@@ -351,6 +351,9 @@ def load_dem(path: str | Path, *, cell: float | None = None) -> Terrain:
     suffix = p.suffix.lower()
     try:
         if suffix == ".npy":
+            with p.open("rb") as fh:
+                if fh.read(6) != b"\x93NUMPY":
+                    raise OSError("no .npy header")
             z = np.load(p, allow_pickle=False)
             c = 1.0 if cell is None else float(cell)
             return Terrain(_heights(z, "array"), 0.0, 0.0, c, c, source=f"{p.name}")
@@ -368,6 +371,8 @@ def load_dem(path: str | Path, *, cell: float | None = None) -> Terrain:
         if suffix in (".tif", ".tiff"):
             return _load_geotiff(p)
     except ValueError as exc:
+        if "allow_pickle" in str(exc):  # numpy's refusal of an object array
+            raise ValueError(f"{p}: holds pickled objects, which are never loaded") from None
         raise ValueError(f"{p}: {exc}") from None
     except (EOFError, OSError, zipfile.BadZipFile, KeyError) as exc:
         what = {".npy": "a .npy array", ".npz": "a .npz archive"}.get(suffix, "a DEM file")
