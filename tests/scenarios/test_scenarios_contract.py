@@ -40,6 +40,7 @@ def test_every_generator_makes_scenes_of_the_kind_it_is_listed_under(gen: str) -
         assert "path" in str(exc), exc
         return
     assert scene.kind.name == kind.name and isinstance(scene.scenario, kind.model)
+    assert resolve(scene.name).scenario == scene.scenario  # the name it prints resolves again
     assert gen in GENERATOR_SUMMARIES  # its line in 'uvnav scenarios list'
 
 

@@ -200,7 +200,7 @@ def test_cli_simulate_json() -> None:
     )
     assert res.exit_code == 0, res.output
     data = json.loads(res.stdout)
-    assert data["scenario"] == "crowdnav-circle-3" and data["controller"] == "orca-holonomic-v1"
+    assert data["scenario"] == "crowdnav-circle:3" and data["controller"] == "orca-holonomic-v1"
     assert data["status"] in ("success", "collision", "timeout")
 
 

@@ -97,6 +97,11 @@ class Resolved:
 
     @property
     def name(self) -> str:
+        """The scene's name for output: a ``generator:N`` spec as typed (so that it resolves
+        again, where some generators name their scenes ``generator-N``), else the model's."""
+        gen, sep, _ = self.spec.partition(":")
+        if sep and gen in generators():
+            return self.spec
         return str(getattr(self.scenario, "name", self.spec))
 
 
