@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 from typer.testing import CliRunner
 
-from uvnav.bench.summary import TIMING_COLUMNS
+from uvnav.bench.summary import TIMING_COLUMNS, simulate_spec
 from uvnav.cli.app import app
 
 runner = CliRunner()
@@ -111,7 +111,11 @@ def test_bench_failures_lists_each_failed_episode(tmp_path: Path) -> None:
     assert f"{len(failed)} episode(s) did not succeed" in res.stdout
     lines = res.stdout.splitlines()
     for f in failed:
-        assert any(f["scenario"] in ln and f["cause"] in ln for ln in lines), f
+        scene = simulate_spec(f["scenario"])  # random-ch2/0003 -> random-ch2:3
+        assert scene == f"random-ch2:{f['seed']}"
+        assert any(scene in ln and f["cause"] in ln for ln in lines), f
+    again = json.loads(invoke("simulate", scene, "-c", "straight-v1", "--json").stdout)
+    assert (again["status"], again["min_clearance"]) == (f["status"], f["min_clearance"])
     assert "failures" not in json.loads(
         invoke("bench", str(path), "--db", str(db), "--resume", "--json").stdout
     )

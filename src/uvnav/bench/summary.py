@@ -143,6 +143,26 @@ def _cause(row: Any) -> str:
     return status
 
 
+def simulate_spec(label: str) -> str:
+    """The scene of a stored scenario label as ``uvnav simulate`` takes it: a campaign's
+    generated scene ``generator/NNNN`` is ``generator:N``; any other label (a built-in name, a
+    file, a generator with parameters) is returned as stored.
+
+    >>> simulate_spec("random-ch2/0017")
+    'random-ch2:17'
+    >>> simulate_spec("random-ch2[n_obstacles=3]/0017")
+    'random-ch2[n_obstacles=3]/0017'
+    >>> simulate_spec("scenes/0017")
+    'scenes/0017'
+    """
+    from uvnav.scenarios.catalog import generators
+
+    head, sep, number = label.rpartition("/")
+    if sep and number.isdigit() and head in generators():
+        return f"{head}:{int(number)}"
+    return label
+
+
 def failure_rows(store: ResultsStore, campaign: int | str) -> list[dict[str, Any]]:
     """Every episode of one campaign that did not succeed, sorted by controller, params,
     scenario and seed: the keys of :data:`FAILURE_COLUMNS` (``min_clearance`` [m], ``None``

@@ -990,8 +990,14 @@ def compact_table(title: str, caption: str | None = None) -> Any:
 
 
 def _print_failures(rows: list[dict[str, Any]]) -> None:
-    """The episodes that did not succeed, one line each (``uvnav bench --failures``)."""
-    table = compact_table(f"{len(rows)} episode(s) did not succeed")
+    """The episodes that did not succeed, one line each (``uvnav bench --failures``); the
+    scenario as ``uvnav simulate`` takes it, so that a row reruns as it is."""
+    from uvnav.bench.summary import simulate_spec
+
+    table = compact_table(
+        f"{len(rows)} episode(s) did not succeed",
+        caption="rerun one: uvnav simulate SCENARIO -c CONTROLLER (and its params as --param)",
+    )
     for head in ("controller", "scenario", "seed"):
         table.add_column(head, overflow="fold")
     table.add_column("cause", overflow="fold", ratio=1)
@@ -999,7 +1005,8 @@ def _print_failures(rows: list[dict[str, Any]]) -> None:
     for r in rows:
         law = r["controller"] if r["params"] == "-" else f"{r['controller']} {r['params']}"
         gap = "-" if r["min_clearance"] is None else f"{r['min_clearance']:.3f}"
-        table.add_row(*(_text(x) for x in (law, r["scenario"], str(r["seed"]), r["cause"], gap)))
+        scene = simulate_spec(r["scenario"])
+        table.add_row(*(_text(x) for x in (law, scene, str(r["seed"]), r["cause"], gap)))
     _console().print(table)
 
 
