@@ -1,8 +1,11 @@
 """The CLI's one error path: user errors are one line and exit 2; a bug is one line naming a
-crash log that holds the traceback, exit 70; --debug / UVNAV_DEBUG re-raise; Ctrl-C is 130."""
+crash log that holds the traceback, exit 70; --debug / UVNAV_DEBUG re-raise; Ctrl-C is 130; a
+closed pipe is a quiet 141."""
 
 from __future__ import annotations
 
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -10,7 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from uvnav.cli.app import app
-from uvnav.cli.errors import EX_SOFTWARE, crash_log_dir
+from uvnav.cli.errors import EX_PIPE, EX_SOFTWARE, crash_log_dir
 
 runner = CliRunner()
 
@@ -105,6 +108,17 @@ def test_ctrl_c_is_exit_130(log_dir: Path, monkeypatch: pytest.MonkeyPatch) -> N
     result = runner.invoke(app, ["scenarios", "list"])
     assert result.exit_code == 130
     assert not log_dir.exists()
+
+
+def test_a_closed_pipe_ends_the_command_quietly(log_dir: Path) -> None:
+    """``uvnav scenarios list | head -1``: the reader is gone before the command writes."""
+    cmd = [sys.executable, "-c", "from uvnav.cli.app import main; main()", "scenarios", "list"]
+    proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    assert proc.stdout is not None and proc.stderr is not None
+    proc.stdout.close()  # before the imports are done: the first write meets a closed pipe
+    err = proc.stderr.read()
+    assert proc.wait(timeout=120) == EX_PIPE and err == b"", err
+    assert not log_dir.exists()  # not a bug: no crash log
 
 
 def test_crash_log_folder(monkeypatch: pytest.MonkeyPatch, tmp_path: Path) -> None:

@@ -10,6 +10,8 @@
   ``internal error: <ExcType>: <message> (traceback in <path>; please report it)`` is printed,
   exit status 70 (``EX_SOFTWARE``).  ``uvnav --debug`` or ``UVNAV_DEBUG=1`` re-raises instead.
 * Ctrl-C is exit status 130.
+* A closed pipe (``uvnav scenarios list | head``) ends the command quietly, exit status 141, as
+  a tool killed by SIGPIPE would.
 """
 
 from __future__ import annotations
@@ -33,6 +35,8 @@ EX_SOFTWARE = 70
 """Exit status of an internal error (a bug), as ``sysexits.h``."""
 EX_INTERRUPTED = 130
 """Exit status after Ctrl-C (128 + SIGINT)."""
+EX_PIPE = 141
+"""Exit status when the reader of the output went away (128 + SIGPIPE)."""
 
 DEBUG_KEY = "uvnav.debug"
 """``ctx.meta`` key set by the root ``--debug`` option."""
@@ -162,6 +166,9 @@ def handle(exc: BaseException, ctx: Any = None) -> None:
     if isinstance(exc, KeyboardInterrupt):
         typer.echo("interrupted", err=True)
         raise typer.Exit(EX_INTERRUPTED) from None
+    if isinstance(exc, BrokenPipeError):  # nothing reads stdout any more: nothing to say
+        _stdout_to_devnull()
+        raise typer.Exit(EX_PIPE) from None
     handled = user_error(exc)
     if handled is not None:
         message, code = handled
@@ -171,6 +178,16 @@ def handle(exc: BaseException, ctx: Any = None) -> None:
         raise exc
     typer.echo(internal_error_line(exc, write_crash_log(exc)), err=True)
     raise typer.Exit(EX_SOFTWARE) from None
+
+
+def _stdout_to_devnull() -> None:
+    """Point stdout at the null device, so that the flush at exit does not fail again on the
+    closed pipe (the recipe of Python's ``signal`` documentation)."""
+    try:
+        fd = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(fd, sys.stdout.fileno())
+    except (OSError, ValueError):  # no real stdout (a test runner's buffer): nothing to flush
+        pass
 
 
 def summary(help_text: str | None) -> str:
