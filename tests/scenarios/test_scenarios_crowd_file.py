@@ -187,13 +187,17 @@ def test_crowd_file_on_the_shipped_eth_file_crosses_the_same_walkway() -> None:
 def test_crowd_file_needs_a_path_and_sane_params(tmp_path: Path) -> None:
     with pytest.raises(ScenarioError, match=r"crowd-file:3: params: crowd-file needs params: path"):
         GENERATORS["crowd-file"](3)
-    with pytest.raises(ScenarioError, match="format must be one of"):
+    with pytest.raises(ScenarioError, match=r"params.format: must be 'obsmat', 'xy4' or 'trajnet'"):
         crowd_file_scenario(0, path=str(ETH), format="csv")
+    with pytest.raises(ScenarioError, match=r"crowd-file:0: params.stitch: "):
+        crowd_file_scenario(0, path=str(ETH), stitch="maybe")
+    with pytest.raises(ScenarioError, match=r"crowd-file:0: params.t_max: .*finite"):
+        crowd_file_scenario(0, path=str(ETH), t_max=float("nan"))
     with pytest.raises(ScenarioError, match="both start and goal"):
         crowd_file_scenario(0, path=str(ETH), start=[0, 0])
     with pytest.raises(ScenarioError, match="params: path: no such file"):
         crowd_file_scenario(0, path=str(tmp_path / "none.txt"))
-    with pytest.raises(ScenarioError, match=r"crowd-file:0: params: scale: must be > 0"):
+    with pytest.raises(ScenarioError, match=r"crowd-file:0: params.scale: must be > 0"):
         crowd_file_scenario(0, path=str(ETH), scale=-1.0)
 
 

@@ -155,6 +155,9 @@ def test_random_ch4_hard_speeds_and_counts_follow_the_parameters(
         ("random-ch3-periodic", {"motion": 3}, "random-ch3-periodic:0: params.motion"),
         ("random-ch4", {"max_rate": [0.3, 0.1]}, "params.max_rate: need min <= max"),
         ("random-ch4-hard", {"rate": [0.3, 0.8], "speed_max": 0.3}, "not below V_max"),
+        ("crowd-eth", {"t_max": math.nan}, "crowd-eth:0: params.t_max: expected a finite"),
+        ("crowd-hotel", {"v_max": -1.0}, "crowd-hotel:0: params.v_max: must be > 0"),
+        ("crowd-hotel", {"dataset": "eth"}, "unknown parameter 'dataset' (known: v_max,"),
     ],
 )
 def test_parameters_out_of_range_are_one_line(

@@ -348,19 +348,39 @@ def _segment_distance(points: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.nd
     return np.hypot(*(points - (a + s[:, None] * ab)).T)
 
 
+def _positive(description: str) -> Any:
+    """A finite number > 0, described (the crowd generators' parameters)."""
+    return Field(gt=0, allow_inf_nan=False, description=description)
+
+
+#: the parameters the crowd generators share (``crowd-eth``, ``crowd-hotel``, ``crowd-file``)
+_VMax = Annotated[float, _positive("robot V_max [m/s]")]
+_UMax = Annotated[float, _positive("robot U_max [rad/s]")]
+_Radius = Annotated[float, _positive("pedestrian disc radius [m]")]
+_RobotRadius = Annotated[float, _positive("robot disc radius [m]")]
+_TMax = Annotated[float, _positive("time limit, also the replayed window [s]")]
+_Dt = Annotated[float, _positive("integration and decision step [s]")]
+_TStart = Annotated[
+    float | None,
+    Field(allow_inf_nan=False, description="recording time of t = 0 [s] (drawn when null)"),
+]
+_Law = Annotated[str, Field(description="default law of the scene")]
+_LawParams = Annotated[dict[str, Any] | None, Field(description="its parameters")]
+
+
 def crowd_crossing_scenario(
     seed: int,
     *,
-    dataset: str = "eth",
-    v_max: float = CROWD_V_MAX,
-    u_max: float = CROWD_U_MAX,
-    radius: float = 0.3,
-    robot_radius: float = CROWD_ROBOT_RADIUS,
-    t_max: float = CROWD_T_MAX,
-    dt: float = 0.1,
-    t_start: float | None = None,
-    controller: str = "zhang2019-v1",
-    controller_params: dict[str, Any] | None = None,
+    dataset: Annotated[Literal["eth", "hotel"], Field(description="ETH recording")] = "eth",
+    v_max: _VMax = CROWD_V_MAX,
+    u_max: _UMax = CROWD_U_MAX,
+    radius: _Radius = 0.3,
+    robot_radius: _RobotRadius = CROWD_ROBOT_RADIUS,
+    t_max: _TMax = CROWD_T_MAX,
+    dt: _Dt = 0.1,
+    t_start: _TStart = None,
+    controller: _Law = "zhang2019-v1",
+    controller_params: _LawParams = None,
 ) -> Scenario:
     """A robot crossing a walkway of real pedestrians (ETH ``eth`` or ``hotel``), seeded.
 
@@ -535,29 +555,46 @@ def _crowd_crossing(
 CROWD_FILE_FORMATS = pedestrians.FORMATS
 
 
+@typed_generator("crowd-file")
 def crowd_file_scenario(
     seed: int,
     *,
-    path: str | None = None,
-    format: str = "obsmat",
-    frame_rate: float | None = None,
-    scale: float = 1.0,
-    offset: tuple[float, float] | list[float] = (0.0, 0.0),
-    start: tuple[float, float] | list[float] | None = None,
-    goal: tuple[float, float] | list[float] | None = None,
-    stitch: bool = True,
-    at_rest: bool = False,
-    region: tuple[float, float, float, float] | list[float] | None = None,
-    min_near: int = _MIN_NEAR,
-    v_max: float = CROWD_V_MAX,
-    u_max: float = CROWD_U_MAX,
-    radius: float = 0.3,
-    robot_radius: float = CROWD_ROBOT_RADIUS,
-    t_max: float = CROWD_T_MAX,
-    dt: float = 0.1,
-    t_start: float | None = None,
-    controller: str = "zhang2019-v1",
-    controller_params: dict[str, Any] | None = None,
+    path: Annotated[str | None, Field(description="trajectory file (required)")] = None,
+    format: Annotated[
+        Literal["obsmat", "xy4", "trajnet"], Field(description="its format")
+    ] = "obsmat",
+    frame_rate: Annotated[
+        float | None,
+        Field(gt=0, allow_inf_nan=False, description="frames/s (inferred when null)"),
+    ] = None,
+    scale: Annotated[float, _positive("positions scale * p + offset")] = 1.0,
+    offset: Annotated[
+        tuple[float, float], Field(description="positions scale * p + offset [m]")
+    ] = (0.0, 0.0),
+    start: Annotated[
+        tuple[float, float] | None, Field(description="robot start [m] (with goal)")
+    ] = None,
+    goal: Annotated[
+        tuple[float, float] | None, Field(description="robot goal [m] (with start)")
+    ] = None,
+    stitch: Annotated[bool, Field(description="join a track that ends where one starts")] = True,
+    at_rest: Annotated[bool, Field(description="people wait at their first position")] = False,
+    region: Annotated[
+        tuple[float, float, float, float] | None,
+        Field(description="only people inside x0, y0, x1, y1 [m]"),
+    ] = None,
+    min_near: Annotated[
+        int, Field(ge=0, description="people near the line while crossing (0: any)")
+    ] = _MIN_NEAR,
+    v_max: _VMax = CROWD_V_MAX,
+    u_max: _UMax = CROWD_U_MAX,
+    radius: _Radius = 0.3,
+    robot_radius: _RobotRadius = CROWD_ROBOT_RADIUS,
+    t_max: _TMax = CROWD_T_MAX,
+    dt: _Dt = 0.1,
+    t_start: _TStart = None,
+    controller: _Law = "zhang2019-v1",
+    controller_params: _LawParams = None,
 ) -> Scenario:
     """A robot crossing the crowd of any trajectory file (``crowd-file:<seed>``), seeded.
 
@@ -594,16 +631,8 @@ def crowd_file_scenario(
             "campaign entry (generator: crowd-file, params: {path: ...}) or write a scene with "
             "a crowd: section",
         )
-    if format not in CROWD_FILE_FORMATS:
-        raise ScenarioError(
-            source,
-            "params",
-            f"format must be one of {', '.join(CROWD_FILE_FORMATS)} (got {format!r})",
-        )
     if (start is None) != (goal is None):
         raise ScenarioError(source, "params", "give both start and goal, or neither")
-    if int(min_near) < 0:
-        raise ScenarioError(source, "params", f"min_near must be >= 0 (got {min_near})")
     file = Path(str(path)).expanduser()
     if not file.is_file():
         raise ScenarioError(source, "params", f"path: no such file {str(path)!r}")
@@ -658,8 +687,10 @@ def crowd_file_scenario(
 GENERATORS: dict[str, Callable[..., Any]] = {
     "random-ch2": random_ch2_scenario,
     "random-ch2-edge": generator_variant("random-ch2-edge", random_ch2_scenario, **CH2_EDGE),
-    "crowd-eth": partial(crowd_crossing_scenario, dataset="eth"),
-    "crowd-hotel": partial(crowd_crossing_scenario, dataset="hotel"),
+    "crowd-eth": typed_generator("crowd-eth")(partial(crowd_crossing_scenario, dataset="eth")),
+    "crowd-hotel": typed_generator("crowd-hotel")(
+        partial(crowd_crossing_scenario, dataset="hotel")
+    ),
     "crowd-file": crowd_file_scenario,
     "random-ch3": random_ch3_scenario,
     "random-ch3-periodic": generator_variant(

@@ -40,9 +40,12 @@ def typed_generator(name: str) -> Callable[[F], F]:
 
     def wrap(fn: F) -> F:
         checked = validate_call(config=_CONFIG)(fn)
+        fixed = set(fn.keywords) if isinstance(fn, functools.partial) else set()
 
         @functools.wraps(fn)
         def run(seed: int, **params: Any) -> Any:
+            if fixed & set(params):  # a partial's keywords (crowd-eth's dataset) are not params
+                raise _unknown_param(name, seed, fn, min(fixed & set(params)))
             try:
                 return checked(seed, **params)
             except ValidationError as exc:
@@ -71,6 +74,15 @@ def generator_variant(name: str, fn: Callable[..., Any], **defaults: Any) -> Cal
     return run
 
 
+def _unknown_param(name: str, seed: int, fn: Callable[..., Any], key: str) -> ScenarioError:
+    """One line: ``key`` is not a parameter of generator ``name``; the ones that are."""
+    fixed = set(fn.keywords) if isinstance(fn, functools.partial) else set()
+    known = ", ".join(p for p in list(inspect.signature(fn).parameters)[1:] if p not in fixed)
+    return ScenarioError(
+        f"{name}:{seed}", "params", f"{name}: unknown parameter {key!r} (known: {known})"
+    )
+
+
 def _params_error(
     name: str, seed: int, fn: Callable[..., Any], exc: ValidationError
 ) -> ScenarioError:
@@ -78,11 +90,7 @@ def _params_error(
     source = f"{name}:{seed}"
     unknown = [e for e in exc.errors() if e.get("type") == "unexpected_keyword_argument"]
     if unknown:
-        known = ", ".join(list(inspect.signature(fn).parameters)[1:])
-        key = str(unknown[0]["loc"][-1])
-        return ScenarioError(
-            source, "params", f"{name}: unknown parameter {key!r} (known: {known})"
-        )
+        return _unknown_param(name, seed, fn, str(unknown[0]["loc"][-1]))
     err = from_validation_error(exc, source)
     return ScenarioError(source, f"params.{err.path}", err.problem)
 
@@ -135,8 +143,9 @@ def describe_params(fn: Callable[..., Any]) -> list[ParamInfo]:
     :func:`generator_variant` (its defaults), or of a ``functools.partial`` (less the keywords it
     fixes: ``crowd-eth`` is the ETH walkway)."""
     variant = getattr(fn, "variant_of", None)
-    fixed = set(fn.keywords) if isinstance(fn, functools.partial) else set()
-    fn = variant if variant is not None else fn
+    inner = inspect.unwrap(fn)  # a typed_generator's function, or partial
+    fixed = set(inner.keywords) if isinstance(inner, functools.partial) else set()
+    fn = variant if variant is not None else inner
     base = fn.func if isinstance(fn, functools.partial) else fn
     hints = typing.get_type_hints(inspect.unwrap(base), include_extras=True)
     out: list[ParamInfo] = []
