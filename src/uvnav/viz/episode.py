@@ -29,9 +29,8 @@ def plot_outcome(outcome: Any, path: Path) -> Path:
         setup = outcome.setup  # its obstacles were advanced to the episode's end in place
         goals = np.array([robot.goal for robot in setup.robots], dtype=float)
         ends = [o.world_outline() for o in setup.obstacles]
-        plot_swap(outcome.result, goals, title=title, path=path, outlines=ends)
-        return path
-    if kind == "nav3d":
+        fig = plot_swap(outcome.result, goals, title=title, outlines=ends)
+    elif kind == "nav3d":
         from uvnav.viz.figures3d import trajectory_figure
 
         fig = trajectory_figure(outcome.trajectory, title)
