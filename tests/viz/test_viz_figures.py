@@ -124,6 +124,22 @@ def test_plot_campaign_summary_handles_errors_and_nulls(tmp_path: Path) -> None:
     assert_png(plot_campaign_summary(df.iloc[0:0], tmp_path / "empty.png"), min_bytes=2_000)
 
 
+def test_many_pairs_make_a_success_matrix_over_the_episodes_run() -> None:
+    import pandas as pd
+
+    from uvnav.viz.figures import _success_matrix, new_figure
+
+    rows = [("a", "law1", "success"), ("a", "law1", "collision"), ("a", "law1", "refused")]
+    rows += [("a", "law2", "refused"), ("b", "law2", "success")]
+    df = pd.DataFrame(rows, columns=["family", "controller", "status"])
+    ax = new_figure(6.0, 4.0).subplots()
+    _success_matrix(ax, df, df["family"])
+    rates = np.ma.filled(ax.images[0].get_array(), np.nan)
+    assert rates[0, 0] == 50.0  # 1 of the 2 that ran; the refused one is not a failure
+    assert np.isnan(rates[0, 1]) and np.isnan(rates[1, 0]) and rates[1, 1] == 100.0
+    assert [t.get_text() for t in ax.texts].count("ref.") == 1  # (a, law2): all refused
+
+
 def test_helpers() -> None:
     assert list(snapshot_indices(11, 3)) == [0, 5, 10]
     assert list(snapshot_indices(2, 10)) == [0, 1]

@@ -16,6 +16,7 @@ safe in worker processes, servers and tests.
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -42,6 +43,7 @@ _STATUS_COLOURS = {
     "collision": "tab:red",
     "timeout": "tab:orange",
     "error": "tab:gray",
+    "refused": "tab:blue",
 }
 #: resolution of every report figure [dots per inch]
 DPI = 120
@@ -429,7 +431,7 @@ def _box(
         rng = np.random.default_rng(0)  # fixed jitter: figures are reproducible
         for i, (_, v) in enumerate(data, start=1):
             ax.scatter(i + rng.uniform(-0.12, 0.12, len(v)), v, s=6, alpha=0.35, color="0.3")
-        ax.tick_params(axis="x", labelrotation=20)
+        ax.tick_params(axis="x", labelrotation=20 if len(data) <= 8 else 90)
     if ref is not None:
         ax.axhline(ref, color="tab:red", ls="--", lw=0.8, label=ref_label)
         ax.legend(loc="upper right", fontsize="small")
@@ -438,27 +440,8 @@ def _box(
     ax.grid(True, axis="y", alpha=0.3)
 
 
-def plot_campaign_summary(df: pd.DataFrame, path: str | Path, *, title: str | None = None) -> Path:
-    """Outcome shares per (family, controller), and min-clearance / detour-ratio distributions.
-
-    Args:
-        df: episodes as from :meth:`uvnav.bench.store.ResultsStore.episodes_frame` (columns
-            ``controller``, ``status``, ``min_clearance``, ``detour_ratio``, optionally
-            ``family``).
-        path: output PNG file.
-        title: figure title.
-
-    Returns:
-        ``path``.
-    """
-    fig = new_figure(15.0, 5.5)
-    ax_s, ax_c, ax_d = fig.subplots(1, 3, width_ratios=[1.3, 1.0, 1.0])
-    if df.empty:
-        for ax in (ax_s, ax_c, ax_d):
-            ax.text(0.5, 0.5, "no episodes", ha="center", va="center", transform=ax.transAxes)
-        return save_figure(fig, path)
-    family = df["family"] if "family" in df.columns else df["controller"].map(lambda _: "")
-    groups = sorted({(str(f), str(c)) for f, c in zip(family, df["controller"], strict=True)})
+def _outcome_bars(ax: Axes, df: pd.DataFrame, family: Any, groups: list[tuple[str, str]]) -> None:
+    """One bar per (family, controller): the share of each status, the success rate at right."""
     statuses = [s for s in _STATUS_COLOURS if (df["status"] == s).any()]
     statuses += sorted(set(df["status"].astype(str)) - set(statuses))
     labels = [f"{f} · {c}" if f else c for f, c in groups]
@@ -471,19 +454,80 @@ def plot_campaign_summary(df: pd.DataFrame, path: str | Path, *, title: str | No
                 for f, c in groups
             ]
         )
-        ax_s.barh(labels, shares, left=left, color=_STATUS_COLOURS.get(s), label=s)
+        ax.barh(labels, shares, left=left, color=_STATUS_COLOURS.get(s), label=s)
         left += shares
     for y, (f, c) in enumerate(groups):
-        sel = (family == f) & (df["controller"] == c)
-        rate = float((df.loc[sel, "status"] == "success").mean())
-        ax_s.text(1.01, y, f"{rate:.1%} of {int(sel.sum())}", va="center", fontsize="small")
-    ax_s.set_xlim(0, 1.25)
-    ax_s.invert_yaxis()
-    ax_s.set_xlabel("share of episodes")
-    ax_s.set_title("outcomes (success rate at right)", fontsize="medium", loc="left")
-    ax_s.legend(
+        status = df.loc[(family == f) & (df["controller"] == c), "status"]
+        ran = status[status != "refused"]
+        text = f"{(ran == 'success').mean():.1%} of {len(ran)}" if len(ran) else "refused"
+        ax.text(1.01, y, text, va="center", fontsize="small")
+    ax.set_xlim(0, 1.25)
+    ax.invert_yaxis()
+    ax.set_xlabel("share of episodes")
+    ax.set_title("outcomes (success of those run, at right)", fontsize="medium", loc="left")
+    ax.legend(
         loc="upper center", bbox_to_anchor=(0.5, -0.12), ncols=len(statuses), fontsize="small"
     )
+
+
+def _success_matrix(ax: Axes, df: pd.DataFrame, family: Any) -> None:
+    """Success rate [%] of each family (row) x controller (column) over the episodes that ran;
+    blank where none ran ("ref." where every episode was refused)."""
+    families = sorted({str(f) for f in family})
+    laws = sorted(df["controller"].astype(str).unique())
+    ok = (df["status"] == "success").to_numpy()
+    ran = (df["status"] != "refused").to_numpy()
+    rates = np.full((len(families), len(laws)), np.nan)
+    for (i, f), (j, c) in itertools.product(enumerate(families), enumerate(laws)):
+        sel = ((family == f) & (df["controller"] == c)).to_numpy()
+        if (sel & ran).any():
+            rates[i, j] = 100.0 * float(ok[sel & ran].mean())
+        elif sel.any():
+            ax.text(j, i, "ref.", ha="center", va="center", fontsize="x-small", color="0.4")
+    image = ax.imshow(rates, cmap="RdYlGn", vmin=0.0, vmax=100.0, aspect="auto")
+    for (i, j), rate in np.ndenumerate(rates):
+        if np.isfinite(rate):
+            ax.text(j, i, f"{rate:.0f}", ha="center", va="center", fontsize="x-small")
+    ax.set_xticks(range(len(laws)), laws, rotation=90, fontsize="small")
+    ax.set_yticks(range(len(families)), families, fontsize="small")
+    ax.figure.colorbar(image, ax=ax, label="success [%]", fraction=0.04)
+    ax.set_title("success [%] of the episodes run (blank: none)", fontsize="medium", loc="left")
+
+
+#: above this many (family, controller) pairs the outcome panel is a success-rate matrix
+_MAX_OUTCOME_BARS = 24
+
+
+def plot_campaign_summary(df: pd.DataFrame, path: str | Path, *, title: str | None = None) -> Path:
+    """Outcome shares per (family, controller), and min-clearance / detour-ratio distributions.
+
+    With more than :data:`_MAX_OUTCOME_BARS` pairs the outcomes are a families x controllers
+    matrix of success rates (a pair not run is blank), and the figure widens with the number
+    of controllers, so that every label stays readable.
+
+    Args:
+        df: episodes as from :meth:`uvnav.bench.store.ResultsStore.episodes_frame` (columns
+            ``controller``, ``status``, ``min_clearance``, ``detour_ratio``, optionally
+            ``family``).
+        path: output PNG file.
+        title: figure title.
+
+    Returns:
+        ``path``.
+    """
+    n_laws = int(df["controller"].nunique()) if not df.empty else 1
+    fig = new_figure(max(15.0, 6.0 + 0.75 * n_laws), 5.5 if n_laws <= 8 else 7.5)
+    ax_s, ax_c, ax_d = fig.subplots(1, 3, width_ratios=[1.3, 1.0, 1.0])
+    if df.empty:
+        for ax in (ax_s, ax_c, ax_d):
+            ax.text(0.5, 0.5, "no episodes", ha="center", va="center", transform=ax.transAxes)
+        return save_figure(fig, path)
+    family = df["family"] if "family" in df.columns else df["controller"].map(lambda _: "")
+    groups = sorted({(str(f), str(c)) for f, c in zip(family, df["controller"], strict=True)})
+    if len(groups) > _MAX_OUTCOME_BARS:
+        _success_matrix(ax_s, df, family)
+    else:
+        _outcome_bars(ax_s, df, family, groups)
     controllers = sorted(df["controller"].astype(str).unique())
 
     def column(name: str, mask: Any = None) -> list[tuple[str, np.ndarray]]:
