@@ -158,15 +158,7 @@ def _uuv2d_load(spec: str) -> Any:
 
 def _generate(name: str, seed: int, params: Mapping[str, Any]) -> Any:
     """Scene ``seed`` of the seed generator ``name`` with keyword ``params`` (any kind)."""
-    from uvnav.scenarios.ch5 import GENERATOR_CH5_DENSE, random_ch5_scenario
-    from uvnav.scenarios.generators import GENERATORS
-    from uvnav.scenarios.uuv2d import UUV2D_GENERATORS
-
-    if name in GENERATORS:
-        return GENERATORS[name](seed, **params)
-    if name in UUV2D_GENERATORS:
-        return UUV2D_GENERATORS[name](seed, **params)
-    return random_ch5_scenario(seed, dense=name == GENERATOR_CH5_DENSE, **params)
+    return generator_function(name)(seed, **params)
 
 
 def generator_function(name: str) -> Callable[..., Any]:
@@ -175,17 +167,11 @@ def generator_function(name: str) -> Callable[..., Any]:
     Raises:
         KeyError: ``name`` is not a seed generator.
     """
-    from uvnav.scenarios.ch5 import GENERATOR_CH5, GENERATOR_CH5_DENSE, random_ch5_scenario
+    from uvnav.scenarios.ch5 import CH5_GENERATORS
     from uvnav.scenarios.generators import GENERATORS
     from uvnav.scenarios.uuv2d import UUV2D_GENERATORS
 
-    table: dict[str, Callable[..., Any]] = {
-        **GENERATORS,
-        **UUV2D_GENERATORS,
-        GENERATOR_CH5: functools.partial(random_ch5_scenario, dense=False),
-        GENERATOR_CH5_DENSE: functools.partial(random_ch5_scenario, dense=True),
-        **plugin_generators(),
-    }
+    table = {**GENERATORS, **UUV2D_GENERATORS, **CH5_GENERATORS, **plugin_generators()}
     return table[name]
 
 

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from functools import cache
+from functools import cache, partial
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
@@ -30,6 +30,7 @@ from uvnav.obstacles.deforming3d import CompoundBody, as_compound, horseshoe, ra
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
 from uvnav.scenarios.limits import BoundedScene, FileModel, check_timing
 from uvnav.scenarios.loader import builtin_yaml_files, parse_yaml
+from uvnav.scenarios.params import typed_generator
 from uvnav.sensors.sonar_array import SonarArray
 from uvnav.sim.episode_uuv3d import UUV3DSetup
 
@@ -194,7 +195,7 @@ def load_ch5_scenario(name: str) -> Scenario5:
                 raise ScenarioError(
                     name, "seed", f"must be a non-negative integer (got {seed_text!r})"
                 )
-            return random_ch5_scenario(int(seed_text), dense=generator == GENERATOR_CH5_DENSE)
+            return CH5_GENERATORS[generator](int(seed_text))
     if name in _builtin_files():
         return _load_builtin(name)
     path = Path(name)
@@ -300,7 +301,16 @@ def random_ch5_end_clearance(r0: float) -> float:
 
 
 def random_ch5_scenario(
-    seed: int, *, n_obstacles: int | None = None, locator: str = "geometric", dense: bool = False
+    seed: int,
+    *,
+    n_obstacles: Annotated[
+        int | None, Field(description="number of bodies, 1..3 (2..4 dense; drawn when null)")
+    ] = None,
+    locator: Annotated[
+        Literal["geometric", "network", "oracle"],
+        Field(description="the scene's locator (the law's default)"),
+    ] = "geometric",
+    dense: bool = False,
 ) -> Scenario5:
     """A random scene within the assumptions of the Chapter 5 law (seeded; generator v2).
 
@@ -318,14 +328,16 @@ def random_ch5_scenario(
     no scene is filtered after the fact.
 
     Raises:
-        ValueError: ``n_obstacles`` outside 1..3 (2..4 with ``dense``).
+        ScenarioError: ``n_obstacles`` outside 1..3 (2..4 with ``dense``).
     """
     rng = np.random.default_rng(seed)
     lo, hi = (2, 4) if dense else (1, 3)
+    generator = GENERATOR_CH5_DENSE if dense else GENERATOR_CH5
     n = int(n_obstacles) if n_obstacles is not None else int(rng.integers(lo, hi + 1))
     if not lo <= n <= hi:
-        raise ValueError(f"n_obstacles must be in {lo}..{hi} (got {n})")
-    generator = GENERATOR_CH5_DENSE if dense else GENERATOR_CH5
+        raise ScenarioError(
+            f"{generator}:{seed}", "params.n_obstacles", f"must be in {lo}..{hi} (got {n})"
+        )
     dist = float(rng.uniform(26.0, 32.0))
     az = float(rng.uniform(0, 2 * math.pi))
     el = float(rng.uniform(-math.pi / 6, math.pi / 6))
@@ -374,3 +386,10 @@ def random_ch5_scenario(
         "controller": {"locator": locator},
     }
     return scenario5_from_dict(data, f"{generator}:{seed}")
+
+
+#: the Chapter 5 seed generators, ``f(seed, **params)`` with typed parameters
+CH5_GENERATORS: dict[str, Any] = {
+    name: typed_generator(name)(partial(random_ch5_scenario, dense=name == GENERATOR_CH5_DENSE))
+    for name in (GENERATOR_CH5, GENERATOR_CH5_DENSE)
+}
