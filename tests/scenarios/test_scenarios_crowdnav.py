@@ -109,10 +109,12 @@ def test_human_speed_and_sensing_noise_params() -> None:
     # CrowdSim scales the circle-crossing start noise with v_pref: other starts, same draws
     assert not np.allclose(_humans(default)[0], _humans(fast)[0])
     assert np.allclose(_humans(default)[0], _humans(crowdnav_scenario(4, human_v_pref=1.0))[0])
-    with pytest.raises(ValueError, match="position_noise needs velocities='estimated'"):
+    with pytest.raises(ScenarioError, match=r"params\.position_noise: needs velocities='estim"):
         crowdnav_scenario(4, position_noise=0.1)
-    with pytest.raises(ValueError, match="human_v_pref"):
+    with pytest.raises(ScenarioError, match=r"params\.human_v_pref: must be > 0"):
         crowdnav_scenario(4, human_v_pref=0.0)
+    with pytest.raises(ScenarioError, match=r"crowdnav-square:4: params\.robot_visible: expected"):
+        GENERATORS["crowdnav-square"](4, robot_visible=math.nan)
 
 
 def test_an_unplaceable_crowd_is_refused_not_drawn_forever() -> None:

@@ -30,7 +30,7 @@ import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Annotated, Any, Literal, Union
+from typing import Annotated, Any, Union
 
 import numpy as np
 from pydantic import Discriminator, Tag, TypeAdapter
@@ -206,15 +206,8 @@ def generator_summary(name: str) -> str:
 def generator_params(name: str) -> list[Any]:
     """The keyword parameters of seed generator ``name``
     (:class:`uvnav.scenarios.params.ParamInfo`: name, type, default, bounds, description)."""
-    from uvnav.scenarios.crowdnav import crowdnav_scenario
     from uvnav.scenarios.params import describe_params
 
-    if name in ("crowdnav-circle", "crowdnav-square"):  # f(seed, **params) passing them on
-        circle = name == "crowdnav-circle"
-        rule: Literal["circle_crossing", "square_crossing"] = (
-            "circle_crossing" if circle else "square_crossing"
-        )
-        return describe_params(functools.partial(crowdnav_scenario, rule=rule))
     return describe_params(generator_function(name))
 
 

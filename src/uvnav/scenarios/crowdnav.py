@@ -50,13 +50,16 @@ unicycle (``u_max`` pi rad/s: CrowdNav's unicycle turns at most pi/4 per 0.25 s 
 from __future__ import annotations
 
 import math
-from typing import Any, Literal
+from functools import partial
+from typing import Annotated, Any, Literal
 
 import numpy as np
+from pydantic import Field
 
 from uvnav.controllers.orca import CROWDNAV_ORCA
 from uvnav.scenarios.errors import ScenarioError
 from uvnav.scenarios.loader import scenario_from_dict
+from uvnav.scenarios.params import typed_generator
 from uvnav.scenarios.schema import Scenario
 
 #: CrowdNav's ``env.config``
@@ -207,29 +210,56 @@ def _draw_humans(
     )  # fmt: skip
 
 
+def _positive(description: str, *, above: float = 0.0) -> Any:
+    """A finite number > ``above``, described."""
+    return Field(gt=above, allow_inf_nan=False, description=description)
+
+
+@typed_generator("crowdnav")
 def crowdnav_scenario(
     case: int,
     *,
     rule: Literal["circle_crossing", "square_crossing"] = "circle_crossing",
-    n_humans: int = N_HUMANS,
-    circle_radius: float = CIRCLE_RADIUS,
-    square_width: float = SQUARE_WIDTH,
-    phase: Literal["test", "val", "train"] = "test",
-    randomize_attributes: bool = False,
-    dt: float = TIME_STEP,
-    time_step: float = TIME_STEP,
-    time_limit: float = TIME_LIMIT,
-    robot_radius: float = ROBOT_RADIUS,
-    v_pref: float = ROBOT_V_PREF,
-    u_max: float = UNICYCLE_U_MAX,
-    sensing_range: float = SENSING_RANGE,
-    controller: str = "orca-holonomic-v1",
-    controller_params: dict[str, Any] | None = None,
-    robot_visible: bool = False,
-    human_policy: Literal["orca", "social_force"] = "orca",
-    human_v_pref: float = HUMAN_V_PREF,
-    velocities: Literal["known", "estimated"] = "known",
-    position_noise: float = 0.0,
+    n_humans: Annotated[int, Field(ge=0, description="number of humans")] = N_HUMANS,
+    circle_radius: Annotated[
+        float, _positive("humans' circle, and the robot's start/goal distance [m]")
+    ] = CIRCLE_RADIUS,
+    square_width: Annotated[float, _positive("side of the square crossing [m]")] = SQUARE_WIDTH,
+    phase: Annotated[
+        Literal["test", "val", "train"], Field(description="CrowdNav phase of the seeds")
+    ] = "test",
+    randomize_attributes: Annotated[
+        bool, Field(description="humans draw their v_pref and radius")
+    ] = False,
+    dt: Annotated[float, _positive("integration step [s], a divisor of time_step")] = TIME_STEP,
+    time_step: Annotated[float, _positive("decision period of robot and crowd [s]")] = TIME_STEP,
+    time_limit: Annotated[
+        float, _positive("CrowdNav's time limit [s]; the episode lasts 1 s less", above=1.0)
+    ] = TIME_LIMIT,
+    robot_radius: Annotated[
+        float, _positive("robot disc radius, also the goal tolerance [m]")
+    ] = ROBOT_RADIUS,
+    v_pref: Annotated[float, _positive("robot V_max [m/s]")] = ROBOT_V_PREF,
+    u_max: Annotated[float, _positive("U_max of the unicycle variant [rad/s]")] = UNICYCLE_U_MAX,
+    sensing_range: Annotated[
+        float, _positive("the robot sees humans within this [m]")
+    ] = SENSING_RANGE,
+    controller: Annotated[str, Field(description="the scene's own law")] = "orca-holonomic-v1",
+    controller_params: Annotated[dict[str, Any] | None, Field(description="its parameters")] = None,
+    robot_visible: Annotated[
+        bool, Field(description="the humans see the robot and avoid it")
+    ] = False,
+    human_policy: Annotated[
+        Literal["orca", "social_force"], Field(description="the humans' policy")
+    ] = "orca",
+    human_v_pref: Annotated[float, _positive("the humans' preferred speed [m/s]")] = HUMAN_V_PREF,
+    velocities: Annotated[
+        Literal["known", "estimated"], Field(description="the humans' velocities, as sensed")
+    ] = "known",
+    position_noise: Annotated[
+        float,
+        Field(ge=0, allow_inf_nan=False, description="std of the sensed centres [m] (estimated)"),
+    ] = 0.0,
 ) -> Scenario:
     """CrowdNav's test case ``case`` of ``rule`` (module docstring for every choice and source).
 
@@ -263,29 +293,17 @@ def crowdnav_scenario(
             differences of the sensed centres, :mod:`uvnav.prediction.finite_difference`).
         position_noise: std of the Gaussian noise on the sensed centres [m] when ``estimated``.
     """
-    if human_policy not in ("orca", "social_force"):
-        raise ValueError(f"human_policy must be 'orca' or 'social_force' (got {human_policy!r})")
     case = int(case)
-    if case < 0:
-        raise ValueError(f"case must be >= 0 (got {case})")
-    if rule not in ("circle_crossing", "square_crossing"):
-        raise ValueError(f"rule must be circle_crossing or square_crossing (got {rule!r})")
-    if phase not in PHASE_OFFSET:
-        raise ValueError(f"phase must be one of {', '.join(PHASE_OFFSET)} (got {phase!r})")
-    if int(n_humans) < 0:
-        raise ValueError(f"n_humans must be >= 0 (got {n_humans})")
-    if not (math.isfinite(human_v_pref) and human_v_pref > 0):
-        raise ValueError(f"human_v_pref must be > 0 m/s (got {human_v_pref})")
-    if velocities not in ("known", "estimated"):
-        raise ValueError(f"velocities must be 'known' or 'estimated' (got {velocities!r})")
-    if not (math.isfinite(position_noise) and position_noise >= 0):
-        raise ValueError(f"position_noise must be >= 0 m (got {position_noise})")
-    if position_noise > 0 and velocities == "known":
-        raise ValueError("position_noise needs velocities='estimated' (known velocities are exact)")
-    if not time_limit - 1.0 > 0:
-        raise ValueError(f"time_limit must be > 1 s (got {time_limit})")
-    seed = PHASE_OFFSET[phase] + case
     short = "circle" if rule == "circle_crossing" else "square"
+    if case < 0:
+        raise ScenarioError(f"crowdnav-{short}:{case}", "seed", f"must be >= 0 (got {case})")
+    if position_noise > 0 and velocities == "known":
+        raise ScenarioError(
+            f"crowdnav-{short}:{case}",
+            "params.position_noise",
+            "needs velocities='estimated' (known velocities are exact)",
+        )
+    seed = PHASE_OFFSET[phase] + case
     if seed >= 2**32:  # numpy's legacy seeds are 32-bit
         raise ScenarioError(
             f"crowdnav-{short}:{case}",
@@ -363,13 +381,11 @@ def crowdnav_scenario(
     return scenario_from_dict(data, source=f"crowdnav-{short}:{case}")
 
 
-def crowdnav_circle(seed: int, **params: Any) -> Scenario:
-    """``crowdnav-circle:<case>``: CrowdNav's circle-crossing test case
-    (:func:`crowdnav_scenario`)."""
-    return crowdnav_scenario(seed, rule="circle_crossing", **params)
-
-
-def crowdnav_square(seed: int, **params: Any) -> Scenario:
-    """``crowdnav-square:<case>``: CrowdNav's square-crossing test case
-    (:func:`crowdnav_scenario`)."""
-    return crowdnav_scenario(seed, rule="square_crossing", **params)
+#: ``crowdnav-circle:<case>`` and ``crowdnav-square:<case>``: CrowdNav's test cases
+#: (:func:`crowdnav_scenario` of each rule, its other parameters typed and checked)
+crowdnav_circle = typed_generator("crowdnav-circle")(
+    partial(crowdnav_scenario, rule="circle_crossing")
+)
+crowdnav_square = typed_generator("crowdnav-square")(
+    partial(crowdnav_scenario, rule="square_crossing")
+)

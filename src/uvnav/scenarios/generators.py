@@ -407,10 +407,13 @@ def crowd_crossing_scenario(
         controller_params: its parameters.
     """
     crowd: dict[str, Any] = {"dataset": dataset}
-    found = _crowd_crossing(
-        seed, crowd, what=dataset, v_max=v_max, radius=radius, robot_radius=robot_radius,
-        t_max=t_max, t_start=t_start,
-    )  # fmt: skip
+    try:
+        found = _crowd_crossing(
+            seed, crowd, what=dataset, v_max=v_max, radius=radius, robot_radius=robot_radius,
+            t_max=t_max, t_start=t_start,
+        )  # fmt: skip
+    except RuntimeError as exc:  # no crossing (a t_start outside the recording, say)
+        raise ScenarioError(f"crowd-{dataset}:{seed}", "", str(exc)) from None
     start, goal, t0, near, length, horizon = found
     data: dict[str, Any] = {
         "name": f"crowd-{dataset}-seed{seed}",
