@@ -200,3 +200,24 @@ def test_gymnasium_make_in_a_fresh_interpreter(code: str) -> None:
         check=False,
     )
     assert out.returncode == 0 and out.stdout.strip() == "ok", out.stderr
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"n_rays": -3}, "n_rays must be a whole number >= 0"),
+        ({"n_rays": 2.5}, "n_rays must be a whole number >= 0"),
+        ({"max_range": float("nan")}, "max_range must be a finite number > 0"),
+        ({"max_range": 0.0}, "max_range must be a finite number > 0"),
+        ({"goal_scale": -1.0}, "goal_scale must be a finite number > 0"),
+        ({"reward": {"bogus": 1.0}}, "reward: unknown field(s) bogus; known: "),
+    ],
+)
+def test_bad_settings_are_refused_by_name(kwargs: dict[str, object], message: str) -> None:
+    from uvnav.envs.multi_robot import MultiNav2DParallelEnv
+    from uvnav.envs.nav2d_vec import Nav2DVectorEnv
+
+    for make in (Nav2DEnv, MultiNav2DParallelEnv, Nav2DVectorEnv):
+        with pytest.raises(ValueError) as info:
+            make(**kwargs)  # type: ignore[arg-type]
+        assert message in str(info.value), (make, str(info.value))

@@ -336,8 +336,7 @@ class EnvWorldEnv:
         raw_commands: bool,
     ) -> None:
         self.render_mode = render_mode
-        self.n_rays = int(n_rays)
-        self.max_range = float(max_range)
+        self.n_rays, self.max_range = checked_lidar(n_rays, max_range)
         self.reward_config = reward
         self.raw_commands = raw_commands
         self._world: EnvWorld | None = None
@@ -384,10 +383,27 @@ class EnvWorldEnv:
             self._world = None
 
 
+def checked_lidar(n_rays: Any, max_range: Any) -> tuple[int, float]:
+    """An env's lidar: ``n_rays`` (a whole number >= 0) and ``max_range`` [m] (finite, > 0).
+
+    Raises:
+        ValueError: either is out of range (one line naming it).
+    """
+    if isinstance(n_rays, bool) or not float(n_rays).is_integer() or n_rays < 0:
+        raise ValueError(f"n_rays must be a whole number >= 0 (got {n_rays!r})")
+    if not (math.isfinite(max_range) and max_range > 0):
+        raise ValueError(f"max_range must be a finite number > 0 [m] (got {max_range!r})")
+    return int(n_rays), float(max_range)
+
+
 def goal_scale_for(distance: float, goal_scale: float | None) -> float:
     """The distance [m] an observation maps to 1: ``goal_scale`` when given, else 1.5 x the
     scene's start-goal ``distance`` [m] (at least 1 m), the default of every uvnav env."""
-    return float(goal_scale) if goal_scale else max(1.5 * distance, 1.0)
+    if goal_scale is None:
+        return max(1.5 * distance, 1.0)
+    if not (math.isfinite(goal_scale) and goal_scale > 0):
+        raise ValueError(f"goal_scale must be a finite number > 0 [m] (got {goal_scale!r})")
+    return float(goal_scale)
 
 
 def scene_bounds(world: EnvWorld, margin: float = 1.5) -> tuple[float, float, float, float]:

@@ -32,7 +32,7 @@ generator :func:`uvnav.sim.run_rng` ``(k)`` (the law's generator is ``env.world.
 
 from __future__ import annotations
 
-from dataclasses import replace
+from dataclasses import fields, replace
 from typing import Any
 
 import numpy as np
@@ -57,6 +57,12 @@ def reward_config(reward: RewardConfig | dict[str, float] | None) -> RewardConfi
         return RewardConfig()
     if isinstance(reward, RewardConfig):
         return reward
+    known = [f.name for f in fields(RewardConfig)]
+    unknown = sorted(set(reward) - set(known))
+    if unknown:
+        raise ValueError(
+            f"reward: unknown field(s) {', '.join(unknown)}; known: {', '.join(known)}"
+        )
     return replace(RewardConfig(), **reward)
 
 

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.envs.core import RewardConfig, action_commands, goal_scale_for
+from uvnav.envs.core import RewardConfig, action_commands, checked_lidar, goal_scale_for
 from uvnav.envs.nav2d import act_space, episode_seed, obs_space, reward_config
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
@@ -87,8 +87,7 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         r = self.scenario.robot
         dist = float(np.hypot(r.goal[0] - r.start[0], r.goal[1] - r.start[1]))
         self.goal_scale = goal_scale_for(dist, goal_scale)
-        self.n_rays = int(n_rays)
-        self.max_range = float(max_range)
+        self.n_rays, self.max_range = checked_lidar(n_rays, max_range)
         self.reward_config = reward_config(reward)
         self.raw_commands = raw_commands
         self.single_observation_space = obs_space(self.n_rays)
