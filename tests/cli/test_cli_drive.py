@@ -192,5 +192,10 @@ def test_errors_are_one_line_exit_2(
 
 def test_parse_seeds() -> None:
     assert parse_seeds("1000-1003,7") == [1000, 1001, 1002, 1003, 7]
-    with pytest.raises(ValueError, match="--seeds"):
-        parse_seeds("a-b")
+    assert parse_seeds(" 4 ,, 2-2 ") == [4, 2]
+    for text, why in (("a-b", "not a seed"), ("5-2", "a <= b"), ("", "no seeds")):
+        with pytest.raises(ValueError, match=why):
+            parse_seeds(text)
+    # a range too long to run is refused before anything is built (it once ran out of memory)
+    with pytest.raises(ValueError, match="more than 100000 seeds"):
+        parse_seeds("0-9999999999")

@@ -40,26 +40,32 @@ def _user_errors() -> Iterator[None]:
         raise CliError(str(exc)) from None
 
 
+#: the most episodes one ``--seeds`` may name (a CarRacing episode takes seconds)
+MAX_SEEDS = 100_000
+
+
 def parse_seeds(text: str) -> list[int]:
-    """Seeds from ``"1000-1019"``, ``"1,2,5"`` or a mix (``"1-3,7"``)."""
+    """Seeds from ``"1000-1019"``, ``"1,2,5"`` or a mix (``"1-3,7"``).
+
+    >>> parse_seeds("1-3,7")
+    [1, 2, 3, 7]
+
+    Raises:
+        ValueError: a part that is not a seed ``>= 0`` or a range ``a-b`` with ``a <= b``, no
+            seed at all, or more than :data:`MAX_SEEDS` of them (one line).
+    """
     seeds: list[int] = []
-    for part in text.split(","):
-        part = part.strip()
-        if not part:
-            continue
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        a, dash, b = part.partition("-")
         try:
-            if "-" in part:
-                a, b = part.split("-", 1)
-                lo, hi = int(a), int(b)
-                if hi < lo or lo < 0:
-                    raise ValueError
-                seeds.extend(range(lo, hi + 1))
-            else:
-                seeds.append(int(part))
-                if seeds[-1] < 0:
-                    raise ValueError
+            lo, hi = int(a), int(b if dash else a)
         except ValueError:
             raise ValueError(f"--seeds: {part!r} is not a seed or a range a-b") from None
+        if not 0 <= lo <= hi:
+            raise ValueError(f"--seeds: {part!r} is not a seed >= 0 or a range a-b with a <= b")
+        if len(seeds) + hi - lo + 1 > MAX_SEEDS:
+            raise ValueError(f"--seeds: {text!r} names more than {MAX_SEEDS} seeds")
+        seeds.extend(range(lo, hi + 1))
     if not seeds:
         raise ValueError("--seeds: no seeds given")
     return seeds
