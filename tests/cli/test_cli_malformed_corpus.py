@@ -654,6 +654,7 @@ def _option_cases() -> list[Case]:
         (["report", "missing.sqlite"], "missing.sqlite"),
         (["run", "--workers", "0"], "--workers"),
         (["sonar", "dataset", "--samples", "0"], "--samples"),
+        (["sonar", "dataset", "--samples", "1000000000"], "--samples"),
         (["sonar", "dataset", "--seed", "-1"], "--seed"),
         (["sonar", "dataset", "--dropout", "2"], "--dropout"),
         (["sonar", "dataset", "--dropout", "nan"], "--dropout"),

@@ -160,6 +160,7 @@ def test_random_ch4_hard_speeds_and_counts_follow_the_parameters(
         ("crowd-hotel", {"dataset": "eth"}, "unknown parameter 'dataset' (known: v_max,"),
         ("random-ch5", {"dense": True}, "unknown parameter 'dense' (known: n_obstacles, loc"),
         ("crowdnav-circle", {"bogus": 1}, "crowdnav-circle: unknown parameter 'bogus'"),
+        ("crowdnav-square", {"n_humans": 100_000}, "params.n_humans: must be <= 1000"),
         ("crowd-eth", {"t_start": -1e300}, "crowd-eth:0: no busy, clear crossing found"),
         ("random-ch5-dense", {"n_obstacles": 1}, "params.n_obstacles: must be in 2..4 (got 1)"),
         ("random-ch5", {"locator": "psychic"}, "random-ch5:0: params.locator: must be"),

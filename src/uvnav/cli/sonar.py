@@ -32,6 +32,9 @@ import typer
 from uvnav.cli.checks import dumps, finite
 from uvnav.cli.errors import CliError, uvnav_typer
 
+#: the largest dataset ``sonar dataset`` draws (each sample is one placed scene and its R(t))
+MAX_SAMPLES = 1_000_000
+
 sonar_app = uvnav_typer(
     help="Chapter 5: nine-sonar array data and the BPNN locator (dataset, train, evaluate).",
 )
@@ -72,7 +75,10 @@ def _load_dataset(path: Path) -> Any:
 @sonar_app.command("dataset")
 def dataset_cmd(
     out: Annotated[Path, typer.Option("--out", help="Output .npz file.")] = Path("sonar.npz"),
-    samples: Annotated[int, typer.Option("--samples", "-n", min=1, help="Samples.")] = 150,
+    samples: Annotated[
+        int,
+        typer.Option("--samples", "-n", min=1, max=MAX_SAMPLES, help="Samples (the thesis: 150)."),
+    ] = 150,
     seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the sampling.")] = 0,
     noise: Annotated[
         float, typer.Option(min=0.0, callback=finite, help="Sonar range noise std [m].")

@@ -220,7 +220,7 @@ def crowdnav_scenario(
     case: int,
     *,
     rule: Literal["circle_crossing", "square_crossing"] = "circle_crossing",
-    n_humans: Annotated[int, Field(ge=0, description="number of humans")] = N_HUMANS,
+    n_humans: Annotated[int, Field(ge=0, le=1000, description="number of humans")] = N_HUMANS,
     circle_radius: Annotated[
         float, _positive("humans' circle, and the robot's start/goal distance [m]")
     ] = CIRCLE_RADIUS,
