@@ -225,3 +225,15 @@ def test_errored_episodes_exit_non_zero_with_the_first_error(
     assert last.startswith("error: 6 episode(s) errored; the first: random-ch2")
     assert "RuntimeError: law exploded" in last and "Traceback" not in res.output
     assert json.loads(res.stdout)["errors"] == 6
+
+
+def test_a_local_pool_of_more_workers_than_the_machine_can_run_is_refused(
+    campaign: Path, tmp_path: Path
+) -> None:
+    from uvnav.cli.checks import max_pool_workers
+
+    db = tmp_path / "r.sqlite"
+    too_many = str(max_pool_workers() + 1)
+    res = invoke("bench", str(campaign), "--db", str(db), "--workers", too_many)
+    assert_one_line_error(res, 2, "--workers", "per CPU of this machine")
+    assert not db.exists()  # refused before the database is created

@@ -650,6 +650,8 @@ def _option_cases() -> list[Case]:
         (["controllers", "list", "--vehicle", "boat"], "--vehicle"),
         (["bench", "missing.yaml"], "missing.yaml"),
         (["bench", "missing.yaml", "--workers", "0"], "--workers"),
+        (["run", "--workers", "100000"], "--workers"),
+        (["reproduce", "ch2", "--workers", "100000"], "--workers"),
         (["bench", "missing.yaml", "--engine", "gpu"], "--engine"),
         (["report", "missing.sqlite"], "missing.sqlite"),
         (["run", "--workers", "0"], "--workers"),

@@ -27,6 +27,7 @@ import numpy as np
 import typer
 import yaml
 
+from uvnav.cli.checks import WORKERS_PER_CPU, max_pool_workers, pool_workers
 from uvnav.cli.drive import drive_app
 from uvnav.cli.errors import (
     DEBUG_KEY,
@@ -688,7 +689,9 @@ def run(
     full: Annotated[
         bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
     ] = False,
-    workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 2,
+    workers: Annotated[
+        int, typer.Option(min=1, callback=pool_workers, help="Worker processes.")
+    ] = 2,
     results: Annotated[Path, typer.Option(help="Directory of the results database.")] = Path(
         "results"
     ),
@@ -898,6 +901,9 @@ def bench(
         except EngineUnavailableError as exc:
             raise CliError(str(exc), code=1) from None
     n_workers = workers or os.cpu_count() or 1
+    if engine == "local" and n_workers > max_pool_workers():  # Ray's CPUs may be a cluster's
+        raise CliError(f"--workers: {n_workers} is more than {WORKERS_PER_CPU} per CPU of this "
+                       f"machine ({max_pool_workers()}) for --engine local")  # fmt: skip
     with ResultsStore(db) as store:
         if resume:
             before = next((c for c in store.campaigns() if c["name"] == spec.name), None)

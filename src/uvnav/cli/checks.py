@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import json
 import math
+import os
 from pathlib import Path
 from typing import Any
 
@@ -28,6 +29,30 @@ def finite(value: float | None) -> float | None:
     """
     if value is not None and not math.isfinite(value):
         raise typer.BadParameter(f"{value} is not a finite number")
+    return value
+
+
+#: a local process pool runs at most this many workers per CPU of the machine
+WORKERS_PER_CPU = 4
+
+
+def max_pool_workers() -> int:
+    """The most worker processes a local pool may start here: :data:`WORKERS_PER_CPU` per CPU
+    (episodes are CPU-bound; more would only queue, each holding its memory)."""
+    return WORKERS_PER_CPU * (os.cpu_count() or 1)
+
+
+def pool_workers(value: int | None) -> int | None:
+    """Option callback of ``--workers`` for a local process pool: at most
+    :func:`max_pool_workers` (``--workers 100000`` would start one process per episode).
+
+    Raises:
+        typer.BadParameter: too many (click names the option).
+    """
+    if value is not None and value > max_pool_workers():
+        raise typer.BadParameter(
+            f"{value} is more than {WORKERS_PER_CPU} per CPU of this machine ({max_pool_workers()})"
+        )
     return value
 
 

@@ -19,6 +19,7 @@ from typing import Annotated, Any
 import typer
 
 from uvnav.cli.app import CliError, _console, _fmt, _optional, _text, compact_table
+from uvnav.cli.checks import pool_workers
 
 _COLUMNS = ("quantity", "thesis", "measured", "note")
 _TITLE = "uvnav — reproduction of the thesis's experiments"
@@ -36,7 +37,9 @@ def reproduce_cmd(
     full: Annotated[
         bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
     ] = False,
-    workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 2,
+    workers: Annotated[
+        int, typer.Option(min=1, callback=pool_workers, help="Worker processes.")
+    ] = 2,
     results: Annotated[Path, typer.Option(help="Directory of the results database.")] = Path(
         "results"
     ),
