@@ -35,7 +35,7 @@ import uvnav.controllers.zhang2022_uuv2d as z22
 from uvnav.controllers.base import make_law
 from uvnav.dynamics.holonomic import HolonomicSpec
 from uvnav.obstacles.deforming import DeformingStar
-from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
+from uvnav.prediction.amaps import AmapsConfig, AmapsGrid, law_grid
 from uvnav.prediction.amaps_kernels import load_kernel
 from uvnav.scenarios.uuv2d import load_uuv2d_scenario
 from uvnav.sensors.sonar2d import SonarConfig, SonarObservation, sonar_scan
@@ -119,8 +119,7 @@ def _time_law(
     ctrl.reset(spec, goal, np.random.default_rng(0))
     if engine is not None:
         p = ctrl.params  # type: ignore[attr-defined]
-        cfg = AmapsConfig(cell=p.cell, decay=p.decay, threshold=p.threshold,
-                          free_weight=p.free_weight, hit_depth=p.hit_depth)  # fmt: skip
+        cfg = law_grid(p)
         lo = np.minimum(obs[0].position, goal)
         hi = np.maximum(obs[0].position, goal)
         ctrl.grid = AmapsGrid.covering(  # type: ignore[attr-defined]

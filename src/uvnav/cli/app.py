@@ -48,6 +48,7 @@ from uvnav.scenarios import (
     ScenarioError,
     check_constraints,
 )
+from uvnav.scenarios.loader import yaml_value
 from uvnav.sim import METRIC_NAMES
 from uvnav.sim.metrics import SOCIAL_METRIC_NAMES
 
@@ -185,7 +186,7 @@ def parse_params(items: list[str] | None, option: str = "--param") -> dict[str, 
                 f"{option} {item!r}: expected KEY=VALUE with an identifier KEY (e.g. alpha0=0.1)"
             )
         try:
-            value = yaml.safe_load(raw) if raw.strip() else ""
+            value = yaml_value(raw) if raw.strip() else ""
         except yaml.YAMLError:
             raise CliError(f"{option} {item!r}: value is not a valid YAML scalar or list") from None
         params[key] = value

@@ -20,7 +20,9 @@ it from keyword arguments and rejects unknown names with a clear message.
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
+import typing
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from importlib import import_module
@@ -28,6 +30,7 @@ from importlib.metadata import entry_points
 from typing import Any, ClassVar, Generic, Protocol, TypeVar, cast, runtime_checkable
 
 import numpy as np
+from pydantic import TypeAdapter, ValidationError
 
 from uvnav.core import SENSINGS
 from uvnav.core import VEHICLES as CORE_VEHICLES
@@ -221,10 +224,50 @@ def build_params(params_type: type | None, params: dict[str, Any]) -> Any:
         raise ControllerParamsError(
             f"unknown parameter(s) {', '.join(unknown)}; known: {', '.join(sorted(fields))}"
         )
+    hints = _field_types(params_type)
+    for name, value in params.items():
+        try:  # each given value against its field's type, strictly ("yes" is not a bool)
+            _type_adapter(hints[name]).validate_python(value, strict=True)
+        except ValidationError as exc:
+            raise ControllerParamsError(_first_problem(exc, name)) from None
+        if isinstance(value, float) and math.isnan(value):  # never a meaningful setting
+            raise ControllerParamsError(f"{name}: expected a number (got nan)")
     try:
         return params_type(**params)
     except (TypeError, ValueError) as exc:
         raise ControllerParamsError(str(exc)) from exc
+
+
+@functools.cache
+def _field_types(params_type: type) -> dict[str, Any]:
+    """The resolved type of each field of a parameter dataclass."""
+    return typing.get_type_hints(params_type)
+
+
+@functools.cache
+def _type_adapter(hint: Any) -> TypeAdapter[Any]:
+    return TypeAdapter(hint)
+
+
+def _first_problem(exc: ValidationError, name: str) -> str:
+    """One line for the first error of parameter ``name``'s check: ``NAME: problem (got X)``."""
+    err = exc.errors()[0]
+    expected = _EXPECTED.get(str(err["type"]).split("_")[0])
+    where = ".".join((name, *(str(part) for part in err["loc"])))
+    what = f"expected {expected}" if expected else str(err["msg"])
+    return f"{where}: {what} (got {err.get('input')!r})"
+
+
+#: what a pydantic error type's first word (``float_parsing``: ``float``) asks for
+_EXPECTED = {
+    "float": "a number",
+    "int": "a whole number",
+    "bool": "true or false",
+    "string": "a text",
+    "dict": "a mapping",
+    "list": "a list",
+    "tuple": "a list",
+}
 
 
 def make_controller(name: str, *, oracle: bool = False, **params: Any) -> Controller:

@@ -54,6 +54,9 @@ from uvnav.planners.dstar_lite import DStarLite
 from uvnav.planners.grid import OccupancyGrid, empty_grid, rasterize
 from uvnav.sensors.observation import Observation, ObstacleReading
 
+#: the most cells the planning grid's margin alone may make (a larger grid would not fit)
+MAX_GRID_CELLS = 1e8
+
 
 @dataclass(frozen=True)
 class HybridParams:
@@ -93,6 +96,13 @@ class HybridParams:
             raise ValueError("law must be a reactive law, not another hybrid")
         if self.bounds and len(self.bounds) != 4:
             raise ValueError(f"bounds must be [xmin, ymin, xmax, ymax] (got {list(self.bounds)})")
+        side = 2.0 * self.margin / self.resolution  # cells across the margin's part of the grid
+        if side > math.sqrt(MAX_GRID_CELLS):
+            raise ValueError(
+                f"margin {self.margin:g} m at resolution {self.resolution:g} m makes a grid "
+                f"{side:.3g} cells wide, more than {math.sqrt(MAX_GRID_CELLS):.0f}: lower margin "
+                "or raise resolution"
+            )
         make_controller(self.law, **dict(self.law_params))  # fail early on a bad law or params
 
 

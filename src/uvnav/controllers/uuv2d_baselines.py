@@ -28,12 +28,18 @@ from typing import Any, ClassVar
 import numpy as np
 
 from uvnav.controllers.apf import ApfController, ApfParams
-from uvnav.controllers.base import ControllerInfo, UnicycleController, register
+from uvnav.controllers.base import (
+    ControllerInfo,
+    UnicycleController,
+    build_params,
+    check_params,
+    register,
+)
 from uvnav.controllers.zhang2019 import Zhang2019Controller, Zhang2019Params
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec
 from uvnav.dynamics.unicycle import UnicycleSpec
 from uvnav.geometry.angles import FloatArray
-from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
+from uvnav.prediction.amaps import AmapsGrid, law_grid
 from uvnav.sensors.observation import Observation, ObstacleReading
 from uvnav.sensors.sonar2d import SonarObservation, close_narrow_openings
 
@@ -175,6 +181,13 @@ class Zhang2019Uuv2dParams:
     grid_margin: float = 4.0
     mouth_margin: float = 0.1
 
+    def __post_init__(self) -> None:
+        """Every check at construction (one line each), none at the first decision: the inner
+        law's parameters, the grid's (:class:`AmapsConfig`) and the margins [m]."""
+        build_params(Zhang2019Params, dict(self.law or {}))
+        law_grid(self)
+        check_params(self, non_negative=("mouth_margin",))
+
 
 class Zhang2019Uuv2dController(_UnicycleOnUuv):
     """``zhang2019-v1`` on AMAPS-derived obstacles."""
@@ -193,15 +206,8 @@ class Zhang2019Uuv2dController(_UnicycleOnUuv):
         p = self.params
         pos = np.asarray(obs.position, dtype=float)
         if self.grid is None:
-            cfg = AmapsConfig(
-                cell=p.cell,
-                decay=p.decay,
-                threshold=p.threshold,
-                free_weight=p.free_weight,
-                hit_depth=p.hit_depth,
-            )
             lo, hi = np.minimum(pos, self._goal), np.maximum(pos, self._goal)
-            self.grid = AmapsGrid.covering(lo, hi, cfg, margin=p.grid_margin)
+            self.grid = AmapsGrid.covering(lo, hi, law_grid(p), margin=p.grid_margin)
         s = obs.sonar
         width = 2.0 * (self._spec.radius + p.mouth_margin)
         ranges, ids = close_narrow_openings(s.origin, s.angles, s.ranges, s.hit_ids, width)

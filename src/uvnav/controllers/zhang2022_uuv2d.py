@@ -78,7 +78,7 @@ from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec, velocity_t
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.polygons import points_to_segment
 from uvnav.geometry.tangents import circle_tangents
-from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
+from uvnav.prediction.amaps import AmapsGrid, law_grid
 from uvnav.sensors.sonar2d import SonarObservation, close_narrow_openings
 
 
@@ -157,6 +157,7 @@ class Zhang2022Params:
                 "mouth_margin",
             ),
         )
+        law_grid(self)  # the grid's settings, checked now rather than at the first decision
 
 
 @dataclass(frozen=True)
@@ -245,16 +246,9 @@ class Zhang2022Uuv2dController:
     def _grid_for(self, position: FloatArray) -> AmapsGrid:
         if self.grid is None:
             p = self.params
-            cfg = AmapsConfig(
-                cell=p.cell,
-                decay=p.decay,
-                threshold=p.threshold,
-                free_weight=p.free_weight,
-                hit_depth=p.hit_depth,
-            )
             lo = np.minimum(position, self._goal)
             hi = np.maximum(position, self._goal)
-            self.grid = AmapsGrid.covering(lo, hi, cfg, margin=p.grid_margin)
+            self.grid = AmapsGrid.covering(lo, hi, law_grid(p), margin=p.grid_margin)
         return self.grid
 
     @staticmethod

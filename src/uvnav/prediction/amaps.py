@@ -32,11 +32,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
 from uvnav.prediction.amaps_kernels import load_kernel
+
+#: the side of a square [m] a grid may have; the most depth [m] behind a return it marks; the
+#: most margin [m] around the start-goal box it covers (larger would only make a huge grid)
+CELL_RANGE = (1e-3, 10.0)
+MAX_HIT_DEPTH = 10.0
+MAX_GRID_MARGIN = 1000.0
 
 
 @dataclass(frozen=True)
@@ -66,8 +73,10 @@ class AmapsConfig:
     free_range: float = 3.0
 
     def __post_init__(self) -> None:
-        if not (self.cell > 0):
-            raise ValueError(f"cell must be > 0 m (got {self.cell})")
+        if not (CELL_RANGE[0] <= self.cell <= CELL_RANGE[1]):
+            raise ValueError(
+                f"cell must be in [{CELL_RANGE[0]:g}, {CELL_RANGE[1]:g}] m (got {self.cell})"
+            )
         if not (0 < self.decay <= 1):
             raise ValueError(f"decay must be in (0, 1] (got {self.decay})")
         if not (self.threshold > 0 and self.hit_weight > 0):
@@ -76,8 +85,29 @@ class AmapsConfig:
             raise ValueError(f"free_range must be > 0 m (got {self.free_range})")
         if not (0 < self.free_step <= 2):
             raise ValueError(f"free_step must be in (0, 2] squares (got {self.free_step})")
-        if self.free_weight < 0 or self.hit_depth < 0:
-            raise ValueError("free_weight and hit_depth must be >= 0")
+        if not (self.free_weight >= 0 and 0 <= self.hit_depth <= MAX_HIT_DEPTH):
+            raise ValueError(f"free_weight must be >= 0 and hit_depth in [0, {MAX_HIT_DEPTH:g}] m")
+
+
+def law_grid(params: Any) -> AmapsConfig:
+    """The grid of a law's parameters (``cell``, ``decay``, ``threshold``, ``free_weight``,
+    ``hit_depth`` as :class:`AmapsConfig`), with its ``grid_margin`` [m] checked: the one place
+    the Chapter 4 laws build it from (their ``__post_init__`` checks it at construction).
+
+    Raises:
+        ValueError: a setting out of range (one line).
+    """
+    if not (0 <= params.grid_margin <= MAX_GRID_MARGIN):
+        raise ValueError(
+            f"grid_margin must be in [0, {MAX_GRID_MARGIN:g}] m (got {params.grid_margin})"
+        )
+    return AmapsConfig(
+        cell=params.cell,
+        decay=params.decay,
+        threshold=params.threshold,
+        free_weight=params.free_weight,
+        hit_depth=params.hit_depth,
+    )
 
 
 class AmapsGrid:

@@ -56,6 +56,21 @@ def _construct_unique_mapping(
 _UniqueKeyLoader.add_constructor(
     yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_unique_mapping
 )
+# YAML 1.2's exponent numbers without a dot (1e3, -2E-4), which YAML 1.1 reads as text
+_UniqueKeyLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?[0-9]+[eE][-+]?[0-9]+$"),
+    list("-+0123456789"),
+)
+
+
+def yaml_value(text: str) -> Any:
+    """One YAML value, read as the scenario and campaign files are (``1e3`` is a number).
+
+    >>> yaml_value("1e3"), yaml_value("[1, -2E-1]"), yaml_value("1.5"), yaml_value("e3")
+    (1000.0, [1, -0.2], 1.5, 'e3')
+    """
+    return yaml.load(text, Loader=_UniqueKeyLoader)
 
 
 def parse_yaml(
