@@ -277,3 +277,12 @@ def test_a_campaign_whose_first_scene_cannot_be_placed_still_loads(tmp_path: Pat
     )
     jobs = load_campaign(path).jobs()
     assert [j.generator_seed for j in jobs] == [0, 1]
+
+
+def test_random_ch5_noise_is_a_generator_parameter() -> None:
+    """``--gen-param noise_std=...`` (what ``uvnav sonar simulate --noise`` did): the same scene
+    with a noisy sonar."""
+    plain = generate("random-ch5", 3).scenario
+    noisy = generate("random-ch5", 3, {"noise_std": 0.05}).scenario
+    assert noisy.sonar.noise_std == 0.05 and plain.sonar.noise_std == 0.0
+    assert noisy.model_copy(update={"sonar": plain.sonar}) == plain

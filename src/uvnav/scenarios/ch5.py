@@ -310,6 +310,9 @@ def random_ch5_scenario(
         Literal["geometric", "network", "oracle"],
         Field(description="the scene's locator (the law's default)"),
     ] = "geometric",
+    noise_std: Annotated[
+        float, Field(ge=0, allow_inf_nan=False, description="sonar range noise std [m]")
+    ] = 0.0,
     dense: bool = False,
 ) -> Scenario5:
     """A random scene within the assumptions of the Chapter 5 law (seeded; generator v2).
@@ -377,6 +380,7 @@ def random_ch5_scenario(
             + (", closer than the law needs (beyond the assumptions)" if dense else "")
         ),
         "t_max": 120.0,
+        "sonar": {"noise_std": noise_std},
         "robot": {
             "start": [0.0, 0.0, 0.0],
             "heading": [float(x) for x in d],
