@@ -41,6 +41,7 @@ This module imports nothing from uvnav: it is the bottom layer.
 
 from __future__ import annotations
 
+import functools
 import time as _time
 from collections.abc import Collection, Hashable, Sequence
 from dataclasses import dataclass, field
@@ -287,9 +288,11 @@ def run_loop(
     return logs
 
 
+@functools.cache
 def load_plugins(group: str, taken: Collection[str] = (), what: str = "plug-in") -> dict[str, Any]:
     """The objects of the entry points of ``group`` by name (third-party laws' siblings: scene
-    generators, motion models, sensors).
+    generators, motion models, sensors, Chapter 5 locators), loaded once per arguments
+    (``taken`` hashable: a tuple or a frozenset; ``load_plugins.cache_clear()`` loads again).
 
     Raises:
         RuntimeError: a plug-in takes a name in ``taken`` (the built-ins') or another plug-in's.

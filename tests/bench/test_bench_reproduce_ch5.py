@@ -9,7 +9,8 @@ import pytest
 
 pytest.importorskip("torch")
 
-from uvnav.bench.reproduce_ch5 import make_locator, reproduce_ch5
+from uvnav.bench.reproduce_ch5 import reproduce_ch5
+from uvnav.controllers.zhang_uuv3d import ModelLocator, make_locator
 from uvnav.learning.bpnn import load_checkpoint
 from uvnav.viz.figures_ch5 import render_ch5
 
@@ -64,7 +65,8 @@ def test_small_reproduction_writes_measured_table_and_figures(
     assert outcome["measured"].endswith("/2 seeds")  # the literal experiment's seeds
     model = load_checkpoint(tmp_path / "results" / "ch5_bpnn")
     assert model.config.residual
-    assert make_locator("network", tmp_path / "results" / "ch5_bpnn.safetensors") is not None
+    network = make_locator("network", tmp_path / "results" / "ch5_bpnn.safetensors")
+    assert isinstance(network, ModelLocator) and network.model.config == model.config
     names = {p.name for p in s.figures}
     assert {"ch5_array.png", "ch5_learning_curve.png"} <= names
     assert any(n.startswith("ch5_traj_thesis-ch5-scene1") for n in names)

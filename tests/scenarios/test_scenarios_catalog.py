@@ -29,10 +29,10 @@ def plugins(monkeypatch: pytest.MonkeyPatch) -> Any:
         monkeypatch.setattr(
             core, "entry_points", lambda group: eps if group == catalog.GENERATOR_GROUP else []
         )
-        monkeypatch.setattr(catalog, "_PLUGINS", None)
+        core.load_plugins.cache_clear()
 
     yield install
-    catalog._PLUGINS = None
+    core.load_plugins.cache_clear()
 
 
 @pytest.mark.parametrize(

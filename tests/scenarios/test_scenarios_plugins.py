@@ -59,9 +59,9 @@ def plugins(monkeypatch: pytest.MonkeyPatch) -> Any:
         sensors.SENSOR_GROUP: [FakeEntryPoint("gap", nearest_gap)],
     }
     monkeypatch.setattr(core, "entry_points", lambda group: groups.get(group, []))
-    monkeypatch.setattr(motion, "_PLUGINS", None)
-    monkeypatch.setattr(sensors, "_PLUGINS", None)
-    return groups
+    core.load_plugins.cache_clear()  # load these fakes, and forget them afterwards
+    yield groups
+    core.load_plugins.cache_clear()
 
 
 def scene(motion_params: dict[str, Any], sensor: str = "gap") -> dict[str, Any]:

@@ -982,7 +982,6 @@ __all__ = [
     "checkpoint_digest",
     "failures",
     "learning_row",
-    "make_locator",
     "random_ch5_scenario",
     "reproduce_ch5",
     "run_ch5_job",

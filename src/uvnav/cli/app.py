@@ -27,7 +27,7 @@ import numpy as np
 import typer
 import yaml
 
-from uvnav.cli.checks import WORKERS_PER_CPU, max_pool_workers, pool_workers
+from uvnav.cli.checks import pool_workers, too_many_workers
 from uvnav.cli.drive import drive_app
 from uvnav.cli.errors import (
     DEBUG_KEY,
@@ -902,9 +902,9 @@ def bench(
         except EngineUnavailableError as exc:
             raise CliError(str(exc), code=1) from None
     n_workers = workers or os.cpu_count() or 1
-    if engine == "local" and n_workers > max_pool_workers():  # Ray's CPUs may be a cluster's
-        raise CliError(f"--workers: {n_workers} is more than {WORKERS_PER_CPU} per CPU of this "
-                       f"machine ({max_pool_workers()}) for --engine local")  # fmt: skip
+    too_many = too_many_workers(n_workers) if engine == "local" else None  # Ray: a cluster's
+    if too_many is not None:
+        raise CliError(f"--workers: {too_many} for --engine local")
     with ResultsStore(db) as store:
         if resume:
             before = next((c for c in store.campaigns() if c["name"] == spec.name), None)

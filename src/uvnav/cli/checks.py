@@ -42,17 +42,24 @@ def max_pool_workers() -> int:
     return WORKERS_PER_CPU * (os.cpu_count() or 1)
 
 
+def too_many_workers(value: int | None) -> str | None:
+    """Why ``value`` workers are too many for a local process pool (more than
+    :func:`max_pool_workers`: ``--workers 100000`` would start one process per episode), or
+    ``None``."""
+    if value is None or value <= max_pool_workers():
+        return None
+    return f"{value} is more than {WORKERS_PER_CPU} per CPU of this machine ({max_pool_workers()})"
+
+
 def pool_workers(value: int | None) -> int | None:
-    """Option callback of ``--workers`` for a local process pool: at most
-    :func:`max_pool_workers` (``--workers 100000`` would start one process per episode).
+    """Option callback of ``--workers`` for a local process pool (:func:`too_many_workers`).
 
     Raises:
         typer.BadParameter: too many (click names the option).
     """
-    if value is not None and value > max_pool_workers():
-        raise typer.BadParameter(
-            f"{value} is more than {WORKERS_PER_CPU} per CPU of this machine ({max_pool_workers()})"
-        )
+    problem = too_many_workers(value)
+    if problem is not None:
+        raise typer.BadParameter(problem)
     return value
 
 

@@ -36,6 +36,7 @@ from uvnav.core import SENSINGS
 from uvnav.core import VEHICLES as CORE_VEHICLES
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.sensors.observation import Observation
+from uvnav.validation import describe_error
 
 
 @runtime_checkable
@@ -250,24 +251,11 @@ def _type_adapter(hint: Any) -> TypeAdapter[Any]:
 
 
 def _first_problem(exc: ValidationError, name: str) -> str:
-    """One line for the first error of parameter ``name``'s check: ``NAME: problem (got X)``."""
-    err = exc.errors()[0]
-    expected = _EXPECTED.get(str(err["type"]).split("_")[0])
+    """One line for the first error of parameter ``name``'s check: ``NAME: problem``, worded
+    as a scenario file's (:func:`uvnav.validation.describe_error`)."""
+    err = exc.errors(include_url=False)[0]
     where = ".".join((name, *(str(part) for part in err["loc"])))
-    what = f"expected {expected}" if expected else str(err["msg"])
-    return f"{where}: {what} (got {err.get('input')!r})"
-
-
-#: what a pydantic error type's first word (``float_parsing``: ``float``) asks for
-_EXPECTED = {
-    "float": "a number",
-    "int": "a whole number",
-    "bool": "true or false",
-    "string": "a text",
-    "dict": "a mapping",
-    "list": "a list",
-    "tuple": "a list",
-}
+    return f"{where}: {describe_error(err, None)}"
 
 
 def make_controller(name: str, *, oracle: bool = False, **params: Any) -> Controller:

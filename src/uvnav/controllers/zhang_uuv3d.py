@@ -71,7 +71,6 @@ BUILTIN_LOCATORS: tuple[str, ...] = ("geometric", "oracle")
 #: entry-point group of locator plug-ins: a name -> ``factory(model: str) -> Locator``, where
 #: ``model`` is the law's ``model`` parameter (uvnav's own ``network``: the trained BPNN)
 LOCATOR_GROUP = "uvnav.locators"
-_PLUGINS: dict[str, Any] | None = None
 
 
 def locator_plugins() -> dict[str, Any]:
@@ -80,10 +79,7 @@ def locator_plugins() -> dict[str, Any]:
     Raises:
         RuntimeError: a plug-in takes a built-in name or another plug-in's.
     """
-    global _PLUGINS
-    if _PLUGINS is None:
-        _PLUGINS = load_plugins(LOCATOR_GROUP, BUILTIN_LOCATORS, "locator")
-    return _PLUGINS
+    return load_plugins(LOCATOR_GROUP, BUILTIN_LOCATORS, "locator")
 
 
 def locator_names() -> tuple[str, ...]:

@@ -76,7 +76,6 @@ BUILTIN_MOTIONS: tuple[str, ...] = (
     "social_force",
     "plugin",
 )
-_PLUGINS: dict[str, Callable[..., Any]] | None = None
 
 
 def motion_plugins() -> dict[str, Callable[..., Any]]:
@@ -85,10 +84,7 @@ def motion_plugins() -> dict[str, Callable[..., Any]]:
     Raises:
         RuntimeError: a plug-in takes a built-in name or another plug-in's.
     """
-    global _PLUGINS
-    if _PLUGINS is None:
-        _PLUGINS = load_plugins(MOTION_GROUP, BUILTIN_MOTIONS, "motion")
-    return _PLUGINS
+    return load_plugins(MOTION_GROUP, BUILTIN_MOTIONS, "motion")
 
 
 class MotionGroup(Protocol):

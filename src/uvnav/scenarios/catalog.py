@@ -302,24 +302,23 @@ KINDS: tuple[str, ...] = ("nav2d", "nav3d", "uuv2d", "uuv3d", "multi2d")
 #: ``scene_kind`` attribute names that kind (``nav2d`` when absent).  A name already taken is
 #: refused.
 GENERATOR_GROUP = "uvnav.generators"
-_PLUGINS: dict[str, Callable[..., Any]] | None = None
 
 
 def plugin_generators() -> dict[str, Callable[..., Any]]:
-    """The generators of the :data:`GENERATOR_GROUP` entry points (loaded once)."""
-    global _PLUGINS
-    if _PLUGINS is None:
-        builtin = {g for k in kinds().values() for g in k.generators}
-        plugins = load_plugins(GENERATOR_GROUP, builtin, "scene generator")
-        for name, fn in plugins.items():
-            kind = getattr(fn, "scene_kind", "nav2d")
-            if kind not in KINDS:
-                raise RuntimeError(
-                    f"scene generator {name!r}: unknown scene_kind {kind!r}; "
-                    f"known: {', '.join(KINDS)}"
-                )
-        _PLUGINS = plugins
-    return _PLUGINS
+    """The generators of the :data:`GENERATOR_GROUP` entry points (loaded once).
+
+    Raises:
+        RuntimeError: a plug-in takes a taken name, or names an unknown ``scene_kind``.
+    """
+    builtin = frozenset(g for k in kinds().values() for g in k.generators)
+    plugins = load_plugins(GENERATOR_GROUP, builtin, "scene generator")
+    for name, fn in plugins.items():
+        kind = getattr(fn, "scene_kind", "nav2d")
+        if kind not in KINDS:
+            raise RuntimeError(
+                f"scene generator {name!r}: unknown scene_kind {kind!r}; known: {', '.join(KINDS)}"
+            )
+    return plugins
 
 
 def generators() -> dict[str, SceneKind]:

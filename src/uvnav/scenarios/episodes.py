@@ -10,7 +10,7 @@ refused on a 2D scene that breaks it (:func:`uvnav.scenarios.validate_for_contro
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import Any
 
 from uvnav.controllers.base import (
@@ -61,9 +61,12 @@ class Outcome:
 
 
 def default_law(resolved: Resolved) -> tuple[str, dict[str, Any]]:
-    """The scene's own law and parameters."""
+    """The scene's own law and parameters: its controller section's ``params``, and any other
+    setting the section has besides ``name`` (Chapter 5's ``locator``) as the parameter of that
+    name."""
     ctrl = resolved.scenario.controller
-    return str(ctrl.name), dict(getattr(ctrl, "params", {}) or {})
+    settings = ctrl.model_dump(exclude={"name", "params"})
+    return str(ctrl.name), {**settings, **dict(getattr(ctrl, "params", {}) or {})}
 
 
 def check_law(
@@ -201,26 +204,16 @@ def _uuv2d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bo
 
 
 def _uuv3d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
-    """The law with the scene's locator (``controller.locator``) unless ``params`` name one."""
     from uvnav.scenarios.ch5 import build_uuv3d
     from uvnav.sim.episode_uuv3d import run_uuv3d_episode
 
-    built = dict(params)
-    if "locator" in _param_names(name) and "locator" not in built:
-        built["locator"] = r.scenario.controller.locator
-    law = make_law(name, **built)
+    law = make_law(name, **params)
     setup = build_uuv3d(r.scenario)
     res = run_uuv3d_episode(setup, law, r.kind.episode_rng(seed), record=record)
     out = _single(r, name, params, seed, res, setup=setup)
     out.extra["entered_inner_space"] = bool(res.entered_inner_space)
-    out.extra["locator"] = built.get("locator", "")
+    out.extra["locator"] = str(getattr(law.params, "locator", ""))
     return out
-
-
-def _param_names(law: str) -> set[str]:
-    """The parameter names of the registered law ``law``."""
-    params_type = controller_info(law).params_type
-    return {f.name for f in fields(params_type)} if params_type is not None else set()
 
 
 def _mean(values: list[Any]) -> float | None:

@@ -10,11 +10,12 @@ and exit with status 2 instead of showing a traceback.
 
 from __future__ import annotations
 
-import re
 from collections.abc import Sequence
 from typing import Any
 
 from pydantic import ValidationError
+
+from uvnav.validation import describe_error, one_line
 
 
 class ScenarioError(ValueError):
@@ -30,7 +31,7 @@ class ScenarioError(ValueError):
     def __init__(self, source: str, path: str, problem: str) -> None:
         self.source = str(source)
         self.path = str(path)
-        self.problem = _one_line(problem)
+        self.problem = one_line(problem)
         super().__init__(str(self))
 
     def __str__(self) -> str:
@@ -45,90 +46,6 @@ class FieldError(ValueError):
         self.path = path
         self.problem = problem
         super().__init__(problem)
-
-
-def _one_line(text: str) -> str:
-    return re.sub(r"\s+", " ", str(text)).strip()
-
-
-def _show(value: Any, limit: int = 40) -> str:
-    """Compact rendering of an offending input value (``0.0`` as ``0``, strings quoted)."""
-    if isinstance(value, float) and value.is_integer():
-        text = str(int(value))
-    elif isinstance(value, str):
-        text = repr(value)
-    elif isinstance(value, dict):
-        text = "{" + ", ".join(str(k) for k in value) + "}"
-    else:
-        text = repr(value)
-    text = _one_line(text)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
-
-
-#: pydantic error types about the kind of value, and the noun we expect instead
-_TYPE_NOUNS = {
-    "float_type": "a number",
-    "float_parsing": "a number",
-    "int_type": "an integer",
-    "int_parsing": "an integer",
-    "int_from_float": "an integer",
-    "bool_type": "true or false",
-    "bool_parsing": "true or false",
-    "string_type": "a string",
-    "dict_type": "a mapping",
-    "model_type": "a mapping",
-    "model_attributes_type": "a mapping",
-    "list_type": "a list",
-    "tuple_type": "a list",
-    "finite_number": "a finite number",
-}
-
-
-def _describe(err: Any, allowed: Sequence[str] | None) -> str:
-    """Translate one pydantic error dict into a short problem statement."""
-    kind = err.get("type", "")
-    ctx = err.get("ctx") or {}
-    value = err.get("input")
-    if kind == "value_error" and isinstance(ctx.get("error"), Exception):
-        return str(ctx["error"])
-    bounds = {
-        "greater_than": ">",
-        "greater_than_equal": ">=",
-        "less_than": "<",
-        "less_than_equal": "<=",
-    }
-    if kind in bounds:
-        key = {
-            "greater_than": "gt",
-            "greater_than_equal": "ge",
-            "less_than": "lt",
-            "less_than_equal": "le",
-        }[kind]
-        return f"must be {bounds[kind]} {_show(ctx.get(key))} (got {_show(value)})"
-    if kind == "missing":
-        return "required field is missing"
-    if kind == "extra_forbidden":
-        hint = f" (allowed: {', '.join(allowed)})" if allowed else ""
-        return f"unknown field{hint}"
-    if kind in _TYPE_NOUNS:
-        return f"expected {_TYPE_NOUNS[kind]} (got {_show(value)})"
-    if kind == "literal_error":
-        return f"must be {ctx.get('expected')} (got {_show(value)})"
-    if kind in ("too_short", "too_long"):
-        n = ctx.get("actual_length")
-        limit = ctx.get("min_length") if kind == "too_short" else ctx.get("max_length")
-        word = "at least" if kind == "too_short" else "at most"
-        return f"needs {word} {limit} item(s) (got {n})"
-    if kind == "union_tag_invalid":
-        what = ctx.get("discriminator", "tag")
-        expected = ctx.get("expected_tags")
-        return f"unknown {what} {_show(ctx.get('tag'))} (expected one of: {expected})"
-    if kind == "union_tag_not_found":
-        return f"missing {ctx.get('discriminator', 'tag')} (one of the motion types)"
-    msg = str(err.get("msg", "invalid value"))
-    return (
-        f"{msg} (got {_show(value)})" if value is not None and not isinstance(value, dict) else msg
-    )
 
 
 def format_loc(loc: Sequence[str | int], tags: Sequence[str] = ()) -> str:
@@ -174,7 +91,7 @@ def from_validation_error(
     allowed = None
     if first.get("type") == "extra_forbidden" and allowed_fields is not None:
         allowed = allowed_fields(loc[:-1])
-    problem = _describe(first, allowed)
+    problem = describe_error(first, allowed)
     if len(errors) > 1:
         problem += f" (and {len(errors) - 1} more error{'s' if len(errors) > 2 else ''})"
     return ScenarioError(source, path or "<root>", problem)

@@ -20,8 +20,6 @@ SENSOR_GROUP = "uvnav.sensors"
 #: names of the built-in sensors (a plug-in may not take them)
 BUILTIN_SENSORS: tuple[str, ...] = ("exact", "lidar", "sonar-fan", "sonar-array")
 
-_PLUGINS: dict[str, Callable[..., Any]] | None = None
-
 
 def sensor_plugins() -> dict[str, Callable[..., Any]]:
     """The sensors of the :data:`SENSOR_GROUP` entry points by name (loaded once).
@@ -29,10 +27,7 @@ def sensor_plugins() -> dict[str, Callable[..., Any]]:
     Raises:
         RuntimeError: a plug-in takes a built-in name or another plug-in's.
     """
-    global _PLUGINS
-    if _PLUGINS is None:
-        _PLUGINS = load_plugins(SENSOR_GROUP, BUILTIN_SENSORS, "sensor")
-    return _PLUGINS
+    return load_plugins(SENSOR_GROUP, BUILTIN_SENSORS, "sensor")
 
 
 def sensor_plugin(name: str) -> Callable[..., Any]:
