@@ -66,7 +66,8 @@ class Claim:
             noise) unless the figures come out of iterative training: the numerical libraries'
             builds (BLAS kernels, summation order) change last bits within the pinned ranges,
             and the optimiser's iterations grow them (a fresh install moved Ch. 5's BPNN
-            figures by up to 5e-9, same code); such claims say :data:`TRAINED`.
+            figures by up to 5e-9, another CPU's SIMD kernels one of them by 1.8e-6, same
+            code); such claims say :data:`TRAINED`, well below the digits the notes quote.
     """
 
     key: str
@@ -77,7 +78,7 @@ class Claim:
 
 CLAIMS: dict[str, Claim] = {}
 #: :attr:`Claim.rel_tol` of claims whose figures come out of training
-TRAINED = 1e-6
+TRAINED = 1e-4
 
 
 def claim(
