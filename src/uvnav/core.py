@@ -92,14 +92,17 @@ class World(Protocol[ObsT_co, CmdT]):
     """One scene stepped by :func:`run_loop`.
 
     Class attributes ``vehicle`` and ``sensing`` (one of :data:`VEHICLES` / :data:`SENSINGS`)
-    say which laws can drive it.  ``t`` is the time [s], ``dt`` the integration step [s];
-    ``done`` becomes True when every agent has arrived, collided, or ``t_max`` is reached.
+    say which laws can drive it.  ``t`` is the time [s], ``dt`` the integration step [s],
+    ``ratio`` the integration steps per decision; ``done`` becomes True when every agent has
+    arrived, collided, or ``t_max`` is reached.  The counting rules (steps, status, arrival
+    time, sums) are one bookkeeper's, :mod:`uvnav.sim.ledger`.
     """
 
     vehicle: ClassVar[str]
     sensing: ClassVar[str]
     t: float
     dt: float
+    ratio: int
     done: bool
 
     @property
@@ -127,6 +130,14 @@ class World(Protocol[ObsT_co, CmdT]):
 
     def advance(self) -> None:
         """One integration step ``dt``."""
+        ...
+
+    def metrics(self, log: AgentLog, agent: int = 0) -> Any:
+        """Agent ``agent``'s :class:`~uvnav.sim.metrics.EpisodeMetrics`, from the loop's log."""
+        ...
+
+    def close(self) -> None:
+        """The episode is over: write back what the scene's objects should hold."""
         ...
 
 

@@ -169,7 +169,7 @@ def test_raw_commands_are_applied_as_the_simulator_applies_them() -> None:
     np.testing.assert_array_equal(box.high, [spec.v_max, spec.u_max])
     env.reset(seed=0)
     env.step(np.array([2.0 * spec.v_max, 0.0]))  # outside the limits: saturated and counted
-    assert env.world.violations == 1 and env.world.applied.v == spec.v_max
+    assert env.world.book.violations == 1 and env.world.applied.v == spec.v_max
 
 
 @pytest.mark.parametrize(

@@ -92,8 +92,8 @@ def test_packed_swarm_is_the_loop_world_bit_for_bit(case: str, use_numba: bool) 
     assert first is None, f"step {first} differs"
     assert swarm.statuses() == world.status
     assert swarm.collided_pairs() == sorted(world.pairs)
-    assert swarm.rob[:, R_PATH].tobytes() == world.path.tobytes()
-    assert swarm.rob[:, R_LOW].tobytes() == world.min_clear.tobytes()
+    assert swarm.rob[:, R_PATH].tobytes() == np.array([b.path for b in world.books]).tobytes()
+    assert swarm.rob[:, R_LOW].tobytes() == np.array([b.min_clear for b in world.books]).tobytes()
     reached = [np.nan if r is None else r for r in world.reached]
     np.testing.assert_array_equal(swarm.rob[:, R_REACHED], reached)
 

@@ -6,7 +6,7 @@ instead of running for days or allocating petabytes.  They are module constants:
 really needs more can raise them (``uvnav.scenarios.limits.MAX_EPISODE_STEPS = ...``) before
 loading.
 
-* :data:`MAX_EPISODE_STEPS` — integration steps of one episode, ``ceil(t_max / dt)`` (10^7: about
+* :data:`MAX_EPISODE_STEPS` — integration steps of one episode, ``t_max / dt`` (10^7: about
   a day of simulated time at dt = 0.01 s; the built-ins need at most 10^4).
 * :data:`MAX_CAMPAIGN_EPISODES` — episodes (jobs) of one campaign file (10^6).
 
@@ -21,6 +21,7 @@ from typing import Any
 from pydantic import BaseModel, ConfigDict, PrivateAttr, model_validator
 
 from uvnav.scenarios.errors import FieldError
+from uvnav.sim.ledger import decision_ratio, step_count
 
 
 class FileModel(BaseModel):
@@ -85,20 +86,20 @@ def check_episode_steps(t_max: float, dt: float) -> None:
 
 
 def check_timing(t_max: float, dt: float, control_period: float) -> None:
-    """The timing of every scene kind: at most :data:`MAX_EPISODE_STEPS` integration steps, and
-    a decision period that is a positive whole multiple of ``dt`` (within 1e-9 relative, as
-    :func:`uvnav.sim.episode.decision_ratio` requires).
+    """The timing of every scene kind: at most :data:`MAX_EPISODE_STEPS` integration steps, a
+    ``t_max`` that is a whole multiple of ``dt`` and a decision period that is a positive whole
+    multiple of ``dt`` (the worlds' rules: :mod:`uvnav.sim.ledger`).
 
     Raises:
-        FieldError: on ``dt`` or ``control_period``.
+        FieldError: on ``dt``, ``t_max`` or ``control_period``.
     """
     check_episode_steps(t_max, dt)
-    ratio = control_period / dt
-    if round(ratio) < 1 or abs(ratio - round(ratio)) > 1e-9 * max(1.0, ratio):
-        raise FieldError(
-            "control_period",
-            f"must be a positive multiple of dt={dt:g} s (got {control_period:g})",
-        )
+    rules = (("t_max", step_count, t_max), ("control_period", decision_ratio, control_period))
+    for name, rule, value in rules:
+        try:
+            rule(value, dt)
+        except ValueError as e:
+            raise FieldError(name, str(e).removeprefix(f"{name} ")) from None
 
 
 #: largest magnitude of a number in a 3D scene file (coordinates [m], sizes [m], speeds [m/s]):

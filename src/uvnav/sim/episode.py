@@ -46,7 +46,8 @@ from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
 from uvnav.sensors.exact import lidar_scan, sense_obstacles
 from uvnav.sensors.observation import Observation
 from uvnav.sensors.plugins import sensor_plugin
-from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
+from uvnav.sim.ledger import Clock, Ledger
+from uvnav.sim.metrics import EpisodeMetrics
 from uvnav.sim.packed import PackedObstacles, pack_check
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
 from uvnav.sim.social import SocialTracker, collision_by, pedestrian_ids
@@ -191,30 +192,13 @@ class _MinClearance:
         return self._best
 
 
-def decision_ratio(control_period: float, dt: float) -> int:
-    """Integration steps per decision: ``control_period / dt`` as a whole number >= 1.
-
-    Raises:
-        ValueError: ``control_period`` is not a positive whole multiple of ``dt`` within 1e-9
-            relative (the same rule as the scenario schema).
-    """
-    if not (dt > 0 and math.isfinite(dt)):
-        raise ValueError(f"dt must be a positive number of seconds (got {dt!r})")
-    ratio = control_period / dt
-    n = round(ratio) if math.isfinite(ratio) else 0
-    if n < 1 or abs(ratio - n) > 1e-9 * max(1.0, ratio):
-        raise ValueError(
-            f"control_period must be a positive multiple of dt={dt:g} s (got {control_period:g})"
-        )
-    return int(n)
-
-
 class UnicycleWorld:
     """The Chapter-2 world: one unicycle among rigid moving bodies (:class:`uvnav.core.World`).
 
-    Bookkeeping (path, effort, limit violations, clearance, status, the social metrics of
-    :mod:`uvnav.sim.social`) lives here, so :func:`run_episode` and the Gymnasium env
-    ``uvnav/Nav2D-v0`` get the same numbers.  Without
+    Bookkeeping (path, effort, limit violations, clearance, status: the one
+    :class:`~uvnav.sim.ledger.Ledger`; the social metrics of :mod:`uvnav.sim.social`) is the
+    world's, so :func:`run_episode` and the Gymnasium env ``uvnav/Nav2D-v0`` get the same
+    numbers.  Without
     ``exact`` the minimum clearance is tracked by :class:`_MinClearance` (the same minimum, and
     the per-step ``clearance`` only exact when it can matter).
 
@@ -241,9 +225,8 @@ class UnicycleWorld:
         self.setup = setup
         self._law_rng, self.sense_rng = rng.spawn(2)
         self.spec: Any = setup.spec  # UnicycleSpec (OmniSpec in HolonomicWorld)
-        self.dt = float(setup.dt)
-        self.ratio = decision_ratio(float(setup.control_period), self.dt)
-        self.n_steps = round(setup.t_max / self.dt)
+        self.clock = Clock(setup.dt, setup.control_period, setup.t_max)
+        self.dt, self.ratio = self.clock.dt, self.clock.ratio
         self.goal = np.asarray(setup.goal, dtype=float)
         start = np.asarray(setup.start, dtype=float)
         self.x, self.y, self.th = float(start[0]), float(start[1]), float(start[2])
@@ -300,13 +283,11 @@ class UnicycleWorld:
         if sensing.velocities == "estimated" and not oracles[0]:
             self.estimator = FiniteDifferenceEstimator(self.sense_rng, sensing.position_noise)
         self.clearance, self.nearest = self._clearance(self.sensing_range)
-        self.min_clear = self.clearance
         self.tracker = (
             _MinClearance(float(self.spec.radius), self.clearance)
             if self.obstacles and not self.exact and self.packed is None
             else None
         )
-        self.start_dist = math.hypot(self.goal[0] - self.x, self.goal[1] - self.y)
         self.social: SocialTracker | None = None
         if len(self.pedestrians):
             radius = float(self.spec.radius)
@@ -316,23 +297,21 @@ class UnicycleWorld:
             self.social.observe(self.field, self.x, self.y, 0)
         self.collision_by: str | None = None
         self.turn = 0.0  # total absolute heading change [rad]
-        self.path = 0.0
-        self.effort = 0.0
-        self.violations = 0
         self.applied: Any = UnicycleCommand(0.0, 0.0)  # the command held now
-        self.status = "timeout"
-        self.reached_at: float | None = None
-        self.step_index = 0
-        if self.clearance < 0:
-            self.status, self.done = "collision", True
+        self.book = book = Ledger(self.setup.goal_tolerance)
+        gd = math.hypot(self.goal[0] - self.x, self.goal[1] - self.y)
+        self.done = book.begin(self.clearance, gd) or self.clock.up
+        if book.status == "collision":
             self.collision_by = self._collision_by()
-        elif self.start_dist <= float(self.setup.goal_tolerance):
-            self.status, self.reached_at, self.done = "success", 0.0, True
-        self.done = self.done or self.n_steps <= 0
+
+    @property
+    def status(self) -> str:
+        """``success``, ``collision`` or ``timeout`` (also while running)."""
+        return self.book.status
 
     def acting(self) -> tuple[int, ...]:
         """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
-        return (0,) if self.step_index % self.ratio == 0 else ()
+        return (0,) if self.clock.due else ()
 
     def observe(self, agent: int = 0) -> Observation:
         """Readings within the sensing range (estimated rates unless known), the lidar scan."""
@@ -392,10 +371,10 @@ class UnicycleWorld:
         """Hold ``cmd``: counted in ``limit_violations`` when outside (2.4), saturated."""
         spec = self.spec
         if cmd.violates(spec):
-            self.violations += 1
+            self.book.violations += 1
         new = cmd.clipped(spec)
-        if self.step_index > 0:
-            self.effort += self._speed_change(new) / (self.ratio * self.dt)
+        if self.clock.step_index > 0:
+            self.book.effort += self._speed_change(new) / (self.ratio * self.dt)
         self.applied = new
         return new
 
@@ -403,23 +382,23 @@ class UnicycleWorld:
         """Integrate the robot over ``dt`` [s] (exact); returns the new position, updates the
         heading and the turn part of the control effort."""
         v, u = self.applied.v, self.applied.u
-        self.effort += u**2 * dt
+        self.book.effort += u**2 * dt
         self.turn += abs(u) * dt
         nx, ny, self.th = unicycle_advance(self.x, self.y, self.th, v, u, dt)
         return nx, ny
 
     def advance(self) -> None:
         """One step ``dt``: robot (exact), obstacles, clearance, collision and arrival."""
-        dt = self.dt
+        dt, book, clock = self.dt, self.book, self.clock
         x, y = self.x, self.y
         if self.batch.sees_robot:  # bodies that react to the robot see it as it starts the step
             self.batch.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
         nx, ny = self._move(dt)
-        self.path += math.hypot(nx - x, ny - y)
+        book.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
         was_present = None
         if self.packed is not None:  # compiled: the exact clearance, the field on demand
-            sense = self.sensing_range if (self.step_index + 1) % self.ratio == 0 else -1.0
+            sense = self.sensing_range if (clock.step_index + 1) % self.ratio == 0 else -1.0
             self.clearance, self.nearest = self.packed.step(
                 self.t, dt, nx, ny, self.spec.radius, sense
             )
@@ -428,25 +407,20 @@ class UnicycleWorld:
             self.batch.step(self.t, dt)
             was_present = self.field.present
             self._field = self.batch.field(self.template)
-        self.step_index = i = self.step_index + 1
-        self.t = i * dt
+        self.t = t = clock.tick()
+        i = clock.step_index
         if self.packed is None:
-            radius = self.sensing_range if i % self.ratio == 0 else 0.0
+            radius = self.sensing_range if clock.due else 0.0
             if self.tracker is not None:
                 self.clearance = self.tracker.step(self.field, nx, ny, radius)
             else:
                 self.clearance, self.nearest = self._clearance(radius)
-        if self.tracker is None:
-            self.min_clear = min(self.min_clear, self.clearance)
         if self.social is not None:
             self.social.observe(self.field, nx, ny, i)
-        if self.clearance < 0:
-            self.status, self.done = "collision", True
+        gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)
+        self.done = book.judge(t, self.clearance, gd) or clock.up
+        if book.status == "collision":
             self.collision_by = self._collision_by(was_present)
-        elif math.hypot(self.goal[0] - nx, self.goal[1] - ny) <= float(self.setup.goal_tolerance):
-            self.status, self.reached_at, self.done = "success", self.t, True
-        elif i >= self.n_steps:
-            self.done = True
 
     def close(self) -> None:
         """Write the obstacles' states back to their models (the setup's objects)."""
@@ -457,23 +431,14 @@ class UnicycleWorld:
 
     def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
         """The episode's metrics (:mod:`uvnav.sim.metrics`)."""
-        if self.tracker is not None:
-            self.min_clear = self.tracker.finish()
+        if self.tracker is not None:  # the exact minimum of the steps it deferred
+            self.book.min_clear = self.tracker.finish()
             self.tracker = None
-        spec = self.spec
-        shortest = max(self.start_dist - float(self.setup.goal_tolerance), 0.0)
-        return episode_metrics(
-            status=self.status,
-            path_length=self.path,
-            shortest=shortest,
-            straight_time=shortest / spec.v_max if spec.v_max > 0 else 0.0,
-            reached_at=self.reached_at,
-            min_clearance=float(self.min_clear) if math.isfinite(self.min_clear) else None,
-            control_effort=self.effort,
-            limit_violations=self.violations,
-            mode_switches=log.mode_switches,
-            decision_us=log.timed_us,
-            path_irregularity=self.turn / self.path if self.path > 0 else None,
+        path = self.book.path
+        return self.book.metrics(
+            log,
+            top_speed=float(self.spec.v_max),
+            path_irregularity=self.turn / path if path > 0 else None,
             collision_by=self.collision_by,
             **self._social_metrics(len(log.decision_us)),
         )

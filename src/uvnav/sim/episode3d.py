@@ -34,8 +34,9 @@ from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.frames3d import check_unit
 from uvnav.obstacles.motion3d import Obstacle3D
 from uvnav.sensors.sensing3d import FiniteDifference3D, Observation3D, sense_obstacles3d
-from uvnav.sim.episode import EpisodeResult, decision_ratio
-from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
+from uvnav.sim.episode import EpisodeResult
+from uvnav.sim.ledger import Clock, Ledger
+from uvnav.sim.metrics import EpisodeMetrics
 
 
 @dataclass(frozen=True)
@@ -193,8 +194,8 @@ class Vehicle3DWorld:
     (:class:`uvnav.core.World`), run by :func:`run_episode3d` and stepped by the Gymnasium env
     ``uvnav/Nav3D-v0`` (:mod:`uvnav.envs.nav3d`).
 
-    The bookkeeping (path, effort, limit violations, clearance, status) lives here, so both users
-    get the same numbers.
+    The bookkeeping (path, effort, limit violations, clearance, status) is the one
+    :class:`~uvnav.sim.ledger.Ledger`'s, so both users get the same numbers.
 
     Args:
         setup: the episode (its obstacles are advanced in place).
@@ -216,9 +217,8 @@ class Vehicle3DWorld:
         self.setup = setup
         self._law_rng, self.sense_rng = rng.spawn(2)
         self.spec = setup.spec
-        self.dt = float(setup.dt)
-        self.ratio = decision_ratio(float(setup.control_period), self.dt)
-        self.n_steps = round(setup.t_max / self.dt)
+        self.clock = Clock(setup.dt, setup.control_period, setup.t_max)
+        self.dt, self.ratio = self.clock.dt, self.clock.ratio
         self.goal = np.asarray(setup.goal, dtype=float)
         self.pos = np.asarray(setup.start, dtype=float).copy()
         self.a = check_unit(setup.heading, name="heading").copy()
@@ -247,30 +247,24 @@ class Vehicle3DWorld:
         for ob in obstacles:
             ob.state.velocity, ob.state.rotation_rate = ob.motion.rates(0.0, ob.state)
         self.clearance, self.nearest = clearance3d(self.pos, obstacles, spec.radius)
-        self.min_clear = self.clearance
         self.tracker = (
             None if self.exact or not obstacles else _GapTracker(obstacles, spec.radius, self.pos)
         )
-        self.start_dist = float(np.linalg.norm(self.goal - self.pos))
-        self.path = 0.0
-        self.effort = 0.0
-        self.violations = 0
         self.applied = Vehicle3DCommand(0.0, np.zeros(3))
         self.u_held = np.zeros(3)
-        self.status = "timeout"
         self.t = 0.0
-        self.step_index = 0
-        self.reached_at: float | None = None
-        self.done = False
-        if self.clearance < 0:
-            self.status, self.done = "collision", True
-        elif self.start_dist <= self.setup.goal_tolerance:
-            self.status, self.reached_at, self.done = "success", 0.0, True
-        self.done = self.done or self.n_steps <= 0
+        self.book = Ledger(self.setup.goal_tolerance)
+        gd = float(np.linalg.norm(self.goal - self.pos))
+        self.done = self.book.begin(self.clearance, gd) or self.clock.up
+
+    @property
+    def status(self) -> str:
+        """``success``, ``collision`` or ``timeout`` (also while running)."""
+        return self.book.status
 
     def acting(self) -> tuple[int, ...]:
         """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
-        return (0,) if self.step_index % self.ratio == 0 else ()
+        return (0,) if self.clock.due else ()
 
     def observe(self, agent: int = 0) -> Observation3D:
         """What the robot senses now (rates known or estimated; see :class:`Sensing3DConfig`)."""
@@ -288,60 +282,45 @@ class Vehicle3DWorld:
         """Hold ``cmd`` from now on: counted in ``limit_violations`` when outside (3.4)-(3.6),
         made physical (:meth:`Vehicle3DCommand.clipped`); returns what is applied."""
         if cmd.violates(self.spec, self.a):
-            self.violations += 1
+            self.book.violations += 1
         new = cmd.clipped(self.spec, self.a)
-        if self.step_index > 0:
-            self.effort += (new.v - self.applied.v) ** 2 / (self.ratio * self.dt)
+        if self.clock.step_index > 0:
+            self.book.effort += (new.v - self.applied.v) ** 2 / (self.ratio * self.dt)
         self.applied = new
         self.u_held = new.u
         return new
 
     def advance(self) -> None:
         """One integration step ``dt``: robot, obstacles, clearance, collision and arrival."""
-        dt = self.dt
+        dt, book = self.dt, self.book
         u_held = self.u_held
-        self.effort += float(u_held @ u_held) * dt
+        book.effort += float(u_held @ u_held) * dt
         new_pos, self.a, self.u_held = vehicle3d_advance(
             self.pos, self.a, self.applied.v, u_held, dt
         )
-        self.path += float(np.linalg.norm(new_pos - self.pos))
+        book.path += float(np.linalg.norm(new_pos - self.pos))
         self.pos = new_pos
         t = self.t
         for ob in self.obstacles:
             ob.step(t, dt)
-        self.step_index += 1
-        self.t = t = self.step_index * dt
+        self.t = t = self.clock.tick()
         if self.tracker is None:
             self.clearance, self.nearest = clearance3d(self.pos, self.obstacles, self.spec.radius)
         else:  # (uses the rates held over the step just done)
             self.clearance, self.nearest = self.tracker.step(
-                self.pos, self.applied.v, dt, self.min_clear
+                self.pos, self.applied.v, dt, book.min_clear
             )
         for ob in self.obstacles:  # rates of the next step, visible to the next sensing
             ob.state.velocity, ob.state.rotation_rate = ob.motion.rates(t, ob.state)
-        self.min_clear = min(self.min_clear, self.clearance)
-        if self.clearance < 0:
-            self.status, self.done = "collision", True
-        elif float(np.linalg.norm(self.goal - self.pos)) <= self.setup.goal_tolerance:
-            self.status, self.reached_at, self.done = "success", t, True
-        elif self.step_index >= self.n_steps:
-            self.done = True
+        gd = float(np.linalg.norm(self.goal - self.pos))
+        self.done = book.judge(t, self.clearance, gd) or self.clock.up
+
+    def close(self) -> None:
+        """Nothing to write back (the obstacles were advanced in place)."""
 
     def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
         """The episode's metrics (:mod:`uvnav.sim.metrics`) so far."""
-        shortest = max(self.start_dist - self.setup.goal_tolerance, 0.0)
-        return episode_metrics(
-            status=self.status,
-            path_length=self.path,
-            shortest=shortest,
-            straight_time=shortest / self.spec.v_max,
-            reached_at=self.reached_at,
-            min_clearance=float(self.min_clear) if self.obstacles else None,
-            control_effort=self.effort,
-            limit_violations=self.violations,
-            mode_switches=log.mode_switches,
-            decision_us=log.timed_us,
-        )
+        return self.book.metrics(log, top_speed=self.spec.v_max)
 
 
 class Trajectory3DProbe(BaseProbe):

@@ -34,8 +34,8 @@ from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.polygons import closed_rings, rings_nearest
 from uvnav.obstacles.deforming import ShapeChanging
 from uvnav.sensors.sonar2d import SonarConfig, SonarObservation, sonar_scan
-from uvnav.sim.episode import decision_ratio
-from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
+from uvnav.sim.ledger import Clock, Ledger
+from uvnav.sim.metrics import EpisodeMetrics
 
 
 @dataclass
@@ -127,8 +127,9 @@ class Uuv2dWorld:
     (:class:`uvnav.core.World`), run by :func:`run_uuv2d_episode` and stepped by the Gymnasium
     env ``uvnav/UUV2D-v0`` (:mod:`uvnav.envs.uuv2d`).
 
-    The bookkeeping (path, effort, limit violations, clearance, forbidden regions, status) lives
-    here, so both users get the same numbers.
+    The bookkeeping (path, effort, limit violations, clearance, status) is the one
+    :class:`~uvnav.sim.ledger.Ledger`'s, the forbidden regions this world's, so both users get
+    the same numbers.
 
     Args:
         setup: the episode.
@@ -144,10 +145,9 @@ class Uuv2dWorld:
         self.setup = setup
         self._law_rng, self.sense_rng = rng.spawn(2)
         self.spec = setup.spec
-        self.dt = float(setup.dt)
+        self.clock = Clock(setup.dt, setup.control_period, setup.t_max)
+        self.dt, self.ratio = self.clock.dt, self.clock.ratio
         self.period = float(setup.control_period)
-        self.ratio = decision_ratio(self.period, self.dt)
-        self.n_steps = round(setup.t_max / self.dt)
         self.goal = np.asarray(setup.goal, dtype=float)
         self.state = np.asarray(setup.start, dtype=float).copy()
         self.shapes = setup.shapes
@@ -168,26 +168,20 @@ class Uuv2dWorld:
         state = self.state
         self.outlines = self.outlines_at(0.0)
         self.clearance, _ = clearance_of((state[0], state[1]), self.outlines, self.spec.radius)
-        self.min_clear = self.clearance
         self.entered = inside_any((state[0], state[1]), self.setup.forbidden)
-        self.start_dist = float(np.hypot(*(self.goal - state[:2])))
-        self.status = "timeout"
-        self.done = self.n_steps <= 0
-        if self.clearance < 0:
-            self.status, self.done = "collision", True
-        elif self.start_dist <= self.setup.goal_tolerance:
-            self.status, self.done = "success", True
-        self.path = 0.0
-        self.effort = 0.0
-        self.violations = 0
+        self.book = Ledger(self.setup.goal_tolerance)
+        self.done = self.book.begin(self.clearance, float(np.hypot(*(self.goal - state[:2]))))
         self.applied = HolonomicCommand(0.0, 0.0)
-        self.reached: float | None = None
         self.t = 0.0
-        self.step_index = 0
+
+    @property
+    def status(self) -> str:
+        """``success``, ``collision`` or ``timeout`` (also while running)."""
+        return self.book.status
 
     def acting(self) -> tuple[int, ...]:
         """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
-        return (0,) if self.step_index % self.ratio == 0 else ()
+        return (0,) if self.clock.due else ()
 
     def observe(self, agent: int = 0) -> SonarObservation:
         """The sonar sweep now and the vehicle's own state (:class:`SonarObservation`)."""
@@ -212,13 +206,15 @@ class Uuv2dWorld:
         state = self.state
         period = self.period
         if cmd.violates(self.spec, float(state[2]), period):
-            self.violations += 1
+            self.book.violations += 1
         new = cmd.clipped(self.spec, float(state[2]), period)
-        if self.step_index > 0:
+        if self.clock.step_index > 0:
             turn = (
                 wrap_scalar(math.atan2(new.vy, new.vx) - float(state[2])) if new.speed > 0 else 0.0
             )
-            self.effort += turn * turn / period + (new.speed - self.applied.speed) ** 2 / period
+            self.book.effort += (
+                turn * turn / period + (new.speed - self.applied.speed) ** 2 / period
+            )
         self.applied = new
         return new
 
@@ -227,43 +223,26 @@ class Uuv2dWorld:
         and arrival."""
         state = self.state
         nxt = holonomic_step(state, self.applied, self.dt)
-        self.path += math.hypot(nxt[0] - state[0], nxt[1] - state[1])
+        self.book.path += math.hypot(nxt[0] - state[0], nxt[1] - state[1])
         self.state = state = nxt
-        self.step_index += 1
-        self.t = t = self.step_index * self.dt
+        self.t = t = self.clock.tick()
         self.outlines = self.outlines_at(t)
         self.clearance, _ = clearance_of((state[0], state[1]), self.outlines, self.spec.radius)
-        self.min_clear = min(self.min_clear, self.clearance)
         self.entered = self.entered or inside_any((state[0], state[1]), self.setup.forbidden)
         goal = self.goal
-        if self.clearance < 0:
-            self.status, self.done = "collision", True
-        elif math.hypot(goal[0] - state[0], goal[1] - state[1]) <= self.setup.goal_tolerance:
-            self.status, self.reached, self.done = "success", t, True
-        elif self.step_index >= self.n_steps:
-            self.done = True
+        gd = math.hypot(goal[0] - state[0], goal[1] - state[1])
+        self.done = self.book.judge(t, self.clearance, gd) or self.clock.up
+
+    def close(self) -> None:
+        """Nothing to write back (the outlines are functions of time)."""
 
     def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
-        """The episode's metrics (:mod:`uvnav.sim.metrics`) so far."""
-        setup = self.setup
-        spec = self.spec
-        goal = self.goal
-        shortest = max(self.start_dist - setup.goal_tolerance, 0.0)
-        # the fastest straight run: along the start->goal direction at the box's speed there
+        """The episode's metrics (:mod:`uvnav.sim.metrics`) so far; the time ratio's top speed is
+        the box's along the start-goal line (its components are bounded separately)."""
+        setup, goal = self.setup, self.goal
         direction = math.atan2(goal[1] - setup.start[1], goal[0] - setup.start[0])
-        v_line = spec.v_max / max(abs(math.cos(direction)), abs(math.sin(direction)))
-        return episode_metrics(
-            status=self.status,
-            path_length=self.path,
-            shortest=shortest,
-            straight_time=shortest / v_line if v_line > 0 else 0.0,
-            reached_at=self.reached,
-            min_clearance=float(self.min_clear) if self.shapes else None,
-            control_effort=self.effort,
-            limit_violations=self.violations,
-            mode_switches=log.mode_switches,
-            decision_us=log.timed_us,
-        )
+        v_line = self.spec.v_max / max(abs(math.cos(direction)), abs(math.sin(direction)))
+        return self.book.metrics(log, top_speed=v_line)
 
 
 class Uuv2dTrajectoryProbe(BaseProbe):

@@ -32,8 +32,8 @@ from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.mesh3d import nearest_on_mesh
 from uvnav.obstacles.deforming3d import CompoundBody
 from uvnav.sensors.sonar_array import SonarArray, merge_triangles, sonar_scan
-from uvnav.sim.episode import decision_ratio
-from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
+from uvnav.sim.ledger import Clock, Ledger
+from uvnav.sim.metrics import EpisodeMetrics
 
 
 @dataclass(frozen=True)
@@ -107,9 +107,9 @@ class UUV3DWorld:
     (:class:`uvnav.core.World`).
 
     Every integration step ends with the checks (clearance to the nearest mesh point, inner
-    space, arrival): :meth:`start` makes them at t = 0, :meth:`advance` integrates one ``dt`` and
-    makes them at the new time.  The episode ends on collision, arrival or after
-    ``n_steps = ceil(t_max / dt - 1e-9)`` steps.
+    space, arrival; the status and sums are the one :class:`~uvnav.sim.ledger.Ledger`'s):
+    :meth:`start` makes them at t = 0, :meth:`advance` integrates one ``dt`` and makes them at the
+    new time.  The episode ends on collision, arrival or at ``t_max``.
 
     Random streams: unlike the other worlds, one generator serves both the law and the sonar:
     :meth:`law_setup` returns ``rng`` itself (not a child), so the law's reset draws and each
@@ -129,9 +129,8 @@ class UUV3DWorld:
         self.setup = setup
         self.rng = rng
         self.spec = setup.spec
-        self.dt = float(setup.dt)
-        self.ratio = decision_ratio(setup.control_period, setup.dt)
-        self.n_steps = math.ceil(setup.t_max / setup.dt - 1e-9)
+        self.clock = Clock(setup.dt, setup.control_period, setup.t_max)
+        self.dt, self.ratio = self.clock.dt, self.clock.ratio
         self.goal = np.asarray(setup.goal, dtype=float)
         self.pos = np.asarray(setup.start, dtype=float).copy()
         head = np.asarray(setup.heading, dtype=float)
@@ -147,40 +146,29 @@ class UUV3DWorld:
     def start(self, oracles: Sequence[bool] = (False,)) -> None:
         """Bookkeeping and the checks at t = 0; an oracle law gets the true nearest point."""
         self.oracle = bool(oracles[0])
-        self.step_index = 0
         self.v_held = 0.0
         self.u_held = np.zeros(3)
         self.v_prev = 0.0
-        self.effort = 0.0
-        self.path = 0.0
-        self.violations = 0
-        self.min_clear = math.inf
-        self.collided = False
         self.inner = False
-        self.reached_at: float | None = None
-        self._check()
+        self.book = Ledger(self.setup.goal_tolerance)
+        gd = self._measure()
+        self.done = self.book.begin(self.clearance, gd) or self.clock.up
 
-    def _check(self) -> None:
-        """Clearance, nearest point, inner space and arrival at ``t``; ends the episode on
-        collision, arrival or the last step."""
+    def _measure(self) -> float:
+        """Clearance, nearest point and inner space at ``t``; returns the distance to B [m]."""
         pos, t = self.pos, self.t
         if self.obstacles:
             d, self.nearest = _nearest(pos, self.obstacles, t, math.inf)
         else:
             d, self.nearest = math.inf, None
         self.clearance = d - self.spec.radius
-        self.min_clear = min(self.min_clear, self.clearance)
-        if self.clearance < 0:
-            self.collided = True
         if not self.inner and any(bool(ob.in_inner_space(pos[None])[0]) for ob in self.obstacles):
             self.inner = True
-        if float(np.linalg.norm(self.goal - pos)) <= self.setup.goal_tolerance:
-            self.reached_at = t
-        self.done = self.collided or self.reached_at is not None or self.step_index >= self.n_steps
+        return float(np.linalg.norm(self.goal - pos))
 
     def acting(self) -> tuple[int, ...]:
         """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
-        return (0,) if self.step_index % self.ratio == 0 else ()
+        return (0,) if self.clock.due else ()
 
     def observe(self, agent: int = 0) -> SonarObservation3D:
         """The nine-sonar scan of the tessellations now (noise and dropout from ``rng``); the
@@ -205,62 +193,42 @@ class UUV3DWorld:
         """Hold ``cmd``: counted in ``limit_violations`` when outside the limits (judged against
         the current heading, as the turn rate must be normal to it), saturated."""
         if cmd.violates(self.spec, self.head):
-            self.violations += 1
+            self.book.violations += 1
         cmd = cmd.clipped(self.spec, self.head)
         self.v_held, self.u_held = float(cmd.v), np.asarray(cmd.u, dtype=float)
         return cmd
 
     def advance(self) -> None:
         """One step ``dt``: effort, the vehicle (exact), then the checks at the new time."""
-        dt = self.dt
-        self.effort += float(self.u_held @ self.u_held) * dt
-        if self.step_index % self.ratio == 0:
+        dt, book = self.dt, self.book
+        book.effort += float(self.u_held @ self.u_held) * dt
+        if self.clock.due:
             # Ch. 5's speed term differs from the other worlds' on purpose (the recorded Ch. 5
             # numbers use it): it is counted at every decision, the first included (from rest,
             # v = 0), as ((v - v_prev) / period)^2 * period.
             period = self.setup.control_period
-            self.effort += ((self.v_held - self.v_prev) / period) ** 2 * period
+            book.effort += ((self.v_held - self.v_prev) / period) ** 2 * period
             self.v_prev = self.v_held
         new_pos, self.head, self.u_held = vehicle3d_advance(
             self.pos, self.head, self.v_held, self.u_held, dt
         )
-        self.path += float(np.linalg.norm(new_pos - self.pos))
+        book.path += float(np.linalg.norm(new_pos - self.pos))
         self.pos = new_pos
-        self.step_index = k = self.step_index + 1
-        self.t = k * dt
-        self._check()
+        self.t = self.clock.tick()
+        gd = self._measure()
+        self.done = book.judge(self.t, self.clearance, gd) or self.clock.up
 
     @property
     def status(self) -> str:
         """``success`` (arrived without collision), ``collision`` or ``timeout``."""
-        if self.collided:
-            return "collision"
-        return "success" if self.reached_at is not None else "timeout"
+        return self.book.status
 
     def close(self) -> None:
         """Nothing to write back (the obstacles' surfaces are functions of time)."""
 
     def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
         """The episode's metrics (:mod:`uvnav.sim.metrics`)."""
-        spec, status = self.spec, self.status
-        straight = max(
-            float(np.linalg.norm(self.goal - np.asarray(self.setup.start, float)))
-            - self.setup.goal_tolerance,
-            1e-9,
-        )
-        finite = bool(self.obstacles) and math.isfinite(self.min_clear)
-        return episode_metrics(
-            status=status,
-            path_length=self.path,
-            shortest=straight,
-            straight_time=straight / spec.v_max,
-            reached_at=self.reached_at if status == "success" else None,
-            min_clearance=float(self.min_clear) if finite else None,
-            control_effort=self.effort,
-            limit_violations=self.violations,
-            mode_switches=log.mode_switches,
-            decision_us=log.timed_us,
-        )
+        return self.book.metrics(log, top_speed=self.spec.v_max)
 
 
 class LocatedTraceProbe(BaseProbe):

@@ -63,8 +63,9 @@ from uvnav.obstacles.obstacle import (
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
 from uvnav.sensors.exact import sense_obstacles
 from uvnav.sensors.observation import Observation, ObstacleReading
-from uvnav.sim.episode import SensingConfig, decision_ratio
-from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
+from uvnav.sim.episode import SensingConfig
+from uvnav.sim.ledger import Clock, Ledger
+from uvnav.sim.metrics import EpisodeMetrics
 
 _NO_OUTLINE = np.zeros((0, 2))  # a disc's outline in a reading (as sense_obstacles gives it)
 
@@ -246,9 +247,10 @@ class MultiUnicycleWorld:
     decision at a time, by the PettingZoo env :mod:`uvnav.envs.multi_robot`.
 
     Agent i is robot i.  Per-robot bookkeeping (path, effort, limit violations, clearance,
-    status) and the group's (robot pairs that overlapped, obstacle hits, the deadlock window)
-    live here.  ``clearance[i]`` is robot i's gap after the last step [m] (``inf`` when nothing
-    is within its reach, or once it is done).
+    status) is robot i's :class:`~uvnav.sim.ledger.Ledger` (``books[i]``), the group's (robot
+    pairs that overlapped, obstacle hits, the deadlock window) lives here.  ``clearance[i]`` is
+    robot i's gap after the last step [m] (``inf`` when nothing is within its reach, or once it
+    is done).
 
     Args:
         setup: the scene; its obstacles are advanced in place and written back by :meth:`close`.
@@ -273,9 +275,8 @@ class MultiUnicycleWorld:
             raise ValueError("a multi-robot episode needs at least one robot")
         self.setup = setup
         self.robots = robots
-        self.dt = dt = float(setup.dt)
-        self.ratio = decision_ratio(float(setup.control_period), dt)
-        self.n_steps = round(setup.t_max / dt)
+        self.clock = Clock(setup.dt, setup.control_period, setup.t_max)
+        self.dt, self.ratio = self.clock.dt, self.clock.ratio
         self.tol = float(setup.goal_tolerance)
         self._children = rng.spawn(2 * n)
         self.obstacles = setup.obstacles
@@ -332,45 +333,48 @@ class MultiUnicycleWorld:
         self.speeds = np.zeros(n)
         self.turns = np.zeros(n)
         self.active = np.ones(n, dtype=bool)  # neither arrived nor collided
-        self.status = ["timeout"] * n
-        self.reached: list[float | None] = [None] * n
-        self.start_dist = np.hypot(*(self.goals - self.state[:, :2]).T)
-        self.path = np.zeros(n)
-        self.effort = np.zeros(n)
-        self.violations = np.zeros(n, dtype=int)
-        self.min_clear = np.full(n, np.inf)
+        self.books = [Ledger(self.tol) for _ in range(n)]
         self.clearance = np.full(n, np.inf)
         self.pairs: set[tuple[int, int]] = set()
         self.obstacle_hits = 0
         self.window = max(1, round(self.setup.deadlock_window / self.dt))
         self.history: list[FloatArray] = []
         self.applied = [UnicycleCommand(0.0, 0.0) for _ in range(n)]
-        self.step_index = 0
         self._pairs: _DiscPairs | None = None
         self.field = self._field()
         self._check()
-        for i in range(n):
-            if self.active[i] and self.start_dist[i] <= self.tol:
-                self.status[i], self.reached[i], self.active[i] = "success", 0.0, False
-        self.done = not self.active.any() or self.n_steps <= 0
+        for i, gd in enumerate(self._goal_dists()):
+            self.active[i] = not self.books[i].begin(float(self.clearance[i]), gd)
+        self.done = not self.active.any() or self.clock.up
+
+    @property
+    def status(self) -> list[str]:
+        """Each robot's ``success``, ``collision`` or ``timeout`` (also while running)."""
+        return [b.status for b in self.books]
+
+    @property
+    def reached(self) -> list[float | None]:
+        """Each robot's arrival time [s] (``None`` before)."""
+        return [b.reached_at for b in self.books]
+
+    def _goal_dists(self) -> list[float]:
+        """Each robot's distance to its goal now [m]."""
+        return np.hypot(*(self.goals - self.state[:, :2]).T).tolist()
 
     def _check(self) -> None:
-        """Clearances, collisions (robot pairs, obstacle hits) after a step or at t = 0."""
-        n, k, fld, active, status = self.n_agents, self.k, self.field, self.active, self.status
+        """Clearances (``inf`` for a robot that is done) and the collisions' pairs and obstacle
+        hits, after a step or at t = 0; the ledgers judge them."""
+        n, k, fld, active = self.n_agents, self.k, self.field, self.active
         if self.batched:
             dp = _DiscPairs(fld, self.state[:, :2], self.reach)
             self._pairs = dp
             keep = dp.within & active[:, None]
             np.fill_diagonal(keep, False)
             gaps = dp.signed - self.radii[:, None]
-            seen = keep.any(axis=1)
-            low = np.where(keep, gaps, np.inf).min(axis=1)
-            self.clearance = low
-            self.min_clear[seen] = np.minimum(self.min_clear[seen], low[seen])
+            self.clearance = np.where(keep, gaps, np.inf).min(axis=1)
             hit_i, hit_j = np.nonzero(keep & (gaps < 0))
             for i, j in zip(hit_i.tolist(), hit_j.tolist(), strict=True):
                 self.pairs.add((min(i, j), max(i, j)))
-                status[i] = "collision"
         else:
             self.clearance = np.full(n, np.inf)
             for i in range(n):
@@ -384,21 +388,16 @@ class MultiUnicycleWorld:
                 ids = q.ids[~own]
                 if len(gaps) == 0:
                     continue
-                self.clearance[i] = low_i = float(gaps.min())
-                self.min_clear[i] = min(self.min_clear[i], low_i)
+                self.clearance[i] = float(gaps.min())
                 for j in ids[gaps < 0].tolist():
                     if j >= k:
                         self.pairs.add((min(i, j - k), max(i, j - k)))
                     else:
                         self.obstacle_hits += 1
-                    status[i] = "collision"
-        for i in range(n):
-            if status[i] == "collision":
-                active[i] = False
 
     def acting(self) -> list[int]:
         """The active robots, in index order, at a decision time (every ``control_period``)."""
-        if self.step_index % self.ratio:
+        if not self.clock.due:
             return []
         return np.flatnonzero(self.active).tolist()
 
@@ -448,11 +447,13 @@ class MultiUnicycleWorld:
         (2.4), saturated."""
         i = agent
         spec = self.robots[i].spec
+        book = self.books[i]
         if cmd.violates(spec):
-            self.violations[i] += 1
+            book.violations += 1
         new = cmd.clipped(spec)
         prev = self.applied[i].v
-        self.effort[i] += ((new.v - prev) ** 2) / (self.ratio * self.dt) if self.step_index else 0.0
+        if self.clock.step_index:
+            book.effort += ((new.v - prev) ** 2) / (self.ratio * self.dt)
         self.applied[i] = new
         return new
 
@@ -468,34 +469,29 @@ class MultiUnicycleWorld:
                 self.speeds[i] = self.turns[i] = 0.0
                 continue
             v, u = self.applied[i].v, self.applied[i].u
-            self.effort[i] += u * u * dt
+            book = self.books[i]
+            book.effort += u * u * dt
             x, y, th = state[i]
             nx, ny, nth = unicycle_advance(float(x), float(y), float(th), v, u, dt)
-            self.path[i] += math.hypot(nx - x, ny - y)
+            book.path += math.hypot(nx - x, ny - y)
             state[i] = (nx, ny, nth)
             self.speeds[i], self.turns[i] = v, u
         self.batch.step(self.t, dt)
-        self.step_index = step = self.step_index + 1
-        self.t = step * dt
+        self.t = t = self.clock.tick()
         self.field = self._field()
         self._check()
-        for i in range(self.n_agents):
-            if active[i] and math.hypot(*(self.goals[i] - state[i, :2])) <= self.tol:
-                self.status[i], self.reached[i], active[i] = "success", self.t, False
-        self.done = not active.any() or step >= self.n_steps
+        for i, gd in enumerate(self._goal_dists()):
+            if active[i]:
+                active[i] = not self.books[i].judge(t, float(self.clearance[i]), gd)
+        self.done = not active.any() or self.clock.up
 
     def close(self) -> None:
         """Write the obstacles' states back to their models (the setup's objects)."""
         self.batch.write_back()
 
-    def metrics(self, log: AgentLog, agent: int) -> EpisodeMetrics:
+    def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
         """Robot ``agent``'s metrics (the names of a single-robot episode's)."""
-        i = agent
-        return robot_metrics(
-            self.robots[i].spec, float(self.start_dist[i]), self.tol, self.status[i],
-            float(self.path[i]), self.reached[i], float(self.min_clear[i]), float(self.effort[i]),
-            int(self.violations[i]), log,
-        )  # fmt: skip
+        return self.books[agent].metrics(log, top_speed=float(self.robots[agent].spec.v_max))
 
     def group_metrics(self) -> GroupMetrics:
         """The group's outcome (module docstring, :func:`group_outcome`)."""
@@ -504,28 +500,6 @@ class MultiUnicycleWorld:
             self.history[0] if self.history else None, self.t, len(self.pairs),
             self.obstacle_hits,
         )  # fmt: skip
-
-
-def robot_metrics(
-    spec: UnicycleSpec, start_dist: float, tol: float, status: str, path: float,
-    reached: float | None, min_clear: float, effort: float, violations: int, log: AgentLog,
-) -> EpisodeMetrics:  # fmt: skip
-    """One robot's metrics (the names of a single-robot episode's) from its bookkeeping: the
-    distance to its goal at the start [m], path [m], arrival time [s], lowest clearance [m]
-    (``inf``: nothing ever within reach), effort, violations and the loop's log."""
-    shortest = max(start_dist - tol, 0.0)
-    return episode_metrics(
-        status=status,
-        path_length=path,
-        shortest=shortest,
-        straight_time=shortest / spec.v_max if spec.v_max > 0 else 0.0,
-        reached_at=reached,
-        min_clearance=min_clear if math.isfinite(min_clear) else None,
-        control_effort=effort,
-        limit_violations=violations,
-        mode_switches=log.mode_switches,
-        decision_us=log.timed_us,
-    )
 
 
 def group_outcome(

@@ -43,6 +43,7 @@ from uvnav.obstacles.bodies import PolygonBody
 from uvnav.obstacles.motion import ConstantVelocity, RandomTurn
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField, ObstacleState
 from uvnav.sensors.observation import ObstacleReading
+from uvnav.sim.ledger import decision_ratio, step_count
 
 if TYPE_CHECKING:
     from uvnav.sim.episode import EpisodeSetup
@@ -591,8 +592,6 @@ class PackedWorlds:
         obstacles = setup.obstacles
         m = len(obstacles)
         tpl = self._template([o.body for o in obstacles])
-        from uvnav.sim.episode import decision_ratio  # (episode imports this module)
-
         spec, dt = setup.spec, float(setup.dt)
         ratio = decision_ratio(float(setup.control_period), dt)
         b = max(self.ubuf.shape[2], 4 * ratio)  # half a row: a decision's draws, 2 a step
@@ -604,7 +603,7 @@ class PackedWorlds:
         wf[[W_X, W_Y, W_TH, W_GX, W_GY]] = (x, y, th, gx, gy)
         wf[[W_RADIUS, W_TOL, W_DT]] = (float(spec.radius), float(setup.goal_tolerance), dt)
         wf[[W_VMAX, W_UMAX]] = (float(spec.v_max), float(spec.u_max))
-        n_steps = round(setup.t_max / dt)
+        n_steps = step_count(float(setup.t_max), dt)
         wi[[I_STEP, I_RATIO, I_NSTEPS, I_NOBS]] = (0, ratio, n_steps, m)
         # at t = 0 as UnicycleWorld.start measures it (the field's query), from the slot
         gap = float(kernel("clearance_one")(x, y, float(spec.radius), m, self.params[slot],
@@ -615,8 +614,6 @@ class PackedWorlds:
             status = COLLISION
         elif math.hypot(gx - x, gy - y) <= setup.goal_tolerance:
             status = SUCCESS
-        elif n_steps <= 0:
-            status = TIMEOUT
         wi[I_STATUS] = status
         # the slot's rows are full: a top-up is due no sooner for it than for the others
         self._safe_calls = min(self._safe_calls, b // (2 * ratio))

@@ -52,8 +52,8 @@ from uvnav.geometry.kernels3d import compile_family, numba_enabled
 from uvnav.geometry.small import pyhypot
 from uvnav.obstacles.bodies import DiscBody
 from uvnav.obstacles.obstacle import _CULL_ABS, _CULL_REL, _X_AXIS, FieldTemplate
-from uvnav.sim.episode import decision_ratio
-from uvnav.sim.multi import MultiResult, MultiSetup, group_outcome, robot_metrics
+from uvnav.sim.ledger import Ledger, decision_ratio, step_count
+from uvnav.sim.multi import MultiResult, MultiSetup, group_outcome
 
 #: status codes of a packed robot (those of :mod:`uvnav.sim.packed`)
 RUNNING, SUCCESS, COLLISION, TIMEOUT = 0, 1, 2, 3
@@ -325,7 +325,7 @@ class PackedSwarm:
         self.status = np.zeros(n, dtype=np.int64)
         self.pairs = np.zeros((n, n), dtype=np.uint8)
         self.ints = np.array(
-            [0, decision_ratio(float(setup.control_period), dt), round(setup.t_max / dt), 0,
+            [0, decision_ratio(float(setup.control_period), dt), step_count(setup.t_max, dt), 0,
              int(p.max_neighbors), 0, 0], dtype=np.int64,
         )  # fmt: skip
         self.flt = np.array(
@@ -453,11 +453,12 @@ class PackedSwarm:
         tol = float(self.flt[F_TOL])
         robots = []
         for i in range(self.n):
-            robots.append(robot_metrics(
-                setup.robots[i].spec, float(self.start_dist[i]), tol, status[i],
-                float(rob[i, R_PATH]), reached[i], float(rob[i, R_LOW]), float(rob[i, R_EFFORT]),
-                int(rob[i, R_VIOL]), logs[i],
-            ))  # fmt: skip
+            book = Ledger.settled(
+                tol, status=status[i], start_dist=float(self.start_dist[i]),
+                reached_at=reached[i], path=float(rob[i, R_PATH]), effort=float(rob[i, R_EFFORT]),
+                violations=int(rob[i, R_VIOL]), min_clear=float(rob[i, R_LOW]),
+            )  # fmt: skip
+            robots.append(book.metrics(logs[i], top_speed=float(setup.robots[i].spec.v_max)))
         return MultiResult(
             robots=robots,
             statuses=status,
