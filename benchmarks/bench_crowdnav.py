@@ -24,6 +24,8 @@ Options for the protocol study (defaults = the reproduction):
   radius of the goal; else on; the first of these events wins (the world's own end comes at or
   after it: a discrete overlap is a collision at CrowdSim's next step, whose swept segment starts
   inside; the time limit a timeout).  Needs ``--substeps 1``.
+* ``--kinematics arc``: a unicycle law's robot turns on arcs (the thesis's) instead of CrowdNav's
+  turn-then-move (``ActionRot``), the scenes' default.
 * ``--pref crowdnav``: the robot's preferred velocity as CrowdNav's ORCA sets it (1 m/s toward
   the goal beyond 1 m, the gap within) instead of ``orca-holonomic-v1``'s (V_max, lowered to
   ``dist / period`` on the last step).
@@ -119,6 +121,7 @@ def run(
     outcome: str = "uvnav",
     first: int = 0,
     law_name: str = PAPER_LAW,
+    kinematics: str = "turn-then-move",
 ) -> dict[str, Any]:
     """Run the cases; returns the counts, rates, intervals and times."""
     rng_of = kinds()["nav2d"].episode_rng
@@ -128,7 +131,12 @@ def run(
     statuses: list[str] = []
     cpu0, wall0 = time.process_time(), time.perf_counter()
     for case in range(first, first + cases):
-        scn = crowdnav_scenario(case, rule=rule, dt=TIME_STEP / substeps)  # type: ignore[arg-type]
+        scn = crowdnav_scenario(
+            case,
+            rule=rule,
+            dt=TIME_STEP / substeps,
+            kinematics=kinematics,  # type: ignore[arg-type]
+        )
         setup = build_episode(scn, case)
         law: Any
         if law_name != PAPER_LAW:
@@ -166,6 +174,7 @@ def run(
         "pref": pref,
         "outcome": outcome,
         "law": law_name,
+        "kinematics": kinematics if vehicle == "unicycle" else None,
         "params": dict(CROWDNAV_ORCA_PARAMS) if law_name == PAPER_LAW else {},
         "rates": rates,
         "time_to_goal_mean": float(np.mean(times)) if times else None,
@@ -187,7 +196,8 @@ def report(r: dict[str, Any]) -> str:
     lines = [
         f"crowdnav-{r['rule'].split('_')[0]} cases {r['first_case']}.."
         f"{r['first_case'] + r['cases'] - 1} ({r['cases']}), {r['law']} {r['params']}, "
-        f"dt {r['dt']:g} s, pref {r['pref']}, outcome {r['outcome']}",
+        f"dt {r['dt']:g} s, pref {r['pref']}, outcome {r['outcome']}"
+        + (f", {r['kinematics']} unicycle" if r["kinematics"] else ""),
     ]
     for key in ("success", "collision", "timeout"):
         x = r["rates"][key]
@@ -230,6 +240,8 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--law", default=PAPER_LAW,
                     help="2D law (default orca-holonomic-v1, the paper's row; zhang2019-v2 "
                     "and zhang2019-holonomic-v2 are held to issue 19's targets)")  # fmt: skip
+    ap.add_argument("--kinematics", choices=("turn-then-move", "arc"), default="turn-then-move",
+                    help="a unicycle law's robot: CrowdNav's or the arc")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write crowdnav.json here")
     args = ap.parse_args(argv)
     if args.cases < 1 or args.substeps < 1:
@@ -238,7 +250,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.error("--outcome crowdnav judges 0.25 s steps: use --substeps 1")
     r = run(
         args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
-        outcome=args.outcome, first=args.first, law_name=args.law,
+        outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
     )  # fmt: skip
     print(report(r))
     if args.out is not None:

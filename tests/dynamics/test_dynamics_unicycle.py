@@ -12,6 +12,7 @@ from hypothesis import strategies as st
 from uvnav.dynamics.unicycle import (
     UnicycleCommand,
     UnicycleSpec,
+    turn_then_move,
     unicycle_advance,
     unicycle_step,
 )
@@ -172,3 +173,19 @@ def test_clipped_equals_numpy_clip(v: float, u: float) -> None:
     n = UnicycleCommand(np.float64(v), np.float64(u)).clipped(spec)
     assert (n.v, n.u) == (ev, eu)
     assert type(n.v) is float and type(n.u) is float
+
+
+@given(pose, speed, st.floats(-math.pi, math.pi), step)
+def test_turn_then_move_turns_first_then_goes_straight(
+    p: tuple[float, float, float], v: float, turn: float, dt: float
+) -> None:
+    x, y, th = turn_then_move(*p, v, turn, dt)
+    assert abs(math.remainder(th - (p[2] + turn), 2 * math.pi)) < 1e-12
+    # a straight move of v dt along the new heading
+    assert x - p[0] == pytest.approx(v * dt * math.cos(th), abs=1e-9)
+    assert y - p[1] == pytest.approx(v * dt * math.sin(th), abs=1e-9)
+
+
+def test_an_unknown_kinematics_is_refused() -> None:
+    with pytest.raises(ValueError, match="kinematics must be one of arc, turn-then-move"):
+        UnicycleSpec(1.0, 1.0, kinematics="skid")

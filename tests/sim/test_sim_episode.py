@@ -500,3 +500,37 @@ def test_final_obstacle_states_are_left_on_the_setup() -> None:
         assert ob.motion.course == ref.motion.course  # type: ignore[attr-defined]
     j = int(res.trajectory.nearest_id[-1])
     assert np.array_equal(res.trajectory.obstacle_centres[-1, j], setup.obstacles[j].state.position)
+
+
+def test_a_turn_then_move_unicycle_turns_at_the_decision_then_goes_straight() -> None:
+    """CrowdNav's unicycle (``kinematics='turn-then-move'``): a held (v, u) turns the robot by
+    u T when the decision is taken, then moves it straight for the rest of the period."""
+    spec = UnicycleSpec(v_max=1.0, u_max=2.0, radius=0.1, kinematics="turn-then-move")
+    setup = _setup(
+        [], spec=spec, start=np.zeros(3), goal=np.array([50.0, 0.0]), dt=0.05,
+        control_period=0.25, t_max=0.5,
+    )  # fmt: skip
+
+    class Turning(Probe):
+        def act(self, obs: Observation) -> UnicycleCommand:
+            self.seen.append(obs)
+            return UnicycleCommand(1.0, 2.0)
+
+    res = run_episode(setup, Turning(make_controller("straight-v1")), np.random.default_rng(0))
+    tr = res.trajectory
+    assert tr is not None
+    heading = tr.robot[:, 2]
+    # after the first step of each period the heading holds: u T = 0.5 rad per decision
+    np.testing.assert_allclose(heading[1:6], 0.5, atol=1e-12)
+    np.testing.assert_allclose(heading[6:11], 1.0, atol=1e-12)
+    steps = np.diff(tr.robot[:, :2], axis=0)
+    np.testing.assert_allclose(np.hypot(*steps.T), 0.05, atol=1e-12)  # v dt every step
+    np.testing.assert_allclose(np.arctan2(steps[:, 1], steps[:, 0]), heading[1:], atol=1e-12)
+    arc = run_episode(
+        _setup([], spec=UnicycleSpec(1.0, 2.0, 0.1), start=np.zeros(3),
+               goal=np.array([50.0, 0.0]), dt=0.05, control_period=0.25, t_max=0.5),
+        Turning(make_controller("straight-v1")), np.random.default_rng(0),
+    )  # fmt: skip
+    assert arc.trajectory is not None
+    assert arc.trajectory.robot[-1, 2] == pytest.approx(1.0)  # the same total turn, on arcs
+    assert not np.allclose(arc.trajectory.robot[-1, :2], tr.robot[-1, :2])

@@ -8,6 +8,12 @@ make the robot unable to turn when heading along +-y, contradicting the rest of 
 the standard unicycle is used (docs/thesis-notes.md).  Integration is exact for piecewise-constant
 commands (motion along a circular arc, written as the arc's chord so that it stays exact as
 u -> 0), not Euler.
+
+A second kinematics, ``turn-then-move`` (:data:`KINEMATICS`), is the unicycle of the CrowdNav
+benchmark (Chen et al., ICRA 2019; CrowdSim's ``ActionRot``: ``theta += r``, then a straight move
+at ``v`` for the time step): the turn of a whole decision period, ``u T``, happens at once when
+the decision is taken, and the robot then moves straight along its new heading
+(:func:`turn_then_move`).  The same command ``(v, u)`` and limits (2.4) drive both.
 """
 
 from __future__ import annotations
@@ -21,6 +27,10 @@ from uvnav.geometry.angles import FloatArray, wrap_scalar
 
 _EPS = float(np.finfo(float).eps)
 
+#: how a unicycle integrates a held command over a decision period: ``arc`` (the thesis's
+#: continuous turn, exact) or ``turn-then-move`` (CrowdNav's ``ActionRot``)
+KINEMATICS: tuple[str, ...] = ("arc", "turn-then-move")
+
 
 @dataclass(frozen=True, slots=True)
 class UnicycleSpec:
@@ -30,11 +40,19 @@ class UnicycleSpec:
         v_max: maximum speed V_max [m/s] (> 0).
         u_max: maximum turn rate U_max [rad/s] (> 0).
         radius: radius of the robot's disc body [m] (>= 0).
+        kinematics: ``arc`` or ``turn-then-move`` (:data:`KINEMATICS`, module docstring).
     """
 
     v_max: float
     u_max: float
     radius: float = 0.1
+    kinematics: str = "arc"
+
+    def __post_init__(self) -> None:
+        if self.kinematics not in KINEMATICS:
+            raise ValueError(
+                f"kinematics must be one of {', '.join(KINEMATICS)} (got {self.kinematics!r})"
+            )
 
 
 @dataclass(frozen=True, slots=True)
@@ -86,6 +104,19 @@ def unicycle_advance(
         y + chord * math.sin(theta + half),
         wrap_scalar(theta + 2.0 * half),
     )
+
+
+def turn_then_move(
+    x: float, y: float, theta: float, v: float, turn: float, dt: float
+) -> tuple[float, float, float]:
+    """CrowdNav's unicycle step: turn by ``turn`` [rad] at once, then move straight at ``v``
+    [m/s] for ``dt`` [s]; the new ``(x, y, theta)``, theta wrapped to (-pi, pi].
+
+    >>> [round(c, 12) for c in turn_then_move(0.0, 0.0, 0.0, 1.0, math.pi / 2, 0.25)]
+    [0.0, 0.25, 1.570796326795]
+    """
+    th = wrap_scalar(theta + turn)
+    return x + v * dt * math.cos(th), y + v * dt * math.sin(th), th
 
 
 def unicycle_step(state: FloatArray, v: float, u: float, dt: float) -> FloatArray:

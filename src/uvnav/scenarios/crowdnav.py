@@ -44,7 +44,10 @@ with ``safety_space`` 0, ``crowd_nav/test.py``): time horizon 5 s, neighbour dis
 10 neighbours, reciprocal responsibility 0.5 (RVO2's own), and a combined radius 0.62 m (CrowdNav
 adds 0.01 m to the robot's and to each human's radius: ``safety_margin`` 0.02 on the robot here).
 The law picks the robot: a holonomic law drives the holonomic disc robot, a unicycle law the
-unicycle (``u_max`` pi rad/s: CrowdNav's unicycle turns at most pi/4 per 0.25 s step).
+unicycle (``u_max`` pi rad/s: CrowdNav's unicycle turns at most pi/4 per 0.25 s step), which moves
+as CrowdNav's does (``kinematics: turn-then-move``: CrowdSim's ``ActionRot`` turns the robot by
+the step's rotation, then moves it straight at its speed); ``kinematics=arc`` gives the thesis's
+continuous turn instead.
 """
 
 from __future__ import annotations
@@ -241,6 +244,10 @@ def crowdnav_scenario(
     ] = ROBOT_RADIUS,
     v_pref: Annotated[float, _positive("robot V_max [m/s]")] = ROBOT_V_PREF,
     u_max: Annotated[float, _positive("U_max of the unicycle variant [rad/s]")] = UNICYCLE_U_MAX,
+    kinematics: Annotated[
+        Literal["turn-then-move", "arc"],
+        Field(description="the unicycle variant's kinematics (CrowdNav's: turn-then-move)"),
+    ] = "turn-then-move",
     sensing_range: Annotated[
         float, _positive("the robot sees humans within this [m]")
     ] = SENSING_RANGE,
@@ -282,6 +289,8 @@ def crowdnav_scenario(
         robot_radius: robot disc radius [m] (also the goal tolerance).
         v_pref: robot V_max [m/s].
         u_max: U_max of the unicycle variant [rad/s].
+        kinematics: how the unicycle variant moves: ``turn-then-move`` (CrowdNav's
+            ``ActionRot``: the period's turn at once, then straight) or ``arc`` (the thesis's).
         sensing_range: the robot sees humans within this [m].
         controller: the scene's own law.
         controller_params: its parameters (``orca-holonomic-v1``: CrowdNav's robot ORCA).
@@ -369,6 +378,7 @@ def crowdnav_scenario(
             "v_max": v_pref,
             "u_max": u_max,
             "radius": robot_radius,
+            "kinematics": kinematics,
         },
         "sensing": {
             "range": sensing_range,

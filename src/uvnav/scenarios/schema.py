@@ -95,6 +95,13 @@ class RobotSpec(_Model):
     v_max: float = Field(gt=0, description="maximum speed V_max [m/s]")
     u_max: float = Field(gt=0, description="maximum angular velocity U_max [rad/s]")
     radius: float = Field(0.1, ge=0, description="radius of the robot's disc body [m]")
+    kinematics: Literal["arc", "turn-then-move"] = Field(
+        "arc",
+        description=(
+            "how a held command moves the unicycle: 'arc' (the thesis's, a continuous turn) or "
+            "'turn-then-move' (CrowdNav's: the period's turn at once, then straight)"
+        ),
+    )
 
     def initial_heading(self) -> float:
         """``heading`` or, when omitted, the direction from start to goal [rad]."""
@@ -105,7 +112,9 @@ class RobotSpec(_Model):
 
     def to_spec(self) -> UnicycleSpec:
         """The simulator's :class:`~uvnav.dynamics.UnicycleSpec`."""
-        return UnicycleSpec(v_max=self.v_max, u_max=self.u_max, radius=self.radius)
+        return UnicycleSpec(
+            v_max=self.v_max, u_max=self.u_max, radius=self.radius, kinematics=self.kinematics
+        )
 
 
 # ----------------------------------------------------------------------------------------- sensing

@@ -37,7 +37,12 @@ import numpy as np
 from uvnav.controllers.base import Controller
 from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
 from uvnav.dynamics.omni import OmniSpec, VelocityCommand, omni_advance
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
+from uvnav.dynamics.unicycle import (
+    UnicycleCommand,
+    UnicycleSpec,
+    turn_then_move,
+    unicycle_advance,
+)
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.obstacles.batch import ObstacleBatch
@@ -379,12 +384,17 @@ class UnicycleWorld:
         return new
 
     def _move(self, dt: float) -> tuple[float, float]:
-        """Integrate the robot over ``dt`` [s] (exact); returns the new position, updates the
-        heading and the turn part of the control effort."""
+        """Integrate the robot over ``dt`` [s] (exact, by the spec's kinematics: on the arc, or
+        the whole period's turn at the decision and then straight); returns the new position,
+        updates the heading and the turn part of the control effort."""
         v, u = self.applied.v, self.applied.u
         self.book.effort += u**2 * dt
         self.turn += abs(u) * dt
-        nx, ny, self.th = unicycle_advance(self.x, self.y, self.th, v, u, dt)
+        if self.spec.kinematics == "arc":
+            nx, ny, self.th = unicycle_advance(self.x, self.y, self.th, v, u, dt)
+        else:
+            turn = u * (self.ratio * dt) if self.clock.due else 0.0
+            nx, ny, self.th = turn_then_move(self.x, self.y, self.th, v, turn, dt)
         return nx, ny
 
     def advance(self) -> None:

@@ -273,6 +273,9 @@ class MultiUnicycleWorld:
         n = len(robots)
         if n == 0:
             raise ValueError("a multi-robot episode needs at least one robot")
+        for i, r in enumerate(robots):
+            if r.spec.kinematics != "arc":
+                raise ValueError(f"robot {i}: multi-robot worlds integrate arc unicycles")
         self.setup = setup
         self.robots = robots
         self.clock = Clock(setup.dt, setup.control_period, setup.t_max)

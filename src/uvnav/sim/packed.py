@@ -439,6 +439,8 @@ def pack_check(setup: EpisodeSetup) -> str | None:
     generator (the numbers are pre-drawn per obstacle)."""
     if type(setup.spec) is not UnicycleSpec:
         return f"the robot is a {type(setup.spec).__name__}, packed worlds hold unicycles"
+    if setup.spec.kinematics != "arc":
+        return f"the robot's kinematics is {setup.spec.kinematics}, packed worlds integrate arcs"
     owner: dict[int, int] = {}
     for j, ob in enumerate(setup.obstacles):
         rng = getattr(ob.motion, "rng", None)
