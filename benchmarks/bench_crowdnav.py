@@ -24,6 +24,8 @@ Options for the protocol study (defaults = the reproduction):
   radius of the goal; else on; the first of these events wins (the world's own end comes at or
   after it: a discrete overlap is a collision at CrowdSim's next step, whose swept segment starts
   inside; the time limit a timeout).  Needs ``--substeps 1``.
+* ``--sampled``: judge collisions at the end of each step only (the world's judgement is along
+  the whole step, :mod:`uvnav.sim.swept`, as CrowdSim's swept-segment test).
 * ``--kinematics arc``: a unicycle law's robot turns on arcs (the thesis's) instead of CrowdNav's
   turn-then-move (``ActionRot``), the scenes' default.
 * ``--pref crowdnav``: the robot's preferred velocity as CrowdNav's ORCA sets it (1 m/s toward
@@ -122,6 +124,7 @@ def run(
     first: int = 0,
     law_name: str = PAPER_LAW,
     kinematics: str = "turn-then-move",
+    swept: bool = True,
 ) -> dict[str, Any]:
     """Run the cases; returns the counts, rates, intervals and times."""
     rng_of = kinds()["nav2d"].episode_rng
@@ -148,7 +151,8 @@ def run(
             law = make_law(PAPER_LAW, **CROWDNAV_ORCA_PARAMS)
         probe = CrowdSimOutcome()
         probes: list[Any] = [probe] if outcome == "crowdnav" else []
-        res = run_episode(setup, law, rng_of(case), record=False, vehicle=vehicle, probes=probes)
+        res = run_episode(setup, law, rng_of(case), record=False, vehicle=vehicle, probes=probes,
+                          swept=swept)  # fmt: skip
         status, arrival = res.status, res.metrics.time_to_goal
         if outcome == "crowdnav":
             # no event before the world's end: a discrete overlap is a collision in CrowdSim's
@@ -175,6 +179,7 @@ def run(
         "outcome": outcome,
         "law": law_name,
         "kinematics": kinematics if vehicle == "unicycle" else None,
+        "judged": "along each step" if swept else "at each step's end",
         "params": dict(CROWDNAV_ORCA_PARAMS) if law_name == PAPER_LAW else {},
         "rates": rates,
         "time_to_goal_mean": float(np.mean(times)) if times else None,
@@ -196,8 +201,8 @@ def report(r: dict[str, Any]) -> str:
     lines = [
         f"crowdnav-{r['rule'].split('_')[0]} cases {r['first_case']}.."
         f"{r['first_case'] + r['cases'] - 1} ({r['cases']}), {r['law']} {r['params']}, "
-        f"dt {r['dt']:g} s, pref {r['pref']}, outcome {r['outcome']}"
-        + (f", {r['kinematics']} unicycle" if r["kinematics"] else ""),
+        f"dt {r['dt']:g} s, pref {r['pref']}, outcome {r['outcome']}, collisions judged "
+        f"{r['judged']}" + (f", {r['kinematics']} unicycle" if r["kinematics"] else ""),
     ]
     for key in ("success", "collision", "timeout"):
         x = r["rates"][key]
@@ -242,6 +247,8 @@ def main(argv: list[str] | None = None) -> int:
                     "and zhang2019-holonomic-v2 are held to issue 19's targets)")  # fmt: skip
     ap.add_argument("--kinematics", choices=("turn-then-move", "arc"), default="turn-then-move",
                     help="a unicycle law's robot: CrowdNav's or the arc")  # fmt: skip
+    ap.add_argument("--sampled", action="store_true",
+                    help="judge collisions at each step's end only")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write crowdnav.json here")
     args = ap.parse_args(argv)
     if args.cases < 1 or args.substeps < 1:
@@ -251,6 +258,7 @@ def main(argv: list[str] | None = None) -> int:
     r = run(
         args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
         outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
+        swept=not args.sampled,
     )  # fmt: skip
     print(report(r))
     if args.out is not None:

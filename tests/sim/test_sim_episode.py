@@ -434,7 +434,8 @@ def test_record_off_gives_same_metrics_and_observations_in_a_crowd(seed: int, k:
         if not name.startswith("decision_us"):
             assert a.metrics.to_dict()[name] == b.metrics.to_dict()[name], name
     assert a.trajectory is not None
-    assert a.metrics.min_clearance == float(np.min(a.trajectory.clearance))
+    # the minimum along the steps, at most the least sampled one
+    assert a.metrics.min_clearance <= float(np.min(a.trajectory.clearance))
     assert len(seen_a) == len(seen_b)
     for oa, ob in zip(seen_a, seen_b, strict=True):
         assert [r.obstacle_id for r in oa.obstacles] == [r.obstacle_id for r in ob.obstacles]

@@ -34,8 +34,8 @@ The set-up, with its source (``crowd_nav/configs/env.config`` unless said otherw
   (``goal_tolerance`` = robot radius);
 * collision: the robot's disc touching a human's (radius sum 0.6 m).  CrowdNav tests the segment
   the relative position would sweep over the step with the human's *previous* velocity; here
-  the world checks the exact positions after every integration step ``dt`` (0.25 s by default;
-  give a smaller ``dt`` for a nearly continuous check, the crowd still deciding every 0.25 s);
+  the world judges the whole of every integration step ``dt`` (0.25 s by default) with the
+  positions the robot and the humans actually pass through (:mod:`uvnav.sim.swept`);
 * randomised attributes (``randomize_attributes = false``): off by default; when on, each human
   draws ``v_pref`` in [0.5, 1.5) and radius in [0.3, 0.5) first, as ``sample_random_attributes``.
 

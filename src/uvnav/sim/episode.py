@@ -7,9 +7,12 @@ robot of the crowd benchmarks (the law's vehicle picks the world: :data:`WORLDS_
 
 Decision rate and integration rate are separate: the law is asked every ``control_period`` [s]
 (a whole multiple of ``dt``, else :func:`run_episode` raises ``ValueError``); robot and obstacles
-are integrated every ``dt`` [s] with the last command held.  Collisions are checked at *every*
-integration step, exactly (robot disc against disc or polygon sets, see
-:meth:`uvnav.obstacles.ObstacleField.query`; the kernel is property-tested against shapely).
+are integrated every ``dt`` [s] with the last command held.  Collisions are judged along the
+whole of every integration step (:class:`~uvnav.sim.swept.SweptClearance`: the robot's disc
+against the bodies' sweep, exact for bodies that do not rotate and at most 1 mm short for those
+that do), besides the exact clearance sampled at the end of each step (robot disc against disc
+or polygon sets, see :meth:`uvnav.obstacles.ObstacleField.query`; the kernel is property-tested
+against shapely); the minimum clearance is the minimum along the steps.
 
 The simulator clips nothing silently: a command outside the limits ((2.4), or the V_max disc) is
 saturated to what the vehicle can physically do *and* counted in ``limit_violations``.
@@ -45,6 +48,7 @@ from uvnav.dynamics.unicycle import (
 )
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.kernels3d import numba_enabled
+from uvnav.geometry.sweep import arc_slack
 from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
@@ -56,6 +60,7 @@ from uvnav.sim.metrics import EpisodeMetrics
 from uvnav.sim.packed import PackedObstacles, pack_check
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
 from uvnav.sim.social import SocialTracker, collision_by, pedestrian_ids
+from uvnav.sim.swept import StepPoses, SweptClearance
 
 
 @dataclass(frozen=True)
@@ -120,12 +125,15 @@ class EpisodeSetup:
 
 @dataclass
 class EpisodeResult:
-    """Metrics, status (``success``, ``collision`` or ``timeout``) and the recorded trajectory."""
+    """Metrics, status (``success``, ``collision`` or ``timeout``), the recorded trajectory and,
+    for a collision, the time of the first contact [s] (``None`` otherwise, or where the world
+    does not know it)."""
 
     metrics: EpisodeMetrics
     status: str
     trajectory: Trajectory | None
     decision_us: FloatArray
+    contact_time: float | None = None
 
 
 class _MinClearance:
@@ -160,6 +168,11 @@ class _MinClearance:
     def _exact(self, fld: ObstacleField, px: float, py: float, radius: float = 0.0) -> float:
         q = fld.query((px, py), radius, nearest=True)
         return float((q.signed - self._radius).min())
+
+    @property
+    def best(self) -> float:
+        """The least exact clearance evaluated so far [m] (an upper bound of the minimum)."""
+        return self._best
 
     def step(self, fld: ObstacleField, px: float, py: float, radius: float) -> float:
         """Account for the robot at ``(px, py)`` in ``fld``; the query also covers ``radius`` [m]
@@ -216,6 +229,9 @@ class UnicycleWorld:
             packs (:func:`~uvnav.sim.packed.pack_check`): compiled motion, clearance (exact at
             every step) and sensing, the numpy path's numbers; :attr:`field` is then built on
             demand.
+        swept: judge collisions and the minimum clearance along every step
+            (:class:`~uvnav.sim.swept.SweptClearance`); ``False`` samples the end of each step
+            only (for comparisons with the sampled judgement).
     """
 
     vehicle: ClassVar[str] = "unicycle"
@@ -225,9 +241,16 @@ class UnicycleWorld:
     COMMAND_NAMES: ClassVar[tuple[str, str]] = ("V_R [m/s]", "u_R [rad/s]")
 
     def __init__(
-        self, setup: EpisodeSetup, rng: np.random.Generator, *, exact: bool, packed: bool = False
+        self,
+        setup: EpisodeSetup,
+        rng: np.random.Generator,
+        *,
+        exact: bool,
+        packed: bool = False,
+        swept: bool = True,
     ) -> None:
         self.setup = setup
+        self.swept = swept
         self._law_rng, self.sense_rng = rng.spawn(2)
         self.spec: Any = setup.spec  # UnicycleSpec (OmniSpec in HolonomicWorld)
         self.clock = Clock(setup.dt, setup.control_period, setup.t_max)
@@ -300,6 +323,11 @@ class UnicycleWorld:
                 self.pedestrians, self.template.radii, radius, self.dt, self.ratio
             )
             self.social.observe(self.field, self.x, self.y, 0)
+        self.sweep = (
+            SweptClearance(self.template, float(self.spec.radius))
+            if self.swept and self.obstacles
+            else None
+        )
         self.collision_by: str | None = None
         self.turn = 0.0  # total absolute heading change [rad]
         self.applied: Any = UnicycleCommand(0.0, 0.0)  # the command held now
@@ -372,6 +400,21 @@ class UnicycleWorld:
         """Squared change of the velocity command from the applied one [m^2/s^2]."""
         return float((new.v - self.applied.v) ** 2)
 
+    def _travel(self, dt: float) -> tuple[float, float]:
+        """The robot's path length over a step of ``dt`` [s] under the held command and its
+        path's largest distance from the step's chord [m] (an arc's; none turning in place)."""
+        v, u = self.applied.v, self.applied.u
+        slack = arc_slack(v, u, dt) if self.spec.kinematics == "arc" else 0.0
+        return abs(v) * dt, slack
+
+    def _poses(self) -> tuple[FloatArray, FloatArray, np.ndarray | None]:
+        """The bodies' centres, headings and presence now."""
+        if self.packed is not None:
+            c, h = self.packed.poses()
+            return c, h, None
+        f = self.field
+        return f.centres, f.headings, f.present
+
     def apply(self, cmd: UnicycleCommand, agent: int = 0) -> UnicycleCommand:
         """Hold ``cmd``: counted in ``limit_violations`` when outside (2.4), saturated."""
         spec = self.spec
@@ -400,9 +443,11 @@ class UnicycleWorld:
     def advance(self) -> None:
         """One step ``dt``: robot (exact), obstacles, clearance, collision and arrival."""
         dt, book, clock = self.dt, self.book, self.clock
-        x, y = self.x, self.y
+        x, y, t0, g0 = self.x, self.y, self.t, self.clearance
         if self.batch.sees_robot:  # bodies that react to the robot see it as it starts the step
             self.batch.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
+        start = self._poses() if self.sweep is not None else None
+        travel, slack = self._travel(dt)
         nx, ny = self._move(dt)
         book.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
@@ -427,8 +472,23 @@ class UnicycleWorld:
                 self.clearance, self.nearest = self._clearance(radius)
         if self.social is not None:
             self.social.observe(self.field, nx, ny, i)
+        contact_at = None
+        if start is not None and self.sweep is not None:
+            c1, h1, pr1 = self._poses()
+            poses = StepPoses(*start[:2], c1, h1, start[2], pr1, np.array((x, y)),
+                              np.array((nx, ny)), slack)  # fmt: skip
+            # an upper bound of the sampled minimum so far (the tracker's clearance may be a
+            # lower bound, its best is not)
+            ceiling = (
+                self.tracker.best
+                if self.tracker is not None
+                else min(book.min_clear, self.clearance)
+            )
+            s = self.sweep.step(poses, travel, g0, self.clearance, ceiling)
+            if not math.isnan(s):
+                contact_at = t0 + s * dt
         gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)
-        self.done = book.judge(t, self.clearance, gd) or clock.up
+        self.done = book.judge(t, self.clearance, gd, contact_at) or clock.up
         if book.status == "collision":
             self.collision_by = self._collision_by(was_present)
 
@@ -444,6 +504,9 @@ class UnicycleWorld:
         if self.tracker is not None:  # the exact minimum of the steps it deferred
             self.book.min_clear = self.tracker.finish()
             self.tracker = None
+        if self.sweep is not None:  # the minimum along the steps
+            self.book.min_clear = self.sweep.finish(self.book.min_clear)
+            self.sweep = None
         path = self.book.path
         return self.book.metrics(
             log,
@@ -479,9 +542,15 @@ class HolonomicWorld(UnicycleWorld):
     COMMAND_NAMES: ClassVar[tuple[str, str]] = ("v_x [m/s]", "v_y [m/s]")
 
     def __init__(
-        self, setup: EpisodeSetup, rng: np.random.Generator, *, exact: bool, packed: bool = False
+        self,
+        setup: EpisodeSetup,
+        rng: np.random.Generator,
+        *,
+        exact: bool,
+        packed: bool = False,
+        swept: bool = True,
     ) -> None:
-        super().__init__(setup, rng, exact=exact, packed=packed)
+        super().__init__(setup, rng, exact=exact, packed=packed, swept=swept)
         self.spec = OmniSpec(v_max=float(setup.spec.v_max), radius=float(setup.spec.radius))
 
     def start(self, oracles: Sequence[bool] = (False,)) -> None:
@@ -502,6 +571,9 @@ class HolonomicWorld(UnicycleWorld):
 
     def _speed_change(self, new: Any) -> float:
         return float((new.vx - self.applied.vx) ** 2 + (new.vy - self.applied.vy) ** 2)
+
+    def _travel(self, dt: float) -> tuple[float, float]:
+        return float(self.applied.speed) * dt, 0.0
 
     def _move(self, dt: float) -> tuple[float, float]:
         vx, vy = self.applied.vx, self.applied.vy
@@ -558,6 +630,7 @@ def run_episode(
     probes: Sequence[Probe] = (),
     vehicle: str = "unicycle",
     compiled: bool | None = None,
+    swept: bool = True,
 ) -> EpisodeResult:
     """Run one episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
     :class:`UnicycleWorld`).
@@ -573,6 +646,8 @@ def run_episode(
         compiled: move and measure the obstacles in compiled calls where the scene allows it
             (:class:`~uvnav.sim.packed.PackedObstacles`: the same numbers); default: when numba
             is enabled (:func:`~uvnav.geometry.kernels3d.numba_enabled`).
+        swept: judge collisions and the minimum clearance along every step (the default);
+            ``False`` judges the sampled end of each step only.
 
     Raises:
         ValueError: ``setup.control_period`` is not a whole multiple of ``setup.dt``.
@@ -581,7 +656,7 @@ def run_episode(
         raise ValueError(f"no 2D world for vehicle {vehicle!r}; known: {', '.join(WORLDS_2D)}")
     if compiled is None:
         compiled = numba_enabled()
-    world = WORLDS_2D[vehicle](setup, rng, exact=record, packed=compiled)
+    world = WORLDS_2D[vehicle](setup, rng, exact=record, packed=compiled, swept=swept)
     rec = TrajectoryProbe() if record else None
     try:
         (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
@@ -594,4 +669,5 @@ def run_episode(
         status=world.status,
         trajectory=rec.finish() if rec is not None else None,
         decision_us=dec,
+        contact_time=world.book.contact_at,
     )

@@ -17,8 +17,9 @@ The status rules, the same in every world:
 * at t = 0 (:meth:`Ledger.begin`): a clearance below 0 is a ``collision``; else a start within
   the goal tolerance is a ``success`` with ``time_to_goal = 0.0``; the episode has not started
   otherwise;
-* after each step (:meth:`Ledger.judge`): collision first, then arrival (``time_to_goal`` = the
-  step's end time), then ``timeout`` once the clock is up;
+* after each step (:meth:`Ledger.judge`): collision first (a sampled gap below 0, or a contact
+  the world found along the step), then arrival (``time_to_goal`` = the step's end time), then
+  ``timeout`` once the clock is up;
 * the detour and time ratios are measured against the straight distance from the start to the
   edge of the goal disc (``None`` when the start is inside it: there is no detour to measure).
 
@@ -147,12 +148,14 @@ class Ledger:
         status: ``success``, ``collision`` or ``timeout`` (also while running).
         ended: the agent arrived or collided (its episode is over, whatever the clock says).
         reached_at: arrival time [s], ``None`` before.
+        contact_at: time of the first contact of a collision [s] (``None`` without one).
         start_dist: distance from the start to the goal [m].
         min_clear: smallest clearance reported [m] (``inf`` before any, or without bodies).
         path, effort, violations: the sums the world keeps.
     """
 
     __slots__ = (
+        "contact_at",
         "effort",
         "ended",
         "goal_tolerance",
@@ -169,6 +172,7 @@ class Ledger:
         self.status = "timeout"
         self.ended = False
         self.reached_at: float | None = None
+        self.contact_at: float | None = None
         self.start_dist = math.nan
         self.min_clear = math.inf
         self.path = 0.0
@@ -188,7 +192,8 @@ class Ledger:
         violations: int,
         min_clear: float,
     ) -> Ledger:
-        """The ledger of an episode counted elsewhere (a compiled world's arrays)."""
+        """The ledger of an episode counted elsewhere (a compiled world's arrays; the time of
+        a contact is not known there)."""
         book = cls(goal_tolerance)
         book.status, book.ended = status, status != "timeout"
         book.start_dist, book.reached_at = float(start_dist), reached_at
@@ -201,26 +206,26 @@ class Ledger:
         self.start_dist = float(goal_dist)
         self.min_clear = float(clearance)
         if clearance < 0:
-            self.status, self.ended = "collision", True
+            self.status, self.ended, self.contact_at = "collision", True, 0.0
         elif goal_dist <= self.goal_tolerance:
             self.status, self.reached_at, self.ended = "success", 0.0, True
         return self.ended
 
-    def judge(self, t: float, clearance: float, goal_dist: float) -> bool:
-        """The state at the end of a step at time ``t`` [s]: collision, then arrival; returns
-        :attr:`ended`.  ``clearance`` [m] may be a lower bound >= 0 where the exact value cannot
-        matter (the world then passes the exact minimum to :meth:`metrics`)."""
+    def judge(
+        self, t: float, clearance: float, goal_dist: float, contact_at: float | None = None
+    ) -> bool:
+        """The state at the end of a step at time ``t`` [s]: collision (a ``clearance`` below 0
+        [m], or a contact the world found along the step at ``contact_at`` [s]), then arrival;
+        returns :attr:`ended`.  ``clearance`` may be a lower bound >= 0 where the exact value
+        cannot matter (the world then passes the exact minimum to :meth:`metrics`)."""
         if clearance < self.min_clear:
             self.min_clear = clearance
-        if clearance < 0:
+        if contact_at is not None or clearance < 0:
             self.status, self.ended = "collision", True
+            self.contact_at = t if contact_at is None else contact_at
         elif goal_dist <= self.goal_tolerance:
             self.status, self.reached_at, self.ended = "success", t, True
         return self.ended
-
-    def collide(self) -> None:
-        """A collision found by the world itself (e.g. between samples of a step)."""
-        self.status, self.ended = "collision", True
 
     @property
     def shortest(self) -> float:

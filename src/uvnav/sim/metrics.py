@@ -51,9 +51,11 @@ class EpisodeMetrics:
 
     Attributes:
         success: reached the goal tolerance before ``t_max`` without collision.
-        collision: the robot's disc overlapped an obstacle at some integration step.
-        min_clearance: smallest gap between the robot's disc and any obstacle over the episode's
-            integration steps [m] (negative on overlap); ``None`` when the world has no obstacle.
+        collision: the robot's disc overlapped an obstacle: anywhere along an integration step
+            in the 2D worlds (:mod:`uvnav.sim.swept`), at the end of one in the others.
+        min_clearance: smallest gap between the robot's disc and any obstacle [m] (negative on
+            overlap), along every step in the 2D worlds, over the ends of the integration steps
+            in the others; ``None`` when the world has no obstacle.
         path_length: distance travelled by the robot centre [m].
         detour_ratio: path length / straight distance from the start to the edge of the goal
             tolerance disc (1.0 is the physical limit); ``None`` for a failed episode.

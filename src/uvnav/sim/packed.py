@@ -792,6 +792,11 @@ class PackedObstacles:
         gap, at = kernel("clearance_one")(x, y, radius, self.n, self._prm, self._st, self._rings)
         return float(gap), int(at)
 
+    def poses(self) -> tuple[FloatArray, FloatArray]:
+        """The obstacles' centres (k, 2) [m] and headings (k,) [rad] now (copies)."""
+        st, n = self._st, self.n
+        return st[S_X : S_Y + 1, :n].T.copy(), st[S_HEADING, :n].copy()
+
     def readings(self, x: float, y: float, sensing_range: float) -> tuple[ObstacleReading, ...]:
         """:func:`uvnav.sensors.exact.sense_obstacles` from ``(x, y)``: the readings within
         ``sensing_range`` [m], nearest first (ties in obstacle order).  Their arrays are views

@@ -1,0 +1,108 @@
+"""Collisions and clearance judged along each step of the 2D worlds (:mod:`uvnav.sim.swept`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from uvnav.controllers.base import make_law
+from uvnav.dynamics import UnicycleSpec
+from uvnav.obstacles import ConstantVelocity, DiscBody, Obstacle, ObstacleState, PolygonBody
+from uvnav.sim import EpisodeResult, EpisodeSetup, run_episode
+
+WALL = np.array([[-0.02, -2.0], [0.02, -2.0], [0.02, 2.0], [-0.02, 2.0]])  # 4 cm thick
+
+
+def _episode(obstacles: list[Obstacle], *, swept: bool, v_max: float = 2.0, dt: float = 0.1,
+             vehicle: str = "unicycle", record: bool = False,
+             compiled: bool = False) -> EpisodeResult:  # fmt: skip
+    """A robot driving straight along y = 0 from x = -1.1 at ``v_max`` [m/s]."""
+    setup = EpisodeSetup(
+        spec=UnicycleSpec(v_max=v_max, u_max=1.0, radius=0.05), start=np.array([-1.1, 0.0, 0.0]),
+        goal=np.array([3.0, 0.0]), obstacles=obstacles, dt=dt, control_period=dt, t_max=4.0,
+    )  # fmt: skip
+    law = make_law(
+        "straight-holonomic-v1" if vehicle == "holonomic" else "straight-v1", vehicle=vehicle
+    )
+    return run_episode(setup, law, np.random.default_rng(0), record=record, swept=swept,
+                       vehicle=vehicle, compiled=compiled)  # fmt: skip
+
+
+def _wall(x: float = 0.0, velocity: tuple[float, float] = (0.0, 0.0)) -> Obstacle:
+    return Obstacle(PolygonBody.from_vertices(WALL), ObstacleState(position=np.array([x, 0.0])),
+                    ConstantVelocity(np.array(velocity)))  # fmt: skip
+
+
+@pytest.mark.parametrize("record", [False, True])
+def test_a_robot_that_passes_through_a_thin_wall_between_samples_collides(record: bool) -> None:
+    # 0.2 m a step: the samples fall at x = -0.1 and 0.1, 3 cm clear of the wall's faces, and
+    # the wall is crossed in between
+    sampled = _episode([_wall()], swept=False, record=record)
+    assert sampled.status == "success" and sampled.contact_time is None
+    got = _episode([_wall()], swept=True, record=record)
+    assert got.status == "collision" and got.metrics.collision
+    # first contact: the robot's front (x + 0.05) meets the face x = -0.02 at x = -0.07
+    assert got.contact_time == pytest.approx((-0.07 + 1.1) / 2.0, abs=1e-9)
+    assert got.metrics.min_clearance is not None and got.metrics.min_clearance < 0
+    assert got.metrics.path_length == pytest.approx(1.2)  # the episode ends with that step
+
+
+def test_a_fast_disc_that_crosses_the_path_between_samples_collides() -> None:
+    # a disc at 20 m/s sweeps across the robot's line within one step
+    def disc() -> Obstacle:  # (an episode leaves its bodies where they ended)
+        return Obstacle(DiscBody(0.1), ObstacleState(position=np.array([-1.09, -1.5])),
+                        ConstantVelocity(np.array([0.0, 20.0])))  # fmt: skip
+
+    sampled = _episode([disc()], swept=False, v_max=0.1, dt=0.1)
+    swept = _episode([disc()], swept=True, v_max=0.1, dt=0.1)
+    assert sampled.status != "collision"
+    assert swept.status == "collision" and swept.contact_time is not None
+    # the discs touch when the disc's centre is 0.15 m below the robot's: y = -0.15
+    assert swept.contact_time == pytest.approx((1.5 - 0.15) / 20.0, abs=1e-3)
+
+
+def test_the_holonomic_robot_is_judged_along_the_step_too() -> None:
+    got = _episode([_wall()], swept=True, vehicle="holonomic")
+    assert got.status == "collision" and got.contact_time is not None
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    x=st.floats(-0.5, 2.0),
+    vx=st.floats(-1.0, 1.0),
+    vy=st.floats(-0.2, 0.2),
+    spin=st.floats(-1.0, 1.0),
+)
+def test_the_minimum_along_the_steps_never_exceeds_a_sampled_one_and_paths_agree(
+    x: float, vx: float, vy: float, spin: float
+) -> None:
+    """Recorded or not, compiled or not: one status and one minimum clearance, at most the
+    least sampled clearance."""
+
+    def bodies() -> list[Obstacle]:
+        return [
+            Obstacle(PolygonBody.from_vertices(0.3 * WALL + 0.0), ObstacleState(
+                position=np.array([x, 0.3]), heading=0.3), ConstantVelocity(np.array([vx, vy]),
+                spin)),
+            _wall(x + 1.0, (vx, -vy)),
+        ]  # fmt: skip
+
+    runs = [
+        _episode(bodies(), swept=True, record=rec, compiled=comp, v_max=1.0)
+        for rec in (True, False)
+        for comp in (False, True)
+    ]
+    assert len({r.status for r in runs}) == 1
+    assert len({r.metrics.min_clearance for r in runs}) == 1
+    assert len({r.contact_time for r in runs}) == 1
+    rec = runs[0]
+    assert rec.trajectory is not None and rec.metrics.min_clearance is not None
+    assert rec.metrics.min_clearance <= float(np.min(rec.trajectory.clearance))
+    if rec.status == "collision":
+        assert rec.contact_time is not None
+        assert rec.contact_time <= rec.trajectory.times[-1] + 1e-12
+        assert math.isfinite(rec.contact_time)
