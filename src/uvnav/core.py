@@ -91,19 +91,23 @@ class Law(Protocol[ObsT_contra, CmdT_co]):
 class World(Protocol[ObsT_co, CmdT]):
     """One scene stepped by :func:`run_loop`.
 
-    Class attributes ``vehicle`` and ``sensing`` (one of :data:`VEHICLES` / :data:`SENSINGS`)
-    say which laws can drive it.  ``t`` is the time [s], ``dt`` the integration step [s],
-    ``ratio`` the integration steps per decision; ``done`` becomes True when every agent has
-    arrived, collided, or ``t_max`` is reached.  The counting rules (steps, status, arrival
-    time, sums) are one bookkeeper's, :mod:`uvnav.sim.ledger`.
+    ``vehicle`` and ``sensing`` (a vehicle kind: :data:`VEHICLES` or a plug-in's; one of
+    :data:`SENSINGS`) say which laws can drive it.  ``t`` is the time [s], ``dt`` the
+    integration step [s], ``ratio`` the integration steps per decision; ``done`` becomes True
+    when every agent has arrived, collided, or ``t_max`` is reached.  The counting rules (steps,
+    status, arrival time, sums) are one bookkeeper's, :mod:`uvnav.sim.ledger`.
     """
 
-    vehicle: ClassVar[str]
-    sensing: ClassVar[str]
     t: float
     dt: float
     ratio: int
     done: bool
+
+    @property
+    def vehicle(self) -> str: ...
+
+    @property
+    def sensing(self) -> str: ...
 
     @property
     def n_agents(self) -> int: ...

@@ -19,7 +19,7 @@ from uvnav.scenarios import pedestrians as P  # noqa: N812
 from uvnav.scenarios.generators import crowd_file_scenario
 from uvnav.sensors.exact import sense_obstacles
 from uvnav.sim import run_episode, run_rng
-from uvnav.sim.episode import UnicycleWorld
+from uvnav.sim.episode import World2D
 
 ETH = Path(P.__file__).parent / "data" / "pedestrians" / "eth" / "obsmat.txt.gz"
 
@@ -229,7 +229,7 @@ def test_nobody_present_means_no_clearance(tmp_path: Path, record: bool) -> None
 def test_absent_pedestrians_are_never_sensed_nor_in_the_clearance() -> None:
     """crowd-eth:1 stepped by hand: every reading and the clearance use present people only."""
     setup = build_episode(GENERATORS["crowd-eth"](1), 0)
-    world = UnicycleWorld(setup, run_rng(1), exact=True)
+    world = World2D(setup, run_rng(1), exact=True)
     world.start()
     models = [o.motion for o in setup.obstacles]
     absent_seen = 0

@@ -1,5 +1,5 @@
-"""The holonomic disc robot in any 2D scene (``HolonomicWorld``): exact straight motion, the
-V_max disc counted and enforced, and ORCA's velocity taken as it is."""
+"""The holonomic disc robot in any 2D scene (``World2D`` with ``vehicle="holonomic"``): exact
+straight motion, the V_max disc counted and enforced, and ORCA's velocity taken as it is."""
 
 from __future__ import annotations
 

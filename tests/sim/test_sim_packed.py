@@ -22,7 +22,7 @@ from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.sensors.exact import lidar_scan
-from uvnav.sim.episode import EpisodeResult, EpisodeSetup, UnicycleWorld, run_episode
+from uvnav.sim.episode import EpisodeResult, EpisodeSetup, World2D, run_episode
 from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, pack_check
 from uvnav.sim.seeding import run_rng
 
@@ -82,7 +82,7 @@ def mixed_setup(seed: int, n: int = 12, t_max: float = 30.0) -> EpisodeSetup:
 def run_both(make: object, seed: int, max_decisions: int = 10**6) -> tuple[str, int]:
     """Drive the loop world and a packed world with the same random commands; every decision
     the pose, clearance, status and lidar must be equal.  Returns (status, decisions)."""
-    ref = UnicycleWorld(make(), run_rng(seed), exact=True)  # type: ignore[operator]
+    ref = World2D(make(), run_rng(seed), exact=True)  # type: ignore[operator]
     ref.start([False])
     packed = PackedWorlds(1)
     packed.load(0, make())  # type: ignore[operator]
@@ -368,13 +368,13 @@ def test_the_compiled_episode_path_equals_the_numpy_path(scene: str, law: str,
 
 def test_the_compiled_path_serves_the_scenes_it_can_pack() -> None:
     scene = load_scenario("random-ch2:0")
-    assert UnicycleWorld(build_episode(scene, 0), run_rng(0), exact=False,
+    assert World2D(build_episode(scene, 0), run_rng(0), exact=False,
                          packed=True).packed is not None  # fmt: skip
-    assert UnicycleWorld(build_episode(scene, 0), run_rng(0), exact=False).packed is None
+    assert World2D(build_episode(scene, 0), run_rng(0), exact=False).packed is None
     setup = mixed_setup(0, n=2)
     setup.obstacles[1] = Obstacle(DiscBody(0.3), ObstacleState(position=np.zeros(2)),
                                   ConstantVelocity(np.zeros(2)))  # fmt: skip
-    assert UnicycleWorld(setup, run_rng(0), exact=False, packed=True).packed is None
+    assert World2D(setup, run_rng(0), exact=False, packed=True).packed is None
 
 
 def test_the_compiled_path_leaves_the_generators_where_the_numpy_path_does_across_top_ups() -> None:
@@ -394,7 +394,7 @@ def test_the_compiled_path_leaves_the_generators_where_the_numpy_path_does_acros
     got, got_left = episode(make, "zhang2019-v1", 4, compiled=True, record=False)
     same_result(ref, got)
     assert got_left == ref_left
-    world = UnicycleWorld(make(), run_rng(4), exact=False, packed=True)
+    world = World2D(make(), run_rng(4), exact=False, packed=True)
     assert world.packed is not None
     for _ in range(200):
         world.packed.step(0.05 * _, 0.05, 0.0, 0.0, 0.2)

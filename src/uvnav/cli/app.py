@@ -43,7 +43,7 @@ from uvnav.controllers import (
     available_controllers,
     controller_info,
 )
-from uvnav.controllers.base import VEHICLES
+from uvnav.dynamics.vehicles import vehicle_names
 from uvnav.scenarios import (
     ScenarioError,
     check_constraints,
@@ -600,8 +600,9 @@ def controllers_list(
     ] = None,
 ) -> None:
     """List the registered controllers of every vehicle (or of one)."""
-    if vehicle is not None and vehicle not in VEHICLES:
-        raise CliError(f"--vehicle: unknown vehicle {vehicle!r}; known: {', '.join(VEHICLES)}")
+    if vehicle is not None and vehicle not in vehicle_names():
+        known = ", ".join(vehicle_names())
+        raise CliError(f"--vehicle: unknown vehicle {vehicle!r}; known: {known}")
     infos = available_controllers(vehicle)
     rows = [
         {

@@ -7,7 +7,8 @@ theirs through the ``uvnav.controllers`` entry-point group (the entry point must
 :class:`ControllerInfo` or to a controller class with a ``name`` attribute).
 
 There is one registry for every vehicle.  Each entry says which vehicle it drives
-(:data:`VEHICLES`: the command it returns and the observation it reads) and what it senses;
+(:func:`~uvnav.dynamics.vehicles.vehicle_names`: the command it returns and the observation it
+reads) and what it senses;
 :func:`available_controllers` lists one vehicle's laws (the unicycle's by default, the contract the
 2D simulator and campaigns use) or all of them, and :func:`make_controller` builds unicycle laws
 (:func:`make_law` builds any vehicle's).
@@ -33,8 +34,8 @@ import numpy as np
 from pydantic import TypeAdapter, ValidationError
 
 from uvnav.core import SENSINGS
-from uvnav.core import VEHICLES as CORE_VEHICLES
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
+from uvnav.dynamics.vehicles import vehicle_names
 from uvnav.sensors.observation import Observation
 from uvnav.validation import describe_error
 
@@ -73,17 +74,13 @@ class ControllerInfo:
     #: the observation the law reads: ``"exact"`` (range-limited exact readings, Ch. 2/3) or a
     #: sensor model's name (``"sonar-array"`` for the Ch. 5 nine-beam array)
     sensing: str = "exact"
-    #: the vehicle the law drives, one of :data:`VEHICLES`
+    #: the vehicle the law drives (:func:`~uvnav.dynamics.vehicles.vehicle_names`: a built-in
+    #: one or a plug-in's)
     vehicle: str = "unicycle"
     #: the parameter naming a law this one runs inside (``hybrid-v1``'s ``law``; its parameters
     #: in ``<name>_params``): that law's assumptions are this law's too
     inner_law: str = ""
 
-
-#: Vehicle kinds of the registry (:data:`uvnav.core.VEHICLES`): the Ch. 2 unicycle
-#: (:class:`UnicycleCommand`), the Ch. 3/5 3D vehicle (``Vehicle3DCommand``) and the Ch. 4
-#: holonomic underwater vehicle (``HolonomicCommand``).
-VEHICLES: tuple[str, ...] = CORE_VEHICLES
 
 _REGISTRY: dict[str, ControllerInfo] = {}
 #: Modules of ``uvnav.controllers`` that register built-in unicycle laws when imported.
@@ -120,13 +117,13 @@ def register(info: ControllerInfo) -> ControllerInfo:
     """Add ``info`` to the registry (registering the same entry again is a no-op).
 
     Raises:
-        ValueError: ``info.vehicle`` is not one of :data:`VEHICLES`, ``info.sensing`` not one of
-            :data:`uvnav.core.SENSINGS`, or another law already has the name.
+        ValueError: ``info.vehicle`` is no vehicle's (:func:`vehicle_names`), ``info.sensing``
+            not one of :data:`uvnav.core.SENSINGS`, or another law already has the name.
     """
-    if info.vehicle not in VEHICLES:
+    if info.vehicle not in vehicle_names():
         raise ValueError(
             f"controller {info.name!r}: unknown vehicle {info.vehicle!r}; "
-            f"known: {', '.join(VEHICLES)}"
+            f"known: {', '.join(vehicle_names())}"
         )
     if info.sensing not in SENSINGS:
         raise ValueError(
@@ -169,9 +166,9 @@ def available_controllers(vehicle: str | None = "unicycle") -> dict[str, Control
     """Registered controllers by name (built-ins and entry points).
 
     Args:
-        vehicle: only the laws driving this vehicle (one of :data:`VEHICLES`); ``None`` = all.
+        vehicle: only the laws driving this vehicle (:func:`vehicle_names`); ``None`` = all.
     """
-    kinds = VEHICLES if vehicle is None else (vehicle,)
+    kinds = vehicle_names() if vehicle is None else (vehicle,)
     _import_builtins(kinds)
     return {n: i for n, i in sorted(_REGISTRY.items()) if i.vehicle in kinds}
 
@@ -186,9 +183,9 @@ def _import_builtins(kinds: Iterable[str]) -> None:
     for kind in kinds:
         if kind in _IMPORTED:
             continue
-        if kind not in BUILTIN_MODULES_BY_VEHICLE:
-            raise ValueError(f"unknown vehicle {kind!r}; known: {', '.join(VEHICLES)}")
-        for module in BUILTIN_MODULES_BY_VEHICLE[kind]:
+        if kind not in vehicle_names():
+            raise ValueError(f"unknown vehicle {kind!r}; known: {', '.join(vehicle_names())}")
+        for module in BUILTIN_MODULES_BY_VEHICLE.get(kind, ()):  # (a plug-in vehicle has none)
             import_module(f"uvnav.controllers.{module}")
         _IMPORTED.add(kind)
     _load_entry_points()
@@ -201,7 +198,7 @@ def controller_info(name: str, vehicle: str | None = None) -> ControllerInfo:
         UnknownControllerError: not registered, or registered for another vehicle (the message
             names the vehicle it drives).
     """
-    _import_builtins(VEHICLES)
+    _import_builtins(vehicle_names())
     info = _REGISTRY.get(name)
     if info is None:
         known = available_controllers(vehicle)

@@ -16,6 +16,9 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any, ClassVar
+
+from uvnav.geometry.angles import wrap_scalar
 
 
 @dataclass(frozen=True, slots=True)
@@ -71,3 +74,62 @@ def omni_advance(x: float, y: float, vx: float, vy: float, dt: float) -> tuple[f
     (2.0, 0.0)
     """
     return x + vx * dt, y + vy * dt
+
+
+class OmniRobot:
+    """The holonomic robot as a planar vehicle of the 2D world (:class:`uvnav.dynamics.vehicles.
+    Vehicle2D`): the scene's V_max and radius, a velocity ``(vx, vy)`` within the V_max disc,
+    exact straight motion; its heading is the direction of the last non-zero velocity, and the
+    effort has no turn term.
+
+    Args:
+        robot: the scene's robot block (its ``v_max`` and ``radius`` apply).
+    """
+
+    name: ClassVar[str] = "holonomic"
+    command_names: ClassVar[tuple[str, str]] = ("v_x [m/s]", "v_y [m/s]")
+
+    def __init__(self, robot: Any) -> None:
+        self.spec = OmniSpec(v_max=float(robot.v_max), radius=float(robot.radius))
+
+    def rest(self) -> VelocityCommand:
+        return VelocityCommand(0.0, 0.0)
+
+    def saturate(self, cmd: VelocityCommand, heading: float) -> tuple[VelocityCommand, bool]:
+        return cmd.clipped(self.spec), cmd.violates(self.spec)
+
+    def pair(self, cmd: VelocityCommand) -> tuple[float, float]:
+        return cmd.vx, cmd.vy
+
+    def command(self, a: float, b: float) -> VelocityCommand:
+        return VelocityCommand(a, b)
+
+    def bounds(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        v = self.spec.v_max
+        return (-v, -v), (v, v)
+
+    def speed(self, cmd: VelocityCommand) -> float:
+        return float(cmd.speed)
+
+    def velocity(self, cmd: VelocityCommand, heading: float) -> tuple[float, float]:
+        return float(cmd.vx), float(cmd.vy)
+
+    def speed_change(self, new: VelocityCommand, old: VelocityCommand) -> float:
+        return float((new.vx - old.vx) ** 2 + (new.vy - old.vy) ** 2)
+
+    def move(
+        self, x: float, y: float, heading: float, cmd: VelocityCommand, dt: float,
+        decision: bool, period: float,
+    ) -> tuple[float, float, float, float, float]:  # fmt: skip
+        vx, vy = cmd.vx, cmd.vy
+        turn = 0.0
+        if vx != 0.0 or vy != 0.0:
+            th = math.atan2(vy, vx)
+            if th != heading:
+                turn = abs(wrap_scalar(th - heading))
+            heading = th
+        nx, ny = omni_advance(x, y, vx, vy, dt)
+        return nx, ny, heading, turn, 0.0
+
+    def travel(self, cmd: VelocityCommand, dt: float) -> tuple[float, float]:
+        return float(cmd.speed) * dt, 0.0

@@ -20,10 +20,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.geometry.sweep import arc_slack
 
 _EPS = float(np.finfo(float).eps)
 
@@ -129,3 +131,60 @@ def unicycle_step(state: FloatArray, v: float, u: float, dt: float) -> FloatArra
         The new ``[x, y, theta]`` with theta wrapped to (-pi, pi].
     """
     return np.array(unicycle_advance(float(state[0]), float(state[1]), float(state[2]), v, u, dt))
+
+
+class Unicycle:
+    """The unicycle as a planar vehicle of the 2D world (:class:`uvnav.dynamics.vehicles.
+    Vehicle2D`): the command ``(V_R, u_R)`` within (2.4), moved by the robot block's
+    ``kinematics`` (module docstring); the effort's turn term is ``u_R^2 dt``.
+
+    Args:
+        robot: limits, radius and kinematics (the law is reset with it).
+    """
+
+    name: ClassVar[str] = "unicycle"
+    command_names: ClassVar[tuple[str, str]] = ("V_R [m/s]", "u_R [rad/s]")
+
+    def __init__(self, robot: UnicycleSpec) -> None:
+        self.spec = robot
+
+    def rest(self) -> UnicycleCommand:
+        return UnicycleCommand(0.0, 0.0)
+
+    def saturate(self, cmd: UnicycleCommand, heading: float) -> tuple[UnicycleCommand, bool]:
+        return cmd.clipped(self.spec), cmd.violates(self.spec)
+
+    def pair(self, cmd: UnicycleCommand) -> tuple[float, float]:
+        return cmd.v, cmd.u
+
+    def command(self, a: float, b: float) -> UnicycleCommand:
+        return UnicycleCommand(a, b)
+
+    def bounds(self) -> tuple[tuple[float, float], tuple[float, float]]:
+        s = self.spec
+        return (0.0, -s.u_max), (s.v_max, s.u_max)
+
+    def speed(self, cmd: UnicycleCommand) -> float:
+        return float(cmd.v)
+
+    def velocity(self, cmd: UnicycleCommand, heading: float) -> tuple[float, float]:
+        v = float(cmd.v)
+        return v * math.cos(heading), v * math.sin(heading)
+
+    def speed_change(self, new: UnicycleCommand, old: UnicycleCommand) -> float:
+        return float((new.v - old.v) ** 2)
+
+    def move(
+        self, x: float, y: float, heading: float, cmd: UnicycleCommand, dt: float,
+        decision: bool, period: float,
+    ) -> tuple[float, float, float, float, float]:  # fmt: skip
+        v, u = cmd.v, cmd.u
+        if self.spec.kinematics == "arc":
+            nx, ny, th = unicycle_advance(x, y, heading, v, u, dt)
+        else:  # the period's turn at the decision, then straight
+            nx, ny, th = turn_then_move(x, y, heading, v, u * period if decision else 0.0, dt)
+        return nx, ny, th, abs(u) * dt, u**2 * dt
+
+    def travel(self, cmd: UnicycleCommand, dt: float) -> tuple[float, float]:
+        slack = arc_slack(cmd.v, cmd.u, dt) if self.spec.kinematics == "arc" else 0.0
+        return abs(cmd.v) * dt, slack

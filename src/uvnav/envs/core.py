@@ -1,7 +1,7 @@
 """What the Gymnasium and PettingZoo environments add to the loop's worlds (no gymnasium import).
 
 The envs step the worlds of the one step loop (:mod:`uvnav.core`): ``uvnav/Nav2D-v0`` a
-:class:`uvnav.sim.episode.UnicycleWorld`, the multi-robot ParallelEnv a
+:class:`uvnav.sim.episode.World2D`, the multi-robot ParallelEnv a
 :class:`uvnav.sim.multi.MultiUnicycleWorld`.  :class:`EnvWorld` steps such a world one *decision*
 at a time — the agents' commands are applied at a decision time, then the world advances (every
 ``dt``, integration, obstacles and collision checks are the world's own) until the next decision
@@ -49,7 +49,7 @@ from uvnav.obstacles.bodies import Body, DiscBody
 from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
 from uvnav.sensors.exact import lidar_scan
 from uvnav.sensors.observation import Observation
-from uvnav.sim.episode import UnicycleWorld
+from uvnav.sim.episode import World2D
 from uvnav.sim.multi import MultiUnicycleWorld
 
 OBS_DOC = (
@@ -153,7 +153,7 @@ def action_commands(
 class EnvWorld:
     """A loop world stepped one decision at a time, and the env's view of it (module docstring).
 
-    Robot i is agent i of ``world`` (a :class:`UnicycleWorld` or a :class:`MultiUnicycleWorld`,
+    Robot i is agent i of ``world`` (a :class:`World2D` or a :class:`MultiUnicycleWorld`,
     started here as for laws that are not oracles: with ``velocities: estimated`` sensing the
     observations carry estimated rates).
 
@@ -168,7 +168,7 @@ class EnvWorld:
 
     def __init__(
         self,
-        world: UnicycleWorld | MultiUnicycleWorld,
+        world: World2D | MultiUnicycleWorld,
         *,
         n_rays: int = 32,
         max_range: float = 5.0,
@@ -343,7 +343,7 @@ class EnvWorldEnv:
         self._bounds = (0.0, 0.0, 1.0, 1.0)
         self.episode_seed: int | None = None
 
-    def _open(self, world: UnicycleWorld | MultiUnicycleWorld) -> EnvWorld:
+    def _open(self, world: World2D | MultiUnicycleWorld) -> EnvWorld:
         """Step ``world`` (fresh, of the episode ``reset`` starts) from now on."""
         self._world = w = EnvWorld(
             world,
@@ -356,7 +356,7 @@ class EnvWorldEnv:
         self._bounds = scene_bounds(w)
         return w
 
-    def _loop_world(self) -> UnicycleWorld | MultiUnicycleWorld:
+    def _loop_world(self) -> World2D | MultiUnicycleWorld:
         if self._world is None:
             raise RuntimeError("call reset() first")
         return self._world.world

@@ -1,7 +1,7 @@
 """``uvnav/Nav2D-v0``: a Gymnasium environment on the 2D world of the thesis's Ch. 2.
 
 One robot (unicycle, (2.1)-(2.4)) among a scenario's obstacles.  The env steps the simulator's
-own world, :class:`uvnav.sim.episode.UnicycleWorld` (:class:`uvnav.envs.core.EnvWorld`): one env
+own world, :class:`uvnav.sim.episode.World2D` (:class:`uvnav.envs.core.EnvWorld`): one env
 step is one decision (``control_period``), integrated with the scenario's ``dt`` and checked for
 collisions at every integration step by the world, so that an env episode driven by a law's
 commands (``raw_commands=True``) is bit for bit :func:`uvnav.sim.run_episode`'s.
@@ -41,7 +41,7 @@ from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig, goal_scale_for
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.scenarios.schema import Scenario
-from uvnav.sim.episode import UnicycleWorld
+from uvnav.sim.episode import World2D
 from uvnav.sim.seeding import run_rng
 
 try:
@@ -126,10 +126,10 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         self.action_space = act_space(r.v_max, r.u_max, raw=raw_commands)
 
     @property
-    def world(self) -> UnicycleWorld:
+    def world(self) -> World2D:
         """The loop world of the current episode (metrics, ``law_setup``...)."""
         world = self._loop_world()
-        assert isinstance(world, UnicycleWorld)
+        assert isinstance(world, World2D)
         return world
 
     def reset(
@@ -139,7 +139,7 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         if self._world is not None:
             self._world.close()
         self.episode_seed = k = episode_seed(self.np_random, options)
-        w = self._open(UnicycleWorld(build_episode(self.scenario, k), run_rng(k), exact=True))
+        w = self._open(World2D(build_episode(self.scenario, k), run_rng(k), exact=True))
         return w.vector(0), self._info(0)
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:

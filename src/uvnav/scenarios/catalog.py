@@ -36,6 +36,7 @@ import numpy as np
 from pydantic import Discriminator, Tag, TypeAdapter
 
 from uvnav.core import load_plugins
+from uvnav.dynamics.vehicles import vehicles_2d
 from uvnav.scenarios.errors import ScenarioError
 
 
@@ -45,8 +46,9 @@ class SceneKind:
 
     Attributes:
         name: the kind's name (:data:`KINDS`).
-        vehicles: the vehicles of :data:`uvnav.core.VEHICLES` its laws may drive (the first is
-            the scene's own; a 2D scene also holds the holonomic robot).
+        vehicles: the vehicles its laws may drive (the first is the scene's own; a 2D scene
+            holds every planar vehicle: the holonomic robot and the plug-ins'
+            (:func:`~uvnav.dynamics.vehicles.vehicles_2d`)).
         sensing: the observation of :data:`uvnav.core.SENSINGS` its world makes.
         summary: one line for listings.
         model: the pydantic model of its files.
@@ -254,7 +256,7 @@ def _kinds() -> dict[str, SceneKind]:
         k.name: k
         for k in (
             SceneKind(
-                "nav2d", ("unicycle", "holonomic"), "exact",
+                "nav2d", tuple(vehicles_2d()), "exact",
                 "Ch. 2 unicycle among moving bodies and crowds",
                 models["nav2d"], _nav2d_load, lambda: list(_builtins_of_dim(2)), gen2d, _run_rng,
             ),

@@ -1,9 +1,9 @@
-"""The 2D worlds (thesis Ch. 2; DESIGN §2, §4): sensing, exact integration, collision checks and
+"""The 2D world (thesis Ch. 2; DESIGN §2, §4): sensing, exact integration, collision checks and
 metrics of one robot among moving bodies, stepped by the one loop :func:`uvnav.core.run_loop`.
 
-:class:`UnicycleWorld` holds the thesis's unicycle, :class:`HolonomicWorld` the holonomic disc
-robot of the crowd benchmarks (the law's vehicle picks the world: :data:`WORLDS_2D`);
-:func:`run_episode` runs one episode with either.
+:class:`World2D` holds any planar vehicle (:class:`~uvnav.dynamics.vehicles.Vehicle2D`: the
+thesis's unicycle, the holonomic disc robot of the crowd benchmarks, or a plug-in; the law's
+vehicle picks it); :func:`run_episode` runs one episode.
 
 Decision rate and integration rate are separate: the law is asked every ``control_period`` [s]
 (a whole multiple of ``dt``, else :func:`run_episode` raises ``ValueError``); robot and obstacles
@@ -39,16 +39,10 @@ import numpy as np
 
 from uvnav.controllers.base import Controller
 from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
-from uvnav.dynamics.omni import OmniSpec, VelocityCommand, omni_advance
-from uvnav.dynamics.unicycle import (
-    UnicycleCommand,
-    UnicycleSpec,
-    turn_then_move,
-    unicycle_advance,
-)
-from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.dynamics.unicycle import UnicycleSpec
+from uvnav.dynamics.vehicles import Vehicle2D, make_vehicle, vehicles_2d
+from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import numba_enabled
-from uvnav.geometry.sweep import arc_slack
 from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
@@ -210,8 +204,8 @@ class _MinClearance:
         return self._best
 
 
-class UnicycleWorld:
-    """The Chapter-2 world: one unicycle among rigid moving bodies (:class:`uvnav.core.World`).
+class World2D:
+    """The 2D world: one planar vehicle among rigid moving bodies (:class:`uvnav.core.World`).
 
     Bookkeeping (path, effort, limit violations, clearance, status: the one
     :class:`~uvnav.sim.ledger.Ledger`; the social metrics of :mod:`uvnav.sim.social`) is the
@@ -232,13 +226,12 @@ class UnicycleWorld:
         swept: judge collisions and the minimum clearance along every step
             (:class:`~uvnav.sim.swept.SweptClearance`); ``False`` samples the end of each step
             only (for comparisons with the sampled judgement).
+        vehicle: the planar vehicle's name (:func:`~uvnav.dynamics.vehicles.vehicles_2d`),
+            built from the setup's robot block.
     """
 
-    vehicle: ClassVar[str] = "unicycle"
     sensing: ClassVar[str] = "exact"
     n_agents: ClassVar[int] = 1
-    #: what :meth:`command_pair` returns, with units
-    COMMAND_NAMES: ClassVar[tuple[str, str]] = ("V_R [m/s]", "u_R [rad/s]")
 
     def __init__(
         self,
@@ -248,11 +241,15 @@ class UnicycleWorld:
         exact: bool,
         packed: bool = False,
         swept: bool = True,
+        vehicle: str = "unicycle",
     ) -> None:
         self.setup = setup
         self.swept = swept
         self._law_rng, self.sense_rng = rng.spawn(2)
-        self.spec: Any = setup.spec  # UnicycleSpec (OmniSpec in HolonomicWorld)
+        self.vehicle = vehicle
+        self.body: Vehicle2D = make_vehicle(vehicle, setup.spec)
+        self.spec: Any = self.body.spec  # what the law is reset with
+        self.command_names = self.body.command_names
         self.clock = Clock(setup.dt, setup.control_period, setup.t_max)
         self.dt, self.ratio = self.clock.dt, self.clock.ratio
         self.goal = np.asarray(setup.goal, dtype=float)
@@ -330,7 +327,7 @@ class UnicycleWorld:
         )
         self.collision_by: str | None = None
         self.turn = 0.0  # total absolute heading change [rad]
-        self.applied: Any = UnicycleCommand(0.0, 0.0)  # the command held now
+        self.applied: Any = self.body.rest()  # the command held now
         self.book = book = Ledger(self.setup.goal_tolerance)
         gd = math.hypot(self.goal[0] - self.x, self.goal[1] - self.y)
         self.done = book.begin(self.clearance, gd) or self.clock.up
@@ -379,12 +376,11 @@ class UnicycleWorld:
     @property
     def speed(self) -> float:
         """The robot's speed now [m/s] (its applied command's)."""
-        return float(self.applied.v)
+        return self.body.speed(self.applied)
 
     def velocity(self) -> tuple[float, float]:
-        """The robot's velocity now [m/s]: its applied speed along its heading."""
-        v = float(self.applied.v)
-        return v * math.cos(self.th), v * math.sin(self.th)
+        """The robot's velocity now [m/s]."""
+        return self.body.velocity(self.applied, self.th)
 
     def _collision_by(self, was_present: np.ndarray | None = None) -> str:
         """Who closed the gap at the collision now (:func:`uvnav.sim.social.collision_by`);
@@ -393,19 +389,29 @@ class UnicycleWorld:
                             was_present=was_present)  # fmt: skip
 
     def command_pair(self) -> tuple[float, float]:
-        """The applied command as two numbers for the trajectory: ``(V_R, u_R)``."""
-        return self.applied.v, self.applied.u
+        """The applied command as two numbers for the trajectory (:attr:`command_names`)."""
+        return self.body.pair(self.applied)
 
-    def _speed_change(self, new: Any) -> float:
-        """Squared change of the velocity command from the applied one [m^2/s^2]."""
-        return float((new.v - self.applied.v) ** 2)
+    def apply(self, cmd: Any, agent: int = 0) -> Any:
+        """Hold ``cmd``: counted in ``limit_violations`` when outside the vehicle's limits,
+        saturated."""
+        new, outside = self.body.saturate(cmd, self.th)
+        if outside:
+            self.book.violations += 1
+        if self.clock.step_index > 0:
+            self.book.effort += self.body.speed_change(new, self.applied) / (self.ratio * self.dt)
+        self.applied = new
+        return new
 
-    def _travel(self, dt: float) -> tuple[float, float]:
-        """The robot's path length over a step of ``dt`` [s] under the held command and its
-        path's largest distance from the step's chord [m] (an arc's; none turning in place)."""
-        v, u = self.applied.v, self.applied.u
-        slack = arc_slack(v, u, dt) if self.spec.kinematics == "arc" else 0.0
-        return abs(v) * dt, slack
+    def _move(self, dt: float) -> tuple[float, float]:
+        """Integrate the robot over ``dt`` [s] (the vehicle's exact motion); returns the new
+        position, updates the heading, the total turn and the effort's turn term."""
+        nx, ny, self.th, turn, effort = self.body.move(
+            self.x, self.y, self.th, self.applied, dt, self.clock.due, self.ratio * dt
+        )
+        self.book.effort += effort
+        self.turn += turn
+        return nx, ny
 
     def _poses(self) -> tuple[FloatArray, FloatArray, np.ndarray | None]:
         """The bodies' centres, headings and presence now."""
@@ -415,31 +421,6 @@ class UnicycleWorld:
         f = self.field
         return f.centres, f.headings, f.present
 
-    def apply(self, cmd: UnicycleCommand, agent: int = 0) -> UnicycleCommand:
-        """Hold ``cmd``: counted in ``limit_violations`` when outside (2.4), saturated."""
-        spec = self.spec
-        if cmd.violates(spec):
-            self.book.violations += 1
-        new = cmd.clipped(spec)
-        if self.clock.step_index > 0:
-            self.book.effort += self._speed_change(new) / (self.ratio * self.dt)
-        self.applied = new
-        return new
-
-    def _move(self, dt: float) -> tuple[float, float]:
-        """Integrate the robot over ``dt`` [s] (exact, by the spec's kinematics: on the arc, or
-        the whole period's turn at the decision and then straight); returns the new position,
-        updates the heading and the turn part of the control effort."""
-        v, u = self.applied.v, self.applied.u
-        self.book.effort += u**2 * dt
-        self.turn += abs(u) * dt
-        if self.spec.kinematics == "arc":
-            nx, ny, self.th = unicycle_advance(self.x, self.y, self.th, v, u, dt)
-        else:
-            turn = u * (self.ratio * dt) if self.clock.due else 0.0
-            nx, ny, self.th = turn_then_move(self.x, self.y, self.th, v, turn, dt)
-        return nx, ny
-
     def advance(self) -> None:
         """One step ``dt``: robot (exact), obstacles, clearance, collision and arrival."""
         dt, book, clock = self.dt, self.book, self.clock
@@ -447,7 +428,7 @@ class UnicycleWorld:
         if self.batch.sees_robot:  # bodies that react to the robot see it as it starts the step
             self.batch.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
         start = self._poses() if self.sweep is not None else None
-        travel, slack = self._travel(dt)
+        travel, slack = self.body.travel(self.applied, dt)
         nx, ny = self._move(dt)
         book.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
@@ -529,71 +510,8 @@ class UnicycleWorld:
         }
 
 
-class HolonomicWorld(UnicycleWorld):
-    """Any 2D scene with the holonomic disc robot (:mod:`uvnav.dynamics.omni`) instead of the
-    unicycle: the scene's V_max and radius, a velocity command ``(vx, vy)`` of norm <= V_max
-    held over the decision period, exact straight motion.  Bodies, sensing, clearance and metrics
-    are the unicycle world's; ``pose[2]`` is the direction of the last non-zero velocity, the
-    control effort is the integral of ||dv/dt||^2 (no turn term), and the trajectory's command
-    columns hold ``(vx, vy)``.
-    """
-
-    vehicle: ClassVar[str] = "holonomic"
-    COMMAND_NAMES: ClassVar[tuple[str, str]] = ("v_x [m/s]", "v_y [m/s]")
-
-    def __init__(
-        self,
-        setup: EpisodeSetup,
-        rng: np.random.Generator,
-        *,
-        exact: bool,
-        packed: bool = False,
-        swept: bool = True,
-    ) -> None:
-        super().__init__(setup, rng, exact=exact, packed=packed, swept=swept)
-        self.spec = OmniSpec(v_max=float(setup.spec.v_max), radius=float(setup.spec.radius))
-
-    def start(self, oracles: Sequence[bool] = (False,)) -> None:
-        super().start(oracles)
-        self.applied = VelocityCommand(0.0, 0.0)
-
-    @property
-    def speed(self) -> float:
-        return float(self.applied.speed)
-
-    def velocity(self) -> tuple[float, float]:
-        """``(vx, vy)`` [m/s]."""
-        return float(self.applied.vx), float(self.applied.vy)
-
-    def command_pair(self) -> tuple[float, float]:
-        """``(vx, vy)`` [m/s]."""
-        return self.applied.vx, self.applied.vy
-
-    def _speed_change(self, new: Any) -> float:
-        return float((new.vx - self.applied.vx) ** 2 + (new.vy - self.applied.vy) ** 2)
-
-    def _travel(self, dt: float) -> tuple[float, float]:
-        return float(self.applied.speed) * dt, 0.0
-
-    def _move(self, dt: float) -> tuple[float, float]:
-        vx, vy = self.applied.vx, self.applied.vy
-        if vx != 0.0 or vy != 0.0:
-            th = math.atan2(vy, vx)
-            if th != self.th:
-                self.turn += abs(wrap_scalar(th - self.th))
-            self.th = th
-        return omni_advance(self.x, self.y, vx, vy, dt)
-
-
-#: The 2D worlds by the vehicle of the law that drives them.
-WORLDS_2D: dict[str, type[UnicycleWorld]] = {
-    "unicycle": UnicycleWorld,
-    "holonomic": HolonomicWorld,
-}
-
-
 class TrajectoryProbe(BaseProbe):
-    """Records a :class:`UnicycleWorld` at every integration step and at the end."""
+    """Records a :class:`World2D` at every integration step and at the end."""
 
     def __init__(self) -> None:
         self.recorder: TrajectoryRecorder | None = None
@@ -601,7 +519,7 @@ class TrajectoryProbe(BaseProbe):
 
     def on_start(self, world: Any, laws: Sequence[Any]) -> None:
         self.recorder = TrajectoryRecorder(
-            [o.body.outline() for o in world.obstacles], world.COMMAND_NAMES
+            [o.body.outline() for o in world.obstacles], world.command_names
         )
 
     def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
@@ -633,7 +551,7 @@ def run_episode(
     swept: bool = True,
 ) -> EpisodeResult:
     """Run one episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
-    :class:`UnicycleWorld`).
+    :class:`World2D`).
 
     Args:
         setup: the instantiated scenario; its obstacles' states (and their motion models' internal
@@ -642,7 +560,8 @@ def run_episode(
         rng: the episode generator; independent children feed the controller and the sensors.
         record: keep the full trajectory (needed for figures; off for large campaigns).
         probes: more probes to run in the loop.
-        vehicle: the robot the law drives (:data:`WORLDS_2D`: ``unicycle`` or ``holonomic``).
+        vehicle: the robot the law drives (:func:`~uvnav.dynamics.vehicles.vehicles_2d`:
+            ``unicycle``, ``holonomic`` or a plug-in's).
         compiled: move and measure the obstacles in compiled calls where the scene allows it
             (:class:`~uvnav.sim.packed.PackedObstacles`: the same numbers); default: when numba
             is enabled (:func:`~uvnav.geometry.kernels3d.numba_enabled`).
@@ -652,11 +571,12 @@ def run_episode(
     Raises:
         ValueError: ``setup.control_period`` is not a whole multiple of ``setup.dt``.
     """
-    if vehicle not in WORLDS_2D:
-        raise ValueError(f"no 2D world for vehicle {vehicle!r}; known: {', '.join(WORLDS_2D)}")
+    if vehicle not in vehicles_2d():
+        known = ", ".join(vehicles_2d())
+        raise ValueError(f"no 2D world for vehicle {vehicle!r}; known: {known}")
     if compiled is None:
         compiled = numba_enabled()
-    world = WORLDS_2D[vehicle](setup, rng, exact=record, packed=compiled, swept=swept)
+    world = World2D(setup, rng, exact=record, packed=compiled, swept=swept, vehicle=vehicle)
     rec = TrajectoryProbe() if record else None
     try:
         (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])

@@ -7,7 +7,7 @@ preallocated arrays (robot pose and command, obstacle poses, random-turn draws, 
 :func:`step_worlds_py` advances every running world by one decision (``control_period / dt``
 integration steps) in one loop, compiled by numba when it is enabled (:func:`numba_enabled`).
 
-The numbers are those of :class:`uvnav.sim.episode.UnicycleWorld` with exact clearance, bit for
+The numbers are those of :class:`uvnav.sim.episode.World2D` with exact clearance, bit for
 bit (the test suite compares them):
 
 * robot: :func:`uvnav.dynamics.unicycle.unicycle_advance`, the same operations;
@@ -494,8 +494,8 @@ class PackedWorlds:
     :attr:`command`, :attr:`status`... are views of them).  A slot's random-turn obstacles keep
     their generators, read ahead by up to a row of pre-drawn numbers (:data:`ROW_BLOCKS` x
     :data:`BLOCK`, more where a decision has over :data:`BLOCK` integration steps): the models
-    are not written back (unlike :meth:`UnicycleWorld.close
-    <uvnav.sim.episode.UnicycleWorld.close>`).
+    are not written back (unlike :meth:`World2D.close
+    <uvnav.sim.episode.World2D.close>`).
     """
 
     oi: np.ndarray
@@ -582,8 +582,8 @@ class PackedWorlds:
         self.read = read
 
     def load(self, slot: int, setup: EpisodeSetup) -> None:
-        """Put ``setup``'s episode in ``slot`` as :meth:`UnicycleWorld.start
-        <uvnav.sim.episode.UnicycleWorld.start>` begins it (status and clearance at t = 0).
+        """Put ``setup``'s episode in ``slot`` as :meth:`World2D.start
+        <uvnav.sim.episode.World2D.start>` begins it (status and clearance at t = 0).
 
         Raises:
             ValueError: the episode cannot be packed (:func:`pack_check`).
@@ -607,7 +607,7 @@ class PackedWorlds:
         wf[[W_VMAX, W_UMAX]] = (float(spec.v_max), float(spec.u_max))
         n_steps = step_count(float(setup.t_max), dt)
         wi[[I_STEP, I_RATIO, I_NSTEPS, I_NOBS]] = (0, ratio, n_steps, m)
-        # at t = 0 as UnicycleWorld.start measures it (the field's query), from the slot
+        # at t = 0 as World2D.start measures it (the field's query), from the slot
         gap = float(kernel("clearance_one")(x, y, float(spec.radius), m, self.params[slot],
                                             self.state[slot], self.rings[slot])[0])  # fmt: skip
         wf[W_CLEAR], wf[W_LOW] = gap, math.inf
@@ -730,8 +730,8 @@ class PackedWorlds:
 
 
 class PackedObstacles:
-    """One episode's obstacles in a packed slot: :class:`UnicycleWorld
-    <uvnav.sim.episode.UnicycleWorld>`'s compiled path.  The obstacles move, the clearance is
+    """One episode's obstacles in a packed slot: :class:`World2D
+    <uvnav.sim.episode.World2D>`'s compiled path.  The obstacles move, the clearance is
     measured and the exact sensor reads them in compiled calls (:func:`advance_one_py`,
     :func:`sense_one_py`), with the numbers of :class:`ObstacleBatch` and
     :meth:`ObstacleField.query`, bit for bit; :meth:`field` builds the field of the moment for

@@ -1,9 +1,9 @@
 """Social metrics of a 2D episode: how the robot treats the pedestrians of a crowd scene.
 
 Crowd-navigation papers report, beside success and collisions, how close the robot came to people
-and how often it made them uncomfortable.  The 2D worlds (:class:`uvnav.sim.episode.UnicycleWorld`
-and :class:`~uvnav.sim.episode.HolonomicWorld`) keep the numbers below with :class:`SocialTracker`
-at every integration step; every other vehicle kind reports them as ``None``.
+and how often it made them uncomfortable.  The 2D world (:class:`uvnav.sim.episode.World2D`, any
+planar vehicle) keeps the numbers below with :class:`SocialTracker` at every integration step;
+every other vehicle kind reports them as ``None``.
 
 **Who is a pedestrian.**  The scene schema has no pedestrian flag, so the rule is structural: a
 pedestrian is an obstacle whose body is a *disc* and whose motion model can move it
