@@ -22,12 +22,15 @@ index                 what                                                      
                       first beam straight behind, counter-clockwise)
 ====================  ==========================================================  =========
 
-Action (float32, in [-1, 1]^2): ``v = (a0 + 1) / 2 * V_max``, ``u = a1 * U_max`` (inside the
-limits (2.4) by construction, so no limit is ever violated).  With ``raw_commands=True`` the
-action is instead the command itself, ``(v [m/s], u [rad/s])`` as float64, handed to the world
-as a uvnav law's command is (saturated and counted in ``limit_violations`` when outside the
-limits): the normalised float32 map cannot carry a law's command exactly (a law's ``u`` rounded
-to float32 moves the trajectory by ~1e-9 m per step), the raw one can.
+Action (float32, in [-1, 1]^2): for the unicycle ``v = (a0 + 1) / 2 * V_max``, ``u = a1 *
+U_max``; for another planar vehicle each component mapped linearly onto its command box
+(:meth:`~uvnav.dynamics.vehicles.Vehicle2D.bounds`) — inside the limits by construction, so no
+limit is ever violated.  With ``raw_commands=True`` the action is instead the command itself
+(the unicycle's ``(v [m/s], u [rad/s])``, a vehicle's :meth:`~uvnav.dynamics.vehicles.Vehicle2D.
+pair`) as float64, handed to the world as a uvnav law's command is (saturated and counted in
+``limit_violations`` when outside the limits): the normalised float32 map cannot carry a law's
+command exactly (a law's ``u`` rounded to float32 moves the trajectory by ~1e-9 m per step), the
+raw one can.
 
 Reward per decision (weights in :class:`RewardConfig`): ``progress`` x (decrease of the distance
 to the goal [m]) ``- time`` ``- clearance`` x max(0, ``clearance_margin`` - clearance [m]) ``+
@@ -44,7 +47,7 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
+from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.obstacles.bodies import Body, DiscBody
 from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
 from uvnav.sensors.exact import lidar_scan
@@ -97,15 +100,17 @@ class RewardConfig:
 class ControllerView:
     """What a uvnav controller is given at this decision: its
     :class:`~uvnav.sensors.Observation` (made by the world's sensor, as in the simulator) and its
-    vehicle limits (``info["uvnav"]`` of the envs), and whether the env takes raw commands.
+    vehicle limits (``info["uvnav"]`` of the envs), whether the env takes raw commands, and the
+    planar vehicle when it is not the unicycle (whose commands the action maps).
 
     Equality compares the contents (numpy arrays element-wise), so Gymnasium's determinism
     checks can compare infos.
     """
 
     observation: Observation
-    spec: UnicycleSpec
+    spec: Any
     raw_commands: bool = False  # the env's action is the command (v, u) itself
+    vehicle: Any = None  # a Vehicle2D other than the unicycle
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, ControllerView):
@@ -148,6 +153,27 @@ def action_commands(
     a = np.clip(a, -1.0, 1.0)
     a = np.where(np.isfinite(a), a, 0.0)
     return 0.5 * (a[:, 0] + 1.0) * v_max, a[:, 1] * u_max
+
+
+def box_command(
+    action: np.ndarray, low: tuple[float, float], high: tuple[float, float], raw: bool
+) -> tuple[float, float]:
+    """A planar vehicle's two command numbers from an action: the action itself when ``raw``,
+    else a normalised action in [-1, 1]^2 (clipped; non-finite components 0) mapped linearly onto
+    the box ``[low, high]``.
+
+    >>> box_command(np.array([0.0, np.nan]), (-2.0, -1.0), (2.0, 1.0), raw=False)
+    (0.0, 0.0)
+    >>> box_command(np.array([1.0, -1.0]), (-2.0, -1.0), (2.0, 1.0), raw=False)
+    (2.0, -1.0)
+    """
+    a = np.asarray(action, dtype=float)
+    if raw:
+        return float(a[0]), float(a[1])
+    a = np.clip(np.where(np.isfinite(a), a, 0.0), -1.0, 1.0)
+    lo, hi = np.asarray(low, dtype=float), np.asarray(high, dtype=float)
+    c = lo + 0.5 * (a + 1.0) * (hi - lo)
+    return float(c[0]), float(c[1])
 
 
 class EnvWorld:
@@ -207,7 +233,7 @@ class EnvWorld:
         w = self.world
         return w.goals[i] if isinstance(w, MultiUnicycleWorld) else w.goal
 
-    def spec(self, i: int) -> UnicycleSpec:
+    def spec(self, i: int) -> Any:
         w = self.world
         return w.robots[i].spec if isinstance(w, MultiUnicycleWorld) else w.spec
 
@@ -225,7 +251,7 @@ class EnvWorld:
         w = self.world
         if not self.running(i):
             return 0.0
-        return float(w.applied[i].v if isinstance(w, MultiUnicycleWorld) else w.applied.v)
+        return float(w.applied[i].v if isinstance(w, MultiUnicycleWorld) else w.speed)
 
     def _gap(self, i: int) -> float:
         """Robot i's gap after the last step [m] (``max_range`` when nothing is within reach)."""
@@ -243,7 +269,9 @@ class EnvWorld:
     def view(self, i: int) -> ControllerView:
         """Robot i's :class:`ControllerView`: the world's observation (call once per decision:
         an estimator, a noisy lidar, advance with it) and its limits."""
-        return ControllerView(self.world.observe(i), self.spec(i), self.raw_commands)
+        w = self.world
+        body = w.body if isinstance(w, World2D) and w.vehicle != "unicycle" else None
+        return ControllerView(w.observe(i), self.spec(i), self.raw_commands, body)
 
     def vector(self, i: int) -> np.ndarray:
         """Robot i's observation vector (module docstring), float32."""
@@ -276,13 +304,22 @@ class EnvWorld:
             None if f.present is None else f.present[keep],
         )  # fmt: skip
 
-    def command(self, i: int, action: np.ndarray) -> UnicycleCommand:
-        """The unicycle command of robot ``i``'s action (:func:`action_commands`)."""
-        spec = self.spec(i)
+    def command(self, i: int, action: np.ndarray) -> Any:
+        """The command of robot ``i``'s action: a unicycle's by :func:`action_commands`,
+        another vehicle's by :func:`box_command`."""
+        w = self.world
         a = np.asarray(action, dtype=float).reshape(1, 2)
+        if isinstance(w, World2D) and w.vehicle != "unicycle":
+            return w.body.command(*box_command(a[0], *w.body.bounds(), self.raw_commands))
+        spec = self.spec(i)
         v, u = action_commands(a, np.array([spec.v_max]), np.array([spec.u_max]),
                                self.raw_commands)  # fmt: skip
         return UnicycleCommand(float(v[0]), float(u[0]))
+
+    def rest(self, i: int) -> Any:
+        """Robot ``i``'s command when it has no action: standing still."""
+        w = self.world
+        return w.body.rest() if isinstance(w, World2D) else UnicycleCommand(0.0, 0.0)
 
     def step(self, actions: dict[int, np.ndarray]) -> np.ndarray:
         """One decision: the acting robots' commands (a robot without an action stands still)
@@ -294,7 +331,7 @@ class EnvWorld:
         low = np.full(n, np.inf)
         if not w.done:
             for i in w.acting():
-                cmd = self.command(i, actions[i]) if i in actions else UnicycleCommand(0.0, 0.0)
+                cmd = self.command(i, actions[i]) if i in actions else self.rest(i)
                 w.apply(cmd, i)
             while True:
                 alive = [i for i in range(n) if self.running(i)]

@@ -1,7 +1,9 @@
 """``uvnav/Nav2D-v0``: a Gymnasium environment on the 2D world of the thesis's Ch. 2.
 
-One robot (unicycle, (2.1)-(2.4)) among a scenario's obstacles.  The env steps the simulator's
-own world, :class:`uvnav.sim.episode.World2D` (:class:`uvnav.envs.core.EnvWorld`): one env
+One robot (the unicycle, (2.1)-(2.4), or another planar vehicle: ``vehicle=``, the holonomic
+robot or a plug-in's, :mod:`uvnav.dynamics.vehicles`) among a scenario's obstacles.  The env
+steps the simulator's own world, :class:`uvnav.sim.episode.World2D`
+(:class:`uvnav.envs.core.EnvWorld`): one env
 step is one decision (``control_period``), integrated with the scenario's ``dt`` and checked for
 collisions at every integration step by the world, so that an env episode driven by a law's
 commands (``raw_commands=True``) is bit for bit :func:`uvnav.sim.run_episode`'s.
@@ -12,7 +14,8 @@ commands (``raw_commands=True``) is bit for bit :func:`uvnav.sim.run_episode`'s.
 * **Action** ``Box([-1, -1], [1, 1])`` float32: ``v = (a0 + 1) / 2 V_max``, ``u = a1 U_max``;
   with ``raw_commands=True``, ``Box([0, -U_max], [V_max, U_max])`` float64: the command
   ``(v [m/s], u [rad/s])`` itself, saturated and counted as a limit violation when outside, as
-  the simulator does with a law's command (:mod:`uvnav.envs.core`).
+  the simulator does with a law's command (:mod:`uvnav.envs.core`).  Another vehicle's action
+  is its command box (``Vehicle2D.bounds``), normalised the same way or raw.
 * **Reward**: :class:`uvnav.envs.core.RewardConfig` (progress, time, clearance, success,
   collision), configurable with ``reward={...}``.
 * **Termination**: arrival (``info["status"] == "success"``) or collision; **truncation** at the
@@ -37,6 +40,7 @@ from typing import Any
 
 import numpy as np
 
+from uvnav.dynamics.vehicles import make_vehicle, vehicles_2d
 from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig, goal_scale_for
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
@@ -99,7 +103,10 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         max_range: lidar range [m].
         goal_scale: distance [m] mapped to 1 (default: the scenario's start-goal distance x 1.5).
         reward: reward weights (:class:`RewardConfig` or a dict of its fields).
-        raw_commands: actions are unicycle commands ``(v, u)`` (module docstring).
+        raw_commands: actions are the vehicle's commands (the unicycle's ``(v, u)``; module
+            docstring).
+        vehicle: the planar vehicle the agent drives (the unicycle; ``holonomic`` or a plug-in
+            vehicle's name, :func:`~uvnav.dynamics.vehicles.vehicles_2d`).
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 10}  # noqa: RUF012 - gymnasium declares it an instance variable
@@ -114,7 +121,12 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         goal_scale: float | None = None,
         reward: RewardConfig | dict[str, float] | None = None,
         raw_commands: bool = False,
+        vehicle: str = "unicycle",
     ) -> None:
+        if vehicle not in vehicles_2d():
+            known = ", ".join(vehicles_2d())
+            raise ValueError(f"vehicle: no 2D vehicle {vehicle!r}; known: {known}")
+        self.vehicle = vehicle
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
         self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
@@ -123,7 +135,15 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         self.goal_scale = goal_scale_for(dist, goal_scale)
         self._configure(render_mode, n_rays, max_range, reward_config(reward), raw_commands)
         self.observation_space = obs_space(self.n_rays)
-        self.action_space = act_space(r.v_max, r.u_max, raw=raw_commands)
+        if vehicle == "unicycle":
+            self.action_space = act_space(r.v_max, r.u_max, raw=raw_commands)
+        else:
+            low, high = make_vehicle(vehicle, self.scenario.robot.to_spec()).bounds()
+            self.action_space = (
+                spaces.Box(low=np.array(low), high=np.array(high), dtype=np.float64)
+                if raw_commands
+                else spaces.Box(low=-1.0, high=1.0, shape=(2,), dtype=np.float32)
+            )
 
     @property
     def world(self) -> World2D:
@@ -139,7 +159,8 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         if self._world is not None:
             self._world.close()
         self.episode_seed = k = episode_seed(self.np_random, options)
-        w = self._open(World2D(build_episode(self.scenario, k), run_rng(k), exact=True))
+        setup = build_episode(self.scenario, k)
+        w = self._open(World2D(setup, run_rng(k), exact=True, vehicle=self.vehicle))
         return w.vector(0), self._info(0)
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:

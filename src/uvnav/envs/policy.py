@@ -43,6 +43,10 @@ class ControllerPolicy:
         to_action = getattr(view, "to_action", None)
         if to_action is not None:  # the Chapter 3 / 4 envs: their own inverse action map
             return np.asarray(to_action(self.controller.act(o)), dtype=np.float32)
+        body = getattr(view, "vehicle", None)
+        if body is not None:  # a planar vehicle other than the unicycle: its command box
+            return vehicle_action(body, self.controller.act(o), float(o.pose[2]),
+                                  view.raw_commands)  # fmt: skip
         if getattr(view, "raw_commands", False):  # the command itself, exactly
             raw = self.controller.act(o)
             return np.array([raw.v, raw.u], dtype=float)
@@ -50,6 +54,18 @@ class ControllerPolicy:
         a0 = 2.0 * cmd.v / spec.v_max - 1.0
         a1 = cmd.u / spec.u_max
         return np.clip(np.array([a0, a1], dtype=np.float32), -1.0, 1.0)
+
+
+def vehicle_action(body: Any, cmd: Any, heading: float, raw: bool) -> np.ndarray:
+    """A planar vehicle's command as an env action: its two numbers (float64) when ``raw``,
+    else the saturated command placed in [-1, 1]^2 over the vehicle's command box (float32; the
+    inverse of :func:`uvnav.envs.core.box_command`)."""
+    if raw:
+        return np.array(body.pair(cmd), dtype=float)
+    low, high = (np.asarray(b, dtype=float) for b in body.bounds())
+    sat, _ = body.saturate(cmd, heading)
+    a = 2.0 * (np.asarray(body.pair(sat), dtype=float) - low) / (high - low) - 1.0
+    return np.clip(a.astype(np.float32), -1.0, 1.0)
 
 
 def check_env_law(env: Any, name: str) -> None:
