@@ -5,9 +5,10 @@ written by ``tests/sim/golden_cases.py`` on the code before the move), to 1e-9.
 Changed since, on purpose, and only these entries: the ``dwa-v1`` episodes (issue 19: its heading
 term is evaluated at the rollout's point nearest T where the rollout passes T, which fixed the
 robot parking short of T; the entries were rewritten from the fixed law, every other entry kept
-byte for byte), and the 2D worlds' ``min_clearance`` (issue 32: the minimum along each step, not
-at its end; 28 entries moved down by 0.02 to 4.7 mm, no status or other number moved: see
-``docs/design-notes.md``, "Collisions judged along the step")."""
+byte for byte), and the 2D and multi-robot worlds' ``min_clearance`` (issue 32: the minimum
+along each step, not at its end; 28 single-robot entries moved down by 0.02 to 4.7 mm, 7 robots
+of 3 multi-robot entries by up to 2.4 mm; no status or other number moved: see
+``docs/design-notes.md``, "One world model, first steps")."""
 
 from __future__ import annotations
 

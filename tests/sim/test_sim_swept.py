@@ -106,3 +106,113 @@ def test_the_minimum_along_the_steps_never_exceeds_a_sampled_one_and_paths_agree
         assert rec.contact_time is not None
         assert rec.contact_time <= rec.trajectory.times[-1] + 1e-12
         assert math.isfinite(rec.contact_time)
+
+
+# ------------------------------------------------- every world: a contact between two samples
+
+
+class _Straight:
+    """A test law holding one command (any vehicle's)."""
+
+    oracle = False
+    mode = "M1"
+
+    def __init__(self, command: object) -> None:
+        self.command = command
+
+    def reset(self, spec: object, goal: np.ndarray, rng: np.random.Generator) -> None:
+        pass
+
+    def act(self, obs: object) -> object:
+        return self.command
+
+
+def _ch3() -> tuple[str, float | None]:
+    from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
+    from uvnav.obstacles.bodies3d import SphereBody
+    from uvnav.obstacles.motion3d import ConstantMotion3D, Obstacle3D, ObstacleState3D
+    from uvnav.sim.episode3d import Episode3DSetup, run_episode3d
+
+    ball = Obstacle3D(SphereBody(0.05), ConstantMotion3D(np.zeros(3)),
+                      ObstacleState3D(centre=np.zeros(3)))  # fmt: skip
+    setup = Episode3DSetup(
+        spec=Vehicle3DSpec(v_max=3.0, u_max=1.0, radius=0.05), start=np.array([-1.35, 0, 0]),
+        heading=np.array([1.0, 0, 0]), goal=np.array([5.0, 0, 0]), obstacles=[ball], dt=0.1,
+        control_period=0.1, t_max=1.0,
+    )  # fmt: skip
+    law = _Straight(Vehicle3DCommand(3.0, np.zeros(3)))
+    res, _ = run_episode3d(setup, law, np.random.default_rng(0), record=False)  # type: ignore[arg-type]
+    return res.status, res.contact_time
+
+
+def _ch4(swept: bool = True) -> tuple[str, float | None]:
+    from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec
+    from uvnav.obstacles.deforming import RigidShape
+    from uvnav.sim.episode_uuv2d import Uuv2dSetup, run_uuv2d_episode
+
+    wall = RigidShape(local=WALL, centre=np.zeros(2))
+    setup = Uuv2dSetup(
+        spec=HolonomicSpec(v_max=2.0, u_max=1.0, radius=0.05), start=np.array([-1.1, 0.0, 0.0]),
+        goal=np.array([3.0, 0.0]), shapes=[wall], dt=0.1, control_period=0.1, t_max=1.0,
+    )  # fmt: skip
+    law = _Straight(HolonomicCommand(2.0, 0.0))
+    res = run_uuv2d_episode(setup, law, np.random.default_rng(0), record=False, swept=swept)
+    return res.status, res.contact_time
+
+
+def _ch5() -> tuple[str, float | None]:
+    from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
+    from uvnav.obstacles.deforming3d import CompoundBody, DeformingStar
+    from uvnav.sensors.sonar_array import SonarArray
+    from uvnav.sim.episode_uuv3d import UUV3DSetup, run_uuv3d_episode
+
+    ball = CompoundBody(parts=(DeformingStar(centre=np.zeros(3), base_radius=0.05),))
+    setup = UUV3DSetup(
+        start=np.array([-1.35, 0.0, 0.0]), heading=np.array([1.0, 0, 0]),
+        goal=np.array([5.0, 0, 0]), spec=Vehicle3DSpec(v_max=3.0, u_max=1.0, radius=0.05),
+        obstacles=(ball,), array=SonarArray(hull_radius=0.05), dt=0.1, control_period=0.1,
+        t_max=1.0,
+    )  # fmt: skip
+    law = _Straight(Vehicle3DCommand(3.0, np.zeros(3)))
+    res = run_uuv3d_episode(setup, law, np.random.default_rng(0))  # type: ignore[arg-type]
+    return res.status, res.contact_time
+
+
+@pytest.mark.parametrize(
+    ("run", "contact"),
+    [
+        # a 10 cm ball crossed at 0.3 m a step: samples 5 cm clear at x = -0.15 and 0.15;
+        # first contact at x = -0.1 (radius sum 0.1 m), t = 1.25 / 3 s
+        (_ch3, 1.25 / 3.0),
+        (_ch4, (-0.07 + 1.1) / 2.0),  # the thin wall of the 2D tests, at 2 m/s
+        (_ch5, 1.25 / 3.0),  # the ball as a Ch. 5 body (its tessellation lies inside it)
+    ],
+    ids=["vehicle3d", "uuv2d", "uuv3d"],
+)
+def test_every_world_judges_a_contact_between_two_samples(run: object, contact: float) -> None:
+    status, at = run()  # type: ignore[operator]
+    assert status == "collision" and at is not None
+    # conservative advancement: the first sample in contact, at most 0.1 mm of travel late (the
+    # tessellated ball's surface lies up to 1 mm inside the sphere: later, not earlier)
+    assert contact - 1e-9 <= at <= contact + 0.002 / 3.0
+
+
+def test_the_ch4_world_judged_at_step_ends_passes_through() -> None:
+    assert _ch4(False) == ("timeout", None)
+
+
+def test_two_robots_that_cross_between_two_samples_collide() -> None:
+    from uvnav.sim.multi import MultiSetup, RobotSetup, run_multi
+
+    def robot(start: tuple[float, float, float], goal: tuple[float, float]) -> RobotSetup:
+        spec = UnicycleSpec(v_max=2.0, u_max=1.0, radius=0.05)
+        return RobotSetup(spec, np.array(start), np.array(goal), make_law("straight-v1"))
+
+    # 0.2 m a step: at 0.5 s and 0.6 s the robots are 4 cm clear, at 0.55 s both at the origin
+    setup = MultiSetup(
+        robots=[robot((-1.1, 0.0, 0.0), (3.0, 0.0)), robot((0.0, -1.1, math.pi / 2), (0.0, 3.0))],
+        dt=0.1, control_period=0.1, t_max=2.0,
+    )  # fmt: skip
+    res = run_multi(setup, np.random.default_rng(0), record=False, vectorised=True)
+    assert res.statuses == ["collision", "collision"] and res.collided_pairs == [(0, 1)]
+    assert all(m.min_clearance is not None and m.min_clearance < 0 for m in res.robots)

@@ -190,6 +190,17 @@ class DeformingStar:
             * self.axes.max()
         )
 
+    @property
+    def boundary_speed(self) -> float:
+        """A bound [m/s] on the speed of every surface point (and every tessellation vertex):
+        ``|M r_ref(d) d| |d delta / dt| <= R0 (1 + sum |b_k|) max(axes) sum |c_k w_k|``."""
+        return float(
+            self.base_radius
+            * (1.0 + np.abs(self.shape).sum())
+            * self.axes.max()
+            * np.abs(self.amplitude * self.frequency).sum()
+        )
+
     def reference_radius(self, dirs: FloatArray, basis: FloatArray | None = None) -> FloatArray:
         """r_ref(d) [m] (shape-space radius) at unit directions (n, 3)."""
         b = harmonic_basis(dirs) if basis is None else basis
@@ -359,6 +370,11 @@ class CompoundBody:
         """Radius [m] of a sphere about :attr:`centre` containing the body at every time."""
         c = self.centre
         return max(float(np.linalg.norm(p.centre - c)) + p.bounding_radius for p in self.parts)
+
+    @property
+    def boundary_speed(self) -> float:
+        """A bound [m/s] on the speed of every surface point (the fastest part's)."""
+        return max(p.boundary_speed for p in self.parts)
 
     def triangles(self, t: float) -> list[Triangles]:
         """The parts' tessellations at time ``t``."""

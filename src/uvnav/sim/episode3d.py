@@ -5,11 +5,15 @@ decision in CPU time).
 The controller is asked every ``control_period`` [s] (a whole multiple of ``dt``); the robot
 (:func:`uvnav.dynamics.vehicle3d.vehicle3d_advance`, exact on the sphere of headings) and the
 obstacles (exact translation and rotation) are integrated every ``dt`` [s] with the last command
-held.  At *every* integration step the clearance between the robot's sphere and every obstacle is
-checked exactly: obstacles are culled by bounding spheres (a lower bound of their distance), and
-the exact signed distance (mesh kernel with pseudo-normal sign, or the sphere's closed form) is
-computed for those whose lower bound is below the step's best value or may overlap.  The minimum
-clearance is therefore the exact minimum over all steps.
+held.  Collisions are judged along the whole of every step by conservative advancement
+(:func:`~uvnav.sim.swept.first_contact`: the robot's arc and each body's pose, moved by the rates
+held over the step, are exact at any fraction of it), so a contact between two samples deeper
+than 0.1 mm is a collision.  At the end of every integration step the clearance between the
+robot's sphere and every obstacle is checked exactly: obstacles are culled by bounding spheres
+(a lower bound of their distance), and the exact signed distance (mesh kernel with pseudo-normal
+sign, or the sphere's closed form) is computed for those whose lower bound is below the step's
+best value or may overlap.  The minimum clearance is the exact minimum over the steps' ends and
+the samples the advancement took.
 
 The metrics are those of :mod:`uvnav.sim.metrics` (same names).  The simulator clips nothing
 silently: a command outside (3.4)-(3.6) is made physical (:meth:`Vehicle3DCommand.clipped`) and
@@ -31,12 +35,13 @@ from uvnav.controllers.base3d import Controller3D
 from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec, vehicle3d_advance
 from uvnav.geometry.angles import FloatArray
-from uvnav.geometry.frames3d import check_unit
+from uvnav.geometry.frames3d import check_unit, rotation_from_vector
 from uvnav.obstacles.motion3d import Obstacle3D
 from uvnav.sensors.sensing3d import FiniteDifference3D, Observation3D, sense_obstacles3d
 from uvnav.sim.episode import EpisodeResult
 from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.swept import first_contact
 
 
 @dataclass(frozen=True)
@@ -295,14 +300,16 @@ class Vehicle3DWorld:
         dt, book = self.dt, self.book
         u_held = self.u_held
         book.effort += float(u_held @ u_held) * dt
-        new_pos, self.a, self.u_held = vehicle3d_advance(
-            self.pos, self.a, self.applied.v, u_held, dt
-        )
-        book.path += float(np.linalg.norm(new_pos - self.pos))
+        start, head, v, g0 = self.pos, self.a, self.applied.v, self.clearance
+        new_pos, self.a, self.u_held = vehicle3d_advance(start, head, v, u_held, dt)
+        book.path += float(np.linalg.norm(new_pos - start))
         self.pos = new_pos
-        t = self.t
+        t = t0 = self.t
+        poses = [(ob.state.centre, ob.state.rotation) for ob in self.obstacles]
         for ob in self.obstacles:
             ob.step(t, dt)
+        # the rates held over the step (the next step's are set below)
+        rates = [(ob.state.velocity.copy(), ob.state.rotation_rate.copy()) for ob in self.obstacles]
         self.t = t = self.clock.tick()
         if self.tracker is None:
             self.clearance, self.nearest = clearance3d(self.pos, self.obstacles, self.spec.radius)
@@ -312,8 +319,27 @@ class Vehicle3DWorld:
             )
         for ob in self.obstacles:  # rates of the next step, visible to the next sensing
             ob.state.velocity, ob.state.rotation_rate = ob.motion.rates(t, ob.state)
+        contact_at = None
+        if self.obstacles:
+
+            def gap_at(s: float) -> float:
+                p = vehicle3d_advance(start, head, v, u_held, s * dt)[0]
+                return min(
+                    ob.body.nearest_world(p, c + vel * (s * dt),
+                                          rotation_from_vector(w * (s * dt)) @ rot)[1]
+                    for ob, (c, rot), (vel, w) in zip(self.obstacles, poses, rates, strict=True)
+                ) - self.spec.radius  # fmt: skip
+
+            reach = dt * (abs(v) + max(
+                float(np.linalg.norm(vel)) + float(np.linalg.norm(w)) * ob.body.bounding_radius
+                for ob, (vel, w) in zip(self.obstacles, rates, strict=True)
+            ))  # fmt: skip
+            s_hit, least = first_contact(gap_at, g0, self.clearance, reach)
+            book.min_clear = min(book.min_clear, least)
+            if not math.isnan(s_hit):
+                contact_at = t0 + s_hit * dt
         gd = float(np.linalg.norm(self.goal - self.pos))
-        self.done = book.judge(t, self.clearance, gd) or self.clock.up
+        self.done = book.judge(t, self.clearance, gd, contact_at) or self.clock.up
 
     def close(self) -> None:
         """Nothing to write back (the obstacles were advanced in place)."""
@@ -418,6 +444,7 @@ def run_episode3d(
     (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
     dec = np.asarray(log.decision_us) if log.decision_us else np.zeros(1)
     result = EpisodeResult(
-        metrics=world.metrics(log), status=world.status, trajectory=None, decision_us=dec
-    )
+        metrics=world.metrics(log), status=world.status, trajectory=None, decision_us=dec,
+        contact_time=world.book.contact_at,
+    )  # fmt: skip
     return result, (rec.finish() if rec is not None else None)

@@ -9,9 +9,13 @@ world's rigid-body field cannot hold them):
 * every ``control_period`` [s] (a whole multiple of ``dt``) the sonar sweeps the viewing cone
   and the law is asked for a velocity; a command outside the limits (4.4)-(4.6) is counted in
   ``limit_violations`` and saturated (:meth:`HolonomicCommand.clipped`), never silently;
-* every ``dt`` the vehicle moves exactly (constant velocity) and the collision check is exact:
-  signed distance from the vehicle's centre to every outline at that instant
+* every ``dt`` the vehicle moves exactly (constant velocity) and the clearance is exact at the
+  step's end: signed distance from the vehicle's centre to every outline at that instant
   (:func:`~uvnav.geometry.polygons.rings_nearest` with the even-odd test), minus its radius;
+  collisions are judged along the whole step by conservative advancement
+  (:func:`~uvnav.sim.swept.first_contact`: the outlines are functions of time, and no boundary
+  point moves faster than its body's ``max_rate`` plus its centre's speed), so a contact between
+  two samples deeper than 0.1 mm is a collision (``swept=False``: at the step's end only);
 * ``forbidden`` regions (the inner space of a Fig. 4.2(b) trap) are checked each step too: the
   result says whether the vehicle's centre ever entered one.
 
@@ -36,6 +40,7 @@ from uvnav.obstacles.deforming import ShapeChanging
 from uvnav.sensors.sonar2d import SonarConfig, SonarObservation, sonar_scan
 from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.swept import first_contact
 
 
 @dataclass
@@ -89,13 +94,14 @@ class Uuv2dTrajectory:
 @dataclass
 class Uuv2dResult:
     """Metrics, status (``success``, ``collision`` or ``timeout``), whether a forbidden region was
-    entered, and the recorded trajectory."""
+    entered, the recorded trajectory and the time of a collision's first contact [s]."""
 
     metrics: EpisodeMetrics
     status: str
     entered_forbidden: bool
     trajectory: Uuv2dTrajectory | None
     decision_us: FloatArray
+    contact_time: float | None = None
 
 
 def clearance_of(
@@ -141,8 +147,9 @@ class Uuv2dWorld:
     sensing: ClassVar[str] = "sonar-fan"
     n_agents: ClassVar[int] = 1
 
-    def __init__(self, setup: Uuv2dSetup, rng: np.random.Generator) -> None:
+    def __init__(self, setup: Uuv2dSetup, rng: np.random.Generator, *, swept: bool = True) -> None:
         self.setup = setup
+        self.swept = swept
         self._law_rng, self.sense_rng = rng.spawn(2)
         self.spec = setup.spec
         self.clock = Clock(setup.dt, setup.control_period, setup.t_max)
@@ -151,6 +158,10 @@ class Uuv2dWorld:
         self.goal = np.asarray(setup.goal, dtype=float)
         self.state = np.asarray(setup.start, dtype=float).copy()
         self.shapes = setup.shapes
+        #: the most a boundary point moves in a step [m] (centre speed plus deformation rate)
+        self._body_reach = self.dt * max(
+            (float(np.hypot(*s.velocity)) + float(s.max_rate) for s in self.shapes), default=0.0
+        )
         self.t = 0.0
         self.done = False
 
@@ -221,17 +232,33 @@ class Uuv2dWorld:
     def advance(self) -> None:
         """One integration step ``dt``: vehicle, outlines, clearance, forbidden regions, collision
         and arrival."""
-        state = self.state
-        nxt = holonomic_step(state, self.applied, self.dt)
-        self.book.path += math.hypot(nxt[0] - state[0], nxt[1] - state[1])
+        start, t0, g0 = self.state, self.t, self.clearance
+        nxt = holonomic_step(start, self.applied, self.dt)
+        step = math.hypot(nxt[0] - start[0], nxt[1] - start[1])
+        self.book.path += step
         self.state = state = nxt
         self.t = t = self.clock.tick()
         self.outlines = self.outlines_at(t)
         self.clearance, _ = clearance_of((state[0], state[1]), self.outlines, self.spec.radius)
         self.entered = self.entered or inside_any((state[0], state[1]), self.setup.forbidden)
+        contact_at = None
+        if self.swept and self.shapes:
+            s_hit, least = first_contact(
+                lambda s: self._gap_at(start, nxt, t0, s), g0, self.clearance,
+                step + self._body_reach,
+            )  # fmt: skip
+            self.book.min_clear = min(self.book.min_clear, least)
+            if not math.isnan(s_hit):
+                contact_at = t0 + s_hit * self.dt
         goal = self.goal
         gd = math.hypot(goal[0] - state[0], goal[1] - state[1])
-        self.done = self.book.judge(t, self.clearance, gd) or self.clock.up
+        self.done = self.book.judge(t, self.clearance, gd, contact_at) or self.clock.up
+
+    def _gap_at(self, start: FloatArray, end: FloatArray, t0: float, s: float) -> float:
+        """The exact gap [m] at fraction ``s`` of the step from ``start`` (time ``t0``) to
+        ``end``: the vehicle on the segment, the outlines of that instant."""
+        p = (start[0] + s * (end[0] - start[0]), start[1] + s * (end[1] - start[1]))
+        return clearance_of(p, self.outlines_at(t0 + s * self.dt), self.spec.radius)[0]
 
     def close(self) -> None:
         """Nothing to write back (the outlines are functions of time)."""
@@ -302,6 +329,7 @@ def run_uuv2d_episode(
     *,
     record: bool = True,
     probes: Sequence[Probe] = (),
+    swept: bool = True,
 ) -> Uuv2dResult:
     """Run one episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
     :class:`Uuv2dWorld`).
@@ -313,8 +341,9 @@ def run_uuv2d_episode(
         rng: the episode generator; independent children feed the controller and the sonar.
         record: keep the trajectory (for figures).
         probes: more probes to run in the loop.
+        swept: judge collisions along each step (the default), else at its end only.
     """
-    world = Uuv2dWorld(setup, rng)
+    world = Uuv2dWorld(setup, rng, swept=swept)
     rec = Uuv2dTrajectoryProbe() if record else None
     (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
     dec = np.asarray(log.decision_us) if log.decision_us else np.zeros(1)
@@ -324,4 +353,5 @@ def run_uuv2d_episode(
         entered_forbidden=world.entered,
         trajectory=rec.finish() if rec is not None else None,
         decision_us=dec,
+        contact_time=world.book.contact_at,
     )

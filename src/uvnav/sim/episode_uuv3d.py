@@ -6,9 +6,13 @@ the one loop :func:`uvnav.core.run_loop`, with the 2D world's conventions
 (:mod:`uvnav.sim.episode`): the law is asked every ``control_period`` [s] (a whole multiple of
 ``dt``), vehicle and obstacles advance every ``dt`` [s] with the command held (the vehicle's exact
 sphere integration, :func:`~uvnav.dynamics.vehicle3d.vehicle3d_advance`), a command outside the
-limits is saturated *and* counted in ``limit_violations``, and collisions are checked at every
-integration step against the obstacles' tessellations at that time (hull sphere against triangle
+limits is saturated *and* counted in ``limit_violations``, and the clearance is exact at every
+step's end against the obstacles' tessellations at that time (hull sphere against triangle
 meshes, exact for the mesh; the mesh is within ``tessellation_error`` of the analytic surface).
+Collisions are judged along the whole step by conservative advancement
+(:func:`~uvnav.sim.swept.first_contact`: the vehicle's arc is exact at any fraction of the step,
+the surfaces are functions of time and no surface point moves faster than its body's
+``boundary_speed``), so a contact between two samples deeper than 0.1 mm is a collision.
 Metrics carry the names of :data:`uvnav.sim.metrics.METRIC_NAMES`.
 
 Scene 2's check that the vehicle never enters an obstacle's inner space is reported separately
@@ -34,6 +38,7 @@ from uvnav.obstacles.deforming3d import CompoundBody
 from uvnav.sensors.sonar_array import SonarArray, merge_triangles, sonar_scan
 from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.swept import first_contact
 
 
 @dataclass(frozen=True)
@@ -72,6 +77,7 @@ class UUV3DResult:
         located: the located point at each decision (NaN when none).
         true_nearest: the true nearest obstacle point at each decision.
         status: ``"success"``, ``"collision"`` or ``"timeout"``.
+        contact_time: the time of a collision's first contact [s] (``None`` without one).
     """
 
     metrics: EpisodeMetrics
@@ -82,6 +88,7 @@ class UUV3DResult:
     modes: list[str] = field(default_factory=list)
     located: list[FloatArray] = field(default_factory=list)
     true_nearest: list[FloatArray] = field(default_factory=list)
+    contact_time: float | None = None
 
 
 def _nearest(
@@ -136,6 +143,7 @@ class UUV3DWorld:
         head = np.asarray(setup.heading, dtype=float)
         self.head = head / np.linalg.norm(head)
         self.obstacles = setup.obstacles
+        self._body_speed = max((ob.boundary_speed for ob in self.obstacles), default=0.0)
         self.t = 0.0
         self.done = False
 
@@ -209,14 +217,26 @@ class UUV3DWorld:
             period = self.setup.control_period
             book.effort += ((self.v_held - self.v_prev) / period) ** 2 * period
             self.v_prev = self.v_held
-        new_pos, self.head, self.u_held = vehicle3d_advance(
-            self.pos, self.head, self.v_held, self.u_held, dt
-        )
-        book.path += float(np.linalg.norm(new_pos - self.pos))
+        start, head, v, u = self.pos, self.head, self.v_held, self.u_held
+        t0, g0 = self.t, self.clearance
+        new_pos, self.head, self.u_held = vehicle3d_advance(start, head, v, u, dt)
+        book.path += float(np.linalg.norm(new_pos - start))
         self.pos = new_pos
         self.t = self.clock.tick()
         gd = self._measure()
-        self.done = book.judge(self.t, self.clearance, gd) or self.clock.up
+        contact_at = None
+        if self.obstacles:
+
+            def gap_at(s: float) -> float:
+                p = vehicle3d_advance(start, head, v, u, s * dt)[0]
+                return _nearest(p, self.obstacles, t0 + s * dt, math.inf)[0] - self.spec.radius
+
+            reach = (abs(v) + self._body_speed) * dt
+            s_hit, least = first_contact(gap_at, g0, self.clearance, reach)
+            book.min_clear = min(book.min_clear, least)
+            if not math.isnan(s_hit):
+                contact_at = t0 + s_hit * dt
+        self.done = book.judge(self.t, self.clearance, gd, contact_at) or self.clock.up
 
     @property
     def status(self) -> str:
@@ -290,7 +310,9 @@ def run_uuv3d_episode(
         (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
     finally:
         world.close()
-    out = UUV3DResult(world.metrics(log), world.inner, world.status)
+    out = UUV3DResult(
+        world.metrics(log), world.inner, world.status, contact_time=world.book.contact_at
+    )
     if rec is not None:
         out.times, out.positions, out.modes = rec.times, rec.positions, rec.modes
         out.located, out.true_nearest = rec.located, rec.true_nearest

@@ -50,6 +50,7 @@ from uvnav.dynamics.unicycle import unicycle_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
 from uvnav.geometry.small import pyhypot
+from uvnav.geometry.sweep import segment_gap
 from uvnav.obstacles.bodies import DiscBody
 from uvnav.obstacles.obstacle import _CULL_ABS, _CULL_REL, _X_AXIS, FieldTemplate
 from uvnav.sim.ledger import Ledger, decision_ratio, step_count
@@ -97,9 +98,14 @@ def swarm_check(setup: MultiSetup) -> str | None:
     return None
 
 
-def _pair_check(rob: FloatArray, status: np.ndarray, pairs: np.ndarray) -> None:
+def _pair_check(
+    rob: FloatArray, status: np.ndarray, pairs: np.ndarray, start: FloatArray, swept: bool
+) -> None:
     """Clearances and collisions of the active robots (:meth:`MultiUnicycleWorld._check` with
-    :class:`~uvnav.sim.multi._DiscPairs`' arithmetic); a robot that collided stops."""
+    :class:`~uvnav.sim.multi._DiscPairs`' arithmetic) and, with ``swept``, of the pairs along the
+    step from the positions ``start`` (N, 2), as :meth:`MultiUnicycleWorld._sweep_robots` judges
+    them (:func:`~uvnav.geometry.sweep.segment_gap` on the robots' chords); a robot that collided
+    stops."""
     n = rob.shape[0]
     for i in range(n):
         if status[i] != RUNNING:
@@ -108,6 +114,7 @@ def _pair_check(rob: FloatArray, status: np.ndarray, pairs: np.ndarray) -> None:
         px, py = rob[i, R_X], rob[i, R_Y]
         limit = rob[i, R_REACH] * (1.0 + _CULL_REL) + _CULL_ABS * (1.0 + abs(px) + abs(py))
         low = math.inf
+        lowest = math.inf
         seen = False
         for j in range(n):
             if j == i:
@@ -127,15 +134,23 @@ def _pair_check(rob: FloatArray, status: np.ndarray, pairs: np.ndarray) -> None:
             else:
                 signed = max(r - rad, 0.0)
             gap = signed - rob[i, R_RADIUS]
+            along = gap
+            if swept:
+                along = segment_gap(
+                    start[i, 0] - start[j, 0], start[i, 1] - start[j, 1], px - cx, py - cy,
+                    rad + rob[i, R_RADIUS],
+                )  # fmt: skip
             seen = True
             if gap < low:
                 low = gap
-            if gap < 0:
+            if min(gap, along) < lowest:
+                lowest = min(gap, along)
+            if gap < 0 or along < 0:
                 pairs[min(i, j), max(i, j)] = 1
                 status[i] = COLLISION
         rob[i, R_CLEAR] = low
-        if seen and low < rob[i, R_LOW]:
-            rob[i, R_LOW] = low
+        if seen and lowest < rob[i, R_LOW]:
+            rob[i, R_LOW] = lowest
 
 
 def _arrivals(rob: FloatArray, status: np.ndarray, t: float, tol: float) -> None:
@@ -246,7 +261,7 @@ def swarm_advance_py(
         rob[i, R_VY] = rob[i, R_V] * math.sin(nth)
     step = ints[I_STEP] + 1
     ints[I_STEP] = step
-    _pair_check(rob, status, pairs)
+    _pair_check(rob, status, pairs, hist[slot], True)
     _arrivals(rob, status, step * dt, flt[F_TOL])
     running = False
     for i in range(n):
@@ -266,7 +281,8 @@ def _kernels() -> tuple[Callable[..., Any], Callable[..., Any]]:
         return swarm_decide_py, swarm_advance_py
     if not _KERNELS:
         _KERNELS.update(compile_family(
-            (*FAMILY, unicycle_advance, _pair_check, _arrivals, swarm_decide_py, swarm_advance_py)
+            (*FAMILY, unicycle_advance, segment_gap, _pair_check, _arrivals, swarm_decide_py,
+             swarm_advance_py)
         ))  # fmt: skip
     return _KERNELS["swarm_decide_py"], _KERNELS["swarm_advance_py"]
 
@@ -351,7 +367,7 @@ class PackedSwarm:
     def _start(self) -> None:
         """Checks and arrivals at t = 0 (:meth:`MultiUnicycleWorld.start`)."""
         rob, status = self.rob, self.status
-        _pair_check(rob, status, self.pairs)
+        _pair_check(rob, status, self.pairs, rob[:, R_X : R_Y + 1], False)
         self.start_dist = np.hypot(*(rob[:, R_GX : R_GY + 1] - rob[:, R_X : R_Y + 1]).T)
         for i in range(self.n):
             if status[i] == RUNNING and self.start_dist[i] <= self.flt[F_TOL]:
