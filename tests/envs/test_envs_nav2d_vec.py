@@ -19,7 +19,9 @@ gym.register_envs(uvnav.envs)
 def assert_same_run(scene: str, k: int, steps: int, **kwargs: Any) -> int:
     """Step both with the same seeded random actions (outside the box too); every output must
     be equal.  Returns how many episodes ended."""
-    ref = gym.vector.SyncVectorEnv([lambda: Nav2DEnv(scene, **kwargs) for _ in range(k)])
+    ref = gym.vector.SyncVectorEnv(
+        [lambda: Nav2DEnv(scene, swept=False, **kwargs) for _ in range(k)]
+    )
     vec = gym.make_vec("uvnav/Nav2D-v0", num_envs=k, vectorization_mode="vector_entry_point",
                        scenario=scene, **kwargs)  # fmt: skip
     assert isinstance(vec, Nav2DVectorEnv)
@@ -77,3 +79,8 @@ def test_seeds_per_env_and_episode_seed_option() -> None:
 def test_scenes_that_cannot_be_batched_are_refused() -> None:
     with pytest.raises(ValueError, match="cannot be batched: obstacle 0 is a DiscBody"):
         Nav2DVectorEnv(2, "crowd-eth:0")
+
+
+def test_the_batched_env_says_it_judges_collisions_at_step_ends() -> None:
+    with pytest.raises(ValueError, match="swept: the batched worlds judge collisions at the end"):
+        Nav2DVectorEnv(2, "random-ch2:1", swept=True)

@@ -18,6 +18,7 @@ import shapely
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 from shapely.geometry import Polygon
+from test_geometry_polygons import star_polygons  # type: ignore[import-not-found]
 
 from uvnav.dynamics.unicycle import unicycle_advance
 from uvnav.geometry.polygons import polygon_nearest
@@ -40,24 +41,6 @@ FINE = np.linspace(0.0, 1.0, 101)
 GRID_HALF_STEP = 0.005
 #: floating-point slack [m] of the comparisons
 TOL = 1e-8
-
-
-@st.composite
-def star_polygons(draw: st.DrawFn, max_n: int = 12) -> np.ndarray:
-    """Random simple (generally non-convex) polygons, star-shaped about a point near the body
-    frame's origin; either orientation (as in test_geometry_polygons)."""
-    n = draw(st.integers(3, max_n))
-    gaps = np.array(draw(st.lists(st.floats(0.2, 1.0), min_size=n, max_size=n)))
-    radii = np.array(draw(st.lists(st.floats(0.2, 2.5), min_size=n, max_size=n)))
-    centre = np.array([draw(st.floats(-1.0, 1.0)), draw(st.floats(-1.0, 1.0))])
-    rot = draw(heading)
-    ang = rot + 2.0 * math.pi * np.concatenate([[0.0], np.cumsum(gaps)[:-1]]) / gaps.sum()
-    verts = centre + radii[:, None] * np.stack([np.cos(ang), np.sin(ang)], axis=-1)
-    if draw(st.booleans()):
-        verts = verts[::-1].copy()
-    poly = Polygon(verts)
-    assume(poly.is_valid and poly.area > 1e-3)
-    return verts
 
 
 def _ring(verts: np.ndarray) -> np.ndarray:

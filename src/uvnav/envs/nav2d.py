@@ -107,6 +107,8 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
             docstring).
         vehicle: the planar vehicle the agent drives (the unicycle; ``holonomic`` or a plug-in
             vehicle's name, :func:`~uvnav.dynamics.vehicles.vehicles_2d`).
+        swept: collisions judged along each integration step, as ``uvnav simulate`` judges them
+            (``False``: at each step's end, as the batched env does).
     """
 
     metadata: dict[str, Any] = {"render_modes": ["rgb_array"], "render_fps": 10}  # noqa: RUF012 - gymnasium declares it an instance variable
@@ -122,11 +124,13 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         reward: RewardConfig | dict[str, float] | None = None,
         raw_commands: bool = False,
         vehicle: str = "unicycle",
+        swept: bool = True,
     ) -> None:
         if vehicle not in vehicles_2d():
             known = ", ".join(vehicles_2d())
             raise ValueError(f"vehicle: no 2D vehicle {vehicle!r}; known: {known}")
         self.vehicle = vehicle
+        self.swept = swept
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
         self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
@@ -160,7 +164,8 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
             self._world.close()
         self.episode_seed = k = episode_seed(self.np_random, options)
         setup = build_episode(self.scenario, k)
-        w = self._open(World2D(setup, run_rng(k), exact=True, vehicle=self.vehicle))
+        world = World2D(setup, run_rng(k), exact=True, vehicle=self.vehicle, swept=self.swept)
+        w = self._open(world)
         return w.vector(0), self._info(0)
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:

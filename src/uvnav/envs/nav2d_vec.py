@@ -1,18 +1,20 @@
 """``uvnav/Nav2D-v0`` batched: K worlds stepped by one compiled call, a Gymnasium ``VectorEnv``.
 
 ``gymnasium.make_vec("uvnav/Nav2D-v0", num_envs=K, vectorization_mode="vector_entry_point")``
-gives :class:`Nav2DVectorEnv`.  Its K sub-environments are :class:`uvnav.envs.nav2d.Nav2DEnv`'s,
-number for number: the same observation vector (goal distance, goal bearing, speed, lidar), the
-same actions, rewards, terminations and truncations, and the same episodes for the same seeds
-(``reset(seed=s)`` seeds sub-environment ``i`` with ``s + i``, as ``SyncVectorEnv`` does), with
-Gymnasium's default ``NEXT_STEP`` autoreset.  The test suite checks equality with a
-``SyncVectorEnv`` of ``Nav2DEnv`` s, not closeness.
+gives :class:`Nav2DVectorEnv`.  Its K sub-environments are :class:`uvnav.envs.nav2d.Nav2DEnv`'s
+with ``swept=False``, number for number: the same observation vector (goal distance, goal
+bearing, speed, lidar), the same actions, rewards, terminations and truncations, and the same
+episodes for the same seeds (``reset(seed=s)`` seeds sub-environment ``i`` with ``s + i``, as
+``SyncVectorEnv`` does), with Gymnasium's default ``NEXT_STEP`` autoreset.  The test suite
+checks equality with a ``SyncVectorEnv`` of ``Nav2DEnv`` s, not closeness.
 
 The worlds live in :class:`uvnav.sim.packed.PackedWorlds` (compiled with numba when it is
 installed, the plain Python loops otherwise: the same numbers, far slower), so only scenes whose
 obstacles are polygons moving with constant velocity or random turns can be batched (the
 ``random-ch2`` generator and the thesis's Ch. 2 scenes); another scene is refused with the reason.
-What the single env has and this one has not: rendering, and ``info["uvnav"]`` (the
+What the single env has and this one has not: collisions judged along each step (the batched
+worlds judge them at its end: the equal single env is ``Nav2DEnv(..., swept=False)``, and
+``swept=True`` is refused here), rendering, and ``info["uvnav"]`` (the
 :class:`~uvnav.sensors.Observation` a uvnav law would get), which needs the per-step objects that
 batching removes.  ``info`` holds ``status``, ``distance`` [m], ``clearance`` [m] and ``time`` [s]
 per sub-environment.
@@ -73,9 +75,15 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         reward: RewardConfig | dict[str, float] | None = None,
         raw_commands: bool = False,
         render_mode: None = None,
+        swept: bool = False,
     ) -> None:
         if num_envs < 1:
             raise ValueError(f"num_envs must be at least 1 (got {num_envs})")
+        if swept:
+            raise ValueError(
+                "swept: the batched worlds judge collisions at the end of each step; "
+                "Nav2DEnv judges them along it"
+            )
         if render_mode is not None:
             raise ValueError("the batched Nav2D env does not render; use Nav2DEnv")
         self.num_envs = k = int(num_envs)
