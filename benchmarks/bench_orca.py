@@ -67,7 +67,7 @@ def uvnav_run(n: int, law: str, params: dict[str, Any], steps: int) -> dict[str,
     cpu0, wall0 = time.thread_time(), time.perf_counter()
     logs = run_loop(world, laws)
     cpu, wall = time.thread_time() - cpu0, time.perf_counter() - wall0
-    done = world.step_index
+    done = world.clock.step_index
     decisions_s = sum(sum(log.decision_us) for log in logs) * 1e-6
     return {
         "steps": done,

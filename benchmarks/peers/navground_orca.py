@@ -123,7 +123,7 @@ def uvnav_episode(
         run_loop(world, laws)
         cpu = peerstats.cpu_s() - cpu0
         statuses, pairs = world.status, sorted(world.pairs)
-        done_steps = world.step_index
+        done_steps = world.clock.step_index
     return {
         "steps": int(done_steps),
         "cpu_s": cpu,

@@ -10,6 +10,7 @@ from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from uvnav.dynamics.unicycle import (
+    Unicycle,
     UnicycleCommand,
     UnicycleSpec,
     turn_then_move,
@@ -189,3 +190,40 @@ def test_turn_then_move_turns_first_then_goes_straight(
 def test_an_unknown_kinematics_is_refused() -> None:
     with pytest.raises(ValueError, match="kinematics must be one of arc, turn-then-move"):
         UnicycleSpec(1.0, 1.0, kinematics="skid")
+
+
+@given(
+    st.lists(st.tuples(st.floats(0.0, 2.0), st.floats(-2.0, 2.0)), min_size=1, max_size=30),
+    st.floats(0.1, 5.0), st.floats(0.1, 10.0), st.sampled_from([0.01, 0.05, 0.1]),
+)  # fmt: skip
+def test_an_acceleration_limited_unicycle_changes_its_velocity_by_at_most_its_limits(
+    commands: list[tuple[float, float]], accel: float, turn_accel: float, dt: float
+) -> None:
+    spec = UnicycleSpec(2.0, 2.0, 0.1, accel_max=accel, turn_accel_max=turn_accel)
+    body = Unicycle(spec)
+    x = y = th = 0.0
+    v0 = u0 = 0.0
+    for v, u in commands:
+        body.hold(UnicycleCommand(v, u))
+        for _ in range(3):
+            path, _ = body.travel(dt)
+            nx, ny, th, turn, _ = body.move(x, y, th, dt, False, 3 * dt)
+            v1 = body.speed()
+            assert abs(v1 - v0) <= accel * dt + 1e-12
+            assert abs(body.turn_rate() - u0) <= turn_accel * dt + 1e-12
+            assert turn == pytest.approx(abs(body.turn_rate()) * dt)
+            assert math.hypot(nx - x, ny - y) <= path + 1e-12  # the chord of the arc travelled
+            x, y, v0, u0 = nx, ny, v1, body.turn_rate()
+    # held long enough, it reaches the command
+    body.hold(UnicycleCommand(1.5, -1.0))
+    for _ in range(int(4.0 / min(accel, turn_accel) / dt) + 2):  # (changes of at most 3)
+        body.move(0.0, 0.0, 0.0, dt, False, dt)
+    assert body.speed() == pytest.approx(1.5) and body.turn_rate() == pytest.approx(-1.0)
+
+
+def test_an_ideal_unicycle_takes_the_command_at_once() -> None:
+    body = Unicycle(UnicycleSpec(1.0, 1.0))
+    body.hold(UnicycleCommand(0.7, 0.3))
+    assert body.speed() == 0.7 and body.velocity(0.0) == (0.7, 0.0)
+    with pytest.raises(ValueError, match="accel_max must be > 0"):
+        UnicycleSpec(1.0, 1.0, accel_max=0.0)

@@ -65,14 +65,14 @@ def _rounded(value: object) -> object:
 
 
 #: fields added to the scene schema since the hashes, at their default value: left out
-LATER_DEFAULTS = {"robot": {"kinematics": "arc"}}
+LATER_DEFAULTS = {"robot": {"kinematics": "arc", "accel_max": None, "turn_accel_max": None}}
 
 
 def scene_hash(scenario: object) -> str:
     data: Any = _rounded(scenario.model_dump(mode="json"))  # type: ignore[attr-defined]
     for section, fields in LATER_DEFAULTS.items():
         for name, default in fields.items():
-            if data.get(section, {}).get(name) == default:
+            if name in data.get(section, {}) and data[section][name] == default:
                 del data[section][name]
     text = json.dumps(data, sort_keys=True)
     return hashlib.sha256(text.encode()).hexdigest()[:16]

@@ -535,3 +535,20 @@ def test_a_turn_then_move_unicycle_turns_at_the_decision_then_goes_straight() ->
     assert arc.trajectory is not None
     assert arc.trajectory.robot[-1, 2] == pytest.approx(1.0)  # the same total turn, on arcs
     assert not np.allclose(arc.trajectory.robot[-1, :2], tr.robot[-1, :2])
+
+
+def test_an_acceleration_limited_unicycle_ramps_up_and_the_sensor_says_so() -> None:
+    """With ``accel_max`` the robot's speed climbs at most ``accel_max dt`` a step toward the
+    held command, and the observation reports the speed it has, not the command."""
+    spec = UnicycleSpec(v_max=1.0, u_max=1.0, radius=0.1, accel_max=0.5)
+    setup = _setup([], spec=spec, start=np.zeros(3), goal=np.array([50.0, 0.0]), dt=0.1,
+                   control_period=0.5, t_max=3.0)  # fmt: skip
+    probe = Probe(make_controller("straight-v1"))
+    res = run_episode(setup, probe, np.random.default_rng(0))
+    speeds = [o.speed for o in probe.seen]
+    assert speeds == pytest.approx([0.0, 0.25, 0.5, 0.75, 1.0, 1.0])  # 0.5 m/s^2, at 0.5 s
+    tr = res.trajectory
+    assert tr is not None
+    steps = np.hypot(*np.diff(tr.robot[:, :2], axis=0).T)
+    np.testing.assert_allclose(steps[:10], 0.05 * np.arange(1, 11) * 0.1, atol=1e-12)
+    assert res.metrics.limit_violations == 0  # the law asked for V_max: inside (2.4)

@@ -91,9 +91,16 @@ class OmniRobot:
 
     def __init__(self, robot: Any) -> None:
         self.spec = OmniSpec(v_max=float(robot.v_max), radius=float(robot.radius))
+        self.reset()
 
     def rest(self) -> VelocityCommand:
         return VelocityCommand(0.0, 0.0)
+
+    def reset(self) -> None:
+        self._cmd = self.rest()
+
+    def hold(self, cmd: VelocityCommand) -> None:
+        self._cmd = cmd
 
     def saturate(self, cmd: VelocityCommand, heading: float) -> tuple[VelocityCommand, bool]:
         return cmd.clipped(self.spec), cmd.violates(self.spec)
@@ -108,20 +115,19 @@ class OmniRobot:
         v = self.spec.v_max
         return (-v, -v), (v, v)
 
-    def speed(self, cmd: VelocityCommand) -> float:
-        return float(cmd.speed)
+    def speed(self) -> float:
+        return float(self._cmd.speed)
 
-    def velocity(self, cmd: VelocityCommand, heading: float) -> tuple[float, float]:
-        return float(cmd.vx), float(cmd.vy)
+    def velocity(self, heading: float) -> tuple[float, float]:
+        return float(self._cmd.vx), float(self._cmd.vy)
 
     def speed_change(self, new: VelocityCommand, old: VelocityCommand) -> float:
         return float((new.vx - old.vx) ** 2 + (new.vy - old.vy) ** 2)
 
     def move(
-        self, x: float, y: float, heading: float, cmd: VelocityCommand, dt: float,
-        decision: bool, period: float,
-    ) -> tuple[float, float, float, float, float]:  # fmt: skip
-        vx, vy = cmd.vx, cmd.vy
+        self, x: float, y: float, heading: float, dt: float, decision: bool, period: float
+    ) -> tuple[float, float, float, float, float]:
+        vx, vy = self._cmd.vx, self._cmd.vy
         turn = 0.0
         if vx != 0.0 or vy != 0.0:
             th = math.atan2(vy, vx)
@@ -131,5 +137,5 @@ class OmniRobot:
         nx, ny = omni_advance(x, y, vx, vy, dt)
         return nx, ny, heading, turn, 0.0
 
-    def travel(self, cmd: VelocityCommand, dt: float) -> tuple[float, float]:
-        return float(cmd.speed) * dt, 0.0
+    def travel(self, dt: float) -> tuple[float, float]:
+        return float(self._cmd.speed) * dt, 0.0

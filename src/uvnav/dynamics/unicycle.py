@@ -9,6 +9,13 @@ the standard unicycle is used (docs/thesis-notes.md).  Integration is exact for 
 commands (motion along a circular arc, written as the arc's chord so that it stays exact as
 u -> 0), not Euler.
 
+Acceleration limits (``UnicycleSpec.accel_max`` [m/s^2], ``turn_accel_max`` [rad/s^2]; unbounded
+by default, as in the thesis) make the vehicle's speed and turn rate states of their own: at
+each integration step of ``dt`` they move toward the held command by at most ``accel_max dt``
+and ``turn_accel_max dt`` (:func:`approach`), and the step integrates the arc under the values
+reached (a staircase at the step's resolution, exact for it).  A law's command is then what the
+vehicle aims at, not what it does; the observation reports the speed it has.
+
 A second kinematics, ``turn-then-move`` (:data:`KINEMATICS`), is the unicycle of the CrowdNav
 benchmark (Chen et al., ICRA 2019; CrowdSim's ``ActionRot``: ``theta += r``, then a straight move
 at ``v`` for the time step): the turn of a whole decision period, ``u T``, happens at once when
@@ -43,18 +50,31 @@ class UnicycleSpec:
         u_max: maximum turn rate U_max [rad/s] (> 0).
         radius: radius of the robot's disc body [m] (>= 0).
         kinematics: ``arc`` or ``turn-then-move`` (:data:`KINEMATICS`, module docstring).
+        accel_max: largest rate of change of the speed [m/s^2] (``inf``: the speed follows the
+            command at once, the thesis's model).
+        turn_accel_max: largest rate of change of the turn rate [rad/s^2] (``inf``: at once).
     """
 
     v_max: float
     u_max: float
     radius: float = 0.1
     kinematics: str = "arc"
+    accel_max: float = math.inf
+    turn_accel_max: float = math.inf
 
     def __post_init__(self) -> None:
         if self.kinematics not in KINEMATICS:
             raise ValueError(
                 f"kinematics must be one of {', '.join(KINEMATICS)} (got {self.kinematics!r})"
             )
+        for name in ("accel_max", "turn_accel_max"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"{name} must be > 0 (got {getattr(self, name)!r})")
+
+    @property
+    def ideal(self) -> bool:
+        """The speed and the turn rate follow the command at once (no acceleration limit)."""
+        return math.isinf(self.accel_max) and math.isinf(self.turn_accel_max)
 
 
 @dataclass(frozen=True, slots=True)
@@ -121,6 +141,17 @@ def turn_then_move(
     return x + v * dt * math.cos(th), y + v * dt * math.sin(th), th
 
 
+def approach(value: float, target: float, most: float) -> float:
+    """``value`` moved toward ``target`` by at most ``most`` (>= 0).
+
+    >>> approach(0.0, 1.0, 0.1), approach(0.5, 0.45, 0.1), approach(0.0, -1.0, math.inf)
+    (0.1, 0.45, -1.0)
+    """
+    if math.isinf(most):
+        return target
+    return value + min(max(target - value, -most), most)
+
+
 def unicycle_step(state: FloatArray, v: float, u: float, dt: float) -> FloatArray:
     """Exact unicycle motion for ``dt`` [s] under constant ``v`` [m/s], ``u`` [rad/s].
 
@@ -136,10 +167,11 @@ def unicycle_step(state: FloatArray, v: float, u: float, dt: float) -> FloatArra
 class Unicycle:
     """The unicycle as a planar vehicle of the 2D world (:class:`uvnav.dynamics.vehicles.
     Vehicle2D`): the command ``(V_R, u_R)`` within (2.4), moved by the robot block's
-    ``kinematics`` (module docstring); the effort's turn term is ``u_R^2 dt``.
+    ``kinematics`` and acceleration limits (module docstring); the effort's turn term is
+    ``u_R^2 dt`` of the turn rate it has.
 
     Args:
-        robot: limits, radius and kinematics (the law is reset with it).
+        robot: limits, radius, kinematics and acceleration limits (the law is reset with it).
     """
 
     name: ClassVar[str] = "unicycle"
@@ -147,9 +179,28 @@ class Unicycle:
 
     def __init__(self, robot: UnicycleSpec) -> None:
         self.spec = robot
+        self.reset()
 
     def rest(self) -> UnicycleCommand:
         return UnicycleCommand(0.0, 0.0)
+
+    def reset(self) -> None:
+        self._cmd = self.rest()
+        self._v, self._u = 0.0, 0.0  # the speed and turn rate it has
+
+    def hold(self, cmd: UnicycleCommand) -> None:
+        self._cmd = cmd
+        if self.spec.ideal:
+            self._v, self._u = cmd.v, cmd.u
+
+    def _next(self, dt: float) -> tuple[float, float]:
+        """The speed and turn rate of the coming step of ``dt`` [s]."""
+        cmd, s = self._cmd, self.spec
+        if s.ideal:
+            return cmd.v, cmd.u
+        return approach(self._v, cmd.v, s.accel_max * dt), approach(
+            self._u, cmd.u, s.turn_accel_max * dt
+        )
 
     def saturate(self, cmd: UnicycleCommand, heading: float) -> tuple[UnicycleCommand, bool]:
         return cmd.clipped(self.spec), cmd.violates(self.spec)
@@ -164,27 +215,31 @@ class Unicycle:
         s = self.spec
         return (0.0, -s.u_max), (s.v_max, s.u_max)
 
-    def speed(self, cmd: UnicycleCommand) -> float:
-        return float(cmd.v)
+    def speed(self) -> float:
+        return float(self._v)
 
-    def velocity(self, cmd: UnicycleCommand, heading: float) -> tuple[float, float]:
-        v = float(cmd.v)
+    def turn_rate(self) -> float:
+        """The turn rate it has now [rad/s]."""
+        return float(self._u)
+
+    def velocity(self, heading: float) -> tuple[float, float]:
+        v = float(self._v)
         return v * math.cos(heading), v * math.sin(heading)
 
     def speed_change(self, new: UnicycleCommand, old: UnicycleCommand) -> float:
         return float((new.v - old.v) ** 2)
 
     def move(
-        self, x: float, y: float, heading: float, cmd: UnicycleCommand, dt: float,
-        decision: bool, period: float,
-    ) -> tuple[float, float, float, float, float]:  # fmt: skip
-        v, u = cmd.v, cmd.u
+        self, x: float, y: float, heading: float, dt: float, decision: bool, period: float
+    ) -> tuple[float, float, float, float, float]:
+        v, u = self._v, self._u = self._next(dt)
         if self.spec.kinematics == "arc":
             nx, ny, th = unicycle_advance(x, y, heading, v, u, dt)
         else:  # the period's turn at the decision, then straight
             nx, ny, th = turn_then_move(x, y, heading, v, u * period if decision else 0.0, dt)
         return nx, ny, th, abs(u) * dt, u**2 * dt
 
-    def travel(self, cmd: UnicycleCommand, dt: float) -> tuple[float, float]:
-        slack = arc_slack(cmd.v, cmd.u, dt) if self.spec.kinematics == "arc" else 0.0
-        return abs(cmd.v) * dt, slack
+    def travel(self, dt: float) -> tuple[float, float]:
+        v, u = self._next(dt)
+        slack = arc_slack(v, u, dt) if self.spec.kinematics == "arc" else 0.0
+        return abs(v) * dt, slack

@@ -3,9 +3,12 @@
 :data:`VEHICLE_GROUP`).
 
 The 2D world (:class:`uvnav.sim.episode.World2D`) owns the bodies, the sensor, the collision
-judgement and the bookkeeping; a :class:`Vehicle2D` says how its disc moves under a held command
-and what a command is: its limits, saturation, the numbers a trajectory records, the box of an
-env's actions.  A vehicle is built from the scene's robot block (a
+judgement and the bookkeeping; a :class:`Vehicle2D` says what a command is (its limits,
+saturation, the numbers a trajectory records, the box of an env's actions) and how its disc
+moves under the command it holds.  A vehicle has a state of its own — its velocity now — which
+an ideal vehicle takes from the held command at once and a vehicle with acceleration limits
+approaches step by step; the sensor reports that velocity, and the bodies that see the robot
+see it.  A vehicle is built from the scene's robot block (a
 :class:`~uvnav.dynamics.unicycle.UnicycleSpec`: V_max, U_max, radius, kinematics; each vehicle
 reads what applies to it), and a law that drives it names it as its ``vehicle``
 (:class:`uvnav.controllers.ControllerInfo`): the law picks the vehicle in a 2D scene.
@@ -45,7 +48,15 @@ class Vehicle2D(Protocol):
     spec: Any
 
     def rest(self) -> Any:
-        """The command held before the first decision (standing still)."""
+        """The command that stands still (held before the first decision)."""
+        ...
+
+    def reset(self) -> None:
+        """At rest, holding :meth:`rest` (the start of an episode)."""
+        ...
+
+    def hold(self, cmd: Any) -> None:
+        """Hold ``cmd`` (already saturated) from now on."""
         ...
 
     def saturate(self, cmd: Any, heading: float) -> tuple[Any, bool]:
@@ -66,12 +77,12 @@ class Vehicle2D(Protocol):
         limits (an env's action box)."""
         ...
 
-    def speed(self, cmd: Any) -> float:
-        """The speed under ``cmd`` [m/s]."""
+    def speed(self) -> float:
+        """The speed now [m/s]."""
         ...
 
-    def velocity(self, cmd: Any, heading: float) -> tuple[float, float]:
-        """The world-frame velocity under ``cmd`` at ``heading`` [m/s]."""
+    def velocity(self, heading: float) -> tuple[float, float]:
+        """The world-frame velocity now at ``heading`` [rad], [m/s]."""
         ...
 
     def speed_change(self, new: Any, old: Any) -> float:
@@ -80,15 +91,15 @@ class Vehicle2D(Protocol):
         ...
 
     def move(
-        self, x: float, y: float, heading: float, cmd: Any, dt: float, decision: bool, period: float
+        self, x: float, y: float, heading: float, dt: float, decision: bool, period: float
     ) -> tuple[float, float, float, float, float]:
-        """One step ``dt`` [s] under the held ``cmd`` (``decision``: the step starts a decision
+        """One step ``dt`` [s] under the held command (``decision``: the step starts a decision
         period of ``period`` [s]): ``(x, y, heading, |heading change| [rad], effort's turn
         term)``."""
         ...
 
-    def travel(self, cmd: Any, dt: float) -> tuple[float, float]:
-        """The path length [m] of a step ``dt`` under ``cmd`` and the path's largest distance
+    def travel(self, dt: float) -> tuple[float, float]:
+        """The path length [m] of the coming step ``dt`` [s] and the path's largest distance
         from the step's chord [m] (the collision sweep's slack)."""
         ...
 

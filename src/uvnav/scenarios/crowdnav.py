@@ -248,6 +248,22 @@ def crowdnav_scenario(
         Literal["turn-then-move", "arc"],
         Field(description="the unicycle variant's kinematics (CrowdNav's: turn-then-move)"),
     ] = "turn-then-move",
+    accel_max: Annotated[
+        float | None,
+        Field(
+            gt=0,
+            allow_inf_nan=False,
+            description="the robot's largest speed change [m/s^2] (omitted: at once)",
+        ),
+    ] = None,
+    turn_accel_max: Annotated[
+        float | None,
+        Field(
+            gt=0,
+            allow_inf_nan=False,
+            description="the unicycle's largest turn-rate change [rad/s^2] (omitted: at once)",
+        ),
+    ] = None,
     sensing_range: Annotated[
         float, _positive("the robot sees humans within this [m]")
     ] = SENSING_RANGE,
@@ -291,6 +307,8 @@ def crowdnav_scenario(
         u_max: U_max of the unicycle variant [rad/s].
         kinematics: how the unicycle variant moves: ``turn-then-move`` (CrowdNav's
             ``ActionRot``: the period's turn at once, then straight) or ``arc`` (the thesis's).
+        accel_max, turn_accel_max: the unicycle variant's acceleration limits [m/s^2], [rad/s^2]
+            (:class:`~uvnav.dynamics.unicycle.UnicycleSpec`; ``None``: the command at once).
         sensing_range: the robot sees humans within this [m].
         controller: the scene's own law.
         controller_params: its parameters (``orca-holonomic-v1``: CrowdNav's robot ORCA).
@@ -379,6 +397,8 @@ def crowdnav_scenario(
             "u_max": u_max,
             "radius": robot_radius,
             "kinematics": kinematics,
+            "accel_max": accel_max,
+            "turn_accel_max": turn_accel_max,
         },
         "sensing": {
             "range": sensing_range,

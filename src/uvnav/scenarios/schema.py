@@ -102,6 +102,13 @@ class RobotSpec(_Model):
             "'turn-then-move' (CrowdNav's: the period's turn at once, then straight)"
         ),
     )
+    accel_max: float | None = Field(
+        None, gt=0, description="largest rate of change of the speed [m/s^2]; omitted = at once"
+    )
+    turn_accel_max: float | None = Field(
+        None, gt=0,
+        description="largest rate of change of the turn rate [rad/s^2]; omitted = at once",
+    )  # fmt: skip
 
     def initial_heading(self) -> float:
         """``heading`` or, when omitted, the direction from start to goal [rad]."""
@@ -113,8 +120,10 @@ class RobotSpec(_Model):
     def to_spec(self) -> UnicycleSpec:
         """The simulator's :class:`~uvnav.dynamics.UnicycleSpec`."""
         return UnicycleSpec(
-            v_max=self.v_max, u_max=self.u_max, radius=self.radius, kinematics=self.kinematics
-        )
+            v_max=self.v_max, u_max=self.u_max, radius=self.radius, kinematics=self.kinematics,
+            accel_max=math.inf if self.accel_max is None else self.accel_max,
+            turn_accel_max=math.inf if self.turn_accel_max is None else self.turn_accel_max,
+        )  # fmt: skip
 
 
 # ----------------------------------------------------------------------------------------- sensing

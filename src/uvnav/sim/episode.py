@@ -327,6 +327,7 @@ class World2D:
         )
         self.collision_by: str | None = None
         self.turn = 0.0  # total absolute heading change [rad]
+        self.body.reset()
         self.applied: Any = self.body.rest()  # the command held now
         self.book = book = Ledger(self.setup.goal_tolerance)
         gd = math.hypot(self.goal[0] - self.x, self.goal[1] - self.y)
@@ -375,12 +376,12 @@ class World2D:
 
     @property
     def speed(self) -> float:
-        """The robot's speed now [m/s] (its applied command's)."""
-        return self.body.speed(self.applied)
+        """The robot's speed now [m/s] (its vehicle's: the held command's, or on its way to it)."""
+        return self.body.speed()
 
     def velocity(self) -> tuple[float, float]:
         """The robot's velocity now [m/s]."""
-        return self.body.velocity(self.applied, self.th)
+        return self.body.velocity(self.th)
 
     def _collision_by(self, was_present: np.ndarray | None = None) -> str:
         """Who closed the gap at the collision now (:func:`uvnav.sim.social.collision_by`);
@@ -401,13 +402,14 @@ class World2D:
         if self.clock.step_index > 0:
             self.book.effort += self.body.speed_change(new, self.applied) / (self.ratio * self.dt)
         self.applied = new
+        self.body.hold(new)
         return new
 
     def _move(self, dt: float) -> tuple[float, float]:
         """Integrate the robot over ``dt`` [s] (the vehicle's exact motion); returns the new
         position, updates the heading, the total turn and the effort's turn term."""
         nx, ny, self.th, turn, effort = self.body.move(
-            self.x, self.y, self.th, self.applied, dt, self.clock.due, self.ratio * dt
+            self.x, self.y, self.th, dt, self.clock.due, self.ratio * dt
         )
         self.book.effort += effort
         self.turn += turn
@@ -428,7 +430,7 @@ class World2D:
         if self.batch.sees_robot:  # bodies that react to the robot see it as it starts the step
             self.batch.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
         start = self._poses() if self.sweep is not None else None
-        travel, slack = self.body.travel(self.applied, dt)
+        travel, slack = self.body.travel(dt)
         nx, ny = self._move(dt)
         book.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny

@@ -283,8 +283,11 @@ class MultiUnicycleWorld:
         if n == 0:
             raise ValueError("a multi-robot episode needs at least one robot")
         for i, r in enumerate(robots):
-            if r.spec.kinematics != "arc":
-                raise ValueError(f"robot {i}: multi-robot worlds integrate arc unicycles")
+            if r.spec.kinematics != "arc" or not r.spec.ideal:
+                raise ValueError(
+                    f"robot {i}: multi-robot worlds hold ideal arc unicycles (no acceleration "
+                    "limits, no turn-then-move)"
+                )
         self.setup = setup
         self.robots = robots
         self.clock = Clock(setup.dt, setup.control_period, setup.t_max)

@@ -441,6 +441,8 @@ def pack_check(setup: EpisodeSetup) -> str | None:
         return f"the robot is a {type(setup.spec).__name__}, packed worlds hold unicycles"
     if setup.spec.kinematics != "arc":
         return f"the robot's kinematics is {setup.spec.kinematics}, packed worlds integrate arcs"
+    if not setup.spec.ideal:
+        return "the robot has acceleration limits, packed worlds hold ideal unicycles"
     owner: dict[int, int] = {}
     for j, ob in enumerate(setup.obstacles):
         rng = getattr(ob.motion, "rng", None)

@@ -90,8 +90,8 @@ def swarm_check(setup: MultiSetup) -> str | None:
             return f"robot {i} is driven by {r.controller.name}, packed swarms hold orca-shared-v1"
         if r.sensing.velocities != "known":
             return f"robot {i} estimates velocities, packed swarms sense exactly"
-        if r.spec.kinematics != "arc":
-            return f"robot {i} turns then moves, packed swarms integrate arcs"
+        if r.spec.kinematics != "arc" or not r.spec.ideal:
+            return f"robot {i} is not an ideal arc unicycle, packed swarms hold those"
         keys.add(r.controller.group_key)
     if len(keys) > 1:
         return "the robots' orca-shared-v1 parameters differ (more than one group)"

@@ -47,9 +47,16 @@ class PointRobot:
 
     def __init__(self, robot: Any) -> None:
         self.spec = PointSpec(float(robot.v_max), float(robot.radius))
+        self.held = self.rest()
 
     def rest(self) -> Velocity:
         return Velocity(0.0, 0.0)
+
+    def reset(self) -> None:
+        self.held = self.rest()
+
+    def hold(self, cmd: Velocity) -> None:
+        self.held = cmd
 
     def saturate(self, cmd: Velocity, heading: float) -> tuple[Velocity, bool]:
         vx, vy, v = float(cmd.vx), float(cmd.vy), self.spec.v_max
@@ -68,23 +75,22 @@ class PointRobot:
         v = self.spec.v_max
         return (-v, -v), (v, v)
 
-    def speed(self, cmd: Velocity) -> float:
-        return math.hypot(cmd.vx, cmd.vy)
+    def speed(self) -> float:
+        return math.hypot(self.held.vx, self.held.vy)
 
-    def velocity(self, cmd: Velocity, heading: float) -> tuple[float, float]:
-        return cmd.vx, cmd.vy
+    def velocity(self, heading: float) -> tuple[float, float]:
+        return self.held.vx, self.held.vy
 
     def speed_change(self, new: Velocity, old: Velocity) -> float:
         return (new.vx - old.vx) ** 2 + (new.vy - old.vy) ** 2
 
     def move(
-        self, x: float, y: float, heading: float, cmd: Velocity, dt: float, decision: bool,
-        period: float,
-    ) -> tuple[float, float, float, float, float]:  # fmt: skip
-        return x + cmd.vx * dt, y + cmd.vy * dt, heading, 0.0, 0.0
+        self, x: float, y: float, heading: float, dt: float, decision: bool, period: float
+    ) -> tuple[float, float, float, float, float]:
+        return x + self.held.vx * dt, y + self.held.vy * dt, heading, 0.0, 0.0
 
-    def travel(self, cmd: Velocity, dt: float) -> tuple[float, float]:
-        return self.speed(cmd) * dt, 0.0
+    def travel(self, dt: float) -> tuple[float, float]:
+        return self.speed() * dt, 0.0
 
 
 class PointStraight:
