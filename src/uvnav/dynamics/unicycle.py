@@ -179,6 +179,7 @@ class Unicycle:
 
     def __init__(self, robot: UnicycleSpec) -> None:
         self.spec = robot
+        self._ideal = robot.ideal
         self.reset()
 
     def rest(self) -> UnicycleCommand:
@@ -190,13 +191,13 @@ class Unicycle:
 
     def hold(self, cmd: UnicycleCommand) -> None:
         self._cmd = cmd
-        if self.spec.ideal:
+        if self._ideal:
             self._v, self._u = cmd.v, cmd.u
 
     def _next(self, dt: float) -> tuple[float, float]:
         """The speed and turn rate of the coming step of ``dt`` [s]."""
         cmd, s = self._cmd, self.spec
-        if s.ideal:
+        if self._ideal:
             return cmd.v, cmd.u
         return approach(self._v, cmd.v, s.accel_max * dt), approach(
             self._u, cmd.u, s.turn_accel_max * dt

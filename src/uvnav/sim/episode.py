@@ -429,7 +429,8 @@ class World2D:
         x, y, t0, g0 = self.x, self.y, self.t, self.clearance
         if self.batch.sees_robot:  # bodies that react to the robot see it as it starts the step
             self.batch.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
-        start = self._poses() if self.sweep is not None else None
+        # the bodies' poses at the start (the packed path keeps its own, and the shift)
+        start = self._poses() if self.sweep is not None and self.packed is None else None
         travel, slack = self.body.travel(dt)
         nx, ny = self._move(dt)
         book.path += math.hypot(nx - x, ny - y)
@@ -456,10 +457,7 @@ class World2D:
         if self.social is not None:
             self.social.observe(self.field, nx, ny, i)
         contact_at = None
-        if start is not None and self.sweep is not None:
-            c1, h1, pr1 = self._poses()
-            poses = StepPoses(*start[:2], c1, h1, start[2], pr1, np.array((x, y)),
-                              np.array((nx, ny)), slack)  # fmt: skip
+        if self.sweep is not None:
             # an upper bound of the sampled minimum so far (the tracker's clearance may be a
             # lower bound, its best is not)
             ceiling = (
@@ -467,7 +465,19 @@ class World2D:
                 if self.tracker is not None
                 else min(book.min_clear, self.clearance)
             )
-            s = self.sweep.step(poses, travel, g0, self.clearance, ceiling)
+            packed = self.packed
+            if packed is not None:
+                s = self.sweep.step(
+                    lambda: StepPoses(*packed.poses_before(), *packed.poses(), None, None,
+                                      np.array((x, y)), np.array((nx, ny)), slack),
+                    travel, g0, self.clearance, ceiling, shift=packed.shift,
+                )  # fmt: skip
+            else:
+                assert start is not None
+                c1, h1, pr1 = self._poses()
+                poses = StepPoses(*start[:2], c1, h1, start[2], pr1, np.array((x, y)),
+                                  np.array((nx, ny)), slack)  # fmt: skip
+                s = self.sweep.step(poses, travel, g0, self.clearance, ceiling)
             if not math.isnan(s):
                 contact_at = t0 + s * dt
         gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)

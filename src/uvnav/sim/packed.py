@@ -244,21 +244,34 @@ def step_worlds_py(
 def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs: int,
                    oi: np.ndarray, prm: FloatArray, st: FloatArray, ubuf: FloatArray,
                    rings: FloatArray, sensing_range: float, ids: np.ndarray, rows: FloatArray,
-                   outlines: FloatArray) -> tuple[float, int, int]:  # fmt: skip
+                   outlines: FloatArray,
+                   prev: FloatArray) -> tuple[float, int, int, float]:  # fmt: skip
     """Move the ``n_obs`` obstacles of one world (one slot's ``oi``, ``params``, ``state``,
     ``ubuf`` and ``rings``: :func:`step_worlds_py`'s layout) from ``t`` by ``dt`` [s]; return
-    :func:`_clearance` of the robot disc of ``radius`` [m] at ``(x, y)`` then and, for a
-    ``sensing_range`` >= 0 [m], the number of readings :func:`sense_one_py` writes from there
-    (else -1): the step of :class:`PackedObstacles`, in one call.  The caller guarantees two
-    unread draws per obstacle."""
+    :func:`_clearance` of the robot disc of ``radius`` [m] at ``(x, y)`` then, for a
+    ``sensing_range`` >= 0 [m] the number of readings :func:`sense_one_py` writes from there
+    (else -1), and the most any body point moved [m] (centre shift plus bounding radius times
+    the turn): the step of :class:`PackedObstacles`, in one call.  The poses before the step go
+    to ``prev`` (3, n): x, y, heading.  The caller guarantees two unread draws per obstacle."""
     ring = np.empty((2, rings.shape[2]))
     low = np.empty(rings.shape[1])
+    for o in range(n_obs):
+        prev[0, o], prev[1, o], prev[2, o] = st[S_X, o], st[S_Y, o], st[S_HEADING, o]
     _move_obstacles(n_obs, st, prm, oi, ubuf, t, dt)
+    shift = 0.0
+    for o in range(n_obs):
+        dx, dy = st[S_X, o] - prev[0, o], st[S_Y, o] - prev[1, o]
+        turn = abs(st[S_HEADING, o] - prev[2, o])
+        if turn > math.pi:  # (headings are wrapped)
+            turn = 2.0 * math.pi - turn
+        s = math.sqrt(dx * dx + dy * dy) + turn * prm[P_BOUND, o]
+        if s > shift:
+            shift = s
     gap, at = _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)
     m = -1
     if sensing_range >= 0.0:
         m = sense_one_py(x, y, sensing_range, n_obs, prm, st, rings, ids, rows, outlines)
-    return gap, at, m
+    return gap, at, m, shift
 
 
 def clearance_one_py(x: float, y: float, radius: float, n_obs: int, prm: FloatArray,
@@ -772,6 +785,9 @@ class PackedObstacles:
         #: ``(x, y, range, m)`` of the readings the last step took, if it took any
         self._sensed: tuple[float, float, float, int] | None = None
         self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
+        self._prev = np.zeros((3, n))  # the poses before the last step: x, y, heading
+        #: the most any body point moved over the last step [m]
+        self.shift = 0.0
 
     def step(
         self, t: float, dt: float, x: float, y: float, radius: float, sensing_range: float = -1.0
@@ -782,9 +798,10 @@ class PackedObstacles:
         :meth:`readings` to return."""
         self._pw.ensure_draws()
         self._stepped = True
-        gap, at, m = self._advance(x, y, radius, t, dt, self.n, self._oi, self._prm, self._st,
-                                   self._ubuf, self._rings, sensing_range, self._ids,
-                                   self._rows, self._outlines)  # fmt: skip
+        gap, at, m, self.shift = self._advance(
+            x, y, radius, t, dt, self.n, self._oi, self._prm, self._st, self._ubuf, self._rings,
+            sensing_range, self._ids, self._rows, self._outlines, self._prev,
+        )  # fmt: skip
         self._sensed = (x, y, sensing_range, m) if m >= 0 else None
         return float(gap), int(at)
 
@@ -798,6 +815,11 @@ class PackedObstacles:
         """The obstacles' centres (k, 2) [m] and headings (k,) [rad] now (copies)."""
         st, n = self._st, self.n
         return st[S_X : S_Y + 1, :n].T.copy(), st[S_HEADING, :n].copy()
+
+    def poses_before(self) -> tuple[FloatArray, FloatArray]:
+        """The obstacles' centres (k, 2) [m] and headings (k,) [rad] before the last
+        :meth:`step` (copies)."""
+        return self._prev[:2].T.copy(), self._prev[2].copy()
 
     def readings(self, x: float, y: float, sensing_range: float) -> tuple[ObstacleReading, ...]:
         """:func:`uvnav.sensors.exact.sense_obstacles` from ``(x, y)``: the readings within

@@ -84,31 +84,46 @@ class SweptClearance:
             for row in range(len(template.poly_ids))
         ]
 
-    def step(self, poses: StepPoses, travel: float, g0: float, g1: float, ceiling: float) -> float:
+    def step(
+        self,
+        poses: StepPoses | Callable[[], StepPoses],
+        travel: float,
+        g0: float,
+        g1: float,
+        ceiling: float,
+        shift: float | None = None,
+    ) -> float:
         """Account for one step; returns the fraction of the step [0, 1] at the robot's first
         contact with a body, or NaN when it touched none.
 
         Args:
-            poses: the step's start and end.
+            poses: the step's start and end, or a function making them (called only when the
+                step must be swept or kept).
             travel: the robot's path length over the step [m].
             g0, g1: lower bounds of the sampled gaps at the step's start and end [m].
             ceiling: an upper bound of the episode's sampled minimum clearance so far [m].
+            shift: the most any body point moved over the step [m], when the caller knows it
+                (every body present at both ends); else it is measured on ``poses``.
         """
         self._ceiling = min(self._ceiling, ceiling)
-        c0, c1, h0, h1 = _moving(poses)
-        if not len(c0):
+        if not len(self.template):
             return math.nan
-        spin = np.abs(np.remainder(h1 - h0 + np.pi, 2.0 * np.pi) - np.pi)
-        reach = travel + float((np.hypot(*(c1 - c0).T) + spin * self.template.bounding_radii).max())
+        made: StepPoses | None = None if callable(poses) else poses
+        if shift is None:
+            made = made or poses()  # type: ignore[operator]
+            c0, c1, h0, h1 = _moving(made)
+            spin = np.abs(np.remainder(h1 - h0 + np.pi, 2.0 * np.pi) - np.pi)
+            shift = float((np.hypot(*(c1 - c0).T) + spin * self.template.bounding_radii).max())
+        reach = travel + shift
         bound = 0.5 * (g0 + g1 - reach)
-        if poses.present0 is not None or poses.present1 is not None:
-            bound = min(bound, _changed_bound(poses, g0, g1, reach))
+        if made is not None and (made.present0 is not None or made.present1 is not None):
+            bound = min(bound, _changed_bound(made, g0, g1, reach))
         if bound < 0.0:  # a contact is possible: now
-            gap, s_hit = self._sweep(poses, collide=True)
+            gap, s_hit = self._sweep(made or poses(), collide=True)  # type: ignore[operator]
             self.best = min(self.best, gap)
             return s_hit
         if bound < min(self.best, self._ceiling):
-            self._kept.append((bound, poses))
+            self._kept.append((bound, made or poses()))  # type: ignore[operator]
             if len(self._kept) >= self.BATCH:
                 self._flush()
         return math.nan
