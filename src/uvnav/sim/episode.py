@@ -456,34 +456,48 @@ class World2D:
                 self.clearance, self.nearest = self._clearance(radius)
         if self.social is not None:
             self.social.observe(self.field, nx, ny, i)
-        contact_at = None
-        if self.sweep is not None:
-            # an upper bound of the sampled minimum so far (the tracker's clearance may be a
-            # lower bound, its best is not)
-            ceiling = (
-                self.tracker.best
-                if self.tracker is not None
-                else min(book.min_clear, self.clearance)
-            )
-            packed = self.packed
-            if packed is not None:
-                s = self.sweep.step(
-                    lambda: StepPoses(*packed.poses_before(), *packed.poses(), None, None,
-                                      np.array((x, y)), np.array((nx, ny)), slack),
-                    travel, g0, self.clearance, ceiling, shift=packed.shift,
-                )  # fmt: skip
-            else:
-                assert start is not None
-                c1, h1, pr1 = self._poses()
-                poses = StepPoses(*start[:2], c1, h1, start[2], pr1, np.array((x, y)),
-                                  np.array((nx, ny)), slack)  # fmt: skip
-                s = self.sweep.step(poses, travel, g0, self.clearance, ceiling)
-            if not math.isnan(s):
-                contact_at = t0 + s * dt
+        contact_at = self._swept(start, (x, y), (nx, ny), t0, g0, travel, slack)
         gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)
         self.done = book.judge(t, self.clearance, gd, contact_at) or clock.up
         if book.status == "collision":
             self.collision_by = self._collision_by(was_present)
+
+    def _swept(
+        self,
+        start: tuple[FloatArray, FloatArray, np.ndarray | None] | None,
+        p0: tuple[float, float],
+        p1: tuple[float, float],
+        t0: float,
+        g0: float,
+        travel: float,
+        slack: float,
+    ) -> float | None:
+        """The step just made from ``p0`` (time ``t0`` [s], sampled gap ``g0`` [m]) to ``p1``,
+        judged along its length (:class:`~uvnav.sim.swept.SweptClearance`; ``start``: the
+        bodies' poses it began from, or ``None`` on the packed path, which keeps them): the time
+        of the first contact [s], ``None`` without one."""
+        if self.sweep is None:
+            return None
+        # an upper bound of the sampled minimum so far (the tracker's clearance may be a lower
+        # bound, its best is not)
+        ceiling = (
+            self.tracker.best
+            if self.tracker is not None
+            else min(self.book.min_clear, self.clearance)
+        )
+        packed = self.packed
+        if packed is not None:
+            s = self.sweep.step(
+                lambda: StepPoses(*packed.poses_before(), *packed.poses(), None, None,
+                                  np.array(p0), np.array(p1), slack),
+                travel, g0, self.clearance, ceiling, shift=packed.shift,
+            )  # fmt: skip
+        else:
+            assert start is not None
+            c1, h1, pr1 = self._poses()
+            poses = StepPoses(*start[:2], c1, h1, start[2], pr1, np.array(p0), np.array(p1), slack)
+            s = self.sweep.step(poses, travel, g0, self.clearance, ceiling)
+        return None if math.isnan(s) else t0 + s * self.dt
 
     def close(self) -> None:
         """Write the obstacles' states back to their models (the setup's objects)."""

@@ -108,10 +108,16 @@ class SweptClearance:
         self._ceiling = min(self._ceiling, ceiling)
         if not len(self.template):
             return math.nan
-        made: StepPoses | None = None if callable(poses) else poses
+        made = None if callable(poses) else poses
+
+        def get() -> StepPoses:
+            nonlocal made
+            if made is None:
+                made = poses() if callable(poses) else poses
+            return made
+
         if shift is None:
-            made = made or poses()  # type: ignore[operator]
-            c0, c1, h0, h1 = _moving(made)
+            c0, c1, h0, h1 = _moving(get())
             spin = np.abs(np.remainder(h1 - h0 + np.pi, 2.0 * np.pi) - np.pi)
             shift = float((np.hypot(*(c1 - c0).T) + spin * self.template.bounding_radii).max())
         reach = travel + shift
@@ -119,11 +125,11 @@ class SweptClearance:
         if made is not None and (made.present0 is not None or made.present1 is not None):
             bound = min(bound, _changed_bound(made, g0, g1, reach))
         if bound < 0.0:  # a contact is possible: now
-            gap, s_hit = self._sweep(made or poses(), collide=True)  # type: ignore[operator]
+            gap, s_hit = self._sweep(get(), collide=True)
             self.best = min(self.best, gap)
             return s_hit
         if bound < min(self.best, self._ceiling):
-            self._kept.append((bound, made or poses()))  # type: ignore[operator]
+            self._kept.append((bound, get()))
             if len(self._kept) >= self.BATCH:
                 self._flush()
         return math.nan
