@@ -487,6 +487,8 @@ class World2D:
         )
         packed = self.packed
         if packed is not None:
+            if self.sweep.idle(0.5 * (g0 + self.clearance - travel - packed.shift), ceiling):
+                return None  # (most steps: no poses made)
             s = self.sweep.step(
                 lambda: StepPoses(*packed.poses_before(), *packed.poses(), None, None,
                                   np.array(p0), np.array(p1), slack),

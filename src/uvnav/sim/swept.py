@@ -134,6 +134,13 @@ class SweptClearance:
                 self._flush()
         return math.nan
 
+    def idle(self, bound: float, ceiling: float) -> bool:
+        """Whether a step whose closest approach is at least ``bound`` [m] can be left alone
+        (neither a contact nor a new minimum), noting ``ceiling`` as :meth:`step` does: the
+        shortcut of a caller that knows the step's shift without making its poses."""
+        self._ceiling = min(self._ceiling, ceiling)
+        return bound >= 0.0 and bound >= min(self.best, self._ceiling)
+
     def finish(self, sampled_min: float) -> float:
         """The episode's minimum clearance along every step [m], given the exact minimum of the
         sampled gaps ``sampled_min`` (``inf`` without any)."""
