@@ -49,6 +49,8 @@ def test_a_robot_that_passes_through_a_thin_wall_between_samples_collides(record
     assert got.contact_time == pytest.approx((-0.07 + 1.1) / 2.0, abs=1e-9)
     assert got.metrics.min_clearance is not None and got.metrics.min_clearance < 0
     assert got.metrics.path_length == pytest.approx(1.2)  # the episode ends with that step
+    # judged at the contact: the robot drove into a still wall (at the step's end it is past it)
+    assert got.metrics.collision_by == "robot"
 
 
 def test_a_fast_disc_that_crosses_the_path_between_samples_collides() -> None:
@@ -63,6 +65,7 @@ def test_a_fast_disc_that_crosses_the_path_between_samples_collides() -> None:
     assert swept.status == "collision" and swept.contact_time is not None
     # the discs touch when the disc's centre is 0.15 m below the robot's: y = -0.15
     assert swept.contact_time == pytest.approx((1.5 - 0.15) / 20.0, abs=1e-3)
+    assert swept.metrics.collision_by == "pedestrian"  # (a moving disc is one) it ran into it
 
 
 def test_the_holonomic_robot_is_judged_along_the_step_too() -> None:

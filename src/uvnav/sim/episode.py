@@ -459,8 +459,10 @@ class World2D:
         contact_at = self._swept(start, (x, y), (nx, ny), t0, g0, travel, slack)
         gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)
         self.done = book.judge(t, self.clearance, gd, contact_at) or clock.up
-        if book.status == "collision":
-            self.collision_by = self._collision_by(was_present)
+        if book.status == "collision":  # judged at the first contact when the sweep found it
+            sweep = self.sweep
+            by = sweep.contact_by(dt, self.velocity(), self.pedestrians) if sweep else None
+            self.collision_by = by or self._collision_by(was_present)
 
     def _swept(
         self,

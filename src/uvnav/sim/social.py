@@ -49,7 +49,9 @@ Metrics (``None`` in a scene without pedestrians, except where said):
     step, else ``"pedestrian"`` (or ``"obstacle"`` when the body is not a pedestrian); ``None``
     without collision.  The direction is from the robot's centre to the body's centre (disc) or to
     its nearest boundary point (polygon); the body's velocity is that of its touching point
-    (translation plus rotation).  A body that did not exist one step before (a replayed
+    (translation plus rotation).  Where the world found the contact along the step, this is
+    judged at the first contact (:meth:`uvnav.sim.swept.SweptClearance.contact_by`), else at the
+    step's end.  A body that did not exist one step before (a replayed
     pedestrian whose recorded track starts in contact with the robot) closed the gap by
     appearing: ``"pedestrian"`` (``"obstacle"``), whatever the velocities.  Set for every 2D
     scene, with or without pedestrians.
@@ -191,24 +193,51 @@ def collision_by(
     q = fld.query((px, py), 0.0, nearest=True)
     j = int(q.signed.argmin())
     body = int(q.ids[j])
-    cx, cy = float(fld.centres[body, 0]), float(fld.centres[body, 1])
+    centre = (float(fld.centres[body, 0]), float(fld.centres[body, 1]))
+    disc = bool(fld.template.radii[body] > 0)
+    touch = (float(q.nearest[j, 0]), float(q.nearest[j, 1]))
+    appeared = was_present is not None and not bool(was_present[body])
+    robot = not appeared and robot_closed(
+        (px, py), centre, touch, disc, bool(q.inside[j]), robot_velocity,
+        (float(fld.velocities[body, 0]), float(fld.velocities[body, 1])),
+        float(fld.angular_velocities[body]),
+    )  # fmt: skip
+    return _blame(robot, body, pedestrians)
+
+
+def _blame(robot: bool, body: int, pedestrians: np.ndarray) -> str:
+    if robot:
+        return "robot"
+    return "pedestrian" if bool(np.isin(body, pedestrians)) else "obstacle"
+
+
+def robot_closed(
+    point: tuple[float, float],
+    centre: tuple[float, float],
+    touch: tuple[float, float],
+    disc: bool,
+    inside: bool,
+    robot_velocity: tuple[float, float],
+    body_velocity: tuple[float, float],
+    omega: float,
+) -> bool:
+    """Whether the robot at ``point`` closed the gap to a body (centre ``centre``, nearest
+    boundary point ``touch``, the robot's centre ``inside`` it or not) faster than the body did
+    (module docstring, ``collision_by``): velocities [m/s], the body's rotation rate [rad/s]."""
+    px, py = point
+    cx, cy = centre
     # the touching point: a disc's centre (its rotation moves its boundary tangentially, never
     # along the normal), a polygon's nearest boundary point
-    disc = bool(fld.template.radii[body] > 0)
-    tx, ty = (cx, cy) if disc else (float(q.nearest[j, 0]), float(q.nearest[j, 1]))
+    tx, ty = (cx, cy) if disc else touch
     nx, ny = tx - px, ty - py
-    if q.inside[j] and not disc:
+    if inside and not disc:
         nx, ny = -nx, -ny  # the robot's centre is inside: the body lies behind the boundary
     norm = math.hypot(nx, ny)
     if norm == 0.0:  # no direction to close along (centre on the boundary or the centre)
         nx, ny, norm = cx - px, cy - py, max(math.hypot(cx - px, cy - py), 1.0)
     nx, ny = nx / norm, ny / norm
-    omega = float(fld.angular_velocities[body])
-    bvx = float(fld.velocities[body, 0]) - omega * (ty - cy)
-    bvy = float(fld.velocities[body, 1]) + omega * (tx - cx)
+    bvx = body_velocity[0] - omega * (ty - cy)
+    bvy = body_velocity[1] + omega * (tx - cx)
     robot_in = robot_velocity[0] * nx + robot_velocity[1] * ny
     body_in = -(bvx * nx + bvy * ny)
-    appeared = was_present is not None and not bool(was_present[body])
-    if robot_in > body_in and not appeared:
-        return "robot"
-    return "pedestrian" if bool(np.isin(body, pedestrians)) else "obstacle"
+    return robot_in > body_in

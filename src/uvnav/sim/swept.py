@@ -33,8 +33,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.polygons import polygon_nearest
 from uvnav.geometry.sweep import body_sweep, disc_sweep
 from uvnav.obstacles.obstacle import FieldTemplate
+from uvnav.sim.social import robot_closed
 
 #: the kernels' tolerance for a rotating body [m]: a gap is at most twice it below the true one
 ROT_TOL = 5e-4
@@ -77,6 +79,8 @@ class SweptClearance:
         self.template = template
         self.radius = float(robot_radius)
         self.best = math.inf  # the least swept gap so far [m]
+        #: the last step's first contact: its poses, the body, the fraction of the step
+        self.contact: tuple[StepPoses, int, float] | None = None
         self._kept: list[tuple[float, StepPoses]] = []
         self._ceiling = math.inf
         self._rings = [
@@ -106,6 +110,7 @@ class SweptClearance:
                 (every body present at both ends); else it is measured on ``poses``.
         """
         self._ceiling = min(self._ceiling, ceiling)
+        self.contact = None
         if not len(self.template):
             return math.nan
         made = None if callable(poses) else poses
@@ -184,7 +189,42 @@ class SweptClearance:
             gap = min(gap, g)
             if collide and g < 0.0 and (math.isnan(s_hit) or hit < s_hit):
                 s_hit = hit
+                self.contact = (poses, j, hit)
         return gap, s_hit
+
+    def contact_by(
+        self, dt: float, robot_velocity: tuple[float, float], pedestrians: np.ndarray
+    ) -> str | None:
+        """Who closed the gap at the last step's first contact (``None``: it had none), judged
+        at that instant (:func:`uvnav.sim.social.robot_closed`): the robot's centre and the
+        body's pose there under the sweep's motion model, the body's velocity over the step of
+        ``dt`` [s], the robot's ``robot_velocity`` [m/s]; a body absent at the step's start
+        appeared in contact."""
+        if self.contact is None:
+            return None
+        poses, j, s = self.contact
+        tpl = self.template
+        p = poses.p0 + s * (poses.p1 - poses.p0)
+        c0, c1, h0, h1 = _moving(poses)
+        c = c0[j] + s * (c1[j] - c0[j])
+        dh = math.remainder(float(h1[j] - h0[j]), 2.0 * math.pi)
+        disc = bool(tpl.radii[j] > 0)
+        touch, inside = (float(c[0]), float(c[1])), False
+        if not disc:
+            ring = self._rings[int(tpl.poly_row[j])][:-1]
+            h = float(h0[j]) + s * dh
+            rot = np.array([[math.cos(h), -math.sin(h)], [math.sin(h), math.cos(h)]])
+            _, near, inside = polygon_nearest(p, ring @ rot.T + c)
+            touch = (float(near[0]), float(near[1]))
+        appeared = poses.present0 is not None and not bool(poses.present0[j])
+        velocity = ((c1[j] - c0[j]) / dt).tolist()
+        robot = not appeared and robot_closed(
+            (float(p[0]), float(p[1])), (float(c[0]), float(c[1])), touch, disc, inside,
+            robot_velocity, (velocity[0], velocity[1]), dh / dt,
+        )  # fmt: skip
+        if robot:
+            return "robot"
+        return "pedestrian" if bool(np.isin(j, pedestrians)) else "obstacle"
 
 
 def _changed_bound(poses: StepPoses, g0: float, g1: float, reach: float) -> float:
