@@ -106,3 +106,13 @@ def test_plot_draws_an_episode_of_every_kind(spec: str, tmp_path: Path) -> None:
     res = runner.invoke(app, ["simulate", spec, "--plot", str(out)])
     assert res.exit_code == 0, res.output
     assert out.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_simulate_reports_the_time_of_the_first_contact() -> None:
+    got = runner.invoke(app, ["simulate", "crowdnav-circle:1", "-c", "orca-holonomic-v1", "--json"])
+    assert got.exit_code == 0, got.output
+    row = json.loads(got.stdout)
+    assert row["status"] == "collision"
+    assert 0.0 < row["contact_time"] <= 24.0  # within the episode (t_max 24 s)
+    table = runner.invoke(app, ["simulate", "crowdnav-circle:1", "-c", "orca-holonomic-v1"])
+    assert "contact_time" in table.stdout

@@ -204,6 +204,7 @@ _METRIC_UNITS = {
     "too_close_time": "s",
     "intrusion_time": "s",
     "path_irregularity": "rad/m",
+    "contact_time": "s",
 }
 
 
@@ -324,7 +325,7 @@ def simulate(
         table.add_row(key, _fmt(out.metrics[key]), _METRIC_UNITS.get(key, ""))
     for key, value in out.extra.items():
         if not isinstance(value, dict | list):
-            table.add_row(key, _fmt(value), "")
+            table.add_row(key, _fmt(value), _METRIC_UNITS.get(key, ""))
     con = _console()
     con.print(table)
     robots = out.extra.get("robots")

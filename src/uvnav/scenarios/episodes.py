@@ -43,7 +43,9 @@ class Outcome:
             robot arrived, ``collision`` when any collided, else ``timeout``).
         metrics: the :data:`METRIC_NAMES` of the episode (multi-robot: of the group: success
             = all arrived, collision = any, the others the robots' mean).
-        extra: the kind's own results (forbidden regions, inner space, group metrics, robots).
+        extra: the kind's own results (forbidden regions, inner space, group metrics, robots;
+            a single robot's ``contact_time``: the first contact of a collision [s], ``None``
+            without one).
         result, setup: the simulator's own result and setup (for figures).
     """
 
@@ -166,6 +168,7 @@ def _single(
         seed=seed,
         status=res.status,
         metrics=res.metrics.to_dict(),
+        extra={"contact_time": res.contact_time},
         result=res,
         **kw,
     )
