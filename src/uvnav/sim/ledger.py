@@ -34,7 +34,7 @@ True
 >>> step_count(1.0, 0.3)
 Traceback (most recent call last):
 ...
-ValueError: t_max must be a whole multiple of dt=0.3 s (got 1 s: 3.33 steps)
+ValueError: t_max must be a whole multiple of dt=0.3 s (got 1 s: 3.33333 steps)
 """
 
 from __future__ import annotations
@@ -94,7 +94,7 @@ def step_count(t_max: float, dt: float) -> int:
     if not n:
         raise ValueError(
             f"t_max must be a whole multiple of dt={dt:g} s "
-            f"(got {t_max:g} s: {t_max / dt:.3g} steps)"
+            f"(got {t_max:g} s: {t_max / dt:.6g} steps)"
         )
     return n
 
