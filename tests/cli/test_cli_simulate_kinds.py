@@ -12,7 +12,7 @@ from typer.testing import CliRunner
 from uvnav.cli.app import app
 from uvnav.scenarios.catalog import builtin_names
 from uvnav.sim.metrics import METRIC_NAMES
-from uvnav.sim.multi import GROUP_METRIC_NAMES
+from uvnav.sim.setup import GROUP_METRIC_NAMES
 
 runner = CliRunner()
 

@@ -20,7 +20,8 @@ from uvnav.obstacles import Obstacle
 from uvnav.scenarios import build_episode, random_ch2_scenario
 from uvnav.scenarios.multi import antipodal_scenario, build_multi
 from uvnav.sim import SensingConfig, run_episode, run_rng
-from uvnav.sim.multi import MultiSetup, MultiUnicycleWorld, RobotSetup, run_multi
+from uvnav.sim.multi import MultiUnicycleWorld, run_multi
+from uvnav.sim.setup import MultiSetup, RobotSetup
 
 
 def shared_setup(n: int, **params: Any) -> MultiSetup:

@@ -16,7 +16,8 @@ from uvnav.obstacles import Obstacle
 from uvnav.sensors import Observation
 from uvnav.sim import SensingConfig
 from uvnav.sim.metrics import METRIC_NAMES
-from uvnav.sim.multi import GROUP_METRIC_NAMES, MultiSetup, RobotSetup, run_multi, summarize
+from uvnav.sim.multi import run_multi, summarize
+from uvnav.sim.setup import GROUP_METRIC_NAMES, MultiSetup, RobotSetup
 
 SPEC = UnicycleSpec(0.7, 1.4, 0.2)
 

@@ -22,9 +22,10 @@ from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.sensors.exact import lidar_scan
-from uvnav.sim.episode import EpisodeResult, EpisodeSetup, World2D, run_episode
+from uvnav.sim.episode import World2D, run_episode
 from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, pack_check
 from uvnav.sim.seeding import run_rng
+from uvnav.sim.setup import EpisodeResult, EpisodeSetup
 
 REL = np.linspace(-np.pi, np.pi, 16, endpoint=False)
 SPEC = UnicycleSpec(v_max=0.8, u_max=1.2, radius=0.2)

@@ -14,7 +14,7 @@ from uvnav.geometry.kernels3d import compiled, numba_available
 from uvnav.obstacles import Obstacle
 from uvnav.scenarios.multi import antipodal_scenario, build_multi
 from uvnav.sim import SensingConfig
-from uvnav.sim.multi import MultiSetup, MultiUnicycleWorld, RobotSetup, run_multi
+from uvnav.sim.multi import MultiUnicycleWorld, run_multi
 from uvnav.sim.packed_swarm import (
     BLOCK,
     R_CLEAR,
@@ -26,6 +26,7 @@ from uvnav.sim.packed_swarm import (
     PackedSwarm,
     swarm_check,
 )
+from uvnav.sim.setup import MultiSetup, RobotSetup
 
 KERNELS = [False, pytest.param(True, marks=pytest.mark.skipif(
     not numba_available(), reason="numba is not installed"))]  # fmt: skip

@@ -205,7 +205,8 @@ def test_the_ch4_world_judged_at_step_ends_passes_through() -> None:
 
 
 def test_two_robots_that_cross_between_two_samples_collide() -> None:
-    from uvnav.sim.multi import MultiSetup, RobotSetup, run_multi
+    from uvnav.sim.multi import run_multi
+    from uvnav.sim.setup import MultiSetup, RobotSetup
 
     def robot(start: tuple[float, float, float], goal: tuple[float, float]) -> RobotSetup:
         spec = UnicycleSpec(v_max=2.0, u_max=1.0, radius=0.05)

@@ -38,8 +38,8 @@ from uvnav.scenarios.schema import (
     RobotSpec,
     SensingSpec,
 )
-from uvnav.sim.multi import MultiSetup, RobotSetup
 from uvnav.sim.seeding import world_rng
+from uvnav.sim.setup import MultiSetup, RobotSetup
 
 
 class MultiRobotSpec(RobotSpec):

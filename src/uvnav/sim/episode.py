@@ -32,8 +32,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass, field
-from typing import Any, ClassVar, Literal
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -44,7 +43,7 @@ from uvnav.dynamics.vehicles import Vehicle2D, make_vehicle, vehicles_2d
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.obstacles.batch import ObstacleBatch
-from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField
+from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
 from uvnav.sensors.exact import lidar_scan, sense_obstacles
 from uvnav.sensors.observation import Observation
@@ -53,81 +52,9 @@ from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
 from uvnav.sim.packed import PackedObstacles, pack_check
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
+from uvnav.sim.setup import EpisodeResult, EpisodeSetup
 from uvnav.sim.social import SocialTracker, collision_by, pedestrian_ids
 from uvnav.sim.swept import StepPoses, SweptClearance
-
-
-@dataclass(frozen=True)
-class LidarConfig:
-    """Lidar on the robot: ``n_rays`` beams over ``fov`` [rad], ``max_range`` [m], noise [m]."""
-
-    n_rays: int = 72
-    max_range: float = 5.0
-    fov: float = 2.0 * np.pi
-    noise_std: float = 0.0
-    dropout: float = 0.0
-
-
-@dataclass(frozen=True)
-class SensingConfig:
-    """How observations are made.
-
-    Attributes:
-        sensing_range: obstacles farther than this [m] are not reported.
-        velocities: ``"known"`` gives true v_i, u_i (the thesis's assumption); ``"estimated"``
-            gives finite differences of the sensed centre and outline
-            (:class:`FiniteDifferenceEstimator`).
-        position_noise: std [m] of the noise on the observed centre when estimating.
-        lidar: optional range scanner.
-        plugins: ``(name, params)`` of plug-in sensors (:mod:`uvnav.sensors.plugins`), read
-            after the built-in sensors from the same sensing generator.
-    """
-
-    sensing_range: float = 5.0
-    velocities: Literal["known", "estimated"] = "known"
-    position_noise: float = 0.0
-    lidar: LidarConfig | None = None
-    plugins: tuple[tuple[str, dict[str, Any]], ...] = ()
-
-
-@dataclass
-class EpisodeSetup:
-    """A fully instantiated episode (what a scenario builds for one seed).
-
-    Attributes:
-        spec: robot limits and radius.
-        start: initial pose ``[x, y, theta]``.
-        goal: target T [m].
-        obstacles: obstacles with their episode-specific motion models.
-        dt: integration step [s].
-        control_period: decision period [s], a whole multiple of ``dt`` (within 1e-9 relative).
-        t_max: time limit [s].
-        goal_tolerance: the goal is reached within this distance [m].
-        sensing: sensing configuration.
-    """
-
-    spec: UnicycleSpec
-    start: FloatArray
-    goal: FloatArray
-    obstacles: list[Obstacle]
-    dt: float = 0.1
-    control_period: float = 0.1
-    t_max: float = 60.0
-    goal_tolerance: float = 0.2
-    sensing: SensingConfig = field(default_factory=SensingConfig)
-
-
-@dataclass
-class EpisodeResult:
-    """Metrics, status (``success``, ``collision`` or ``timeout``), the recorded trajectory and,
-    for a collision, the time of the first contact [s] (``None`` otherwise, or where the world
-    does not know it)."""
-
-    metrics: EpisodeMetrics
-    status: str
-    trajectory: Trajectory | None
-    decision_us: FloatArray
-    contact_time: float | None = None
 
 
 class _MinClearance:

@@ -38,9 +38,9 @@ from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.frames3d import check_unit, rotation_from_vector
 from uvnav.obstacles.motion3d import Obstacle3D
 from uvnav.sensors.sensing3d import FiniteDifference3D, Observation3D, sense_obstacles3d
-from uvnav.sim.episode import EpisodeResult
 from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.setup import EpisodeResult
 from uvnav.sim.swept import first_contact
 
 

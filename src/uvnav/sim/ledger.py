@@ -40,10 +40,15 @@ ValueError: t_max must be a whole multiple of dt=0.3 s (got 1 s: 3.33333 steps)
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
+
 from uvnav.core import AgentLog
+from uvnav.geometry.angles import FloatArray
 from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
+from uvnav.sim.setup import GroupMetrics, MultiSetup
 
 #: relative tolerance of the whole-multiple rules (the scenario schema uses the same)
 MULTIPLE_RTOL = 1e-9
@@ -265,3 +270,34 @@ class Ledger:
             decision_us=log.timed_us,
             **extra,
         )
+
+
+def group_outcome(
+    setup: MultiSetup, status: Sequence[str], reached: Sequence[float | None], xy: FloatArray,
+    window_start: FloatArray | None, t: float, robot_collisions: int, obstacle_collisions: int,
+) -> GroupMetrics:  # fmt: skip
+    """The group's outcome (:class:`~uvnav.sim.setup.GroupMetrics`, :mod:`uvnav.sim.multi`) from
+    every robot's status, arrival time and position now [m], the positions at the start of the
+    deadlock window (None: no step yet), the time [s] and the collision counts; a robot is stuck
+    when it moved less than ``deadlock_distance`` since the window's start."""
+    n = len(status)
+    arrived = sum(s == "success" for s in status)
+    all_arrived = arrived == n
+    arrival_times = [a for a in reached if a is not None]
+    moved = np.hypot(*(xy - window_start).T) if window_start is not None else np.zeros(n)
+    stuck = sum(
+        1
+        for i in range(n)
+        if status[i] == "timeout"
+        and t >= setup.deadlock_window
+        and moved[i] < setup.deadlock_distance
+    )
+    return GroupMetrics(
+        all_arrived=all_arrived,
+        arrived=int(arrived),
+        robot_collisions=robot_collisions,
+        obstacle_collisions=obstacle_collisions,
+        makespan=max(arrival_times) if all_arrived else None,
+        sum_of_times=float(sum(arrival_times)) if all_arrived else None,
+        deadlocks=int(stuck),
+    )

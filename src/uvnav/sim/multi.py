@@ -48,12 +48,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import asdict, dataclass, field
 from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.controllers.base import Controller
 from uvnav.core import AgentLog, BaseProbe, DiscAgents, run_loop
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
 from uvnav.geometry.angles import FloatArray
@@ -65,114 +63,22 @@ from uvnav.obstacles.obstacle import (
     _CULL_REL,
     _X_AXIS,
     FieldTemplate,
-    Obstacle,
     ObstacleField,
 )
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
 from uvnav.sensors.exact import sense_obstacles
 from uvnav.sensors.observation import Observation, ObstacleReading
-from uvnav.sim.episode import SensingConfig
-from uvnav.sim.ledger import Clock, Ledger
+from uvnav.sim.ledger import Clock, Ledger, group_outcome
 from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.packed_swarm import run_swarm, swarm_check
+from uvnav.sim.setup import (
+    GroupMetrics,
+    MultiResult,
+    MultiSetup,
+)
 from uvnav.sim.swept import StepPoses, SweptClearance
 
 _NO_OUTLINE = np.zeros((0, 2))  # a disc's outline in a reading (as sense_obstacles gives it)
-
-GROUP_METRIC_NAMES: tuple[str, ...] = (
-    "all_arrived",
-    "arrived",
-    "robot_collisions",
-    "obstacle_collisions",
-    "makespan",
-    "sum_of_times",
-    "deadlocks",
-)
-
-
-@dataclass
-class RobotSetup:
-    """One robot of a multi-robot episode.
-
-    Attributes:
-        spec: limits and radius.
-        start: initial pose ``[x, y, theta]`` ([m], [m], [rad]).
-        goal: target [m], shape (2,).
-        controller: its navigation law (reset at the start of the episode).
-        sensing: its sensing configuration.
-        name: label.
-    """
-
-    spec: UnicycleSpec
-    start: FloatArray
-    goal: FloatArray
-    controller: Controller
-    sensing: SensingConfig = field(default_factory=SensingConfig)
-    name: str = ""
-
-
-@dataclass
-class MultiSetup:
-    """A fully instantiated multi-robot episode.
-
-    Attributes:
-        robots: the robots.
-        obstacles: the world's (non-robot) obstacles.
-        dt: integration step [s].
-        control_period: decision period [s] (a whole multiple of ``dt``).
-        t_max: time limit [s].
-        goal_tolerance: arrival radius [m].
-        deadlock_window: the window of the deadlock test [s].
-        deadlock_distance: a robot that moved less than this [m] over the window is stuck.
-    """
-
-    robots: list[RobotSetup]
-    obstacles: list[Obstacle] = field(default_factory=list)
-    dt: float = 0.1
-    control_period: float = 0.1
-    t_max: float = 60.0
-    goal_tolerance: float = 0.2
-    deadlock_window: float = 10.0
-    deadlock_distance: float = 0.2
-
-
-@dataclass(frozen=True)
-class GroupMetrics:
-    """Outcome of the group (see the module docstring)."""
-
-    all_arrived: bool
-    arrived: int
-    robot_collisions: int
-    obstacle_collisions: int
-    makespan: float | None
-    sum_of_times: float | None
-    deadlocks: int
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
-
-
-@dataclass
-class MultiResult:
-    """Per-robot metrics and statuses, group metrics, and the recorded robot trajectories.
-
-    Attributes:
-        robots: per-robot :class:`EpisodeMetrics` (same names as single-robot episodes).
-        statuses: per robot ``success``, ``collision`` or ``timeout``.
-        group: the group metrics.
-        times: (n,) sample times [s] (empty when not recorded).
-        poses: (n, N, 3) robot poses (empty when not recorded).
-        collided_pairs: the robot index pairs that overlapped.
-        obstacle_paths: (n, K, 2) positions of the world's K obstacles [m] at the same times
-            (empty when not recorded or when there are none).
-    """
-
-    robots: list[EpisodeMetrics]
-    statuses: list[str]
-    group: GroupMetrics
-    times: FloatArray
-    poses: FloatArray
-    collided_pairs: list[tuple[int, int]]
-    obstacle_paths: FloatArray = field(default_factory=lambda: np.zeros((0, 0, 2)))
 
 
 def _robot_velocity(v: float, th: float) -> tuple[float, float]:
@@ -595,37 +501,6 @@ class MultiUnicycleWorld:
         )  # fmt: skip
 
 
-def group_outcome(
-    setup: MultiSetup, status: Sequence[str], reached: Sequence[float | None], xy: FloatArray,
-    window_start: FloatArray | None, t: float, robot_collisions: int, obstacle_collisions: int,
-) -> GroupMetrics:  # fmt: skip
-    """The group's outcome (module docstring) from every robot's status, arrival time and
-    position now [m], the positions at the start of the deadlock window (None: no step yet),
-    the time [s] and the collision counts; a robot is stuck when it moved less than
-    ``deadlock_distance`` since the window's start."""
-    n = len(status)
-    arrived = sum(s == "success" for s in status)
-    all_arrived = arrived == n
-    arrival_times = [a for a in reached if a is not None]
-    moved = np.hypot(*(xy - window_start).T) if window_start is not None else np.zeros(n)
-    stuck = sum(
-        1
-        for i in range(n)
-        if status[i] == "timeout"
-        and t >= setup.deadlock_window
-        and moved[i] < setup.deadlock_distance
-    )
-    return GroupMetrics(
-        all_arrived=all_arrived,
-        arrived=int(arrived),
-        robot_collisions=robot_collisions,
-        obstacle_collisions=obstacle_collisions,
-        makespan=max(arrival_times) if all_arrived else None,
-        sum_of_times=float(sum(arrival_times)) if all_arrived else None,
-        deadlocks=int(stuck),
-    )
-
-
 class PosesProbe(BaseProbe):
     """Records every robot's pose and every obstacle's position of a
     :class:`MultiUnicycleWorld` at every step and at the end."""
@@ -665,8 +540,6 @@ def run_multi(
     Raises:
         ValueError: ``control_period`` is not a whole multiple of ``dt``, or no robot.
     """
-    from uvnav.sim.packed_swarm import run_swarm, swarm_check
-
     if vectorised and swarm_check(setup) is None:
         return run_swarm(setup, rng, record=record)
     world = MultiUnicycleWorld(setup, rng, vectorised=vectorised)

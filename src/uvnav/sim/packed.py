@@ -30,7 +30,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
@@ -44,9 +44,7 @@ from uvnav.obstacles.motion import ConstantVelocity, RandomTurn
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField, ObstacleState
 from uvnav.sensors.observation import ObstacleReading
 from uvnav.sim.ledger import decision_ratio, step_count
-
-if TYPE_CHECKING:
-    from uvnav.sim.episode import EpisodeSetup
+from uvnav.sim.setup import EpisodeSetup
 
 #: status codes of a packed world
 RUNNING, SUCCESS, COLLISION, TIMEOUT = 0, 1, 2, 3

@@ -13,7 +13,7 @@ group's (:func:`uvnav.core.run_loop`: CPU and wall time divided among the member
 
 It is :func:`uvnav.core.run_loop` over :class:`~uvnav.sim.multi.MultiUnicycleWorld` bit for bit
 (the tests compare every pose, status, clearance and collided pair at every step, and the whole
-:class:`~uvnav.sim.multi.MultiResult`), so :func:`~uvnav.sim.multi.run_multi` runs such scenes
+:class:`~uvnav.sim.setup.MultiResult`), so :func:`~uvnav.sim.multi.run_multi` runs such scenes
 here (:func:`run_swarm`; campaigns and ``uvnav simulate`` with them):
 
 * decisions: the group law's own kernel; each robot's decision clock is its law's
@@ -53,8 +53,8 @@ from uvnav.geometry.small import pyhypot
 from uvnav.geometry.sweep import segment_gap
 from uvnav.obstacles.bodies import DiscBody
 from uvnav.obstacles.obstacle import _CULL_ABS, _CULL_REL, _X_AXIS, FieldTemplate
-from uvnav.sim.ledger import Ledger, decision_ratio, step_count
-from uvnav.sim.multi import MultiResult, MultiSetup, group_outcome
+from uvnav.sim.ledger import Ledger, decision_ratio, group_outcome, step_count
+from uvnav.sim.setup import MultiResult, MultiSetup
 
 #: status codes of a packed robot (those of :mod:`uvnav.sim.packed`)
 RUNNING, SUCCESS, COLLISION, TIMEOUT = 0, 1, 2, 3
@@ -459,7 +459,7 @@ class PackedSwarm:
         return out
 
     def result(self, poses: Sequence[FloatArray] = (), times: Sequence[float] = ()) -> MultiResult:
-        """The episode's :class:`~uvnav.sim.multi.MultiResult` (``poses`` / ``times``: the
+        """The episode's :class:`~uvnav.sim.setup.MultiResult` (``poses`` / ``times``: the
         recorded poses before each step and at the end, as :class:`PosesProbe` records them)."""
         rob, setup = self.rob, self.setup
         status = self.statuses()

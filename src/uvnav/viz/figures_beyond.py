@@ -24,7 +24,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 from uvnav.planners.grid import OccupancyGrid
-from uvnav.sim.multi import MultiResult
+from uvnav.sim.setup import MultiResult
 
 
 def _figure(width: float, height: float) -> Figure:
