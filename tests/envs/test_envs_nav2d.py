@@ -180,6 +180,9 @@ def test_raw_commands_are_applied_as_the_simulator_applies_them() -> None:
         "env = gym.make('uvnav/Nav2D-v0', scenario='office-floor')",
         # or let gymnasium import it
         "import gymnasium as gym; env = gym.make('uvnav.envs:uvnav/Nav2D-v0', scenario='corridor')",
+        # or import uvnav, before or after gymnasium
+        "import gymnasium as gym, uvnav; env = gym.make('uvnav/Nav2D-v0', scenario='corridor')",
+        "import uvnav, gymnasium as gym; env = gym.make('uvnav/Nav2D-v0', scenario='corridor')",
     ],
 )
 def test_gymnasium_make_in_a_fresh_interpreter(code: str) -> None:

@@ -13,12 +13,13 @@
 gymnasium and pettingzoo (``uvnav[envs]``) are imported only when an env class is used.
 
 Making the envs with Gymnasium 1.x, which does not load plugin entry points (a plain
-``gymnasium.make("uvnav/Nav2D-v0")`` in a fresh interpreter raises ``NamespaceNotFound``)::
+``gymnasium.make("uvnav/Nav2D-v0")`` in a fresh interpreter without uvnav raises
+``NamespaceNotFound``): ``import uvnav`` registers them, before or after gymnasium's import (the
+hook of :mod:`uvnav`), and so does importing this package::
 
     import gymnasium as gym
-    import uvnav.envs
+    import uvnav
 
-    gym.register_envs(uvnav.envs)  # importing uvnav.envs registers them; this names the import
     env = gym.make("uvnav/Nav2D-v0", scenario="office-floor")
 
 or, with no import of uvnav, the ``module:`` form (Gymnasium imports the module first)::
