@@ -65,7 +65,10 @@ def _rounded(value: object) -> object:
 
 
 #: fields added to the scene schema since the hashes, at their default value: left out
-LATER_DEFAULTS = {"robot": {"kinematics": "arc", "accel_max": None, "turn_accel_max": None}}
+LATER_DEFAULTS = {
+    "robot": {"kinematics": "arc", "accel_max": None, "turn_accel_max": None},
+    "sensing": {"bodies": "exact"},
+}
 
 
 def scene_hash(scenario: object) -> str:

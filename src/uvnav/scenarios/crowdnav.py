@@ -283,6 +283,16 @@ def crowdnav_scenario(
         float,
         Field(ge=0, allow_inf_nan=False, description="std of the sensed centres [m] (estimated)"),
     ] = 0.0,
+    bodies: Annotated[
+        Literal["exact", "lidar"],
+        Field(description="the humans as read exactly, or as a lidar scan shows them"),
+    ] = "exact",
+    lidar_beams: Annotated[
+        int, Field(ge=1, le=100_000, description="lidar beams (bodies=lidar)")
+    ] = 360,
+    lidar_noise: Annotated[
+        float, Field(ge=0, allow_inf_nan=False, description="lidar range noise std [m]")
+    ] = 0.01,
 ) -> Scenario:
     """CrowdNav's test case ``case`` of ``rule`` (module docstring for every choice and source).
 
@@ -319,6 +329,10 @@ def crowdnav_scenario(
             ``known`` (CrowdNav's ``coordinates`` sensor, exact) or ``estimated`` (finite
             differences of the sensed centres, :mod:`uvnav.prediction.finite_difference`).
         position_noise: std of the Gaussian noise on the sensed centres [m] when ``estimated``.
+        bodies: ``exact`` readings of the humans, or ``lidar``: the humans a lidar of
+            ``lidar_beams`` beams over a full turn with ``lidar_noise`` [m] range noise and the
+            sensing range as its range shows (:mod:`uvnav.sensors.scan_bodies`; needs
+            ``velocities=estimated``).
     """
     case = int(case)
     short = "circle" if rule == "circle_crossing" else "square"
@@ -404,6 +418,18 @@ def crowdnav_scenario(
             "range": sensing_range,
             "velocities": velocities,
             "position_noise": float(position_noise),
+            "bodies": bodies,
+            **(
+                {
+                    "lidar": {
+                        "n_rays": lidar_beams,
+                        "max_range": sensing_range,
+                        "noise_std": lidar_noise,
+                    }
+                }
+                if bodies == "lidar"
+                else {}
+            ),
         },
         "obstacles": obstacles,
         "controller": {"name": controller, "params": dict(controller_params)},

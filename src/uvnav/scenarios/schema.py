@@ -181,6 +181,20 @@ class SensingSpec(_Model):
         description="third-party sensors (entry-point group uvnav.sensors); readings in "
         "Observation.extras",
     )
+    bodies: Literal["exact", "lidar"] = Field(
+        "exact",
+        description="the law's readings of the bodies: 'exact' geometry, or 'lidar': the bodies "
+        "the scan shows (segmented, fitted as discs, tracked; needs lidar and velocities: "
+        "estimated)",
+    )
+
+    @model_validator(mode="after")
+    def _lidar_bodies(self) -> SensingSpec:
+        if self.bodies == "lidar" and self.lidar is None:
+            raise FieldError("bodies", "'lidar' needs a lidar block")
+        if self.bodies == "lidar" and self.velocities != "estimated":
+            raise FieldError("bodies", "'lidar' needs velocities: estimated (the scan has none)")
+        return self
 
     def to_config(self) -> SensingConfig:
         """The simulator's :class:`~uvnav.sim.SensingConfig`."""
@@ -190,6 +204,7 @@ class SensingSpec(_Model):
             position_noise=self.position_noise,
             lidar=self.lidar.to_config() if self.lidar is not None else None,
             plugins=tuple((p.name, dict(p.params)) for p in self.plugins),
+            bodies=self.bodies,
         )
 
 

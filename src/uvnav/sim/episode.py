@@ -46,8 +46,9 @@ from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
 from uvnav.sensors.exact import lidar_scan, sense_obstacles
-from uvnav.sensors.observation import Observation
+from uvnav.sensors.observation import LidarScan, Observation
 from uvnav.sensors.plugins import sensor_plugin
+from uvnav.sensors.scan_bodies import ScanBodies
 from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
 from uvnav.sim.packed import PackedObstacles, pack_check
@@ -234,6 +235,7 @@ class World2D:
         self.estimator = None
         if sensing.velocities == "estimated" and not oracles[0]:
             self.estimator = FiniteDifferenceEstimator(self.sense_rng, sensing.position_noise)
+        self.scan_bodies = ScanBodies() if sensing.bodies == "lidar" and not oracles[0] else None
         self.clearance, self.nearest = self._clearance(self.sensing_range)
         self.tracker = (
             _MinClearance(float(self.spec.radius), self.clearance)
@@ -272,21 +274,22 @@ class World2D:
         return (0,) if self.clock.due else ()
 
     def observe(self, agent: int = 0) -> Observation:
-        """Readings within the sensing range (estimated rates unless known), the lidar scan."""
+        """Readings within the sensing range (estimated rates unless known; the exact bodies,
+        or those the lidar scan shows), the lidar scan."""
         robot = self.pose
-        if self.packed is not None:
+        scan = None
+        lc = self.setup.sensing.lidar
+        if self.scan_bodies is not None:  # the scan first: the readings are made from it
+            scan = self._scan(robot)
+            readings = self.scan_bodies.readings(self.t, robot, scan, self.sensing_range)
+        elif self.packed is not None:
             readings = self.packed.readings(self.x, self.y, self.sensing_range)
         else:
             readings = sense_obstacles(robot[:2], self.field, sensing_range=self.sensing_range)
         if self.estimator is not None:
             readings = self.estimator.update(self.t, readings)
-        scan = None
-        lc = self.setup.sensing.lidar
-        if lc is not None:
-            scan = lidar_scan(
-                robot, self.field, self.sense_rng, n_rays=lc.n_rays, max_range=lc.max_range,
-                fov=lc.fov, noise_std=lc.noise_std, dropout=lc.dropout,
-            )  # fmt: skip
+        if lc is not None and scan is None:
+            scan = self._scan(robot)
         plugins = self.setup.sensing.plugins
         extras = (
             {
@@ -299,6 +302,15 @@ class World2D:
         return Observation(
             time=self.t, pose=robot, speed=self.speed, goal=self.goal, obstacles=readings,
             lidar=scan, extras=extras,
+        )  # fmt: skip
+
+    def _scan(self, robot: FloatArray) -> LidarScan:
+        """The lidar's scan from ``robot`` now (noise and dropout from the sensing generator)."""
+        lc = self.setup.sensing.lidar
+        assert lc is not None
+        return lidar_scan(
+            robot, self.field, self.sense_rng, n_rays=lc.n_rays, max_range=lc.max_range,
+            fov=lc.fov, noise_std=lc.noise_std, dropout=lc.dropout,
         )  # fmt: skip
 
     @property

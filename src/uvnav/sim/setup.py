@@ -45,6 +45,10 @@ class SensingConfig:
         lidar: optional range scanner.
         plugins: ``(name, params)`` of plug-in sensors (:mod:`uvnav.sensors.plugins`), read
             after the built-in sensors from the same sensing generator.
+        bodies: where the law's readings of the bodies come from: ``"exact"`` (each body's
+            exact geometry within the range) or ``"lidar"`` (the bodies the lidar scan shows,
+            :mod:`uvnav.sensors.scan_bodies`: needs ``lidar`` and estimated velocities; a law
+            that is an oracle still gets the exact readings).
     """
 
     sensing_range: float = 5.0
@@ -52,6 +56,11 @@ class SensingConfig:
     position_noise: float = 0.0
     lidar: LidarConfig | None = None
     plugins: tuple[tuple[str, dict[str, Any]], ...] = ()
+    bodies: Literal["exact", "lidar"] = "exact"
+
+    def __post_init__(self) -> None:
+        if self.bodies == "lidar" and (self.lidar is None or self.velocities != "estimated"):
+            raise ValueError("bodies sensed by lidar need a lidar and estimated velocities")
 
 
 @dataclass
