@@ -25,6 +25,8 @@ Options for the protocol study (defaults = the reproduction):
   radius of the goal; else on; the first of these events wins (the world's own end comes at or
   after it: a discrete overlap is a collision at CrowdSim's next step, whose swept segment starts
   inside; the time limit a timeout).  Needs ``--substeps 1``.
+* ``--lidar BEAMS``: the robot senses the humans with a lidar alone (BEAMS beams over a full
+  turn, 1 cm range noise, 5 m range: :mod:`uvnav.sensors.scan_bodies`), velocities estimated.
 * ``--sampled``: judge collisions at the end of each step only (the world's judgement is along
   the whole step, :mod:`uvnav.sim.swept`, as CrowdSim's swept-segment test).
 * ``--kinematics arc``: a unicycle law's robot turns on arcs (the thesis's) instead of CrowdNav's
@@ -117,6 +119,8 @@ PAPER_LAW = "orca-holonomic-v1"
 
 #: CrowdNav's test cases
 TEST_CASES = 500
+#: the lidar of ``--lidar``: range noise std [m] and range [m] (also the sensing range)
+LIDAR_NOISE, LIDAR_RANGE = 0.01, 5.0
 
 
 def case_numbers(cases: int, first: int | None) -> list[int]:
@@ -150,6 +154,7 @@ def run(
     law_name: str = PAPER_LAW,
     kinematics: str = "turn-then-move",
     swept: bool = True,
+    lidar: int | None = None,
 ) -> dict[str, Any]:
     """Run the cases; returns the counts, rates, intervals and times."""
     rng_of = kinds()["nav2d"].episode_rng
@@ -159,12 +164,16 @@ def run(
     statuses: list[str] = []
     cpu0, wall0 = time.process_time(), time.perf_counter()
     for case in case_numbers(cases, first):
+        sensing: dict[str, Any] = (
+            {"bodies": "lidar", "lidar_beams": lidar, "lidar_noise": LIDAR_NOISE,
+             "velocities": "estimated", "sensing_range": LIDAR_RANGE}
+            if lidar
+            else {}
+        )  # fmt: skip
         scn = crowdnav_scenario(
-            case,
-            rule=rule,
-            dt=TIME_STEP / substeps,
-            kinematics=kinematics,  # type: ignore[arg-type]
-        )
+            case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
+            kinematics=kinematics, **sensing,  # type: ignore[arg-type]
+        )  # fmt: skip
         setup = build_episode(scn, case)
         law: Any
         if law_name != PAPER_LAW:
@@ -206,6 +215,9 @@ def run(
         "law": law_name,
         "kinematics": kinematics if vehicle == "unicycle" else None,
         "judged": "along each step" if swept else "at each step's end",
+        "sensing": (
+            f"lidar {lidar} beams, {LIDAR_NOISE:g} m noise, {LIDAR_RANGE:g} m" if lidar else "exact"
+        ),
         "params": dict(CROWDNAV_ORCA_PARAMS) if law_name == PAPER_LAW else {},
         "rates": rates,
         "time_to_goal_mean": float(np.mean(times)) if times else None,
@@ -227,7 +239,8 @@ def report(r: dict[str, Any]) -> str:
     lines = [
         f"crowdnav-{r['rule'].split('_')[0]} {_cases_text(r)}, {r['law']} {r['params']}, "
         f"dt {r['dt']:g} s, pref {r['pref']}, outcome {r['outcome']}, collisions judged "
-        f"{r['judged']}" + (f", {r['kinematics']} unicycle" if r["kinematics"] else ""),
+        f"{r['judged']}, sensing {r['sensing']}"
+        + (f", {r['kinematics']} unicycle" if r["kinematics"] else ""),
     ]
     for key in ("success", "collision", "timeout"):
         x = r["rates"][key]
@@ -273,6 +286,8 @@ def main(argv: list[str] | None = None) -> int:
                     "and zhang2019-holonomic-v2 are held to issue 19's targets)")  # fmt: skip
     ap.add_argument("--kinematics", choices=("turn-then-move", "arc"), default="turn-then-move",
                     help="a unicycle law's robot: CrowdNav's or the arc")  # fmt: skip
+    ap.add_argument("--lidar", type=int, default=None, metavar="BEAMS",
+                    help="the robot senses the humans with a BEAMS-beam lidar alone")  # fmt: skip
     ap.add_argument("--sampled", action="store_true",
                     help="judge collisions at each step's end only")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write crowdnav.json here")
@@ -284,7 +299,7 @@ def main(argv: list[str] | None = None) -> int:
     r = run(
         args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
         outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
-        swept=not args.sampled,
+        swept=not args.sampled, lidar=args.lidar,
     )  # fmt: skip
     print(report(r))
     if args.out is not None:
