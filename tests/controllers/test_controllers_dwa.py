@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -180,3 +181,15 @@ def test_random_ch2_episodes_that_parked_short_of_the_goal_now_arrive(seed: int)
     out = run_scene(resolve(f"random-ch2:{seed}"), "dwa-v1")
     assert out.status == "success"
     assert out.metrics["time_to_goal"] < 25.0
+
+
+def test_the_window_narrows_to_a_vehicle_with_tighter_acceleration_limits() -> None:
+    law = fresh()  # its own limits: 1 m/s^2, 4 rad/s^2
+    v, u = law.window(0.3, 0.5)
+    assert (v.min(), v.max()) == pytest.approx((0.0, 0.707))  # 0.3 -/+ 0.5 m/s, clipped
+    limited = make_controller("dwa-v1")
+    limited.reset(replace(SPEC, accel_max=0.2, turn_accel_max=0.5), GOAL,
+                  np.random.default_rng(0))  # fmt: skip
+    v, u = limited.window(0.3, 0.5)
+    assert (v.min(), v.max()) == pytest.approx((0.2, 0.4))  # the vehicle's 0.2 m/s^2
+    assert (u.min(), u.max()) == pytest.approx((-0.25, 0.25))  # its 0.5 rad/s^2

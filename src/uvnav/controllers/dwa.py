@@ -15,8 +15,10 @@ What is implemented, for the thesis's unicycle (2.1)-(2.4) and sensing model (§
   (4.0 rad/s^2) are chosen: the robot reaches V_max = 0.707 m/s in 0.7 s and U_max = 1.414 rad/s
   in 0.35 s, a brisk but physical small robot.  V_d is the window of half-widths
   ``max_accel * T`` and ``max_ang_accel * T`` around the current (v, w), T the decision period
-  (measured between calls); the current v is the observed speed, the current w the law's own last
-  command (the observation carries no turn rate).  The window is sampled on a regular
+  (measured between calls); a vehicle with tighter acceleration limits of its own
+  (``UnicycleSpec.accel_max``, ``turn_accel_max``) narrows the window to them.  The current v is
+  the observed speed, the current w the law's own last command (the observation carries no turn
+  rate).  The window is sampled on a regular
   ``v_samples x u_samples`` grid (15 x 21), its corners included.
 * **Rollouts.** Every sample is rolled out for ``horizon`` [s] at steps of ``rollout_dt`` [s]
   with the *exact* arc of the unicycle (the chord formula of
@@ -309,7 +311,10 @@ class DwaController(UnicycleController):
         p, spec = self.params, self._spec
         v_now = min(max(speed if math.isfinite(speed) else 0.0, 0.0), spec.v_max)
         u_now = min(max(self._last_u, -spec.u_max), spec.u_max)
-        dv, du = p.max_accel * period, p.max_ang_accel * period
+        # the vehicle's own acceleration limits where it has tighter ones than the law's
+        accel = min(p.max_accel, getattr(spec, "accel_max", math.inf))
+        ang_accel = min(p.max_ang_accel, getattr(spec, "turn_accel_max", math.inf))
+        dv, du = accel * period, ang_accel * period
         v_lo, v_hi = max(0.0, v_now - dv), min(spec.v_max, v_now + dv)
         u_lo, u_hi = max(-spec.u_max, u_now - du), min(spec.u_max, u_now + du)
         vv, uu = np.meshgrid(
