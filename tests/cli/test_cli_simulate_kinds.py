@@ -116,3 +116,16 @@ def test_simulate_reports_the_time_of_the_first_contact() -> None:
     assert 0.0 < row["contact_time"] <= 24.0  # within the episode (t_max 24 s)
     table = runner.invoke(app, ["simulate", "crowdnav-circle:1", "-c", "orca-holonomic-v1"])
     assert "contact_time" in table.stdout
+
+
+@pytest.mark.parametrize(
+    ("law", "told"), [("zhang2019-v2", True), ("dwa-v1", False), ("zhang2019-holonomic-v2", False)]
+)
+def test_a_law_that_ignores_the_robots_acceleration_limits_is_told_so(law: str, told: bool) -> None:
+    # dwa-v1 plans with them; the holonomic robot keeps none (it takes its commands at once)
+    args = ["simulate", "crowdnav-circle:3", "-c", law, "--gen-param", "accel_max=1", "--json"]
+    got = runner.invoke(app, args)
+    assert got.exit_code == 0, got.output
+    assert ("does not plan with the robot's acceleration limits" in got.stderr) is told
+    plain = runner.invoke(app, ["simulate", "crowdnav-circle:3", "-c", law, "--json"])
+    assert "acceleration limits" not in plain.stderr

@@ -284,13 +284,16 @@ def simulate(
     override them.  With another --controller only --param values apply.  A law that drives
     another vehicle or reads another sensor than the scene's is refused.
     """
-    from uvnav.scenarios.episodes import run_scene
+    from uvnav.scenarios.episodes import limits_note, run_scene
 
     resolved = resolve_scene(scenario, gen_param)
     plot_outcome = (
         _optional("uvnav.viz.episode", "plot_outcome", "plotting (--plot)") if plot else None
     )
     out = run_scene(resolved, controller, parse_params(param), seed, record=plot is not None)
+    note = limits_note(resolved, out.law)
+    if note is not None:
+        typer.echo(note, err=True)
     record: dict[str, Any] = {
         "scenario": out.scene,
         "kind": out.kind,

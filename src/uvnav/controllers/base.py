@@ -80,6 +80,10 @@ class ControllerInfo:
     #: the parameter naming a law this one runs inside (``hybrid-v1``'s ``law``; its parameters
     #: in ``<name>_params``): that law's assumptions are this law's too
     inner_law: str = ""
+    #: the law plans with its vehicle's acceleration limits (``UnicycleSpec.accel_max``,
+    #: ``turn_accel_max``) when the vehicle has some; a law that does not is told so when it is
+    #: run on such a vehicle (:func:`uvnav.scenarios.episodes.limits_note`)
+    acceleration_limits: bool = False
 
 
 _REGISTRY: dict[str, ControllerInfo] = {}

@@ -442,5 +442,6 @@ register(
         summary="Dynamic Window Approach: sampled (v, w) window, exact-arc rollouts against "
         "constant-velocity obstacle predictions, G = alpha heading + beta clearance + gamma vel.",
         reference="D. Fox, W. Burgard, S. Thrun, IEEE Robot. Autom. Mag. 4(1), 1997",
+        acceleration_limits=True,
     )
 )

@@ -105,6 +105,30 @@ def check_law(
     return info
 
 
+def limits_note(resolved: Resolved, law: str) -> str | None:
+    """One line telling that ``law`` does not plan with the acceleration limits its vehicle has
+    in the scene (its commands are what the robot aims at, not what it does), or ``None``: no
+    limits that its vehicle keeps (the holonomic robot has none), or a law that plans with them
+    (``ControllerInfo.acceleration_limits``)."""
+    from uvnav.dynamics.vehicles import make_vehicle, vehicles_2d
+
+    robot: Any = getattr(resolved.scenario, "robot", None)
+    limits = {name: getattr(robot, name, None) for name in ("accel_max", "turn_accel_max")}
+    given = {k: v for k, v in limits.items() if v is not None}
+    info = controller_info(law)
+    if robot is None or not given or info.acceleration_limits:
+        return None
+    if info.vehicle not in vehicles_2d():
+        return None
+    if getattr(make_vehicle(info.vehicle, robot.to_spec()).spec, "ideal", True):
+        return None  # its vehicle keeps no acceleration limit
+    said = ", ".join(f"{k} {v:g}" for k, v in given.items())
+    return (
+        f"note: {law} does not plan with the robot's acceleration limits ({said}); the robot "
+        "lags its commands"
+    )
+
+
 def episode_seed(resolved: Resolved, seed: int | None) -> int:
     """The episode seed: the generator's number for ``generator:seed``, else ``seed`` (0).
 
