@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import os
+import shlex
 import signal
 import sqlite3
 import subprocess
@@ -119,6 +120,32 @@ def test_bench_failures_lists_each_failed_episode(tmp_path: Path) -> None:
     assert "failures" not in json.loads(
         invoke("bench", str(path), "--db", str(db), "--resume", "--json").stdout
     )
+
+
+def test_a_failure_of_a_generator_with_parameters_reruns_from_its_line(tmp_path: Path) -> None:
+    path = tmp_path / "fails.yaml"
+    path.write_text(
+        "name: fails-params\nscenarios:\n  - generator: random-ch2\n    seeds: [0, 4]\n"
+        "    params: {n_obstacles: 4, body: disc}\ncontrollers:\n  - name: straight-v1\n"
+    )
+    db = tmp_path / "r.sqlite"
+    res = runner.invoke(
+        app, ["bench", str(path), "--db", str(db), "--workers", "1", "--failures", "--json"]
+    )
+    assert res.exit_code == 0, res.output
+    failed = json.loads(res.stdout)["failures"]
+    assert failed, "straight-v1 meets a disc on some of random-ch2 seeds 0-3 with 4 bodies"
+    f = failed[0]
+    spec = simulate_spec(f["scenario"])
+    assert spec == (
+        f"random-ch2:{f['seed']} --gen-param 'body=\"disc\"' --gen-param n_obstacles=4"
+    ), spec
+    args = ["simulate", *shlex.split(spec), "-c", "straight-v1", "--json"]
+    again = json.loads(invoke(*args).stdout)
+    assert (again["status"], again["min_clearance"]) == (f["status"], f["min_clearance"])
+    plain = json.loads(invoke("simulate", f"random-ch2:{f['seed']}", "-c", "straight-v1",
+                              "--json").stdout)  # fmt: skip
+    assert plain["min_clearance"] != f["min_clearance"], "the parameters change the scene"
 
 
 def assert_one_line_error(result: Any, code: int, *fragments: str) -> str:

@@ -39,6 +39,8 @@ from __future__ import annotations
 
 import json
 import math
+import re
+import shlex
 from typing import Any
 
 import numpy as np
@@ -145,22 +147,35 @@ def _cause(row: Any) -> str:
 
 def simulate_spec(label: str) -> str:
     """The scene of a stored scenario label as ``uvnav simulate`` takes it: a campaign's
-    generated scene ``generator/NNNN`` is ``generator:N``; any other label (a built-in name, a
-    file, a generator with parameters) is returned as stored.
+    generated scene ``generator/NNNN`` is ``generator:N``, and ``generator[k=v,...]/NNNN`` is
+    ``generator:N`` with one ``--gen-param k=v`` per parameter (values as stored, canonical
+    JSON, which ``--gen-param`` reads as YAML); any other label (a built-in name, a file, a
+    campaign's own label) is returned as stored.
 
     >>> simulate_spec("random-ch2/0017")
     'random-ch2:17'
-    >>> simulate_spec("random-ch2[n_obstacles=3]/0017")
-    'random-ch2[n_obstacles=3]/0017'
+    >>> simulate_spec('random-ch2[n_obstacles=3,speeds=[0.5,1]]/0017')
+    "random-ch2:17 --gen-param n_obstacles=3 --gen-param 'speeds=[0.5,1]'"
+    >>> simulate_spec("unknown-generator[a=1]/0017")
+    'unknown-generator[a=1]/0017'
     >>> simulate_spec("scenes/0017")
     'scenes/0017'
     """
     from uvnav.scenarios.catalog import generators
 
     head, sep, number = label.rpartition("/")
-    if sep and number.isdigit() and head in generators():
-        return f"{head}:{int(number)}"
-    return label
+    if not (sep and number.isdigit()):
+        return label
+    name, bracket, args = head.partition("[")
+    if name not in generators() or (bracket and not args.endswith("]")):
+        return label
+    items = _GEN_ARG_SPLIT.split(args[:-1]) if bracket else []
+    flags = "".join(f" --gen-param {shlex.quote(item)}" for item in items)
+    return f"{name}:{int(number)}{flags}"
+
+
+#: Where ``k=v,...`` splits: a comma followed by an identifier and ``=`` (list values keep theirs).
+_GEN_ARG_SPLIT = re.compile(r",(?=[A-Za-z_][A-Za-z0-9_]*=)")
 
 
 def failure_rows(store: ResultsStore, campaign: int | str) -> list[dict[str, Any]]:

@@ -1008,7 +1008,7 @@ def _print_failures(rows: list[dict[str, Any]]) -> None:
 
     table = compact_table(
         f"{len(rows)} episode(s) did not succeed",
-        caption="rerun one: uvnav simulate SCENARIO -c CONTROLLER (and its params as --param)",
+        caption="rerun one: uvnav simulate SCENARIO -c CONTROLLER --seed SEED (its params as -p)",
     )
     for head in ("controller", "scenario", "seed"):
         table.add_column(head, overflow="fold")
