@@ -127,20 +127,24 @@ def test_a_failure_of_a_generator_with_parameters_reruns_from_its_line(tmp_path:
     path.write_text(
         "name: fails-params\nscenarios:\n  - generator: random-ch2\n    seeds: [0, 4]\n"
         "    params: {n_obstacles: 4, body: disc}\ncontrollers:\n  - name: straight-v1\n"
+        "beyond_assumptions: true\n"
     )
     db = tmp_path / "r.sqlite"
     res = runner.invoke(
-        app, ["bench", str(path), "--db", str(db), "--workers", "1", "--failures", "--json"]
-    )
+        app, ["bench", str(path), "--db", str(db), "--workers", "1", "--failures"],
+        env={"COLUMNS": "160"},
+    )  # fmt: skip
     assert res.exit_code == 0, res.output
-    failed = json.loads(res.stdout)["failures"]
+    assert "--seed SEED --beyond-assumptions" in res.stdout, res.stdout
+    again_json = invoke("bench", str(path), "--db", str(db), "--resume", "--failures", "--json")
+    failed = json.loads(again_json.stdout)["failures"]
     assert failed, "straight-v1 meets a disc on some of random-ch2 seeds 0-3 with 4 bodies"
     f = failed[0]
     spec = simulate_spec(f["scenario"])
     assert spec == (
         f"random-ch2:{f['seed']} --gen-param 'body=\"disc\"' --gen-param n_obstacles=4"
     ), spec
-    args = ["simulate", *shlex.split(spec), "-c", "straight-v1", "--json"]
+    args = ["simulate", *shlex.split(spec), "-c", "straight-v1", "--beyond-assumptions", "--json"]
     again = json.loads(invoke(*args).stdout)
     assert (again["status"], again["min_clearance"]) == (f["status"], f["min_clearance"])
     plain = json.loads(invoke("simulate", f"random-ch2:{f['seed']}", "-c", "straight-v1",

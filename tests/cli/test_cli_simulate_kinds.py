@@ -129,3 +129,15 @@ def test_a_law_that_ignores_the_robots_acceleration_limits_is_told_so(law: str, 
     assert ("does not plan with the robot's acceleration limits" in got.stderr) is told
     plain = runner.invoke(app, ["simulate", "crowdnav-circle:3", "-c", law, "--json"])
     assert "acceleration limits" not in plain.stderr
+
+
+def test_beyond_assumptions_runs_what_simulate_otherwise_refuses() -> None:
+    args = ["simulate", "crowdnav-circle:0", "-c", "hybrid-v1", "--json"]
+    refused = runner.invoke(app, args)
+    _one_line_error(refused)
+    assert "(2.6)" in refused.output and "hybrid-v1" in refused.output
+    ran = runner.invoke(app, [*args, "--beyond-assumptions"])
+    assert ran.exit_code == 0, ran.output
+    record = json.loads(ran.stdout)
+    assert record["controller"] == "hybrid-v1"
+    assert record["status"] in ("success", "collision", "timeout")

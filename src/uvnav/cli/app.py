@@ -277,12 +277,21 @@ def simulate(
         Path | None, typer.Option(help="Also draw the episode into this image file.")
     ] = None,
     gen_param: GenParamOption = None,
+    beyond_assumptions: Annotated[
+        bool,
+        typer.Option(
+            "--beyond-assumptions",
+            help="Run the law even where the scene breaks an assumption it declares (a "
+            "deliberate experiment, as a campaign's beyond_assumptions: true).",
+        ),
+    ] = False,
 ) -> None:
     """Run one episode of SCENARIO (any vehicle) and print its metrics.
 
     The scenario's law parameters are used when the law is the scenario's own; --param values
     override them.  With another --controller only --param values apply.  A law that drives
-    another vehicle or reads another sensor than the scene's is refused.
+    another vehicle or reads another sensor than the scene's is refused, and so is one whose
+    declared assumption the scene breaks, unless --beyond-assumptions.
     """
     from uvnav.scenarios.episodes import limits_note, run_scene
 
@@ -290,7 +299,14 @@ def simulate(
     plot_outcome = (
         _optional("uvnav.viz.episode", "plot_outcome", "plotting (--plot)") if plot else None
     )
-    out = run_scene(resolved, controller, parse_params(param), seed, record=plot is not None)
+    out = run_scene(
+        resolved,
+        controller,
+        parse_params(param),
+        seed,
+        record=plot is not None,
+        beyond_assumptions=beyond_assumptions,
+    )
     note = limits_note(resolved, out.law)
     if note is not None:
         typer.echo(note, err=True)
@@ -983,7 +999,7 @@ def bench(
         table.add_row(_text(label), *(_text(c) for c in r))
     _console().print(table)
     if failures:
-        _print_failures(failed)
+        _print_failures(failed, spec.beyond_assumptions)
     speed = f", {rate:.2f} episodes/s" if rate is not None else ""
     typer.echo(
         f"ran {result.ran} episode(s) ({result.errors} error(s)), skipped {result.skipped} already "
@@ -1001,14 +1017,17 @@ def compact_table(title: str, caption: str | None = None) -> Any:
                  collapse_padding=True)  # fmt: skip
 
 
-def _print_failures(rows: list[dict[str, Any]]) -> None:
+def _print_failures(rows: list[dict[str, Any]], beyond: bool) -> None:
     """The episodes that did not succeed, one line each (``uvnav bench --failures``); the
-    scenario as ``uvnav simulate`` takes it, so that a row reruns as it is."""
+    scenario as ``uvnav simulate`` takes it, so that a row reruns as it is (with
+    ``--beyond-assumptions`` when the campaign ran ``beyond``)."""
     from uvnav.bench.summary import simulate_spec
 
+    flag = " --beyond-assumptions" if beyond else ""
     table = compact_table(
         f"{len(rows)} episode(s) did not succeed",
-        caption="rerun one: uvnav simulate SCENARIO -c CONTROLLER --seed SEED (its params as -p)",
+        caption=f"rerun one: uvnav simulate SCENARIO -c CONTROLLER --seed SEED{flag} "
+        "(its params as -p)",
     )
     for head in ("controller", "scenario", "seed"):
         table.add_column(head, overflow="fold")
