@@ -141,3 +141,41 @@ def test_beyond_assumptions_runs_what_simulate_otherwise_refuses() -> None:
     record = json.loads(ran.stdout)
     assert record["controller"] == "hybrid-v1"
     assert record["status"] in ("success", "collision", "timeout")
+
+
+@pytest.mark.parametrize(
+    ("extra", "fragment"),
+    [
+        (["-c", ""], "empty law name"),
+        (["-c", " "], "empty law name"),
+        (["--plot", "."], "is a directory"),
+        (["--plot", "episode"], "unknown image format (no suffix)"),
+        (["--plot", "episode.docx"], "unknown image format .docx"),
+        (["-p", "alpha0=" + "9" * 5000], "a number too long to read"),
+        (["-p", "alpha0=" + "[" * 3000 + "]" * 3000], "nested too deeply"),
+    ],
+)
+def test_hostile_simulate_options_are_one_line_before_any_work(
+    extra: list[str], fragment: str, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    res = runner.invoke(app, ["simulate", "random-ch2:1", *extra])
+    _one_line_error(res)
+    assert fragment in res.output and len(res.output) < 300, res.output
+    assert list(tmp_path.iterdir()) == [], "nothing is written"
+
+
+@pytest.mark.parametrize(
+    ("text", "fragment"),
+    [
+        ("a: " + "[" * 3000 + "]" * 3000 + "\n", "nested too deeply"),
+        ("name: x\nt_max: " + "9" * 5000 + "\n", "a number too long to read"),
+    ],
+)
+def test_yaml_python_cannot_hold_is_one_line(text: str, fragment: str, tmp_path: Path) -> None:
+    scene = tmp_path / "hostile.yaml"
+    scene.write_text(text)
+    for command in (["simulate", str(scene)], ["scenarios", "validate", str(scene)]):
+        res = runner.invoke(app, command)
+        _one_line_error(res)
+        assert f"{scene}: malformed YAML: {fragment}" in res.output, res.output

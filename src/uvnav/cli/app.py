@@ -181,14 +181,17 @@ def parse_params(items: list[str] | None, option: str = "--param") -> dict[str, 
     for item in items or []:
         key, sep, raw = item.partition("=")
         key = key.strip()
+        shown = repr(item if len(item) <= 60 else item[:50] + "...")
         if not sep or not _PARAM_KEY.match(key):
             raise CliError(
-                f"{option} {item!r}: expected KEY=VALUE with an identifier KEY (e.g. alpha0=0.1)"
+                f"{option} {shown}: expected KEY=VALUE with an identifier KEY (e.g. alpha0=0.1)"
             )
         try:
             value = yaml_value(raw) if raw.strip() else ""
-        except yaml.YAMLError:
-            raise CliError(f"{option} {item!r}: value is not a valid YAML scalar or list") from None
+        except yaml.YAMLError as exc:
+            marked = isinstance(exc, yaml.MarkedYAMLError)
+            why = "not a valid YAML scalar or list" if marked else exc
+            raise CliError(f"{option} {shown}: value is {why}") from None
         params[key] = value
     return params
 
@@ -295,10 +298,14 @@ def simulate(
     """
     from uvnav.scenarios.episodes import limits_note, run_scene
 
+    if controller is not None and not controller.strip():
+        raise CliError("--controller '': empty law name ('uvnav controllers list' names them)")
     resolved = resolve_scene(scenario, gen_param)
     plot_outcome = (
         _optional("uvnav.viz.episode", "plot_outcome", "plotting (--plot)") if plot else None
     )
+    if plot is not None:
+        _check_image_path(plot)
     out = run_scene(
         resolved,
         controller,
@@ -1015,6 +1022,25 @@ def compact_table(title: str, caption: str | None = None) -> Any:
 
     return Table(title=title, caption=caption, box=box.SIMPLE_HEAD, pad_edge=False,
                  collapse_padding=True)  # fmt: skip
+
+
+def _check_image_path(path: Path) -> None:
+    """Refuse, before any work, an image path matplotlib would not write as given: a folder, or
+    a name without a format suffix it knows (it would write ``NAME.png`` beside it instead).
+
+    Raises:
+        CliError: one line naming the path and the formats.
+    """
+    from matplotlib.backend_bases import FigureCanvasBase
+
+    formats = FigureCanvasBase.get_supported_filetypes()
+    if path.is_dir():
+        raise CliError(f"--plot {path}: is a directory; give an image file such as run.png")
+    if path.suffix.lower().lstrip(".") not in formats:
+        raise CliError(
+            f"--plot {path}: unknown image format {path.suffix or '(no suffix)'}; "
+            f"use one of {', '.join('.' + f for f in sorted(formats))}"
+        )
 
 
 def _print_failures(rows: list[dict[str, Any]], beyond: bool) -> None:

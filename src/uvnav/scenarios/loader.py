@@ -69,8 +69,22 @@ def yaml_value(text: str) -> Any:
 
     >>> yaml_value("1e3"), yaml_value("[1, -2E-1]"), yaml_value("1.5"), yaml_value("e3")
     (1000.0, [1, -0.2], 1.5, 'e3')
+
+    Raises:
+        yaml.YAMLError: malformed YAML, and also a value Python cannot hold (an integer of more
+            than 4,300 digits, nesting deeper than the interpreter's recursion limit).
     """
-    return yaml.load(text, Loader=_UniqueKeyLoader)
+    try:
+        return yaml.load(text, Loader=_UniqueKeyLoader)
+    except (ValueError, RecursionError) as exc:
+        raise yaml.YAMLError(_unholdable(exc)) from None
+
+
+def _unholdable(exc: ValueError | RecursionError) -> str:
+    """Why YAML that parsed cannot be held: nested too deep, or a number too long."""
+    if isinstance(exc, RecursionError):
+        return "nested too deeply"
+    return "a number too long to read (more than 4,300 digits)"
 
 
 def parse_yaml(
@@ -100,6 +114,8 @@ def parse_yaml(
         raise error(source, where, f"malformed YAML: {what}") from None
     except yaml.YAMLError as exc:
         raise error(source, "", f"malformed YAML: {exc}") from None
+    except (ValueError, RecursionError) as exc:
+        raise error(source, "", f"malformed YAML: {_unholdable(exc)}") from None
     if data is None:
         raise error(source, "", f"empty file (expected a {kind} mapping)")
     if not isinstance(data, dict):
