@@ -13,7 +13,7 @@ import pytest
 from typer.testing import CliRunner
 
 from uvnav.cli.app import app
-from uvnav.cli.errors import EX_PIPE, EX_SOFTWARE, crash_log_dir
+from uvnav.cli.errors import EX_IOERR, EX_PIPE, EX_SOFTWARE, crash_log_dir
 
 runner = CliRunner()
 
@@ -144,3 +144,43 @@ def test_unwritable_log_folder_falls_back_to_the_temp_dir(
     assert result.exit_code == 70
     logs = list((tmp_path / "tmp" / "uvnav").glob("crash-*.log"))
     assert len(logs) == 1 and str(logs[0]) in result.stderr
+
+
+def test_a_name_too_long_for_the_file_system_is_one_clipped_line(log_dir: Path) -> None:
+    name = "a" * 5000
+    for command in (["simulate", name], ["bench", name], ["scenarios", "validate", name]):
+        res = runner.invoke(app, command)
+        assert res.exit_code == 2, res.output
+        assert res.output.startswith("error: File name too long: aaa"), res.output
+        assert res.output.count("\n") == 1 and len(res.output) < 120, res.output
+    assert not log_dir.exists(), "not a bug: no crash log"
+
+
+@pytest.mark.skipif(not Path("/dev/full").exists(), reason="needs Linux's /dev/full")
+def test_a_full_disk_is_one_line_exit_74_not_a_bug(log_dir: Path) -> None:
+    with open("/dev/full", "w") as full:
+        proc = subprocess.run(
+            [sys.executable, "-m", "uvnav.cli", "scenarios", "show", "random-ch2:1"],
+            stdout=full,
+            stderr=subprocess.PIPE,
+            text=True,
+            timeout=120,
+        )
+    assert proc.returncode == EX_IOERR, proc.stderr
+    assert proc.stderr == "error: No space left on device\n"
+    assert not log_dir.exists(), "not a bug: no crash log"
+
+
+def test_a_full_or_read_only_results_database_is_one_line() -> None:
+    import sqlite3
+
+    from uvnav.cli.errors import user_error
+
+    full = sqlite3.OperationalError("database or disk is full")
+    assert user_error(full) == ("results database: database or disk is full", EX_IOERR)
+    locked = sqlite3.OperationalError("attempt to write a readonly database")
+    assert user_error(locked) == (
+        "results database: attempt to write a readonly database",
+        EX_IOERR,
+    )
+    assert user_error(sqlite3.OperationalError("no such table: episodes")) is None  # a bug

@@ -5,6 +5,9 @@
   :class:`CliError` names).  Commands raise :class:`CliError`; the library's own input errors
   (:class:`~uvnav.scenarios.ScenarioError`, unknown controllers, bad law parameters, missing
   files, click's usage errors) are recognised by :func:`user_error`.
+* A **machine error** (a full disk, a read-only file system, a results database SQLite cannot
+  write) is ONE line ``error: <message>`` and exit status 74 (``EX_IOERR``): not the input, not a
+  bug.  A name too long for the file system is a user error, clipped to one readable line.
 * Anything else is a **bug**: it is not disguised as a user error, and no traceback fills the
   screen.  The full traceback goes to a crash log (:func:`crash_log_dir`) and ONE line
   ``internal error: <ExcType>: <message> (traceback in <path>; please report it)`` is printed,
@@ -16,6 +19,7 @@
 
 from __future__ import annotations
 
+import errno
 import inspect
 import os
 import re
@@ -31,6 +35,9 @@ from typer.core import TyperGroup
 
 EX_USAGE = 2
 """Exit status of a user error."""
+EX_IOERR = 74
+"""Exit status when the machine, not the input, stopped the command (a full disk, a read-only
+file system), as ``sysexits.h``."""
 EX_SOFTWARE = 70
 """Exit status of an internal error (a bug), as ``sysexits.h``."""
 EX_INTERRUPTED = 130
@@ -85,11 +92,19 @@ def user_error(exc: BaseException) -> tuple[str, int] | None:
         return str(exc), EX_USAGE
     if type(exc).__name__ in ("StaleCampaignError", "NotAStoreError"):  # bench.store: not
         return str(exc), EX_USAGE  # imported here, for a fast start
-    if isinstance(
-        exc, FileNotFoundError | IsADirectoryError | NotADirectoryError | PermissionError
-    ):
-        name = f": {exc.filename}" if exc.filename else ""
-        return f"{exc.strerror or exc}{name}", EX_USAGE
+    if isinstance(exc, OSError):
+        name = f": {_clip(str(exc.filename))}" if exc.filename else ""
+        if (
+            isinstance(
+                exc, FileNotFoundError | IsADirectoryError | NotADirectoryError | PermissionError
+            )
+            or exc.errno == errno.ENAMETOOLONG
+        ):
+            return f"{exc.strerror or exc}{name}", EX_USAGE
+        if exc.errno in _MACHINE_ERRNOS:
+            return f"{exc.strerror or exc}{name}", EX_IOERR
+    if type(exc).__module__ == "sqlite3" and any(m in str(exc) for m in _SQLITE_MACHINE):
+        return f"results database: {exc}", EX_IOERR
     names = _click_classes(exc)
     if "ClickException" in names and "NoArgsIsHelpError" not in names:
         hint = ""
@@ -98,6 +113,18 @@ def user_error(exc: BaseException) -> tuple[str, int] | None:
             hint = f" (see '{ctx.command_path} --help')"
         return f"{exc.format_message()}{hint}", int(getattr(exc, "exit_code", 1))  # type: ignore[attr-defined]
     return None
+
+
+#: ``errno`` values that say the machine, not the input, stopped the command.
+_MACHINE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS})
+#: SQLite's messages for the same (``sqlite3.OperationalError``).
+_SQLITE_MACHINE = ("database or disk is full", "attempt to write a readonly database")
+
+
+def _clip(text: str, limit: int = 80) -> str:
+    """``text``, cut to ``limit`` characters with ``...`` (a 5,000-character name stays one
+    readable line)."""
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def debug_enabled(ctx: Any = None) -> bool:
