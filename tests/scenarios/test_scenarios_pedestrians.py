@@ -286,3 +286,21 @@ def test_vectorised_crowd_replay_equals_per_pedestrian_step_bit_for_bit(name: st
             assert np.array_equal(got.velocity, s.velocity), (i, j)
             assert got.angular_velocity == s.angular_velocity, (i, j)
     assert appeared > 0 and departed > 0  # the scene exercises both transitions
+
+
+def test_a_corrupt_gz_or_a_file_that_never_ends_is_one_line(tmp_path: Path) -> None:
+    import gzip
+    import os
+
+    good = gzip.compress(XY4.encode())
+    corrupt = tmp_path / "tracks.txt.gz"
+    corrupt.write_bytes(good[:12] + bytes(b ^ 0x5A for b in good[12:]))
+    with pytest.raises(ScenarioError, match=r"tracks\.txt\.gz: cannot decode") as info:
+        P.read_tracks(corrupt, "xy4", frame_rate=25.0)
+    assert "\n" not in str(info.value)
+    fifo = tmp_path / "fifo.txt"
+    os.mkfifo(fifo)  # reading it would block for ever
+    with pytest.raises(ScenarioError, match=r"fifo\.txt: is not a regular file"):
+        P.read_tracks(fifo, "xy4", frame_rate=25.0)
+    with pytest.raises(ScenarioError, match="is not a regular file"):
+        P.read_tracks(tmp_path, "xy4", frame_rate=25.0)

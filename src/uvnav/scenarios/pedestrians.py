@@ -51,6 +51,7 @@ import itertools
 import json
 import math
 import warnings
+import zlib
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -280,11 +281,13 @@ def read_tracks(
     p = Path(path)
     source = str(path)
     try:
+        if p.exists() and not p.is_file():  # a FIFO or /dev/zero would never end
+            raise ScenarioError(source, "", "is not a regular file")
         data = p.read_bytes()
     except FileNotFoundError:
         raise ScenarioError(source, "", "no such file") from None
     except OSError as exc:
-        raise ScenarioError(source, "", f"cannot read: {exc}") from None
+        raise ScenarioError(source, "", f"cannot read: {exc.strerror or exc}") from None
     return _parse(_decode(data, source, p.name), source, fmt, frame_rate)
 
 
@@ -293,7 +296,7 @@ def _decode(data: bytes, source: str, name: str) -> str:
         if name.endswith(".gz"):
             data = gzip.decompress(data)
         return data.decode("utf-8")
-    except (OSError, EOFError, UnicodeDecodeError) as exc:
+    except (OSError, EOFError, UnicodeDecodeError, zlib.error) as exc:
         raise ScenarioError(source, "", f"cannot decode: {exc}") from None
 
 
