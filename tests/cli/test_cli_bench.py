@@ -171,6 +171,10 @@ def test_bench_errors_are_one_line(
         invoke("bench", str(bad)), 2, str(bad), "controllers.1.grid", "switch_distanse"
     )
     assert_one_line_error(invoke("bench", str(tmp_path / "none.yaml")), 2, "no such campaign file")
+    assert_one_line_error(invoke("bench", str(tmp_path)), 2, "is a directory, not a campaign")
+    endless = tmp_path / "endless.yaml"
+    os.mkfifo(endless)  # reading it would block for ever
+    assert_one_line_error(invoke("bench", str(endless)), 2, "endless.yaml: is not a regular file")
     assert_one_line_error(invoke("bench", str(campaign), "--engine", "dask"), 2, "--engine")
     assert_one_line_error(invoke("bench", str(campaign), "--address", "auto"), 2, "--engine ray")
     monkeypatch.setitem(sys.modules, "ray", None)  # as if Ray were not installed

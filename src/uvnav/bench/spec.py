@@ -423,11 +423,17 @@ def load_campaign(path: str | Path) -> CampaignSpec:
     path = Path(path)
     source = str(path)
     try:
+        if path.is_dir():
+            raise CampaignError(source, "", "is a directory, not a campaign file")
+        if path.exists() and not path.is_file():  # a FIFO or /dev/zero would never end
+            raise CampaignError(source, "", "is not a regular file")
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise CampaignError(source, "", "no such campaign file") from None
-    except (IsADirectoryError, PermissionError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError as exc:
         raise CampaignError(source, "", f"cannot read: {exc}") from None
+    except OSError as exc:
+        raise CampaignError(source, "", f"cannot read: {exc.strerror or exc}") from None
     data = parse_yaml(text, source, kind="campaign", error=CampaignError)
     spec = campaign_from_dict(data, source, base_dir=path.parent)
     return spec
