@@ -151,8 +151,9 @@ def test_a_name_too_long_for_the_file_system_is_one_clipped_line(log_dir: Path) 
     for command in (["simulate", name], ["bench", name], ["scenarios", "validate", name]):
         res = runner.invoke(app, command)
         assert res.exit_code == 2, res.output
-        assert res.output.startswith("error: File name too long: aaa"), res.output
-        assert res.output.count("\n") == 1 and len(res.output) < 120, res.output
+        assert res.output.startswith("error: ") and "File name too long" in res.output
+        assert "aaa..." in res.output, "the name is clipped"
+        assert res.output.count("\n") == 1 and len(res.output) < 260, res.output
     assert not log_dir.exists(), "not a bug: no crash log"
 
 

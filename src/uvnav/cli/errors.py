@@ -121,7 +121,7 @@ _MACHINE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS})
 _SQLITE_MACHINE = ("database or disk is full", "attempt to write a readonly database")
 
 
-def _clip(text: str, limit: int = 80) -> str:
+def _clip(text: str, limit: int = 200) -> str:
     """``text``, cut to ``limit`` characters with ``...`` (a 5,000-character name stays one
     readable line)."""
     return text if len(text) <= limit else text[: limit - 3] + "..."

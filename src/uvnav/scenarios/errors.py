@@ -3,7 +3,8 @@
 Every problem found while reading a scenario — malformed YAML, an unknown or mistyped field, a
 value out of range, an inconsistent scene — is raised as :class:`ScenarioError`, whose ``str()``
 is a single line ``<file>: <field path>: <problem>``, e.g.
-``thesis.yaml: robot.v_max: must be > 0 (got -1)``.
+``thesis.yaml: robot.v_max: must be > 0 (got -1)``; a source longer than 200 characters is cut
+with ``...`` so that the line stays readable.
 Pydantic's structured errors are translated here, so that the command line can print them verbatim
 and exit with status 2 instead of showing a traceback.
 """
@@ -35,7 +36,8 @@ class ScenarioError(ValueError):
         super().__init__(str(self))
 
     def __str__(self) -> str:
-        parts = [p for p in (self.source, self.path, self.problem) if p]
+        source = self.source if len(self.source) <= 200 else self.source[:197] + "..."
+        parts = [p for p in (source, self.path, self.problem) if p]
         return ": ".join(parts)
 
 
