@@ -213,3 +213,29 @@ def test_one_and_two_workers_store_identical_metrics(tmp_path: Path) -> None:
     assert {r["controller"] for r in tables[0]} == {"straight-v1", "zhang2019-v1"}
     zhang = next(r for r in tables[0] if r["controller"] == "zhang2019-v1")
     assert zhang["episodes"] == 3 and zhang["success_rate"] == 1.0
+
+
+@pytest.mark.parametrize(
+    ("where", "field", "value"),
+    [
+        ("controller", "oracle", "yes"),
+        ("controller", "oracle", 1),
+        ("campaign", "record", "true"),
+        ("campaign", "beyond_assumptions", "no"),
+    ],
+)
+def test_a_switch_is_true_or_false_not_a_word_or_a_number(
+    where: str, field: str, value: object
+) -> None:
+    controller: dict[str, object] = {"name": "zhang2019-v1"}
+    data: dict[str, object] = {
+        "name": "switches",
+        "scenarios": [{"generator": "random-ch2", "seeds": [0, 1]}],
+        "controllers": [controller],
+    }
+    (controller if where == "controller" else data)[field] = value
+    with pytest.raises(CampaignError, match=f"{field}: expected true or false") as info:
+        campaign_from_dict(data, "switches.yaml")
+    assert "\n" not in str(info.value)
+    (controller if where == "controller" else data)[field] = True
+    assert campaign_from_dict(data, "switches.yaml").name == "switches"

@@ -51,6 +51,7 @@ from pydantic import (
     ConfigDict,
     Field,
     PrivateAttr,
+    StrictBool,
     ValidationError,
     ValidationInfo,
     model_validator,
@@ -253,7 +254,7 @@ class ControllerEntry(_Strict):
     name: str
     params: dict[str, Any] = Field(default_factory=dict)
     grid: dict[str, list[Any]] = Field(default_factory=dict)
-    oracle: bool = False
+    oracle: StrictBool = False
 
     @model_validator(mode="after")
     def _check(self) -> ControllerEntry:
@@ -306,8 +307,8 @@ class CampaignSpec(_Strict):
     description: str = ""
     scenarios: list[ScenarioEntry] = Field(min_length=1)
     controllers: list[ControllerEntry] = Field(min_length=1)
-    record: bool = False
-    beyond_assumptions: bool = False
+    record: StrictBool = False
+    beyond_assumptions: StrictBool = False
 
     @model_validator(mode="after")
     def _bounded(self) -> CampaignSpec:
