@@ -25,6 +25,15 @@ def one_line(text: str) -> str:
     return re.sub(r"\s+", " ", str(text)).strip()
 
 
+def clip(text: str, limit: int) -> str:
+    """``text``, cut to ``limit`` characters ending in ``...`` when longer.
+
+    >>> clip("abcdef", 5), clip("abc", 5)
+    ('ab...', 'abc')
+    """
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
 def show_value(value: Any, limit: int = 40) -> str:
     """Compact rendering of an offending input value (``0.0`` as ``0``, strings quoted)."""
     if isinstance(value, float) and value.is_integer():
@@ -35,8 +44,7 @@ def show_value(value: Any, limit: int = 40) -> str:
         text = "{" + ", ".join(str(k) for k in value) + "}"
     else:
         text = repr(value)
-    text = one_line(text)
-    return text if len(text) <= limit else text[: limit - 3] + "..."
+    return clip(one_line(text), limit)
 
 
 #: pydantic error types about the kind of value, and the noun we expect instead

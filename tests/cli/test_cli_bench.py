@@ -89,19 +89,25 @@ def test_bench_prints_the_per_controller_table(campaign: Path, tmp_path: Path) -
     assert rows[1]["detour_ratio"] >= 1.0 and rows[1]["decision_us_median"] > 0
 
 
-def test_bench_failures_lists_each_failed_episode(tmp_path: Path) -> None:
-    """--failures: one row per episode that did not succeed, with its seed and cause; also in
-    the JSON record, and from a finished campaign with --resume (nothing runs again)."""
-    path = tmp_path / "c.yaml"
-    path.write_text(CAMPAIGN.replace("cli-small", "fails").replace("[0, 2]", "[0, 4]"))
-    db = tmp_path / "r.sqlite"
+def run_with_failures(path: Path, db: Path) -> tuple[Any, dict[str, Any]]:
+    """Run campaign ``path`` with ``--failures`` (table, 160 columns), then read its JSON record
+    with ``--resume`` (nothing runs again)."""
     res = runner.invoke(
         app, ["bench", str(path), "--db", str(db), "--workers", "1", "--failures"],
         env={"COLUMNS": "160"},
     )  # fmt: skip
     assert res.exit_code == 0, res.output
     fresh = invoke("bench", str(path), "--db", str(db), "--resume", "--failures", "--json")
-    record = json.loads(fresh.stdout)
+    return res, json.loads(fresh.stdout)
+
+
+def test_bench_failures_lists_each_failed_episode(tmp_path: Path) -> None:
+    """--failures: one row per episode that did not succeed, with its seed and cause; also in
+    the JSON record, and from a finished campaign with --resume (nothing runs again)."""
+    path = tmp_path / "c.yaml"
+    path.write_text(CAMPAIGN.replace("cli-small", "fails").replace("[0, 2]", "[0, 4]"))
+    db = tmp_path / "r.sqlite"
+    res, record = run_with_failures(path, db)
     assert record["ran"] == 0
     failed = record["failures"]
     assert failed, "straight-v1 collides on random-ch2 seeds 0-3"
@@ -129,15 +135,9 @@ def test_a_failure_of_a_generator_with_parameters_reruns_from_its_line(tmp_path:
         "    params: {n_obstacles: 4, body: disc}\ncontrollers:\n  - name: straight-v1\n"
         "beyond_assumptions: true\n"
     )
-    db = tmp_path / "r.sqlite"
-    res = runner.invoke(
-        app, ["bench", str(path), "--db", str(db), "--workers", "1", "--failures"],
-        env={"COLUMNS": "160"},
-    )  # fmt: skip
-    assert res.exit_code == 0, res.output
+    res, record = run_with_failures(path, tmp_path / "r.sqlite")
     assert "--seed SEED --beyond-assumptions" in res.stdout, res.stdout
-    again_json = invoke("bench", str(path), "--db", str(db), "--resume", "--failures", "--json")
-    failed = json.loads(again_json.stdout)["failures"]
+    failed = record["failures"]
     assert failed, "straight-v1 meets a disc on some of random-ch2 seeds 0-3 with 4 bodies"
     f = failed[0]
     spec = simulate_spec(f["scenario"])

@@ -51,6 +51,7 @@ from uvnav.scenarios import (
 from uvnav.scenarios.loader import yaml_value
 from uvnav.sim import METRIC_NAMES
 from uvnav.sim.metrics import SOCIAL_METRIC_NAMES
+from uvnav.validation import clip
 
 # ---------------------------------------------------------------------------------- error handling
 # One path for every command (see uvnav.cli.errors): user errors are one ``error:`` line and exit
@@ -181,7 +182,7 @@ def parse_params(items: list[str] | None, option: str = "--param") -> dict[str, 
     for item in items or []:
         key, sep, raw = item.partition("=")
         key = key.strip()
-        shown = repr(item if len(item) <= 60 else item[:50] + "...")
+        shown = repr(clip(item, 60))
         if not sep or not _PARAM_KEY.match(key):
             raise CliError(
                 f"{option} {shown}: expected KEY=VALUE with an identifier KEY (e.g. alpha0=0.1)"

@@ -22,7 +22,6 @@ from __future__ import annotations
 import errno
 import inspect
 import os
-import re
 import sys
 import tempfile
 import traceback
@@ -32,6 +31,8 @@ from typing import Any
 
 import typer
 from typer.core import TyperGroup
+
+from uvnav.validation import clip, one_line
 
 EX_USAGE = 2
 """Exit status of a user error."""
@@ -56,11 +57,6 @@ class CliError(Exception):
         super().__init__(message)
         self.message = message
         self.code = code
-
-
-def one_line(text: str) -> str:
-    """``text`` with every run of white space (newlines included) as one space."""
-    return re.sub(r"\s+", " ", text).strip()
 
 
 def _click_classes(exc: BaseException) -> set[str]:
@@ -93,7 +89,7 @@ def user_error(exc: BaseException) -> tuple[str, int] | None:
     if type(exc).__name__ in ("StaleCampaignError", "NotAStoreError"):  # bench.store: not
         return str(exc), EX_USAGE  # imported here, for a fast start
     if isinstance(exc, OSError):
-        name = f": {_clip(str(exc.filename))}" if exc.filename else ""
+        name = f": {clip(str(exc.filename), 200)}" if exc.filename else ""
         if (
             isinstance(
                 exc, FileNotFoundError | IsADirectoryError | NotADirectoryError | PermissionError
@@ -119,12 +115,6 @@ def user_error(exc: BaseException) -> tuple[str, int] | None:
 _MACHINE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS})
 #: SQLite's messages for the same (``sqlite3.OperationalError``).
 _SQLITE_MACHINE = ("database or disk is full", "attempt to write a readonly database")
-
-
-def _clip(text: str, limit: int = 200) -> str:
-    """``text``, cut to ``limit`` characters with ``...`` (a 5,000-character name stays one
-    readable line)."""
-    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def debug_enabled(ctx: Any = None) -> bool:

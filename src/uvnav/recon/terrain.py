@@ -30,7 +30,6 @@ Units: lengths [m].
 from __future__ import annotations
 
 import math
-import re
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -39,6 +38,8 @@ from typing import Any
 import numpy as np
 import shapely
 from shapely.geometry import Polygon, box
+
+from uvnav.validation import one_line
 
 FloatArray = np.ndarray
 
@@ -427,7 +428,7 @@ def _load_geotiff(p: Path) -> Terrain:
             fill = float(band.min()) if band.count() else 0.0
             z = np.ma.filled(band, fill)
     except RasterioError as exc:
-        raise ValueError(f"not a readable GeoTIFF ({_one_line(str(exc))})") from None
+        raise ValueError(f"not a readable GeoTIFF ({one_line(str(exc))})") from None
     dx, dy = abs(t.a), abs(t.e)
     z = z[::-1] if t.e < 0 else z
     x0 = t.c + dx / 2
@@ -443,7 +444,3 @@ def load_jacksboro(crop: JacksboroCrop = JACKSBORO_DEFAULT) -> Terrain:
     with d:
         data = {k: d[k] for k in d.files}
     return jacksboro_terrain(data, crop)
-
-
-def _one_line(text: str) -> str:
-    return re.sub(r"\s+", " ", text).strip()

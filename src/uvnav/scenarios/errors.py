@@ -16,7 +16,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from uvnav.validation import describe_error, one_line
+from uvnav.validation import clip, describe_error, one_line
 
 
 class ScenarioError(ValueError):
@@ -36,8 +36,7 @@ class ScenarioError(ValueError):
         super().__init__(str(self))
 
     def __str__(self) -> str:
-        source = self.source if len(self.source) <= 200 else self.source[:197] + "..."
-        parts = [p for p in (source, self.path, self.problem) if p]
+        parts = [p for p in (clip(self.source, 200), self.path, self.problem) if p]
         return ": ".join(parts)
 
 
