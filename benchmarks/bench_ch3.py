@@ -7,10 +7,10 @@ run).  Writes ``<out>/ch3.json`` with the machine, the parameters, the measureme
   non-convex mesh obstacles (star bodies, 320 triangles each) within sensing range, rates known
   (oracle) and AR-predicted (``prediction="ar"``: AR fits included when they fall due); target
   <= 300 µs (issue 4);
-* ``world_steps_per_s_10``: integration steps per second of :func:`run_episode3d` with 10 moving,
-  rotating mesh obstacles (AR motion), a straight-flying robot beside them (so the episode never
-  ends early), sensing every decision (0.1 s) and the exact clearance check every step (0.05 s);
-  target >= 2,000 steps/s (issue 4).  Reported for recorded and unrecorded episodes.
+* ``world_steps_per_s_10``: integration steps per second of :func:`uvnav.sim.run_episode` with 10
+  moving, rotating mesh obstacles (AR motion), a straight-flying robot beside them (so the episode
+  never ends early), sensing every decision (0.1 s) and the exact clearance check every step (0.05
+  s); target >= 2,000 steps/s (issue 4).  Reported for recorded and unrecorded episodes.
 
 Both are measured side by side, in alternating rounds, for the compiled kernels
 (:mod:`uvnav.geometry.kernels3d`, numba) and their pure-numpy fallback (``UVNAV_NO_NUMBA=1``),
@@ -46,7 +46,8 @@ from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
 from uvnav.obstacles.bodies3d import StarBody
 from uvnav.obstacles.motion3d import ARMotion3D, Obstacle3D, ObstacleState3D
 from uvnav.sensors.sensing3d import FiniteDifference3D, Observation3D, sense_obstacles3d
-from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, run_episode3d
+from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig
+from uvnav.sim.run import run_episode
 
 TARGETS = {"decision_us_median_10": 300.0, "world_steps_per_s_10": 2000.0}
 
@@ -121,7 +122,7 @@ def bench_world(seconds: float) -> dict[str, Any]:
             control_period=0.1, t_max=seconds, sensing=Sensing3DConfig(8.0, "estimated"),
         )  # fmt: skip
         tic, cpu = time.perf_counter(), time.process_time()
-        res, _ = run_episode3d(setup, _Straight(), np.random.default_rng(0), record=record)
+        res = run_episode(setup, _Straight(), np.random.default_rng(0), record=record)
         wall = time.perf_counter() - tic
         cpu = time.process_time() - cpu
         steps = round(seconds / 0.05)
@@ -249,7 +250,7 @@ def run(quick: bool, against: Path | None = None, rounds: int | None = None) -> 
     report: dict[str, Any] = {
         "benchmark": "ch3",
         "description": "thesis Ch. 3 (3D): zhang2020-3d-v1 decision time with 10 mesh obstacles "
-        "in range; run_episode3d steps/s with 10 moving mesh obstacles; compiled kernels vs "
+        "in range; 3D run_episode steps/s with 10 moving mesh obstacles; compiled kernels vs "
         "numpy fallback (and --against a baseline tree), alternating rounds",
         "machine": {
             "platform": platform.platform(),
@@ -285,7 +286,7 @@ def run(quick: bool, against: Path | None = None, rounds: int | None = None) -> 
             },
             "ch3_world_steps_per_s_10": {
                 "benchmark": "ch3",
-                "what": "run_episode3d steps per CPU second, 10 moving mesh obstacles",
+                "what": "3D run_episode steps per CPU second, 10 moving mesh obstacles",
                 "limit": TARGETS["world_steps_per_s_10"],
                 "direction": ">=",
                 "measured": sps_cpu,  # judged on CPU time

@@ -116,7 +116,7 @@ def main() -> None:
     setup = build_uuv3d(load_ch5_scenario("thesis-ch5-scene3"))
     with tempfile.TemporaryDirectory() as tmp:
         tic = time.process_time()
-        save_animation3d(res, setup.obstacles, setup.goal, Path(tmp) / "a.gif")
+        save_animation3d(res.trajectory, setup.obstacles, setup.goal, Path(tmp) / "a.gif")
         animation_s = time.process_time() - tic
     out = {
         "machine": {

@@ -58,7 +58,7 @@ from uvnav.core import BaseProbe
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.catalog import kinds
 from uvnav.scenarios.crowdnav import CROWDNAV_ORCA_PARAMS, TIME_STEP, crowdnav_scenario
-from uvnav.sim.episode import run_episode
+from uvnav.sim.run import run_episode
 
 #: Chen et al. ICRA 2019, Table I, ORCA (invisible robot)
 PAPER = {"success": 0.43, "collision": 0.57, "time_to_goal": 10.86}

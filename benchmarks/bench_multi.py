@@ -4,7 +4,7 @@ Run: ``.venv/bin/python benchmarks/bench_multi.py --out benchmarks/results`` (``
 it; ``--quick``: fewer steps, indicative only).  Writes ``<out>/multi.json``.
 
 Scene: the antipodal circle swap ``antipodal:N`` (:func:`uvnav.scenarios.multi.antipodal_scenario`)
-with every robot driven by the same law, run with :func:`uvnav.sim.multi.run_multi` for a fixed
+with every robot driven by the same law, run with :func:`uvnav.sim.run.run_episode` for a fixed
 number of integration steps (``t_max`` cut so the swap is still under way: every robot senses the
 others at every step, dt = control period = 0.1 s).  Times are this thread's CPU time (wall time
 reported beside it).  Each law's ``act`` is timed by a thin wrapper,
@@ -62,7 +62,7 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
     """One timed episode: ``{"n", "law", "steps", "seed"}`` -> wall time, the laws' share and
     the outcome (statuses, pairs, final poses checksum)."""
     from uvnav.scenarios.multi import antipodal_scenario, build_multi
-    from uvnav.sim.multi import run_multi
+    from uvnav.sim.run import run_episode
 
     n, law, steps, seed = int(job["n"]), str(job["law"]), int(job["steps"]), int(job["seed"])
     setup = build_multi(antipodal_scenario(n), seed, controller=law)
@@ -71,7 +71,7 @@ def run_job(job: dict[str, Any]) -> dict[str, Any]:
     for r, c in zip(setup.robots, timed, strict=True):
         r.controller = c  # type: ignore[assignment]
     tic, cpu0 = time.perf_counter(), time.thread_time()
-    res = run_multi(setup, np.random.default_rng(seed), record=True)
+    res = run_episode(setup, None, np.random.default_rng(seed), record=True)
     wall, cpu = time.perf_counter() - tic, time.thread_time() - cpu0
     done = len(res.times) - 1
     laws = sum(c.seconds for c in timed)
@@ -178,7 +178,7 @@ def main(argv: list[str] | None = None) -> int:
             w.close()
     out = {
         "benchmark": "multi",
-        "what": "run_multi steps per second on antipodal:N (all robots every step), best of "
+        "what": "run_episode steps per second on antipodal:N (all robots every step), best of "
         f"{repeats}; world = the simulator's own share (the laws' act calls subtracted)",
         "machine": machine(),
         "load_average_before": load_before,

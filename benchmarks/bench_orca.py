@@ -84,11 +84,11 @@ def uvnav_run(n: int, law: str, params: dict[str, Any], steps: int) -> dict[str,
 def uvnav_episode(n: int, law: str, params: dict[str, Any], seed: int) -> dict[str, Any]:
     """One whole episode of ``antipodal:n`` (to arrival, collision or t_max): the outcome."""
     from uvnav.scenarios.multi import antipodal_scenario, build_multi
-    from uvnav.sim.multi import run_multi
+    from uvnav.sim.run import run_episode
 
     setup = build_multi(antipodal_scenario(n), seed, controller=law, params=params)
     cpu0 = time.thread_time()
-    res = run_multi(setup, np.random.default_rng(seed), record=False)
+    res = run_episode(setup, None, np.random.default_rng(seed), record=False)
     cpu = time.thread_time() - cpu0
     g = res.group
     clear = [m.min_clearance for m in res.robots if m.min_clearance is not None]

@@ -25,7 +25,7 @@ calls (imports, JIT compilation) run before the clock starts and are discarded.
 * ``episodes``: episodes per second of the thesis Ch. 2 one-obstacle scene (I = [0, 0],
   T = [10, 10], V_max = 0.707 m/s, U_max = 1.414 rad/s, one random-turn polygon) per controller.
 * ``ch3``: thesis Ch. 3 (3D), from ``benchmarks/bench_ch3.py``: ``zhang2020-3d-v1`` decision time
-  with 10 mesh obstacles in range (target <= 300 µs median) and ``run_episode3d`` steps per second
+  with 10 mesh obstacles in range (target <= 300 µs median) and ``run_episode`` 3D steps per second
   with 10 moving mesh obstacles (target >= 2,000), compiled kernels vs the numpy fallback.
 
 ``--quick`` runs a few hundred samples of each for a smoke test (numbers are then indicative only);
@@ -840,7 +840,7 @@ def print_tables(reports: dict[str, dict[str, Any]]) -> None:
 
 def bench_ch3(quick: bool) -> dict[str, Any]:
     """Thesis Ch. 3 (3D): ``benchmarks/bench_ch3.py`` (decision time of zhang2020-3d-v1 and
-    run_episode3d steps/s with 10 mesh obstacles; compiled kernels vs numpy fallback side by
+    3D run_episode steps/s with 10 mesh obstacles; compiled kernels vs numpy fallback side by
     side), with its targets (``ch3_decision_us_median_10``, ``ch3_world_steps_per_s_10``)."""
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     import bench_ch3 as ch3

@@ -233,6 +233,10 @@ class AgentLog:
         it stays in :attr:`decision_us`)."""
         return self.decision_us[1:] if len(self.decision_us) > 1 else list(self.decision_us)
 
+    def decision_array(self) -> np.ndarray:
+        """:attr:`decision_us` as an array (one zero when no decision was made)."""
+        return np.asarray(self.decision_us) if self.decision_us else np.zeros(1)
+
     def record(self, mode: str, cpu_ns: int, wall_ns: int) -> None:
         """Account for one decision."""
         if self._decided and mode != self.last_mode:

@@ -109,7 +109,7 @@ def test_simulate_runs_the_law_with_the_locator_its_parameters_name(
     from uvnav.controllers.zhang_uuv3d import ZhangUUV3D, make_locator
     from uvnav.scenarios.catalog import resolve
     from uvnav.scenarios.ch5 import build_uuv3d
-    from uvnav.sim.episode_uuv3d import run_uuv3d_episode
+    from uvnav.sim.run import run_episode
 
     model = str(tmp_path / "m") if locator == "network" else ""
     if model:
@@ -125,7 +125,7 @@ def test_simulate_runs_the_law_with_the_locator_its_parameters_name(
     out = json.loads(r.stdout)
     scene = resolve("thesis-ch5-scene1")
     law = ZhangUUV3D(None, make_locator(locator, model))
-    direct = run_uuv3d_episode(build_uuv3d(scene.scenario), law, scene.kind.episode_rng(0))
+    direct = run_episode(build_uuv3d(scene.scenario), law, scene.kind.episode_rng(0), record=False)
     assert out["locator"] == locator and law.oracle == (locator == "oracle")
     assert (out["status"], out["path_length"], out["min_clearance"]) == (
         direct.status,

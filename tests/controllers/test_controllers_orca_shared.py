@@ -20,7 +20,7 @@ from uvnav.obstacles import Obstacle
 from uvnav.scenarios import build_episode, random_ch2_scenario
 from uvnav.scenarios.multi import antipodal_scenario, build_multi
 from uvnav.sim import SensingConfig, run_episode, run_rng
-from uvnav.sim.multi import MultiUnicycleWorld, run_multi
+from uvnav.sim.multi import MultiUnicycleWorld
 from uvnav.sim.setup import MultiSetup, RobotSetup
 
 
@@ -31,7 +31,7 @@ def shared_setup(n: int, **params: Any) -> MultiSetup:
 
 @pytest.mark.parametrize("seed", [0, 1, 2, 3])
 def test_antipodal_10_swaps_without_collision_or_deadlock(seed: int) -> None:
-    res = run_multi(shared_setup(10), np.random.default_rng(seed), record=False)
+    res = run_episode(shared_setup(10), None, np.random.default_rng(seed), record=False)
     assert res.group.all_arrived
     assert res.group.robot_collisions == 0 and res.group.deadlocks == 0
 
@@ -59,8 +59,8 @@ def test_the_group_decides_once_per_decision_time() -> None:
 
 
 def test_same_episode_twice_gives_the_same_trajectories() -> None:
-    a = run_multi(shared_setup(6), np.random.default_rng(3))
-    b = run_multi(shared_setup(6), np.random.default_rng(3))
+    a = run_episode(shared_setup(6), None, np.random.default_rng(3))
+    b = run_episode(shared_setup(6), None, np.random.default_rng(3))
     assert a.poses.tobytes() == b.poses.tobytes()
     assert a.statuses == b.statuses
 
@@ -112,7 +112,7 @@ def test_reciprocal_option_swaps_without_collision() -> None:
     """responsibility 0.5 (ORCA's reciprocal rule; the kernel's agreement with RVO2's own step is
     tested in test_controllers_orca_kernels): the swap ends without collision on antipodal:10."""
     setup = shared_setup(10, responsibility=0.5, perturbation=0.01)
-    res = run_multi(setup, np.random.default_rng(0), record=False)
+    res = run_episode(setup, None, np.random.default_rng(0), record=False)
     assert res.group.robot_collisions == 0
 
 
@@ -129,12 +129,12 @@ def test_estimated_sensing_and_world_obstacles_are_refused() -> None:
 
     noisy = MultiSetup(robots(SensingConfig(velocities="estimated")), t_max=1.0)
     with pytest.raises(ControllerParamsError, match="exact"):
-        run_multi(noisy, np.random.default_rng(0))
+        run_episode(noisy, None, np.random.default_rng(0))
     walled = MultiSetup(
         robots(SensingConfig()), obstacles=[Obstacle.moving_disc((3.0, 3.0), 0.3, (0.0, 0.0))]
     )
     with pytest.raises(ControllerParamsError, match="robots only"):
-        run_multi(walled, np.random.default_rng(0))
+        run_episode(walled, None, np.random.default_rng(0))
 
 
 def test_parameters_are_checked_and_group_by_value() -> None:

@@ -10,13 +10,13 @@ import pytest
 from uvnav.controllers.base import make_law
 from uvnav.controllers.uuv2d_baselines import reading_from_points
 from uvnav.scenarios.uuv2d import load_uuv2d_scenario
-from uvnav.sim.episode_uuv2d import run_uuv2d_episode
+from uvnav.sim.run import run_episode
 
 
 @pytest.mark.parametrize("name", ["apf-uuv2d-v1", "zhang2019-uuv2d-v1"])
 def test_baseline_runs_within_the_limits_and_avoids_the_fig_4_7_obstacle(name: str) -> None:
     sc = load_uuv2d_scenario("thesis-ch4-fig4-7-approach")
-    res = run_uuv2d_episode(
+    res = run_episode(
         sc.to_setup(), make_law(name, vehicle="uuv2d"), np.random.default_rng(0), record=False
     )
     assert res.metrics.limit_violations == 0

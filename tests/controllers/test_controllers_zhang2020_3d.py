@@ -111,10 +111,10 @@ def test_a_group_is_passed_on_one_side(seed: int, motion: str) -> None:
     the two got opposite passing sides and the robot was squeezed into the closing gap (these
     seeds collided).  Passed on one side, the robot reaches E and keeps off both."""
     from uvnav.scenarios import load_scenario
-    from uvnav.sim.episode3d import run_episode3d
+    from uvnav.sim.run import run_episode
 
     setup = load_scenario(f"random-ch3:{seed}").build(seed, velocities=motion)
     law = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=motion == "known")
-    res, _ = run_episode3d(setup, law, np.random.default_rng(seed))
+    res = run_episode(setup, law, np.random.default_rng(seed))
     assert res.status == "success"
     assert res.metrics.min_clearance > 0.05

@@ -18,7 +18,7 @@ from uvnav.prediction.amaps import AmapsConfig, AmapsGrid
 from uvnav.prediction.amaps_kernels import load_kernel
 from uvnav.scenarios.uuv2d import load_uuv2d_scenario
 from uvnav.sensors.sonar2d import SonarConfig, SonarObservation, sonar_scan
-from uvnav.sim.episode_uuv2d import run_uuv2d_episode
+from uvnav.sim.run import run_episode
 
 SPEC = HolonomicSpec(v_max=1.0, u_max=2.0, radius=0.2)
 GOAL = np.array([10.0, 10.0])
@@ -121,7 +121,7 @@ def test_fig_4_7_target_approaching_for_t_0_to_4() -> None:
     sc = load_uuv2d_scenario("thesis-ch4-fig4-7-approach")
     setup = sc.to_setup()
     setup.t_max = 4.2
-    res = run_uuv2d_episode(
+    res = run_episode(
         setup, make_law(sc.controller.name, vehicle="uuv2d"), np.random.default_rng(0)
     )
     tr = res.trajectory
@@ -192,7 +192,7 @@ def test_the_passing_side_is_kept_when_r_min_moves_to_another_body(seed: int) ->
     from uvnav.scenarios.uuv2d import random_ch4_hard_scenario
 
     sc = random_ch4_hard_scenario(seed)
-    res = run_uuv2d_episode(
+    res = run_episode(
         sc.to_setup(), make_law("zhang2022-uuv2d-v1", vehicle="uuv2d"), np.random.default_rng(seed)
     )
     assert res.status == "success"

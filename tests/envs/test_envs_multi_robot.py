@@ -12,7 +12,7 @@ from uvnav.envs import as_policy
 from uvnav.envs.multi_robot import MultiNav2DParallelEnv
 from uvnav.scenarios.multi import MultiScenario, build_multi, load_multi_scenario
 from uvnav.sim import run_rng
-from uvnav.sim.multi import run_multi
+from uvnav.sim.run import run_episode
 
 
 def test_parallel_api_test_passes() -> None:
@@ -57,7 +57,7 @@ def test_env_episode_is_run_multis_bit_for_bit(
     spec: str, law: str, params: dict, period: float | None
 ) -> None:
     """Each agent driven by its law's own commands (raw actions) with the world's law generator:
-    every robot's pose at every decision, the statuses and the metrics equal ``run_multi``'s."""
+    every robot's pose at every decision, the statuses and the metrics equal ``run_episode``'s."""
     sc = load_multi_scenario(spec)
     if period is not None:
         sc = MultiScenario.model_validate({**sc.model_dump(), "control_period": period})
@@ -76,7 +76,9 @@ def test_env_episode_is_run_multis_bit_for_bit(
             actions[a] = np.array([cmd.v, cmd.u])
         _, _, _, _, infos = env.step(actions)
         poses.append(env.world.state.copy())
-    res = run_multi(build_multi(sc, 1, controller=law, params=params), run_rng(1), record=True)
+    res = run_episode(
+        build_multi(sc, 1, controller=law, params=params), None, run_rng(1), record=True
+    )
     ratio = env.world.ratio
     expected = [*res.poses[: len(res.poses) - 1 : ratio], res.poses[-1]]
     np.testing.assert_array_equal(np.array(poses), np.array(expected))

@@ -15,7 +15,7 @@ from uvnav.dynamics.holonomic import HolonomicSpec
 from uvnav.envs import as_policy
 from uvnav.envs.uuv2d import Uuv2DEnv, action_of, command_of
 from uvnav.scenarios.uuv2d import load_uuv2d_scenario
-from uvnav.sim.episode_uuv2d import run_uuv2d_episode
+from uvnav.sim.run import run_episode
 
 SCENE = "thesis-ch4-fig4-9-whole-run"
 
@@ -95,7 +95,7 @@ def test_zhang2022_as_policy_reaches_the_goal_like_in_the_simulator(scene: str) 
     info = _drive(Uuv2DEnv(scene), as_policy("zhang2022-uuv2d-v1"))
     assert info["status"] == "success" and info["distance"] <= 0.2
     assert info["clearance"] > 0 and not info["entered_forbidden"]
-    sim = run_uuv2d_episode(
+    sim = run_episode(
         load_uuv2d_scenario(scene).to_setup(),
         make_law("zhang2022-uuv2d-v1", vehicle="uuv2d"),
         np.random.default_rng(0),

@@ -89,7 +89,7 @@ class _Standing:
 @pytest.mark.parametrize("visible", [False, True])
 def test_a_visible_robot_repels_an_invisible_one_does_not(visible: bool) -> None:
     from uvnav.scenarios.catalog import kinds
-    from uvnav.sim.episode import run_episode
+    from uvnav.sim.run import run_episode
 
     statuses = []
     for case in range(4):

@@ -137,7 +137,7 @@ def test_robot_is_invisible() -> None:
     """The pedestrians walk the same whatever the robot does, and as without any robot."""
     from uvnav.controllers.base import make_law
     from uvnav.scenarios.catalog import kinds
-    from uvnav.sim.episode import run_episode
+    from uvnav.sim.run import run_episode
 
     scn = GENERATORS["crowdnav-circle"](3)
     logs = []
@@ -227,7 +227,7 @@ def _closest_pedestrian(case: int, visible: bool) -> tuple[float, np.ndarray, st
     pedestrian's way (a quarter of its straight path), and the pedestrians' positions, for
     CrowdNav circle case ``case``."""
     from uvnav.scenarios.catalog import kinds
-    from uvnav.sim.episode import run_episode
+    from uvnav.sim.run import run_episode
 
     scn = crowdnav_scenario(case, robot_visible=visible)
     setup = build_episode(scn, case)

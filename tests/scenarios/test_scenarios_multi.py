@@ -12,7 +12,7 @@ from uvnav.scenarios.multi import (
     load_multi_scenario,
     multi_from_dict,
 )
-from uvnav.sim.multi import run_multi
+from uvnav.sim.run import run_episode
 from uvnav.sim.seeding import run_rng
 
 
@@ -56,8 +56,8 @@ def test_controller_override_and_per_robot_law() -> None:
 def test_antipodal_4_with_tuned_zhang2019_all_arrive() -> None:
     sc = load_multi_scenario("antipodal:4")
     tuned = {"switch_distance": 2.5, "forecast_horizon": 2.0, "safety_margin": 0.3}
-    res = run_multi(
-        build_multi(sc, 0, controller="zhang2019-v1", params=tuned), run_rng(0), record=False
+    res = run_episode(
+        build_multi(sc, 0, controller="zhang2019-v1", params=tuned), None, run_rng(0), record=False
     )
     assert res.group.all_arrived and res.group.robot_collisions == 0
     assert min(m.min_clearance for m in res.robots) > 0.0

@@ -15,7 +15,7 @@ import uvnav.sensors.plugins as sensors
 from uvnav.obstacles.motion import ObstacleState
 from uvnav.scenarios import ScenarioError, build_episode, scenario_from_dict
 from uvnav.sim import run_rng
-from uvnav.sim.episode import run_episode
+from uvnav.sim.run import run_episode
 
 
 class FakeEntryPoint:

@@ -16,7 +16,7 @@ from uvnav.scenarios.uuv2d import (
     random_ch4_scenario,
     uuv2d_from_dict,
 )
-from uvnav.sim.episode_uuv2d import run_uuv2d_episode
+from uvnav.sim.run import run_episode
 
 THESIS = [
     "thesis-ch4-fig4-2b-trap",
@@ -35,7 +35,7 @@ def test_builtins_are_listed() -> None:
 )
 def test_thesis_scene_is_collision_free_and_reaches_e(name: str) -> None:
     sc = load_uuv2d_scenario(name)
-    res = run_uuv2d_episode(
+    res = run_episode(
         sc.to_setup(),
         make_law(sc.controller.name, vehicle="uuv2d"),
         np.random.default_rng(0),
@@ -45,7 +45,7 @@ def test_thesis_scene_is_collision_free_and_reaches_e(name: str) -> None:
     assert not res.metrics.collision and res.metrics.min_clearance is not None
     assert res.metrics.min_clearance > 0.05
     assert res.metrics.limit_violations == 0
-    assert not res.entered_forbidden
+    assert not res.flags["entered_forbidden"]
 
 
 def test_trap_scene_is_a_real_trap_and_is_never_entered() -> None:
@@ -55,14 +55,14 @@ def test_trap_scene_is_a_real_trap_and_is_never_entered() -> None:
     # the straight run from I to E crosses the inner space through the mouth
     inner = setup.forbidden[0]
     assert np.hypot(*(inner.mean(axis=0) - np.array([5.0, 5.0]))) < 1e-9
-    res = run_uuv2d_episode(
+    res = run_episode(
         setup, make_law("zhang2022-uuv2d-v1", vehicle="uuv2d"), np.random.default_rng(1)
     )
     assert res.trajectory is not None
     poses = res.trajectory.poses[:, :2]
     # never inside the inner disc (radius 1.1 about (5, 5)), not even its mouth
     assert np.hypot(poses[:, 0] - 5.0, poses[:, 1] - 5.0).min() > 1.1 + 0.2
-    assert not res.entered_forbidden and res.status == "success"
+    assert not res.flags["entered_forbidden"] and res.status == "success"
 
 
 def test_generator_is_seeded_and_keeps_the_assumptions() -> None:

@@ -56,16 +56,17 @@ def ch2(scene: str, law: str, seed: int, record: bool) -> dict[str, Any]:
 def ch3(scene: str, law: str, seed: int, known: bool) -> dict[str, Any]:
     from uvnav.controllers.base import make_law
     from uvnav.scenarios import load_scenario
-    from uvnav.sim.episode3d import run_episode3d
+    from uvnav.sim.run import run_episode
 
     sc: Any = load_scenario(scene)
     setup = sc.build(seed, velocities="known" if known else "estimated")
-    res, traj = run_episode3d(
+    res = run_episode(
         setup,
         make_law(law, vehicle="vehicle3d", oracle=known),
         np.random.default_rng(seed),
         record=True,
     )
+    traj = res.trajectory
     assert traj is not None
     return {
         "status": res.status,
@@ -85,7 +86,7 @@ def ch4(scene: str, law: str, seed: int, noise: float) -> dict[str, Any]:
     return {
         "status": res.status,
         "metrics": _metrics(res.metrics),
-        "forbidden": res.entered_forbidden,
+        "forbidden": res.flags["entered_forbidden"],
         "poses": _summary(tr.poses),
         "commands": _summary(tr.commands),
         "modes": "".join(m[-1:] for m in tr.modes),
@@ -99,21 +100,25 @@ def ch5(scene: str, locator: str, seed: int, noise: float) -> dict[str, Any]:
     return {
         "status": res.status,
         "metrics": _metrics(res.metrics),
-        "inner": res.entered_inner_space,
-        "positions": _summary(res.positions),
-        "located": _summary(res.located),
-        "modes": "".join(m[-1:] for m in res.modes),
+        "inner": res.flags["entered_inner_space"],
+        "positions": _summary(res.trajectory.positions),
+        "located": _summary(res.trajectory.located),
+        "modes": "".join(m[-1:] for m in res.trajectory.modes),
     }
 
 
 def multi(spec: str, law: str, seed: int, vectorised: bool) -> dict[str, Any]:
     from uvnav.scenarios.multi import build_multi, load_multi_scenario
     from uvnav.sim import run_rng
-    from uvnav.sim.multi import run_multi
+    from uvnav.sim.run import run_episode
 
     sc = load_multi_scenario(spec)
-    res = run_multi(
-        build_multi(sc, seed, controller=law), run_rng(seed), record=True, vectorised=vectorised
+    res = run_episode(
+        build_multi(sc, seed, controller=law),
+        None,
+        run_rng(seed),
+        record=True,
+        vectorised=vectorised,
     )
     return {
         "statuses": list(res.statuses),

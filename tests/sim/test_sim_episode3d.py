@@ -11,8 +11,9 @@ from uvnav.geometry.mesh3d import box_mesh
 from uvnav.obstacles.bodies3d import MeshBody, SphereBody
 from uvnav.obstacles.motion3d import ConstantMotion3D, Obstacle3D, ObstacleState3D
 from uvnav.scenarios import load_scenario
-from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, run_episode3d
+from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig
 from uvnav.sim.metrics import METRIC_NAMES
+from uvnav.sim.run import run_episode
 
 
 class _Straight:
@@ -38,7 +39,8 @@ def _setup(obstacles: list[Obstacle3D]) -> Episode3DSetup:
 
 
 def test_free_flight_reaches_the_goal_straight() -> None:
-    res, tr = run_episode3d(_setup([]), _Straight(), np.random.default_rng(0))
+    res = run_episode(_setup([]), _Straight(), np.random.default_rng(0))
+    tr = res.trajectory
     m = res.metrics
     assert res.status == "success" and set(m.to_dict()) == set(METRIC_NAMES)
     assert m.detour_ratio == pytest.approx(1.0, abs=1e-6)
@@ -50,7 +52,7 @@ def test_free_flight_reaches_the_goal_straight() -> None:
 def test_collision_with_a_mesh_is_detected_at_the_first_overlapping_step(record: bool) -> None:
     box = MeshBody.from_mesh(*box_mesh([0.5, 0.5, 0.5]))
     ob = Obstacle3D(box, ConstantMotion3D(np.zeros(3)), ObstacleState3D(np.array([5.0, 0.2, 0])))
-    res, _ = run_episode3d(_setup([ob]), _Straight(), np.random.default_rng(0), record=record)
+    res = run_episode(_setup([ob]), _Straight(), np.random.default_rng(0), record=record)
     assert res.status == "collision"
     # the robot's sphere (r = 0.1) first overlaps the face x = 4.5 when its centre passes 4.4
     assert -0.05 <= res.metrics.min_clearance < 0
@@ -62,7 +64,7 @@ def test_unrecorded_and_recorded_runs_give_identical_metrics() -> None:
         ob = Obstacle3D(SphereBody(1.0), ConstantMotion3D(np.array([0.0, 0.2, 0.0])),
                         ObstacleState3D(np.array([5.0, -1.5, 0.3])))  # fmt: skip
         c = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=True)
-        res, _ = run_episode3d(_setup([ob]), c, np.random.default_rng(1), record=record)
+        res = run_episode(_setup([ob]), c, np.random.default_rng(1), record=record)
         d = res.metrics.to_dict()
         d.pop("decision_us_median"), d.pop("decision_us_p99")
         return d
@@ -84,7 +86,7 @@ def test_zhang2020_3d_reaches_e_without_collision_on_the_thesis_scenes(
     sc = load_scenario(scene)
     setup = sc.build(0, velocities=velocities)
     c = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=velocities == "known")
-    res, _ = run_episode3d(setup, c, np.random.default_rng(0), record=False)
+    res = run_episode(setup, c, np.random.default_rng(0), record=False)
     assert res.status == "success"
     assert res.metrics.min_clearance > 0.1
     assert res.metrics.limit_violations == 0
@@ -109,7 +111,7 @@ def test_compiled_kernels_and_numpy_fallback_give_the_same_episode(
         setup = sc.build(3, velocities="known")
         setup.t_max = 15.0
         c = make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=True)
-        res, _ = run_episode3d(setup, c, np.random.default_rng(3), record=False)
+        res = run_episode(setup, c, np.random.default_rng(3), record=False)
         out.append(res)
     a, b = out
     assert a.status == b.status

@@ -12,8 +12,8 @@ from uvnav.controllers.base import make_law
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec
 from uvnav.scenarios.uuv2d import load_uuv2d_scenario, random_ch4_scenario
 from uvnav.sensors.sonar2d import SonarObservation
-from uvnav.sim.episode_uuv2d import run_uuv2d_episode
 from uvnav.sim.metrics import METRIC_NAMES
+from uvnav.sim.run import run_episode
 
 
 class Straight:
@@ -38,7 +38,7 @@ class TooFast(Straight):
 
 def test_straight_run_collides_exactly_when_the_disc_touches_the_body() -> None:
     sc = load_uuv2d_scenario("thesis-ch4-fig4-9-whole-run")
-    res = run_uuv2d_episode(sc.to_setup(), Straight(), np.random.default_rng(0))
+    res = run_episode(sc.to_setup(), Straight(), np.random.default_rng(0))
     assert res.status == "collision" and res.metrics.collision
     tr = res.trajectory
     assert tr is not None
@@ -55,10 +55,10 @@ def test_straight_run_collides_exactly_when_the_disc_touches_the_body() -> None:
 
 def test_same_seed_same_run_with_a_noisy_sonar() -> None:
     sc = random_ch4_scenario(5, noise_std=0.05, dropout=0.1)
-    a = run_uuv2d_episode(
+    a = run_episode(
         sc.to_setup(), make_law("zhang2022-uuv2d-v1", vehicle="uuv2d"), np.random.default_rng(9)
     )
-    b = run_uuv2d_episode(
+    b = run_episode(
         sc.to_setup(), make_law("zhang2022-uuv2d-v1", vehicle="uuv2d"), np.random.default_rng(9)
     )
     assert a.trajectory is not None and b.trajectory is not None
@@ -70,7 +70,7 @@ def test_commands_outside_the_limits_are_counted_and_saturated() -> None:
     sc = load_uuv2d_scenario("thesis-ch4-fig4-7-approach")
     setup = sc.to_setup()
     setup.t_max = 1.0
-    res = run_uuv2d_episode(setup, TooFast(), np.random.default_rng(0))
+    res = run_episode(setup, TooFast(), np.random.default_rng(0))
     assert res.metrics.limit_violations == 5  # every decision (T = 0.2 s)
     tr = res.trajectory
     assert tr is not None

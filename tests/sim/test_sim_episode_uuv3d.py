@@ -11,36 +11,43 @@ import pytest
 from uvnav.controllers.zhang_uuv3d import GeometricLocator, OracleLocator, ZhangUUV3D
 from uvnav.core import SENSINGS, VEHICLES
 from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
-from uvnav.sim.episode_uuv3d import UUV3DWorld, run_uuv3d_episode
+from uvnav.sim.episode_uuv3d import UUV3DWorld
 from uvnav.sim.metrics import METRIC_NAMES
+from uvnav.sim.run import run_episode
 
 
 @pytest.mark.parametrize("scene", ["thesis-ch5-scene1", "thesis-ch5-scene2"])
 def test_thesis_scene_reached_without_collision(scene: str) -> None:
     setup = build_uuv3d(load_ch5_scenario(scene))
-    res = run_uuv3d_episode(
+    res = run_episode(
         setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(0), record=True
     )
     m = res.metrics
     assert res.status == "success", res.status
     assert m.success and not m.collision
     assert m.min_clearance is not None and m.min_clearance > 0.2
-    assert not res.entered_inner_space
+    assert not res.flags["entered_inner_space"]
     assert m.limit_violations == 0
     assert m.mode_switches >= 2  # it did avoid (M1 -> M2 -> M1)
     assert 1.0 <= m.detour_ratio < 1.3
     assert set(m.to_dict()) == set(METRIC_NAMES)
-    assert "M2" in res.modes
+    assert "M2" in res.trajectory.modes
 
 
 @pytest.mark.slow
 def test_scene3_with_the_oracle_and_noise_is_deterministic() -> None:
     setup = build_uuv3d(load_ch5_scenario("thesis-ch5-scene3"), noise_std=0.05)
-    a = run_uuv3d_episode(setup, ZhangUUV3D(None, OracleLocator()), np.random.default_rng(4))
+    a = run_episode(
+        setup, ZhangUUV3D(None, OracleLocator()), np.random.default_rng(4), record=False
+    )
     assert a.metrics.success
     setup = build_uuv3d(load_ch5_scenario("thesis-ch5-scene3"), noise_std=0.05)
-    b = run_uuv3d_episode(setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(4))
-    c = run_uuv3d_episode(setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(4))
+    b = run_episode(
+        setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(4), record=False
+    )
+    c = run_episode(
+        setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(4), record=False
+    )
     assert b.metrics.success
     assert b.metrics.path_length == c.metrics.path_length
 
@@ -62,10 +69,17 @@ def test_world_contract_shared_generator_and_oracle_truth() -> None:
 
 def test_step_count_and_trace_ends_at_t_max() -> None:
     setup = dataclasses.replace(build_uuv3d(load_ch5_scenario("thesis-ch5-scene1")), t_max=0.5)
-    res = run_uuv3d_episode(
+    res = run_episode(
         setup, ZhangUUV3D(None, GeometricLocator()), np.random.default_rng(0), record=True
     )
     assert res.status == "timeout"
-    assert res.times == pytest.approx([0.0, 0.2, 0.4, 0.5])  # decisions, then the final state
-    assert len(res.located) == len(res.true_nearest) == len(res.modes) == 4
-    assert np.isnan(res.located[-1]).all()
+    assert res.trajectory.times == pytest.approx(
+        [0.0, 0.2, 0.4, 0.5]
+    )  # decisions, then the final state
+    assert (
+        len(res.trajectory.located)
+        == len(res.trajectory.true_nearest)
+        == len(res.trajectory.modes)
+        == 4
+    )
+    assert np.isnan(res.trajectory.located[-1]).all()

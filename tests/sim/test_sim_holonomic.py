@@ -15,7 +15,7 @@ from uvnav.scenarios import build_episode, load_scenario
 from uvnav.scenarios.catalog import resolve
 from uvnav.scenarios.episodes import run_scene
 from uvnav.sim import run_rng
-from uvnav.sim.episode import run_episode
+from uvnav.sim.run import run_episode
 
 
 class TooFast:

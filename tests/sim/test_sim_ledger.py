@@ -22,6 +22,7 @@ from uvnav.core import AgentLog, BaseProbe
 from uvnav.scenarios.catalog import resolve
 from uvnav.scenarios.episodes import default_law
 from uvnav.sim.ledger import Clock, Ledger, decision_ratio, step_count
+from uvnav.sim.run import run_episode
 
 # ------------------------------------------------------------------------- the rules themselves
 
@@ -92,58 +93,40 @@ Run = Callable[[Any], tuple[str, Any, float]]
 
 
 def _setup_and_runner(world: str, scene: str) -> tuple[Any, Run]:
-    """The scene's setup and a function running it with the scene's own law: ``(status,
-    metrics of agent 0, end time [s])``."""
-    end = _End()
+    """The scene's setup and a function running it through the one
+    :func:`~uvnav.sim.run.run_episode` with the scene's own law: ``(status, metrics of agent 0,
+    end time [s])``."""
+    from uvnav.scenarios.build import build_episode
+    from uvnav.scenarios.ch5 import build_uuv3d
+    from uvnav.scenarios.multi import build_multi
+
     r = resolve(scene)
     law, params = default_law(r)
-    rng = r.kind.episode_rng(0)
+    options: dict[str, Any] = {}
     if world in ("unicycle", "holonomic"):
-        from uvnav.scenarios.build import build_episode
-        from uvnav.sim.episode import run_episode
-
-        name = "orca-holonomic-v1" if world == "holonomic" else law
-        par = {} if world == "holonomic" else params
-
-        def run(s: Any) -> tuple[str, Any, float]:
-            law_ = make_law(name, **par)
-            res = run_episode(s, law_, rng, record=False, vehicle=world, probes=[end])
-            return res.status, res.metrics, end.t
-
-        return build_episode(r.scenario, 0), run
-    if world == "vehicle3d":
-        from uvnav.sim.episode3d import run_episode3d
-
-        def run(s: Any) -> tuple[str, Any, float]:
-            res, _ = run_episode3d(s, make_law(law, **params), rng, record=False, probes=[end])
-            return res.status, res.metrics, end.t
-
-        return r.scenario.build(0), run
-    if world == "uuv2d":
-        from uvnav.sim.episode_uuv2d import run_uuv2d_episode
-
-        def run(s: Any) -> tuple[str, Any, float]:
-            res = run_uuv2d_episode(s, make_law(law, **params), rng, record=False, probes=[end])
-            return res.status, res.metrics, end.t
-
-        return r.scenario.to_setup(), run
-    if world == "uuv3d":
-        from uvnav.scenarios.ch5 import build_uuv3d
-        from uvnav.sim.episode_uuv3d import run_uuv3d_episode
-
-        def run(s: Any) -> tuple[str, Any, float]:
-            res = run_uuv3d_episode(s, make_law(law, **params), rng, probes=[end])
-            return res.status, res.metrics, end.t
-
-        return build_uuv3d(r.scenario), run
-    from uvnav.scenarios.multi import build_multi
-    from uvnav.sim.multi import run_multi
+        setup: Any = build_episode(r.scenario, 0)
+        options["vehicle"] = world
+        if world == "holonomic":
+            law, params = "orca-holonomic-v1", {}
+    else:
+        setup = {
+            "vehicle3d": lambda: r.scenario.build(0),
+            "uuv2d": lambda: r.scenario.to_setup(),
+            "uuv3d": lambda: build_uuv3d(r.scenario),
+            "multi": lambda: build_multi(r.scenario, 0),
+        }[world]()
+    rng = r.kind.episode_rng(0)
 
     def run(s: Any) -> tuple[str, Any, float]:
-        res = run_multi(s, rng, record=True)
-        return res.statuses[0], res.robots[0], float(res.times[-1])
+        end = _End()
+        multi = world == "multi"
+        res = run_episode(s, None if multi else make_law(law, **params), rng, record=False,
+                          probes=[end], **options)  # fmt: skip
+        if multi:
+            return res.statuses[0], res.robots[0], end.t
+        return res.status, res.metrics, end.t
 
-    return build_multi(r.scenario, 0), run
+    return setup, run
 
 
 def _with_goal_at_start(world: str, setup: Any) -> Any:

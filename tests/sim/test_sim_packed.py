@@ -22,8 +22,9 @@ from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.sensors.exact import lidar_scan
-from uvnav.sim.episode import World2D, run_episode
+from uvnav.sim.episode import World2D
 from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, pack_check
+from uvnav.sim.run import run_episode
 from uvnav.sim.seeding import run_rng
 from uvnav.sim.setup import EpisodeResult, EpisodeSetup
 

@@ -14,7 +14,7 @@ from uvnav.geometry.kernels3d import compiled, numba_available
 from uvnav.obstacles import Obstacle
 from uvnav.scenarios.multi import antipodal_scenario, build_multi
 from uvnav.sim import SensingConfig
-from uvnav.sim.multi import MultiUnicycleWorld, run_multi
+from uvnav.sim.multi import MultiUnicycleWorld
 from uvnav.sim.packed_swarm import (
     BLOCK,
     R_CLEAR,
@@ -26,6 +26,7 @@ from uvnav.sim.packed_swarm import (
     PackedSwarm,
     swarm_check,
 )
+from uvnav.sim.run import run_episode
 from uvnav.sim.setup import MultiSetup, RobotSetup
 
 KERNELS = [False, pytest.param(True, marks=pytest.mark.skipif(
@@ -132,11 +133,11 @@ def test_what_cannot_be_packed_is_refused_with_its_reason() -> None:
 def test_run_multi_gives_the_loop_worlds_result_through_the_swarm(
     case: str, use_numba: bool
 ) -> None:
-    """run_multi runs these scenes as a packed swarm: its whole result (per-robot metrics, group
+    """run_episode runs these scenes as a packed swarm: its whole result (per-robot metrics, group
     metrics, recorded poses) is the loop world's, decision times apart."""
     with compiled(use_numba):
-        loop = run_multi(CASES[case](), np.random.default_rng(9), vectorised=False)
-        packed = run_multi(CASES[case](), np.random.default_rng(9))
+        loop = run_episode(CASES[case](), None, np.random.default_rng(9), vectorised=False)
+        packed = run_episode(CASES[case](), None, np.random.default_rng(9))
     timing = {"decision_us_median", "decision_us_p99"}
     for a, b in zip(loop.robots, packed.robots, strict=True):
         da, db = a.to_dict(), b.to_dict()

@@ -134,7 +134,8 @@ def _ch3() -> tuple[str, float | None]:
     from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
     from uvnav.obstacles.bodies3d import SphereBody
     from uvnav.obstacles.motion3d import ConstantMotion3D, Obstacle3D, ObstacleState3D
-    from uvnav.sim.episode3d import Episode3DSetup, run_episode3d
+    from uvnav.sim.episode3d import Episode3DSetup
+    from uvnav.sim.run import run_episode
 
     ball = Obstacle3D(SphereBody(0.05), ConstantMotion3D(np.zeros(3)),
                       ObstacleState3D(centre=np.zeros(3)))  # fmt: skip
@@ -144,14 +145,15 @@ def _ch3() -> tuple[str, float | None]:
         control_period=0.1, t_max=1.0,
     )  # fmt: skip
     law = _Straight(Vehicle3DCommand(3.0, np.zeros(3)))
-    res, _ = run_episode3d(setup, law, np.random.default_rng(0), record=False)  # type: ignore[arg-type]
+    res = run_episode(setup, law, np.random.default_rng(0), record=False)  # type: ignore[arg-type]
     return res.status, res.contact_time
 
 
 def _ch4(swept: bool = True) -> tuple[str, float | None]:
     from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec
     from uvnav.obstacles.deforming import RigidShape
-    from uvnav.sim.episode_uuv2d import Uuv2dSetup, run_uuv2d_episode
+    from uvnav.sim.episode_uuv2d import Uuv2dSetup
+    from uvnav.sim.run import run_episode
 
     wall = RigidShape(local=WALL, centre=np.zeros(2))
     setup = Uuv2dSetup(
@@ -159,7 +161,7 @@ def _ch4(swept: bool = True) -> tuple[str, float | None]:
         goal=np.array([3.0, 0.0]), shapes=[wall], dt=0.1, control_period=0.1, t_max=1.0,
     )  # fmt: skip
     law = _Straight(HolonomicCommand(2.0, 0.0))
-    res = run_uuv2d_episode(setup, law, np.random.default_rng(0), record=False, swept=swept)
+    res = run_episode(setup, law, np.random.default_rng(0), record=False, swept=swept)
     return res.status, res.contact_time
 
 
@@ -167,7 +169,8 @@ def _ch5() -> tuple[str, float | None]:
     from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec
     from uvnav.obstacles.deforming3d import CompoundBody, DeformingStar
     from uvnav.sensors.sonar_array import SonarArray
-    from uvnav.sim.episode_uuv3d import UUV3DSetup, run_uuv3d_episode
+    from uvnav.sim.episode_uuv3d import UUV3DSetup
+    from uvnav.sim.run import run_episode
 
     ball = CompoundBody(parts=(DeformingStar(centre=np.zeros(3), base_radius=0.05),))
     setup = UUV3DSetup(
@@ -177,7 +180,7 @@ def _ch5() -> tuple[str, float | None]:
         t_max=1.0,
     )  # fmt: skip
     law = _Straight(Vehicle3DCommand(3.0, np.zeros(3)))
-    res = run_uuv3d_episode(setup, law, np.random.default_rng(0))  # type: ignore[arg-type]
+    res = run_episode(setup, law, np.random.default_rng(0), record=False)  # type: ignore[arg-type]
     return res.status, res.contact_time
 
 
@@ -205,7 +208,7 @@ def test_the_ch4_world_judged_at_step_ends_passes_through() -> None:
 
 
 def test_two_robots_that_cross_between_two_samples_collide() -> None:
-    from uvnav.sim.multi import run_multi
+    from uvnav.sim.run import run_episode
     from uvnav.sim.setup import MultiSetup, RobotSetup
 
     def robot(start: tuple[float, float, float], goal: tuple[float, float]) -> RobotSetup:
@@ -217,6 +220,6 @@ def test_two_robots_that_cross_between_two_samples_collide() -> None:
         robots=[robot((-1.1, 0.0, 0.0), (3.0, 0.0)), robot((0.0, -1.1, math.pi / 2), (0.0, 3.0))],
         dt=0.1, control_period=0.1, t_max=2.0,
     )  # fmt: skip
-    res = run_multi(setup, np.random.default_rng(0), record=False, vectorised=True)
+    res = run_episode(setup, None, np.random.default_rng(0), record=False, vectorised=True)
     assert res.statuses == ["collision", "collision"] and res.collided_pairs == [(0, 1)]
     assert all(m.min_clearance is not None and m.min_clearance < 0 for m in res.robots)

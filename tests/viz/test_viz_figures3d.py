@@ -11,7 +11,8 @@ from uvnav.dynamics.vehicle3d import Vehicle3DSpec
 from uvnav.geometry.mesh3d import box_mesh
 from uvnav.obstacles.bodies3d import MeshBody
 from uvnav.obstacles.motion3d import ConstantMotion3D, Obstacle3D, ObstacleState3D
-from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, run_episode3d
+from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig
+from uvnav.sim.run import run_episode
 from uvnav.viz.figures3d import interactive_trajectory, render_ch3
 
 
@@ -23,8 +24,12 @@ def test_render_ch3_writes_every_figure(tmp_path: Path) -> None:
                            heading=np.array([1.0, 0, 0]), goal=np.array([6.0, 0, 0]),
                            obstacles=[ob], t_max=12.0,
                            sensing=Sensing3DConfig(velocities="known"))  # fmt: skip
-    res, tr = run_episode3d(setup, make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=True),
-                            np.random.default_rng(0))  # fmt: skip
+    res = run_episode(
+        setup,
+        make_law("zhang2020-3d-v1", vehicle="vehicle3d", oracle=True),
+        np.random.default_rng(0),
+    )
+    tr = res.trajectory  # fmt: skip
     assert res.status == "success" and tr is not None
     assert np.isfinite(tr.predicted_velocity).any()  # the law's predictions were recorded
     files = render_ch3(tmp_path / "db.sqlite", tmp_path, [("scene", "zhang2020-3d-v1", tr)])

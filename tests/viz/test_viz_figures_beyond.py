@@ -7,7 +7,7 @@ import pytest
 
 from uvnav.planners import DStarLite, astar, occupancy_grid, visibility_path
 from uvnav.scenarios.multi import build_multi, load_multi_scenario
-from uvnav.sim.multi import run_multi
+from uvnav.sim.run import run_episode
 from uvnav.viz.figures_beyond import plot_grid_paths, plot_swap, plot_trajectories
 
 
@@ -43,7 +43,7 @@ def test_grid_paths_figure(tmp_path) -> None:
 
 def test_swap_and_trajectory_figures(tmp_path) -> None:
     sc = load_multi_scenario("antipodal:4")
-    res = run_multi(build_multi(sc, 0, controller="straight-v1"), np.random.default_rng(0))
+    res = run_episode(build_multi(sc, 0, controller="straight-v1"), None, np.random.default_rng(0))
     goals = np.array([r.goal for r in sc.robots])
     fig = plot_swap(res, goals, path=tmp_path / "swap.png")
     assert "0/4 arrived" in fig.axes[0].get_title()
@@ -54,8 +54,8 @@ def test_swap_and_trajectory_figures(tmp_path) -> None:
         path=tmp_path / "t.png",
     )
     assert (tmp_path / "t.png").exists()
-    unrecorded = run_multi(
-        build_multi(sc, 0, controller="straight-v1"), np.random.default_rng(0), record=False
+    unrecorded = run_episode(
+        build_multi(sc, 0, controller="straight-v1"), None, np.random.default_rng(0), record=False
     )
     with pytest.raises(ValueError, match="not recorded"):
         plot_swap(unrecorded, goals)

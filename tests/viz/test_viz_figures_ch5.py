@@ -11,8 +11,7 @@ pytest.importorskip("torch")
 
 from uvnav.obstacles.deforming3d import as_compound, random_star
 from uvnav.sensors.sonar_array import SonarArray
-from uvnav.sim.episode_uuv3d import UUV3DResult
-from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.episode_uuv3d import LocatedTrace
 from uvnav.viz.figures_ch5 import (
     animation_frames,
     fig_array,
@@ -37,11 +36,7 @@ def test_error_figure_reports_the_error_range() -> None:
 
 
 def test_trajectory_figure() -> None:
-    m = EpisodeMetrics(True, False, 0.5, 10.0, 1.1, 10.0, 1.0, 0.0, 0, 2, 1.0, 2.0)
-    res = UUV3DResult(
-        metrics=m,
-        entered_inner_space=False,
-        status="success",
+    res = LocatedTrace(
         times=[0.0, 1.0],
         positions=[np.zeros(3), np.ones(3)],
         modes=["M1", "M2"],
@@ -63,12 +58,11 @@ def test_animation_frames_are_spread_and_keep_both_ends() -> None:
 
 def test_animation_is_a_gif_with_one_frame_per_chosen_decision(tmp_path: Path) -> None:
     Image = pytest.importorskip("PIL.Image")
-    m = EpisodeMetrics(True, False, 0.5, 10.0, 1.1, 10.0, 1.0, 0.0, 0, 2, 1.0, 2.0)
     n = 12
     times = [0.5 * k for k in range(n)]
     pos = [np.array([0.5 * k, 0.0, 0.0]) for k in range(n)]
     located = [np.full(3, np.nan)] * 4 + [np.array([4.0, 0.5, 0.0])] * (n - 4)
-    res = UUV3DResult(m, False, "success", times, pos, ["M1"] * 4 + ["M2"] * (n - 4), located, [])
+    res = LocatedTrace(times, pos, ["M1"] * 4 + ["M2"] * (n - 4), located, [])
     ob = as_compound(
         random_star(
             np.random.default_rng(0),
@@ -87,5 +81,5 @@ def test_animation_is_a_gif_with_one_frame_per_chosen_decision(tmp_path: Path) -
             im.seek(k)
             frames.append(np.asarray(im.convert("RGB")))
     assert not np.array_equal(frames[0], frames[-1])  # the vehicle moved (and the body deformed)
-    short = UUV3DResult(m, False, "success", [0.0], [np.zeros(3)], ["M1"], located[:1], [])
+    short = LocatedTrace([0.0], [np.zeros(3)], ["M1"], located[:1], [])
     assert save_animation3d(short, [ob], np.ones(3), tmp_path / "b.gif") is None

@@ -146,13 +146,15 @@ def test_beyond_section_from_a_real_swap(tmp_path: Path) -> None:
     """Issue 9: rows and a swap figure from a real 4-robot antipodal swap."""
     from uvnav.bench.reproduce_beyond import ZHANG_MULTI, swap_rows
     from uvnav.scenarios.multi import build_multi, load_multi_scenario
-    from uvnav.sim.multi import run_multi
+    from uvnav.sim.run import run_episode
     from uvnav.sim.seeding import run_rng
     from uvnav.viz.figures_beyond import plot_swap
 
     rows = swap_rows("antipodal:4", [("zhang2019-v1", ZHANG_MULTI)])
     ms = load_multi_scenario("antipodal:4")
-    res = run_multi(build_multi(ms, 0, controller="zhang2019-v1", params=ZHANG_MULTI), run_rng(0))
+    res = run_episode(
+        build_multi(ms, 0, controller="zhang2019-v1", params=ZHANG_MULTI), None, run_rng(0)
+    )
     fig = tmp_path / "beyond" / "beyond-swap-zhang2019-v1.png"
     plot_swap(res, np.array([r.goal for r in ms.robots]), path=fig)
     s = sec.beyond_section(rows, [fig, tmp_path / "missing.png"], full=False)

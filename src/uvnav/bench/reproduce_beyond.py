@@ -21,8 +21,7 @@ from uvnav.controllers.base import make_controller
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.scenarios.multi import build_multi, load_multi_scenario
-from uvnav.sim.episode import run_episode
-from uvnav.sim.multi import run_multi
+from uvnav.sim.run import run_episode
 from uvnav.sim.seeding import run_rng
 
 BEYOND = "— (beyond the thesis)"
@@ -77,8 +76,8 @@ def swap_rows(
     n = len(sc.robots)
     rows = []
     for name, params in controllers:
-        res = run_multi(
-            build_multi(sc, 0, controller=name, params=params), run_rng(0), record=False
+        res = run_episode(
+            build_multi(sc, 0, controller=name, params=params), None, run_rng(0), record=False
         )
         g = res.group
         mk = f"{g.makespan:.1f} s" if g.makespan is not None else "n/a"

@@ -103,7 +103,7 @@ def run_one(job: tuple[str, str, int, str, bool]) -> dict[str, Any]:
     Returns a row with the metrics, status, wall time and (when recorded) the trajectory."""
     from uvnav.controllers.base import make_law
     from uvnav.scenarios import load_scenario
-    from uvnav.sim.episode3d import run_episode3d
+    from uvnav.sim.run import run_episode
 
     scene, ctrl, seed, motion, record = job
     sc: Any = load_scenario(scene)
@@ -112,7 +112,8 @@ def run_one(job: tuple[str, str, int, str, bool]) -> dict[str, Any]:
     extra = {"prediction": "last"} if motion == "constant" else {}
     c = make_law(ctrl, vehicle="vehicle3d", oracle=motion == "known", **extra)
     tic = time.perf_counter()
-    res, traj = run_episode3d(setup, c, np.random.default_rng(seed), record=record)
+    res = run_episode(setup, c, np.random.default_rng(seed), record=record)
+    traj = res.trajectory
     return {
         "scene": scene, "controller": ctrl, "seed": seed, "motion": motion,
         "status": res.status, "metrics": res.metrics, "wall": time.perf_counter() - tic,
@@ -229,7 +230,7 @@ def ar_usage(family: str, seeds: Sequence[int]) -> dict[str, float]:
     from uvnav.controllers.base import make_law
     from uvnav.core import BaseProbe
     from uvnav.scenarios import load_scenario
-    from uvnav.sim.episode3d import run_episode3d
+    from uvnav.sim.run import run_episode
 
     class _Use(BaseProbe):
         def __init__(self) -> None:
@@ -246,7 +247,7 @@ def ar_usage(family: str, seeds: Sequence[int]) -> dict[str, float]:
         sc: Any = load_scenario(f"{family}:{g}")
         setup = sc.build(g, velocities="estimated")
         law = make_law(PREDICTION_LAW, vehicle="vehicle3d")
-        run_episode3d(setup, law, np.random.default_rng(g), record=False, probes=(use,))
+        run_episode(setup, law, np.random.default_rng(g), record=False, probes=(use,))
     share = use.ar / use.total if use.total else float("nan")
     return {"decisions": float(use.total), "ar_share": share}
 

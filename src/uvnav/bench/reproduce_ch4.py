@@ -60,8 +60,10 @@ from uvnav.bench.store import ResultsStore
 from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.base import make_law
 from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin, load_uuv2d_scenario
-from uvnav.sim.episode_uuv2d import Uuv2dResult, Uuv2dTrajectory, run_uuv2d_episode
+from uvnav.sim.episode_uuv2d import Uuv2dTrajectory
 from uvnav.sim.metrics import METRIC_NAMES
+from uvnav.sim.run import run_episode
+from uvnav.sim.setup import EpisodeResult
 
 LAW = "zhang2022-uuv2d-v1"
 #: Fig. 4.7's scene and the end [s] of its "t = 0...4 in target approach"
@@ -91,7 +93,9 @@ def ch4_job(scene: str, law: str, seed: int, noise_std: float = 0.0, dropout: fl
     return Job(law, int(seed), label=scene, family=family, tags=tags, runner=_run_job)
 
 
-def run_ch4_job(job: Job, *, record: bool = False) -> tuple[dict[str, Any], Uuv2dResult]:
+def run_ch4_job(
+    job: Job, *, record: bool = False
+) -> tuple[dict[str, Any], EpisodeResult[Uuv2dTrajectory]]:
     """Run one job in this process; returns its row (as :func:`stored_rows` reads it back) and
     the full result.
 
@@ -112,8 +116,8 @@ def _run_job(job: Job) -> EpisodeRun:
         sc = load_uuv2d_scenario(scene)
     law = make_law(job.controller, vehicle="uuv2d")
     rng = np.random.default_rng(job.seed)
-    res = run_uuv2d_episode(sc.to_setup(), law, rng, record=job.record)
-    facts = {"n_obstacles": len(sc.obstacles), "entered_forbidden": bool(res.entered_forbidden)}
+    res = run_episode(sc.to_setup(), law, rng, record=job.record)
+    facts = {"n_obstacles": len(sc.obstacles), "entered_forbidden": res.flags["entered_forbidden"]}
     return res.status, res.metrics.to_dict(), res, facts
 
 
@@ -354,7 +358,7 @@ def reproduce_ch4(
         else (FULL_NOISE_SEEDS if full else QUICK_NOISE_SEEDS)
     )
     nh = hard_seeds if hard_seeds is not None else (FULL_HARD_SEEDS if full else QUICK_HARD_SEEDS)
-    scene_results: dict[tuple[str, str], Uuv2dResult] = {}
+    scene_results: dict[tuple[str, str], EpisodeResult[Uuv2dTrajectory]] = {}
     with ResultsStore(db_path) as store:
         cid = store.campaign(SCENES_CAMPAIGN, {"chapter": 4, "laws": list(LAWS), "seed": 0})
         stored = store.done_keys(cid)

@@ -110,8 +110,10 @@ from uvnav.scenarios.ch5 import (
     random_ch5_scenario,
 )
 from uvnav.sensors.sonar_dataset import SonarDataset, sample_sonar_dataset
-from uvnav.sim.episode_uuv3d import UUV3DResult, run_uuv3d_episode
+from uvnav.sim.episode_uuv3d import LocatedTrace
 from uvnav.sim.metrics import METRIC_NAMES
+from uvnav.sim.run import run_episode
+from uvnav.sim.setup import EpisodeResult
 from uvnav.stages import Stages, write_atomic
 
 QUICK_SIZES: tuple[int, ...] = (50, 150)
@@ -410,15 +412,17 @@ def _run_job(job: Job, *, model: str | TrainedBPNN | None = None) -> EpisodeRun:
     setup = build_uuv3d(scn, noise_std=tags["noise_std"])
     params = ZhangUUV3DParams(**scn.controller.params)  # type: ignore[arg-type]
     law = ZhangUUV3D(params, make_locator(tags["locator"], model=model))
-    res = run_uuv3d_episode(setup, law, np.random.default_rng(job.seed), record=job.record)
+    res = run_episode(setup, law, np.random.default_rng(job.seed), record=job.record)
     facts = {
         "n_obstacles": len(scn.obstacles),
-        "entered_inner_space": bool(res.entered_inner_space),
+        "entered_inner_space": res.flags["entered_inner_space"],
     }
     return res.status, res.metrics.to_dict(), res, facts
 
 
-def run_ch5_job(job: Job, *, record: bool = False) -> tuple[dict[str, Any], UUV3DResult]:
+def run_ch5_job(
+    job: Job, *, record: bool = False
+) -> tuple[dict[str, Any], EpisodeResult[LocatedTrace]]:
     """Run one job in this process; returns its row (as :func:`stored_rows` reads it back) and
     its result.
 
@@ -887,7 +891,7 @@ def reproduce_ch5(
             map(len, jobs.values())
         )
         task2 = prog.add_task("Ch5 closed loop", total=n_episodes)
-        kept: dict[tuple[str, str, float], UUV3DResult] = {}
+        kept: dict[tuple[str, str, float], EpisodeResult[LocatedTrace]] = {}
         base_cfg = {"chapter": 5, "law": LAW, "locators": list(LOCATORS), "model": model_id}
         with ResultsStore(db_path) as store:
             cid = store.campaign(SCENES_CAMPAIGN, {**base_cfg, "noises": list(noise_list)})

@@ -6,7 +6,7 @@ The envs step the worlds of the one step loop (:mod:`uvnav.core`): ``uvnav/Nav2D
 at a time — the agents' commands are applied at a decision time, then the world advances (every
 ``dt``, integration, obstacles and collision checks are the world's own) until the next decision
 or the end — so an env episode is, bit for bit, the simulator's episode
-(:func:`uvnav.sim.run_episode`, :func:`uvnav.sim.multi.run_multi`) driven by the same commands.
+(:func:`uvnav.sim.run_episode`, :func:`uvnav.sim.run.run_episode`) driven by the same commands.
 What is genuinely the env's is here: the observation vector, the action map, the reward and the
 frames.
 

@@ -4,7 +4,7 @@ The world is the simulator's own :class:`uvnav.sim.multi.MultiUnicycleWorld`, st
 decision at a time (:class:`uvnav.envs.core.EnvWorld`), built from a multi-robot scenario
 (:mod:`uvnav.scenarios.multi`: ``antipodal:N``, ``crossing:N``, ``thesis-ch2-multi:N`` or a YAML
 file); episode ``k`` (``reset(options={"episode_seed": k})``) is
-:func:`uvnav.sim.multi.run_multi`'s on ``build_multi(scenario, k)`` with ``run_rng(k)``, bit for
+:func:`uvnav.sim.run.run_episode`'s on ``build_multi(scenario, k)`` with ``run_rng(k)``, bit for
 bit when the agents' actions are their laws' commands (``raw_commands=True``).
 
 Agents ``robot_0 ... robot_{N-1}`` have the observation and action spaces of ``uvnav/Nav2D-v0``

@@ -3,7 +3,7 @@
 One flying robot (the vehicle (3.1)-(3.6) of :mod:`uvnav.dynamics.vehicle3d`) among a Chapter-3
 scene's moving, rotating 3D obstacles.  The env steps the simulator's own world
 (:class:`uvnav.sim.episode3d.Vehicle3DWorld`, the one
-:func:`~uvnav.sim.episode3d.run_episode3d` runs): one env step is one decision
+:func:`~uvnav.sim.run.run_episode` runs): one env step is one decision
 (``control_period``), integrated exactly with the scene's ``dt``, with the exact clearance
 checked at every integration step.
 

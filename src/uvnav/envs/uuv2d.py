@@ -5,7 +5,7 @@ velocity, each component bounded by V_max, its direction turning at most U_max p
 a Chapter-4 scene's shape-changing obstacles, sensed by the viewing-cone sonar of §4.2
 (:func:`uvnav.sensors.sonar2d.sonar_scan`).  The env steps the simulator's own world
 (:class:`uvnav.sim.episode_uuv2d.Uuv2dWorld`, the one
-:func:`~uvnav.sim.episode_uuv2d.run_uuv2d_episode` runs): one env step is one decision
+:func:`~uvnav.sim.run.run_episode` runs): one env step is one decision
 (``control_period``), integrated with the scene's ``dt``, with the exact clearance to the
 outlines of that instant checked at every integration step.
 

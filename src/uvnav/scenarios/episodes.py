@@ -200,7 +200,7 @@ def _single(
 
 def _nav2d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
     from uvnav.scenarios.build import build_episode
-    from uvnav.sim.episode import run_episode
+    from uvnav.sim.run import run_episode
 
     setup = build_episode(r.scenario, seed)
     vehicle = controller_info(name).vehicle  # the unicycle, or the holonomic robot
@@ -211,34 +211,35 @@ def _nav2d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bo
 
 
 def _nav3d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
-    from uvnav.sim.episode3d import run_episode3d
+    from uvnav.sim.run import run_episode
 
     setup = r.scenario.build(seed)
     law = make_law(name, **params)
-    res, traj = run_episode3d(setup, law, r.kind.episode_rng(seed), record=record)
+    res = run_episode(setup, law, r.kind.episode_rng(seed), record=record)
+    traj = res.trajectory
     return _single(r, name, params, seed, res, setup=setup, trajectory=traj)
 
 
 def _uuv2d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
-    from uvnav.sim.episode_uuv2d import run_uuv2d_episode
+    from uvnav.sim.run import run_episode
 
     setup = r.scenario.to_setup()
     law = make_law(name, **params)
-    res = run_uuv2d_episode(setup, law, r.kind.episode_rng(seed), record=record)
+    res = run_episode(setup, law, r.kind.episode_rng(seed), record=record)
     out = _single(r, name, params, seed, res, setup=setup, trajectory=res.trajectory)
-    out.extra["entered_forbidden"] = bool(res.entered_forbidden)
+    out.extra["entered_forbidden"] = res.flags["entered_forbidden"]
     return out
 
 
 def _uuv3d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
     from uvnav.scenarios.ch5 import build_uuv3d
-    from uvnav.sim.episode_uuv3d import run_uuv3d_episode
+    from uvnav.sim.run import run_episode
 
     law = make_law(name, **params)
     setup = build_uuv3d(r.scenario)
-    res = run_uuv3d_episode(setup, law, r.kind.episode_rng(seed), record=record)
-    out = _single(r, name, params, seed, res, setup=setup)
-    out.extra["entered_inner_space"] = bool(res.entered_inner_space)
+    res = run_episode(setup, law, r.kind.episode_rng(seed), record=record)
+    out = _single(r, name, params, seed, res, setup=setup, trajectory=res.trajectory)
+    out.extra["entered_inner_space"] = res.flags["entered_inner_space"]
     out.extra["locator"] = str(getattr(law.params, "locator", ""))
     return out
 
@@ -250,14 +251,14 @@ def _mean(values: list[Any]) -> float | None:
 
 def _multi(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
     from uvnav.scenarios.multi import build_multi
-    from uvnav.sim.multi import run_multi
+    from uvnav.sim.run import run_episode
 
     own, own_params = default_law(r)
     if name == own and params == own_params:  # each robot keeps its own law, if it has one
         setup = build_multi(r.scenario, seed)
     else:
         setup = build_multi(r.scenario, seed, controller=name, params=params)
-    res = run_multi(setup, r.kind.episode_rng(seed), record=record)
+    res = run_episode(setup, None, r.kind.episode_rng(seed), record=record)
     robots = [m.to_dict() for m in res.robots]
     g = res.group
     status = (

@@ -1,5 +1,5 @@
 """Multi-robot scenarios (issue 9): a pydantic schema beside the single-robot one, generators
-and the builder for :func:`uvnav.sim.multi.run_multi`.
+and the builder for :func:`uvnav.sim.run.run_episode`.
 
 A multi-robot scenario has a list of robots (each a single-robot ``robot`` block plus an optional
 ``controller`` and ``sensing`` of its own; omitted, the scenario's defaults apply) and the same

@@ -3,16 +3,16 @@ metrics of one robot among moving bodies, stepped by the one loop :func:`uvnav.c
 
 :class:`World2D` holds any planar vehicle (:class:`~uvnav.dynamics.vehicles.Vehicle2D`: the
 thesis's unicycle, the holonomic disc robot of the crowd benchmarks, or a plug-in; the law's
-vehicle picks it); :func:`run_episode` runs one episode.
+vehicle picks it); :func:`uvnav.sim.run.run_episode` runs one episode.
 
-Decision rate and integration rate are separate: the law is asked every ``control_period`` [s]
-(a whole multiple of ``dt``, else :func:`run_episode` raises ``ValueError``); robot and obstacles
-are integrated every ``dt`` [s] with the last command held.  Collisions are judged along the
-whole of every integration step (:class:`~uvnav.sim.swept.SweptClearance`: the robot's disc
-against the bodies' sweep, exact for bodies that do not rotate and at most 1 mm short for those
-that do), besides the exact clearance sampled at the end of each step (robot disc against disc
-or polygon sets, see :meth:`uvnav.obstacles.ObstacleField.query`; the kernel is property-tested
-against shapely); the minimum clearance is the minimum along the steps.
+Decision rate and integration rate are separate: the law is asked every ``control_period`` [s] (a
+whole multiple of ``dt``, else the world refuses the setup with ``ValueError``); robot and obstacles
+are integrated every ``dt`` [s] with the last command held.  Collisions are judged along the whole
+of every integration step (:class:`~uvnav.sim.swept.SweptClearance`: the robot's disc against the
+bodies' sweep, exact for bodies that do not rotate and at most 1 mm short for those that do),
+besides the exact clearance sampled at the end of each step (robot disc against disc or polygon
+sets, see :meth:`uvnav.obstacles.ObstacleField.query`; the kernel is property-tested against
+shapely); the minimum clearance is the minimum along the steps.
 
 The simulator clips nothing silently: a command outside the limits ((2.4), or the V_max disc) is
 saturated to what the vehicle can physically do *and* counted in ``limit_violations``.
@@ -36,12 +36,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.controllers.base import Controller
-from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
+from uvnav.core import AgentLog, BaseProbe
 from uvnav.dynamics.unicycle import UnicycleSpec
-from uvnav.dynamics.vehicles import Vehicle2D, make_vehicle, vehicles_2d
+from uvnav.dynamics.vehicles import Vehicle2D, make_vehicle
 from uvnav.geometry.angles import FloatArray
-from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
@@ -53,7 +51,7 @@ from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
 from uvnav.sim.packed import PackedObstacles, pack_check
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
-from uvnav.sim.setup import EpisodeResult, EpisodeSetup
+from uvnav.sim.setup import EpisodeResult, EpisodeSetup, single_result
 from uvnav.sim.social import SocialTracker, collision_by, pedestrian_ids
 from uvnav.sim.swept import StepPoses, SweptClearance
 
@@ -137,8 +135,8 @@ class World2D:
 
     Bookkeeping (path, effort, limit violations, clearance, status: the one
     :class:`~uvnav.sim.ledger.Ledger`; the social metrics of :mod:`uvnav.sim.social`) is the
-    world's, so :func:`run_episode` and the Gymnasium env ``uvnav/Nav2D-v0`` get the same
-    numbers.  Without
+    world's, so :func:`~uvnav.sim.run.run_episode` and the Gymnasium env ``uvnav/Nav2D-v0``
+    get the same numbers.  Without
     ``exact`` the minimum clearance is tracked by :class:`_MinClearance` (the same minimum, and
     the per-step ``clearance`` only exact when it can matter).
 
@@ -466,6 +464,16 @@ class World2D:
             **self._social_metrics(len(log.decision_us)),
         )
 
+    def recorder(self) -> TrajectoryProbe:
+        """The probe that records this world's trajectory."""
+        return TrajectoryProbe()
+
+    def result(
+        self, logs: Sequence[AgentLog], recorder: TrajectoryProbe | None
+    ) -> EpisodeResult[Trajectory]:
+        """The episode's result (after :meth:`close`)."""
+        return single_result(self, logs, recorder)
+
     def _social_metrics(self, decisions: int) -> dict[str, float]:
         """The pedestrian metrics (:mod:`uvnav.sim.social`); none without pedestrians."""
         soc = self.social
@@ -506,57 +514,3 @@ class TrajectoryProbe(BaseProbe):
     def finish(self) -> Trajectory:
         assert self.recorder is not None
         return self.recorder.finish()
-
-
-def run_episode(
-    setup: EpisodeSetup,
-    controller: Controller,
-    rng: np.random.Generator,
-    *,
-    record: bool = True,
-    probes: Sequence[Probe] = (),
-    vehicle: str = "unicycle",
-    compiled: bool | None = None,
-    swept: bool = True,
-) -> EpisodeResult:
-    """Run one episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
-    :class:`World2D`).
-
-    Args:
-        setup: the instantiated scenario; its obstacles' states (and their motion models' internal
-            state) are left as they are at the end of the episode.
-        controller: a fresh or reusable controller; it is reset here.
-        rng: the episode generator; independent children feed the controller and the sensors.
-        record: keep the full trajectory (needed for figures; off for large campaigns).
-        probes: more probes to run in the loop.
-        vehicle: the robot the law drives (:func:`~uvnav.dynamics.vehicles.vehicles_2d`:
-            ``unicycle``, ``holonomic`` or a plug-in's).
-        compiled: move and measure the obstacles in compiled calls where the scene allows it
-            (:class:`~uvnav.sim.packed.PackedObstacles`: the same numbers); default: when numba
-            is enabled (:func:`~uvnav.geometry.kernels3d.numba_enabled`).
-        swept: judge collisions and the minimum clearance along every step (the default);
-            ``False`` judges the sampled end of each step only.
-
-    Raises:
-        ValueError: ``setup.control_period`` is not a whole multiple of ``setup.dt``.
-    """
-    if vehicle not in vehicles_2d():
-        known = ", ".join(vehicles_2d())
-        raise ValueError(f"no 2D world for vehicle {vehicle!r}; known: {known}")
-    if compiled is None:
-        compiled = numba_enabled()
-    world = World2D(setup, rng, exact=record, packed=compiled, swept=swept, vehicle=vehicle)
-    rec = TrajectoryProbe() if record else None
-    try:
-        (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
-    finally:
-        world.close()
-    metrics = world.metrics(log)
-    dec = np.asarray(log.decision_us) if log.decision_us else np.zeros(1)
-    return EpisodeResult(
-        metrics=metrics,
-        status=world.status,
-        trajectory=rec.finish() if rec is not None else None,
-        decision_us=dec,
-        contact_time=world.book.contact_at,
-    )

@@ -31,8 +31,7 @@ from typing import Any, ClassVar, Literal
 
 import numpy as np
 
-from uvnav.controllers.base3d import Controller3D
-from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
+from uvnav.core import AgentLog, BaseProbe
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec, vehicle3d_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.frames3d import check_unit, rotation_from_vector
@@ -40,7 +39,7 @@ from uvnav.obstacles.motion3d import Obstacle3D
 from uvnav.sensors.sensing3d import FiniteDifference3D, Observation3D, sense_obstacles3d
 from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
-from uvnav.sim.setup import EpisodeResult
+from uvnav.sim.setup import EpisodeResult, single_result
 from uvnav.sim.swept import first_contact
 
 
@@ -196,8 +195,8 @@ class _GapTracker:
 
 class Vehicle3DWorld:
     """The Chapter-3 world: one 3D vehicle among moving, rotating bodies
-    (:class:`uvnav.core.World`), run by :func:`run_episode3d` and stepped by the Gymnasium env
-    ``uvnav/Nav3D-v0`` (:mod:`uvnav.envs.nav3d`).
+    (:class:`uvnav.core.World`), run by :func:`~uvnav.sim.run.run_episode` and stepped by the
+    Gymnasium env ``uvnav/Nav3D-v0`` (:mod:`uvnav.envs.nav3d`).
 
     The bookkeeping (path, effort, limit violations, clearance, status) is the one
     :class:`~uvnav.sim.ledger.Ledger`'s, so both users get the same numbers.
@@ -348,6 +347,16 @@ class Vehicle3DWorld:
         """The episode's metrics (:mod:`uvnav.sim.metrics`) so far."""
         return self.book.metrics(log, top_speed=self.spec.v_max)
 
+    def recorder(self) -> Trajectory3DProbe:
+        """The probe that records this world's trajectory."""
+        return Trajectory3DProbe()
+
+    def result(
+        self, logs: Sequence[AgentLog], recorder: Trajectory3DProbe | None
+    ) -> EpisodeResult[Trajectory3D]:
+        """The episode's result."""
+        return single_result(self, logs, recorder)
+
 
 class Trajectory3DProbe(BaseProbe):
     """Records a :class:`Vehicle3DWorld` at every integration step and at the end.
@@ -411,40 +420,3 @@ class Trajectory3DProbe(BaseProbe):
             obstacle_outlines=self.outlines,
             obstacle_faces=self.faces,
         )
-
-
-def run_episode3d(
-    setup: Episode3DSetup,
-    controller: Controller3D,
-    rng: np.random.Generator,
-    *,
-    record: bool = True,
-    probes: Sequence[Probe] = (),
-) -> tuple[EpisodeResult, Trajectory3D | None]:
-    """Run one 3D episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
-    :class:`Vehicle3DWorld`).
-
-    Args:
-        setup: the instantiated scene; its obstacles are left as they are at the end.
-        controller: a Chapter-3 law; it is reset here.
-        rng: the episode generator; independent children feed the controller and the sensing.
-        record: keep the trajectory (for figures).
-        probes: more probes to run in the loop.
-
-    Returns:
-        ``(result, trajectory)``: the result carries the metrics of :mod:`uvnav.sim.metrics`
-        (its ``trajectory`` field is ``None``; the 3D trajectory is returned beside it).
-
-    Raises:
-        ValueError: a non-unit initial heading, or a control period that is not a whole multiple
-            of ``dt``.
-    """
-    world = Vehicle3DWorld(setup, rng, exact=record)
-    rec = Trajectory3DProbe() if record else None
-    (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
-    dec = np.asarray(log.decision_us) if log.decision_us else np.zeros(1)
-    result = EpisodeResult(
-        metrics=world.metrics(log), status=world.status, trajectory=None, decision_us=dec,
-        contact_time=world.book.contact_at,
-    )  # fmt: skip
-    return result, (rec.finish() if rec is not None else None)

@@ -32,7 +32,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
+from uvnav.core import AgentLog, BaseProbe
 from uvnav.dynamics.holonomic import HolonomicCommand, HolonomicSpec, holonomic_step
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.polygons import closed_rings, rings_nearest
@@ -40,6 +40,7 @@ from uvnav.obstacles.deforming import ShapeChanging
 from uvnav.sensors.sonar2d import SonarConfig, SonarObservation, sonar_scan
 from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.setup import EpisodeResult, single_result
 from uvnav.sim.swept import first_contact
 
 
@@ -91,19 +92,6 @@ class Uuv2dTrajectory:
     grid: Any = None
 
 
-@dataclass
-class Uuv2dResult:
-    """Metrics, status (``success``, ``collision`` or ``timeout``), whether a forbidden region was
-    entered, the recorded trajectory and the time of a collision's first contact [s]."""
-
-    metrics: EpisodeMetrics
-    status: str
-    entered_forbidden: bool
-    trajectory: Uuv2dTrajectory | None
-    decision_us: FloatArray
-    contact_time: float | None = None
-
-
 def clearance_of(
     point: tuple[float, float], outlines: list[FloatArray], radius: float
 ) -> tuple[float, int]:
@@ -130,8 +118,8 @@ def inside_any(point: tuple[float, float], polygons: list[FloatArray]) -> bool:
 
 class Uuv2dWorld:
     """The Chapter-4 world: one planar UUV among shape-changing bodies, sensed by its sonar
-    (:class:`uvnav.core.World`), run by :func:`run_uuv2d_episode` and stepped by the Gymnasium
-    env ``uvnav/UUV2D-v0`` (:mod:`uvnav.envs.uuv2d`).
+    (:class:`uvnav.core.World`), run by :func:`~uvnav.sim.run.run_episode` and stepped by the
+    Gymnasium env ``uvnav/UUV2D-v0`` (:mod:`uvnav.envs.uuv2d`).
 
     The bookkeeping (path, effort, limit violations, clearance, status) is the one
     :class:`~uvnav.sim.ledger.Ledger`'s, the forbidden regions this world's, so both users get
@@ -271,6 +259,17 @@ class Uuv2dWorld:
         v_line = self.spec.v_max / max(abs(math.cos(direction)), abs(math.sin(direction)))
         return self.book.metrics(log, top_speed=v_line)
 
+    def recorder(self) -> Uuv2dTrajectoryProbe:
+        """The probe that records this world's trajectory."""
+        return Uuv2dTrajectoryProbe()
+
+    def result(
+        self, logs: Sequence[AgentLog], recorder: Uuv2dTrajectoryProbe | None
+    ) -> EpisodeResult[Uuv2dTrajectory]:
+        """The episode's result; ``flags["entered_forbidden"]``: the vehicle entered a region
+        it may not."""
+        return single_result(self, logs, recorder, {"entered_forbidden": bool(self.entered)})
+
 
 class Uuv2dTrajectoryProbe(BaseProbe):
     """Records a :class:`Uuv2dWorld`: times, poses and clearances at every integration step and at
@@ -320,38 +319,3 @@ class Uuv2dTrajectoryProbe(BaseProbe):
             goal=self.goal,
             grid=self.grid,
         )
-
-
-def run_uuv2d_episode(
-    setup: Uuv2dSetup,
-    controller: Any,
-    rng: np.random.Generator,
-    *,
-    record: bool = True,
-    probes: Sequence[Probe] = (),
-    swept: bool = True,
-) -> Uuv2dResult:
-    """Run one episode to success, collision or ``t_max`` (:func:`uvnav.core.run_loop` over a
-    :class:`Uuv2dWorld`).
-
-    Args:
-        setup: the instantiated scene.
-        controller: a Chapter-4 law (:class:`~uvnav.controllers.zhang2022_uuv2d.Uuv2dController`);
-            it is reset here.
-        rng: the episode generator; independent children feed the controller and the sonar.
-        record: keep the trajectory (for figures).
-        probes: more probes to run in the loop.
-        swept: judge collisions along each step (the default), else at its end only.
-    """
-    world = Uuv2dWorld(setup, rng, swept=swept)
-    rec = Uuv2dTrajectoryProbe() if record else None
-    (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
-    dec = np.asarray(log.decision_us) if log.decision_us else np.zeros(1)
-    return Uuv2dResult(
-        metrics=world.metrics(log),
-        status=world.status,
-        entered_forbidden=world.entered,
-        trajectory=rec.finish() if rec is not None else None,
-        decision_us=dec,
-        contact_time=world.book.contact_at,
-    )

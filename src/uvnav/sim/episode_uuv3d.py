@@ -16,7 +16,7 @@ the surfaces are functions of time and no surface point moves faster than its bo
 Metrics carry the names of :data:`uvnav.sim.metrics.METRIC_NAMES`.
 
 Scene 2's check that the vehicle never enters an obstacle's inner space is reported separately
-(:attr:`UUV3DResult.entered_inner_space`), as is the located-point error when recorded
+(the result's ``flags["entered_inner_space"]``), as is the located-point error when recorded
 (:class:`LocatedTraceProbe`).
 """
 
@@ -29,8 +29,8 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.controllers.zhang_uuv3d import SonarObservation3D, ZhangUUV3D
-from uvnav.core import AgentLog, BaseProbe, Probe, run_loop
+from uvnav.controllers.zhang_uuv3d import SonarObservation3D
+from uvnav.core import AgentLog, BaseProbe
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand, Vehicle3DSpec, vehicle3d_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.mesh3d import nearest_on_mesh
@@ -38,6 +38,7 @@ from uvnav.obstacles.deforming3d import CompoundBody
 from uvnav.sensors.sonar_array import SonarArray, merge_triangles, sonar_scan
 from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.setup import EpisodeResult, single_result
 from uvnav.sim.swept import first_contact
 
 
@@ -67,28 +68,20 @@ class UUV3DSetup:
 
 
 @dataclass
-class UUV3DResult:
-    """Outcome of one episode.
+class LocatedTrace:
+    """The Ch. 5 run at each decision and at the end.
 
     Attributes:
-        metrics: the common metrics (DESIGN §4).
-        entered_inner_space: the vehicle centre was ever inside an obstacle's inner-space box.
-        times, positions, modes: the trajectory at decisions (recorded runs only).
-        located: the located point at each decision (NaN when none).
-        true_nearest: the true nearest obstacle point at each decision.
-        status: ``"success"``, ``"collision"`` or ``"timeout"``.
-        contact_time: the time of a collision's first contact [s] (``None`` without one).
+        times [s], positions [m], modes: the vehicle and the law's mode.
+        located: the law's located point [m] (NaN when it located nothing).
+        true_nearest: the true nearest obstacle point [m] (NaN where unknown).
     """
 
-    metrics: EpisodeMetrics
-    entered_inner_space: bool
-    status: str
     times: list[float] = field(default_factory=list)
     positions: list[FloatArray] = field(default_factory=list)
     modes: list[str] = field(default_factory=list)
     located: list[FloatArray] = field(default_factory=list)
     true_nearest: list[FloatArray] = field(default_factory=list)
-    contact_time: float | None = None
 
 
 def _nearest(
@@ -250,6 +243,18 @@ class UUV3DWorld:
         """The episode's metrics (:mod:`uvnav.sim.metrics`)."""
         return self.book.metrics(log, top_speed=self.spec.v_max)
 
+    def recorder(self) -> LocatedTraceProbe:
+        """The probe that records this world's trace."""
+        return LocatedTraceProbe()
+
+    def result(
+        self, logs: Sequence[AgentLog], recorder: LocatedTraceProbe | None
+    ) -> EpisodeResult[LocatedTrace]:
+        """The episode's result; ``flags["entered_inner_space"]``: the vehicle centre was ever
+        inside an obstacle's inner-space box."""
+        flags = {"entered_inner_space": bool(self.inner)}
+        return single_result(self, logs, recorder, flags)
+
 
 class LocatedTraceProbe(BaseProbe):
     """Records a :class:`UUV3DWorld` at each decision and at the end: time, position, the law's
@@ -261,59 +266,24 @@ class LocatedTraceProbe(BaseProbe):
     """
 
     def __init__(self) -> None:
-        self.times: list[float] = []
-        self.positions: list[FloatArray] = []
-        self.modes: list[str] = []
-        self.located: list[FloatArray] = []
-        self.true_nearest: list[FloatArray] = []
+        self.trace = LocatedTrace()
+
+    def _add(self, world: Any, mode: str, located: FloatArray, nearest: FloatArray) -> None:
+        tr = self.trace
+        tr.times.append(world.t)
+        tr.positions.append(world.pos.copy())
+        tr.modes.append(mode)
+        tr.located.append(located)
+        tr.true_nearest.append(nearest)
 
     def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
-        self.times.append(world.t)
-        self.positions.append(world.pos.copy())
-        self.modes.append(law.mode)
         loc = getattr(law, "last_located", None)
-        self.located.append(loc.point.copy() if loc is not None else np.full(3, np.nan))
         q = world.nearest
-        self.true_nearest.append(q.copy() if q is not None else np.full(3, np.nan))
+        self._add(world, law.mode, loc.point.copy() if loc is not None else np.full(3, np.nan),
+                  q.copy() if q is not None else np.full(3, np.nan))  # fmt: skip
 
     def on_end(self, world: Any, laws: Sequence[Any]) -> None:
-        self.times.append(world.t)
-        self.positions.append(world.pos.copy())
-        self.modes.append(laws[0].mode)
-        self.located.append(np.full(3, np.nan))
-        self.true_nearest.append(np.full(3, np.nan))
+        self._add(world, laws[0].mode, np.full(3, np.nan), np.full(3, np.nan))
 
-
-def run_uuv3d_episode(
-    setup: UUV3DSetup,
-    controller: ZhangUUV3D,
-    rng: np.random.Generator,
-    *,
-    record: bool = False,
-    probes: Sequence[Probe] = (),
-) -> UUV3DResult:
-    """Run one episode (:func:`uvnav.core.run_loop` over a :class:`UUV3DWorld`).
-
-    Args:
-        setup: the instantiated scene.
-        controller: the Ch. 5 law; it is reset here with ``rng`` itself (shared with the sonar).
-        rng: the episode generator.
-        record: keep the trace at decisions (:class:`LocatedTraceProbe`).
-        probes: more probes to run in the loop.
-
-    Raises:
-        ValueError: ``control_period`` is not a whole multiple of ``dt``.
-    """
-    world = UUV3DWorld(setup, rng)
-    rec = LocatedTraceProbe() if record else None
-    try:
-        (log,) = run_loop(world, [controller], [*probes, *([rec] if rec else [])])
-    finally:
-        world.close()
-    out = UUV3DResult(
-        world.metrics(log), world.inner, world.status, contact_time=world.book.contact_at
-    )
-    if rec is not None:
-        out.times, out.positions, out.modes = rec.times, rec.positions, rec.modes
-        out.located, out.true_nearest = rec.located, rec.true_nearest
-    return out
+    def finish(self) -> LocatedTrace:
+        return self.trace

@@ -12,7 +12,7 @@ else passes between them.  Obstacle ids in the observations are the world's obst
 (0..k-1), then the robots (k + j).
 
 The world is :class:`MultiUnicycleWorld` (N agents of :class:`uvnav.core.World`), stepped by
-the one loop :func:`uvnav.core.run_loop` (:func:`run_multi`; the PettingZoo env
+the one loop :func:`uvnav.core.run_loop` (:func:`~uvnav.sim.run.run_episode`; the PettingZoo env
 :mod:`uvnav.envs.multi_robot` steps the same world): at each decision time the active robots
 decide in index order, each reading the world as it is before anyone moves.
 
@@ -52,7 +52,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.core import AgentLog, BaseProbe, DiscAgents, run_loop
+from uvnav.core import AgentLog, BaseProbe, DiscAgents
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec, unicycle_advance
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.sweep import disc_sweep, segment_gaps
@@ -70,7 +70,6 @@ from uvnav.sensors.exact import sense_obstacles
 from uvnav.sensors.observation import Observation, ObstacleReading
 from uvnav.sim.ledger import Clock, Ledger, group_outcome
 from uvnav.sim.metrics import EpisodeMetrics
-from uvnav.sim.packed_swarm import run_swarm, swarm_check
 from uvnav.sim.setup import (
     GroupMetrics,
     MultiResult,
@@ -158,8 +157,9 @@ class _DiscPairs:
 
 class MultiUnicycleWorld:
     """N unicycles (and the world's obstacles) in one world (:class:`uvnav.core.World`, see the
-    module docstring), stepped by :func:`uvnav.core.run_loop` (:func:`run_multi`) or, one
-    decision at a time, by the PettingZoo env :mod:`uvnav.envs.multi_robot`.
+    module docstring), stepped by :func:`uvnav.core.run_loop`
+    (:func:`~uvnav.sim.run.run_episode`) or, one decision at a time, by the PettingZoo env
+    :mod:`uvnav.envs.multi_robot`.
 
     Agent i is robot i.  Per-robot bookkeeping (path, effort, limit violations, clearance,
     status) is robot i's :class:`~uvnav.sim.ledger.Ledger` (``books[i]``), the group's (robot
@@ -500,6 +500,25 @@ class MultiUnicycleWorld:
             self.obstacle_hits,
         )  # fmt: skip
 
+    def recorder(self) -> PosesProbe:
+        """The probe that records every robot's pose and every obstacle's position."""
+        return PosesProbe()
+
+    def result(self, logs: Sequence[AgentLog], recorder: PosesProbe | None) -> MultiResult:
+        """The episode's result: per robot and for the group."""
+        rec, n = recorder, self.n_agents
+        return MultiResult(
+            robots=[self.metrics(log, i) for i, log in enumerate(logs)],
+            statuses=self.status,
+            group=self.group_metrics(),
+            times=np.asarray(rec.times) if rec else np.zeros(0),
+            poses=np.asarray(rec.poses) if rec and rec.poses else np.zeros((0, n, 3)),
+            collided_pairs=sorted(self.pairs),
+            obstacle_paths=(
+                np.asarray(rec.obstacles) if rec and rec.obstacles else np.zeros((0, 0, 2))
+            ),
+        )
+
 
 class PosesProbe(BaseProbe):
     """Records every robot's pose and every obstacle's position of a
@@ -516,48 +535,6 @@ class PosesProbe(BaseProbe):
         self.obstacles.append(np.array(world.batch.positions, dtype=float).reshape(-1, 2))
 
     on_end = on_step
-
-
-def run_multi(
-    setup: MultiSetup,
-    rng: np.random.Generator,
-    *,
-    record: bool = True,
-    vectorised: bool = True,
-) -> MultiResult:
-    """Run one multi-robot episode (:func:`uvnav.core.run_loop` over a
-    :class:`MultiUnicycleWorld`; see the module docstring).
-
-    Args:
-        setup: the instantiated scene; its obstacles are advanced in place.
-        rng: episode generator; each robot gets independent children for its law and sensors.
-        record: keep every robot's pose at every integration step (figures).
-        vectorised: check and sense all robots at once when the world holds only robots, and
-            run a swarm of ``orca-shared-v1`` robots as a
-            :class:`~uvnav.sim.packed_swarm.PackedSwarm` (identical results, decision times
-            apart; ``False`` forces the loop world with one field query per robot).
-
-    Raises:
-        ValueError: ``control_period`` is not a whole multiple of ``dt``, or no robot.
-    """
-    if vectorised and swarm_check(setup) is None:
-        return run_swarm(setup, rng, record=record)
-    world = MultiUnicycleWorld(setup, rng, vectorised=vectorised)
-    rec = PosesProbe() if record else None
-    try:
-        logs = run_loop(world, [r.controller for r in setup.robots], [rec] if rec else [])
-    finally:
-        world.close()
-    n = world.n_agents
-    return MultiResult(
-        robots=[world.metrics(log, i) for i, log in enumerate(logs)],
-        statuses=world.status,
-        group=world.group_metrics(),
-        times=np.asarray(rec.times) if rec else np.zeros(0),
-        poses=np.asarray(rec.poses) if rec and rec.poses else np.zeros((0, n, 3)),
-        collided_pairs=sorted(world.pairs),
-        obstacle_paths=np.asarray(rec.obstacles) if rec and rec.obstacles else np.zeros((0, 0, 2)),
-    )
 
 
 def summarize(results: Sequence[MultiResult]) -> dict[str, float | None]:

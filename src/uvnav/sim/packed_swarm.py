@@ -13,7 +13,7 @@ group's (:func:`uvnav.core.run_loop`: CPU and wall time divided among the member
 
 It is :func:`uvnav.core.run_loop` over :class:`~uvnav.sim.multi.MultiUnicycleWorld` bit for bit
 (the tests compare every pose, status, clearance and collided pair at every step, and the whole
-:class:`~uvnav.sim.setup.MultiResult`), so :func:`~uvnav.sim.multi.run_multi` runs such scenes
+:class:`~uvnav.sim.setup.MultiResult`), so :func:`~uvnav.sim.run.run_episode` runs such scenes
 here (:func:`run_swarm`; campaigns and ``uvnav simulate`` with them):
 
 * decisions: the group law's own kernel; each robot's decision clock is its law's
@@ -490,7 +490,7 @@ class PackedSwarm:
 
 
 def run_swarm(setup: MultiSetup, rng: np.random.Generator, *, record: bool = True) -> MultiResult:
-    """:func:`uvnav.sim.multi.run_multi`'s episode in a :class:`PackedSwarm` (the same result,
+    """:func:`uvnav.sim.run.run_episode`'s episode in a :class:`PackedSwarm` (the same result,
     decision times apart); ``record`` keeps every robot's pose at every step."""
     swarm = PackedSwarm(setup, rng)
     poses: list[FloatArray] = []

@@ -1,6 +1,6 @@
-"""What an episode of the 2D worlds is given and what it returns, in one module: the one-robot
-setup and result (:func:`uvnav.sim.episode.run_episode`), the multi-robot setup and result
-(:func:`uvnav.sim.multi.run_multi`, the compiled swarm) and the sensing configuration they share.
+"""What an episode is given and what it returns (:func:`uvnav.sim.run.run_episode`), in one
+module: the result of one vehicle in any world, the 2D setup, the multi-robot setup and result
+(the loop world and the compiled swarm) and the sensing configuration they share.
 
 The worlds import these and nothing here imports a world, so the loop world, the packed worlds
 and the swarm build on one definition without importing each other.
@@ -8,8 +8,9 @@ and the swarm build on one definition without importing each other.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
-from typing import Any, Literal
+from typing import Any, Generic, Literal, TypeVar
 
 import numpy as np
 
@@ -18,7 +19,6 @@ from uvnav.dynamics.unicycle import UnicycleSpec
 from uvnav.geometry.angles import FloatArray
 from uvnav.obstacles.obstacle import Obstacle
 from uvnav.sim.metrics import EpisodeMetrics
-from uvnav.sim.recorder import Trajectory
 
 
 @dataclass(frozen=True)
@@ -90,17 +90,49 @@ class EpisodeSetup:
     sensing: SensingConfig = field(default_factory=SensingConfig)
 
 
+TrajT = TypeVar("TrajT")
+
+
 @dataclass
-class EpisodeResult:
-    """Metrics, status (``success``, ``collision`` or ``timeout``), the recorded trajectory and,
-    for a collision, the time of the first contact [s] (``None`` otherwise, or where the world
-    does not know it)."""
+class EpisodeResult(Generic[TrajT]):
+    """One vehicle's episode, whatever its world (:func:`uvnav.sim.run.run_episode`).
+
+    Attributes:
+        metrics: the common metrics (:mod:`uvnav.sim.metrics`).
+        status: ``success``, ``collision`` or ``timeout``.
+        trajectory: the world's own record of the run (2D :class:`~uvnav.sim.recorder.Trajectory`,
+            :class:`~uvnav.sim.episode3d.Trajectory3D`,
+            :class:`~uvnav.sim.episode_uuv2d.Uuv2dTrajectory`,
+            :class:`~uvnav.sim.episode_uuv3d.LocatedTrace`); ``None`` unrecorded.
+        decision_us: the law's CPU time per decision [us].
+        contact_time: a collision's first contact [s] (``None`` without one).
+        flags: the world's own events (Ch. 4 ``entered_forbidden``, Ch. 5
+            ``entered_inner_space``); empty where the world has none.
+    """
 
     metrics: EpisodeMetrics
     status: str
-    trajectory: Trajectory | None
+    trajectory: TrajT | None
     decision_us: FloatArray
     contact_time: float | None = None
+    flags: dict[str, bool] = field(default_factory=dict)
+
+
+def single_result(
+    world: Any, logs: Sequence[Any], recorder: Any, flags: dict[str, bool] | None = None
+) -> EpisodeResult[Any]:
+    """The :class:`EpisodeResult` of a one-vehicle ``world`` at its end: its metrics, status and
+    first contact (its ``book``), the loop's decision times, ``recorder.finish()`` when recorded,
+    and the world's own ``flags``."""
+    (log,) = logs
+    return EpisodeResult(
+        metrics=world.metrics(log),
+        status=world.status,
+        trajectory=recorder.finish() if recorder is not None else None,
+        decision_us=log.decision_array(),
+        contact_time=world.book.contact_at,
+        flags=flags or {},
+    )
 
 
 GROUP_METRIC_NAMES: tuple[str, ...] = (

@@ -43,7 +43,7 @@ def plot_outcome(outcome: Any, path: Path) -> Path:
         from uvnav.viz.figures_ch5 import fig_trajectory3d
 
         setup = outcome.setup
-        fig = fig_trajectory3d(outcome.result, setup.obstacles, setup.goal, title)
+        fig = fig_trajectory3d(outcome.result.trajectory, setup.obstacles, setup.goal, title)
     else:
         raise ValueError(f"--plot: no episode figure for {kind} scenes yet")
     fig.savefig(path, dpi=110)

@@ -145,7 +145,7 @@ def plot_swap(
     (x for a collision, square for a timeout); the world's obstacles' paths in grey and their
     ``outlines`` [m] (at the end of the episode) filled."""
     if result.poses.size == 0:
-        raise ValueError("the multi-robot episode was not recorded (run_multi(record=True))")
+        raise ValueError("the multi-robot episode was not recorded (run_episode(..., record=True))")
     fig = _figure(6.0, 6.0)
     ax = fig.add_subplot()
     for k in range(result.obstacle_paths.shape[1]):
@@ -199,8 +199,7 @@ def beyond_figures(
     from uvnav.scenarios.build import build_episode
     from uvnav.scenarios.loader import load_scenario
     from uvnav.scenarios.multi import build_multi, load_multi_scenario
-    from uvnav.sim.episode import run_episode
-    from uvnav.sim.multi import run_multi
+    from uvnav.sim.run import run_episode
     from uvnav.sim.seeding import run_rng
 
     out = Path(out_dir)
@@ -248,7 +247,9 @@ def beyond_figures(
     ms = load_multi_scenario(swap)
     goals = np.array([r.goal for r in ms.robots])
     for law, params in swap_laws:
-        res_m = run_multi(build_multi(ms, 0, controller=law, params=dict(params)), run_rng(0))
+        res_m = run_episode(
+            build_multi(ms, 0, controller=law, params=dict(params)), None, run_rng(0)
+        )
         p = out / f"beyond-swap-{law}.png"
         plot_swap(res_m, goals, path=p)
         written.append(p)

@@ -25,7 +25,8 @@ import numpy as np
 from matplotlib.axes import Axes
 from matplotlib.figure import Figure
 
-from uvnav.sim.episode_uuv2d import Uuv2dResult, Uuv2dTrajectory
+from uvnav.sim.episode_uuv2d import Uuv2dTrajectory
+from uvnav.sim.setup import EpisodeResult
 
 
 def _closed(o: np.ndarray) -> np.ndarray:
@@ -214,7 +215,9 @@ def save_animation(
 
 
 def render_ch4(
-    out_dir: Path, scene_results: Mapping[tuple[str, str], Uuv2dResult], summary: Any = None
+    out_dir: Path,
+    scene_results: Mapping[tuple[str, str], EpisodeResult[Uuv2dTrajectory]],
+    summary: Any = None,
 ) -> list[Path]:
     """Figures for the Chapter-4 thesis scenes (the thesis's law), written under ``out_dir``."""
     out_dir = Path(out_dir)

@@ -25,7 +25,8 @@ from uvnav.geometry.angles import FloatArray
 from uvnav.learning.bpnn import TrainedBPNN
 from uvnav.obstacles.deforming3d import CompoundBody
 from uvnav.sensors.sonar_array import SonarArray
-from uvnav.sim.episode_uuv3d import UUV3DResult
+from uvnav.sim.episode_uuv3d import LocatedTrace
+from uvnav.sim.setup import EpisodeResult
 
 
 def fig_array(array: SonarArray, *, beam_length: float = 2.0) -> Figure:
@@ -153,7 +154,7 @@ def fig_learning_curve(rows: Sequence[dict[str, Any]]) -> Figure:
 
 
 def fig_trajectory3d(
-    result: UUV3DResult, obstacles: Sequence[CompoundBody], goal: FloatArray, title: str
+    trace: LocatedTrace, obstacles: Sequence[CompoundBody], goal: FloatArray, title: str
 ) -> Figure:
     """Vehicle path (coloured by mode), located points, and the obstacles' meshes at t = 0."""
     fig = plt.figure(figsize=(7, 6))
@@ -164,13 +165,13 @@ def fig_trajectory3d(
             ax.plot_trisurf(
                 v[:, 0], v[:, 1], v[:, 2], triangles=part.faces, color="C1", alpha=0.25, linewidth=0
             )
-    pos = np.asarray(result.positions)
+    pos = np.asarray(trace.positions)
     if len(pos):
         ax.plot(*pos.T, color="C0", lw=1.5, label="vehicle")
-        m2 = np.array([m == "M2" for m in result.modes])
+        m2 = np.array([m == "M2" for m in trace.modes])
         if m2.any():
             ax.scatter(*pos[m2].T, color="C3", s=4, label="avoidance (M2)")
-        loc = np.asarray(result.located)
+        loc = np.asarray(trace.located)
         ok = np.all(np.isfinite(loc), axis=1) if len(loc) else np.zeros(0, bool)
         if ok.any():
             ax.scatter(*loc[ok].T, color="k", s=3, label="point to evade")
@@ -204,7 +205,7 @@ def animation_frames(n_decisions: int, max_frames: int) -> list[int]:
 
 
 def save_animation3d(
-    result: UUV3DResult,
+    trace: LocatedTrace,
     obstacles: Sequence[CompoundBody],
     goal: FloatArray,
     path: Path,
@@ -227,11 +228,11 @@ def save_animation3d(
         from matplotlib.animation import FuncAnimation, PillowWriter
     except ImportError:  # pragma: no cover
         return None
-    pos = np.asarray(result.positions, dtype=float)
-    frames = animation_frames(len(result.times), max_frames)
+    pos = np.asarray(trace.positions, dtype=float)
+    frames = animation_frames(len(trace.times), max_frames)
     if len(frames) < 2:
         return None
-    loc = np.asarray(result.located, dtype=float)
+    loc = np.asarray(trace.located, dtype=float)
     goal = np.asarray(goal, dtype=float)
     pts = [pos, goal[None]]
     for ob in obstacles:
@@ -266,7 +267,7 @@ def save_animation3d(
 
     def draw(i: int) -> list[Any]:
         k = frames[i]
-        t = float(result.times[k])
+        t = float(trace.times[k])
         c = pos[k]
         while moving:
             moving.pop().remove()
@@ -288,7 +289,7 @@ def save_animation3d(
             pts = np.stack([c, loc[k]]) if seen else np.zeros((0, 3))
             marks[j].set_data_3d(*pts[1:].T)
             links[j].set_data_3d(*pts.T)
-        mode = result.modes[k] if k < len(result.modes) else ""
+        mode = trace.modes[k] if k < len(trace.modes) else ""
         fig.suptitle(f"{title}  t = {t:.1f} s  ({mode})", fontsize=10)
         return []
 
@@ -351,9 +352,13 @@ def render_ch5(summary: Any, report_dir: Path) -> list[Path]:
     if summary.learning:
         save(fig_learning_curve(summary.learning), "ch5_learning_curve.png")
     for (scene, loc, noise), res in dict(summary.models.get("episodes", {})).items():
+        if res.trajectory is None:
+            continue
         setup = build_uuv3d(load_ch5_scenario(scene))
         save(
-            fig_trajectory3d(res, setup.obstacles, setup.goal, f"{scene}, {loc}, noise {noise} m"),
+            fig_trajectory3d(
+                res.trajectory, setup.obstacles, setup.goal, f"{scene}, {loc}, noise {noise} m"
+            ),
             f"ch5_traj_{scene}_{loc}_{noise}.png",
         )
     gif = _animate_one(dict(summary.models.get("episodes", {})), out)
@@ -374,17 +379,20 @@ ANIMATION_PREFERENCE: tuple[tuple[str, str], ...] = (
 )
 
 
-def _animate_one(episodes: dict[tuple[str, str, float], UUV3DResult], out: Path) -> Path | None:
+def _animate_one(
+    episodes: dict[tuple[str, str, float], EpisodeResult[LocatedTrace]], out: Path
+) -> Path | None:
     """Animate the preferred recorded noise-free thesis run (:data:`ANIMATION_PREFERENCE`)."""
     from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
 
     for scene, loc in ANIMATION_PREFERENCE:
         res = episodes.get((scene, loc, 0.0))
-        if res is None or len(res.times) < 2:
+        trace = res.trajectory if res is not None else None
+        if trace is None or len(trace.times) < 2:
             continue
         setup = build_uuv3d(load_ch5_scenario(scene))
         return save_animation3d(
-            res,
+            trace,
             setup.obstacles,
             setup.goal,
             out / f"ch5_anim_{scene}_{loc}.gif",
