@@ -198,49 +198,40 @@ def _single(
     )
 
 
-def _nav2d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
-    from uvnav.scenarios.build import build_episode
-    from uvnav.sim.run import run_episode
+def _setup(r: Resolved, seed: int) -> Any:
+    """The setup of ``r``'s scene for episode ``seed`` (what :func:`~uvnav.sim.run.run_episode`
+    builds the kind's world from)."""
+    kind = r.kind.name
+    if kind == "nav2d":
+        from uvnav.scenarios.build import build_episode
 
-    setup = build_episode(r.scenario, seed)
-    vehicle = controller_info(name).vehicle  # the unicycle, or the holonomic robot
-    res = run_episode(
-        setup, make_law(name, **params), r.kind.episode_rng(seed), record=record, vehicle=vehicle
-    )
-    return _single(r, name, params, seed, res, setup=setup, trajectory=res.trajectory)
-
-
-def _nav3d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
-    from uvnav.sim.run import run_episode
-
-    setup = r.scenario.build(seed)
-    law = make_law(name, **params)
-    res = run_episode(setup, law, r.kind.episode_rng(seed), record=record)
-    traj = res.trajectory
-    return _single(r, name, params, seed, res, setup=setup, trajectory=traj)
-
-
-def _uuv2d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
-    from uvnav.sim.run import run_episode
-
-    setup = r.scenario.to_setup()
-    law = make_law(name, **params)
-    res = run_episode(setup, law, r.kind.episode_rng(seed), record=record)
-    out = _single(r, name, params, seed, res, setup=setup, trajectory=res.trajectory)
-    out.extra["entered_forbidden"] = res.flags["entered_forbidden"]
-    return out
-
-
-def _uuv3d(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
+        return build_episode(r.scenario, seed)
+    if kind == "nav3d":
+        return r.scenario.build(seed)
+    if kind == "uuv2d":
+        return r.scenario.to_setup()
     from uvnav.scenarios.ch5 import build_uuv3d
+
+    return build_uuv3d(r.scenario)
+
+
+def _one_vehicle(
+    r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool
+) -> Outcome:
+    """One episode of a single-vehicle kind; the world's flags go into ``extra``."""
     from uvnav.sim.run import run_episode
 
+    setup = _setup(r, seed)
     law = make_law(name, **params)
-    setup = build_uuv3d(r.scenario)
-    res = run_episode(setup, law, r.kind.episode_rng(seed), record=record)
+    # a 2D scene holds every planar vehicle: the law's picks the world's
+    options: dict[str, Any] = {}
+    if r.kind.name == "nav2d":
+        options["vehicle"] = controller_info(name).vehicle
+    res = run_episode(setup, law, r.kind.episode_rng(seed), record=record, **options)
     out = _single(r, name, params, seed, res, setup=setup, trajectory=res.trajectory)
-    out.extra["entered_inner_space"] = res.flags["entered_inner_space"]
-    out.extra["locator"] = str(getattr(law.params, "locator", ""))
+    out.extra.update(res.flags)
+    if r.kind.name == "uuv3d":
+        out.extra["locator"] = str(getattr(law.params, "locator", ""))
     return out
 
 
@@ -290,9 +281,9 @@ def _multi(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bo
 
 
 _RUNNERS = {
-    "nav2d": _nav2d,
-    "nav3d": _nav3d,
-    "uuv2d": _uuv2d,
-    "uuv3d": _uuv3d,
+    "nav2d": _one_vehicle,
+    "nav3d": _one_vehicle,
+    "uuv2d": _one_vehicle,
+    "uuv3d": _one_vehicle,
     "multi2d": _multi,
 }
