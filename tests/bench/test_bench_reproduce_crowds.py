@@ -10,7 +10,7 @@ import pytest
 from uvnav.bench import chapters
 from uvnav.bench import reproduce_crowds as rc
 from uvnav.bench.chapters import reproduce_chapter
-from uvnav.bench.sections import SECTIONS_DIR, crowds_section, load_sections
+from uvnav.bench.sections import SECTIONS_DIR, load_sections
 from uvnav.bench.store import ResultsStore
 
 TWO_LAWS = ("orca-holonomic-v1", "zhang2019-v1")
@@ -61,7 +61,7 @@ def test_tiny_run_table_intervals_paper_refusal_and_resume(tmp_path: Path) -> No
     with ResultsStore(s.db_path) as store:
         assert {name: store.count(name) for name in rc.CAMPAIGNS} == before
     # the section: intro with the size and the choice about refused laws, the rows as they are
-    sec = crowds_section(s)
+    sec = rc.crowds_section(s)
     assert sec.key == "crowds" and "3 test cases per scene (cases 0–2" in sec.intro
     assert "quick size" in sec.intro and "refused" in sec.intro and "beyond" in sec.intro
     assert sec.rows == s.table
@@ -86,10 +86,8 @@ def test_reproduce_chapter_crowds_saves_and_report_rebuilds(tmp_path: Path, two_
 def test_uvnav_run_puts_the_crowd_section_after_chapter_2(
     tmp_path: Path, two_laws: None, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from uvnav.bench import reproduce as rp
-
     monkeypatch.setattr(rc, "QUICK_CASES", 1)
-    s = rp.reproduce(
+    s = chapters.reproduce_all(
         tmp_path / "res", tmp_path / "rep", n_random=1, baselines=(), crowds=True, workers=1,
         progress=False, render=None,
     )  # fmt: skip

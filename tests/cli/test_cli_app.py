@@ -374,9 +374,9 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
 
     from uvnav.viz.reproduction import render_reproduction
 
-    fake = types.ModuleType("uvnav.bench.reproduce")
-    fake.reproduce = reproduce  # type: ignore[attr-defined]
-    monkeypatch.setitem(sys.modules, "uvnav.bench.reproduce", fake)
+    fake = types.ModuleType("uvnav.bench.chapters")
+    fake.reproduce_all = reproduce  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "uvnav.bench.chapters", fake)
     res_dir, rep_dir = tmp_path / "res", tmp_path / "rep"
     result = runner.invoke(
         app,
@@ -411,8 +411,8 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
 
 
 def test_run_without_bench_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setitem(sys.modules, "uvnav.bench.reproduce", None)
-    assert_one_line_error(invoke("run"), 1, "uvnav.bench.reproduce")
+    monkeypatch.setitem(sys.modules, "uvnav.bench.chapters", None)
+    assert_one_line_error(invoke("run"), 1, "uvnav.bench.chapters")
 
 
 def test_report_calls_write_report(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

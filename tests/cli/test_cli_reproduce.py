@@ -95,11 +95,10 @@ def test_a_stale_campaign_is_refused_in_one_line(
 
 
 def test_reproduce_all_is_uvnav_run(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    import sys
+    from uvnav.cli import reproduce as cli_reproduce
 
-    cli_app = sys.modules["uvnav.cli.app"]  # the package's ``app`` attribute is the Typer app
     seen: list[dict[str, Any]] = []
-    monkeypatch.setattr(cli_app, "run", lambda **kw: seen.append(kw))
+    monkeypatch.setattr(cli_reproduce, "run_cmd", lambda **kw: seen.append(kw))
     result = runner.invoke(app, ["reproduce", "all", "--full", "--results", str(tmp_path)])
     assert result.exit_code == 0, result.output
     assert seen == [{"full": True, "workers": 2, "results": tmp_path, "report": Path("report")}]

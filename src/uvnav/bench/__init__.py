@@ -1,13 +1,19 @@
 """Layer 6: benchmark campaigns — scenarios × controllers × seeds → a SQLite results store.
 
 * :mod:`uvnav.bench.store` — the results database (DESIGN §5).
-* :mod:`uvnav.bench.campaign` — picklable jobs run on a local process pool (or Ray), resumable.
+* :mod:`uvnav.bench.jobs` — picklable job descriptions, their outcomes and task sizes.
+* :mod:`uvnav.bench.campaign` — the jobs run on a local process pool (or Ray), resumable.
+* :mod:`uvnav.bench.fingerprint` — the results database's name, the code fingerprint and the
+  staleness check of stored campaigns.
 * :mod:`uvnav.bench.spec` — campaign YAML files (scenarios × controllers × seeds) → jobs.
-* :mod:`uvnav.bench.ray_engine` — the jobs as Ray tasks (extra ``uvnav[bench]``, imported lazily).
+* :mod:`uvnav.bench.ray_engine` — the jobs as Ray tasks (extra ``uvnav[bench]``; Ray is imported
+  only when the engine runs).
 * :mod:`uvnav.bench.summary` — the per-controller table ``uvnav bench`` prints.
-* :mod:`uvnav.bench.reproduce` — the thesis Chapter 2 reproduction behind ``uvnav run``
+* :mod:`uvnav.bench.reproduce` — the thesis Chapter 2 reproduction
   (``from uvnav.bench.reproduce import reproduce``; the function is not re-exported here so that it
   does not shadow its module).
+* :mod:`uvnav.bench.chapters` — one chapter at a time (``uvnav reproduce CH``) and every chapter
+  (``uvnav run``: :func:`~uvnav.bench.chapters.reproduce_all`).
 """
 
 from uvnav.bench.campaign import CampaignRun, Job, JobOutcome, grid_jobs, run_campaign, run_job

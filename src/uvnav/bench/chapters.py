@@ -10,9 +10,9 @@ the results store ``results_dir/uvnav.sqlite`` (and the chapter's own files unde
 report section in ``results_dir/sections/<chapter>.json`` (:func:`~uvnav.bench.sections.
 save_section`), so the report shows it beside the sections of the chapters run before.
 
-``uvnav run`` (:func:`uvnav.bench.reproduce.reproduce`) calls the same per-chapter runners
-(:func:`run_ch3` … :func:`run_beyond`, :func:`run_crowds`), so the two entry points run the same
-experiments.
+``uvnav run`` (:func:`reproduce_all`) runs Chapter 2 (:mod:`uvnav.bench.reproduce`) and then the
+same per-chapter runners (:func:`run_ch3` … :func:`run_beyond`, :func:`run_crowds`,
+:func:`run_regime`), so the two entry points run the same experiments.
 
 Every chapter adds to the store: stored episodes are skipped (resume) and never deleted or
 replaced by a later run; a campaign that cannot be resumed (stored by other code) is refused with
@@ -27,12 +27,16 @@ random-ch5 closed-loop scenes; crowds: CrowdNav's test cases ``start_seed`` ..
 
 from __future__ import annotations
 
+import dataclasses
 import sys
-from collections.abc import Callable
+import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from uvnav.bench import reproduce as rp
+from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.sections import SECTIONS_DIR, ChapterRenderers, ChapterSection, save_section
 
 #: What ``uvnav reproduce`` accepts (``all`` is ``uvnav run``).
@@ -49,7 +53,6 @@ CHAPTERS: tuple[str, ...] = (
 )
 #: Chapters that run random seeds (``seeds`` / ``start_seed`` apply).
 SEEDED: frozenset[str] = frozenset({"ch2", "ch3", "ch4", "ch5", "crowds", "regime"})
-DB_NAME = "uvnav.sqlite"
 
 
 class ChapterError(ValueError):
@@ -242,8 +245,7 @@ def run_crowds(
 ) -> tuple[ChapterSection, Any]:
     """Every 2D law on CrowdNav's crowds (:func:`uvnav.bench.reproduce_crowds.reproduce_crowds`:
     ``seeds`` test cases per scene from ``start_seed``) and its section."""
-    from uvnav.bench import sections as sec
-    from uvnav.bench.reproduce_crowds import reproduce_crowds
+    from uvnav.bench.reproduce_crowds import crowds_section, reproduce_crowds
 
     sc = reproduce_crowds(
         results_dir,
@@ -253,7 +255,7 @@ def run_crowds(
         start_case=start_seed,
         progress=progress,
     )
-    return sec.crowds_section(sc), sc
+    return crowds_section(sc), sc
 
 
 def run_regime(
@@ -267,8 +269,7 @@ def run_regime(
 ) -> tuple[ChapterSection, Any]:
     """The regime map (:func:`uvnav.bench.regime.run_regime_map`: ``seeds`` seeds per regime and
     law from ``start_seed``) and its section."""
-    from uvnav.bench import sections as sec
-    from uvnav.bench.regime import run_regime_map
+    from uvnav.bench.regime import regime_section, run_regime_map
 
     rm = run_regime_map(
         results_dir,
@@ -278,7 +279,116 @@ def run_regime(
         start_seed=start_seed,
         progress=progress,
     )
-    return sec.regime_section(rm, full=full), rm
+    return regime_section(rm, full=full), rm
+
+
+# ------------------------------------------------------------------------------- uvnav run
+
+
+def reproduce_all(
+    results_dir: Path,
+    report_dir: Path,
+    *,
+    full: bool = False,
+    workers: int = 2,
+    progress: bool = True,
+    fresh: bool = False,
+    n_random: int | None = None,
+    start_seed: int = 0,
+    controllers: Sequence[str] | None = None,
+    baselines: Sequence[str] | None = None,
+    n_baseline_seeds: int | None = None,
+    n_crowd_seeds: int | None = None,
+    render: Any = None,
+    ch7: bool | None = None,
+    ch5: bool = False,
+    ch5_render: Callable[..., list[Path]] | None = None,
+    renderers: ChapterRenderers | None = None,
+    save_sections: bool = True,
+    crowds: bool | None = None,
+    regime: bool | None = None,
+) -> rp.ReproductionSummary:
+    """``uvnav run``: Chapter 2 (:func:`uvnav.bench.reproduce.run_ch2`), then the other chapters,
+    one report over all of them, every section saved.
+
+    After Chapter 2 come, in a real run (``n_random`` not given), the crowd section (every 2D law
+    on CrowdNav's crowds, after Chapter 2's ETH crowds), the regime map (the report's first
+    screen), the experiments beyond the thesis, Chapter 6 (the CNN that drives: at
+    :data:`uvnav.bench.reproduce_ch6.RUN_QUICK`'s size in quick mode, the thesis size with
+    ``full``; in ``results_dir/ch6-quick`` and ``results_dir/ch6``), Chapter 3, Chapter 7 and
+    Chapter 4; Chapter 5 with ``ch5``.  The table and the sections keep that order, sections in
+    report order (the thesis chapters, then "beyond").
+
+    Args:
+        results_dir, report_dir, full, workers, progress, n_random, start_seed, controllers,
+            baselines, n_baseline_seeds, n_crowd_seeds, render, save_sections: as
+            :func:`uvnav.bench.reproduce.reproduce` (``None``: its defaults).
+        fresh: rerun Chapter 6's finished stages (its files; stored episodes are never deleted).
+        ch7: also run Chapter 7 (:mod:`uvnav.bench.reproduce_ch7`); ``None`` = in a real run.
+        ch5: also run Chapter 5 (:func:`uvnav.bench.reproduce_ch5.reproduce_ch5`); ``ch5_render``
+            draws its figures into ``report_dir/ch5`` (default ``renderers.ch5``).
+        renderers: the other chapters' figure renderers (the CLI passes
+            :func:`uvnav.viz.reproduction.chapter_renderers`); each chapter's figures go to
+            ``report_dir/<chapter>`` and into its report section.
+        crowds: also run the crowd section; ``None`` = in a real run with baselines.
+        regime: also run the regime map; ``None`` = in a real run with baselines.
+
+    Returns:
+        The :class:`uvnav.bench.reproduce.ReproductionSummary` of the whole run.
+
+    Raises:
+        StaleCampaignError: a stored campaign cannot be resumed (see the module docstring).
+    """
+    tic = time.perf_counter()
+    base = rp.BASELINES if baselines is None else baselines
+    ch2 = rp.run_ch2(
+        results_dir, full=full, workers=workers, progress=progress, n_random=n_random,
+        start_seed=start_seed, controllers=rp.CONTROLLERS if controllers is None else controllers,
+        baselines=base, n_baseline_seeds=n_baseline_seeds, n_crowd_seeds=n_crowd_seeds,
+    )  # fmt: skip
+    table, sections, campaigns = list(ch2.table), [ch2.section], dict(ch2.campaigns)
+    rend = renderers or ChapterRenderers()
+    real_run = n_random is None  # test-sized runs (n_random given) leave the other chapters out
+    later: list[ChapterSection] = []  # what goes beyond the thesis comes after the chapters
+    by_key: dict[str, ChapterSection] = {}
+    dirs = (Path(results_dir), Path(report_dir))
+    kw: dict[str, Any] = {"full": full, "workers": workers}
+    if crowds if crowds is not None else (base and real_run):  # after the ETH crowds
+        sec_c, _ = run_crowds(dirs[0], **kw, progress=progress)
+        table += sec_c.rows
+        sections.append(sec_c)
+    if regime if regime is not None else (base and real_run):  # "which law, where"
+        sec_r, rm = run_regime(dirs[0], **kw, progress=progress)
+        campaigns["regime-map"] = rm.campaign
+        sections.append(sec_r)
+    if base and real_run:  # beyond the thesis (a real run, not a quick look)
+        sec_b, rows_b = run_beyond(dirs[1], full=full, renderers=rend)
+        table += rows_b
+        later.append(sec_b)
+    if real_run:  # Chapter 6 (CNN driving): the thesis size with --full, else RUN_QUICK's size
+        by_key["ch6"], s6 = run_ch6(
+            *dirs, full=full, renderers=rend, fresh=fresh, progress=progress
+        )
+        table += s6.table
+    if real_run:  # Chapter 3 (3D): scenes + random campaign rows
+        by_key["ch3"], s3 = run_ch3(*dirs, **kw, renderers=rend)
+        table += s3.table
+    if ch7 if ch7 is not None else real_run:
+        by_key["ch7"], s7 = run_ch7(*dirs, full=full, renderers=rend)
+        table += s7.table
+    if ch5:  # Chapter 5: BPNN experiment and closed-loop runs (needs the learning extra)
+        r5 = rend if ch5_render is None else dataclasses.replace(rend, ch5=ch5_render)
+        by_key["ch5"], s5 = run_ch5(*dirs, **kw, renderers=r5, progress=progress)
+        table += s5.table
+    if real_run:  # Chapter 4; tests that shrink the Chapter 2 campaign leave it out
+        by_key["ch4"], s4 = run_ch4(*dirs, **kw, renderers=rend)
+        table += s4.table
+    sections += [by_key[k] for k in ("ch3", "ch4", "ch5", "ch6", "ch7") if k in by_key]
+    sections += later
+    return rp.finish(
+        ch2, dirs[0], dirs[1], table=table, sections=sections, campaigns=campaigns,
+        render=render, save_sections=save_sections, started=tic,
+    )  # fmt: skip
 
 
 # ------------------------------------------------------------------------------- the dispatcher
@@ -340,13 +450,10 @@ def reproduce_chapter(
     summary: Any
     report_path: Path | None = None
     if chapter == "ch2":
-        from uvnav.bench import reproduce as rp
-
         n = seeds if seeds is not None else (rp.FULL_SEEDS if full else rp.QUICK_SEEDS)
         summary = rp.reproduce(
             results_dir, report_dir, full=full, workers=workers, progress=progress, n_random=n,
-            start_seed=start_seed, n_baseline_seeds=seeds, render=render, ch7=False, ch5=False,
-            save_sections=False,
+            start_seed=start_seed, n_baseline_seeds=seeds, render=render, save_sections=False,
         )  # fmt: skip
         section = next(s for s in summary.sections if s.key == "ch2")
         report_path = summary.report_path
@@ -397,21 +504,13 @@ def _rerun_section(key: str, why: str) -> ChapterSection:
 
 
 def _ch2_from_store(store: Any) -> ChapterSection | None:
-    from uvnav.bench import reproduce as rp
     from uvnav.bench.sections import rows_of
 
     cfg = next((c["config"] for c in store.campaigns() if c["name"] == rp.SCENES_CAMPAIGN), None)
     if cfg is None:
         return None
     scenes, ctrls = list(cfg.get("scenes", [])), list(cfg.get("controllers", []))
-    straight: float | None = None
-    if rp.COMPARISON_SCENE in scenes:
-        import numpy as np
-
-        import uvnav.scenarios as scenarios
-
-        setup = scenarios.build_episode(scenarios.load_scenario(rp.COMPARISON_SCENE), 0)
-        straight = float(np.hypot(*(np.asarray(setup.goal) - np.asarray(setup.start)[:2])))
+    straight = rp.comparison_straight_line(scenes)
     table, _ = rp.build_table(store, scenes, ctrls, straight_line=straight)
     if store.campaign_id(rp.BASELINES_CAMPAIGN) is not None:
         table += rp.comparison_rows(store)
@@ -492,7 +591,7 @@ def report_sections(db_path: Path) -> list[ChapterSection]:
             elif key == "crowds" and stored:
                 section = _crowds_from_store(store)
             elif key == "regime" and stored:
-                from uvnav.bench.sections import regime_section
+                from uvnav.bench.regime import regime_section
 
                 section = regime_section(None, full=False)
             if section is None and (stored or files):
@@ -513,6 +612,7 @@ __all__ = [
     "ChapterError",
     "ChapterRun",
     "report_sections",
+    "reproduce_all",
     "reproduce_chapter",
     "run_beyond",
     "run_ch3",

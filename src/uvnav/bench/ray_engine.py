@@ -1,12 +1,13 @@
 """Ray engine: a campaign's jobs as Ray tasks, results streamed back to the driver.
 
 The same tasks as on the local process pool — scene groups of picklable
-:class:`~uvnav.bench.campaign.Job` s (:func:`~uvnav.bench.campaign.scene_groups`: the jobs of one
+:class:`~uvnav.bench.jobs.Job` s (:func:`~uvnav.bench.campaign.scene_groups`: the jobs of one
 scene and seed go to one worker, which builds the scene once), as many groups to a task as run
-about :data:`~uvnav.bench.campaign.TASK_SECONDS` (a quarter of a second,
-:class:`~uvnav.bench.campaign.TaskSizer`), since each task costs Ray a fixed overhead — run
-:func:`~uvnav.bench.campaign.run_group_batch` as Ray tasks (one CPU each).  Workers only compute;
-each group's :class:`~uvnav.bench.campaign.JobOutcome` s come back to the driver, which writes
+about :data:`~uvnav.bench.jobs.TASK_SECONDS` (a quarter of a second,
+:class:`~uvnav.bench.jobs.TaskSizer`), since each task costs Ray a fixed overhead — run by the
+batch function the campaign passes in (:func:`~uvnav.bench.campaign.run_group_batch`) as Ray
+tasks (one CPU each).  Workers only compute;
+each group's :class:`~uvnav.bench.jobs.JobOutcome` s come back to the driver, which writes
 them to the SQLite store in one transaction (DESIGN §5) — exactly as with the local engine, so
 resume, progress and the stored metrics are the same whatever the engine.
 
@@ -41,14 +42,7 @@ from contextlib import contextmanager
 from types import ModuleType
 from typing import Any
 
-from uvnav.bench.campaign import (
-    TASK_SECONDS,
-    Job,
-    JobOutcome,
-    TaskSizer,
-    run_group_batch,
-    sized_batches,
-)
+from uvnav.bench.jobs import TASK_SECONDS, Job, JobOutcome, TaskSizer, sized_batches
 from uvnav.bench.store import STATUS_ERROR
 
 
@@ -157,6 +151,7 @@ def run_ray(
     groups: Sequence[Sequence[Job]],
     handle: Callable[[list[JobOutcome]], None],
     *,
+    run_batch: Callable[[Batch], list[list[JobOutcome]]],
     workers: int = 1,
     address: str | None = None,
     task_seconds: float = TASK_SECONDS,
@@ -164,8 +159,8 @@ def run_ray(
     """Run ``groups`` (scene groups, :func:`~uvnav.bench.campaign.scene_groups`) as Ray tasks,
     handing each group's outcomes to ``handle`` (in this process) as its task ends.
 
-    A task runs a batch of groups (:func:`~uvnav.bench.campaign.run_group_batch`), as many as
-    take about ``task_seconds`` (:class:`~uvnav.bench.campaign.TaskSizer`: one until the first
+    A task runs ``run_batch`` on a batch of groups, as many as
+    take about ``task_seconds`` (:class:`~uvnav.bench.jobs.TaskSizer`: one until the first
     come back).  A task that Ray cannot complete (its worker died, even after Ray's retries) is
     run again split (its groups one per task, a lone group's jobs one per task), so only the job
     that kills its worker is stored as an error.
@@ -173,6 +168,8 @@ def run_ray(
     Args:
         groups: the jobs, grouped by scene.
         handle: called with each group's outcomes, in completion order (it stores them).
+        run_batch: a module-level (picklable) function running a batch of groups in a worker
+            and returning each group's outcomes (:func:`uvnav.bench.campaign.run_group_batch`).
         workers: CPUs of the local Ray instance started here, and half the tasks kept in flight.
         address: Ray cluster to connect to (``"auto"``, ``"ray://host:10001"``...; default
             ``$RAY_ADDRESS``); none starts
@@ -199,7 +196,7 @@ def run_ray(
                 logging_level=logging.WARNING,
             )
         started = True
-    remote = ray.remote(num_cpus=1, max_retries=2)(run_group_batch)
+    remote = ray.remote(num_cpus=1, max_retries=2)(run_batch)
     window = 2 * max(1, workers)
     sizer = TaskSizer(task_seconds)
     queue = sized_batches(deque(list(g) for g in groups), sizer)

@@ -40,7 +40,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.campaign import Job
+from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
+from uvnav.bench.jobs import Job
+from uvnav.bench.reproduce_crowds import crowd_laws
+from uvnav.bench.sections import ChapterSection, mode_text
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
 
@@ -178,9 +181,6 @@ def run_regime_map(
     Raises:
         StaleCampaignError: the stored campaign was made by other code.
     """
-    from uvnav.bench.reproduce import DB_NAME, code_fingerprint, run_checked
-    from uvnav.bench.reproduce_crowds import crowd_laws
-
     tic = time.perf_counter()
     results_dir = Path(results_dir)
     results_dir.mkdir(parents=True, exist_ok=True)
@@ -496,6 +496,42 @@ def _slower(law: str) -> bool:
         return False
 
 
+# ------------------------------------------------------------------------------ the section
+
+
+def regime_section(summary: RegimeSummary | None, *, full: bool) -> ChapterSection:
+    """The regime map's section of the report from a run's :class:`RegimeSummary`
+    (``None``: rebuilt from the store, what was run unknown).  Its numbers are the report's first
+    screen ("Which law, where", drawn from the store), so the section only says what ran."""
+    if summary is None:
+        ran = "every stored cell and law"
+    else:
+        dens = ", ".join(str(d) for d in sorted({c.n_humans for c in summary.cells}))
+        speeds = ", ".join(f"{v:g}" for v in sorted({c.speed_ratio for c in summary.cells}))
+        noises = ", ".join(f"{z:g}" for z in sorted({c.noise for c in summary.cells}))
+        ran = (
+            f"{len(summary.cells)} regimes ({dens} humans; speed {speeds} x V_max; robot "
+            f"invisible and visible; sensing noise {noises} m), {summary.seeds} "
+            f"seed{'' if summary.seeds == 1 else 's'} per regime "
+            f"and law ({mode_text(full)}), laws {', '.join(summary.laws)}"
+        )
+    return ChapterSection(
+        key="regime",
+        title="Beyond the thesis — where each law wins (regime map)",
+        intro=(
+            f"Every 2D law on CrowdNav's circle crossing over crowd density x pedestrian speed / "
+            f"V_max x robot visible or not x sensing noise (campaign {CAMPAIGN}): {ran}. Every "
+            "law runs in every regime, beyond its declared assumption where the regime breaks it "
+            "(marked †)."
+        ),
+        notes=[
+            "The heat maps, the recommendation per regime and every cell's rates with 95 % "
+            "intervals are the first screen of this report ('Which law, where'), read from the "
+            "store."
+        ],
+    )
+
+
 __all__ = [
     "CAMPAIGN",
     "DENSITIES",
@@ -517,6 +553,7 @@ __all__ = [
     "ranking",
     "recommend",
     "regime_jobs",
+    "regime_section",
     "regimes",
     "run_regime_map",
 ]

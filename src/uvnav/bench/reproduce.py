@@ -1,42 +1,37 @@
-"""Thesis Chapter 2 reproduction: the job behind ``uvnav run`` (DESIGN §6).
+"""Thesis Chapter 2 reproduction: the first section of ``uvnav run`` and ``uvnav reproduce ch2``.
 
-:func:`reproduce` runs
+:func:`run_ch2` runs
 
 1. every built-in ``thesis-ch2-*`` scene (Figs. 2.7–2.10) with both ``zhang2019-v1`` (the thesis's
    law, Ch. 2 §2.3) and ``savkin-wang2013-v1`` (the baseline of thesis ref. [3.14]), seed 0, with
    trajectories recorded — campaign ``ch2-thesis-scenes``;
 2. a random campaign on ``random_ch2_scenario(seed)`` for seeds ``0..199`` (``1000`` with
    ``full=True``) with both laws — campaign ``ch2-random``;
+3. with baselines, the classical laws on the thesis scenes and random seeds (``ch2-baselines``)
+   and every law on the ETH crowd crossings (``crowds-eth``);
 
-and, in a real run (``n_random`` not given), the crowd section (every 2D law on CrowdNav's
-crowds, :mod:`uvnav.bench.reproduce_crowds`, after Chapter 2's ETH crowds), the regime map
-(:mod:`uvnav.bench.regime`, the report's first screen) and the other
-chapters' reproductions (Chapter 6, the
-CNN that drives: at :data:`uvnav.bench.reproduce_ch6.RUN_QUICK`'s size in quick mode, the
-thesis size with ``full=True``; in ``results_dir/ch6-quick`` and ``results_dir/ch6``);
+stores everything in ``results_dir/uvnav.sqlite`` and builds the table "thesis reported vs uvnav
+measured" whose *measured* column is read back from the stored episodes (never typed in).
+:func:`reproduce` is Chapter 2 alone: :func:`run_ch2`, then :func:`finish`, which hands the
+sections to a *renderer* passed in by the caller (the CLI passes
+:func:`uvnav.viz.reproduction.render_reproduction`) and saves them.  The other chapters of
+``uvnav run`` are :func:`uvnav.bench.chapters.reproduce_all`'s, which calls the same two steps.
 
-stores everything in ``results_dir/uvnav.sqlite``, and builds the table "thesis reported vs uvnav
-measured" whose *measured* column is read back from the stored episodes (never typed in).  Figures
-and the HTML report are then made by a *renderer* passed in by the caller
-(the CLI passes :func:`uvnav.viz.reproduction.render_reproduction`).
-
-Layering (DESIGN §1): ``bench`` (layer 6) sits below ``viz`` (layer 7) and must not import it, so
-``uvnav.viz`` sits above ``uvnav.bench`` in the layers (DESIGN §1), so this module never imports
-it: the renderer is injected (``render=``), which keeps the layer contract enforceable.
+Layering (DESIGN §1): ``uvnav.viz`` sits above ``uvnav.bench`` in the layers, so this module never
+imports it: the renderer is injected (``render=``), which keeps the layer contract enforceable.
 ``matplotlib`` is never imported here.
 
-Resume and staleness: both campaigns carry a fingerprint of the code and scenario files that decide
-episode outcomes (:func:`code_fingerprint`).  Re-running with unchanged code resumes (an interrupted
-run only finishes what is missing; a finished one costs nothing).  If the code changed since a
-campaign was stored, the run refuses (:class:`~uvnav.bench.store.StaleCampaignError`, one line
-naming the campaign to remove with ``uvnav forget``), so the table never mixes results of
-different code and no run deletes another run's episodes.
+Resume and staleness: every campaign carries a fingerprint of the code and scenario files that
+decide episode outcomes (:func:`uvnav.bench.fingerprint.code_fingerprint`).  Re-running with
+unchanged code resumes (an interrupted run only finishes what is missing; a finished one costs
+nothing).  If the code changed since a campaign was stored, the run refuses
+(:class:`~uvnav.bench.store.StaleCampaignError`, one line naming the campaign to remove with
+``uvnav forget``), so the table never mixes results of different code and no run deletes another
+run's episodes.
 """
 
 from __future__ import annotations
 
-import dataclasses
-import hashlib
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
@@ -45,9 +40,10 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.bench.campaign import Job, run_campaign
-from uvnav.bench.sections import ChapterRenderers, ChapterSection
-from uvnav.bench.store import STATUS_ERROR, ResultsStore, StaleCampaignError
+from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
+from uvnav.bench.jobs import Job
+from uvnav.bench.sections import SECTIONS_DIR, ChapterSection, ch2_section, save_section
+from uvnav.bench.store import STATUS_ERROR, ResultsStore
 
 CONTROLLERS: tuple[str, ...] = ("zhang2019-v1", "savkin-wang2013-v1")
 #: Classical baselines run beside the thesis's comparison (not in the thesis).
@@ -66,7 +62,6 @@ RANDOM_CAMPAIGN = "ch2-random"
 RANDOM_FAMILY = "random-ch2"
 QUICK_SEEDS = 200
 FULL_SEEDS = 1000
-DB_NAME = "uvnav.sqlite"
 
 #: Thesis Fig. 2.10 (Ch. 2 §2.4): path lengths [m] reported for the two laws on that scene.
 THESIS_PATH_LENGTH = {"zhang2019-v1": 14.9, "savkin-wang2013-v1": 15.7}
@@ -189,89 +184,6 @@ class ReproductionSummary:
     campaigns: dict[str, dict[str, Any]] = field(default_factory=dict)
     wall_time: float = 0.0
     sections: list[ChapterSection] = field(default_factory=list)
-
-
-#: Package parts whose code decides Ch. 2 episode outcomes (hashed by :func:`code_fingerprint`).
-FINGERPRINT_PARTS: tuple[str, ...] = (
-    "geometry",
-    "dynamics",
-    "obstacles",
-    "sensors",
-    "prediction",
-    "controllers",
-    "sim",
-    "scenarios",
-    "bench/campaign.py",
-)
-
-
-def code_fingerprint() -> str:
-    """Hash of the code and data that decide Chapter 2 episode outcomes.
-
-    Covers the sources and scenario files under :data:`FINGERPRINT_PARTS` and the numpy version
-    (results are bitwise only for one numpy); not ``viz``, ``cli`` or other chapters' packages, so
-    editing those does not invalidate stored results.
-
-    Returns:
-        16 hex digits.
-    """
-    import uvnav
-
-    root = Path(uvnav.__file__).parent
-    h = hashlib.sha256(f"{getattr(uvnav, '__version__', '')}|numpy {np.__version__}".encode())
-    for part in FINGERPRINT_PARTS:
-        base = root / part
-        paths = [base] if base.is_file() else sorted(base.rglob("*")) if base.is_dir() else []
-        for p in paths:
-            if not p.is_file() or p.suffix not in {".py", ".yaml", ".yml", ".json"}:
-                continue
-            if "__pycache__" in p.parts:
-                continue
-            h.update(str(p.relative_to(root)).encode())
-            h.update(p.read_bytes())
-    return h.hexdigest()[:16]
-
-
-def _check_campaigns(store: ResultsStore, configs: dict[str, dict[str, Any]]) -> None:
-    """Check that every stored campaign of ``configs`` (name -> config) was made by the same code
-    (fingerprint); never deletes one.
-
-    Raises:
-        StaleCampaignError: naming every stored campaign whose fingerprint differs (its episodes
-            cannot be resumed and would be mixed with new ones; the user removes them).
-    """
-    stale = []
-    for c in store.campaigns():
-        cfg = configs.get(c["name"])
-        if cfg is not None and c["config"].get("fingerprint") != cfg["fingerprint"]:
-            stale.append(c["name"])
-    if stale:
-        raise StaleCampaignError(
-            store.path, stale, f"{'was' if len(stale) == 1 else 'were'} stored by other code"
-        )
-
-
-def run_checked(
-    store: ResultsStore,
-    plans: Sequence[tuple[str, dict[str, Any], list[Job]]],
-    *,
-    workers: int,
-    progress: bool,
-    statuses: bool = False,
-) -> dict[str, dict[str, Any]]:
-    """Check the stored campaigns of ``plans`` ((name, config, jobs); :func:`_check_campaigns`),
-    then run each; returns name -> its counts: jobs, ran, skipped, errors, the status counts (with
-    ``statuses``) and the wall time [s]."""
-    _check_campaigns(store, {name: cfg for name, cfg, _ in plans})
-    out: dict[str, dict[str, Any]] = {}
-    for name, cfg, jobs in plans:
-        run = run_campaign(store, name, jobs, config=cfg, workers=workers, progress=progress)
-        counts: dict[str, Any] = {"jobs": run.total, "ran": run.ran, "skipped": run.skipped}
-        counts["errors"] = run.errors
-        if statuses:
-            counts["statuses"] = dict(run.statuses)
-        out[name] = {**counts, "wall_time": round(run.wall_time, 2)}
-    return out
 
 
 def _fmt_m(x: Any, digits: int = 2) -> str:
@@ -463,183 +375,164 @@ def comparison_rows(store: ResultsStore) -> list[dict[str, str]]:
     return rows
 
 
-def reproduce(
+@dataclass
+class Ch2Run:
+    """What :func:`run_ch2` ran and measured.
+
+    Attributes:
+        db_path: the results database.
+        table: Chapter 2's rows of the table (and, with baselines, the comparison rows).
+        failures: ``(controller, seed, status)`` of every random-campaign episode that failed.
+        scenes: the thesis scenes run.
+        scene_episodes: the recorded thesis-scene episodes (one figure each).
+        campaigns: per campaign: ``ran``, ``skipped``, ``errors``, ``wall_time`` [s].
+        section: Chapter 2's report section (the renderer adds its figures).
+    """
+
+    db_path: Path
+    table: list[dict[str, str]]
+    failures: list[tuple[str, int, str]]
+    scenes: list[str]
+    scene_episodes: list[SceneEpisode]
+    campaigns: dict[str, dict[str, Any]]
+    section: ChapterSection
+
+
+def _plans(
+    scenes: list[str],
+    ctrls: list[str],
+    base: list[str],
+    *,
+    seeds: range,
+    baseline_seeds: range,
+    n_crowd: int,
+    with_baselines: bool,
+    fp: str,
+) -> list[tuple[str, dict[str, Any], list[Job]]]:
+    """Chapter 2's campaigns: (name, config, jobs) of the thesis scenes, the random scenes and,
+    ``with_baselines``, the baselines and the ETH crowds."""
+    scene_cfg = {"chapter": 2, "scenes": scenes, "controllers": ctrls, "seed": 0, "fingerprint": fp}
+    random_cfg = {"chapter": 2, "generator": RANDOM_FAMILY, "controllers": ctrls, "fingerprint": fp}
+    plans = [
+        (
+            SCENES_CAMPAIGN,
+            scene_cfg,
+            [Job(controller=c, seed=0, scenario=s, record=True) for s in scenes for c in ctrls],
+        ),
+        (
+            RANDOM_CAMPAIGN,
+            random_cfg,
+            [Job(controller=c, seed=g, generator_seed=g) for g in seeds for c in ctrls],
+        ),
+    ]
+    if not with_baselines:
+        return plans
+    base_cfg = {
+        "chapter": 2,
+        "scenes": scenes,
+        "generator": RANDOM_FAMILY,
+        "controllers": base,
+        "seeds": len(baseline_seeds),
+        "fingerprint": fp,
+    }
+    base_jobs = [Job(controller=c, seed=0, scenario=s) for s in scenes for c in base] + [
+        Job(controller=c, seed=g, generator_seed=g) for g in baseline_seeds for c in base
+    ]
+    crowd_ctrls = [*ctrls, *base]
+    crowd_cfg = {
+        "generators": list(CROWD_GENERATORS),
+        "v_max": CROWD_V_MAX,
+        "controllers": crowd_ctrls,
+        "seeds": n_crowd,
+        "fingerprint": fp,
+    }
+    crowd_jobs = [
+        Job(
+            controller=c,
+            seed=g,
+            generator=gen,
+            generator_seed=g,
+            generator_params={"v_max": CROWD_V_MAX},
+            # measured where people often walk faster than V_max: the laws that assume slower
+            # obstacles are run beyond that assumption on purpose
+            beyond_assumptions=True,
+        )
+        for gen in CROWD_GENERATORS
+        for g in range(n_crowd)
+        for c in crowd_ctrls
+    ]
+    return [
+        *plans,
+        (BASELINES_CAMPAIGN, base_cfg, base_jobs),
+        (CROWD_CAMPAIGN, crowd_cfg, crowd_jobs),
+    ]
+
+
+def _thesis_scenes() -> list[str]:
+    """The built-in ``thesis-ch2-*`` scenes, in the order of :data:`SCENE_LABELS`."""
+    import uvnav.scenarios as scenarios
+
+    order = list(SCENE_LABELS)
+    return sorted(
+        (n for n in scenarios.list_builtin() if n.startswith(THESIS_PREFIX)),
+        key=lambda n: (order.index(n) if n in order else len(order), n),
+    )
+
+
+def comparison_straight_line(scenes: Sequence[str]) -> float | None:
+    """The I–T distance of the comparison scene [m] (``None`` when it is not among ``scenes``)."""
+    if COMPARISON_SCENE not in scenes:
+        return None
+    import uvnav.scenarios as scenarios
+
+    setup = scenarios.build_episode(scenarios.load_scenario(COMPARISON_SCENE), 0)
+    return float(np.hypot(*(np.asarray(setup.goal) - np.asarray(setup.start)[:2])))
+
+
+def run_ch2(
     results_dir: Path,
-    report_dir: Path,
     *,
     full: bool = False,
     workers: int = 2,
     progress: bool = True,
-    fresh: bool = False,
     n_random: int | None = None,
     start_seed: int = 0,
     controllers: Sequence[str] = CONTROLLERS,
     baselines: Sequence[str] = BASELINES,
     n_baseline_seeds: int | None = None,
     n_crowd_seeds: int | None = None,
-    render: Renderer | None = None,
-    ch7: bool | None = None,
-    ch5: bool = False,
-    ch5_render: Callable[..., list[Path]] | None = None,
-    renderers: ChapterRenderers | None = None,
-    save_sections: bool = True,
-    crowds: bool | None = None,
-    regime: bool | None = None,
-) -> ReproductionSummary:
-    """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
+) -> Ch2Run:
+    """Run Chapter 2's campaigns into ``results_dir/uvnav.sqlite`` and build its table and section.
 
-    Args:
-        results_dir: folder of the results database ``uvnav.sqlite`` (created).
-        report_dir: folder of ``index.html`` and the figures (created).
-        full: thesis-size random campaign (1000 seeds instead of 200).
-        workers: worker processes (1 = in-process).
-        progress: show rich progress bars on stderr.
-        fresh: rerun Chapter 6's finished stages (its files; stored episodes are never deleted).
-        n_random: override the number of random seeds (tests, quick looks).
-        start_seed: first random seed of the random and baseline campaigns.
-        baselines: classical controllers run beside the thesis's two laws: on the thesis scenes
-            and a subset of the random seeds (campaign ``ch2-baselines``), and with the two laws
-            on crowd crossings of the ETH recordings (campaign ``crowds-eth``); empty to skip both.
-        n_baseline_seeds: random seeds for the baselines (default the random campaign's: the
-            baselines and the thesis's laws are compared on the same seeds).
-        n_crowd_seeds: seeds per crowd generator (default 8 quick, 50 full).
-        controllers: laws to run (default both Ch. 2 laws).
-        render: renderer callable (e.g. ``uvnav.viz.reproduction.render_reproduction``);
-            ``None`` skips figures and report.
-        ch7: also run the thesis Ch. 7 reconnaissance experiments
-            (:mod:`uvnav.bench.reproduce_ch7`, rows appended to the table); ``None`` = only when
-            ``n_random`` is not given (test-sized runs skip it).
-        ch5: also run the Chapter 5 reproduction (:func:`uvnav.bench.reproduce_ch5.reproduce_ch5`;
-            its rows join the table); ``ch5_render`` draws its figures into ``report_dir/ch5``.
-        renderers: the other chapters' figure renderers (the CLI passes
-            :func:`uvnav.viz.reproduction.chapter_renderers`); each chapter's figures go to
-            ``report_dir/chN`` (issue 9: ``report_dir/beyond``) and into its report section.
-            ``renderers.ch5`` is used when ``ch5_render`` is not given.
-        save_sections: save every section in ``results_dir/sections`` (so ``uvnav report`` and
-            ``uvnav reproduce CH`` show them beside later single-chapter runs).
-        crowds: also run every 2D law on CrowdNav's crowds (campaigns ``crowdnav`` and
-            ``crowdnav-beyond``, :mod:`uvnav.bench.reproduce_crowds`; quick or full size), its
-            section after Chapter 2's; ``None`` = in a real run with baselines.
-        regime: also run the regime map (:mod:`uvnav.bench.regime`: every 2D law over crowd
-            density x pedestrian speed x visibility x sensing noise, quick or full size; the
-            report's first screen); ``None`` = in a real run with baselines.
-
-    Returns:
-        The summary: table, database and report paths, random-campaign failures.
+    Args: as :func:`reproduce`'s.
 
     Raises:
-        ImportError: :mod:`uvnav.scenarios` is not available.
+        StaleCampaignError: a stored Chapter 2 campaign was made by other code.
     """
-    import uvnav.scenarios as scenarios
-
-    tic = time.perf_counter()
     results_dir = Path(results_dir)
-    report_dir = Path(report_dir)
     results_dir.mkdir(parents=True, exist_ok=True)
     db_path = results_dir / DB_NAME
     n_seeds = n_random if n_random is not None else (FULL_SEEDS if full else QUICK_SEEDS)
-    order = list(SCENE_LABELS)
-    scenes = sorted(
-        (n for n in scenarios.list_builtin() if n.startswith(THESIS_PREFIX)),
-        key=lambda n: (order.index(n) if n in order else len(order), n),
-    )
-    fp = code_fingerprint()
+    n_base = n_baseline_seeds if n_baseline_seeds is not None else n_seeds
+    n_crowd = n_crowd_seeds
+    if n_crowd is None:
+        n_crowd = FULL_CROWD_SEEDS if full else QUICK_CROWD_SEEDS
+    scenes = _thesis_scenes()
     ctrls = list(controllers)
-    summary_campaigns: dict[str, dict[str, Any]] = {}
-
+    base = [b for b in baselines if b not in ctrls]
+    plans = _plans(
+        scenes,
+        ctrls,
+        base,
+        seeds=range(start_seed, start_seed + n_seeds),
+        baseline_seeds=range(start_seed, start_seed + n_base),
+        n_crowd=n_crowd,
+        with_baselines=bool(baselines),
+        fp=code_fingerprint(),
+    )
     with ResultsStore(db_path) as store:
-        scene_cfg = {
-            "chapter": 2,
-            "scenes": scenes,
-            "controllers": ctrls,
-            "seed": 0,
-            "fingerprint": fp,
-        }
-        random_cfg = {
-            "chapter": 2,
-            "generator": RANDOM_FAMILY,
-            "controllers": ctrls,
-            "fingerprint": fp,
-        }
-        plans = [
-            (
-                SCENES_CAMPAIGN,
-                scene_cfg,
-                [Job(controller=c, seed=0, scenario=s, record=True) for s in scenes for c in ctrls],
-            ),
-            (
-                RANDOM_CAMPAIGN,
-                random_cfg,
-                [
-                    Job(controller=c, seed=g, generator_seed=g)
-                    for g in range(start_seed, start_seed + n_seeds)
-                    for c in ctrls
-                ],
-            ),
-        ]
-        n_base = n_baseline_seeds if n_baseline_seeds is not None else n_seeds
-        n_crowd = (
-            n_crowd_seeds
-            if n_crowd_seeds is not None
-            else (FULL_CROWD_SEEDS if full else QUICK_CROWD_SEEDS)
-        )
-        base = [b for b in baselines if b not in ctrls]
-        if baselines:
-            plans.append(
-                (
-                    BASELINES_CAMPAIGN,
-                    {
-                        "chapter": 2,
-                        "scenes": scenes,
-                        "generator": RANDOM_FAMILY,
-                        "controllers": base,
-                        "seeds": n_base,
-                        "fingerprint": fp,
-                    },
-                    [Job(controller=c, seed=0, scenario=s) for s in scenes for c in base]
-                    + [
-                        Job(controller=c, seed=g, generator_seed=g)
-                        for g in range(start_seed, start_seed + n_base)
-                        for c in base
-                    ],
-                )
-            )
-            crowd_ctrls = [*ctrls, *base]
-            plans.append(
-                (
-                    CROWD_CAMPAIGN,
-                    {
-                        "generators": list(CROWD_GENERATORS),
-                        "v_max": CROWD_V_MAX,
-                        "controllers": crowd_ctrls,
-                        "seeds": n_crowd,
-                        "fingerprint": fp,
-                    },
-                    [
-                        Job(
-                            controller=c,
-                            seed=g,
-                            generator=gen,
-                            generator_seed=g,
-                            generator_params={"v_max": CROWD_V_MAX},
-                            # measured where people often walk faster than V_max: the laws that
-                            # assume slower obstacles are run beyond that assumption on purpose
-                            beyond_assumptions=True,
-                        )
-                        for gen in CROWD_GENERATORS
-                        for g in range(n_crowd)
-                        for c in crowd_ctrls
-                    ],
-                )
-            )
-        summary_campaigns.update(
-            run_checked(store, plans, workers=workers, progress=progress, statuses=True)
-        )
-
-        straight: float | None = None
-        if COMPARISON_SCENE in scenes:
-            setup = scenarios.build_episode(scenarios.load_scenario(COMPARISON_SCENE), 0)
-            straight = float(np.hypot(*(np.asarray(setup.goal) - np.asarray(setup.start)[:2])))
+        campaigns = run_checked(store, plans, workers=workers, progress=progress, statuses=True)
+        straight = comparison_straight_line(scenes)
         table, failures = build_table(store, scenes, ctrls, straight_line=straight)
         if baselines:
             table += comparison_rows(store)
@@ -650,79 +543,46 @@ def reproduce(
                 if eid is not None:
                     status = str(store.episode_row(eid)["status"])
                     scene_episodes.append(SceneEpisode(s, c, 0, eid, status))
+    section = ch2_section(
+        table,
+        scenes=scenes,
+        controllers=ctrls,
+        n_random=n_seeds,
+        start_seed=start_seed,
+        baselines=base,
+        n_baseline=n_base,
+        n_crowd=n_crowd,
+        crowd_generators=CROWD_GENERATORS,
+        crowd_v_max=CROWD_V_MAX,
+        full=full,
+    )
+    return Ch2Run(db_path, table, failures, scenes, scene_episodes, campaigns, section)
 
-    from uvnav.bench import sections as sec
 
-    rend = renderers or ChapterRenderers()
-    sections: list[ChapterSection] = [
-        sec.ch2_section(
-            table,
-            scenes=scenes,
-            controllers=ctrls,
-            n_random=n_seeds,
-            start_seed=start_seed,
-            baselines=base,
-            n_baseline=n_base,
-            n_crowd=n_crowd,
-            crowd_generators=CROWD_GENERATORS,
-            crowd_v_max=CROWD_V_MAX,
-            full=full,
-        )
-    ]
-    real_run = n_random is None  # test-sized runs (n_random given) leave the other chapters out
-    later: list[ChapterSection] = []  # issue 9 goes after the thesis chapters
-    by_key: dict[str, ChapterSection] = {}
-    from uvnav.bench import chapters
-
-    if crowds if crowds is not None else (baselines and real_run):  # after the ETH crowds
-        sec_c, _ = chapters.run_crowds(results_dir, full=full, workers=workers, progress=progress)
-        table += sec_c.rows
-        sections.append(sec_c)
-    if regime if regime is not None else (baselines and real_run):  # "which law, where"
-        sec_r, rm = chapters.run_regime(results_dir, full=full, workers=workers, progress=progress)
-        summary_campaigns["regime-map"] = rm.campaign
-        sections.append(sec_r)
-    if baselines and real_run:  # beyond the thesis (a real run, not a quick look)
-        sec_b, rows_b = chapters.run_beyond(report_dir, full=full, renderers=rend)
-        table += rows_b
-        later.append(sec_b)
-    if real_run:  # Chapter 6 (CNN driving): the thesis size with --full, else RUN_QUICK's size
-        by_key["ch6"], s6 = chapters.run_ch6(
-            results_dir, report_dir, full=full, renderers=rend, fresh=fresh, progress=progress
-        )
-        table += s6.table
-    if real_run:  # thesis Ch. 3 (3D): scenes + random campaign rows (bench/reproduce_ch3)
-        by_key["ch3"], s3 = chapters.run_ch3(
-            results_dir, report_dir, full=full, workers=workers, renderers=rend
-        )
-        table += s3.table
-    run_ch7 = ch7 if ch7 is not None else real_run
-    if run_ch7:  # thesis Ch. 7 (issue 8)
-        by_key["ch7"], s7 = chapters.run_ch7(results_dir, report_dir, full=full, renderers=rend)
-        table += s7.table
-    if ch5:  # thesis Chapter 5: BPNN experiment and closed-loop runs (needs the learning extra)
-        r5 = rend if ch5_render is None else dataclasses.replace(rend, ch5=ch5_render)
-        by_key["ch5"], s5 = chapters.run_ch5(
-            results_dir, report_dir, full=full, workers=workers, renderers=r5, progress=progress
-        )
-        table += s5.table
-    if real_run:  # Chapter 4 (issue 5); tests that shrink the Ch. 2 campaign leave it out
-        by_key["ch4"], s4 = chapters.run_ch4(
-            results_dir, report_dir, full=full, workers=workers, renderers=rend
-        )
-        table = table + s4.table
-    sections += [by_key[k] for k in ("ch3", "ch4", "ch5", "ch6", "ch7") if k in by_key]
-    sections += later
+def finish(
+    ch2: Ch2Run,
+    results_dir: Path,
+    report_dir: Path,
+    *,
+    table: list[dict[str, str]],
+    sections: list[ChapterSection],
+    campaigns: dict[str, dict[str, Any]],
+    render: Renderer | None,
+    save_sections: bool,
+    started: float,
+) -> ReproductionSummary:
+    """Render the report (``render``: Chapter 2's figures, then the page with ``sections`` and
+    ``table``), save every section in ``results_dir/sections`` (``save_sections``) and sum up;
+    ``started`` is the run's :func:`time.perf_counter` at its start."""
     report_path: Path | None = None
     figures: list[Path] = []
     if render is not None:
-        renderer = render
-        out = renderer(
+        out = render(
             RenderRequest(
-                db_path=db_path,
-                report_dir=report_dir,
-                scene_episodes=scene_episodes,
-                comparison_scene=COMPARISON_SCENE if COMPARISON_SCENE in scenes else None,
+                db_path=ch2.db_path,
+                report_dir=Path(report_dir),
+                scene_episodes=ch2.scene_episodes,
+                comparison_scene=COMPARISON_SCENE if COMPARISON_SCENE in ch2.scenes else None,
                 random_campaign=RANDOM_CAMPAIGN,
                 table=table,
                 sections=sections,
@@ -731,14 +591,70 @@ def reproduce(
         report_path, figures = out.report_path, list(out.figures)
     if save_sections:  # after rendering: the renderer adds the Chapter 2 figures to its section
         for section in sections:
-            sec.save_section(section, results_dir / sec.SECTIONS_DIR)
+            save_section(section, Path(results_dir) / SECTIONS_DIR)
     return ReproductionSummary(
         table=table,
-        db_path=db_path,
+        db_path=ch2.db_path,
         report_path=report_path,
-        failures=failures,
+        failures=ch2.failures,
         figures=figures,
-        campaigns=summary_campaigns,
-        wall_time=time.perf_counter() - tic,
+        campaigns=campaigns,
+        wall_time=time.perf_counter() - started,
         sections=sections,
     )
+
+
+def reproduce(
+    results_dir: Path,
+    report_dir: Path,
+    *,
+    full: bool = False,
+    workers: int = 2,
+    progress: bool = True,
+    n_random: int | None = None,
+    start_seed: int = 0,
+    controllers: Sequence[str] = CONTROLLERS,
+    baselines: Sequence[str] = BASELINES,
+    n_baseline_seeds: int | None = None,
+    n_crowd_seeds: int | None = None,
+    render: Renderer | None = None,
+    save_sections: bool = True,
+) -> ReproductionSummary:
+    """Reproduce thesis Chapter 2: thesis scenes and a random campaign, table, figures, report.
+
+    Args:
+        results_dir: folder of the results database ``uvnav.sqlite`` (created).
+        report_dir: folder of ``index.html`` and the figures (created by the renderer).
+        full: thesis-size random campaign (1000 seeds instead of 200).
+        workers: worker processes (1 = in-process).
+        progress: show rich progress bars on stderr.
+        n_random: override the number of random seeds (tests, quick looks).
+        start_seed: first random seed of the random and baseline campaigns.
+        controllers: laws to run (default both Ch. 2 laws).
+        baselines: classical controllers run beside the thesis's two laws: on the thesis scenes
+            and a subset of the random seeds (campaign ``ch2-baselines``), and with the two laws
+            on crowd crossings of the ETH recordings (campaign ``crowds-eth``); empty to skip both.
+        n_baseline_seeds: random seeds for the baselines (default the random campaign's: the
+            baselines and the thesis's laws are compared on the same seeds).
+        n_crowd_seeds: seeds per crowd generator (default 8 quick, 50 full).
+        render: renderer callable (e.g. ``uvnav.viz.reproduction.render_reproduction``);
+            ``None`` skips figures and report.
+        save_sections: save the section in ``results_dir/sections`` (so ``uvnav report`` and
+            ``uvnav reproduce CH`` show it beside later single-chapter runs).
+
+    Returns:
+        The summary: table, database and report paths, random-campaign failures.
+
+    Raises:
+        StaleCampaignError: a stored Chapter 2 campaign was made by other code.
+    """
+    tic = time.perf_counter()
+    ch2 = run_ch2(
+        results_dir, full=full, workers=workers, progress=progress, n_random=n_random,
+        start_seed=start_seed, controllers=controllers, baselines=baselines,
+        n_baseline_seeds=n_baseline_seeds, n_crowd_seeds=n_crowd_seeds,
+    )  # fmt: skip
+    return finish(
+        ch2, results_dir, report_dir, table=ch2.table, sections=[ch2.section],
+        campaigns=dict(ch2.campaigns), render=render, save_sections=save_sections, started=tic,
+    )  # fmt: skip

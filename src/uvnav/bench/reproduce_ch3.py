@@ -44,6 +44,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.bench.campaign import run_in_workers
+from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.store import ResultsStore, params_hash
 
 CONTROLLERS_3D: tuple[str, ...] = ("zhang2020-3d-v1", "apf3d-v1", "vo3d-v1")
@@ -65,7 +66,6 @@ PREDICTION_ARMS: dict[str, str] = {
 PREDICTION_MIN_SEEDS = 20
 #: horizons [periods T_s] of :func:`horizon_errors`
 HORIZONS: tuple[int, ...] = (1, 3)
-DB_NAME = "uvnav.sqlite"
 
 #: What the thesis reports for its Chapter 3 experiments (§3.4).
 THESIS_CLAIMS: dict[str, str] = {

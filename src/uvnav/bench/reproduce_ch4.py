@@ -56,6 +56,7 @@ from uvnav.bench.campaign import (
     store_outcome,
     stored_records,
 )
+from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.store import ResultsStore
 from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.base import make_law
@@ -76,7 +77,6 @@ QUICK_SEEDS, FULL_SEEDS = 10, 200
 QUICK_NOISE_SEEDS, FULL_NOISE_SEEDS = 4, 50
 QUICK_HARD_SEEDS, FULL_HARD_SEEDS = 4, 100
 HARD_FAMILY = "random-ch4-hard"
-DB_NAME = "uvnav.sqlite"  # the same results database as ``uvnav run`` and Chapter 3
 SCENES_CAMPAIGN = "ch4-thesis-scenes"
 RANDOM_CAMPAIGN = "ch4-random"
 NOISE_CAMPAIGN = "ch4-noise"

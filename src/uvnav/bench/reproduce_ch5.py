@@ -79,6 +79,7 @@ from uvnav.bench.campaign import (
     store_outcome,
     stored_records,
 )
+from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.store import EpisodeKey, ResultsStore
 from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.zhang_uuv3d import (
@@ -159,7 +160,6 @@ def split_model_key(key: str) -> tuple[int, str] | None:
 #: tessellation level of the sampled obstacles (320 triangles: readings and targets are computed
 #: on the same mesh, so the data are consistent; the mesh is within a few cm of the analytic body)
 DATA_SUBDIVISIONS = 2
-DB_NAME = "uvnav.sqlite"  # the results database of ``uvnav run`` (Chapters 2-4 too)
 SCENES_CAMPAIGN = "ch5-thesis-scenes"
 RANDOM_CAMPAIGN = "ch5-random"
 NOISE_CAMPAIGN = "ch5-noise"

@@ -21,9 +21,9 @@ beyond that assumption, in a separate campaign :data:`BEYOND_CAMPAIGN` whose row
 ``zhang2019-v1`` inside and inherits that law's assumption (``ControllerInfo.inner_law``), so it is
 refused and run beyond like it.
 
-Both campaigns live in the results store ``results_dir/uvnav.sqlite``, carry the Ch. 2 code
-fingerprint (:func:`uvnav.bench.reproduce.code_fingerprint`) and only add: a second run skips every
-stored episode; a campaign stored by other code is refused
+Both campaigns live in the results store ``results_dir/uvnav.sqlite``, carry the code
+fingerprint (:func:`uvnav.bench.fingerprint.code_fingerprint`) and only add: a second run skips
+every stored episode; a campaign stored by other code is refused
 (:class:`~uvnav.bench.store.StaleCampaignError`).  The table shows the run's own cases (those it
 ran or found stored); ``uvnav report`` rebuilds it from every stored case (:func:`crowd_rows`).
 """
@@ -36,7 +36,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.campaign import Job
+from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
+from uvnav.bench.jobs import Job
+from uvnav.bench.sections import ChapterSection, mode_text, rows_of
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
 
@@ -133,8 +135,6 @@ def reproduce_crowds(
     Raises:
         StaleCampaignError: a stored crowd campaign was made by other code.
     """
-    from uvnav.bench.reproduce import DB_NAME, code_fingerprint, run_checked
-
     tic = time.perf_counter()
     results_dir = Path(results_dir)
     results_dir.mkdir(parents=True, exist_ok=True)
@@ -314,6 +314,50 @@ def eth_rows(store: ResultsStore) -> list[dict[str, str]]:
     return rows
 
 
+# ------------------------------------------------------------------------------ the section
+
+
+def crowds_section(summary: CrowdsSummary) -> ChapterSection:
+    """The crowd section of the report from a run's :class:`CrowdsSummary`."""
+    first, last = summary.start_case, summary.start_case + summary.cases - 1
+    size = (
+        f"{summary.cases} test cases per scene (cases {first}–{last}"
+        + (
+            f"; the quick size, CrowdNav's test set is {FULL_CASES} cases: --full"
+            if not summary.full and summary.cases < FULL_CASES
+            else ""
+        )
+        + ")"
+    )
+    intro = (
+        f"CrowdNav's crowds ({mode_text(summary.full)}): every 2D law on CrowdNav's circle and "
+        f"square crossing (Chen, Liu, Kreiss, Alahi, ICRA 2019; five ORCA pedestrians at 1 m/s "
+        f"who do not see the robot, robot V_max 1 m/s, 24 s), {size}: "
+        f"{', '.join(summary.laws)}. Success and collision rates with 95 % Wilson intervals; "
+        "the paper's ORCA figure stands beside orca-holonomic-v1 on circle crossing (CrowdNav's "
+        "robot ORCA). The notes give the social metrics: mean share of decisions closer than "
+        "0.2 m, mean time closer than 0.45 m, min separation, and the share of the collisions a "
+        "pedestrian closed (these pedestrians do not avoid the robot). When the store holds the "
+        "ETH crowd campaign of Chapter 2 (real pedestrians, replayed), its walkways follow in the "
+        "same form. Laws that assume "
+        "obstacles slower than the robot (thesis (2.6)) are refused here, and shown as refused: "
+        "the pedestrians walk at the robot's speed, so their guarantees do not apply."
+    )
+    if summary.beyond:
+        intro += (
+            f" Because the thesis's laws are this library's subject, {', '.join(summary.beyond)} "
+            "also ran beyond that assumption, as a separate row group ('beyond assumption "
+            "(2.6)', campaign crowdnav-beyond), as in the ETH crowd campaign of Chapter 2 "
+            "(hybrid-v1 drives with zhang2019-v1 inside and inherits its assumption)."
+        )
+    return ChapterSection(
+        key="crowds",
+        title="Beyond the thesis — CrowdNav's crowds, every 2D law",
+        intro=intro,
+        rows=rows_of(summary.table),
+    )
+
+
 __all__ = [
     "BEYOND_CAMPAIGN",
     "CAMPAIGN",
@@ -326,6 +370,7 @@ __all__ = [
     "crowd_jobs",
     "crowd_laws",
     "crowd_rows",
+    "crowds_section",
     "eth_rows",
     "reproduce_crowds",
 ]

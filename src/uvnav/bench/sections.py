@@ -1,21 +1,26 @@
-"""One report section per thesis chapter: the contract between ``uvnav run`` and the HTML report.
+"""One report section per chapter: the contract between the reproductions and the HTML report.
 
-:func:`uvnav.bench.reproduce.reproduce` runs every chapter's reproduction (``reproduce_chN``) and
-turns what each returns (its summary object: ``.table`` rows, ``.figures`` files) into a
-:class:`ChapterSection` with one of the ``*_section`` builders below; the renderer
-(:func:`uvnav.viz.reproduction.render_reproduction`) hands the sections to
+Each chapter's run (:mod:`uvnav.bench.chapters`: ``uvnav run`` and ``uvnav reproduce CH``) turns
+what its reproduction returns (its summary object: ``.table`` rows, ``.figures`` files) into a
+:class:`ChapterSection` with a ``*_section`` builder: the thesis chapters' builders are here, the
+crowd section's and the regime map's beside their runs
+(:func:`uvnav.bench.reproduce_crowds.crowds_section`, :func:`uvnav.bench.regime.regime_section`).
+The renderer (:func:`uvnav.viz.reproduction.render_reproduction`) hands the sections to
 :func:`uvnav.viz.report.write_report`, which gives each a heading, its intro paragraph, its rows of
 the "thesis reported vs uvnav measured" table, its figures with captions and links to its other
-files (interactive 3D views, JSON results).
+files (interactive 3D views, JSON results).  :func:`save_section` and :func:`load_sections` keep
+the last section of every chapter next to the results database, in :data:`SECTION_ORDER`.
 
 Figures are *drawn* only in ``viz`` (layer 7), above this module: chapters whose figures need a
 renderer receive it injected through :class:`ChapterRenderers` (the CLI builds one with
 :func:`uvnav.viz.reproduction.chapter_renderers`), so ``bench`` never imports ``viz`` (DESIGN §1).
 
-To add a section: write a builder ``chN_section(summary, *, full) -> ChapterSection`` here (intro
-from the run's parameters, rows from ``summary.table``, figures from ``summary.figures`` with
-:func:`caption_files`), call it in :func:`uvnav.bench.reproduce.reproduce` after the chapter ran,
-and append the result to the list of sections; nothing else changes.
+To add a section: a builder ``<key>_section(summary, *, full) -> ChapterSection`` (intro from the
+run's parameters, rows from ``summary.table``, figures from ``summary.figures`` with
+:func:`caption_files`), a runner ``run_<key>`` and its entries in :data:`uvnav.bench.chapters.
+CHAPTERS` and :func:`~uvnav.bench.chapters.reproduce_chapter`'s dispatch, the key in
+:data:`SECTION_ORDER`, and, for ``uvnav run``, a call in
+:func:`uvnav.bench.chapters.reproduce_all`.
 """
 
 from __future__ import annotations
@@ -510,90 +515,6 @@ def beyond_section(
     if not sec.figures:
         sec.notes.append("No figures: the run had no beyond-the-thesis renderer.")
     return sec
-
-
-# ----------------------------------------------------------------------------- CrowdNav's crowds
-
-
-def crowds_section(summary: Any) -> ChapterSection:
-    """The crowd section (issue 18) from a :class:`uvnav.bench.reproduce_crowds.CrowdsSummary`."""
-    from uvnav.bench import reproduce_crowds as rc
-
-    first, last = summary.start_case, summary.start_case + summary.cases - 1
-    size = (
-        f"{summary.cases} test cases per scene (cases {first}–{last}"
-        + (
-            f"; the quick size, CrowdNav's test set is {rc.FULL_CASES} cases: --full"
-            if not summary.full and summary.cases < rc.FULL_CASES
-            else ""
-        )
-        + ")"
-    )
-    intro = (
-        f"CrowdNav's crowds ({mode_text(summary.full)}): every 2D law on CrowdNav's circle and "
-        f"square crossing (Chen, Liu, Kreiss, Alahi, ICRA 2019; five ORCA pedestrians at 1 m/s "
-        f"who do not see the robot, robot V_max 1 m/s, 24 s), {size}: "
-        f"{', '.join(summary.laws)}. Success and collision rates with 95 % Wilson intervals; "
-        "the paper's ORCA figure stands beside orca-holonomic-v1 on circle crossing (CrowdNav's "
-        "robot ORCA). The notes give the social metrics: mean share of decisions closer than "
-        "0.2 m, mean time closer than 0.45 m, min separation, and the share of the collisions a "
-        "pedestrian closed (these pedestrians do not avoid the robot). When the store holds the "
-        "ETH crowd campaign of Chapter 2 (real pedestrians, replayed), its walkways follow in the "
-        "same form. Laws that assume "
-        "obstacles slower than the robot (thesis (2.6)) are refused here, and shown as refused: "
-        "the pedestrians walk at the robot's speed, so their guarantees do not apply."
-    )
-    if summary.beyond:
-        intro += (
-            f" Because the thesis's laws are this library's subject, {', '.join(summary.beyond)} "
-            "also ran beyond that assumption, as a separate row group ('beyond assumption "
-            "(2.6)', campaign crowdnav-beyond), as in the ETH crowd campaign of Chapter 2 "
-            "(hybrid-v1 drives with zhang2019-v1 inside and inherits its assumption)."
-        )
-    return ChapterSection(
-        key="crowds",
-        title="Beyond the thesis — CrowdNav's crowds, every 2D law",
-        intro=intro,
-        rows=rows_of(summary.table),
-    )
-
-
-# ---------------------------------------------------------------------------- the regime map
-
-
-def regime_section(summary: Any | None, *, full: bool) -> ChapterSection:
-    """The regime map's section (issue 19) from a :class:`uvnav.bench.regime.RegimeSummary`
-    (``None``: rebuilt from the store, what was run unknown).  Its numbers are the report's first
-    screen ("Which law, where", drawn from the store), so the section only says what ran."""
-    from uvnav.bench import regime as rg
-
-    if summary is None:
-        ran = "every stored cell and law"
-    else:
-        dens = ", ".join(str(d) for d in sorted({c.n_humans for c in summary.cells}))
-        speeds = ", ".join(f"{v:g}" for v in sorted({c.speed_ratio for c in summary.cells}))
-        noises = ", ".join(f"{z:g}" for z in sorted({c.noise for c in summary.cells}))
-        ran = (
-            f"{len(summary.cells)} regimes ({dens} humans; speed {speeds} x V_max; robot "
-            f"invisible and visible; sensing noise {noises} m), {summary.seeds} "
-            f"seed{'' if summary.seeds == 1 else 's'} per regime "
-            f"and law ({mode_text(full)}), laws {', '.join(summary.laws)}"
-        )
-    return ChapterSection(
-        key="regime",
-        title="Beyond the thesis — where each law wins (regime map)",
-        intro=(
-            f"Every 2D law on CrowdNav's circle crossing over crowd density x pedestrian speed / "
-            f"V_max x robot visible or not x sensing noise (campaign {rg.CAMPAIGN}): {ran}. Every "
-            "law runs in every regime, beyond its declared assumption where the regime breaks it "
-            "(marked †)."
-        ),
-        notes=[
-            "The heat maps, the recommendation per regime and every cell's rates with 95 % "
-            "intervals are the first screen of this report ('Which law, where'), read from the "
-            "store."
-        ],
-    )
 
 
 # ------------------------------------------------------------------------- sections on disk

@@ -14,20 +14,23 @@ command that needs them, so ``uvnav scenarios list`` stays fast and works withou
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import inspect
-import json
 import re
 import shutil
 import sys
 from pathlib import Path
 from typing import Annotated, Any
 
-import numpy as np
 import typer
 import yaml
 
-from uvnav.cli.checks import pool_workers, too_many_workers
+from uvnav.cli.checks import too_many_workers
+from uvnav.cli.common import compact_table
+from uvnav.cli.common import console as _console
+from uvnav.cli.common import dumps as _dumps
+from uvnav.cli.common import fmt as _fmt
+from uvnav.cli.common import optional as _optional
+from uvnav.cli.common import text as _text
 from uvnav.cli.drive import drive_app
 from uvnav.cli.errors import (
     DEBUG_KEY,
@@ -36,6 +39,7 @@ from uvnav.cli.errors import (
     uvnav_typer,
 )
 from uvnav.cli.recon import recon_app
+from uvnav.cli.reproduce import forget_cmd, reproduce_cmd, run_cmd
 from uvnav.cli.sonar import sonar_app
 from uvnav.controllers import (
     ControllerInfo,
@@ -112,61 +116,6 @@ def _root(
 
 
 # ----------------------------------------------------------------------------------------- helpers
-
-
-def _console(stderr: bool = False) -> Any:
-    """A rich console; into a file or a pipe, wide enough that no identifier is cut."""
-    from rich.console import Console
-
-    stream = sys.stderr if stderr else sys.stdout
-    width = None if stream.isatty() else 1000
-    return Console(stderr=stderr, highlight=False, width=width)
-
-
-def _text(value: Any) -> Any:
-    from rich.text import Text
-
-    return Text(str(value))
-
-
-def _fmt(value: Any) -> str:
-    if value is None:
-        return "-"
-    if isinstance(value, bool | np.bool_):
-        return "yes" if value else "no"
-    if isinstance(value, int | np.integer):
-        return str(int(value))
-    if isinstance(value, float | np.floating):
-        return f"{float(value):.4g}"
-    return str(value)
-
-
-def _jsonable(value: Any) -> Any:
-    """``json.dumps`` fallback: numpy values and paths as JSON data (non-finite floats: null)."""
-    from uvnav.cli.checks import json_safe
-
-    if isinstance(value, np.generic | np.ndarray | Path):
-        return json_safe(value)
-    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
-
-
-def _dumps(data: Any, *, indent: int | None = None) -> str:
-    """Strict JSON: a NaN/±inf float (a missing value) is printed as ``null``, never ``NaN``."""
-    from uvnav.cli.checks import json_safe
-
-    return json.dumps(json_safe(data), default=_jsonable, indent=indent, allow_nan=False)
-
-
-def _optional(module: str, attr: str, what: str) -> Any:
-    """``module.attr`` imported on demand; a missing part is a one-line error (status 1)."""
-    try:
-        mod = importlib.import_module(module)
-    except ImportError as exc:
-        raise CliError(f"{what} is not available: cannot import {module} ({exc})", code=1) from None
-    obj = getattr(mod, attr, None)
-    if obj is None:
-        raise CliError(f"{what} is not available: {module} has no {attr!r}", code=1)
-    return obj
 
 
 _PARAM_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -714,87 +663,7 @@ def controllers_show(
 # ------------------------------------------------------------------------------------- run / report
 
 
-@app.command()
-def run(
-    full: Annotated[
-        bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
-    ] = False,
-    workers: Annotated[
-        int, typer.Option(min=1, callback=pool_workers, help="Worker processes.")
-    ] = 2,
-    results: Annotated[Path, typer.Option(help="Directory of the results database.")] = Path(
-        "results"
-    ),
-    report: Annotated[Path, typer.Option(help="Directory of the HTML report.")] = Path("report"),
-) -> None:
-    """Reproduce the thesis's experiments: results database, report, and the comparison table."""
-    reproduce = _optional("uvnav.bench.reproduce", "reproduce", "the reproduction job (uvnav run)")
-    render = _optional("uvnav.viz.reproduction", "render_reproduction", "the report renderer")
-    renderers = _optional("uvnav.viz.reproduction", "chapter_renderers", "the chapter figures")
-    summary = reproduce(
-        results,
-        report,
-        full=full,
-        workers=workers,
-        progress=True,
-        render=render,
-        ch5=True,
-        renderers=renderers(),
-    )
-    rows = list(getattr(summary, "table", []) or [])
-    table_path = write_comparison_table(rows, results)
-    for line in run_summary_lines(getattr(summary, "sections", []) or [], rows):
-        typer.echo(line)
-    typer.echo(f"wrote {table_path} (the whole table: {len(rows)} rows)")
-    written: list[Path] = []
-    for attr in ("db_path", "report_path"):
-        value = getattr(summary, attr, None)
-        if isinstance(value, Path):
-            written.append(value)
-    for default in (results / "uvnav.sqlite", report / "index.html"):
-        if default.exists() and default not in written:
-            written.append(default)
-    for path in written:
-        typer.echo(f"wrote {path}")
-    figures = [f for f in getattr(summary, "figures", None) or [] if isinstance(f, Path)]
-    if figures:
-        folders = sorted({str(f.parent) for f in figures})
-        typer.echo(f"wrote {len(figures)} figure file(s) in {', '.join(folders)}")
-
-
-def _cut(text: str, width: int) -> str:
-    text = _one_line(text)
-    return text if len(text) <= width else text[: width - 1] + "…"
-
-
-def run_summary_lines(sections: list[Any], rows: list[dict[str, Any]]) -> list[str]:
-    """One screen after ``uvnav run``: per chapter its title, how many table rows it has, and
-    its first row (quantity, the thesis's figure and ours), each line at most 80 characters."""
-    lines = ["thesis reported vs uvnav measured (first row of each chapter)"]
-    for sec in sections:
-        sec_rows = list(getattr(sec, "rows", []) or [])
-        lines.append(_cut(f"{sec.title} ({len(sec_rows)} rows)", 80))
-        if sec_rows:
-            head = sec_rows[0]
-            lines.append("  " + _cut(str(head.get("quantity", "")), 78))
-            figures = f"thesis {_fmt(head.get('thesis'))} | uvnav {_fmt(head.get('measured'))}"
-            lines.append("    " + _cut(figures, 76))
-    if not sections:
-        lines.append(f"  {len(rows)} rows")
-    return lines
-
-
-def write_comparison_table(rows: list[dict[str, Any]], results: Path) -> Path:
-    """The whole "thesis reported vs uvnav measured" table as Markdown in ``results``."""
-    path = results / "thesis-vs-uvnav.md"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    cols = ("quantity", "thesis", "measured", "note")
-    out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    for row in rows:
-        cells = [_one_line(_fmt(row.get(c))).replace("|", "\\|") for c in cols]
-        out.append("| " + " | ".join(cells) + " |")
-    path.write_text("\n".join(out) + "\n", encoding="utf-8")
-    return path
+app.command("run")(run_cmd)
 
 
 @app.command("report")
@@ -1016,15 +885,6 @@ def bench(
     _fail_on_errors(result.errors, first_error)
 
 
-def compact_table(title: str, caption: str | None = None) -> Any:
-    """A rich table with a rule under its header only, no outer padding: the summaries'."""
-    from rich import box
-    from rich.table import Table
-
-    return Table(title=title, caption=caption, box=box.SIMPLE_HEAD, pad_edge=False,
-                 collapse_padding=True)  # fmt: skip
-
-
 def _check_image_path(path: Path) -> None:
     """Refuse, before any work, an image path matplotlib would not write as given: a folder, or
     a name without a format suffix it knows (it would write ``NAME.png`` beside it instead).
@@ -1090,8 +950,6 @@ def main() -> None:
     """Console-script entry point (``uvnav``)."""
     app(prog_name="uvnav")
 
-
-from uvnav.cli.reproduce import forget_cmd, reproduce_cmd  # noqa: E402  (one chapter at a time)
 
 app.command("reproduce")(reproduce_cmd)
 app.command("forget")(forget_cmd)

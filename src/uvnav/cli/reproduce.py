@@ -1,5 +1,9 @@
-"""``uvnav reproduce CHAPTER`` and ``uvnav forget``: one chapter's reproduction, and the removal of
-a stored campaign a reproduction refused to mix with (thin: parse, call the library, print).
+"""``uvnav run``, ``uvnav reproduce CHAPTER`` and ``uvnav forget``: every chapter's reproduction,
+one chapter's, and the removal of a stored campaign a reproduction refused to mix with (thin:
+parse, call the library, print).
+
+``uvnav run`` runs :func:`uvnav.bench.chapters.reproduce_all` (every chapter, the report, the
+whole "thesis reported vs uvnav measured" table in ``RESULTS/thesis-vs-uvnav.md``).
 
 ``uvnav reproduce CH`` runs :func:`uvnav.bench.chapters.reproduce_chapter` into the results store
 (``--results``), draws the chapter's figures (the viz renderers are injected, as ``uvnav run``
@@ -18,11 +22,97 @@ from typing import Annotated, Any
 
 import typer
 
-from uvnav.cli.app import CliError, _console, _fmt, _optional, _text, compact_table
 from uvnav.cli.checks import pool_workers
+from uvnav.cli.common import compact_table, console, fmt, optional, text
+from uvnav.cli.errors import CliError
+from uvnav.validation import one_line
 
 _COLUMNS = ("quantity", "thesis", "measured", "note")
 _TITLE = "uvnav — reproduction of the thesis's experiments"
+
+
+def run_cmd(
+    full: Annotated[
+        bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
+    ] = False,
+    workers: Annotated[
+        int, typer.Option(min=1, callback=pool_workers, help="Worker processes.")
+    ] = 2,
+    results: Annotated[Path, typer.Option(help="Directory of the results database.")] = Path(
+        "results"
+    ),
+    report: Annotated[Path, typer.Option(help="Directory of the HTML report.")] = Path("report"),
+) -> None:
+    """Reproduce the thesis's experiments: results database, report, and the comparison table."""
+    reproduce = optional(
+        "uvnav.bench.chapters", "reproduce_all", "the reproduction job (uvnav run)"
+    )
+    render = optional("uvnav.viz.reproduction", "render_reproduction", "the report renderer")
+    renderers = optional("uvnav.viz.reproduction", "chapter_renderers", "the chapter figures")
+    summary = reproduce(
+        results,
+        report,
+        full=full,
+        workers=workers,
+        progress=True,
+        render=render,
+        ch5=True,
+        renderers=renderers(),
+    )
+    rows = list(getattr(summary, "table", []) or [])
+    table_path = write_comparison_table(rows, results)
+    for line in run_summary_lines(getattr(summary, "sections", []) or [], rows):
+        typer.echo(line)
+    typer.echo(f"wrote {table_path} (the whole table: {len(rows)} rows)")
+    written: list[Path] = []
+    for attr in ("db_path", "report_path"):
+        value = getattr(summary, attr, None)
+        if isinstance(value, Path):
+            written.append(value)
+    for default in (results / "uvnav.sqlite", report / "index.html"):
+        if default.exists() and default not in written:
+            written.append(default)
+    for path in written:
+        typer.echo(f"wrote {path}")
+    figures = [f for f in getattr(summary, "figures", None) or [] if isinstance(f, Path)]
+    if figures:
+        folders = sorted({str(f.parent) for f in figures})
+        typer.echo(f"wrote {len(figures)} figure file(s) in {', '.join(folders)}")
+
+
+def _cut(line: str, width: int) -> str:
+    line = one_line(line)
+    return line if len(line) <= width else line[: width - 1] + "…"
+
+
+def run_summary_lines(sections: list[Any], rows: list[dict[str, Any]]) -> list[str]:
+    """One screen after ``uvnav run``: per chapter its title, how many table rows it has, and
+    its first row (quantity, the thesis's figure and ours), each line at most 80 characters."""
+    lines = ["thesis reported vs uvnav measured (first row of each chapter)"]
+    for sec in sections:
+        sec_rows = list(getattr(sec, "rows", []) or [])
+        lines.append(_cut(f"{sec.title} ({len(sec_rows)} rows)", 80))
+        if sec_rows:
+            head = sec_rows[0]
+            lines.append("  " + _cut(str(head.get("quantity", "")), 78))
+            figures = f"thesis {fmt(head.get('thesis'))} | uvnav {fmt(head.get('measured'))}"
+            lines.append("    " + _cut(figures, 76))
+    if not sections:
+        lines.append(f"  {len(rows)} rows")
+    return lines
+
+
+def write_comparison_table(rows: list[dict[str, Any]], results: Path) -> Path:
+    """The whole "thesis reported vs uvnav measured" table as Markdown in ``results``."""
+    path = results / "thesis-vs-uvnav.md"
+    path.parent.mkdir(parents=True, exist_ok=True)
+    cols = ("quantity", "thesis", "measured", "note")
+    out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for row in rows:
+        cells = [one_line(fmt(row.get(c))).replace("|", "\\|") for c in cols]
+        out.append("| " + " | ".join(cells) + " |")
+    path.write_text("\n".join(out) + "\n", encoding="utf-8")
+    return path
 
 
 def reproduce_cmd(
@@ -72,17 +162,15 @@ def reproduce_cmd(
             raise CliError(
                 "reproduce all: --seeds/--start-seed apply to one chapter (ch2-ch5, crowds, regime)"
             )
-        from uvnav.cli.app import run
-
-        run(full=full, workers=workers, results=results, report=report)
+        run_cmd(full=full, workers=workers, results=results, report=report)
         return
-    chapters = _optional("uvnav.bench.chapters", "reproduce_chapter", "the reproduction job")
+    chapters = optional("uvnav.bench.chapters", "reproduce_chapter", "the reproduction job")
     from uvnav.bench.chapters import ChapterError
     from uvnav.bench.sections import SECTIONS_DIR, load_sections
     from uvnav.bench.store import StaleCampaignError
 
-    renderers = _optional("uvnav.viz.reproduction", "chapter_renderers", "the chapter figures")
-    render_reproduction = _optional(
+    renderers = optional("uvnav.viz.reproduction", "chapter_renderers", "the chapter figures")
+    render_reproduction = optional(
         "uvnav.viz.reproduction", "render_reproduction", "the report renderer"
     )
     saved = results / SECTIONS_DIR
@@ -118,8 +206,8 @@ def reproduce_cmd(
         for col in _COLUMNS:
             table.add_column(col, justify="right" if col in ("thesis", "measured") else "left")
         for row in out.section.rows:
-            table.add_row(*(_text(_fmt(row.get(col))) for col in _COLUMNS))
-        _console().print(table)
+            table.add_row(*(text(fmt(row.get(col))) for col in _COLUMNS))
+        console().print(table)
     if chapter == "regime":
         _print_regime_leaders(out.db_path)
     for f in out.failures[:20]:
@@ -150,8 +238,8 @@ def _print_regime_leaders(db: Path) -> None:
     table.add_column("tied", justify="right")
     for r in rows:
         cells = (r["regime"], r["best"], r["success"], r["robot_driven"], r["tied"])
-        table.add_row(*(_text(c) for c in cells))
-    _console().print(table)
+        table.add_row(*(text(c) for c in cells))
+    console().print(table)
 
 
 def _write_report(db: Path, report: Path, sections: list[Any]) -> Path:
@@ -161,7 +249,7 @@ def _write_report(db: Path, report: Path, sections: list[Any]) -> Path:
 
     if not db.exists():
         ResultsStore(db).close()
-    write_report = _optional("uvnav.viz.report", "write_report", "the report")
+    write_report = optional("uvnav.viz.report", "write_report", "the report")
     path: Path = write_report(
         db,
         report,

@@ -61,8 +61,8 @@ from pydantic import Field
 
 from uvnav.controllers.orca import CROWDNAV_ORCA
 from uvnav.scenarios.errors import ScenarioError
-from uvnav.scenarios.loader import scenario_from_dict
 from uvnav.scenarios.params import typed_generator
+from uvnav.scenarios.parse import scenario_from_dict
 from uvnav.scenarios.schema import Scenario
 
 #: CrowdNav's ``env.config``

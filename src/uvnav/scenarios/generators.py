@@ -22,13 +22,19 @@ import numpy as np
 from pydantic import Field, ValidationError
 
 from uvnav.geometry.polygons import cyclic_next, cyclic_prev, polygon_area, polygon_centroid
-from uvnav.scenarios import pedestrians
 from uvnav.scenarios.build import obstacle_bounds
 from uvnav.scenarios.crowdnav import crowdnav_circle, crowdnav_square
 from uvnav.scenarios.errors import PlacementError, ScenarioError, from_validation_error
 from uvnav.scenarios.generators3d import random_ch3_scenario
-from uvnav.scenarios.loader import scenario_from_dict
 from uvnav.scenarios.params import generator_variant, typed_generator
+from uvnav.scenarios.parse import scenario_from_dict
+from uvnav.scenarios.pedestrians import (
+    FORMATS,
+    all_positions,
+    episode_tracks,
+    load_tracks,
+    walkway_axes,
+)
 from uvnav.scenarios.schema import CrowdSpec, ObstacleSpec, Scenario
 
 CH2_START = (0.0, 0.0)
@@ -499,8 +505,8 @@ def _crowd_crossing(
         if length <= 0.0:
             raise ValueError("start and goal must differ")
     else:
-        centre, along, across = pedestrians.walkway_axes(tracks)
-        pts = pedestrians.all_positions(tracks)
+        centre, along, across = walkway_axes(tracks)
+        pts = all_positions(tracks)
         spread = float(np.std((pts - centre) @ along))
     t_first = min(float(t.times[0]) for t in tracks.values())
     t_last = max(float(t.times[-1]) for t in tracks.values())
@@ -524,7 +530,7 @@ def _crowd_crossing(
             start = np.round(mid - side * 0.5 * length * across, 3)
             goal = np.round(mid + side * 0.5 * length * across, 3)
         assert start is not None and goal is not None
-        pieces = pedestrians.episode_tracks(
+        pieces = episode_tracks(
             tracks, t_start=t0, duration=t_max, region=spec.region, at_rest=spec.at_rest
         )
         now = [p for p in pieces if p.times[0] <= 1e-9 <= p.times[-1] + 1e-9]
@@ -555,7 +561,7 @@ def _crowd_crossing(
     raise RuntimeError(f"no busy, clear crossing found in {what} (seed {seed})")
 
 
-CROWD_FILE_FORMATS = pedestrians.FORMATS
+CROWD_FILE_FORMATS = FORMATS
 
 
 @typed_generator("crowd-file")
@@ -651,7 +657,7 @@ def crowd_file_scenario(
     }
     crowd = {k: v for k, v in crowd.items() if v is not None}
     try:  # the file's own problems first: one line naming it and the line
-        pedestrians.load_tracks(crowd["dataset"], format, frame_rate=frame_rate)
+        load_tracks(crowd["dataset"], format, frame_rate=frame_rate)
     except ScenarioError as exc:
         raise ScenarioError(source, "params", f"path: {exc}") from None
     try:

@@ -48,9 +48,17 @@ from uvnav.obstacles import (
 from uvnav.obstacles import crowd as orca_crowd
 from uvnav.obstacles.motion import motion_plugins
 from uvnav.obstacles.social_force import SocialForcePedestrian
-from uvnav.scenarios import pedestrians
 from uvnav.scenarios.errors import FieldError, ScenarioError
 from uvnav.scenarios.limits import FieldEqualScene, FileModel, check_timing
+from uvnav.scenarios.pedestrians import (
+    DATASETS,
+    DEFAULT_RADIUS,
+    Track,
+    all_positions,
+    crowd_obstacles,
+    episode_tracks,
+    load_tracks,
+)
 from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sim import LidarConfig, SensingConfig
 
@@ -708,7 +716,7 @@ class CrowdSpec(_Model):
     duration: float | None = Field(
         None, gt=0, description="length of the replayed window [s]; omitted = the scene's t_max"
     )
-    radius: float = Field(pedestrians.DEFAULT_RADIUS, gt=0, description="pedestrian disc [m]")
+    radius: float = Field(DEFAULT_RADIUS, gt=0, description="pedestrian disc [m]")
     frame_rate: float | None = Field(
         None,
         gt=0,
@@ -738,7 +746,7 @@ class CrowdSpec(_Model):
     @field_validator("dataset")
     @classmethod
     def _resolve(cls, value: str, info: ValidationInfo) -> str:
-        if value in pedestrians.DATASETS:
+        if value in DATASETS:
             return value
         base = (info.context or {}).get("base_dir") if info.context else None
         path = Path(value).expanduser()
@@ -754,9 +762,9 @@ class CrowdSpec(_Model):
             raise FieldError("dataset", str(exc)) from None
         return self
 
-    def tracks(self) -> dict[int, pedestrians.Track]:
+    def tracks(self) -> dict[int, Track]:
         """All tracks of the recording (recording times) [s], [m]."""
-        return pedestrians.load_tracks(
+        return load_tracks(
             self.dataset,
             self.format,
             frame_rate=self.frame_rate,
@@ -769,9 +777,9 @@ class CrowdSpec(_Model):
         """Length of the replayed window [s]: ``duration`` or the scene's ``t_max``."""
         return float(self.duration) if self.duration is not None else float(t_max)
 
-    def pieces(self, t_max: float) -> list[pedestrians.Track]:
+    def pieces(self, t_max: float) -> list[Track]:
         """Episode-time track pieces, :func:`uvnav.scenarios.pedestrians.episode_tracks`."""
-        return pedestrians.episode_tracks(
+        return episode_tracks(
             self.tracks(),
             t_start=self.t_start,
             duration=self.window(t_max),
@@ -782,8 +790,8 @@ class CrowdSpec(_Model):
     def to_obstacles(self, t_max: float) -> list[Obstacle]:
         """Fresh replayed disc obstacles for one episode of a scene with time limit ``t_max``."""
         tracks = self.tracks()
-        centre = pedestrians.all_positions(tracks).mean(axis=0)
-        return pedestrians.crowd_obstacles(self.pieces(t_max), radius=self.radius, centre=centre)
+        centre = all_positions(tracks).mean(axis=0)
+        return crowd_obstacles(self.pieces(t_max), radius=self.radius, centre=centre)
 
 
 class ControllerSpec(_Model):

@@ -1,0 +1,80 @@
+"""Helpers shared by the command modules: rich output, strict JSON, optional parts.
+
+Every command module (:mod:`uvnav.cli.app`, :mod:`uvnav.cli.reproduce`, ...) may import this one;
+it imports no command module, so the command modules never import each other for a helper.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from uvnav.cli.checks import dumps as strict_dumps
+from uvnav.cli.checks import json_safe
+from uvnav.cli.errors import CliError
+
+
+def console(stderr: bool = False) -> Any:
+    """A rich console; into a file or a pipe, wide enough that no identifier is cut."""
+    from rich.console import Console
+
+    stream = sys.stderr if stderr else sys.stdout
+    width = None if stream.isatty() else 1000
+    return Console(stderr=stderr, highlight=False, width=width)
+
+
+def text(value: Any) -> Any:
+    """``value`` as rich text, shown as it is (no markup)."""
+    from rich.text import Text
+
+    return Text(str(value))
+
+
+def fmt(value: Any) -> str:
+    """A table cell: ``-`` for none, ``yes``/``no``, integers whole, floats to 4 digits."""
+    if value is None:
+        return "-"
+    if isinstance(value, bool | np.bool_):
+        return "yes" if value else "no"
+    if isinstance(value, int | np.integer):
+        return str(int(value))
+    if isinstance(value, float | np.floating):
+        return f"{float(value):.4g}"
+    return str(value)
+
+
+def _jsonable(value: Any) -> Any:
+    """``json.dumps`` fallback: numpy values and paths as JSON data (non-finite floats: null)."""
+    if isinstance(value, np.generic | np.ndarray | Path):
+        return json_safe(value)
+    raise TypeError(f"not JSON serialisable: {type(value).__name__}")
+
+
+def dumps(data: Any, *, indent: int | None = None) -> str:
+    """Strict JSON: a NaN/±inf float (a missing value) is printed as ``null``, never ``NaN``."""
+    return strict_dumps(data, indent=indent, default=_jsonable)
+
+
+def optional(module: str, attr: str, what: str) -> Any:
+    """``module.attr`` imported on demand; a missing part is a one-line error (status 1)."""
+    try:
+        mod = importlib.import_module(module)
+    except ImportError as exc:
+        raise CliError(f"{what} is not available: cannot import {module} ({exc})", code=1) from None
+    obj = getattr(mod, attr, None)
+    if obj is None:
+        raise CliError(f"{what} is not available: {module} has no {attr!r}", code=1)
+    return obj
+
+
+def compact_table(title: str, caption: str | None = None) -> Any:
+    """A rich table with a rule under its header only, no outer padding: the summaries'."""
+    from rich import box
+    from rich.table import Table
+
+    return Table(title=title, caption=caption, box=box.SIMPLE_HEAD, pad_edge=False,
+                 collapse_padding=True)  # fmt: skip
