@@ -31,13 +31,13 @@ class Interruption:
 
 
 @pytest.fixture
-def interrupt_after(monkeypatch: pytest.MonkeyPatch) -> Callable[[ModuleType, int], Interruption]:
-    """``interrupt_after(module, k)``: the chapter module's episode runner (its ``_run_job``)
+def interrupt_after(monkeypatch: pytest.MonkeyPatch) -> Callable[..., Interruption]:
+    """``interrupt_after(module, k, name="_run_job")``: the module's episode runner ``name``
     raises :class:`KeyboardInterrupt` (a Ctrl-C) once, when asked for episode ``k + 1``; the
     episodes asked for after that run as usual (a resumed run)."""
 
-    def arm(module: ModuleType, k: int) -> Interruption:
-        real = module._run_job
+    def arm(module: ModuleType, k: int, name: str = "_run_job") -> Interruption:
+        real = getattr(module, name)
         seen = Interruption()
 
         def runner(job: Any, **kw: Any) -> Any:
@@ -47,7 +47,7 @@ def interrupt_after(monkeypatch: pytest.MonkeyPatch) -> Callable[[ModuleType, in
             (seen.after if seen.fired else seen.before).append(f"{job.label} {job.controller}")
             return real(job, **kw)
 
-        monkeypatch.setattr(module, "_run_job", runner)
+        monkeypatch.setattr(module, name, runner)
         return seen
 
     return arm

@@ -683,7 +683,9 @@ def reproduce(
         summary_campaigns["regime-map"] = rm.campaign
         sections.append(sec_r)
     if baselines and real_run:  # beyond the thesis (a real run, not a quick look)
-        sec_b, rows_b = chapters.run_beyond(report_dir, full=full, renderers=rend)
+        sec_b, rows_b = chapters.run_beyond(
+            report_dir, full=full, renderers=rend, results_dir=results_dir
+        )
         table += rows_b
         later.append(sec_b)
     if real_run:  # Chapter 6 (CNN driving): the thesis size with --full, else RUN_QUICK's size
