@@ -22,14 +22,15 @@
    the section's one sentence.
 
 Every episode is an ordinary campaign job (:func:`ch3_job`: a :class:`~uvnav.bench.campaign.Job`
-with this chapter's runner) stored in the results database (SQLite, :class:`ResultsStore`) in its
-own transaction as it finishes, the controller column holding the law and ``params`` the motion
-knowledge (``{"motion": "known"|"predicted"}``, and ``"constant"`` in ``ch3-prediction``); every
-campaign carries the code's :func:`fingerprint`, and a run refuses to resume a campaign stored by
-other code (:class:`~uvnav.bench.store.StaleCampaignError`, one line naming it for
-``uvnav forget``); the table "thesis reported vs uvnav measured" is read back from the stored rows.  Figures are made
-by an injected renderer (``render=``; the CLI passes :func:`uvnav.viz.figures3d.render_ch3`), so
-this module never imports ``viz`` (DESIGN §1 layers).
+with this chapter's runner) stored in the results database (SQLite, :class:`ResultsStore`) in
+its own transaction as it finishes, the controller column holding the law and ``params`` the
+motion knowledge (``{"motion": "known"|"predicted"}``, and ``"constant"`` in
+``ch3-prediction``); every campaign carries the code's :func:`fingerprint`, and a run refuses to
+resume a campaign stored by other code (:class:`~uvnav.bench.store.StaleCampaignError`, one line
+naming it for ``uvnav forget``); the table "thesis reported vs uvnav measured" is read back from
+the stored rows. Figures are made by an injected renderer (``render=``; the CLI passes
+:func:`uvnav.viz.figures3d.render_ch3`), so this module never imports ``viz`` (DESIGN §1
+layers).
 
 Run it alone with ``uvnav reproduce ch3 [--seeds N] [--start-seed S] [--workers W]``; a run adds
 to the store (resume), it never replaces another run's episodes.

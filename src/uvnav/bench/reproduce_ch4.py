@@ -16,22 +16,23 @@
    (quick: 4 seeds; ``full``: 100) — campaign ``ch4-hard``.
 
 Every episode is an ordinary campaign job (:class:`~uvnav.bench.campaign.Job` with this chapter's
-runner, :func:`ch4_job`; run, stored and resumed by :func:`~uvnav.bench.campaign.run_campaign`) and
-a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
+runner, :func:`ch4_job`; run, stored and resumed by :func:`~uvnav.bench.campaign.run_campaign`)
+and a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
 ``results_dir/uvnav.sqlite``, the database ``uvnav run`` and Chapter 3 use, DESIGN §5): the
-``controller`` column holds the law, ``params`` the sensing level (the job's tags: ``{"noise_std",
-"dropout"}``, part of the resume key), ``family`` the generator (``random-ch4``,
-``random-ch4-hard``) or the scene, the metrics of :data:`~uvnav.sim.metrics.METRIC_NAMES` their own
-columns; the two facts the store has no column for, the number of obstacles and whether a forbidden
-region (the Fig. 4.2(b) inner space) was entered, are kept in ``effective_params``. Campaigns
-resume (a re-run skips the stored episodes) and only add to the store: no run deletes or replaces
-another run's episodes. Every campaign carries the code's :func:`fingerprint`; a run refuses to
-resume one stored by other code (:class:`~uvnav.bench.store.StaleCampaignError`, one line naming
-it for ``uvnav forget``), so old and new episodes are never mixed. The summary (``results_dir/ch4/summary.json``) and the table "thesis
-reported vs uvnav measured" are computed from the stored rows, never typed in. The thesis reports
-no numbers for Chapter 4 (only Figs. 4.7-4.9: the vehicle reaches E without collision), so the
-table's thesis column states that; Fig. 4.7's one checkable statement, "t = 0...4 in target
-approach", is a row of its own (:func:`target_approach_check` on the recorded run).
+``controller`` column holds the law, ``params`` the sensing level (the job's tags:
+``{"noise_std", "dropout"}``, part of the resume key), ``family`` the generator (``random-ch4``,
+``random-ch4-hard``) or the scene, the metrics of :data:`~uvnav.sim.metrics.METRIC_NAMES` their
+own columns; the two facts the store has no column for, the number of obstacles and whether a
+forbidden region (the Fig. 4.2(b) inner space) was entered, are kept in ``effective_params``.
+Campaigns resume (a re-run skips the stored episodes) and only add to the store: no run deletes
+or replaces another run's episodes. Every campaign carries the code's :func:`fingerprint`; a run
+refuses to resume one stored by other code (:class:`~uvnav.bench.store.StaleCampaignError`, one
+line naming it for ``uvnav forget``), so old and new episodes are never mixed. The summary
+(``results_dir/ch4/summary.json``) and the table "thesis reported vs uvnav measured" are computed
+from the stored rows, never typed in. The thesis reports no numbers for Chapter 4 (only Figs.
+4.7-4.9: the vehicle reaches E without collision), so the table's thesis column states that; Fig.
+4.7's one checkable statement, "t = 0...4 in target approach", is a row of its own
+(:func:`target_approach_check` on the recorded run).
 
 Figures are made by a renderer injected by the caller (``render=``; the CLI passes
 :func:`uvnav.viz.figures_ch4.render_ch4`), because ``bench`` (layer 6) must not import ``viz``.
