@@ -2,7 +2,14 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from uvnav.bench import reproduce_beyond as rb
 from uvnav.bench.reproduce_beyond import BEYOND, office_rows, replan_rows, swap_rows
+from uvnav.bench.store import ResultsStore, StaleCampaignError
 
 
 def test_office_rows_measure_law_alone_and_hybrid() -> None:
@@ -29,3 +36,33 @@ def test_replan_row_compares_dstar_lite_with_astar_from_scratch() -> None:
     expansions = float(row["measured"].split("x fewer expansions")[0])
     assert expansions > 1.0  # the incremental replan expands fewer vertices than A* anew
     assert "median of 2 changes" in row["note"]
+
+
+def _beyond(store: ResultsStore) -> list[dict[str, str]]:
+    return office_rows(["apf-v1", "straight-v1"], scenario="corridor", store=store) + swap_rows(
+        "antipodal:4", [("straight-v1", {})], store=store
+    )
+
+
+def test_the_rows_are_read_back_from_stored_episodes_and_a_run_resumes(
+    tmp_path: Path, interrupt_after: Any, stored_rows: Any, set_fingerprint: Any
+) -> None:
+    with ResultsStore(tmp_path / "whole.sqlite") as store:
+        rows = _beyond(store)
+    assert rows == office_rows(["apf-v1", "straight-v1"], scenario="corridor") + swap_rows(
+        "antipodal:4", [("straight-v1", {})]
+    )  # a temporary store: the same figures
+    expected = stored_rows(tmp_path / "whole.sqlite")
+    assert {k: len(v) for k, v in expected.items()} == {rb.OFFICE_CAMPAIGN: 4, rb.MULTI_CAMPAIGN: 1}
+    db = tmp_path / "uvnav.sqlite"
+    seen = interrupt_after(rb, 3, "_run_office")
+    with ResultsStore(db) as store, pytest.raises(KeyboardInterrupt):
+        _beyond(store)
+    assert {k: len(v) for k, v in stored_rows(db).items()} == {rb.OFFICE_CAMPAIGN: 3}
+    with ResultsStore(db) as store:
+        assert _beyond(store) == rows  # the resume runs the missing episodes only
+    assert stored_rows(db) == expected and len(seen.after) == 1
+    set_fingerprint(db, rb.MULTI_CAMPAIGN)
+    with pytest.raises(StaleCampaignError, match=f"'{rb.MULTI_CAMPAIGN}'") as err:
+        rb.reproduce_beyond(tmp_path)
+    assert "\n" not in str(err.value) and len(seen.after) == 1  # refused before anything ran

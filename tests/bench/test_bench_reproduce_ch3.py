@@ -8,6 +8,7 @@ from typing import Any
 import pytest
 
 from uvnav.bench import reproduce_ch3 as r3
+from uvnav.bench.campaign import EpisodeRun, Job, run_job
 from uvnav.bench.sections import ch3_section
 from uvnav.bench.store import ResultsStore
 
@@ -61,13 +62,13 @@ def test_the_study_stores_three_arms_per_family_and_resumes(
 ) -> None:
     monkeypatch.setattr(r3, "horizon_errors", lambda motion: {"v1_ar": 1.0, "v1_cv": 2.0})
     calls: list[str] = []
-    real_run_one = r3.run_one
+    real_run_job = r3._run_job
 
-    def run_one(job: tuple[str, str, int, str, bool]) -> dict[str, Any]:
-        calls.append(job[3])
-        return real_run_one(job)
+    def run_job(job: Job) -> EpisodeRun:
+        calls.append(dict(job.tags)["motion"])
+        return real_run_job(job)
 
-    monkeypatch.setattr(r3, "run_one", run_one)
+    monkeypatch.setattr(r3, "_run_job", run_job)
     with ResultsStore(tmp_path / "db.sqlite") as store:
         study = r3.prediction_study(store, n_seeds=1, start_seed=2)
         assert sorted(calls) == sorted(list(r3.PREDICTION_ARMS) * len(r3.PREDICTION_FAMILIES))
@@ -84,13 +85,16 @@ def test_the_study_stores_three_arms_per_family_and_resumes(
 def test_constant_velocity_arm_uses_the_sensed_rates() -> None:
     """The "constant" arm is zhang2020-3d-v1 with prediction="last" on estimated rates: on the
     periodic family its episode differs from the AR arm's, and both are deterministic."""
-    job = ("random-ch3-periodic:0", r3.PREDICTION_LAW, 0, "constant", True)
-    a, b = r3.run_one(job), r3.run_one(job)
-    assert a["metrics"].min_clearance == b["metrics"].min_clearance
-    assert a["metrics"].path_length == b["metrics"].path_length
-    ar = r3.run_one(("random-ch3-periodic:0", r3.PREDICTION_LAW, 0, "predicted", True))
-    assert ar["trajectory"] is not None and a["trajectory"] is not None
-    assert ar["metrics"].min_clearance != a["metrics"].min_clearance
+    job = r3.ch3_job("random-ch3-periodic:0", r3.PREDICTION_LAW, 0, "constant", record=True)
+    a, b = run_job(job), run_job(job)
+    assert a.metrics is not None and b.metrics is not None
+    assert a.metrics["min_clearance"] == b.metrics["min_clearance"]
+    assert a.metrics["path_length"] == b.metrics["path_length"]
+    ar = run_job(
+        r3.ch3_job("random-ch3-periodic:0", r3.PREDICTION_LAW, 0, "predicted", record=True)
+    )
+    assert ar.result is not None and a.result is not None and ar.metrics is not None
+    assert ar.metrics["min_clearance"] != a.metrics["min_clearance"]
 
 
 def test_the_section_shows_the_rows_and_the_sentence() -> None:

@@ -222,14 +222,19 @@ def run_ch7(
 
 
 def run_beyond(
-    report_dir: Path, *, full: bool, renderers: ChapterRenderers
+    report_dir: Path,
+    *,
+    full: bool,
+    renderers: ChapterRenderers,
+    results_dir: Path | None = None,
 ) -> tuple[ChapterSection, list[dict[str, str]]]:
-    """The experiments beyond the thesis (:mod:`uvnav.bench.reproduce_beyond`); figures in
+    """The experiments beyond the thesis (:mod:`uvnav.bench.reproduce_beyond`; their episodes
+    stored in ``results_dir``'s database, a temporary one for ``None``); figures in
     ``report_dir/beyond``."""
     from uvnav.bench import sections as sec
     from uvnav.bench.reproduce_beyond import replan_rows, reproduce_beyond
 
-    rows = reproduce_beyond(full=full) + replan_rows()
+    rows = reproduce_beyond(results_dir, full=full) + replan_rows()
     figs = renderers.beyond(Path(report_dir) / "beyond") if renderers.beyond is not None else []
     return sec.beyond_section(rows, figs, full=full), rows
 
@@ -362,7 +367,7 @@ def reproduce_all(
         campaigns["regime-map"] = rm.campaign
         sections.append(sec_r)
     if base and real_run:  # beyond the thesis (a real run, not a quick look)
-        sec_b, rows_b = run_beyond(dirs[1], full=full, renderers=rend)
+        sec_b, rows_b = run_beyond(dirs[1], full=full, renderers=rend, results_dir=dirs[0])
         table += rows_b
         later.append(sec_b)
     if real_run:  # Chapter 6 (CNN driving): the thesis size with --full, else RUN_QUICK's size
@@ -469,7 +474,9 @@ def reproduce_chapter(
             "ch7": lambda: run_ch7(*dirs, full=full, renderers=rend),
             "crowds": lambda: run_crowds(results_dir, **seeded, progress=progress),
             "regime": lambda: run_regime(results_dir, **seeded, progress=progress),
-            "beyond": lambda: run_beyond(report_dir, full=full, renderers=rend),
+            "beyond": lambda: run_beyond(
+                report_dir, full=full, renderers=rend, results_dir=results_dir
+            ),
         }
         section, summary = runs[chapter]()
     path = save_section(section, results_dir / SECTIONS_DIR)

@@ -21,12 +21,16 @@
    ``PREDICTION_MIN_SEEDS`` seeds per family; :func:`prediction_finding` turns the numbers into
    the section's one sentence.
 
-Every episode is stored in the results database (SQLite, :class:`ResultsStore`), the controller
-column holding the law and ``params`` the motion knowledge (``{"motion": "known"|"predicted"}``,
-and ``"constant"`` in ``ch3-prediction``);
-the table "thesis reported vs uvnav measured" is read back from the stored rows.  Figures are made
-by an injected renderer (``render=``; the CLI passes :func:`uvnav.viz.figures3d.render_ch3`), so
-this module never imports ``viz`` (DESIGN §1 layers).
+Every episode is an ordinary campaign job (:func:`ch3_job`: a :class:`~uvnav.bench.campaign.Job`
+with this chapter's runner) stored in the results database (SQLite, :class:`ResultsStore`) in
+its own transaction as it finishes, the controller column holding the law and ``params`` the
+motion knowledge (``{"motion": "known"|"predicted"}``, and ``"constant"`` in
+``ch3-prediction``); every campaign carries the code's :func:`fingerprint`, and a run refuses to
+resume a campaign stored by other code (:class:`~uvnav.bench.store.StaleCampaignError`, one line
+naming it for ``uvnav forget``); the table "thesis reported vs uvnav measured" is read back from
+the stored rows. Figures are made by an injected renderer (``render=``; the CLI passes
+:func:`uvnav.viz.figures3d.render_ch3`), so this module never imports ``viz`` (DESIGN §1
+layers).
 
 Run it alone with ``uvnav reproduce ch3 [--seeds N] [--start-seed S] [--workers W]``; a run adds
 to the store (resume), it never replaces another run's episodes.
@@ -34,6 +38,7 @@ to the store (resume), it never replaces another run's episodes.
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import time
 from collections.abc import Callable, Sequence
@@ -43,9 +48,24 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.bench.campaign import run_in_workers
+from uvnav.bench.campaign import (
+    EpisodeRun,
+    Job,
+    JobOutcome,
+    outcome_record,
+    run_in_workers,
+    run_job,
+    run_stored,
+    store_outcome,
+)
 from uvnav.bench.fingerprint import DB_NAME
-from uvnav.bench.store import ResultsStore, params_hash
+from uvnav.bench.store import (
+    FINGERPRINT_KEY,
+    EpisodeKey,
+    ResultsStore,
+    check_fingerprints,
+    extend_fingerprint,
+)
 
 CONTROLLERS_3D: tuple[str, ...] = ("zhang2020-3d-v1", "apf3d-v1", "vo3d-v1")
 SCENES_CAMPAIGN = "ch3-thesis-scenes"
@@ -95,46 +115,57 @@ class Ch3Summary:
 Renderer = Callable[[Path, Path, list[tuple[str, str, Any]]], list[Path]]
 
 
-def run_one(job: tuple[str, str, int, str, bool]) -> dict[str, Any]:
-    """One episode: ``(scene name or generator label, controller, seed, motion, record)``;
-    ``motion`` is ``"known"`` (oracle), ``"predicted"`` (estimated rates, the law's own
-    prediction) or ``"constant"`` (estimated rates used as they are, ``prediction="last"``).
+def ch3_job(scene: str, law: str, seed: int, motion: str, *, record: bool = False) -> Job:
+    """One episode as a campaign job: a scene (built-in name or generator label such as
+    ``random-ch3:4``), a 3D law, a seed and the motion knowledge (the job's tags: the store's
+    ``params``, part of the resume key): ``"known"`` (oracle), ``"predicted"`` (estimated rates,
+    the law's own prediction) or ``"constant"`` (estimated rates used as they are,
+    ``prediction="last"``); ``record`` keeps the trajectory (the outcome's ``result``)."""
+    family = scene.split(":", 1)[0]
+    return Job(
+        law, int(seed), label=scene, family=family, tags={"motion": motion}, record=record,
+        runner=_run_job,
+    )  # fmt: skip
 
-    Returns a row with the metrics, status, wall time and (when recorded) the trajectory."""
+
+def _run_job(job: Job) -> EpisodeRun:
+    """The campaign's runner: the scene with the rates the job's motion knowledge senses, the
+    law (oracle, or with ``prediction="last"`` for ``"constant"``), the episode."""
     from uvnav.controllers.base import make_law
     from uvnav.scenarios import load_scenario
     from uvnav.sim.run import run_episode
 
-    scene, ctrl, seed, motion, record = job
-    sc: Any = load_scenario(scene)
-    setup = sc.build(seed, velocities="known" if motion == "known" else "estimated")
+    motion = str(dict(job.tags)["motion"])
+    sc: Any = load_scenario(str(job.label))
+    setup = sc.build(job.seed, velocities="known" if motion == "known" else "estimated")
     # "constant": the sensed (estimated) rates as they are, no AR models (zhang2020-3d-v1 only)
     extra = {"prediction": "last"} if motion == "constant" else {}
-    c = make_law(ctrl, vehicle="vehicle3d", oracle=motion == "known", **extra)
-    tic = time.perf_counter()
-    res = run_episode(setup, c, np.random.default_rng(seed), record=record)
+    law = make_law(job.controller, vehicle="vehicle3d", oracle=motion == "known", **extra)
+    res = run_episode(setup, law, np.random.default_rng(job.seed), record=job.record)
     traj = res.trajectory
-    return {
-        "scene": scene, "controller": ctrl, "seed": seed, "motion": motion,
-        "status": res.status, "metrics": res.metrics, "wall": time.perf_counter() - tic,
-        "trajectory": traj,
-    }  # fmt: skip
+    return res.status, res.metrics.to_dict(), traj, {}
 
 
-def _run_jobs(
-    jobs: list[tuple[str, str, int, str, bool]], workers: int, progress: bool
-) -> list[dict[str, Any]]:
-    """Run the jobs (in worker processes when ``workers > 1``); rows in job order."""
-    by_key: dict[tuple[str, str, int, str], dict[str, Any]] = {}
+def fingerprint() -> str:
+    """The code fingerprint of this chapter's campaigns: the packages that decide an episode
+    (``code_fingerprint`` of :mod:`uvnav.bench.reproduce`) and this module (its runner)."""
+    from uvnav.bench.fingerprint import code_fingerprint
 
-    def keep(row: dict[str, Any]) -> None:
-        by_key[(row["scene"], row["controller"], row["seed"], row["motion"])] = row
-        if progress:
-            print(f"  {len(by_key)}/{len(jobs)} {row['scene']} {row['controller']} "
-                  f"{row['motion']}: {row['status']}")  # fmt: skip
+    return extend_fingerprint(code_fingerprint(), "bench/reproduce_ch3.py")
 
-    run_in_workers(jobs, run_one, keep, workers=workers)
-    return [by_key[(j[0], j[1], j[2], j[3])] for j in jobs]
+
+def _announce(total: int) -> Callable[[JobOutcome, int], None]:
+    """An ``on_outcome`` printing one line per episode run (``progress``)."""
+    done = 0
+
+    def say(out: JobOutcome, _episode: int) -> None:
+        nonlocal done
+        done += 1
+        job = out.job
+        print(f"  {done}/{total} {job.label} {job.controller} {dict(job.tags)['motion']}: "
+              f"{out.status}")  # fmt: skip
+
+    return say
 
 
 def prediction_errors(n_series: int = 20, length: int = 120) -> dict[str, float]:
@@ -252,10 +283,10 @@ def ar_usage(family: str, seeds: Sequence[int]) -> dict[str, float]:
     return {"decisions": float(use.total), "ar_share": share}
 
 
-def prediction_jobs(n_seeds: int, start_seed: int = 0) -> list[tuple[str, str, int, str, bool]]:
+def prediction_jobs(n_seeds: int, start_seed: int = 0) -> list[Job]:
     """The ``ch3-prediction`` episodes: every family x arm x seed, ``PREDICTION_LAW``."""
     return [
-        (f"{fam}:{g}", PREDICTION_LAW, g, arm, False)
+        ch3_job(f"{fam}:{g}", PREDICTION_LAW, g, arm)
         for fam in PREDICTION_FAMILIES for g in range(start_seed, start_seed + n_seeds)
         for arm in PREDICTION_ARMS
     ]  # fmt: skip
@@ -284,14 +315,23 @@ def prediction_study(
     start_seed: int = 0,
     workers: int = 1,
     progress: bool = False,
+    fp: str | None = None,
 ) -> dict[str, Any]:
     """What prediction buys (module docstring, item 4): the ``ch3-prediction`` episodes the
-    store lacks are run and stored; returns ``{"errors": {family: horizon_errors},
-    "closed_loop": closed_loop_rates, "usage": {family: ar_usage}, "seeds": n}`` (the usage
-    episodes run again every call: their counts are not stored)."""
+    store lacks are run and stored, each as it finishes; returns ``{"errors": {family:
+    horizon_errors}, "closed_loop": closed_loop_rates, "usage": {family: ar_usage}, "seeds": n}``
+    (the usage episodes run again every call: their counts are not stored).
+
+    ``fp`` is :func:`fingerprint`'s (computed when not given).
+
+    Raises:
+        StaleCampaignError: the stored campaign was made by other code (nothing runs).
+    """
+    fp = fp if fp is not None else fingerprint()
+    check_fingerprints(store, {PREDICTION_CAMPAIGN: fp})
     jobs = prediction_jobs(n_seeds, start_seed)
-    config = {"chapter": 3, "law": PREDICTION_LAW, "seeds": n_seeds}
-    _store_jobs(store, PREDICTION_CAMPAIGN, config, jobs, workers, progress)
+    config = {"chapter": 3, "law": PREDICTION_LAW, "seeds": n_seeds, FINGERPRINT_KEY: fp}
+    _run_stored(store, PREDICTION_CAMPAIGN, config, jobs, workers, progress)
     frame = _requested(store.episodes_frame(PREDICTION_CAMPAIGN), jobs)
     errors = {fam: horizon_errors(motion) for fam, motion in PREDICTION_FAMILIES.items()}
     seeds = range(start_seed, start_seed + n_seeds)
@@ -394,54 +434,65 @@ def prediction_finding(study: dict[str, Any]) -> str:
     )
 
 
-def _job_key(job: tuple[str, str, int, str, bool]) -> tuple[str, str, str, int]:
-    """The store's resume key ``(scenario, controller, params_hash, seed)`` of a job."""
-    return (job[0], job[1], params_hash({"motion": job[3]}), int(job[2]))
-
-
-def _store_jobs(
+def _run_stored(
     store: ResultsStore,
     campaign: str,
     config: dict[str, Any],
-    jobs: list[tuple[str, str, int, str, bool]],
+    jobs: list[Job],
     workers: int,
     progress: bool,
-    *,
-    rerun: bool = False,
-) -> list[dict[str, Any]]:
-    """Run the jobs of ``campaign`` the store lacks and store each as it finishes (resume); with
-    ``rerun`` run the stored ones too (for their trajectories) without storing them again.
-    Episodes of other jobs (other controllers, seeds) already in the campaign are kept.
+) -> None:
+    """Run the jobs of ``campaign`` the store lacks, each stored in its own transaction as it
+    finishes (:func:`~uvnav.bench.campaign.run_stored`: an interrupt loses only the episodes in
+    flight); other jobs' episodes already in the campaign are kept."""
+    total = len({j.key for j in jobs} - store.done_keys(store.campaign(campaign, config)))
+    say = _announce(total) if progress else None
+    run_stored(store, campaign, jobs, config=config, workers=workers, on_outcome=say)
+
+
+def _rerun_recorded(
+    store: ResultsStore,
+    campaign: str,
+    config: dict[str, Any],
+    jobs: list[Job],
+    workers: int,
+) -> dict[EpisodeKey, Any]:
+    """Run every job again with its trajectory recorded (for the figures); an episode the
+    campaign lacks is stored in its own transaction as it finishes, a stored one is kept.
 
     Returns:
-        The rows this call ran (job order)."""
-    cid = store.campaign(campaign, config)
-    done = store.done_keys(cid)
-    todo = [j for j in jobs if rerun or _job_key(j) not in done]
-    rows = _run_jobs(todo, workers, progress)
-    for r in rows:
-        key = (r["scene"], r["controller"], params_hash({"motion": r["motion"]}), int(r["seed"]))
-        if key in done:
-            continue
-        store.add_episode(
-            cid, scenario=r["scene"], controller=r["controller"], seed=r["seed"],
-            status=r["status"], params={"motion": r["motion"]}, metrics=r["metrics"],
-            family=r["scene"].split(":")[0], wall_time=r["wall"],
-        )  # fmt: skip
-    return rows
+        The recorded trajectory of each job by its resume key.
+
+    Raises:
+        RuntimeError: an episode failed (the one stored before is kept).
+    """
+    kept: dict[EpisodeKey, Any] = {}
+    with store.writer_lease():
+        cid = store.campaign(campaign, config)
+        done = store.done_keys(cid, include_errors=False)
+
+        def keep(out: JobOutcome) -> None:
+            outcome_record(out)  # raises for a failed episode
+            if out.job.key not in done:
+                store_outcome(store, cid, out)
+            kept[out.job.key] = out.result
+
+        recorded = [dataclasses.replace(j, record=True) for j in jobs]
+        run_in_workers(recorded, run_job, keep, workers=workers)
+    return kept
 
 
-def _requested(frame: Any, jobs: list[tuple[str, str, int, str, bool]]) -> Any:
-    """The rows of ``frame`` (a campaign's episodes) that belong to ``jobs``: the table of a run
-    describes what it asked for; the store keeps every other run's rows."""
-    keys = {_job_key(j) for j in jobs}
-    mask = [
-        (str(sc), str(c), str(h), int(sd)) in keys
-        for sc, c, h, sd in zip(
-            frame["scenario"], frame["controller"], frame["params_hash"], frame["seed"], strict=True
-        )
-    ]
-    return frame[mask]
+def _requested(frame: Any, jobs: list[Job]) -> Any:
+    """The rows of ``frame`` (a campaign's episodes) that belong to ``jobs``, in job order: the
+    table of a run describes what it asked for; the store keeps every other run's rows."""
+    order: dict[EpisodeKey, int] = {}
+    for i, job in enumerate(jobs):
+        order.setdefault(job.key, i)
+    keys = zip(frame["scenario"], frame["controller"], frame["params_hash"], frame["seed"],
+               strict=True)  # fmt: skip
+    pos = [order.get((str(sc), str(c), str(h), int(sd))) for sc, c, h, sd in keys]
+    rows = sorted((p, i) for i, p in enumerate(pos) if p is not None)
+    return frame.iloc[[i for _, i in rows]]
 
 
 def reproduce_ch3(
@@ -472,9 +523,15 @@ def reproduce_ch3(
         prediction_seeds: seeds per family of the prediction comparison (default: the random
             campaign's, at least ``PREDICTION_MIN_SEEDS``); 0 skips it.
 
-    Resumable and additive: episodes already in the store are not run again (the thesis scenes
-    run again only for the figures' trajectories), and another run's episodes (other
-    controllers, other seeds) are kept; the table describes the episodes this call asked for.
+    Resumable and additive: every episode is stored in its own transaction as it finishes, so
+    an interrupted run keeps what it finished; episodes already in the store are not run again
+    (the thesis scenes run again only for the figures' trajectories), and another run's
+    episodes (other controllers, other seeds) are kept; the table describes the episodes this
+    call asked for.
+
+    Raises:
+        StaleCampaignError: a stored campaign of this run was made by other code (its
+            fingerprint differs; nothing runs).
     """
     import uvnav.scenarios as scenarios
 
@@ -484,29 +541,32 @@ def reproduce_ch3(
     db_path = results_dir / DB_NAME
     n_seeds = n_random if n_random is not None else (FULL_SEEDS if full else QUICK_SEEDS)
     scenes = [n for n in scenarios.list_builtin() if n.startswith("thesis-ch3-")]
-    scene_jobs = [(s, c, 0, "predicted", True) for s in scenes for c in controllers]
+    scene_jobs = [ch3_job(s, c, 0, "predicted") for s in scenes for c in controllers]
     rand_jobs = [
-        (f"{RANDOM_FAMILY}:{g}", c, g, m, False)
+        ch3_job(f"{RANDOM_FAMILY}:{g}", c, g, m)
         for g in range(start_seed, start_seed + n_seeds) for m in MOTIONS for c in controllers
     ]  # fmt: skip
-    scene_rows: list[dict[str, Any]] = []
+    n_pred = (
+        prediction_seeds if prediction_seeds is not None else max(n_seeds, PREDICTION_MIN_SEEDS)
+    )
+    fp = fingerprint()
+    recorded: dict[EpisodeKey, Any] = {}
     with ResultsStore(db_path) as store:
-        size = {"chapter": 3, "controllers": list(controllers)}
-        # the thesis scenes run again when figures are drawn (the trajectories are not stored);
-        # only episodes missing from the store are written, stored ones are never replaced
-        scene_rows = _store_jobs(store, SCENES_CAMPAIGN, {**size, "seed": 0}, scene_jobs,
-                                 workers, progress, rerun=render is not None)  # fmt: skip
-        _store_jobs(store, RANDOM_CAMPAIGN, {**size, "seeds": n_seeds}, rand_jobs, workers,
+        names = [SCENES_CAMPAIGN, RANDOM_CAMPAIGN] + ([PREDICTION_CAMPAIGN] if n_pred > 0 else [])
+        check_fingerprints(store, dict.fromkeys(names, fp))  # before anything runs
+        size = {"chapter": 3, "controllers": list(controllers), FINGERPRINT_KEY: fp}
+        scene_cfg = {**size, "seed": 0}
+        if render is not None:  # the figures' trajectories (not stored): the scenes run again
+            recorded = _rerun_recorded(store, SCENES_CAMPAIGN, scene_cfg, scene_jobs, workers)
+        else:
+            _run_stored(store, SCENES_CAMPAIGN, scene_cfg, scene_jobs, workers, progress)
+        _run_stored(store, RANDOM_CAMPAIGN, {**size, "seeds": n_seeds}, rand_jobs, workers,
                     progress)  # fmt: skip
         frame = _requested(store.episodes_frame(RANDOM_CAMPAIGN), rand_jobs)
         scene_frame = _requested(store.episodes_frame(SCENES_CAMPAIGN), scene_jobs)
-        n_pred = (
-            prediction_seeds if prediction_seeds is not None
-            else max(n_seeds, PREDICTION_MIN_SEEDS)
-        )  # fmt: skip
         study = (
             prediction_study(store, n_seeds=n_pred, start_seed=start_seed, workers=workers,
-                             progress=progress)
+                             progress=progress, fp=fp)
             if n_pred > 0 else {}
         )  # fmt: skip
     pred = prediction_errors()
@@ -554,8 +614,8 @@ def reproduce_ch3(
         finding = prediction_finding(study)
     figures: list[Path] = []
     if render is not None:
-        recorded = [(r["scene"], r["controller"], r["trajectory"]) for r in scene_rows]
-        figures = render(db_path, Path(report_dir), recorded)
+        trajectories = [(str(j.label), j.controller, recorded[j.key]) for j in scene_jobs]
+        figures = render(db_path, Path(report_dir), trajectories)
     return Ch3Summary(
         table, db_path, failures, pred, figures, time.perf_counter() - tic, study, finding
     )

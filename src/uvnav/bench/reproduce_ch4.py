@@ -16,20 +16,23 @@
    (quick: 4 seeds; ``full``: 100) — campaign ``ch4-hard``.
 
 Every episode is an ordinary campaign job (:class:`~uvnav.bench.campaign.Job` with this chapter's
-runner, :func:`ch4_job`; run, stored and resumed by :func:`~uvnav.bench.campaign.run_campaign`) and
-a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
+runner, :func:`ch4_job`; run, stored and resumed by :func:`~uvnav.bench.campaign.run_campaign`)
+and a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
 ``results_dir/uvnav.sqlite``, the database ``uvnav run`` and Chapter 3 use, DESIGN §5): the
-``controller`` column holds the law, ``params`` the sensing level (the job's tags: ``{"noise_std",
-"dropout"}``, part of the resume key), ``family`` the generator (``random-ch4``,
-``random-ch4-hard``) or the scene, the metrics of :data:`~uvnav.sim.metrics.METRIC_NAMES` their own
-columns; the two facts the store has no column for, the number of obstacles and whether a forbidden
-region (the Fig. 4.2(b) inner space) was entered, are kept in ``effective_params``. Campaigns
-resume (a re-run skips the stored episodes) and only add to the store: no run deletes or replaces
-another run's episodes. The summary (``results_dir/ch4/summary.json``) and the table "thesis
-reported vs uvnav measured" are computed from the stored rows, never typed in. The thesis reports
-no numbers for Chapter 4 (only Figs. 4.7-4.9: the vehicle reaches E without collision), so the
-table's thesis column states that; Fig. 4.7's one checkable statement, "t = 0...4 in target
-approach", is a row of its own (:func:`target_approach_check` on the recorded run).
+``controller`` column holds the law, ``params`` the sensing level (the job's tags:
+``{"noise_std", "dropout"}``, part of the resume key), ``family`` the generator (``random-ch4``,
+``random-ch4-hard``) or the scene, the metrics of :data:`~uvnav.sim.metrics.METRIC_NAMES` their
+own columns; the two facts the store has no column for, the number of obstacles and whether a
+forbidden region (the Fig. 4.2(b) inner space) was entered, are kept in ``effective_params``.
+Campaigns resume (a re-run skips the stored episodes) and only add to the store: no run deletes
+or replaces another run's episodes. Every campaign carries the code's :func:`fingerprint`; a run
+refuses to resume one stored by other code (:class:`~uvnav.bench.store.StaleCampaignError`, one
+line naming it for ``uvnav forget``), so old and new episodes are never mixed. The summary
+(``results_dir/ch4/summary.json``) and the table "thesis reported vs uvnav measured" are computed
+from the stored rows, never typed in. The thesis reports no numbers for Chapter 4 (only Figs.
+4.7-4.9: the vehicle reaches E without collision), so the table's thesis column states that; Fig.
+4.7's one checkable statement, "t = 0...4 in target approach", is a row of its own
+(:func:`target_approach_check` on the recorded run).
 
 Figures are made by a renderer injected by the caller (``render=``; the CLI passes
 :func:`uvnav.viz.figures_ch4.render_ch4`), because ``bench`` (layer 6) must not import ``viz``.
@@ -57,7 +60,7 @@ from uvnav.bench.campaign import (
     stored_records,
 )
 from uvnav.bench.fingerprint import DB_NAME
-from uvnav.bench.store import ResultsStore
+from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, check_fingerprints, extend_fingerprint
 from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.base import make_law
 from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin, load_uuv2d_scenario
@@ -91,6 +94,14 @@ def ch4_job(scene: str, law: str, seed: int, noise_std: float = 0.0, dropout: fl
     tags = {"noise_std": float(noise_std), "dropout": float(dropout)}
     family = scene.split(":", 1)[0]
     return Job(law, int(seed), label=scene, family=family, tags=tags, runner=_run_job)
+
+
+def fingerprint() -> str:
+    """The code fingerprint of this chapter's campaigns: the packages that decide an episode
+    (``code_fingerprint`` of :mod:`uvnav.bench.reproduce`) and this module (its runner)."""
+    from uvnav.bench.fingerprint import code_fingerprint
+
+    return extend_fingerprint(code_fingerprint(), "bench/reproduce_ch4.py")
 
 
 def run_ch4_job(
@@ -345,7 +356,11 @@ def reproduce_ch4(
 
     Additive: an episode already in the store is never run again nor replaced (the thesis
     scenes run again for the figures' trajectories, but only missing ones are stored), and
-    other runs' episodes are kept.
+    other runs' episodes are kept; each is stored in its own transaction as it finishes.
+
+    Raises:
+        StaleCampaignError: a stored campaign of this chapter was made by other code (its
+            :func:`fingerprint` differs; nothing runs).
     """
     results_dir = Path(results_dir)
     out_dir = results_dir / "ch4"
@@ -359,8 +374,11 @@ def reproduce_ch4(
     )
     nh = hard_seeds if hard_seeds is not None else (FULL_HARD_SEEDS if full else QUICK_HARD_SEEDS)
     scene_results: dict[tuple[str, str], EpisodeResult[Uuv2dTrajectory]] = {}
+    fp = fingerprint()
+    size = {"chapter": 4, "laws": list(LAWS), FINGERPRINT_KEY: fp}
     with ResultsStore(db_path) as store:
-        cid = store.campaign(SCENES_CAMPAIGN, {"chapter": 4, "laws": list(LAWS), "seed": 0})
+        check_fingerprints(store, dict.fromkeys((SCENES_CAMPAIGN, *CAMPAIGNS), fp))
+        cid = store.campaign(SCENES_CAMPAIGN, {**size, "seed": 0})
         stored = store.done_keys(cid)
         for scene in list_uuv2d_builtin():
             for law in LAWS:
@@ -376,7 +394,6 @@ def reproduce_ch4(
             if (r["scene"], r["law"]) in scene_results
         ]
         clean, noisy = campaign_jobs(n, nn, start=start_seed)
-        size = {"chapter": 4, "laws": list(LAWS)}
         rows_random = run_jobs(clean, store, RANDOM_CAMPAIGN, workers=workers,
                                progress=progress, config={**size, "seeds": n})  # fmt: skip
         rows_noise = run_jobs(noisy, store, NOISE_CAMPAIGN, workers=workers, progress=progress,

@@ -45,7 +45,10 @@ row and its trained network are cached under ``results_dir/ch5/cache`` as they f
 :class:`uvnav.stages.Stages` in ``ch5/cache/stages/``, the files written atomically; a row is
 built on its data set's stage and names the independent test set, so new data retrain it — and
 every random-campaign episode is one transaction of the store; a re-run skips what is there
-(``fresh`` drops the cache; stored episodes are never deleted or replaced by a later run).  A
+(``fresh`` drops the cache; stored episodes are never deleted or replaced by a later run).
+Every campaign carries the code's :func:`fingerprint`; a run refuses to resume one stored by other
+code (:class:`~uvnav.bench.store.StaleCampaignError`, one line naming it for ``uvnav forget``)
+before it trains anything, so old and new episodes are never mixed.  A
 cache written before the stage cache (``row_*.json``, ``data_*.rng.json``, no ``stages/``) is
 dropped and recomputed from the same seeds (the same data; a network trained again to the same
 weights keeps its digest, which covers the weights only, and so its stored episodes).
@@ -80,7 +83,13 @@ from uvnav.bench.campaign import (
     stored_records,
 )
 from uvnav.bench.fingerprint import DB_NAME
-from uvnav.bench.store import EpisodeKey, ResultsStore
+from uvnav.bench.store import (
+    FINGERPRINT_KEY,
+    EpisodeKey,
+    ResultsStore,
+    check_fingerprints,
+    extend_fingerprint,
+)
 from uvnav.bench.summary import outcome_stats
 from uvnav.controllers.zhang_uuv3d import (
     NAME as LAW,
@@ -385,6 +394,15 @@ def ch5_job(
         tags["generator"] = RANDOM_CH5_VERSION
     runner = _run_job if model is None else functools.partial(_run_job, model=model)
     return Job(LAW, int(seed), label=scene, family=scene.split(":", 1)[0], tags=tags, runner=runner)
+
+
+def fingerprint() -> str:
+    """The code fingerprint of this chapter's campaigns: the packages that decide an episode
+    (``code_fingerprint`` of :mod:`uvnav.bench.reproduce`), :mod:`uvnav.learning` (the
+    network's locator) and this module (its runner)."""
+    from uvnav.bench.fingerprint import code_fingerprint
+
+    return extend_fingerprint(code_fingerprint(), "learning", "bench/reproduce_ch5.py")
 
 
 def checkpoint_digest(path: Path) -> str:
@@ -804,7 +822,11 @@ def reproduce_ch5(
 
     Additive: an episode already in the store is never run again nor replaced (the thesis
     scenes run again for the figures' trajectories, but only missing ones are stored), and other
-    runs' episodes are kept.
+    runs' episodes are kept; each is stored in its own transaction as it finishes.
+
+    Raises:
+        StaleCampaignError: a stored campaign of this chapter was made by other code (its
+            :func:`fingerprint` differs); checked before anything is trained or run.
     """
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
@@ -815,6 +837,9 @@ def reproduce_ch5(
     db_path = results_dir / DB_NAME
     if cache.exists() and (fresh or not (cache / STAGES_DIR).is_dir()):
         shutil.rmtree(cache)  # asked for, or a cache of the older layout (recomputed cleanly)
+    fp = fingerprint()
+    with ResultsStore(db_path) as store:
+        check_fingerprints(store, dict.fromkeys(CAMPAIGNS, fp))  # before any training
     stages = Stages(cache / STAGES_DIR)
     sizes = tuple(sizes) if sizes is not None else (FULL_SIZES if full else QUICK_SIZES)
     seeds = n_seeds if n_seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
@@ -892,8 +917,12 @@ def reproduce_ch5(
         )
         task2 = prog.add_task("Ch5 closed loop", total=n_episodes)
         kept: dict[tuple[str, str, float], EpisodeResult[LocatedTrace]] = {}
-        base_cfg = {"chapter": 5, "law": LAW, "locators": list(LOCATORS), "model": model_id}
+        base_cfg = {
+            "chapter": 5, "law": LAW, "locators": list(LOCATORS), "model": model_id,
+            FINGERPRINT_KEY: fp,
+        }  # fmt: skip
         with ResultsStore(db_path) as store:
+            check_fingerprints(store, dict.fromkeys(CAMPAIGNS, fp))
             cid = store.campaign(SCENES_CAMPAIGN, {**base_cfg, "noises": list(noise_list)})
             stored = store.done_keys(cid)
             wanted: set[EpisodeKey] = set()

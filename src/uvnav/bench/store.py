@@ -269,6 +269,54 @@ class StaleCampaignError(RuntimeError):
         )
 
 
+#: the config key of a campaign that holds the fingerprint of the code that made its episodes
+FINGERPRINT_KEY = "fingerprint"
+#: the files a fingerprint reads (sources and scenario data, never caches)
+_FINGERPRINT_SUFFIXES = frozenset({".py", ".yaml", ".yml", ".json"})
+
+
+def extend_fingerprint(base: str, *parts: str) -> str:
+    """``base`` (a code fingerprint) extended with the files under ``parts``: paths relative
+    to the ``uvnav`` package, each a source file or a folder (its ``.py``, ``.yaml``, ``.yml``
+    and ``.json`` files, ``__pycache__`` left out), hashed with their relative paths.
+
+    Returns:
+        16 hex digits.
+    """
+    import uvnav
+
+    root = Path(uvnav.__file__).parent
+    h = hashlib.sha256(base.encode())
+    for part in parts:
+        path = root / part
+        files = [path] if path.is_file() else sorted(path.rglob("*")) if path.is_dir() else []
+        for p in files:
+            if p.is_file() and p.suffix in _FINGERPRINT_SUFFIXES and "__pycache__" not in p.parts:
+                h.update(str(p.relative_to(root)).encode())
+                h.update(p.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def check_fingerprints(store: ResultsStore, fingerprints: Mapping[str, str]) -> None:
+    """Refuse to resume a campaign made by other code: every stored campaign named in
+    ``fingerprints`` (name -> the fingerprint of the code about to run it) must have been
+    created with that fingerprint (its config's :data:`FINGERPRINT_KEY`; a campaign stored
+    without one was made by unknown code).  Campaigns not stored yet pass; nothing is deleted.
+
+    Raises:
+        StaleCampaignError: one line naming every stored campaign whose fingerprint differs.
+    """
+    stale = [
+        c["name"]
+        for c in store.campaigns()
+        if c["name"] in fingerprints and c["config"].get(FINGERPRINT_KEY) != fingerprints[c["name"]]
+    ]
+    if stale:
+        raise StaleCampaignError(
+            store.path, stale, f"{'was' if len(stale) == 1 else 'were'} stored by other code"
+        )
+
+
 #: tables and columns a uvnav results database has whatever its age (metrics may be missing)
 _REQUIRED = {
     "campaigns": {"id", "name", "created", "config"},
