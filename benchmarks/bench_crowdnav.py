@@ -99,7 +99,7 @@ class CrowdSimOutcome(BaseProbe):
             th = float(obs.heading) + float(applied.u) * dt
             vx, vy = float(applied.v) * math.cos(th), float(applied.v) * math.sin(th)
         r = float(world.spec.radius)
-        pos, vel = world.batch.positions, world.batch.velocities
+        pos, vel = world.field.centres, world.field.velocities
         for j, ob in enumerate(world.obstacles):
             px, py = float(pos[j, 0]) - x, float(pos[j, 1]) - y
             ex = px + (float(vel[j, 0]) - vx) * dt

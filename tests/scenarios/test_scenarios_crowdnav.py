@@ -130,7 +130,7 @@ class _PedestrianLog(BaseProbe):
         self.rows: list[np.ndarray] = []
 
     def on_step(self, world: Any, laws: Any) -> None:
-        self.rows.append(world.batch.positions.copy())
+        self.rows.append(world.field.centres.copy())
 
 
 def test_robot_is_invisible() -> None:

@@ -22,6 +22,7 @@ from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.sensors.exact import lidar_scan
+from uvnav.sim.bodies2d import FieldBodies, PackedBodies
 from uvnav.sim.episode import World2D
 from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, pack_check
 from uvnav.sim.run import run_episode
@@ -350,7 +351,7 @@ CASES = [
 @pytest.mark.parametrize("record", [False, True])
 def test_the_compiled_episode_path_equals_the_numpy_path(scene: str, law: str,
                                                          record: bool) -> None:  # fmt: skip
-    """run_episode with the obstacles packed (PackedObstacles) gives the numpy path's episode
+    """run_episode with the obstacles packed (PackedBodies) gives the numpy path's episode
     bit for bit: status, metrics, trajectory, and the obstacles and generators it leaves."""
     if not numba_available():
         pytest.skip("needs numba (the fast extra)")
@@ -370,13 +371,15 @@ def test_the_compiled_episode_path_equals_the_numpy_path(scene: str, law: str,
 
 def test_the_compiled_path_serves_the_scenes_it_can_pack() -> None:
     scene = load_scenario("random-ch2:0")
-    assert World2D(build_episode(scene, 0), run_rng(0), exact=False,
-                         packed=True).packed is not None  # fmt: skip
-    assert World2D(build_episode(scene, 0), run_rng(0), exact=False).packed is None
+    def bodies(setup: EpisodeSetup, packed: bool) -> object:
+        return World2D(setup, run_rng(0), exact=False, packed=packed).bodies
+
+    assert isinstance(bodies(build_episode(scene, 0), True), PackedBodies)
+    assert isinstance(bodies(build_episode(scene, 0), False), FieldBodies)
     setup = mixed_setup(0, n=2)
     setup.obstacles[1] = Obstacle(DiscBody(0.3), ObstacleState(position=np.zeros(2)),
                                   ConstantVelocity(np.zeros(2)))  # fmt: skip
-    assert World2D(setup, run_rng(0), exact=False, packed=True).packed is None
+    assert isinstance(bodies(setup, True), FieldBodies)
 
 
 def test_the_compiled_path_leaves_the_generators_where_the_numpy_path_does_across_top_ups() -> None:
@@ -397,7 +400,7 @@ def test_the_compiled_path_leaves_the_generators_where_the_numpy_path_does_acros
     same_result(ref, got)
     assert got_left == ref_left
     world = World2D(make(), run_rng(4), exact=False, packed=True)
-    assert world.packed is not None
+    assert isinstance(world.bodies, PackedBodies)
     for _ in range(200):
-        world.packed.step(0.05 * _, 0.05, 0.0, 0.0, 0.2)
-    assert world.packed._pw.read.max() > 0  # the rows were topped up
+        world.bodies.step(0.05 * _, 0.05, 0.0, 0.0, 0.2)
+    assert world.bodies._pw.read.max() > 0  # the rows were topped up

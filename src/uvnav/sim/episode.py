@@ -40,94 +40,20 @@ from uvnav.core import AgentLog, BaseProbe
 from uvnav.dynamics.unicycle import UnicycleSpec
 from uvnav.dynamics.vehicles import Vehicle2D, make_vehicle
 from uvnav.geometry.angles import FloatArray
-from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
 from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
-from uvnav.sensors.exact import lidar_scan, sense_obstacles
+from uvnav.sensors.exact import lidar_scan
 from uvnav.sensors.observation import LidarScan, Observation
 from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sensors.scan_bodies import ScanBodies
+from uvnav.sim.bodies2d import Bodies2D, FieldBodies, PackedBodies
 from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
-from uvnav.sim.packed import PackedObstacles, pack_check
+from uvnav.sim.packed import pack_check
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
 from uvnav.sim.setup import EpisodeResult, EpisodeSetup, single_result
 from uvnav.sim.social import SocialTracker, collision_by, pedestrian_ids
-from uvnav.sim.swept import StepPoses, SweptClearance
-
-
-class _MinClearance:
-    """Exact minimum clearance over an unrecorded episode, without the exact kernel every step.
-
-    A step's clearance (gap between the robot's disc and the nearest obstacle set [m]) matters to
-    an unrecorded run only through the episode minimum and the collision test (gap < 0).  Each
-    step the field's query bounds it by bounding discs (``NearestQuery.bounds``, the same pass
-    that culls for the sensors), and:
-
-    * a step that may overlap (lower bound <= 0) gets its exact clearance now;
-    * a step whose sensor query already contains the nearest obstacle gives it exactly for free;
-    * any other step is kept (its field and robot position: a few references) only while its
-      lower bound is below the best upper bound of the minimum seen so far, and the kept steps
-      are evaluated exactly in batches and at the end, in increasing lower-bound order.
-
-    The result is the minimum of the exact clearances of all steps, bit for bit what evaluating
-    every step gives: a step that is dropped has a lower bound above the exact clearance of some
-    other step.
-    """
-
-    __slots__ = ("_best", "_kept", "_radius")
-
-    #: evaluate the kept steps once there are this many (bounds memory and work)
-    BATCH = 64
-
-    def __init__(self, robot_radius: float, initial: float) -> None:
-        self._radius = robot_radius
-        self._best = initial  # exact minimum so far
-        self._kept: list[tuple[float, ObstacleField, float, float]] = []
-
-    def _exact(self, fld: ObstacleField, px: float, py: float, radius: float = 0.0) -> float:
-        q = fld.query((px, py), radius, nearest=True)
-        return float((q.signed - self._radius).min())
-
-    @property
-    def best(self) -> float:
-        """The least exact clearance evaluated so far [m] (an upper bound of the minimum)."""
-        return self._best
-
-    def step(self, fld: ObstacleField, px: float, py: float, radius: float) -> float:
-        """Account for the robot at ``(px, py)`` in ``fld``; the query also covers ``radius`` [m]
-        for the sensors.  Returns the step's exact clearance, or a lower bound of it that is
-        >= 0 (no collision) when it was deferred or not needed."""
-        q = fld.query((px, py), radius, nearest=False)
-        low = q.bounds[0] - self._radius
-        if low <= 0.0:  # possible overlap: the collision test needs the exact value now
-            gap = self._exact(fld, px, py, radius)
-        elif len(q.ids) and float(q.distance.min()) <= radius:
-            # the nearest obstacle is within the sensors' radius, hence in the query
-            gap = float((q.signed - self._radius).min())
-        else:
-            if low < self._best:
-                self._kept.append((low, fld, px, py))
-                if len(self._kept) >= self.BATCH:
-                    self._flush()
-            return max(low, 0.0)
-        if gap < self._best:
-            self._best = gap
-        return gap
-
-    def _flush(self) -> None:
-        for low, fld, px, py in sorted(self._kept, key=lambda e: e[0]):
-            if low >= self._best:
-                break
-            gap = self._exact(fld, px, py)
-            if gap < self._best:
-                self._best = gap
-        self._kept.clear()
-
-    def finish(self) -> float:
-        """The exact minimum clearance of the episode [m]."""
-        self._flush()
-        return self._best
+from uvnav.sim.swept import SweptClearance
 
 
 class World2D:
@@ -145,10 +71,10 @@ class World2D:
             :meth:`close`.
         rng: the episode generator; two independent children feed the law and the sensors.
         exact: the exact clearance and nearest obstacle at every step (recorded runs).
-        packed: keep the obstacles in a :class:`~uvnav.sim.packed.PackedObstacles` when the scene
+        packed: hold the obstacles as :class:`~uvnav.sim.bodies2d.PackedBodies` when the scene
             packs (:func:`~uvnav.sim.packed.pack_check`): compiled motion, clearance (exact at
-            every step) and sensing, the numpy path's numbers; :attr:`field` is then built on
-            demand.
+            every step) and sensing, the numbers of :class:`~uvnav.sim.bodies2d.FieldBodies`
+            (the other scenes' bodies).
         swept: judge collisions and the minimum clearance along every step
             (:class:`~uvnav.sim.swept.SweptClearance`); ``False`` samples the end of each step
             only (for comparisons with the sampled judgement).
@@ -183,11 +109,11 @@ class World2D:
         self.x, self.y, self.th = float(start[0]), float(start[1]), float(start[2])
         self.obstacles = setup.obstacles
         self.template = FieldTemplate.from_bodies([o.body for o in self.obstacles])
-        self.batch = ObstacleBatch(self.obstacles)
-        self._field: ObstacleField | None = self.batch.field(self.template)
-        self.packed: PackedObstacles | None = None
-        if packed and self.obstacles and pack_check(setup) is None:
-            self.packed = PackedObstacles(self.obstacles, self.template, self.ratio)
+        self.bodies: Bodies2D = (
+            PackedBodies(self.obstacles, self.template, self.ratio)
+            if packed and self.obstacles and pack_check(setup) is None
+            else FieldBodies(self.obstacles, self.template, exact)
+        )
         self.sensing_range = float(setup.sensing.sensing_range)
         self.pedestrians = pedestrian_ids(self.obstacles)
         self.exact = exact
@@ -196,11 +122,8 @@ class World2D:
 
     @property
     def field(self) -> ObstacleField:
-        """The obstacles now (built on first use at a step of the compiled path)."""
-        if self._field is None:
-            assert self.packed is not None
-            self._field = self.packed.field()
-        return self._field
+        """The obstacles now."""
+        return self.bodies.field()
 
     def law_setup(self, agent: int = 0) -> tuple[UnicycleSpec, FloatArray, np.random.Generator]:
         """The law's limits, goal and generator."""
@@ -211,21 +134,6 @@ class World2D:
         """``[x, y, theta]`` now."""
         return np.array((self.x, self.y, self.th))
 
-    def _clearance(self, radius: float) -> tuple[float, int]:
-        """Exact gap [m] to the nearest obstacle (negative on overlap) and its index; the field's
-        query also covers ``radius`` [m] for the sensors, which reuse it (packed obstacles are
-        measured by their compiled kernel instead, and sensed in their own call)."""
-        if not self.obstacles:
-            return math.inf, -1
-        if self.packed is not None:  # the compiled measure of every later step, no field built
-            return self.packed.clearance(self.x, self.y, float(self.spec.radius))
-        q = self.field.query((self.x, self.y), radius, nearest=True)
-        if len(q.ids) == 0:
-            return math.inf, -1
-        gaps = q.signed - float(self.spec.radius)
-        j = int(gaps.argmin())
-        return float(gaps[j]), int(q.ids[j])
-
     def start(self, oracles: Sequence[bool] = (False,)) -> None:
         """Clearance and status at t = 0; the finite-difference estimator unless the law is an
         oracle or the velocities are known."""
@@ -234,11 +142,8 @@ class World2D:
         if sensing.velocities == "estimated" and not oracles[0]:
             self.estimator = FiniteDifferenceEstimator(self.sense_rng, sensing.position_noise)
         self.scan_bodies = ScanBodies() if sensing.bodies == "lidar" and not oracles[0] else None
-        self.clearance, self.nearest = self._clearance(self.sensing_range)
-        self.tracker = (
-            _MinClearance(float(self.spec.radius), self.clearance)
-            if self.obstacles and not self.exact and self.packed is None
-            else None
+        self.clearance, self.nearest = self.bodies.start(
+            self.x, self.y, float(self.spec.radius), self.sensing_range
         )
         self.social: SocialTracker | None = None
         if len(self.pedestrians):
@@ -280,10 +185,8 @@ class World2D:
         if self.scan_bodies is not None:  # the scan first: the readings are made from it
             scan = self._scan(robot)
             readings = self.scan_bodies.readings(self.t, robot, scan, self.sensing_range)
-        elif self.packed is not None:
-            readings = self.packed.readings(self.x, self.y, self.sensing_range)
         else:
-            readings = sense_obstacles(robot[:2], self.field, sensing_range=self.sensing_range)
+            readings = self.bodies.readings(self.x, self.y, self.sensing_range)
         if self.estimator is not None:
             readings = self.estimator.update(self.t, readings)
         if lc is not None and scan is None:
@@ -352,58 +255,34 @@ class World2D:
         self.turn += turn
         return nx, ny
 
-    def _poses(self) -> tuple[FloatArray, FloatArray, np.ndarray | None]:
-        """The bodies' centres, headings and presence now."""
-        if self.packed is not None:
-            c, h = self.packed.poses()
-            return c, h, None
-        f = self.field
-        return f.centres, f.headings, f.present
-
     def advance(self) -> None:
         """One step ``dt``: robot (exact), obstacles, clearance, collision and arrival."""
-        dt, book, clock = self.dt, self.book, self.clock
+        dt, book, clock, bodies = self.dt, self.book, self.clock, self.bodies
         x, y, t0, g0 = self.x, self.y, self.t, self.clearance
-        if self.batch.sees_robot:  # bodies that react to the robot see it as it starts the step
-            self.batch.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
-        # the bodies' poses at the start (the packed path keeps its own, and the shift)
-        start = self._poses() if self.sweep is not None and self.packed is None else None
+        if bodies.sees_robot:  # bodies that react to the robot see it as it starts the step
+            bodies.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
         travel, slack = self.body.travel(dt)
         nx, ny = self._move(dt)
         book.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
-        was_present = None
-        if self.packed is not None:  # compiled: the exact clearance, the field on demand
-            sense = self.sensing_range if (clock.step_index + 1) % self.ratio == 0 else -1.0
-            self.clearance, self.nearest = self.packed.step(
-                self.t, dt, nx, ny, self.spec.radius, sense
-            )
-            self._field = None
-        else:
-            self.batch.step(self.t, dt)
-            was_present = self.field.present
-            self._field = self.batch.field(self.template)
+        sense = self.sensing_range if (clock.step_index + 1) % self.ratio == 0 else -1.0
+        gap, nearest = bodies.measure(self.t, dt, nx, ny, self.spec.radius, sense)
+        self.clearance = gap
+        if nearest is not None:
+            self.nearest = nearest
         self.t = t = clock.tick()
-        i = clock.step_index
-        if self.packed is None:
-            radius = self.sensing_range if clock.due else 0.0
-            if self.tracker is not None:
-                self.clearance = self.tracker.step(self.field, nx, ny, radius)
-            else:
-                self.clearance, self.nearest = self._clearance(radius)
         if self.social is not None:
-            self.social.observe(self.field, nx, ny, i)
-        contact_at = self._swept(start, (x, y), (nx, ny), t0, g0, travel, slack)
+            self.social.observe(self.field, nx, ny, clock.step_index)
+        contact_at = self._swept((x, y), (nx, ny), t0, g0, travel, slack)
         gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)
         self.done = book.judge(t, self.clearance, gd, contact_at) or clock.up
         if book.status == "collision":  # judged at the first contact when the sweep found it
             sweep = self.sweep
             by = sweep.contact_by(dt, self.velocity(), self.pedestrians) if sweep else None
-            self.collision_by = by or self._collision_by(was_present)
+            self.collision_by = by or self._collision_by(bodies.present_before)
 
     def _swept(
         self,
-        start: tuple[FloatArray, FloatArray, np.ndarray | None] | None,
         p0: tuple[float, float],
         p1: tuple[float, float],
         t0: float,
@@ -412,46 +291,29 @@ class World2D:
         slack: float,
     ) -> float | None:
         """The step just made from ``p0`` (time ``t0`` [s], sampled gap ``g0`` [m]) to ``p1``,
-        judged along its length (:class:`~uvnav.sim.swept.SweptClearance`; ``start``: the
-        bodies' poses it began from, or ``None`` on the packed path, which keeps them): the time
-        of the first contact [s], ``None`` without one."""
-        if self.sweep is None:
+        judged along its length (:class:`~uvnav.sim.swept.SweptClearance`): the time of the
+        first contact [s], ``None`` without one."""
+        sweep, bodies = self.sweep, self.bodies
+        if sweep is None:
             return None
-        # an upper bound of the sampled minimum so far (the tracker's clearance may be a lower
-        # bound, its best is not)
-        ceiling = (
-            self.tracker.best
-            if self.tracker is not None
-            else min(self.book.min_clear, self.clearance)
-        )
-        packed = self.packed
-        if packed is not None:
-            if self.sweep.idle(0.5 * (g0 + self.clearance - travel - packed.shift), ceiling):
-                return None  # (most steps: no poses made)
-            s = self.sweep.step(
-                lambda: StepPoses(*packed.poses_before(), *packed.poses(), None, None,
-                                  np.array(p0), np.array(p1), slack),
-                travel, g0, self.clearance, ceiling, shift=packed.shift,
-            )  # fmt: skip
-        else:
-            assert start is not None
-            c1, h1, pr1 = self._poses()
-            poses = StepPoses(*start[:2], c1, h1, start[2], pr1, np.array(p0), np.array(p1), slack)
-            s = self.sweep.step(poses, travel, g0, self.clearance, ceiling)
+        ceiling = bodies.ceiling(self.book.min_clear, self.clearance)
+        shift = bodies.shift
+        if shift is not None and sweep.idle(0.5 * (g0 + self.clearance - travel - shift), ceiling):
+            return None  # (most steps: no poses made)
+        s = sweep.step(
+            lambda: bodies.step_poses(np.array(p0), np.array(p1), slack),
+            travel, g0, self.clearance, ceiling, shift=shift,
+        )  # fmt: skip
         return None if math.isnan(s) else t0 + s * self.dt
 
     def close(self) -> None:
         """Write the obstacles' states back to their models (the setup's objects)."""
-        if self.packed is not None:
-            self.packed.write_back()
-        else:
-            self.batch.write_back()
+        self.bodies.write_back()
 
     def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
         """The episode's metrics (:mod:`uvnav.sim.metrics`)."""
-        if self.tracker is not None:  # the exact minimum of the steps it deferred
-            self.book.min_clear = self.tracker.finish()
-            self.tracker = None
+        # the exact minimum of the steps the bodies deferred
+        self.book.min_clear = self.bodies.min_clearance(self.book.min_clear)
         if self.sweep is not None:  # the minimum along the steps
             self.book.min_clear = self.sweep.finish(self.book.min_clear)
             self.sweep = None
