@@ -9,6 +9,8 @@ loading.
 * :data:`MAX_EPISODE_STEPS` — integration steps of one episode, ``t_max / dt`` (10^7: about
   a day of simulated time at dt = 0.01 s; the built-ins need at most 10^4).
 * :data:`MAX_CAMPAIGN_EPISODES` — episodes (jobs) of one campaign file (10^6).
+* :data:`MAX_GRID_POINTS` — parameter sets of one controller entry's ``grid`` (10^4; each is
+  checked by building the law when the file is read).
 
 (The terrain of ``uvnav recon plan`` has its own: :data:`uvnav.recon.terrain.MAX_TERRAIN_NODES`.)
 """
@@ -67,6 +69,8 @@ class BoundedScene(SceneModel):
 MAX_EPISODE_STEPS = 10_000_000
 #: most episodes of one campaign (scenario seeds x controller parameter sets)
 MAX_CAMPAIGN_EPISODES = 1_000_000
+#: most parameter sets of one campaign controller entry (the product of its grid's value counts)
+MAX_GRID_POINTS = 10_000
 
 
 def check_episode_steps(t_max: float, dt: float) -> None:
