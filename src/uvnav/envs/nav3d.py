@@ -98,8 +98,9 @@ def body_frame(heading: np.ndarray) -> np.ndarray:
 def command_of(
     action: np.ndarray, heading: np.ndarray, v_max: float, u_max: float
 ) -> Vehicle3DCommand:
-    """The vehicle command of a normalised action (module docstring); the env refuses a non-finite one
-    before (:func:`~uvnav.envs.core.checked_actions`), a direct caller's non-finite entries are 0."""
+    """The vehicle command of a normalised action (module docstring); the env
+    refuses a non-finite action before (:func:`~uvnav.envs.core.checked_actions`), a direct
+    caller's non-finite entries are 0."""
     a = np.asarray(action, dtype=float).reshape(3)
     a = np.clip(np.where(np.isfinite(a), a, 0.0), -1.0, 1.0)
     frame = body_frame(heading)
