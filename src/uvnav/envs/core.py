@@ -143,7 +143,7 @@ def checked_actions(name: str, actions: Any, shape: tuple[int, ...]) -> np.ndarr
     """
     try:
         a = np.asarray(actions, dtype=float)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ValueError(
             f"{name} must be numbers, shape {shape} (got {clip(one_line(repr(actions)), 60)})"
         ) from None
