@@ -239,3 +239,16 @@ def test_a_switch_is_true_or_false_not_a_word_or_a_number(
     assert "\n" not in str(info.value)
     (controller if where == "controller" else data)[field] = True
     assert campaign_from_dict(data, "switches.yaml").name == "switches"
+
+
+def test_a_grid_of_more_parameter_sets_than_the_limit_is_refused_before_expanding() -> None:
+    grid = {f"k{i}": list(range(20)) for i in range(9)}  # 20^9 sets: expanding them never ends
+    data = {
+        "name": "huge-grid",
+        "scenarios": [{"generator": "random-ch2", "seeds": [0, 2]}],
+        "controllers": [{"name": "dwa-v1", "grid": grid}],
+    }
+    with pytest.raises(CampaignError, match=r"controllers\.0\.grid: 20 x 20 .* = 5\.12e\+11 "):
+        campaign_from_dict(data, "huge.yaml")
+    data["controllers"] = [{"name": "dwa-v1", "grid": {"safety_margin": [0.2, 0.3]}}]
+    assert len(campaign_from_dict(data, "small.yaml").jobs()) == 4

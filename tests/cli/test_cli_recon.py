@@ -134,3 +134,17 @@ def test_recon_plan_area_outside_dem(tmp_path: Path) -> None:
     )
     assert res.exit_code == 2
     assert "dem.npy: area" in res.output
+
+
+def test_recon_plan_out_onto_an_existing_file_is_one_line_and_leaves_it(tmp_path: Path) -> None:
+    taken = tmp_path / "notes.txt"
+    taken.write_text("keep me")
+    res = runner.invoke(
+        app, ["recon", "plan", "--synthetic", "1", "--area", "100", "--out", str(taken)]
+    )
+    assert res.exit_code == 2, res.output
+    assert (
+        res.output.strip()
+        == f"error: {taken}: --out: exists and is not a folder (the plan is several files)"
+    )
+    assert taken.read_text() == "keep me"

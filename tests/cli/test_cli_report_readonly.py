@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import hashlib
+import shlex
 import sqlite3
+import subprocess
+import sys
 from collections.abc import Callable
 from pathlib import Path
 
@@ -96,3 +99,37 @@ def test_readonly_store_cannot_write_and_refuses_foreign_files(tmp_path: Path) -
     with pytest.raises(FileNotFoundError):
         ResultsStore(tmp_path / "missing.sqlite", readonly=True)
     assert not (tmp_path / "missing.sqlite").exists()
+
+
+def _read_only_mount(src: Path, dst: Path, command: str) -> subprocess.CompletedProcess[str]:
+    """``command`` run where ``dst`` is ``src`` mounted read-only (a private mount namespace)."""
+    script = f"mount --bind -o ro {shlex.quote(str(src))} {shlex.quote(str(dst))} && {command}"
+    return subprocess.run(
+        ["unshare", "-m", "sh", "-c", script], capture_output=True, text=True, timeout=120
+    )
+
+
+def test_report_reads_a_store_on_read_only_media(tmp_path: Path) -> None:
+    """SQLite cannot create the ``-shm`` file of a WAL database on read-only media."""
+    src, mnt = tmp_path / "src", tmp_path / "mnt"
+    src.mkdir()
+    mnt.mkdir()
+    with ResultsStore(src / "r.sqlite") as store:
+        store.add_episode(
+            store.campaign("c"), scenario="s", controller="straight-v1", seed=0, status="timeout"
+        )
+    if _read_only_mount(src, mnt, f"touch {shlex.quote(str(mnt / 'x'))}").returncode == 0:
+        pytest.skip("the bind mount is not read-only here")
+    probe = _read_only_mount(src, mnt, "true")
+    if probe.returncode != 0:
+        pytest.skip(f"no read-only bind mount here (needs root): {probe.stderr.strip()}")
+    code = (
+        "from uvnav.bench.store import ResultsStore; "
+        f"s = ResultsStore({str(mnt / 'r.sqlite')!r}, readonly=True); "
+        "print(s._conn.execute('SELECT count(*) FROM episodes').fetchone()[0])"
+    )
+    src_dir = Path(__file__).resolve().parents[2] / "src"
+    env = f"PYTHONPATH={shlex.quote(str(src_dir))}"
+    out = _read_only_mount(src, mnt, f"{env} {shlex.quote(sys.executable)} -c {shlex.quote(code)}")
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "1"

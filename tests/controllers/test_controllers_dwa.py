@@ -125,6 +125,7 @@ def test_prediction_avoids_a_crossing_obstacle_that_a_static_window_would_hit() 
     ("bad", "message"),
     [
         ({"v_samples": 1}, "v_samples"),
+        ({"u_samples": 100_000}, "u_samples must be an integer from 2 to 100 \\(got 100000\\)"),
         ({"horizon": -1.0}, "horizon"),
         ({"rollout_dt": 5.0}, "rollout_dt"),
         ({"clearance_weight": float("nan")}, "clearance_weight"),

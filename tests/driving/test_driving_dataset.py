@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -209,4 +211,25 @@ def test_exact_side_labels_replace_the_correction_where_a_row_has_them(tmp_path)
     assert np.allclose(fixed.steering[3:], [0.3, 0.3, 0.0, -0.1, -0.1, -0.4])
     (tmp_path / "driving_log.csv").write_text(lines[2].rsplit(",", 1)[0] + ",left\n")
     with pytest.raises(DatasetError, match="column 'steering_right'"):
+        read_log(tmp_path)
+
+
+@pytest.mark.parametrize(
+    ("column", "value", "shown"),
+    [
+        (3, "1e308", "1e+308 is outside its range [-1, 1]"),
+        (5, "-0.5", "-0.5 is outside its range [0, 1]"),
+    ],
+)
+def test_a_label_outside_its_physical_range_is_refused(
+    tmp_path, column: int, value: str, shown: str
+) -> None:
+    w = LogWriter(tmp_path)
+    w.write("a", (_img(1), _img(1), _img(1)), steering=1.0, throttle=-1.0, brake=1.0, speed=0.0)
+    w.close()
+    assert len(read_log(tmp_path)) == 1  # the ends of the ranges are labels
+    row = (tmp_path / "driving_log.csv").read_text().split(",")
+    row[column] = value
+    (tmp_path / "driving_log.csv").write_text(",".join(row))
+    with pytest.raises(DatasetError, match=rf"row 1, column '\w+': {re.escape(shown)}$"):
         read_log(tmp_path)

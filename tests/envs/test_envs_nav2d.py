@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import gymnasium as gym
 import numpy as np
 import pytest
@@ -214,6 +216,10 @@ def test_gymnasium_make_in_a_fresh_interpreter(code: str) -> None:
         ({"max_range": 0.0}, "max_range must be a finite number > 0"),
         ({"goal_scale": -1.0}, "goal_scale must be a finite number > 0"),
         ({"reward": {"bogus": 1.0}}, "reward: unknown field(s) bogus; known: "),
+        ({"n_rays": 10**9}, "n_rays must be a whole number >= 0 and <= 4096 (got 1000000000)"),
+        ({"reward": {"success": float("nan")}}, "reward.success must be a finite number"),
+        ({"reward": {"time": 1e300}}, "reward.time must be a finite number within +-1e+06"),
+        ({"goal_scale": 1e15}, "goal_scale must be a finite number > 0 and <= 1e+06"),
     ],
 )
 def test_bad_settings_are_refused_by_name(kwargs: dict[str, object], message: str) -> None:
@@ -224,3 +230,38 @@ def test_bad_settings_are_refused_by_name(kwargs: dict[str, object], message: st
         with pytest.raises(ValueError) as info:
             make(**kwargs)  # type: ignore[arg-type]
         assert message in str(info.value), (make, str(info.value))
+
+
+@pytest.mark.parametrize("env_id", ["uvnav/Nav2D-v0", "uvnav/Nav3D-v0", "uvnav/UUV2D-v0"])
+@pytest.mark.parametrize("bad", [np.nan, np.inf, -np.inf])
+def test_a_non_finite_action_is_refused_before_it_reaches_the_state(
+    env_id: str, bad: float
+) -> None:
+    import gymnasium as gym
+
+    env = gym.make(env_id).unwrapped
+    env.reset(seed=0)
+    n = 3 if env_id == "uvnav/Nav3D-v0" else 2
+    action = np.zeros(n)
+    action[-1] = bad
+    with pytest.raises(ValueError) as info:
+        env.step(action)
+    assert str(info.value) == f"action[{n - 1}] is {bad}: an action must be finite"
+    again, reward, *_ = env.step(np.zeros(n))
+    assert math.isfinite(float(reward)) and np.isfinite(again).all()
+    fresh = gym.make(env_id).unwrapped
+    fresh.reset(seed=0)
+    assert np.array_equal(fresh.step(np.zeros(n))[0], again)
+
+
+def test_the_multi_robot_env_refuses_a_non_finite_action_before_any_robot_moves() -> None:
+    from uvnav.envs.multi_robot import MultiNav2DParallelEnv
+
+    env = MultiNav2DParallelEnv("antipodal:3")
+    env.reset(seed=0)
+    poses = env.world.state.copy()
+    actions = {a: np.zeros(2) for a in env.agents}
+    actions["robot_2"] = np.array([0.5, np.nan])
+    with pytest.raises(ValueError, match=r"^action of robot_2\[1\] is nan: an action must be"):
+        env.step(actions)
+    assert np.array_equal(env.world.state, poses) and env.world.t == 0.0

@@ -113,3 +113,50 @@ def test_area_checks() -> None:
     assert T.square_area(10.0, center=(5.0, 5.0)).bounds == (0.0, 0.0, 10.0, 10.0)
     nodes = t.nodes_in(box(0, 0, 20, 20))
     assert len(nodes) == 9
+
+
+def _forged_npy(shape: tuple[int, ...]) -> bytes:
+    """A .npy header claiming ``shape`` float64 values, followed by 64 bytes only."""
+    import io
+
+    buf = io.BytesIO()
+    header = {"descr": "<f8", "fortran_order": False, "shape": shape}
+    np.lib.format.write_array_header_1_0(buf, header)
+    return buf.getvalue() + bytes(64)
+
+
+def test_a_forged_header_is_refused_before_any_allocation(tmp_path: Path) -> None:
+    import zipfile
+
+    npy = tmp_path / "huge.npy"
+    npy.write_bytes(_forged_npy((1_000_000, 1_000_000)))
+    with pytest.raises(ValueError, match=r"huge\.npy: array: the header claims shape \(1000000, "):
+        T.load_dem(npy)
+    npz = tmp_path / "huge.npz"
+    with zipfile.ZipFile(npz, "w") as zf:
+        zf.writestr("z.npy", _forged_npy((1000, 1000)))  # within the limit, but 64 bytes of data
+    with pytest.raises(ValueError, match=r"array 'z': .* but only 64 bytes follow it"):
+        T.load_dem(npz)
+
+
+def test_heights_and_coordinates_outside_the_physical_range_are_refused(tmp_path: Path) -> None:
+    with pytest.raises(ValueError, match=r"height of 1e\+300 m is outside .* \|z\| <= 100000 m"):
+        T.Terrain(np.array([[0.0, 1e300], [0.0, 0.0]]))
+    with pytest.raises(ValueError, match=r"outside \|x\|, \|y\| <= 1e\+08 m"):
+        T.Terrain(np.zeros((2, 2)), x0=1e15)
+    path = tmp_path / "far.npz"
+    np.savez(path, z=np.zeros((3, 3)), y0=-2e8)
+    with pytest.raises(ValueError, match=r"far\.npz: terrain: the grid spans"):
+        T.load_dem(path)
+    assert T.Terrain(np.full((2, 2), 8848.0), x0=500_000.0, y0=6_250_000.0).shape == (2, 2)
+
+
+def test_a_geotiff_without_crs_is_refused(tmp_path: Path) -> None:
+    rasterio = pytest.importorskip("rasterio")
+    path = tmp_path / "nocrs.tif"
+    profile = {"driver": "GTiff", "height": 4, "width": 5, "count": 1, "dtype": "float32"}
+    transform = rasterio.Affine(10.0, 0.0, 1000.0, 0.0, -10.0, 2000.0)
+    with rasterio.open(path, "w", transform=transform, **profile) as ds:
+        ds.write(np.zeros((4, 5), dtype=np.float32), 1)
+    with pytest.raises(ValueError, match=r"nocrs\.tif: GeoTIFF has no CRS; .* metric CRS"):
+        T.load_dem(path)

@@ -73,6 +73,8 @@ def test_parsers_read_both_formats(tmp_path: Path, fmt: str, text: str) -> None:
         ("obsmat", XY4, r"line 1: expected 8 columns for obsmat \(got 4\)"),
         ("xy4", "10 1.5 1 2\n", r"line 1: person id must be an integer"),
         ("xy4", "# nothing\n", r"bad\.txt: no annotations"),
+        ("xy4", "10 1 1 2\n20 1 1e300 2\n", r"line 2: x: 1e\+300 is outside .* <= 1e\+06 m$"),
+        ("xy4", "1e300 1 1 2\n", r"line 1: frame 1e\+300 is above 1e\+09$"),
     ],
 )
 def test_bad_files_give_one_line_naming_file_line_and_problem(
@@ -304,3 +306,12 @@ def test_a_corrupt_gz_or_a_file_that_never_ends_is_one_line(tmp_path: Path) -> N
         P.read_tracks(fifo, "xy4", frame_rate=25.0)
     with pytest.raises(ScenarioError, match="is not a regular file"):
         P.read_tracks(tmp_path, "xy4", frame_rate=25.0)
+
+
+def test_a_scale_that_puts_people_beyond_the_modelled_range_is_refused(tmp_path: Path) -> None:
+    tracks = P.read_tracks(write(tmp_path, "t.txt", XY4), "xy4", frame_rate=25.0)
+    with pytest.raises(
+        ScenarioError, match=r"scale: a position scale \* p \+ offset of .* 1e\+06 m"
+    ):
+        P.shape_tracks(tracks, scale=1e300)
+    assert P.shape_tracks(tracks, scale=2.0)[1].positions.shape[1] == 2

@@ -113,6 +113,24 @@ BAD_CASES = [
         "at most 2 item(s) (got 3)",
         id="point-length",
     ),
+    pytest.param(
+        BASE.replace("start: [0, 0]", "start: [1.0e15, 0]"),
+        "robot.start.0",
+        "1e+15 is outside the modelled range |x| <= 1e+06 m",
+        id="coordinate",
+    ),
+    pytest.param(
+        BASE + obstacle(body="{polygon: [[0, 0], [1, 0], [0, -2.0e6]]}"),
+        "obstacles.0.body.polygon.2.1",
+        "-2e+06 is outside the modelled range",
+        id="polygon-vertex",
+    ),
+    pytest.param(
+        BASE.replace("v_max: 0.7", "v_max: 1.0e300"),  # YAML 1.1: a string pydantic converts
+        "robot.v_max",
+        "1e+300 is above the limit of 1e+09",
+        id="magnitude-of-a-string-number",
+    ),
 ]
 
 

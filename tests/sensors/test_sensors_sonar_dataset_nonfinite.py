@@ -1,4 +1,5 @@
-"""A sonar dataset with NaN/±inf or an impossible sensor number is refused (issue 17)."""
+"""A sonar dataset with NaN/±inf, a distance beyond 1000 km, an impossible sensor number or no
+samples is refused."""
 
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ def _arrays(n: int = 4) -> dict[str, np.ndarray]:
         ("target_distance", (3,), -np.inf, "'target_distance', row 3: -inf is not a finite"),
         ("target_index", (1,), np.nan, "'target_index', row 1: nan is not a finite number"),
         ("baseline_index", (1,), 12, "'baseline_index', row 1: 12 is not a sensor number 1..9"),
+        ("inputs", (1, 3), 1e300, r"'inputs', row 1, column 3: 1e\+300 is outside .* 1e\+06 m"),
     ],
 )
 def test_bad_values_are_refused_naming_array_and_row(
@@ -44,3 +46,9 @@ def test_bad_values_are_refused_naming_array_and_row(
 
 def test_finite_arrays_load() -> None:
     assert len(SonarDataset.from_arrays(_arrays())) == 4
+
+
+def test_an_empty_dataset_is_refused() -> None:
+    arrays = {k: v[:0] for k, v in _arrays().items()}
+    with pytest.raises(ValueError, match=r"^dataset array 'ranges' has no samples \(0 rows\)$"):
+        SonarDataset.from_arrays(arrays)

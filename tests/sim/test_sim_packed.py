@@ -371,6 +371,7 @@ def test_the_compiled_episode_path_equals_the_numpy_path(scene: str, law: str,
 
 def test_the_compiled_path_serves_the_scenes_it_can_pack() -> None:
     scene = load_scenario("random-ch2:0")
+
     def bodies(setup: EpisodeSetup, packed: bool) -> object:
         return World2D(setup, run_rng(0), exact=False, packed=packed).bodies
 

@@ -42,6 +42,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import math
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -63,7 +64,7 @@ from uvnav.controllers import ControllerParamsError, available_controllers
 from uvnav.controllers.base import controller_info, make_law
 from uvnav.scenarios import ScenarioError
 from uvnav.scenarios.errors import FieldError, from_validation_error
-from uvnav.scenarios.limits import MAX_CAMPAIGN_EPISODES
+from uvnav.scenarios.limits import MAX_CAMPAIGN_EPISODES, MAX_GRID_POINTS
 from uvnav.scenarios.loader import parse_yaml
 
 
@@ -270,6 +271,14 @@ class ControllerEntry(_Strict):
                 raise FieldError(f"grid.{key}", "needs at least one value")
             if key in self.params:
                 raise FieldError(f"grid.{key}", "is also in params (give it in one place)")
+        points = math.prod(len(values) for values in self.grid.values())
+        if points > MAX_GRID_POINTS:
+            counts = " x ".join(str(len(values)) for values in self.grid.values())
+            raise FieldError(
+                "grid",
+                f"{counts} = {points:.3g} parameter sets, more than the limit of "
+                f"{MAX_GRID_POINTS} (uvnav.scenarios.limits.MAX_GRID_POINTS); split the grid",
+            )
         for point in self.param_sets():
             try:
                 make_law(self.name, **point)

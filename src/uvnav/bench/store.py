@@ -328,6 +328,10 @@ _REQUIRED = {
 def connect_readonly(path: str | Path) -> sqlite3.Connection:
     """An SQLite connection that cannot write ``path`` (URI ``mode=ro``; never creates it).
 
+    A WAL database on read-only media (a mounted archive, a CD) cannot be opened so, since
+    SQLite needs to create its ``-shm`` file beside it: when its folder cannot be written, it
+    is opened ``immutable``, which reads the file as it is (no writer can work there either).
+
     Raises:
         FileNotFoundError: no such file.
     """
@@ -335,7 +339,16 @@ def connect_readonly(path: str | Path) -> sqlite3.Connection:
     if not path.is_file():
         raise FileNotFoundError(2, "No such database file", str(path))
     uri = f"file:{urllib.parse.quote(str(path.resolve()))}?mode=ro"
-    return sqlite3.connect(uri, uri=True, timeout=30.0, isolation_level=None)
+    conn = sqlite3.connect(uri, uri=True, timeout=30.0, isolation_level=None)
+    try:
+        conn.execute("SELECT 1 FROM sqlite_master LIMIT 1").fetchall()
+    except sqlite3.OperationalError:
+        if not os.access(path.parent, os.W_OK):  # else a real error, which check_store reports
+            conn.close()
+            return sqlite3.connect(f"{uri}&immutable=1", uri=True, isolation_level=None)
+    except sqlite3.DatabaseError:
+        pass  # not a database: check_store says so
+    return conn
 
 
 def check_store(conn: sqlite3.Connection, path: str | Path) -> None:

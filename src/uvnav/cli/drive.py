@@ -139,6 +139,8 @@ def train(
     correction: Annotated[
         float,
         typer.Option(
+            min=-1.0,
+            max=1.0,
             callback=finite,
             help="Left/right steering correction where a row has no exact side label.",
         ),

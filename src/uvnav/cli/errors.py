@@ -92,7 +92,12 @@ def user_error(exc: BaseException) -> tuple[str, int] | None:
         name = f": {clip(str(exc.filename), 200)}" if exc.filename else ""
         if (
             isinstance(
-                exc, FileNotFoundError | IsADirectoryError | NotADirectoryError | PermissionError
+                exc,
+                FileNotFoundError
+                | FileExistsError
+                | IsADirectoryError
+                | NotADirectoryError
+                | PermissionError,
             )
             or exc.errno == errno.ENAMETOOLONG
         ):

@@ -222,6 +222,8 @@ def plan_cmd(
         terrain_nodes,
     )
 
+    if out.exists() and not out.is_dir():
+        raise CliError(f"{out}: --out: exists and is not a folder (the plan is several files)")
     chosen = sum([dem is not None, synthetic is not None, jacksboro])
     if chosen > 1:
         raise CliError("recon plan: --dem, --synthetic and --jacksboro are exclusive; give one")

@@ -55,13 +55,14 @@ def _progress() -> Any:
 
 
 def _load_dataset(path: Path) -> Any:
+    from uvnav.sensors.sonar_array import N_SONARS
     from uvnav.sensors.sonar_dataset import SonarDataset
+    from uvnav.validation import load_npz
 
     if not path.is_file():
         raise CliError(f"{path}: dataset file not found")
     try:
-        with np.load(path, allow_pickle=False) as data:
-            arrays = {k: data[k] for k in data.files}
+        arrays = load_npz(path, N_SONARS * MAX_SAMPLES)
     except (ValueError, OSError, EOFError, zipfile.BadZipFile) as exc:
         raise CliError(
             f"{path}: not a uvnav sonar dataset (.npz): {exc or type(exc).__name__}"

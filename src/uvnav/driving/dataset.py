@@ -221,16 +221,38 @@ def _optional(values: list[float]) -> NDArray[np.float64] | None:
     return None if np.isnan(a).all() else a
 
 
+#: the physical range of each numeric column (steering and throttle are normalised commands,
+#: brake a pedal in [0, 1], speeds [m/s] or [mph]); a value outside is a broken log, not a label
+COLUMN_RANGES = {
+    "steering": (-1.0, 1.0),
+    "throttle": (-1.0, 1.0),
+    "brake": (0.0, 1.0),
+    "speed": (-1000.0, 1000.0),
+    "target_speed": (0.0, 1000.0),
+    "steering_left": (-1.0, 1.0),
+    "steering_right": (-1.0, 1.0),
+}
+#: rounding slack of the written labels at the ends of their ranges
+_SLACK = 1e-6
+
+
 def _number(x: str, log: Path, row: int, col: str, *, missing: bool = False) -> float:
-    """One CSV field as a finite float (``missing``: ``nan`` is allowed, meaning "no value").
+    """One CSV field as a finite float within its :data:`COLUMN_RANGES` range (``missing``:
+    ``nan`` is allowed, meaning "no value").
 
     Raises:
-        DatasetError: not a number, or not finite (``nan`` where a value is required, ``±inf``).
+        DatasetError: not a number, not finite (``nan`` where a value is required, ``±inf``), or
+            outside the column's range.
     """
     try:
         value = float(x)
     except ValueError:
         raise DatasetError(f"{log}: row {row}, column '{col}': {x!r} is not a number") from None
+    lo, hi = COLUMN_RANGES[col]
+    if math.isfinite(value) and not lo - _SLACK <= value <= hi + _SLACK:
+        raise DatasetError(
+            f"{log}: row {row}, column '{col}': {value:g} is outside its range [{lo:g}, {hi:g}]"
+        )
     if math.isfinite(value) or (missing and math.isnan(value)):
         return value
     raise DatasetError(

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.envs.core import RewardConfig
+from uvnav.envs.core import RewardConfig, checked_actions
 from uvnav.envs.nav2d import reward_config
 
 try:
@@ -160,6 +160,7 @@ class VehicleWorldEnv(gym.Env[np.ndarray, np.ndarray]):
             raise RuntimeError("call reset() before step()")
         if world.done:
             raise RuntimeError("the episode is over: call reset()")
+        action = checked_actions("action", action, self.action_space.shape or ())
         rw = self.reward_config
         before = self._distance()
         world.apply(self._command(action))

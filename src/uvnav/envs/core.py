@@ -42,7 +42,9 @@ the robot's disc to an obstacle or another robot over the decision's integration
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import numbers
+import os
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
@@ -54,6 +56,7 @@ from uvnav.sensors.exact import lidar_scan
 from uvnav.sensors.observation import Observation
 from uvnav.sim.episode import World2D
 from uvnav.sim.multi import MultiUnicycleWorld
+from uvnav.validation import MAX_COORDINATE, clip, one_line
 
 OBS_DOC = (
     "[goal distance / goal_scale, cos(goal bearing), sin(goal bearing), speed / v_max, "
@@ -62,6 +65,97 @@ OBS_DOC = (
 
 #: A robot's episode is over (terminated) in these statuses; it is ``"running"`` before.
 TERMINAL = ("success", "collision")
+
+#: Most lidar beams of an observation vector (each beam is a ray cast at every decision).
+MAX_RAYS = 4096
+#: Largest magnitude of a reward weight (a larger one is a mistake, and its rewards overflow).
+MAX_WEIGHT = 1e6
+#: Largest lidar range or goal scale [m] (:data:`uvnav.validation.MAX_COORDINATE`).
+MAX_LENGTH = MAX_COORDINATE
+
+
+def checked_real(name: str, value: Any, limit: float, *, positive: bool = False) -> float:
+    """``value`` as a float when it is a real number (not a bool) with ``|value| <= limit``
+    (and ``> 0`` when ``positive``).
+
+    Raises:
+        TypeError: not a real number (one line naming ``name``).
+        ValueError: NaN, ±inf or beyond ``limit`` (one line naming ``name``).
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(
+            f"{name} must be a number (got {type(value).__name__} {clip(repr(value), 40)})"
+        )
+    try:
+        v = float(value)
+    except OverflowError:  # an int beyond float's range
+        v = math.inf
+    if positive and not (math.isfinite(v) and 0 < v <= limit):
+        raise ValueError(f"{name} must be a finite number > 0 and <= {limit:g} (got {v:g})")
+    if not (math.isfinite(v) and abs(v) <= limit):
+        raise ValueError(f"{name} must be a finite number within +-{limit:g} (got {v:g})")
+    return v
+
+
+def checked_count(name: str, value: Any, low: int, high: int) -> int:
+    """``value`` as an int when it is a whole number (an int, or a float such as 32.0; not a
+    bool) from ``low`` to ``high``.
+
+    Raises:
+        TypeError: not a number; ValueError: not whole, or out of range (one line naming it).
+    """
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(
+            f"{name} must be a whole number (got {type(value).__name__} {clip(repr(value), 40)})"
+        )
+    try:
+        v = float(value)
+    except OverflowError:  # an int beyond float's range
+        v = math.inf
+    if not (math.isfinite(v) and v.is_integer() and low <= v <= high):
+        raise ValueError(
+            f"{name} must be a whole number >= {low} and <= {high} (got {clip(repr(value), 40)})"
+        )
+    return int(v)
+
+
+def checked_scenario(scenario: Any, kind: type) -> None:
+    """Refuse a ``scenario`` argument that is neither a ``kind`` scene nor a name or a path
+    (a built-in name, a YAML path or ``generator:seed``).
+
+    Raises:
+        TypeError: one line naming the argument and the type given.
+    """
+    if not isinstance(scenario, kind | str | os.PathLike):
+        raise TypeError(
+            f"scenario must be a built-in name, a YAML path, GENERATOR:SEED or a {kind.__name__} "
+            f"(got {type(scenario).__name__})"
+        )
+
+
+def checked_actions(name: str, actions: Any, shape: tuple[int, ...]) -> np.ndarray:
+    """``actions`` as a float array of ``shape`` whose entries are all finite; an env calls it
+    before any command is applied, so a refused action changes nothing.
+
+    Raises:
+        ValueError: another shape, entries that are not numbers, or NaN/±inf (one line naming
+            ``name`` and the first bad entry).
+    """
+    try:
+        a = np.asarray(actions, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(
+            f"{name} must be numbers, shape {shape} (got {clip(one_line(repr(actions)), 60)})"
+        ) from None
+    if a.shape != shape:
+        raise ValueError(f"{name} must have shape {shape} (got {a.shape})")
+    bad = np.argwhere(~np.isfinite(a))
+    if len(bad):
+        where = tuple(int(i) for i in bad[0])
+        raise ValueError(
+            f"{name}[{', '.join(map(str, where))}] is {a[where]}: an action must be finite"
+        )
+    return a
 
 
 @dataclass(frozen=True)
@@ -83,6 +177,15 @@ class RewardConfig:
     clearance_margin: float = 0.3
     success: float = 10.0
     collision: float = 10.0
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value = checked_real(f"reward.{f.name}", getattr(self, f.name), MAX_WEIGHT)
+            object.__setattr__(self, f.name, value)
+        if self.clearance_margin < 0:
+            raise ValueError(
+                f"reward.clearance_margin must be >= 0 [m] (got {self.clearance_margin})"
+            )
 
     def reward(self, progress: float, clearance: float, status: str) -> float:
         """One decision's reward: ``progress`` [m] toward the goal, the ``clearance`` [m] over the
@@ -136,41 +239,40 @@ class ControllerView:
 def action_commands(
     actions: np.ndarray, v_max: np.ndarray, u_max: np.ndarray, raw: bool
 ) -> tuple[np.ndarray, np.ndarray]:
-    """(n, 2) actions to unicycle commands ``(v, u)`` [m/s, rad/s], (n,) each, before the
-    world saturates them to (2.4): the actions themselves when ``raw``, else normalised actions
-    in [-1, 1]^2 (clipped; non-finite components 0) mapped onto [0, V_max] x [-U_max, U_max]
-    (``v_max``, ``u_max``: (n,) limits).  The one rule of :meth:`EnvWorld.command` and the
-    batched env.
+    """(n, 2) finite actions (:func:`checked_actions`) to unicycle commands ``(v, u)`` [m/s,
+    rad/s], (n,) each, before the world saturates them to (2.4): the actions themselves when
+    ``raw``, else normalised actions in [-1, 1]^2 (clipped) mapped onto [0, V_max] x [-U_max,
+    U_max] (``v_max``, ``u_max``: (n,) limits).  The one rule of :meth:`EnvWorld.command` and
+    the batched env.
 
-    >>> v, u = action_commands(np.array([[0.0, -1.0], [np.nan, 2.0]]), np.full(2, 1.2),
+    >>> v, u = action_commands(np.array([[0.0, -1.0], [3.0, 2.0]]), np.full(2, 1.2),
     ...                        np.full(2, 0.8), raw=False)
     >>> v.tolist(), u.tolist()
-    ([0.6, 0.6], [-0.8, 0.8])
+    ([0.6, 1.2], [-0.8, 0.8])
     """
     a = np.asarray(actions, dtype=float)
     if raw:
         return a[:, 0], a[:, 1]
     a = np.clip(a, -1.0, 1.0)
-    a = np.where(np.isfinite(a), a, 0.0)
     return 0.5 * (a[:, 0] + 1.0) * v_max, a[:, 1] * u_max
 
 
 def box_command(
     action: np.ndarray, low: tuple[float, float], high: tuple[float, float], raw: bool
 ) -> tuple[float, float]:
-    """A planar vehicle's two command numbers from an action: the action itself when ``raw``,
-    else a normalised action in [-1, 1]^2 (clipped; non-finite components 0) mapped linearly onto
-    the box ``[low, high]``.
+    """A planar vehicle's two command numbers from a finite action (:func:`checked_actions`):
+    the action itself when ``raw``, else a normalised action in [-1, 1]^2 (clipped) mapped
+    linearly onto the box ``[low, high]``.
 
-    >>> box_command(np.array([0.0, np.nan]), (-2.0, -1.0), (2.0, 1.0), raw=False)
-    (0.0, 0.0)
+    >>> box_command(np.array([0.0, 5.0]), (-2.0, -1.0), (2.0, 1.0), raw=False)
+    (0.0, 1.0)
     >>> box_command(np.array([1.0, -1.0]), (-2.0, -1.0), (2.0, 1.0), raw=False)
     (2.0, -1.0)
     """
     a = np.asarray(action, dtype=float)
     if raw:
         return float(a[0]), float(a[1])
-    a = np.clip(np.where(np.isfinite(a), a, 0.0), -1.0, 1.0)
+    a = np.clip(a, -1.0, 1.0)
     lo, hi = np.asarray(low, dtype=float), np.asarray(high, dtype=float)
     c = lo + 0.5 * (a + 1.0) * (hi - lo)
     return float(c[0]), float(c[1])
@@ -304,6 +406,10 @@ class EnvWorld:
             None if f.present is None else f.present[keep],
         )  # fmt: skip
 
+    def action_name(self, i: int) -> str:
+        """How errors name robot ``i``'s action."""
+        return f"action of robot_{i}" if self.multi else "action"
+
     def command(self, i: int, action: np.ndarray) -> Any:
         """The command of robot ``i``'s action: a unicycle's by :func:`action_commands`,
         another vehicle's by :func:`box_command`."""
@@ -326,6 +432,7 @@ class EnvWorld:
         are applied, then the world advances to the next decision time or the end.  Returns the
         rewards (0 for robots that were already done)."""
         n, w = self.n, self.world
+        actions = {i: checked_actions(self.action_name(i), a, (2,)) for i, a in actions.items()}
         before = [self.distance(i) for i in range(n)]
         was_running = [self.running(i) for i in range(n)]
         low = np.full(n, np.inf)
@@ -421,16 +528,15 @@ class EnvWorldEnv:
 
 
 def checked_lidar(n_rays: Any, max_range: Any) -> tuple[int, float]:
-    """An env's lidar: ``n_rays`` (a whole number >= 0) and ``max_range`` [m] (finite, > 0).
+    """An env's lidar: ``n_rays`` (a whole number from 0 to :data:`MAX_RAYS`) and ``max_range``
+    [m] (> 0 and at most :data:`MAX_LENGTH`).
 
     Raises:
-        ValueError: either is out of range (one line naming it).
+        TypeError: either is not a number; ValueError: either is out of range (one line naming
+            it).
     """
-    if isinstance(n_rays, bool) or not float(n_rays).is_integer() or n_rays < 0:
-        raise ValueError(f"n_rays must be a whole number >= 0 (got {n_rays!r})")
-    if not (math.isfinite(max_range) and max_range > 0):
-        raise ValueError(f"max_range must be a finite number > 0 [m] (got {max_range!r})")
-    return int(n_rays), float(max_range)
+    rays = checked_count("n_rays", n_rays, 0, MAX_RAYS)
+    return rays, checked_real("max_range", max_range, MAX_LENGTH, positive=True)
 
 
 def goal_scale_for(distance: float, goal_scale: float | None) -> float:
@@ -438,9 +544,7 @@ def goal_scale_for(distance: float, goal_scale: float | None) -> float:
     scene's start-goal ``distance`` [m] (at least 1 m), the default of every uvnav env."""
     if goal_scale is None:
         return max(1.5 * distance, 1.0)
-    if not (math.isfinite(goal_scale) and goal_scale > 0):
-        raise ValueError(f"goal_scale must be a finite number > 0 [m] (got {goal_scale!r})")
-    return float(goal_scale)
+    return checked_real("goal_scale", goal_scale, MAX_LENGTH, positive=True)
 
 
 def scene_bounds(world: EnvWorld, margin: float = 1.5) -> tuple[float, float, float, float]:

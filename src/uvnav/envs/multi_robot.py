@@ -22,7 +22,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig, goal_scale_for
+from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig, checked_scenario, goal_scale_for
 from uvnav.envs.nav2d import act_space, episode_seed, obs_space, reward_config
 from uvnav.scenarios.multi import MultiScenario, build_multi, load_multi_scenario
 from uvnav.sim.multi import MultiUnicycleWorld
@@ -71,6 +71,7 @@ class MultiNav2DParallelEnv(EnvWorldEnv, ParallelEnv):
     ) -> None:
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
+        checked_scenario(scenario, MultiScenario)
         self.scenario = (
             scenario if isinstance(scenario, MultiScenario) else load_multi_scenario(scenario)
         )

@@ -41,7 +41,14 @@ from typing import Any
 import numpy as np
 
 from uvnav.dynamics.vehicles import make_vehicle, vehicles_2d
-from uvnav.envs.core import TERMINAL, EnvWorldEnv, RewardConfig, goal_scale_for
+from uvnav.envs.core import (
+    TERMINAL,
+    EnvWorldEnv,
+    RewardConfig,
+    checked_count,
+    checked_scenario,
+    goal_scale_for,
+)
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.scenarios.schema import Scenario
@@ -61,6 +68,10 @@ def reward_config(reward: RewardConfig | dict[str, float] | None) -> RewardConfi
         return RewardConfig()
     if isinstance(reward, RewardConfig):
         return reward
+    if not isinstance(reward, dict):
+        raise TypeError(
+            f"reward must be a RewardConfig or a dict of its fields (got {type(reward).__name__})"
+        )
     known = [f.name for f in fields(RewardConfig)]
     unknown = sorted(set(reward) - set(known))
     if unknown:
@@ -88,7 +99,7 @@ def act_space(v_max: float = 1.0, u_max: float = 1.0, *, raw: bool = False) -> s
 def episode_seed(rng: np.random.Generator, options: dict[str, Any] | None) -> int:
     """``options["episode_seed"]`` when given, else one drawn from ``rng``."""
     if options and options.get("episode_seed") is not None:
-        return int(options["episode_seed"])
+        return checked_count("options['episode_seed']", options["episode_seed"], 0, 2**63 - 1)
     return int(rng.integers(2**31 - 1))
 
 
@@ -133,6 +144,7 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         self.swept = swept
         if render_mode is not None and render_mode not in self.metadata["render_modes"]:
             raise ValueError(f"render_mode must be None or 'rgb_array' (got {render_mode!r})")
+        checked_scenario(scenario, Scenario)
         self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
         r = self.scenario.robot
         dist = float(np.hypot(r.goal[0] - r.start[0], r.goal[1] - r.start[1]))

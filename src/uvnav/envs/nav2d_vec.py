@@ -26,7 +26,15 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.envs.core import RewardConfig, action_commands, checked_lidar, goal_scale_for
+from uvnav.envs.core import (
+    RewardConfig,
+    action_commands,
+    checked_actions,
+    checked_count,
+    checked_lidar,
+    checked_scenario,
+    goal_scale_for,
+)
 from uvnav.envs.nav2d import act_space, episode_seed, obs_space, reward_config
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
@@ -48,18 +56,23 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
     raise ImportError("uvnav.envs needs gymnasium: pip install 'uvnav[envs]'") from exc
 
 
+#: Most sub-environments of one :class:`Nav2DVectorEnv` (each holds a world and its arrays).
+MAX_NUM_ENVS = 10_000
+
+
 class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
     """K ``uvnav/Nav2D-v0`` worlds in one (module docstring).
 
     Args:
-        num_envs: K.
+        num_envs: K, a whole number from 1 to :data:`MAX_NUM_ENVS`.
         scenario: as :class:`~uvnav.envs.nav2d.Nav2DEnv`'s (built-in name, YAML path,
             ``generator:seed`` or a :class:`~uvnav.scenarios.Scenario`).
         n_rays, max_range, goal_scale, reward, raw_commands: as
             :class:`~uvnav.envs.nav2d.Nav2DEnv`'s.
 
     Raises:
-        ValueError: the scene cannot be batched (its reason, one line).
+        ValueError: the scene cannot be batched, or an argument is out of range (one line).
+        TypeError: an argument is not a number (one line).
     """
 
     metadata: dict[str, Any] = {"autoreset_mode": gym.vector.AutoresetMode.NEXT_STEP}  # noqa: RUF012 - gymnasium declares it an instance variable
@@ -77,8 +90,7 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         render_mode: None = None,
         swept: bool = False,
     ) -> None:
-        if num_envs < 1:
-            raise ValueError(f"num_envs must be at least 1 (got {num_envs})")
+        k = checked_count("num_envs", num_envs, 1, MAX_NUM_ENVS)
         if swept:
             raise ValueError(
                 "swept: the batched worlds judge collisions at the end of each step; "
@@ -86,7 +98,8 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             )
         if render_mode is not None:
             raise ValueError("the batched Nav2D env does not render; use Nav2DEnv")
-        self.num_envs = k = int(num_envs)
+        self.num_envs = k
+        checked_scenario(scenario, Scenario)
         self.scenario = scenario if isinstance(scenario, Scenario) else load_scenario(scenario)
         why = pack_check(build_episode(self.scenario, 0))
         if why is not None:
@@ -159,11 +172,10 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         """The ``acting`` worlds' actions to held commands: :func:`action_commands
         <uvnav.envs.core.action_commands>`, then the saturation of :meth:`UnicycleCommand.clipped
         <uvnav.dynamics.unicycle.UnicycleCommand.clipped>` on arrays."""
-        a = np.asarray(actions, dtype=float).reshape(self.num_envs, 2)
         vmax, umax = self.worlds.limits[:, 0], self.worlds.limits[:, 1]
-        v, u = action_commands(a, vmax, umax, self.raw_commands)
-        v = np.where(np.isfinite(v), np.minimum(np.maximum(v, 0.0), vmax), 0.0)
-        u = np.where(np.isfinite(u), np.minimum(np.maximum(u, -umax), umax), 0.0)
+        v, u = action_commands(actions, vmax, umax, self.raw_commands)
+        v = np.minimum(np.maximum(v, 0.0), vmax)
+        u = np.minimum(np.maximum(u, -umax), umax)
         self.worlds.command[acting, 0] = v[acting]
         self.worlds.command[acting, 1] = u[acting]
 
@@ -172,6 +184,7 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
         """One decision in every sub-environment (those that ended last step restart instead,
         ignoring their action)."""
+        actions = checked_actions("actions", actions, (self.num_envs, 2))
         w = self.worlds
         restart = self._autoreset.copy()
         for i in restart.nonzero()[0].tolist():

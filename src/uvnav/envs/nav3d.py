@@ -62,7 +62,14 @@ import numpy as np
 
 from uvnav.dynamics.vehicle3d import Vehicle3DCommand
 from uvnav.envs.common import SimView, VehicleWorldEnv, fill_polygon
-from uvnav.envs.core import ROBOT_COLOURS, RewardConfig, goal_scale_for, pixel_grid, square_bounds
+from uvnav.envs.core import (
+    ROBOT_COLOURS,
+    RewardConfig,
+    checked_count,
+    goal_scale_for,
+    pixel_grid,
+    square_bounds,
+)
 from uvnav.sensors.sensing3d import Observation3D
 from uvnav.sim.episode3d import Vehicle3DWorld
 
@@ -72,6 +79,8 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
     raise ImportError("uvnav.envs needs gymnasium: pip install 'uvnav[envs]'") from exc
 
 SLOT = 8  # values per obstacle slot
+#: most obstacle slots of the observation vector (``n_obstacles``)
+MAX_OBSTACLE_SLOTS = 100
 
 
 def body_frame(heading: np.ndarray) -> np.ndarray:
@@ -89,7 +98,9 @@ def body_frame(heading: np.ndarray) -> np.ndarray:
 def command_of(
     action: np.ndarray, heading: np.ndarray, v_max: float, u_max: float
 ) -> Vehicle3DCommand:
-    """The vehicle command of a normalised action (module docstring); non-finite entries are 0."""
+    """The vehicle command of a normalised action (module docstring); the env
+    refuses a non-finite action before (:func:`~uvnav.envs.core.checked_actions`), a direct
+    caller's non-finite entries are 0."""
     a = np.asarray(action, dtype=float).reshape(3)
     a = np.clip(np.where(np.isfinite(a), a, 0.0), -1.0, 1.0)
     frame = body_frame(heading)
@@ -179,8 +190,7 @@ class Nav3DEnv(VehicleWorldEnv):
                 raise ValueError(f"{scenario!r} is not a Chapter-3 (dim: 3) scene")
             return sc
 
-        if int(n_obstacles) < 1:
-            raise ValueError(f"n_obstacles must be >= 1 (got {n_obstacles})")
+        checked_count("n_obstacles", n_obstacles, 1, MAX_OBSTACLE_SLOTS)
         first = self._configure(
             scenario, {"random-ch3": random_ch3_scenario}, load, render_mode, reward
         )

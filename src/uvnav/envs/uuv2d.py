@@ -70,7 +70,9 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
 def command_of(
     action: np.ndarray, heading: float, v_max: float, u_max: float, period: float
 ) -> HolonomicCommand:
-    """The velocity command of a normalised action (module docstring); non-finite entries are 0."""
+    """The velocity command of a normalised action (module docstring); the env
+    refuses a non-finite action before (:func:`~uvnav.envs.core.checked_actions`), a direct
+    caller's non-finite entries are 0."""
     a = np.asarray(action, dtype=float).reshape(2)
     a = np.clip(np.where(np.isfinite(a), a, 0.0), -1.0, 1.0)
     ang = heading + float(a[1]) * u_max * period

@@ -39,13 +39,19 @@ import numpy as np
 import shapely
 from shapely.geometry import Polygon, box
 
-from uvnav.validation import one_line
+from uvnav.validation import load_npy, load_npz, one_line
 
 FloatArray = np.ndarray
 
 #: Most nodes of a terrain grid, loaded or generated (10^8 nodes: 800 MB of float64 heights); a
 #: module constant: raise it before loading for a larger DEM.
 MAX_TERRAIN_NODES = 100_000_000
+
+#: Largest terrain height magnitude [m] (the Earth's relief spans -11 km to +9 km).
+MAX_HEIGHT = 1e5
+#: Largest magnitude [m] of a terrain's planar coordinates (the Earth's circumference is 4e7 m;
+#: projected eastings and northings stay below it).
+MAX_MAP_COORDINATE = 1e8
 
 #: Metres per arc-second of latitude (WGS84 mean) used by the equirectangular projection.
 METRES_PER_ARCSEC = 30.87
@@ -88,6 +94,20 @@ class Terrain:
         if not (self.dx > 0 and self.dy > 0):
             raise ValueError(
                 f"terrain: cell sizes must be positive, got dx={self.dx}, dy={self.dy}"
+            )
+        peak = float(np.abs(z).max())
+        if peak > MAX_HEIGHT:
+            raise ValueError(
+                f"terrain z: a height of {peak:g} m is outside the physical range "
+                f"|z| <= {MAX_HEIGHT:g} m (uvnav.recon.terrain.MAX_HEIGHT)"
+            )
+        ny, nx = z.shape
+        corners = (self.x0, self.y0, self.x0 + self.dx * (nx - 1), self.y0 + self.dy * (ny - 1))
+        if max(abs(c) for c in corners) > MAX_MAP_COORDINATE:
+            raise ValueError(
+                f"terrain: the grid spans x {corners[0]:g}..{corners[2]:g} m, y {corners[1]:g}.."
+                f"{corners[3]:g} m, outside |x|, |y| <= {MAX_MAP_COORDINATE:g} m "
+                "(uvnav.recon.terrain.MAX_MAP_COORDINATE)"
             )
         object.__setattr__(self, "z", z)
 
@@ -355,20 +375,20 @@ def load_dem(path: str | Path, *, cell: float | None = None) -> Terrain:
             with p.open("rb") as fh:
                 if fh.read(6) != b"\x93NUMPY":
                     raise OSError("no .npy header")
-            z = np.load(p, allow_pickle=False)
+            z = load_npy(p, MAX_TERRAIN_NODES)
             c = 1.0 if cell is None else float(cell)
             return Terrain(_heights(z, "array"), 0.0, 0.0, c, c, source=f"{p.name}")
         if suffix == ".npz":
-            with np.load(p, allow_pickle=False) as d:
-                key = "z" if "z" in d else "elevation" if "elevation" in d else None
-                if key is None:
-                    raise ValueError("needs an array named 'z' (or 'elevation')")
-                default = 1.0 if cell is None else float(cell)
-                dx = _npz_number(d, "dx", default)
-                dy = _npz_number(d, "dy", dx)
-                x0 = _npz_number(d, "x0", 0.0)
-                y0 = _npz_number(d, "y0", 0.0)
-                return Terrain(_heights(d[key], key), x0, y0, dx, dy, source=p.name)
+            d = load_npz(p, MAX_TERRAIN_NODES)
+            key = "z" if "z" in d else "elevation" if "elevation" in d else None
+            if key is None:
+                raise ValueError("needs an array named 'z' (or 'elevation')")
+            default = 1.0 if cell is None else float(cell)
+            dx = _npz_number(d, "dx", default)
+            dy = _npz_number(d, "dy", dx)
+            x0 = _npz_number(d, "x0", 0.0)
+            y0 = _npz_number(d, "y0", 0.0)
+            return Terrain(_heights(d[key], key), x0, y0, dx, dy, source=p.name)
         if suffix in (".tif", ".tiff"):
             return _load_geotiff(p)
     except ValueError as exc:
@@ -419,7 +439,12 @@ def _load_geotiff(p: Path) -> Terrain:
                 )
             band = ds.read(1, masked=True).astype(float)
             t = ds.transform
-            if ds.crs is not None and ds.crs.is_geographic:
+            if ds.crs is None:
+                raise ValueError(
+                    "GeoTIFF has no CRS; its coordinates must be in a projected, metric CRS "
+                    "(assign one, e.g. gdal_edit.py -a_srs EPSG:32617)"
+                )
+            if ds.crs.is_geographic:
                 raise ValueError(
                     "GeoTIFF CRS is geographic (degrees); reproject to a metric CRS first"
                 )

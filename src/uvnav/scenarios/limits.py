@@ -9,6 +9,11 @@ loading.
 * :data:`MAX_EPISODE_STEPS` — integration steps of one episode, ``t_max / dt`` (10^7: about
   a day of simulated time at dt = 0.01 s; the built-ins need at most 10^4).
 * :data:`MAX_CAMPAIGN_EPISODES` — episodes (jobs) of one campaign file (10^6).
+* :data:`uvnav.validation.MAX_COORDINATE` — magnitude of a point's coordinates (10^6 m, the
+  :data:`Coordinate` type of every scene kind's points) and of a pedestrian track's positions;
+  :data:`MAX_MAGNITUDE` bounds every other number of a scene file (10^9).
+* :data:`MAX_GRID_POINTS` — parameter sets of one controller entry's ``grid`` (10^4; each is
+  checked by building the law when the file is read).
 
 (The terrain of ``uvnav recon plan`` has its own: :data:`uvnav.recon.terrain.MAX_TERRAIN_NODES`.)
 """
@@ -16,12 +21,24 @@ loading.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Annotated, Any
 
-from pydantic import BaseModel, ConfigDict, PrivateAttr, model_validator
+from pydantic import AfterValidator, BaseModel, ConfigDict, PrivateAttr, model_validator
 
 from uvnav.scenarios.errors import FieldError
 from uvnav.sim.ledger import decision_ratio, step_count
+from uvnav.validation import coordinate_problem
+
+
+def _coordinate(value: float) -> float:
+    problem = coordinate_problem(value)
+    if problem is not None:
+        raise ValueError(f"{problem} (uvnav.validation.MAX_COORDINATE)")
+    return value
+
+
+#: A coordinate of a point [m]: finite and within :data:`uvnav.validation.MAX_COORDINATE`.
+Coordinate = Annotated[float, AfterValidator(_coordinate)]
 
 
 class FileModel(BaseModel):
@@ -62,11 +79,19 @@ class BoundedScene(SceneModel):
         check_magnitudes(data)
         return data
 
+    @model_validator(mode="after")
+    def _bounded_values(self) -> BoundedScene:
+        # YAML 1.1 reads ``1.0e300`` as a string, which pydantic turns into a number afterwards
+        check_magnitudes(self)
+        return self
+
 
 #: most integration steps ``t_max / dt`` of one episode
 MAX_EPISODE_STEPS = 10_000_000
 #: most episodes of one campaign (scenario seeds x controller parameter sets)
 MAX_CAMPAIGN_EPISODES = 1_000_000
+#: most parameter sets of one campaign controller entry (the product of its grid's value counts)
+MAX_GRID_POINTS = 10_000
 
 
 def check_episode_steps(t_max: float, dt: float) -> None:
@@ -102,17 +127,21 @@ def check_timing(t_max: float, dt: float, control_period: float) -> None:
             raise FieldError(name, str(e).removeprefix(f"{name} ")) from None
 
 
-#: largest magnitude of a number in a 3D scene file (coordinates [m], sizes [m], speeds [m/s]):
-#: beyond it squared distances overflow float64 in the mesh geometry; seeds are exempt
+#: largest magnitude of a number in a scene file of any kind (sizes [m], speeds [m/s], times
+#: [s]; points have the tighter :data:`Coordinate`): beyond it squared distances overflow
+#: float64 in the geometry; seeds are exempt
 MAX_MAGNITUDE = 1e9
 
 
 def check_magnitudes(data: Any, path: str = "") -> None:
-    """Refuse a number above :data:`MAX_MAGNITUDE` anywhere in a scene mapping (not seeds).
+    """Refuse a number above :data:`MAX_MAGNITUDE` anywhere in a scene mapping or model (not
+    seeds).
 
     Raises:
         FieldError: naming the field's dotted path and the number.
     """
+    if isinstance(data, BaseModel):
+        data = {name: getattr(data, name) for name in type(data).model_fields}
     if isinstance(data, dict):
         for key, value in data.items():
             if "seed" not in str(key):

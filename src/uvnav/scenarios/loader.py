@@ -110,6 +110,10 @@ def scenario_text(name_or_path: str | Path) -> tuple[str, str]:
     Raises:
         ScenarioError: no such file or built-in, or the file cannot be read.
     """
+    try:
+        Path(name_or_path).exists()
+    except OSError as exc:  # a name longer than the system allows
+        raise ScenarioError(str(name_or_path), "", exc.strerror or str(exc)) from None
     if isinstance(name_or_path, str) and not _looks_like_path(name_or_path):
         if name_or_path in _builtin_files():
             return f"{name_or_path}.yaml", builtin_text(name_or_path)

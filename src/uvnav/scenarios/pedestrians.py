@@ -65,6 +65,8 @@ from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.obstacles import DiscBody, Obstacle, ObstacleState, Replay
 from uvnav.obstacles.batch import wrap_array
 from uvnav.scenarios.errors import ScenarioError
+from uvnav.scenarios.limits import MAX_MAGNITUDE
+from uvnav.validation import coordinate_problem
 
 #: time between two annotations of the ETH/UCY recordings [s] (2.5 Hz)
 ANNOTATION_PERIOD = 0.4
@@ -138,9 +140,17 @@ def _parse(text: str, source: str, fmt: str, frame_rate: float | None) -> dict[i
     hidden: list[int] = []
     entries = _json_rows(text, source) if fmt == "trajnet" else _text_rows(text, source, fmt)
     for lineno, frame, pid, x, y in entries:
+        if abs(frame) > MAX_MAGNITUDE:
+            raise ScenarioError(
+                source, f"line {lineno}", f"frame {frame:g} is above {MAX_MAGNITUDE:g}"
+            )
         if x is None or y is None:
             hidden.append(lineno)
             continue
+        for axis, value in (("x", x), ("y", y)):
+            problem = coordinate_problem(value)
+            if problem is not None:
+                raise ScenarioError(source, f"line {lineno}", f"{axis}: {problem}")
         key = (frame, pid)
         if key in seen:
             raise ScenarioError(
@@ -384,6 +394,10 @@ def shape_tracks(
     if scale != 1.0 or offset != (0.0, 0.0):
         shift = np.asarray(offset, dtype=float)
         out = {i: Track(i, t.times, t.positions * scale + shift) for i, t in out.items()}
+        reach = max((float(np.abs(t.positions).max()) for t in out.values()), default=0.0)
+        problem = coordinate_problem(reach)
+        if problem is not None:
+            raise ScenarioError("", "scale", f"a position scale * p + offset of {problem}")
     if stitch:
         out = stitch_tracks(out)
     return out

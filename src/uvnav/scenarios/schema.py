@@ -49,7 +49,13 @@ from uvnav.obstacles import crowd as orca_crowd
 from uvnav.obstacles.motion import motion_plugins
 from uvnav.obstacles.social_force import SocialForcePedestrian
 from uvnav.scenarios.errors import FieldError, ScenarioError
-from uvnav.scenarios.limits import FieldEqualScene, FileModel, check_timing
+from uvnav.scenarios.limits import (
+    BoundedScene,
+    Coordinate,
+    FieldEqualScene,
+    FileModel,
+    check_timing,
+)
 from uvnav.scenarios.pedestrians import (
     DATASETS,
     DEFAULT_RADIUS,
@@ -62,7 +68,7 @@ from uvnav.scenarios.pedestrians import (
 from uvnav.sensors.plugins import sensor_plugin
 from uvnav.sim import LidarConfig, SensingConfig
 
-Point2 = Annotated[tuple[float, float], Field(description="[x, y] [m]")]
+Point2 = Annotated[tuple[Coordinate, Coordinate], Field(description="[x, y] [m]")]
 """A planar point ``[x, y]`` [m]."""
 
 
@@ -304,7 +310,7 @@ class ConstantMotion(_Model):
     """Straight line at constant velocity, constant spin (Savkin–Wang's obstacle model)."""
 
     type: Literal["constant"]
-    velocity: Point2 = Field(description="velocity v_i [m/s], [vx, vy]")
+    velocity: tuple[float, float] = Field(description="velocity v_i [m/s], [vx, vy]")
     angular_velocity: float = Field(0.0, description="spin u_i about the mass centre [rad/s]")
 
     def to_model(self, rng: np.random.Generator) -> ConstantVelocity:
@@ -809,7 +815,7 @@ class ControllerSpec(_Model):
 # ---------------------------------------------------------------------------------------- scenario
 
 
-class Scenario(FieldEqualScene):
+class Scenario(BoundedScene, FieldEqualScene):
     """A complete scenario (DESIGN §3): robot, sensing, obstacles, timing and default controller."""
 
     name: str = Field(min_length=1, description="scenario name, e.g. thesis-ch2-one-obstacle")

@@ -43,10 +43,16 @@ from uvnav.obstacles.motion3d import (
     Waypoints3D,
 )
 from uvnav.scenarios.errors import FieldError, ScenarioError, from_validation_error
-from uvnav.scenarios.limits import BoundedScene, FieldEqualScene, FileModel, check_timing
+from uvnav.scenarios.limits import (
+    BoundedScene,
+    Coordinate,
+    FieldEqualScene,
+    FileModel,
+    check_timing,
+)
 from uvnav.sim.episode3d import Episode3DSetup, Sensing3DConfig, clearance3d
 
-Point3 = Annotated[tuple[float, float, float], Field(description="[x, y, z] [m]")]
+Point3 = Annotated[tuple[Coordinate, Coordinate, Coordinate], Field(description="[x, y, z] [m]")]
 Vec3 = tuple[float, float, float]
 
 

@@ -38,13 +38,13 @@ from uvnav.scenarios.errors import (
     ScenarioError,
     from_validation_error,
 )
-from uvnav.scenarios.limits import FileModel, SceneModel, check_timing
+from uvnav.scenarios.limits import BoundedScene, Coordinate, FileModel, check_timing
 from uvnav.scenarios.loader import builtin_yaml_files, natural_key, parse_yaml
 from uvnav.scenarios.params import typed_generator
 from uvnav.sensors.sonar2d import SonarConfig
 from uvnav.sim.episode_uuv2d import Uuv2dSetup, clearance_of, inside_any
 
-Point2 = Annotated[tuple[float, float], Field(description="[x, y] [m]")]
+Point2 = Annotated[tuple[Coordinate, Coordinate], Field(description="[x, y] [m]")]
 BUILTIN_SUBDIR = "ch4"  # of the built-in scenario folder
 
 
@@ -93,7 +93,9 @@ class DeformingSpec(_Model):
     roughness: float = Field(
         0.35, gt=0, le=MAX_RELATIVE_AMPLITUDE, description="total relative amplitude"
     )
-    velocity: Point2 = Field((0.0, 0.0), description="velocity of the mass centre [m/s]")
+    velocity: tuple[float, float] = Field(
+        (0.0, 0.0), description="velocity of the mass centre [m/s]"
+    )
 
     def to_shape(self) -> DeformingStar:
         """The body (memoised: the same spec gives the same, immutable, calibrated body)."""
@@ -170,7 +172,7 @@ class ControllerChoice(_Model):
     params: dict[str, Any] = Field(default_factory=dict)
 
 
-class Uuv2dScenario(SceneModel):
+class Uuv2dScenario(BoundedScene):
     """A Chapter-4 scene: vehicle, sonar, shape-changing obstacles, timing, default law."""
 
     kind: Literal["uuv2d"] = Field(description="marks a Chapter-4 UUV scene")

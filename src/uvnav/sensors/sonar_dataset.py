@@ -48,6 +48,7 @@ from uvnav.sensors.sonar_array import (
     nearest_beam,
     sonar_scan,
 )
+from uvnav.validation import MAX_COORDINATE, coordinate_problem
 
 
 @dataclass(frozen=True)
@@ -159,7 +160,9 @@ class SonarDataset:
         for name in need:
             if name not in arrays:
                 raise ValueError(f"dataset misses the array {name!r}")
-        n = np.asarray(arrays["ranges"]).shape[0]
+        n = np.asarray(arrays["ranges"]).shape[0] if np.ndim(arrays["ranges"]) else 0
+        if n == 0:
+            raise ValueError("dataset array 'ranges' has no samples (0 rows)")
         for name in need:
             a = np.asarray(arrays[name])
             want = (n, N_SONARS) if name in ("ranges", "inputs") else (n,)
@@ -186,22 +189,24 @@ class SonarDataset:
 
 
 def _check_finite(name: str, a: np.ndarray) -> None:
-    """Raise a one-line :class:`ValueError` at the first entry of ``a`` that is not finite.
+    """Raise a one-line :class:`ValueError` at the first entry of ``a`` that is not a finite
+    number within :data:`uvnav.validation.MAX_COORDINATE` (distances [m]; the indices 1..9 are
+    checked by the caller).
 
     Raises:
-        ValueError: a non-numeric array, or a NaN/±inf entry (naming the array, row and column).
+        ValueError: a non-numeric array, or a NaN/±inf or out-of-range entry (naming the array,
+            row and column).
     """
     if not (np.issubdtype(a.dtype, np.number) or a.dtype == np.bool_):
         raise ValueError(f"dataset array {name!r} has dtype {a.dtype}, expected numbers")
     if np.issubdtype(a.dtype, np.integer) or a.dtype == np.bool_:
         return
-    bad = np.argwhere(~np.isfinite(a))
+    bad = np.argwhere(~(np.abs(a) <= MAX_COORDINATE))
     if len(bad):
         where = bad[0]
         cell = f"row {int(where[0])}" + (f", column {int(where[1])}" if len(where) > 1 else "")
-        raise ValueError(
-            f"dataset array {name!r}, {cell}: {float(a[tuple(where)])} is not a finite number"
-        )
+        problem = coordinate_problem(float(a[tuple(where)]))
+        raise ValueError(f"dataset array {name!r}, {cell}: {problem}")
 
 
 def _random_unit(rng: np.random.Generator) -> FloatArray:
