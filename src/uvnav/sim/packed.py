@@ -248,8 +248,9 @@ def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs
     :func:`_clearance` of the robot disc of ``radius`` [m] at ``(x, y)`` then, for a
     ``sensing_range`` >= 0 [m] the number of readings :func:`sense_one_py` writes from there
     (else -1), and the most any body point moved [m] (centre shift plus bounding radius times
-    the turn): the step of :class:`PackedObstacles`, in one call.  The poses before the step go
-    to ``prev`` (3, n): x, y, heading.  The caller guarantees two unread draws per obstacle."""
+    the turn): the step of :class:`~uvnav.sim.bodies2d.PackedBodies`, in one call.  The poses
+    before the step go to ``prev`` (3, n): x, y, heading.  The caller guarantees two unread
+    draws per obstacle."""
     ring = np.empty((2, rings.shape[2]))
     low = np.empty(rings.shape[1])
     for o in range(n_obs):
@@ -717,7 +718,7 @@ class PackedWorlds:
     def ensure_draws(self) -> None:
         """Top up the rows (:meth:`refill`) when the next call could run one out, and count that
         call: :meth:`step`'s rule, for a caller that steps the slots' arrays itself (one
-        integration step a call, as :class:`PackedObstacles` does)."""
+        integration step a call, as :class:`~uvnav.sim.bodies2d.PackedBodies` does)."""
         if self._safe_calls <= 0:
             self.refill()
         self._safe_calls -= 1
