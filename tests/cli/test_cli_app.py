@@ -468,3 +468,11 @@ def test_console_script_exit_codes_and_streams(free_scene: Path, tmp_path: Path)
 def test_version() -> None:
     result = invoke("--version")
     assert result.exit_code == 0 and result.stdout.startswith("uvnav ")
+
+
+@pytest.mark.parametrize("module", ["uvnav", "uvnav.cli"])
+def test_python_dash_m_runs_the_console_script(module: str) -> None:
+    out = subprocess.run(
+        [sys.executable, "-m", module, "--version"], capture_output=True, text=True, check=False
+    )
+    assert out.returncode == 0 and out.stdout == invoke("--version").stdout
