@@ -172,6 +172,15 @@ def test_cli_json_is_strict_and_writes_missing_values_as_null(
     assert row == {"n": 1.0, "return": None, "return_vs_expert": None}
 
 
+def test_a_steering_correction_outside_its_range_is_a_usage_error(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.chdir(tmp_path)
+    r = runner.invoke(app, ["drive", "train", "data", "--correction", "2"])
+    assert r.exit_code == 2
+    assert "'--correction': must be within [-1, 1] (got 2.0)" in _one_error_line(r.output)
+
+
 def test_sonar_json_is_strict(tmp_path: Path) -> None:
     pytest.importorskip("torch")
     data = tmp_path / "d.npz"
@@ -180,15 +189,15 @@ def test_sonar_json_is_strict(tmp_path: Path) -> None:
         app, ["sonar", "train", str(data), "--out", str(tmp_path / "m"), "--max-epochs", "3"]
     )
     assert r.exit_code == 0, r.output
-    # a dataset of one sample: no test group inside it, no error statistics (NaN -> null)
+    # a dataset of one sample: finite statistics, strict JSON
     one = tmp_path / "one.npz"
     _sonar_npz(one, n=1)
+    r = runner.invoke(app, ["sonar", "evaluate", str(tmp_path / "m"), str(one), "--json"])
+    assert r.exit_code == 0, r.output
+    _strict_loads(r.output)
+    # no sample at all: no statistic to give, refused in one line
     with np.load(one) as f:
         arrays = {k: f[k][:0] for k in f.files}
     np.savez(one, **arrays)
     r = runner.invoke(app, ["sonar", "evaluate", str(tmp_path / "m"), str(one), "--json"])
-    assert r.exit_code == 0, r.output
-    table = _strict_loads(r.output)
-    assert (
-        table["network"]["distance"]["mae"] is None and table["network"]["index_accuracy"] is None
-    )
+    assert r.exit_code == 2 and "has no samples (0 rows)" in _one_error_line(r.output)

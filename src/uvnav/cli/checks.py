@@ -32,6 +32,18 @@ def finite(value: float | None) -> float | None:
     return value
 
 
+def unit_range(value: float | None) -> float | None:
+    """Option callback: ``value`` unchanged when finite and within [-1, 1].
+
+    Raises:
+        typer.BadParameter: ``value`` is NaN, ±inf or outside [-1, 1].
+    """
+    finite(value)
+    if value is not None and not -1.0 <= value <= 1.0:
+        raise typer.BadParameter(f"must be within [-1, 1] (got {value})")
+    return value
+
+
 #: a local process pool runs at most this many workers per CPU of the machine
 WORKERS_PER_CPU = 4
 

@@ -17,7 +17,7 @@ from typing import Annotated, Any
 
 import typer
 
-from uvnav.cli.checks import dumps, finite
+from uvnav.cli.checks import dumps, finite, unit_range
 from uvnav.cli.errors import CliError, uvnav_typer
 
 drive_app = uvnav_typer(
@@ -139,9 +139,7 @@ def train(
     correction: Annotated[
         float,
         typer.Option(
-            min=-1.0,
-            max=1.0,
-            callback=finite,
+            callback=unit_range,
             help="Left/right steering correction where a row has no exact side label.",
         ),
     ] = 0.2,
