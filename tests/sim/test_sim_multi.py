@@ -14,7 +14,7 @@ from uvnav.controllers.base import UnicycleController
 from uvnav.dynamics import UnicycleCommand, UnicycleSpec
 from uvnav.obstacles import Obstacle
 from uvnav.sensors import Observation
-from uvnav.sim import SensingConfig
+from uvnav.sim import LidarConfig, SensingConfig
 from uvnav.sim.metrics import METRIC_NAMES
 from uvnav.sim.multi import summarize
 from uvnav.sim.run import run_episode
@@ -100,6 +100,22 @@ def test_estimated_sensing_gives_finite_differences_of_the_other_robot() -> None
     other = a.seen[5].obstacles[0]
     assert other.velocity_source == "estimated"
     np.testing.assert_allclose(other.velocity, [-0.7, 0.0], atol=1e-6)
+
+
+def test_a_robots_lidar_sees_the_other_robot_and_not_its_own_disc() -> None:
+    """Each robot's sensors are the 2D worlds' one part: its lidar scans the obstacles and the
+    other robots (its own disc left out), as the one-robot world's does."""
+    a, b = Recording(), Recording()
+    setup = _pair(a, b, t_max=0.2)
+    lidar = LidarConfig(n_rays=8, max_range=10.0)
+    for r in setup.robots:
+        r.sensing = SensingConfig(sensing_range=10.0, lidar=lidar)
+    run_episode(setup, None, np.random.default_rng(0))
+    first = a.seen[0]
+    assert first.lidar is not None and b.seen[0].lidar is not None
+    ranges, ahead = first.lidar.ranges, np.isclose(first.lidar.angles, 0.0)
+    assert ranges[ahead] == pytest.approx([6.0 - 0.2])  # robot 1's disc, 6 m along +x
+    assert np.all(ranges[~ahead] == 10.0)  # nothing else, and never its own disc (0.2 m)
 
 
 def test_arrival_makespan_and_deadlock() -> None:

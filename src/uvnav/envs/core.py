@@ -50,8 +50,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.dynamics.unicycle import UnicycleCommand
-from uvnav.obstacles.bodies import Body, DiscBody
-from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
+from uvnav.obstacles.obstacle import ObstacleField
 from uvnav.sensors.exact import lidar_scan
 from uvnav.sensors.observation import Observation
 from uvnav.sim.episode import World2D
@@ -314,7 +313,6 @@ class EnvWorld:
         self.k = len(world.obstacles)
         world.start([False] * world.n_agents)
         self.clearance = np.array([self._gap(i) for i in range(self.n)])
-        self._lidar_fields: dict[int, tuple[FieldTemplate, np.ndarray]] = {}
 
     # ----------------------------------------------------------------- robot i of either world
     @property
@@ -392,19 +390,7 @@ class EnvWorld:
     def _lidar_field(self, i: int) -> ObstacleField:
         """The field robot i's lidar sees: everything but its own disc."""
         w = self.world
-        if not isinstance(w, MultiUnicycleWorld):
-            return w.field  # the obstacles only
-        if i not in self._lidar_fields:
-            bodies: list[Body] = [o.body for o in w.obstacles]
-            bodies += [DiscBody(max(float(r.spec.radius), 1e-6)) for r in w.robots]
-            keep = np.array([m for m in range(len(bodies)) if m != self.k + i], dtype=int)
-            self._lidar_fields[i] = (FieldTemplate.from_bodies([bodies[m] for m in keep]), keep)
-        tpl, keep = self._lidar_fields[i]
-        f = w.field
-        return tpl.field(
-            f.centres[keep], f.headings[keep], f.velocities[keep], f.angular_velocities[keep],
-            None if f.present is None else f.present[keep],
-        )  # fmt: skip
+        return w.field_seen_by(i) if isinstance(w, MultiUnicycleWorld) else w.field
 
     def action_name(self, i: int) -> str:
         """How errors name robot ``i``'s action."""

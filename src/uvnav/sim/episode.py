@@ -41,11 +41,8 @@ from uvnav.dynamics.unicycle import UnicycleSpec
 from uvnav.dynamics.vehicles import Vehicle2D, make_vehicle
 from uvnav.geometry.angles import FloatArray
 from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
-from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
-from uvnav.sensors.exact import lidar_scan
-from uvnav.sensors.observation import LidarScan, Observation
-from uvnav.sensors.plugins import sensor_plugin
-from uvnav.sensors.scan_bodies import ScanBodies
+from uvnav.sensors.observation import Observation
+from uvnav.sensors.suite2d import Sensors2D
 from uvnav.sim.bodies2d import Bodies2D, FieldBodies, PackedBodies
 from uvnav.sim.ledger import Clock, Ledger
 from uvnav.sim.metrics import EpisodeMetrics
@@ -115,6 +112,7 @@ class World2D:
             else FieldBodies(self.obstacles, self.template, exact)
         )
         self.sensing_range = float(setup.sensing.sensing_range)
+        self.sensors = Sensors2D(setup.sensing, self.sense_rng)
         self.pedestrians = pedestrian_ids(self.obstacles)
         self.exact = exact
         self.t = 0.0
@@ -137,11 +135,7 @@ class World2D:
     def start(self, oracles: Sequence[bool] = (False,)) -> None:
         """Clearance and status at t = 0; the finite-difference estimator unless the law is an
         oracle or the velocities are known."""
-        sensing = self.setup.sensing
-        self.estimator = None
-        if sensing.velocities == "estimated" and not oracles[0]:
-            self.estimator = FiniteDifferenceEstimator(self.sense_rng, sensing.position_noise)
-        self.scan_bodies = ScanBodies() if sensing.bodies == "lidar" and not oracles[0] else None
+        self.sensors.reset(oracles[0])
         self.clearance, self.nearest = self.bodies.start(
             self.x, self.y, float(self.spec.radius), self.sensing_range
         )
@@ -177,41 +171,12 @@ class World2D:
         return (0,) if self.clock.due else ()
 
     def observe(self, agent: int = 0) -> Observation:
-        """Readings within the sensing range (estimated rates unless known; the exact bodies,
-        or those the lidar scan shows), the lidar scan."""
-        robot = self.pose
-        scan = None
-        lc = self.setup.sensing.lidar
-        if self.scan_bodies is not None:  # the scan first: the readings are made from it
-            scan = self._scan(robot)
-            readings = self.scan_bodies.readings(self.t, robot, scan, self.sensing_range)
-        else:
-            readings = self.bodies.readings(self.x, self.y, self.sensing_range)
-        if self.estimator is not None:
-            readings = self.estimator.update(self.t, readings)
-        if lc is not None and scan is None:
-            scan = self._scan(robot)
-        plugins = self.setup.sensing.plugins
-        extras = (
-            {
-                name: sensor_plugin(name)(robot, self.field, self.sense_rng, **params)
-                for name, params in plugins
-            }
-            if plugins
-            else {}
-        )
-        return Observation(
-            time=self.t, pose=robot, speed=self.speed, goal=self.goal, obstacles=readings,
-            lidar=scan, extras=extras,
-        )  # fmt: skip
-
-    def _scan(self, robot: FloatArray) -> LidarScan:
-        """The lidar's scan from ``robot`` now (noise and dropout from the sensing generator)."""
-        lc = self.setup.sensing.lidar
-        assert lc is not None
-        return lidar_scan(
-            robot, self.field, self.sense_rng, n_rays=lc.n_rays, max_range=lc.max_range,
-            fov=lc.fov, noise_std=lc.noise_std, dropout=lc.dropout,
+        """What the robot's sensors give now (:class:`~uvnav.sensors.suite2d.Sensors2D`: the
+        bodies within the range, exact or from the lidar scan, their rates known or estimated,
+        the scan, the plug-ins)."""
+        return self.sensors.observe(
+            self.t, self.pose, self.speed, self.goal,
+            lambda: self.bodies.readings(self.x, self.y, self.sensing_range), self.bodies.field,
         )  # fmt: skip
 
     @property

@@ -65,9 +65,9 @@ from uvnav.obstacles.obstacle import (
     FieldTemplate,
     ObstacleField,
 )
-from uvnav.prediction.finite_difference import FiniteDifferenceEstimator
 from uvnav.sensors.exact import sense_obstacles
 from uvnav.sensors.observation import Observation, ObstacleReading
+from uvnav.sensors.suite2d import Sensors2D
 from uvnav.sim.ledger import Clock, Ledger, group_outcome
 from uvnav.sim.metrics import EpisodeMetrics
 from uvnav.sim.setup import (
@@ -170,7 +170,8 @@ class MultiUnicycleWorld:
     Args:
         setup: the scene; its obstacles are advanced in place and written back by :meth:`close`.
         rng: the episode generator: ``rng.spawn(2 N)``, robot i's law gets child 2i and its
-            finite-difference estimator child 2i + 1.
+            sensors (:class:`~uvnav.sensors.suite2d.Sensors2D`: the estimator, the lidar, the
+            plug-ins) child 2i + 1.
         vectorised: check and sense all robots at once (:class:`_DiscPairs`) when the world holds
             only robots (identical results; ``False`` forces one field query per robot).
 
@@ -200,11 +201,16 @@ class MultiUnicycleWorld:
         self.dt, self.ratio = self.clock.dt, self.clock.ratio
         self.tol = float(setup.goal_tolerance)
         self._children = rng.spawn(2 * n)
+        self.sensors = [
+            Sensors2D(r.sensing, self._children[2 * i + 1]) for i, r in enumerate(robots)
+        ]
+        self._seen: dict[int, tuple[FieldTemplate, np.ndarray]] = {}
         self.obstacles = setup.obstacles
         self.k = k = len(setup.obstacles)
         bodies: list[Body] = [o.body for o in setup.obstacles]
         bodies += [DiscBody(max(float(r.spec.radius), 1e-6)) for r in robots]
         self.template = FieldTemplate.from_bodies(bodies)
+        self._bodies = bodies
         self.batch = ObstacleBatch(setup.obstacles)
         self.radii = np.array([float(r.spec.radius) for r in robots])
         floor = 4.0 * float(self.radii.max()) + 1.0  # the reach covers any robot that can touch
@@ -245,12 +251,8 @@ class MultiUnicycleWorld:
         """Clearances, collisions and arrivals at t = 0; robot i's finite-difference estimator
         unless its law is an oracle or its velocities are known."""
         n = self.n_agents
-        self.estimators: list[FiniteDifferenceEstimator | None] = []
-        for i, r in enumerate(self.robots):
-            est = None
-            if r.sensing.velocities == "estimated" and not oracles[i]:
-                est = FiniteDifferenceEstimator(self._children[2 * i + 1], r.sensing.position_noise)
-            self.estimators.append(est)
+        for sensors, oracle in zip(self.sensors, oracles, strict=True):
+            sensors.reset(oracle)
         self.speeds = np.zeros(n)
         self.turns = np.zeros(n)
         self.active = np.ones(n, dtype=bool)  # neither arrived nor collided
@@ -334,17 +336,30 @@ class MultiUnicycleWorld:
         i = agent
         sensing_range = float(self.robots[i].sensing.sensing_range)
         pose = self.state[i].copy()
-        if self._pairs is not None:
-            readings = self._pairs.readings(i, self.field, sensing_range)
-        else:
+
+        def exact() -> tuple[ObstacleReading, ...]:
+            if self._pairs is not None:
+                return self._pairs.readings(i, self.field, sensing_range)
             readings = sense_obstacles(pose[:2], self.field, sensing_range=sensing_range)
-            readings = tuple(rd for rd in readings if rd.obstacle_id != self.k + i)
-        est = self.estimators[i]
-        if est is not None:
-            readings = est.update(self.t, readings)
-        return Observation(
-            time=self.t, pose=pose, speed=self.applied[i].v, goal=self.goals[i], obstacles=readings
+            return tuple(rd for rd in readings if rd.obstacle_id != self.k + i)
+
+        return self.sensors[i].observe(
+            self.t, pose, self.applied[i].v, self.goals[i], exact, lambda: self.field_seen_by(i)
         )
+
+    def field_seen_by(self, agent: int) -> ObstacleField:
+        """The bodies robot ``agent``'s lidar and plug-in sensors see: the obstacles and the
+        other robots (its own disc left out)."""
+        if agent not in self._seen:
+            keep = np.array([m for m in range(len(self._bodies)) if m != self.k + agent], dtype=int)
+            tpl = FieldTemplate.from_bodies([self._bodies[m] for m in keep])
+            self._seen[agent] = (tpl, keep)
+        tpl, keep = self._seen[agent]
+        f = self.field
+        return tpl.field(
+            f.centres[keep], f.headings[keep], f.velocities[keep], f.angular_velocities[keep],
+            None if f.present is None else f.present[keep],
+        )  # fmt: skip
 
     def disc_agents(self) -> DiscAgents:
         """Every robot's disc now, for a group law (:class:`uvnav.core.DiscAgents`; velocities
@@ -366,7 +381,7 @@ class MultiUnicycleWorld:
             radii=self.radii.copy(),
             active=self.active.copy(),
             sensing_range=np.array([float(r.sensing.sensing_range) for r in self.robots]),
-            exact=np.array([est is None for est in self.estimators]),
+            exact=np.array([sensors.true_rates for sensors in self.sensors]),
         )
 
     def apply(self, cmd: UnicycleCommand, agent: int = 0) -> UnicycleCommand:
