@@ -21,6 +21,7 @@ PYPROJECT = ROOT / "pyproject.toml"
 DESIGN_LAYERS = [
     {"uvnav.cli"},
     {"uvnav.viz"},
+    {"uvnav.experiments"},  # the registered reproductions, over bench; renderers injected
     {"uvnav.learning", "uvnav.driving", "uvnav.bench", "uvnav.envs"},
     {"uvnav.scenarios"},
     {"uvnav.sim"},

@@ -1,4 +1,5 @@
-"""One chapter at a time (bench.chapters): every reproduction adds to the store, none deletes."""
+"""One experiment at a time (``uvnav reproduce NAME``): every reproduction adds to the store,
+none deletes."""
 
 from __future__ import annotations
 
@@ -7,9 +8,9 @@ from pathlib import Path
 import pytest
 
 from uvnav.bench import reproduce_ch3 as r3
-from uvnav.bench.chapters import ChapterError, reproduce_chapter
 from uvnav.bench.sections import SECTIONS_DIR, ChapterSection, load_sections, save_section
 from uvnav.bench.store import ResultsStore
+from uvnav.experiments import ExperimentContext, ExperimentError, run_experiment
 
 
 @pytest.fixture
@@ -64,24 +65,30 @@ def test_a_later_ch3_run_with_one_controller_keeps_the_other_controllers_rows(
     assert first.db_path == second.db_path == db
 
 
-def test_reproduce_chapter_checks_its_options(tmp_path: Path) -> None:
-    with pytest.raises(ChapterError, match="unknown chapter 'ch9'"):
-        reproduce_chapter("ch9", tmp_path, tmp_path)
-    with pytest.raises(ChapterError, match="ch7 runs no random seeds"):
-        reproduce_chapter("ch7", tmp_path, tmp_path, seeds=2)
-    with pytest.raises(ChapterError, match="ch6 runs no random seeds"):
-        reproduce_chapter("ch6", tmp_path, tmp_path, start_seed=3)
+def test_run_experiment_checks_its_options(tmp_path: Path) -> None:
+    def ctx(**kw: int) -> ExperimentContext:
+        return ExperimentContext(tmp_path, tmp_path, **kw)
+
+    with pytest.raises(ExperimentError, match="unknown experiment 'ch9'"):
+        run_experiment("ch9", ctx())
+    with pytest.raises(ExperimentError, match="ch7 runs no random seeds"):
+        run_experiment("ch7", ctx(seeds=2))
+    with pytest.raises(ExperimentError, match="ch6 runs no random seeds"):
+        run_experiment("ch6", ctx(start_seed=3))
+    with pytest.raises(ExperimentError, match="--seeds 0: at least one seed"):
+        run_experiment("ch3", ctx(seeds=0))
     assert not (tmp_path / "uvnav.sqlite").exists()
 
 
-def test_reproduce_chapter_ch3_saves_its_section(tmp_path: Path, no_prediction: None) -> None:
-    out = reproduce_chapter(
-        "ch3", tmp_path / "res", tmp_path / "rep", seeds=1, start_seed=4, workers=1
-    )
-    assert out.section.key == "ch3" and "seeds 4–4" in out.section.intro
-    assert out.section_path == tmp_path / "res" / SECTIONS_DIR / "ch3.json"
+def test_run_experiment_ch3_saves_its_section(tmp_path: Path, no_prediction: None) -> None:
+    ctx = ExperimentContext(tmp_path / "res", tmp_path / "rep", seeds=1, start_seed=4, workers=1)
+    out = run_experiment("ch3", ctx)
+    (section,) = out.sections
+    assert section.key == "ch3" and "seeds 4–4" in section.intro
+    assert out.section_paths == [tmp_path / "res" / SECTIONS_DIR / "ch3.json"]
+    assert out.table == out.runs["ch3"].summary.table
     (loaded,) = load_sections(tmp_path / "res" / SECTIONS_DIR)
-    assert loaded.rows == out.section.rows and loaded.intro == out.section.intro
+    assert loaded.rows == section.rows and loaded.intro == section.intro
     assert {k[3] for k in _keys(out.db_path, r3.RANDOM_CAMPAIGN)} == {4}
 
 

@@ -140,11 +140,13 @@ def test_family_table_compares_laws_on_equal_seeds(tmp_path: Path) -> None:
 
 def test_reproduce_regime_chapter_and_its_rebuilt_section(tmp_path: Path) -> None:
     pytest.importorskip("pyrvo")
-    from uvnav.bench.chapters import report_sections, reproduce_chapter
+    from uvnav.experiments import ExperimentContext, report_sections, run_experiment
 
     res = tmp_path / "res"
-    out = reproduce_chapter("regime", res, tmp_path / "rep", seeds=1, start_seed=3, workers=2)
-    assert out.section.key == "regime" and "1 seed per regime" in out.section.intro
+    ctx = ExperimentContext(res, tmp_path / "rep", seeds=1, start_seed=3, workers=2)
+    out = run_experiment("regime", ctx)
+    (section,) = out.sections
+    assert section.key == "regime" and "1 seed per regime" in section.intro
     with ResultsStore(out.db_path, readonly=True) as store:
         stats = rg.cell_stats(store)
     assert len(stats) == len(rg.regimes())

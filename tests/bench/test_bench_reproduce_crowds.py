@@ -7,11 +7,11 @@ from pathlib import Path
 
 import pytest
 
-from uvnav.bench import chapters
+from uvnav.bench import reproduce as rp
 from uvnav.bench import reproduce_crowds as rc
-from uvnav.bench.chapters import reproduce_chapter
 from uvnav.bench.sections import SECTIONS_DIR, load_sections
 from uvnav.bench.store import ResultsStore
+from uvnav.experiments import ExperimentContext, report_sections, run_all, run_experiment
 
 TWO_LAWS = ("orca-holonomic-v1", "zhang2019-v1")
 
@@ -67,31 +67,32 @@ def test_tiny_run_table_intervals_paper_refusal_and_resume(tmp_path: Path) -> No
     assert sec.rows == s.table
 
 
-def test_reproduce_chapter_crowds_saves_and_report_rebuilds(tmp_path: Path, two_laws: None) -> None:
+def test_reproduce_crowds_saves_and_report_rebuilds(tmp_path: Path, two_laws: None) -> None:
     res = tmp_path / "res"
-    out = reproduce_chapter("crowds", res, tmp_path / "rep", seeds=2, start_seed=5, workers=1)
-    assert out.section.key == "crowds" and "cases 5–6" in out.section.intro
-    assert out.section_path == res / SECTIONS_DIR / "crowds.json"
+    ctx = ExperimentContext(res, tmp_path / "rep", seeds=2, start_seed=5, workers=1)
+    out = run_experiment("crowds", ctx)
+    (section,) = out.sections
+    assert section.key == "crowds" and "cases 5–6" in section.intro
+    assert out.section_paths == [res / SECTIONS_DIR / "crowds.json"]
     (loaded,) = load_sections(res / SECTIONS_DIR)
-    assert loaded.rows == out.section.rows
+    assert loaded.rows == section.rows == out.table
     with ResultsStore(out.db_path) as store:
         df = store.episodes_frame(rc.CAMPAIGN)
     assert set(df["seed"]) == {5, 6} and set(df["controller"]) == set(TWO_LAWS)
     # without the saved section, ``uvnav report`` rebuilds it from the stored episodes
     (res / SECTIONS_DIR / "crowds.json").unlink()
-    (rebuilt,) = chapters.report_sections(out.db_path)
-    assert rebuilt.key == "crowds" and rebuilt.rows == out.section.rows
+    (rebuilt,) = report_sections(out.db_path)
+    assert rebuilt.key == "crowds" and rebuilt.rows == section.rows
 
 
 def test_uvnav_run_puts_the_crowd_section_after_chapter_2(
     tmp_path: Path, two_laws: None, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(rc, "QUICK_CASES", 1)
-    s = chapters.reproduce_all(
-        tmp_path / "res", tmp_path / "rep", n_random=1, baselines=(), crowds=True, workers=1,
-        progress=False, render=None,
-    )  # fmt: skip
-    assert [x.key for x in s.sections] == ["ch2", "crowds"]
+    monkeypatch.setattr(rp, "BASELINES", ())
+    ctx = ExperimentContext(tmp_path / "res", tmp_path / "rep", seeds=1, workers=1, progress=False)
+    s = run_all(ctx, names=("crowds", "ch2"))
+    assert [x.key for x in s.sections] == ["ch2", "crowds"] and list(s.runs) == ["ch2", "crowds"]
     assert any(r["quantity"] == "CrowdNav circle crossing, orca-holonomic-v1" for r in s.table)
     assert [x.key for x in load_sections(tmp_path / "res" / SECTIONS_DIR)] == ["ch2", "crowds"]
 

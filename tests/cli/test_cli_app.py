@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import subprocess
 import sys
@@ -362,21 +363,23 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
     }
     long_title = "Chapter 2 — a unicycle among moving, rotating, non-convex obstacles " * 2
 
-    def reproduce(results_dir: Path, report_dir: Path, **kwargs: Any) -> FakeSummary:
-        calls.append({"results": results_dir, "report": report_dir, **kwargs})
+    def reproduce(ctx: Any) -> FakeSummary:
+        calls.append({f.name: getattr(ctx, f.name) for f in dataclasses.fields(ctx)})
         return FakeSummary(
             table=[row],
-            db_path=results_dir / "uvnav.sqlite",
-            report_path=report_dir / "index.html",
-            figures=[report_dir / "a.png", report_dir / "b.png"],
+            db_path=ctx.results_dir / "uvnav.sqlite",
+            report_path=ctx.report_dir / "index.html",
+            figures=[ctx.report_dir / "a.png", ctx.report_dir / "b.png"],
             sections=[ChapterSection("ch2", long_title, "", rows=[row])],
         )
 
+    from uvnav.experiments import ExperimentContext
     from uvnav.viz.reproduction import render_reproduction
 
-    fake = types.ModuleType("uvnav.bench.chapters")
-    fake.reproduce_all = reproduce  # type: ignore[attr-defined]
-    monkeypatch.setitem(sys.modules, "uvnav.bench.chapters", fake)
+    fake = types.ModuleType("uvnav.experiments")
+    fake.run_all = reproduce  # type: ignore[attr-defined]
+    fake.ExperimentContext = ExperimentContext  # type: ignore[attr-defined]
+    monkeypatch.setitem(sys.modules, "uvnav.experiments", fake)
     res_dir, rep_dir = tmp_path / "res", tmp_path / "rep"
     result = runner.invoke(
         app,
@@ -387,13 +390,15 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
     renderers = calls[0].pop("renderers")
     assert calls == [
         {
-            "results": res_dir,
-            "report": rep_dir,
+            "results_dir": res_dir,
+            "report_dir": rep_dir,
             "full": False,
             "workers": 3,
+            "seeds": None,
+            "start_seed": 0,
             "progress": True,
             "render": render_reproduction,
-            "ch5": True,
+            "fresh": False,
         }
     ]
     # every chapter with figures gets its renderer (Chapters 3-7 and issue 9)
@@ -411,8 +416,8 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
 
 
 def test_run_without_bench_is_a_clear_error(monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setitem(sys.modules, "uvnav.bench.chapters", None)
-    assert_one_line_error(invoke("run"), 1, "uvnav.bench.chapters")
+    monkeypatch.setitem(sys.modules, "uvnav.experiments", None)
+    assert_one_line_error(invoke("run"), 1, "uvnav.experiments")
 
 
 def test_report_calls_write_report(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:

@@ -1,4 +1,5 @@
-"""``uvnav reproduce CHAPTER`` (one chapter, additive) and ``uvnav forget`` (the only delete)."""
+"""``uvnav reproduce NAME`` (one experiment, additive), ``uvnav reproduce --list`` and ``uvnav
+forget`` (the only delete)."""
 
 from __future__ import annotations
 
@@ -8,11 +9,16 @@ from typing import Any
 import pytest
 from typer.testing import CliRunner
 
-from uvnav.bench import chapters
-from uvnav.bench.chapters import ChapterRun
+import uvnav.experiments as experiments
 from uvnav.bench.sections import SECTIONS_DIR, ChapterRenderers, ChapterSection, save_section
 from uvnav.bench.store import ResultsStore, StaleCampaignError
 from uvnav.cli.app import app
+from uvnav.experiments import (
+    ExperimentContext,
+    ExperimentRun,
+    Reproduction,
+    report_sections,
+)
 
 runner = CliRunner()
 
@@ -34,15 +40,17 @@ def test_reproduce_one_chapter_writes_its_section_beside_the_saved_ones(
     save_section(earlier, res / SECTIONS_DIR)
     calls: list[dict[str, Any]] = []
 
-    def fake(chapter: str, results_dir: Path, report_dir: Path, **kw: Any) -> ChapterRun:
-        calls.append({"chapter": chapter, "results": results_dir, "report": report_dir, **kw})
+    def fake(name: str, ctx: ExperimentContext) -> Reproduction:
+        calls.append({"name": name, "ctx": ctx})
         section = ChapterSection(
             "ch3", "Chapter 3 — now", "ran now", rows=[{"quantity": "q3", "measured": "42 %"}]
         )
-        path = save_section(section, results_dir / SECTIONS_DIR)
-        return ChapterRun(chapter, section, None, results_dir / "uvnav.sqlite", path)
+        path = save_section(section, ctx.results_dir / SECTIONS_DIR)
+        run = ExperimentRun([section], rows=section.rows)
+        db = ctx.results_dir / "uvnav.sqlite"
+        return Reproduction({name: run}, run.rows, [section], db, section_paths=[path])
 
-    monkeypatch.setattr(chapters, "reproduce_chapter", fake)
+    monkeypatch.setattr(experiments, "run_experiment", fake)
     result = runner.invoke(
         app,
         [
@@ -53,9 +61,11 @@ def test_reproduce_one_chapter_writes_its_section_beside_the_saved_ones(
     )
     assert result.exit_code == 0, result.output
     (call,) = calls
-    assert (call["chapter"], call["seeds"], call["start_seed"], call["workers"]) == ("ch3", 2, 7, 1)
-    assert call["full"] is False and callable(call["render"])
-    assert isinstance(call["renderers"], ChapterRenderers) and call["renderers"].ch3 is not None
+    ctx = call["ctx"]
+    assert (call["name"], ctx.seeds, ctx.start_seed, ctx.workers) == ("ch3", 2, 7, 1)
+    assert (ctx.results_dir, ctx.report_dir) == (res, rep)
+    assert ctx.full is False and callable(ctx.render)
+    assert isinstance(ctx.renderers, ChapterRenderers) and ctx.renderers.ch3 is not None
     html = (rep / "index.html").read_text(encoding="utf-8")
     # the chapter just run and the one saved by an earlier run, in chapter order
     assert html.index('id="section-ch3"') < html.index('id="section-ch4"')
@@ -68,8 +78,10 @@ def test_reproduce_one_chapter_writes_its_section_beside_the_saved_ones(
     [
         (["ch7", "--seeds", "2"], ["ch7 runs no random seeds"]),
         (["beyond", "--start-seed", "1"], ["beyond runs no random seeds"]),
-        (["ch9"], ["unknown chapter 'ch9'", "beyond"]),
+        (["ch9"], ["unknown experiment 'ch9'", "beyond", "regime"]),
         (["all", "--seeds", "3"], ["reproduce all", "--seeds"]),
+        ([], ["name an experiment", "--list"]),
+        (["--list", "ch2"], ["--list takes no experiment name"]),
     ],
 )
 def test_reproduce_bad_options_are_one_line_errors(
@@ -89,7 +101,7 @@ def test_a_stale_campaign_is_refused_in_one_line(
             tmp_path / "uvnav.sqlite", ["ch2-random"], "was stored by other code"
         )
 
-    monkeypatch.setattr(chapters, "reproduce_chapter", stale)
+    monkeypatch.setattr(experiments, "run_experiment", stale)
     result = runner.invoke(app, ["reproduce", "ch2", "--results", str(tmp_path)])
     _one_line_error(result, "'ch2-random'", "uvnav forget", "ch2-random' or use another")
 
@@ -102,6 +114,18 @@ def test_reproduce_all_is_uvnav_run(tmp_path: Path, monkeypatch: pytest.MonkeyPa
     result = runner.invoke(app, ["reproduce", "all", "--full", "--results", str(tmp_path)])
     assert result.exit_code == 0, result.output
     assert seen == [{"full": True, "workers": 2, "results": tmp_path, "report": Path("report")}]
+
+
+def test_list_shows_every_experiment_on_80_columns() -> None:
+    result = runner.invoke(app, ["reproduce", "--list"])
+    assert result.exit_code == 0, result.output
+    lines = result.stdout.splitlines()
+    assert lines[0].split() == ["name", "seeded", "title"]
+    rows = {line.split()[0]: line.split()[1] for line in lines[1:]}
+    assert list(rows) == ["ch2", "crowds", "regime", "ch3", "ch4", "ch5", "ch6", "ch7", "beyond"]
+    assert rows["ch3"] == "yes" and rows["ch7"] == "no"
+    assert any("Chapter 7: UAV reconnaissance" in line for line in lines)
+    assert max(len(line) for line in lines) <= 80
 
 
 def test_the_old_entry_points_are_gone() -> None:
@@ -156,7 +180,7 @@ def test_report_rebuilds_the_chapter_sections_it_can(tmp_path: Path) -> None:
         tmp_path / SECTIONS_DIR,
     )
     before = db.read_bytes()
-    secs = chapters.report_sections(db)
+    secs = report_sections(db)
     assert [s.key for s in secs] == ["ch2", "ch3", "ch7", "beyond"]
     ch2 = secs[0]
     assert any("Fig. 2.10 path length, zhang2019-v1" in r["quantity"] for r in ch2.rows)

@@ -1,85 +1,29 @@
-"""One chapter's reproduction at a time: the job behind ``uvnav reproduce CHAPTER``.
+"""One runner per chapter: ``run_ch3`` … ``run_ch7``, ``run_beyond``, ``run_crowds`` and
+``run_regime`` each run one reproduction into the results store ``results_dir/uvnav.sqlite`` (and
+the chapter's own files under ``results_dir``), draw its figures with the injected renderers
+(:class:`~uvnav.bench.sections.ChapterRenderers`) into ``report_dir/<chapter>``, and return its
+report section with the chapter's summary object.  Chapter 2's runner is
+:func:`uvnav.bench.reproduce.run_ch2`.  The experiments of ``uvnav reproduce NAME`` and ``uvnav
+run`` are registered over these runners in :mod:`uvnav.experiments`, which this module never
+imports.
 
-:func:`reproduce_chapter` runs one of :data:`CHAPTERS` — a thesis chapter ``ch2`` … ``ch7``,
-``beyond`` (the experiments beyond the thesis: planners, office floor, multi-robot swap) or
-``crowds`` (every 2D law on CrowdNav's crowds, :mod:`uvnav.bench.reproduce_crowds`) or
-``regime`` (the regime map, :mod:`uvnav.bench.regime`) — into
-the results store ``results_dir/uvnav.sqlite`` (and the chapter's own files under
-``results_dir``), draws its figures with the injected renderers
-(:class:`~uvnav.bench.sections.ChapterRenderers`) into ``report_dir/<chapter>``, and saves its
-report section in ``results_dir/sections/<chapter>.json`` (:func:`~uvnav.bench.sections.
-save_section`), so the report shows it beside the sections of the chapters run before.
-
-``uvnav run`` (:func:`reproduce_all`) runs Chapter 2 (:mod:`uvnav.bench.reproduce`) and then the
-same per-chapter runners (:func:`run_ch3` … :func:`run_beyond`, :func:`run_crowds`,
-:func:`run_regime`), so the two entry points run the same experiments.
+:func:`report_sections` gives the sections of ``uvnav report DB``: saved ones as they are, others
+rebuilt from the stored rows where a chapter's table is computed from them alone.
 
 Every chapter adds to the store: stored episodes are skipped (resume) and never deleted or
 replaced by a later run; a campaign that cannot be resumed (stored by other code) is refused with
 :class:`~uvnav.bench.store.StaleCampaignError`.
-
-``seeds`` and ``start_seed`` (chapters with random scenes, :data:`SEEDED`) choose the random
-scenes: ``seeds`` scenes from ``start_seed`` (Ch. 2: the random and baseline campaigns; Ch. 3: the
-random-ch3 scenes; Ch. 4: every family — random-ch4, the noise sweep, random-ch4-hard; Ch. 5: the
-random-ch5 closed-loop scenes; crowds: CrowdNav's test cases ``start_seed`` ..
-``start_seed + seeds - 1`` of each scene; regime: the seeds of every regime).
 """
 
 from __future__ import annotations
 
-import dataclasses
 import sys
-import time
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 from uvnav.bench import reproduce as rp
-from uvnav.bench.fingerprint import DB_NAME
-from uvnav.bench.sections import SECTIONS_DIR, ChapterRenderers, ChapterSection, save_section
-
-#: What ``uvnav reproduce`` accepts (``all`` is ``uvnav run``).
-CHAPTERS: tuple[str, ...] = (
-    "ch2",
-    "ch3",
-    "ch4",
-    "ch5",
-    "ch6",
-    "ch7",
-    "beyond",
-    "crowds",
-    "regime",
-)
-#: Chapters that run random seeds (``seeds`` / ``start_seed`` apply).
-SEEDED: frozenset[str] = frozenset({"ch2", "ch3", "ch4", "ch5", "crowds", "regime"})
-
-
-class ChapterError(ValueError):
-    """An unknown chapter, or an option the chapter does not take (one line)."""
-
-
-@dataclass
-class ChapterRun:
-    """What :func:`reproduce_chapter` ran and wrote.
-
-    Attributes:
-        chapter: the chapter key.
-        section: its report section (rows, figures, links, notes).
-        summary: the chapter's own summary object (``Ch3Summary``, ...; ``None`` for ``beyond``).
-        db_path: the results database.
-        section_path: where the section was saved.
-        report_path: ``index.html`` when a report renderer was given.
-        failures: failed episodes the chapter lists (its summary's ``failures``).
-    """
-
-    chapter: str
-    section: ChapterSection
-    summary: Any
-    db_path: Path
-    section_path: Path | None = None
-    report_path: Path | None = None
-    failures: list[Any] = field(default_factory=list)
+from uvnav.bench.sections import SECTIONS_DIR, ChapterRenderers, ChapterSection
 
 
 def _say(chapter: str) -> Callable[[str], None]:
@@ -287,210 +231,6 @@ def run_regime(
     return regime_section(rm, full=full), rm
 
 
-# ------------------------------------------------------------------------------- uvnav run
-
-
-def reproduce_all(
-    results_dir: Path,
-    report_dir: Path,
-    *,
-    full: bool = False,
-    workers: int = 2,
-    progress: bool = True,
-    fresh: bool = False,
-    n_random: int | None = None,
-    start_seed: int = 0,
-    controllers: Sequence[str] | None = None,
-    baselines: Sequence[str] | None = None,
-    n_baseline_seeds: int | None = None,
-    n_crowd_seeds: int | None = None,
-    render: Any = None,
-    ch7: bool | None = None,
-    ch5: bool = False,
-    ch5_render: Callable[..., list[Path]] | None = None,
-    renderers: ChapterRenderers | None = None,
-    save_sections: bool = True,
-    crowds: bool | None = None,
-    regime: bool | None = None,
-) -> rp.ReproductionSummary:
-    """``uvnav run``: Chapter 2 (:func:`uvnav.bench.reproduce.run_ch2`), then the other chapters,
-    one report over all of them, every section saved.
-
-    After Chapter 2 come, in a real run (``n_random`` not given), the crowd section (every 2D law
-    on CrowdNav's crowds, after Chapter 2's ETH crowds), the regime map (the report's first
-    screen), the experiments beyond the thesis, Chapter 6 (the CNN that drives: at
-    :data:`uvnav.bench.reproduce_ch6.RUN_QUICK`'s size in quick mode, the thesis size with
-    ``full``; in ``results_dir/ch6-quick`` and ``results_dir/ch6``), Chapter 3, Chapter 7 and
-    Chapter 4; Chapter 5 with ``ch5``.  The table and the sections keep that order, sections in
-    report order (the thesis chapters, then "beyond").
-
-    Args:
-        results_dir, report_dir, full, workers, progress, n_random, start_seed, controllers,
-            baselines, n_baseline_seeds, n_crowd_seeds, render, save_sections: as
-            :func:`uvnav.bench.reproduce.reproduce` (``None``: its defaults).
-        fresh: rerun Chapter 6's finished stages (its files; stored episodes are never deleted).
-        ch7: also run Chapter 7 (:mod:`uvnav.bench.reproduce_ch7`); ``None`` = in a real run.
-        ch5: also run Chapter 5 (:func:`uvnav.bench.reproduce_ch5.reproduce_ch5`); ``ch5_render``
-            draws its figures into ``report_dir/ch5`` (default ``renderers.ch5``).
-        renderers: the other chapters' figure renderers (the CLI passes
-            :func:`uvnav.viz.reproduction.chapter_renderers`); each chapter's figures go to
-            ``report_dir/<chapter>`` and into its report section.
-        crowds: also run the crowd section; ``None`` = in a real run with baselines.
-        regime: also run the regime map; ``None`` = in a real run with baselines.
-
-    Returns:
-        The :class:`uvnav.bench.reproduce.ReproductionSummary` of the whole run.
-
-    Raises:
-        StaleCampaignError: a stored campaign cannot be resumed (see the module docstring).
-    """
-    tic = time.perf_counter()
-    base = rp.BASELINES if baselines is None else baselines
-    ch2 = rp.run_ch2(
-        results_dir, full=full, workers=workers, progress=progress, n_random=n_random,
-        start_seed=start_seed, controllers=rp.CONTROLLERS if controllers is None else controllers,
-        baselines=base, n_baseline_seeds=n_baseline_seeds, n_crowd_seeds=n_crowd_seeds,
-    )  # fmt: skip
-    table, sections, campaigns = list(ch2.table), [ch2.section], dict(ch2.campaigns)
-    rend = renderers or ChapterRenderers()
-    real_run = n_random is None  # test-sized runs (n_random given) leave the other chapters out
-    later: list[ChapterSection] = []  # what goes beyond the thesis comes after the chapters
-    by_key: dict[str, ChapterSection] = {}
-    dirs = (Path(results_dir), Path(report_dir))
-    kw: dict[str, Any] = {"full": full, "workers": workers}
-    if crowds if crowds is not None else (base and real_run):  # after the ETH crowds
-        sec_c, _ = run_crowds(dirs[0], **kw, progress=progress)
-        table += sec_c.rows
-        sections.append(sec_c)
-    if regime if regime is not None else (base and real_run):  # "which law, where"
-        sec_r, rm = run_regime(dirs[0], **kw, progress=progress)
-        campaigns["regime-map"] = rm.campaign
-        sections.append(sec_r)
-    if base and real_run:  # beyond the thesis (a real run, not a quick look)
-        sec_b, rows_b = run_beyond(dirs[1], full=full, renderers=rend, results_dir=dirs[0])
-        table += rows_b
-        later.append(sec_b)
-    if real_run:  # Chapter 6 (CNN driving): the thesis size with --full, else RUN_QUICK's size
-        by_key["ch6"], s6 = run_ch6(
-            *dirs, full=full, renderers=rend, fresh=fresh, progress=progress
-        )
-        table += s6.table
-    if real_run:  # Chapter 3 (3D): scenes + random campaign rows
-        by_key["ch3"], s3 = run_ch3(*dirs, **kw, renderers=rend)
-        table += s3.table
-    if ch7 if ch7 is not None else real_run:
-        by_key["ch7"], s7 = run_ch7(*dirs, full=full, renderers=rend)
-        table += s7.table
-    if ch5:  # Chapter 5: BPNN experiment and closed-loop runs (needs the learning extra)
-        r5 = rend if ch5_render is None else dataclasses.replace(rend, ch5=ch5_render)
-        by_key["ch5"], s5 = run_ch5(*dirs, **kw, renderers=r5, progress=progress)
-        table += s5.table
-    if real_run:  # Chapter 4; tests that shrink the Chapter 2 campaign leave it out
-        by_key["ch4"], s4 = run_ch4(*dirs, **kw, renderers=rend)
-        table += s4.table
-    sections += [by_key[k] for k in ("ch3", "ch4", "ch5", "ch6", "ch7") if k in by_key]
-    sections += later
-    return rp.finish(
-        ch2, dirs[0], dirs[1], table=table, sections=sections, campaigns=campaigns,
-        render=render, save_sections=save_sections, started=tic,
-    )  # fmt: skip
-
-
-# ------------------------------------------------------------------------------- the dispatcher
-
-
-def reproduce_chapter(
-    chapter: str,
-    results_dir: Path,
-    report_dir: Path,
-    *,
-    full: bool = False,
-    workers: int = 2,
-    seeds: int | None = None,
-    start_seed: int = 0,
-    renderers: ChapterRenderers | None = None,
-    render: Any = None,
-    progress: bool = True,
-) -> ChapterRun:
-    """Run one chapter's reproduction into the store and save its report section.
-
-    Args:
-        chapter: one of :data:`CHAPTERS`.
-        results_dir: folder of ``uvnav.sqlite``, the chapter's files and ``sections/``.
-        report_dir: folder of the figures (``report_dir/<chapter>``) and of the report.
-        full: thesis-size runs.
-        workers: worker processes.
-        seeds: random scenes to run (chapters in :data:`SEEDED`; default the chapter's quick or
-            full size).
-        start_seed: first random scene (chapters in :data:`SEEDED`).
-        renderers: the chapters' figure renderers (``None``: no figures).
-        render: Chapter 2's report renderer (:func:`uvnav.viz.reproduction.render_reproduction`),
-            which draws its figures from the database and writes ``index.html``; the other
-            chapters' reports are written by the caller from the saved sections.
-        progress: progress output on stderr.
-
-    Raises:
-        ChapterError: unknown chapter, or ``seeds``/``start_seed`` for a chapter without random
-            scenes.
-        StaleCampaignError: a stored campaign cannot be resumed (see the module docstring).
-    """
-    if chapter not in CHAPTERS:
-        raise ChapterError(
-            f"unknown chapter {chapter!r}; expected one of {', '.join(CHAPTERS)} or all"
-        )
-    if chapter not in SEEDED and (seeds is not None or start_seed != 0):
-        raise ChapterError(
-            f"{chapter} runs no random seeds: --seeds/--start-seed apply to "
-            f"{', '.join(sorted(SEEDED))}"
-        )
-    if seeds is not None and seeds < 1:
-        raise ChapterError(f"--seeds {seeds}: at least one seed")
-    if start_seed < 0:
-        raise ChapterError(f"--start-seed {start_seed}: seeds are >= 0")
-    results_dir = Path(results_dir)
-    report_dir = Path(report_dir)
-    results_dir.mkdir(parents=True, exist_ok=True)
-    rend = renderers or ChapterRenderers()
-    db_path = results_dir / DB_NAME
-    summary: Any
-    report_path: Path | None = None
-    if chapter == "ch2":
-        n = seeds if seeds is not None else (rp.FULL_SEEDS if full else rp.QUICK_SEEDS)
-        summary = rp.reproduce(
-            results_dir, report_dir, full=full, workers=workers, progress=progress, n_random=n,
-            start_seed=start_seed, n_baseline_seeds=seeds, render=render, save_sections=False,
-        )  # fmt: skip
-        section = next(s for s in summary.sections if s.key == "ch2")
-        report_path = summary.report_path
-    else:
-        dirs = (results_dir, report_dir)
-        seeded: dict[str, Any] = {"full": full, "workers": workers, "seeds": seeds}
-        seeded["start_seed"] = start_seed
-        runs: dict[str, Callable[[], tuple[ChapterSection, Any]]] = {
-            "ch3": lambda: run_ch3(*dirs, **seeded, renderers=rend, progress=False),
-            "ch4": lambda: run_ch4(*dirs, **seeded, renderers=rend),
-            "ch5": lambda: run_ch5(*dirs, **seeded, renderers=rend, progress=progress),
-            "ch6": lambda: run_ch6(*dirs, full=full, renderers=rend, progress=progress),
-            "ch7": lambda: run_ch7(*dirs, full=full, renderers=rend),
-            "crowds": lambda: run_crowds(results_dir, **seeded, progress=progress),
-            "regime": lambda: run_regime(results_dir, **seeded, progress=progress),
-            "beyond": lambda: run_beyond(
-                report_dir, full=full, renderers=rend, results_dir=results_dir
-            ),
-        }
-        section, summary = runs[chapter]()
-    path = save_section(section, results_dir / SECTIONS_DIR)
-    return ChapterRun(
-        chapter=chapter,
-        section=section,
-        summary=summary,
-        db_path=db_path,
-        section_path=path,
-        report_path=report_path,
-        failures=list(getattr(summary, "failures", []) or []),
-    )
-
-
 # ------------------------------------------------------------------ sections for ``uvnav report``
 
 #: Chapters whose results are files under the results folder, not store campaigns.
@@ -614,13 +354,7 @@ def report_sections(db_path: Path) -> list[ChapterSection]:
 
 
 __all__ = [
-    "CHAPTERS",
-    "SEEDED",
-    "ChapterError",
-    "ChapterRun",
     "report_sections",
-    "reproduce_all",
-    "reproduce_chapter",
     "run_beyond",
     "run_ch3",
     "run_ch4",

@@ -15,7 +15,8 @@ measured" whose *measured* column is read back from the stored episodes (never t
 :func:`reproduce` is Chapter 2 alone: :func:`run_ch2`, then :func:`finish`, which hands the
 sections to a *renderer* passed in by the caller (the CLI passes
 :func:`uvnav.viz.reproduction.render_reproduction`) and saves them.  The other chapters of
-``uvnav run`` are :func:`uvnav.bench.chapters.reproduce_all`'s, which calls the same two steps.
+``uvnav run`` (:func:`uvnav.experiments.run_all`) are experiments of their own; there Chapter 2's
+:func:`finish` writes the page with every experiment's section.
 
 Layering (DESIGN §1): ``uvnav.viz`` sits above ``uvnav.bench`` in the layers, so this module never
 imports it: the renderer is injected (``render=``), which keeps the layer contract enforceable.

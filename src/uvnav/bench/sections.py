@@ -1,8 +1,9 @@
 """One report section per chapter: the contract between the reproductions and the HTML report.
 
-Each chapter's run (:mod:`uvnav.bench.chapters`: ``uvnav run`` and ``uvnav reproduce CH``) turns
-what its reproduction returns (its summary object: ``.table`` rows, ``.figures`` files) into a
-:class:`ChapterSection` with a ``*_section`` builder: the thesis chapters' builders are here, the
+Each chapter's run (:mod:`uvnav.bench.chapters`, an experiment of :mod:`uvnav.experiments` run
+by ``uvnav run`` and ``uvnav reproduce NAME``) turns what its reproduction returns (its summary
+object: ``.table`` rows, ``.figures`` files) into a :class:`ChapterSection` with a
+``*_section`` builder: the thesis chapters' builders are here, the
 crowd section's and the regime map's beside their runs
 (:func:`uvnav.bench.reproduce_crowds.crowds_section`, :func:`uvnav.bench.regime.regime_section`).
 The renderer (:func:`uvnav.viz.reproduction.render_reproduction`) hands the sections to
@@ -15,12 +16,9 @@ Figures are *drawn* only in ``viz`` (layer 7), above this module: chapters whose
 renderer receive it injected through :class:`ChapterRenderers` (the CLI builds one with
 :func:`uvnav.viz.reproduction.chapter_renderers`), so ``bench`` never imports ``viz`` (DESIGN §1).
 
-To add a section: a builder ``<key>_section(summary, *, full) -> ChapterSection`` (intro from the
-run's parameters, rows from ``summary.table``, figures from ``summary.figures`` with
-:func:`caption_files`), a runner ``run_<key>`` and its entries in :data:`uvnav.bench.chapters.
-CHAPTERS` and :func:`~uvnav.bench.chapters.reproduce_chapter`'s dispatch, the key in
-:data:`SECTION_ORDER`, and, for ``uvnav run``, a call in
-:func:`uvnav.bench.chapters.reproduce_all`.
+A new experiment builds its section itself and registers as an
+:class:`uvnav.experiments.Experiment` (one module, see :mod:`uvnav.experiments`); the built-ins'
+keys are listed in :data:`SECTION_ORDER` too, in the order of their registry.
 """
 
 from __future__ import annotations
@@ -560,13 +558,15 @@ def save_section(section: ChapterSection, folder: Path) -> Path:
     return path
 
 
-def load_sections(folder: Path) -> list[ChapterSection]:
-    """The sections saved by :func:`save_section` in ``folder``, in :data:`SECTION_ORDER`; files
-    that no longer exist are left out (noted in the section).  A missing folder: no sections."""
+def load_sections(folder: Path, keys: Sequence[str] = SECTION_ORDER) -> list[ChapterSection]:
+    """The sections saved by :func:`save_section` in ``folder`` whose key is in ``keys``, in that
+    order (default :data:`SECTION_ORDER`; :func:`uvnav.experiments.saved_sections` passes every
+    registered experiment's); files that no longer exist are left out (noted in the section).  A
+    missing folder: no sections."""
     import json
 
     out: list[ChapterSection] = []
-    for key in SECTION_ORDER:
+    for key in keys:
         path = Path(folder) / f"{key}.json"
         if not path.is_file():
             continue

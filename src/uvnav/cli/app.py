@@ -694,9 +694,9 @@ def report_cmd(
     except NotAStoreError as exc:
         raise CliError(str(exc)) from None
     write_report = _optional("uvnav.viz.report", "write_report", "the report (uvnav report)")
-    from uvnav.bench.chapters import report_sections
+    from uvnav.experiments import report_sections
 
-    sections = report_sections(db)  # saved by the chapters' runs, or rebuilt from stored rows
+    sections = report_sections(db)  # saved by the experiments' runs, or rebuilt from stored rows
     try:
         path = write_report(
             db,

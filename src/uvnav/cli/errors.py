@@ -86,8 +86,8 @@ def user_error(exc: BaseException) -> tuple[str, int] | None:
         return str(exc.args[0]) if exc.args else "unknown controller", EX_USAGE
     if isinstance(exc, ControllerParamsError):
         return str(exc), EX_USAGE
-    if type(exc).__name__ in ("StaleCampaignError", "NotAStoreError"):  # bench.store: not
-        return str(exc), EX_USAGE  # imported here, for a fast start
+    if type(exc).__name__ in ("StaleCampaignError", "NotAStoreError", "ExperimentError"):
+        return str(exc), EX_USAGE  # bench.store, uvnav.experiments: not imported here (fast start)
     if isinstance(exc, OSError):
         name = f": {clip(str(exc.filename), 200)}" if exc.filename else ""
         if (

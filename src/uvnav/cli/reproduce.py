@@ -1,14 +1,16 @@
-"""``uvnav run``, ``uvnav reproduce CHAPTER`` and ``uvnav forget``: every chapter's reproduction,
-one chapter's, and the removal of a stored campaign a reproduction refused to mix with (thin:
-parse, call the library, print).
+"""``uvnav run``, ``uvnav reproduce NAME`` and ``uvnav forget``: every registered experiment's
+reproduction, one experiment's, and the removal of a stored campaign a reproduction refused to mix
+with (thin: parse, call the library, print).
 
-``uvnav run`` runs :func:`uvnav.bench.chapters.reproduce_all` (every chapter, the report, the
-whole "thesis reported vs uvnav measured" table in ``RESULTS/thesis-vs-uvnav.md``).
+``uvnav run`` runs :func:`uvnav.experiments.run_all` (every registered experiment in report order,
+the report, the whole "thesis reported vs uvnav measured" table in ``RESULTS/thesis-vs-uvnav.md``).
 
-``uvnav reproduce CH`` runs :func:`uvnav.bench.chapters.reproduce_chapter` into the results store
-(``--results``), draws the chapter's figures (the viz renderers are injected, as ``uvnav run``
-does) and rewrites the report (``--report``) with the chapter's section beside the sections the
-earlier runs saved (``RESULTS/sections``).  ``uvnav reproduce all`` is ``uvnav run``.
+``uvnav reproduce NAME`` runs :func:`uvnav.experiments.run_experiment` into the results store
+(``--results``), draws the experiment's figures (the viz renderers are injected, as ``uvnav run``
+does) and rewrites the report (``--report``) with its section beside the sections the earlier runs
+saved (``RESULTS/sections``).  ``uvnav reproduce --list`` lists the experiments (the built-ins and
+the plug-ins of the ``uvnav.experiments`` entry-point group); ``uvnav reproduce all`` is
+``uvnav run``.
 
 Chapter 6's pipeline with every option (noise, threads, head, DAgger rounds, ...) stays
 ``uvnav drive reproduce``; ``uvnav reproduce ch6`` runs the same function at ``uvnav run``'s size
@@ -31,6 +33,21 @@ _COLUMNS = ("quantity", "thesis", "measured", "note")
 _TITLE = "uvnav — reproduction of the thesis's experiments"
 
 
+def _context(results: Path, report: Path, **kw: Any) -> Any:
+    """The experiments' context with the viz renderers injected."""
+    context = optional("uvnav.experiments", "ExperimentContext", "the experiments")
+    render = optional("uvnav.viz.reproduction", "render_reproduction", "the report renderer")
+    renderers = optional("uvnav.viz.reproduction", "chapter_renderers", "the chapter figures")
+    return context(results, report, renderers=renderers(), render=render, progress=True, **kw)
+
+
+def _user_errors() -> tuple[type[Exception], ...]:
+    from uvnav.bench.store import StaleCampaignError
+    from uvnav.experiments import ExperimentError
+
+    return ExperimentError, StaleCampaignError
+
+
 def run_cmd(
     full: Annotated[
         bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
@@ -44,24 +61,18 @@ def run_cmd(
     report: Annotated[Path, typer.Option(help="Directory of the HTML report.")] = Path("report"),
 ) -> None:
     """Reproduce the thesis's experiments: results database, report, and the comparison table."""
-    reproduce = optional(
-        "uvnav.bench.chapters", "reproduce_all", "the reproduction job (uvnav run)"
-    )
-    render = optional("uvnav.viz.reproduction", "render_reproduction", "the report renderer")
-    renderers = optional("uvnav.viz.reproduction", "chapter_renderers", "the chapter figures")
-    summary = reproduce(
-        results,
-        report,
-        full=full,
-        workers=workers,
-        progress=True,
-        render=render,
-        ch5=True,
-        renderers=renderers(),
-    )
+    run_all = optional("uvnav.experiments", "run_all", "the reproduction job (uvnav run)")
+    ctx = _context(results, report, full=full, workers=workers)
+    try:
+        summary = run_all(ctx)
+    except _user_errors() as exc:
+        raise CliError(str(exc)) from None
     rows = list(getattr(summary, "table", []) or [])
+    sections = list(getattr(summary, "sections", []) or [])
+    if getattr(summary, "report_path", None) is None and sections:  # no run wrote the page
+        summary.report_path = _write_report(results / "uvnav.sqlite", report, sections)
     table_path = write_comparison_table(rows, results)
-    for line in run_summary_lines(getattr(summary, "sections", []) or [], rows):
+    for line in run_summary_lines(sections, rows):
         typer.echo(line)
     typer.echo(f"wrote {table_path} (the whole table: {len(rows)} rows)")
     written: list[Path] = []
@@ -115,15 +126,29 @@ def write_comparison_table(rows: list[dict[str, Any]], results: Path) -> Path:
     return path
 
 
+def experiment_lines(known: dict[str, Any], width: int = 80) -> list[str]:
+    """``uvnav reproduce --list``: a header, then per experiment its name, whether it runs random
+    seeds and its title, each line at most ``width`` characters."""
+    w = max([len("name"), *(len(n) for n in known)]) + 2
+    lines = [f"{'name':<{w}}seeded  title"]
+    for name, exp in known.items():
+        line = f"{name:<{w}}{'yes' if exp.seeded else 'no':<8}{one_line(str(exp.title))}"
+        lines.append(line if len(line) <= width else line[: width - 1] + "…")
+    return lines
+
+
 def reproduce_cmd(
-    chapter: Annotated[
-        str,
+    name: Annotated[
+        str | None,
         typer.Argument(
-            help="ch2, ch3, ch4, ch5, ch6, ch7, beyond (planners, office floor, multi-robot), "
-            "crowds (every 2D law on CrowdNav's crowds), regime (where each law wins: the "
-            "regime map), or all (= uvnav run)."
+            help="The experiment to run (see --list: ch2 ... ch7, beyond, crowds, regime and any "
+            "plug-in), or all (= uvnav run)."
         ),
-    ],
+    ] = None,
+    list_: Annotated[
+        bool,
+        typer.Option("--list", help="List the experiments (name, seeded, title) and exit."),
+    ] = False,
     full: Annotated[
         bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
     ] = False,
@@ -138,8 +163,9 @@ def reproduce_cmd(
         int | None,
         typer.Option(
             min=1,
-            help="Random scenes to run (ch2-ch5; crowds: CrowdNav test cases per scene; "
-            "regime: seeds per regime; default: the chapter's quick or full size).",
+            help="Random scenes to run (seeded experiments, see --list; crowds: CrowdNav test "
+            "cases per scene; regime: seeds per regime; default: the experiment's quick or full "
+            "size).",
         ),
     ] = None,
     start_seed: Annotated[
@@ -147,76 +173,73 @@ def reproduce_cmd(
         typer.Option(
             "--start-seed",
             min=0,
-            help="First random scene (ch2-ch5, crowds, regime): seeds S .. S+N-1.",
+            help="First random scene (seeded experiments): seeds S .. S+N-1.",
         ),
     ] = 0,
 ) -> None:
-    """Reproduce one chapter into the results store and its report section.
+    """Reproduce one experiment into the results store and its report section.
 
     Adds to the store: stored episodes are skipped, no other run's episodes are deleted or
     replaced; a campaign stored by other code is refused (remove it with 'uvnav forget').
     """
-    chapter = chapter.strip().lower()
-    if chapter == "all":
+    if list_:
+        if name is not None:
+            raise CliError(f"reproduce --list takes no experiment name (got {name!r})")
+        experiments = optional("uvnav.experiments", "experiments", "the experiments")
+        try:
+            known = experiments()
+        except _user_errors() as exc:
+            raise CliError(str(exc)) from None
+        for line in experiment_lines(known):
+            typer.echo(line)
+        return
+    if name is None:
+        raise CliError("reproduce: name an experiment ('uvnav reproduce --list' shows them) or all")
+    name = name.strip().lower()
+    if name == "all":
         if seeds is not None or start_seed:
             raise CliError(
-                "reproduce all: --seeds/--start-seed apply to one chapter (ch2-ch5, crowds, regime)"
+                "reproduce all: --seeds/--start-seed apply to one seeded experiment "
+                "(see 'uvnav reproduce --list')"
             )
         run_cmd(full=full, workers=workers, results=results, report=report)
         return
-    chapters = optional("uvnav.bench.chapters", "reproduce_chapter", "the reproduction job")
-    from uvnav.bench.chapters import ChapterError
-    from uvnav.bench.sections import SECTIONS_DIR, load_sections
-    from uvnav.bench.store import StaleCampaignError
-
-    renderers = optional("uvnav.viz.reproduction", "chapter_renderers", "the chapter figures")
-    render_reproduction = optional(
-        "uvnav.viz.reproduction", "render_reproduction", "the report renderer"
-    )
-    saved = results / SECTIONS_DIR
-
-    def render_ch2(req: Any) -> Any:  # Chapter 2's figures, then the page with every section
-        others = [s for s in load_sections(saved) if s.key != "ch2"]
-        req.sections = [*req.sections, *others]
-        req.table = list(req.table) + [r for s in others for r in s.rows]
-        return render_reproduction(req)
-
+    run_experiment = optional("uvnav.experiments", "run_experiment", "the reproduction job")
+    ctx = _context(results, report, full=full, workers=workers, seeds=seeds, start_seed=start_seed)
     try:
-        out = chapters(
-            chapter,
-            results,
-            report,
-            full=full,
-            workers=workers,
-            seeds=seeds,
-            start_seed=start_seed,
-            renderers=renderers(),
-            render=render_ch2,
-            progress=True,
-        )
-    except (ChapterError, StaleCampaignError) as exc:
+        out = run_experiment(name, ctx)
+    except _user_errors() as exc:
         raise CliError(str(exc)) from None
     report_path = out.report_path
     if report_path is None:
-        report_path = _write_report(out.db_path, report, load_sections(saved))
-    from rich.table import Table
+        from uvnav.experiments import saved_sections
 
-    if out.section.rows:
-        table = Table(title=f"{out.section.title}: thesis reported vs uvnav measured")
-        for col in _COLUMNS:
-            table.add_column(col, justify="right" if col in ("thesis", "measured") else "left")
-        for row in out.section.rows:
-            table.add_row(*(text(fmt(row.get(col))) for col in _COLUMNS))
-        console().print(table)
-    if chapter == "regime":
+        report_path = _write_report(out.db_path, report, saved_sections(results))
+    _print_rows(out.sections)
+    if name == "regime":
         _print_regime_leaders(out.db_path)
     for f in out.failures[:20]:
         typer.echo(f"failure: {f}")
     if len(out.failures) > 20:
         typer.echo(f"... and {len(out.failures) - 20} more failure(s) (see the report)")
-    n_files = len(out.section.figures) + len(out.section.links)
+    n_files = sum(len(s.figures) + len(s.links) for s in out.sections)
     typer.echo(f"wrote {out.db_path}")
-    typer.echo(f"wrote {report_path} ({n_files} file(s) in the {chapter} section)")
+    typer.echo(f"wrote {report_path} ({n_files} file(s) in the {name} section)")
+
+
+def _print_rows(sections: list[Any]) -> None:
+    """Each section's rows of the table "thesis reported vs uvnav measured"."""
+    from rich.table import Table
+
+    for section in sections:
+        if not section.rows:
+            continue
+        table = Table(title=f"{section.title}: thesis reported vs uvnav measured")
+        for col in _COLUMNS:
+            table.add_column(col, justify="right" if col in ("thesis", "measured") else "left")
+        for row in section.rows:
+            table.add_row(*(text(fmt(row.get(col))) for col in _COLUMNS))
+        console().print(table)
 
 
 def _print_regime_leaders(db: Path) -> None:
@@ -243,8 +266,8 @@ def _print_regime_leaders(db: Path) -> None:
 
 
 def _write_report(db: Path, report: Path, sections: list[Any]) -> Path:
-    """The report page from the saved sections (the database is created empty if a chapter
-    stores no episodes, as Chapters 6, 7 and beyond)."""
+    """The report page from ``sections`` (the database is created empty if the experiments
+    stored no episodes, as Chapters 6 and 7)."""
     from uvnav.bench.store import ResultsStore
 
     if not db.exists():

@@ -1,4 +1,5 @@
-"""Figures and report of ``uvnav run`` (:func:`uvnav.bench.chapters.reproduce_all`'s renderers).
+"""Figures and report of ``uvnav run`` (the renderers the CLI injects into
+:func:`uvnav.experiments.run_all`).
 
 :func:`render_reproduction` draws the Chapter 2 figures into ``report_dir/ch2`` — for each
 recorded thesis-scene episode a :func:`~uvnav.viz.figures.plot_episode` figure (Figs. 2.7–2.9
@@ -9,7 +10,7 @@ vehicle limits) are rebuilt from the scenario with the stored seed; the trajecto
 the database.
 
 :func:`chapter_renderers` gives the other chapters' figure renderers
-(:class:`uvnav.bench.sections.ChapterRenderers`) the CLI injects into ``reproduce_all``.
+(:class:`uvnav.bench.sections.ChapterRenderers`) the CLI injects into the experiments.
 """
 
 from __future__ import annotations
@@ -150,9 +151,9 @@ def _beyond(out_dir: Path) -> list[Path]:
 
 
 def chapter_renderers() -> ChapterRenderers:
-    """The figure renderers of Chapters 3–7 and issue 9 for
-    :func:`uvnav.bench.chapters.reproduce_all` (imported lazily: a chapter's plotting extras load
-    only when it draws)."""
+    """The figure renderers of Chapters 3–7 and "beyond" for the experiments
+    (:class:`uvnav.experiments.ExperimentContext`; imported lazily: a chapter's plotting extras
+    load only when it draws)."""
 
     def ch3(db_path: Path, report_dir: Path, recorded: list[tuple[str, str, Any]]) -> list[Path]:
         from uvnav.viz.figures3d import render_ch3
