@@ -17,9 +17,13 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import numpy.typing as npt
 
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.contact import first_contact
+
+#: a mask, one entry per path
+BoolArray = npt.NDArray[np.bool_]
 
 
 @dataclass(frozen=True)
@@ -95,10 +99,11 @@ def rollout(
     model: RampModel,
     horizon: float,
     step: float,
-) -> tuple[FloatArray, FloatArray]:
+) -> tuple[FloatArray, FloatArray, FloatArray]:
     """The paths of the robot steering toward each aim direction ``aim`` (K,) [rad] at the
     speeds ``speed`` (K,) [m/s] for ``horizon`` [s], from ``pose`` ``[x, y, theta]`` at speed
-    ``v_now`` and turn rate ``u_now``: ``(times (S + 1,), positions (K, S + 1, 2))``.
+    ``v_now`` and turn rate ``u_now``: ``(times (S + 1,), positions (K, S + 1, 2), speeds
+    (K, S + 1))``.
 
     At every decision (each period T) the law commands ``speed cos(beta)`` (0 for an aim behind)
     and :func:`turn_command`, both within the window; between decisions the vehicle moves its
@@ -106,7 +111,7 @@ def rollout(
     integrated on its arc at the substep's mean speed and turn rate.
 
     >>> m = RampModel(1.0, 1.0, 1.0, math.inf, 0.25)
-    >>> t, xy = rollout(np.zeros(3), 0.0, 0.0, np.zeros(1), np.ones(1), m, 1.0, 0.25)
+    >>> t, xy, v = rollout(np.zeros(3), 0.0, 0.0, np.zeros(1), np.ones(1), m, 1.0, 0.25)
     >>> np.round(xy[0, :, 0], 6).tolist()  # from rest at 1 m/s^2: x = t^2 / 2
     [0.0, 0.03125, 0.125, 0.28125, 0.5]
     """
@@ -118,8 +123,8 @@ def rollout(
     th = np.full(k, float(pose[2]))
     v, u = np.full(k, float(v_now)), np.full(k, float(u_now))
     v_cmd, u_cmd = v, u
-    xy = np.empty((k, n + 1, 2))
-    xy[:, 0, 0], xy[:, 0, 1] = x, y
+    xy, speeds = np.empty((k, n + 1, 2)), np.empty((k, n + 1))
+    xy[:, 0, 0], xy[:, 0, 1], speeds[:, 0] = x, y, v
     for i in range(n):
         if i % n_sub == 0:
             beta = (aim - th + np.pi) % (2.0 * np.pi) - np.pi
@@ -133,8 +138,32 @@ def rollout(
         y = y + chord * np.sin(th + half)
         th = th + 2.0 * half
         v, u = v1, u1
-        xy[:, i + 1, 0], xy[:, i + 1, 1] = x, y
-    return np.asarray(h * np.arange(n + 1), dtype=float), xy
+        xy[:, i + 1, 0], xy[:, i + 1, 1], speeds[:, i + 1] = x, y, v
+    return np.asarray(h * np.arange(n + 1), dtype=float), xy, speeds
+
+
+def stoppable(
+    times: FloatArray, xy: FloatArray, speeds: FloatArray, ttc: FloatArray, model: RampModel
+) -> BoolArray:
+    """Per path of :func:`rollout`, whether the robot, having followed it for one period, can
+    still stop before its first contact ``ttc`` [s]: the path length to the contact is at least
+    ``v_T T + v_T^2 / (2 a)`` (``v_T`` its speed after the period; the braking starts at the
+    next decision at the latest).  A path without contact is stoppable.
+
+    >>> m = RampModel(1.0, 1.0, 1.0, math.inf, 0.25)
+    >>> t = np.array([0.0, 0.25, 0.5, 0.75, 1.0])
+    >>> xy = np.stack([np.column_stack([t, 0 * t]), np.column_stack([t, 0 * t])])
+    >>> stoppable(t, xy, np.ones((2, 5)), np.array([0.5, 1.0]), m).tolist()  # 0.75 m needed
+    [False, True]
+    """
+    step = np.hypot(*np.moveaxis(np.diff(xy, axis=1), -1, 0))
+    length = np.concatenate([np.zeros((len(xy), 1)), np.cumsum(step, axis=1)], axis=1)
+    finite = np.isfinite(ttc)
+    at = np.where(finite, ttc, 0.0)
+    to_contact = np.array([np.interp(a, times, row) for a, row in zip(at, length, strict=True)])
+    v_t = speeds[:, min(int(np.searchsorted(times, model.period - 1e-9)), len(times) - 1)]
+    need = v_t * model.period + v_t * v_t / (2.0 * model.accel)
+    return np.asarray(~finite | (to_contact >= need), dtype=bool)
 
 
 def path_risk(

@@ -80,11 +80,13 @@ from uvnav.controllers.base import (
 )
 from uvnav.controllers.holonomic import HolonomicLaw, toward_goal
 from uvnav.controllers.zhang2019_limits import (
+    BoolArray,
     RampModel,
     approach,
     path_risk,
     rollout,
     speed_command,
+    stoppable,
     turn_command,
 )
 from uvnav.dynamics.omni import VelocityCommand
@@ -343,14 +345,22 @@ def least_cost(
     v_pref: FloatArray,
     v_prev: FloatArray,
     params: Zhang2019V2Params,
+    *,
+    admissible: BoolArray | None = None,
 ) -> Choice:
     """The candidate of least cost among ``cand`` (ordered as :func:`candidates` makes them),
     given each one's first contact ``ttc`` [s] and comfort penalty ``pen`` [m] (module
-    docstring, steps 3-4)."""
+    docstring, steps 3-4).  With ``admissible`` (a mask: the robot can still stop before the
+    contact), a safe candidate must be admissible too, and where none is safe an admissible
+    one is preferred."""
     p = params
     cost = np.hypot(*(cand - v_pref).T) + p.w_change * np.hypot(*(cand - v_prev).T)
     cost = cost + p.w_ttc / np.maximum(ttc, 1e-3) + p.w_comfort * pen
     safe = ttc > p.min_ttc
+    if admissible is not None:
+        safe = safe & admissible
+        if not np.any(safe) and np.any(admissible):
+            safe = admissible
     if np.any(safe):
         cost = np.where(safe, cost, np.inf)
     k = int(np.argmin(cost))
@@ -482,11 +492,12 @@ def plan_limited(
     tangents = nearest_tangents(pos, (q, w, reach, owner), p)
     headings = np.concatenate([tangents, extra_headings(p.n_headings, v_pref, v_prev)])
     ang, spd, cand = candidates(headings, model.v_max, p.speed_levels, v_pref)
-    times, xy = rollout(np.asarray(obs.pose, dtype=float), now[0], now[1], ang, spd, model,
-                        p.horizon, p.rollout_step)  # fmt: skip
+    times, xy, speeds = rollout(np.asarray(obs.pose, dtype=float), now[0], now[1], ang, spd,
+                                model, p.horizon, p.rollout_step)  # fmt: skip
     ttc, pen = path_risk(times, xy, (q, w, reach), p.horizon, p.comfort, p.comfort_horizon,
                          p.safety_margin)  # fmt: skip
-    return least_cost(cand, ttc, pen, v_pref, v_prev, p)
+    brakes = stoppable(times, xy, speeds, ttc, model)
+    return least_cost(cand, ttc, pen, v_pref, v_prev, p, admissible=brakes)
 
 
 # -- the two laws -----------------------------------------------------------------------------
