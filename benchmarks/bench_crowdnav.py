@@ -179,8 +179,8 @@ def run(
         )  # fmt: skip
         scn = crowdnav_scenario(
             case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
-            kinematics=kinematics, accel_max=accel, turn_accel_max=turn_accel,
-            **sensing,  # type: ignore[arg-type]
+            kinematics=kinematics, **sensing,  # type: ignore[arg-type]
+            accel_max=accel, turn_accel_max=turn_accel,
         )  # fmt: skip
         setup = build_episode(scn, case)
         law: Any
