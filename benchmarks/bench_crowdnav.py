@@ -31,6 +31,10 @@ Options for the protocol study (defaults = the reproduction):
   the whole step, :mod:`uvnav.sim.swept`, as CrowdSim's swept-segment test).
 * ``--kinematics arc``: a unicycle law's robot turns on arcs (the thesis's) instead of CrowdNav's
   turn-then-move (``ActionRot``), the scenes' default.
+* ``--accel A`` / ``--turn-accel B``: the unicycle robot changes its speed by at most A [m/s^2]
+  and its turn rate by at most B [rad/s^2] (``UnicycleSpec.accel_max``, ``turn_accel_max``;
+  default: at once).  Collisions the robot drove into (``collision_by`` ``robot``) are counted
+  in every run.
 * ``--pref crowdnav``: the robot's preferred velocity as CrowdNav's ORCA sets it (1 m/s toward
   the goal beyond 1 m, the gap within) instead of ``orca-holonomic-v1``'s (V_max, lowered to
   ``dist / period`` on the last step).
@@ -155,11 +159,14 @@ def run(
     kinematics: str = "turn-then-move",
     swept: bool = True,
     lidar: int | None = None,
+    accel: float | None = None,
+    turn_accel: float | None = None,
 ) -> dict[str, Any]:
     """Run the cases; returns the counts, rates, intervals and times."""
     rng_of = kinds()["nav2d"].episode_rng
     vehicle = controller_info(law_name).vehicle
     counts = {"success": 0, "collision": 0, "timeout": 0}
+    robot_driven = 0
     times: list[float] = []
     statuses: list[str] = []
     cpu0, wall0 = time.process_time(), time.perf_counter()
@@ -173,6 +180,7 @@ def run(
         scn = crowdnav_scenario(
             case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
             kinematics=kinematics, **sensing,  # type: ignore[arg-type]
+            accel_max=accel, turn_accel_max=turn_accel,
         )  # fmt: skip
         setup = build_episode(scn, case)
         law: Any
@@ -194,6 +202,7 @@ def run(
             status = probe.status or res.status
             arrival = probe.at if probe.status == "success" else arrival
         counts[status] += 1
+        robot_driven += int(status == "collision" and res.metrics.collision_by == "robot")
         statuses.append(status)
         if status == "success" and arrival is not None:
             times.append(float(arrival))
@@ -203,6 +212,7 @@ def run(
         lo, hi = wilson_interval(k, cases)
         rates[key] = {"count": k, "rate": k / cases, "ci95": [lo, hi]}
     lo, hi = wilson_interval(counts["success"], cases)
+    rd_lo, rd_hi = wilson_interval(robot_driven, cases)
     return {
         "cases": cases,
         "first_case": first,
@@ -219,7 +229,14 @@ def run(
             f"lidar {lidar} beams, {LIDAR_NOISE:g} m noise, {LIDAR_RANGE:g} m" if lidar else "exact"
         ),
         "params": dict(CROWDNAV_ORCA_PARAMS) if law_name == PAPER_LAW else {},
+        "accel_max": accel,
+        "turn_accel_max": turn_accel,
         "rates": rates,
+        "robot_driven_collisions": {
+            "count": robot_driven,
+            "rate": robot_driven / cases,
+            "ci95": [rd_lo, rd_hi],
+        },
         "time_to_goal_mean": float(np.mean(times)) if times else None,
         "cpu_s": cpu,
         "wall_s": wall,
@@ -240,7 +257,12 @@ def report(r: dict[str, Any]) -> str:
         f"crowdnav-{r['rule'].split('_')[0]} {_cases_text(r)}, {r['law']} {r['params']}, "
         f"dt {r['dt']:g} s, pref {r['pref']}, outcome {r['outcome']}, collisions judged "
         f"{r['judged']}, sensing {r['sensing']}"
-        + (f", {r['kinematics']} unicycle" if r["kinematics"] else ""),
+        + (f", {r['kinematics']} unicycle" if r["kinematics"] else "")
+        + (
+            f", limits {r['accel_max']} m/s^2, {r['turn_accel_max']} rad/s^2"
+            if r["accel_max"] is not None or r["turn_accel_max"] is not None
+            else ""
+        ),
     ]
     for key in ("success", "collision", "timeout"):
         x = r["rates"][key]
@@ -249,6 +271,10 @@ def report(r: dict[str, Any]) -> str:
         lines.append(
             f"  {key:<9} {x['count']:4d}  {x['rate']:.3f}  95% [{lo:.3f}, {hi:.3f}]{paper}"
         )
+    rd = r["robot_driven_collisions"]
+    lo, hi = rd["ci95"]
+    lines.append(f"  robot-driven collisions {rd['count']:4d}  {rd['rate']:.3f}  95% "
+                 f"[{lo:.3f}, {hi:.3f}]")  # fmt: skip
     ttg = r["time_to_goal_mean"]
     lines.append(
         f"  time to goal (successes) {ttg:.2f} s   paper {PAPER['time_to_goal']:.2f} s"
@@ -290,16 +316,33 @@ def main(argv: list[str] | None = None) -> int:
                     help="the robot senses the humans with a BEAMS-beam lidar alone")  # fmt: skip
     ap.add_argument("--sampled", action="store_true",
                     help="judge collisions at each step's end only")  # fmt: skip
+    ap.add_argument(
+        "--accel",
+        type=float,
+        default=None,
+        metavar="A",
+        help="the unicycle's largest speed change [m/s^2] (default: at once)",
+    )
+    ap.add_argument(
+        "--turn-accel",
+        type=float,
+        default=None,
+        metavar="B",
+        help="the unicycle's largest turn-rate change [rad/s^2] (default: at once)",
+    )
     ap.add_argument("--out", type=Path, default=None, help="write crowdnav.json here")
     args = ap.parse_args(argv)
     if args.cases < 1 or args.substeps < 1:
         ap.error("--cases and --substeps must be >= 1")
+    for name, value in (("--accel", args.accel), ("--turn-accel", args.turn_accel)):
+        if value is not None and not (math.isfinite(value) and value > 0):
+            ap.error(f"{name} must be a number > 0 (got {value!r})")
     if args.outcome == "crowdnav" and args.substeps != 1:
         ap.error("--outcome crowdnav judges 0.25 s steps: use --substeps 1")
     r = run(
         args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
         outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
-        swept=not args.sampled, lidar=args.lidar,
+        swept=not args.sampled, lidar=args.lidar, accel=args.accel, turn_accel=args.turn_accel,
     )  # fmt: skip
     print(report(r))
     if args.out is not None:

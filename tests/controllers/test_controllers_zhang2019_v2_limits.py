@@ -1,0 +1,134 @@
+"""``zhang2019-v2`` on a unicycle with acceleration limits: every command within the window the
+vehicle can reach in one period, the turn rate it tracks equal to the vehicle's, the paths it
+checks equal to the vehicle's motion, and scenes where the law planning as if the vehicle were
+ideal collides or orbits the goal while the planning law arrives."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import Any
+
+import numpy as np
+import pytest
+
+from uvnav.controllers.base import controller_info
+from uvnav.controllers.zhang2019_limits import RampModel, rollout, turn_command
+from uvnav.controllers.zhang2019_v2 import Zhang2019V2
+from uvnav.core import BaseProbe
+from uvnav.dynamics.unicycle import Unicycle, UnicycleCommand, UnicycleSpec
+from uvnav.scenarios.build import build_episode
+from uvnav.scenarios.catalog import kinds
+from uvnav.scenarios.crowdnav import crowdnav_scenario
+from uvnav.sim.run import run_episode
+
+ACCEL, TURN_ACCEL, DT, PERIOD = 1.0, 2.0, 0.05, 0.25
+
+
+class IdealPlanning(Zhang2019V2):
+    """v2 told that its vehicle is ideal (the law before it planned with the limits)."""
+
+    def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
+        ideal = dataclasses.replace(spec, accel_max=math.inf, turn_accel_max=math.inf)
+        super().reset(ideal, goal, rng)
+
+
+class Window(BaseProbe):
+    """Records, at every decision, the vehicle's speed and turn rate and the command held."""
+
+    def __init__(self) -> None:
+        self.rows: list[tuple[float, float, float, float, float, float]] = []
+
+    def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
+        body = world.body
+        self.rows.append((obs.time, obs.speed, body.speed(), body.turn_rate(), applied.v,
+                          applied.u))  # fmt: skip
+
+
+def run(case: int, law: Zhang2019V2, n_humans: int = 5, probe: Window | None = None) -> Any:
+    scn = crowdnav_scenario(case, dt=DT, accel_max=ACCEL, turn_accel_max=TURN_ACCEL,
+                            n_humans=n_humans)  # fmt: skip
+    probes = [probe] if probe else []
+    rng = kinds()["nav2d"].episode_rng(case)
+    return run_episode(build_episode(scn, case), law, rng, record=False, vehicle="unicycle",
+                       probes=probes)  # fmt: skip
+
+
+@pytest.mark.parametrize("case", [0, 7, 12])
+def test_every_command_is_reachable_within_one_period(case: int) -> None:
+    probe = Window()
+    law = Zhang2019V2()
+    run(case, law, probe=probe)
+    rows = np.array(probe.rows)
+    assert len(rows) > 10
+    t, obs_v, v, u, cmd_v, cmd_u = rows.T
+    assert np.allclose(obs_v, v)  # the odometry the law reads is the vehicle's speed
+    _, u_cmd = law._turn  # the law's own record of the last command
+    assert u_cmd == pytest.approx(cmd_u[-1])
+    periods = np.diff(t)
+    assert np.allclose(periods, PERIOD)
+    tol = 1e-9
+    assert np.all(np.abs(cmd_v - v) <= ACCEL * PERIOD + tol)
+    assert np.all(np.abs(cmd_u - u) <= TURN_ACCEL * PERIOD + tol)
+    # the vehicle reached every command within its period: the next decision finds it there
+    assert np.allclose(v[1:], cmd_v[:-1], atol=1e-9)
+    assert np.allclose(u[1:], cmd_u[:-1], atol=1e-9)
+
+
+def test_the_ideal_planning_law_issues_commands_out_of_reach() -> None:
+    probe = Window()
+    run(7, IdealPlanning(), probe=probe)
+    _, _, v, u, cmd_v, cmd_u = np.array(probe.rows).T
+    assert np.any(np.abs(cmd_v - v) > ACCEL * PERIOD + 1e-6)
+    assert np.any(np.abs(cmd_u - u) > TURN_ACCEL * PERIOD + 1e-6)
+
+
+def test_planning_with_the_limits_avoids_the_collision_the_ideal_plan_drives_into() -> None:
+    before = run(12, IdealPlanning(), n_humans=2)
+    assert before.status == "collision" and before.metrics.collision_by == "robot"
+    after = run(12, Zhang2019V2(), n_humans=2)
+    assert after.status == "success"
+
+
+def test_the_goal_is_reached_not_orbited() -> None:
+    # one human: the ideal plan overshoots its turn onto the goal and circles it
+    assert run(1, IdealPlanning(), n_humans=1).status == "timeout"
+    assert run(1, Zhang2019V2(), n_humans=1).status == "success"
+
+
+def test_the_checked_path_is_the_path_the_vehicle_drives() -> None:
+    spec = UnicycleSpec(1.0, math.pi, 0.3, kinematics="arc", accel_max=ACCEL,
+                        turn_accel_max=TURN_ACCEL)  # fmt: skip
+    model = RampModel(1.0, math.pi, ACCEL, TURN_ACCEL, PERIOD)
+    aim, speed = np.array([1.2]), np.array([0.8])
+    times, xy, speeds = rollout(np.zeros(3), 0.3, 0.0, aim, speed, model, 3.0, DT)
+    car = Unicycle(spec)
+    car._v = 0.3  # the state the rollout starts from
+    x, y, th, u_now = 0.0, 0.0, 0.0, 0.0
+    for i in range(len(times) - 1):
+        if i % round(PERIOD / DT) == 0:  # the law's steering, as the rollout plays it
+            beta = math.remainder(1.2 - th, 2.0 * math.pi)
+            v_cmd = min(max(0.8 * max(math.cos(beta), 0.0), car.speed() - ACCEL * PERIOD),
+                        car.speed() + ACCEL * PERIOD)  # fmt: skip
+            u_cmd = float(turn_command(np.array([beta]), np.array([u_now]), model)[0])
+            car.hold(UnicycleCommand(v_cmd, u_cmd))
+        x, y, th, _, _ = car.move(x, y, th, DT, False, PERIOD)
+        u_now = car.turn_rate()
+    # the rollout integrates each substep at its mean speed and turn rate, the vehicle at the
+    # values it reached: a few centimetres apart after 3 s
+    assert math.hypot(xy[0, -1, 0] - x, xy[0, -1, 1] - y) < 0.05
+    assert speeds[0, -1] == pytest.approx(car.speed())
+
+
+def test_turn_command_brakes_the_turn_before_the_heading_is_reached() -> None:
+    model = RampModel(1.0, math.pi, ACCEL, TURN_ACCEL, PERIOD)
+    u = turn_command(np.array([0.3, 0.3]), np.array([1.5, 0.0]), model)
+    # turning at 1.5 rad/s with 0.3 rad to go: slow down (by the window's most, 0.5 rad/s)
+    assert u[0] == pytest.approx(1.0)
+    # from rest: no faster than a turn that can still be stopped within 0.3 rad
+    assert 0.0 < u[1] <= math.sqrt(2.0 * TURN_ACCEL * 0.3)
+
+
+def test_the_law_declares_that_it_plans_with_the_limits() -> None:
+    assert controller_info("zhang2019-v2").acceleration_limits
+    assert not controller_info("zhang2019-holonomic-v2").acceleration_limits
