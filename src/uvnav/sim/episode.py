@@ -44,16 +44,16 @@ from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
 from uvnav.sensors.observation import Observation
 from uvnav.sensors.suite2d import Sensors2D
 from uvnav.sim.bodies2d import Bodies2D, FieldBodies, PackedBodies
-from uvnav.sim.ledger import Clock, Ledger
+from uvnav.sim.ledger import Clock, Ledger, OneVehicle
 from uvnav.sim.metrics import EpisodeMetrics
 from uvnav.sim.packed import pack_check
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
-from uvnav.sim.setup import EpisodeResult, EpisodeSetup, single_result
+from uvnav.sim.setup import EpisodeSetup
 from uvnav.sim.social import SocialTracker, collision_by, pedestrian_ids
 from uvnav.sim.swept import SweptClearance
 
 
-class World2D:
+class World2D(OneVehicle):
     """The 2D world: one planar vehicle among rigid moving bodies (:class:`uvnav.core.World`).
 
     Bookkeeping (path, effort, limit violations, clearance, status: the one
@@ -80,7 +80,6 @@ class World2D:
     """
 
     sensing: ClassVar[str] = "exact"
-    n_agents: ClassVar[int] = 1
 
     def __init__(
         self,
@@ -160,15 +159,6 @@ class World2D:
         self.done = book.begin(self.clearance, gd) or self.clock.up
         if book.status == "collision":
             self.collision_by = self._collision_by()
-
-    @property
-    def status(self) -> str:
-        """``success``, ``collision`` or ``timeout`` (also while running)."""
-        return self.book.status
-
-    def acting(self) -> tuple[int, ...]:
-        """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
-        return (0,) if self.clock.due else ()
 
     def observe(self, agent: int = 0) -> Observation:
         """What the robot's sensors give now (:class:`~uvnav.sensors.suite2d.Sensors2D`: the
@@ -294,12 +284,6 @@ class World2D:
     def recorder(self) -> TrajectoryProbe:
         """The probe that records this world's trajectory."""
         return TrajectoryProbe()
-
-    def result(
-        self, logs: Sequence[AgentLog], recorder: TrajectoryProbe | None
-    ) -> EpisodeResult[Trajectory]:
-        """The episode's result (after :meth:`close`)."""
-        return single_result(self, logs, recorder)
 
     def _social_metrics(self, decisions: int) -> dict[str, float]:
         """The pedestrian metrics (:mod:`uvnav.sim.social`); none without pedestrians."""

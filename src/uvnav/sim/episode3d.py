@@ -37,9 +37,8 @@ from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.frames3d import check_unit, rotation_from_vector
 from uvnav.obstacles.motion3d import Obstacle3D
 from uvnav.sensors.sensing3d import FiniteDifference3D, Observation3D, sense_obstacles3d
-from uvnav.sim.ledger import Clock, Ledger
+from uvnav.sim.ledger import Clock, Ledger, OneVehicle
 from uvnav.sim.metrics import EpisodeMetrics
-from uvnav.sim.setup import EpisodeResult, single_result
 from uvnav.sim.swept import first_contact
 
 
@@ -193,7 +192,7 @@ class _GapTracker:
         return out, out_i
 
 
-class Vehicle3DWorld:
+class Vehicle3DWorld(OneVehicle):
     """The Chapter-3 world: one 3D vehicle among moving, rotating bodies
     (:class:`uvnav.core.World`), run by :func:`~uvnav.sim.run.run_episode` and stepped by the
     Gymnasium env ``uvnav/Nav3D-v0`` (:mod:`uvnav.envs.nav3d`).
@@ -215,7 +214,6 @@ class Vehicle3DWorld:
 
     vehicle: ClassVar[str] = "vehicle3d"
     sensing: ClassVar[str] = "exact"
-    n_agents: ClassVar[int] = 1
 
     def __init__(self, setup: Episode3DSetup, rng: np.random.Generator, *, exact: bool) -> None:
         self.setup = setup
@@ -260,15 +258,6 @@ class Vehicle3DWorld:
         self.book = Ledger(self.setup.goal_tolerance)
         gd = float(np.linalg.norm(self.goal - self.pos))
         self.done = self.book.begin(self.clearance, gd) or self.clock.up
-
-    @property
-    def status(self) -> str:
-        """``success``, ``collision`` or ``timeout`` (also while running)."""
-        return self.book.status
-
-    def acting(self) -> tuple[int, ...]:
-        """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
-        return (0,) if self.clock.due else ()
 
     def observe(self, agent: int = 0) -> Observation3D:
         """What the robot senses now (rates known or estimated; see :class:`Sensing3DConfig`)."""
@@ -350,12 +339,6 @@ class Vehicle3DWorld:
     def recorder(self) -> Trajectory3DProbe:
         """The probe that records this world's trajectory."""
         return Trajectory3DProbe()
-
-    def result(
-        self, logs: Sequence[AgentLog], recorder: Trajectory3DProbe | None
-    ) -> EpisodeResult[Trajectory3D]:
-        """The episode's result."""
-        return single_result(self, logs, recorder)
 
 
 class Trajectory3DProbe(BaseProbe):

@@ -38,9 +38,8 @@ from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.polygons import closed_rings, rings_nearest
 from uvnav.obstacles.deforming import ShapeChanging
 from uvnav.sensors.sonar2d import SonarConfig, SonarObservation, sonar_scan
-from uvnav.sim.ledger import Clock, Ledger
+from uvnav.sim.ledger import Clock, Ledger, OneVehicle
 from uvnav.sim.metrics import EpisodeMetrics
-from uvnav.sim.setup import EpisodeResult, single_result
 from uvnav.sim.swept import first_contact
 
 
@@ -116,7 +115,7 @@ def inside_any(point: tuple[float, float], polygons: list[FloatArray]) -> bool:
     return bool(inside is not None and inside.any())
 
 
-class Uuv2dWorld:
+class Uuv2dWorld(OneVehicle):
     """The Chapter-4 world: one planar UUV among shape-changing bodies, sensed by its sonar
     (:class:`uvnav.core.World`), run by :func:`~uvnav.sim.run.run_episode` and stepped by the
     Gymnasium env ``uvnav/UUV2D-v0`` (:mod:`uvnav.envs.uuv2d`).
@@ -133,7 +132,6 @@ class Uuv2dWorld:
 
     vehicle: ClassVar[str] = "uuv2d"
     sensing: ClassVar[str] = "sonar-fan"
-    n_agents: ClassVar[int] = 1
 
     def __init__(self, setup: Uuv2dSetup, rng: np.random.Generator, *, swept: bool = True) -> None:
         self.setup = setup
@@ -172,15 +170,6 @@ class Uuv2dWorld:
         self.done = self.book.begin(self.clearance, float(np.hypot(*(self.goal - state[:2]))))
         self.applied = HolonomicCommand(0.0, 0.0)
         self.t = 0.0
-
-    @property
-    def status(self) -> str:
-        """``success``, ``collision`` or ``timeout`` (also while running)."""
-        return self.book.status
-
-    def acting(self) -> tuple[int, ...]:
-        """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
-        return (0,) if self.clock.due else ()
 
     def observe(self, agent: int = 0) -> SonarObservation:
         """The sonar sweep now and the vehicle's own state (:class:`SonarObservation`)."""
@@ -263,12 +252,9 @@ class Uuv2dWorld:
         """The probe that records this world's trajectory."""
         return Uuv2dTrajectoryProbe()
 
-    def result(
-        self, logs: Sequence[AgentLog], recorder: Uuv2dTrajectoryProbe | None
-    ) -> EpisodeResult[Uuv2dTrajectory]:
-        """The episode's result; ``flags["entered_forbidden"]``: the vehicle entered a region
-        it may not."""
-        return single_result(self, logs, recorder, {"entered_forbidden": bool(self.entered)})
+    def flags(self) -> dict[str, bool]:
+        """``entered_forbidden``: the vehicle's centre was in a region it may not enter."""
+        return {"entered_forbidden": bool(self.entered)}
 
 
 class Uuv2dTrajectoryProbe(BaseProbe):

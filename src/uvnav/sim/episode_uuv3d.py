@@ -36,9 +36,8 @@ from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.mesh3d import nearest_on_mesh
 from uvnav.obstacles.deforming3d import CompoundBody
 from uvnav.sensors.sonar_array import SonarArray, merge_triangles, sonar_scan
-from uvnav.sim.ledger import Clock, Ledger
+from uvnav.sim.ledger import Clock, Ledger, OneVehicle
 from uvnav.sim.metrics import EpisodeMetrics
-from uvnav.sim.setup import EpisodeResult, single_result
 from uvnav.sim.swept import first_contact
 
 
@@ -102,7 +101,7 @@ def _nearest(
     return best, point
 
 
-class UUV3DWorld:
+class UUV3DWorld(OneVehicle):
     """The Chapter-5 world: one 3D UUV, its sonar array, deforming obstacles
     (:class:`uvnav.core.World`).
 
@@ -123,7 +122,6 @@ class UUV3DWorld:
 
     vehicle: ClassVar[str] = "vehicle3d"
     sensing: ClassVar[str] = "sonar-array"
-    n_agents: ClassVar[int] = 1
 
     def __init__(self, setup: UUV3DSetup, rng: np.random.Generator) -> None:
         self.setup = setup
@@ -166,10 +164,6 @@ class UUV3DWorld:
         if not self.inner and any(bool(ob.in_inner_space(pos[None])[0]) for ob in self.obstacles):
             self.inner = True
         return float(np.linalg.norm(self.goal - pos))
-
-    def acting(self) -> tuple[int, ...]:
-        """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
-        return (0,) if self.clock.due else ()
 
     def observe(self, agent: int = 0) -> SonarObservation3D:
         """The nine-sonar scan of the tessellations now (noise and dropout from ``rng``); the
@@ -231,11 +225,6 @@ class UUV3DWorld:
                 contact_at = t0 + s_hit * dt
         self.done = book.judge(self.t, self.clearance, gd, contact_at) or self.clock.up
 
-    @property
-    def status(self) -> str:
-        """``success`` (arrived without collision), ``collision`` or ``timeout``."""
-        return self.book.status
-
     def close(self) -> None:
         """Nothing to write back (the obstacles' surfaces are functions of time)."""
 
@@ -247,13 +236,10 @@ class UUV3DWorld:
         """The probe that records this world's trace."""
         return LocatedTraceProbe()
 
-    def result(
-        self, logs: Sequence[AgentLog], recorder: LocatedTraceProbe | None
-    ) -> EpisodeResult[LocatedTrace]:
-        """The episode's result; ``flags["entered_inner_space"]``: the vehicle centre was ever
-        inside an obstacle's inner-space box."""
-        flags = {"entered_inner_space": bool(self.inner)}
-        return single_result(self, logs, recorder, flags)
+    def flags(self) -> dict[str, bool]:
+        """``entered_inner_space``: the vehicle centre was ever inside an obstacle's
+        inner-space box."""
+        return {"entered_inner_space": bool(self.inner)}
 
 
 class LocatedTraceProbe(BaseProbe):

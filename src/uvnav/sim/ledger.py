@@ -41,14 +41,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, ClassVar
 
 import numpy as np
 
 from uvnav.core import AgentLog
 from uvnav.geometry.angles import FloatArray
 from uvnav.sim.metrics import EpisodeMetrics, episode_metrics
-from uvnav.sim.setup import GroupMetrics, MultiSetup
+from uvnav.sim.setup import EpisodeResult, GroupMetrics, MultiSetup
 
 #: relative tolerance of the whole-multiple rules (the scenario schema uses the same)
 MULTIPLE_RTOL = 1e-9
@@ -301,3 +301,44 @@ def group_outcome(
         sum_of_times=float(sum(arrival_times)) if all_arrived else None,
         deadlocks=int(stuck),
     )
+
+
+class OneVehicle:
+    """What every one-vehicle world shares: one agent whose :class:`Ledger` (``book``) holds
+    the status, a decision whenever the :class:`Clock` (``clock``) says, and the episode's one
+    :class:`~uvnav.sim.setup.EpisodeResult`.  A world adds its own :meth:`metrics` and, where it
+    has events of its own, :meth:`flags`."""
+
+    n_agents: ClassVar[int] = 1
+    book: Ledger
+    clock: Clock
+
+    @property
+    def status(self) -> str:
+        """``success``, ``collision`` or ``timeout`` (also while running)."""
+        return self.book.status
+
+    def acting(self) -> tuple[int, ...]:
+        """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
+        return (0,) if self.clock.due else ()
+
+    def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
+        """The episode's metrics (each world's own)."""
+        raise NotImplementedError
+
+    def flags(self) -> dict[str, bool]:
+        """The world's own events (none here)."""
+        return {}
+
+    def result(self, logs: Sequence[AgentLog], recorder: Any) -> EpisodeResult[Any]:
+        """The episode's result: the metrics, status and first contact, the loop's decision
+        times, ``recorder.finish()`` when recorded (the world's trajectory), the flags."""
+        (log,) = logs
+        return EpisodeResult(
+            metrics=self.metrics(log),
+            status=self.status,
+            trajectory=recorder.finish() if recorder is not None else None,
+            decision_us=log.decision_array(),
+            contact_time=self.book.contact_at,
+            flags=self.flags(),
+        )

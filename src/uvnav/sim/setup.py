@@ -8,7 +8,6 @@ and the swarm build on one definition without importing each other.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 from typing import Any, Generic, TypeVar
 
@@ -75,23 +74,6 @@ class EpisodeResult(Generic[TrajT]):
     decision_us: FloatArray
     contact_time: float | None = None
     flags: dict[str, bool] = field(default_factory=dict)
-
-
-def single_result(
-    world: Any, logs: Sequence[Any], recorder: Any, flags: dict[str, bool] | None = None
-) -> EpisodeResult[Any]:
-    """The :class:`EpisodeResult` of a one-vehicle ``world`` at its end: its metrics, status and
-    first contact (its ``book``), the loop's decision times, ``recorder.finish()`` when recorded,
-    and the world's own ``flags``."""
-    (log,) = logs
-    return EpisodeResult(
-        metrics=world.metrics(log),
-        status=world.status,
-        trajectory=recorder.finish() if recorder is not None else None,
-        decision_us=log.decision_array(),
-        contact_time=world.book.contact_at,
-        flags=flags or {},
-    )
 
 
 GROUP_METRIC_NAMES: tuple[str, ...] = (
