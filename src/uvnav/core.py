@@ -144,6 +144,17 @@ class World(Protocol[ObsT_co, CmdT]):
         """The episode is over: write back what the scene's objects should hold."""
         ...
 
+    def recorder(self) -> Any:
+        """A probe that records the run (the world's own trajectory type from its
+        ``finish()``)."""
+        ...
+
+    def result(self, logs: Sequence[AgentLog], recorder: Any) -> Any:
+        """The episode's result from the loop's logs and the recorder (``None`` unrecorded):
+        :class:`~uvnav.sim.setup.EpisodeResult` for one vehicle,
+        :class:`~uvnav.sim.setup.MultiResult` for N robots."""
+        ...
+
 
 @runtime_checkable
 class LawGroup(Protocol):

@@ -2,8 +2,9 @@
 one loop :func:`uvnav.core.run_loop` over it with the law(s) and the probes, and returns the
 world's result.
 
-Every world answers the same questions (:class:`uvnav.core.World`, plus :meth:`recorder` and
-:meth:`result` here); which world a setup builds is decided once, by its type:
+Every world answers the same questions (:class:`uvnav.core.World`: the loop's, then
+``recorder()`` and ``result(logs, recorder)``); which world a setup builds is decided once, by
+its type:
 
 ========================  ==============================================  =====================
 setup                     world                                           result
@@ -22,11 +23,11 @@ setup                     world                                           result
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any, Protocol, overload
+from typing import Any, overload
 
 import numpy as np
 
-from uvnav.core import AgentLog, Probe, run_loop
+from uvnav.core import Probe, run_loop
 from uvnav.dynamics.vehicles import vehicles_2d
 from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.sim.episode import World2D
@@ -37,21 +38,6 @@ from uvnav.sim.multi import MultiUnicycleWorld
 from uvnav.sim.packed_swarm import run_swarm, swarm_check
 from uvnav.sim.recorder import Trajectory
 from uvnav.sim.setup import EpisodeResult, EpisodeSetup, MultiResult, MultiSetup
-
-
-class RecordingWorld(Protocol):
-    """What :func:`run_episode` asks of a world besides :class:`uvnav.core.World`."""
-
-    n_agents: int
-
-    def recorder(self) -> Any:
-        """A probe that records the run (its record goes into the result)."""
-
-    def result(self, logs: Sequence[AgentLog], recorder: Any) -> Any:
-        """The episode's result from the loop's logs and the recorder (``None`` unrecorded)."""
-
-    def close(self) -> None:
-        """Write the bodies' states back to the setup's objects."""
 
 
 def _world_2d(
