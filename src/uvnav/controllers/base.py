@@ -417,7 +417,7 @@ def approach_speed(v_max: float, u_max: float, dist: float, beta: float) -> floa
     [rad] from its heading: V_max, lowered where T lies inside the minimum turning circle (radius
     V / U_max) to the largest speed whose turning circle passes through T,
     ``U_max dist / (2 sin|beta|)``, and to ``U_max dist / 2`` with T behind — so that the robot does
-    not orbit T (``zhang2019-v1``'s note 10; ``savkin-wang2013-v1``'s M1, issue 19).
+    not orbit T (``zhang2019-v1``'s note 10; ``savkin-wang2013-v1``'s M1).
 
     >>> approach_speed(1.0, 1.0, 10.0, 0.5)
     1.0

@@ -422,7 +422,7 @@ def heading_term(
     nearest T, and 1 (less 0.01 d / ``step``, so that the nearest pass wins) where that point
     is within the sample's rollout ``step`` [m] of T (it reaches T).  Evaluated past T, a
     rollout that drives onto T would face away from it and score worst, so that standing still
-    short of T scored best: the robot parked 0.13 m from T (issue 19).
+    short of T would score best and the robot would park short of T (0.13 m from it, measured).
 
     >>> t = np.array([1.0, 2.0, 3.0])
     >>> xs = np.array([[0.5, 1.0, 1.5], [0.0, 0.0, 0.0]]); z = np.zeros_like(xs)

@@ -1,5 +1,4 @@
-"""``orca-shared-v1``: a group of robots decided by ORCA together, in one compiled call (issue 20,
-item 2).
+"""``orca-shared-v1``: a group of robots decided by ORCA together, in one compiled call.
 
 References:
     J. van den Berg, S. J. Guy, M. Lin, D. Manocha, "Reciprocal n-body collision avoidance",

@@ -30,7 +30,7 @@ reconstruction in docs/thesis-notes.md):
   longer points into the widened cone — heading to the target has become safe.
 * *Pure pursuit slows near T* (:func:`~uvnav.controllers.base.approach_speed`): at V_max a
   unicycle whose target lies inside its minimum turning circle (radius V_max / U_max) circles it
-  for ever (measured: whole episodes at V_max round T, issue 19); the speed is lowered to the
+  for ever (measured: whole episodes at V_max round T); the speed is lowered to the
   largest one whose turning circle passes through T — the same rule as the thesis law's M1
   (``zhang2019-v1``, note 10), so the comparison does not turn on it.
 * ``V`` is set to ``||v_obs||`` (the smallest value allowed), which gives the largest relative

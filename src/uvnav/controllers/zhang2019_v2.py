@@ -19,8 +19,8 @@ stays unchanged for the reproduction.
   (2.15; v1's note 5), and slowing by cos(beta) while turning (v1's note 7), for the unicycle.
 * M1 (2.16): V_max toward T when nothing can reach the robot; the speed lowered near T.
 
-**What it adds, and why.**  Measured on crowds (issue 19: CrowdNav circle crossing, ETH
-recordings) v1 fails because it avoids the *one* nearest obstacle (or group) in its way, turns
+**What it adds, and why.**  Measured on crowds (CrowdNav circle crossing, ETH recordings), v1
+fails because it avoids the *one* nearest obstacle (or group) in its way, turns
 into the next stream of people, and never slows down, waits or backs off.  v2 therefore
 
 1. takes the tangent directions of *all* forecast circles of bodies that can reach the robot within

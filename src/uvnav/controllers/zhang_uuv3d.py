@@ -8,7 +8,7 @@ the BPNN gives "the position information of the specific point needs to evade"; 
 "traditional biologically inspired algorithm" of Chapter 4, §4.3: the tag, the forecast circle
 (4.11)-(4.12) and the tangent points (4.13)), on the vehicle (5.1)-(5.7).
 
-Law, at each decision (the thesis states it for the plane; lifted to 3D as the issue asks):
+Law, at each decision (the thesis states it for the plane; lifted here to 3D):
 
 1. **Locate.**  A *locator* turns the sonar readings R(t) (5.8) into ``(d, k)``: the distance [m]
    from the hull to the nearest obstacle point and the number of the sensor whose beam holds it.

@@ -1,4 +1,4 @@
-"""Gymnasium / PettingZoo environments (layer 6; issue 9).
+"""Gymnasium / PettingZoo environments (layer 6).
 
 * ``uvnav/Nav2D-v0`` (:class:`uvnav.envs.nav2d.Nav2DEnv`): one robot on a uvnav scenario.
 * ``uvnav/Nav3D-v0`` (:class:`uvnav.envs.nav3d.Nav3DEnv`): the Chapter-3 3D flying robot.

@@ -1,4 +1,4 @@
-"""A PettingZoo ``ParallelEnv`` of several robots (issue 9): every robot is an agent.
+"""A PettingZoo ``ParallelEnv`` of several robots: every robot is an agent.
 
 The world is the simulator's own :class:`uvnav.sim.multi.MultiUnicycleWorld`, stepped one
 decision at a time (:class:`uvnav.envs.core.EnvWorld`), built from a multi-robot scenario

@@ -1,4 +1,4 @@
-"""Any uvnav controller as a Gymnasium / PettingZoo policy (issue 9).
+"""Any uvnav controller as a Gymnasium / PettingZoo policy.
 
 :func:`as_policy` wraps a :class:`~uvnav.controllers.Controller` into ``policy(obs, info) ->
 action``.  The controller sees exactly what it sees in the simulator — the

@@ -22,8 +22,8 @@ Why numba and not a library BVH (python-fcl): a body has a few hundred triangles
 pass with the bounding-sphere cull is already a few microseconds, and the cost of a query from
 Python is dominated by the call itself, which a BVH does not reduce (fcl's Python binding builds a
 request/result object per query); fcl also returns no triangle index, which the exact inside/outside
-sign (angle-weighted pseudo-normals of the nearest feature) needs.  Numpy alone cannot reach the
-step rates of issue 4, because each query is a handful of array operations whose fixed overhead
+sign (angle-weighted pseudo-normals of the nearest feature) needs.  Numpy alone is much slower
+here, because each query is a handful of array operations whose fixed overhead
 (~1 µs each) dominates arrays this small.
 """
 

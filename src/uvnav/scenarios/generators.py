@@ -114,7 +114,7 @@ def random_star_polygon(
 #: defaults of :func:`random_ch2_scenario`'s envelope (the family as it always was)
 CH2_SPEED_RATIO = 0.5  # largest obstacle speed / V_max
 CH2_TURN_RATIO = 0.3 / CH2_U_MAX  # largest course turn rate / U_max (0.3 rad/s; 0.21 U_max)
-#: ``random-ch2-edge``: random-ch2 at the edge of (2.6)-(2.7) (issue 19): 8 fast, fast-turning
+#: ``random-ch2-edge``: random-ch2 at the edge of (2.6)-(2.7): 8 fast, fast-turning
 #: discs (discs: a polygon that fast and turning that fast breaks (2.8))
 CH2_EDGE: dict[str, Any] = {
     "n_obstacles": 8,

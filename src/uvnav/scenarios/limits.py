@@ -1,4 +1,4 @@
-"""Documented limits on the size of what a file or an option can ask for (issue 17).
+"""Documented limits on the size of what a file or an option can ask for.
 
 A scenario, a campaign or a terrain request that would need more than these is refused when it
 is read, with one line naming the field (or the option), the number it asks for and the limit,

@@ -1,4 +1,4 @@
-"""Multi-robot scenarios (issue 9): a pydantic schema beside the single-robot one, generators
+"""Multi-robot scenarios: a pydantic schema beside the single-robot one, generators
 and the builder for :func:`uvnav.sim.run.run_episode`.
 
 A multi-robot scenario has a list of robots (each a single-robot ``robot`` block plus an optional

@@ -6,8 +6,8 @@ checks every call against that signature (pydantic's ``validate_call``: names, t
 turns a refusal into one :class:`~uvnav.scenarios.errors.ScenarioError` line
 ``GENERATOR:SEED: params.NAME: PROBLEM``, and :func:`describe_params` reads the same signature back
 for ``uvnav scenarios show GENERATOR`` (name, type, default, range, description).  A parameter's
-default is the value the generator used before it was a parameter, so the default scenes are
-unchanged bit for bit.
+default is the family's own value, so a ``GENERATOR:SEED`` scene without ``params`` is the
+family's scene bit for bit.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """Several robots in one world: each with its own goal, law and sensing, each seeing the others
-as moving obstacles (issue 9; thesis Ch. 8's "next step": robots as a networked system, each
+as moving obstacles (thesis Ch. 8's "next step": robots as a networked system, each
 avoiding the others).
 
 Every robot is a unicycle (thesis (2.1)-(2.4)) with a disc body.  At a decision time robot i

@@ -1,7 +1,7 @@
 """The report's first screen, "which law, where": regime map heat maps and the law x family table.
 
 :func:`decision_view` reads a results store (never writes it) and returns what the report template
-shows first (issue 19):
+shows first:
 
 * two plotly heat maps over the regime grid of :mod:`uvnav.bench.regime` — success and robot-driven
   collisions, one row per law, one panel per (robot visible?, sensing) pair, one column per

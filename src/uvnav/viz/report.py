@@ -1,7 +1,7 @@
 """The HTML report of a results database (DESIGN §5–6: ``uvnav report DB`` and ``uvnav run``).
 
 :func:`write_report` renders ``out_dir/index.html`` from the Jinja2 template
-``uvnav/viz/templates/report.html``, a decision tool first and a record second (issue 19):
+``uvnav/viz/templates/report.html``, a decision tool first and a record second:
 
 * **first screen, "which law, where"** (:func:`uvnav.viz.regime.decision_view`, read from the
   store): the regime map's heat maps of success and of robot-driven collisions per law, a

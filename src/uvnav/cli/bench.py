@@ -1,0 +1,234 @@
+"""``uvnav bench CAMPAIGN``: run a campaign file into a results database, then summarise it.
+
+Thin Typer command over :mod:`uvnav.bench` (the campaign spec, the local and Ray engines, the
+store and the per-controller summary).  Each finished episode is stored at once, so an
+interrupted campaign resumes with ``--resume``; errored episodes exit with status 1.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from uvnav.cli.checks import too_many_workers
+from uvnav.cli.common import compact_table
+from uvnav.cli.common import console as _console
+from uvnav.cli.common import dumps as _dumps
+from uvnav.cli.common import fmt as _fmt
+from uvnav.cli.common import text as _text
+from uvnav.cli.errors import CliError, one_line
+
+_SUMMARY_HEADERS = {
+    "episodes": "n",
+    "errors": "err",
+    "refused": "ref.",
+    "success_rate": "success",
+    "collision_rate": "collide",
+    "min_clearance": "min\nclear.\n[m]",
+    "detour_ratio": "detour\nratio",
+    "time_ratio": "time\nratio",
+    "decision_us_median": "decide\nµs\nmedian",
+    "decision_us_p99": "decide\nµs\np99",
+}
+
+
+def _summary_cell(col: str, value: Any) -> str:
+    if value is None:
+        return "-"
+    if col.endswith("_rate"):
+        return f"{100.0 * float(value):.1f}%"
+    if col in ("min_clearance", "detour_ratio", "time_ratio"):
+        return f"{float(value):.3f}"
+    if col.startswith("decision_us"):
+        return f"{float(value):.0f}"
+    return _fmt(value)
+
+
+def bench_cmd(
+    campaign: Annotated[Path, typer.Argument(help="Campaign YAML file (scenarios × controllers).")],
+    engine: Annotated[
+        str, typer.Option(help="local (process pool) or ray (Ray tasks; extra uvnav[bench]).")
+    ] = "local",
+    workers: Annotated[
+        int | None, typer.Option(min=1, help="Worker processes / Ray CPUs (default: all CPUs).")
+    ] = None,
+    db: Annotated[Path, typer.Option(help="Results database (SQLite).")] = Path(
+        "results/bench.sqlite"
+    ),
+    resume: Annotated[
+        bool, typer.Option("--resume", help="Continue a campaign of the same name in --db.")
+    ] = False,
+    address: Annotated[
+        str | None, typer.Option(help="Ray cluster address (--engine ray; default: local Ray).")
+    ] = None,
+    retry_errors: Annotated[
+        bool, typer.Option("--retry-errors", help="With --resume: run 'error' episodes again.")
+    ] = False,
+    json_out: Annotated[
+        bool,
+        typer.Option(
+            "--json", help="Print one JSON object (the run and the summary) instead of the table."
+        ),
+    ] = False,
+    failures: Annotated[
+        bool,
+        typer.Option(
+            "--failures",
+            help="Also list every episode that did not succeed: seed and cause (who closed the "
+            "gap at a collision, or timeout / refused / error).  With --resume on a finished "
+            "campaign: only the listing.",
+        ),
+    ] = False,
+) -> None:
+    """Run a benchmark campaign into a results database, then print a per-controller summary.
+
+    Each finished episode is stored at once (one transaction), so an interrupted campaign resumes
+    with --resume and never duplicates an episode.
+    """
+    import os
+    import time
+
+    from uvnav.bench.campaign import ENGINES
+    from uvnav.bench.ray_engine import EngineUnavailableError, import_ray
+    from uvnav.bench.spec import load_campaign, run_campaign_spec
+    from uvnav.bench.store import ResultsStore, StoreInUseError
+    from uvnav.bench.summary import SUMMARY_COLUMNS, controller_summary, failure_rows
+
+    if engine not in ENGINES:
+        raise CliError(f"--engine {engine!r}: expected one of {', '.join(ENGINES)}")
+    if address is not None and engine != "ray":
+        raise CliError("--address needs --engine ray")
+    spec = load_campaign(campaign)
+    if engine == "ray":
+        try:
+            import_ray()  # before the database is created
+        except EngineUnavailableError as exc:
+            raise CliError(str(exc), code=1) from None
+    n_workers = workers or os.cpu_count() or 1
+    too_many = too_many_workers(n_workers) if engine == "local" else None  # Ray: a cluster's
+    if too_many is not None:
+        raise CliError(f"--workers: {too_many} for --engine local")
+    with ResultsStore(db) as store:
+        if resume:
+            before = next((c for c in store.campaigns() if c["name"] == spec.name), None)
+            if before is not None and before["config"] != spec.config():
+                typer.echo(
+                    f"warning: {campaign} changed since campaign {spec.name!r} was created; "
+                    "stored episodes are kept, new keys are run",
+                    err=True,
+                )
+        tic = time.perf_counter()
+        try:
+            result = run_campaign_spec(
+                store,
+                spec,
+                resume=resume,
+                engine=engine,
+                workers=n_workers,
+                address=address,
+                progress=not json_out,
+                retry_errors=retry_errors,
+            )
+        except EngineUnavailableError as exc:
+            raise CliError(str(exc), code=1) from None
+        except StoreInUseError as exc:
+            raise CliError(str(exc)) from None
+        except KeyboardInterrupt:
+            typer.echo(
+                f"interrupted: {store.count(spec.name)} episode(s) of {spec.name!r} are stored in "
+                f"{db}; run again with --resume to finish",
+                err=True,
+            )
+            raise typer.Exit(130) from None
+        elapsed = time.perf_counter() - tic
+        rows = controller_summary(store, spec.name)
+        failed = failure_rows(store, spec.name) if failures else []
+        first_error = _first_error(store, spec.name) if result.errors else None
+    rate = result.ran / elapsed if result.ran and elapsed > 0 else None
+    if json_out:
+        record = {
+            "campaign": spec.name,
+            "db": str(db),
+            "engine": engine,
+            "workers": n_workers,
+            "total": result.total,
+            "ran": result.ran,
+            "skipped": result.skipped,
+            "errors": result.errors,
+            "wall_time": elapsed,
+            "episodes_per_s": rate,
+            "controllers": rows,
+            "first_error": first_error,
+        }
+        if failures:
+            record["failures"] = failed
+        typer.echo(_dumps(record))
+        _fail_on_errors(result.errors, first_error)
+        return
+    table = compact_table(f"campaign {spec.name} ({result.total} episodes)")
+    numeric = [c for c in SUMMARY_COLUMNS if c in _SUMMARY_HEADERS]
+    table.add_column("controller\nparams", overflow="fold", ratio=1, min_width=12)
+    cells = [[_summary_cell(col, row[col]) for col in numeric] for row in rows]
+    for i, col in enumerate(numeric):
+        widest = max(len(r[i]) for r in cells) if cells else 1
+        head = _SUMMARY_HEADERS[col]
+        width = max(widest, *(len(w) for w in head.split("\n")))
+        table.add_column(head, justify="right", no_wrap=True, min_width=width)
+    for row, r in zip(rows, cells, strict=True):
+        label = (
+            row["controller"] if row["params"] == "-" else f"{row['controller']}\n{row['params']}"
+        )
+        table.add_row(_text(label), *(_text(c) for c in r))
+    _console().print(table)
+    if failures:
+        _print_failures(failed, spec.beyond_assumptions)
+    speed = f", {rate:.2f} episodes/s" if rate is not None else ""
+    typer.echo(
+        f"ran {result.ran} episode(s) ({result.errors} error(s)), skipped {result.skipped} already "
+        f"stored, in {elapsed:.1f} s{speed} on {engine} × {n_workers}; results in {db}"
+    )
+    _fail_on_errors(result.errors, first_error)
+
+
+def _print_failures(rows: list[dict[str, Any]], beyond: bool) -> None:
+    """The episodes that did not succeed, one line each (``uvnav bench --failures``); the
+    scenario as ``uvnav simulate`` takes it, so that a row reruns as it is (with
+    ``--beyond-assumptions`` when the campaign ran ``beyond``)."""
+    from uvnav.bench.summary import simulate_spec
+
+    flag = " --beyond-assumptions" if beyond else ""
+    table = compact_table(
+        f"{len(rows)} episode(s) did not succeed",
+        caption=f"rerun one: uvnav simulate SCENARIO -c CONTROLLER --seed SEED{flag} "
+        "(its params as -p)",
+    )
+    for head in ("controller", "scenario", "seed"):
+        table.add_column(head, overflow="fold")
+    table.add_column("cause", overflow="fold", ratio=1)
+    table.add_column("clearance\n[m]", justify="right", no_wrap=True)
+    for r in rows:
+        law = r["controller"] if r["params"] == "-" else f"{r['controller']} {r['params']}"
+        gap = "-" if r["min_clearance"] is None else f"{r['min_clearance']:.3f}"
+        scene = simulate_spec(r["scenario"])
+        table.add_row(*(_text(x) for x in (law, scene, str(r["seed"]), r["cause"], gap)))
+    _console().print(table)
+
+
+def _first_error(store: Any, campaign: str) -> str | None:
+    """The message of the first stored ``error`` episode of ``campaign``, with its job."""
+    frame = store.episodes_frame(campaign)
+    bad = frame[frame["status"] == "error"]
+    if bad.empty:
+        return None
+    row = bad.iloc[0]
+    message = one_line(str(row["error"]))
+    return f"{row['scenario']} | {row['controller']} | seed {row['seed']}: {message}"
+
+
+def _fail_on_errors(errors: int, first: str | None) -> None:
+    """Exit status 1 when episodes errored (their rows are kept, as ``error``)."""
+    if errors:
+        typer.echo(f"error: {errors} episode(s) errored; the first: {first}", err=True)
+        raise typer.Exit(1)

@@ -1,0 +1,172 @@
+"""``uvnav controllers``: list the registered navigation laws and show one's parameters.
+
+Thin Typer commands over :mod:`uvnav.controllers`; an unknown law or vehicle is a one-line
+``error:`` and exit status 2 (the CLI's one error path, :mod:`uvnav.cli.errors`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import re
+from typing import Annotated, Any
+
+import typer
+
+from uvnav.cli.common import console as _console
+from uvnav.cli.common import dumps as _dumps
+from uvnav.cli.common import fmt as _fmt
+from uvnav.cli.common import text as _text
+from uvnav.cli.errors import CliError, uvnav_typer
+from uvnav.controllers import ControllerInfo, available_controllers, controller_info
+from uvnav.dynamics.vehicles import vehicle_names
+
+controllers_app = uvnav_typer(help="Registered navigation laws.")
+
+
+def attribute_docs(cls: type) -> dict[str, str]:
+    """Field descriptions from the ``Attributes:`` section of a Google-style class docstring."""
+    doc = inspect.getdoc(cls) or ""
+    out: dict[str, str] = {}
+    in_section = False
+    indent: int | None = None
+    current: str | None = None
+    for line in doc.splitlines():
+        stripped = line.strip()
+        if stripped in ("Attributes:", "Args:", "Parameters:"):
+            in_section, indent, current = True, None, None
+            continue
+        if not in_section:
+            continue
+        if not stripped:
+            current = None
+            continue
+        level = len(line) - len(line.lstrip())
+        if level == 0:
+            in_section = False
+            continue
+        match = re.match(r"^(\w+)(?:\s*\([^)]*\))?:\s*(.*)$", stripped)
+        if match and (indent is None or level == indent):
+            indent = level
+            current = match.group(1)
+            out[current] = match.group(2)
+        elif current is not None:
+            out[current] = f"{out[current]} {stripped}".strip()
+    return out
+
+
+def _param_rows(info: ControllerInfo) -> list[dict[str, Any]]:
+    ptype = info.params_type
+    if ptype is None or not dataclasses.is_dataclass(ptype):
+        return []
+    docs = attribute_docs(ptype)
+    rows = []
+    for f in dataclasses.fields(ptype):
+        if f.default is not dataclasses.MISSING:
+            default: Any = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            default = f.default_factory()
+        else:
+            default = None
+        type_name = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
+        rows.append(
+            {"name": f.name, "type": type_name, "default": default, "doc": docs.get(f.name, "")}
+        )
+    return rows
+
+
+@controllers_app.command("list")
+def controllers_list(
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print one JSON array instead of the table.")
+    ] = False,
+    vehicle: Annotated[
+        str | None,
+        typer.Option(
+            "--vehicle",
+            help="Only one vehicle's laws: unicycle (Ch. 2), vehicle3d (Ch. 3/5), uuv2d (Ch. 4).",
+        ),
+    ] = None,
+) -> None:
+    """List the registered controllers of every vehicle (or of one)."""
+    if vehicle is not None and vehicle not in vehicle_names():
+        known = ", ".join(vehicle_names())
+        raise CliError(f"--vehicle: unknown vehicle {vehicle!r}; known: {known}")
+    infos = available_controllers(vehicle)
+    rows = [
+        {
+            "name": name,
+            "vehicle": info.vehicle,
+            "sensing": info.sensing,
+            "summary": info.summary,
+            "reference": info.reference,
+            "requires_slower_obstacles": info.requires_slower_obstacles,
+        }
+        for name, info in infos.items()
+    ]
+    if json_out:
+        typer.echo(_dumps(rows))
+        return
+    from rich.table import Table
+
+    table = Table(title="controllers")
+    table.add_column("name", no_wrap=True)
+    table.add_column("vehicle", no_wrap=True)
+    table.add_column("sensing", no_wrap=True)
+    table.add_column("summary")
+    table.add_column("slower obstacles")
+    for row in rows:
+        table.add_row(
+            _text(row["name"]),
+            _text(row["vehicle"]),
+            _text(row["sensing"]),
+            _text(row["summary"]),
+            "required" if row["requires_slower_obstacles"] else "",
+        )
+    _console().print(table)
+
+
+@controllers_app.command("show")
+def controllers_show(
+    name: Annotated[str, typer.Argument(help="Registered controller name, e.g. zhang2019-v1.")],
+    json_out: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object instead of the table.")
+    ] = False,
+) -> None:
+    """Show a controller: summary, reference and parameters with defaults and units."""
+    info = controller_info(name)
+    rows = _param_rows(info)
+    if json_out:
+        typer.echo(
+            _dumps(
+                {
+                    "name": info.name,
+                    "summary": info.summary,
+                    "reference": info.reference,
+                    "requires_slower_obstacles": info.requires_slower_obstacles,
+                    "params": rows,
+                }
+            )
+        )
+        return
+    from rich.table import Table
+
+    con = _console()
+    con.print(_text(f"{info.name}: {info.summary}"))
+    if info.reference:
+        con.print(_text(f"reference: {info.reference}"))
+    if info.requires_slower_obstacles:
+        con.print(_text("requires obstacles slower than the robot (thesis (2.6))"))
+    if not rows:
+        con.print(_text("no parameters"))
+        return
+    table = Table(title="parameters")
+    table.add_column("name", no_wrap=True)
+    table.add_column("type")
+    table.add_column("default", justify="right")
+    table.add_column("description")
+    for row in rows:
+        table.add_row(
+            _text(row["name"]), _text(row["type"]), _text(_fmt(row["default"])), _text(row["doc"])
+        )
+    con.print(table)
