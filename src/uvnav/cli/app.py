@@ -38,7 +38,9 @@ from uvnav.cli.errors import (
     one_line,
     uvnav_typer,
 )
+from uvnav.cli.mcap import close_episode, open_episode
 from uvnav.cli.recon import recon_app
+from uvnav.cli.replay import replay_cmd
 from uvnav.cli.reproduce import forget_cmd, reproduce_cmd, run_cmd
 from uvnav.cli.sonar import sonar_app
 from uvnav.controllers import (
@@ -238,6 +240,13 @@ def simulate(
             "deliberate experiment, as a campaign's beyond_assumptions: true).",
         ),
     ] = False,
+    mcap: Annotated[
+        Path | None,
+        typer.Option(
+            help="Also write the episode into this MCAP file, as ROS 2 messages (Foxglove, "
+            "ros2 bag); 2D scenes; needs the 'ros' extra."
+        ),
+    ] = None,
 ) -> None:
     """Run one episode of SCENARIO (any vehicle) and print its metrics.
 
@@ -256,14 +265,24 @@ def simulate(
     )
     if plot is not None:
         _check_image_path(plot)
-    out = run_scene(
-        resolved,
-        controller,
-        parse_params(param),
-        seed,
-        record=plot is not None,
-        beyond_assumptions=beyond_assumptions,
-    )
+    params = parse_params(param)
+    episode = open_episode(mcap, resolved, controller, seed) if mcap is not None else None
+    try:
+        out = run_scene(
+            resolved,
+            controller,
+            params,
+            seed,
+            record=plot is not None,
+            beyond_assumptions=beyond_assumptions,
+            probes=[episode] if episode is not None else (),
+        )
+    except BaseException:
+        if episode is not None:
+            close_episode(episode, ok=False)
+        raise
+    if episode is not None:
+        close_episode(episode, ok=True)
     note = limits_note(resolved, out.law)
     if note is not None:
         typer.echo(note, err=True)
@@ -288,6 +307,8 @@ def simulate(
         typer.echo(_dumps(record))
         if plot is not None:
             typer.echo(f"wrote {plot}", err=True)
+        if mcap is not None:
+            typer.echo(f"wrote {mcap}", err=True)
         return
     from rich.table import Table
 
@@ -316,6 +337,8 @@ def simulate(
             )
     if plot is not None:
         typer.echo(f"wrote {plot}")
+    if mcap is not None:
+        typer.echo(f"wrote {mcap}")
 
 
 # --------------------------------------------------------------------------------------- scenarios
@@ -953,3 +976,4 @@ def main() -> None:
 
 app.command("reproduce")(reproduce_cmd)
 app.command("forget")(forget_cmd)
+app.command("replay")(replay_cmd)

@@ -7,15 +7,19 @@ it imports no command module, so the command modules never import each other for
 from __future__ import annotations
 
 import importlib
+import re
 import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
+import yaml
 
 from uvnav.cli.checks import dumps as strict_dumps
 from uvnav.cli.checks import json_safe
 from uvnav.cli.errors import CliError
+from uvnav.scenarios.loader import yaml_value
+from uvnav.validation import clip
 
 
 def console(stderr: bool = False) -> Any:
@@ -78,3 +82,31 @@ def compact_table(title: str, caption: str | None = None) -> Any:
 
     return Table(title=title, caption=caption, box=box.SIMPLE_HEAD, pad_edge=False,
                  collapse_padding=True)  # fmt: skip
+
+
+_PARAM_KEY = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+
+
+def parse_params(items: list[str] | None, option: str = "--param") -> dict[str, Any]:
+    """``["alpha0=0.1", "mode=fast"]`` -> ``{"alpha0": 0.1, "mode": "fast"}`` (values read as YAML).
+
+    Raises:
+        CliError: an item is not ``KEY=VALUE`` with an identifier key, or its value is not YAML.
+    """
+    params: dict[str, Any] = {}
+    for item in items or []:
+        key, sep, raw = item.partition("=")
+        key = key.strip()
+        shown = repr(clip(item, 60))
+        if not sep or not _PARAM_KEY.match(key):
+            raise CliError(
+                f"{option} {shown}: expected KEY=VALUE with an identifier KEY (e.g. alpha0=0.1)"
+            )
+        try:
+            value = yaml_value(raw) if raw.strip() else ""
+        except yaml.YAMLError as exc:
+            marked = isinstance(exc, yaml.MarkedYAMLError)
+            why = "not a valid YAML scalar or list" if marked else exc
+            raise CliError(f"{option} {shown}: value is {why}") from None
+        params[key] = value
+    return params
