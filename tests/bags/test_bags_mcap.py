@@ -49,7 +49,7 @@ def _read(path: Path) -> tuple[Any, dict[str, list[tuple[int, Any]]]]:
     """The file's summary and its decoded messages by topic, ``(log_time, message)``."""
     by_topic: dict[str, list[tuple[int, Any]]] = defaultdict(list)
     with path.open("rb") as fh:
-        reader = make_reader(fh, decoder_factories=[DecoderFactory()])
+        reader = make_reader(fh, validate_crcs=True, decoder_factories=[DecoderFactory()])
         header = reader.get_header()
         summary = reader.get_summary()
         for _, channel, message, decoded in reader.iter_decoded_messages(log_time_order=False):
