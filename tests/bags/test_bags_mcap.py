@@ -171,3 +171,26 @@ def test_multi_robot_episode_has_topics_per_robot(tmp_path: Path) -> None:
         np.testing.assert_array_equal(got, poses[i][:, :2])
     robots = [mk for mk in msgs["/bodies"][-1][1].markers if mk.ns == "robots"]
     assert [mk.id for mk in robots] == [0, 1, 2]
+
+
+@pytest.mark.parametrize("heading", [0.0, 0.785, -0.5, 3.0, -3.1])
+def test_scan_angles_are_relative_to_the_heading(heading: float) -> None:
+    from uvnav.bags.messages import laser_scan, scan_of
+    from uvnav.obstacles.bodies import DiscBody
+    from uvnav.obstacles.obstacle import FieldTemplate
+    from uvnav.sensors.exact import lidar_scan
+
+    field = FieldTemplate.from_bodies([DiscBody(0.5)]).field(
+        np.array([[2.0, 1.0]]), np.zeros(1), np.zeros((1, 2)), np.zeros(1)
+    )
+    for fov in (2 * math.pi, 1.5):
+        scan = lidar_scan(np.array((0.0, 0.0, heading)), field, n_rays=72, fov=fov)
+        msg = laser_scan(scan, heading, 0.0, "base_link")
+        assert -math.pi <= msg["angle_min"] < math.pi
+        if fov < math.pi:
+            assert msg["angle_min"] == pytest.approx(-0.75)
+        decoded = type("Scan", (), {**msg, "ranges": np.float32(msg["ranges"])})
+        back = scan_of(decoded, heading)
+        diff = np.angle(np.exp(1j * (back.angles - scan.angles)))
+        np.testing.assert_allclose(diff, 0.0, atol=1e-6)
+        np.testing.assert_allclose(back.ranges, scan.ranges, atol=1e-6)

@@ -141,11 +141,14 @@ def command_twist(cmd: Any, yaw: float) -> dict[str, Any]:
 def laser_scan(scan: LidarScan, heading: float, t: float, frame: str) -> dict[str, Any]:
     """``sensor_msgs/LaserScan`` of ``scan`` (world-frame beam angles) taken at heading
     ``heading`` [rad] at time ``t`` [s]: angles relative to the body frame ``frame``, evenly
-    spaced from the first beam; a beam that saw nothing reads ``range_max``, a dropped one NaN
-    (both invalid to a ROS reader, as ``range_max`` is exclusive there)."""
+    spaced from the first beam (``angle_min`` in [-pi, pi)); a beam that saw nothing reads
+    ``range_max``, a dropped one NaN (both invalid to a ROS reader, as ``range_max`` is
+    exclusive there)."""
     angles = np.asarray(scan.angles, dtype=float)
     n = len(angles)
-    first = wrap_scalar(float(angles[0]) - heading) if n else 0.0
+    first = math.remainder(float(angles[0]) - heading, 2.0 * math.pi) if n else 0.0
+    if first >= math.pi - 1e-9:  # in [-pi, pi): a full turn runs from -pi
+        first -= 2.0 * math.pi
     step = math.remainder(float(angles[1] - angles[0]), 2.0 * math.pi) if n > 1 else 0.0
     return {
         "header": header(t, frame),
