@@ -20,7 +20,7 @@ PYPROJECT = ROOT / "pyproject.toml"
 #: DESIGN §1, top (may import everything below) to bottom.
 DESIGN_LAYERS = [
     {"uvnav.cli"},
-    {"uvnav.viz"},
+    {"uvnav.viz", "uvnav.bags"},  # figures; episodes and recordings in ROS 2 formats (files)
     {"uvnav.experiments"},  # the registered reproductions, over bench; renderers injected
     {"uvnav.learning", "uvnav.driving", "uvnav.bench", "uvnav.envs"},
     {"uvnav.scenarios"},

@@ -39,7 +39,9 @@ from uvnav.cli.common import text as _text
 from uvnav.cli.controllers import controllers_app
 from uvnav.cli.drive import drive_app
 from uvnav.cli.errors import DEBUG_KEY, CliError, uvnav_typer
+from uvnav.cli.mcap import close_episode, open_episode
 from uvnav.cli.recon import recon_app
+from uvnav.cli.replay import replay_cmd
 from uvnav.cli.report import report_cmd
 from uvnav.cli.reproduce import forget_cmd, reproduce_cmd, run_cmd
 from uvnav.cli.scenarios import scenarios_app
@@ -151,6 +153,13 @@ def simulate(
             "deliberate experiment, as a campaign's beyond_assumptions: true).",
         ),
     ] = False,
+    mcap: Annotated[
+        Path | None,
+        typer.Option(
+            help="Also write the episode into this MCAP file, as ROS 2 messages (Foxglove, "
+            "ros2 bag); 2D scenes; needs the 'ros' extra."
+        ),
+    ] = None,
 ) -> None:
     """Run one episode of SCENARIO (any vehicle) and print its metrics.
 
@@ -169,14 +178,24 @@ def simulate(
     )
     if plot is not None:
         _check_image_path(plot)
-    out = run_scene(
-        resolved,
-        controller,
-        parse_params(param),
-        seed,
-        record=plot is not None,
-        beyond_assumptions=beyond_assumptions,
-    )
+    params = parse_params(param)
+    episode = open_episode(mcap, resolved, controller, seed) if mcap is not None else None
+    try:
+        out = run_scene(
+            resolved,
+            controller,
+            params,
+            seed,
+            record=plot is not None,
+            beyond_assumptions=beyond_assumptions,
+            probes=[episode] if episode is not None else (),
+        )
+    except BaseException:
+        if episode is not None:
+            close_episode(episode, ok=False)
+        raise
+    if episode is not None:
+        close_episode(episode, ok=True)
     note = limits_note(resolved, out.law)
     if note is not None:
         typer.echo(note, err=True)
@@ -201,6 +220,8 @@ def simulate(
         typer.echo(_dumps(record))
         if plot is not None:
             typer.echo(f"wrote {plot}", err=True)
+        if mcap is not None:
+            typer.echo(f"wrote {mcap}", err=True)
         return
     from rich.table import Table
 
@@ -229,6 +250,8 @@ def simulate(
             )
     if plot is not None:
         typer.echo(f"wrote {plot}")
+    if mcap is not None:
+        typer.echo(f"wrote {mcap}")
 
 
 def _check_image_path(path: Path) -> None:
@@ -260,3 +283,4 @@ app.command("report")(report_cmd)
 app.command("bench")(bench_cmd)
 app.command("reproduce")(reproduce_cmd)
 app.command("forget")(forget_cmd)
+app.command("replay")(replay_cmd)

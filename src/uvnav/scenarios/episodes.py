@@ -10,6 +10,7 @@ refused on a 2D scene that breaks it (:func:`uvnav.scenarios.validate_for_contro
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -156,11 +157,13 @@ def run_scene(
     record: bool = False,
     use_scene_params: bool = True,
     beyond_assumptions: bool = False,
+    probes: Sequence[Any] = (),
 ) -> Outcome:
     """Run one episode of ``resolved`` with ``law`` (default: the scene's own, with its
     parameters unless ``use_scene_params`` is false; ``params`` override them, and are the only
     ones for another law).  ``beyond_assumptions`` runs a law on a scene that breaks an
-    assumption it declares (a deliberate experiment; never the default).
+    assumption it declares (a deliberate experiment; never the default).  ``probes``
+    (:class:`uvnav.core.Probe`) watch the run.
 
     Raises:
         UnknownControllerError, ControllerParamsError, LawMismatchError, AssumptionError: as
@@ -174,7 +177,7 @@ def run_scene(
     s = episode_seed(resolved, seed)
     runner = _RUNNERS[resolved.kind.name]
     try:
-        return runner(resolved, name, merged, s, record)
+        return runner(resolved, name, merged, s, record, probes)
     except ControllerParamsError as exc:
         if str(exc).startswith(f"controller {name}"):
             raise
@@ -216,7 +219,12 @@ def _setup(r: Resolved, seed: int) -> Any:
 
 
 def _one_vehicle(
-    r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool
+    r: Resolved,
+    name: str,
+    params: dict[str, Any],
+    seed: int,
+    record: bool,
+    probes: Sequence[Any] = (),
 ) -> Outcome:
     """One episode of a single-vehicle kind; the world's flags go into ``extra``."""
     from uvnav.sim.run import run_episode
@@ -227,7 +235,7 @@ def _one_vehicle(
     options: dict[str, Any] = {}
     if r.kind.name == "nav2d":
         options["vehicle"] = controller_info(name).vehicle
-    res = run_episode(setup, law, r.kind.episode_rng(seed), record=record, **options)
+    res = run_episode(setup, law, r.kind.episode_rng(seed), record=record, probes=probes, **options)
     out = _single(r, name, params, seed, res, setup=setup, trajectory=res.trajectory)
     out.extra.update(res.flags)
     if r.kind.name == "uuv3d":
@@ -240,7 +248,14 @@ def _mean(values: list[Any]) -> float | None:
     return sum(nums) / len(nums) if nums else None
 
 
-def _multi(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bool) -> Outcome:
+def _multi(
+    r: Resolved,
+    name: str,
+    params: dict[str, Any],
+    seed: int,
+    record: bool,
+    probes: Sequence[Any] = (),
+) -> Outcome:
     from uvnav.scenarios.multi import build_multi
     from uvnav.sim.run import run_episode
 
@@ -249,7 +264,7 @@ def _multi(r: Resolved, name: str, params: dict[str, Any], seed: int, record: bo
         setup = build_multi(r.scenario, seed)
     else:
         setup = build_multi(r.scenario, seed, controller=name, params=params)
-    res = run_episode(setup, None, r.kind.episode_rng(seed), record=record)
+    res = run_episode(setup, None, r.kind.episode_rng(seed), record=record, probes=probes)
     robots = [m.to_dict() for m in res.robots]
     g = res.group
     status = (
