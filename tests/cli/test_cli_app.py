@@ -338,6 +338,29 @@ def test_controllers_list_shows_every_vehicle_and_filters_by_one() -> None:
     assert bad.stderr.strip().startswith("error: --vehicle: unknown vehicle 'boat'")
 
 
+def test_controllers_list_fits_an_80_column_terminal(monkeypatch: pytest.MonkeyPatch) -> None:
+    from rich.console import Console
+
+    import uvnav.cli.controllers as cc
+
+    monkeypatch.setattr(cc, "_console", lambda: Console(width=80, highlight=False))
+    out = invoke("controllers", "list").stdout.splitlines()
+    listed = json.loads(invoke("controllers", "list", "--json").stdout)
+    assert max(len(line) for line in out) <= 80
+    assert len(out) < 4 * len(listed) + 5  # a name line and a few summary lines per law
+    named = {line.split()[0] for line in out if line and not line.startswith(" ")}
+    assert {row["name"] for row in listed} <= named
+    v1 = next(line for line in out if line.startswith("zhang2019-v1 "))
+    assert v1.endswith("*") and out[-1].startswith("* requires obstacles slower")
+
+
+def test_controllers_show_reads_without_python_types_or_markup() -> None:
+    shown = json.loads(invoke("controllers", "show", "zhang2019-v1", "--json").stdout)
+    by_name = {p["name"]: p for p in shown["params"]}
+    assert by_name["tangent_rule"]["type"] == "side | min_beta"
+    assert "``" not in by_name["tangent_rule"]["doc"] and '"side"' in by_name["tangent_rule"]["doc"]
+
+
 # ------------------------------------------------------------------------------- run / report
 
 

@@ -70,9 +70,37 @@ def _param_rows(info: ControllerInfo) -> list[dict[str, Any]]:
             default = None
         type_name = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
         rows.append(
-            {"name": f.name, "type": type_name, "default": default, "doc": docs.get(f.name, "")}
+            {
+                "name": f.name,
+                "type": plain_type(type_name),
+                "default": default,
+                "doc": plain_doc(docs.get(f.name, "")),
+            }
         )
     return rows
+
+
+def plain_type(annotation: str) -> str:
+    """A parameter's type as a user reads it: ``Literal['a', 'b']`` is ``a | b``.
+
+    >>> plain_type("Literal['side', 'min_beta']"), plain_type("float | None")
+    ('side | min_beta', 'float | None')
+    """
+    m = re.fullmatch(r"Literal\[(.*)\]", annotation.strip())
+    if m is None:
+        return annotation
+    return " | ".join(v.strip().strip("'\"") for v in m.group(1).split(","))
+
+
+def plain_doc(doc: str) -> str:
+    """A docstring line without reStructuredText markup: ````x```` and :role:`~a.b.x` read
+    ``x``.
+
+    >>> plain_doc('``"side"`` (see :func:`~uvnav.geometry.tangents.tangent_points`)')
+    '"side" (see tangent_points)'
+    """
+    doc = re.sub(r":\w+:`~?(?:[\w.]*\.)?([^`]+)`", r"\1", doc)
+    return doc.replace("``", "")
 
 
 @controllers_app.command("list")
@@ -107,6 +135,11 @@ def controllers_list(
     if json_out:
         typer.echo(_dumps(rows))
         return
+    con = _console()
+    if con.width < WIDE:
+        for line in compact_lines(rows, con.width):
+            con.print(_text(line), soft_wrap=True)
+        return
     from rich.table import Table
 
     table = Table(title="controllers")
@@ -123,7 +156,28 @@ def controllers_list(
             _text(row["summary"]),
             "required" if row["requires_slower_obstacles"] else "",
         )
-    _console().print(table)
+    con.print(table)
+
+
+#: a terminal at least this wide [columns] gets the table; a narrower one the compact listing
+WIDE = 120
+
+
+def compact_lines(rows: list[dict[str, Any]], width: int) -> list[str]:
+    """``controllers list`` for a narrow terminal: per law one line of name, vehicle and
+    sensing (``*``: requires obstacles slower than the robot), its summary wrapped below it,
+    indented, every line at most ``width`` characters."""
+    import textwrap
+
+    w = max([len(r["name"]) for r in rows] or [4]) + 2
+    lines = [f"{'name':<{w}}{'vehicle':<11}sensing", ""]
+    for r in rows:
+        star = "  *" if r["requires_slower_obstacles"] else ""
+        lines.append(f"{r['name']:<{w}}{r['vehicle']:<11}{r['sensing']}{star}"[:width])
+        lines += textwrap.wrap(str(r["summary"]), width=max(width, 40) - 4,
+                               initial_indent="    ", subsequent_indent="    ")  # fmt: skip
+    lines += ["", "* requires obstacles slower than the robot (thesis (2.6))"]
+    return lines
 
 
 @controllers_app.command("show")
