@@ -82,6 +82,7 @@ app.add_typer(controllers_app, name="controllers")
 app.add_typer(recon_app, name="recon")
 app.add_typer(drive_app, name="drive")
 app.add_typer(sonar_app, name="sonar")
+app.add_typer(__import__("uvnav.cli.ros2", fromlist=["ros2_app"]).ros2_app, name="ros2")
 
 
 def _version(value: bool) -> None:

@@ -1,0 +1,154 @@
+"""A law's parameters as ROS 2 parameters: name, ROS 2 type, default and description, and a
+parameter file in the layout ``ros2 param dump`` writes (``NODE: {ros__parameters: {...}}``).
+
+The names, defaults and descriptions come from the law's registry entry (its ``Params``
+dataclass and the ``Attributes:`` section of that class's docstring); the type is the ROS 2
+parameter type of the field's Python type, named as ``ros2 param describe`` names them
+(``boolean``, ``integer``, ``double``, ``string`` and their ``array`` forms); a field of any
+other type (a nested law's parameters, polygons) is a ``string`` read as YAML.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import inspect
+import re
+import types
+import typing
+from dataclasses import dataclass
+from typing import Any
+
+from uvnav.controllers.base import controller_info
+
+_SCALARS: dict[Any, str] = {bool: "boolean", int: "integer", float: "double", str: "string"}
+_ENTRY = re.compile(r"^(\w+)(?:\s*\([^)]*\))?:\s*(.*)$")
+
+
+@dataclass(frozen=True)
+class ParamDescriptor:
+    """One parameter as ``ros2 param describe`` shows it, with its default."""
+
+    name: str
+    type: str
+    default: Any
+    description: str
+
+
+def ros_type(hint: Any) -> str:
+    """The ROS 2 parameter type of a Python type hint.
+
+    >>> ros_type(float), ros_type(tuple[float, ...]), ros_type(typing.Literal["a", "b"])
+    ('double', 'double array', 'string')
+    """
+    if hint in _SCALARS:
+        return _SCALARS[hint]
+    origin, args = typing.get_origin(hint), typing.get_args(hint)
+    if origin is typing.Literal and args:
+        return _SCALARS.get(type(args[0]), "string")
+    if origin in (tuple, list) and args and args[0] in _SCALARS:
+        return f"{_SCALARS[args[0]]} array"
+    if origin in (typing.Union, types.UnionType):
+        kinds = {ros_type(a) for a in args if a is not type(None)}
+        if len(kinds) == 1:
+            return kinds.pop()
+    return "string"
+
+
+def field_docs(cls: type) -> dict[str, str]:
+    """Each field's description from the ``Attributes:`` section of ``cls``'s docstring."""
+    out: dict[str, str] = {}
+    indent: int | None = None
+    current: str | None = None
+    in_section = False
+    for line in (inspect.getdoc(cls) or "").splitlines():
+        stripped = line.strip()
+        level = len(line) - len(line.lstrip())
+        if stripped == "Attributes:":
+            in_section, indent, current = True, None, None
+            continue
+        if not in_section:
+            continue
+        if not stripped:
+            current = None
+            continue
+        if level == 0:
+            in_section = False
+            continue
+        match = _ENTRY.match(stripped)
+        if match and indent in (None, level):
+            indent, current = level, match.group(1)
+            out[current] = match.group(2)
+        elif current is not None:
+            out[current] = f"{out[current]} {stripped}"
+    return out
+
+
+def describe(law: str) -> list[ParamDescriptor]:
+    """The parameters of the registered law ``law``, in their declaration order.
+
+    Raises:
+        UnknownControllerError: ``law`` is not registered.
+    """
+    ptype = controller_info(law).params_type
+    if ptype is None or not dataclasses.is_dataclass(ptype):
+        return []
+    hints = typing.get_type_hints(ptype)
+    docs = field_docs(ptype)
+    out = []
+    for f in dataclasses.fields(ptype):
+        if f.default is not dataclasses.MISSING:
+            default: Any = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            default = f.default_factory()
+        else:
+            default = None
+        out.append(ParamDescriptor(f.name, ros_type(hints[f.name]), default, docs.get(f.name, "")))
+    return out
+
+
+def law_arguments(law: str, values: dict[str, Any]) -> dict[str, Any]:
+    """``values`` as the law's parameter dataclass takes them: a list (a ROS 2 array, a YAML
+    sequence) given for a tuple field becomes a tuple; everything else is left as it is.
+
+    Raises:
+        UnknownControllerError: ``law`` is not registered.
+    """
+    ptype = controller_info(law).params_type
+    if ptype is None or not dataclasses.is_dataclass(ptype):
+        return dict(values)
+    hints = typing.get_type_hints(ptype)
+    return {
+        k: tuple(v) if isinstance(v, list) and typing.get_origin(hints.get(k)) is tuple else v
+        for k, v in values.items()
+    }
+
+
+def parameter_file(node: str, params: list[ParamDescriptor]) -> dict[str, Any]:
+    """The defaults as a ROS 2 parameter file's mapping (``ros2 param dump``'s layout)."""
+    return {node: {"ros__parameters": {p.name: plain(p.default) for p in params}}}
+
+
+def file_parameters(data: Any) -> dict[str, Any]:
+    """The parameters of a ROS 2 parameter file's mapping (every node's, in file order).
+
+    Raises:
+        ValueError: the mapping is not ``NODE: {ros__parameters: {NAME: VALUE, ...}}``.
+    """
+    if not isinstance(data, dict) or not data:
+        raise ValueError("expected a mapping NODE: {ros__parameters: {...}}")
+    out: dict[str, Any] = {}
+    for node, body in data.items():
+        params = body.get("ros__parameters") if isinstance(body, dict) else None
+        if not isinstance(params, dict):
+            raise ValueError(f"{node}: expected a mapping with a 'ros__parameters' mapping")
+        out.update({str(k): v for k, v in params.items()})
+    return out
+
+
+def plain(value: Any) -> Any:
+    """A default as YAML writes it (tuples as lists, dataclasses as mappings)."""
+    if isinstance(value, tuple | list):
+        return [plain(v) for v in value]
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {k: plain(v) for k, v in dataclasses.asdict(value).items()}
+    return value
