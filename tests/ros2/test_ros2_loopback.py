@@ -1,10 +1,11 @@
 """The ROS 2 node over DDS on the loopback interface: ``uvnav ros2 run`` in its own process, and
 in this one a small simulator that speaks ROS 2's wire format (Cyclone DDS, the ROS 2 type and
-topic names): a holonomic robot among moving discs, its scans (uvnav's exact lidar) and odometry
-published, a goal published, the robot moved by the ``Twist`` commands it receives.  The robot
-must reach the goal without touching a disc, although the discs cross the straight path (a robot
-driving straight would hit them), and the node must stop it at the goal, stop it when the scans
-stop, and send a zero ``Twist`` when it is terminated.
+topic names): a holonomic robot (``zhang2019-holonomic-v2``) or a unicycle (``zhang2019-v2``),
+its body turned away from the goal, among moving discs, its scans (uvnav's exact lidar) and
+odometry published, a goal published, the robot moved by the ``Twist`` commands it receives.
+The robot must reach the goal without touching a disc, although the discs cross the straight
+path (a robot driving straight would hit them), and the node must stop it at the goal, stop it
+when the scans stop, and send a zero ``Twist`` when it is terminated.
 
 Cyclone DDS runs here with unicast discovery on 127.0.0.1 (no multicast); where DDS cannot start
 a participant at all, the test is skipped with the reason.
@@ -72,7 +73,8 @@ def test_the_scene_is_not_trivial() -> None:
 
 @dataclass
 class Robot:
-    """The simulated holonomic robot: body yaw fixed, velocity = the last Twist received."""
+    """The simulated robot: it moves and turns at the last Twist received (in its own frame),
+    exactly as a holonomic robot or a unicycle does under the command its law sends."""
 
     x: float = START[0]
     y: float = START[1]
@@ -148,8 +150,8 @@ def sim() -> Iterator[Sim]:
     yield s
 
 
-def _node(domain: int, log: Path) -> subprocess.Popen[bytes]:
-    cmd = [sys.executable, "-m", "uvnav.cli", "ros2", "run", "zhang2019-holonomic-v2",
+def _node(law: str, domain: int, log: Path) -> subprocess.Popen[bytes]:
+    cmd = [sys.executable, "-m", "uvnav.cli", "ros2", "run", law,
            "--domain", str(domain), "--v-max", str(V_MAX), "--radius", str(RADIUS),
            "--goal-tolerance", str(TOLERANCE), "--scan-timeout", "0.5", "--rate", "10"]  # fmt: skip
     env = dict(os.environ, CYCLONEDDS_URI=LOOPBACK)
@@ -165,9 +167,11 @@ def _at_goal(robot: Robot, now: float) -> bool:
     return math.dist((robot.x, robot.y), GOAL) <= TOLERANCE
 
 
-def test_the_node_drives_the_robot_to_its_goal_over_dds(sim: Sim, tmp_path: Path) -> None:
+@pytest.mark.slow
+@pytest.mark.parametrize("law", ["zhang2019-holonomic-v2", "zhang2019-v2"])
+def test_the_node_drives_the_robot_to_its_goal_over_dds(law: str, sim: Sim, tmp_path: Path) -> None:
     log = tmp_path / "node.log"
-    node = _node(sim.domain_id, log)
+    node = _node(law, sim.domain_id, log)
     try:
         robot = Robot()
         reached = sim.run(robot, _at_goal, DEADLINE)
