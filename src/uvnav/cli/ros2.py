@@ -101,7 +101,9 @@ def run_cmd(
     sensing_range: Annotated[
         float, typer.Option(callback=finite, help="Bodies the law is given, within [m].")
     ] = 5.0,
-    seed: Annotated[int, typer.Option(min=0, help="Seed of the law's generator.")] = 0,
+    seed: Annotated[
+        int, typer.Option(min=0, help="Seed of the law's and the perception's generators.")
+    ] = 0,
     duration: Annotated[
         float, typer.Option(callback=finite, help="Stop after this long [s]; 0: on Ctrl-C.")
     ] = 0.0,
