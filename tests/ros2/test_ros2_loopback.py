@@ -186,8 +186,13 @@ def test_the_node_drives_the_robot_to_its_goal_over_dds(law: str, sim: Sim, tmp_
         moving = sim.run(robot, lambda r, now: not _stopped(r, now), 3.0, goal=far)
         assert moving, "no command toward the new goal: " + why
         assert sim.run(robot, _stopped, 2.0, goal=far, scans=False), "scans stopped: " + why
+        # terminated while driving, the node's last command stops the robot
+        moving = sim.run(robot, lambda r, now: not _stopped(r, now), 3.0, goal=far)
+        assert moving, "no command once the scans came back: " + why
         node.send_signal(signal.SIGTERM)
         assert node.wait(timeout=10) == 0
+        sim.run(robot, lambda r, now: False, 0.3, goal=far)  # take what is left
+        assert robot.cmd == Twist(), "the last command was not a stop: " + why
     finally:
         if node.poll() is None:
             node.kill()

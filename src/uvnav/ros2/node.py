@@ -102,7 +102,8 @@ class Ros2Node:
 
     def spin(self, should_stop: Callable[[], bool], duration_s: float = 0.0) -> None:
         """Decide every period until ``should_stop()`` (or for ``duration_s`` [s] when it is
-        positive); a zero ``Twist`` is the last command written, however the loop ends."""
+        positive); a zero ``Twist`` is the last command written, however the loop ends, and
+        the node waits up to a second for the readers to acknowledge it."""
         next_t = self.now()
         try:
             while not should_stop() and (duration_s <= 0 or self.now() < duration_s):
@@ -112,6 +113,7 @@ class Ros2Node:
                 next_t = max(next_t, self.now() - self.period)  # never catch up in a burst
         finally:
             self.cmd_writer.write(Twist())
+            self.cmd_writer.wait_for_acks(duration(seconds=1))
 
 
 def _take_all(reader: DataReader[Any]) -> list[Any]:
