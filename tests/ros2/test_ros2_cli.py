@@ -59,7 +59,6 @@ def test_bad_run_options_are_one_line_errors(args: list[str], message: str) -> N
 
 
 def test_a_law_of_another_vehicle_is_refused() -> None:
-    pytest.importorskip("cyclonedds")
     r = runner.invoke(app, ["ros2", "run", "zhang2020-3d-v1"])
     assert r.exit_code == 2
     assert r.stderr.strip() == (

@@ -14,7 +14,7 @@ pytest.importorskip("cyclonedds")
 from ros2_world import goal_pose, laser_scan, odometry
 
 from uvnav.ros2.msgs import Twist
-from uvnav.ros2.navigator import Navigator, RobotConfig, law_vehicle
+from uvnav.ros2.navigator import Navigator, RobotConfig
 from uvnav.sensors.observation import Observation
 
 ZERO = Twist()
@@ -115,10 +115,3 @@ def test_the_law_reads_the_scans_bodies_with_estimated_velocities(
     assert rd.centre == pytest.approx((2.0, -0.3), abs=0.06)
     assert rd.velocity == pytest.approx((0.0, 1.0), abs=0.15)
     assert seen[3].time == 0.25 and seen[3].obstacles == seen[2].obstacles
-
-
-def test_laws_of_other_vehicles_are_refused() -> None:
-    assert law_vehicle("zhang2019-v2") == "unicycle"
-    assert law_vehicle("zhang2019-holonomic-v2") == "holonomic"
-    with pytest.raises(ValueError, match="drives the vehicle3d vehicle"):
-        law_vehicle("zhang2020-3d-v1")

@@ -116,15 +116,19 @@ def run_cmd(
         _positive(option, value)
     if radius < 0 or duration < 0:
         raise CliError(f"{'--radius' if radius < 0 else '--duration'}: must not be negative")
-    params = _law_params(law, params_file, param)
-    _require_cyclonedds()
-    from uvnav.ros2.navigator import Navigator, RobotConfig, law_vehicle
-    from uvnav.ros2.node import Ros2Node
+    from uvnav.controllers.base import build_params, controller_info
+    from uvnav.ros2.params import law_vehicle
 
     try:
         law_vehicle(law)
     except ValueError as exc:
         raise CliError(str(exc)) from None
+    params = _law_params(law, params_file, param)
+    build_params(controller_info(law).params_type, params)  # bad parameters: one line
+    _require_cyclonedds()
+    from uvnav.ros2.navigator import Navigator, RobotConfig
+    from uvnav.ros2.node import Ros2Node
+
     robot = RobotConfig(
         v_max=v_max, u_max=u_max, radius=radius, goal_tolerance=goal_tolerance,
         sensing_range=sensing_range, scan_timeout=scan_timeout, seed=seed,

@@ -23,19 +23,17 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.controllers.base import controller_info, make_law
+from uvnav.controllers.base import make_law
 from uvnav.dynamics.unicycle import UnicycleSpec
 from uvnav.dynamics.vehicles import Vehicle2D, make_vehicle
 from uvnav.geometry.angles import FloatArray
 from uvnav.obstacles.obstacle import ObstacleField
 from uvnav.ros2.convert import goal_of, lidar_of, pose_of, speed_of, twist_of
 from uvnav.ros2.msgs import LaserScan, Odometry, PoseStamped, Twist
+from uvnav.ros2.params import law_vehicle
 from uvnav.sensors.config import LidarConfig, SensingConfig
 from uvnav.sensors.observation import LidarScan, Observation
 from uvnav.sensors.suite2d import Sensors2D
-
-#: the vehicles whose commands a ``Twist`` carries
-TWIST_VEHICLES = ("unicycle", "holonomic")
 
 
 @dataclass(frozen=True)
@@ -69,22 +67,6 @@ class _ReceivedScan(Sensors2D):
     def scan(self, pose: FloatArray, field: ObstacleField) -> LidarScan:
         assert self.received is not None
         return self.received
-
-
-def law_vehicle(name: str) -> str:
-    """The vehicle of the 2D law ``name``.
-
-    Raises:
-        UnknownControllerError: ``name`` is not registered.
-        ValueError: the law drives a vehicle a ``Twist`` does not command.
-    """
-    vehicle = controller_info(name).vehicle
-    if vehicle not in TWIST_VEHICLES:
-        raise ValueError(
-            f"law {name!r} drives the {vehicle} vehicle; the ROS 2 node drives "
-            f"{' and '.join(TWIST_VEHICLES)} laws"
-        )
-    return vehicle
 
 
 class Navigator:

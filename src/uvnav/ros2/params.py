@@ -6,6 +6,8 @@ dataclass and the ``Attributes:`` section of that class's docstring); the type i
 parameter type of the field's Python type, named as ``ros2 param describe`` names them
 (``boolean``, ``integer``, ``double``, ``string`` and their ``array`` forms); a field of any
 other type (a nested law's parameters, polygons) is a ``string`` read as YAML.
+:func:`law_vehicle` says whether a ``Twist`` can carry a law's commands.  Nothing here needs
+``cyclonedds``.
 """
 
 from __future__ import annotations
@@ -20,6 +22,8 @@ from typing import Any
 
 from uvnav.controllers.base import controller_info
 
+#: the vehicles whose commands a ``Twist`` carries
+TWIST_VEHICLES = ("unicycle", "holonomic")
 _SCALARS: dict[Any, str] = {bool: "boolean", int: "integer", float: "double", str: "string"}
 _ENTRY = re.compile(r"^(\w+)(?:\s*\([^)]*\))?:\s*(.*)$")
 
@@ -104,6 +108,22 @@ def describe(law: str) -> list[ParamDescriptor]:
             default = None
         out.append(ParamDescriptor(f.name, ros_type(hints[f.name]), default, docs.get(f.name, "")))
     return out
+
+
+def law_vehicle(name: str) -> str:
+    """The vehicle of the 2D law ``name``.
+
+    Raises:
+        UnknownControllerError: ``name`` is not registered.
+        ValueError: the law drives a vehicle a ``Twist`` does not command.
+    """
+    vehicle = controller_info(name).vehicle
+    if vehicle not in TWIST_VEHICLES:
+        raise ValueError(
+            f"law {name!r} drives the {vehicle} vehicle; the ROS 2 node drives "
+            f"{' and '.join(TWIST_VEHICLES)} laws"
+        )
+    return vehicle
 
 
 def law_arguments(law: str, values: dict[str, Any]) -> dict[str, Any]:
