@@ -3,8 +3,8 @@ PYTHON ?= python3.11
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
 # Extras installed by `make run` / `make test`; later chapters add theirs here (see docs/design-notes.md).
-RUN_EXTRAS  ?= prediction,report,bench,learning,envs,recon,fast,ros
-TEST_EXTRAS ?= prediction,report,bench,learning,envs,recon,fast,ros,test
+RUN_EXTRAS  ?= prediction,report,bench,learning,envs,recon,fast,ros,ros2
+TEST_EXTRAS ?= prediction,report,bench,learning,envs,recon,fast,ros,ros2,test
 # torch is installed before the package (the CPU build is served to pip here; never torchvision)
 TORCH_PIN  ?= torch==2.13.0
 STAMP_TORCH := $(VENV)/.installed-torch

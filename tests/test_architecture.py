@@ -20,6 +20,7 @@ PYPROJECT = ROOT / "pyproject.toml"
 #: DESIGN §1, top (may import everything below) to bottom.
 DESIGN_LAYERS = [
     {"uvnav.cli"},
+    {"uvnav.ros2"},  # a law as a ROS 2 node: over controllers and sensors, beside the CLI
     {"uvnav.viz", "uvnav.bags"},  # figures; episodes and recordings in ROS 2 formats (files)
     {"uvnav.experiments"},  # the registered reproductions, over bench; renderers injected
     {"uvnav.learning", "uvnav.driving", "uvnav.bench", "uvnav.envs"},

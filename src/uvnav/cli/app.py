@@ -44,6 +44,7 @@ from uvnav.cli.recon import recon_app
 from uvnav.cli.replay import replay_cmd
 from uvnav.cli.report import report_cmd
 from uvnav.cli.reproduce import forget_cmd, reproduce_cmd, run_cmd
+from uvnav.cli.ros2 import ros2_app
 from uvnav.cli.scenarios import scenarios_app
 from uvnav.cli.sonar import sonar_app
 from uvnav.sim import METRIC_NAMES
@@ -58,6 +59,7 @@ app.add_typer(controllers_app, name="controllers")
 app.add_typer(recon_app, name="recon")
 app.add_typer(drive_app, name="drive")
 app.add_typer(sonar_app, name="sonar")
+app.add_typer(ros2_app, name="ros2")
 
 
 def _version(value: bool) -> None:
