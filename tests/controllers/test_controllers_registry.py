@@ -110,3 +110,12 @@ def test_a_bad_parameter_is_one_line_at_construction(
 def test_a_number_is_a_number_for_any_float_parameter() -> None:
     """An int where a float is declared is accepted (YAML writes 2 for 2.0), as given."""
     assert make_law("straight-v1", slow_radius=2).params.slow_radius == 2
+
+
+def test_a_list_is_a_tuple_parameter() -> None:
+    """A sequence written as YAML, JSON or ``-p k=[a,b]`` arrives as a list; a tuple field takes
+    it as that tuple, and its items are still checked."""
+    law = make_law("zhang2019-v2", speed_levels=[1.0, 0.5])
+    assert law.params.speed_levels == (1.0, 0.5)
+    with pytest.raises(ControllerParamsError, match="speed_levels.1: expected a number"):
+        make_law("zhang2019-v2", speed_levels=[1.0, "fast"])

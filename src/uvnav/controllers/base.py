@@ -23,6 +23,7 @@ from __future__ import annotations
 import dataclasses
 import functools
 import math
+import types
 import typing
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
@@ -227,6 +228,7 @@ def build_params(params_type: type | None, params: dict[str, Any]) -> Any:
             f"unknown parameter(s) {', '.join(unknown)}; known: {', '.join(sorted(fields))}"
         )
     hints = _field_types(params_type)
+    params = {name: _as_tuple(hints[name], value) for name, value in params.items()}
     for name, value in params.items():
         try:  # each given value against its field's type, strictly ("yes" is not a bool)
             _type_adapter(hints[name]).validate_python(value, strict=True)
@@ -238,6 +240,15 @@ def build_params(params_type: type | None, params: dict[str, Any]) -> Any:
         return params_type(**params)
     except (TypeError, ValueError) as exc:
         raise ControllerParamsError(str(exc)) from exc
+
+
+def _as_tuple(hint: Any, value: Any) -> Any:
+    """A list (how YAML, JSON and ``-p k=[a,b]`` write a sequence) given for a tuple field, as
+    that tuple; any other value unchanged."""
+    kinds = [hint, *typing.get_args(hint)] if typing.get_origin(hint) is types.UnionType else [hint]
+    if isinstance(value, list) and any(typing.get_origin(k) is tuple for k in kinds):
+        return tuple(value)
+    return value
 
 
 @functools.cache
