@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import Any
 
 import matplotlib.image as mpimg
 import numpy as np
@@ -148,3 +149,18 @@ def test_helpers() -> None:
     length = path_length_over_time(result.trajectory)  # type: ignore[arg-type]
     assert length[0] == 0.0 and np.all(np.diff(length) >= 0)
     assert length[-1] == pytest.approx(result.metrics.path_length)
+
+
+def test_the_avoidance_mode_is_labelled_by_what_it_means() -> None:
+    """Every 2D law names its avoidance ``M2`` (the thesis's sliding mode, ORCA away from its
+    preferred velocity): the shaded spans say "avoiding", other mode names stay as they are."""
+    import types
+
+    from matplotlib.figure import Figure
+
+    from uvnav.viz.figures import _shade_modes
+
+    ax = Figure().add_subplot()
+    traj: Any = types.SimpleNamespace(times=np.arange(5.0), modes=["M1", "M2", "M2", "M3", "M1"])
+    labels = [h.get_label() for h in _shade_modes(ax, traj)]
+    assert labels == ["avoiding (M2)", "mode M3"]

@@ -47,6 +47,8 @@ def test_swap_and_trajectory_figures(tmp_path) -> None:
     goals = np.array([r.goal for r in sc.robots])
     fig = plot_swap(res, goals, path=tmp_path / "swap.png")
     assert "0/4 arrived" in fig.axes[0].get_title()
+    legend = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
+    assert legend[:2] == ["start", "goal"] and "collided" in legend  # straight-v1 robots meet
     assert (tmp_path / "swap.png").exists()
     plot_trajectories(
         [np.array([[0, 0], [1, 0], [1, 1]], dtype=float)],

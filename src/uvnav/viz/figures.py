@@ -204,7 +204,17 @@ def _shade_modes(ax: Axes, traj: Trajectory) -> list[Any]:
             start = i
     from matplotlib.patches import Patch
 
-    return [Patch(color=c, alpha=0.6, label=f"mode {m or '(none)'}") for m, c in palette.items()]
+    return [Patch(color=c, alpha=0.6, label=_mode_label(m)) for m, c in palette.items()]
+
+
+#: what the 2D laws' mode names mean (every law names avoidance ``M2``: the thesis's sliding
+#: mode, ORCA's velocity away from the preferred one)
+MODE_MEANINGS = {"M1": "to the goal (M1)", "M2": "avoiding (M2)"}
+
+
+def _mode_label(mode: str) -> str:
+    """A mode's legend label: its meaning where it has one, else ``mode NAME``."""
+    return MODE_MEANINGS.get(mode, f"mode {mode or '(none)'}")
 
 
 def _draw_signals(ax: Axes, traj: Trajectory, setup: EpisodeSetup) -> None:

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from matplotlib import colormaps
@@ -171,10 +172,29 @@ def plot_swap(
         or f"{grp.arrived}/{n} arrived, {grp.robot_collisions} collisions, "
         f"{grp.deadlocks} deadlocked"
     )
+    ax.legend(handles=_swap_legend(result), loc="upper right", fontsize=7, framealpha=0.8)
     ax.set_aspect("equal")
     ax.set_xlabel("x [m]")
     ax.set_ylabel("y [m]")
     return _maybe_save(fig, path)
+
+
+def _swap_legend(result: MultiResult) -> list[Any]:
+    """What the markers of :func:`plot_swap` mean (one colour per robot): start, goal, and the
+    end of a robot that collided or timed out, where there is one; obstacle paths."""
+    from matplotlib.lines import Line2D
+
+    def mark(marker: str, label: str, ms: float) -> Any:
+        return Line2D([], [], ls="", marker=marker, color="k", mfc="none", ms=ms, label=label)
+
+    handles = [mark("o", "start", 4), mark("*", "goal", 7)]
+    if "collision" in result.statuses:
+        handles.append(mark("x", "collided", 8))
+    if "timeout" in result.statuses:
+        handles.append(mark("s", "timed out", 6))
+    if result.obstacle_paths.shape[1]:
+        handles.append(Line2D([], [], color="0.6", lw=0.8, ls="--", label="obstacle path"))
+    return handles
 
 
 def beyond_figures(
