@@ -245,8 +245,16 @@ def _draw_signals(ax: Axes, traj: Trajectory, setup: EpisodeSetup) -> None:
     ax.set_title(f"(b) robot {what} and clearance", fontsize="medium", loc="left")
 
 
+def _round(shape: np.ndarray) -> bool:
+    """Whether a body-frame outline is a disc's (every vertex at one distance from the centre,
+    many vertices): its rotation moves no part of its boundary."""
+    r = np.hypot(shape[:, 0], shape[:, 1]) if len(shape) else np.zeros(0)
+    return len(r) >= 16 and bool(np.ptp(r) <= 1e-9 * max(float(r.max()), 1.0))
+
+
 def _draw_nearest(ax: Axes, traj: Trajectory) -> None:
-    """Panel (c): ||v_i|| and u_i of the nearest obstacle over time."""
+    """Panel (c): ||v_i|| and u_i of the nearest obstacle over time (u_i of a rotating body
+    only: a disc's rotation, a walking person's heading rate, moves none of its boundary)."""
     t = traj.times
     near = np.asarray(traj.nearest_id, dtype=int)
     n = len(t)
@@ -258,6 +266,9 @@ def _draw_nearest(ax: Axes, traj: Trajectory) -> None:
         v = traj.obstacle_velocities[rows, near[ok], :]
         speed[rows] = np.hypot(v[:, 0], v[:, 1])
         omega[rows] = traj.obstacle_omegas[rows, near[ok]]
+        discs = np.array([_round(np.asarray(s)) for s in traj.obstacle_shapes], dtype=bool)
+        if len(discs) == traj.obstacle_omegas.shape[1]:
+            omega[rows[discs[near[ok]]]] = np.nan
     ax.plot(t, speed, color="tab:purple", label="||v_i|| [m/s]")
     ax.plot(t, omega, color="tab:brown", lw=0.9, label="u_i [rad/s]")
     ax.axhline(0.0, color="0.5", lw=0.5)
