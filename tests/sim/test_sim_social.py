@@ -156,9 +156,10 @@ def _appearing(t0: float) -> Obstacle:
 def test_pedestrian_appearing_in_contact_is_not_the_robots_doing() -> None:
     """straight-v1 drives along y = 0 at 1 m/s, at x = 1.0 at t = 1 s: a track starting then at
     (1.3, 0) overlaps it on the step it appears.  By velocities alone the robot closed the gap
-    (it drives at the body, which walks across); but the body did not exist one step before."""
+    (it drives at the body, which walks across); but the body did not exist one step before:
+    it appeared in contact, its own cause."""
     res = _run(_setup([_appearing(1.0)]), make_controller("straight-v1"))
-    assert res.status == "collision" and res.metrics.collision_by == "pedestrian"
+    assert res.status == "collision" and res.metrics.collision_by == "appeared"
     # the same body on the scene from the start and met at the same place: the robot's doing
     present = Obstacle.moving_disc((1.3, -1.0), PED_R, (0.0, 1.0))
     res = _run(_setup([present]), make_controller("straight-v1"))

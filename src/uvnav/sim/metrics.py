@@ -79,7 +79,8 @@ class EpisodeMetrics:
         path_irregularity: total absolute heading change per metre of path [rad/m] (every 2D
             episode that moved).
         collision_by: who closed the gap at the collision: ``"robot"``, ``"pedestrian"`` or
-            ``"obstacle"`` (a body that is not a pedestrian); ``None`` without collision.
+            ``"obstacle"`` (a body that is not a pedestrian), or ``"appeared"`` (the body's
+            track starts in contact); ``None`` without collision.
     """
 
     success: bool

@@ -53,8 +53,8 @@ Metrics (``None`` in a scene without pedestrians, except where said):
     judged at the first contact (:meth:`uvnav.sim.swept.SweptClearance.contact_by`), else at the
     step's end.  A body that did not exist one step before (a replayed
     pedestrian whose recorded track starts in contact with the robot) closed the gap by
-    appearing: ``"pedestrian"`` (``"obstacle"``), whatever the velocities.  Set for every 2D
-    scene, with or without pedestrians.
+    appearing there: ``"appeared"``, whatever the velocities (no one drove into it).  Set for
+    every 2D scene, with or without pedestrians.
 """
 
 from __future__ import annotations
@@ -170,6 +170,10 @@ class SocialTracker:
         return min(self._close_periods / decisions, 1.0) if decisions > 0 else 0.0
 
 
+#: the cause of a collision with a body that appeared in contact (its track starts there)
+APPEARED = "appeared"
+
+
 def collision_by(
     fld: ObstacleField,
     px: float,
@@ -188,7 +192,8 @@ def collision_by(
         was_present: per body, whether it existed one step before (``None``: all did).
 
     Returns:
-        ``"robot"``, ``"pedestrian"`` or ``"obstacle"``.
+        ``"robot"``, ``"pedestrian"``, ``"obstacle"`` or ``"appeared"`` (the body did not exist
+        one step before).
     """
     q = fld.query((px, py), 0.0, nearest=True)
     j = int(q.signed.argmin())
@@ -196,8 +201,9 @@ def collision_by(
     centre = (float(fld.centres[body, 0]), float(fld.centres[body, 1]))
     disc = bool(fld.template.radii[body] > 0)
     touch = (float(q.nearest[j, 0]), float(q.nearest[j, 1]))
-    appeared = was_present is not None and not bool(was_present[body])
-    robot = not appeared and robot_closed(
+    if was_present is not None and not bool(was_present[body]):
+        return APPEARED
+    robot = robot_closed(
         (px, py), centre, touch, disc, bool(q.inside[j]), robot_velocity,
         (float(fld.velocities[body, 0]), float(fld.velocities[body, 1])),
         float(fld.angular_velocities[body]),

@@ -36,7 +36,7 @@ from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.polygons import polygon_nearest
 from uvnav.geometry.sweep import body_sweep, disc_sweep
 from uvnav.obstacles.obstacle import FieldTemplate
-from uvnav.sim.social import robot_closed
+from uvnav.sim.social import APPEARED, robot_closed
 
 #: the kernels' tolerance for a rotating body [m]: a gap is at most twice it below the true one
 ROT_TOL = 5e-4
@@ -199,7 +199,7 @@ class SweptClearance:
         at that instant (:func:`uvnav.sim.social.robot_closed`): the robot's centre and the
         body's pose there under the sweep's motion model, the body's velocity over the step of
         ``dt`` [s], the robot's ``robot_velocity`` [m/s]; a body absent at the step's start
-        appeared in contact."""
+        appeared in contact (``"appeared"``)."""
         if self.contact is None:
             return None
         poses, j, s = self.contact
@@ -216,9 +216,10 @@ class SweptClearance:
             rot = np.array([[math.cos(h), -math.sin(h)], [math.sin(h), math.cos(h)]])
             _, near, inside = polygon_nearest(p, ring @ rot.T + c)
             touch = (float(near[0]), float(near[1]))
-        appeared = poses.present0 is not None and not bool(poses.present0[j])
+        if poses.present0 is not None and not bool(poses.present0[j]):
+            return APPEARED  # the body appeared in contact within the step
         velocity = ((c1[j] - c0[j]) / dt).tolist()
-        robot = not appeared and robot_closed(
+        robot = robot_closed(
             (float(p[0]), float(p[1])), (float(c[0]), float(c[1])), touch, disc, inside,
             robot_velocity, (velocity[0], velocity[1]), dh / dt,
         )  # fmt: skip
