@@ -12,8 +12,6 @@
 * :mod:`uvnav.bench.reproduce` — the thesis Chapter 2 reproduction
   (``from uvnav.bench.reproduce import reproduce``; the function is not re-exported here so that it
   does not shadow its module).
-* :mod:`uvnav.bench.chapters` — one runner per chapter, registered as experiments in
-  :mod:`uvnav.experiments` (``uvnav reproduce NAME``, ``uvnav run``).
 """
 
 from uvnav.bench.campaign import CampaignRun, Job, JobOutcome, grid_jobs, run_campaign, run_job

@@ -1,6 +1,6 @@
 """One report section per chapter: the contract between the reproductions and the HTML report.
 
-Each chapter's run (:mod:`uvnav.bench.chapters`, an experiment of :mod:`uvnav.experiments` run
+Each chapter's run (:mod:`uvnav.experiments.builtin`, an experiment of :mod:`uvnav.experiments` run
 by ``uvnav run`` and ``uvnav reproduce NAME``) turns what its reproduction returns (its summary
 object: ``.table`` rows, ``.figures`` files) into a :class:`ChapterSection` with a
 ``*_section`` builder: the thesis chapters' builders are here, the
