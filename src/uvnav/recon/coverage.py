@@ -30,7 +30,7 @@ of flat ground on the 0.5 m grid (largest gap 2.0–2.6 m past a footprint) and
 99.39 % [ev:ch7-coverage.jacksboro_300_R50_node_rule_grid_pct]
 of the Jacksboro crop; the cell rule (:func:`.visibility.assign_altitudes`) reads 100.00 % on all
 three checks for both terrains (0 [ev:ch7-coverage.grid_points_unseen] grid points unseen;
-``python -m uvnav.bench.evidence --only ch7-coverage`` regenerates these figures).
+``python -m uvnav.experiments.evidence --only ch7-coverage`` regenerates these figures).
 
 Units: lengths [m], areas [m²], angles [rad].
 """

@@ -16,13 +16,13 @@ last full run (:func:`write_record`).  The test suite re-runs the quick size and
 the recorded quick figures (so a change of behaviour cannot pass unnoticed), and asserts that
 every tagged number in the notes and docstrings equals the recorded full figure (so the notes
 cannot drift from the record).  A change that moves a figure therefore fails the suite until
-``python -m uvnav.bench.evidence --write docs/evidence.json`` is run again and the notes are
+``python -m uvnav.experiments.evidence --write docs/evidence.json`` is run again and the notes are
 corrected.
 
 Command line::
 
-    python -m uvnav.bench.evidence [--quick] [--only CLAIM ...] [--json] [--write FILE]
-    python -m uvnav.bench.evidence --check [--record FILE] [FILE ...]
+    python -m uvnav.experiments.evidence [--quick] [--only CLAIM ...] [--json] [--write FILE]
+    python -m uvnav.experiments.evidence --check [--record FILE] [FILE ...]
 
 Figures that cannot be re-run in minutes (the Chapter 6 training runs, the Chapter 5 closed-loop
 campaigns) are not claims here: their paragraphs in the notes name the command that produced them
@@ -471,9 +471,9 @@ def _format(figures: dict[str, Figures]) -> list[str]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m uvnav.bench.evidence``: print, record or check the claims' figures."""
+    """``python -m uvnav.experiments.evidence``: print, record or check the claims' figures."""
     ap = argparse.ArgumentParser(
-        prog="python -m uvnav.bench.evidence",
+        prog="python -m uvnav.experiments.evidence",
         description="Regenerate the measured figures quoted in docs/thesis-notes.md and the "
         "module docstrings (tags [ev:CLAIM.FIELD]).",
     )
