@@ -8,7 +8,7 @@ The chain (each stage a row of the closed-loop table, evaluated on the same held
    Udacity's drive.py).
 2. **Target-speed readout** (``readout=True``, beyond the thesis): a ridge readout of the
    expert's target speed on the network's 10 last hidden units
-   (:func:`uvnav.bench.ch6_pipeline.fit_target_speed_readout`; the steering is unchanged),
+   (:func:`uvnav.driving.pipeline.fit_target_speed_readout`; the steering is unchanged),
    driven by the "learned-speed" throttle (the expert's proportional law tracking the predicted
    speed).  Row ``cnn-learned-speed``.
 3. **DAgger** (``dagger_rounds``, beyond the thesis; Ross et al. 2011): the network drives
@@ -237,7 +237,7 @@ def reproduce_ch6(
     Returns:
         The summary (table rows "thesis vs measured", closed-loop means, arrays for figures).
     """
-    from uvnav.bench.ch6_pipeline import (
+    from uvnav.driving.pipeline import (
         THROTTLE_MODES,
         Throttle,
         cnn_policy,
