@@ -9,8 +9,8 @@
 * :mod:`uvnav.bench.ray_engine` — the jobs as Ray tasks (extra ``uvnav[bench]``; Ray is imported
   only when the engine runs).
 * :mod:`uvnav.bench.summary` — the per-controller table ``uvnav bench`` prints.
-* :mod:`uvnav.bench.reproduce` — the thesis Chapter 2 reproduction
-  (``from uvnav.bench.reproduce import reproduce``; the function is not re-exported here so that it
+* :mod:`uvnav.experiments.ch2` — the thesis Chapter 2 reproduction
+  (``from uvnav.experiments.ch2 import reproduce``; the function is not re-exported here so that it
   does not shadow its module).
 """
 

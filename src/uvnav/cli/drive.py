@@ -608,7 +608,7 @@ def reproduce(
         from rich.console import Console
         from rich.table import Table
 
-        from uvnav.bench.reproduce_ch6 import reproduce_ch6
+        from uvnav.experiments.ch6 import reproduce_ch6
         from uvnav.viz.figures_ch6 import render_ch6
 
         con = Console(stderr=True)

@@ -20,9 +20,10 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench import reproduce as rp
-from uvnav.bench.sections import ChapterSection
+import uvnav.experiments.ch2 as rp
+import uvnav.experiments.sections as sec
 from uvnav.experiments.protocol import Experiment, ExperimentContext, ExperimentRun
+from uvnav.experiments.sections import ChapterSection
 
 
 def _run(section: ChapterSection, summary: Any, rows: list[dict[str, str]]) -> ExperimentRun:
@@ -61,9 +62,8 @@ def run_ch2(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_ch3(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 3 (:func:`uvnav.bench.reproduce_ch3.reproduce_ch3`) and its section."""
-    from uvnav.bench import sections as sec
-    from uvnav.bench.reproduce_ch3 import reproduce_ch3
+    """Chapter 3 (:func:`uvnav.experiments.ch3.reproduce_ch3`) and its section."""
+    from uvnav.experiments.ch3 import reproduce_ch3
 
     s3 = reproduce_ch3(
         ctx.results_dir, ctx.report_dir, full=ctx.full, workers=ctx.workers,
@@ -74,10 +74,9 @@ def run_ch3(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_ch4(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 4 (:func:`uvnav.bench.reproduce_ch4.reproduce_ch4`): ``seeds`` scenes of every
+    """Chapter 4 (:func:`uvnav.experiments.ch4.reproduce_ch4`): ``seeds`` scenes of every
     family, and its section."""
-    from uvnav.bench import sections as sec
-    from uvnav.bench.reproduce_ch4 import reproduce_ch4
+    from uvnav.experiments.ch4 import reproduce_ch4
 
     seeds = ctx.seeds
     s4 = reproduce_ch4(
@@ -90,9 +89,8 @@ def run_ch4(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_ch5(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 5 (:func:`uvnav.bench.reproduce_ch5.reproduce_ch5`) and its section."""
-    from uvnav.bench import sections as sec
-    from uvnav.bench.reproduce_ch5 import reproduce_ch5
+    """Chapter 5 (:func:`uvnav.experiments.ch5.reproduce_ch5`) and its section."""
+    from uvnav.experiments.ch5 import reproduce_ch5
 
     s5 = reproduce_ch5(
         ctx.results_dir, full=ctx.full, progress=ctx.progress, render=ctx.renderers.ch5,
@@ -103,11 +101,10 @@ def run_ch5(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_ch6(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 6 at ``uvnav run``'s size (:data:`uvnav.bench.reproduce_ch6.RUN_QUICK`; the thesis
+    """Chapter 6 at ``uvnav run``'s size (:data:`uvnav.experiments.ch6.RUN_QUICK`; the thesis
     size with ``full``) in ``results_dir/ch6-quick`` (``results_dir/ch6``); every pipeline option
     is ``uvnav drive reproduce``'s."""
-    from uvnav.bench import sections as sec
-    from uvnav.bench.reproduce_ch6 import RUN_QUICK, reproduce_ch6
+    from uvnav.experiments.ch6 import RUN_QUICK, reproduce_ch6
 
     s6 = reproduce_ch6(
         Path(ctx.results_dir) / ("ch6" if ctx.full else "ch6-quick"),
@@ -122,9 +119,8 @@ def run_ch6(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_ch7(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 7 (:func:`uvnav.bench.reproduce_ch7.reproduce_ch7`, JSON in ``results_dir/ch7``)."""
-    from uvnav.bench import sections as sec
-    from uvnav.bench.reproduce_ch7 import reproduce_ch7
+    """Chapter 7 (:func:`uvnav.experiments.ch7.reproduce_ch7`, JSON in ``results_dir/ch7``)."""
+    from uvnav.experiments.ch7 import reproduce_ch7
 
     draw7 = ctx.renderers.ch7
     s7 = reproduce_ch7(
@@ -138,10 +134,9 @@ def run_ch7(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_beyond(ctx: ExperimentContext) -> ExperimentRun:
-    """The experiments beyond the thesis (:mod:`uvnav.bench.reproduce_beyond`; their episodes
+    """The experiments beyond the thesis (:mod:`uvnav.experiments.beyond`; their episodes
     stored in ``results_dir``'s database); figures in ``report_dir/beyond``."""
-    from uvnav.bench import sections as sec
-    from uvnav.bench.reproduce_beyond import replan_rows, reproduce_beyond
+    from uvnav.experiments.beyond import replan_rows, reproduce_beyond
 
     rows = reproduce_beyond(ctx.results_dir, full=ctx.full) + replan_rows()
     draw = ctx.renderers.beyond
@@ -150,9 +145,9 @@ def run_beyond(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_crowds(ctx: ExperimentContext) -> ExperimentRun:
-    """Every 2D law on CrowdNav's crowds (:func:`uvnav.bench.reproduce_crowds.reproduce_crowds`:
+    """Every 2D law on CrowdNav's crowds (:func:`uvnav.experiments.crowds.reproduce_crowds`:
     ``seeds`` test cases per scene from ``start_seed``) and its section."""
-    from uvnav.bench.reproduce_crowds import crowds_section, reproduce_crowds
+    from uvnav.experiments.crowds import crowds_section, reproduce_crowds
 
     sc = reproduce_crowds(
         ctx.results_dir, full=ctx.full, workers=ctx.workers, cases=ctx.seeds,
@@ -163,9 +158,9 @@ def run_crowds(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_regime(ctx: ExperimentContext) -> ExperimentRun:
-    """The regime map (:func:`uvnav.bench.regime.run_regime_map`: ``seeds`` seeds per regime and
-    law from ``start_seed``): a section, no table rows."""
-    from uvnav.bench.regime import regime_section, run_regime_map
+    """The regime map (:func:`uvnav.experiments.regime.run_regime_map`: ``seeds`` seeds per
+    regime and law from ``start_seed``): a section, no table rows."""
+    from uvnav.experiments.regime import regime_section, run_regime_map
 
     rm = run_regime_map(
         ctx.results_dir, full=ctx.full, workers=ctx.workers, seeds=ctx.seeds,

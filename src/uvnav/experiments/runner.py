@@ -19,13 +19,6 @@ from pathlib import Path
 from typing import Any
 
 from uvnav.bench.fingerprint import DB_NAME
-from uvnav.bench.sections import (
-    SECTION_ORDER,
-    SECTIONS_DIR,
-    ChapterSection,
-    load_sections,
-    save_section,
-)
 from uvnav.experiments.protocol import (
     Experiment,
     ExperimentContext,
@@ -33,6 +26,13 @@ from uvnav.experiments.protocol import (
     ExperimentRun,
 )
 from uvnav.experiments.registry import check_options, experiments, get_experiment, section_order
+from uvnav.experiments.sections import (
+    SECTION_ORDER,
+    SECTIONS_DIR,
+    ChapterSection,
+    load_sections,
+    save_section,
+)
 from uvnav.experiments.stored import report_sections as builtin_sections
 
 

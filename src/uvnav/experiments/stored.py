@@ -12,8 +12,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench import reproduce as rp
-from uvnav.bench.sections import SECTIONS_DIR, ChapterSection
+import uvnav.experiments.ch2 as rp
+from uvnav.experiments.sections import SECTIONS_DIR, ChapterSection
 
 #: Chapters whose results are files under the results folder, not store campaigns.
 _FILE_CHAPTERS = {"ch6": ("ch6", "ch6-quick"), "ch7": ("ch7",)}
@@ -33,7 +33,7 @@ def _rerun_section(key: str, why: str) -> ChapterSection:
 
 
 def _ch2_from_store(store: Any) -> ChapterSection | None:
-    from uvnav.bench.sections import rows_of
+    from uvnav.experiments.sections import rows_of
 
     cfg = next((c["config"] for c in store.campaigns() if c["name"] == rp.SCENES_CAMPAIGN), None)
     if cfg is None:
@@ -54,8 +54,8 @@ def _ch2_from_store(store: Any) -> ChapterSection | None:
 
 
 def _ch4_from_store(store: Any) -> ChapterSection:
-    from uvnav.bench import reproduce_ch4 as r4
-    from uvnav.bench.sections import rows_of
+    import uvnav.experiments.ch4 as r4
+    from uvnav.experiments.sections import rows_of
 
     rows = [r for name in r4.CAMPAIGNS for r in r4.stored_rows(store, name)]
     table = r4._table(r4.stored_rows(store, r4.SCENES_CAMPAIGN), r4.summarise(rows))
@@ -70,8 +70,8 @@ def _ch4_from_store(store: Any) -> ChapterSection:
 
 
 def _crowds_from_store(store: Any) -> ChapterSection:
-    from uvnav.bench import reproduce_crowds as rc
-    from uvnav.bench.sections import rows_of
+    import uvnav.experiments.crowds as rc
+    from uvnav.experiments.sections import rows_of
 
     return ChapterSection(
         key="crowds",
@@ -93,8 +93,8 @@ def report_sections(db_path: Path) -> list[ChapterSection]:
     files but no saved section gets a section that says to rerun ``uvnav reproduce CH``.  The
     database is only read.
     """
-    from uvnav.bench.sections import SECTION_ORDER, load_sections
     from uvnav.bench.store import ResultsStore
+    from uvnav.experiments.sections import SECTION_ORDER, load_sections
 
     db_path = Path(db_path)
     saved = {s.key: s for s in load_sections(db_path.parent / SECTIONS_DIR)}
@@ -106,7 +106,7 @@ def report_sections(db_path: Path) -> list[ChapterSection]:
                 out.append(saved[key])
                 continue
             if key == "crowds":  # its campaigns are CrowdNav's ("crowds-eth" is Chapter 2's)
-                from uvnav.bench.reproduce_crowds import CAMPAIGNS
+                from uvnav.experiments.crowds import CAMPAIGNS
 
                 stored = any(n in CAMPAIGNS for n in names)
             else:
@@ -120,7 +120,7 @@ def report_sections(db_path: Path) -> list[ChapterSection]:
             elif key == "crowds" and stored:
                 section = _crowds_from_store(store)
             elif key == "regime" and stored:
-                from uvnav.bench.regime import regime_section
+                from uvnav.experiments.regime import regime_section
 
                 section = regime_section(None, full=False)
             if section is None and (stored or files):

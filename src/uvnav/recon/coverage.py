@@ -20,7 +20,7 @@ Two checks that share nothing with the planner's samples:
   over the DEM; reported against all points and against those seen from some waypoint at Z_max
   (the ground a camera can see at all).
 
-Measured (``uvnav run``'s Chapter 7 rows, :func:`uvnav.bench.reproduce_ch7.coverage_rows`; 300 m
+Measured (``uvnav run``'s Chapter 7 rows, :func:`uvnav.experiments.ch7.coverage_rows`; 300 m
 and 600 m squares, R = 20/30/50 m, θ = 90°): altitudes that see the 5 m DEM nodes of each cell
 (:func:`.visibility.node_altitudes`) see only
 98.49 [ev:ch7-coverage.flat_600_R20_node_rule_grid_pct]–

@@ -148,10 +148,10 @@ def _run_job(job: Job) -> EpisodeRun:
 
 def fingerprint() -> str:
     """The code fingerprint of this chapter's campaigns: the packages that decide an episode
-    (``code_fingerprint`` of :mod:`uvnav.bench.reproduce`) and this module (its runner)."""
+    (``code_fingerprint`` of :mod:`uvnav.experiments.ch2`) and this module (its runner)."""
     from uvnav.bench.fingerprint import code_fingerprint
 
-    return extend_fingerprint(code_fingerprint(), "bench/reproduce_ch3.py")
+    return extend_fingerprint(code_fingerprint(), "experiments/ch3.py")
 
 
 def _announce(total: int) -> Callable[[JobOutcome, int], None]:

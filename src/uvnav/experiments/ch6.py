@@ -237,6 +237,13 @@ def reproduce_ch6(
     Returns:
         The summary (table rows "thesis vs measured", closed-loop means, arrays for figures).
     """
+    from uvnav.driving.collect import (
+        CollectParams,
+        collect,
+        dataset_meta,
+        meta_conflict,
+        recording_meta,
+    )
     from uvnav.driving.pipeline import (
         THROTTLE_MODES,
         Throttle,
@@ -248,13 +255,6 @@ def reproduce_ch6(
         fit_target_speed_readout,
         prepare_data,
         train_on,
-    )
-    from uvnav.driving.collect import (
-        CollectParams,
-        collect,
-        dataset_meta,
-        meta_conflict,
-        recording_meta,
     )
     from uvnav.driving.sim import DrivingSim
     from uvnav.learning import PilotNetConfig, TrainConfig

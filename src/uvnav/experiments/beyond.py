@@ -55,11 +55,11 @@ CAMPAIGNS: tuple[str, ...] = (OFFICE_CAMPAIGN, MULTI_CAMPAIGN)
 
 def fingerprint() -> str:
     """The code fingerprint of these campaigns: the packages that decide an episode
-    (``code_fingerprint`` of :mod:`uvnav.bench.reproduce`), :mod:`uvnav.planners` (hybrid-v1's
+    (``code_fingerprint`` of :mod:`uvnav.experiments.ch2`), :mod:`uvnav.planners` (hybrid-v1's
     D* Lite) and this module (its runner)."""
     from uvnav.bench.fingerprint import code_fingerprint
 
-    return extend_fingerprint(code_fingerprint(), "planners", "bench/reproduce_beyond.py")
+    return extend_fingerprint(code_fingerprint(), "planners", "experiments/beyond.py")
 
 
 def office_job(law: str, scenario: str = "office-floor", *, hybrid: bool = False) -> Job:

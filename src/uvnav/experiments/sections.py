@@ -5,7 +5,7 @@ by ``uvnav run`` and ``uvnav reproduce NAME``) turns what its reproduction retur
 object: ``.table`` rows, ``.figures`` files) into a :class:`ChapterSection` with a
 ``*_section`` builder: the thesis chapters' builders are here, the
 crowd section's and the regime map's beside their runs
-(:func:`uvnav.bench.reproduce_crowds.crowds_section`, :func:`uvnav.bench.regime.regime_section`).
+(:func:`uvnav.experiments.crowds.crowds_section`, :func:`uvnav.experiments.regime.regime_section`).
 The renderer (:func:`uvnav.viz.reproduction.render_reproduction`) hands the sections to
 :func:`uvnav.viz.report.write_report`, which gives each a heading, its intro paragraph, its rows of
 the "thesis reported vs uvnav measured" table, its figures with captions and links to its other
@@ -183,8 +183,8 @@ def _ch3_caption(p: Path) -> str:
 def ch3_section(
     summary: Any, *, full: bool, n_random: int | None = None, start_seed: int = 0
 ) -> ChapterSection:
-    """The Chapter 3 section from a :class:`uvnav.bench.reproduce_ch3.Ch3Summary`."""
-    from uvnav.bench import reproduce_ch3 as r3
+    """The Chapter 3 section from a :class:`uvnav.experiments.ch3.Ch3Summary`."""
+    import uvnav.experiments.ch3 as r3
 
     n = n_random if n_random is not None else (r3.FULL_SEEDS if full else r3.QUICK_SEEDS)
     intro = (
@@ -240,9 +240,9 @@ def _ch4_caption(p: Path) -> str:
 def ch4_section(
     summary: Any, *, full: bool, seeds: int | None = None, start_seed: int = 0
 ) -> ChapterSection:
-    """The Chapter 4 section from a :class:`uvnav.bench.reproduce_ch4.Ch4Summary` (``seeds``:
+    """The Chapter 4 section from a :class:`uvnav.experiments.ch4.Ch4Summary` (``seeds``:
     the run's override of every family's seed count)."""
-    from uvnav.bench import reproduce_ch4 as r4
+    import uvnav.experiments.ch4 as r4
 
     n = seeds if seeds is not None else (r4.FULL_SEEDS if full else r4.QUICK_SEEDS)
     nn = seeds if seeds is not None else (r4.FULL_NOISE_SEEDS if full else r4.QUICK_NOISE_SEEDS)
@@ -272,7 +272,7 @@ def ch4_section(
 
 
 def _ch5_caption(p: Path) -> str:
-    from uvnav.bench import reproduce_ch5 as r5
+    import uvnav.experiments.ch5 as r5
 
     s = p.stem
     if s == "ch5_array":
@@ -305,10 +305,10 @@ def _ch5_caption(p: Path) -> str:
 
 
 def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
-    """The Chapter 5 section from a :class:`uvnav.bench.reproduce_ch5.Ch5Summary`."""
+    """The Chapter 5 section from a :class:`uvnav.experiments.ch5.Ch5Summary`."""
     import json
 
-    from uvnav.bench import reproduce_ch5 as r5
+    import uvnav.experiments.ch5 as r5
 
     cfg: dict[str, Any] = {}
     p = getattr(summary, "json_path", None)
@@ -373,7 +373,7 @@ _CH6_CAPTIONS = {
 
 
 def ch6_section(summary: Any | None, *, full: bool) -> ChapterSection:
-    """The Chapter 6 section from a :class:`uvnav.bench.reproduce_ch6.Ch6Summary` (``None``: not
+    """The Chapter 6 section from a :class:`uvnav.experiments.ch6.Ch6Summary` (``None``: not
     run, as in a test-sized run)."""
     title = "Chapter 6 — a CNN that drives (PilotNet on CarRacing)"
     if summary is None:
@@ -433,8 +433,8 @@ def _ch7_caption(p: Path) -> str:
 
 
 def ch7_section(summary: Any, *, full: bool) -> ChapterSection:
-    """The Chapter 7 section from a :class:`uvnav.bench.reproduce_ch7.Ch7Summary`."""
-    from uvnav.bench import reproduce_ch7 as r7
+    """The Chapter 7 section from a :class:`uvnav.experiments.ch7.Ch7Summary`."""
+    import uvnav.experiments.ch7 as r7
 
     if full:
         plans = "synthetic and Jacksboro terrains × 300/600 m × R 20/30/50 m"
@@ -488,7 +488,7 @@ def beyond_section(
     rows: Sequence[Mapping[str, Any]], figures: Sequence[Path], *, full: bool
 ) -> ChapterSection:
     """The issue-9 section: global + local navigation (office floor) and multi-robot swap."""
-    from uvnav.bench import reproduce_beyond as rb
+    import uvnav.experiments.beyond as rb
 
     laws = rb.FULL_LAWS if full else rb.QUICK_LAWS
     swap = ", ".join(

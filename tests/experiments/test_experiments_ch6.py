@@ -10,8 +10,8 @@ import pytest
 pytest.importorskip("torch")
 pytest.importorskip("gymnasium")
 
-from uvnav.bench.reproduce_ch6 import reproduce_ch6
 from uvnav.driving.dataset import read_log
+from uvnav.experiments.ch6 import reproduce_ch6
 
 
 def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
@@ -69,7 +69,7 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     figs = render_ch6(s, tmp_path / "figs")
     assert len(figs) == 6 and all(f.stat().st_size > 5000 for f in figs)
     # the report section of a quick run: every figure with its thesis caption, the table
-    from uvnav.bench.sections import ch6_section
+    from uvnav.experiments.sections import ch6_section
 
     s.figures = figs
     sec = ch6_section(s, full=False)
@@ -154,7 +154,7 @@ def test_full_chain_stages_and_resume(tmp_path: Path) -> None:
 
 
 def test_closed_loop_notes_name_the_tracks_with_interventions() -> None:
-    from uvnav.bench.reproduce_ch6 import _intervention_tracks
+    from uvnav.experiments.ch6 import _intervention_tracks
 
     tracks = [{"seed": 1000 + k, "interventions": n} for k, n in enumerate([0, 1, 0, 2])]
     assert _intervention_tracks(tracks) == "; interventions on tracks 1001 (1), 1003 (2)"

@@ -38,9 +38,9 @@ from typing import Any
 
 from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
 from uvnav.bench.jobs import Job
-from uvnav.bench.sections import ChapterSection, mode_text, rows_of
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
+from uvnav.experiments.sections import ChapterSection, mode_text, rows_of
 
 CAMPAIGN = "crowdnav"
 BEYOND_CAMPAIGN = "crowdnav-beyond"

@@ -9,8 +9,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from uvnav.bench import reproduce_ch5 as r5
-from uvnav.bench.reproduce_ch5 import (
+from uvnav.bench.store import ResultsStore
+from uvnav.experiments import ch5 as r5
+from uvnav.experiments.ch5 import (
     LAW,
     cached_dataset,
     ch5_job,
@@ -18,7 +19,6 @@ from uvnav.bench.reproduce_ch5 import (
     stored_rows,
     summarise,
 )
-from uvnav.bench.store import ResultsStore
 from uvnav.scenarios.ch5 import RANDOM_CH5_VERSION
 from uvnav.sensors.sonar_dataset import sample_sonar_dataset
 
@@ -187,7 +187,7 @@ def test_a_cache_of_the_older_layout_is_dropped(tmp_path: Path) -> None:
 def test_ch5_section_shows_the_animation_and_names_failures(tmp_path: Path) -> None:
     from types import SimpleNamespace
 
-    from uvnav.bench.sections import ch5_section
+    from uvnav.experiments.sections import ch5_section
 
     gif = tmp_path / "ch5_anim_thesis-ch5-scene3_network.gif"
     gif.write_bytes(b"GIF89a")
@@ -259,7 +259,7 @@ def test_model_keys_name_every_variant_and_nothing_else() -> None:
     for variant, suffix in r5.VARIANT_KEYS.items():  # every config variant has a key and label
         assert r5.split_model_key(f"n7{suffix}") == (7, variant)
         assert variant in r5.VARIANT_LABELS
-    from uvnav.bench.sections import _ch5_caption
+    from uvnav.experiments.sections import _ch5_caption
 
     caption = _ch5_caption(Path("ch5_errors_n150h_independent.png"))
     assert "150-sample residual (Huber loss) network on the independent test set" in caption

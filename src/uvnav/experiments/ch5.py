@@ -398,11 +398,11 @@ def ch5_job(
 
 def fingerprint() -> str:
     """The code fingerprint of this chapter's campaigns: the packages that decide an episode
-    (``code_fingerprint`` of :mod:`uvnav.bench.reproduce`), :mod:`uvnav.learning` (the
+    (``code_fingerprint`` of :mod:`uvnav.experiments.ch2`), :mod:`uvnav.learning` (the
     network's locator) and this module (its runner)."""
     from uvnav.bench.fingerprint import code_fingerprint
 
-    return extend_fingerprint(code_fingerprint(), "learning", "bench/reproduce_ch5.py")
+    return extend_fingerprint(code_fingerprint(), "learning", "experiments/ch5.py")
 
 
 def checkpoint_digest(path: Path) -> str:
