@@ -303,7 +303,7 @@ def _ch4_fig47(quick: bool) -> Figures:
 def _ch5_literal(quick: bool) -> Figures:
     import numpy as np
 
-    from uvnav.experiments.ch5 import (
+    from uvnav.experiments.ch5_bpnn import (
         ACCEPTED_SAMPLES,
         TEST_SEED,
         THESIS_ERROR_RANGES,
@@ -344,7 +344,7 @@ def _ch5_literal(quick: bool) -> Figures:
 def _ch5_geometry(quick: bool) -> Figures:
     import numpy as np
 
-    from uvnav.experiments.ch5 import TEST_SEED, cached_dataset, learning_row, seed_succeeds
+    from uvnav.experiments.ch5_bpnn import TEST_SEED, cached_dataset, learning_row, seed_succeeds
     from uvnav.learning.bpnn import VARIANTS, variant_config
 
     test, _ = cached_dataset(500, TEST_SEED, None, None)

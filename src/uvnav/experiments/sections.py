@@ -272,7 +272,7 @@ def ch4_section(
 
 
 def _ch5_caption(p: Path) -> str:
-    import uvnav.experiments.ch5 as r5
+    import uvnav.experiments.ch5_bpnn as b5
 
     s = p.stem
     if s == "ch5_array":
@@ -282,12 +282,12 @@ def _ch5_caption(p: Path) -> str:
             "Learning curve: test error of the BPNN as the sample count grows, beside the "
             "min/argmin-of-readings baseline."
         )
-    if (m := re.fullmatch(r"ch5_training_(n\w+)", s)) and (nv := r5.split_model_key(m[1])):
-        kind = r5.VARIANT_LABELS[nv[1]]
+    if (m := re.fullmatch(r"ch5_training_(n\w+)", s)) and (nv := b5.split_model_key(m[1])):
+        kind = b5.VARIANT_LABELS[nv[1]]
         return f"BPNN training on {nv[0]} samples, {kind} network: loss per epoch."
     m = re.fullmatch(r"ch5_errors_(n[^_]+)_(test_group|independent)", s)
-    if m and (nv := r5.split_model_key(m[1])):
-        kind = r5.VARIANT_LABELS[nv[1]]
+    if m and (nv := b5.split_model_key(m[1])):
+        kind = b5.VARIANT_LABELS[nv[1]]
         where = "its own test group" if m[2] == "test_group" else "the independent test set"
         return (
             f"Figs. 5.5–5.8 style: errors and target-vs-output of the {nv[0]}-sample {kind} "
@@ -309,13 +309,14 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
     import json
 
     import uvnav.experiments.ch5 as r5
+    import uvnav.experiments.ch5_bpnn as b5
 
     cfg: dict[str, Any] = {}
     p = getattr(summary, "json_path", None)
     if p is not None and Path(p).is_file():  # what was run, as ch5.json records it
         cfg = json.loads(Path(p).read_text(encoding="utf-8")).get("config", {})
-    sizes = cfg.get("sizes", r5.FULL_SIZES if full else r5.QUICK_SIZES)
-    seeds = cfg.get("seeds", r5.FULL_SEEDS if full else r5.QUICK_SEEDS)
+    sizes = cfg.get("sizes", b5.FULL_SIZES if full else b5.QUICK_SIZES)
+    seeds = cfg.get("seeds", b5.FULL_SEEDS if full else b5.QUICK_SEEDS)
     n_rand = cfg.get("n_random", r5.FULL_RANDOM if full else r5.QUICK_RANDOM)
     first = int(cfg.get("start_seed", 0))
     n_dense = cfg.get("n_dense", r5.FULL_DENSE if full else r5.QUICK_DENSE)

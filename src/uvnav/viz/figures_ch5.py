@@ -20,7 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from uvnav.experiments.ch5 import VARIANT_LABELS, split_model_key
+from uvnav.experiments.ch5_bpnn import VARIANT_LABELS, split_model_key
 from uvnav.geometry.angles import FloatArray
 from uvnav.learning.bpnn import TrainedBPNN
 from uvnav.obstacles.deforming3d import CompoundBody
