@@ -18,8 +18,9 @@ sections to a *renderer* passed in by the caller (the CLI passes
 ``uvnav run`` (:func:`uvnav.experiments.run_all`) are experiments of their own; there Chapter 2's
 :func:`finish` writes the page with every experiment's section.
 
-Layering (DESIGN §1): ``uvnav.viz`` sits above ``uvnav.bench`` in the layers, so this module never
-imports it: the renderer is injected (``render=``), which keeps the layer contract enforceable.
+Layering (DESIGN §1): ``uvnav.viz`` sits above ``uvnav.experiments`` in the layers, so this
+module never imports it: the renderer is injected (``render=``), which keeps the layer contract
+enforceable.
 ``matplotlib`` is never imported here.
 
 Resume and staleness: every campaign carries a fingerprint of the code and scenario files that

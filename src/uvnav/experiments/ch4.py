@@ -35,7 +35,7 @@ from the stored rows, never typed in. The thesis reports no numbers for Chapter 
 (:func:`target_approach_check` on the recorded run).
 
 Figures are made by a renderer injected by the caller (``render=``; the CLI passes
-:func:`uvnav.viz.figures_ch4.render_ch4`), because ``bench`` (layer 6) must not import ``viz``.
+:func:`uvnav.viz.figures_ch4.render_ch4`), because ``viz`` is a layer above this one (DESIGN §1).
 """
 
 from __future__ import annotations

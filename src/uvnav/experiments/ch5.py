@@ -480,7 +480,7 @@ def reproduce_ch5(
     cache = results_dir / "ch5" / "cache"
     db_path = results_dir / DB_NAME
     if cache.exists() and (fresh or not (cache / STAGES_DIR).is_dir()):
-        shutil.rmtree(cache)  # asked for, or a cache of the older layout (recomputed cleanly)
+        shutil.rmtree(cache)  # asked for, or a cache without stages/ (recomputed cleanly)
     fp = fingerprint()
     with ResultsStore(db_path) as store:
         check_fingerprints(store, dict.fromkeys(CAMPAIGNS, fp))  # before any training

@@ -1,4 +1,4 @@
-"""CrowdNav's crowds for every 2D law: the ``crowds`` section of ``uvnav run`` (issue 18).
+"""CrowdNav's crowds for every 2D law: the ``crowds`` section of ``uvnav run``.
 
 :func:`reproduce_crowds` runs every registered 2D law — the unicycle laws and the holonomic ones
 (:func:`uvnav.controllers.base.available_controllers`) — on CrowdNav's test cases of circle and

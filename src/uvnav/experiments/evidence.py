@@ -1,5 +1,5 @@
 """Evidence: the measured figures quoted in ``docs/thesis-notes.md`` and the module docstrings,
-regenerated from a fresh run (issue 21, item 4).
+regenerated from a fresh run.
 
 A justification such as "the literal speed law collides at 8.42 m on Fig. 2.10" goes stale the day
 the code changes unless something re-measures it.  Here every such figure is a *field* of a

@@ -1,4 +1,4 @@
-"""Where each law wins: the regime map campaign and its generated recommendations (issue 19).
+"""Where each law wins: the regime map campaign and its generated recommendations.
 
 The regime map runs every registered 2D law (:func:`uvnav.experiments.crowds.crowd_laws`: the
 unicycle laws and the holonomic ones, so laws registered later join by themselves) on CrowdNav's

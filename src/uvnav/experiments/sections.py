@@ -1,7 +1,7 @@
 """One report section per chapter: the contract between the reproductions and the HTML report.
 
-Each chapter's run (:mod:`uvnav.experiments.builtin`, an experiment of :mod:`uvnav.experiments` run
-by ``uvnav run`` and ``uvnav reproduce NAME``) turns what its reproduction returns (its summary
+Each chapter's run (:mod:`uvnav.experiments.builtin`, an experiment of :mod:`uvnav.experiments`
+run by ``uvnav run`` and ``uvnav reproduce NAME``) turns what its reproduction returns (its summary
 object: ``.table`` rows, ``.figures`` files) into a :class:`ChapterSection` with a
 ``*_section`` builder: the thesis chapters' builders are here, the
 crowd section's and the regime map's beside their runs
@@ -12,9 +12,10 @@ the "thesis reported vs uvnav measured" table, its figures with captions and lin
 files (interactive 3D views, JSON results).  :func:`save_section` and :func:`load_sections` keep
 the last section of every chapter next to the results database, in :data:`SECTION_ORDER`.
 
-Figures are *drawn* only in ``viz`` (layer 7), above this module: chapters whose figures need a
+Figures are *drawn* only in ``viz``, the layer above this package: chapters whose figures need a
 renderer receive it injected through :class:`ChapterRenderers` (the CLI builds one with
-:func:`uvnav.viz.reproduction.chapter_renderers`), so ``bench`` never imports ``viz`` (DESIGN §1).
+:func:`uvnav.viz.reproduction.chapter_renderers`), so ``uvnav.experiments`` never imports ``viz``
+(DESIGN §1).
 
 A new experiment builds its section itself and registers as an
 :class:`uvnav.experiments.Experiment` (one module, see :mod:`uvnav.experiments`); the built-ins'
@@ -78,7 +79,7 @@ Ch4Renderer = Callable[..., list[Path]]
 SummaryRenderer = Callable[[Any, Path], list[Path]]
 #: Draws one Ch. 7 plan: ``(plan, path prefix) -> files``.
 PlanRenderer = Callable[[Any, Path], list[Path]]
-#: Runs and draws the issue-9 figures into a folder: ``(out_dir) -> files``.
+#: Runs and draws the beyond-the-thesis figures into a folder: ``(out_dir) -> files``.
 FolderRenderer = Callable[[Path], list[Path]]
 
 
@@ -488,7 +489,8 @@ def _beyond_caption(p: Path) -> str:
 def beyond_section(
     rows: Sequence[Mapping[str, Any]], figures: Sequence[Path], *, full: bool
 ) -> ChapterSection:
-    """The issue-9 section: global + local navigation (office floor) and multi-robot swap."""
+    """The beyond-the-thesis section: global + local navigation (office floor) and multi-robot
+    swap."""
     import uvnav.experiments.beyond as rb
 
     laws = rb.FULL_LAWS if full else rb.QUICK_LAWS
