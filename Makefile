@@ -59,7 +59,7 @@ lint: $(STAMP_TEST)
 
 # every measured figure quoted in docs/thesis-notes.md, regenerated (both sizes) into the record
 evidence: $(STAMP_RUN)
-	$(PY) -m uvnav.bench.evidence --write docs/evidence.json
+	$(PY) -m uvnav.experiments.evidence --write docs/evidence.json
 
 # a peer that does not install is not fatal: its script records "available": false
 $(STAMP_PEERS): pyproject.toml $(STAMP_RUN) | $(PY)

@@ -106,7 +106,7 @@ def main() -> None:
         dec[name] = _median_time(lambda c=ctrl: c.act(obs), repeat * 20) * 1e6
     import tempfile
 
-    from uvnav.bench.reproduce_ch5 import ch5_job, run_ch5_job
+    from uvnav.experiments.ch5 import ch5_job, run_ch5_job
     from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
     from uvnav.viz.figures_ch5 import save_animation3d
 

@@ -186,7 +186,7 @@ def bench_closed_loop(backend: str, steps: int) -> float:
     """Closed-loop control steps per second (frame → network → command → physics step)."""
     import torch
 
-    from uvnav.bench.ch6_pipeline import cnn_policy
+    from uvnav.driving.pipeline import cnn_policy
     from uvnav.driving.sim import DrivingSim
     from uvnav.learning import PilotNetConfig
     from uvnav.learning.pilotnet import build_pilotnet

@@ -32,7 +32,7 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.bench.reproduce_ch7 import experiment_terrain
+from uvnav.experiments.ch7 import experiment_terrain
 from uvnav.recon.plan import ReconConfig, ground_truth_coverage, plan_recon
 from uvnav.recon.tour import distance_matrix, rotate_to_start, tour_length, tsp_order
 

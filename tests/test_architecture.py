@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pkgutil
+import re
 import shutil
 import subprocess
 import sys
@@ -121,3 +122,29 @@ def test_low_layers_do_not_import_heavy_dependencies(module: str) -> None:
         [sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True
     )
     assert proc.stdout.strip() == "", f"importing {module} loaded {proc.stdout.strip()}"
+
+
+SRC = ROOT / "src" / "uvnav"
+#: a chapter's name in any spelling: what the campaign engine must not mention
+CHAPTER = re.compile(r"ch[2-7]|chapter", re.IGNORECASE)
+
+
+def test_bench_is_the_campaign_engine_only() -> None:
+    """The experiments live in uvnav.experiments; no module of bench names a chapter."""
+    named = [
+        f"{p.relative_to(SRC)}:{n}"
+        for p in sorted((SRC / "bench").rglob("*.py"))
+        for n, line in enumerate(p.read_text(encoding="utf-8").splitlines(), 1)
+        if CHAPTER.search(line)
+    ]
+    assert named == [], f"bench names a chapter: {', '.join(named)}"
+
+
+@pytest.mark.parametrize("package", ["bench", "experiments"])
+def test_no_module_of_the_engine_or_the_experiments_exceeds_800_lines(package: str) -> None:
+    long = {
+        str(p.relative_to(SRC)): n
+        for p in sorted((SRC / package).rglob("*.py"))
+        if (n := len(p.read_text(encoding="utf-8").splitlines())) > 800
+    }
+    assert long == {}

@@ -376,7 +376,7 @@ class FakeSummary:
 def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
     calls: list[dict[str, Any]] = []
 
-    from uvnav.bench.sections import ChapterRenderers, ChapterSection
+    from uvnav.experiments.sections import ChapterRenderers, ChapterSection
 
     row = {
         "quantity": "path length Fig. 2.10 (Zhang)",

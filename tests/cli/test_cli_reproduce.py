@@ -10,7 +10,6 @@ import pytest
 from typer.testing import CliRunner
 
 import uvnav.experiments as experiments
-from uvnav.bench.sections import SECTIONS_DIR, ChapterRenderers, ChapterSection, save_section
 from uvnav.bench.store import ResultsStore, StaleCampaignError
 from uvnav.cli.app import app
 from uvnav.experiments import (
@@ -19,6 +18,7 @@ from uvnav.experiments import (
     Reproduction,
     report_sections,
 )
+from uvnav.experiments.sections import SECTIONS_DIR, ChapterRenderers, ChapterSection, save_section
 
 runner = CliRunner()
 
@@ -132,7 +132,7 @@ def test_the_old_entry_points_are_gone() -> None:
     for args in (["ch4", "run"], ["sonar", "reproduce"]):
         result = runner.invoke(app, args)
         assert result.exit_code == 2, (args, result.output)
-    import uvnav.bench.reproduce_ch3 as r3
+    import uvnav.experiments.ch3 as r3
 
     assert not hasattr(r3, "main")
 
@@ -157,7 +157,7 @@ def test_forget_removes_only_the_named_campaigns(tmp_path: Path) -> None:
 def test_report_rebuilds_the_chapter_sections_it_can(tmp_path: Path) -> None:
     """``uvnav report DB`` of a ``uvnav run`` database keeps the chapters: saved sections as
     they are, Ch. 2 rebuilt from its stored rows, the rest named with the command to rerun."""
-    from uvnav.bench import reproduce as rp
+    from uvnav.experiments import ch2 as rp
 
     db = tmp_path / "uvnav.sqlite"
     with ResultsStore(db) as store:
@@ -199,7 +199,7 @@ def test_report_rebuilds_the_chapter_sections_it_can(tmp_path: Path) -> None:
 def test_reproduce_crowds_runs_the_crowd_section(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    from uvnav.bench import reproduce_crowds as rc
+    from uvnav.experiments import crowds as rc
 
     # two laws instead of every 2D law (the rest of the run is real: 2 cases per scene)
     monkeypatch.setattr(rc, "crowd_laws", lambda: (["orca-holonomic-v1", "zhang2019-v1"], []))

@@ -117,5 +117,5 @@ def test_a_list_is_a_tuple_parameter() -> None:
     it as that tuple, and its items are still checked."""
     law = make_law("zhang2019-v2", speed_levels=[1.0, 0.5])
     assert law.params.speed_levels == (1.0, 0.5)
-    with pytest.raises(ControllerParamsError, match="speed_levels.1: expected a number"):
+    with pytest.raises(ControllerParamsError, match=r"speed_levels\.1: expected a number"):
         make_law("zhang2019-v2", speed_levels=[1.0, "fast"])

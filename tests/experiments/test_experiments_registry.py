@@ -13,7 +13,6 @@ import pytest
 from typer.testing import CliRunner
 
 import uvnav.core
-from uvnav.bench.sections import SECTION_ORDER, SECTIONS_DIR, ChapterSection, save_section
 from uvnav.cli.app import app
 from uvnav.experiments import (
     EXPERIMENT_GROUP,
@@ -29,6 +28,7 @@ from uvnav.experiments import (
     run_experiment,
     saved_sections,
 )
+from uvnav.experiments.sections import SECTION_ORDER, SECTIONS_DIR, ChapterSection, save_section
 
 PLUGIN = Path(__file__).resolve().parents[1] / "plugins" / "dummy_experiment"
 

@@ -101,7 +101,7 @@ def test_an_old_format_bpnn_checkpoint_still_loads(tmp_path: Path) -> None:
     assert back.config == m.config and back.best_epoch == m.best_epoch
     np.testing.assert_array_equal(back.split["test"], m.split["test"])
     # the Ch. 5 digest covers the weights only: the same network in either format, same digest
-    from uvnav.bench.reproduce_ch5 import checkpoint_digest
+    from uvnav.experiments.ch5 import checkpoint_digest
 
     bpnn.save_checkpoint(back, tmp_path / "new")
     assert checkpoint_digest(tmp_path / "new") == checkpoint_digest(tmp_path / "old")

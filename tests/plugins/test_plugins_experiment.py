@@ -17,8 +17,8 @@ from pathlib import Path
 
 import pytest
 
-from uvnav.bench.sections import SECTIONS_DIR, ChapterSection, save_section
 from uvnav.bench.store import ResultsStore
+from uvnav.experiments.sections import SECTIONS_DIR, ChapterSection, save_section
 
 PLUGIN = Path(__file__).with_name("dummy_experiment")
 

@@ -78,7 +78,7 @@ def ch3(scene: str, law: str, seed: int, known: bool) -> dict[str, Any]:
 
 
 def ch4(scene: str, law: str, seed: int, noise: float) -> dict[str, Any]:
-    from uvnav.bench.reproduce_ch4 import ch4_job, run_ch4_job
+    from uvnav.experiments.ch4 import ch4_job, run_ch4_job
 
     _row, res = run_ch4_job(ch4_job(scene, law, seed, noise_std=noise), record=True)
     tr = res.trajectory
@@ -94,7 +94,7 @@ def ch4(scene: str, law: str, seed: int, noise: float) -> dict[str, Any]:
 
 
 def ch5(scene: str, locator: str, seed: int, noise: float) -> dict[str, Any]:
-    from uvnav.bench.reproduce_ch5 import ch5_job, run_ch5_job
+    from uvnav.experiments.ch5 import ch5_job, run_ch5_job
 
     _, res = run_ch5_job(ch5_job(scene, locator, seed, noise_std=noise), record=True)
     return {

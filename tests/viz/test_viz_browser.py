@@ -18,10 +18,10 @@ from pathlib import Path
 import pytest
 import report_layout as layout
 
-from uvnav.bench import regime
 from uvnav.bench.campaign import Job, run_campaign
-from uvnav.bench.sections import ChapterSection, SectionFile
 from uvnav.bench.store import ResultsStore
+from uvnav.experiments import regime
+from uvnav.experiments.sections import ChapterSection, SectionFile
 from uvnav.sim import EpisodeResult
 from uvnav.viz.figures import plot_episode
 from uvnav.viz.report import write_report

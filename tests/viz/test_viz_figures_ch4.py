@@ -6,7 +6,7 @@ from pathlib import Path
 
 import matplotlib.pyplot as plt
 
-from uvnav.bench.reproduce_ch4 import ch4_job, run_ch4_job
+from uvnav.experiments.ch4 import ch4_job, run_ch4_job
 from uvnav.viz.figures_ch4 import (
     first_avoidance,
     plot_amaps,

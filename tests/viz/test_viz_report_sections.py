@@ -13,10 +13,10 @@ import pytest
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
-from uvnav.bench import sections as sec
 from uvnav.bench.campaign import Job, run_campaign
-from uvnav.bench.sections import ChapterRenderers, ChapterSection, SectionFile
 from uvnav.bench.store import ResultsStore
+from uvnav.experiments import sections as sec
+from uvnav.experiments.sections import ChapterRenderers, ChapterSection, SectionFile
 from uvnav.viz.report import write_report
 from uvnav.viz.reproduction import chapter_renderers
 
@@ -126,7 +126,7 @@ def test_add_files_sorts_images_and_links(tmp_path: Path) -> None:
 
 def test_ch4_section_from_a_real_recorded_run(tmp_path: Path) -> None:
     """Chapter 4: one real thesis-scene run drawn by the CLI's renderer, then the section."""
-    from uvnav.bench.reproduce_ch4 import LAW, _table, ch4_job, run_ch4_job
+    from uvnav.experiments.ch4 import LAW, _table, ch4_job, run_ch4_job
 
     scene = "thesis-ch4-fig4-7-approach"
     r, res = run_ch4_job(ch4_job(scene, LAW, 0), record=True)
@@ -144,7 +144,7 @@ def test_ch4_section_from_a_real_recorded_run(tmp_path: Path) -> None:
 
 def test_beyond_section_from_a_real_swap(tmp_path: Path) -> None:
     """Issue 9: rows and a swap figure from a real 4-robot antipodal swap."""
-    from uvnav.bench.reproduce_beyond import ZHANG_MULTI, swap_rows
+    from uvnav.experiments.beyond import ZHANG_MULTI, swap_rows
     from uvnav.scenarios.multi import build_multi, load_multi_scenario
     from uvnav.sim.run import run_episode
     from uvnav.sim.seeding import run_rng

@@ -1,4 +1,4 @@
-"""Layer 6: benchmark campaigns — scenarios × controllers × seeds → a SQLite results store.
+"""Layer 6: the campaign engine — scenarios × controllers × seeds → a SQLite results store.
 
 * :mod:`uvnav.bench.store` — the results database (DESIGN §5).
 * :mod:`uvnav.bench.jobs` — picklable job descriptions, their outcomes and task sizes.
@@ -9,11 +9,9 @@
 * :mod:`uvnav.bench.ray_engine` — the jobs as Ray tasks (extra ``uvnav[bench]``; Ray is imported
   only when the engine runs).
 * :mod:`uvnav.bench.summary` — the per-controller table ``uvnav bench`` prints.
-* :mod:`uvnav.bench.reproduce` — the thesis Chapter 2 reproduction
-  (``from uvnav.bench.reproduce import reproduce``; the function is not re-exported here so that it
-  does not shadow its module).
-* :mod:`uvnav.bench.chapters` — one runner per chapter, registered as experiments in
-  :mod:`uvnav.experiments` (``uvnav reproduce NAME``, ``uvnav run``).
+
+The experiments that run campaigns on this engine (``uvnav reproduce NAME``, ``uvnav run``) are
+:mod:`uvnav.experiments`, a layer above; nothing here imports them.
 """
 
 from uvnav.bench.campaign import CampaignRun, Job, JobOutcome, grid_jobs, run_campaign, run_job

@@ -53,10 +53,11 @@ from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
-from uvnav.bench.jobs import EpisodeRun as EpisodeRun  # the chapters' runners return one
+from uvnav.bench.jobs import EpisodeRun as EpisodeRun  # what a job's runner returns
 from uvnav.bench.jobs import Job, JobOutcome, TaskSizer, sized_batches
 from uvnav.bench.ray_engine import import_ray, run_ray
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, EpisodeKey, ResultsStore
+from uvnav.scenarios.generators import DEFAULT_GENERATOR
 from uvnav.sim import EpisodeSetup, Trajectory, run_episode, run_rng
 
 ENGINES = ("local", "ray")
@@ -169,7 +170,7 @@ def run_job(job: Job) -> JobOutcome:
 
     Jobs with a scene (any kind) run through :func:`uvnav.scenarios.episodes.run_scene`, the
     path of ``uvnav simulate``; jobs with a ``setup_factory`` run the 2D loop directly, jobs with
-    a ``runner`` their chapter's own episode.  The outcome's ``cpu_time`` is this thread's.
+    a ``runner`` their experiment's own episode.  The outcome's ``cpu_time`` is this thread's.
     """
     cpu = time.thread_time()
     out = _run_job(job)
@@ -343,7 +344,7 @@ def run_stored(
 ) -> list[dict[str, Any]]:
     """Run ``jobs`` as campaign ``name`` (:func:`run_campaign`: each episode stored as it
     finishes, stored ones skipped) and return the :func:`stored_records` of the jobs, in job
-    order: the chapters' campaigns.
+    order: the campaigns of jobs with their own runner.
 
     Raises:
         RuntimeError: a job failed (stored with status ``error``; a later run retries it).
@@ -388,9 +389,9 @@ def default_mp_context() -> mp.context.BaseContext:
 
 
 def warm_up() -> None:
-    """Run one short episode (``straight-v1`` on random-ch2 scene 0) and drop it: the lazy
-    imports and the compiled kernels' loading that a process's first episode pays are paid
-    here, once (the fork server does, :mod:`uvnav.bench.forkserver_warm`; the workers it forks
+    """Run one short episode (``straight-v1`` on the default generator's scene 0) and drop it:
+    the lazy imports and the compiled kernels' loading that a process's first episode pays are
+    paid here, once (the fork server does, :mod:`uvnav.bench.forkserver_warm`; the workers it forks
     inherit them).  Never raises: a failure only leaves the workers to warm up themselves."""
     with suppress(Exception):  # warming up is an optimisation, never a failure
         run_job(Job(controller="straight-v1", seed=0, generator_seed=0))
@@ -640,7 +641,7 @@ def run_in_workers(
 ) -> None:
     """``handle(compute(item))`` for every item: ``compute`` in worker processes, ``handle`` here.
 
-    The loop of every resumable campaign (this module's and the chapters' own stores): workers
+    The loop of every resumable campaign (this module's and the experiments' own stores): workers
     only compute, this process writes each result as it finishes (one store transaction each),
     so an interrupted run keeps all it finished.  ``workers <= 1`` or a single item runs
     in-process, in order; otherwise results come in the order they finish.  ``compute`` must be
@@ -744,7 +745,7 @@ def grid_jobs(
     *,
     scenarios: Sequence[str] = (),
     generator_seeds: Iterable[int] | None = None,
-    generator: str = "random-ch2",
+    generator: str = DEFAULT_GENERATOR,
     record: bool = False,
 ) -> list[Job]:
     """The cartesian product scenarios × controllers × seeds as jobs.

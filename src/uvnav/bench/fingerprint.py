@@ -1,12 +1,13 @@
 """The results database's name, the code fingerprint of stored campaigns, and checked runs.
 
-Every reproduction writes into ``<results>/``:data:`DB_NAME`.  The 2D campaigns (Chapter 2, the
-crowds, the regime map) carry :func:`code_fingerprint` in their stored config; :func:`run_checked`
-refuses to resume a campaign stored by other code (:class:`~uvnav.bench.store.StaleCampaignError`,
-one line naming the campaigns to remove with ``uvnav forget``) before running any, so a table
-never mixes episodes of different code and no run deletes another run's episodes.
+Every experiment writes into ``<results>/``:data:`DB_NAME`.  A campaign carries
+:func:`code_fingerprint` (or that fingerprint extended with the experiment's own code,
+:func:`uvnav.bench.store.extend_fingerprint`) in its stored config; :func:`run_checked` refuses to
+resume a campaign stored by other code (:class:`~uvnav.bench.store.StaleCampaignError`, one line
+naming the campaigns to remove with ``uvnav forget``) before running any, so a table never mixes
+episodes of different code and no run deletes another run's episodes.
 
-This module imports only the campaign engine and the store, never a reproduction.
+This module imports only the campaign engine and the store.
 """
 
 from __future__ import annotations
@@ -44,8 +45,8 @@ def code_fingerprint() -> str:
     """Hash of the code and data that decide 2D episode outcomes.
 
     Covers the sources and scenario files under :data:`FINGERPRINT_PARTS` and the numpy version
-    (results are bitwise only for one numpy); not ``viz``, ``cli`` or other chapters' packages, so
-    editing those does not invalidate stored results.
+    (results are bitwise only for one numpy); not ``viz``, ``cli``, the experiments or other
+    packages, so editing those does not invalidate stored results.
 
     Returns:
         16 hex digits.

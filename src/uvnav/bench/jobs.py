@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from uvnav.bench.store import EpisodeKey, canonical_json, params_hash
+from uvnav.scenarios.generators import DEFAULT_GENERATOR
 from uvnav.sim import EpisodeSetup, Trajectory
 
 SetupFactory = Callable[[int], EpisodeSetup]
@@ -43,7 +44,7 @@ class Job:
         scenario: built-in scenario name or path to a YAML file.
         generator_seed: seed of the scenario generator named by ``generator``.
         generator: generator name, a key of :data:`uvnav.scenarios.GENERATORS` (default
-            ``"random-ch2"``).
+            :data:`uvnav.scenarios.generators.DEFAULT_GENERATOR`).
         generator_params: keyword arguments of the generator (a mapping is accepted and frozen to
             sorted pairs); they become part of the scenario label, hence of the resume key.
         setup_factory: a *module-level* (picklable) function ``seed -> EpisodeSetup``; needs
@@ -59,11 +60,11 @@ class Job:
         record: keep the trajectory and store it (for figures; costs memory and disk).
         beyond_assumptions: run the law even where the scene breaks an assumption it declares
             (thesis (2.6)); by default such an episode is stored as ``refused``.
-        tags: what identifies the episode beyond the controller parameters (a chapter's sensing
-            level, locator, ...): stored with them in the ``params`` column and part of the
+        tags: what identifies the episode beyond the controller parameters (an experiment's
+            sensing level, locator, ...): stored with them in the ``params`` column and part of the
             resume key, never passed to the law (a mapping is frozen to sorted pairs).
         runner: a *module-level* (picklable) function ``job -> (status, metrics, trajectory,
-            facts)`` running a chapter's own episode of ``label`` (a chapter's world set-up);
+            facts)`` running an experiment's own episode of ``label`` (its own world set-up);
             ``facts`` are stored in ``effective_params`` after the tags.
     """
 
@@ -71,7 +72,7 @@ class Job:
     seed: int
     scenario: str | None = None
     generator_seed: int | None = None
-    generator: str = "random-ch2"
+    generator: str = DEFAULT_GENERATOR
     generator_params: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
     setup_factory: SetupFactory | None = None
     label: str | None = None

@@ -18,9 +18,9 @@ num_cpus=workers)``; with no address a local instance) and is shut down again at
 that already called ``ray.init`` keeps its instance (tests start Ray once per module this way).
 
 What Ray adds to a campaign's CPU is measured by ``benchmarks/bench_ray.py``: on 2,000
-random-ch2 episodes and 2 workers, 0.8-1.6 CPU-ms per episode over the local pool (4-7 % of an
-episode's 20-21 CPU-ms; one job per task, as before, added 5.2), and its start-up about 3 CPU-s
-per campaign.
+episodes of the default generator's scenes and 2 workers, 0.8-1.6 CPU-ms per episode over the
+local pool (4-7 % of an episode's 20-21 CPU-ms; one job per task added 5.2), and its start-up
+about 3 CPU-s per campaign.
 
 A local instance started here listens on the loopback interface only (:func:`start_local_ray`):
 its GCS server, raylet, object manager, workers and agents accept no connection from the network.

@@ -1,14 +1,14 @@
 """Campaign files: a YAML description of scenarios × controllers × seeds, expanded into jobs.
 
-Example (``uvnav bench ch2.yaml``)::
+Example (``uvnav bench crowds.yaml``)::
 
-    name: ch2-baselines            # campaign name in the results database (the resume identity)
+    name: crowd-baselines          # campaign name in the results database (the resume identity)
     description: optional text
     scenarios:
-      - generator: random-ch2      # a seed generator of any kind (uvnav scenarios list)
+      - generator: crowdnav-circle # a seed generator of any kind (uvnav scenarios list)
         seeds: [0, 200]            # two integers: the range [start, stop)
-        params: {n_obstacles: 3}   # optional generator keyword arguments
-      - builtin: thesis-ch2-one-obstacle   # a built-in scene of any kind
+        params: {n_humans: 3}      # optional generator keyword arguments
+      - builtin: open-field        # a built-in scene of any kind
         seeds: {values: [0, 7]}    # explicit seeds (any list that is not two integers is too)
       - file: scenes/corridor.yaml # a scenario YAML file of any kind, relative to this file
         seeds: [0, 5]

@@ -6,13 +6,13 @@ One database file holds three tables:
     ``id``, ``name`` (unique), ``created`` (ISO 8601 UTC), ``config`` (JSON text).
 ``episodes``
     one row per finished episode: ``campaign_id``, ``scenario``, ``family`` (the scenario family a
-    report groups by, e.g. ``random-ch2`` for generated scenes), ``controller``, ``params_hash``,
-    ``params`` (JSON of the job's controller parameters, the hashed ones), ``effective_params``
-    (JSON of what the controller was finally built with), ``seed``, ``status`` (``success``,
-    ``collision``, ``timeout`` or ``error``), ``error`` (message, NULL unless status is ``error``),
-    every metric of :data:`uvnav.sim.METRIC_NAMES` as its own column under exactly that name,
-    ``wall_time`` [s] and ``created``.  ``UNIQUE(campaign_id, scenario, controller, params_hash,
-    seed)`` is the resume key.
+    report groups by, e.g. ``crowdnav-circle`` for generated scenes), ``controller``,
+    ``params_hash``, ``params`` (JSON of the job's controller parameters, the hashed ones),
+    ``effective_params`` (JSON of what the controller was finally built with), ``seed``, ``status``
+    (``success``, ``collision``, ``timeout`` or ``error``), ``error`` (message, NULL unless status
+    is ``error``), every metric of :data:`uvnav.sim.METRIC_NAMES` as its own column under exactly
+    that name, ``wall_time`` [s] and ``created``. ``UNIQUE(campaign_id, scenario, controller,
+    params_hash, seed)`` is the resume key.
 ``trajectories``
     ``episode_id`` and ``data``: a compressed ``.npz`` blob of the :class:`uvnav.sim.Trajectory`
     arrays (optional, written only for recorded episodes).

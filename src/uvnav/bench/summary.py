@@ -152,10 +152,10 @@ def simulate_spec(label: str) -> str:
     JSON, which ``--gen-param`` reads as YAML); any other label (a built-in name, a file, a
     campaign's own label) is returned as stored.
 
-    >>> simulate_spec("random-ch2/0017")
-    'random-ch2:17'
-    >>> simulate_spec('random-ch2[n_obstacles=3,speeds=[0.5,1]]/0017')
-    "random-ch2:17 --gen-param n_obstacles=3 --gen-param 'speeds=[0.5,1]'"
+    >>> simulate_spec("crowdnav-circle/0017")
+    'crowdnav-circle:17'
+    >>> simulate_spec('crowdnav-circle[n_humans=3,velocities=[0.5,1]]/0017')
+    "crowdnav-circle:17 --gen-param n_humans=3 --gen-param 'velocities=[0.5,1]'"
     >>> simulate_spec("unknown-generator[a=1]/0017")
     'unknown-generator[a=1]/0017'
     >>> simulate_spec("scenes/0017")
@@ -221,8 +221,8 @@ def _social(ok: Any) -> dict[str, float | None]:
 
 def outcome_stats(rows: list[dict[str, Any]]) -> dict[str, Any]:
     """Outcome statistics of a group of episode rows (dicts with ``status``, ``path_length``,
-    ``detour_ratio``, ``min_clearance``, ``decision_us_median``), as the chapter reproductions
-    (Ch. 4, Ch. 5) summarise them: ``episodes``, ``success_rate``, ``collision_rate``,
+    ``detour_ratio``, ``min_clearance``, ``decision_us_median``), as the experiments summarise
+    them: ``episodes``, ``success_rate``, ``collision_rate``,
     ``timeout_rate``, the medians of path length [m], detour ratio and decision time [µs], and the
     smallest ``min_clearance`` [m] (None where no row has the value)."""
     n = len(rows)

@@ -2,7 +2,7 @@
 reproduce.
 
 Thin Typer commands over :mod:`uvnav.driving`, :mod:`uvnav.learning` and
-:mod:`uvnav.bench.ch6_pipeline`.  User errors (a missing or malformed dataset or model, a bad
+:mod:`uvnav.driving.pipeline`.  User errors (a missing or malformed dataset or model, a bad
 seed list, a missing extra) are raised as :class:`~uvnav.cli.errors.CliError`: ONE line
 ``error: ...`` and exit status 2 (the CLI's one error path).
 """
@@ -177,7 +177,7 @@ def train(
 ) -> None:
     """Train the Chapter 6 CNN (Adam, MSE) and write the model and its loss curves."""
     with _user_errors():
-        from uvnav.bench.ch6_pipeline import prepare_data, train_on
+        from uvnav.driving.pipeline import prepare_data, train_on
         from uvnav.learning import PilotNetConfig, TrainConfig
 
         second = _parse_head(head)
@@ -257,7 +257,7 @@ def speed_head(
 ) -> None:
     """Replace the throttle output by a linear target-speed readout (steering unchanged)."""
     with _user_errors():
-        from uvnav.bench.ch6_pipeline import fit_target_speed_readout, prepare_data
+        from uvnav.driving.pipeline import fit_target_speed_readout, prepare_data
         from uvnav.learning.checkpoint import load_checkpoint, save_checkpoint
 
         net, _ = load_checkpoint(model)
@@ -320,9 +320,9 @@ def _load_policy(
     """The model's policy and the simulator settings it was trained for: ``(policy, on_reset,
     DrivingSim keyword arguments)`` — the camera, and the front camera's field of view from the
     training record (90° for checkpoints older than that record)."""
-    from uvnav.bench.ch6_pipeline import THROTTLE_MODES, cnn_policy
     from uvnav.driving.camera import CameraSpec
     from uvnav.driving.collect import LEGACY_FOV_DEG
+    from uvnav.driving.pipeline import THROTTLE_MODES, cnn_policy
     from uvnav.learning.checkpoint import load_checkpoint
 
     if throttle not in THROTTLE_MODES:
@@ -380,9 +380,9 @@ def evaluate(
 ) -> None:
     """Closed loop on held-out tracks: return, tiles %, laps, centre distance, autonomy."""
     with _user_errors():
-        from uvnav.bench.ch6_pipeline import default_learned_mode
-        from uvnav.bench.ch6_pipeline import evaluate as run_eval
         from uvnav.driving.evaluate import expert_policy, summarize
+        from uvnav.driving.pipeline import default_learned_mode
+        from uvnav.driving.pipeline import evaluate as run_eval
         from uvnav.driving.sim import DrivingSim
         from uvnav.learning.checkpoint import load_checkpoint
 
@@ -530,9 +530,9 @@ def dagger(
 ) -> None:
     """DAgger: the CNN drives, the expert labels, retrain; prints closed loop per round."""
     with _user_errors():
-        from uvnav.bench.ch6_pipeline import THROTTLE_MODES, cnn_policy, run_dagger
-        from uvnav.bench.ch6_pipeline import evaluate as run_eval
         from uvnav.driving.evaluate import summarize
+        from uvnav.driving.pipeline import THROTTLE_MODES, cnn_policy, run_dagger
+        from uvnav.driving.pipeline import evaluate as run_eval
         from uvnav.learning.checkpoint import load_checkpoint
 
         if throttle not in THROTTLE_MODES:
@@ -608,7 +608,7 @@ def reproduce(
         from rich.console import Console
         from rich.table import Table
 
-        from uvnav.bench.reproduce_ch6 import reproduce_ch6
+        from uvnav.experiments.ch6 import reproduce_ch6
         from uvnav.viz.figures_ch6 import render_ch6
 
         con = Console(stderr=True)

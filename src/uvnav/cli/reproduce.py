@@ -244,8 +244,8 @@ def _print_rows(sections: list[Any]) -> None:
 
 def _print_regime_leaders(db: Path) -> None:
     """The regime map on one screen: per regime the law that succeeds most often."""
-    from uvnav.bench.regime import cell_stats, leaders
     from uvnav.bench.store import ResultsStore
+    from uvnav.experiments.regime import cell_stats, leaders
 
     with ResultsStore(db, readonly=True) as store:
         rows = leaders(cell_stats(store))

@@ -54,7 +54,7 @@ in docs/thesis-notes.md, where the reasons are given at more length):
    8.42 m [ev:ch2-notes.fig210_tangent_path_m] of path where the default arrives after
    14.46 m [ev:ch2-notes.fig210_default_path_m], and it is less safe on the random Chapter-2
    scenes (97.5 % [ev:ch2-notes.random_tangent_pct] success against
-   99 % [ev:ch2-notes.random_default_pct], seeds 0-199; ``python -m uvnav.bench.evidence``
+   99 % [ev:ch2-notes.random_default_pct], seeds 0-199; ``python -m uvnav.experiments.evidence``
    regenerates these figures, docs/thesis-notes.md), so the default is
    ``speed_law="max"`` — V_max in M2 as in M1 — with ``turn_slowdown``: V_R scaled by cos(beta_J)
    (a unicycle cannot follow a direction change faster than U_max; slowing while turning keeps the

@@ -1,24 +1,29 @@
 """uvnav's own experiments: the thesis chapters ``ch2`` … ``ch7``, ``crowds``, ``regime`` and
-``beyond``, each a thin adapter over its runner in :mod:`uvnav.bench.chapters` (Chapter 2:
-:func:`uvnav.bench.reproduce.run_ch2` and :func:`~uvnav.bench.reproduce.finish`).
+``beyond``.  Each ``run_*`` runs one reproduction into the results store
+``results_dir/uvnav.sqlite`` (and its own files under ``results_dir``), draws its figures with the
+context's renderers into ``report_dir/<name>`` and returns its report section, its table rows and
+its summary object.
 
 ``seeds`` / ``start_seed`` choose the random scenes of the seeded ones: ``seeds`` scenes from
 ``start_seed`` (Ch. 2: the random and baseline campaigns; Ch. 3: the random-ch3 scenes; Ch. 4:
 every family — random-ch4, the noise sweep, random-ch4-hard; Ch. 5: the random-ch5 closed-loop
 scenes; crowds: CrowdNav's test cases ``start_seed`` .. ``start_seed + seeds - 1`` of each scene;
-regime: the seeds of every regime).
+regime: the seeds of every regime).  The reproductions are imported when run, so the registry
+loads fast.
 """
 
 from __future__ import annotations
 
+import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench import chapters as ch
-from uvnav.bench import reproduce as rp
-from uvnav.bench.sections import ChapterSection
+import uvnav.experiments.ch2 as rp
+import uvnav.experiments.sections as sec
 from uvnav.experiments.protocol import Experiment, ExperimentContext, ExperimentRun
+from uvnav.experiments.sections import ChapterSection
 
 
 def _run(section: ChapterSection, summary: Any, rows: list[dict[str, str]]) -> ExperimentRun:
@@ -26,9 +31,11 @@ def _run(section: ChapterSection, summary: Any, rows: list[dict[str, str]]) -> E
     return ExperimentRun(sections=[section], rows=list(rows), summary=summary, failures=failures)
 
 
-def _seeded(ctx: ExperimentContext) -> dict[str, Any]:
-    return {"full": ctx.full, "workers": ctx.workers, "seeds": ctx.seeds,
-            "start_seed": ctx.start_seed}  # fmt: skip
+def _say(name: str) -> Callable[[str], None]:
+    def say(message: str) -> None:
+        print(f"{name}: {message}", file=sys.stderr, flush=True)
+
+    return say
 
 
 def run_ch2(ctx: ExperimentContext) -> ExperimentRun:
@@ -55,61 +62,111 @@ def run_ch2(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_ch3(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 3 (:func:`uvnav.bench.chapters.run_ch3`)."""
-    dirs = (ctx.results_dir, ctx.report_dir)
-    section, s3 = ch.run_ch3(*dirs, **_seeded(ctx), renderers=ctx.renderers, progress=False)
+    """Chapter 3 (:func:`uvnav.experiments.ch3.reproduce_ch3`) and its section."""
+    from uvnav.experiments.ch3 import reproduce_ch3
+
+    s3 = reproduce_ch3(
+        ctx.results_dir, ctx.report_dir, full=ctx.full, workers=ctx.workers,
+        n_random=ctx.seeds, start_seed=ctx.start_seed, render=ctx.renderers.ch3, progress=False,
+    )  # fmt: skip
+    section = sec.ch3_section(s3, full=ctx.full, n_random=ctx.seeds, start_seed=ctx.start_seed)
     return _run(section, s3, s3.table)
 
 
 def run_ch4(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 4 (:func:`uvnav.bench.chapters.run_ch4`)."""
-    dirs = (ctx.results_dir, ctx.report_dir)
-    section, s4 = ch.run_ch4(*dirs, **_seeded(ctx), renderers=ctx.renderers)
+    """Chapter 4 (:func:`uvnav.experiments.ch4.reproduce_ch4`): ``seeds`` scenes of every
+    family, and its section."""
+    from uvnav.experiments.ch4 import reproduce_ch4
+
+    seeds = ctx.seeds
+    s4 = reproduce_ch4(
+        ctx.results_dir, ctx.report_dir, full=ctx.full, workers=ctx.workers,
+        render=ctx.renderers.ch4, seeds=seeds, noise_seeds=seeds, hard_seeds=seeds,
+        start_seed=ctx.start_seed,
+    )  # fmt: skip
+    section = sec.ch4_section(s4, full=ctx.full, seeds=seeds, start_seed=ctx.start_seed)
     return _run(section, s4, s4.table)
 
 
 def run_ch5(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 5 (:func:`uvnav.bench.chapters.run_ch5`)."""
-    dirs = (ctx.results_dir, ctx.report_dir)
-    kw = _seeded(ctx)
-    section, s5 = ch.run_ch5(*dirs, **kw, renderers=ctx.renderers, progress=ctx.progress)
-    return _run(section, s5, s5.table)
+    """Chapter 5 (:func:`uvnav.experiments.ch5.reproduce_ch5`) and its section."""
+    from uvnav.experiments.ch5 import reproduce_ch5
+
+    s5 = reproduce_ch5(
+        ctx.results_dir, full=ctx.full, progress=ctx.progress, render=ctx.renderers.ch5,
+        report_dir=ctx.report_dir, workers=ctx.workers, n_random=ctx.seeds,
+        start_seed=ctx.start_seed,
+    )  # fmt: skip
+    return _run(sec.ch5_section(s5, full=ctx.full), s5, s5.table)
 
 
 def run_ch6(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 6 at ``uvnav run``'s size (:func:`uvnav.bench.chapters.run_ch6`)."""
-    section, s6 = ch.run_ch6(
-        ctx.results_dir, ctx.report_dir, full=ctx.full, renderers=ctx.renderers,
-        fresh=ctx.fresh, progress=ctx.progress,
-    )  # fmt: skip
-    return _run(section, s6, s6.table)
+    """Chapter 6 at ``uvnav run``'s size (:data:`uvnav.experiments.ch6.RUN_QUICK`; the thesis
+    size with ``full``) in ``results_dir/ch6-quick`` (``results_dir/ch6``); every pipeline option
+    is ``uvnav drive reproduce``'s."""
+    from uvnav.experiments.ch6 import RUN_QUICK, reproduce_ch6
+
+    s6 = reproduce_ch6(
+        Path(ctx.results_dir) / ("ch6" if ctx.full else "ch6-quick"),
+        full=ctx.full,
+        fresh=ctx.fresh,
+        progress=_say("ch6") if ctx.progress else None,
+        **({} if ctx.full else RUN_QUICK),
+    )
+    if ctx.renderers.ch6 is not None:
+        s6.figures = list(ctx.renderers.ch6(s6, ctx.figures_dir("ch6")))
+    return _run(sec.ch6_section(s6, full=ctx.full), s6, s6.table)
 
 
 def run_ch7(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 7 (:func:`uvnav.bench.chapters.run_ch7`)."""
-    dirs = (ctx.results_dir, ctx.report_dir)
-    section, s7 = ch.run_ch7(*dirs, full=ctx.full, renderers=ctx.renderers)
-    return _run(section, s7, s7.table)
+    """Chapter 7 (:func:`uvnav.experiments.ch7.reproduce_ch7`, JSON in ``results_dir/ch7``)."""
+    from uvnav.experiments.ch7 import reproduce_ch7
+
+    draw7 = ctx.renderers.ch7
+    s7 = reproduce_ch7(
+        Path(ctx.results_dir) / "ch7",
+        full=ctx.full,
+        render_plan=None
+        if draw7 is None
+        else (lambda plan, prefix: draw7(plan, ctx.figures_dir("ch7") / Path(prefix).name)),
+    )
+    return _run(sec.ch7_section(s7, full=ctx.full), s7, s7.table)
 
 
 def run_beyond(ctx: ExperimentContext) -> ExperimentRun:
-    """The experiments beyond the thesis (:func:`uvnav.bench.chapters.run_beyond`)."""
-    section, rows = ch.run_beyond(
-        ctx.report_dir, full=ctx.full, renderers=ctx.renderers, results_dir=ctx.results_dir
-    )
-    return _run(section, rows, rows)
+    """The experiments beyond the thesis (:mod:`uvnav.experiments.beyond`; their episodes
+    stored in ``results_dir``'s database); figures in ``report_dir/beyond``."""
+    from uvnav.experiments.beyond import replan_rows, reproduce_beyond
+
+    rows = reproduce_beyond(ctx.results_dir, full=ctx.full) + replan_rows()
+    draw = ctx.renderers.beyond
+    figs = draw(ctx.figures_dir("beyond")) if draw is not None else []
+    return _run(sec.beyond_section(rows, figs, full=ctx.full), rows, rows)
 
 
 def run_crowds(ctx: ExperimentContext) -> ExperimentRun:
-    """Every 2D law on CrowdNav's crowds (:func:`uvnav.bench.chapters.run_crowds`)."""
-    section, sc = ch.run_crowds(ctx.results_dir, **_seeded(ctx), progress=ctx.progress)
+    """Every 2D law on CrowdNav's crowds (:func:`uvnav.experiments.crowds.reproduce_crowds`:
+    ``seeds`` test cases per scene from ``start_seed``) and its section."""
+    from uvnav.experiments.crowds import crowds_section, reproduce_crowds
+
+    sc = reproduce_crowds(
+        ctx.results_dir, full=ctx.full, workers=ctx.workers, cases=ctx.seeds,
+        start_case=ctx.start_seed, progress=ctx.progress,
+    )  # fmt: skip
+    section = crowds_section(sc)
     return _run(section, sc, section.rows)
 
 
 def run_regime(ctx: ExperimentContext) -> ExperimentRun:
-    """The regime map (:func:`uvnav.bench.chapters.run_regime`): a section, no table rows."""
-    section, rm = ch.run_regime(ctx.results_dir, **_seeded(ctx), progress=ctx.progress)
-    out = _run(section, rm, [])
+    """The regime map (:func:`uvnav.experiments.regime.run_regime_map`: ``seeds`` seeds per
+    regime and law from ``start_seed``): a section, no table rows."""
+    from uvnav.experiments.regime import regime_section, run_regime_map
+
+    rm = run_regime_map(
+        ctx.results_dir, full=ctx.full, workers=ctx.workers, seeds=ctx.seeds,
+        start_seed=ctx.start_seed, progress=ctx.progress,
+    )  # fmt: skip
+    out = _run(regime_section(rm, full=ctx.full), rm, [])
     out.campaigns = {"regime-map": rm.campaign}
     return out
 

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.sections import ChapterRenderers, ChapterSection
+from uvnav.experiments.sections import ChapterRenderers, ChapterSection
 
 #: entry-point group of plug-in experiments
 EXPERIMENT_GROUP = "uvnav.experiments"

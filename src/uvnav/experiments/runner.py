@@ -19,13 +19,6 @@ from pathlib import Path
 from typing import Any
 
 from uvnav.bench.fingerprint import DB_NAME
-from uvnav.bench.sections import (
-    SECTION_ORDER,
-    SECTIONS_DIR,
-    ChapterSection,
-    load_sections,
-    save_section,
-)
 from uvnav.experiments.protocol import (
     Experiment,
     ExperimentContext,
@@ -33,6 +26,14 @@ from uvnav.experiments.protocol import (
     ExperimentRun,
 )
 from uvnav.experiments.registry import check_options, experiments, get_experiment, section_order
+from uvnav.experiments.sections import (
+    SECTION_ORDER,
+    SECTIONS_DIR,
+    ChapterSection,
+    load_sections,
+    save_section,
+)
+from uvnav.experiments.stored import report_sections as builtin_sections
 
 
 @dataclass
@@ -158,10 +159,8 @@ def run_all(ctx: ExperimentContext, names: Sequence[str] | None = None) -> Repro
 
 def report_sections(db_path: Path) -> list[ChapterSection]:
     """The sections of the report of a results database (``uvnav report DB``): the built-ins'
-    (:func:`uvnav.bench.chapters.report_sections`: saved, or rebuilt from the stored rows) and
-    the plug-ins' saved sections, in report order.  The database is only read."""
-    from uvnav.bench.chapters import report_sections as builtin_sections
-
+    (:func:`uvnav.experiments.stored.report_sections`: saved, or rebuilt from the stored rows)
+    and the plug-ins' saved sections, in report order.  The database is only read."""
     db_path = Path(db_path)
     found = {s.key: s for s in builtin_sections(db_path)}
     extra = [k for k in section_order() if k not in SECTION_ORDER]

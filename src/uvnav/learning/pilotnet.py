@@ -29,7 +29,7 @@ Thesis ambiguities and what was chosen (also in docs/thesis-notes.md):
   ``second_output="target_speed"`` trains the second output on ``v_target`` (capped at
   ``target_speed_max``, divided by ``speed_scale``: :func:`target_speed_label`); at drive time
   the same proportional law as the expert's tracks the prediction (the "learned-speed" throttle,
-  :mod:`uvnav.bench.ch6_pipeline`).  The network still decides how fast to go; the law only
+  :mod:`uvnav.driving.pipeline`).  The network still decides how fast to go; the law only
   closes the loop on the measured speed.  ``second_output="throttle"`` is the thesis's head.
 """
 

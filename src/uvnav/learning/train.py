@@ -318,7 +318,7 @@ class Predictor:
 
     For a network whose second output is the target speed (``second_output="target_speed"``)
     use :meth:`outputs`, which returns ``(steer, target speed [m/s])``; turning that into a pedal
-    is the driver's business (:mod:`uvnav.bench.ch6_pipeline`, the "learned-speed" throttle).
+    is the driver's business (:mod:`uvnav.driving.pipeline`, the "learned-speed" throttle).
 
     Args:
         model: the trained network (put in eval mode).

@@ -20,7 +20,7 @@ Two checks that share nothing with the planner's samples:
   over the DEM; reported against all points and against those seen from some waypoint at Z_max
   (the ground a camera can see at all).
 
-Measured (``uvnav run``'s Chapter 7 rows, :func:`uvnav.bench.reproduce_ch7.coverage_rows`; 300 m
+Measured (``uvnav run``'s Chapter 7 rows, :func:`uvnav.experiments.ch7.coverage_rows`; 300 m
 and 600 m squares, R = 20/30/50 m, θ = 90°): altitudes that see the 5 m DEM nodes of each cell
 (:func:`.visibility.node_altitudes`) see only
 98.49 [ev:ch7-coverage.flat_600_R20_node_rule_grid_pct]–
@@ -30,7 +30,7 @@ of flat ground on the 0.5 m grid (largest gap 2.0–2.6 m past a footprint) and
 99.39 % [ev:ch7-coverage.jacksboro_300_R50_node_rule_grid_pct]
 of the Jacksboro crop; the cell rule (:func:`.visibility.assign_altitudes`) reads 100.00 % on all
 three checks for both terrains (0 [ev:ch7-coverage.grid_points_unseen] grid points unseen;
-``python -m uvnav.bench.evidence --only ch7-coverage`` regenerates these figures).
+``python -m uvnav.experiments.evidence --only ch7-coverage`` regenerates these figures).
 
 Units: lengths [m], areas [m²], angles [rad].
 """

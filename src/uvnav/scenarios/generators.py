@@ -691,6 +691,9 @@ def crowd_file_scenario(
     return scenario_from_dict(data, source=source)
 
 
+#: The generator a campaign job draws its scene from when it names none.
+DEFAULT_GENERATOR = "random-ch2"
+
 #: Seeded scenario generators by name: ``GENERATORS[name](seed, **params) -> Scenario``.
 #: ``load_scenario("<name>:<seed>")`` and campaign files refer to them by these names.
 GENERATORS: dict[str, Callable[..., Any]] = {

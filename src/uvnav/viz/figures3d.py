@@ -8,7 +8,7 @@
 * :func:`clearance_figure` — d_min(t), the clearance over time;
 * :func:`interactive_trajectory` — the same trajectory as an interactive plotly page;
 * :func:`render_ch3` — all of them for the recorded thesis-scene episodes (the renderer passed to
-  :func:`uvnav.bench.reproduce_ch3.reproduce_ch3`).
+  :func:`uvnav.experiments.ch3.reproduce_ch3`).
 """
 
 from __future__ import annotations

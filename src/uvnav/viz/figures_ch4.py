@@ -8,7 +8,7 @@
 * :func:`plot_amaps` — Fig. 4.4(b): the AMAPS count map as a heat map with r_imin marks.
 * :func:`save_animation` — the run as an animated GIF (matplotlib + Pillow), for the report.
 * :func:`render_ch4` — all of them for the thesis scenes (the renderer ``uvnav run`` injects into
-  :func:`uvnav.bench.reproduce_ch4.reproduce_ch4`).
+  :func:`uvnav.experiments.ch4.reproduce_ch4`).
 """
 
 from __future__ import annotations

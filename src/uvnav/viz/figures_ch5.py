@@ -20,7 +20,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.figure import Figure
 
-from uvnav.bench.reproduce_ch5 import VARIANT_LABELS, split_model_key
+from uvnav.experiments.ch5_bpnn import VARIANT_LABELS, split_model_key
 from uvnav.geometry.angles import FloatArray
 from uvnav.learning.bpnn import TrainedBPNN
 from uvnav.obstacles.deforming3d import CompoundBody
@@ -304,7 +304,7 @@ def save_animation3d(
 
 
 def render_ch5(summary: Any, report_dir: Path) -> list[Path]:
-    """All Chapter 5 figures of a :class:`~uvnav.bench.reproduce_ch5.Ch5Summary` as PNG files in
+    """All Chapter 5 figures of a :class:`~uvnav.experiments.ch5.Ch5Summary` as PNG files in
     ``report_dir/ch5``."""
     from uvnav.scenarios.ch5 import build_uuv3d, load_ch5_scenario
 

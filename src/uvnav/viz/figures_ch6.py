@@ -156,7 +156,7 @@ def write_drive_video(
 
 
 def render_ch6(summary: Any, out_dir: str | Path) -> list[Path]:
-    """All Chapter 6 figures of a :class:`uvnav.bench.reproduce_ch6.Ch6Summary`."""
+    """All Chapter 6 figures of a :class:`uvnav.experiments.ch6.Ch6Summary`."""
     out = Path(out_dir)
     rec = summary.record
     return [

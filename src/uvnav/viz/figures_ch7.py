@@ -233,7 +233,7 @@ def recon_3d_html(plan: ReconPlan, path: str | Path) -> Path:
 def render_plan(plan: ReconPlan, prefix: str | Path) -> list[Path]:
     """Fig. 7.4 PNG and the 3D HTML of one plan at ``<prefix>-fig7_4.png`` / ``<prefix>-3d.html``.
 
-    The shape :func:`uvnav.bench.reproduce_ch7.reproduce_ch7` takes as ``render_plan``.
+    The shape :func:`uvnav.experiments.ch7.reproduce_ch7` takes as ``render_plan``.
     """
     p = Path(prefix)
     png = p.parent / f"{p.name}-fig7_4.png"

@@ -3,13 +3,13 @@
 :func:`decision_view` reads a results store (never writes it) and returns what the report template
 shows first:
 
-* two plotly heat maps over the regime grid of :mod:`uvnav.bench.regime` — success and robot-driven
-  collisions, one row per law, one panel per (robot visible?, sensing) pair, one column per
-  (pedestrian speed / V_max, crowd density) — with each rate's 95 % Wilson interval and sample
-  size on hover, a star on the laws the evidence cannot separate from the best;
-* one generated recommendation per regime (:func:`uvnav.bench.regime.recommend`);
-* the law x scene-family table at equal seeds (:func:`uvnav.bench.regime.family_table`), rates with
-  intervals, small samples flagged.
+* two plotly heat maps over the regime grid of :mod:`uvnav.experiments.regime` — success and
+  robot-driven collisions, one row per law, one panel per (robot visible?, sensing) pair, one
+  column per (pedestrian speed / V_max, crowd density) — with each rate's 95 % Wilson interval
+  and sample size on hover, a star on the laws the evidence cannot separate from the best;
+* one generated recommendation per regime (:func:`uvnav.experiments.regime.recommend`);
+* the law x scene-family table at equal seeds (:func:`uvnav.experiments.regime.family_table`),
+  rates with intervals, small samples flagged.
 
 The figures are ``<div>`` fragments that use the report's ``plotly.min.js``.
 """
@@ -20,7 +20,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.regime import (
+from uvnav.experiments.regime import (
     BEYOND_MARK,
     SMALL_SAMPLE,
     CellStats,

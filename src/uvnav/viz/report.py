@@ -7,7 +7,7 @@
   store): the regime map's heat maps of success and of robot-driven collisions per law, a
   recommendation per regime generated from the numbers, and the law x scene-family table at equal
   seeds with 95 % intervals; rates on fewer than ``SMALL_SAMPLE`` episodes carry a ⚠ marker;
-* one section per chapter (:class:`uvnav.bench.sections.ChapterSection`): heading, what was
+* one section per chapter (:class:`uvnav.experiments.sections.ChapterSection`): heading, what was
   run, that chapter's rows of the "thesis reported vs uvnav measured" table (folded in a
   ``<details>`` when longer than 12 rows), its figures as a grid of thumbnails each linking to the
   full-size file, links to its other files — every file linked relatively: a file already inside
@@ -43,7 +43,7 @@ from uvnav.bench.summary import wilson_interval
 if TYPE_CHECKING:
     import pandas as pd
 
-    from uvnav.bench.sections import ChapterSection
+    from uvnav.experiments.sections import ChapterSection
 
 SIMULATION_NOTE = (
     "In this chapter (thesis Ch. 2) the obstacles are simulated: their shapes and motions come "
@@ -83,7 +83,7 @@ def _mean_median(values: pd.Series, digits: int = 3) -> str:
 
 def _rate(hits: pd.Series) -> str:
     """``"87.0% [80.1%, 91.8%]"``, flagged ``⚠`` when on fewer than SMALL_SAMPLE episodes."""
-    from uvnav.bench.regime import SMALL_SAMPLE
+    from uvnav.experiments.regime import SMALL_SAMPLE
 
     k, n = int(hits.sum()), len(hits)
     lo, hi = wilson_interval(k, n)
@@ -361,8 +361,8 @@ def write_report(
         out_dir: output folder (created); receives ``index.html`` and the PNG figures.
         figures: PNG files to include, optionally as ``(path, caption)`` pairs; they are copied into
             ``out_dir`` (a file already there is used in place).
-        sections: chapter sections (:mod:`uvnav.bench.sections`), shown after the table in this
-            order, each with its rows, figures and links.
+        sections: chapter sections (:mod:`uvnav.experiments.sections`), shown after the table in
+            this order, each with its rows, figures and links.
         table: rows of the "thesis reported vs uvnav measured" table, dicts with keys ``quantity``,
             ``thesis``, ``measured``, ``note`` (further keys become further columns).
         title: page title.
@@ -382,8 +382,8 @@ def write_report(
     import jinja2
 
     from uvnav import __version__
-    from uvnav.bench.regime import SMALL_SAMPLE
     from uvnav.bench.store import ResultsStore
+    from uvnav.experiments.regime import SMALL_SAMPLE
 
     db_path = Path(db_path)
     if not db_path.is_file():
@@ -427,7 +427,7 @@ def write_report(
     for r in table_rows:
         table_columns += [k for k in r if k not in table_columns]
 
-    from uvnav.bench.regime import CAMPAIGN as REGIME_CAMPAIGN
+    from uvnav.experiments.regime import CAMPAIGN as REGIME_CAMPAIGN
 
     # the regime map's cells (36 families x every law) are tabulated, with intervals, on the
     # first screen: not again here

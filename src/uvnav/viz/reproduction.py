@@ -10,7 +10,7 @@ vehicle limits) are rebuilt from the scenario with the stored seed; the trajecto
 the database.
 
 :func:`chapter_renderers` gives the other chapters' figure renderers
-(:class:`uvnav.bench.sections.ChapterRenderers`) the CLI injects into the experiments.
+(:class:`uvnav.experiments.sections.ChapterRenderers`) the CLI injects into the experiments.
 """
 
 from __future__ import annotations
@@ -18,9 +18,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.reproduce import RenderRequest, RenderResult
-from uvnav.bench.sections import ChapterRenderers, ChapterSection, SectionFile
 from uvnav.bench.store import ResultsStore
+from uvnav.experiments.ch2 import RenderRequest, RenderResult
+from uvnav.experiments.sections import ChapterRenderers, ChapterSection, SectionFile
 from uvnav.sim import EpisodeResult, EpisodeSetup
 from uvnav.viz.figures import plot_campaign_summary, plot_comparison, plot_episode
 from uvnav.viz.report import write_report

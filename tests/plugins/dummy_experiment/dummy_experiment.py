@@ -13,9 +13,9 @@ from __future__ import annotations
 
 from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
 from uvnav.bench.jobs import Job
-from uvnav.bench.sections import ChapterSection
 from uvnav.bench.store import ResultsStore
 from uvnav.experiments import Experiment, ExperimentContext, ExperimentRun
+from uvnav.experiments.sections import ChapterSection
 
 CAMPAIGN = "dummy-open-field"
 LAW = "straight-v1"

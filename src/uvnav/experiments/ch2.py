@@ -18,8 +18,9 @@ sections to a *renderer* passed in by the caller (the CLI passes
 ``uvnav run`` (:func:`uvnav.experiments.run_all`) are experiments of their own; there Chapter 2's
 :func:`finish` writes the page with every experiment's section.
 
-Layering (DESIGN §1): ``uvnav.viz`` sits above ``uvnav.bench`` in the layers, so this module never
-imports it: the renderer is injected (``render=``), which keeps the layer contract enforceable.
+Layering (DESIGN §1): ``uvnav.viz`` sits above ``uvnav.experiments`` in the layers, so this
+module never imports it: the renderer is injected (``render=``), which keeps the layer contract
+enforceable.
 ``matplotlib`` is never imported here.
 
 Resume and staleness: every campaign carries a fingerprint of the code and scenario files that
@@ -43,8 +44,8 @@ import numpy as np
 
 from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
 from uvnav.bench.jobs import Job
-from uvnav.bench.sections import SECTIONS_DIR, ChapterSection, ch2_section, save_section
 from uvnav.bench.store import STATUS_ERROR, ResultsStore
+from uvnav.experiments.sections import SECTIONS_DIR, ChapterSection, ch2_section, save_section
 
 CONTROLLERS: tuple[str, ...] = ("zhang2019-v1", "savkin-wang2013-v1")
 #: Classical baselines run beside the thesis's comparison (not in the thesis).
@@ -136,7 +137,7 @@ class RenderRequest:
         comparison_scene: scene drawn as the Fig. 2.10 comparison of all controllers (or ``None``).
         random_campaign: name of the random campaign (summary figure).
         table: the "thesis reported vs uvnav measured" rows (all chapters).
-        sections: one section per chapter run (:mod:`uvnav.bench.sections`); the renderer adds
+        sections: one section per chapter run (:mod:`uvnav.experiments.sections`); the renderer adds
             the Chapter 2 figures to the ``"ch2"`` one.
     """
 

@@ -7,10 +7,10 @@ from typing import Any
 
 import pytest
 
-from uvnav.bench import reproduce_ch3 as r3
 from uvnav.bench.campaign import EpisodeRun, Job, run_job
-from uvnav.bench.sections import ch3_section
 from uvnav.bench.store import ResultsStore
+from uvnav.experiments import ch3 as r3
+from uvnav.experiments.sections import ch3_section
 
 
 def test_the_default_familys_one_step_figure_is_unchanged() -> None:

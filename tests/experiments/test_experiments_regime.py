@@ -1,5 +1,5 @@
-"""The regime map (:mod:`uvnav.bench.regime`): the generated recommendation follows the numbers,
-rates are compared on equal seeds, and a small campaign stores one cell per regime."""
+"""The regime map (:mod:`uvnav.experiments.regime`): the generated recommendation follows the
+numbers, rates are compared on equal seeds, and a small campaign stores one cell per regime."""
 
 from __future__ import annotations
 
@@ -8,9 +8,9 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from uvnav.bench import regime as rg
 from uvnav.bench.campaign import Job, run_campaign
 from uvnav.bench.store import ResultsStore
+from uvnav.experiments import regime as rg
 
 
 def cell(law: str, ok: int, n: int, robot_hits: int = 0, *, beyond: bool = False) -> rg.CellStats:

@@ -8,7 +8,7 @@ The chain (each stage a row of the closed-loop table, evaluated on the same held
    Udacity's drive.py).
 2. **Target-speed readout** (``readout=True``, beyond the thesis): a ridge readout of the
    expert's target speed on the network's 10 last hidden units
-   (:func:`uvnav.bench.ch6_pipeline.fit_target_speed_readout`; the steering is unchanged),
+   (:func:`uvnav.driving.pipeline.fit_target_speed_readout`; the steering is unchanged),
    driven by the "learned-speed" throttle (the expert's proportional law tracking the predicted
    speed).  Row ``cnn-learned-speed``.
 3. **DAgger** (``dagger_rounds``, beyond the thesis; Ross et al. 2011): the network drives
@@ -21,7 +21,7 @@ the pedal head drives at autonomy 0.00 (it does not brake for corners), PI 1.00,
 0.947, and one DAgger round with the learned-speed throttle 1.00 (also on 20 further unseen
 tracks); in the ``--full`` run itself (20 episodes): 0.00, 1.00, 1.00 and 0.986 with the fixed
 ±0.2 side-camera correction, 0.00, 1.00, 0.939 and 1.00 with the exact side labels the
-recorder now writes, and 0.00, 1.00, 1.00 and 0.926 with them and the 120° camera (the default;
+recorder writes, and 0.00, 1.00, 1.00 and 0.926 with them and the 120° camera (the default;
 validation steering MSE 0.041).
 ``head="target_speed"`` trains the second output on the target speed directly instead (rows
 ``cnn-learned-speed``, ``cnn-pi``, then the DAgger rows; no readout stage).
@@ -37,8 +37,7 @@ Resumable: the collection skips recorded episodes, and every stage (training, re
 round, each closed loop) writes its checkpoint and ``stages/<stage>.json`` as it finishes; a rerun
 with the same settings skips finished stages (``fresh=True`` reruns them; the recorded episodes
 are kept).  A stage is reused only when its settings, and those of the stages it builds on, are
-the same as recorded (:class:`uvnav.stages.Stages`, the cache every reproduction uses; a
-``stages/`` folder written before it has the same layout and is reused, its checkpoints too).
+the same as recorded (:class:`uvnav.stages.Stages`, the cache every reproduction uses).
 
 Figures are drawn by the caller from the returned :class:`Ch6Summary`
 (:func:`uvnav.viz.figures_ch6.render_ch6`), since figures live in the ``viz`` layer.
@@ -237,7 +236,14 @@ def reproduce_ch6(
     Returns:
         The summary (table rows "thesis vs measured", closed-loop means, arrays for figures).
     """
-    from uvnav.bench.ch6_pipeline import (
+    from uvnav.driving.collect import (
+        CollectParams,
+        collect,
+        dataset_meta,
+        meta_conflict,
+        recording_meta,
+    )
+    from uvnav.driving.pipeline import (
         THROTTLE_MODES,
         Throttle,
         cnn_policy,
@@ -248,13 +254,6 @@ def reproduce_ch6(
         fit_target_speed_readout,
         prepare_data,
         train_on,
-    )
-    from uvnav.driving.collect import (
-        CollectParams,
-        collect,
-        dataset_meta,
-        meta_conflict,
-        recording_meta,
     )
     from uvnav.driving.sim import DrivingSim
     from uvnav.learning import PilotNetConfig, TrainConfig

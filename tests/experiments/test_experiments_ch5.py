@@ -9,8 +9,8 @@ import pytest
 
 pytest.importorskip("torch")
 
-from uvnav.bench.reproduce_ch5 import reproduce_ch5
 from uvnav.controllers.zhang_uuv3d import ModelLocator, make_locator
+from uvnav.experiments.ch5 import reproduce_ch5
 from uvnav.learning.bpnn import load_checkpoint
 from uvnav.viz.figures_ch5 import render_ch5
 
@@ -72,8 +72,8 @@ def test_small_reproduction_writes_measured_table_and_figures(
     assert any(n.startswith("ch5_traj_thesis-ch5-scene1") for n in names)
     assert all(p.stat().st_size > 5000 for p in s.figures)
     assert "ch5_anim_thesis-ch5-scene1_network.gif" in names  # the animated run
-    from uvnav.bench.reproduce_ch5 import SCENES_CAMPAIGN, stored_rows
     from uvnav.bench.store import ResultsStore
+    from uvnav.experiments.ch5 import SCENES_CAMPAIGN, stored_rows
 
     with ResultsStore(tmp_path / "results" / "uvnav.sqlite") as store:
         stored = stored_rows(store, SCENES_CAMPAIGN)
@@ -107,7 +107,8 @@ def _row(n: int, dist: tuple[float, float], index: tuple[float, float]) -> dict[
 
 
 def test_inside_the_thesiss_failed_50_sample_range_is_not_agreement() -> None:
-    from uvnav.bench.reproduce_ch5 import Ch5Summary, build_ch5_table, thesis_statement
+    from uvnav.experiments.ch5 import Ch5Summary, build_ch5_table
+    from uvnav.experiments.ch5_bpnn import thesis_statement
 
     # three seeds inside the thesis's 50-sample ranges (which it reports as a failure) but
     # outside its accepted 150-sample ones: they fail as the thesis did

@@ -7,9 +7,9 @@ from typing import Any
 
 import pytest
 
-from uvnav.bench import reproduce_beyond as rb
-from uvnav.bench.reproduce_beyond import BEYOND, office_rows, replan_rows, swap_rows
 from uvnav.bench.store import ResultsStore, StaleCampaignError
+from uvnav.experiments import beyond as rb
+from uvnav.experiments.beyond import BEYOND, office_rows, replan_rows, swap_rows
 
 
 def test_office_rows_measure_law_alone_and_hybrid() -> None:

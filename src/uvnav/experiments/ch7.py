@@ -11,7 +11,7 @@ claims and the *measured* column gives what uvnav measures on the same experimen
   A/(1.5·√3·R²) (Kershner) for R ∈ {20, 30, 50} m on both sizes (pure geometry);
 * coverage on ground truth (:func:`coverage_rows`, both modes): flat ground and the Jacksboro
   DEM x both sizes x R ∈ {20, 30, 50} m, Stage 1 altitudes by the cell rule
-  (:func:`uvnav.recon.visibility.assign_altitudes`) and by the earlier DEM-node rule
+  (:func:`uvnav.recon.visibility.assign_altitudes`) and by the DEM-node rule
   (:func:`uvnav.recon.visibility.node_altitudes`), each checked on a 0.5 m grid offset from every
   planning sample, on 2·10^5 random points and with footprint polygons
   (:mod:`uvnav.recon.coverage`); the rows give the independent coverage and the altitude the
@@ -21,9 +21,9 @@ claims and the *measured* column gives what uvnav measures on the same experimen
   Z_max, tour lengths (TSP vs spiral, two UAVs vs one integrated), δ, curvature vs 1/r_min,
   planning time.
 
-Every plan's summary is written to ``out_dir/<name>.json``; a caller that can draw (the CLI,
-layer 8) passes ``render_plan(plan, out_dir / name) -> list[Path]`` for figures — this module
-(layer 6) never imports :mod:`uvnav.viz`.
+Every plan's summary is written to ``out_dir/<name>.json``; a caller that can draw (the CLI)
+passes ``render_plan(plan, out_dir / name) -> list[Path]`` for figures — this module never
+imports :mod:`uvnav.viz`, a layer above it.
 """
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""The evidence command (:mod:`uvnav.bench.evidence`): the figures quoted in the notes and the
+"""The evidence command (:mod:`uvnav.experiments.evidence`): the figures quoted in the notes and the
 docstrings are the recorded ones, and the quick size re-run today equals its record."""
 
 from __future__ import annotations
@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from uvnav.bench import evidence
-from uvnav.bench.evidence import CLAIMS, check_text, read_record, run_claims
+from uvnav.experiments import evidence
+from uvnav.experiments.evidence import CLAIMS, check_text, read_record, run_claims
 
 ROOT = Path(__file__).resolve().parents[2]
 RECORD = ROOT / "docs" / "evidence.json"
@@ -71,7 +71,7 @@ def test_every_tagged_figure_equals_the_recorded_one(record: dict[str, dict]) ->
 def test_quick_run_today_equals_its_record(record: dict[str, dict], key: str) -> None:
     """Re-running the quick size gives the recorded quick figures: a change of behaviour that
     moves a quoted figure fails here until the record (and the notes) are regenerated with
-    ``python -m uvnav.bench.evidence --write docs/evidence.json``.  One test per claim, so the
+    ``python -m uvnav.experiments.evidence --write docs/evidence.json``.  One test per claim, so the
     test workers share them (the whole quick size is about two CPU-minutes)."""
     fresh = run_claims([key], quick=True)[key]
     figs = record["quick"][key]

@@ -1,6 +1,6 @@
-"""Where each law wins: the regime map campaign and its generated recommendations (issue 19).
+"""Where each law wins: the regime map campaign and its generated recommendations.
 
-The regime map runs every registered 2D law (:func:`uvnav.bench.reproduce_crowds.crowd_laws`: the
+The regime map runs every registered 2D law (:func:`uvnav.experiments.crowds.crowd_laws`: the
 unicycle laws and the holonomic ones, so laws registered later join by themselves) on CrowdNav's
 circle crossing (:mod:`uvnav.scenarios.crowdnav`: humans on a 4 m circle walking to the opposite
 point, the robot from (0, -4) to (0, 4) at V_max 1 m/s, 24 s) over a grid of regimes
@@ -42,10 +42,10 @@ from typing import Any
 
 from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
 from uvnav.bench.jobs import Job
-from uvnav.bench.reproduce_crowds import crowd_laws
-from uvnav.bench.sections import ChapterSection, mode_text
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
+from uvnav.experiments.crowds import crowd_laws
+from uvnav.experiments.sections import ChapterSection, mode_text
 
 CAMPAIGN = "regime-map"
 GENERATOR = "crowdnav-circle"

@@ -1,9 +1,9 @@
-"""Chapter 6 pipeline: dataset → balanced split → trained CNN → closed-loop evaluation, DAgger.
+"""The Chapter 6 pipeline: dataset → balanced split → trained CNN → closed-loop evaluation, DAgger.
 
-The glue between :mod:`uvnav.driving` (data, simulator, expert, evaluator) and
-:mod:`uvnav.learning` (the network), which are independent layers (DESIGN §1): a learned policy
-sees only what the car's camera and speedometer give — the frame and the speed — while the
-expert (an oracle) reads the pose and track.
+It joins the driving parts of this package (data, simulator, expert, evaluator) with the network
+of :mod:`uvnav.learning`, imported when a function needs it: a learned policy sees only what the
+car's camera and speedometer give — the frame and the speed — while the expert (an oracle) reads
+the pose and track.
 
 DAgger (Ross, Gordon & Bagnell, "A Reduction of Imitation Learning and Structured Prediction to
 No-Regret Online Learning", AISTATS 2011), beyond the thesis: the network drives, the expert

@@ -12,10 +12,10 @@ from typing import Any
 import pytest
 from typer.testing import CliRunner
 
-from uvnav.bench import reproduce_ch3 as r3
-from uvnav.bench import reproduce_ch4 as r4
 from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, StaleCampaignError
 from uvnav.cli.app import app
+from uvnav.experiments import ch3 as r3
+from uvnav.experiments import ch4 as r4
 
 Run = Callable[[Path], Any]
 
@@ -48,7 +48,7 @@ def _ch4(results: Path) -> Any:
 def _ch5(results: Path) -> Any:
     """No learning rows but the closed-loop network's (60 samples), one thesis scene and one
     random scene with every locator: 6 episodes."""
-    from uvnav.bench import reproduce_ch5 as r5
+    from uvnav.experiments import ch5 as r5
 
     return r5.reproduce_ch5(
         results, sizes=(), n_seeds=0, literal_seeds=0, n_random=1, n_test=30,
@@ -59,7 +59,7 @@ def _ch5(results: Path) -> Any:
 def _chapter(name: str) -> tuple[ModuleType, Run]:
     if name == "ch5":
         pytest.importorskip("torch")
-        from uvnav.bench import reproduce_ch5 as r5
+        from uvnav.experiments import ch5 as r5
 
         return r5, _ch5
     return (r3, _ch3) if name == "ch3" else (r4, _ch4)

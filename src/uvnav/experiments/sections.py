@@ -1,20 +1,21 @@
 """One report section per chapter: the contract between the reproductions and the HTML report.
 
-Each chapter's run (:mod:`uvnav.bench.chapters`, an experiment of :mod:`uvnav.experiments` run
-by ``uvnav run`` and ``uvnav reproduce NAME``) turns what its reproduction returns (its summary
+Each chapter's run (:mod:`uvnav.experiments.builtin`, an experiment of :mod:`uvnav.experiments`
+run by ``uvnav run`` and ``uvnav reproduce NAME``) turns what its reproduction returns (its summary
 object: ``.table`` rows, ``.figures`` files) into a :class:`ChapterSection` with a
 ``*_section`` builder: the thesis chapters' builders are here, the
 crowd section's and the regime map's beside their runs
-(:func:`uvnav.bench.reproduce_crowds.crowds_section`, :func:`uvnav.bench.regime.regime_section`).
+(:func:`uvnav.experiments.crowds.crowds_section`, :func:`uvnav.experiments.regime.regime_section`).
 The renderer (:func:`uvnav.viz.reproduction.render_reproduction`) hands the sections to
 :func:`uvnav.viz.report.write_report`, which gives each a heading, its intro paragraph, its rows of
 the "thesis reported vs uvnav measured" table, its figures with captions and links to its other
 files (interactive 3D views, JSON results).  :func:`save_section` and :func:`load_sections` keep
 the last section of every chapter next to the results database, in :data:`SECTION_ORDER`.
 
-Figures are *drawn* only in ``viz`` (layer 7), above this module: chapters whose figures need a
+Figures are *drawn* only in ``viz``, the layer above this package: chapters whose figures need a
 renderer receive it injected through :class:`ChapterRenderers` (the CLI builds one with
-:func:`uvnav.viz.reproduction.chapter_renderers`), so ``bench`` never imports ``viz`` (DESIGN §1).
+:func:`uvnav.viz.reproduction.chapter_renderers`), so ``uvnav.experiments`` never imports ``viz``
+(DESIGN §1).
 
 A new experiment builds its section itself and registers as an
 :class:`uvnav.experiments.Experiment` (one module, see :mod:`uvnav.experiments`); the built-ins'
@@ -78,7 +79,7 @@ Ch4Renderer = Callable[..., list[Path]]
 SummaryRenderer = Callable[[Any, Path], list[Path]]
 #: Draws one Ch. 7 plan: ``(plan, path prefix) -> files``.
 PlanRenderer = Callable[[Any, Path], list[Path]]
-#: Runs and draws the issue-9 figures into a folder: ``(out_dir) -> files``.
+#: Runs and draws the beyond-the-thesis figures into a folder: ``(out_dir) -> files``.
 FolderRenderer = Callable[[Path], list[Path]]
 
 
@@ -183,8 +184,8 @@ def _ch3_caption(p: Path) -> str:
 def ch3_section(
     summary: Any, *, full: bool, n_random: int | None = None, start_seed: int = 0
 ) -> ChapterSection:
-    """The Chapter 3 section from a :class:`uvnav.bench.reproduce_ch3.Ch3Summary`."""
-    from uvnav.bench import reproduce_ch3 as r3
+    """The Chapter 3 section from a :class:`uvnav.experiments.ch3.Ch3Summary`."""
+    import uvnav.experiments.ch3 as r3
 
     n = n_random if n_random is not None else (r3.FULL_SEEDS if full else r3.QUICK_SEEDS)
     intro = (
@@ -240,9 +241,9 @@ def _ch4_caption(p: Path) -> str:
 def ch4_section(
     summary: Any, *, full: bool, seeds: int | None = None, start_seed: int = 0
 ) -> ChapterSection:
-    """The Chapter 4 section from a :class:`uvnav.bench.reproduce_ch4.Ch4Summary` (``seeds``:
+    """The Chapter 4 section from a :class:`uvnav.experiments.ch4.Ch4Summary` (``seeds``:
     the run's override of every family's seed count)."""
-    from uvnav.bench import reproduce_ch4 as r4
+    import uvnav.experiments.ch4 as r4
 
     n = seeds if seeds is not None else (r4.FULL_SEEDS if full else r4.QUICK_SEEDS)
     nn = seeds if seeds is not None else (r4.FULL_NOISE_SEEDS if full else r4.QUICK_NOISE_SEEDS)
@@ -272,7 +273,7 @@ def ch4_section(
 
 
 def _ch5_caption(p: Path) -> str:
-    from uvnav.bench import reproduce_ch5 as r5
+    import uvnav.experiments.ch5_bpnn as b5
 
     s = p.stem
     if s == "ch5_array":
@@ -282,12 +283,12 @@ def _ch5_caption(p: Path) -> str:
             "Learning curve: test error of the BPNN as the sample count grows, beside the "
             "min/argmin-of-readings baseline."
         )
-    if (m := re.fullmatch(r"ch5_training_(n\w+)", s)) and (nv := r5.split_model_key(m[1])):
-        kind = r5.VARIANT_LABELS[nv[1]]
+    if (m := re.fullmatch(r"ch5_training_(n\w+)", s)) and (nv := b5.split_model_key(m[1])):
+        kind = b5.VARIANT_LABELS[nv[1]]
         return f"BPNN training on {nv[0]} samples, {kind} network: loss per epoch."
     m = re.fullmatch(r"ch5_errors_(n[^_]+)_(test_group|independent)", s)
-    if m and (nv := r5.split_model_key(m[1])):
-        kind = r5.VARIANT_LABELS[nv[1]]
+    if m and (nv := b5.split_model_key(m[1])):
+        kind = b5.VARIANT_LABELS[nv[1]]
         where = "its own test group" if m[2] == "test_group" else "the independent test set"
         return (
             f"Figs. 5.5–5.8 style: errors and target-vs-output of the {nv[0]}-sample {kind} "
@@ -305,17 +306,18 @@ def _ch5_caption(p: Path) -> str:
 
 
 def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
-    """The Chapter 5 section from a :class:`uvnav.bench.reproduce_ch5.Ch5Summary`."""
+    """The Chapter 5 section from a :class:`uvnav.experiments.ch5.Ch5Summary`."""
     import json
 
-    from uvnav.bench import reproduce_ch5 as r5
+    import uvnav.experiments.ch5 as r5
+    import uvnav.experiments.ch5_bpnn as b5
 
     cfg: dict[str, Any] = {}
     p = getattr(summary, "json_path", None)
     if p is not None and Path(p).is_file():  # what was run, as ch5.json records it
         cfg = json.loads(Path(p).read_text(encoding="utf-8")).get("config", {})
-    sizes = cfg.get("sizes", r5.FULL_SIZES if full else r5.QUICK_SIZES)
-    seeds = cfg.get("seeds", r5.FULL_SEEDS if full else r5.QUICK_SEEDS)
+    sizes = cfg.get("sizes", b5.FULL_SIZES if full else b5.QUICK_SIZES)
+    seeds = cfg.get("seeds", b5.FULL_SEEDS if full else b5.QUICK_SEEDS)
     n_rand = cfg.get("n_random", r5.FULL_RANDOM if full else r5.QUICK_RANDOM)
     first = int(cfg.get("start_seed", 0))
     n_dense = cfg.get("n_dense", r5.FULL_DENSE if full else r5.QUICK_DENSE)
@@ -373,7 +375,7 @@ _CH6_CAPTIONS = {
 
 
 def ch6_section(summary: Any | None, *, full: bool) -> ChapterSection:
-    """The Chapter 6 section from a :class:`uvnav.bench.reproduce_ch6.Ch6Summary` (``None``: not
+    """The Chapter 6 section from a :class:`uvnav.experiments.ch6.Ch6Summary` (``None``: not
     run, as in a test-sized run)."""
     title = "Chapter 6 — a CNN that drives (PilotNet on CarRacing)"
     if summary is None:
@@ -433,8 +435,8 @@ def _ch7_caption(p: Path) -> str:
 
 
 def ch7_section(summary: Any, *, full: bool) -> ChapterSection:
-    """The Chapter 7 section from a :class:`uvnav.bench.reproduce_ch7.Ch7Summary`."""
-    from uvnav.bench import reproduce_ch7 as r7
+    """The Chapter 7 section from a :class:`uvnav.experiments.ch7.Ch7Summary`."""
+    import uvnav.experiments.ch7 as r7
 
     if full:
         plans = "synthetic and Jacksboro terrains × 300/600 m × R 20/30/50 m"
@@ -487,8 +489,9 @@ def _beyond_caption(p: Path) -> str:
 def beyond_section(
     rows: Sequence[Mapping[str, Any]], figures: Sequence[Path], *, full: bool
 ) -> ChapterSection:
-    """The issue-9 section: global + local navigation (office floor) and multi-robot swap."""
-    from uvnav.bench import reproduce_beyond as rb
+    """The beyond-the-thesis section: global + local navigation (office floor) and multi-robot
+    swap."""
+    import uvnav.experiments.beyond as rb
 
     laws = rb.FULL_LAWS if full else rb.QUICK_LAWS
     swap = ", ".join(

@@ -7,16 +7,16 @@ from pathlib import Path
 
 import pytest
 
-from uvnav.bench import reproduce_ch3 as r3
-from uvnav.bench.sections import SECTIONS_DIR, ChapterSection, load_sections, save_section
 from uvnav.bench.store import ResultsStore
 from uvnav.experiments import ExperimentContext, ExperimentError, run_experiment
+from uvnav.experiments import ch3 as r3
+from uvnav.experiments.sections import SECTIONS_DIR, ChapterSection, load_sections, save_section
 
 
 @pytest.fixture
 def no_prediction(monkeypatch: pytest.MonkeyPatch) -> None:
     """Chapter 3's AR-vs-constant prediction errors and the what-prediction-buys comparison
-    take seconds to minutes (tested in test_bench_reproduce_ch3)."""
+    take seconds to minutes (tested in test_experiments_ch3)."""
     fake = {"ar_rms": 1.0, "constant_rms": 2.0, "series": 1.0, "ratio": 0.5}
     monkeypatch.setattr(r3, "prediction_errors", lambda: fake)
     monkeypatch.setattr(r3, "prediction_study", lambda store, **kw: {})
@@ -112,6 +112,6 @@ def test_saved_sections_load_in_report_order_without_missing_files(tmp_path: Pat
 
 
 def _file(p: Path):  # type: ignore[no-untyped-def]
-    from uvnav.bench.sections import SectionFile
+    from uvnav.experiments.sections import SectionFile
 
     return SectionFile(p, p.stem)

@@ -1,4 +1,4 @@
-"""Chapter 6 pipeline: the tiny end-to-end reproduction and a DAgger round's data."""
+"""Chapter 6's reproduction: the tiny end-to-end run, its stages and resume, its notes."""
 
 from __future__ import annotations
 
@@ -10,11 +10,8 @@ import pytest
 pytest.importorskip("torch")
 pytest.importorskip("gymnasium")
 
-from uvnav.bench.ch6_pipeline import dagger_collect
-from uvnav.bench.reproduce_ch6 import reproduce_ch6
 from uvnav.driving.dataset import read_log
-from uvnav.learning import PilotNetConfig
-from uvnav.learning.pilotnet import build_pilotnet
+from uvnav.experiments.ch6 import reproduce_ch6
 
 
 def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
@@ -72,7 +69,7 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     figs = render_ch6(s, tmp_path / "figs")
     assert len(figs) == 6 and all(f.stat().st_size > 5000 for f in figs)
     # the report section of a quick run: every figure with its thesis caption, the table
-    from uvnav.bench.sections import ch6_section
+    from uvnav.experiments.sections import ch6_section
 
     s.figures = figs
     sec = ch6_section(s, full=False)
@@ -156,66 +153,8 @@ def test_full_chain_stages_and_resume(tmp_path: Path) -> None:
     assert "train" not in s6.reused and s6.record["camera_fov_deg"] == 120.0
 
 
-def test_dagger_round_appends_expert_labelled_rows(tmp_path: Path) -> None:
-    import torch
-
-    torch.manual_seed(0)
-    model = build_pilotnet(PilotNetConfig()).eval()
-    rows = dagger_collect(model, tmp_path, [4], round_id=1, max_steps=40, record_every=4)
-    assert rows == 10
-    log = read_log(tmp_path)
-    assert len(log) == 10 and all("d1_00004" in p.name for p in log.center)
-    assert np.all(np.abs(log.steering) <= 1.0) and np.all(np.abs(log.throttle) <= 1.0)
-    # the first state is the start of the track, where the expert's label is near straight
-    assert abs(log.steering[0]) < 0.3
-    # the side images carry the expert's command at the shifted poses: from 1.5 m left of the
-    # car, steer more to the right (+), and the reverse
-    assert log.steering_left is not None and log.steering_right is not None
-    assert log.steering_left[0] > log.steering[0] + 0.05 > log.steering_right[0] + 0.1
-
-
-def test_throttle_modes_of_the_cnn_policy() -> None:
-    """learned-speed = the expert's P law on the network's target speed; modes match the head."""
-    import torch
-
-    from uvnav.bench.ch6_pipeline import cnn_policy, default_learned_mode
-    from uvnav.driving.sim import Telemetry
-
-    torch.manual_seed(0)
-    net = PilotNetConfig(height=48, width=96, second_output="target_speed")
-    model = build_pilotnet(net).eval()
-    with torch.no_grad():  # the second output is 0.8 whatever the image: 0.8 * 50 = 40 m/s
-        model.head[-1].weight[1].zero_()
-        model.head[-1].bias[1] = 0.8
-    frame = np.zeros((48, 96, 3), dtype=np.uint8)
-
-    def tel(v: float) -> Telemetry:
-        return Telemetry(0, 0.0, 0.0, 0.0, v, 0.0, 0.0, 0, 0, 10, False)
-
-    assert default_learned_mode(model) == "learned-speed"
-    act, on_reset = cnn_policy(model, throttle="learned-speed")
-    assert on_reset is None
-    assert act(frame, tel(36.0))[1] == pytest.approx(0.15 * (40.0 - 36.0))
-    assert act(frame, tel(45.0))[1] == pytest.approx(0.15 * (40.0 - 45.0))  # brakes above it
-    assert act(frame, tel(0.0))[1] == 1.0  # clipped
-    slow, _ = cnn_policy(model, throttle="learned-speed", speed_factor=0.5)
-    assert slow(frame, tel(15.0))[1] == pytest.approx(0.15 * (20.0 - 15.0))
-    capped, _ = cnn_policy(model, throttle="learned-speed", max_speed=32.0)
-    assert capped(frame, tel(30.0))[1] == pytest.approx(0.15 * (32.0 - 30.0))
-    pi, reset = cnn_policy(model, throttle="pi", set_speed=35.0)
-    assert reset is not None and pi(frame, tel(10.0))[1] > 0 and pi(frame, tel(60.0))[1] < 0
-    with pytest.raises(ValueError, match="learned-speed"):
-        cnn_policy(model, throttle="learned")
-    with pytest.raises(ValueError, match="throttle head"):
-        cnn_policy(build_pilotnet(PilotNetConfig(height=48, width=96)), throttle="learned-speed")
-    with pytest.raises(ValueError, match="speed_factor"):
-        cnn_policy(model, throttle="learned-speed", speed_factor=0.0)
-    with pytest.raises(ValueError, match="must be one of"):
-        cnn_policy(model, throttle="turbo")  # type: ignore[arg-type]
-
-
 def test_closed_loop_notes_name_the_tracks_with_interventions() -> None:
-    from uvnav.bench.reproduce_ch6 import _intervention_tracks
+    from uvnav.experiments.ch6 import _intervention_tracks
 
     tracks = [{"seed": 1000 + k, "interventions": n} for k, n in enumerate([0, 1, 0, 2])]
     assert _intervention_tracks(tracks) == "; interventions on tracks 1001 (1), 1003 (2)"

@@ -12,7 +12,7 @@
    ``ch3-random``; quick mode ``QUICK_SEEDS`` seeds, ``full=True`` ``FULL_SEEDS``;
 3. the one-step velocity prediction error of the AR models against constant velocity on the AR
    motion of the random scenes' obstacles (sampled every T_s = 1 s);
-4. *what prediction buys* (issue 21): on the default family (``random-ch3``, slowly varying AR
+4. *what prediction buys*: on the default family (``random-ch3``, slowly varying AR
    motion) and on the periodic one (``random-ch3-periodic``, weaving / circling bodies whose
    velocity is a noise-driven oscillator), the AR models' k-step velocity and position errors
    against constant velocity (:func:`horizon_errors`), and ``zhang2020-3d-v1`` closed loop with
@@ -148,10 +148,10 @@ def _run_job(job: Job) -> EpisodeRun:
 
 def fingerprint() -> str:
     """The code fingerprint of this chapter's campaigns: the packages that decide an episode
-    (``code_fingerprint`` of :mod:`uvnav.bench.reproduce`) and this module (its runner)."""
+    (``code_fingerprint`` of :mod:`uvnav.experiments.ch2`) and this module (its runner)."""
     from uvnav.bench.fingerprint import code_fingerprint
 
-    return extend_fingerprint(code_fingerprint(), "bench/reproduce_ch3.py")
+    return extend_fingerprint(code_fingerprint(), "experiments/ch3.py")
 
 
 def _announce(total: int) -> Callable[[JobOutcome, int], None]:

@@ -1,5 +1,5 @@
 """Evidence: the measured figures quoted in ``docs/thesis-notes.md`` and the module docstrings,
-regenerated from a fresh run (issue 21, item 4).
+regenerated from a fresh run.
 
 A justification such as "the literal speed law collides at 8.42 m on Fig. 2.10" goes stale the day
 the code changes unless something re-measures it.  Here every such figure is a *field* of a
@@ -16,13 +16,13 @@ last full run (:func:`write_record`).  The test suite re-runs the quick size and
 the recorded quick figures (so a change of behaviour cannot pass unnoticed), and asserts that
 every tagged number in the notes and docstrings equals the recorded full figure (so the notes
 cannot drift from the record).  A change that moves a figure therefore fails the suite until
-``python -m uvnav.bench.evidence --write docs/evidence.json`` is run again and the notes are
+``python -m uvnav.experiments.evidence --write docs/evidence.json`` is run again and the notes are
 corrected.
 
 Command line::
 
-    python -m uvnav.bench.evidence [--quick] [--only CLAIM ...] [--json] [--write FILE]
-    python -m uvnav.bench.evidence --check [--record FILE] [FILE ...]
+    python -m uvnav.experiments.evidence [--quick] [--only CLAIM ...] [--json] [--write FILE]
+    python -m uvnav.experiments.evidence --check [--record FILE] [FILE ...]
 
 Figures that cannot be re-run in minutes (the Chapter 6 training runs, the Chapter 5 closed-loop
 campaigns) are not claims here: their paragraphs in the notes name the command that produced them
@@ -240,8 +240,8 @@ def _eth_runs(specs: list[Any], law: str) -> list[Any]:
 def _ch3_prediction(quick: bool) -> Figures:
     import tempfile
 
-    from uvnav.bench.reproduce_ch3 import prediction_study
     from uvnav.bench.store import ResultsStore
+    from uvnav.experiments.ch3 import prediction_study
 
     with tempfile.TemporaryDirectory() as tmp, ResultsStore(Path(tmp) / "e.sqlite") as store:
         study = prediction_study(store, n_seeds=3 if quick else 100)
@@ -287,7 +287,7 @@ def _ch4_notes(quick: bool) -> Figures:
 
 @claim("ch4-fig47", "Fig. 4.7's target approach for t = 0...4 s (thesis-notes Ch. 4 parameters)")
 def _ch4_fig47(quick: bool) -> Figures:
-    from uvnav.bench.reproduce_ch4 import FIG47_SCENE, LAW, target_approach_check
+    from uvnav.experiments.ch4 import FIG47_SCENE, LAW, target_approach_check
     from uvnav.scenarios.catalog import resolve
     from uvnav.scenarios.episodes import run_scene
 
@@ -303,7 +303,7 @@ def _ch4_fig47(quick: bool) -> Figures:
 def _ch5_literal(quick: bool) -> Figures:
     import numpy as np
 
-    from uvnav.bench.reproduce_ch5 import (
+    from uvnav.experiments.ch5_bpnn import (
         ACCEPTED_SAMPLES,
         TEST_SEED,
         THESIS_ERROR_RANGES,
@@ -344,7 +344,7 @@ def _ch5_literal(quick: bool) -> Figures:
 def _ch5_geometry(quick: bool) -> Figures:
     import numpy as np
 
-    from uvnav.bench.reproduce_ch5 import TEST_SEED, cached_dataset, learning_row, seed_succeeds
+    from uvnav.experiments.ch5_bpnn import TEST_SEED, cached_dataset, learning_row, seed_succeeds
     from uvnav.learning.bpnn import VARIANTS, variant_config
 
     test, _ = cached_dataset(500, TEST_SEED, None, None)
@@ -369,7 +369,7 @@ def _ch5_geometry(quick: bool) -> Figures:
 
 @claim("ch7-coverage", "Ch. 7 coverage on ground truth and Stage 1 counts (thesis-notes Ch. 7)")
 def _ch7_coverage(quick: bool) -> Figures:
-    from uvnav.bench.reproduce_ch7 import RADII, SIZES, coverage_case
+    from uvnav.experiments.ch7 import RADII, SIZES, coverage_case
     from uvnav.recon.lattice import naive_count
     from uvnav.recon.terrain import square_area
 
@@ -471,9 +471,9 @@ def _format(figures: dict[str, Figures]) -> list[str]:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    """``python -m uvnav.bench.evidence``: print, record or check the claims' figures."""
+    """``python -m uvnav.experiments.evidence``: print, record or check the claims' figures."""
     ap = argparse.ArgumentParser(
-        prog="python -m uvnav.bench.evidence",
+        prog="python -m uvnav.experiments.evidence",
         description="Regenerate the measured figures quoted in docs/thesis-notes.md and the "
         "module docstrings (tags [ev:CLAIM.FIELD]).",
     )

@@ -1,4 +1,4 @@
-"""CrowdNav's crowds for every 2D law: the ``crowds`` section of ``uvnav run`` (issue 18).
+"""CrowdNav's crowds for every 2D law: the ``crowds`` section of ``uvnav run``.
 
 :func:`reproduce_crowds` runs every registered 2D law — the unicycle laws and the holonomic ones
 (:func:`uvnav.controllers.base.available_controllers`) — on CrowdNav's test cases of circle and
@@ -38,9 +38,9 @@ from typing import Any
 
 from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
 from uvnav.bench.jobs import Job
-from uvnav.bench.sections import ChapterSection, mode_text, rows_of
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
+from uvnav.experiments.sections import ChapterSection, mode_text, rows_of
 
 CAMPAIGN = "crowdnav"
 BEYOND_CAMPAIGN = "crowdnav-beyond"

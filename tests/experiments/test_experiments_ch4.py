@@ -7,7 +7,8 @@ from pathlib import Path
 
 import numpy as np
 
-from uvnav.bench.reproduce_ch4 import (
+from uvnav.bench.store import ResultsStore
+from uvnav.experiments.ch4 import (
     HARD_CAMPAIGN,
     _table,
     ch4_job,
@@ -17,7 +18,6 @@ from uvnav.bench.reproduce_ch4 import (
     summarise,
     target_approach_check,
 )
-from uvnav.bench.store import ResultsStore
 from uvnav.sim.episode_uuv2d import Uuv2dTrajectory
 from uvnav.sim.metrics import METRIC_NAMES
 

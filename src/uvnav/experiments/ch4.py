@@ -35,7 +35,7 @@ from the stored rows, never typed in. The thesis reports no numbers for Chapter 
 (:func:`target_approach_check` on the recorded run).
 
 Figures are made by a renderer injected by the caller (``render=``; the CLI passes
-:func:`uvnav.viz.figures_ch4.render_ch4`), because ``bench`` (layer 6) must not import ``viz``.
+:func:`uvnav.viz.figures_ch4.render_ch4`), because ``viz`` is a layer above this one (DESIGN §1).
 """
 
 from __future__ import annotations
@@ -98,10 +98,10 @@ def ch4_job(scene: str, law: str, seed: int, noise_std: float = 0.0, dropout: fl
 
 def fingerprint() -> str:
     """The code fingerprint of this chapter's campaigns: the packages that decide an episode
-    (``code_fingerprint`` of :mod:`uvnav.bench.reproduce`) and this module (its runner)."""
+    (``code_fingerprint`` of :mod:`uvnav.experiments.ch2`) and this module (its runner)."""
     from uvnav.bench.fingerprint import code_fingerprint
 
-    return extend_fingerprint(code_fingerprint(), "bench/reproduce_ch4.py")
+    return extend_fingerprint(code_fingerprint(), "experiments/ch4.py")
 
 
 def run_ch4_job(

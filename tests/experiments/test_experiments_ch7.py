@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from uvnav.bench import reproduce_ch7 as r7
+from uvnav.experiments import ch7 as r7
 
 
 def test_reproduce_ch7_rows_come_from_plans(tmp_path: Path) -> None:

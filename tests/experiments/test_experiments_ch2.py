@@ -7,8 +7,8 @@ from typing import Any
 
 import pytest
 
-from uvnav.bench import reproduce as rp
 from uvnav.bench.store import ResultsStore, StaleCampaignError
+from uvnav.experiments import ch2 as rp
 
 SCENES = ["thesis-ch2-fig2-10-comparison", "thesis-ch2-one-obstacle"]
 LAWS = ["zhang2019-v1", "savkin-wang2013-v1"]
