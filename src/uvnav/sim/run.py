@@ -129,7 +129,8 @@ def run_episode(
         rng: the episode generator; the world hands independent children to the law(s) and the
             sensors.
         record: keep the world's record of the run (figures; off for large campaigns).
-        probes: more probes to run in the loop.
+        probes: more probes to run in the loop (a swarm that would run compiled runs in the
+            loop world when there are any: the same result).
         options: the world's own options: 2D ``vehicle`` (the law's vehicle, a name of
             :func:`~uvnav.dynamics.vehicles.vehicles_2d`; ``unicycle``), ``compiled`` (move and
             measure the bodies in compiled calls where the scene allows it, the same numbers;
