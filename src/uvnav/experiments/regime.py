@@ -10,7 +10,11 @@ point, the robot from (0, -4) to (0, 4) at V_max 1 m/s, 24 s) over a grid of reg
   the robot's V_max is CrowdNav's 1 m/s, so the ratio is the speed in m/s);
 * the robot invisible to the humans (CrowdNav's test protocol) or visible (they avoid it);
 * sensing: exact (velocities known) or noisy (velocities estimated by finite differences of
-  centres sensed with Gaussian noise of :data:`NOISES` std, :mod:`uvnav.prediction`),
+  centres sensed with Gaussian noise of :data:`NOISES` std, :mod:`uvnav.prediction`), or a lidar
+  alone (:data:`LIDAR_BEAMS` beams over a full turn, :data:`LIDAR_NOISE` range noise, range and
+  sensing range :data:`LIDAR_RANGE`; the humans the scan shows, tracked, their velocities
+  estimated: :mod:`uvnav.sensors.scan_bodies`), for the robot visible or not as
+  :data:`LIDAR_VISIBLE` says,
 
 with the same ``seeds`` test cases in every cell (:data:`QUICK_SEEDS` in ``uvnav run``,
 :data:`FULL_SEEDS` with ``--full``), in one campaign :data:`CAMPAIGN` of the results store (the
@@ -57,6 +61,12 @@ SPEED_RATIOS: tuple[float, ...] = (0.5, 1.0, 1.5)
 VISIBLE: tuple[bool, ...] = (False, True)
 #: std of the noise on sensed centres [m]; 0 = exact sensing (velocities known)
 NOISES: tuple[float, ...] = (0.0, 0.1)
+#: the lidar of the lidar cells: beams over a full turn, range noise std [m], range [m] (also the
+#: sensing range), as ``benchmarks/bench_crowdnav.py --lidar 360`` senses
+LIDAR_BEAMS, LIDAR_NOISE, LIDAR_RANGE = 360, 0.01, 5.0
+#: the robot visibilities that get lidar cells: the invisible robot, CrowdNav's test protocol
+#: (the visible robot's cells would add a third of the map's cost again)
+LIDAR_VISIBLE: tuple[bool, ...] = (False,)
 #: the robot's V_max in these scenes [m/s] (CrowdNav's robot ``v_pref``)
 V_MAX = 1.0
 QUICK_SEEDS, FULL_SEEDS = 15, 60
@@ -66,12 +76,14 @@ SMALL_SAMPLE = 30
 
 @dataclass(frozen=True, order=True)
 class Regime:
-    """One cell of the grid: humans, their speed / V_max, robot visible, sensing noise [m]."""
+    """One cell of the grid: humans, their speed / V_max, robot visible, sensing noise [m],
+    and whether the robot senses by lidar alone (then ``noise`` is 0)."""
 
     n_humans: int
     speed_ratio: float
     visible: bool
     noise: float
+    lidar: bool = False
 
     def generator_params(self) -> dict[str, Any]:
         """Keyword arguments of the ``crowdnav-circle`` generator for this cell."""
@@ -82,6 +94,11 @@ class Regime:
         }
         if self.noise > 0:
             p.update(velocities="estimated", position_noise=float(self.noise))
+        if self.lidar:
+            p.update(
+                bodies="lidar", velocities="estimated", lidar_beams=LIDAR_BEAMS,
+                lidar_noise=LIDAR_NOISE, sensing_range=LIDAR_RANGE,
+            )  # fmt: skip
         return p
 
     @property
@@ -97,6 +114,9 @@ class Regime:
 
     @property
     def sensing(self) -> str:
+        """``"exact sensing"``, ``"noise 0.1 m"`` or ``"lidar 360 beams"``."""
+        if self.lidar:
+            return f"lidar {LIDAR_BEAMS} beams"
         return "exact sensing" if self.noise == 0 else f"noise {self.noise:g} m"
 
     @property
@@ -114,15 +134,24 @@ def regimes(
     speed_ratios: Sequence[float] = SPEED_RATIOS,
     visible: Sequence[bool] = VISIBLE,
     noises: Sequence[float] = NOISES,
+    lidar_visible: Sequence[bool] = LIDAR_VISIBLE,
 ) -> list[Regime]:
-    """The grid, visible and noise outermost (the report's panels), then speed, then density."""
-    return [
+    """The grid, visible and sensing outermost (the report's panels), then speed, then density;
+    the lidar cells (for the visibilities of ``lidar_visible``) after the others."""
+    cells = [
         Regime(int(n), float(s), bool(v), float(z))
         for v in visible
         for z in noises
         for s in speed_ratios
         for n in densities
     ]
+    lidar = [
+        Regime(int(n), float(s), bool(v), 0.0, True)
+        for v in lidar_visible
+        for s in speed_ratios
+        for n in densities
+    ]
+    return cells + lidar
 
 
 def regime_jobs(laws: Sequence[str], cells: Sequence[Regime], seeds: range) -> list[Job]:
@@ -191,7 +220,7 @@ def run_regime_map(
     cfg = {
         "generator": GENERATOR,
         "controllers": run_laws,
-        "cells": [[c.n_humans, c.speed_ratio, c.visible, c.noise] for c in grid],
+        "cells": [[c.n_humans, c.speed_ratio, c.visible, c.noise, c.lidar] for c in grid],
         "v_max": V_MAX,
         "beyond_assumptions": True,
         "fingerprint": code_fingerprint(),
@@ -281,7 +310,7 @@ def cell_stats(store: ResultsStore) -> dict[Regime, list[CellStats]]:
     df = store.episodes_frame(CAMPAIGN)
     if df.empty:
         return {}
-    cells = [Regime(int(n), float(s), bool(v), float(z)) for n, s, v, z in camp["config"]["cells"]]
+    cells = [_regime(row) for row in camp["config"]["cells"]]
     out: dict[Regime, list[CellStats]] = {}
     for cell in cells:
         g = equal_seeds(df[df["family"].astype(str) == cell.family])
@@ -298,6 +327,57 @@ def cell_stats(store: ResultsStore) -> dict[Regime, list[CellStats]]:
             stats.append(CellStats(str(law), s, rc, c, beyond=beyond, errors=err))
         out[cell] = stats
     return out
+
+
+def _regime(row: Sequence[Any]) -> Regime:
+    """A stored cell ``[n, speed ratio, visible, noise(, lidar)]``."""
+    lidar = bool(row[4]) if len(row) > 4 else False
+    return Regime(int(row[0]), float(row[1]), bool(row[2]), float(row[3]), lidar)
+
+
+@dataclass(frozen=True)
+class SensingCost:
+    """One law's success pooled over the regimes that have a lidar cell, per way of sensing,
+    on the same crowds (densities, speeds, visibility): exact, noisy centres, lidar alone."""
+
+    law: str
+    exact: Rate
+    noisy: Rate
+    lidar: Rate
+
+    @property
+    def lidar_cost(self) -> float:
+        """Success lost by sensing with the lidar instead of exactly (points of a rate)."""
+        return self.exact.p - self.lidar.p
+
+
+def sensing_costs(stats_by_cell: dict[Regime, list[CellStats]]) -> list[SensingCost]:
+    """What sensing costs each law: per law its successes pooled over every lidar cell and the
+    exact and noisy cells of the same crowds (each law on its own equal seeds per cell), laws
+    by decreasing lidar success; empty without lidar cells."""
+    pooled: dict[str, dict[str, list[int]]] = {}
+    for cell in (c for c in stats_by_cell if c.lidar):
+        twins = {"lidar": [cell]}
+        same = [
+            c
+            for c in stats_by_cell
+            if not c.lidar
+            and (c.n_humans, c.speed_ratio, c.visible)
+            == (cell.n_humans, cell.speed_ratio, cell.visible)
+        ]
+        twins["exact"] = [c for c in same if c.noise == 0]
+        twins["noisy"] = [c for c in same if c.noise > 0]
+        for mode, cells in twins.items():
+            for c in cells:
+                for s in stats_by_cell[c]:
+                    k_n = pooled.setdefault(s.law, {}).setdefault(mode, [0, 0])
+                    k_n[0] += s.success.k
+                    k_n[1] += s.success.n
+    out = [
+        SensingCost(law, *(Rate(*modes.get(m, [0, 0])) for m in ("exact", "noisy", "lidar")))
+        for law, modes in pooled.items()
+    ]
+    return sorted(out, key=lambda c: (-c.lidar.p, c.law))
 
 
 def equal_seeds(df: Any) -> Any:
@@ -509,9 +589,12 @@ def regime_section(summary: RegimeSummary | None, *, full: bool) -> ChapterSecti
         dens = ", ".join(str(d) for d in sorted({c.n_humans for c in summary.cells}))
         speeds = ", ".join(f"{v:g}" for v in sorted({c.speed_ratio for c in summary.cells}))
         noises = ", ".join(f"{z:g}" for z in sorted({c.noise for c in summary.cells}))
+        lidar = (
+            f" or a {LIDAR_BEAMS}-beam lidar alone" if any(c.lidar for c in summary.cells) else ""
+        )
         ran = (
             f"{len(summary.cells)} regimes ({dens} humans; speed {speeds} x V_max; robot "
-            f"invisible and visible; sensing noise {noises} m), {summary.seeds} "
+            f"invisible and visible; sensing noise {noises} m{lidar}), {summary.seeds} "
             f"seed{'' if summary.seeds == 1 else 's'} per regime "
             f"and law ({mode_text(full)}), laws {', '.join(summary.laws)}"
         )
@@ -520,7 +603,7 @@ def regime_section(summary: RegimeSummary | None, *, full: bool) -> ChapterSecti
         title="Beyond the thesis — where each law wins (regime map)",
         intro=(
             f"Every 2D law on CrowdNav's circle crossing over crowd density x pedestrian speed / "
-            f"V_max x robot visible or not x sensing noise (campaign {CAMPAIGN}): {ran}. Every "
+            f"V_max x robot visible or not x sensing (campaign {CAMPAIGN}): {ran}. Every "
             "law runs in every regime, beyond its declared assumption where the regime breaks it "
             "(marked †)."
         ),
@@ -536,6 +619,10 @@ __all__ = [
     "CAMPAIGN",
     "DENSITIES",
     "FULL_SEEDS",
+    "LIDAR_BEAMS",
+    "LIDAR_NOISE",
+    "LIDAR_RANGE",
+    "LIDAR_VISIBLE",
     "NOISES",
     "QUICK_SEEDS",
     "SMALL_SAMPLE",
@@ -546,6 +633,7 @@ __all__ = [
     "Rate",
     "Regime",
     "RegimeSummary",
+    "SensingCost",
     "cell_stats",
     "equal_seeds",
     "family_table",
@@ -556,4 +644,5 @@ __all__ = [
     "regime_section",
     "regimes",
     "run_regime_map",
+    "sensing_costs",
 ]

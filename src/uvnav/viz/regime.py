@@ -8,6 +8,8 @@ shows first:
   column per (pedestrian speed / V_max, crowd density) — with each rate's 95 % Wilson interval
   and sample size on hover, a star on the laws the evidence cannot separate from the best;
 * one generated recommendation per regime (:func:`uvnav.experiments.regime.recommend`);
+* what sensing costs each law: its success with exact readings, noisy centres and a lidar
+  alone on the same crowds (:func:`uvnav.experiments.regime.sensing_costs`);
 * the law x scene-family table at equal seeds (:func:`uvnav.experiments.regime.family_table`),
   rates with intervals, small samples flagged.
 
@@ -31,19 +33,29 @@ from uvnav.experiments.regime import (
     family_table,
     ranking,
     recommend,
+    sensing_costs,
 )
 
 #: the small-sample marker of the report (rates on fewer than SMALL_SAMPLE episodes)
 SMALL_MARK = "⚠"
 
 
-def _panels(cells: Sequence[Regime]) -> list[tuple[bool, float]]:
-    return sorted({(c.visible, c.noise) for c in cells})
+def _panel(c: Regime) -> tuple[bool, bool, float]:
+    """A cell's panel: the robot visible or not, then its sensing."""
+    return (c.visible, c.lidar, c.noise)
 
 
-def _panel_title(visible: bool, noise: float) -> str:
+def _panels(cells: Sequence[Regime]) -> list[tuple[bool, bool, float]]:
+    return sorted({_panel(c) for c in cells})
+
+
+def _order(c: Regime) -> tuple[bool, bool, float, float, int]:
+    return (*_panel(c), c.speed_ratio, c.n_humans)
+
+
+def _panel_title(visible: bool, lidar: bool, noise: float) -> str:
     seen = "visible robot" if visible else "invisible robot"
-    return f"{seen}, {'exact sensing' if noise == 0 else f'noise {noise:g} m'}"
+    return f"{seen}, {Regime(0, 0.0, visible, noise, lidar).sensing}"
 
 
 def regime_heatmap(stats: dict[Regime, list[CellStats]], metric: str, *, div_id: str) -> str:
@@ -51,7 +63,7 @@ def regime_heatmap(stats: dict[Regime, list[CellStats]], metric: str, *, div_id:
     import plotly.graph_objects as go
     from plotly.subplots import make_subplots
 
-    cells = sorted(stats, key=lambda c: (c.visible, c.noise, c.speed_ratio, c.n_humans))
+    cells = sorted(stats, key=_order)
     laws = sorted({s.law for v in stats.values() for s in v})
     panels = _panels(cells)
     fig = make_subplots(
@@ -62,8 +74,8 @@ def regime_heatmap(stats: dict[Regime, list[CellStats]], metric: str, *, div_id:
         subplot_titles=[_panel_title(*p) for p in panels],
     )
     good = metric == "success"
-    for col, (vis, noise) in enumerate(panels, start=1):
-        here = [c for c in cells if (c.visible, c.noise) == (vis, noise)]
+    for col, panel in enumerate(panels, start=1):
+        here = [c for c in cells if _panel(c) == panel]
         xs = [f"v{c.speed_ratio:g}·n{c.n_humans}" for c in here]
         z: list[list[float | None]] = []
         text: list[list[str]] = []
@@ -179,13 +191,15 @@ def decision_view(db_path: Path) -> dict[str, Any]:
     with ResultsStore(Path(db_path), readonly=True) as store:
         stats = cell_stats(store)
         fams = family_table(store)
-    out: dict[str, Any] = {"heatmaps": [], "recommendations": [], "cells": [], "families": None}
+    out: dict[str, Any] = {
+        "heatmaps": [], "recommendations": [], "cells": [], "families": None, "sensing_costs": [],
+    }  # fmt: skip
     if stats:
         out["heatmaps"] = [
             regime_heatmap(stats, "success", div_id="regime-success"),
             regime_heatmap(stats, "robot_collision", div_id="regime-collision"),
         ]
-        order = sorted(stats, key=lambda c: (c.visible, c.noise, c.speed_ratio, c.n_humans))
+        order = sorted(stats, key=_order)
         seeds = sorted({s.success.n for v in stats.values() for s in v})
         out["seeds"] = seeds
         out["small"] = seeds[0] < SMALL_SAMPLE
@@ -212,6 +226,17 @@ def decision_view(db_path: Path) -> dict[str, Any]:
                         "collision": _rate_cell(s.collision),
                     }
                 )
+        out["sensing_costs"] = [
+            {
+                "law": c.law,
+                "exact": _rate_cell(c.exact),
+                "noisy": _rate_cell(c.noisy),
+                "lidar": _rate_cell(c.lidar),
+                "cost": f"{100 * c.lidar_cost:+.0f}",
+                "n": c.lidar.n,
+            }
+            for c in sensing_costs(stats)
+        ]
     if fams:
         out["families"] = family_view(fams)
     return out
