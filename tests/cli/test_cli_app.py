@@ -396,13 +396,10 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
             sections=[ChapterSection("ch2", long_title, "", rows=[row])],
         )
 
-    from uvnav.experiments import ExperimentContext
+    import uvnav.experiments
     from uvnav.viz.reproduction import render_reproduction
 
-    fake = types.ModuleType("uvnav.experiments")
-    fake.run_all = reproduce  # type: ignore[attr-defined]
-    fake.ExperimentContext = ExperimentContext  # type: ignore[attr-defined]
-    monkeypatch.setitem(sys.modules, "uvnav.experiments", fake)
+    monkeypatch.setattr(uvnav.experiments, "run_all", reproduce)
     res_dir, rep_dir = tmp_path / "res", tmp_path / "rep"
     result = runner.invoke(
         app,
@@ -429,11 +426,15 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
     assert all(
         getattr(renderers, k) is not None for k in ("ch3", "ch4", "ch5", "ch6", "ch7", "beyond")
     )
-    assert "thesis reported vs uvnav measured" in result.stdout
-    assert "thesis 14.9 m | uvnav 15.2 m" in result.stdout
-    assert max(len(line) for line in result.stdout.splitlines()[:4]) <= 80  # one screen
+    screen = result.stdout.splitlines()
+    assert screen[0] == "uvnav run: 1 experiments, 1 reproduced"
+    assert "thesis 14.9 m | uvnav 15.2 m -> reproduced" in result.stdout  # within 5 %
+    summary = screen[: next(i for i, line in enumerate(screen) if line.startswith("wrote"))]
+    assert len(summary) <= 40 and max(len(line) for line in summary) <= 80  # one screen
     table = (res_dir / "thesis-vs-uvnav.md").read_text()
-    assert "| path length Fig. 2.10 (Zhang) | 14.9 m | 15.2 m | geometry chosen" in table
+    row_md = "| path length Fig. 2.10 (Zhang) | 14.9 m | 15.2 m | reproduced | geometry chosen"
+    assert row_md in table
+    assert "1 reproduced" in table.split("| quantity")[0]  # the counts open the table
     assert str(res_dir / "uvnav.sqlite") in result.stdout
     assert "2 figure file(s)" in result.stdout
 

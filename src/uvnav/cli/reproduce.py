@@ -19,6 +19,7 @@ Chapter 6's pipeline with every option (noise, threads, head, DAgger rounds, ...
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -71,8 +72,9 @@ def run_cmd(
     sections = list(getattr(summary, "sections", []) or [])
     if getattr(summary, "report_path", None) is None and sections:  # no run wrote the page
         summary.report_path = _write_report(results / "uvnav.sqlite", report, sections)
-    table_path = write_comparison_table(rows, results)
-    for line in run_summary_lines(sections, rows):
+    table_path = write_comparison_table(rows, results, sections)
+    report_path = getattr(summary, "report_path", None) or report / "index.html"
+    for line in run_summary_lines(sections, report_path, table_path, results / "uvnav.sqlite"):
         typer.echo(line)
     typer.echo(f"wrote {table_path} (the whole table: {len(rows)} rows)")
     written: list[Path] = []
@@ -91,38 +93,41 @@ def run_cmd(
         typer.echo(f"wrote {len(figures)} figure file(s) in {', '.join(folders)}")
 
 
-def _cut(line: str, width: int) -> str:
-    line = one_line(line)
-    return line if len(line) <= width else line[: width - 1] + "…"
+def run_summary_lines(
+    sections: list[Any], report_path: Path, table_path: Path, db_path: Path
+) -> list[str]:
+    """The one screen ``uvnav run`` ends with (:func:`uvnav.experiments.verdict.summary_lines`):
+    the report and the table, per experiment its verdicts and headline row, and "which law,
+    where" from the stored regime map."""
+    from uvnav.experiments.verdict import summary_lines
+
+    return summary_lines(
+        sections, report=str(report_path), table=str(table_path), laws=_law_lines(db_path)
+    )
 
 
-def run_summary_lines(sections: list[Any], rows: list[dict[str, Any]]) -> list[str]:
-    """One screen after ``uvnav run``: per chapter its title, how many table rows it has, and
-    its first row (quantity, the thesis's figure and ours), each line at most 80 characters."""
-    lines = ["thesis reported vs uvnav measured (first row of each chapter)"]
-    for sec in sections:
-        sec_rows = list(getattr(sec, "rows", []) or [])
-        lines.append(_cut(f"{sec.title} ({len(sec_rows)} rows)", 80))
-        if sec_rows:
-            head = sec_rows[0]
-            lines.append("  " + _cut(str(head.get("quantity", "")), 78))
-            figures = f"thesis {fmt(head.get('thesis'))} | uvnav {fmt(head.get('measured'))}"
-            lines.append("    " + _cut(figures, 76))
-    if not sections:
-        lines.append(f"  {len(rows)} rows")
-    return lines
+def _law_lines(db_path: Path) -> list[str]:
+    """ "Which law, where" from the regime map stored in ``db_path`` (none when it is not)."""
+    from uvnav.bench.store import ResultsStore
+    from uvnav.experiments.regime import cell_stats, law_lines
+
+    if not db_path.is_file():
+        return []
+    with ResultsStore(db_path, readonly=True) as store:
+        return law_lines(cell_stats(store))
 
 
-def write_comparison_table(rows: list[dict[str, Any]], results: Path) -> Path:
-    """The whole "thesis reported vs uvnav measured" table as Markdown in ``results``."""
+def write_comparison_table(
+    rows: list[dict[str, Any]], results: Path, sections: Sequence[Any] = ()
+) -> Path:
+    """The whole "thesis reported vs uvnav measured" table as Markdown in ``results``: the
+    per-experiment verdict counts and the rule first, then every row with its verdict
+    (:func:`uvnav.experiments.verdict.table_lines`)."""
+    from uvnav.experiments.verdict import table_lines
+
     path = results / "thesis-vs-uvnav.md"
     path.parent.mkdir(parents=True, exist_ok=True)
-    cols = ("quantity", "thesis", "measured", "note")
-    out = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    for row in rows:
-        cells = [one_line(fmt(row.get(c))).replace("|", "\\|") for c in cols]
-        out.append("| " + " | ".join(cells) + " |")
-    path.write_text("\n".join(out) + "\n", encoding="utf-8")
+    path.write_text("\n".join(table_lines(list(sections), rows)) + "\n", encoding="utf-8")
     return path
 
 

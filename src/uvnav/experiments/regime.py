@@ -501,6 +501,32 @@ def leaders(stats_by_cell: dict[Regime, list[CellStats]]) -> list[dict[str, str]
     return rows
 
 
+def law_lines(stats_by_cell: dict[Regime, list[CellStats]]) -> list[str]:
+    """ "Which law, where" in a few lines: per panel of the map (robot visible or not, sensing)
+    the law that is best or tied best (:func:`ranking`) in the most of its regimes, with how
+    many; empty without a stored map."""
+    panels: dict[tuple[bool, bool, float], list[Regime]] = {}
+    for cell in stats_by_cell:
+        panels.setdefault((cell.visible, cell.lidar, cell.noise), []).append(cell)
+    lines = []
+    for (visible, lidar, noise), cells in sorted(panels.items()):
+        wins: dict[str, int] = {}
+        for c in cells:
+            for s in ranking(stats_by_cell[c])[0]:
+                wins[s.law] = wins.get(s.law, 0) + 1
+        if not wins:
+            continue
+        top = max(wins.values())
+        laws = sorted(law for law, k in wins.items() if k == top)
+        sensing = Regime(0, 0.0, visible, noise, lidar).sensing
+        shown = ", ".join(laws[:2]) + (f" +{len(laws) - 2}" if len(laws) > 2 else "")
+        seen = "visible" if visible else "invisible"
+        lines.append(f"  {seen} robot, {sensing}: {shown} ({top}/{len(cells)})")
+    if lines:
+        lines.insert(0, "which law, where (regime map: best or tied best in most regimes):")
+    return lines
+
+
 # --------------------------------------------------------------------- law x scene family
 
 
@@ -637,6 +663,7 @@ __all__ = [
     "cell_stats",
     "equal_seeds",
     "family_table",
+    "law_lines",
     "leaders",
     "ranking",
     "recommend",

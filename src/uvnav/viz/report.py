@@ -39,6 +39,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from uvnav.bench.summary import wilson_interval
+from uvnav.experiments.verdict import count_text, counts, row_verdict
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -52,7 +53,7 @@ SIMULATION_NOTE = (
     "point, velocity and rotation rate). No recorded sensor data is used."
 )
 
-_TABLE_ORDER = ("quantity", "thesis", "measured", "note")
+_TABLE_ORDER = ("quantity", "thesis", "measured", "verdict", "note")
 _TEXT_COLUMNS = ("family", "controller")
 _MAX_ERRORS = 50
 
@@ -317,7 +318,7 @@ def section_rows(sections: Sequence[ChapterSection], out_dir: Path) -> list[dict
     """Template rows of the chapter sections, their files linked relatively to ``out_dir``."""
     out: list[dict[str, Any]] = []
     for sec in sections:
-        rows = [dict(r) for r in sec.rows]
+        rows = [{**r, "verdict": row_verdict(r)} for r in sec.rows]
         columns = list(_TABLE_ORDER) if rows else []
         for r in rows:
             columns += [k for k in r if k not in columns]
@@ -327,6 +328,7 @@ def section_rows(sections: Sequence[ChapterSection], out_dir: Path) -> list[dict
                 "title": sec.title,
                 "intro": sec.intro,
                 "rows": rows,
+                "verdicts": count_text(counts(sec.rows)),
                 "columns": columns,
                 "figures": [
                     {"src": _relative_file(f.path, out_dir, sec.key), "caption": f.caption}
@@ -422,7 +424,9 @@ def write_report(
 
     in_sections = [dict(r) for sec in sections or [] for r in sec.rows]
     # a row a section shows is not repeated in the global table (which keeps the others)
-    table_rows = [dict(r) for r in (table or []) if dict(r) not in in_sections]
+    table_rows = [
+        {**r, "verdict": row_verdict(r)} for r in (table or []) if dict(r) not in in_sections
+    ]
     table_columns = list(_TABLE_ORDER) if table_rows else []
     for r in table_rows:
         table_columns += [k for k in r if k not in table_columns]
