@@ -312,6 +312,11 @@ def _table(
                 "measured": f"{r['status']}, min clearance "
                 + (f"{clear:.3f} m" if clear is not None else "-")
                 + (", ENTERED inner space" if r["entered_forbidden"] else ""),
+                "verdict": (
+                    "reproduced"
+                    if r["status"] == "success" and not r["entered_forbidden"]
+                    else "differs"
+                ),
                 "note": LAW,
             }
         )

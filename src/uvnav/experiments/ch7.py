@@ -161,6 +161,7 @@ def coverage_rows(
             ),
             "thesis": '"covered completely"',
             "measured": f"{100 * r['after_grid']:.2f} %",
+            "verdict": "reproduced" if r["after_grid_unseen"] == 0 else "differs",
             "note": (
                 f"{r['after_grid_unseen']} of {r['after_grid_points']} grid points unseen; "
                 f"{CHECK_POINTS} random points {100 * r['after_random']:.2f} %; footprint "
@@ -244,6 +245,7 @@ def reproduce_ch7(
                 ),
                 "thesis": '"covered completely"',
                 "measured": f"{100 * s['coverage_grid_visible']:.2f} %",
+                "verdict": "reproduced" if s["grid_unseen_visible"] == 0 else "differs",
                 "note": (
                     f"{s['grid_unseen_visible']} of {s['check_grid_points']} grid points unseen; "
                     f"{s['check_random_points']} random points "
