@@ -48,6 +48,9 @@ from uvnav.bags import messages as m
 from uvnav.bags import require
 from uvnav.core import BaseProbe
 
+#: the scene kinds whose episodes are written
+KINDS = ("nav2d", "multi2d")
+
 #: the message types an episode file declares
 TYPES = (m.TF_T, m.MARKERS_T, m.ODOM_T, m.TWIST_T, m.STRING_T, m.SCAN_T)
 
@@ -207,11 +210,14 @@ class McapEpisode(EpisodeProbe):
         self.close()
 
     def close(self) -> None:
-        """Write the file's summary and end it (and close the file :meth:`open` opened)."""
+        """Write the file's summary and end it (and close the file :meth:`open` opened; that
+        file is removed when no run started, as when the law was refused)."""
         self.writer.finish()
         if self._owned is not None:
             self._owned.close()
             self._owned = None
+            if not self.names and self.path is not None:
+                self.path.unlink(missing_ok=True)
 
     def _send(
         self, topic: str, type_name: str, message: dict[str, Any], t: float, seq: int
@@ -250,3 +256,36 @@ def _bodies(world: Any) -> tuple[Any, int]:
     world's field ends with its robots)."""
     field = world.field
     return field, int(getattr(world, "k", len(field)))
+
+
+def episode_file(label: str, controller: str, seed: int) -> str:
+    """The file name of a campaign's episode, ``<label>__<controller>__<seed>.mcap``, with
+    every run of characters other than letters, digits, ``.``, ``-`` and ``_`` as one ``_``."""
+
+    def clean(text: str) -> str:
+        return re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("._") or "_"
+
+    return f"{clean(label)}__{clean(controller)}__{int(seed)}.mcap"
+
+
+class McapFolder:
+    """A campaign's ``probe_factory`` (:func:`uvnav.bench.campaign.run_campaign`): for each
+    job whose scene is 2D (``nav2d``, ``multi2d``), an :class:`McapEpisode` writing
+    :func:`episode_file` in ``folder`` (replaced if it exists), with the job's scene, law and
+    seed as metadata; no probe for other jobs.  Picklable: it crosses to the workers."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = Path(folder)
+
+    def __call__(self, job: Any) -> list[McapEpisode]:
+        """The probes of ``job``'s episode (none, or one :class:`McapEpisode`)."""
+        from uvnav.bench.campaign import job_scene
+
+        if job.scenario is None and job.generator_seed is None:
+            return []
+        if job_scene(job).kind.name not in KINDS:
+            return []
+        label = job.scenario_label
+        meta = {"scene": label, "law": job.controller, "seed": str(int(job.seed))}
+        path = self.folder / episode_file(label, job.controller, int(job.seed))
+        return [McapEpisode.open(path, meta)]
