@@ -29,6 +29,10 @@ topic                       type                                 when
                                                                  odometry)
 ==========================  ===================================  ==============================
 
+:class:`EpisodeProbe` builds these messages; :class:`McapEpisode` writes them, and
+:class:`uvnav.bags.live.FoxgloveEpisode` serves them live.  :class:`McapFolder` makes one
+:class:`McapEpisode` per campaign job (``uvnav bench --mcap-dir``).
+
 One robot has the topics without a prefix and the frame ``base_link``; robot ``NAME`` of a
 multi-robot scene has ``/NAME/...`` and ``NAME/base_link``.  ``uvnav replay`` reads ``/scan``
 and ``/odom`` of such a file back.
