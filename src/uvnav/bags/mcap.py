@@ -29,6 +29,10 @@ topic                       type                                 when
                                                                  odometry)
 ==========================  ===================================  ==============================
 
+:class:`EpisodeProbe` builds these messages; :class:`McapEpisode` writes them, and
+:class:`uvnav.bags.live.FoxgloveEpisode` serves them live.  :class:`McapFolder` makes one
+:class:`McapEpisode` per campaign job (``uvnav bench --mcap-dir``).
+
 One robot has the topics without a prefix and the frame ``base_link``; robot ``NAME`` of a
 multi-robot scene has ``/NAME/...`` and ``NAME/base_link``.  ``uvnav replay`` reads ``/scan``
 and ``/odom`` of such a file back.
@@ -47,6 +51,9 @@ import numpy as np
 from uvnav.bags import messages as m
 from uvnav.bags import require
 from uvnav.core import BaseProbe
+
+#: the scene kinds whose episodes are written
+KINDS = ("nav2d", "multi2d")
 
 #: the message types an episode file declares
 TYPES = (m.TF_T, m.MARKERS_T, m.ODOM_T, m.TWIST_T, m.STRING_T, m.SCAN_T)
@@ -67,72 +74,35 @@ def _names(world: Any) -> list[str]:
     return out
 
 
-class McapEpisode(BaseProbe):
-    """Writes the episode it watches into ``stream`` (module docstring); call :meth:`close`
-    after the run (or use it as a context manager).
+class EpisodeProbe(BaseProbe):
+    """The messages of an episode (the topics of the module docstring), handed with their topic,
+    ROS 2 type and simulation time to :meth:`_send`, which a subclass defines."""
 
-    Args:
-        stream: a binary file open for writing.
-        metadata: written as the file's ``uvnav`` metadata record (scene, law, seed...).
-
-    Raises:
-        MissingExtraError: the ``ros`` extra is not installed.
-    """
-
-    def __init__(self, stream: IO[bytes], metadata: dict[str, str] | None = None) -> None:
-        require("writing an episode as MCAP")
-        from mcap_ros2.writer import Writer
-
-        self.writer = Writer(stream)
-        self.schemas = {t: self.writer.register_msgdef(t, m.msgdef(t)) for t in TYPES}
-        if metadata:
-            self.writer.add_metadata("uvnav", {k: str(v) for k, v in metadata.items()})
+    def __init__(self) -> None:
         self.names: list[str] = []
         self._seq: dict[str, int] = {}
-        self._owned: IO[bytes] | None = None
         self._scans: list[tuple[int, dict[str, Any]]] = []  # (agent, LaserScan) to write
-        self.path: Path | None = None  # the file :meth:`open` opened
 
-    @classmethod
-    def open(cls, path: Path, metadata: dict[str, str] | None = None) -> McapEpisode:
-        """A probe writing into a new file at ``path`` (replaced if it exists), which
-        :meth:`close` closes.
-
-        Raises:
-            MissingExtraError: the ``ros`` extra is not installed.
-            OSError: the file cannot be written.
-        """
-        require("writing an episode as MCAP")
-        stream = Path(path).open("wb")  # noqa: SIM115 (closed by close())
-        try:
-            probe = cls(stream, metadata)
-        except BaseException:
-            stream.close()
-            raise
-        probe._owned = stream
-        probe.path = Path(path)
-        return probe
-
-    def __enter__(self) -> McapEpisode:
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self.close()
-
-    def close(self) -> None:
-        """Write the file's summary and end it (and close the file :meth:`open` opened)."""
-        self.writer.finish()
-        if self._owned is not None:
-            self._owned.close()
-            self._owned = None
+    def _send(
+        self, topic: str, type_name: str, message: dict[str, Any], t: float, seq: int
+    ) -> None:
+        """Deliver ``message`` (the ``seq``-th on ``topic``) stamped with time ``t`` [s]."""
+        raise NotImplementedError
 
     def _write(self, topic: str, type_name: str, message: dict[str, Any], t: float) -> None:
         seq = self._seq.get(topic, 0)
         self._seq[topic] = seq + 1
-        ns = m.nanoseconds(t)
-        self.writer.write_message(
-            topic, self.schemas[type_name], message, log_time=ns, publish_time=ns, sequence=seq
-        )
+        self._send(topic, type_name, message, t, seq)
+
+    def topics(self) -> list[tuple[str, str]]:
+        """``(topic, type)`` of every topic the episode may use (``/scan`` topics included,
+        which carry messages only when the robot reads a lidar); known after :meth:`on_start`."""
+        out = [("/tf", m.TF_T), ("/bodies", m.MARKERS_T)]
+        for i in range(len(self.names)):
+            for leaf, type_name in (("odom", m.ODOM_T), ("cmd_vel", m.TWIST_T),
+                                    ("mode", m.STRING_T), ("scan", m.SCAN_T)):  # fmt: skip
+                out.append((self._topic(i, leaf), type_name))
+        return out
 
     def _frame(self, i: int) -> str:
         return f"{self.names[i]}/base_link" if self.names[i] else "base_link"
@@ -143,7 +113,7 @@ class McapEpisode(BaseProbe):
     def on_start(self, world: Any, laws: Sequence[Any]) -> None:
         """Name the robots (their topics and frames)."""
         if not (hasattr(world, "field") and (hasattr(world, "pose") or hasattr(world, "state"))):
-            raise TypeError(f"no MCAP episode of a {type(world).__name__}: 2D worlds only")
+            raise TypeError(f"no episode messages of a {type(world).__name__}: 2D worlds only")
         self.names = _names(world)
 
     def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
@@ -193,6 +163,75 @@ class McapEpisode(BaseProbe):
     on_end = on_step
 
 
+class McapEpisode(EpisodeProbe):
+    """Writes the episode it watches into ``stream`` (module docstring); call :meth:`close`
+    after the run (or use it as a context manager).
+
+    Args:
+        stream: a binary file open for writing.
+        metadata: written as the file's ``uvnav`` metadata record (scene, law, seed...).
+
+    Raises:
+        MissingExtraError: the ``ros`` extra is not installed.
+    """
+
+    def __init__(self, stream: IO[bytes], metadata: dict[str, str] | None = None) -> None:
+        require("writing an episode as MCAP")
+        from mcap_ros2.writer import Writer
+
+        super().__init__()
+        self.writer = Writer(stream)
+        self.schemas = {t: self.writer.register_msgdef(t, m.msgdef(t)) for t in TYPES}
+        if metadata:
+            self.writer.add_metadata("uvnav", {k: str(v) for k, v in metadata.items()})
+        self._owned: IO[bytes] | None = None
+        self.path: Path | None = None  # the file :meth:`open` opened
+
+    @classmethod
+    def open(cls, path: Path, metadata: dict[str, str] | None = None) -> McapEpisode:
+        """A probe writing into a new file at ``path`` (replaced if it exists), which
+        :meth:`close` closes.
+
+        Raises:
+            MissingExtraError: the ``ros`` extra is not installed.
+            OSError: the file cannot be written.
+        """
+        require("writing an episode as MCAP")
+        stream = Path(path).open("wb")  # noqa: SIM115 (closed by close())
+        try:
+            probe = cls(stream, metadata)
+        except BaseException:
+            stream.close()
+            raise
+        probe._owned = stream
+        probe.path = Path(path)
+        return probe
+
+    def __enter__(self) -> McapEpisode:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """Write the file's summary and end it (and close the file :meth:`open` opened; that
+        file is removed when no run started, as when the law was refused)."""
+        self.writer.finish()
+        if self._owned is not None:
+            self._owned.close()
+            self._owned = None
+            if not self.names and self.path is not None:
+                self.path.unlink(missing_ok=True)
+
+    def _send(
+        self, topic: str, type_name: str, message: dict[str, Any], t: float, seq: int
+    ) -> None:
+        ns = m.nanoseconds(t)
+        self.writer.write_message(
+            topic, self.schemas[type_name], message, log_time=ns, publish_time=ns, sequence=seq
+        )
+
+
 def _robots(world: Any) -> tuple[list[tuple[float, float, float]], list[tuple[float, float]],
                                  list[float], list[Any], list[float], list[Any]]:  # fmt: skip
     """Poses ``(x, y, yaw)``, world-frame velocities [m/s], turn rates [rad/s] (the vehicle's
@@ -221,3 +260,36 @@ def _bodies(world: Any) -> tuple[Any, int]:
     world's field ends with its robots)."""
     field = world.field
     return field, int(getattr(world, "k", len(field)))
+
+
+def episode_file(label: str, controller: str, seed: int) -> str:
+    """The file name of a campaign's episode, ``<label>__<controller>__<seed>.mcap``, with
+    every run of characters other than letters, digits, ``.``, ``-`` and ``_`` as one ``_``."""
+
+    def clean(text: str) -> str:
+        return re.sub(r"[^A-Za-z0-9._-]+", "_", text).strip("._") or "_"
+
+    return f"{clean(label)}__{clean(controller)}__{int(seed)}.mcap"
+
+
+class McapFolder:
+    """A campaign's ``probe_factory`` (:func:`uvnav.bench.campaign.run_campaign`): for each
+    job whose scene is 2D (``nav2d``, ``multi2d``), an :class:`McapEpisode` writing
+    :func:`episode_file` in ``folder`` (replaced if it exists), with the job's scene, law and
+    seed as metadata; no probe for other jobs.  Picklable: it crosses to the workers."""
+
+    def __init__(self, folder: Path) -> None:
+        self.folder = Path(folder)
+
+    def __call__(self, job: Any) -> list[McapEpisode]:
+        """The probes of ``job``'s episode (none, or one :class:`McapEpisode`)."""
+        from uvnav.bench.campaign import job_scene
+
+        if job.scenario is None and job.generator_seed is None:
+            return []
+        if job_scene(job).kind.name not in KINDS:
+            return []
+        label = job.scenario_label
+        meta = {"scene": label, "law": job.controller, "seed": str(int(job.seed))}
+        path = self.folder / episode_file(label, job.controller, int(job.seed))
+        return [McapEpisode.open(path, meta)]

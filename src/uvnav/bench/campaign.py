@@ -201,17 +201,21 @@ def _run_job(job: Job) -> JobOutcome:
         else:
             from uvnav.scenarios.episodes import run_scene
 
+            probes = list(job.probe_factory(job)) if job.probe_factory is not None else []
             try:
                 out = run_scene(
                     job_scene(job), job.controller, params, int(job.seed), record=job.record,
                     use_scene_params=job.use_scenario_params,
-                    beyond_assumptions=job.beyond_assumptions,
+                    beyond_assumptions=job.beyond_assumptions, probes=probes,
                 )  # fmt: skip
             except (AssumptionError, LawMismatchError) as exc:  # the law is refused here
                 return JobOutcome(
                     job, STATUS_REFUSED, None, exc.problem, time.perf_counter() - tic, None,
                     params,
                 )  # fmt: skip
+            finally:
+                for probe in probes:
+                    getattr(probe, "close", lambda: None)()
             status, metrics, traj, params = out.status, out.metrics, out.trajectory, out.params
     except PlacementError as exc:  # the scene cannot be built: refused, with the generator's line
         return JobOutcome(
@@ -410,6 +414,7 @@ def run_campaign(
     on_outcome: Callable[[JobOutcome, int], None] | None = None,
     engine: str = "local",
     address: str | None = None,
+    probe_factory: Callable[[Job], Sequence[Any]] | None = None,
 ) -> CampaignRun:
     """Run ``jobs`` under campaign ``name``, storing each episode as it finishes; resume-safe.
 
@@ -427,6 +432,8 @@ def run_campaign(
         engine: ``"local"`` (process pool) or ``"ray"`` (Ray tasks, see
             :func:`uvnav.bench.ray_engine.run_ray`); the stored metrics are the same.
         address: Ray cluster address (``engine="ray"`` only; default: a local Ray instance).
+        probe_factory: set as each job's :attr:`~uvnav.bench.jobs.Job.probe_factory` (probes
+            that watch the episodes this call runs; they only observe).
 
     Returns:
         What was skipped, run and stored.
@@ -444,6 +451,8 @@ def run_campaign(
         raise ValueError(f"unknown engine {engine!r}; known: {', '.join(ENGINES)}")
     if engine == "ray":
         import_ray()  # fail before touching the store when Ray is missing
+    if probe_factory is not None:
+        jobs = [dataclasses.replace(job, probe_factory=probe_factory) for job in jobs]
     # one campaign writer per database (a second refuses at once); SIGTERM is handled as Ctrl-C
     with store.writer_lease(), sigterm_as_interrupt():
         return _run_campaign(

@@ -66,6 +66,10 @@ class Job:
         runner: a *module-level* (picklable) function ``job -> (status, metrics, trajectory,
             facts)`` running an experiment's own episode of ``label`` (its own world set-up);
             ``facts`` are stored in ``effective_params`` after the tags.
+        probe_factory: a *module-level* (picklable) callable ``job -> list of probes``
+            (:class:`uvnav.core.Probe`) that watch a scene job's episode (not a
+            ``setup_factory`` or ``runner`` job's); a probe with a ``close()`` is closed after
+            it.  Not part of the resume key; :func:`~uvnav.bench.campaign.run_campaign` sets it.
     """
 
     controller: str
@@ -83,6 +87,7 @@ class Job:
     beyond_assumptions: bool = False
     tags: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
     runner: Callable[[Job], EpisodeRun] | None = None
+    probe_factory: Callable[[Job], Sequence[Any]] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", _freeze(self.params))

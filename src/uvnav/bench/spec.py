@@ -43,7 +43,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -459,6 +459,7 @@ def run_campaign_spec(
     address: str | None = None,
     progress: bool = False,
     retry_errors: bool = False,
+    probe_factory: Callable[[Job], Sequence[Any]] | None = None,
 ) -> CampaignRun:
     """Run a campaign file's jobs into ``store`` (see :func:`~uvnav.bench.campaign.run_campaign`).
 
@@ -473,6 +474,7 @@ def run_campaign_spec(
         address: Ray cluster address.
         progress: rich progress bar on stderr.
         retry_errors: run again the episodes stored with status ``error``.
+        probe_factory: probes that watch each episode run (``run_campaign``'s).
 
     Raises:
         CampaignError: the campaign exists and ``resume`` is false.
@@ -496,4 +498,5 @@ def run_campaign_spec(
             retry_errors=retry_errors,
             engine=engine,
             address=address,
+            probe_factory=probe_factory,
         )

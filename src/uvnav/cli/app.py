@@ -47,6 +47,7 @@ from uvnav.cli.reproduce import forget_cmd, reproduce_cmd, run_cmd
 from uvnav.cli.ros2 import ros2_app
 from uvnav.cli.scenarios import scenarios_app
 from uvnav.cli.sonar import sonar_app
+from uvnav.cli.view import view_cmd
 from uvnav.sim import METRIC_NAMES
 from uvnav.sim.metrics import SOCIAL_METRIC_NAMES
 
@@ -286,3 +287,4 @@ app.command("bench")(bench_cmd)
 app.command("reproduce")(reproduce_cmd)
 app.command("forget")(forget_cmd)
 app.command("replay")(replay_cmd)
+app.command("view")(view_cmd)

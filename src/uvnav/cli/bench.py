@@ -81,6 +81,16 @@ def bench_cmd(
             "campaign: only the listing.",
         ),
     ] = False,
+    mcap_dir: Annotated[
+        Path | None,
+        typer.Option(
+            "--mcap-dir",
+            help="Also write each episode this invocation runs (2D scenes) into this folder "
+            "(created if missing), one MCAP file of ROS 2 messages each, named "
+            "LABEL__CONTROLLER__SEED.mcap; episodes already stored and skipped get none.  "
+            "Needs the 'ros' extra.",
+        ),
+    ] = None,
 ) -> None:
     """Run a benchmark campaign into a results database, then print a per-controller summary.
 
@@ -106,6 +116,7 @@ def bench_cmd(
             import_ray()  # before the database is created
         except EngineUnavailableError as exc:
             raise CliError(str(exc), code=1) from None
+    probe_factory = _mcap_folder(mcap_dir) if mcap_dir is not None else None
     n_workers = workers or os.cpu_count() or 1
     too_many = too_many_workers(n_workers) if engine == "local" else None  # Ray: a cluster's
     if too_many is not None:
@@ -130,6 +141,7 @@ def bench_cmd(
                 address=address,
                 progress=not json_out,
                 retry_errors=retry_errors,
+                probe_factory=probe_factory,
             )
         except EngineUnavailableError as exc:
             raise CliError(str(exc), code=1) from None
@@ -190,6 +202,29 @@ def bench_cmd(
         f"stored, in {elapsed:.1f} s{speed} on {engine} × {n_workers}; results in {db}"
     )
     _fail_on_errors(result.errors, first_error)
+
+
+def _mcap_folder(folder: Path) -> Any:
+    """The campaign's probe factory writing episodes into ``folder``
+    (:class:`uvnav.bags.mcap.McapFolder`), the folder made if missing.
+
+    Raises:
+        CliError: the folder cannot be made (status 2); the ``ros`` extra missing (status 1).
+    """
+    from uvnav.bags import MissingExtraError, require
+    from uvnav.bags.mcap import McapFolder
+
+    try:
+        require("--mcap-dir")
+    except MissingExtraError as exc:
+        raise CliError(str(exc), code=1) from None
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except FileExistsError:
+        raise CliError(f"--mcap-dir {folder}: is a file; give a folder") from None
+    except OSError as exc:
+        raise CliError(f"--mcap-dir {folder}: cannot make it: {exc.strerror or exc}") from None
+    return McapFolder(folder.resolve())
 
 
 def _print_failures(rows: list[dict[str, Any]], beyond: bool) -> None:
