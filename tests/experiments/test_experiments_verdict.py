@@ -31,6 +31,7 @@ from uvnav.experiments.verdict import (
         ("[0.1, 0.4]: a failure", "median [0.02, 0.05]", "differs"),
         ("not reported (beyond the thesis)", "75.0% (6/8)", "beyond"),
         ("", "0.95", "beyond"),
+        ("—", "success, path 25.3 m", "beyond"),
         ("path shown (Fig. 2.9), outcome not stated: a guess", "success", "-"),
         ("17592", "750", "differs"),
     ],

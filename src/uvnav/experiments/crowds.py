@@ -258,7 +258,10 @@ def _row(gen: str, law: str, g: Any, *, beyond: bool) -> dict[str, str]:
     if errors:
         extra.append(f"errors {errors}")
     note = "; ".join([*extra, _social_note(ok)] if _social_note(ok) else extra)
-    return {"quantity": quantity, "thesis": thesis, "measured": measured, "note": note}
+    row = {"quantity": quantity, "thesis": thesis, "measured": measured, "note": note}
+    if paper:  # the paper's figure against ours: inside our 95 % interval or not
+        row["verdict"] = "reproduced" if inside else "differs"
+    return row
 
 
 def crowd_rows(

@@ -30,7 +30,7 @@ REL_TOL = 0.05
 VERDICTS: tuple[str, ...] = ("reproduced", "differs", "beyond", "-")
 #: a thesis cell that gives nothing to compare
 _NOTHING = re.compile(
-    r"^\s*(?:(?:-+|–|n/?a|none|\.\.\.)?\s*$|(?:not reported|not given|not shown|no numbers?)\b)",
+    r"^\s*(?:(?:-+|–|—|n/?a|none|\.\.\.)?\s*$|(?:not reported|not given|not shown|no numbers?)\b)",
     re.IGNORECASE,
 )
 #: a bound: ``> 0``, ``>= 0.9``, ``< 1 s``
