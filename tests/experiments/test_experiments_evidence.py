@@ -103,3 +103,12 @@ def test_cli_check_and_errors(tmp_path: Path, capsys: pytest.CaptureFixture[str]
     assert "error: --record" in capsys.readouterr().err
     assert evidence.main(["--check", str(tmp_path / "none.md"), "--record", str(rec)]) == 2
     assert "none.md: no such file" in capsys.readouterr().err
+
+
+def test_the_notes_are_checked_from_any_working_directory(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Without arguments, --check reads the checkout's notes and record, wherever it runs."""
+    monkeypatch.chdir(tmp_path)
+    assert evidence.main(["--check"]) == 0
+    assert "0 problem(s)" in capsys.readouterr().err

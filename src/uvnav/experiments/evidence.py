@@ -493,8 +493,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         help="check the tagged numbers of FILEs (default: docs/thesis-notes.md and src/) "
         "against --record without running anything",
     )
-    ap.add_argument("--record", type=Path, default=Path("docs/evidence.json"), metavar="FILE")
+    ap.add_argument(
+        "--record", type=Path, default=None, metavar="FILE",
+        help="the record (default: docs/evidence.json of the checkout uvnav runs from)",
+    )  # fmt: skip
     args = ap.parse_args(argv)
+    if args.record is None:
+        args.record = _checkout() / "docs" / "evidence.json"
     echo = (lambda s: print(s, file=sys.stderr)) if not args.json else None
     if args.check is not None:
         try:
@@ -529,8 +534,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     return 0
 
 
+def _checkout() -> Path:
+    """The checkout this uvnav runs from (``src/uvnav`` inside it), so that the notes and the
+    record are found from any working directory; the working directory for an installed copy."""
+    root = Path(__file__).resolve().parents[3]
+    return root if (root / "docs" / "thesis-notes.md").is_file() else Path.cwd()
+
+
 def _default_files() -> list[Path]:
-    return [Path("docs/thesis-notes.md"), *sorted(Path("src/uvnav").rglob("*.py"))]
+    root = _checkout()
+    return [root / "docs" / "thesis-notes.md", *sorted((root / "src" / "uvnav").rglob("*.py"))]
 
 
 def _check_files(files: Sequence[Path], figures: dict[str, Figures]) -> int:
