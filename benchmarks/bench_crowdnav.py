@@ -35,6 +35,8 @@ Options for the protocol study (defaults = the reproduction):
   and its turn rate by at most B [rad/s^2] (``UnicycleSpec.accel_max``, ``turn_accel_max``;
   default: at once).  Collisions the robot drove into (``collision_by`` ``robot``) are counted
   in every run.
+* ``--humans N``: N humans (0-1000) instead of CrowdNav's 5 (the scenes' ``n_humans``, the
+  same case seeds).
 * ``--pref crowdnav``: the robot's preferred velocity as CrowdNav's ORCA sets it (1 m/s toward
   the goal beyond 1 m, the gap within) instead of ``orca-holonomic-v1``'s (V_max, lowered to
   ``dist / period`` on the last step).
@@ -61,7 +63,12 @@ from uvnav.controllers.holonomic import OrcaHolonomic
 from uvnav.core import BaseProbe
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.catalog import kinds
-from uvnav.scenarios.crowdnav import CROWDNAV_ORCA_PARAMS, TIME_STEP, crowdnav_scenario
+from uvnav.scenarios.crowdnav import (
+    CROWDNAV_ORCA_PARAMS,
+    N_HUMANS,
+    TIME_STEP,
+    crowdnav_scenario,
+)
 from uvnav.sim.run import run_episode
 
 #: Chen et al. ICRA 2019, Table I, ORCA (invisible robot)
@@ -161,6 +168,7 @@ def run(
     lidar: int | None = None,
     accel: float | None = None,
     turn_accel: float | None = None,
+    humans: int = N_HUMANS,
 ) -> dict[str, Any]:
     """Run the cases; returns the counts, rates, intervals and times."""
     rng_of = kinds()["nav2d"].episode_rng
@@ -179,7 +187,7 @@ def run(
         )  # fmt: skip
         scn = crowdnav_scenario(
             case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
-            kinematics=kinematics, **sensing,  # type: ignore[arg-type]
+            kinematics=kinematics, n_humans=humans, **sensing,  # type: ignore[arg-type]
             accel_max=accel, turn_accel_max=turn_accel,
         )  # fmt: skip
         setup = build_episode(scn, case)
@@ -218,6 +226,7 @@ def run(
         "first_case": first,
         "case_numbers": case_numbers(cases, first),
         "rule": rule,
+        "humans": humans,
         "substeps": substeps,
         "dt": TIME_STEP / substeps,
         "pref": pref,
@@ -254,7 +263,8 @@ def run(
 
 def report(r: dict[str, Any]) -> str:
     lines = [
-        f"crowdnav-{r['rule'].split('_')[0]} {_cases_text(r)}, {r['law']} {r['params']}, "
+        f"crowdnav-{r['rule'].split('_')[0]} {_cases_text(r)}, {r['humans']} humans, "
+        f"{r['law']} {r['params']}, "
         f"dt {r['dt']:g} s, pref {r['pref']}, outcome {r['outcome']}, collisions judged "
         f"{r['judged']}, sensing {r['sensing']}"
         + (f", {r['kinematics']} unicycle" if r["kinematics"] else "")
@@ -330,10 +340,14 @@ def main(argv: list[str] | None = None) -> int:
         metavar="B",
         help="the unicycle's largest turn-rate change [rad/s^2] (default: at once)",
     )
+    ap.add_argument("--humans", type=int, default=N_HUMANS, metavar="N",
+                    help=f"number of humans (default CrowdNav's {N_HUMANS})")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write crowdnav.json here")
     args = ap.parse_args(argv)
     if args.cases < 1 or args.substeps < 1:
         ap.error("--cases and --substeps must be >= 1")
+    if not 0 <= args.humans <= 1000:
+        ap.error(f"--humans must be in 0..1000 (got {args.humans})")
     for name, value in (("--accel", args.accel), ("--turn-accel", args.turn_accel)):
         if value is not None and not (math.isfinite(value) and value > 0):
             ap.error(f"{name} must be a number > 0 (got {value!r})")
@@ -343,6 +357,7 @@ def main(argv: list[str] | None = None) -> int:
         args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
         outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
         swept=not args.sampled, lidar=args.lidar, accel=args.accel, turn_accel=args.turn_accel,
+        humans=args.humans,
     )  # fmt: skip
     print(report(r))
     if args.out is not None:

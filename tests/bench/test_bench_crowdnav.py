@@ -1,0 +1,40 @@
+"""``benchmarks/bench_crowdnav.py``: the crowd size and the reported social figures (one short
+episode each)."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+BENCH = Path(__file__).resolve().parents[2] / "benchmarks"
+if str(BENCH) not in sys.path:
+    sys.path.insert(0, str(BENCH))
+
+import bench_crowdnav  # noqa: E402
+
+
+def test_humans_sets_the_crowd_size_of_every_case(monkeypatch: pytest.MonkeyPatch) -> None:
+    built: list[int] = []
+    scenario = bench_crowdnav.crowdnav_scenario
+
+    def spy(case: int, **kw: Any) -> Any:
+        scn = scenario(case, **kw)
+        built.append(len(scn.obstacles))
+        return scn
+
+    monkeypatch.setattr(bench_crowdnav, "crowdnav_scenario", spy)
+    r = bench_crowdnav.run(1, rule="circle_crossing", substeps=1, pref="uvnav", first=0,
+                           humans=2)  # fmt: skip
+    assert built == [2] and r["humans"] == 2
+    assert "2 humans" in bench_crowdnav.report(r)
+    assert sum(x["count"] for x in r["rates"].values()) == 1
+
+
+def test_humans_out_of_range_is_a_one_line_error(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exc:
+        bench_crowdnav.main(["--cases", "1", "--humans", "-1"])
+    assert exc.value.code == 2
+    assert "--humans must be in 0..1000" in capsys.readouterr().err
