@@ -38,3 +38,22 @@ def test_humans_out_of_range_is_a_one_line_error(capsys: pytest.CaptureFixture[s
         bench_crowdnav.main(["--cases", "1", "--humans", "-1"])
     assert exc.value.code == 2
     assert "--humans must be in 0..1000" in capsys.readouterr().err
+
+
+def test_report_gives_the_mean_intrusion_ratio_with_an_interval() -> None:
+    r = bench_crowdnav.run(2, rule="circle_crossing", substeps=1, pref="uvnav", first=0,
+                           humans=5)  # fmt: skip
+    ir = r["intrusion_ratio"]
+    assert ir["episodes"] == 2 and 0.0 <= ir["ci95"][0] <= ir["mean"] <= ir["ci95"][1] <= 1.0
+    assert f"intrusion ratio (mean of 2 episodes) {ir['mean']:.3f}" in bench_crowdnav.report(r)
+
+
+def test_mean_interval_is_a_bootstrap_of_the_mean() -> None:
+    flat = bench_crowdnav.mean_interval([0.2] * 10)
+    assert flat["mean"] == pytest.approx(0.2) and flat["ci95"] == pytest.approx([0.2, 0.2])
+    spread = bench_crowdnav.mean_interval([0.0] * 50 + [1.0] * 50)
+    lo, hi = spread["ci95"]
+    # the normal approximation: 0.5 +- 1.96 * 0.5 / sqrt(100) = [0.402, 0.598]
+    assert spread["mean"] == 0.5 and lo == pytest.approx(0.402, abs=0.02)
+    assert hi == pytest.approx(0.598, abs=0.02)
+    assert bench_crowdnav.mean_interval([])["mean"] is None
