@@ -39,7 +39,9 @@ Options for the protocol study (defaults = the reproduction):
   default: at once).  Collisions the robot drove into (``collision_by`` ``robot``) are counted
   in every run.
 * ``--humans N``: N humans (0-1000) instead of CrowdNav's 5 (the scenes' ``n_humans``, the
-  same case seeds).
+  same case seeds).  A case whose humans CrowdSim's rule cannot place apart (20 humans on the
+  4 m circle: a few cases) is left out and listed as ``unplaceable``; the rates are over the
+  cases run.
 * ``--pref crowdnav``: the robot's preferred velocity as CrowdNav's ORCA sets it (1 m/s toward
   the goal beyond 1 m, the gap within) instead of ``orca-holonomic-v1``'s (V_max, lowered to
   ``dist / period`` on the last step).
@@ -72,6 +74,7 @@ from uvnav.scenarios.crowdnav import (
     TIME_STEP,
     crowdnav_scenario,
 )
+from uvnav.scenarios.errors import ScenarioError
 from uvnav.sim.run import run_episode
 
 #: Chen et al. ICRA 2019, Table I, ORCA (invisible robot)
@@ -137,6 +140,10 @@ TEST_CASES = 500
 LIDAR_NOISE, LIDAR_RANGE = 0.01, 5.0
 
 
+class NoCaseError(ValueError):
+    """No asked case could be built (every one unplaceable)."""
+
+
 #: bootstrap resamples of the mean intrusion ratio's interval (generator seeded 0)
 RESAMPLES = 2000
 
@@ -165,11 +172,13 @@ def case_numbers(cases: int, first: int | None) -> list[int]:
 
 
 def _cases_text(r: dict[str, Any]) -> str:
-    """``cases 0..499 (500)`` or ``100 sampled cases of 500``."""
-    if r["first_case"] is None and r["cases"] < TEST_CASES:
-        return f"{r['cases']} sampled cases of {TEST_CASES}"
+    """``cases 0..499 (500)`` or ``100 sampled cases of 500``, and the unplaceable ones."""
+    asked, out = r["asked"], r["unplaceable"]
+    left = f", {len(out)} unplaceable left out" if out else ""
+    if r["first_case"] is None and asked < TEST_CASES:
+        return f"{asked} sampled cases of {TEST_CASES}{left}"
     first = r["first_case"] or 0
-    return f"cases {first}..{first + r['cases'] - 1} ({r['cases']})"
+    return f"cases {first}..{first + asked - 1} ({asked}){left}"
 
 
 def run(
@@ -196,6 +205,7 @@ def run(
     times: list[float] = []
     intrusion: list[float] = []
     statuses: list[str] = []
+    unplaceable: list[int] = []
     cpu0, wall0 = time.process_time(), time.perf_counter()
     for case in case_numbers(cases, first):
         sensing: dict[str, Any] = (
@@ -204,11 +214,17 @@ def run(
             if lidar
             else {}
         )  # fmt: skip
-        scn = crowdnav_scenario(
-            case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
-            kinematics=kinematics, n_humans=humans, **sensing,  # type: ignore[arg-type]
-            accel_max=accel, turn_accel_max=turn_accel,
-        )  # fmt: skip
+        try:
+            scn = crowdnav_scenario(
+                case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
+                kinematics=kinematics, n_humans=humans, **sensing,  # type: ignore[arg-type]
+                accel_max=accel, turn_accel_max=turn_accel,
+            )  # fmt: skip
+        except ScenarioError as exc:
+            if exc.path != "n_humans":
+                raise
+            unplaceable.append(case)
+            continue
         setup = build_episode(scn, case)
         law: Any
         if law_name != PAPER_LAW:
@@ -236,6 +252,9 @@ def run(
         if status == "success" and arrival is not None:
             times.append(float(arrival))
     cpu, wall = time.process_time() - cpu0, time.perf_counter() - wall0
+    asked, cases = cases, len(statuses)
+    if not cases:
+        raise NoCaseError(f"--humans {humans}: no case's humans could be placed apart")
     rates: dict[str, dict[str, Any]] = {}
     for key, k in counts.items():
         lo, hi = wilson_interval(k, cases)
@@ -245,7 +264,9 @@ def run(
     return {
         "cases": cases,
         "first_case": first,
-        "case_numbers": case_numbers(cases, first),
+        "case_numbers": [c for c in case_numbers(asked, first) if c not in unplaceable],
+        "asked": asked,
+        "unplaceable": unplaceable,
         "rule": rule,
         "humans": humans,
         "substeps": substeps,
@@ -264,7 +285,7 @@ def run(
         "rates": rates,
         "robot_driven_collisions": {
             "count": robot_driven,
-            "rate": robot_driven / cases,
+            "rate": robot_driven / max(cases, 1),
             "ci95": [rd_lo, rd_hi],
         },
         "time_to_goal_mean": float(np.mean(times)) if times else None,
@@ -275,7 +296,7 @@ def run(
         "paper": PAPER,
         "target": TARGETS.get(law_name),
         "pass": bool(
-            counts["success"] / cases >= TARGETS[law_name]
+            counts["success"] / max(cases, 1) >= TARGETS[law_name]
             if law_name in TARGETS
             else lo <= PAPER["success"] <= hi
         ),
@@ -380,12 +401,15 @@ def main(argv: list[str] | None = None) -> int:
             ap.error(f"{name} must be a number > 0 (got {value!r})")
     if args.outcome == "crowdnav" and args.substeps != 1:
         ap.error("--outcome crowdnav judges 0.25 s steps: use --substeps 1")
-    r = run(
-        args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
-        outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
-        swept=not args.sampled, lidar=args.lidar, accel=args.accel, turn_accel=args.turn_accel,
-        humans=args.humans,
-    )  # fmt: skip
+    try:
+        r = run(
+            args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
+            outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
+            swept=not args.sampled, lidar=args.lidar, accel=args.accel, turn_accel=args.turn_accel,
+            humans=args.humans,
+        )  # fmt: skip
+    except NoCaseError as exc:
+        ap.error(str(exc))
     print(report(r))
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)

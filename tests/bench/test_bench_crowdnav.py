@@ -57,3 +57,26 @@ def test_mean_interval_is_a_bootstrap_of_the_mean() -> None:
     assert spread["mean"] == 0.5 and lo == pytest.approx(0.402, abs=0.02)
     assert hi == pytest.approx(0.598, abs=0.02)
     assert bench_crowdnav.mean_interval([])["mean"] is None
+
+
+def test_unplaceable_cases_are_left_out_and_listed(monkeypatch: pytest.MonkeyPatch) -> None:
+    scenario = bench_crowdnav.crowdnav_scenario
+
+    def crowded(case: int, **kw: Any) -> Any:
+        if case == 1:
+            raise bench_crowdnav.ScenarioError("crowdnav-circle:1", "n_humans", "cannot place")
+        return scenario(case, **kw)
+
+    monkeypatch.setattr(bench_crowdnav, "crowdnav_scenario", crowded)
+    r = bench_crowdnav.run(2, rule="circle_crossing", substeps=1, pref="uvnav", first=0,
+                           humans=2)  # fmt: skip
+    assert r["unplaceable"] == [1] and r["case_numbers"] == [0] and r["cases"] == 1
+    assert sum(x["count"] for x in r["rates"].values()) == 1
+    assert "cases 0..1 (2), 1 unplaceable left out" in bench_crowdnav.report(r)
+
+
+def test_no_placeable_case_is_a_one_line_error(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exc:
+        bench_crowdnav.main(["--cases", "1", "--first", "0", "--humans", "1000"])
+    assert exc.value.code == 2
+    assert "no case's humans could be placed apart" in capsys.readouterr().err
