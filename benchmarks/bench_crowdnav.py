@@ -12,7 +12,10 @@ test cases, :mod:`uvnav.scenarios.crowdnav`), the robot driven by ``orca-holonom
 robot ORCA of CrowdNav (time horizon 5 s, neighbour distance 10 m, at most 10 neighbours,
 reciprocal responsibility 0.5, combined radius 0.62 m: ``safety_margin`` 0.02).  Reported:
 success / collision / timeout rates with 95 % Wilson intervals, the mean time to goal of the
-successes, the CPU time, and PASS when the paper's success rate 0.43 lies inside our interval.
+successes, the mean intrusion ratio over the episodes (:mod:`uvnav.sim.social`: the share of
+steps the robot spends on a visible human's 1.25 s constant-velocity forecast) with a 95 %
+percentile bootstrap interval, the CPU time, and PASS when the paper's success rate 0.43 lies
+inside our interval.
 
 Options for the protocol study (defaults = the reproduction):
 
@@ -35,6 +38,10 @@ Options for the protocol study (defaults = the reproduction):
   and its turn rate by at most B [rad/s^2] (``UnicycleSpec.accel_max``, ``turn_accel_max``;
   default: at once).  Collisions the robot drove into (``collision_by`` ``robot``) are counted
   in every run.
+* ``--humans N``: N humans (0-1000) instead of CrowdNav's 5 (the scenes' ``n_humans``, the
+  same case seeds).  A case whose humans CrowdSim's rule cannot place apart (20 humans on the
+  4 m circle: a few cases) is left out and listed as ``unplaceable``; the rates are over the
+  cases run.
 * ``--pref crowdnav``: the robot's preferred velocity as CrowdNav's ORCA sets it (1 m/s toward
   the goal beyond 1 m, the gap within) instead of ``orca-holonomic-v1``'s (V_max, lowered to
   ``dist / period`` on the last step).
@@ -61,7 +68,13 @@ from uvnav.controllers.holonomic import OrcaHolonomic
 from uvnav.core import BaseProbe
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.catalog import kinds
-from uvnav.scenarios.crowdnav import CROWDNAV_ORCA_PARAMS, TIME_STEP, crowdnav_scenario
+from uvnav.scenarios.crowdnav import (
+    CROWDNAV_ORCA_PARAMS,
+    N_HUMANS,
+    TIME_STEP,
+    crowdnav_scenario,
+)
+from uvnav.scenarios.errors import ScenarioError
 from uvnav.sim.run import run_episode
 
 #: Chen et al. ICRA 2019, Table I, ORCA (invisible robot)
@@ -127,6 +140,25 @@ TEST_CASES = 500
 LIDAR_NOISE, LIDAR_RANGE = 0.01, 5.0
 
 
+class NoCaseError(ValueError):
+    """No asked case could be built (every one unplaceable)."""
+
+
+#: bootstrap resamples of the mean intrusion ratio's interval (generator seeded 0)
+RESAMPLES = 2000
+
+
+def mean_interval(values: list[float], resamples: int = RESAMPLES) -> dict[str, Any]:
+    """The mean of ``values`` and its 95 % percentile bootstrap interval (``resamples`` means of
+    resamples with replacement, drawn by a generator seeded 0); ``None`` figures when empty."""
+    if not values:
+        return {"mean": None, "ci95": [None, None], "episodes": 0}
+    x = np.asarray(values, dtype=float)
+    idx = np.random.default_rng(0).integers(0, len(x), size=(resamples, len(x)))
+    lo, hi = np.percentile(x[idx].mean(axis=1), [2.5, 97.5])
+    return {"mean": float(x.mean()), "ci95": [float(lo), float(hi)], "episodes": len(x)}
+
+
 def case_numbers(cases: int, first: int | None) -> list[int]:
     """The cases to run: ``first`` .. ``first + cases - 1``, or (``first`` None) all 500 when
     ``cases`` is 500 or more, else a sample of them drawn by a generator seeded 0 (cases 0-99
@@ -140,11 +172,13 @@ def case_numbers(cases: int, first: int | None) -> list[int]:
 
 
 def _cases_text(r: dict[str, Any]) -> str:
-    """``cases 0..499 (500)`` or ``100 sampled cases of 500``."""
-    if r["first_case"] is None and r["cases"] < TEST_CASES:
-        return f"{r['cases']} sampled cases of {TEST_CASES}"
+    """``cases 0..499 (500)`` or ``100 sampled cases of 500``, and the unplaceable ones."""
+    asked, out = r["asked"], r["unplaceable"]
+    left = f", {len(out)} unplaceable left out" if out else ""
+    if r["first_case"] is None and asked < TEST_CASES:
+        return f"{asked} sampled cases of {TEST_CASES}{left}"
     first = r["first_case"] or 0
-    return f"cases {first}..{first + r['cases'] - 1} ({r['cases']})"
+    return f"cases {first}..{first + asked - 1} ({asked}){left}"
 
 
 def run(
@@ -161,6 +195,7 @@ def run(
     lidar: int | None = None,
     accel: float | None = None,
     turn_accel: float | None = None,
+    humans: int = N_HUMANS,
 ) -> dict[str, Any]:
     """Run the cases; returns the counts, rates, intervals and times."""
     rng_of = kinds()["nav2d"].episode_rng
@@ -168,7 +203,9 @@ def run(
     counts = {"success": 0, "collision": 0, "timeout": 0}
     robot_driven = 0
     times: list[float] = []
+    intrusion: list[float] = []
     statuses: list[str] = []
+    unplaceable: list[int] = []
     cpu0, wall0 = time.process_time(), time.perf_counter()
     for case in case_numbers(cases, first):
         sensing: dict[str, Any] = (
@@ -177,11 +214,17 @@ def run(
             if lidar
             else {}
         )  # fmt: skip
-        scn = crowdnav_scenario(
-            case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
-            kinematics=kinematics, **sensing,  # type: ignore[arg-type]
-            accel_max=accel, turn_accel_max=turn_accel,
-        )  # fmt: skip
+        try:
+            scn = crowdnav_scenario(
+                case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
+                kinematics=kinematics, n_humans=humans, **sensing,  # type: ignore[arg-type]
+                accel_max=accel, turn_accel_max=turn_accel,
+            )  # fmt: skip
+        except ScenarioError as exc:
+            if exc.path != "n_humans":
+                raise
+            unplaceable.append(case)
+            continue
         setup = build_episode(scn, case)
         law: Any
         if law_name != PAPER_LAW:
@@ -204,9 +247,14 @@ def run(
         counts[status] += 1
         robot_driven += int(status == "collision" and res.metrics.collision_by == "robot")
         statuses.append(status)
+        if res.metrics.intrusion_ratio is not None:
+            intrusion.append(res.metrics.intrusion_ratio)
         if status == "success" and arrival is not None:
             times.append(float(arrival))
     cpu, wall = time.process_time() - cpu0, time.perf_counter() - wall0
+    asked, cases = cases, len(statuses)
+    if not cases:
+        raise NoCaseError(f"--humans {humans}: no case's humans could be placed apart")
     rates: dict[str, dict[str, Any]] = {}
     for key, k in counts.items():
         lo, hi = wilson_interval(k, cases)
@@ -216,8 +264,11 @@ def run(
     return {
         "cases": cases,
         "first_case": first,
-        "case_numbers": case_numbers(cases, first),
+        "case_numbers": [c for c in case_numbers(asked, first) if c not in unplaceable],
+        "asked": asked,
+        "unplaceable": unplaceable,
         "rule": rule,
+        "humans": humans,
         "substeps": substeps,
         "dt": TIME_STEP / substeps,
         "pref": pref,
@@ -234,17 +285,18 @@ def run(
         "rates": rates,
         "robot_driven_collisions": {
             "count": robot_driven,
-            "rate": robot_driven / cases,
+            "rate": robot_driven / max(cases, 1),
             "ci95": [rd_lo, rd_hi],
         },
         "time_to_goal_mean": float(np.mean(times)) if times else None,
+        "intrusion_ratio": mean_interval(intrusion),
         "cpu_s": cpu,
         "wall_s": wall,
         "cpu_ms_per_episode": 1000.0 * cpu / max(cases, 1),
         "paper": PAPER,
         "target": TARGETS.get(law_name),
         "pass": bool(
-            counts["success"] / cases >= TARGETS[law_name]
+            counts["success"] / max(cases, 1) >= TARGETS[law_name]
             if law_name in TARGETS
             else lo <= PAPER["success"] <= hi
         ),
@@ -254,7 +306,8 @@ def run(
 
 def report(r: dict[str, Any]) -> str:
     lines = [
-        f"crowdnav-{r['rule'].split('_')[0]} {_cases_text(r)}, {r['law']} {r['params']}, "
+        f"crowdnav-{r['rule'].split('_')[0]} {_cases_text(r)}, {r['humans']} humans, "
+        f"{r['law']} {r['params']}, "
         f"dt {r['dt']:g} s, pref {r['pref']}, outcome {r['outcome']}, collisions judged "
         f"{r['judged']}, sensing {r['sensing']}"
         + (f", {r['kinematics']} unicycle" if r["kinematics"] else "")
@@ -281,6 +334,11 @@ def report(r: dict[str, Any]) -> str:
         if ttg is not None
         else "  time to goal: no success"
     )
+    ir = r["intrusion_ratio"]
+    if ir["mean"] is not None:
+        lo, hi = ir["ci95"]
+        lines.append(f"  intrusion ratio (mean of {ir['episodes']} episodes) {ir['mean']:.3f}  "
+                     f"95% [{lo:.3f}, {hi:.3f}]")  # fmt: skip
     lines.append(
         f"  CPU {r['cpu_s']:.1f} s ({r['cpu_ms_per_episode']:.1f} ms/episode), "
         f"wall {r['wall_s']:.1f} s"
@@ -330,20 +388,28 @@ def main(argv: list[str] | None = None) -> int:
         metavar="B",
         help="the unicycle's largest turn-rate change [rad/s^2] (default: at once)",
     )
+    ap.add_argument("--humans", type=int, default=N_HUMANS, metavar="N",
+                    help=f"number of humans (default CrowdNav's {N_HUMANS})")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write crowdnav.json here")
     args = ap.parse_args(argv)
     if args.cases < 1 or args.substeps < 1:
         ap.error("--cases and --substeps must be >= 1")
+    if not 0 <= args.humans <= 1000:
+        ap.error(f"--humans must be in 0..1000 (got {args.humans})")
     for name, value in (("--accel", args.accel), ("--turn-accel", args.turn_accel)):
         if value is not None and not (math.isfinite(value) and value > 0):
             ap.error(f"{name} must be a number > 0 (got {value!r})")
     if args.outcome == "crowdnav" and args.substeps != 1:
         ap.error("--outcome crowdnav judges 0.25 s steps: use --substeps 1")
-    r = run(
-        args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
-        outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
-        swept=not args.sampled, lidar=args.lidar, accel=args.accel, turn_accel=args.turn_accel,
-    )  # fmt: skip
+    try:
+        r = run(
+            args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
+            outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
+            swept=not args.sampled, lidar=args.lidar, accel=args.accel, turn_accel=args.turn_accel,
+            humans=args.humans,
+        )  # fmt: skip
+    except NoCaseError as exc:
+        ap.error(str(exc))
     print(report(r))
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)

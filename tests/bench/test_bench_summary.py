@@ -23,9 +23,10 @@ def _metrics(status: str, **social: Any) -> dict[str, Any]:
 def test_social_columns(tmp_path: Path) -> None:
     episodes: list[tuple[str, dict[str, Any]]] = [
         ("success", {"min_separation": 0.3, "too_close_frequency": 0.0, "intrusion_time": 1.0,
-                     "path_irregularity": 0.2}),
+                     "intrusion_ratio": 0.1, "path_irregularity": 0.2}),
         ("collision", {"min_separation": -0.05, "too_close_frequency": 0.5, "intrusion_time": 2.0,
-                       "path_irregularity": 0.4, "collision_by": "pedestrian"}),
+                       "intrusion_ratio": 0.4, "path_irregularity": 0.4,
+                       "collision_by": "pedestrian"}),
         ("collision", {"min_separation": 0.2, "too_close_frequency": 0.1, "intrusion_time": 0.0,
                        "path_irregularity": 0.6, "collision_by": "robot"}),
         ("collision", {"min_separation": -0.01, "too_close_frequency": 0.2, "intrusion_time": 3.0,
@@ -47,11 +48,12 @@ def test_social_columns(tmp_path: Path) -> None:
     assert law["min_separation"] == -0.05
     assert law["too_close_frequency"] == pytest.approx(0.8 / 4)
     assert law["intrusion_time"] == pytest.approx(6.0 / 4)
+    assert law["intrusion_ratio"] == pytest.approx(0.5 / 2)  # the episodes that have it
     assert law["path_irregularity"] == pytest.approx(1.5 / 4)
     assert law["pedestrian_collision_share"] == pytest.approx(2 / 3)
     other = rows["other"]  # no pedestrian, no turn recorded, no collision
-    for col in ("min_separation", "too_close_frequency", "intrusion_time", "path_irregularity",
-                "pedestrian_collision_share"):  # fmt: skip
+    for col in ("min_separation", "too_close_frequency", "intrusion_time", "intrusion_ratio",
+                "path_irregularity", "pedestrian_collision_share"):  # fmt: skip
         assert other[col] is None
 
 

@@ -13,9 +13,10 @@ One row per (controller, parameter set), over every stored episode of the campai
 ``min_separation`` [m]
     the smallest ``min_separation`` (robot to pedestrian, :mod:`uvnav.sim.social`) of any
     episode, like ``min_clearance``; ``None`` when no episode had a pedestrian.
-``too_close_frequency``, ``intrusion_time`` [s]
+``too_close_frequency``, ``intrusion_time`` [s], ``intrusion_ratio``
     means over the episodes with pedestrians (share of decisions closer than 0.2 m, CrowdNav's
-    discomfort frequency; time closer than 0.45 m).
+    discomfort frequency; time closer than 0.45 m; share of steps on a visible pedestrian's
+    1.25 s constant-velocity forecast).
 ``path_irregularity`` [rad/m]
     mean over the episodes that have it (2D episodes in which the robot moved).
 ``pedestrian_collision_share``
@@ -62,6 +63,7 @@ SUMMARY_COLUMNS = (
     "min_separation",
     "too_close_frequency",
     "intrusion_time",
+    "intrusion_ratio",
     "path_irregularity",
     "pedestrian_collision_share",
     "decision_us_median",
@@ -214,6 +216,7 @@ def _social(ok: Any) -> dict[str, float | None]:
         "min_separation": _num(sep.astype(float).min()) if len(sep) else None,
         "too_close_frequency": mean("too_close_frequency"),
         "intrusion_time": mean("intrusion_time"),
+        "intrusion_ratio": mean("intrusion_ratio"),
         "path_irregularity": mean("path_irregularity"),
         "pedestrian_collision_share": _num((by == "pedestrian").mean()) if len(by) else None,
     }

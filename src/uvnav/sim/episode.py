@@ -142,8 +142,9 @@ class World2D(OneVehicle):
         if len(self.pedestrians):
             radius = float(self.spec.radius)
             self.social = SocialTracker(
-                self.pedestrians, self.template.radii, radius, self.dt, self.ratio
-            )
+                self.pedestrians, self.template.radii, radius, self.dt, self.ratio,
+                sensing_range=self.sensing_range,
+            )  # fmt: skip
             self.social.observe(self.field, self.x, self.y, 0)
         self.sweep = (
             SweptClearance(self.template, float(self.spec.radius))
@@ -295,6 +296,7 @@ class World2D(OneVehicle):
             "too_close_time": soc.too_close_time,
             "too_close_frequency": soc.too_close_frequency(decisions),
             "intrusion_time": soc.intrusion_time,
+            "intrusion_ratio": soc.intrusion_ratio,
         }
 
 

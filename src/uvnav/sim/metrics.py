@@ -24,6 +24,7 @@ SOCIAL_METRIC_NAMES: tuple[str, ...] = (
     "too_close_time",
     "too_close_frequency",
     "intrusion_time",
+    "intrusion_ratio",
     "path_irregularity",
     "collision_by",
 )
@@ -76,6 +77,9 @@ class EpisodeMetrics:
         too_close_frequency: share of the decisions whose period had a pedestrian closer than
             0.2 m (CrowdNav's discomfort frequency).
         intrusion_time: time with a pedestrian closer than 0.45 m (Hall's intimate zone) [s].
+        intrusion_ratio: share of the integration steps in which the robot's disc lies on a
+            visible pedestrian's disc as constant velocity forecasts it over the next 1.25 s
+            (the intrusion ratio of crowd-navigation work, CrowdNav++).
         path_irregularity: total absolute heading change per metre of path [rad/m] (every 2D
             episode that moved).
         collision_by: who closed the gap at the collision: ``"robot"``, ``"pedestrian"`` or
@@ -99,6 +103,7 @@ class EpisodeMetrics:
     too_close_time: float | None = None
     too_close_frequency: float | None = None
     intrusion_time: float | None = None
+    intrusion_ratio: float | None = None
     path_irregularity: float | None = None
     collision_by: str | None = None
 
@@ -122,6 +127,7 @@ def episode_metrics(
     too_close_time: float | None = None,
     too_close_frequency: float | None = None,
     intrusion_time: float | None = None,
+    intrusion_ratio: float | None = None,
     path_irregularity: float | None = None,
     collision_by: str | None = None,
 ) -> EpisodeMetrics:
@@ -141,9 +147,9 @@ def episode_metrics(
         limit_violations: decisions whose command was outside the limits.
         mode_switches: changes of the controller's reported mode.
         decision_us: controller compute time of every decision [µs] (empty: no decision).
-        min_separation, too_close_time, too_close_frequency, intrusion_time, path_irregularity,
-        collision_by: the social metrics of a 2D world (:mod:`uvnav.sim.social`), ``None``
-            where they do not apply.
+        min_separation, too_close_time, too_close_frequency, intrusion_time, intrusion_ratio,
+        path_irregularity, collision_by: the social metrics of a 2D world
+            (:mod:`uvnav.sim.social`), ``None`` where they do not apply.
     """
     dec = np.asarray(decision_us, dtype=float) if len(decision_us) else np.zeros(1)
     success = status == "success"
@@ -166,6 +172,7 @@ def episode_metrics(
         too_close_time=_opt(too_close_time),
         too_close_frequency=_opt(too_close_frequency),
         intrusion_time=_opt(intrusion_time),
+        intrusion_ratio=_opt(intrusion_ratio),
         path_irregularity=_opt(path_irregularity),
         collision_by=collision_by,
     )

@@ -35,6 +35,20 @@ Metrics (``None`` in a scene without pedestrians, except where said):
     ``dt`` times the number of integration steps whose end state has a gap < 0.45 m, the outer
     edge of Hall's intimate zone (E. T. Hall, *The Hidden Dimension*, 1966: intimate distance up to
     18 in ≈ 0.45 m) — time with a pedestrian inside the robot's personal space.
+``intrusion_ratio``
+    share of the integration steps (the initial state left out) whose end state puts the robot's
+    disc on the disc of a *visible* pedestrian as that pedestrian will be over the next 1.25 s:
+    ``|c - (p + v k dt)| - r_ped - R < 0`` for some ``k = 1 .. K``, ``K = round(1.25 / dt)``
+    (at least 1), with ``p`` and ``v`` the pedestrian's centre and velocity at that step.  This
+    is the intrusion ratio of Liu et al. (ICRA 2023, "Intention aware robot crowd navigation
+    with attention-based interaction graph"; CrowdNav++), whose simulator checks the robot's
+    position against each visible human's positions at the next five 0.25 s steps, within the
+    radius sum (0.3 + 0.3 = 0.6 m; here each pedestrian's own radius).  CrowdNav++ takes the
+    humans' *true* future positions from its simulator; the world here cannot know the future
+    of humans that react (to each other, or to a visible robot), so the forecast is constant
+    velocity, which is also what a robot could compute.  Visible: the pedestrian's disc within
+    the robot's sensing range, ``|c - p| - r_ped <= sensing_range`` (the exact sensor's
+    rule); an absent pedestrian never counts.
 ``path_irregularity`` [rad/m]
     total absolute heading change divided by the path length: ``sum_k |Δθ_k| / L`` over the
     integration steps (unicycle: ``sum |u_R| dt``, the exact rotation of each step; holonomic
@@ -71,6 +85,8 @@ from uvnav.obstacles.obstacle import Obstacle, ObstacleField
 DISCOMFORT_DISTANCE = 0.2
 #: Hall's intimate distance [m] (gap below which a pedestrian intrudes on the robot's space)
 INTIMATE_DISTANCE = 0.45
+#: how far ahead the intrusion ratio forecasts the pedestrians [s] (CrowdNav++: 5 x 0.25 s)
+INTRUSION_HORIZON = 1.25
 
 
 def pedestrian_ids(obstacles: Sequence[Obstacle]) -> np.ndarray:
@@ -94,17 +110,23 @@ class SocialTracker:
         robot_radius: the robot's radius [m].
         dt: integration step [s].
         ratio: integration steps per decision.
+        sensing_range: the robot's sensing range [m]: only pedestrians within it count for the
+            intrusion ratio.
     """
 
     __slots__ = (
         "_all",
         "_close_periods",
         "_close_steps",
+        "_forecast",
         "_ids",
+        "_intruded_steps",
         "_intrusion_steps",
         "_last_period",
         "_radii",
         "_radius",
+        "_range",
+        "_steps",
         "dt",
         "min_separation",
         "ratio",
@@ -117,6 +139,7 @@ class SocialTracker:
         robot_radius: float,
         dt: float,
         ratio: int,
+        sensing_range: float = math.inf,
     ) -> None:
         self._ids = ids
         self._all = len(ids) == len(radii)
@@ -129,6 +152,11 @@ class SocialTracker:
         self._intrusion_steps = 0
         self._close_periods = 0
         self._last_period = -1
+        self._range = float(sensing_range)
+        k = max(1, round(INTRUSION_HORIZON / self.dt))
+        self._forecast = np.arange(1, k + 1, dtype=float)[:, None] * self.dt  # (K, 1) [s]
+        self._steps = 0
+        self._intruded_steps = 0
 
     def gap(self, fld: ObstacleField, px: float, py: float) -> float:
         """Smallest gap [m] between the robot's disc at ``(px, py)`` and a pedestrian's."""
@@ -146,6 +174,9 @@ class SocialTracker:
         g = self.gap(fld, px, py)
         if g < self.min_separation:
             self.min_separation = g
+        if step > 0:
+            self._steps += 1
+            self._intruded_steps += self.intrudes(fld, px, py)
         if step > 0 and g < INTIMATE_DISTANCE:
             self._intrusion_steps += 1
             if g < DISCOMFORT_DISTANCE:
@@ -154,6 +185,29 @@ class SocialTracker:
                 if period != self._last_period:
                     self._last_period = period
                     self._close_periods += 1
+
+    def intrudes(self, fld: ObstacleField, px: float, py: float) -> bool:
+        """Whether the robot's disc at ``(px, py)`` lies on a visible pedestrian's disc as a
+        constant-velocity forecast puts it over the next :data:`INTRUSION_HORIZON` seconds
+        (module docstring, ``intrusion_ratio``)."""
+        ids = None if self._all else self._ids
+        c = fld.centres if ids is None else fld.centres.take(ids, axis=0)
+        v = fld.velocities if ids is None else fld.velocities.take(ids, axis=0)
+        seen = np.hypot(px - c[:, 0], py - c[:, 1]) - self._radii <= self._range
+        present = fld.present
+        if present is not None:
+            seen &= present if ids is None else present.take(ids)
+        if not seen.any():
+            return False
+        c, v, r = c[seen], v[seen], self._radii[seen]
+        fx = c[:, 0] + v[:, 0] * self._forecast  # (K, n) forecast centres
+        fy = c[:, 1] + v[:, 1] * self._forecast
+        return bool((np.hypot(px - fx, py - fy) - r - self._radius < 0.0).any())
+
+    @property
+    def intrusion_ratio(self) -> float:
+        """Share of the integration steps with an intrusion (:meth:`intrudes`); 0 before any."""
+        return self._intruded_steps / self._steps if self._steps else 0.0
 
     @property
     def too_close_time(self) -> float:
