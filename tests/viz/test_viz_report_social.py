@@ -8,7 +8,7 @@ from typing import Any
 from uvnav.bench.store import ResultsStore
 from uvnav.viz.report import summary_table
 
-SOCIAL = ("min_separation [m]", "too_close_frequency", "intrusion_time [s]")
+SOCIAL = ("min_separation [m]", "too_close_frequency", "intrusion_time [s]", "intrusion_ratio")
 
 
 def _metrics(**social: Any) -> dict[str, Any]:
@@ -27,7 +27,7 @@ def test_summary_lists_social_metrics_of_crowd_campaigns(tmp_path: Path) -> None
                 crowd, scenario="c", family="crowd", controller="law", seed=seed,
                 status="success", metrics=_metrics(
                     min_separation=sep, too_close_frequency=0.5, intrusion_time=1.0,
-                    path_irregularity=0.2,
+                    intrusion_ratio=0.25, path_irregularity=0.2,
                 ),
             )  # fmt: skip
         store.add_episode(
@@ -39,6 +39,7 @@ def test_summary_lists_social_metrics_of_crowd_campaigns(tmp_path: Path) -> None
     assert row["min_separation [m]"].endswith("/ 0.200")  # mean [CI] / median of 0.1, 0.3
     assert row["too_close_frequency"] == "0.500 [0.500, 0.500] / 0.500"
     assert row["intrusion_time [s]"].startswith("1.00")
+    assert row["intrusion_ratio"] == "0.250 [0.250, 0.250] / 0.250"
     assert row["path_irregularity [rad/m]"].startswith("0.200")
     assert list(row).index("path_irregularity [rad/m]") < list(row).index("decision_us_median [µs]")
     assert not set(SOCIAL) & set(other)  # no pedestrian: no pedestrian columns

@@ -97,6 +97,7 @@ _SOCIAL_COLUMNS = (
     ("min_separation [m]", "min_separation", 3),
     ("too_close_frequency", "too_close_frequency", 3),
     ("intrusion_time [s]", "intrusion_time", 2),
+    ("intrusion_ratio", "intrusion_ratio", 3),
     ("path_irregularity [rad/m]", "path_irregularity", 3),
 )
 
