@@ -59,6 +59,23 @@ def campaign(tmp_path: Path) -> Path:
     return path
 
 
+def test_the_summary_fits_an_80_column_terminal_and_says_what_it_leaves_out(
+    campaign: Path, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from rich.console import Console
+
+    import uvnav.cli.bench as cb
+
+    monkeypatch.setattr(cb, "_console", lambda: Console(width=80, highlight=False))
+    db = tmp_path / "r.sqlite"
+    result = invoke("bench", str(campaign), "--db", str(db), "--workers", "1")
+    assert result.exit_code == 0, result.output
+    table = result.stdout.split("ran 6 episode(s)")[0].splitlines()
+    assert max(len(line) for line in table) <= 80
+    assert "not shown at this width: decide µs p99 (--json has all)" in result.stdout
+    assert "success" in result.stdout and "median" in result.stdout
+
+
 def test_bench_prints_the_per_controller_table(campaign: Path, tmp_path: Path) -> None:
     db = tmp_path / "r.sqlite"
     args = ["bench", str(campaign), "--db", str(db), "--workers", "1"]

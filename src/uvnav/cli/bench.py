@@ -34,6 +34,32 @@ _SUMMARY_HEADERS = {
 }
 
 
+#: the summary columns a narrow terminal loses first, in order
+_DROP_FIRST = ("decision_us_p99", "time_ratio", "refused", "errors", "detour_ratio")
+
+
+def fit_columns(widths: dict[str, int], width: int, label: int = 12) -> list[str]:
+    """The summary columns (``widths``: column -> its width) that fit a console of ``width``
+    columns beside a ``label`` column, dropping :data:`_DROP_FIRST` in order until they fit.
+
+    >>> fit_columns({"success_rate": 7, "decision_us_p99": 6, "time_ratio": 5}, 80)
+    ['success_rate', 'decision_us_p99', 'time_ratio']
+    >>> fit_columns({"success_rate": 7, "decision_us_p99": 6, "time_ratio": 5}, 25)
+    ['success_rate']
+    """
+    kept = list(widths)
+
+    def need() -> int:
+        return label + sum(widths[c] + 2 for c in kept)
+
+    for col in _DROP_FIRST:
+        if need() <= width:
+            break
+        if col in kept:
+            kept.remove(col)
+    return kept
+
+
 def _summary_cell(col: str, value: Any) -> str:
     if value is None:
         return "-"
@@ -179,21 +205,34 @@ def bench_cmd(
         typer.echo(_dumps(record))
         _fail_on_errors(result.errors, first_error)
         return
-    table = compact_table(f"campaign {spec.name} ({result.total} episodes)")
+    con = _console()
     numeric = [c for c in SUMMARY_COLUMNS if c in _SUMMARY_HEADERS]
-    table.add_column("controller\nparams", overflow="fold", ratio=1, min_width=12)
     cells = [[_summary_cell(col, row[col]) for col in numeric] for row in rows]
-    for i, col in enumerate(numeric):
-        widest = max(len(r[i]) for r in cells) if cells else 1
-        head = _SUMMARY_HEADERS[col]
-        width = max(widest, *(len(w) for w in head.split("\n")))
-        table.add_column(head, justify="right", no_wrap=True, min_width=width)
+    widths = {
+        col: max(
+            max((len(r[i]) for r in cells), default=1),
+            *(len(w) for w in _SUMMARY_HEADERS[col].split("\n")),
+        )
+        for i, col in enumerate(numeric)
+    }
+    kept = fit_columns(widths, con.width)
+    dropped = [_SUMMARY_HEADERS[c].replace("\n", " ") for c in numeric if c not in kept]
+    caption = f"not shown at this width: {', '.join(dropped)} (--json has all)"
+    table = compact_table(
+        f"campaign {spec.name} ({result.total} episodes)", caption if dropped else None
+    )
+    table.add_column("controller\nparams", overflow="fold", ratio=1, min_width=12)
+    for col in kept:
+        table.add_column(
+            _SUMMARY_HEADERS[col], justify="right", no_wrap=True, min_width=widths[col]
+        )
     for row, r in zip(rows, cells, strict=True):
         label = (
             row["controller"] if row["params"] == "-" else f"{row['controller']}\n{row['params']}"
         )
-        table.add_row(_text(label), *(_text(c) for c in r))
-    _console().print(table)
+        shown = [c for col, c in zip(numeric, r, strict=True) if col in kept]
+        table.add_row(_text(label), *(_text(c) for c in shown))
+    con.print(table)
     if failures:
         _print_failures(failed, spec.beyond_assumptions)
     speed = f", {rate:.2f} episodes/s" if rate is not None else ""
