@@ -199,3 +199,24 @@ def test_parse_seeds() -> None:
     # a range too long to run is refused before anything is built (it once ran out of memory)
     with pytest.raises(ValueError, match="more than 100000 seeds"):
         parse_seeds("0-9999999999")
+
+
+def test_the_closed_loop_table_fits_80_columns(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Every cell whole at 80 columns: short headers, numbers formatted to their precision."""
+    from rich.console import Console
+
+    import uvnav.cli.common as common
+    from uvnav.cli.drive import _print_rows
+
+    monkeypatch.setattr(common, "console", lambda stderr=False: Console(width=80))
+    row = {
+        "n": 20.0, "return": 812.345, "return_vs_expert": 0.912, "tiles_pct": 97.5, "laps": 1.0,
+        "mean_centre_distance": 1.234, "off_track_events": 0.25, "autonomy": 0.9876,
+        "mean_speed": 23.4,
+    }  # fmt: skip
+    _print_rows({"cnn-learned": row, "expert": {"n": 20.0, "return": 900.0}}, False)
+    out = capsys.readouterr().out
+    assert max(len(line) for line in out.splitlines()) <= 80
+    assert "812.3" in out and "0.988" in out and "…" not in out

@@ -431,31 +431,45 @@ def evaluate(
         _print_rows(rows, as_json)
 
 
+#: closed-loop columns: (key, header, format); headers short enough for 80 columns
+_LOOP_COLUMNS = (
+    ("n", "n", "{:.0f}"),
+    ("return", "return", "{:.1f}"),
+    ("return_vs_expert", "return\n/ expert", "{:.2f}"),
+    ("tiles_pct", "tiles\n[%]", "{:.1f}"),
+    ("laps", "laps", "{:.2f}"),
+    ("mean_centre_distance", "centre\ndist.", "{:.2f}"),
+    ("off_track_events", "off\ntrack", "{:.1f}"),
+    ("autonomy", "auto-\nnomy", "{:.3f}"),
+    ("mean_speed", "speed", "{:.1f}"),
+)
+
+
+def loop_cells(row: dict[str, float]) -> list[str]:
+    """One driver's closed-loop cells (:data:`_LOOP_COLUMNS`; ``—`` where it has no value).
+
+    >>> loop_cells({"n": 20.0, "return": 812.345, "autonomy": 0.9876})[:3]
+    ['20', '812.3', '—']
+    """
+    return [fmt.format(row[key]) if key in row else "—" for key, _, fmt in _LOOP_COLUMNS]
+
+
 def _print_rows(rows: dict[str, dict[str, float]], as_json: bool) -> None:
     if as_json:
         typer.echo(dumps(rows, indent=2))  # strict JSON: a missing value is null, never NaN
         return
-    from rich.console import Console
-    from rich.table import Table
+    from uvnav.cli.common import compact_table, console
 
-    cols = [
-        "n",
-        "return",
-        "return_vs_expert",
-        "tiles_pct",
-        "laps",
-        "mean_centre_distance",
-        "off_track_events",
-        "autonomy",
-        "mean_speed",
-    ]
-    table = Table(title="closed loop (means over seeds)")
-    table.add_column("driver")
-    for c in cols:
-        table.add_column(c, justify="right")
+    table = compact_table(
+        "closed loop (means over seeds)",
+        "centre dist.: mean distance to the centreline [m]; off track [events]; speed [m/s]",
+    )
+    table.add_column("driver", overflow="fold")
+    for _, head, _ in _LOOP_COLUMNS:
+        table.add_column(head, justify="right", no_wrap=True)
     for name, row in rows.items():
-        table.add_row(name, *(f"{row[c]:.3f}" if c in row else "—" for c in cols))
-    Console().print(table)
+        table.add_row(name, *loop_cells(row))
+    console().print(table)
 
 
 @drive_app.command()
