@@ -33,6 +33,9 @@ def test_dataset_train_evaluate(tmp_path: Path) -> None:
     first = json.loads(r.stdout)  # --json: stdout holds one JSON object, nothing else
     assert set(first["test"]) == {"network", "baseline"}
     assert "wrote" in r.stderr
+    net, base = (first["test"][k]["distance"]["mae"] for k in ("network", "baseline"))
+    worse = "is worse than the min/argmin baseline's" in r.stderr
+    assert worse == (net > base)  # 5 epochs of the plain network: said when it is worse
     assert (tmp_path / "m.safetensors").is_file() and (tmp_path / "m.json").is_file()
     r = runner.invoke(
         app, ["sonar", "evaluate", str(tmp_path / "m.safetensors"), str(data), "--json"]

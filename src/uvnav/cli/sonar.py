@@ -193,7 +193,36 @@ def train_cmd(
     else:
         _print_table(table, len(ds), f"test group ({len(test)} samples), {_what(model)}")
         typer.echo(f"stopped: {model.stop_reason} (best epoch {model.best_epoch})")
+    note = worse_than_baseline(table, model.variant)
+    if note:
+        typer.echo(note, err=True)
     typer.echo(f"wrote {st} and {js}", err=as_json)  # --json: stdout holds the JSON alone
+
+
+def worse_than_baseline(table: dict[str, Any], variant: str) -> str | None:
+    """A one-line note when the network locates worse than the min/argmin of its own inputs on
+    the test group (its distance MAE above the baseline's), with what to try; ``None``
+    otherwise.
+
+    >>> t = {"network": {"distance": {"mae": 0.41}}, "baseline": {"distance": {"mae": 0.013}}}
+    >>> worse_than_baseline(t, "plain")[:60]
+    "note: the network's distance MAE on its test group, 0.41 m, "
+    >>> worse_than_baseline({**t, "network": {"distance": {"mae": 0.01}}}, "plain") is None
+    True
+    """
+    net = table.get("network", {}).get("distance", {}).get("mae")
+    base = table.get("baseline", {}).get("distance", {}).get("mae")
+    if net is None or base is None or not net > base:
+        return None
+    hint = (
+        "try --variant residual-huber (a correction to the baseline) or more samples"
+        if variant == "plain"
+        else "try more samples or another --seed"
+    )
+    return (
+        f"note: the network's distance MAE on its test group, {net:.2g} m, is worse than the "
+        f"min/argmin baseline's, {base:.2g} m: {hint}"
+    )
 
 
 @sonar_app.command("evaluate")
