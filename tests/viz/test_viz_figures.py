@@ -185,3 +185,5 @@ def test_a_discs_rotation_is_not_plotted() -> None:
     _draw_nearest(ax, traj)
     speed, omega = (line.get_ydata() for line in ax.get_lines()[:2])
     assert np.isfinite(speed).any() and np.isnan(omega).all()
+    legend = [t.get_text() for t in ax.get_legend().get_texts()]
+    assert legend == ["||v_i|| [m/s]"]  # no entry for a line that is not drawn

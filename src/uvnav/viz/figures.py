@@ -270,9 +270,10 @@ def _draw_nearest(ax: Axes, traj: Trajectory) -> None:
         if len(discs) == traj.obstacle_omegas.shape[1]:
             omega[rows[discs[near[ok]]]] = np.nan
     ax.plot(t, speed, color="tab:purple", label="||v_i|| [m/s]")
-    ax.plot(t, omega, color="tab:brown", lw=0.9, label="u_i [rad/s]")
+    rotating = bool(np.isfinite(omega).any())
+    ax.plot(t, omega, color="tab:brown", lw=0.9, label="u_i [rad/s]" if rotating else None)
     ax.axhline(0.0, color="0.5", lw=0.5)
-    ax.set_ylabel("||v_i|| [m/s], u_i [rad/s]")
+    ax.set_ylabel("||v_i|| [m/s], u_i [rad/s]" if rotating else "||v_i|| [m/s]")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper right", fontsize="small", framealpha=0.8)
     ax.set_title("(c) nearest obstacle", fontsize="medium", loc="left")
