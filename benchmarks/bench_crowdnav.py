@@ -38,6 +38,7 @@ Options for the protocol study (defaults = the reproduction):
   and its turn rate by at most B [rad/s^2] (``UnicycleSpec.accel_max``, ``turn_accel_max``;
   default: at once).  Collisions the robot drove into (``collision_by`` ``robot``) are counted
   in every run.
+* ``--sensing-range R``: the robot sees the humans within R [m] (CrowdNav's scenes: 20 m).
 * ``--humans N``: N humans (0-1000) instead of CrowdNav's 5 (the scenes' ``n_humans``, the
   same case seeds).  A case whose humans CrowdSim's rule cannot place apart (20 humans on the
   4 m circle: a few cases) is left out and listed as ``unplaceable``; the rates are over the
@@ -196,6 +197,7 @@ def run(
     accel: float | None = None,
     turn_accel: float | None = None,
     humans: int = N_HUMANS,
+    sensing_range: float | None = None,
 ) -> dict[str, Any]:
     """Run the cases; returns the counts, rates, intervals and times."""
     rng_of = kinds()["nav2d"].episode_rng
@@ -214,6 +216,8 @@ def run(
             if lidar
             else {}
         )  # fmt: skip
+        if sensing_range is not None:
+            sensing["sensing_range"] = sensing_range
         try:
             scn = crowdnav_scenario(
                 case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
@@ -278,7 +282,8 @@ def run(
         "judged": "along each step" if swept else "at each step's end",
         "sensing": (
             f"lidar {lidar} beams, {LIDAR_NOISE:g} m noise, {LIDAR_RANGE:g} m" if lidar else "exact"
-        ),
+        )
+        + (f", humans seen within {sensing_range:g} m" if sensing_range is not None else ""),
         "params": dict(CROWDNAV_ORCA_PARAMS) if law_name == PAPER_LAW else {},
         "accel_max": accel,
         "turn_accel_max": turn_accel,
@@ -390,8 +395,15 @@ def main(argv: list[str] | None = None) -> int:
     )
     ap.add_argument("--humans", type=int, default=N_HUMANS, metavar="N",
                     help=f"number of humans (default CrowdNav's {N_HUMANS})")  # fmt: skip
+    ap.add_argument("--sensing-range", type=float, default=None, metavar="R",
+                    help="the robot sees the humans within R [m] (default: the scenes' 20 m; "
+                    "with --lidar, the lidar's range unless given)")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write crowdnav.json here")
     args = ap.parse_args(argv)
+    if args.sensing_range is not None and not (
+        math.isfinite(args.sensing_range) and args.sensing_range > 0
+    ):
+        ap.error(f"--sensing-range must be a number > 0 (got {args.sensing_range!r})")
     if args.cases < 1 or args.substeps < 1:
         ap.error("--cases and --substeps must be >= 1")
     if not 0 <= args.humans <= 1000:
@@ -406,7 +418,7 @@ def main(argv: list[str] | None = None) -> int:
             args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
             outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
             swept=not args.sampled, lidar=args.lidar, accel=args.accel, turn_accel=args.turn_accel,
-            humans=args.humans,
+            humans=args.humans, sensing_range=args.sensing_range,
         )  # fmt: skip
     except NoCaseError as exc:
         ap.error(str(exc))

@@ -80,3 +80,25 @@ def test_no_placeable_case_is_a_one_line_error(capsys: pytest.CaptureFixture[str
         bench_crowdnav.main(["--cases", "1", "--first", "0", "--humans", "1000"])
     assert exc.value.code == 2
     assert "no case's humans could be placed apart" in capsys.readouterr().err
+
+
+def test_sensing_range_reaches_every_case(monkeypatch: pytest.MonkeyPatch) -> None:
+    ranges: list[float] = []
+    scenario = bench_crowdnav.crowdnav_scenario
+
+    def spy(case: int, **kw: Any) -> Any:
+        scn = scenario(case, **kw)
+        ranges.append(float(scn.sensing.range))
+        return scn
+
+    monkeypatch.setattr(bench_crowdnav, "crowdnav_scenario", spy)
+    r = bench_crowdnav.run(1, rule="circle_crossing", substeps=1, pref="uvnav", first=0,
+                           sensing_range=5.0)  # fmt: skip
+    assert ranges == [5.0] and "humans seen within 5 m" in r["sensing"]
+
+
+def test_a_bad_sensing_range_is_a_one_line_error(capsys: pytest.CaptureFixture[str]) -> None:
+    with pytest.raises(SystemExit) as exc:
+        bench_crowdnav.main(["--cases", "1", "--sensing-range", "nan"])
+    assert exc.value.code == 2
+    assert "--sensing-range must be a number > 0" in capsys.readouterr().err
