@@ -163,3 +163,53 @@ def test_coincident_polygon_points_do_not_break_the_law() -> None:
     ctrl = fresh()
     cmd = ctrl.act(observe([0.0, 0.0, 0.0], [ob]))
     assert math.isfinite(cmd.v) and math.isfinite(cmd.u)
+
+
+def _pairwise_group(first: object, readings: tuple, gap: float, horizon: float) -> list[int]:
+    """The single-linkage group by the plain pairwise scan (the definition), as obstacle ids."""
+    from uvnav.controllers.zhang2019 import body_gap
+
+    pool = [rd for rd in readings if rd.obstacle_id != first.obstacle_id]  # type: ignore[attr-defined]
+    members, frontier = [first], [first]
+    while frontier and pool:
+        cur = frontier.pop()
+        linked = [
+            rd for rd in pool
+            if body_gap(cur, rd) < gap + (cur.speed + rd.speed) * horizon  # type: ignore[attr-defined]
+        ]  # fmt: skip
+        pool = [rd for rd in pool if rd not in linked]
+        members += linked
+        frontier += linked
+    members.sort(key=lambda m: m.distance)  # type: ignore[attr-defined]
+    return [m.obstacle_id for m in members]  # type: ignore[attr-defined]
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_grouping_is_the_pairwise_single_linkage_in_the_same_order(seed: int) -> None:
+    """Crowds of moving discs and squares: the array-pruned grouping gives the members, and
+    their order, of the plain pairwise scan."""
+    rng = np.random.default_rng(seed)
+    bodies: list[Obstacle] = []
+    for _ in range(60):
+        x, y = rng.uniform(-6, 6, 2)
+        v = tuple(rng.uniform(-0.5, 0.5, 2))
+        if rng.random() < 0.7:
+            bodies.append(disc(float(x), float(y), float(rng.uniform(0.1, 0.4)), v))  # type: ignore[arg-type]
+        else:
+            square = np.array([[-0.3, -0.3], [0.3, -0.3], [0.3, 0.3], [-0.3, 0.3]])
+            bodies.append(
+                Obstacle(
+                    PolygonBody(square),
+                    ObstacleState(np.array([x, y]), velocity=np.array(v)),
+                    ConstantVelocity(np.array(v)),
+                )
+            )
+    obs = observe([0.0, 0.0, 0.0], bodies)
+    sizes = []
+    for first in obs.obstacles[:5]:
+        got = group_around(first, obs.obstacles, 0.4, 1.0)
+        assert [m.obstacle_id for m in got.members] == _pairwise_group(
+            first, obs.obstacles, 0.4, 1.0
+        )
+        sizes.append(len(got.members))
+    assert max(sizes) >= 5  # groups of several bodies, not singletons only
