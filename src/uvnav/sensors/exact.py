@@ -6,6 +6,8 @@ noise and dropout, a ``numpy.random.Generator``.
 
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_to_pi
@@ -62,6 +64,22 @@ def sense_obstacles(
     return tuple(out)
 
 
+@functools.lru_cache(maxsize=64)
+def beam_offsets(n_rays: int, fov: float) -> FloatArray:
+    """The beams' angles relative to the heading [rad]: ``n_rays`` evenly over a full turn
+    (from -pi, the last short of pi) or over ``fov`` (both ends included); read-only, shared.
+
+    >>> beam_offsets(4, 2.0 * np.pi).tolist() == [-np.pi, -np.pi / 2, 0.0, np.pi / 2]
+    True
+    """
+    if fov >= 2.0 * np.pi - 1e-9:
+        rel = np.linspace(-np.pi, np.pi, n_rays, endpoint=False)
+    else:
+        rel = np.linspace(-0.5 * fov, 0.5 * fov, n_rays)
+    rel.flags.writeable = False
+    return rel
+
+
 def lidar_scan(
     pose: FloatArray,
     field: ObstacleField,
@@ -86,11 +104,7 @@ def lidar_scan(
         dropout: probability that a beam returns NaN (needs ``rng``).
     """
     x, y, th = float(pose[0]), float(pose[1]), float(pose[2])
-    if fov >= 2.0 * np.pi - 1e-9:
-        rel = np.linspace(-np.pi, np.pi, n_rays, endpoint=False)
-    else:
-        rel = np.linspace(-0.5 * fov, 0.5 * fov, n_rays)
-    angles = wrap_to_pi(th + rel)
+    angles = wrap_to_pi(th + beam_offsets(int(n_rays), float(fov)))
     dirs = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
     ranges = np.full(n_rays, max_range)
     if len(field):
