@@ -4,7 +4,8 @@ campaign whose stored rows equal the local engine's; a wrong token, an unreachab
 malformed one are each one ``error:`` line, exit status 2, within seconds.
 
 The head is stopped by ending its process group (the processes ``ray start`` started), not by
-``ray stop``, which would stop every Ray instance of this user on the machine.  Skipped when Ray
+``ray stop``, which would stop every Ray instance of this user on the machine; its record in
+Ray's temporary folder is removed, so later tests start their own local Ray.  Skipped when Ray
 is not installed or ``ray start`` cannot start a head here.
 """
 
@@ -16,6 +17,7 @@ import socket
 import sqlite3
 import subprocess
 import sys
+import tempfile
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -92,6 +94,18 @@ def head(tmp_path_factory: pytest.TempPathFactory) -> Iterator[str]:
         yield f"127.0.0.1:{port}"
     finally:
         _stop(proc)
+        _forget(port)
+
+
+def _forget(port: int) -> None:
+    """Remove Ray's record of the current cluster if it names this head (a ``ray.init()`` without
+    address would otherwise try to connect to it instead of starting Ray)."""
+    record = Path(tempfile.gettempdir()) / "ray" / "ray_current_cluster"
+    try:
+        if record.read_text(encoding="utf-8").strip().endswith(f":{port}"):
+            record.unlink()
+    except OSError:
+        pass
 
 
 def _bench(tmp_path: Path, db: str, *args: str, **env: str) -> subprocess.CompletedProcess[str]:
