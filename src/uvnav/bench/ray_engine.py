@@ -36,14 +36,17 @@ from __future__ import annotations
 import ipaddress
 import logging
 import os
+import socket
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
+from pathlib import Path
 from types import ModuleType
 from typing import Any
 
 from uvnav.bench.jobs import TASK_SECONDS, Job, JobOutcome, TaskSizer, sized_batches
 from uvnav.bench.store import STATUS_ERROR
+from uvnav.validation import clip, one_line
 
 
 class EngineUnavailableError(RuntimeError):
@@ -128,6 +131,211 @@ def start_local_ray(ray: ModuleType, workers: int) -> None:
         )
 
 
+#: seconds to wait for a cluster's address to accept a TCP connection
+CONNECT_TIMEOUT = 5.0
+#: Ray's default token file (``ray get-auth-token`` prints its token)
+TOKEN_FILE = Path.home() / ".ray" / "auth_token"
+
+
+class ClusterConnectionError(RuntimeError):
+    """A Ray cluster given by address cannot be used: bad address, unreachable, or it refuses
+    this driver's authentication token.  The message is one line naming the address and a fix."""
+
+
+def parse_address(address: str) -> tuple[str, str, int]:
+    """``(scheme, host, port)`` of ``HOST:PORT`` (scheme ``""``) or ``ray://HOST:PORT``
+    (scheme ``"ray://"``, Ray Client); IPv6 hosts in brackets.
+
+    Raises:
+        ClusterConnectionError: not of that form.
+    """
+    scheme = "ray://" if address.startswith("ray://") else ""
+    host, sep, port = address[len(scheme) :].rpartition(":")
+    if not sep or not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise ClusterConnectionError(
+            f"Ray address {address!r}: expected auto, HOST:PORT or ray://HOST:PORT"
+        )
+    return scheme, host.strip("[]"), int(port)
+
+
+def resolve_address(ray: ModuleType, address: str) -> str:
+    """``address`` with ``auto`` replaced by the address of the cluster running on this machine.
+
+    Raises:
+        ClusterConnectionError: ``auto`` and no cluster runs here.
+    """
+    if address != "auto":
+        return address
+    try:
+        found = ray._private.services.canonicalize_bootstrap_address(address)
+    except Exception:  # Ray raises ConnectionError; any failure means "none found"
+        found = None
+    if not found:
+        raise ClusterConnectionError(
+            "Ray address auto: no Ray cluster runs on this machine (start one with "
+            "`ray start --head`, or pass the head's HOST:PORT)"
+        )
+    return str(found)
+
+
+def _token_given() -> bool:
+    """Whether the user named a token for this process (Ray's ``RAY_AUTH_TOKEN`` or
+    ``RAY_AUTH_TOKEN_PATH``)."""
+    return bool(os.environ.get("RAY_AUTH_TOKEN") or os.environ.get("RAY_AUTH_TOKEN_PATH"))
+
+
+@contextmanager
+def _token_auth(ray: ModuleType, local: bool) -> Iterator[None]:
+    """Token authentication for the connection, as Ray decides it for ``ray.init("auto")``.
+
+    ``RAY_AUTH_MODE`` set by the user is kept as it is.  Unset, token mode is turned on (for
+    this process, until the context ends) when the user named a token (``RAY_AUTH_TOKEN``,
+    ``RAY_AUTH_TOKEN_PATH``) or, for a cluster on this machine, when Ray's token file exists:
+    ``ray start`` enables token authentication whenever that file exists, and Ray's own
+    ``ray.init`` sends it only for an address it found itself, never for an explicit one.  A
+    remote cluster's token is sent only when the user asks for it.
+    """
+    turn_on = "RAY_AUTH_MODE" not in os.environ and (
+        _token_given() or (local and TOKEN_FILE.is_file())
+    )
+    config = getattr(getattr(ray, "_raylet", None), "Config", None)
+    if turn_on:
+        os.environ["RAY_AUTH_MODE"] = "token"
+        if config is not None:
+            config.initialize("")  # Ray caches its configuration; re-read the mode
+    try:
+        yield
+    finally:
+        if turn_on:
+            os.environ.pop("RAY_AUTH_MODE", None)
+            if config is not None:
+                config.initialize("")
+
+
+@contextmanager
+def _quiet_stderr() -> Iterator[None]:
+    """Silence file descriptor 2 (Ray's C++ logging writes there directly) for the duration."""
+    saved = os.dup(2)
+    devnull = os.open(os.devnull, os.O_WRONLY)
+    try:
+        os.dup2(devnull, 2)
+        yield
+    finally:
+        os.dup2(saved, 2)
+        os.close(saved)
+        os.close(devnull)
+
+
+def _auth_hint(local: bool) -> str:
+    """How to give this driver the cluster's token."""
+    where = "" if local else " on this machine"
+    mode = "" if os.environ.get("RAY_AUTH_MODE") == "token" else "set RAY_AUTH_MODE=token and "
+    return (
+        f"{mode}give the cluster's token"
+        f"{where} in RAY_AUTH_TOKEN, RAY_AUTH_TOKEN_PATH or ~/.ray/auth_token "
+        "(`ray get-auth-token` on the head prints it)"
+    )
+
+
+def probe_cluster(ray: ModuleType, address: str) -> None:
+    """Check, within :data:`CONNECT_TIMEOUT` seconds, that the Ray cluster at ``address``
+    (``HOST:PORT`` or ``ray://HOST:PORT``, already resolved) accepts a connection and, for a
+    GCS address, this process's token.  Call it inside :func:`_token_auth`.
+
+    Raises:
+        ClusterConnectionError: bad address, unreachable, or the token is missing or refused.
+    """
+    scheme, host, port = parse_address(address)
+    try:
+        socket.create_connection((host, port), timeout=CONNECT_TIMEOUT).close()
+    except OSError as exc:
+        start = "ray start --head" + (" --ray-client-server-port" if scheme else " --port")
+        raise ClusterConnectionError(
+            f"cannot reach the Ray cluster at {address}: {one_line(str(exc) or type(exc).__name__)}"
+            f" (is `{start} {port}` running there, and is the port open to this machine?)"
+        ) from None
+    if scheme:
+        return  # Ray Client: its server checks the token when ray.init connects
+    auth_error = getattr(getattr(ray, "exceptions", None), "AuthenticationError", ())
+    try:
+        with _quiet_stderr():
+            ray._raylet.GcsClient(address=f"{host}:{port}")
+    except auth_error:
+        raise ClusterConnectionError(
+            f"the Ray cluster at {address} refused this driver's authentication token: "
+            + _auth_hint(is_loopback(host) or _is_own_address(host))
+        ) from None
+    except Exception as exc:  # Ray's RPC errors: whatever answers there is no GCS
+        raise ClusterConnectionError(
+            f"{address} does not answer as a Ray cluster's head "
+            f"({clip(one_line(str(exc)), 120)}): pass the head's GCS address, HOST:PORT of "
+            "`ray start --head --port PORT` (default 6379), or ray://HOST:10001"
+        ) from None
+
+
+def _local_target(ray: ModuleType, address: str) -> tuple[str, bool]:
+    """``address`` resolved (:func:`resolve_address`), and whether its cluster is on this
+    machine (``auto``, or a host that is one of this machine's addresses)."""
+    target = resolve_address(ray, address)
+    _, host, _ = parse_address(target)
+    return target, address == "auto" or is_loopback(host) or _is_own_address(host)
+
+
+def _is_own_address(host: str) -> bool:
+    """Whether ``host`` (an IP address) is one of this machine's: a socket can bind to it."""
+    try:
+        family = socket.AF_INET6 if ":" in host else socket.AF_INET
+        with socket.socket(family, socket.SOCK_STREAM) as sock:
+            sock.bind((host, 0))
+    except OSError:
+        return False
+    return True
+
+
+def check_cluster(address: str) -> None:
+    """Check that the Ray cluster at ``address`` can be used (:func:`probe_cluster`), with the
+    token authentication :func:`cluster_connection` would use; the process is left as it was.
+
+    Raises:
+        EngineUnavailableError: Ray is not installed.
+        ClusterConnectionError: the cluster cannot be reached or refuses the token.
+    """
+    ray = import_ray()
+    target, local = _local_target(ray, address)
+    with _token_auth(ray, local):
+        probe_cluster(ray, target)
+
+
+@contextmanager
+def cluster_connection(ray: ModuleType, address: str) -> Iterator[None]:
+    """Connected (``ray.init``) to the existing cluster at ``address`` (``auto``,
+    ``HOST:PORT``, ``ray://HOST:PORT``) for the duration, with token authentication as
+    :func:`_token_auth` decides; checked first by :func:`probe_cluster` so that a cluster that
+    cannot be used fails in seconds with one line.  Shut down (``ray.shutdown``) at the end.
+
+    Raises:
+        ClusterConnectionError: the cluster cannot be reached or refuses the token.
+    """
+    target, local = _local_target(ray, address)
+    with _token_auth(ray, local):
+        probe_cluster(ray, target)
+        try:
+            ray.init(
+                address=target,
+                include_dashboard=False,
+                log_to_driver=False,
+                logging_level=logging.WARNING,
+            )
+        except (ConnectionError, RuntimeError, ray.exceptions.RayError) as exc:
+            raise ClusterConnectionError(
+                f"cannot connect to the Ray cluster at {target}: {clip(one_line(str(exc)), 200)}"
+            ) from None
+        try:
+            yield
+        finally:
+            ray.shutdown()
+
+
 def _crash_outcome(job: Job, exc: BaseException) -> JobOutcome:
     """A task that Ray could not complete (its worker died, even after retries) is an error row."""
     first = (str(exc).strip().splitlines() or [""])[0]
@@ -171,8 +379,8 @@ def run_ray(
         run_batch: a module-level (picklable) function running a batch of groups in a worker
             and returning each group's outcomes (:func:`uvnav.bench.campaign.run_group_batch`).
         workers: CPUs of the local Ray instance started here, and half the tasks kept in flight.
-        address: Ray cluster to connect to (``"auto"``, ``"ray://host:10001"``...; default
-            ``$RAY_ADDRESS``); none starts
+        address: Ray cluster to connect to (``"auto"``, ``"host:port"``, ``"ray://host:10001"``;
+            default ``$RAY_ADDRESS``; :func:`cluster_connection`); none starts
             a local instance with ``num_cpus=workers`` that listens on 127.0.0.1 only
             (:func:`start_local_ray`).  Ignored when Ray is already initialised.
         task_seconds: the worker time a task is sized to.
@@ -180,22 +388,31 @@ def run_ray(
     Raises:
         EngineUnavailableError: Ray is not installed, or a local instance would not be
             loopback-only.
+        ClusterConnectionError: ``address`` names a cluster that cannot be used
+            (:func:`cluster_connection`).
         KeyboardInterrupt: re-raised after cancelling the tasks in flight.
     """
     ray = import_ray()
-    started = False
     address = address or os.environ.get("RAY_ADDRESS") or None  # Ray's own variable: the user's
-    if not ray.is_initialized():
-        if address is None:
-            start_local_ray(ray, workers)
-        else:
-            ray.init(
-                address=address,
-                include_dashboard=False,
-                log_to_driver=False,
-                logging_level=logging.WARNING,
-            )
-        started = True
+    with ExitStack() as stack:
+        if not ray.is_initialized():
+            if address is None:
+                start_local_ray(ray, workers)
+                stack.callback(ray.shutdown)
+            else:
+                stack.enter_context(cluster_connection(ray, address))
+        _run_tasks(ray, groups, handle, run_batch, workers, task_seconds)
+
+
+def _run_tasks(
+    ray: ModuleType,
+    groups: Sequence[Sequence[Job]],
+    handle: Callable[[list[JobOutcome]], None],
+    run_batch: Callable[[Batch], list[list[JobOutcome]]],
+    workers: int,
+    task_seconds: float,
+) -> None:
+    """The task loop of :func:`run_ray`, on an initialised Ray."""
     remote = ray.remote(num_cpus=1, max_retries=2)(run_batch)
     window = 2 * max(1, workers)
     sizer = TaskSizer(task_seconds)
@@ -229,6 +446,3 @@ def run_ray(
         for ref in pending:
             ray.cancel(ref, force=True)
         raise
-    finally:
-        if started:
-            ray.shutdown()

@@ -87,7 +87,11 @@ def bench_cmd(
         bool, typer.Option("--resume", help="Continue a campaign of the same name in --db.")
     ] = False,
     address: Annotated[
-        str | None, typer.Option(help="Ray cluster address (--engine ray; default: local Ray).")
+        str | None,
+        typer.Option(
+            help="Ray cluster to run on (--engine ray): auto, HOST:PORT or ray://HOST:PORT; "
+            "default $RAY_ADDRESS, else a local Ray instance.",
+        ),
     ] = None,
     retry_errors: Annotated[
         bool, typer.Option("--retry-errors", help="With --resume: run 'error' episodes again.")
@@ -127,7 +131,12 @@ def bench_cmd(
     import time
 
     from uvnav.bench.campaign import ENGINES
-    from uvnav.bench.ray_engine import EngineUnavailableError, import_ray
+    from uvnav.bench.ray_engine import (
+        ClusterConnectionError,
+        EngineUnavailableError,
+        check_cluster,
+        import_ray,
+    )
     from uvnav.bench.spec import load_campaign, run_campaign_spec
     from uvnav.bench.store import ResultsStore, StoreInUseError
     from uvnav.bench.summary import SUMMARY_COLUMNS, controller_summary, failure_rows
@@ -142,6 +151,12 @@ def bench_cmd(
             import_ray()  # before the database is created
         except EngineUnavailableError as exc:
             raise CliError(str(exc), code=1) from None
+        cluster = address or os.environ.get("RAY_ADDRESS") or None
+        if cluster is not None:
+            try:
+                check_cluster(cluster)  # fails in seconds, before the database is created
+            except ClusterConnectionError as exc:
+                raise CliError(f"--address: {exc}") from None
     probe_factory = _mcap_folder(mcap_dir) if mcap_dir is not None else None
     n_workers = workers or os.cpu_count() or 1
     too_many = too_many_workers(n_workers) if engine == "local" else None  # Ray: a cluster's
@@ -171,6 +186,8 @@ def bench_cmd(
             )
         except EngineUnavailableError as exc:
             raise CliError(str(exc), code=1) from None
+        except ClusterConnectionError as exc:
+            raise CliError(f"--address: {exc}") from None
         except StoreInUseError as exc:
             raise CliError(str(exc)) from None
         except KeyboardInterrupt:
