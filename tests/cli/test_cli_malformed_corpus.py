@@ -29,32 +29,11 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from typer.testing import CliRunner
 
+from cli_runner import FastRunner
 from uvnav.cli.app import app
 
-
-class _Runner(CliRunner):
-    """``CliRunner`` that builds the click command of the app once, not on every call (Typer
-    rebuilds it from the signatures each time: 80 % of a corpus case's time)."""
-
-    _command: Any = None
-
-    def invoke(self, app: Any, args: Any = None, **kw: Any) -> Any:  # type: ignore[override]
-        import typer.main
-        import typer.testing
-
-        if _Runner._command is None:
-            _Runner._command = typer.main.get_command(app)
-        original = typer.testing._get_command
-        typer.testing._get_command = lambda _app: _Runner._command  # type: ignore[assignment]
-        try:
-            return super().invoke(app, args, prog_name="uvnav", **kw)
-        finally:
-            typer.testing._get_command = original
-
-
-runner = _Runner()
+runner = FastRunner()
 
 ROOT = Path(__file__).resolve().parents[2]
 BUILTIN = ROOT / "src" / "uvnav" / "scenarios" / "builtin"

@@ -29,8 +29,8 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from typer.testing import CliRunner
 
+from cli_runner import FastRunner
 from uvnav.cli.app import app
 
 pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGALRM"), reason="needs SIGALRM")
@@ -39,26 +39,7 @@ pytestmark = pytest.mark.skipif(not hasattr(signal, "SIGALRM"), reason="needs SI
 DEADLINE = 20
 
 
-class _Runner(CliRunner):
-    """``CliRunner`` that builds the app's click command once (Typer rebuilds it per call)."""
-
-    _command: Any = None
-
-    def invoke(self, app: Any, args: Any = None, **kw: Any) -> Any:  # type: ignore[override]
-        import typer.main
-        import typer.testing
-
-        if _Runner._command is None:
-            _Runner._command = typer.main.get_command(app)
-        original = typer.testing._get_command
-        typer.testing._get_command = lambda _app: _Runner._command  # type: ignore[assignment]
-        try:
-            return super().invoke(app, args, prog_name="uvnav", **kw)
-        finally:
-            typer.testing._get_command = original
-
-
-runner = _Runner()
+runner = FastRunner()
 
 
 class HangError(Exception):

@@ -27,7 +27,9 @@ import typer
 
 from uvnav.cli.bench import bench_cmd
 from uvnav.cli.common import (
+    ControllerOption,
     GenParamOption,
+    ParamOption,
     parse_params,
     resolve_scene,
 )
@@ -120,19 +122,8 @@ def simulate(
             "antipodal:8 = 8 robots; see 'uvnav scenarios list')."
         ),
     ],
-    controller: Annotated[
-        str | None,
-        typer.Option("--controller", "-c", help="Law name (default: the scenario's)."),
-    ] = None,
-    param: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--param",
-            "-p",
-            metavar="KEY=VALUE",
-            help="Law parameter KEY=VALUE (repeatable; value read as YAML).",
-        ),
-    ] = None,
+    controller: ControllerOption = None,
+    param: ParamOption = None,
     seed: Annotated[
         int | None,
         typer.Option(

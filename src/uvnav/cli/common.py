@@ -115,6 +115,22 @@ def parse_params(items: list[str] | None, option: str = "--param") -> dict[str, 
     return params
 
 
+#: ``--param/-p KEY=VALUE``: a law's parameters (:func:`parse_params` reads them)
+ParamOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--param",
+        "-p",
+        metavar="KEY=VALUE",
+        help="Law parameter KEY=VALUE (repeatable; value read as YAML).",
+    ),
+]
+#: ``--controller/-c NAME``: the law to run, the scene's own when not given
+ControllerOption = Annotated[
+    str | None,
+    typer.Option("--controller", "-c", help="Law name (default: the scenario's)."),
+]
+
 GenParamOption = Annotated[
     list[str] | None,
     typer.Option(

@@ -6,7 +6,6 @@ Thin Typer commands over :mod:`uvnav.controllers`; an unknown law or vehicle is 
 
 from __future__ import annotations
 
-import dataclasses
 from typing import Annotated, Any
 
 import typer
@@ -17,32 +16,23 @@ from uvnav.cli.common import fmt as _fmt
 from uvnav.cli.common import text as _text
 from uvnav.cli.errors import CliError, uvnav_typer
 from uvnav.controllers import ControllerInfo, available_controllers, controller_info
-from uvnav.controllers.describe import attribute_docs, plain_doc, plain_type
+from uvnav.controllers.describe import param_fields, plain_doc, plain_type
 from uvnav.dynamics.vehicles import vehicle_names
 
 controllers_app = uvnav_typer(help="Registered navigation laws.")
 
 
 def _param_rows(info: ControllerInfo) -> list[dict[str, Any]]:
-    ptype = info.params_type
-    if ptype is None or not dataclasses.is_dataclass(ptype):
-        return []
-    docs = attribute_docs(ptype)
     rows = []
-    for f in dataclasses.fields(ptype):
-        if f.default is not dataclasses.MISSING:
-            default: Any = f.default
-        elif f.default_factory is not dataclasses.MISSING:
-            default = f.default_factory()
-        else:
-            default = None
-        type_name = f.type if isinstance(f.type, str) else getattr(f.type, "__name__", str(f.type))
+    for f in param_fields(info.params_type):
+        ann = f.annotation
+        type_name = ann if isinstance(ann, str) else getattr(ann, "__name__", str(ann))
         rows.append(
             {
                 "name": f.name,
                 "type": plain_type(type_name),
-                "default": default,
-                "doc": plain_doc(docs.get(f.name, "")),
+                "default": f.default,
+                "doc": plain_doc(f.doc),
             }
         )
     return rows

@@ -11,7 +11,7 @@ from typing import Annotated
 import numpy as np
 import typer
 
-from uvnav.cli.common import parse_params
+from uvnav.cli.common import ParamOption, parse_params
 from uvnav.cli.errors import CliError
 from uvnav.validation import coordinate_problem
 
@@ -37,15 +37,7 @@ def replay_cmd(
         tuple[float, float],
         typer.Option(metavar="X Y", help="The goal [m] in the odometry frame."),
     ],
-    param: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--param",
-            "-p",
-            metavar="KEY=VALUE",
-            help="Law parameter KEY=VALUE (repeatable; value read as YAML).",
-        ),
-    ] = None,
+    param: ParamOption = None,
     out: Annotated[
         Path | None,
         typer.Option(

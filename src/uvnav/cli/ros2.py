@@ -26,7 +26,7 @@ import typer
 import yaml
 
 from uvnav.cli.checks import finite
-from uvnav.cli.common import parse_params
+from uvnav.cli.common import ParamOption, parse_params
 from uvnav.cli.errors import CliError, uvnav_typer
 
 #: the name of the node in a parameter file
@@ -73,12 +73,7 @@ def _law_params(law: str, params_file: Path | None, items: list[str] | None) -> 
 @ros2_app.command("run")
 def run_cmd(
     law: Annotated[str, typer.Argument(help="A unicycle or holonomic law of the registry.")],
-    param: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--param", "-p", help="Law parameter KEY=VALUE (repeatable; value read as YAML)."
-        ),
-    ] = None,
+    param: ParamOption = None,
     params_file: Annotated[
         Path | None,
         typer.Option(help="ROS 2 parameter file (NODE: ros__parameters: ...); --param wins."),

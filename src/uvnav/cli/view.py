@@ -10,7 +10,13 @@ from typing import Annotated, Any
 
 import typer
 
-from uvnav.cli.common import GenParamOption, parse_params, resolve_scene
+from uvnav.cli.common import (
+    ControllerOption,
+    GenParamOption,
+    ParamOption,
+    parse_params,
+    resolve_scene,
+)
 from uvnav.cli.errors import CliError
 from uvnav.cli.mcap import KINDS
 
@@ -23,19 +29,8 @@ def view_cmd(
         str,
         typer.Argument(help="Built-in name, YAML file, or GENERATOR:SEED (a 2D scene)."),
     ],
-    controller: Annotated[
-        str | None,
-        typer.Option("--controller", "-c", help="Law name (default: the scenario's)."),
-    ] = None,
-    param: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--param",
-            "-p",
-            metavar="KEY=VALUE",
-            help="Law parameter KEY=VALUE (repeatable; value read as YAML).",
-        ),
-    ] = None,
+    controller: ControllerOption = None,
+    param: ParamOption = None,
     seed: Annotated[
         int | None, typer.Option(min=0, help="Episode seed (as 'uvnav simulate --seed').")
     ] = None,

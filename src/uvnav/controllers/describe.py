@@ -4,8 +4,11 @@ as a user reads them (the ``controllers show`` table, the ROS 2 node's parameter
 
 from __future__ import annotations
 
+import dataclasses
 import inspect
 import re
+from dataclasses import dataclass
+from typing import Any
 
 
 def attribute_docs(cls: type) -> dict[str, str]:
@@ -60,3 +63,32 @@ def plain_doc(doc: str) -> str:
     """
     doc = re.sub(r":\w+:`~?(?:[\w.]*\.)?([^`]+)`", r"\1", doc)
     return doc.replace("``", "")
+
+
+@dataclass(frozen=True)
+class ParamField:
+    """One field of a law's parameter dataclass: its name, its annotation as written, its
+    default (``None`` without one) and its description (the ``Attributes:`` entry)."""
+
+    name: str
+    annotation: Any
+    default: Any
+    doc: str
+
+
+def param_fields(params_type: type | None) -> list[ParamField]:
+    """The fields of a law's parameter dataclass in declaration order (none for ``None`` or a
+    type that is not a dataclass)."""
+    if params_type is None or not dataclasses.is_dataclass(params_type):
+        return []
+    docs = attribute_docs(params_type)
+    out = []
+    for f in dataclasses.fields(params_type):
+        if f.default is not dataclasses.MISSING:
+            default: Any = f.default
+        elif f.default_factory is not dataclasses.MISSING:
+            default = f.default_factory()
+        else:
+            default = None
+        out.append(ParamField(f.name, f.type, default, docs.get(f.name, "")))
+    return out

@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from uvnav.controllers.base import controller_info
-from uvnav.controllers.describe import attribute_docs
+from uvnav.controllers.describe import param_fields
 
 #: the vehicles whose commands a ``Twist`` carries
 TWIST_VEHICLES = ("unicycle", "holonomic")
@@ -63,20 +63,9 @@ def describe(law: str) -> list[ParamDescriptor]:
         UnknownControllerError: ``law`` is not registered.
     """
     ptype = controller_info(law).params_type
-    if ptype is None or not dataclasses.is_dataclass(ptype):
-        return []
-    hints = typing.get_type_hints(ptype)
-    docs = attribute_docs(ptype)
-    out = []
-    for f in dataclasses.fields(ptype):
-        if f.default is not dataclasses.MISSING:
-            default: Any = f.default
-        elif f.default_factory is not dataclasses.MISSING:
-            default = f.default_factory()
-        else:
-            default = None
-        out.append(ParamDescriptor(f.name, ros_type(hints[f.name]), default, docs.get(f.name, "")))
-    return out
+    fields = param_fields(ptype)
+    hints = typing.get_type_hints(ptype) if fields else {}
+    return [ParamDescriptor(f.name, ros_type(hints[f.name]), f.default, f.doc) for f in fields]
 
 
 def law_vehicle(name: str) -> str:
