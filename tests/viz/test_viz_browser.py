@@ -14,6 +14,8 @@ import os
 import shutil
 import sqlite3
 from pathlib import Path
+from urllib.parse import urlparse
+from urllib.request import url2pathname
 
 import pytest
 import report_layout as layout
@@ -108,7 +110,7 @@ def test_report_renders_tables_and_animates(report: tuple[Path, Path]) -> None:
             page.on("console", lambda m: errors.append(m.text) if m.type == "error" else None)
             page.on("pageerror", lambda e: errors.append(str(e)))
             page.goto(index.as_uri())
-            page.wait_for_selector("#regime-success.js-plotly-plot")
+            page.wait_for_selector("table#regime-success")
             page.evaluate("() => document.querySelectorAll('details').forEach(d => d.open = true)")
             text = page.inner_text("body")
             # the summary table holds the database's numbers
@@ -161,9 +163,13 @@ def test_report_layout_is_a_decision_tool(report: tuple[Path, Path]) -> None:
         browser = p.chromium.launch(executable_path=chromium_path(), args=layout.CHROMIUM_ARGS)
         try:
             page = browser.new_page(viewport=layout.VIEWPORT)
+            requested: list[str] = []
+            page.on("request", lambda r: requested.append(r.url))
             page.goto(index.as_uri())
-            page.wait_for_selector("#regime-success.js-plotly-plot")
+            page.wait_for_selector("table#regime-success")
+            page.wait_for_load_state("load")
             closed = layout.measure(page, index)
+            first_screen = list(requested)
             page.evaluate("() => document.querySelectorAll('details').forEach(d => d.open = true)")
             opened = layout.measure(page, index)
         finally:
@@ -175,5 +181,9 @@ def test_report_layout_is_a_decision_tool(report: tuple[Path, Path]) -> None:
         assert m["widest_table_shown"] <= m["column_width"] + 1, m
         assert m["page_overflow_x"] <= 0, m
     assert closed["inline_animation_bytes"] == 0
-    assert closed["plotly_divs_at_load"] == 2  # the two heat maps, no animation
+    assert closed["plotly_divs_at_load"] == 0  # the heat maps are tables, no animation drawn
+    # the first screen loads the page and its images, never plotly (5 MB) before it is asked for
+    assert not any(u.endswith("plotly.min.js") for u in first_screen), first_screen
+    loaded = sum(Path(url2pathname(urlparse(u).path)).stat().st_size for u in first_screen)
+    assert loaded <= 5 * 2**20, loaded
     assert closed["page_height"] < opened["page_height"]  # long tables wait in <details>

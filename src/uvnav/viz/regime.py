@@ -3,17 +3,18 @@
 :func:`decision_view` reads a results store (never writes it) and returns what the report template
 shows first:
 
-* two plotly heat maps over the regime grid of :mod:`uvnav.experiments.regime` — success and
+* two heat maps over the regime grid of :mod:`uvnav.experiments.regime` — success and
   robot-driven collisions, one row per law, one panel per (robot visible?, sensing) pair, one
   column per (pedestrian speed / V_max, crowd density) — with each rate's 95 % Wilson interval
-  and sample size on hover, a star on the laws the evidence cannot separate from the best;
+  and sample size in its tooltip, a star on the laws the evidence cannot separate from the best;
 * one generated recommendation per regime (:func:`uvnav.experiments.regime.recommend`);
 * what sensing costs each law: its success with exact readings, noisy centres and a lidar
   alone on the same crowds (:func:`uvnav.experiments.regime.sensing_costs`);
 * the law x scene-family table at equal seeds (:func:`uvnav.experiments.regime.family_table`),
   rates with intervals, small samples flagged.
 
-The figures are ``<div>`` fragments that use the report's ``plotly.min.js``.
+The heat maps are plain HTML tables (coloured cells, the interval in each cell's tooltip): the
+first screen needs no script and no plotly.
 """
 
 from __future__ import annotations
@@ -58,91 +59,76 @@ def _panel_title(visible: bool, lidar: bool, noise: float) -> str:
     return f"{seen}, {Regime(0, 0.0, visible, noise, lidar).sensing}"
 
 
-def regime_heatmap(stats: dict[Regime, list[CellStats]], metric: str, *, div_id: str) -> str:
-    """One heat map (``metric``: ``"success"`` or ``"robot_collision"``) as an HTML fragment."""
-    import plotly.graph_objects as go
-    from plotly.subplots import make_subplots
+def _cell_colour(p: float, good: bool) -> str:
+    """A rate's background on the red-yellow-green scale (green is good), as ``#rrggbb``.
 
+    >>> _cell_colour(1.0, True), _cell_colour(1.0, False)
+    ('#006837', '#a50026')
+    """
+    from matplotlib import colormaps
+    from matplotlib.colors import to_hex
+
+    cmap = colormaps["RdYlGn" if good else "RdYlGn_r"]
+    return str(to_hex(cmap(min(max(p, 0.0), 1.0))))
+
+
+def _cell(s: CellStats | None, law: str, c: Regime, metric: str, best: set[str]) -> dict[str, str]:
+    """One heat-map cell: its text (rate in %, ★ when best), colours and tooltip."""
+    if s is None:
+        return {"text": "", "bg": "#ffffff", "fg": "#222", "title": f"{law}, {c.label}: not run"}
+    r: Rate = getattr(s, metric)
+    lo, hi = r.interval
+    mark = "★" if law in best else ""
+    title = (
+        f"{law}{BEYOND_MARK if s.beyond else ''}, {c.label}: {metric.replace('_', '-')} "
+        f"{100 * r.p:.0f} % [{100 * lo:.0f}, {100 * hi:.0f}], n={r.n}"
+        + (f" {SMALL_MARK} small sample" if r.small else "")
+        + ("; ★ best or not separable from it" if mark else "")
+    )
+    # dark cells at both ends of the scale carry white text
+    fg = "#fff" if abs(r.p - 0.5) > 0.35 else "#222"
+    return {"text": f"{100 * r.p:.0f}{mark}", "bg": _cell_colour(r.p, metric == "success"),
+            "fg": fg, "title": title}  # fmt: skip
+
+
+def regime_heatmap(
+    stats: dict[Regime, list[CellStats]], metric: str, *, div_id: str
+) -> dict[str, Any]:
+    """One heat map (``metric``: ``"success"`` or ``"robot_collision"``) as a table the report
+    draws with no script: ``{"id", "title", "panels": [{"title", "columns"}], "rows": [{"law",
+    "cells": [{"text", "bg", "fg", "title", "edge"}]}]}``: one row per law, one column group per
+    panel (robot visible or not, sensing; ``edge`` marks a panel's first column), one column per
+    (pedestrian speed / V_max, density); a cell is the rate in %, its tooltip the 95 % Wilson
+    interval and n."""
     cells = sorted(stats, key=_order)
     laws = sorted({s.law for v in stats.values() for s in v})
-    panels = _panels(cells)
-    fig = make_subplots(
-        rows=1,
-        cols=len(panels),
-        shared_yaxes=True,
-        horizontal_spacing=0.015,
-        subplot_titles=[_panel_title(*p) for p in panels],
-    )
-    good = metric == "success"
-    for col, panel in enumerate(panels, start=1):
-        here = [c for c in cells if _panel(c) == panel]
-        xs = [f"v{c.speed_ratio:g}·n{c.n_humans}" for c in here]
-        z: list[list[float | None]] = []
-        text: list[list[str]] = []
-        hover: list[list[str]] = []
-        for law in laws:
-            zr: list[float | None] = []
-            tr: list[str] = []
-            hr: list[str] = []
-            for c in here:
-                s = next((x for x in stats[c] if x.law == law), None)
-                if s is None:
-                    zr.append(None)
-                    tr.append("")
-                    hr.append(f"{law}<br>{c.label}<br>not run")
-                    continue
-                best = {b.law for b in ranking(stats[c])[0]}
-                r: Rate = getattr(s, metric)
-                zr.append(r.p)
-                mark = "★" if law in best else ""
-                tr.append(f"{r.p * 100:.0f}{mark}")
-                lo, hi = r.interval
-                hr.append(
-                    f"{law}{BEYOND_MARK if s.beyond else ''}<br>{c.label}<br>"
-                    f"{metric.replace('_', '-')} {r.p:.2f} [{lo:.2f}, {hi:.2f}], n={r.n}"
-                    + (f" {SMALL_MARK} small sample" if r.small else "")
-                    + ("<br>★ best or not separable from it" if mark else "")
-                )
-            z.append(zr)
-            text.append(tr)
-            hover.append(hr)
-        fig.add_trace(
-            go.Heatmap(
-                z=z,
-                x=xs,
-                y=laws,
-                text=text,
-                texttemplate="%{text}",
-                textfont={"size": 11},
-                customdata=hover,
-                hovertemplate="%{customdata}<extra></extra>",
-                zmin=0,
-                zmax=1,
-                colorscale="RdYlGn" if good else "RdYlGn_r",
-                showscale=col == len(panels),
-                colorbar={"title": {"text": "rate"}, "len": 0.9, "thickness": 12},
-                xgap=1,
-                ygap=1,
-            ),
-            row=1,
-            col=col,
-        )
-    fig.update_xaxes(tickangle=-60, tickfont={"size": 10})
-    fig.update_yaxes(tickfont={"size": 11}, autorange="reversed")
-    fig.update_annotations(font={"size": 12})
-    title = "success rate" if good else "robot-driven collision rate"
-    fig.update_layout(
-        title={"text": f"{title} [%] per law and regime", "font": {"size": 14}, "x": 0},
-        height=150 + 24 * len(laws),
-        margin={"l": 10, "r": 10, "t": 60, "b": 70},
-    )
-    html: str = fig.to_html(
-        full_html=False,
-        include_plotlyjs=False,
-        div_id=div_id,
-        config={"responsive": True, "displaylogo": False},
-    )
-    return html
+    best = {c: {b.law for b in ranking(stats[c])[0]} for c in cells}
+    panels = [
+        {
+            "title": _panel_title(*p),
+            "columns": [f"v{c.speed_ratio:g}·n{c.n_humans}" for c in cells if _panel(c) == p],
+        }
+        for p in _panels(cells)
+    ]
+    edges = {i for i, c in enumerate(cells) if i == 0 or _panel(c) != _panel(cells[i - 1])}
+    rows = [
+        {
+            "law": law,
+            "cells": [
+                _cell(next((x for x in stats[c] if x.law == law), None), law, c, metric, best[c])
+                | {"edge": i in edges}
+                for i, c in enumerate(cells)
+            ],
+        }
+        for law in laws
+    ]
+    title = "success rate" if metric == "success" else "robot-driven collision rate"
+    return {
+        "id": div_id,
+        "title": f"{title} [%] per law and regime",
+        "panels": panels,
+        "rows": rows,
+    }
 
 
 def _rate_cell(r: Rate) -> str:

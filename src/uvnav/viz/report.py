@@ -21,8 +21,9 @@
   the page carries none of them.
 
 Every table fits the text column (fixed layout with wrapping, or a scroll container).  The page
-works offline: inline CSS, plotly loaded from ``plotly.min.js`` next to ``index.html`` (only when
-the page has a heat map or an animation), no external URL.
+works offline: inline CSS, no external URL; the first screen (the regime map's heat maps are
+coloured tables) needs no script, and ``plotly.min.js``, written next to ``index.html`` when the
+page has animations, is loaded with the first animation the reader asks for.
 """
 
 from __future__ import annotations
@@ -459,7 +460,7 @@ def write_report(
     from uvnav.viz.regime import SMALL_MARK, decision_view
 
     decision = decision_view(db_path)
-    if anim_sections or decision["heatmaps"]:
+    if anim_sections:  # loaded by the page only when an animation is asked for
         write_plotly_js(out_dir)
 
     template_text = files("uvnav.viz").joinpath("templates/report.html").read_text(encoding="utf-8")
