@@ -16,7 +16,7 @@ from typing import Any
 import pytest
 from typer.testing import CliRunner
 
-from uvnav.bench.summary import TIMING_COLUMNS, simulate_spec
+from uvnav.bench.summary import TIMING_COLUMNS
 from uvnav.cli.app import app
 
 runner = CliRunner()
@@ -133,40 +133,48 @@ def test_bench_failures_lists_each_failed_episode(tmp_path: Path) -> None:
         assert f["status"] in ("collision", "timeout")
         assert f["cause"] in ("robot-driven", "obstacle-driven", "timeout")
     assert f"{len(failed)} episode(s) did not succeed" in res.stdout
-    lines = res.stdout.splitlines()
-    for f in failed:
-        scene = simulate_spec(f["scenario"])  # random-ch2/0003 -> random-ch2:3
-        assert scene == f"random-ch2:{f['seed']}"
-        assert any(scene in ln and f["cause"] in ln for ln in lines), f
-    again = json.loads(invoke("simulate", scene, "-c", "straight-v1", "--json").stdout)
-    assert (again["status"], again["min_clearance"]) == (f["status"], f["min_clearance"])
+    for f in failed:  # each failure's line, then its command on one line
+        assert f"- straight-v1, seed {f['seed']}: {f['cause']}" in res.stdout
+        assert f"\n  {f['command']}\n" in res.stdout
+        assert f["command"].startswith(f"uvnav simulate random-ch2:{f['seed']} -c straight-v1 ")
     assert "failures" not in json.loads(
         invoke("bench", str(path), "--db", str(db), "--resume", "--json").stdout
     )
 
 
-def test_a_failure_of_a_generator_with_parameters_reruns_from_its_line(tmp_path: Path) -> None:
+def test_every_failure_line_reruns_its_stored_episode_exactly(tmp_path: Path) -> None:
+    """Each --failures line carries the ``uvnav simulate`` command of its episode: generator
+    parameters, the law's grid parameters and --beyond-assumptions; run, it gives the stored
+    status, clearance and path length."""
     path = tmp_path / "fails.yaml"
     path.write_text(
         "name: fails-params\nscenarios:\n  - generator: random-ch2\n    seeds: [0, 4]\n"
         "    params: {n_obstacles: 4, body: disc}\ncontrollers:\n  - name: straight-v1\n"
+        "  - name: apf-v1\n    grid: {repulse_gain: [0.0], escape: [false]}\n"
         "beyond_assumptions: true\n"
     )
-    res, record = run_with_failures(path, tmp_path / "r.sqlite")
-    assert "--seed SEED --beyond-assumptions" in res.stdout, res.stdout
+    db = tmp_path / "r.sqlite"
+    res, record = run_with_failures(path, db)
     failed = record["failures"]
-    assert failed, "straight-v1 meets a disc on some of random-ch2 seeds 0-3 with 4 bodies"
-    f = failed[0]
-    spec = simulate_spec(f["scenario"])
-    assert spec == (
-        f"random-ch2:{f['seed']} --gen-param 'body=\"disc\"' --gen-param n_obstacles=4"
-    ), spec
-    args = ["simulate", *shlex.split(spec), "-c", "straight-v1", "--beyond-assumptions", "--json"]
-    again = json.loads(invoke(*args).stdout)
-    assert (again["status"], again["min_clearance"]) == (f["status"], f["min_clearance"])
+    assert {f["controller"] for f in failed} == {"straight-v1", "apf-v1"}, failed
+    stored = {
+        (r[0], r[1]): r[2:]
+        for r in sqlite3.connect(db).execute(
+            "SELECT controller, seed, status, min_clearance, path_length FROM episodes"
+        )
+    }
+    for f in failed:
+        cmd = shlex.split(f["command"])
+        assert cmd[:2] == ["uvnav", "simulate"] and f["command"] in res.stdout
+        if f["controller"] == "apf-v1":
+            assert {"repulse_gain=0.0", "escape=false"} <= set(cmd), cmd
+        assert "--beyond-assumptions" in cmd and 'body="disc"' in cmd
+        again = json.loads(invoke(*cmd[1:], "--json").stdout)
+        got = (again["status"], again["min_clearance"], again["path_length"])
+        assert got == stored[(f["controller"], f["seed"])], f
     plain = json.loads(invoke("simulate", f"random-ch2:{f['seed']}", "-c", "straight-v1",
                               "--json").stdout)  # fmt: skip
-    assert plain["min_clearance"] != f["min_clearance"], "the parameters change the scene"
+    assert plain["min_clearance"] != stored[("straight-v1", f["seed"])][1], "params change it"
 
 
 def assert_one_line_error(result: Any, code: int, *fragments: str) -> str:

@@ -106,9 +106,9 @@ def bench_cmd(
         bool,
         typer.Option(
             "--failures",
-            help="Also list every episode that did not succeed: seed and cause (who closed the "
-            "gap at a collision, or timeout / refused / error).  With --resume on a finished "
-            "campaign: only the listing.",
+            help="Also list every episode that did not succeed: seed, cause (who closed the "
+            "gap at a collision, or timeout / refused / error) and the uvnav simulate command "
+            "that reruns it.  With --resume on a finished campaign: only the listing.",
         ),
     ] = False,
     mcap_dir: Annotated[
@@ -199,7 +199,7 @@ def bench_cmd(
             raise typer.Exit(130) from None
         elapsed = time.perf_counter() - tic
         rows = controller_summary(store, spec.name)
-        failed = failure_rows(store, spec.name) if failures else []
+        failed = failure_rows(store, spec.name, beyond=spec.beyond_assumptions) if failures else []
         first_error = _first_error(store, spec.name) if result.errors else None
     rate = result.ran / elapsed if result.ran and elapsed > 0 else None
     if json_out:
@@ -251,7 +251,7 @@ def bench_cmd(
         table.add_row(_text(label), *(_text(c) for c in shown))
     con.print(table)
     if failures:
-        _print_failures(failed, spec.beyond_assumptions)
+        _print_failures(failed)
     speed = f", {rate:.2f} episodes/s" if rate is not None else ""
     typer.echo(
         f"ran {result.ran} episode(s) ({result.errors} error(s)), skipped {result.skipped} already "
@@ -283,28 +283,17 @@ def _mcap_folder(folder: Path) -> Any:
     return McapFolder(folder.resolve())
 
 
-def _print_failures(rows: list[dict[str, Any]], beyond: bool) -> None:
-    """The episodes that did not succeed, one line each (``uvnav bench --failures``); the
-    scenario as ``uvnav simulate`` takes it, so that a row reruns as it is (with
-    ``--beyond-assumptions`` when the campaign ran ``beyond``)."""
-    from uvnav.bench.summary import simulate_spec
-
-    flag = " --beyond-assumptions" if beyond else ""
-    table = compact_table(
-        f"{len(rows)} episode(s) did not succeed",
-        caption=f"rerun one: uvnav simulate SCENARIO -c CONTROLLER --seed SEED{flag} "
-        "(its params as -p)",
-    )
-    for head in ("controller", "scenario", "seed"):
-        table.add_column(head, overflow="fold")
-    table.add_column("cause", overflow="fold", ratio=1)
-    table.add_column("clearance\n[m]", justify="right", no_wrap=True)
+def _print_failures(rows: list[dict[str, Any]]) -> None:
+    """The episodes that did not succeed (``uvnav bench --failures``), each as one line of law,
+    seed, cause and clearance, then the ``uvnav simulate`` command that runs it again, on one
+    line however wide (so that it can be copied)."""
+    con = _console()
+    con.print(f"\n{len(rows)} episode(s) did not succeed; each reruns with the command below it:")
     for r in rows:
         law = r["controller"] if r["params"] == "-" else f"{r['controller']} {r['params']}"
-        gap = "-" if r["min_clearance"] is None else f"{r['min_clearance']:.3f}"
-        scene = simulate_spec(r["scenario"])
-        table.add_row(*(_text(x) for x in (law, scene, str(r["seed"]), r["cause"], gap)))
-    _console().print(table)
+        gap = "" if r["min_clearance"] is None else f", clearance {r['min_clearance']:.3f} m"
+        con.print(f"- {law}, seed {r['seed']}: {r['cause']}{gap}", markup=False, highlight=False)
+        con.print(f"  {r['command']}", markup=False, highlight=False, soft_wrap=True)
 
 
 def _first_error(store: Any, campaign: str) -> str | None:
