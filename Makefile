@@ -16,7 +16,7 @@ BENCH_OUT  ?= benchmarks/results
 # Debian's Chromium for the report's browser test (playwright drives it; no browser download)
 CHROMIUM   ?= chromium
 
-.PHONY: run test fuzz bench peers lint clean venv browser evidence
+.PHONY: run test tour fuzz bench peers lint clean venv browser evidence
 
 $(PY):
 	$(PYTHON) -m venv $(VENV) || python3 -m venv $(VENV)
@@ -46,6 +46,11 @@ run: $(STAMP_RUN)
 
 test: $(STAMP_TEST) browser
 	$(PY) -m pytest -n 2 -q --hypothesis-profile=ci
+
+# the README's whole tour on a fresh copy of the tracked files, every command at the quick size
+# (tests/test_readme_tour.py; CI runs it after `make test`)
+tour: $(STAMP_TEST)
+	$(PY) -m pytest -q -s -p no:randomly --tour tests/test_readme_tour.py
 
 # fresh random hypothesis examples (not derandomised, more of them): looks for new counter-examples
 fuzz: $(STAMP_TEST)

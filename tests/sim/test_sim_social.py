@@ -18,7 +18,7 @@ from uvnav.scenarios.pedestrians import PedestrianReplay
 from uvnav.sensors import Observation
 from uvnav.sim import EpisodeSetup, run_episode
 from uvnav.sim.metrics import SOCIAL_METRIC_NAMES, EpisodeMetrics, episode_metrics
-from uvnav.sim.social import DISCOMFORT_DISTANCE, INTIMATE_DISTANCE, pedestrian_ids
+from uvnav.sim.social import DISCOMFORT_DISTANCE, INTIMATE_DISTANCE, GapHistory, pedestrian_ids
 
 ROBOT_R = 0.2
 PED_R = 0.3
@@ -164,6 +164,39 @@ def test_pedestrian_appearing_in_contact_is_not_the_robots_doing() -> None:
     present = Obstacle.moving_disc((1.3, -1.0), PED_R, (0.0, 1.0))
     res = _run(_setup([present]), make_controller("straight-v1"))
     assert res.status == "collision" and res.metrics.collision_by == "robot"
+
+
+def test_who_closed_the_gap_is_judged_over_the_last_second() -> None:
+    """A person walks at 0.8 m/s after a robot that draws away at 0.3 m/s; in the last step the
+    robot turns back at 1 m/s and they touch.  At the contact instant the robot's approach
+    (1 m/s) exceeds the person's (0.8 m/s), but over the last second the person closed 0.8 m of
+    the gap and the robot 0.025 m: the person closed it."""
+
+    def law(t: float) -> VelocityCommand:
+        return VelocityCommand(0.3, 0.0) if t < 4.75 - 1e-9 else VelocityCommand(-1.0, 0.0)
+
+    def chaser() -> Obstacle:  # fresh: an episode leaves its obstacles where it ended
+        return Obstacle.moving_disc((-3.0, 0.0), PED_R, (0.8, 0.0))
+
+    res = _run(_setup([chaser()], t_max=8.0), Scripted(law), vehicle="holonomic")
+    assert res.status == "collision" and 4.75 < res.contact_time <= 5.0
+    assert res.metrics.collision_by == "pedestrian"
+    # the same contact met by a robot that drove at the person the whole last second
+    res = _run(_setup([chaser()], t_max=8.0), Scripted(lambda t: VelocityCommand(-1.0, 0.0)),
+               vehicle="holonomic")  # fmt: skip
+    assert res.status == "collision" and res.metrics.collision_by == "robot"
+
+
+def test_gap_history_shares_sum_the_closing_over_the_window() -> None:
+    h = GapHistory(2, 0.25)  # 1 s: 4 steps, 5 samples kept
+    for k in range(8):  # robot still; body 0 walks in at 1 m/s, body 1 stands
+        h.push(0.0, 0.0, np.array([[5.0 - 0.25 * k, 0.0], [0.0, 3.0]]), None)
+    assert h.shares(0) == pytest.approx((0.0, 1.0))  # only the last second counts
+    assert h.shares(1) == (0.0, 0.0) and not h.robot_closed(1)  # a tie is not the robot's
+    absent = GapHistory(1, 0.25)
+    for k in range(3):  # the body exists from the last sample only: no step of the window
+        absent.push(0.5 * k, 0.0, np.array([[2.0, 0.0]]), np.array([k == 2]))
+    assert absent.shares(0) == (0.0, 0.0)
 
 
 def test_moving_polygon_into_a_standing_robot() -> None:

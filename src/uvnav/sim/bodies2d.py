@@ -68,6 +68,10 @@ class Bodies2D(Protocol):
     def field(self) -> ObstacleField:
         """The bodies now."""
 
+    def centres(self) -> tuple[FloatArray, np.ndarray | None]:
+        """The bodies' centres now (k, 2) [m] (a view: copy to keep) and which exist (``None``:
+        all)."""
+
     def see_robot(self, position: FloatArray, velocity: FloatArray, radius: float) -> None:
         """Tell the bodies that react to the robot where it is (before each step)."""
 
@@ -207,6 +211,9 @@ class FieldBodies:
 
     def field(self) -> ObstacleField:
         return self._field
+
+    def centres(self) -> tuple[FloatArray, np.ndarray | None]:
+        return self._field.centres, self._field.present
 
     def see_robot(self, position: FloatArray, velocity: FloatArray, radius: float) -> None:
         self.batch.see_robot(position, velocity, radius)
@@ -402,6 +409,10 @@ class PackedBodies:
             )  # fmt: skip
             out.append(reading)
         return tuple(out)
+
+    def centres(self) -> tuple[FloatArray, np.ndarray | None]:
+        """The obstacles' centres (k, 2) [m] now (a view) and ``None`` (every body exists)."""
+        return self._st[S_X : S_Y + 1, : self.n].T, None
 
     def field(self) -> ObstacleField:
         """The :class:`ObstacleField` of now (built on first use after a step)."""

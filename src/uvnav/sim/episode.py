@@ -49,7 +49,7 @@ from uvnav.sim.metrics import EpisodeMetrics
 from uvnav.sim.packed import pack_check
 from uvnav.sim.recorder import Trajectory, TrajectoryRecorder
 from uvnav.sim.setup import EpisodeSetup
-from uvnav.sim.social import SocialTracker, collision_by, pedestrian_ids
+from uvnav.sim.social import GapHistory, SocialTracker, collision_by, pedestrian_ids
 from uvnav.sim.swept import SweptClearance
 
 
@@ -152,6 +152,8 @@ class World2D(OneVehicle):
             else None
         )
         self.collision_by: str | None = None
+        self.history = GapHistory(len(self.obstacles), self.dt)
+        self.history.push(self.x, self.y, *self.bodies.centres())
         self.turn = 0.0  # total absolute heading change [rad]
         self.body.reset()
         self.applied: Any = self.body.rest()  # the command held now
@@ -183,7 +185,7 @@ class World2D(OneVehicle):
         """Who closed the gap at the collision now (:func:`uvnav.sim.social.collision_by`);
         ``was_present``: the bodies that existed one step before."""
         return collision_by(self.field, self.x, self.y, self.velocity(), self.pedestrians,
-                            was_present=was_present)  # fmt: skip
+                            was_present=was_present, history=self.history)  # fmt: skip
 
     def command_pair(self) -> tuple[float, float]:
         """The applied command as two numbers for the trajectory (:attr:`command_names`)."""
@@ -229,12 +231,17 @@ class World2D(OneVehicle):
         self.t = t = clock.tick()
         if self.social is not None:
             self.social.observe(self.field, nx, ny, clock.step_index)
+        self.history.push(nx, ny, *bodies.centres())
         contact_at = self._swept((x, y), (nx, ny), t0, g0, travel, slack)
         gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)
         self.done = book.judge(t, self.clearance, gd, contact_at) or clock.up
         if book.status == "collision":  # judged at the first contact when the sweep found it
             sweep = self.sweep
-            by = sweep.contact_by(dt, self.velocity(), self.pedestrians) if sweep else None
+            by = (
+                sweep.contact_by(dt, self.velocity(), self.pedestrians, self.history)
+                if sweep
+                else None
+            )
             self.collision_by = by or self._collision_by(bodies.present_before)
 
     def _swept(

@@ -58,17 +58,23 @@ Metrics (``None`` in a scene without pedestrians, except where said):
     environments") *without* their subtraction of the rotation needed to face the target, so it
     is never negative and needs no goal.
 ``collision_by``
-    at a collision, who closed the gap: ``"robot"`` when the robot's velocity component toward
-    the body it touches is larger than the body's velocity component toward the robot at that
-    step, else ``"pedestrian"`` (or ``"obstacle"`` when the body is not a pedestrian); ``None``
-    without collision.  The direction is from the robot's centre to the body's centre (disc) or to
-    its nearest boundary point (polygon); the body's velocity is that of its touching point
-    (translation plus rotation).  Where the world found the contact along the step, this is
-    judged at the first contact (:meth:`uvnav.sim.swept.SweptClearance.contact_by`), else at the
-    step's end.  A body that did not exist one step before (a replayed
-    pedestrian whose recorded track starts in contact with the robot) closed the gap by
-    appearing there: ``"appeared"``, whatever the velocities (no one drove into it).  Set for
-    every 2D scene, with or without pedestrians.
+    at a collision, who closed the gap: ``"robot"`` or ``"pedestrian"`` (``"obstacle"`` when the
+    body is not a pedestrian); ``None`` without collision.  For a *disc* body (every pedestrian)
+    it is judged over the last second before the contact (:data:`BLAME_WINDOW`,
+    :class:`GapHistory`): at each integration step of that window the gap between the two
+    centres closes by the robot's displacement along the line to the body's centre plus the
+    body's displacement along the line to the robot; the robot closed the gap when its part of
+    the closing, summed over the window, is larger than the body's.  A robot that turns into a
+    person in its last step but had been drawing away is then not blamed for the person's
+    approach, nor is a person who side-steps at the last instant into a robot that drove at them.
+    A *polygon* is judged at the contact instant, where the velocity of its touching point
+    (translation plus rotation) is known: ``"robot"`` when the robot's velocity component toward
+    the body's nearest boundary point is larger than that point's velocity component toward the
+    robot.  Where the world found the contact along the step, the instant is the first contact
+    (:meth:`uvnav.sim.swept.SweptClearance.contact_by`), else the step's end.  A body that did
+    not exist one step before (a replayed pedestrian whose recorded track starts in contact with
+    the robot) closed the gap by appearing there: ``"appeared"``, whatever the motion (no one
+    drove into it).  Set for every 2D scene, with or without pedestrians.
 """
 
 from __future__ import annotations
@@ -226,6 +232,63 @@ class SocialTracker:
 
 #: the cause of a collision with a body that appeared in contact (its track starts there)
 APPEARED = "appeared"
+#: how far back before a contact the blame of a collision with a disc looks [s]
+BLAME_WINDOW = 1.0
+
+
+class GapHistory:
+    """The robot's centre and every body's centre at the last integration steps of a 2D episode,
+    :data:`BLAME_WINDOW` of them and one more (a ring), for :meth:`robot_closed`.
+
+    Args:
+        n_bodies: the bodies of the field.
+        dt: integration step [s].
+    """
+
+    __slots__ = ("_bodies", "_count", "_present", "_robot", "_size")
+
+    def __init__(self, n_bodies: int, dt: float) -> None:
+        self._size = size = max(1, round(BLAME_WINDOW / dt)) + 1
+        self._robot = np.zeros((size, 2))
+        self._bodies = np.zeros((size, n_bodies, 2))
+        self._present = np.ones((size, n_bodies), dtype=bool)
+        self._count = 0
+
+    def push(self, x: float, y: float, centres: np.ndarray, present: np.ndarray | None) -> None:
+        """Keep the state after a step: the robot at ``(x, y)`` [m], the bodies' ``centres``
+        (k, 2) [m], which of them exist (``None``: all)."""
+        i = self._count % self._size
+        self._robot[i] = (x, y)
+        self._bodies[i] = centres
+        self._present[i] = True if present is None else present
+        self._count += 1
+
+    def shares(self, body: int) -> tuple[float, float]:
+        """How much of the closing of the centre-to-centre distance to ``body`` over the window
+        the robot did and the body did [m] (module docstring, ``collision_by``); the steps
+        where the body is absent at either end are left out.
+
+        >>> h = GapHistory(1, 0.5)
+        >>> for k in range(3):  # the robot walks 1 m/s at a body that stands 3 m ahead
+        ...     h.push(0.5 * k, 0.0, np.array([[3.0, 0.0]]), None)
+        >>> h.shares(0)
+        (1.0, 0.0)
+        """
+        m = min(self._count, self._size)
+        order = [(self._count - m + i) % self._size for i in range(m)]
+        r, c, there = self._robot[order], self._bodies[order, body], self._present[order, body]
+        d = c[:-1] - r[:-1]
+        norm = np.hypot(d[:, 0], d[:, 1])
+        toward = d / np.where(norm > 0.0, norm, 1.0)[:, None]
+        both = there[:-1] & there[1:] & (norm > 0.0)
+        robot = ((r[1:] - r[:-1]) * toward).sum(axis=1)
+        moved = -((c[1:] - c[:-1]) * toward).sum(axis=1)
+        return float(robot[both].sum()), float(moved[both].sum())
+
+    def robot_closed(self, body: int) -> bool:
+        """Whether the robot did more of the closing to ``body`` over the window than it did."""
+        robot, moved = self.shares(body)
+        return robot > moved
 
 
 def collision_by(
@@ -236,6 +299,7 @@ def collision_by(
     pedestrians: np.ndarray,
     *,
     was_present: np.ndarray | None = None,
+    history: GapHistory | None = None,
 ) -> str:
     """Who closed the gap at a collision of the robot at ``(px, py)`` (module docstring).
 
@@ -244,6 +308,8 @@ def collision_by(
         robot_velocity: the robot's velocity ``(vx, vy)`` [m/s] at that step.
         pedestrians: indices of the pedestrians (:func:`pedestrian_ids`).
         was_present: per body, whether it existed one step before (``None``: all did).
+        history: the last second of the episode, with this step (a disc is judged over it;
+            ``None``: at this step, as a polygon is).
 
     Returns:
         ``"robot"``, ``"pedestrian"``, ``"obstacle"`` or ``"appeared"`` (the body did not exist
@@ -257,15 +323,19 @@ def collision_by(
     touch = (float(q.nearest[j, 0]), float(q.nearest[j, 1]))
     if was_present is not None and not bool(was_present[body]):
         return APPEARED
+    if disc and history is not None:
+        return blame(history.robot_closed(body), body, pedestrians)
     robot = robot_closed(
         (px, py), centre, touch, disc, bool(q.inside[j]), robot_velocity,
         (float(fld.velocities[body, 0]), float(fld.velocities[body, 1])),
         float(fld.angular_velocities[body]),
     )  # fmt: skip
-    return _blame(robot, body, pedestrians)
+    return blame(robot, body, pedestrians)
 
 
-def _blame(robot: bool, body: int, pedestrians: np.ndarray) -> str:
+def blame(robot: bool, body: int, pedestrians: np.ndarray) -> str:
+    """The cause of a collision with ``body``: ``"robot"`` when the robot closed the gap, else
+    ``"pedestrian"`` or ``"obstacle"`` (``pedestrians``: the pedestrians' indices)."""
     if robot:
         return "robot"
     return "pedestrian" if bool(np.isin(body, pedestrians)) else "obstacle"

@@ -36,7 +36,7 @@ from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.polygons import polygon_nearest
 from uvnav.geometry.sweep import body_sweep, disc_sweep
 from uvnav.obstacles.obstacle import FieldTemplate
-from uvnav.sim.social import APPEARED, robot_closed
+from uvnav.sim.social import APPEARED, GapHistory, blame, robot_closed
 
 #: the kernels' tolerance for a rotating body [m]: a gap is at most twice it below the true one
 ROT_TOL = 5e-4
@@ -193,13 +193,19 @@ class SweptClearance:
         return gap, s_hit
 
     def contact_by(
-        self, dt: float, robot_velocity: tuple[float, float], pedestrians: np.ndarray
+        self,
+        dt: float,
+        robot_velocity: tuple[float, float],
+        pedestrians: np.ndarray,
+        history: GapHistory | None = None,
     ) -> str | None:
-        """Who closed the gap at the last step's first contact (``None``: it had none), judged
-        at that instant (:func:`uvnav.sim.social.robot_closed`): the robot's centre and the
-        body's pose there under the sweep's motion model, the body's velocity over the step of
-        ``dt`` [s], the robot's ``robot_velocity`` [m/s]; a body absent at the step's start
-        appeared in contact (``"appeared"``)."""
+        """Who closed the gap at the last step's first contact (``None``: it had none): with a
+        disc, over the ``history`` that ends with this step (:class:`~uvnav.sim.social.
+        GapHistory`); with a polygon (or no history), at that instant
+        (:func:`uvnav.sim.social.robot_closed`): the robot's centre and the body's pose there
+        under the sweep's motion model, the body's velocity over the step of ``dt`` [s], the
+        robot's ``robot_velocity`` [m/s].  A body absent at the step's start appeared in
+        contact (``"appeared"``)."""
         if self.contact is None:
             return None
         poses, j, s = self.contact
@@ -218,14 +224,14 @@ class SweptClearance:
             touch = (float(near[0]), float(near[1]))
         if poses.present0 is not None and not bool(poses.present0[j]):
             return APPEARED  # the body appeared in contact within the step
+        if disc and history is not None:
+            return blame(history.robot_closed(j), j, pedestrians)
         velocity = ((c1[j] - c0[j]) / dt).tolist()
         robot = robot_closed(
             (float(p[0]), float(p[1])), (float(c[0]), float(c[1])), touch, disc, inside,
             robot_velocity, (velocity[0], velocity[1]), dh / dt,
         )  # fmt: skip
-        if robot:
-            return "robot"
-        return "pedestrian" if bool(np.isin(j, pedestrians)) else "obstacle"
+        return blame(robot, j, pedestrians)
 
 
 def _changed_bound(poses: StepPoses, g0: float, g1: float, reach: float) -> float:
