@@ -43,6 +43,11 @@ Options for the protocol study (defaults = the reproduction):
   same case seeds).  A case whose humans CrowdSim's rule cannot place apart (20 humans on the
   4 m circle: a few cases) is left out and listed as ``unplaceable``; the rates are over the
   cases run.
+* ``--rule crowd_dynamic``: the harder crowd of ``crowd-dynamic:<case>``
+  (:mod:`uvnav.scenarios.crowd_dynamic`: 20 humans of random radius and speed who change goals at
+  random times and on arrival, 6 m circle, 5 m sensing unless ``--sensing-range``) instead of
+  CrowdNav's scenes; no paper figure or target applies (the verdict is ``no target``), cases run
+  in order from ``--first`` (default 0), and ``--humans`` defaults to the scene's 20.
 * ``--pref crowdnav``: the robot's preferred velocity as CrowdNav's ORCA sets it (1 m/s toward
   the goal beyond 1 m, the gap within) instead of ``orca-holonomic-v1``'s (V_max, lowered to
   ``dist / period`` on the last step).
@@ -67,8 +72,10 @@ from uvnav.bench.summary import wilson_interval
 from uvnav.controllers.base import controller_info, make_law
 from uvnav.controllers.holonomic import OrcaHolonomic
 from uvnav.core import BaseProbe
+from uvnav.scenarios import crowd_dynamic
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.catalog import kinds
+from uvnav.scenarios.crowd_dynamic import crowd_dynamic_scenario
 from uvnav.scenarios.crowdnav import (
     CROWDNAV_ORCA_PARAMS,
     N_HUMANS,
@@ -137,6 +144,8 @@ PAPER_LAW = "orca-holonomic-v1"
 
 #: CrowdNav's test cases
 TEST_CASES = 500
+#: the harder crowd's rule (:mod:`uvnav.scenarios.crowd_dynamic`)
+DYNAMIC = "crowd_dynamic"
 #: the lidar of ``--lidar``: range noise std [m] and range [m] (also the sensing range)
 LIDAR_NOISE, LIDAR_RANGE = 0.01, 5.0
 
@@ -196,7 +205,7 @@ def run(
     lidar: int | None = None,
     accel: float | None = None,
     turn_accel: float | None = None,
-    humans: int = N_HUMANS,
+    humans: int | None = None,
     sensing_range: float | None = None,
 ) -> dict[str, Any]:
     """Run the cases; returns the counts, rates, intervals and times."""
@@ -209,6 +218,8 @@ def run(
     statuses: list[str] = []
     unplaceable: list[int] = []
     cpu0, wall0 = time.process_time(), time.perf_counter()
+    if rule == DYNAMIC and first is None:
+        first = 0  # the harder crowd has no fixed case list to sample
     for case in case_numbers(cases, first):
         sensing: dict[str, Any] = (
             {"bodies": "lidar", "lidar_beams": lidar, "lidar_noise": LIDAR_NOISE,
@@ -219,13 +230,9 @@ def run(
         if sensing_range is not None:
             sensing["sensing_range"] = sensing_range
         try:
-            scn = crowdnav_scenario(
-                case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
-                kinematics=kinematics, n_humans=humans, **sensing,  # type: ignore[arg-type]
-                accel_max=accel, turn_accel_max=turn_accel,
-            )  # fmt: skip
+            scn = _scene(case, rule, substeps, kinematics, humans, sensing, accel, turn_accel)
         except ScenarioError as exc:
-            if exc.path != "n_humans":
+            if exc.path not in ("n_humans", "params.n_humans"):
                 raise
             unplaceable.append(case)
             continue
@@ -272,7 +279,9 @@ def run(
         "asked": asked,
         "unplaceable": unplaceable,
         "rule": rule,
-        "humans": humans,
+        "humans": humans
+        if humans is not None
+        else (crowd_dynamic.N_HUMANS if rule == DYNAMIC else N_HUMANS),
         "substeps": substeps,
         "dt": TIME_STEP / substeps,
         "pref": pref,
@@ -283,7 +292,12 @@ def run(
         "sensing": (
             f"lidar {lidar} beams, {LIDAR_NOISE:g} m noise, {LIDAR_RANGE:g} m" if lidar else "exact"
         )
-        + (f", humans seen within {sensing_range:g} m" if sensing_range is not None else ""),
+        + (f", humans seen within {sensing_range:g} m" if sensing_range is not None else "")
+        + (
+            f", humans seen within {crowd_dynamic.SENSING_RANGE:g} m"
+            if sensing_range is None and rule == DYNAMIC
+            else ""
+        ),
         "params": dict(CROWDNAV_ORCA_PARAMS) if law_name == PAPER_LAW else {},
         "accel_max": accel,
         "turn_accel_max": turn_accel,
@@ -299,19 +313,47 @@ def run(
         "wall_s": wall,
         "cpu_ms_per_episode": 1000.0 * cpu / max(cases, 1),
         "paper": PAPER,
-        "target": TARGETS.get(law_name),
+        "target": None if rule == DYNAMIC else TARGETS.get(law_name),
         "pass": bool(
-            counts["success"] / max(cases, 1) >= TARGETS[law_name]
-            if law_name in TARGETS
-            else lo <= PAPER["success"] <= hi
+            rule == DYNAMIC
+            or (
+                counts["success"] / max(cases, 1) >= TARGETS[law_name]
+                if law_name in TARGETS
+                else lo <= PAPER["success"] <= hi
+            )
         ),
         "statuses": statuses,
     }
 
 
+def _scene(
+    case: int,
+    rule: str,
+    substeps: int,
+    kinematics: str,
+    humans: int | None,
+    sensing: dict[str, Any],
+    accel: float | None,
+    turn_accel: float | None,
+) -> Any:
+    """Case ``case``'s scene of ``rule`` (CrowdNav's, or the harder crowd's)."""
+    n: dict[str, Any] = {} if humans is None else {"n_humans": humans}
+    if rule == DYNAMIC:
+        return crowd_dynamic_scenario(
+            case, dt=TIME_STEP / substeps, kinematics=kinematics,  # type: ignore[arg-type]
+            accel_max=accel, turn_accel_max=turn_accel, **n, **sensing,
+        )  # fmt: skip
+    return crowdnav_scenario(
+        case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
+        kinematics=kinematics, **n, **sensing,  # type: ignore[arg-type]
+        accel_max=accel, turn_accel_max=turn_accel,
+    )  # fmt: skip
+
+
 def report(r: dict[str, Any]) -> str:
+    scene = "crowd-dynamic" if r["rule"] == DYNAMIC else f"crowdnav-{r['rule'].split('_')[0]}"
     lines = [
-        f"crowdnav-{r['rule'].split('_')[0]} {_cases_text(r)}, {r['humans']} humans, "
+        f"{scene} {_cases_text(r)}, {r['humans']} humans, "
         f"{r['law']} {r['params']}, "
         f"dt {r['dt']:g} s, pref {r['pref']}, outcome {r['outcome']}, collisions judged "
         f"{r['judged']}, sensing {r['sensing']}"
@@ -325,7 +367,7 @@ def report(r: dict[str, Any]) -> str:
     for key in ("success", "collision", "timeout"):
         x = r["rates"][key]
         lo, hi = x["ci95"]
-        paper = f"   paper {PAPER[key]:.2f}" if key in PAPER else ""
+        paper = f"   paper {PAPER[key]:.2f}" if key in PAPER and r["rule"] != DYNAMIC else ""
         lines.append(
             f"  {key:<9} {x['count']:4d}  {x['rate']:.3f}  95% [{lo:.3f}, {hi:.3f}]{paper}"
         )
@@ -334,8 +376,9 @@ def report(r: dict[str, Any]) -> str:
     lines.append(f"  robot-driven collisions {rd['count']:4d}  {rd['rate']:.3f}  95% "
                  f"[{lo:.3f}, {hi:.3f}]")  # fmt: skip
     ttg = r["time_to_goal_mean"]
+    ref = f"   paper {PAPER['time_to_goal']:.2f} s" if r["rule"] != DYNAMIC else ""
     lines.append(
-        f"  time to goal (successes) {ttg:.2f} s   paper {PAPER['time_to_goal']:.2f} s"
+        f"  time to goal (successes) {ttg:.2f} s{ref}"
         if ttg is not None
         else "  time to goal: no success"
     )
@@ -349,7 +392,9 @@ def report(r: dict[str, Any]) -> str:
         f"wall {r['wall_s']:.1f} s"
     )
     verdict = "PASS" if r["pass"] else "FAIL"
-    if r["target"] is not None:
+    if r["rule"] == DYNAMIC:
+        lines.append("  no target: the harder crowd has no paper figure")
+    elif r["target"] is not None:
         lines.append(f"  {verdict}: success {r['rates']['success']['rate']:.3f} against the "
                      f"target >= {r['target']:.2f}")  # fmt: skip
     else:
@@ -363,7 +408,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--cases", type=int, default=500, help="number of test cases (default 500)")
     ap.add_argument("--first", type=int, default=None,
                     help="cases FIRST.. in order (default: a seeded sample)")  # fmt: skip
-    ap.add_argument("--rule", choices=("circle_crossing", "square_crossing"),
+    ap.add_argument("--rule", choices=("circle_crossing", "square_crossing", DYNAMIC),
                     default="circle_crossing")  # fmt: skip
     ap.add_argument("--substeps", type=int, default=1, help="integration steps per 0.25 s")
     ap.add_argument("--pref", choices=("uvnav", "crowdnav"), default="uvnav",
@@ -393,8 +438,9 @@ def main(argv: list[str] | None = None) -> int:
         metavar="B",
         help="the unicycle's largest turn-rate change [rad/s^2] (default: at once)",
     )
-    ap.add_argument("--humans", type=int, default=N_HUMANS, metavar="N",
-                    help=f"number of humans (default CrowdNav's {N_HUMANS})")  # fmt: skip
+    ap.add_argument("--humans", type=int, default=None, metavar="N",
+                    help=f"number of humans (default: the scene's, CrowdNav's {N_HUMANS}, "
+                    "crowd_dynamic's 20)")  # fmt: skip
     ap.add_argument("--sensing-range", type=float, default=None, metavar="R",
                     help="the robot sees the humans within R [m] (default: the scenes' 20 m; "
                     "with --lidar, the lidar's range unless given)")  # fmt: skip
@@ -406,8 +452,10 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--sensing-range must be a number > 0 (got {args.sensing_range!r})")
     if args.cases < 1 or args.substeps < 1:
         ap.error("--cases and --substeps must be >= 1")
-    if not 0 <= args.humans <= 1000:
+    if args.humans is not None and not 0 <= args.humans <= 1000:
         ap.error(f"--humans must be in 0..1000 (got {args.humans})")
+    if args.rule == DYNAMIC and (args.lidar or args.outcome == "crowdnav"):
+        ap.error("--rule crowd_dynamic takes neither --lidar nor --outcome crowdnav")
     for name, value in (("--accel", args.accel), ("--turn-accel", args.turn_accel)):
         if value is not None and not (math.isfinite(value) and value > 0):
             ap.error(f"{name} must be a number > 0 (got {value!r})")
@@ -434,6 +482,8 @@ def main(argv: list[str] | None = None) -> int:
             "time": datetime.now(UTC).isoformat(timespec="seconds"),
         }
         name = "crowdnav.json" if args.law == PAPER_LAW else f"crowdnav-{args.law}.json"
+        if args.rule == DYNAMIC:
+            name = f"crowd-dynamic-{args.law}.json"
         (args.out / name).write_text(json.dumps(r, indent=1))
     return 0 if r["pass"] else 1
 

@@ -23,15 +23,18 @@ def _metrics(status: str, **social: Any) -> dict[str, Any]:
 def test_social_columns(tmp_path: Path) -> None:
     episodes: list[tuple[str, dict[str, Any]]] = [
         ("success", {"min_separation": 0.3, "too_close_frequency": 0.0, "intrusion_time": 1.0,
-                     "intrusion_ratio": 0.1, "path_irregularity": 0.2}),
+                     "intrusion_ratio": 0.1, "path_irregularity": 0.2, "personal_space_time": 1.5,
+                     "min_time_to_collision": 2.0, "heading_irregularity": 0.3, "jerk": 4.0}),
         ("collision", {"min_separation": -0.05, "too_close_frequency": 0.5, "intrusion_time": 2.0,
                        "intrusion_ratio": 0.4, "path_irregularity": 0.4,
+                       "personal_space_time": 0.5, "min_time_to_collision": 0.0,
                        "collision_by": "pedestrian"}),
         ("collision", {"min_separation": 0.2, "too_close_frequency": 0.1, "intrusion_time": 0.0,
                        "path_irregularity": 0.6, "collision_by": "robot"}),
         ("collision", {"min_separation": -0.01, "too_close_frequency": 0.2, "intrusion_time": 3.0,
                        "path_irregularity": None, "collision_by": "pedestrian"}),
-        ("success", {"path_irregularity": 0.3}),  # a scene without pedestrians
+        # a scene without pedestrians
+        ("success", {"path_irregularity": 0.3, "heading_irregularity": 0.1, "jerk": 2.0}),
     ]  # fmt: skip
     with ResultsStore(tmp_path / "r.sqlite") as store:
         cid = store.campaign("c")
@@ -51,9 +54,15 @@ def test_social_columns(tmp_path: Path) -> None:
     assert law["intrusion_ratio"] == pytest.approx(0.5 / 2)  # the episodes that have it
     assert law["path_irregularity"] == pytest.approx(1.5 / 4)
     assert law["pedestrian_collision_share"] == pytest.approx(2 / 3)
+    # comfort: means over the episodes that have a value (no time to collision: never on course)
+    assert law["personal_space_time"] == pytest.approx(2.0 / 2)
+    assert law["min_time_to_collision"] == pytest.approx(2.0 / 2)
+    assert law["heading_irregularity"] == pytest.approx(0.4 / 2)
+    assert law["jerk"] == pytest.approx(6.0 / 2)
     other = rows["other"]  # no pedestrian, no turn recorded, no collision
     for col in ("min_separation", "too_close_frequency", "intrusion_time", "intrusion_ratio",
-                "path_irregularity", "pedestrian_collision_share"):  # fmt: skip
+                "path_irregularity", "pedestrian_collision_share", "personal_space_time",
+                "min_time_to_collision", "heading_irregularity", "jerk"):  # fmt: skip
         assert other[col] is None
 
 

@@ -8,7 +8,10 @@ from typing import Any
 from uvnav.bench.store import ResultsStore
 from uvnav.viz.report import summary_table
 
-SOCIAL = ("min_separation [m]", "too_close_frequency", "intrusion_time [s]", "intrusion_ratio")
+SOCIAL = (
+    "min_separation [m]", "too_close_frequency", "intrusion_time [s]", "intrusion_ratio",
+    "personal_space_time [s]", "min_time_to_collision [s]",
+)  # fmt: skip
 
 
 def _metrics(**social: Any) -> dict[str, Any]:
@@ -27,12 +30,13 @@ def test_summary_lists_social_metrics_of_crowd_campaigns(tmp_path: Path) -> None
                 crowd, scenario="c", family="crowd", controller="law", seed=seed,
                 status="success", metrics=_metrics(
                     min_separation=sep, too_close_frequency=0.5, intrusion_time=1.0,
-                    intrusion_ratio=0.25, path_irregularity=0.2,
+                    intrusion_ratio=0.25, path_irregularity=0.2, personal_space_time=0.75,
+                    min_time_to_collision=1.5 + seed, heading_irregularity=0.1, jerk=3.0,
                 ),
             )  # fmt: skip
         store.add_episode(
             plain, scenario="p", controller="law", seed=0, status="success",
-            metrics=_metrics(path_irregularity=0.4),
+            metrics=_metrics(path_irregularity=0.4, heading_irregularity=0.2, jerk=1.0),
         )  # fmt: skip
         (row,) = summary_table(store.episodes_frame("crowd"))
         (other,) = summary_table(store.episodes_frame("plain"))
@@ -41,6 +45,11 @@ def test_summary_lists_social_metrics_of_crowd_campaigns(tmp_path: Path) -> None
     assert row["intrusion_time [s]"].startswith("1.00")
     assert row["intrusion_ratio"] == "0.250 [0.250, 0.250] / 0.250"
     assert row["path_irregularity [rad/m]"].startswith("0.200")
-    assert list(row).index("path_irregularity [rad/m]") < list(row).index("decision_us_median [µs]")
+    assert row["personal_space_time [s]"] == "0.75 [0.75, 0.75] / 0.75"
+    assert row["min_time_to_collision [s]"].endswith("/ 2.00")  # of 1.5 and 2.5
+    assert row["heading_irregularity [rad]"] == "0.100 [0.100, 0.100] / 0.100"
+    assert row["jerk [m/s³]"] == "3.00 [3.00, 3.00] / 3.00"
+    assert list(row).index("jerk [m/s³]") < list(row).index("decision_us_median [µs]")
+    assert other["jerk [m/s³]"] == "1.00 / 1.00" and "heading_irregularity [rad]" in other
     assert not set(SOCIAL) & set(other)  # no pedestrian: no pedestrian columns
     assert other["path_irregularity [rad/m]"] == "0.400 / 0.400"

@@ -17,8 +17,17 @@ One row per (controller, parameter set), over every stored episode of the campai
     means over the episodes with pedestrians (share of decisions closer than 0.2 m, CrowdNav's
     discomfort frequency; time closer than 0.45 m; share of steps on a visible pedestrian's
     1.25 s constant-velocity forecast).
+``personal_space_time`` [s]
+    mean over the episodes with pedestrians of the time spent within 0.5 m (disc to disc) of one
+    (:mod:`uvnav.sim.comfort`).
+``min_time_to_collision`` [s]
+    mean over the episodes that came on a constant-velocity collision course with a pedestrian
+    of each one's smallest time to collision (the others have none to average).
 ``path_irregularity`` [rad/m]
     mean over the episodes that have it (2D episodes in which the robot moved).
+``heading_irregularity`` [rad], ``jerk`` [m/s^3]
+    means over the 2D episodes (angle between heading and goal direction; the robot's jerk,
+    :mod:`uvnav.sim.comfort`).
 ``pedestrian_collision_share``
     share of the collisions in which the pedestrian closed the gap (``collision_by`` is
     ``pedestrian``): with replayed or robot-blind pedestrians part of the collisions are people
@@ -65,7 +74,11 @@ SUMMARY_COLUMNS = (
     "too_close_frequency",
     "intrusion_time",
     "intrusion_ratio",
+    "personal_space_time",
+    "min_time_to_collision",
     "path_irregularity",
+    "heading_irregularity",
+    "jerk",
     "pedestrian_collision_share",
     "decision_us_median",
     "decision_us_p99",
@@ -247,7 +260,11 @@ def _social(ok: Any) -> dict[str, float | None]:
         "too_close_frequency": mean("too_close_frequency"),
         "intrusion_time": mean("intrusion_time"),
         "intrusion_ratio": mean("intrusion_ratio"),
+        "personal_space_time": mean("personal_space_time"),
+        "min_time_to_collision": mean("min_time_to_collision"),
         "path_irregularity": mean("path_irregularity"),
+        "heading_irregularity": mean("heading_irregularity"),
+        "jerk": mean("jerk"),
         "pedestrian_collision_share": _num((by == "pedestrian").mean()) if len(by) else None,
     }
 

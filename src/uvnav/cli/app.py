@@ -108,7 +108,11 @@ _METRIC_UNITS = {
     "min_separation": "m",
     "too_close_time": "s",
     "intrusion_time": "s",
+    "personal_space_time": "s",
+    "min_time_to_collision": "s",
     "path_irregularity": "rad/m",
+    "heading_irregularity": "rad",
+    "jerk": "m/s³",
     "contact_time": "s",
 }
 

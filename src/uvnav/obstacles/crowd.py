@@ -41,7 +41,13 @@ What is implemented, with its source in CrowdNav (``crowd_sim/envs/policy/orca.p
   ORCA toward its goal, so it stops there (preferred velocity ~ 0) but still steps aside for the
   others (CrowdNav's docstring: "Agent doesn't stop moving after it reaches the goal, because once
   it stops moving, the reciprocal rule is broken").  No new goal is drawn (CrowdNav's circle
-  crossing draws none).  That is what is implemented.
+  crossing draws none).  That is what is implemented by default.
+* *Goal changes* (optional, for harder crowds; CrowdNav++'s randomly changing goals, Liu et al.,
+  ICRA 2023): a pedestrian may hold further goals (``next_goals``), walked to in order; it moves
+  on to the next one at each of its ``change_times`` (goals changed at random times, drawn by the
+  scene) and, when ``arrival`` > 0, as soon as its centre is within ``arrival`` of the current
+  goal (a pedestrian that arrives sets off again).  The switch is looked at when the crowd
+  decides, from the state it decides on; the last goal is kept.
 * *Timing* (``CrowdSim.step``): all actions are computed from the state at t, then all agents
   move; pedestrians start at rest (``human.set(px, py, gx, gy, 0, 0, 0)``).  Here a decision is
   taken every ``period`` [s] (CrowdNav's time step 0.25 s; ``None`` = every integration step) and
@@ -187,6 +193,10 @@ class OrcaPedestrian(CrowdMember):
         safety_margin: added to the body radius for RVO2 [m].
         period: decision period [s] (every integration step when ``None``); one value per crowd.
         sees_robot: the robot is an agent of the crowd's ORCA (module docstring).
+        next_goals: (k, 2) the goals after ``goal``, in order [m] (module docstring, goal
+            changes).
+        change_times: ascending times [s] at which the pedestrian moves on to its next goal.
+        arrival: within this distance of its goal it moves on to the next [m] (0: never).
     """
 
     goal: FloatArray
@@ -199,15 +209,40 @@ class OrcaPedestrian(CrowdMember):
     safety_margin: float = SAFETY_MARGIN
     period: float | None = None
     sees_robot: bool = False
+    next_goals: FloatArray = field(default_factory=lambda: np.zeros((0, 2)))
+    change_times: FloatArray = field(default_factory=lambda: np.zeros(0))
+    arrival: float = 0.0
     crowd: Crowd | None = field(default=None, init=False, repr=False)
     index: int = field(default=-1, init=False, repr=False)
+    _leg: int = field(default=0, init=False, repr=False)
+    _changed: int = field(default=0, init=False, repr=False)
 
     def __post_init__(self) -> None:
         self.goal = np.asarray(self.goal, dtype=float).reshape(2)
+        self.next_goals = np.asarray(self.next_goals, dtype=float).reshape(-1, 2)
+        self.change_times = np.asarray(self.change_times, dtype=float).reshape(-1)
         if not (math.isfinite(self.v_pref) and self.v_pref > 0):
             raise ValueError(f"v_pref must be > 0 (got {self.v_pref!r})")
         if self.period is not None and not (math.isfinite(self.period) and self.period > 0):
             raise ValueError(f"period must be > 0 (got {self.period!r})")
+        if not (math.isfinite(self.arrival) and self.arrival >= 0):
+            raise ValueError(f"arrival must be >= 0 (got {self.arrival!r})")
+
+    def current_goal(self, position: FloatArray, t: float) -> FloatArray:
+        """The goal [m] at ``t`` [s] from ``position`` [m], after the changes due by then
+        (module docstring, goal changes)."""
+        last = len(self.next_goals)
+        times = self.change_times
+        while self._changed < len(times) and t >= times[self._changed] - _TIME_EPS:
+            self._changed += 1
+            self._leg = min(self._leg + 1, last)
+        goal = self.goal if self._leg == 0 else self.next_goals[self._leg - 1]
+        if self.arrival > 0 and self._leg < last:
+            gap = math.hypot(float(goal[0]) - float(position[0]), float(goal[1]) - position[1])
+            if gap <= self.arrival:
+                self._leg += 1
+                goal = self.next_goals[self._leg - 1]
+        return goal
 
     def speed_bound(self) -> float:
         """``v_pref``: RVO2's maximum speed."""
@@ -217,8 +252,10 @@ class OrcaPedestrian(CrowdMember):
         self, position: FloatArray, velocity: FloatArray, t: float, period: float
     ) -> tuple[float, float]:
         """The preferred velocity [m/s] at ``t`` [s] for the next ``period`` [s]: toward the
-        goal (:func:`preferred_velocity`)."""
-        return preferred_velocity(position, self.goal, float(self.v_pref))
+        goal (:func:`preferred_velocity`; :meth:`current_goal`)."""
+        if len(self.next_goals) == 0:
+            return preferred_velocity(position, self.goal, float(self.v_pref))
+        return preferred_velocity(position, self.current_goal(position, t), float(self.v_pref))
 
     @classmethod
     def make_crowd(

@@ -188,6 +188,7 @@ GENERATOR_SUMMARIES: dict[str, str] = {
     "random-ch3-periodic": "random-ch3 with weaving / circling bodies",
     "crowdnav-circle": "CrowdNav's circle-crossing test case (5 ORCA humans)",
     "crowdnav-square": "CrowdNav's square-crossing test case (5 ORCA humans)",
+    "crowd-dynamic": "20 ORCA humans of random size and speed who change goals; 5 m sensing",
     "random-ch4": "Ch. 4: deforming bodies within the chapter's assumptions",
     "random-ch4-hard": "Ch. 4, harder: faster, translating bodies, narrow gaps",
     "random-ch5": "Ch. 5: deforming 3D bodies between A and B, within the assumptions",

@@ -23,6 +23,7 @@ from pydantic import Field, ValidationError
 
 from uvnav.geometry.polygons import cyclic_next, cyclic_prev, polygon_area, polygon_centroid
 from uvnav.scenarios.build import obstacle_bounds
+from uvnav.scenarios.crowd_dynamic import crowd_dynamic_scenario
 from uvnav.scenarios.crowdnav import crowdnav_circle, crowdnav_square
 from uvnav.scenarios.errors import PlacementError, ScenarioError, from_validation_error
 from uvnav.scenarios.generators3d import random_ch3_scenario
@@ -710,6 +711,7 @@ GENERATORS: dict[str, Callable[..., Any]] = {
     ),
     "crowdnav-circle": crowdnav_circle,
     "crowdnav-square": crowdnav_square,
+    "crowd-dynamic": crowd_dynamic_scenario,
 }
 
 

@@ -5,6 +5,7 @@ force, plug-in), chosen by ``type`` (:data:`MotionSpec`); each builds its motion
 from __future__ import annotations
 
 import itertools
+import math
 from typing import Annotated, Any, Literal
 
 import numpy as np
@@ -136,8 +137,10 @@ class OrcaCrowdMotion(FileModel):
     The scene's ``orca_crowd`` pedestrians with the same ``crowd`` id form one crowd, simulated
     together by one RVO2 simulator (``pyrvo``): each avoids the others reciprocally.  The robot is
     invisible to them (CrowdNav's protocol).  At its goal a pedestrian stops but keeps stepping
-    aside for the others.  Defaults are CrowdNav's (Chen et al., ICRA 2019).  The body must be a
-    disc; the pedestrian starts at rest, and may start on the robot's goal (it walks on).
+    aside for the others, unless it has further goals (``next_goals``), which it moves on to at
+    its ``change_times`` and on arriving within ``arrival`` of its goal.  Defaults are
+    CrowdNav's (Chen et al., ICRA 2019).  The body must be a disc; the pedestrian starts at
+    rest, and may start on the robot's goal (it walks on).
     """
 
     type: Literal["orca_crowd"]
@@ -174,6 +177,28 @@ class OrcaCrowdMotion(FileModel):
         description="the robot is an agent of the crowd's ORCA: the pedestrians avoid it "
         "(CrowdNav's visible robot); false = invisible (CrowdNav's test protocol)",
     )
+    next_goals: list[Point2] = Field(
+        default_factory=list, description="goals after 'goal', walked to in order [m]"
+    )
+    change_times: list[float] = Field(
+        default_factory=list,
+        description="ascending times at which the pedestrian moves on to its next goal [s]",
+    )
+    arrival: float = Field(
+        0.0,
+        ge=0,
+        allow_inf_nan=False,
+        description="within this distance of its goal it moves on to the next [m] (0: never)",
+    )
+
+    @field_validator("change_times")
+    @classmethod
+    def _ascending(cls, value: list[float]) -> list[float]:
+        if any(not math.isfinite(t) or t < 0 for t in value):
+            raise ValueError("change times must be finite and >= 0")
+        if any(b < a for a, b in itertools.pairwise(value)):
+            raise ValueError("change times must be ascending")
+        return value
 
     def to_model(self, rng: np.random.Generator) -> OrcaPedestrian:
         """The motion model (``rng`` unused: ORCA is deterministic); joined to its crowd when the
@@ -189,6 +214,9 @@ class OrcaCrowdMotion(FileModel):
             safety_margin=float(self.safety_margin),
             period=None if self.period is None else float(self.period),
             sees_robot=bool(self.sees_robot),
+            next_goals=np.asarray(self.next_goals, dtype=float).reshape(-1, 2),
+            change_times=np.asarray(self.change_times, dtype=float),
+            arrival=float(self.arrival),
         )
 
 

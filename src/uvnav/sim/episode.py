@@ -44,6 +44,7 @@ from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
 from uvnav.sensors.observation import Observation
 from uvnav.sensors.suite2d import Sensors2D
 from uvnav.sim.bodies2d import Bodies2D, FieldBodies, PackedBodies
+from uvnav.sim.comfort import MotionTracker
 from uvnav.sim.ledger import Clock, Ledger, OneVehicle
 from uvnav.sim.metrics import EpisodeMetrics
 from uvnav.sim.packed import pack_check
@@ -157,6 +158,7 @@ class World2D(OneVehicle):
         self.turn = 0.0  # total absolute heading change [rad]
         self.body.reset()
         self.applied: Any = self.body.rest()  # the command held now
+        self.motion = MotionTracker(self.goal, self.dt, self.x, self.y, self.th, self.velocity())
         self.book = book = Ledger(self.setup.goal_tolerance)
         gd = math.hypot(self.goal[0] - self.x, self.goal[1] - self.y)
         self.done = book.begin(self.clearance, gd) or self.clock.up
@@ -229,8 +231,9 @@ class World2D(OneVehicle):
         if nearest is not None:
             self.nearest = nearest
         self.t = t = clock.tick()
+        self.motion.observe(nx, ny, self.th)
         if self.social is not None:
-            self.social.observe(self.field, nx, ny, clock.step_index)
+            self.social.observe(self.field, nx, ny, clock.step_index, self.velocity())
         self.history.push(nx, ny, *bodies.centres())
         contact_at = self._swept((x, y), (nx, ny), t0, g0, travel, slack)
         gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)
@@ -286,6 +289,7 @@ class World2D(OneVehicle):
             top_speed=float(self.spec.v_max),
             path_irregularity=self.turn / path if path > 0 else None,
             collision_by=self.collision_by,
+            **self.motion.metrics(),
             **self._social_metrics(len(log.decision_us)),
         )
 
@@ -304,6 +308,8 @@ class World2D(OneVehicle):
             "too_close_frequency": soc.too_close_frequency(decisions),
             "intrusion_time": soc.intrusion_time,
             "intrusion_ratio": soc.intrusion_ratio,
+            "personal_space_time": soc.personal_space_time,
+            "min_time_to_collision": soc.min_ttc,
         }
 
 

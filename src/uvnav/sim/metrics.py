@@ -4,8 +4,8 @@ Names are the snake_case column names used in JSON, the results database and the
 that do not exist for an episode (time to goal of a failed run, minimum clearance in a world
 without obstacles) are ``None``, never NaN or infinite.
 
-The social metrics (:data:`uvnav.sim.social.SOCIAL_METRIC_NAMES`, defined in
-:mod:`uvnav.sim.social`) come last; only the 2D worlds compute them, every other vehicle kind
+The social metrics (:data:`SOCIAL_METRIC_NAMES`, defined in :mod:`uvnav.sim.social` and
+:mod:`uvnav.sim.comfort`) come last; only the 2D worlds compute them, every other vehicle kind
 leaves them ``None``.
 """
 
@@ -18,14 +18,19 @@ from typing import Any
 
 import numpy as np
 
-#: the social metrics (:mod:`uvnav.sim.social`), last in :data:`METRIC_NAMES`: 2D worlds only
+#: the social and comfort metrics (:mod:`uvnav.sim.social`, :mod:`uvnav.sim.comfort`), last in
+#: :data:`METRIC_NAMES`: 2D worlds only
 SOCIAL_METRIC_NAMES: tuple[str, ...] = (
     "min_separation",
     "too_close_time",
     "too_close_frequency",
     "intrusion_time",
     "intrusion_ratio",
+    "personal_space_time",
+    "min_time_to_collision",
     "path_irregularity",
+    "heading_irregularity",
+    "jerk",
     "collision_by",
 )
 
@@ -80,8 +85,16 @@ class EpisodeMetrics:
         intrusion_ratio: share of the integration steps in which the robot's disc lies on a
             visible pedestrian's disc as constant velocity forecasts it over the next 1.25 s
             (the intrusion ratio of crowd-navigation work, CrowdNav++).
+        personal_space_time: time with a pedestrian's disc closer than 0.5 m to the robot's,
+            disc to disc [s] (this and the next: :mod:`uvnav.sim.comfort`).
+        min_time_to_collision: smallest constant-velocity time to collision with a pedestrian
+            over the steps [s] (0 in contact); ``None`` when never on a collision course.
         path_irregularity: total absolute heading change per metre of path [rad/m] (every 2D
             episode that moved).
+        heading_irregularity: mean absolute angle between the heading and the direction to the
+            goal over the steps [rad] (SocNavBench's path irregularity; every 2D episode).
+        jerk: mean norm of the robot's jerk over the integration steps [m/s^3] (every 2D
+            episode of two steps or more).
         collision_by: who closed the gap at the collision: ``"robot"``, ``"pedestrian"`` or
             ``"obstacle"`` (a body that is not a pedestrian), or ``"appeared"`` (the body's
             track starts in contact); ``None`` without collision.
@@ -104,7 +117,11 @@ class EpisodeMetrics:
     too_close_frequency: float | None = None
     intrusion_time: float | None = None
     intrusion_ratio: float | None = None
+    personal_space_time: float | None = None
+    min_time_to_collision: float | None = None
     path_irregularity: float | None = None
+    heading_irregularity: float | None = None
+    jerk: float | None = None
     collision_by: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
@@ -128,7 +145,11 @@ def episode_metrics(
     too_close_frequency: float | None = None,
     intrusion_time: float | None = None,
     intrusion_ratio: float | None = None,
+    personal_space_time: float | None = None,
+    min_time_to_collision: float | None = None,
     path_irregularity: float | None = None,
+    heading_irregularity: float | None = None,
+    jerk: float | None = None,
     collision_by: str | None = None,
 ) -> EpisodeMetrics:
     """The DESIGN §4 metrics of one finished episode, the same way for every simulator.
@@ -148,8 +169,10 @@ def episode_metrics(
         mode_switches: changes of the controller's reported mode.
         decision_us: controller compute time of every decision [µs] (empty: no decision).
         min_separation, too_close_time, too_close_frequency, intrusion_time, intrusion_ratio,
-        path_irregularity, collision_by: the social metrics of a 2D world
-            (:mod:`uvnav.sim.social`), ``None`` where they do not apply.
+        personal_space_time, min_time_to_collision, path_irregularity, heading_irregularity,
+        jerk, collision_by: the social and comfort metrics of a 2D world
+            (:mod:`uvnav.sim.social`, :mod:`uvnav.sim.comfort`), ``None`` where they do not
+            apply (an infinite time to collision is ``None``).
     """
     dec = np.asarray(decision_us, dtype=float) if len(decision_us) else np.zeros(1)
     success = status == "success"
@@ -173,7 +196,11 @@ def episode_metrics(
         too_close_frequency=_opt(too_close_frequency),
         intrusion_time=_opt(intrusion_time),
         intrusion_ratio=_opt(intrusion_ratio),
+        personal_space_time=_opt(personal_space_time),
+        min_time_to_collision=_opt(min_time_to_collision),
         path_irregularity=_opt(path_irregularity),
+        heading_irregularity=_opt(heading_irregularity),
+        jerk=_opt(jerk),
         collision_by=collision_by,
     )
 

@@ -49,6 +49,10 @@ Metrics (``None`` in a scene without pedestrians, except where said):
     velocity, which is also what a robot could compute.  Visible: the pedestrian's disc within
     the robot's sensing range, ``|c - p| - r_ped <= sensing_range`` (the exact sensor's
     rule); an absent pedestrian never counts.
+``personal_space_time`` [s], ``min_time_to_collision`` [s]
+    time with a gap < 0.5 m, and the smallest constant-velocity time to collision with a
+    pedestrian (:mod:`uvnav.sim.comfort`, which also defines ``heading_irregularity`` and
+    ``jerk``, metrics of every 2D episode).
 ``path_irregularity`` [rad/m]
     total absolute heading change divided by the path length: ``sum_k |Δθ_k| / L`` over the
     integration steps (unicycle: ``sum |u_R| dt``, the exact rotation of each step; holonomic
@@ -86,6 +90,7 @@ import numpy as np
 
 from uvnav.obstacles.bodies import DiscBody
 from uvnav.obstacles.obstacle import Obstacle, ObstacleField
+from uvnav.sim.comfort import personal_space_time, time_to_collision
 
 #: CrowdNav's discomfort distance [m] (gap below which the robot is "too close")
 DISCOMFORT_DISTANCE = 0.2
@@ -125,6 +130,7 @@ class SocialTracker:
         "_close_periods",
         "_close_steps",
         "_forecast",
+        "_gaps",
         "_ids",
         "_intruded_steps",
         "_intrusion_steps",
@@ -135,6 +141,7 @@ class SocialTracker:
         "_steps",
         "dt",
         "min_separation",
+        "min_ttc",
         "ratio",
     )
 
@@ -163,6 +170,8 @@ class SocialTracker:
         self._forecast = np.arange(1, k + 1, dtype=float)[:, None] * self.dt  # (K, 1) [s]
         self._steps = 0
         self._intruded_steps = 0
+        self._gaps: list[float] = []  # the smallest gap of every step after the first [m]
+        self.min_ttc = math.inf  # smallest time to collision with a pedestrian [s]
 
     def gap(self, fld: ObstacleField, px: float, py: float) -> float:
         """Smallest gap [m] between the robot's disc at ``(px, py)`` and a pedestrian's."""
@@ -174,15 +183,26 @@ class SocialTracker:
             g = np.where(present if self._all else present.take(self._ids), g, np.inf)
         return float(g.min()) if len(g) else math.inf
 
-    def observe(self, fld: ObstacleField, px: float, py: float, step: int) -> None:
+    def observe(
+        self,
+        fld: ObstacleField,
+        px: float,
+        py: float,
+        step: int,
+        velocity: tuple[float, float] = (0.0, 0.0),
+    ) -> None:
         """Account for the state after integration step ``step`` (0: the initial state, which
-        counts for the minimum only)."""
+        counts for the minimum only); ``velocity``: the robot's [m/s] (time to collision)."""
         g = self.gap(fld, px, py)
         if g < self.min_separation:
             self.min_separation = g
         if step > 0:
             self._steps += 1
             self._intruded_steps += self.intrudes(fld, px, py)
+            self._gaps.append(g)
+            ttc = self.time_to_collision(fld, px, py, velocity)
+            if ttc < self.min_ttc:
+                self.min_ttc = ttc
         if step > 0 and g < INTIMATE_DISTANCE:
             self._intrusion_steps += 1
             if g < DISCOMFORT_DISTANCE:
@@ -209,6 +229,29 @@ class SocialTracker:
         fx = c[:, 0] + v[:, 0] * self._forecast  # (K, n) forecast centres
         fy = c[:, 1] + v[:, 1] * self._forecast
         return bool((np.hypot(px - fx, py - fy) - r - self._radius < 0.0).any())
+
+    def time_to_collision(
+        self, fld: ObstacleField, px: float, py: float, velocity: tuple[float, float]
+    ) -> float:
+        """Smallest constant-velocity time to collision [s] of the robot's disc at ``(px, py)``
+        moving at ``velocity`` [m/s] with a present pedestrian's
+        (:func:`uvnav.sim.comfort.time_to_collision`); ``inf`` when on course with none."""
+        ids = None if self._all else self._ids
+        c = fld.centres if ids is None else fld.centres.take(ids, axis=0)
+        v = fld.velocities if ids is None else fld.velocities.take(ids, axis=0)
+        r = self._radii + self._radius
+        present = fld.present
+        if present is not None:
+            here = present if ids is None else present.take(ids)
+            c, v, r = c[here], v[here], r[here]
+        rel_v = v - np.asarray(velocity, dtype=float)
+        ttc = time_to_collision(c - (px, py), rel_v, r)
+        return float(ttc.min()) if len(ttc) else math.inf
+
+    @property
+    def personal_space_time(self) -> float:
+        """Time with a gap < :data:`uvnav.sim.comfort.PERSONAL_DISTANCE` [s]."""
+        return personal_space_time(np.asarray(self._gaps), self.dt)
 
     @property
     def intrusion_ratio(self) -> float:

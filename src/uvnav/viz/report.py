@@ -99,7 +99,11 @@ _SOCIAL_COLUMNS = (
     ("too_close_frequency", "too_close_frequency", 3),
     ("intrusion_time [s]", "intrusion_time", 2),
     ("intrusion_ratio", "intrusion_ratio", 3),
+    ("personal_space_time [s]", "personal_space_time", 2),
+    ("min_time_to_collision [s]", "min_time_to_collision", 2),
     ("path_irregularity [rad/m]", "path_irregularity", 3),
+    ("heading_irregularity [rad]", "heading_irregularity", 3),
+    ("jerk [m/s³]", "jerk", 2),
 )
 
 
@@ -114,10 +118,12 @@ def summary_table(df: pd.DataFrame) -> list[dict[str, Any]]:
         ``success rate`` and ``collision rate`` (with 95 % Wilson intervals), ``timeout rate``,
         ``errors``, and "mean [95 % CI] / median" strings of ``min_clearance [m]``,
         ``path_length [m]``, ``detour_ratio``, ``time_ratio``, ``control_effort``, then the
-        social metrics (:mod:`uvnav.sim.social`) the frame has values of — ``min_separation
-        [m]``, ``too_close_frequency``, ``intrusion_time [s]`` when some episode had a
-        pedestrian, ``path_irregularity [rad/m]`` when some 2D episode moved — and
-        ``decision_us_median [µs]`` and ``decision_us_p99 [µs]``.
+        social and comfort metrics (:mod:`uvnav.sim.social`, :mod:`uvnav.sim.comfort`) the
+        frame has values of — ``min_separation [m]``, ``too_close_frequency``, ``intrusion_time
+        [s]``, ``intrusion_ratio``, ``personal_space_time [s]``, ``min_time_to_collision [s]``
+        when some episode had a pedestrian, ``path_irregularity [rad/m]``, ``heading_irregularity
+        [rad]`` and ``jerk [m/s³]`` when some 2D episode moved — and ``decision_us_median [µs]``
+        and ``decision_us_p99 [µs]``.
     """
     if df.empty:
         return []
