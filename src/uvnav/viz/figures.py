@@ -30,6 +30,7 @@ from matplotlib.collections import LineCollection
 from matplotlib.colors import ListedColormap, Normalize
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.patches import Circle
 
 from uvnav.sim import EpisodeResult, EpisodeSetup, Trajectory
 
@@ -96,6 +97,32 @@ def _fading_cmap() -> ListedColormap:
     return ListedColormap(base(np.linspace(0.25, 1.0, 256)), name="uvnav-fading")
 
 
+#: the most obstacle outlines panel (a) draws: in a dense crowd, fewer snapshots each
+OUTLINE_BUDGET = 80
+
+
+def scene_snapshots(traj: Trajectory, snapshots: int, bodies: int) -> tuple[np.ndarray, int | None]:
+    """The samples at which panel (a) draws the obstacles, and the robot's closest approach (the
+    sample of least clearance; ``None`` without a finite clearance): ``snapshots`` evenly spread
+    with the closest approach among them; in a dense crowd, where ``bodies`` would draw more
+    than :data:`OUTLINE_BUDGET` outlines, the closest approach alone (else the first and last).
+
+    >>> from types import SimpleNamespace
+    >>> t = SimpleNamespace(times=np.arange(11.0), clearance=np.r_[5.0:0.0:-1, 0.5, 1:6.0])
+    >>> scene_snapshots(t, 5, 2)
+    (array([ 0,  2,  5,  8, 10]), 5)
+    >>> scene_snapshots(t, 10, 40)
+    (array([5]), 5)
+    """
+    n = len(traj.times)
+    gaps = _finite(np.asarray(traj.clearance, dtype=float))
+    closest = int(np.nanargmin(gaps)) if n and np.isfinite(gaps).any() else None
+    if bodies * snapshots > OUTLINE_BUDGET:
+        return (np.array([closest]) if closest is not None else snapshot_indices(n, 2)), closest
+    idx = snapshot_indices(n, snapshots)
+    return (idx if closest is None else np.union1d(idx, [closest])), closest
+
+
 def _draw_scene(
     ax: Axes,
     traj: Trajectory,
@@ -107,7 +134,9 @@ def _draw_scene(
 ) -> None:
     """Panel (a): robot path, I and T, obstacle outlines over time, obstacle centre paths."""
     times = traj.times
-    idx = snapshot_indices(len(times), snapshots)
+    k = traj.obstacle_centres.shape[1] if traj.obstacle_centres.ndim == 3 else 0
+    idx, closest = scene_snapshots(traj, snapshots, k)
+    dense = k * snapshots > OUTLINE_BUDGET
     t_end = float(times[-1]) if len(times) else 1.0
     norm = Normalize(vmin=0.0, vmax=max(t_end, 1e-9))
     cmap = _fading_cmap()
@@ -115,14 +144,14 @@ def _draw_scene(
     def shade(t: float) -> Any:
         return cmap(norm(t))
 
-    k = traj.obstacle_centres.shape[1] if traj.obstacle_centres.ndim == 3 else 0
     rings: list[np.ndarray] = []
     ring_colours: list[Any] = []
     for j in range(k):
         c = traj.obstacle_centres[:, j, :]
         away = far_from_path(c, traj.robot[:, :2])
         c = np.where(away[:, None], np.nan, c)  # absent (parked) obstacles: no line to them
-        ax.plot(c[:, 0], c[:, 1], color="tab:blue", lw=0.8, alpha=0.6, ls="-")
+        ax.plot(c[:, 0], c[:, 1], color="tab:blue", lw=0.6 if dense else 0.8,
+                alpha=0.3 if dense else 0.6, ls="-")  # fmt: skip
         for i in idx:
             if away[i]:
                 continue
@@ -162,6 +191,10 @@ def _draw_scene(
         xytext=(6, 4),
         fontweight="bold",
     )
+    if closest is not None and len(robot):  # the robot's disc at its closest approach
+        centre = (float(robot[closest, 0]), float(robot[closest, 1]))
+        ax.add_patch(Circle(centre, float(setup.spec.radius), fill=False, ec=_ROBOT, lw=1.6,
+                            zorder=5))  # fmt: skip
     if status == "collision" and len(robot):
         ax.plot(robot[-1, 0], robot[-1, 1], marker="X", color="k", ms=10, zorder=6)
     ax.set_aspect("equal", adjustable="datalim")
@@ -170,13 +203,22 @@ def _draw_scene(
     ax.grid(True, alpha=0.3)
     handles = [
         Line2D([], [], ls=":", color=_ROBOT, lw=1.8, label="robot path"),
-        Line2D([], [], color=cmap(0.8), lw=1.1, label="obstacles (fading = earlier)"),
+        Line2D(
+            [],
+            [],
+            color=cmap(0.8),
+            lw=1.1,
+            label="obstacles at closest approach" if dense else "obstacles (fading = earlier)",
+        ),
         Line2D([], [], color="tab:blue", lw=0.8, alpha=0.6, label="obstacle centre paths"),
     ]
+    if closest is not None:
+        label = f"robot at closest approach (t = {float(times[closest]):.1f} s)"
+        handles.append(Line2D([], [], color=_ROBOT, lw=1.6, label=label))
     if status == "collision":
         handles.append(Line2D([], [], marker="X", color="k", ls="", label="collision"))
     ax.legend(handles=handles, loc="lower right", fontsize="small", framealpha=0.8)
-    if colorbar_fig is not None and k:
+    if colorbar_fig is not None and k and not dense:
         colorbar_fig.colorbar(
             ScalarMappable(norm=norm, cmap=cmap),
             ax=ax,
@@ -310,7 +352,8 @@ def plot_episode(
         setup: the episode's setup (start, goal and vehicle limits are read from it).
         path: output file (``.png``; parent directories are created).
         title: figure title; the status and key metrics are added below it.
-        snapshots: number of times at which obstacle outlines are drawn.
+        snapshots: number of times at which obstacle outlines are drawn (fewer in a dense
+            crowd, :func:`scene_snapshots`; the closest approach is always drawn).
 
     Returns:
         ``path``.
