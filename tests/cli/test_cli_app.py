@@ -435,6 +435,8 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
     row_md = "| path length Fig. 2.10 (Zhang) | 14.9 m | 15.2 m | reproduced | geometry chosen"
     assert row_md in table
     assert "1 reproduced" in table.split("| quantity")[0]  # the counts open the table
+    # the same screen opens the table, as a text block
+    assert table.split("```text\n", 1)[1].split("\n```", 1)[0].splitlines() == summary
     assert str(res_dir / "uvnav.sqlite") in result.stdout
     assert "2 figure file(s)" in result.stdout
 

@@ -156,6 +156,10 @@ def test_report_layout_is_a_decision_tool(report: tuple[Path, Path]) -> None:
     _, index = report
     html = index.read_text(encoding="utf-8")
     assert '"frames"' not in html  # no animation frames inline: they are side files
+    # the one screen of `uvnav run` opens the page, before the regime map
+    assert html.index('<pre class="screen">uvnav run: 2 experiments') < html.index(
+        'id="regime-map"'
+    )
     assert sorted(p.name for p in (index.parent / "anim").iterdir()) == [
         f"anim-{i}.js" for i in (1, 2)
     ]

@@ -72,9 +72,11 @@ def run_cmd(
     sections = list(getattr(summary, "sections", []) or [])
     if getattr(summary, "report_path", None) is None and sections:  # no run wrote the page
         summary.report_path = _write_report(results / "uvnav.sqlite", report, sections)
-    table_path = write_comparison_table(rows, results, sections)
     report_path = getattr(summary, "report_path", None) or report / "index.html"
-    for line in run_summary_lines(sections, report_path, table_path, results / "uvnav.sqlite"):
+    table_path = results / TABLE_NAME
+    screen = run_summary_lines(sections, report_path, table_path, results / "uvnav.sqlite")
+    write_comparison_table(rows, results, sections, screen)
+    for line in screen:
         typer.echo(line)
     typer.echo(f"wrote {table_path} (the whole table: {len(rows)} rows)")
     written: list[Path] = []
@@ -117,17 +119,28 @@ def _law_lines(db_path: Path) -> list[str]:
         return law_lines(cell_stats(store))
 
 
+#: the whole "thesis reported vs uvnav measured" table, in the results folder
+TABLE_NAME = "thesis-vs-uvnav.md"
+
+
 def write_comparison_table(
-    rows: list[dict[str, Any]], results: Path, sections: Sequence[Any] = ()
+    rows: list[dict[str, Any]],
+    results: Path,
+    sections: Sequence[Any] = (),
+    screen: Sequence[str] = (),
 ) -> Path:
-    """The whole "thesis reported vs uvnav measured" table as Markdown in ``results``: the
-    per-experiment verdict counts and the rule first, then every row with its verdict
+    """The whole "thesis reported vs uvnav measured" table as Markdown in ``results``: the one
+    screen ``uvnav run`` prints (``screen``, as a text block), the per-experiment verdict counts
+    and the rule, then every row with its verdict
     (:func:`uvnav.experiments.verdict.table_lines`)."""
     from uvnav.experiments.verdict import table_lines
 
-    path = results / "thesis-vs-uvnav.md"
+    path = results / TABLE_NAME
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(table_lines(list(sections), rows)) + "\n", encoding="utf-8")
+    lines = table_lines(list(sections), rows)
+    if screen:
+        lines[1:1] = ["", "```text", *screen, "```"]
+    path.write_text("\n".join(lines) + "\n", encoding="utf-8")
     return path
 
 

@@ -32,6 +32,7 @@ from uvnav.experiments.regime import (
     Regime,
     cell_stats,
     family_table,
+    law_lines,
     ranking,
     recommend,
     sensing_costs,
@@ -171,7 +172,9 @@ def family_view(cells: Sequence[FamilyCell]) -> dict[str, Any]:
 
 
 def decision_view(db_path: Path) -> dict[str, Any]:
-    """Everything the first screen shows, read from the store (empty parts when not stored)."""
+    """Everything the first screen shows, read from the store (empty parts when not stored),
+    with "which law, where" in a few lines (``law_lines``, :func:`uvnav.experiments.regime.
+    law_lines`) for the report's summary."""
     from uvnav.bench.store import ResultsStore
 
     with ResultsStore(Path(db_path), readonly=True) as store:
@@ -179,8 +182,10 @@ def decision_view(db_path: Path) -> dict[str, Any]:
         fams = family_table(store)
     out: dict[str, Any] = {
         "heatmaps": [], "recommendations": [], "cells": [], "families": None, "sensing_costs": [],
+        "law_lines": [],
     }  # fmt: skip
     if stats:
+        out["law_lines"] = law_lines(stats)
         out["heatmaps"] = [
             regime_heatmap(stats, "success", div_id="regime-success"),
             regime_heatmap(stats, "robot_collision", div_id="regime-collision"),

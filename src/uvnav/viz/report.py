@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from uvnav.bench.summary import wilson_interval
-from uvnav.experiments.verdict import count_text, counts, row_verdict
+from uvnav.experiments.verdict import count_text, counts, row_verdict, summary_lines
 
 if TYPE_CHECKING:
     import pandas as pd
@@ -466,6 +466,12 @@ def write_report(
     from uvnav.viz.regime import SMALL_MARK, decision_view
 
     decision = decision_view(db_path)
+    # the one screen `uvnav run` ends with (and thesis-vs-uvnav.md opens with) opens the page
+    screen = (
+        summary_lines(sections, report=None, table=None, laws=decision["law_lines"])
+        if sections
+        else []
+    )
     if anim_sections:  # loaded by the page only when an animation is asked for
         write_plotly_js(out_dir)
 
@@ -492,6 +498,7 @@ def write_report(
         animations=anim_sections,
         animations_global=ANIMATIONS_GLOBAL,
         decision=decision,
+        screen=screen,
         small_mark=SMALL_MARK,
         small_sample=SMALL_SAMPLE,
         plotly_js=PLOTLY_JS,
