@@ -153,8 +153,11 @@ class World2D(OneVehicle):
             else None
         )
         self.collision_by: str | None = None
-        self.history = GapHistory(len(self.obstacles), self.dt)
-        self.history.push(self.x, self.y, *self.bodies.centres())
+        # the last second, for the blame of a collision with a disc (none: no disc to judge)
+        discs = bool((self.template.radii > 0).any())
+        self.history = GapHistory(len(self.obstacles), self.dt) if discs else None
+        if self.history is not None:
+            self.history.push(self.x, self.y, *self.bodies.centres())
         self.turn = 0.0  # total absolute heading change [rad]
         self.body.reset()
         self.applied: Any = self.body.rest()  # the command held now
@@ -234,7 +237,8 @@ class World2D(OneVehicle):
         self.motion.observe(nx, ny, self.th)
         if self.social is not None:
             self.social.observe(self.field, nx, ny, clock.step_index, self.velocity())
-        self.history.push(nx, ny, *bodies.centres())
+        if self.history is not None:
+            self.history.push(nx, ny, *bodies.centres())
         contact_at = self._swept((x, y), (nx, ny), t0, g0, travel, slack)
         gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)
         self.done = book.judge(t, self.clearance, gd, contact_at) or clock.up
