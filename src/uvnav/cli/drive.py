@@ -616,7 +616,7 @@ def reproduce(
 
     The chain: the thesis's network (learned pedal head and PI rows), the target-speed readout
     (learned-speed row), DAgger rounds with the learned-speed throttle (one in --full), the
-    expert.  Resumable: finished stages (out/stages/*.json) are skipped on a rerun.
+    expert.  Resumable: finished stages (out/stages/) are skipped on a rerun.
     """
     with _user_errors():
         from rich.console import Console
