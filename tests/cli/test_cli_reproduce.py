@@ -54,7 +54,7 @@ def test_reproduce_one_chapter_writes_its_section_beside_the_saved_ones(
     result = runner.invoke(
         app,
         [
-            *("reproduce", "ch3", "--seeds", "2", "--start-seed", "7", "--workers", "1"),
+            *("reproduce", "ch3", "--seeds", "2", "--start-seed", "7", "--workers", "1", "--fresh"),
             *("--results", str(res), "--report", str(rep)),
         ],
         env={"COLUMNS": "200"},
@@ -64,7 +64,7 @@ def test_reproduce_one_chapter_writes_its_section_beside_the_saved_ones(
     ctx = call["ctx"]
     assert (call["name"], ctx.seeds, ctx.start_seed, ctx.workers) == ("ch3", 2, 7, 1)
     assert (ctx.results_dir, ctx.report_dir) == (res, rep)
-    assert ctx.full is False and callable(ctx.render)
+    assert ctx.full is False and ctx.fresh is True and callable(ctx.render)
     assert isinstance(ctx.renderers, ChapterRenderers) and ctx.renderers.ch3 is not None
     html = (rep / "index.html").read_text(encoding="utf-8")
     # the chapter just run and the one saved by an earlier run, in chapter order

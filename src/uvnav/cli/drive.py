@@ -600,7 +600,7 @@ def reproduce(
         typer.Option(help="Thesis head: also fit the target-speed readout (cnn-learned-speed)."),
     ] = True,
     fresh: Annotated[
-        bool, typer.Option("--fresh", help="Rerun finished stages (episodes are kept).")
+        bool, typer.Option("--fresh", help="Remake every stage (the expert recording too).")
     ] = False,
     threads: Annotated[int, typer.Option(min=1, max=2, help="torch CPU threads for training.")] = 1,
     noise: Annotated[
