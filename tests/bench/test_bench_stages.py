@@ -61,7 +61,8 @@ def test_an_interrupted_build_stores_nothing_and_its_work_folder_resumes(tmp_pat
 
     stage = StageCache(tmp_path, fingerprint="a" * 16).run("data", {"n": 2}, resumed)
     assert stage.value == ["episode-0"]  # what the interrupted build had recorded
-    assert [p.name for p in (tmp_path / STAGES_DIR).iterdir()] == [stage.key]  # no leftovers
+    left = [p.name for p in (tmp_path / STAGES_DIR).iterdir() if p.suffix != ".lock"]
+    assert left == [stage.key]  # no work folder left
 
 
 def test_a_stage_made_by_other_code_is_refused_in_one_line_unless_fresh(tmp_path: Path) -> None:
@@ -103,3 +104,27 @@ def test_the_fingerprint_follows_the_code_and_the_version(monkeypatch: pytest.Mo
     assert a != stage_fingerprint("recon", "geometry")
     monkeypatch.setattr(uvnav, "__version__", "0.0.0+other")
     assert stage_fingerprint("recon") != a
+
+
+def test_a_stage_another_process_is_building_is_refused_at_once(tmp_path: Path) -> None:
+    import fcntl
+    import os
+
+    from uvnav.bench.store import StoreInUseError
+
+    key = stage_key("train", {"epochs": 3})
+    (tmp_path / STAGES_DIR).mkdir()
+    fd = os.open(tmp_path / STAGES_DIR / f".{key}.lock", os.O_RDWR | os.O_CREAT)
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # as another process building it
+        os.write(fd, b"4242\n")
+        calls: list[str] = []
+        cache = StageCache(tmp_path, fingerprint="a" * 16)
+        with pytest.raises(
+            StoreInUseError, match=r"stage 'train' .* another uvnav process \(pid 4242\)"
+        ):
+            cache.run("train", {"epochs": 3}, _build(calls))
+        assert calls == []
+    finally:
+        os.close(fd)
+    assert cache.run("train", {"epochs": 3}, _build(calls)).value == {"v": 1}

@@ -111,6 +111,11 @@ def _arm(monkeypatch: pytest.MonkeyPatch, points: Points) -> None:
     monkeypatch.setattr(dc, "collect_episode", ticking(real_episode))
 
 
+def _finished(results: Path) -> list[Path]:
+    """The stage folders (not the work folders and locks, whose names start with a dot)."""
+    return [p for p in (results / STAGES_DIR).iterdir() if not p.name.startswith(".")]
+
+
 def _section(results: Path, name: str) -> dict[str, Any]:
     return json.loads((results / SECTIONS_DIR / f"{name}.json").read_text())
 
@@ -131,9 +136,9 @@ def test_an_interrupted_run_resumes_to_the_uninterrupted_sections(
     _arm(monkeypatch, points)
     with pytest.raises(KeyboardInterrupt):
         run_experiment(name, tiny(name, cut))
-    finished = [p for p in (cut / STAGES_DIR).iterdir() if not p.name.startswith(".")]
+    finished = _finished(cut)
     assert all((p / STAGE_FILE).is_file() for p in finished)  # no half stage
-    assert len(finished) < len(list((whole / STAGES_DIR).iterdir()))
+    assert len(finished) < len(_finished(whole))
     run_experiment(name, tiny(name, cut))
     assert points.fired and _section(cut, name) == _section(whole, name), f"interrupted at {at}"
     names = [[s["name"] for s in StageCache(r, "").stored()] for r in (cut, whole)]

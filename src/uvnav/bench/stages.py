@@ -13,7 +13,8 @@ it, or :func:`uvnav.bench.fingerprint.code_fingerprint`).
   Only a finished stage is ever in ``stages/<key>/``: an interrupt leaves the previous stage (or
   none), never half of one.  ``work`` (``stages/.work-<key>-<fingerprint>``) outlives an
   interrupt, so a builder that resumes from what it finds there (recorded episodes, a training
-  state) continues where it stopped.
+  state) continues where it stopped.  One process builds a stage at a time (a ``flock`` on
+  ``stages/.<key>.lock``; another is refused at once, :class:`~uvnav.bench.store.StoreInUseError`).
 * A stage stored under another code fingerprint is refused (:class:`StaleStageError`, one line)
   rather than silently reused or replaced; ``fresh=True`` remakes every stage the run reaches.
 * :attr:`Stage.ref` is what a stage built on another puts in its inputs: the other's key and the
@@ -28,14 +29,14 @@ import json
 import os
 import secrets
 import shutil
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.store import StaleCampaignError, extend_fingerprint
+from uvnav.bench.store import StaleCampaignError, StoreInUseError, extend_fingerprint
 from uvnav.stages import normalise_key, write_atomic
 
 #: the folder of the stages inside a results folder
@@ -176,6 +177,16 @@ class StageCache:
                 self.reused.append(name)
             return found
         key = stage_key(name, inputs)
+        with _building(self.folder / f".{key}.lock", name):
+            found = self.get(name, inputs)  # another process may have just finished it
+            if found is not None:
+                self.reused.append(name)
+                return found
+            return self._build(name, key, inputs, build)
+
+    def _build(
+        self, name: str, key: str, inputs: Mapping[str, Any], build: Callable[[Path], Any]
+    ) -> Stage:
         work = self.folder / f".work-{key}-{self.fingerprint}"
         if self.fresh and work.exists() and key not in self._made:
             shutil.rmtree(work)
@@ -218,6 +229,37 @@ class StageCache:
                 keep = ("name", "fingerprint", "created")
                 out.append({"key": path.parent.name, **{k: rec.get(k) for k in keep}})
         return sorted(out, key=lambda r: (str(r["name"]), r["key"]))
+
+
+@contextlib.contextmanager
+def _building(lock: Path, name: str) -> Iterator[None]:
+    """Hold the exclusive right to build one stage (a non-blocking ``flock`` on ``lock``, with
+    this process's pid in it; none where ``flock`` does not exist).
+
+    Raises:
+        StoreInUseError: another process is building it (at once, without waiting).
+    """
+    try:
+        import fcntl
+    except ImportError:  # not POSIX: no lock
+        yield
+        return
+    lock.parent.mkdir(parents=True, exist_ok=True)
+    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+            raise StoreInUseError(
+                f"stage {name!r} in {lock.parent} is being made by another uvnav process (pid "
+                f"{holder}); wait for it to finish or use another --results folder"
+            ) from None
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+        yield
+    finally:
+        os.close(fd)  # releases the flock
 
 
 def _plain(value: Any) -> Any:
