@@ -54,7 +54,7 @@ def test_reproduce_one_chapter_writes_its_section_beside_the_saved_ones(
     result = runner.invoke(
         app,
         [
-            *("reproduce", "ch3", "--seeds", "2", "--start-seed", "7", "--workers", "1"),
+            *("reproduce", "ch3", "--seeds", "2", "--start-seed", "7", "--workers", "1", "--fresh"),
             *("--results", str(res), "--report", str(rep)),
         ],
         env={"COLUMNS": "200"},
@@ -64,7 +64,7 @@ def test_reproduce_one_chapter_writes_its_section_beside_the_saved_ones(
     ctx = call["ctx"]
     assert (call["name"], ctx.seeds, ctx.start_seed, ctx.workers) == ("ch3", 2, 7, 1)
     assert (ctx.results_dir, ctx.report_dir) == (res, rep)
-    assert ctx.full is False and callable(ctx.render)
+    assert ctx.full is False and ctx.fresh is True and callable(ctx.render)
     assert isinstance(ctx.renderers, ChapterRenderers) and ctx.renderers.ch3 is not None
     html = (rep / "index.html").read_text(encoding="utf-8")
     # the chapter just run and the one saved by an earlier run, in chapter order
@@ -113,7 +113,9 @@ def test_reproduce_all_is_uvnav_run(tmp_path: Path, monkeypatch: pytest.MonkeyPa
     monkeypatch.setattr(cli_reproduce, "run_cmd", lambda **kw: seen.append(kw))
     result = runner.invoke(app, ["reproduce", "all", "--full", "--results", str(tmp_path)])
     assert result.exit_code == 0, result.output
-    assert seen == [{"full": True, "workers": 2, "results": tmp_path, "report": Path("report")}]
+    assert seen == [
+        {"full": True, "workers": 2, "results": tmp_path, "report": Path("report"), "fresh": False}
+    ]
 
 
 def test_list_shows_every_experiment_on_80_columns() -> None:
@@ -121,10 +123,14 @@ def test_list_shows_every_experiment_on_80_columns() -> None:
     assert result.exit_code == 0, result.output
     lines = result.stdout.splitlines()
     assert lines[0].split() == ["name", "seeded", "title"]
-    rows = {line.split()[0]: line.split()[1] for line in lines[1:]}
+    heads = [line for line in lines[1:] if not line.startswith(" ")]
+    rows = {line.split()[0]: line.split()[1] for line in heads}
     assert list(rows) == ["ch2", "crowds", "regime", "ch3", "ch4", "ch5", "ch6", "ch7", "beyond"]
     assert rows["ch3"] == "yes" and rows["ch7"] == "no"
     assert any("Chapter 7: UAV reconnaissance" in line for line in lines)
+    sizes = [line.split()[0] for line in lines[1:] if line.startswith(" ")]
+    assert sizes == ["quick:", "full:"] * len(rows)  # every experiment's declared sizes
+    assert any("2 expert episodes of 500 steps" in line for line in lines)  # ch6's quick size
     assert max(len(line) for line in lines) <= 80
 
 

@@ -34,7 +34,8 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     assert s.record["second_output"] == "target_speed" and s.record["val_target_speed_rmse"]
     two = next(r for r in s.table if r["quantity"].startswith("Ch6 validation MSE (steering +"))
     assert "target speed RMSE" in two["note"]
-    assert not list(tmp_path.glob("*.train-state.safetensors"))  # removed once models are saved
+    stages = {r["name"]: tmp_path / "stages" / r["key"] for r in _stored(tmp_path)}
+    assert not list(tmp_path.rglob("*.train-state.safetensors"))  # removed once models are saved
     # every closed-loop row keeps each track's metrics, and the means are theirs
     for name, row in s.closed_loop.items():
         per = s.tracks[name]
@@ -47,9 +48,10 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     assert set(s.record["val_steering_mse_by_camera"]) <= {"centre", "left", "right"}
     # the DAgger rows go to a copy: data/ keeps the expert's 30 rows, the aggregate has more
     assert s.closed_loop["dagger1-learned-speed"]["rows_added"] == 30  # 120 steps, every 4th
-    assert len(read_log(tmp_path / "data")) == 30
-    assert len(read_log(tmp_path / "dagger_data")) == 60
-    assert (tmp_path / "dagger1.safetensors").is_file()
+    assert len(read_log(stages["ch6-data"] / "data")) == 30
+    assert len(read_log(stages["ch6-dagger1"] / "data")) == 60
+    assert (stages["ch6-dagger1"] / "dagger1.safetensors").is_file()
+    assert s.model_path == stages["ch6-train"] / "model.safetensors"
     assert s.closed_loop["expert"]["return_vs_expert"] == pytest.approx(1.0)
     assert all(0.0 <= r["autonomy"] <= 1.0 for r in s.closed_loop.values())
     assert next(r["quantity"] for r in s.table).startswith("Ch6 frames before balancing")
@@ -82,10 +84,19 @@ def test_tiny_reproduction_end_to_end(tmp_path: Path) -> None:
     assert "Quick size" in sec.notes[0] and "1 held-out track of up to 40 steps" in sec.intro
 
 
+def _stored(folder: Path) -> list[dict]:
+    from uvnav.bench.stages import StageCache
+
+    return StageCache(folder, "").stored()
+
+
 def test_full_chain_stages_and_resume(tmp_path: Path) -> None:
     """The thesis head's chain: pedal head, PI, readout, one DAgger round with learned-speed,
-    expert — each stage saved as it finishes and skipped on a rerun."""
+    expert — each stage stored as it finishes and reused on a rerun."""
     import json
+    import shutil
+
+    from uvnav.bench.stages import STAGE_FILE, StaleStageError
 
     kw: dict = {
         "episodes": 1,
@@ -101,56 +112,53 @@ def test_full_chain_stages_and_resume(tmp_path: Path) -> None:
     chain = ["cnn-learned", "cnn-pi", "cnn-learned-speed", "dagger1-learned-speed", "expert"]
     assert list(s.closed_loop) == chain
     assert s.reused == []
-    stages = tmp_path / "stages"
-    assert {p.stem for p in stages.glob("*.json")} == {"train", "readout", "dagger1", *chain}
-    for f in ("model", "readout", "dagger1"):
-        assert (tmp_path / f"{f}.safetensors").is_file()
+    names = ["ch6-data", "ch6-train", "ch6-readout", "ch6-dagger1", *(f"ch6-{c}" for c in chain)]
+    stages = {r["name"]: tmp_path / "stages" / r["key"] for r in _stored(tmp_path)}
+    assert sorted(stages) == sorted(names)
+    for name, f in (("train", "model"), ("readout", "readout"), ("dagger1", "dagger1")):
+        assert (stages[f"ch6-{name}"] / f"{f}.safetensors").is_file()
     assert s.stage_records["readout"]["second_output"] == "target_speed"
     assert s.stage_records["dagger1"]["second_output"] == "target_speed"
     assert any("target-speed readout" in r["quantity"] for r in s.table)
     for r in s.closed_loop.values():
         assert r["interventions_per_lap"] >= 0.0
     # a rerun with the same settings reuses every stage and reports the same numbers
-    before = {p.name: p.stat().st_mtime_ns for p in tmp_path.glob("*.safetensors")}
+    before = {p: p.stat().st_mtime_ns for p in (tmp_path / "stages").rglob("*.safetensors")}
     s2 = reproduce_ch6(tmp_path, **kw)
-    assert sorted(s2.reused) == sorted(["train", "readout", "dagger1", *chain])
-    assert {p.name: p.stat().st_mtime_ns for p in tmp_path.glob("*.safetensors")} == before
-    assert s2.closed_loop == s.closed_loop
-    assert len(read_log(tmp_path / "dagger_data")) == 20 + 20  # not driven again
-    # an interrupted run: the DAgger round's and a later closed loop's stage files are gone,
-    # and the aggregate holds a partial round (rows of a round that did not finish)
-    (stages / "dagger1.json").unlink()
-    (stages / "expert.json").unlink()
-    log = tmp_path / "dagger_data" / "driving_log.csv"
-    log.write_text(log.read_text() + log.read_text().splitlines(keepends=True)[-1])
+    assert sorted(s2.reused) == sorted(names)
+    assert {p: p.stat().st_mtime_ns for p in (tmp_path / "stages").rglob("*.safetensors")} == (
+        before
+    )
+    assert s2.closed_loop == s.closed_loop and s2.table == s.table
+    assert len(read_log(stages["ch6-dagger1"] / "data")) == 20 + 20  # not driven again
+    # an interrupted run: the DAgger round and a later closed loop were not stored; the round
+    # is driven again from the expert's data, the stages before it are reused
+    shutil.rmtree(stages["ch6-dagger1"])
+    shutil.rmtree(stages["ch6-expert"])
     s3 = reproduce_ch6(tmp_path, **kw)
-    assert sorted(s3.reused) == sorted(["train", "readout", *chain[:3]])
-    assert len(read_log(tmp_path / "dagger_data")) == 40  # copied afresh, driven once
-    assert json.loads((stages / "dagger1.json").read_text())["value"]["rows_after"] == 40
-    # other settings (more epochs) invalidate training and every stage built on it; without
+    assert sorted(s3.reused) == sorted(names[:3] + [f"ch6-{c}" for c in chain[:3]])
+    again = {r["name"]: tmp_path / "stages" / r["key"] for r in _stored(tmp_path)}
+    assert len(read_log(again["ch6-dagger1"] / "data")) == 40  # copied afresh, driven once
+    assert json.loads((again["ch6-dagger1"] / STAGE_FILE).read_text())["value"]["rows_after"] == 40
+    # other settings (more epochs) make training and every stage built on it anew; without
     # the readout, DAgger drives with the PI throttle
     s4 = reproduce_ch6(tmp_path, **{**kw, "epochs": 2, "readout": False})
-    assert s4.reused == ["expert"]
+    assert s4.reused == ["ch6-data", "ch6-expert"]
     assert list(s4.closed_loop) == ["cnn-learned", "cnn-pi", "dagger1-pi", "expert"]
     assert len(s4.record["train_loss"]) == 2
     assert s4.stage_records["dagger1"]["second_output"] == "throttle"
     s5 = reproduce_ch6(tmp_path, **{**kw, "dagger_rounds": 0, "readout": False}, fresh=True)
     assert s5.reused == [] and list(s5.closed_loop) == ["cnn-learned", "cnn-pi", "expert"]
-    # a data/ folder recorded with another camera (an older 90° recording) is kept aside, not
-    # extended, and nothing trained on it is reused
-    import json
-
-    meta_path = tmp_path / "data" / "dataset.json"
-    meta = json.loads(meta_path.read_text())
-    meta_path.write_text(json.dumps({k: v for k, v in meta.items() if k != "fov_deg"}))
-    train_path = tmp_path / "stages" / "train.json"  # as trained on that recording
-    stage = json.loads(train_path.read_text())
-    stage["key"]["dataset"]["fov_deg"] = 90.0
-    train_path.write_text(json.dumps(stage))
-    s6 = reproduce_ch6(tmp_path, **{**kw, "dagger_rounds": 0, "readout": False})
-    assert (tmp_path / "data.old1" / "driving_log.csv").is_file()
-    assert json.loads(meta_path.read_text())["fov_deg"] == meta["fov_deg"] == 120.0
-    assert "train" not in s6.reused and s6.record["camera_fov_deg"] == 120.0
+    # another recording (another steering noise) is another data set: nothing is reused but
+    # the expert's closed loop
+    s6 = reproduce_ch6(tmp_path, **{**kw, "dagger_rounds": 0, "readout": False}, noise_sigma=0.1)
+    assert s6.reused == ["ch6-expert"]
+    # a stage made by other code is refused in one line, naming it
+    rec_path = again["ch6-expert"] / STAGE_FILE
+    rec = json.loads(rec_path.read_text())
+    rec_path.write_text(json.dumps({**rec, "fingerprint": "0" * 16}))
+    with pytest.raises(StaleStageError, match=r"stage 'ch6-expert' in .* made by other code"):
+        reproduce_ch6(tmp_path, **{**kw, "dagger_rounds": 0, "readout": False})
 
 
 def test_closed_loop_notes_name_the_tracks_with_interventions() -> None:

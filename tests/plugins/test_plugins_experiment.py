@@ -57,7 +57,7 @@ def test_list_shows_the_plugin_experiment(installed: dict[str, str]) -> None:
     lines = out.stdout.splitlines()
     (line,) = [x for x in lines if x.startswith("dummy ")]
     assert line.split()[1] == "yes" and "straight-v1 on open-field (test)" in line
-    names = [x.split()[0] for x in lines[1:]]
+    names = [x.split()[0] for x in lines[1:] if not x.startswith(" ")]  # not the sizes
     assert names[-3:] == ["ch7", "dummy", "beyond"] and "ch2" in names
     assert max(len(x) for x in lines) <= 80
 

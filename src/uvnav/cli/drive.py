@@ -600,7 +600,7 @@ def reproduce(
         typer.Option(help="Thesis head: also fit the target-speed readout (cnn-learned-speed)."),
     ] = True,
     fresh: Annotated[
-        bool, typer.Option("--fresh", help="Rerun finished stages (episodes are kept).")
+        bool, typer.Option("--fresh", help="Remake every stage (the expert recording too).")
     ] = False,
     threads: Annotated[int, typer.Option(min=1, max=2, help="torch CPU threads for training.")] = 1,
     noise: Annotated[
@@ -616,7 +616,7 @@ def reproduce(
 
     The chain: the thesis's network (learned pedal head and PI rows), the target-speed readout
     (learned-speed row), DAgger rounds with the learned-speed throttle (one in --full), the
-    expert.  Resumable: finished stages (out/stages/*.json) are skipped on a rerun.
+    expert.  Resumable: finished stages (out/stages/) are skipped on a rerun.
     """
     with _user_errors():
         from rich.console import Console

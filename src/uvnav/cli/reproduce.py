@@ -14,7 +14,8 @@ the plug-ins of the ``uvnav.experiments`` entry-point group); ``uvnav reproduce 
 
 Chapter 6's pipeline with every option (noise, threads, head, DAgger rounds, ...) stays
 ``uvnav drive reproduce``; ``uvnav reproduce ch6`` runs the same function at ``uvnav run``'s size
-(``RESULTS/ch6-quick``, or ``RESULTS/ch6`` with ``--full``).
+(its stages in ``RESULTS/stages``, ``ch6.json`` in ``RESULTS/ch6-quick``, or ``RESULTS/ch6`` with
+``--full``).  ``--fresh`` remakes the stages an experiment reaches.
 """
 
 from __future__ import annotations
@@ -60,10 +61,14 @@ def run_cmd(
         "results"
     ),
     report: Annotated[Path, typer.Option(help="Directory of the HTML report.")] = Path("report"),
+    fresh: Annotated[
+        bool,
+        typer.Option("--fresh", help="Remake the experiments' stages (episodes are kept)."),
+    ] = False,
 ) -> None:
     """Reproduce the thesis's experiments: results database, report, and the comparison table."""
     run_all = optional("uvnav.experiments", "run_all", "the reproduction job (uvnav run)")
-    ctx = _context(results, report, full=full, workers=workers)
+    ctx = _context(results, report, full=full, workers=workers, fresh=fresh)
     try:
         summary = run_all(ctx)
     except _user_errors() as exc:
@@ -146,12 +151,16 @@ def write_comparison_table(
 
 def experiment_lines(known: dict[str, Any], width: int = 80) -> list[str]:
     """``uvnav reproduce --list``: a header, then per experiment its name, whether it runs random
-    seeds and its title, each line at most ``width`` characters."""
+    seeds and its title, and under it what each declared size runs (``quick``, ``full``), each
+    line at most ``width`` characters."""
     w = max([len("name"), *(len(n) for n in known)]) + 2
     lines = [f"{'name':<{w}}seeded  title"]
     for name, exp in known.items():
-        line = f"{name:<{w}}{'yes' if exp.seeded else 'no':<8}{one_line(str(exp.title))}"
-        lines.append(line if len(line) <= width else line[: width - 1] + "…")
+        found = [f"{name:<{w}}{'yes' if exp.seeded else 'no':<8}{one_line(str(exp.title))}"]
+        for size, declared in (getattr(exp, "sizes", None) or {}).items():
+            runs = one_line(str(declared.runs))
+            found.append(f"{'':<{w + 2}}{size + ':':<7}{runs}")
+        lines += [line if len(line) <= width else line[: width - 1] + "…" for line in found]
     return lines
 
 
@@ -165,7 +174,7 @@ def reproduce_cmd(
     ] = None,
     list_: Annotated[
         bool,
-        typer.Option("--list", help="List the experiments (name, seeded, title) and exit."),
+        typer.Option("--list", help="List the experiments (name, seeded, title, sizes) and exit."),
     ] = False,
     full: Annotated[
         bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
@@ -194,11 +203,20 @@ def reproduce_cmd(
             help="First random scene (seeded experiments): seeds S .. S+N-1.",
         ),
     ] = 0,
+    fresh: Annotated[
+        bool,
+        typer.Option(
+            "--fresh",
+            help="Remake the experiment's stages (trained networks, planned tours, data sets), "
+            "even those made by other code; stored episodes are kept.",
+        ),
+    ] = False,
 ) -> None:
     """Reproduce one experiment into the results store and its report section.
 
     Adds to the store: stored episodes are skipped, no other run's episodes are deleted or
-    replaced; a campaign stored by other code is refused (remove it with 'uvnav forget').
+    replaced; a campaign stored by other code is refused (remove it with 'uvnav forget'), and so
+    is a stage made by other code (remake it with --fresh).
     """
     if list_:
         if name is not None:
@@ -220,10 +238,12 @@ def reproduce_cmd(
                 "reproduce all: --seeds/--start-seed apply to one seeded experiment "
                 "(see 'uvnav reproduce --list')"
             )
-        run_cmd(full=full, workers=workers, results=results, report=report)
+        run_cmd(full=full, workers=workers, results=results, report=report, fresh=fresh)
         return
     run_experiment = optional("uvnav.experiments", "run_experiment", "the reproduction job")
-    ctx = _context(results, report, full=full, workers=workers, seeds=seeds, start_seed=start_seed)
+    ctx = _context(
+        results, report, full=full, workers=workers, seeds=seeds, start_seed=start_seed, fresh=fresh
+    )
     try:
         out = run_experiment(name, ctx)
     except _user_errors() as exc:

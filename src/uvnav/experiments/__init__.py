@@ -26,6 +26,7 @@ from uvnav.experiments.protocol import (
     ExperimentError,
     ExperimentRun,
     ReportHook,
+    Size,
 )
 from uvnav.experiments.registry import (
     builtin_experiments,
@@ -51,6 +52,7 @@ __all__ = [
     "ExperimentRun",
     "ReportHook",
     "Reproduction",
+    "Size",
     "builtin_experiments",
     "check_options",
     "experiments",

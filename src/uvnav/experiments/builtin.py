@@ -8,8 +8,10 @@ its summary object.
 ``start_seed`` (Ch. 2: the random and baseline campaigns; Ch. 3: the random-ch3 scenes; Ch. 4:
 every family — random-ch4, the noise sweep, random-ch4-hard; Ch. 5: the random-ch5 closed-loop
 scenes; crowds: CrowdNav's test cases ``start_seed`` .. ``start_seed + seeds - 1`` of each scene;
-regime: the seeds of every regime).  The reproductions are imported when run, so the registry
-loads fast.
+regime: the seeds of every regime).  Each declares its quick and full :class:`Size`; a size's
+``params`` are passed to its reproduction as keyword arguments (Chapter 6's quick size is
+:data:`uvnav.experiments.ch6.RUN_QUICK`; a test passes a tinier size in the context).  The
+reproductions are imported when run, so the registry loads fast.
 """
 
 from __future__ import annotations
@@ -22,13 +24,19 @@ from typing import Any
 
 import uvnav.experiments.ch2 as rp
 import uvnav.experiments.sections as sec
-from uvnav.experiments.protocol import Experiment, ExperimentContext, ExperimentRun
+from uvnav.experiments.ch6 import RUN_QUICK
+from uvnav.experiments.protocol import Experiment, ExperimentContext, ExperimentRun, Size
 from uvnav.experiments.sections import ChapterSection
 
 
 def _run(section: ChapterSection, summary: Any, rows: list[dict[str, str]]) -> ExperimentRun:
     failures = list(getattr(summary, "failures", []) or [])
     return ExperimentRun(sections=[section], rows=list(rows), summary=summary, failures=failures)
+
+
+def _params(ctx: ExperimentContext, **given: Any) -> dict[str, Any]:
+    """``given`` updated with the chosen size's ``params``."""
+    return {**given, **(dict(ctx.size.params) if ctx.size is not None else {})}
 
 
 def _say(name: str) -> Callable[[str], None]:
@@ -41,9 +49,11 @@ def _say(name: str) -> Callable[[str], None]:
 def run_ch2(ctx: ExperimentContext) -> ExperimentRun:
     """Chapter 2's campaigns and section; its figures are drawn when the page is written."""
     ch2 = rp.run_ch2(
-        ctx.results_dir, full=ctx.full, workers=ctx.workers, progress=ctx.progress,
-        n_random=ctx.seeds, start_seed=ctx.start_seed, controllers=rp.CONTROLLERS,
-        baselines=rp.BASELINES, n_baseline_seeds=ctx.seeds,
+        ctx.results_dir, **_params(
+            ctx, full=ctx.full, workers=ctx.workers, progress=ctx.progress, n_random=ctx.seeds,
+            start_seed=ctx.start_seed, controllers=rp.CONTROLLERS, baselines=rp.BASELINES,
+            n_baseline_seeds=ctx.seeds,
+        ),
     )  # fmt: skip
 
     def report(
@@ -66,8 +76,10 @@ def run_ch3(ctx: ExperimentContext) -> ExperimentRun:
     from uvnav.experiments.ch3 import reproduce_ch3
 
     s3 = reproduce_ch3(
-        ctx.results_dir, ctx.report_dir, full=ctx.full, workers=ctx.workers,
-        n_random=ctx.seeds, start_seed=ctx.start_seed, render=ctx.renderers.ch3, progress=False,
+        ctx.results_dir, ctx.report_dir, **_params(
+            ctx, full=ctx.full, workers=ctx.workers, n_random=ctx.seeds,
+            start_seed=ctx.start_seed, render=ctx.renderers.ch3, progress=False,
+        ),
     )  # fmt: skip
     section = sec.ch3_section(s3, full=ctx.full, n_random=ctx.seeds, start_seed=ctx.start_seed)
     return _run(section, s3, s3.table)
@@ -80,9 +92,10 @@ def run_ch4(ctx: ExperimentContext) -> ExperimentRun:
 
     seeds = ctx.seeds
     s4 = reproduce_ch4(
-        ctx.results_dir, ctx.report_dir, full=ctx.full, workers=ctx.workers,
-        render=ctx.renderers.ch4, seeds=seeds, noise_seeds=seeds, hard_seeds=seeds,
-        start_seed=ctx.start_seed,
+        ctx.results_dir, ctx.report_dir, **_params(
+            ctx, full=ctx.full, workers=ctx.workers, render=ctx.renderers.ch4, seeds=seeds,
+            noise_seeds=seeds, hard_seeds=seeds, start_seed=ctx.start_seed,
+        ),
     )  # fmt: skip
     section = sec.ch4_section(s4, full=ctx.full, seeds=seeds, start_seed=ctx.start_seed)
     return _run(section, s4, s4.table)
@@ -93,9 +106,11 @@ def run_ch5(ctx: ExperimentContext) -> ExperimentRun:
     from uvnav.experiments.ch5 import reproduce_ch5
 
     s5 = reproduce_ch5(
-        ctx.results_dir, full=ctx.full, progress=ctx.progress, render=ctx.renderers.ch5,
-        report_dir=ctx.report_dir, workers=ctx.workers, n_random=ctx.seeds,
-        start_seed=ctx.start_seed,
+        ctx.results_dir, **_params(
+            ctx, full=ctx.full, progress=ctx.progress, render=ctx.renderers.ch5,
+            report_dir=ctx.report_dir, workers=ctx.workers, n_random=ctx.seeds,
+            start_seed=ctx.start_seed,
+        ),
     )  # fmt: skip
     return _run(sec.ch5_section(s5, full=ctx.full), s5, s5.table)
 
@@ -104,14 +119,15 @@ def run_ch6(ctx: ExperimentContext) -> ExperimentRun:
     """Chapter 6 at ``uvnav run``'s size (:data:`uvnav.experiments.ch6.RUN_QUICK`; the thesis
     size with ``full``) in ``results_dir/ch6-quick`` (``results_dir/ch6``); every pipeline option
     is ``uvnav drive reproduce``'s."""
-    from uvnav.experiments.ch6 import RUN_QUICK, reproduce_ch6
+    from uvnav.bench.stages import StageCache
+    from uvnav.experiments.ch6 import fingerprint, reproduce_ch6
 
     s6 = reproduce_ch6(
         Path(ctx.results_dir) / ("ch6" if ctx.full else "ch6-quick"),
         full=ctx.full,
-        fresh=ctx.fresh,
         progress=_say("ch6") if ctx.progress else None,
-        **({} if ctx.full else RUN_QUICK),
+        cache=StageCache(ctx.results_dir, fingerprint(), fresh=ctx.fresh),
+        **_params(ctx),
     )
     if ctx.renderers.ch6 is not None:
         s6.figures = list(ctx.renderers.ch6(s6, ctx.figures_dir("ch6")))
@@ -119,16 +135,20 @@ def run_ch6(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_ch7(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 7 (:func:`uvnav.experiments.ch7.reproduce_ch7`, JSON in ``results_dir/ch7``)."""
-    from uvnav.experiments.ch7 import reproduce_ch7
+    """Chapter 7 (:func:`uvnav.experiments.ch7.reproduce_ch7`: its stages in the results
+    folder's stage cache, JSON in ``results_dir/ch7``)."""
+    from uvnav.bench.stages import StageCache
+    from uvnav.experiments.ch7 import fingerprint, reproduce_ch7
 
     draw7 = ctx.renderers.ch7
     s7 = reproduce_ch7(
         Path(ctx.results_dir) / "ch7",
         full=ctx.full,
+        cache=StageCache(ctx.results_dir, fingerprint(), fresh=ctx.fresh),
         render_plan=None
         if draw7 is None
         else (lambda plan, prefix: draw7(plan, ctx.figures_dir("ch7") / Path(prefix).name)),
+        **_params(ctx),
     )
     return _run(sec.ch7_section(s7, full=ctx.full), s7, s7.table)
 
@@ -138,7 +158,7 @@ def run_beyond(ctx: ExperimentContext) -> ExperimentRun:
     stored in ``results_dir``'s database); figures in ``report_dir/beyond``."""
     from uvnav.experiments.beyond import replan_rows, reproduce_beyond
 
-    rows = reproduce_beyond(ctx.results_dir, full=ctx.full) + replan_rows()
+    rows = reproduce_beyond(ctx.results_dir, **_params(ctx, full=ctx.full)) + replan_rows()
     draw = ctx.renderers.beyond
     figs = draw(ctx.figures_dir("beyond")) if draw is not None else []
     return _run(sec.beyond_section(rows, figs, full=ctx.full), rows, rows)
@@ -150,8 +170,10 @@ def run_crowds(ctx: ExperimentContext) -> ExperimentRun:
     from uvnav.experiments.crowds import crowds_section, reproduce_crowds
 
     sc = reproduce_crowds(
-        ctx.results_dir, full=ctx.full, workers=ctx.workers, cases=ctx.seeds,
-        start_case=ctx.start_seed, progress=ctx.progress,
+        ctx.results_dir, **_params(
+            ctx, full=ctx.full, workers=ctx.workers, cases=ctx.seeds, start_case=ctx.start_seed,
+            progress=ctx.progress,
+        ),
     )  # fmt: skip
     section = crowds_section(sc)
     return _run(section, sc, section.rows)
@@ -163,31 +185,75 @@ def run_regime(ctx: ExperimentContext) -> ExperimentRun:
     from uvnav.experiments.regime import regime_section, run_regime_map
 
     rm = run_regime_map(
-        ctx.results_dir, full=ctx.full, workers=ctx.workers, seeds=ctx.seeds,
-        start_seed=ctx.start_seed, progress=ctx.progress,
+        ctx.results_dir, **_params(
+            ctx, full=ctx.full, workers=ctx.workers, seeds=ctx.seeds, start_seed=ctx.start_seed,
+            progress=ctx.progress,
+        ),
     )  # fmt: skip
     out = _run(regime_section(rm, full=ctx.full), rm, [])
     out.campaigns = {"regime-map": rm.campaign}
     return out
 
 
+#: The declared sizes of the built-ins (the seeds are the reproductions' defaults, which a test
+#: checks).
+SIZES: dict[str, dict[str, Size]] = {
+    "ch2": {
+        "quick": Size("thesis scenes, 200 random scenes per law, baselines, crowds", 200),
+        "full": Size("thesis scenes, 1000 random scenes per law, baselines, crowds", 1000),
+    },
+    "crowds": {
+        "quick": Size("100 CrowdNav test cases per scene, every 2D law", 100),
+        "full": Size("500 CrowdNav test cases per scene (the test set), every 2D law", 500),
+    },
+    "regime": {
+        "quick": Size("15 seeds per regime and law", 15),
+        "full": Size("60 seeds per regime and law", 60),
+    },
+    "ch3": {
+        "quick": Size("thesis scenes, 2 random scenes, prediction study", 2),
+        "full": Size("thesis scenes, 500 random scenes, prediction study", 500),
+    },
+    "ch4": {
+        "quick": Size("thesis scenes; random 10, noise 4, hard 4 seeds", 10),
+        "full": Size("thesis scenes; random 200, noise 50, hard 100 seeds", 200),
+    },
+    "ch5": {
+        "quick": Size("BPNN rows of 50/150 samples, thesis scenes, 3 random scenes", 3),
+        "full": Size("BPNN rows up to 5000 samples, thesis scenes, 300 random scenes", 300),
+    },
+    "ch6": {
+        "quick": Size("2 expert episodes of 500 steps, 3 epochs, 2 tracks", params=RUN_QUICK),
+        "full": Size("20 episodes of 1200 steps, 30 epochs, DAgger, 20 tracks"),
+    },
+    "ch7": {
+        "quick": Size("counts, coverage; 2 plans (synthetic 300 m, Jacksboro 600 m)"),
+        "full": Size("counts, coverage; 12 plans (2 terrains x 2 sides x 3 radii)"),
+    },
+    "beyond": {
+        "quick": Size("office floor with 2 laws, 16-robot swap, replanning"),
+        "full": Size("office floor with 4 laws, 16-robot swap with ORCA, replanning"),
+    },
+}
+
 #: The built-in experiments, in report order.
 BUILTINS: tuple[Experiment, ...] = (
     Experiment("ch2", "Chapter 2: a unicycle among moving, deforming obstacles", run_ch2,
-               seeded=True, order=10),
+               seeded=True, sizes=SIZES["ch2"], order=10),
     Experiment("crowds", "Every 2D law on CrowdNav's crowds (circle and square crossing)",
-               run_crowds, seeded=True, order=20),
+               run_crowds, seeded=True, sizes=SIZES["crowds"], order=20),
     Experiment("regime", "Where each law wins: the regime map", run_regime, seeded=True,
-               order=30),
+               sizes=SIZES["regime"], order=30),
     Experiment("ch3", "Chapter 3: a 3D flying robot with AR prediction", run_ch3, seeded=True,
-               order=40),
+               sizes=SIZES["ch3"], order=40),
     Experiment("ch4", "Chapter 4: a UUV among shape-changing obstacles", run_ch4, seeded=True,
-               order=50),
+               sizes=SIZES["ch4"], order=50),
     Experiment("ch5", "Chapter 5: a 3D UUV with nine sonars and a BPNN", run_ch5, seeded=True,
-               order=60),
+               sizes=SIZES["ch5"], order=60),
     Experiment("ch6", "Chapter 6: a CNN that drives (PilotNet on CarRacing)", run_ch6,
-               order=70),
-    Experiment("ch7", "Chapter 7: UAV reconnaissance of a terrain", run_ch7, order=80),
+               sizes=SIZES["ch6"], order=70),
+    Experiment("ch7", "Chapter 7: UAV reconnaissance of a terrain", run_ch7,
+               sizes=SIZES["ch7"], order=80),
     Experiment("beyond", "Beyond the thesis: planners, office floor, multi-robot swap",
-               run_beyond, order=90),
+               run_beyond, sizes=SIZES["beyond"], order=90),
 )  # fmt: skip

@@ -33,11 +33,13 @@ CPU minutes, numbers that do not meet the targets and are labelled as the quick 
 experiment — 20 episodes (about 18,000 frames before balancing; the thesis had 17,592), 30 epochs,
 :data:`FULL_DAGGER_ROUNDS` DAgger round, 20 held-out tracks.
 
-Resumable: the collection skips recorded episodes, and every stage (training, readout, DAgger
-round, each closed loop) writes its checkpoint and ``stages/<stage>.json`` as it finishes; a rerun
-with the same settings skips finished stages (``fresh=True`` reruns them; the recorded episodes
-are kept).  A stage is reused only when its settings, and those of the stages it builds on, are
-the same as recorded (:class:`uvnav.stages.Stages`, the cache every reproduction uses).
+Resumable: every stage — the expert's recording, training, readout, DAgger round, each closed
+loop — is a stage of the results folder's stage cache (:class:`uvnav.bench.stages.StageCache`,
+names ``ch6-data``, ``ch6-train``, ``ch6-readout``, ``ch6-dagger{r}``, ``ch6-<row>``), keyed by
+its settings and the stages it builds on, and stored (dataset, checkpoint, record) once it
+finished; a rerun with the same settings reuses the finished stages, an interrupted recording or
+training continues where it stopped, and a stage made by other code (:func:`fingerprint`) is
+refused unless ``fresh=True``, which remakes every stage.
 
 Figures are drawn by the caller from the returned :class:`Ch6Summary`
 (:func:`uvnav.viz.figures_ch6.render_ch6`), since figures live in the ``viz`` layer.
@@ -56,7 +58,8 @@ from typing import Any
 import numpy as np
 from numpy.typing import NDArray
 
-from uvnav.stages import Stages, write_atomic
+from uvnav.bench.stages import STAGES_DIR, Stage, StageCache, stage_fingerprint
+from uvnav.stages import write_atomic
 
 THESIS_VAL_MSE = 0.05
 THESIS_FRAMES = 17592
@@ -70,9 +73,6 @@ THESIS_STEERING = (-1.0, 1.0, -0.009, 0.204)
 #: docs/thesis-notes.md);
 #: ``dagger_rounds`` overrides it
 FULL_DAGGER_ROUNDS = 1
-#: closed-loop stage files keep every track's metrics, not only the means (part of their key,
-#: so stage files of the means-only format are recomputed)
-PER_TRACK = {"per_track": 1}
 #: training tracks the network drives per DAgger round, and epochs per round
 DAGGER_EPISODES, DAGGER_EPOCHS = 6, 5
 #: sizes of the quick (``full=False``) and full runs: expert episodes, steps per episode, epochs,
@@ -152,7 +152,16 @@ def augmentation_examples(
     return out
 
 
-STAGES_DIR = "stages"
+#: the stage names of this experiment in the results folder's stage cache
+DATA, TRAIN, READOUT, EXPERT = "ch6-data", "ch6-train", "ch6-readout", "ch6-expert"
+
+
+def fingerprint() -> str:
+    """The code that makes this experiment's stages: :mod:`uvnav.driving`, :mod:`uvnav.learning`,
+    this module, and the numpy, torch and gymnasium versions."""
+    return stage_fingerprint(
+        "driving", "learning", "experiments/ch6.py", packages=("numpy", "torch", "gymnasium")
+    )
 
 
 def _log_rows(root: Path) -> int:
@@ -166,21 +175,93 @@ def _log_rows(root: Path) -> int:
         return sum(1 for line in fh if line.strip())
 
 
-def _truncate_log(root: Path, n: int) -> None:
-    """Keep the first ``n`` rows of ``driving_log.csv`` (drops a DAgger round that did not finish;
-    its images are overwritten when the round is driven again)."""
-    from uvnav.driving.dataset import LOG_NAME
-
-    f = root / LOG_NAME
-    lines = [ln for ln in f.read_text().splitlines(keepends=True) if ln.strip()]
-    f.write_text("".join(lines[:n]))
-
-
 def _per_lap(row: dict[str, float]) -> None:
     """Add ``interventions_per_lap`` (mean interventions over mean laps; inf when no lap)."""
     laps = row.get("laps", 0.0)
     n = row.get("interventions", 0.0)
     row["interventions_per_lap"] = n / laps if laps > 0 else (0.0 if n == 0 else float("inf"))
+
+
+def _say_stage(say: Callable[[str], None], stage: Stage, what: str) -> None:
+    if stage.reused:
+        say(f"{what}: done before ({STAGES_DIR}/{stage.key})")
+
+
+def _dataset(
+    cache: StageCache,
+    n_ep: int,
+    c_steps: int,
+    noise_sigma: float | None,
+    say: Callable[[str], None],
+) -> Stage:
+    """The expert's recording (stage :data:`DATA`: ``data/`` in its folder; an interrupted
+    recording resumes at its first unrecorded episode)."""
+    from uvnav.driving.collect import CollectParams, collect, dataset_meta, recording_meta
+    from uvnav.driving.sim import DrivingSim
+
+    cp = (
+        CollectParams(max_steps=c_steps)
+        if noise_sigma is None
+        else CollectParams(max_steps=c_steps, noise_sigma=noise_sigma)
+    )
+    sim = DrivingSim(max_steps=cp.max_steps)
+    try:
+        inputs = {"episodes": n_ep, "collect_steps": c_steps, **recording_meta(sim, cp)}
+
+        def record(work: Path) -> dict[str, Any]:
+            say(f"collecting {n_ep} expert episodes")
+            collect(work / "data", range(n_ep), params=cp, sim=sim)
+            return {"rows": _log_rows(work / "data"), **dataset_meta(work / "data")}
+
+        stage = cache.run(DATA, inputs, record)
+    finally:
+        sim.close()
+    _say_stage(say, stage, "expert recording")
+    return stage
+
+
+def _network(
+    cache: StageCache, name: str, inputs: dict[str, Any], file: str, build: Callable[[Path], Any]
+) -> tuple[Any, Stage]:
+    """A stage whose product is the checkpoint ``file`` (``build(work)`` writes it and returns
+    the record): ``(the network loaded from the stage, the stage)``."""
+    from uvnav.learning.checkpoint import load_checkpoint
+
+    stage = cache.run(name, inputs, build)
+    model, _ = load_checkpoint(stage.folder / file)
+    return model, stage
+
+
+def _dagger(
+    cache: StageCache,
+    learner: Any,
+    learner_stage: Stage,
+    data_stage: Stage,
+    r: int,
+    params: dict[str, Any],
+    threads: int,
+    say: Callable[[str], None],
+) -> tuple[Any, Stage]:
+    """DAgger round ``r`` (stage ``ch6-dagger{r}``): the aggregate ``data/`` (a copy of the
+    previous round's, or of the expert's, plus this round's rows) and ``dagger{r}.safetensors``.
+    An interrupted round starts over."""
+    from uvnav.driving.pipeline import dagger_round
+
+    def build(work: Path) -> dict[str, Any]:
+        shutil.rmtree(work)
+        work.mkdir()
+        shutil.copytree(data_stage.folder / "data", work / "data")
+        _, added, _, rec = dagger_round(
+            learner, work / "data", work, round_id=r, episodes=params["episodes"],
+            epochs=params["epochs"], throttle=params["throttle"],
+            collect_steps=params["collect_steps"], threads=threads, progress=say,
+        )  # fmt: skip
+        return {"rows_added": added, "rows_after": _log_rows(work / "data"), "record": rec}
+
+    inputs = {"model": learner_stage.ref, "data": data_stage.ref, **params}
+    model, stage = _network(cache, f"ch6-dagger{r}", inputs, f"dagger{r}.safetensors", build)
+    _say_stage(say, stage, f"DAgger round {r}")
+    return model, stage
 
 
 def reproduce_ch6(
@@ -202,12 +283,12 @@ def reproduce_ch6(
     head: str = "throttle",
     fresh: bool = False,
     progress: Callable[[str], None] | None = None,
+    cache: StageCache | None = None,
 ) -> Ch6Summary:
     """Run the Chapter 6 experiment end to end (the chain in the module docstring).
 
     Args:
-        out_dir: folder of the dataset (``data/``, resumable), the checkpoints
-            (``model``/``readout``/``dagger{r}.safetensors``), ``stages/`` and ``ch6.json``.
+        out_dir: folder of ``ch6.json`` (and of the stage cache, unless ``cache``).
         full: thesis-size run (:data:`FULL`; otherwise :data:`QUICK`).
         episodes: override the number of expert episodes.
         epochs: override the epochs.
@@ -226,28 +307,23 @@ def reproduce_ch6(
             ``cnn-learned-speed``) and start DAgger from it.
         threads: torch CPU threads for training.
         noise_sigma: std of the recording's steering noise (default
-            :class:`uvnav.driving.collect.CollectParams`'s); a dataset folder keeps the one it
-            was recorded with (another one is refused).
+            :class:`uvnav.driving.collect.CollectParams`'s; another one is another recording).
         head: the second output: ``"throttle"`` (thesis; closed loop with the "learned"
             throttle) or ``"target_speed"`` (trained directly; "learned-speed" throttle).
-        fresh: rerun every stage (the recorded expert episodes are kept).
+        fresh: remake every stage (with the default cache).
         progress: called with a one-line status before each stage.
+        cache: the stage cache (default: ``out_dir``'s, made by :func:`fingerprint`).
 
     Returns:
         The summary (table rows "thesis vs measured", closed-loop means, arrays for figures).
+
+    Raises:
+        StaleStageError: a stage of these settings was made by other code (and not ``fresh``).
     """
-    from uvnav.driving.collect import (
-        CollectParams,
-        collect,
-        dataset_meta,
-        meta_conflict,
-        recording_meta,
-    )
     from uvnav.driving.pipeline import (
         THROTTLE_MODES,
         Throttle,
         cnn_policy,
-        dagger_round,
         default_learned_mode,
         evaluate,
         evaluate_expert,
@@ -257,7 +333,7 @@ def reproduce_ch6(
     )
     from uvnav.driving.sim import DrivingSim
     from uvnav.learning import PilotNetConfig, TrainConfig
-    from uvnav.learning.checkpoint import load_checkpoint, save_checkpoint
+    from uvnav.learning.checkpoint import save_checkpoint
 
     if head not in ("throttle", "target_speed"):
         raise ValueError(f"head: {head!r} (must be throttle or target_speed)")
@@ -283,149 +359,81 @@ def reproduce_ch6(
     say = progress or (lambda s: None)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    stages = Stages(out / STAGES_DIR, fresh=fresh)
-    cp = (
-        CollectParams(max_steps=c_steps)
-        if noise_sigma is None
-        else CollectParams(max_steps=c_steps, noise_sigma=noise_sigma)
-    )
-    rec_sim = DrivingSim(max_steps=cp.max_steps)
-    recorded = dataset_meta(out / "data")
-    conflict = meta_conflict(recorded, recording_meta(rec_sim, cp))
-    if conflict:
-        # the folder is this reproduction's own cache: keep the old recording, start a new one
-        k = 1
-        while (out / f"data.old{k}").exists():
-            k += 1
-        (out / "data").rename(out / f"data.old{k}")
-        say(f"data/: {conflict}; kept as data.old{k}/, recording afresh")
-    say(f"collecting {n_ep} expert episodes")
-    try:
-        collect(out / "data", range(n_ep), params=cp, sim=rec_sim)
-    finally:
-        rec_sim.close()
+    cache = cache or StageCache(out, fingerprint(), fresh=fresh)
+    data_stage = _dataset(cache, n_ep, c_steps, noise_sigma, say)
     say("balancing and splitting")
-    data = prepare_data(out / "data")
+    data = prepare_data(data_stage.folder / "data")
     rows: dict[str, dict[str, float]] = {}
     records: dict[str, dict[str, Any]] = {}
-
     tracks: dict[str, list[dict[str, Any]]] = {}
 
-    def closed_loop(name: str, model: Any, mode: Throttle, parent: dict[str, Any]) -> None:
-        key = {"model": parent, "throttle": mode, "seeds": seeds, "max_steps": steps, **PER_TRACK}
-        done = stages.get(name, key)
-        if done is not None:
-            say(f"closed loop {name}: done before (stages/{name}.json)")
-        else:
+    def closed_loop(name: str, model: Any, mode: Throttle, parent: Stage) -> None:
+        def drive(work: Path) -> dict[str, Any]:
             say(f"closed loop {name}, {len(seeds)} tracks")
             policy, on_reset = cnn_policy(model, throttle=mode)
-            done = _loop_record(evaluate(policy, seeds, on_reset=on_reset, max_steps=steps))
-            stages.put(name, key, done)
-        rows[name], tracks[name] = done["summary"], done["tracks"]
+            return _loop_record(evaluate(policy, seeds, on_reset=on_reset, max_steps=steps))
+
+        key = {"model": parent.ref, "throttle": mode, "seeds": seeds, "max_steps": steps}
+        stage = cache.run(f"ch6-{name}", key, drive)
+        _say_stage(say, stage, f"closed loop {name}")
+        rows[name], tracks[name] = dict(stage.value["summary"]), stage.value["tracks"]
 
     # 1. behaviour cloning (the thesis's recipe)
-    train_key: dict[str, Any] = {
-        "rows": data.n_rows,
-        "collect_steps": c_steps,
-        "epochs": n_epochs,
-        "head": head,
-        "side_labels": data.info["side_labels"],
-        "dataset": dataset_meta(out / "data"),
-    }
-    model_path = out / "model.safetensors"
-    record = stages.get("train", train_key, (model_path,))
-    if record is not None:
-        say(f"training: done before ({model_path.name})")
-        model, _ = load_checkpoint(model_path)
-    else:
+    def train(work: Path) -> dict[str, Any]:
         say(f"training {n_epochs} epochs on {data.info['n_train']} images")
-        model, record = train_on(
-            data, model_path, net=net, config=TrainConfig(epochs=n_epochs, threads=threads)
-        )
-        stages.put("train", train_key, record)
+        config = TrainConfig(epochs=n_epochs, threads=threads)
+        return train_on(data, work / "model.safetensors", net=net, config=config)[1]
+
+    inputs = {"data": data_stage.ref, "epochs": n_epochs, "head": head}
+    model, train_stage = _network(cache, TRAIN, inputs, "model.safetensors", train)
+    _say_stage(say, train_stage, "training")
+    record: dict[str, Any] = train_stage.value
     for mode in (default_learned_mode(model), "pi"):
-        closed_loop(f"cnn-{mode}", model, mode, stages.ref("train"))
+        closed_loop(f"cnn-{mode}", model, mode, train_stage)
 
     # 2. the target-speed readout (thesis head only)
-    learner, learner_key = model, stages.ref("train")
+    learner, learner_stage = model, train_stage
     if head == "throttle" and readout:
-        ro_key = {"model": learner_key}
-        ro_path = out / "readout.safetensors"
-        ro_record = stages.get("readout", ro_key, (ro_path,))
-        if ro_record is not None:
-            say("target-speed readout: done before")
-            learner, _ = load_checkpoint(ro_path)
-        else:
-            say("target-speed readout on the last hidden layer")
-            learner, ro_record = fit_target_speed_readout(model, data)
-            save_checkpoint(learner, ro_path, record=ro_record)
-            stages.put("readout", ro_key, ro_record)
-        records["readout"] = ro_record
-        learner_key = stages.ref("readout")
-        closed_loop("cnn-learned-speed", learner, "learned-speed", learner_key)
 
-    # 3. DAgger rounds, from the learner above
+        def fit(work: Path) -> dict[str, Any]:
+            say("target-speed readout on the last hidden layer")
+            fitted, rec = fit_target_speed_readout(model, data)
+            save_checkpoint(fitted, work / "readout.safetensors", record=rec)
+            return rec
+
+        inputs = {"model": train_stage.ref}
+        learner, learner_stage = _network(cache, READOUT, inputs, "readout.safetensors", fit)
+        _say_stage(say, learner_stage, "target-speed readout")
+        records["readout"] = learner_stage.value
+        closed_loop("cnn-learned-speed", learner, "learned-speed", learner_stage)
+
+    # 3. DAgger rounds, from the learner above, each on the previous round's aggregate
     n_rounds = (FULL_DAGGER_ROUNDS if full else 0) if dagger_rounds is None else dagger_rounds
     d_mode: Throttle = dagger_throttle or (  # type: ignore[assignment]
         "learned-speed" if learner.config.predicts_target_speed else "pi"
     )
-    if n_rounds:
-        # the aggregate is a copy of the demonstrations: data/ stays the expert's alone, so a
-        # rerun (resumable collect) trains behaviour cloning on the same rows
-        agg = out / "dagger_data"
-        prev_rows = None  # rows of the aggregate after the last reused round
-        d_eps: int = dagger_episodes or DAGGER_EPISODES
-        d_epochs: int = dagger_epochs or DAGGER_EPOCHS
-        d_steps: int = collect_steps or 1500
-        d_params = {
-            "episodes": d_eps,
-            "epochs": d_epochs,
-            "throttle": d_mode,
-            "collect_steps": d_steps,
-        }
-        for r in range(1, n_rounds + 1):
-            key = {"model": learner_key, **d_params}
-            path = out / f"dagger{r}.safetensors"
-            done = stages.get(f"dagger{r}", key, (path,))
-            if done is not None and _log_rows(agg) >= done["rows_after"]:
-                say(f"DAgger round {r}: done before ({path.name})")
-                learner, _ = load_checkpoint(path)
-                prev_rows = done["rows_after"]
-            else:
-                if prev_rows is None:
-                    if agg.exists():
-                        shutil.rmtree(agg)
-                    shutil.copytree(out / "data", agg)
-                else:
-                    _truncate_log(agg, prev_rows)
-                learner, added, path, rec = dagger_round(
-                    learner,
-                    agg,
-                    out,
-                    round_id=r,
-                    episodes=d_eps,
-                    epochs=d_epochs,
-                    throttle=d_mode,
-                    collect_steps=d_steps,
-                    threads=threads,
-                    progress=say,
-                )
-                prev_rows = _log_rows(agg)
-                done = {"rows_added": added, "rows_after": prev_rows, "record": rec}
-                stages.put(f"dagger{r}", key, done)
-            records[f"dagger{r}"] = done["record"]
-            learner_key = stages.ref(f"dagger{r}")
-            closed_loop(f"dagger{r}-{d_mode}", learner, d_mode, learner_key)
-            rows[f"dagger{r}-{d_mode}"]["rows_added"] = float(done["rows_added"])
+    d_params = {
+        "episodes": dagger_episodes or DAGGER_EPISODES,
+        "epochs": dagger_epochs or DAGGER_EPOCHS,
+        "throttle": d_mode,
+        "collect_steps": collect_steps or 1500,
+    }
+    agg = data_stage
+    for r in range(1, n_rounds + 1):
+        learner, agg = _dagger(cache, learner, learner_stage, agg, r, d_params, threads, say)
+        learner_stage = agg
+        records[f"dagger{r}"] = agg.value["record"]
+        closed_loop(f"dagger{r}-{d_mode}", learner, d_mode, learner_stage)
+        rows[f"dagger{r}-{d_mode}"]["rows_added"] = float(agg.value["rows_added"])
 
     # 4. the expert
-    ex_key = {"seeds": seeds, "max_steps": steps, **PER_TRACK}
-    ex = stages.get("expert", ex_key)
-    if ex is None:
+    def expert(work: Path) -> dict[str, Any]:
         say("closed loop, expert")
-        ex = _loop_record(evaluate_expert(seeds, max_steps=steps))
-        stages.put("expert", ex_key, ex)
-    rows["expert"], tracks["expert"] = ex["summary"], ex["tracks"]
+        return _loop_record(evaluate_expert(seeds, max_steps=steps))
+
+    ex = cache.run(EXPERT, {"seeds": seeds, "max_steps": steps}, expert)
+    _say_stage(say, ex, "closed loop expert")
+    rows["expert"], tracks["expert"] = dict(ex.value["summary"]), ex.value["tracks"]
     for row in rows.values():
         row["return_vs_expert"] = row["return"] / rows["expert"]["return"]
         _per_lap(row)
@@ -450,7 +458,7 @@ def reproduce_ch6(
                 "full": full,
                 "seeds": seeds,
                 "head": head,
-                "reused": stages.reused,
+                "reused": cache.reused,
                 "wall_s": wall,
             },
             indent=2,
@@ -467,10 +475,10 @@ def reproduce_ch6(
         steering_val=data.val[1],
         views=views,
         augment_examples=examples,
-        model_path=model_path,
+        model_path=train_stage.folder / "model.safetensors",
         wall_time=wall,
         stage_records=records,
-        reused=list(stages.reused),
+        reused=list(cache.reused),
         size=size,
     )
 

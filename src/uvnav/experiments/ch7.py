@@ -21,15 +21,21 @@ claims and the *measured* column gives what uvnav measures on the same experimen
   Z_max, tour lengths (TSP vs spiral, two UAVs vs one integrated), δ, curvature vs 1/r_min,
   planning time.
 
-Every plan's summary is written to ``out_dir/<name>.json``; a caller that can draw (the CLI)
-passes ``render_plan(plan, out_dir / name) -> list[Path]`` for figures — this module never
-imports :mod:`uvnav.viz`, a layer above it.
+The Stage 1 counts, each coverage case and each full plan are stages of the results folder's
+stage cache (:class:`uvnav.bench.stages.StageCache`, keyed by their sizes and
+:func:`fingerprint`): a rerun reuses them, an interrupted run keeps the finished ones, and a
+stage made by other code is refused unless ``fresh``.  A plan's stage keeps the
+:class:`~uvnav.recon.plan.ReconPlan` (``plan.pickle``, read back only by the same code) for its
+figures.  Every plan's summary is also written to ``out_dir/<name>.json``; a caller that can draw
+(the CLI) passes ``render_plan(plan, out_dir / name) -> list[Path]`` for figures — this module
+never imports :mod:`uvnav.viz`, a layer above it.
 """
 
 from __future__ import annotations
 
 import json
 import math
+import pickle
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -38,6 +44,7 @@ from typing import Any
 
 import numpy as np
 
+from uvnav.bench.stages import StageCache, stage_fingerprint
 from uvnav.recon.coverage import check_coverage_polygons, check_grid, check_random
 from uvnav.recon.lattice import optimal_lattice
 from uvnav.recon.plan import ReconConfig, ReconPlan, plan_recon, validate_inputs
@@ -51,6 +58,16 @@ THETA = math.radians(90.0)
 COVERAGE_KINDS = ("flat", "jacksboro")
 CHECK_STEP = 0.5
 CHECK_POINTS = 200_000
+#: the file of a plan's stage that keeps the plan itself (for its figures)
+PLAN_FILE = "plan.pickle"
+
+
+def fingerprint() -> str:
+    """The code that makes this experiment's stages: :mod:`uvnav.recon`, the validation helpers
+    it uses, this module, and the numpy and shapely versions."""
+    return stage_fingerprint(
+        "recon", "validation.py", "experiments/ch7.py", packages=("numpy", "shapely")
+    )
 
 
 @dataclass
@@ -150,9 +167,18 @@ def coverage_rows(
     kinds: tuple[str, ...] = COVERAGE_KINDS,
     sizes: tuple[float, ...] = SIZES,
     radii: tuple[float, ...] = RADII,
+    cache: StageCache | None = None,
 ) -> tuple[list[dict[str, Any]], list[dict[str, str]]]:
-    """:func:`coverage_case` for every terrain, size and R: (raw rows, table rows)."""
-    raw = [coverage_case(k, s, R) for k in kinds for s in sizes for R in radii]
+    """:func:`coverage_case` for every terrain, size and R, each a stage of ``cache`` (when
+    given): (raw rows, table rows)."""
+
+    def case(k: str, s: float, R: float) -> dict[str, Any]:
+        if cache is None:
+            return coverage_case(k, s, R)
+        inputs = {"kind": k, "side": s, "R": R, "step": CHECK_STEP, "points": CHECK_POINTS}
+        return dict(cache.run("ch7-coverage", inputs, lambda work: coverage_case(k, s, R)).value)
+
+    raw = [case(k, s, R) for k in kinds for s in sizes for R in radii]
     table = [
         {
             "quantity": (
@@ -177,6 +203,19 @@ def coverage_rows(
     return raw, table
 
 
+def _planner(kind: str, side: float, R: float) -> Callable[[Path], dict[str, Any]]:
+    """The builder of one full plan's stage: the plan's summary, the plan kept in the stage."""
+
+    def build(work: Path) -> dict[str, Any]:
+        terrain, area = experiment_terrain(kind, side)
+        cfg = ReconConfig(theta=THETA, footprint_radius=R, uavs=2, r_min=min(15.0, 0.5 * R))
+        plan = plan_recon(terrain, area, cfg)
+        (work / PLAN_FILE).write_bytes(pickle.dumps(plan, protocol=pickle.HIGHEST_PROTOCOL))
+        return {**plan.summary(), "terrain": terrain.source}
+
+    return build
+
+
 def reproduce_ch7(
     out_dir: Path,
     *,
@@ -186,11 +225,15 @@ def reproduce_ch7(
     radii: tuple[float, ...] = RADII,
     plans: list[tuple[str, float, float]] | None = None,
     coverage_kinds: tuple[str, ...] = COVERAGE_KINDS,
+    cache: StageCache | None = None,
+    fresh: bool = False,
 ) -> Ch7Summary:
     """Run the Ch. 7 experiments (module doc); write JSON summaries; return the table rows.
 
     Args:
         out_dir: Folder of the JSON summaries (and figures, if ``render_plan``).
+        cache: the stage cache (default: ``out_dir``'s, made by :func:`fingerprint`).
+        fresh: remake the stages (with the default cache).
         full: All terrains x sizes x radii instead of the quick pair.
         render_plan: Draws one plan's figures at a path prefix; ``None`` draws nothing.
         sizes: Square sides [m] of the Stage 1 count rows.
@@ -201,8 +244,11 @@ def reproduce_ch7(
     tic = time.perf_counter()
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
+    cache = cache or StageCache(out_dir, fingerprint(), fresh=fresh)
     summary = Ch7Summary()
-    summary.lattice = lattice_rows(sizes, radii)
+    inputs = {"sizes": sizes, "radii": radii}
+    lattice = cache.run("ch7-lattice", inputs, lambda work: lattice_rows(sizes, radii))
+    summary.lattice = list(lattice.value)
     for r in summary.lattice:
         summary.table.append(
             {
@@ -217,7 +263,7 @@ def reproduce_ch7(
             }
         )
     if coverage_kinds:
-        summary.coverage, rows = coverage_rows(coverage_kinds, sizes, radii)
+        summary.coverage, rows = coverage_rows(coverage_kinds, sizes, radii, cache)
         summary.table += rows
     if plans is None:
         plans = (
@@ -226,16 +272,16 @@ def reproduce_ch7(
             else list(QUICK_PLANS)
         )
     for kind, side, R in plans:
-        terrain, area = experiment_terrain(kind, side)
-        cfg = ReconConfig(theta=THETA, footprint_radius=R, uavs=2, r_min=min(15.0, 0.5 * R))
-        plan = plan_recon(terrain, area, cfg)
-        s = plan.summary()
+        stage = cache.run(
+            "ch7-plan", {"kind": kind, "side": side, "R": R, "uavs": 2}, _planner(kind, side, R)
+        )
+        s = dict(stage.value)
         name = f"ch7-{kind}-{side:.0f}m-R{R:.0f}"
-        s["terrain"] = terrain.source
         (out_dir / f"{name}.json").write_text(json.dumps(s, indent=2, default=float))
         summary.plans[name] = s
         if render_plan is not None:
-            summary.figures += render_plan(plan, out_dir / name)
+            with (stage.folder / PLAN_FILE).open("rb") as fh:
+                summary.figures += render_plan(pickle.load(fh), out_dir / name)
         label = f"Ch7 {kind} {side:.0f} m, R = {R:.0f} m"
         summary.table += [
             {

@@ -1,6 +1,7 @@
-"""What an experiment is: a name, a title, whether it runs random seeds, its place in the report,
-and a ``run`` that takes an :class:`ExperimentContext` and returns an :class:`ExperimentRun`
-(its report sections and its rows of the "thesis reported vs uvnav measured" table).
+"""What an experiment is: a name, a title, whether it runs random seeds, its declared sizes
+(:class:`Size`, quick and full), its place in the report, and a ``run`` that takes an
+:class:`ExperimentContext` (with the chosen size) and returns an :class:`ExperimentRun` (its report
+sections and its rows of the "thesis reported vs uvnav measured" table).
 
 This module imports no experiment and no registry: the built-in experiments
 (:mod:`uvnav.experiments.builtin`) and the plug-ins of the entry-point group
@@ -9,7 +10,7 @@ This module imports no experiment and no registry: the built-in experiments
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -26,6 +27,26 @@ ReportHook = Callable[[list[ChapterSection], list[dict[str, str]]], tuple[Path |
 
 class ExperimentError(ValueError):
     """An unknown experiment, an option it does not take, or a broken plug-in (one line)."""
+
+
+#: the sizes every experiment may declare: ``quick`` (the default) and ``full`` (``--full``)
+SIZE_NAMES: tuple[str, ...] = ("quick", "full")
+
+
+@dataclass(frozen=True)
+class Size:
+    """One declared size of an experiment.
+
+    Attributes:
+        runs: one line: what this size runs (shown by ``uvnav reproduce --list``).
+        seeds: the random scenes it runs by default (seeded experiments; ``--seeds`` overrides).
+        params: keyword arguments the experiment's run passes to its reproduction (empty: the
+            reproduction's own defaults for ``full``).
+    """
+
+    runs: str
+    seeds: int | None = None
+    params: Mapping[str, Any] = field(default_factory=dict, hash=False)
 
 
 @dataclass(frozen=True)
@@ -45,7 +66,10 @@ class ExperimentContext:
         render: the report renderer (:func:`uvnav.viz.reproduction.render_reproduction`), which
             an experiment may use to write the page (Chapter 2's :data:`ReportHook`).
         progress: progress output on stderr.
-        fresh: rerun finished stages kept in files (stored episodes are never deleted).
+        fresh: remake the stages of the stage cache this run reaches, even those made by other
+            code (stored episodes are never deleted).
+        size: the chosen size (``None``: the runner fills in the experiment's declared
+            ``full`` or ``quick`` size).
     """
 
     results_dir: Path
@@ -58,6 +82,7 @@ class ExperimentContext:
     render: Any = None
     progress: bool = True
     fresh: bool = False
+    size: Size | None = None
 
     def figures_dir(self, name: str) -> Path:
         """``report_dir/<name>``, the folder of one experiment's figures."""
@@ -99,6 +124,7 @@ class Experiment:
             name).
         sections: the keys of the sections it returns (default: its name); the saved sections are
             found again by these keys.
+        sizes: its declared sizes by name (:data:`SIZE_NAMES`).
     """
 
     name: str
@@ -107,6 +133,11 @@ class Experiment:
     seeded: bool = False
     order: int = 1000
     sections: tuple[str, ...] = ()
+    sizes: Mapping[str, Size] = field(default_factory=dict, hash=False)
+
+    def size(self, full: bool) -> Size:
+        """Its declared ``full`` or ``quick`` size (an undeclared one runs nothing extra)."""
+        return self.sizes.get("full" if full else "quick") or Size(runs="")
 
     @property
     def section_keys(self) -> tuple[str, ...]:

@@ -74,6 +74,8 @@ def saved_sections(results_dir: Path) -> list[ChapterSection]:
 def _run_one(experiment: Experiment, ctx: ExperimentContext) -> ExperimentRun:
     if not experiment.seeded:
         ctx = dataclasses.replace(ctx, seeds=None, start_seed=0)
+    if ctx.size is None:
+        ctx = dataclasses.replace(ctx, size=experiment.size(ctx.full))
     run = experiment.run(ctx)
     keys = experiment.section_keys
     for s in run.sections:
