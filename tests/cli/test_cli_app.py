@@ -419,6 +419,7 @@ def test_run_prints_the_comparison_table(tmp_path: Path, monkeypatch: pytest.Mon
             "progress": True,
             "render": render_reproduction,
             "fresh": False,
+            "size": None,
         }
     ]
     # every chapter with figures gets its renderer (Chapters 3-7 and issue 9)
