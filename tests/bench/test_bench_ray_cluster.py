@@ -1,11 +1,12 @@
 """``uvnav bench --engine ray --address`` on a Ray cluster uvnav did not start.
 
-A real head (``ray start --head --block``, 1 CPU, no dashboard, token authentication on, its
-node address given as 127.0.0.1) and, where a test needs one, a second node (``ray start
+A real head (``ray start --head --block``, 1 CPU, no dashboard, its node address given as
+127.0.0.1, token authentication on: ``RAY_AUTH_MODE=token``, the token in ``RAY_AUTH_TOKEN``,
+which a worker node needs both of) and, where a test needs one, a second node (``ray start
 --address HEAD``, 1 CPU of its own) on this machine.  Campaigns through ``HOST:PORT`` and
 through ``auto`` store the rows the local engine stores; a node killed mid-campaign loses
 nothing (Ray runs its tasks again elsewhere); a node whose workers import other uvnav code is
-refused before anything is stored; a wrong token, an unreachable address, a malformed one and
+refused before the database is created; a wrong token, an unreachable address, a malformed one and
 a Ray Client address without Ray Client are each one ``error:`` line, exit status 2, within
 seconds.
 
@@ -122,7 +123,8 @@ class Cluster:
         return _env(**{"RAY_TMPDIR": str(self.tmp), "RAY_AUTH_TOKEN": TOKEN, **extra})
 
     def start(self, log: Path, *args: str, pythonpath: str = SRC) -> subprocess.Popen[bytes]:
-        """``ray start --block ARGS`` in a new session, once it says it started (or skip)."""
+        """``ray start --block ARGS`` in a new session, once it says it started (the head:
+        skip the module if it cannot start; another node: fail)."""
         with open(log, "wb") as out:
             proc = subprocess.Popen(
                 [_ray_cli(), "start", "--block", "--num-cpus=1",
@@ -134,7 +136,10 @@ class Cluster:
         deadline = time.monotonic() + 60
         while b"Ray runtime started" not in log.read_bytes():
             if proc.poll() is not None or time.monotonic() > deadline:
-                pytest.skip(f"ray start cannot start a node here: {log.read_text()[-300:]}")
+                why = f"ray start cannot start a node here: {log.read_text()[-300:]}"
+                if self.nodes[1:]:
+                    pytest.fail(why)
+                pytest.skip(why)
             time.sleep(0.3)
         return proc
 

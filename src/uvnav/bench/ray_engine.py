@@ -18,13 +18,16 @@ worker running other code than the driver stops the campaign (:class:`CodeMismat
 its outcomes are never stored.  A task whose worker or node dies is run again by Ray
 (:data:`MAX_RETRIES`), elsewhere if its node is gone; its outcomes exist only once it returned,
 so a dead node leaves nothing half-stored.  Ray's driver prints such notices on stdout; they
-are sent to stderr for the duration, so that stdout carries only the command's output.
+go to this module's log instead (:func:`_ray_notices_logged`), so that stdout carries only the
+command's output and stderr its errors.
 
 Like the local pool, at most ``2 × workers`` tasks are in flight: large campaigns do not flood the
 object store, and a killed driver loses at most those tasks' episodes (about half a second of each
 worker's work).  Ray is started here only when it is not running yet (``ray.init(address=...,
 num_cpus=workers)``; with no address a local instance) and is shut down again at the end; a caller
-that already called ``ray.init`` keeps its instance (tests start Ray once per module this way).
+that already called ``ray.init`` keeps its instance (tests start Ray once per module this way;
+``uvnav bench --address`` connects first, :func:`cluster_session`, so that a cluster that
+cannot be used is refused before the results database is created).
 
 What Ray adds to a campaign's CPU is measured by ``benchmarks/bench_ray.py``: on 2,000
 episodes of the default generator's scenes and 2 workers, 0.8-1.6 CPU-ms per episode over the
@@ -43,17 +46,19 @@ Ray is an optional dependency (extra ``uvnav[bench]``), imported only when this 
 from __future__ import annotations
 
 import functools
+import io
 import ipaddress
 import logging
 import os
 import socket
 import sys
+import threading
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager, redirect_stdout
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import Any, TextIO
 
 from uvnav.bench.jobs import TASK_SECONDS, Job, JobOutcome, TaskSizer, sized_batches
 from uvnav.bench.store import STATUS_ERROR
@@ -118,13 +123,15 @@ def start_local_ray(ray: ModuleType, workers: int) -> None:
     """Start a local Ray instance of ``workers`` CPUs that listens on 127.0.0.1 only.
 
     No dashboard; the node address, hence every gRPC server, agent and worker, is the loopback
-    one (see the module docstring).
+    one (see the module docstring).  Always a new instance: ``ray.init()`` alone would connect
+    to a cluster that ``ray start`` recorded on this machine (another user's, say).
 
     Raises:
         EngineUnavailableError: Ray started on another address (it is shut down again).
     """
     with _loopback_node_ip(ray):
         ray.init(
+            address="local",  # a new instance, even where `ray start` recorded a cluster here
             num_cpus=max(1, workers),
             include_dashboard=False,
             dashboard_host=LOOPBACK,
@@ -209,18 +216,28 @@ def _token_auth(ray: ModuleType, local: bool) -> Iterator[None]:
     turn_on = "RAY_AUTH_MODE" not in os.environ and (
         _token_given() or (local and TOKEN_FILE.is_file())
     )
-    config = getattr(getattr(ray, "_raylet", None), "Config", None)
     if turn_on:
         os.environ["RAY_AUTH_MODE"] = "token"
-        if config is not None:
-            config.initialize("")  # Ray caches its configuration; re-read the mode
+    _reload_auth(ray)
     try:
         yield
     finally:
         if turn_on:
             os.environ.pop("RAY_AUTH_MODE", None)
-            if config is not None:
-                config.initialize("")
+        _reload_auth(ray)
+
+
+def _reload_auth(ray: ModuleType) -> None:
+    """Make Ray read the authentication mode and token again: it caches both per process (its
+    configuration, its token loader), so a second connection of a process (another cluster,
+    another token) would otherwise send the first one's."""
+    raylet = getattr(ray, "_raylet", None)
+    config = getattr(raylet, "Config", None)
+    if config is not None:
+        config.initialize("")
+    loader = getattr(raylet, "AuthenticationTokenLoader", None)
+    if loader is not None:
+        loader.instance().reset_cache()
 
 
 @contextmanager
@@ -434,13 +451,45 @@ def _probe() -> tuple[str, str]:
     return worker_fingerprint(), _this_node()
 
 
+#: the thread of Ray's driver that prints cluster notices (``ray._private.worker``)
+RAY_NOTICE_THREAD = "ray_listen_error_messages"
+log = logging.getLogger(__name__)
+
+
+class _NoticeFilter(io.TextIOBase):
+    """``sys.stdout`` less what Ray's notice thread writes, which goes to this module's log."""
+
+    def __init__(self, target: TextIO) -> None:
+        self._target = target
+
+    def write(self, text: str) -> int:
+        if threading.current_thread().name == RAY_NOTICE_THREAD:
+            if text.strip():
+                log.info("ray: %s", text.strip())
+            return len(text)
+        return self._target.write(text)
+
+    def flush(self) -> None:
+        self._target.flush()
+
+
+@contextmanager
+def _ray_notices_logged() -> Iterator[None]:
+    """Ray's driver prints cluster notices on stdout from a thread of its own: a task retried
+    because its node died, a node marked dead (even one of an earlier session).  For the
+    duration they go to this module's log instead, so that stdout carries only the command's
+    output (``--json``) and stderr its one-line errors; everything else printed is unchanged."""
+    with redirect_stdout(_NoticeFilter(sys.stdout)):
+        yield
+
+
 @contextmanager
 def cluster_session(address: str) -> Iterator[None]:
     """Connected to the Ray cluster at ``address`` (:func:`cluster_connection`), every node's
     code checked (:func:`check_node_code`), for the duration; :func:`run_ray` uses this
     connection.  The CLI holds it across a campaign, so that a cluster that cannot be used
-    stops the run in one line before the database is created.  Ray's notices on stdout go to
-    stderr meanwhile (see :func:`run_ray`).
+    stops the run in one line before the database is created.  Ray's notices go to the log
+    meanwhile (:func:`_ray_notices_logged`).
 
     Raises:
         EngineUnavailableError: Ray is not installed.
@@ -448,7 +497,7 @@ def cluster_session(address: str) -> Iterator[None]:
             runs other uvnav code (:class:`CodeMismatchError`).
     """
     ray = import_ray()
-    with redirect_stdout(sys.stderr), cluster_connection(ray, address):
+    with _ray_notices_logged(), cluster_connection(ray, address):
         check_node_code(ray, worker_fingerprint())
         yield
 
@@ -516,9 +565,7 @@ def run_ray(
     ray = import_ray()
     address = address or os.environ.get("RAY_ADDRESS") or None  # Ray's own variable: the user's
     with ExitStack() as stack:
-        # Ray's driver prints cluster notices (a task retried because its node died) on stdout,
-        # which carries the command's own output (``--json``): they go to stderr instead
-        stack.enter_context(redirect_stdout(sys.stderr))
+        stack.enter_context(_ray_notices_logged())
         if not ray.is_initialized():
             if address is None:
                 start_local_ray(ray, workers)
