@@ -53,6 +53,7 @@ import os
 import socket
 import sys
 import threading
+import warnings
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager, redirect_stdout
@@ -346,7 +347,9 @@ def cluster_connection(ray: ModuleType, address: str) -> Iterator[None]:
     """Connected (``ray.init``) to the existing cluster at ``address`` (``auto``,
     ``HOST:PORT``, ``ray://HOST:PORT``) for the duration, with token authentication as
     :func:`_token_auth` decides; checked first by :func:`probe_cluster` so that a cluster that
-    cannot be used fails in seconds with one line.  Shut down (``ray.shutdown``) at the end.
+    cannot be used fails in seconds with one line (through Ray Client, ``ray://``, a refused
+    token is only seen as Ray Client's connection timeout, after about half a minute).  Shut
+    down (``ray.shutdown``) at the end.
 
     Raises:
         ClusterConnectionError: the cluster cannot be reached or refuses the token.
@@ -355,15 +358,23 @@ def cluster_connection(ray: ModuleType, address: str) -> Iterator[None]:
     with _token_auth(ray, local):
         probe_cluster(ray, target)
         try:
-            ray.init(
-                address=target,
-                include_dashboard=False,
-                log_to_driver=False,
-                logging_level=logging.WARNING,
-            )
+            with warnings.catch_warnings():  # Ray Client warns what the error below says
+                warnings.simplefilter("ignore")
+                ray.init(
+                    address=target,
+                    include_dashboard=False,
+                    log_to_driver=False,
+                    logging_level=logging.WARNING,
+                )
         except (ConnectionError, RuntimeError, ray.exceptions.RayError) as exc:
+            hint = (
+                f" (its token too may be refused: {_auth_hint(local)})"
+                if target.startswith("ray://")
+                else ""
+            )
             raise ClusterConnectionError(
-                f"cannot connect to the Ray cluster at {target}: {clip(one_line(str(exc)), 200)}"
+                f"cannot connect to the Ray cluster at {target}: "
+                f"{clip(one_line(str(exc)), 200)}{hint}"
             ) from None
         try:
             yield
