@@ -1,5 +1,6 @@
-"""The Ray engine stores the same metrics as the local engine (Ray is started once, here), and a
-task whose worker dies is run again split, so that only the job that kills its worker is an error.
+"""The Ray engine stores the same metrics as the local engine (Ray is started once, here); a
+task whose worker dies is run again split, so that only the job that kills its worker is an
+error; workers whose code fingerprint is not the driver's are refused and nothing is stored.
 
 Skipped when Ray (extra ``uvnav[bench]``) is not installed.  Ray's start-up costs several seconds,
 so the whole module is one test: under ``pytest -n`` two tests could land in two workers and start
@@ -18,8 +19,14 @@ from typing import Any
 import pytest
 from typer.testing import CliRunner
 
-from uvnav.bench.campaign import Job, run_campaign
-from uvnav.bench.ray_engine import start_local_ray
+from uvnav.bench.campaign import Job, run_campaign, run_group_batch
+from uvnav.bench.ray_engine import (
+    CodeMismatchError,
+    _run_tasks,
+    check_node_code,
+    start_local_ray,
+    worker_fingerprint,
+)
 from uvnav.bench.spec import campaign_from_dict, run_campaign_spec
 from uvnav.bench.store import ResultsStore
 from uvnav.bench.summary import TIMING_COLUMNS
@@ -92,6 +99,22 @@ def test_ray_engine_matches_local_and_cli(tmp_path: Path, ray_instance: object) 
     assert tables[0] == tables[1]
 
     check_a_dying_worker_costs_one_job(tmp_path)
+    check_other_code_is_refused_unstored()
+
+
+def check_other_code_is_refused_unstored() -> None:
+    """A driver whose code fingerprint is not the workers' (as if its uvnav were another one)
+    is refused by the start-up check and by every task, and no outcome is handed on."""
+    expected = worker_fingerprint()
+    check_node_code(ray, expected)  # the same code passes
+    other = "0" * 16
+    with pytest.raises(CodeMismatchError, match=f"code fingerprint {expected}, here {other}"):
+        check_node_code(ray, other)
+    handled: list[object] = []
+    groups = [[Job(controller="straight-v1", seed=s, generator_seed=s)] for s in range(3)]
+    with pytest.raises(CodeMismatchError, match="run other uvnav code than this driver"):
+        _run_tasks(ray, groups, handled.append, run_group_batch, 2, 0.25, other)
+    assert handled == []
 
 
 def check_a_dying_worker_costs_one_job(tmp_path: Path) -> None:

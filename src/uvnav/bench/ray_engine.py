@@ -11,11 +11,23 @@ each group's :class:`~uvnav.bench.jobs.JobOutcome` s come back to the driver, wh
 them to the SQLite store in one transaction (DESIGN §5) — exactly as with the local engine, so
 resume, progress and the stored metrics are the same whatever the engine.
 
+Every task returns its worker's code fingerprint (:func:`worker_fingerprint`, the
+:func:`~uvnav.bench.fingerprint.code_fingerprint` of the uvnav that worker imported), and
+before the first task one small task pinned to each node asks it (:func:`check_node_code`): a
+worker running other code than the driver stops the campaign (:class:`CodeMismatchError`) and
+its outcomes are never stored.  A task whose worker or node dies is run again by Ray
+(:data:`MAX_RETRIES`), elsewhere if its node is gone; its outcomes exist only once it returned,
+so a dead node leaves nothing half-stored.  Ray's driver prints such notices on stdout; they
+go to this module's log instead (:func:`_ray_notices_logged`), so that stdout carries only the
+command's output and stderr its errors.
+
 Like the local pool, at most ``2 × workers`` tasks are in flight: large campaigns do not flood the
 object store, and a killed driver loses at most those tasks' episodes (about half a second of each
 worker's work).  Ray is started here only when it is not running yet (``ray.init(address=...,
 num_cpus=workers)``; with no address a local instance) and is shut down again at the end; a caller
-that already called ``ray.init`` keeps its instance (tests start Ray once per module this way).
+that already called ``ray.init`` keeps its instance (tests start Ray once per module this way;
+``uvnav bench --address`` connects first, :func:`cluster_session`, so that a cluster that
+cannot be used is refused before the results database is created).
 
 What Ray adds to a campaign's CPU is measured by ``benchmarks/bench_ray.py``: on 2,000
 episodes of the default generator's scenes and 2 workers, 0.8-1.6 CPU-ms per episode over the
@@ -33,16 +45,21 @@ Ray is an optional dependency (extra ``uvnav[bench]``), imported only when this 
 
 from __future__ import annotations
 
+import functools
+import io
 import ipaddress
 import logging
 import os
 import socket
+import sys
+import threading
+import warnings
 from collections import deque
 from collections.abc import Callable, Iterator, Sequence
-from contextlib import ExitStack, contextmanager
+from contextlib import ExitStack, contextmanager, redirect_stdout
 from pathlib import Path
 from types import ModuleType
-from typing import Any
+from typing import Any, TextIO
 
 from uvnav.bench.jobs import TASK_SECONDS, Job, JobOutcome, TaskSizer, sized_batches
 from uvnav.bench.store import STATUS_ERROR
@@ -107,13 +124,15 @@ def start_local_ray(ray: ModuleType, workers: int) -> None:
     """Start a local Ray instance of ``workers`` CPUs that listens on 127.0.0.1 only.
 
     No dashboard; the node address, hence every gRPC server, agent and worker, is the loopback
-    one (see the module docstring).
+    one (see the module docstring).  Always a new instance: ``ray.init()`` alone would connect
+    to a cluster that ``ray start`` recorded on this machine (another user's, say).
 
     Raises:
         EngineUnavailableError: Ray started on another address (it is shut down again).
     """
     with _loopback_node_ip(ray):
         ray.init(
+            address="local",  # a new instance, even where `ray start` recorded a cluster here
             num_cpus=max(1, workers),
             include_dashboard=False,
             dashboard_host=LOOPBACK,
@@ -198,18 +217,28 @@ def _token_auth(ray: ModuleType, local: bool) -> Iterator[None]:
     turn_on = "RAY_AUTH_MODE" not in os.environ and (
         _token_given() or (local and TOKEN_FILE.is_file())
     )
-    config = getattr(getattr(ray, "_raylet", None), "Config", None)
     if turn_on:
         os.environ["RAY_AUTH_MODE"] = "token"
-        if config is not None:
-            config.initialize("")  # Ray caches its configuration; re-read the mode
+    _reload_auth(ray)
     try:
         yield
     finally:
         if turn_on:
             os.environ.pop("RAY_AUTH_MODE", None)
-            if config is not None:
-                config.initialize("")
+        _reload_auth(ray)
+
+
+def _reload_auth(ray: ModuleType) -> None:
+    """Make Ray read the authentication mode and token again: it caches both per process (its
+    configuration, its token loader), so a second connection of a process (another cluster,
+    another token) would otherwise send the first one's."""
+    raylet = getattr(ray, "_raylet", None)
+    config = getattr(raylet, "Config", None)
+    if config is not None:
+        config.initialize("")
+    loader = getattr(raylet, "AuthenticationTokenLoader", None)
+    if loader is not None:
+        loader.instance().reset_cache()
 
 
 @contextmanager
@@ -240,12 +269,22 @@ def _auth_hint(local: bool) -> str:
 def probe_cluster(ray: ModuleType, address: str) -> None:
     """Check, within :data:`CONNECT_TIMEOUT` seconds, that the Ray cluster at ``address``
     (``HOST:PORT`` or ``ray://HOST:PORT``, already resolved) accepts a connection and, for a
-    GCS address, this process's token.  Call it inside :func:`_token_auth`.
+    GCS address, this process's token; a ``ray://`` address needs Ray Client installed here
+    (extra ``ray[client]``, which ``uvnav[bench]`` does not install).  Call it inside
+    :func:`_token_auth`.
 
     Raises:
-        ClusterConnectionError: bad address, unreachable, or the token is missing or refused.
+        ClusterConnectionError: bad address, no Ray Client for a ``ray://`` one, unreachable,
+            or the token is missing or refused.
     """
     scheme, host, port = parse_address(address)
+    if scheme and _client_missing(ray) is not None:
+        raise ClusterConnectionError(
+            f"{address} is a Ray Client address, and Ray Client is not installed here "
+            f"({clip(one_line(str(_client_missing(ray))), 60)}): pass the head's GCS address "
+            f"HOST:PORT instead (`ray start --head --port PORT`, default 6379), or "
+            "pip install 'ray[client]' here and on the head"
+        )
     try:
         socket.create_connection((host, port), timeout=CONNECT_TIMEOUT).close()
     except OSError as exc:
@@ -273,6 +312,17 @@ def probe_cluster(ray: ModuleType, address: str) -> None:
         ) from None
 
 
+def _client_missing(ray: ModuleType) -> ImportError | None:
+    """Why Ray Client (``ray://`` addresses, extra ``ray[client]``) cannot run here, or
+    ``None`` when it can."""
+    utils = getattr(getattr(ray, "_private", None), "utils", None)
+    check = getattr(utils, "get_ray_client_dependency_error", None)
+    if check is None:  # another Ray layout: ray.init says
+        return None
+    error = check()
+    return error if isinstance(error, ImportError) else None
+
+
 def _local_target(ray: ModuleType, address: str) -> tuple[str, bool]:
     """``address`` resolved (:func:`resolve_address`), and whether its cluster is on this
     machine (``auto``, or a host that is one of this machine's addresses)."""
@@ -292,26 +342,14 @@ def _is_own_address(host: str) -> bool:
     return True
 
 
-def check_cluster(address: str) -> None:
-    """Check that the Ray cluster at ``address`` can be used (:func:`probe_cluster`), with the
-    token authentication :func:`cluster_connection` would use; the process is left as it was.
-
-    Raises:
-        EngineUnavailableError: Ray is not installed.
-        ClusterConnectionError: the cluster cannot be reached or refuses the token.
-    """
-    ray = import_ray()
-    target, local = _local_target(ray, address)
-    with _token_auth(ray, local):
-        probe_cluster(ray, target)
-
-
 @contextmanager
 def cluster_connection(ray: ModuleType, address: str) -> Iterator[None]:
     """Connected (``ray.init``) to the existing cluster at ``address`` (``auto``,
     ``HOST:PORT``, ``ray://HOST:PORT``) for the duration, with token authentication as
     :func:`_token_auth` decides; checked first by :func:`probe_cluster` so that a cluster that
-    cannot be used fails in seconds with one line.  Shut down (``ray.shutdown``) at the end.
+    cannot be used fails in seconds with one line (through Ray Client, ``ray://``, a refused
+    token is only seen as Ray Client's connection timeout, after about half a minute).  Shut
+    down (``ray.shutdown``) at the end.
 
     Raises:
         ClusterConnectionError: the cluster cannot be reached or refuses the token.
@@ -320,20 +358,159 @@ def cluster_connection(ray: ModuleType, address: str) -> Iterator[None]:
     with _token_auth(ray, local):
         probe_cluster(ray, target)
         try:
-            ray.init(
-                address=target,
-                include_dashboard=False,
-                log_to_driver=False,
-                logging_level=logging.WARNING,
-            )
+            with warnings.catch_warnings():  # Ray Client warns what the error below says
+                warnings.simplefilter("ignore")
+                ray.init(
+                    address=target,
+                    include_dashboard=False,
+                    log_to_driver=False,
+                    logging_level=logging.WARNING,
+                )
         except (ConnectionError, RuntimeError, ray.exceptions.RayError) as exc:
+            hint = (
+                f" (its token too may be refused: {_auth_hint(local)})"
+                if target.startswith("ray://")
+                else ""
+            )
             raise ClusterConnectionError(
-                f"cannot connect to the Ray cluster at {target}: {clip(one_line(str(exc)), 200)}"
+                f"cannot connect to the Ray cluster at {target}: "
+                f"{clip(one_line(str(exc)), 200)}{hint}"
             ) from None
         try:
             yield
         finally:
             ray.shutdown()
+
+
+class CodeMismatchError(ClusterConnectionError):
+    """A Ray worker runs other uvnav code than the driver (its code fingerprint differs); its
+    outcomes are not stored.  The message is one line naming the node and what to do."""
+
+
+#: seconds the start-up check waits for each node's code fingerprint; a node that has not
+#: answered by then (busy starting workers, or dead) is checked by its tasks' fingerprints
+PROBE_SECONDS = 20.0
+#: Ray's retries of a task whose worker or node died (after them the task is split)
+MAX_RETRIES = 3
+
+
+@functools.cache
+def worker_fingerprint() -> str:
+    """The code fingerprint (:func:`uvnav.bench.fingerprint.code_fingerprint`) of the uvnav
+    this process imported, computed once per process."""
+    from uvnav.bench.fingerprint import code_fingerprint
+
+    return code_fingerprint()
+
+
+def _this_node() -> str:
+    """This Ray worker's node: its address and the start of its id."""
+    import ray
+
+    return f"node {ray.util.get_node_ip_address()} ({ray.get_runtime_context().get_node_id()[:8]})"
+
+
+def fingerprinted(
+    run_batch: Callable[[Batch], list[list[JobOutcome]]], batch: Batch, expected: str
+) -> tuple[str, str, list[list[JobOutcome]]]:
+    """The Ray task: ``(fingerprint, node, outcomes)``.  ``run_batch(batch)`` runs only when
+    this worker's code fingerprint is the driver's ``expected``; otherwise the outcomes are
+    empty and ``node`` says where the worker runs."""
+    theirs = worker_fingerprint()
+    if theirs != expected:
+        return theirs, _this_node(), []
+    return theirs, "", run_batch(batch)
+
+
+def _mismatch(where: str, theirs: str, ours: str) -> CodeMismatchError:
+    return CodeMismatchError(
+        f"the Ray workers on {where} run other uvnav code than this driver (code fingerprint "
+        f"{theirs}, here {ours}): install the same uvnav on every node (or start every node "
+        "from the same checkout with its src/ on PYTHONPATH); their episodes were not stored"
+    )
+
+
+def check_node_code(ray: ModuleType, expected: str, timeout: float = PROBE_SECONDS) -> None:
+    """Check, before any task runs, that the workers of every alive node with CPUs compute
+    the driver's code fingerprint ``expected``: one small task pinned to each node.  A node
+    that does not answer within ``timeout`` seconds, or whose probe fails (it died), is left
+    to the per-task check of :func:`run_ray`.
+
+    Raises:
+        CodeMismatchError: a node's workers run other code.
+    """
+    from ray.util.scheduling_strategies import NodeAffinitySchedulingStrategy
+
+    probe = ray.remote(num_cpus=0, max_retries=0)(_probe)
+    refs = []
+    for node in ray.nodes():
+        if node.get("Alive") and node.get("Resources", {}).get("CPU", 0) > 0:
+            strategy = NodeAffinitySchedulingStrategy(node["NodeID"], soft=False)
+            refs.append(probe.options(scheduling_strategy=strategy).remote())
+    ready, _ = ray.wait(refs, num_returns=len(refs), timeout=timeout)
+    for ref in ready:
+        try:
+            theirs, where = ray.get(ref)
+        except ray.exceptions.RayError:
+            continue  # the node died meanwhile: its tasks go elsewhere
+        if theirs != expected:
+            raise _mismatch(where, theirs, expected)
+
+
+def _probe() -> tuple[str, str]:
+    """This worker's code fingerprint and node (:func:`check_node_code`'s task)."""
+    return worker_fingerprint(), _this_node()
+
+
+#: the thread of Ray's driver that prints cluster notices (``ray._private.worker``)
+RAY_NOTICE_THREAD = "ray_listen_error_messages"
+log = logging.getLogger(__name__)
+
+
+class _NoticeFilter(io.TextIOBase):
+    """``sys.stdout`` less what Ray's notice thread writes, which goes to this module's log."""
+
+    def __init__(self, target: TextIO) -> None:
+        self._target = target
+
+    def write(self, text: str) -> int:
+        if threading.current_thread().name == RAY_NOTICE_THREAD:
+            if text.strip():
+                log.info("ray: %s", text.strip())
+            return len(text)
+        return self._target.write(text)
+
+    def flush(self) -> None:
+        self._target.flush()
+
+
+@contextmanager
+def _ray_notices_logged() -> Iterator[None]:
+    """Ray's driver prints cluster notices on stdout from a thread of its own: a task retried
+    because its node died, a node marked dead (even one of an earlier session).  For the
+    duration they go to this module's log instead, so that stdout carries only the command's
+    output (``--json``) and stderr its one-line errors; everything else printed is unchanged."""
+    with redirect_stdout(_NoticeFilter(sys.stdout)):
+        yield
+
+
+@contextmanager
+def cluster_session(address: str) -> Iterator[None]:
+    """Connected to the Ray cluster at ``address`` (:func:`cluster_connection`), every node's
+    code checked (:func:`check_node_code`), for the duration; :func:`run_ray` uses this
+    connection.  The CLI holds it across a campaign, so that a cluster that cannot be used
+    stops the run in one line before the database is created.  Ray's notices go to the log
+    meanwhile (:func:`_ray_notices_logged`).
+
+    Raises:
+        EngineUnavailableError: Ray is not installed.
+        ClusterConnectionError: the cluster cannot be reached, refuses the token, or a node
+            runs other uvnav code (:class:`CodeMismatchError`).
+    """
+    ray = import_ray()
+    with _ray_notices_logged(), cluster_connection(ray, address):
+        check_node_code(ray, worker_fingerprint())
+        yield
 
 
 def _crash_outcome(job: Job, exc: BaseException) -> JobOutcome:
@@ -369,9 +546,11 @@ def run_ray(
 
     A task runs ``run_batch`` on a batch of groups, as many as
     take about ``task_seconds`` (:class:`~uvnav.bench.jobs.TaskSizer`: one until the first
-    come back).  A task that Ray cannot complete (its worker died, even after Ray's retries) is
-    run again split (its groups one per task, a lone group's jobs one per task), so only the job
-    that kills its worker is stored as an error.
+    come back), in a worker whose code fingerprint is the driver's (:func:`check_node_code`
+    first, then each task's).  A task whose worker or node dies is retried by Ray
+    (:data:`MAX_RETRIES` times); one that Ray cannot complete even so is run again split (its
+    groups one per task, a lone group's jobs one per task), so only the job that kills its
+    worker is stored as an error.
 
     Args:
         groups: the jobs, grouped by scene.
@@ -382,26 +561,31 @@ def run_ray(
         address: Ray cluster to connect to (``"auto"``, ``"host:port"``, ``"ray://host:10001"``;
             default ``$RAY_ADDRESS``; :func:`cluster_connection`); none starts
             a local instance with ``num_cpus=workers`` that listens on 127.0.0.1 only
-            (:func:`start_local_ray`).  Ignored when Ray is already initialised.
+            (:func:`start_local_ray`).  Ignored when Ray is already initialised (by the
+            caller, or by :func:`cluster_session`).
         task_seconds: the worker time a task is sized to.
 
     Raises:
         EngineUnavailableError: Ray is not installed, or a local instance would not be
             loopback-only.
         ClusterConnectionError: ``address`` names a cluster that cannot be used
-            (:func:`cluster_connection`).
+            (:func:`cluster_connection`), or a worker runs other uvnav code than this process
+            (:class:`CodeMismatchError`; the outcomes of its tasks are not handed on).
         KeyboardInterrupt: re-raised after cancelling the tasks in flight.
     """
     ray = import_ray()
     address = address or os.environ.get("RAY_ADDRESS") or None  # Ray's own variable: the user's
     with ExitStack() as stack:
+        stack.enter_context(_ray_notices_logged())
         if not ray.is_initialized():
             if address is None:
                 start_local_ray(ray, workers)
                 stack.callback(ray.shutdown)
             else:
                 stack.enter_context(cluster_connection(ray, address))
-        _run_tasks(ray, groups, handle, run_batch, workers, task_seconds)
+        expected = worker_fingerprint()
+        check_node_code(ray, expected)
+        _run_tasks(ray, groups, handle, run_batch, workers, task_seconds, expected)
 
 
 def _run_tasks(
@@ -411,9 +595,11 @@ def _run_tasks(
     run_batch: Callable[[Batch], list[list[JobOutcome]]],
     workers: int,
     task_seconds: float,
+    expected: str,
 ) -> None:
-    """The task loop of :func:`run_ray`, on an initialised Ray."""
-    remote = ray.remote(num_cpus=1, max_retries=2)(run_batch)
+    """The task loop of :func:`run_ray`, on an initialised Ray; a task whose worker's code
+    fingerprint is not ``expected`` stops it (:class:`CodeMismatchError`) unstored."""
+    remote = ray.remote(num_cpus=1, max_retries=MAX_RETRIES)(fingerprinted)
     window = 2 * max(1, workers)
     sizer = TaskSizer(task_seconds)
     queue = sized_batches(deque(list(g) for g in groups), sizer)
@@ -425,20 +611,22 @@ def _run_tasks(
                 batch = again.popleft() if again else next(queue, None)
                 if batch is None:
                     break
-                pending[remote.remote(batch)] = batch
+                pending[remote.remote(run_batch, batch, expected)] = batch
             if not pending:
                 break
             ready, _ = ray.wait(list(pending), num_returns=1)
             for ref in ready:
                 batch = pending.pop(ref)
                 try:
-                    outcomes = ray.get(ref)
+                    theirs, where, outcomes = ray.get(ref)
                 except ray.exceptions.RayError as exc:
                     pieces = _split(batch)
                     if pieces is not None:
                         again.extend(pieces)
                         continue
-                    outcomes = [[_crash_outcome(batch[0][0], exc)]]
+                    theirs, outcomes = expected, [[_crash_outcome(batch[0][0], exc)]]
+                if theirs != expected:
+                    raise _mismatch(where, theirs, expected)
                 for group in outcomes:
                     sizer.add(group)
                     handle(group)

@@ -129,12 +129,13 @@ def bench_cmd(
     """
     import os
     import time
+    from contextlib import ExitStack
 
     from uvnav.bench.campaign import ENGINES
     from uvnav.bench.ray_engine import (
         ClusterConnectionError,
         EngineUnavailableError,
-        check_cluster,
+        cluster_session,
         import_ray,
     )
     from uvnav.bench.spec import load_campaign, run_campaign_spec
@@ -146,6 +147,7 @@ def bench_cmd(
     if address is not None and engine != "ray":
         raise CliError("--address needs --engine ray")
     spec = load_campaign(campaign)
+    session = ExitStack()  # the Ray cluster's connection, when one is given
     if engine == "ray":
         try:
             import_ray()  # before the database is created
@@ -153,8 +155,8 @@ def bench_cmd(
             raise CliError(str(exc), code=1) from None
         cluster = address or os.environ.get("RAY_ADDRESS") or None
         if cluster is not None:
-            try:
-                check_cluster(cluster)  # fails in seconds, before the database is created
+            try:  # fails in seconds, before the database is created; held for the run
+                session.enter_context(cluster_session(cluster))
             except ClusterConnectionError as exc:
                 raise CliError(f"--address: {exc}") from None
     probe_factory = _mcap_folder(mcap_dir) if mcap_dir is not None else None
@@ -162,7 +164,7 @@ def bench_cmd(
     too_many = too_many_workers(n_workers) if engine == "local" else None  # Ray: a cluster's
     if too_many is not None:
         raise CliError(f"--workers: {too_many} for --engine local")
-    with ResultsStore(db) as store:
+    with session, ResultsStore(db) as store:  # Ray's connection ends before the summary
         if resume:
             before = next((c for c in store.campaigns() if c["name"] == spec.name), None)
             if before is not None and before["config"] != spec.config():
