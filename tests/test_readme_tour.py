@@ -34,6 +34,10 @@ SKIP: dict[str, str] = {
     "make test": "the set-up and the test suite, which CI runs before the tour",
     "source .venv/bin/activate": "the tour runs the installed console script directly",
     "uvnav replay my_bag/": "a user's own bag; the line before it replays the tour's run.mcap",
+    "ray get-auth-token": "a multi-node cluster (tests/bench/test_bench_ray_cluster.py starts one)",
+    "ray start": "a multi-node cluster (tests/bench/test_bench_ray_cluster.py starts one)",
+    "RAY_AUTH_MODE=token": "a multi-node cluster (tests/bench/test_bench_ray_cluster.py starts one)",
+    "uvnav bench my-campaign.yaml --engine ray --address": "needs the cluster of the lines above",
 }
 
 #: the quick size: (pattern, replacement) applied in order to each line
