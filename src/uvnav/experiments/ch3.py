@@ -21,24 +21,17 @@
    ``PREDICTION_MIN_SEEDS`` seeds per family; :func:`prediction_finding` turns the numbers into
    the section's one sentence.
 
-Every episode is an ordinary campaign job (:func:`ch3_job`: a :class:`~uvnav.bench.campaign.Job`
-with this chapter's runner) stored in the results database (SQLite, :class:`ResultsStore`) in
-its own transaction as it finishes, the controller column holding the law and ``params`` the
-motion knowledge (``{"motion": "known"|"predicted"}``, and ``"constant"`` in
-``ch3-prediction``); every campaign carries the code's :func:`fingerprint`, and a run refuses to
-resume a campaign stored by other code (:class:`~uvnav.bench.store.StaleCampaignError`, one line
-naming it for ``uvnav forget``); the table "thesis reported vs uvnav measured" is read back from
-the stored rows. Figures are made by an injected renderer (``render=``; the CLI passes
+Every episode is a campaign job (:func:`ch3_job`, this chapter's runner) run and stored by
+:mod:`uvnav.experiments.campaigns` (resumable, fingerprinted, additive), the controller column
+holding the law and ``params`` the motion knowledge (``{"motion": "known"|"predicted"}``, and
+``"constant"`` in ``ch3-prediction``); the table "thesis reported vs uvnav measured" is read back
+from the stored rows. Figures are made by an injected renderer (``render=``; the CLI passes
 :func:`uvnav.viz.figures3d.render_ch3`), so this module never imports ``viz`` (DESIGN §1
 layers).
-
-Run it alone with ``uvnav reproduce ch3 [--seeds N] [--start-seed S] [--workers W]``; a run adds
-to the store (resume), it never replaces another run's episodes.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import time
 from collections.abc import Callable, Sequence
@@ -48,24 +41,10 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.bench.campaign import (
-    EpisodeRun,
-    Job,
-    JobOutcome,
-    outcome_record,
-    run_in_workers,
-    run_job,
-    run_stored,
-    store_outcome,
-)
+import uvnav.experiments.campaigns as cp
+from uvnav.bench.campaign import EpisodeRun, Job
 from uvnav.bench.fingerprint import DB_NAME
-from uvnav.bench.store import (
-    FINGERPRINT_KEY,
-    EpisodeKey,
-    ResultsStore,
-    check_fingerprints,
-    extend_fingerprint,
-)
+from uvnav.bench.store import FINGERPRINT_KEY, EpisodeKey, ResultsStore, check_fingerprints
 
 CONTROLLERS_3D: tuple[str, ...] = ("zhang2020-3d-v1", "apf3d-v1", "vo3d-v1")
 SCENES_CAMPAIGN = "ch3-thesis-scenes"
@@ -148,24 +127,13 @@ def _run_job(job: Job) -> EpisodeRun:
 
 def fingerprint() -> str:
     """The code fingerprint of this chapter's campaigns: the packages that decide an episode
-    (``code_fingerprint`` of :mod:`uvnav.experiments.ch2`) and this module (its runner)."""
-    from uvnav.bench.fingerprint import code_fingerprint
-
-    return extend_fingerprint(code_fingerprint(), "experiments/ch3.py")
+    and this module (its runner)."""
+    return cp.fingerprint("experiments/ch3.py")
 
 
-def _announce(total: int) -> Callable[[JobOutcome, int], None]:
-    """An ``on_outcome`` printing one line per episode run (``progress``)."""
-    done = 0
-
-    def say(out: JobOutcome, _episode: int) -> None:
-        nonlocal done
-        done += 1
-        job = out.job
-        print(f"  {done}/{total} {job.label} {job.controller} {dict(job.tags)['motion']}: "
-              f"{out.status}")  # fmt: skip
-
-    return say
+def _say(campaign: str, progress: bool) -> cp.Progress | None:
+    """With ``progress``, a ``progress`` printing one line per episode run."""
+    return (lambda done, total: print(f"  {campaign}: {done}/{total}")) if progress else None
 
 
 def prediction_errors(n_series: int = 20, length: int = 120) -> dict[str, float]:
@@ -331,7 +299,8 @@ def prediction_study(
     check_fingerprints(store, {PREDICTION_CAMPAIGN: fp})
     jobs = prediction_jobs(n_seeds, start_seed)
     config = {"chapter": 3, "law": PREDICTION_LAW, "seeds": n_seeds, FINGERPRINT_KEY: fp}
-    _run_stored(store, PREDICTION_CAMPAIGN, config, jobs, workers, progress)
+    cp.run_jobs(store, PREDICTION_CAMPAIGN, jobs, config=config, workers=workers,
+                progress=_say(PREDICTION_CAMPAIGN, progress))  # fmt: skip
     frame = _requested(store.episodes_frame(PREDICTION_CAMPAIGN), jobs)
     errors = {fam: horizon_errors(motion) for fam, motion in PREDICTION_FAMILIES.items()}
     seeds = range(start_seed, start_seed + n_seeds)
@@ -434,54 +403,6 @@ def prediction_finding(study: dict[str, Any]) -> str:
     )
 
 
-def _run_stored(
-    store: ResultsStore,
-    campaign: str,
-    config: dict[str, Any],
-    jobs: list[Job],
-    workers: int,
-    progress: bool,
-) -> None:
-    """Run the jobs of ``campaign`` the store lacks, each stored in its own transaction as it
-    finishes (:func:`~uvnav.bench.campaign.run_stored`: an interrupt loses only the episodes in
-    flight); other jobs' episodes already in the campaign are kept."""
-    total = len({j.key for j in jobs} - store.done_keys(store.campaign(campaign, config)))
-    say = _announce(total) if progress else None
-    run_stored(store, campaign, jobs, config=config, workers=workers, on_outcome=say)
-
-
-def _rerun_recorded(
-    store: ResultsStore,
-    campaign: str,
-    config: dict[str, Any],
-    jobs: list[Job],
-    workers: int,
-) -> dict[EpisodeKey, Any]:
-    """Run every job again with its trajectory recorded (for the figures); an episode the
-    campaign lacks is stored in its own transaction as it finishes, a stored one is kept.
-
-    Returns:
-        The recorded trajectory of each job by its resume key.
-
-    Raises:
-        RuntimeError: an episode failed (the one stored before is kept).
-    """
-    kept: dict[EpisodeKey, Any] = {}
-    with store.writer_lease():
-        cid = store.campaign(campaign, config)
-        done = store.done_keys(cid, include_errors=False)
-
-        def keep(out: JobOutcome) -> None:
-            outcome_record(out)  # raises for a failed episode
-            if out.job.key not in done:
-                store_outcome(store, cid, out)
-            kept[out.job.key] = out.result
-
-        recorded = [dataclasses.replace(j, record=True) for j in jobs]
-        run_in_workers(recorded, run_job, keep, workers=workers)
-    return kept
-
-
 def _requested(frame: Any, jobs: list[Job]) -> Any:
     """The rows of ``frame`` (a campaign's episodes) that belong to ``jobs``, in job order: the
     table of a run describes what it asked for; the store keeps every other run's rows."""
@@ -557,11 +478,14 @@ def reproduce_ch3(
         size = {"chapter": 3, "controllers": list(controllers), FINGERPRINT_KEY: fp}
         scene_cfg = {**size, "seed": 0}
         if render is not None:  # the figures' trajectories (not stored): the scenes run again
-            recorded = _rerun_recorded(store, SCENES_CAMPAIGN, scene_cfg, scene_jobs, workers)
+            recorded = cp.run_recorded(
+                store, SCENES_CAMPAIGN, scene_jobs, config=scene_cfg, workers=workers
+            )
         else:
-            _run_stored(store, SCENES_CAMPAIGN, scene_cfg, scene_jobs, workers, progress)
-        _run_stored(store, RANDOM_CAMPAIGN, {**size, "seeds": n_seeds}, rand_jobs, workers,
-                    progress)  # fmt: skip
+            cp.run_jobs(store, SCENES_CAMPAIGN, scene_jobs, config=scene_cfg, workers=workers,
+                        progress=_say(SCENES_CAMPAIGN, progress))  # fmt: skip
+        cp.run_jobs(store, RANDOM_CAMPAIGN, rand_jobs, config={**size, "seeds": n_seeds},
+                    workers=workers, progress=_say(RANDOM_CAMPAIGN, progress))  # fmt: skip
         frame = _requested(store.episodes_frame(RANDOM_CAMPAIGN), rand_jobs)
         scene_frame = _requested(store.episodes_frame(SCENES_CAMPAIGN), scene_jobs)
         study = (
