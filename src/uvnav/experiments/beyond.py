@@ -30,6 +30,7 @@ from uvnav.bench.campaign import EpisodeRun, Job
 from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, check_fingerprints
 from uvnav.controllers.base import make_controller
+from uvnav.experiments.rows import table_row
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.scenarios.multi import build_multi, load_multi_scenario
@@ -110,12 +111,12 @@ def office_rows(
     for i, law in enumerate(laws):
         alone, hybrid = recs[2 * i], recs[2 * i + 1]
         rows.append(
-            {
-                "quantity": f"Global+local, {scenario}: {law} alone / hybrid-v1 with {law}",
-                "thesis": BEYOND,
-                "measured": f"alone: {_episode_text(alone)}; hybrid: {_episode_text(hybrid)}",
-                "note": "hybrid-v1 learns the walls from its observation and replans with D* Lite",
-            }
+            table_row(
+                f"Global+local, {scenario}: {law} alone / hybrid-v1 with {law}",
+                BEYOND,
+                f"alone: {_episode_text(alone)}; hybrid: {_episode_text(hybrid)}",
+                "hybrid-v1 learns the walls from its observation and replans with D* Lite",
+            )
         )
     return rows
 
@@ -135,13 +136,13 @@ def swap_rows(
         mk = f"{g['makespan']:.1f} s" if g["makespan"] is not None else "n/a"
         label = name + (f" ({', '.join(f'{k}={v}' for k, v in params.items())})" if params else "")
         rows.append(
-            {
-                "quantity": f"Multi-robot, {spec}: {label}",
-                "thesis": BEYOND,
-                "measured": f"{g['arrived']}/{n} arrived, {g['robot_collisions']} robot-robot "
+            table_row(
+                f"Multi-robot, {spec}: {label}",
+                BEYOND,
+                f"{g['arrived']}/{n} arrived, {g['robot_collisions']} robot-robot "
                 f"collisions, {g['deadlocks']} deadlocked, makespan {mk}",
-                "note": "each robot senses the others as moving discs (5 m range); no messages",
-            }
+                "each robot senses the others as moving discs (5 m range); no messages",
+            )
         )
     return rows
 
@@ -227,13 +228,13 @@ def replan_rows(size: int = 500, n_changes: int = 3, seed: int = 0) -> list[dict
         ratios_t.append(a_t / d_t)
         path = planner.path()
     return [
-        {
-            "quantity": f"Replanning after a local change, {size}x{size} grid: "
+        table_row(
+            f"Replanning after a local change, {size}x{size} grid: "
             "A* from scratch / D* Lite replan",
-            "thesis": BEYOND,
-            "measured": f"{statistics.median(ratios_exp):.0f}x fewer expansions, "
+            BEYOND,
+            f"{statistics.median(ratios_exp):.0f}x fewer expansions, "
             f"{statistics.median(ratios_t):.0f}x less time",
-            "note": f"median of {len(ratios_exp)} changes (3x3 obstacle on the path); equal "
+            f"median of {len(ratios_exp)} changes (3x3 obstacle on the path); equal "
             "path costs checked; issue-9 target >= 10x",
-        }
+        )
     ]

@@ -45,6 +45,7 @@ import uvnav.experiments.campaigns as cp
 from uvnav.bench.campaign import EpisodeRun, Job
 from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.store import FINGERPRINT_KEY, EpisodeKey, ResultsStore, check_fingerprints
+from uvnav.experiments.rows import table_row
 
 CONTROLLERS_3D: tuple[str, ...] = ("zhang2020-3d-v1", "apf3d-v1", "vo3d-v1")
 SCENES_CAMPAIGN = "ch3-thesis-scenes"
@@ -316,19 +317,23 @@ def prediction_rows(study: dict[str, Any]) -> list[dict[str, str]]:
     rows: list[dict[str, str]] = []
     for fam, e in study["errors"].items():
         for k in HORIZONS:
-            rows.append({
-                "quantity": f"{fam}: {k}-step velocity prediction RMS error [m/s]",
-                "thesis": "AR model (3.13)-(3.14), no numbers",
-                "measured": f"AR {e[f'v{k}_ar']:.4f} vs constant velocity {e[f'v{k}_cv']:.4f}",
-                "note": f"{int(e['series'])} body series, T_s = 1 s, true velocities",
-            })  # fmt: skip
+            rows.append(
+                table_row(
+                    f"{fam}: {k}-step velocity prediction RMS error [m/s]",
+                    "AR model (3.13)-(3.14), no numbers",
+                    f"AR {e[f'v{k}_ar']:.4f} vs constant velocity {e[f'v{k}_cv']:.4f}",
+                    f"{int(e['series'])} body series, T_s = 1 s, true velocities",
+                )
+            )
         k = max(HORIZONS)
-        rows.append({
-            "quantity": f"{fam}: {k} s position prediction RMS error [m]",
-            "thesis": "",
-            "measured": f"AR {e[f'p{k}_ar']:.4f} vs constant velocity {e[f'p{k}_cv']:.4f}",
-            "note": "positions from the predicted velocity samples",
-        })  # fmt: skip
+        rows.append(
+            table_row(
+                f"{fam}: {k} s position prediction RMS error [m]",
+                "",
+                f"AR {e[f'p{k}_ar']:.4f} vs constant velocity {e[f'p{k}_cv']:.4f}",
+                "positions from the predicted velocity samples",
+            )
+        )
     cl = study["closed_loop"]
     for fam in study["errors"]:
         parts = []
@@ -341,21 +346,24 @@ def prediction_rows(study: dict[str, Any]) -> list[dict[str, str]]:
             f"{PREDICTION_ARMS[a]} {cl[f'{fam}|{a}']['min_clearance']:.3f} m"
             for a in PREDICTION_ARMS if f"{fam}|{a}" in cl
         )  # fmt: skip
-        rows.append({
-            "quantity": f"{fam}: {PREDICTION_LAW} success by prediction",
-            "thesis": "",
-            "measured": f"{' / '.join(parts)} of {n}",
-            "note": f"mean min clearance: {clear}",
-        })  # fmt: skip
+        rows.append(
+            table_row(
+                f"{fam}: {PREDICTION_LAW} success by prediction",
+                "",
+                f"{' / '.join(parts)} of {n}",
+                f"mean min clearance: {clear}",
+            )
+        )
         use = study.get("usage", {}).get(fam)
         if use is not None:
-            rows.append({
-                "quantity": f"{fam}: M2 predictions made by AR fits (not the fallback)",
-                "thesis": "",
-                "measured": f"{100 * use['ar_share']:.1f}% of {int(use['decisions'])}",
-                "note": "the rest: constant velocity (under 12 samples of the body, or "
-                        "fits rejected)",
-            })  # fmt: skip
+            rows.append(
+                table_row(
+                    f"{fam}: M2 predictions made by AR fits (not the fallback)",
+                    "",
+                    f"{100 * use['ar_share']:.1f}% of {int(use['decisions'])}",
+                    "the rest: constant velocity (under 12 samples of the body, or fits rejected)",
+                )
+            )
     return rows
 
 
@@ -498,23 +506,27 @@ def reproduce_ch3(
     for _, row in scene_frame.iterrows():
         if row["controller"] != controllers[0]:
             continue
-        table.append({
-            "quantity": f"{row['scenario']} ({row['controller']})",
-            "thesis": THESIS_CLAIMS.get(str(row["scenario"]), ""),
-            "measured": f"{row['status']}, min clearance {row['min_clearance']:.2f} m, "
-                        f"path {row['path_length']:.1f} m",
-            "note": "rates estimated from sensing, AR-predicted",
-        })  # fmt: skip
+        table.append(
+            table_row(
+                f"{row['scenario']} ({row['controller']})",
+                THESIS_CLAIMS.get(str(row["scenario"]), ""),
+                f"{row['status']}, min clearance {row['min_clearance']:.2f} m, "
+                f"path {row['path_length']:.1f} m",
+                "rates estimated from sensing, AR-predicted",
+            )
+        )
     failures: list[dict[str, Any]] = []
     for (ctrl, params), grp in frame.groupby(["controller", "params"]):
         motion = json.loads(str(params)).get("motion", "") if str(params).startswith("{") else ""
         rate = float(grp["success"].astype(float).mean())
-        table.append({
-            "quantity": f"random-ch3 success, {ctrl}, motion {motion or params}",
-            "thesis": ">= 98% (issue target for zhang2020-3d)" if ctrl == controllers[0] else "",
-            "measured": f"{100 * rate:.1f}% of {len(grp)}",
-            "note": f"collisions {int(grp['collision'].astype(float).sum())}",
-        })  # fmt: skip
+        table.append(
+            table_row(
+                f"random-ch3 success, {ctrl}, motion {motion or params}",
+                ">= 98% (issue target for zhang2020-3d)" if ctrl == controllers[0] else "",
+                f"{100 * rate:.1f}% of {len(grp)}",
+                f"collisions {int(grp['collision'].astype(float).sum())}",
+            )
+        )
         for _, fr in grp[~grp["success"].astype(bool)].iterrows():
             cause = (
                 f"collision (min clearance {fr['min_clearance']:.3f} m)"
@@ -526,12 +538,14 @@ def reproduce_ch3(
                 "motion": motion, "params": params, "status": fr["status"],
                 "min_clearance": fr["min_clearance"], "cause": cause,
             })  # fmt: skip
-    table.append({
-        "quantity": "one-step velocity prediction RMS error [m/s]",
-        "thesis": "AR model (3.13)-(3.14), no numbers",
-        "measured": f"AR {pred['ar_rms']:.4f} vs constant velocity {pred['constant_rms']:.4f}",
-        "note": f"{int(pred['series'])} obstacle series of the random scenes",
-    })  # fmt: skip
+    table.append(
+        table_row(
+            "one-step velocity prediction RMS error [m/s]",
+            "AR model (3.13)-(3.14), no numbers",
+            f"AR {pred['ar_rms']:.4f} vs constant velocity {pred['constant_rms']:.4f}",
+            f"{int(pred['series'])} obstacle series of the random scenes",
+        )
+    )
     finding = ""
     if study:
         table += prediction_rows(study)

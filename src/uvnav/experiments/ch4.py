@@ -48,6 +48,7 @@ from uvnav.bench.campaign import EpisodeRun, Job, outcome_record, run_job, store
 from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, check_fingerprints
 from uvnav.controllers.base import make_law
+from uvnav.experiments.rows import table_row
 from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin, load_uuv2d_scenario
 from uvnav.sim.episode_uuv2d import Uuv2dTrajectory
 from uvnav.sim.metrics import METRIC_NAMES
@@ -230,17 +231,13 @@ def target_approach_check(traj: Uuv2dTrajectory, until: float = FIG47_UNTIL) -> 
 
 def _fig47_row(check: dict[str, float]) -> dict[str, Any]:
     held = "held" if check["target_approach"] else "NOT held"
-    return {
-        "quantity": f"Ch.4 Fig. 4.7: target approach for t = 0...{FIG47_UNTIL:g} s",
-        "thesis": f"t = 0...{FIG47_UNTIL:g} in target approach",
-        "measured": (
-            f"{held}; at ({check['x_m']:.2f}, {check['y_m']:.2f}) m at t = {FIG47_UNTIL:g} s"
-        ),
-        "note": (
-            f"{LAW}; clearance {check['clearance_m']:.2f} m there; first avoidance decision at "
-            f"t = {check['first_avoidance_s']:.1f} s"
-        ),
-    }
+    return table_row(
+        f"Ch.4 Fig. 4.7: target approach for t = 0...{FIG47_UNTIL:g} s",
+        f"t = 0...{FIG47_UNTIL:g} in target approach",
+        f"{held}; at ({check['x_m']:.2f}, {check['y_m']:.2f}) m at t = {FIG47_UNTIL:g} s",
+        f"{LAW}; clearance {check['clearance_m']:.2f} m there; first avoidance decision at "
+        f"t = {check['first_avoidance_s']:.1f} s",
+    )
 
 
 def _table(
@@ -254,29 +251,27 @@ def _table(
             continue
         clear = r["min_clearance"]
         table.append(
-            {
-                "quantity": f"Ch.4 {r['scene']}: outcome",
-                "thesis": "reaches E, no collision (figure only)",
-                "measured": f"{r['status']}, min clearance "
+            table_row(
+                f"Ch.4 {r['scene']}: outcome",
+                "reaches E, no collision (figure only)",
+                f"{r['status']}, min clearance "
                 + (f"{clear:.3f} m" if clear is not None else "-")
                 + (", ENTERED inner space" if r["entered_forbidden"] else ""),
-                "verdict": (
-                    "reproduced"
-                    if r["status"] == "success" and not r["entered_forbidden"]
-                    else "differs"
-                ),
-                "note": LAW,
-            }
+                LAW,
+                verdict="reproduced"
+                if r["status"] == "success" and not r["entered_forbidden"]
+                else "differs",
+            )
         )
     for c in campaign:
         if c["noise_std"] == 0 and c["dropout"] == 0:
             table.append(
-                {
-                    "quantity": f"Ch.4 {c['family']} success ({c['law']}, n={c['episodes']})",
-                    "thesis": "not reported",
-                    "measured": f"{100 * c['success_rate']:.1f} %",
-                    "note": f"collisions {100 * c['collision_rate']:.1f} %",
-                }
+                table_row(
+                    f"Ch.4 {c['family']} success ({c['law']}, n={c['episodes']})",
+                    "not reported",
+                    f"{100 * c['success_rate']:.1f} %",
+                    f"collisions {100 * c['collision_rate']:.1f} %",
+                )
             )
     return table
 

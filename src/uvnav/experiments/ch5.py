@@ -73,6 +73,7 @@ from uvnav.experiments.ch5_bpnn import (
     learning_row,
     learning_table,
 )
+from uvnav.experiments.rows import table_row
 from uvnav.learning.bpnn import (
     THESIS_ACCEPTED,
     VARIANTS,
@@ -297,12 +298,12 @@ def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
             ok = sum(bool(r["success"]) for r in thesis_rows)
             inner = sum(bool(r["entered_inner_space"]) for r in thesis_rows)
             rows.append(
-                {
-                    "quantity": f"Ch5 thesis scenes reached, no collision ({loc}, noise {noise} m)",
-                    "thesis": "3/3",
-                    "measured": f"{ok}/{len(thesis_rows)}",
-                    "note": f"entered Scene 2 inner space: {inner}",
-                }
+                table_row(
+                    f"Ch5 thesis scenes reached, no collision ({loc}, noise {noise} m)",
+                    "3/3",
+                    f"{ok}/{len(thesis_rows)}",
+                    f"entered Scene 2 inner space: {inner}",
+                )
             )
         families = (
             ("random scenes", rand_rows),
@@ -314,18 +315,18 @@ def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
             ok = sum(bool(r["success"]) for r in fam_rows)
             fails = [f"{r['scene']} {r['status']}" for r in fam_rows if not r["success"]]
             rows.append(
-                {
-                    "quantity": f"Ch5 {label} success ({loc}, noise {noise} m)",
-                    "thesis": "-",
-                    "measured": f"{ok / len(fam_rows):.1%} of {len(fam_rows)}",
-                    "note": (
+                table_row(
+                    f"Ch5 {label} success ({loc}, noise {noise} m)",
+                    "-",
+                    f"{ok / len(fam_rows):.1%} of {len(fam_rows)}",
+                    (
                         f"{len(fails)} failures: "
                         + ", ".join(fails[:6])
                         + (", ..." if len(fails) > 6 else "")
                     )
                     if fails
                     else "no failure",
-                }
+                )
             )
     return rows
 

@@ -40,6 +40,7 @@ from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
 from uvnav.bench.jobs import Job
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
+from uvnav.experiments.rows import rate_text, table_row
 from uvnav.experiments.sections import ChapterSection, mode_text, rows_of
 
 CAMPAIGN = "crowdnav"
@@ -184,11 +185,6 @@ def reproduce_crowds(
 # ------------------------------------------------------------------------------------ the table
 
 
-def _rate(k: int, n: int) -> str:
-    lo, hi = wilson_interval(k, n)
-    return f"{k / n:.2f} [{lo:.2f}, {hi:.2f}]"
-
-
 def _mean(g: Any, name: str) -> float | None:
     col = g[name].dropna().astype(float)
     return float(col.mean()) if len(col) else None
@@ -235,14 +231,14 @@ def _row(gen: str, law: str, g: Any, *, beyond: bool) -> dict[str, str]:
             note = f"the law's assumption does not hold: {why}"
         else:
             measured, note = f"errors only ({errors})", ""
-        return {"quantity": quantity, "thesis": thesis, "measured": measured, "note": note}
+        return table_row(quantity, thesis, measured, note)
     st = ok["status"].astype(str)
     k_ok, k_hit = int((st == "success").sum()), int((st == "collision").sum())
     k_out = int((st == "timeout").sum())
     wins = ok[st == "success"]
     ttg = _mean(wins, "time_to_goal") if len(wins) else None
     measured = (
-        f"success {_rate(k_ok, n)}, collision {_rate(k_hit, n)}, timeout {k_out / n:.2f} "
+        f"success {rate_text(k_ok, n)}, collision {rate_text(k_hit, n)}, timeout {k_out / n:.2f} "
         f"(n={n}); time to goal {'n/a' if ttg is None else f'{ttg:.2f} s'}"
     )
     extra = []
@@ -258,7 +254,7 @@ def _row(gen: str, law: str, g: Any, *, beyond: bool) -> dict[str, str]:
     if errors:
         extra.append(f"errors {errors}")
     note = "; ".join([*extra, _social_note(ok)] if _social_note(ok) else extra)
-    row = {"quantity": quantity, "thesis": thesis, "measured": measured, "note": note}
+    row = table_row(quantity, thesis, measured, note)
     if paper:  # the paper's figure against ours: inside our 95 % interval or not
         row["verdict"] = "reproduced" if inside else "differs"
     return row
