@@ -18,18 +18,9 @@ sections to a *renderer* passed in by the caller (the CLI passes
 ``uvnav run`` (:func:`uvnav.experiments.run_all`) are experiments of their own; there Chapter 2's
 :func:`finish` writes the page with every experiment's section.
 
-Layering (DESIGN §1): ``uvnav.viz`` sits above ``uvnav.experiments`` in the layers, so this
-module never imports it: the renderer is injected (``render=``), which keeps the layer contract
-enforceable.
-``matplotlib`` is never imported here.
-
-Resume and staleness: every campaign carries a fingerprint of the code and scenario files that
-decide episode outcomes (:func:`uvnav.bench.fingerprint.code_fingerprint`).  Re-running with
-unchanged code resumes (an interrupted run only finishes what is missing; a finished one costs
-nothing).  If the code changed since a campaign was stored, the run refuses
-(:class:`~uvnav.bench.store.StaleCampaignError`, one line naming the campaign to remove with
-``uvnav forget``), so the table never mixes results of different code and no run deletes another
-run's episodes.
+``uvnav.viz`` is a layer above (DESIGN §1): the renderer is injected (``render=``), so neither it
+nor ``matplotlib`` is imported here.  The campaigns resume, carry the code fingerprint and only
+add (:mod:`uvnav.experiments.campaigns`).
 """
 
 from __future__ import annotations
@@ -42,9 +33,10 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
+from uvnav.bench.fingerprint import DB_NAME, code_fingerprint
 from uvnav.bench.jobs import Job
 from uvnav.bench.store import STATUS_ERROR, ResultsStore
+from uvnav.experiments.campaigns import run_checked
 from uvnav.experiments.rows import m_text, table_row
 from uvnav.experiments.sections import SECTIONS_DIR, ChapterSection, ch2_section, save_section
 

@@ -139,27 +139,10 @@ def _say(campaign: str, progress: bool) -> cp.Progress | None:
 
 def prediction_errors(n_series: int = 20, length: int = 120) -> dict[str, float]:
     """One-step velocity prediction RMS error [m/s] of the AR models and of constant velocity on
-    the AR motion of the random scenes' obstacles (one series per obstacle of scenes 0, 1, ...)."""
-    from uvnav.obstacles.motion3d import ObstacleState3D
-    from uvnav.prediction.autoregressive import ARPredictor, one_step_errors, rms
-    from uvnav.scenarios.generators3d import random_ch3_scenario
-
-    e_ar: list[np.ndarray] = []
-    e_cv: list[np.ndarray] = []
-    seed = 0
-    while len(e_ar) < n_series:
-        sc = random_ch3_scenario(seed)
-        setup = sc.build(seed)
-        for ob in setup.obstacles:
-            st = ObstacleState3D(np.zeros(3))
-            series = np.array([ob.motion.rates(float(k), st)[0] for k in range(length)])
-            a, c = one_step_errors(series, ARPredictor(dim=3, max_lag=3))
-            e_ar.append(a)
-            e_cv.append(c)
-        seed += 1
-    ar = rms(np.concatenate(e_ar))
-    cv = rms(np.concatenate(e_cv))
-    return {"ar_rms": ar, "constant_rms": cv, "series": float(len(e_ar)), "ratio": ar / cv}
+    the AR motion of the random scenes' obstacles (:func:`horizon_errors` at k = 1)."""
+    e = horizon_errors("ar", n_series, length, horizons=(1,))
+    ar, cv = e["v1_ar"], e["v1_cv"]
+    return {"ar_rms": ar, "constant_rms": cv, "series": e["series"], "ratio": ar / cv}
 
 
 def horizon_errors(
@@ -172,7 +155,7 @@ def horizon_errors(
     """k-step prediction RMS errors of the AR models and of constant velocity on the bodies of
     the ``random-ch3`` scenes with ``motion`` (one series per body of scenes 0, 1, ... until
     ``n_series``, each ``length`` samples of the true velocity taken every ``period`` T_s [s],
-    the predictor of :func:`prediction_errors`).
+    the predictor ``ARPredictor(dim=3, max_lag=3)``).
 
     After each sample v_i (from the predictor's ``min_samples`` on) both predict v_{i+k}: AR by
     iterating (3.13), constant velocity by v_i.  A sample is held over its period, so the body
@@ -452,11 +435,8 @@ def reproduce_ch3(
         prediction_seeds: seeds per family of the prediction comparison (default: the random
             campaign's, at least ``PREDICTION_MIN_SEEDS``); 0 skips it.
 
-    Resumable and additive: every episode is stored in its own transaction as it finishes, so
-    an interrupted run keeps what it finished; episodes already in the store are not run again
-    (the thesis scenes run again only for the figures' trajectories), and another run's
-    episodes (other controllers, other seeds) are kept; the table describes the episodes this
-    call asked for.
+    Resumable and additive (:mod:`uvnav.experiments.campaigns`; the thesis scenes run again
+    only for the figures' trajectories); the table describes the episodes this call asked for.
 
     Raises:
         StaleCampaignError: a stored campaign of this run was made by other code (its

@@ -302,9 +302,8 @@ def reproduce_ch4(
         progress: ``progress(done, total)`` after each campaign episode.
         start_seed: first seed of every random family (seeds ``start_seed`` onwards).
 
-    Additive: an episode already in the store is never run again nor replaced (the thesis
-    scenes run again for the figures' trajectories, but only missing ones are stored), and
-    other runs' episodes are kept; each is stored in its own transaction as it finishes.
+    Additive (:mod:`uvnav.experiments.campaigns`): the thesis scenes run again for the figures'
+    trajectories, only missing episodes are stored.
 
     Raises:
         StaleCampaignError: a stored campaign of this chapter was made by other code (its

@@ -411,9 +411,8 @@ def reproduce_ch5(
             targets (min/argmin of its inputs) at each of ``sizes`` the thesis reports (50, 150);
             default 20 quick, 50 full.
 
-    Additive: an episode already in the store is never run again nor replaced (the thesis
-    scenes run again for the figures' trajectories, but only missing ones are stored), and other
-    runs' episodes are kept; each is stored in its own transaction as it finishes.
+    Additive (:mod:`uvnav.experiments.campaigns`): the thesis scenes run again for the figures'
+    trajectories, only missing episodes are stored.
 
     Raises:
         StaleCampaignError: a stored campaign of this chapter was made by other code (its

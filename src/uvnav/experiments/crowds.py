@@ -21,11 +21,9 @@ beyond that assumption, in a separate campaign :data:`BEYOND_CAMPAIGN` whose row
 ``zhang2019-v1`` inside and inherits that law's assumption (``ControllerInfo.inner_law``), so it is
 refused and run beyond like it.
 
-Both campaigns live in the results store ``results_dir/uvnav.sqlite``, carry the code
-fingerprint (:func:`uvnav.bench.fingerprint.code_fingerprint`) and only add: a second run skips
-every stored episode; a campaign stored by other code is refused
-(:class:`~uvnav.bench.store.StaleCampaignError`).  The table shows the run's own cases (those it
-ran or found stored); ``uvnav report`` rebuilds it from every stored case (:func:`crowd_rows`).
+Both campaigns live in ``results_dir/uvnav.sqlite`` (:mod:`uvnav.experiments.campaigns`:
+resumable, fingerprinted, additive).  The table shows the run's own cases (those it ran or found
+stored); ``uvnav report`` rebuilds it from every stored case (:func:`crowd_rows`).
 """
 
 from __future__ import annotations
@@ -36,10 +34,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
+from uvnav.bench.fingerprint import DB_NAME, code_fingerprint
 from uvnav.bench.jobs import Job
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
+from uvnav.experiments.campaigns import run_checked
 from uvnav.experiments.rows import rate_text, table_row
 from uvnav.experiments.sections import ChapterSection, mode_text, rows_of
 

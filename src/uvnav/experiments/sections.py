@@ -70,6 +70,15 @@ class ChapterSection:
         for f in files:
             (self.figures if f.path.suffix.lower() in IMAGE_SUFFIXES else self.links).append(f)
 
+    def add_figures(
+        self, paths: Iterable[Path], caption: Callable[[Path], str | None], what: str = ""
+    ) -> None:
+        """Add the existing ``paths`` with their captions (:func:`caption_files`); with ``what``,
+        a note when the section has no figure ("the run had no ``what`` renderer")."""
+        self.add_files(caption_files(paths, caption))
+        if what and not self.figures:
+            self.notes.append(f"No figures: the run had no {what} renderer.")
+
 
 #: Draws Ch. 3 figures: ``(db_path, report_dir, [(scene, law, trajectory)]) -> files``.
 Ch3Renderer = Callable[[Path, Path, list[tuple[str, str, Any]]], list[Path]]
@@ -213,9 +222,7 @@ def ch3_section(
     finding = getattr(summary, "finding", "")
     if finding:
         sec.notes.append(finding)
-    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch3_caption))
-    if not sec.figures:
-        sec.notes.append("No figures: the run had no Chapter 3 renderer.")
+    sec.add_figures(getattr(summary, "figures", []) or [], _ch3_caption, "Chapter 3")
     return sec
 
 
@@ -260,12 +267,10 @@ def ch4_section(
         intro=intro,
         rows=rows_of(summary.table),
     )
-    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch4_caption))
+    sec.add_figures(getattr(summary, "figures", []) or [], _ch4_caption, "Chapter 4")
     p = getattr(summary, "summary_path", None)
     if p is not None:
         sec.links += caption_files([Path(p)], lambda _p: "Chapter 4 results (JSON)")
-    if not sec.figures:
-        sec.notes.append("No figures: the run had no Chapter 4 renderer.")
     return sec
 
 
@@ -346,7 +351,7 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
         intro=intro,
         rows=rows_of(summary.table),
     )
-    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch5_caption))
+    sec.add_figures(getattr(summary, "figures", []) or [], _ch5_caption)
     if p is not None:
         sec.links += caption_files([Path(p)], lambda _p: "Chapter 5 results (JSON)")
     fails = list(getattr(summary, "failures", []) or [])
@@ -415,9 +420,7 @@ def ch6_section(summary: Any | None, *, full: bool) -> ChapterSection:
             "(uvnav reproduce ch6 --full or uvnav drive reproduce --full; measured figures in "
             "docs/thesis-notes.md)."
         )
-    sec.add_files(
-        caption_files(getattr(summary, "figures", []) or [], lambda p: _CH6_CAPTIONS.get(p.stem))
-    )
+    sec.add_figures(getattr(summary, "figures", []) or [], lambda p: _CH6_CAPTIONS.get(p.stem))
     return sec
 
 
@@ -457,9 +460,7 @@ def ch7_section(summary: Any, *, full: bool) -> ChapterSection:
         intro=intro,
         rows=rows_of(summary.table),
     )
-    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch7_caption))
-    if not sec.figures:
-        sec.notes.append("No figures: the run had no Chapter 7 renderer.")
+    sec.add_figures(getattr(summary, "figures", []) or [], _ch7_caption, "Chapter 7")
     return sec
 
 
@@ -512,9 +513,7 @@ def beyond_section(
         intro=intro,
         rows=rows_of(rows),
     )
-    sec.add_files(caption_files(figures, _beyond_caption))
-    if not sec.figures:
-        sec.notes.append("No figures: the run had no beyond-the-thesis renderer.")
+    sec.add_figures(figures, _beyond_caption, "beyond-the-thesis")
     return sec
 
 
