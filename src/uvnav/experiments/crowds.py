@@ -40,7 +40,7 @@ from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
 from uvnav.experiments.campaigns import run_checked
 from uvnav.experiments.rows import rate_text, table_row
-from uvnav.experiments.sections import ChapterSection, mode_text, rows_of
+from uvnav.experiments.sections import TITLES, ChapterSection, mode_text, rows_of
 
 CAMPAIGN = "crowdnav"
 BEYOND_CAMPAIGN = "crowdnav-beyond"
@@ -350,7 +350,7 @@ def crowds_section(summary: CrowdsSummary) -> ChapterSection:
         )
     return ChapterSection(
         key="crowds",
-        title="Beyond the thesis — CrowdNav's crowds, every 2D law",
+        title=TITLES["crowds"],
         intro=intro,
         rows=rows_of(summary.table),
     )

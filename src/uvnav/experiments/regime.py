@@ -51,7 +51,7 @@ from uvnav.bench.summary import wilson_interval
 from uvnav.experiments.campaigns import run_checked
 from uvnav.experiments.crowds import crowd_laws
 from uvnav.experiments.rows import rate_text
-from uvnav.experiments.sections import ChapterSection, mode_text
+from uvnav.experiments.sections import TITLES, ChapterSection, mode_text
 
 CAMPAIGN = "regime-map"
 GENERATOR = "crowdnav-circle"
@@ -623,7 +623,7 @@ def regime_section(summary: RegimeSummary | None, *, full: bool) -> ChapterSecti
         )
     return ChapterSection(
         key="regime",
-        title="Beyond the thesis — where each law wins (regime map)",
+        title=TITLES["regime"],
         intro=(
             f"Every 2D law on CrowdNav's circle crossing over crowd density x pedestrian speed / "
             f"V_max x robot visible or not x sensing (campaign {CAMPAIGN}): {ran}. Every "

@@ -104,6 +104,20 @@ class ChapterRenderers:
     beyond: FolderRenderer | None = None
 
 
+#: The built-in sections' headings by key.
+TITLES: dict[str, str] = {
+    "ch2": "Chapter 2 — a unicycle among moving, deforming obstacles",
+    "ch3": "Chapter 3 — a 3D flying robot with AR prediction",
+    "ch4": "Chapter 4 — a UUV among shape-changing obstacles",
+    "ch5": "Chapter 5 — a 3D UUV with nine sonars and a BPNN",
+    "ch6": "Chapter 6 — a CNN that drives (PilotNet on CarRacing)",
+    "ch7": "Chapter 7 — UAV reconnaissance of a terrain",
+    "crowds": "Beyond the thesis — CrowdNav's crowds, every 2D law",
+    "regime": "Beyond the thesis — where each law wins (regime map)",
+    "beyond": "Beyond the thesis — global planners, hybrid navigation, multi-robot",
+}
+
+
 def mode_text(full: bool) -> str:
     """``"full mode"`` (``uvnav run --full``, thesis-size runs) or ``"quick mode"``."""
     return "full mode" if full else "quick mode"
@@ -164,7 +178,7 @@ def ch2_section(
         )
     return ChapterSection(
         key="ch2",
-        title="Chapter 2 — a unicycle among moving, deforming obstacles",
+        title=TITLES["ch2"],
         intro=intro,
         rows=rows_of(rows),
     )
@@ -215,7 +229,7 @@ def ch3_section(
         )
     sec = ChapterSection(
         key="ch3",
-        title="Chapter 3 — a 3D flying robot with AR prediction",
+        title=TITLES["ch3"],
         intro=intro,
         rows=rows_of(summary.table),
     )
@@ -263,7 +277,7 @@ def ch4_section(
     )
     sec = ChapterSection(
         key="ch4",
-        title="Chapter 4 — a UUV among shape-changing obstacles",
+        title=TITLES["ch4"],
         intro=intro,
         rows=rows_of(summary.table),
     )
@@ -347,7 +361,7 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
     )
     sec = ChapterSection(
         key="ch5",
-        title="Chapter 5 — a 3D UUV with nine sonars and a BPNN",
+        title=TITLES["ch5"],
         intro=intro,
         rows=rows_of(summary.table),
     )
@@ -382,7 +396,7 @@ _CH6_CAPTIONS = {
 def ch6_section(summary: Any | None, *, full: bool) -> ChapterSection:
     """The Chapter 6 section from a :class:`uvnav.experiments.ch6.Ch6Summary` (``None``: not
     run, as in a test-sized run)."""
-    title = "Chapter 6 — a CNN that drives (PilotNet on CarRacing)"
+    title = TITLES["ch6"]
     if summary is None:
         return ChapterSection(
             key="ch6",
@@ -456,7 +470,7 @@ def ch7_section(summary: Any, *, full: bool) -> ChapterSection:
     )
     sec = ChapterSection(
         key="ch7",
-        title="Chapter 7 — UAV reconnaissance of a terrain",
+        title=TITLES["ch7"],
         intro=intro,
         rows=rows_of(summary.table),
     )
@@ -509,7 +523,7 @@ def beyond_section(
     )
     sec = ChapterSection(
         key="beyond",
-        title="Beyond the thesis — global planners, hybrid navigation, multi-robot",
+        title=TITLES["beyond"],
         intro=intro,
         rows=rows_of(rows),
     )
