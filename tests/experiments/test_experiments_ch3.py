@@ -21,7 +21,9 @@ def test_the_default_familys_one_step_figure_is_unchanged() -> None:
     from uvnav.prediction.autoregressive import ARPredictor, one_step_errors, rms
     from uvnav.scenarios.generators3d import random_ch3_scenario
 
-    e_ar, e_cv, seed = [], [], 0
+    e_ar: list[np.ndarray] = []
+    e_cv: list[np.ndarray] = []
+    seed = 0
     while len(e_ar) < 3:
         for ob in random_ch3_scenario(seed).build(seed).obstacles:
             st = ObstacleState3D(np.zeros(3))

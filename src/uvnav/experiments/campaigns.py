@@ -32,7 +32,8 @@ from uvnav.bench.campaign import (
     store_outcome,
     stored_records,
 )
-from uvnav.bench.fingerprint import code_fingerprint, run_checked
+from uvnav.bench.fingerprint import code_fingerprint
+from uvnav.bench.fingerprint import run_checked as run_checked  # scene-job campaigns
 from uvnav.bench.jobs import Job, JobOutcome
 from uvnav.bench.store import EpisodeKey, ResultsStore, extend_fingerprint
 from uvnav.bench.summary import outcome_stats
@@ -165,16 +166,3 @@ def non_successes(rows: Iterable[dict[str, Any]], keep: Sequence[str]) -> list[d
 def family(row: Mapping[str, Any]) -> str:
     """A row's scene family: its ``scene`` before ``:`` (``random-ch4:3`` -> ``random-ch4``)."""
     return str(row["scene"]).split(":", 1)[0]
-
-
-__all__ = [
-    "Progress",
-    "family",
-    "fingerprint",
-    "group_stats",
-    "job_records",
-    "non_successes",
-    "run_checked",
-    "run_jobs",
-    "run_recorded",
-]

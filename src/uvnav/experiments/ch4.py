@@ -366,20 +366,3 @@ def reproduce_ch4(
     if render is not None and report_dir is not None:
         summary.figures = list(render(Path(report_dir) / "ch4", scene_results, summary))
     return summary
-
-
-__all__ = [
-    "LAWS",
-    "METRIC_NAMES",
-    "Ch4Summary",
-    "campaign_jobs",
-    "ch4_job",
-    "failures",
-    "hard_jobs",
-    "reproduce_ch4",
-    "run_ch4_job",
-    "run_jobs",
-    "stored_rows",
-    "summarise",
-    "target_approach_check",
-]

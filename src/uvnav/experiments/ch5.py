@@ -89,7 +89,6 @@ from uvnav.scenarios.ch5 import (
     build_uuv3d,
     list_ch5_builtin,
     load_ch5_scenario,
-    random_ch5_scenario,
 )
 from uvnav.sim.episode_uuv3d import LocatedTrace
 from uvnav.sim.metrics import METRIC_NAMES
@@ -578,20 +577,3 @@ def reproduce_ch5(
     if render is not None and report_dir is not None:
         summary.figures = list(render(summary, Path(report_dir)))
     return summary
-
-
-__all__ = [
-    "CAMPAIGNS",
-    "LAW",
-    "Ch5Summary",
-    "build_ch5_table",
-    "ch5_job",
-    "checkpoint_digest",
-    "failures",
-    "random_ch5_scenario",
-    "reproduce_ch5",
-    "run_ch5_job",
-    "run_jobs",
-    "stored_rows",
-    "summarise",
-]

@@ -419,21 +419,3 @@ def json_default(x: Any) -> Any:
     if isinstance(x, float) and not math.isfinite(x):
         return None
     raise TypeError(type(x).__name__)
-
-
-__all__ = [
-    "FULL_SIZES",
-    "QUICK_SIZES",
-    "TEST_SEED",
-    "VARIANT_KEYS",
-    "VARIANT_LABELS",
-    "beam_ties",
-    "cached_dataset",
-    "json_default",
-    "learning_row",
-    "learning_table",
-    "range_inside",
-    "seed_succeeds",
-    "split_model_key",
-    "thesis_statement",
-]

@@ -354,21 +354,3 @@ def crowds_section(summary: CrowdsSummary) -> ChapterSection:
         intro=intro,
         rows=rows_of(summary.table),
     )
-
-
-__all__ = [
-    "BEYOND_CAMPAIGN",
-    "CAMPAIGN",
-    "CAMPAIGNS",
-    "FULL_CASES",
-    "GENERATORS",
-    "PAPER_ORCA",
-    "QUICK_CASES",
-    "CrowdsSummary",
-    "crowd_jobs",
-    "crowd_laws",
-    "crowd_rows",
-    "crowds_section",
-    "eth_rows",
-    "reproduce_crowds",
-]

@@ -636,37 +636,3 @@ def regime_section(summary: RegimeSummary | None, *, full: bool) -> ChapterSecti
             "store."
         ],
     )
-
-
-__all__ = [
-    "CAMPAIGN",
-    "DENSITIES",
-    "FULL_SEEDS",
-    "LIDAR_BEAMS",
-    "LIDAR_NOISE",
-    "LIDAR_RANGE",
-    "LIDAR_VISIBLE",
-    "NOISES",
-    "QUICK_SEEDS",
-    "SMALL_SAMPLE",
-    "SPEED_RATIOS",
-    "VISIBLE",
-    "CellStats",
-    "FamilyCell",
-    "Rate",
-    "Regime",
-    "RegimeSummary",
-    "SensingCost",
-    "cell_stats",
-    "equal_seeds",
-    "family_table",
-    "law_lines",
-    "leaders",
-    "ranking",
-    "recommend",
-    "regime_jobs",
-    "regime_section",
-    "regimes",
-    "run_regime_map",
-    "sensing_costs",
-]

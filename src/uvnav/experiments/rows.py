@@ -36,6 +36,3 @@ def m_text(x: Any, digits: int = 2) -> str:
     if x is None or not math.isfinite(float(x)):
         return "n/a"
     return f"{float(x):.{digits}f} m"
-
-
-__all__ = ["m_text", "rate_text", "table_row"]

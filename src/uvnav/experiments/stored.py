@@ -121,6 +121,3 @@ def report_sections(db_path: Path) -> list[ChapterSection]:
             if section is not None:
                 out.append(section)
     return out
-
-
-__all__ = ["report_sections"]
