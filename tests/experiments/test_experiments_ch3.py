@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
 
 from uvnav.bench.campaign import EpisodeRun, Job, run_job
@@ -14,11 +15,32 @@ from uvnav.experiments.sections import ch3_section
 
 
 def test_the_default_familys_one_step_figure_is_unchanged() -> None:
-    """horizon_errors' one-step errors on random-ch3 are prediction_errors' own."""
-    old = r3.prediction_errors(n_series=3, length=40)
+    """horizon_errors' one-step errors on random-ch3 (and so prediction_errors') are those of
+    one_step_errors on every body's velocity series, scene by scene."""
+    from uvnav.obstacles.motion3d import ObstacleState3D
+    from uvnav.prediction.autoregressive import ARPredictor, one_step_errors, rms
+    from uvnav.scenarios.generators3d import random_ch3_scenario
+
+    e_ar: list[np.ndarray] = []
+    e_cv: list[np.ndarray] = []
+    seed = 0
+    while len(e_ar) < 3:
+        for ob in random_ch3_scenario(seed).build(seed).obstacles:
+            st = ObstacleState3D(np.zeros(3))
+            series = np.array([ob.motion.rates(float(k), st)[0] for k in range(40)])
+            a, c = one_step_errors(series, ARPredictor(dim=3, max_lag=3))
+            e_ar.append(a)
+            e_cv.append(c)
+        seed += 1
+    old = {"ar_rms": rms(np.concatenate(e_ar)), "constant_rms": rms(np.concatenate(e_cv))}
+    assert r3.prediction_errors(n_series=3, length=40) == {
+        **old,
+        "series": float(len(e_ar)),
+        "ratio": old["ar_rms"] / old["constant_rms"],
+    }
     new = r3.horizon_errors("ar", n_series=3, length=40)
     assert new["v1_ar"] == old["ar_rms"] and new["v1_cv"] == old["constant_rms"]
-    assert new["series"] == old["series"] and new["p1_ar"] == new["p1_cv"] == 0.0
+    assert new["series"] == len(e_ar) and new["p1_ar"] == new["p1_cv"] == 0.0
 
 
 def test_ar_beats_constant_velocity_on_the_periodic_family() -> None:

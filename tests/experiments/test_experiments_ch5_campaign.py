@@ -50,11 +50,11 @@ def test_campaign_rows_are_stored_and_an_interrupted_campaign_resumes(
     jobs = [ch5_job(short_scene, "geometric", 0), ch5_job(short_scene, "oracle", 0, 0.05)]
     db = tmp_path / "uvnav.sqlite"
 
-    def stop_after_first() -> None:
+    def stop_after_first(_done: int, _total: int) -> None:
         raise _KilledError  # the run is "killed" right after the first episode was stored
 
     with ResultsStore(db) as store, pytest.raises(_KilledError):
-        run_jobs(jobs, store, r5.RANDOM_CAMPAIGN, on_episode=stop_after_first)
+        run_jobs(jobs, store, r5.RANDOM_CAMPAIGN, progress=stop_after_first)
     with ResultsStore(db) as store:
         first = stored_rows(store, r5.RANDOM_CAMPAIGN)
         assert [(r["locator"], r["noise_std"]) for r in first] == [("geometric", 0.0)]
@@ -177,9 +177,9 @@ def test_a_store_written_by_the_chapter_s_former_job_type_is_resumed(
             family=short_scene,
             effective_params={**old_params, "n_obstacles": 1, "entered_inner_space": True},
         )
-        calls: list[int] = []
+        calls: list[tuple[int, int]] = []
         job = ch5_job(short_scene, "oracle", 0, 0.05)
-        rows = run_jobs([job], store, r5.NOISE_CAMPAIGN, on_episode=lambda: calls.append(1))
-        assert calls == [1] and store.count(r5.NOISE_CAMPAIGN) == 1
+        rows = run_jobs([job], store, r5.NOISE_CAMPAIGN, progress=lambda k, n: calls.append((k, n)))
+        assert calls == [] and store.count(r5.NOISE_CAMPAIGN) == 1  # the stored episode: not run
     assert rows[0]["status"] == "collision" and rows[0]["entered_inner_space"] is True
     assert (rows[0]["locator"], rows[0]["noise_std"], rows[0]["model"]) == ("oracle", 0.05, "")

@@ -58,19 +58,11 @@ from uvnav.bench.jobs import Job, JobOutcome, TaskSizer, sized_batches
 from uvnav.bench.ray_engine import import_ray, run_ray
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, EpisodeKey, ResultsStore
 from uvnav.scenarios.generators import DEFAULT_GENERATOR
-from uvnav.sim import EpisodeSetup, Trajectory, run_episode, run_rng
+from uvnav.sim import Trajectory, run_episode, run_rng
 
 ENGINES = ("local", "ray")
 T = TypeVar("T")
 R = TypeVar("R")
-
-
-def _plain(params: Any) -> dict[str, Any]:
-    if params is None:
-        return {}
-    if hasattr(params, "model_dump"):
-        return dict(params.model_dump())
-    return dict(params)
 
 
 @functools.lru_cache(maxsize=256)
@@ -106,25 +98,6 @@ def job_scene(job: Job) -> Any:
     return scene
 
 
-def build_job(job: Job) -> tuple[EpisodeSetup, dict[str, Any]]:
-    """A 2D job's episode and the controller parameters to use (the scenario's own parameters
-    under the job's when the scenario names the same law)."""
-    if job.setup_factory is not None:
-        return job.setup_factory(int(job.seed)), job.params_dict
-    import uvnav.scenarios as scenarios  # layer 5; imported lazily so bench works without it
-
-    scenario = job_scene(job).scenario
-    params = job.params_dict
-    ctrl = getattr(scenario, "controller", None)
-    if (
-        job.use_scenario_params
-        and ctrl is not None
-        and getattr(ctrl, "name", None) == job.controller
-    ):
-        params = {**_plain(getattr(ctrl, "params", None)), **params}
-    return scenarios.build_episode(scenario, int(job.seed)), params
-
-
 def _scene_key(job: Job) -> tuple[Any, ...]:
     """What identifies a job's episode set-up but for the law: the scene and the episode seed
     (jobs with their own set-up or runner are their own)."""
@@ -143,14 +116,10 @@ def scene_groups(jobs: Sequence[Job]) -> list[list[Job]]:
     return list(groups.values())
 
 
-def run_job_group(jobs: Sequence[Job]) -> list[JobOutcome]:
-    """:func:`run_job` on each job of one scene group, in one worker (the scene is built once)."""
-    return [run_job(job) for job in jobs]
-
-
 def run_group_batch(groups: Sequence[Sequence[Job]]) -> list[list[JobOutcome]]:
-    """:func:`run_job_group` on each of ``groups`` in turn, in one worker (one task)."""
-    return [run_job_group(group) for group in groups]
+    """:func:`run_job` on each job of each scene group of ``groups`` in turn, in one worker (one
+    task; a group's scene is built once)."""
+    return [[run_job(job) for job in group] for group in groups]
 
 
 def _error(job: Job, exc: BaseException, tic: float, params: dict[str, Any]) -> JobOutcome:
@@ -335,42 +304,6 @@ def stored_records(store: ResultsStore, campaign: str) -> list[dict[str, Any]]:
         }
         for rec in store.episodes_frame(campaign).to_dict("records")
     ]
-
-
-def run_stored(
-    store: ResultsStore,
-    name: str,
-    jobs: Sequence[Job],
-    *,
-    config: Mapping[str, Any],
-    workers: int = 1,
-    on_outcome: Callable[[JobOutcome, int], None] | None = None,
-) -> list[dict[str, Any]]:
-    """Run ``jobs`` as campaign ``name`` (:func:`run_campaign`: each episode stored as it
-    finishes, stored ones skipped) and return the :func:`stored_records` of the jobs, in job
-    order: the campaigns of jobs with their own runner.
-
-    Raises:
-        RuntimeError: a job failed (stored with status ``error``; a later run retries it).
-    """
-    errors: list[str] = []
-
-    def seen(out: JobOutcome, episode_id: int) -> None:
-        if out.error is not None:
-            errors.append(f"{out.job.scenario_label} {out.job.controller}: {out.error}")
-        if on_outcome is not None:
-            on_outcome(out, episode_id)
-
-    run_campaign(
-        store, name, jobs, config=config, workers=workers, retry_errors=True, on_outcome=seen
-    )
-    if errors:
-        raise RuntimeError(f"{name}: {len(errors)} episode(s) failed, first {errors[0]}")
-    by_key = {
-        (r["scenario"], r["controller"], r["params_hash"], r["seed"]): r
-        for r in stored_records(store, name)
-    }
-    return [by_key[j.key] for j in jobs if j.key in by_key]
 
 
 #: what the fork server imports before it forks a worker (the last one runs :func:`warm_up`)

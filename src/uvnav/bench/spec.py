@@ -336,7 +336,7 @@ class CampaignSpec(_Strict):
 
         Seeds come before controllers so that the jobs of one generated scene run close together
         and a worker generates the scene once for all of them (see
-        :func:`uvnav.bench.campaign.build_job`).
+        :func:`uvnav.bench.campaign.scene_groups`).
         """
         sets = [
             (ctrl.name, params, controller_info(ctrl.name))

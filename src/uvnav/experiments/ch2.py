@@ -18,18 +18,9 @@ sections to a *renderer* passed in by the caller (the CLI passes
 ``uvnav run`` (:func:`uvnav.experiments.run_all`) are experiments of their own; there Chapter 2's
 :func:`finish` writes the page with every experiment's section.
 
-Layering (DESIGN §1): ``uvnav.viz`` sits above ``uvnav.experiments`` in the layers, so this
-module never imports it: the renderer is injected (``render=``), which keeps the layer contract
-enforceable.
-``matplotlib`` is never imported here.
-
-Resume and staleness: every campaign carries a fingerprint of the code and scenario files that
-decide episode outcomes (:func:`uvnav.bench.fingerprint.code_fingerprint`).  Re-running with
-unchanged code resumes (an interrupted run only finishes what is missing; a finished one costs
-nothing).  If the code changed since a campaign was stored, the run refuses
-(:class:`~uvnav.bench.store.StaleCampaignError`, one line naming the campaign to remove with
-``uvnav forget``), so the table never mixes results of different code and no run deletes another
-run's episodes.
+``uvnav.viz`` is a layer above (DESIGN §1): the renderer is injected (``render=``), so neither it
+nor ``matplotlib`` is imported here.  The campaigns resume, carry the code fingerprint and only
+add (:mod:`uvnav.experiments.campaigns`).
 """
 
 from __future__ import annotations
@@ -42,9 +33,11 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
+from uvnav.bench.fingerprint import DB_NAME, code_fingerprint
 from uvnav.bench.jobs import Job
 from uvnav.bench.store import STATUS_ERROR, ResultsStore
+from uvnav.experiments.campaigns import run_checked
+from uvnav.experiments.rows import m_text, table_row
 from uvnav.experiments.sections import SECTIONS_DIR, ChapterSection, ch2_section, save_section
 
 CONTROLLERS: tuple[str, ...] = ("zhang2019-v1", "savkin-wang2013-v1")
@@ -188,12 +181,6 @@ class ReproductionSummary:
     sections: list[ChapterSection] = field(default_factory=list)
 
 
-def _fmt_m(x: Any, digits: int = 2) -> str:
-    if x is None or not np.isfinite(float(x)):
-        return "n/a"
-    return f"{float(x):.{digits}f} m"
-
-
 def _outcome(row: dict[str, Any] | None) -> str:
     if row is None:
         return "not run"
@@ -249,38 +236,36 @@ def build_table(
             measured, note = "not run", _outcome(r) if r is not None else "scene not available"
         else:
             measured_len[ctrl] = float(r["path_length"])
-            measured = _fmt_m(r["path_length"])
+            measured = m_text(r["path_length"])
             note = f"status {r['status']}"
             if thesis is not None:
                 note = f"{_pct(measured_len[ctrl], thesis)}; {note}"
         rows.append(
-            {
-                "quantity": f"Fig. 2.10 path length, {ctrl}",
-                "thesis": f"{thesis} m" if thesis is not None else "not reported",
-                "measured": measured,
-                "note": note,
-            }
+            table_row(
+                f"Fig. 2.10 path length, {ctrl}",
+                f"{thesis} m" if thesis is not None else "not reported",
+                measured,
+                note,
+            )
         )
     if {"zhang2019-v1", "savkin-wang2013-v1"} <= set(measured_len):
         ratio = measured_len["savkin-wang2013-v1"] / measured_len["zhang2019-v1"]
         thesis_ratio = THESIS_PATH_LENGTH["savkin-wang2013-v1"] / THESIS_PATH_LENGTH["zhang2019-v1"]
         rows.append(
-            {
-                "quantity": "Fig. 2.10 path length ratio savkin-wang2013-v1 / zhang2019-v1",
-                "thesis": f"{thesis_ratio:.3f} (15.7 / 14.9)",
-                "measured": f"{ratio:.3f}",
-                "note": "thesis: zhang2019 about 5% shorter",
-            }
+            table_row(
+                "Fig. 2.10 path length ratio savkin-wang2013-v1 / zhang2019-v1",
+                f"{thesis_ratio:.3f} (15.7 / 14.9)",
+                f"{ratio:.3f}",
+                "thesis: zhang2019 about 5% shorter",
+            )
         )
     rows.append(
-        {
-            "quantity": "Fig. 2.10 straight-line distance I–T",
-            "thesis": f"{THESIS_STRAIGHT_LINE:.2f} m",
-            "measured": _fmt_m(straight_line)
-            if straight_line is not None
-            else "scene not available",
-            "note": "lower bound of every path length",
-        }
+        table_row(
+            "Fig. 2.10 straight-line distance I–T",
+            f"{THESIS_STRAIGHT_LINE:.2f} m",
+            m_text(straight_line) if straight_line is not None else "scene not available",
+            "lower bound of every path length",
+        )
     )
     # -- per thesis scene and law ------------------------------------------------------------------
     for scene in scenes:
@@ -288,23 +273,23 @@ def build_table(
             claims = THESIS_CLAIMS.get(scene, {}).get(ctrl, ("not reported", "not reported"))
             r = row_of(scene, ctrl)
             rows.append(
-                {
-                    "quantity": f"outcome, {scene_label(scene)}, {ctrl}",
-                    "thesis": claims[0],
-                    "measured": _outcome(r),
-                    "note": ""
+                table_row(
+                    f"outcome, {scene_label(scene)}, {ctrl}",
+                    claims[0],
+                    _outcome(r),
+                    ""
                     if r is None or r["time_to_goal"] is None
                     else f"time to goal {float(r['time_to_goal']):.1f} s, "
                     f"path {float(r['path_length']):.2f} m",
-                }
+                )
             )
             rows.append(
-                {
-                    "quantity": f"min clearance, {scene_label(scene)}, {ctrl}",
-                    "thesis": claims[1],
-                    "measured": "n/a" if r is None else _fmt_m(r["min_clearance"], 3),
-                    "note": "robot disc to obstacle gap; < 0 is a collision",
-                }
+                table_row(
+                    f"min clearance, {scene_label(scene)}, {ctrl}",
+                    claims[1],
+                    "n/a" if r is None else m_text(r["min_clearance"], 3),
+                    "robot disc to obstacle gap; < 0 is a collision",
+                )
             )
     # -- random campaign
     df = store.episodes_frame(random_campaign)
@@ -321,12 +306,12 @@ def build_table(
             k: sum(st == k for _, st in pairs) for k in ("collision", "timeout", STATUS_ERROR)
         }
         rows.append(
-            {
-                "quantity": f"random campaign success rate, {ctrl}",
-                "thesis": "not reported (no random campaign in the thesis)",
-                "measured": f"{n_ok / n:.1%} ({n_ok}/{n})" if n else "not run",
-                "note": ", ".join(f"{k}: {v}" for k, v in counts.items()) if n else "",
-            }
+            table_row(
+                f"random campaign success rate, {ctrl}",
+                "not reported (no random campaign in the thesis)",
+                f"{n_ok / n:.1%} ({n_ok}/{n})" if n else "not run",
+                ", ".join(f"{k}: {v}" for k, v in counts.items()) if n else "",
+            )
         )
         ctrl_fail = [(ctrl, s, st) for s, st in pairs if st != "success"]
         failures += ctrl_fail
@@ -334,12 +319,12 @@ def build_table(
         if len(ctrl_fail) > max_listed_failures:
             listed += f", … (+{len(ctrl_fail) - max_listed_failures} more)"
         rows.append(
-            {
-                "quantity": f"random campaign failed seeds, {ctrl}",
-                "thesis": "not reported",
-                "measured": (listed or "none") if n else "not run",
-                "note": f"{len(ctrl_fail)} of {n} episodes",
-            }
+            table_row(
+                f"random campaign failed seeds, {ctrl}",
+                "not reported",
+                (listed or "none") if n else "not run",
+                f"{len(ctrl_fail)} of {n} episodes",
+            )
         )
     return rows, failures
 
@@ -366,13 +351,13 @@ def comparison_rows(store: ResultsStore) -> list[dict[str, str]]:
         hit = int((status == "collision").sum())
         crowd = str(family).startswith("crowd-")
         rows.append(
-            {
-                "quantity": f"success rate, {family}, {ctrl}",
-                "thesis": "not reported (beyond the thesis)",
-                "measured": f"{ok / n:.1%} ({ok}/{n})",
-                "note": f"collisions {hit}, timeouts {int((status == 'timeout').sum())}"
+            table_row(
+                f"success rate, {family}, {ctrl}",
+                "not reported (beyond the thesis)",
+                f"{ok / n:.1%} ({ok}/{n})",
+                f"collisions {hit}, timeouts {int((status == 'timeout').sum())}"
                 + ("; real pedestrians (ETH), who do not react to the robot" if crowd else ""),
-            }
+            )
         )
     return rows
 

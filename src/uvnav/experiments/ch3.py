@@ -21,24 +21,17 @@
    ``PREDICTION_MIN_SEEDS`` seeds per family; :func:`prediction_finding` turns the numbers into
    the section's one sentence.
 
-Every episode is an ordinary campaign job (:func:`ch3_job`: a :class:`~uvnav.bench.campaign.Job`
-with this chapter's runner) stored in the results database (SQLite, :class:`ResultsStore`) in
-its own transaction as it finishes, the controller column holding the law and ``params`` the
-motion knowledge (``{"motion": "known"|"predicted"}``, and ``"constant"`` in
-``ch3-prediction``); every campaign carries the code's :func:`fingerprint`, and a run refuses to
-resume a campaign stored by other code (:class:`~uvnav.bench.store.StaleCampaignError`, one line
-naming it for ``uvnav forget``); the table "thesis reported vs uvnav measured" is read back from
-the stored rows. Figures are made by an injected renderer (``render=``; the CLI passes
+Every episode is a campaign job (:func:`ch3_job`, this chapter's runner) run and stored by
+:mod:`uvnav.experiments.campaigns` (resumable, fingerprinted, additive), the controller column
+holding the law and ``params`` the motion knowledge (``{"motion": "known"|"predicted"}``, and
+``"constant"`` in ``ch3-prediction``); the table "thesis reported vs uvnav measured" is read back
+from the stored rows. Figures are made by an injected renderer (``render=``; the CLI passes
 :func:`uvnav.viz.figures3d.render_ch3`), so this module never imports ``viz`` (DESIGN §1
 layers).
-
-Run it alone with ``uvnav reproduce ch3 [--seeds N] [--start-seed S] [--workers W]``; a run adds
-to the store (resume), it never replaces another run's episodes.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import time
 from collections.abc import Callable, Sequence
@@ -48,24 +41,11 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.bench.campaign import (
-    EpisodeRun,
-    Job,
-    JobOutcome,
-    outcome_record,
-    run_in_workers,
-    run_job,
-    run_stored,
-    store_outcome,
-)
+import uvnav.experiments.campaigns as cp
+from uvnav.bench.campaign import EpisodeRun, Job
 from uvnav.bench.fingerprint import DB_NAME
-from uvnav.bench.store import (
-    FINGERPRINT_KEY,
-    EpisodeKey,
-    ResultsStore,
-    check_fingerprints,
-    extend_fingerprint,
-)
+from uvnav.bench.store import FINGERPRINT_KEY, EpisodeKey, ResultsStore, check_fingerprints
+from uvnav.experiments.rows import table_row
 
 CONTROLLERS_3D: tuple[str, ...] = ("zhang2020-3d-v1", "apf3d-v1", "vo3d-v1")
 SCENES_CAMPAIGN = "ch3-thesis-scenes"
@@ -148,49 +128,21 @@ def _run_job(job: Job) -> EpisodeRun:
 
 def fingerprint() -> str:
     """The code fingerprint of this chapter's campaigns: the packages that decide an episode
-    (``code_fingerprint`` of :mod:`uvnav.experiments.ch2`) and this module (its runner)."""
-    from uvnav.bench.fingerprint import code_fingerprint
-
-    return extend_fingerprint(code_fingerprint(), "experiments/ch3.py")
+    and this module (its runner)."""
+    return cp.fingerprint("experiments/ch3.py")
 
 
-def _announce(total: int) -> Callable[[JobOutcome, int], None]:
-    """An ``on_outcome`` printing one line per episode run (``progress``)."""
-    done = 0
-
-    def say(out: JobOutcome, _episode: int) -> None:
-        nonlocal done
-        done += 1
-        job = out.job
-        print(f"  {done}/{total} {job.label} {job.controller} {dict(job.tags)['motion']}: "
-              f"{out.status}")  # fmt: skip
-
-    return say
+def _say(campaign: str, progress: bool) -> cp.Progress | None:
+    """With ``progress``, a ``progress`` printing one line per episode run."""
+    return (lambda done, total: print(f"  {campaign}: {done}/{total}")) if progress else None
 
 
 def prediction_errors(n_series: int = 20, length: int = 120) -> dict[str, float]:
     """One-step velocity prediction RMS error [m/s] of the AR models and of constant velocity on
-    the AR motion of the random scenes' obstacles (one series per obstacle of scenes 0, 1, ...)."""
-    from uvnav.obstacles.motion3d import ObstacleState3D
-    from uvnav.prediction.autoregressive import ARPredictor, one_step_errors, rms
-    from uvnav.scenarios.generators3d import random_ch3_scenario
-
-    e_ar: list[np.ndarray] = []
-    e_cv: list[np.ndarray] = []
-    seed = 0
-    while len(e_ar) < n_series:
-        sc = random_ch3_scenario(seed)
-        setup = sc.build(seed)
-        for ob in setup.obstacles:
-            st = ObstacleState3D(np.zeros(3))
-            series = np.array([ob.motion.rates(float(k), st)[0] for k in range(length)])
-            a, c = one_step_errors(series, ARPredictor(dim=3, max_lag=3))
-            e_ar.append(a)
-            e_cv.append(c)
-        seed += 1
-    ar = rms(np.concatenate(e_ar))
-    cv = rms(np.concatenate(e_cv))
-    return {"ar_rms": ar, "constant_rms": cv, "series": float(len(e_ar)), "ratio": ar / cv}
+    the AR motion of the random scenes' obstacles (:func:`horizon_errors` at k = 1)."""
+    e = horizon_errors("ar", n_series, length, horizons=(1,))
+    ar, cv = e["v1_ar"], e["v1_cv"]
+    return {"ar_rms": ar, "constant_rms": cv, "series": e["series"], "ratio": ar / cv}
 
 
 def horizon_errors(
@@ -203,7 +155,7 @@ def horizon_errors(
     """k-step prediction RMS errors of the AR models and of constant velocity on the bodies of
     the ``random-ch3`` scenes with ``motion`` (one series per body of scenes 0, 1, ... until
     ``n_series``, each ``length`` samples of the true velocity taken every ``period`` T_s [s],
-    the predictor of :func:`prediction_errors`).
+    the predictor ``ARPredictor(dim=3, max_lag=3)``).
 
     After each sample v_i (from the predictor's ``min_samples`` on) both predict v_{i+k}: AR by
     iterating (3.13), constant velocity by v_i.  A sample is held over its period, so the body
@@ -331,7 +283,8 @@ def prediction_study(
     check_fingerprints(store, {PREDICTION_CAMPAIGN: fp})
     jobs = prediction_jobs(n_seeds, start_seed)
     config = {"chapter": 3, "law": PREDICTION_LAW, "seeds": n_seeds, FINGERPRINT_KEY: fp}
-    _run_stored(store, PREDICTION_CAMPAIGN, config, jobs, workers, progress)
+    cp.run_jobs(store, PREDICTION_CAMPAIGN, jobs, config=config, workers=workers,
+                progress=_say(PREDICTION_CAMPAIGN, progress))  # fmt: skip
     frame = _requested(store.episodes_frame(PREDICTION_CAMPAIGN), jobs)
     errors = {fam: horizon_errors(motion) for fam, motion in PREDICTION_FAMILIES.items()}
     seeds = range(start_seed, start_seed + n_seeds)
@@ -347,19 +300,23 @@ def prediction_rows(study: dict[str, Any]) -> list[dict[str, str]]:
     rows: list[dict[str, str]] = []
     for fam, e in study["errors"].items():
         for k in HORIZONS:
-            rows.append({
-                "quantity": f"{fam}: {k}-step velocity prediction RMS error [m/s]",
-                "thesis": "AR model (3.13)-(3.14), no numbers",
-                "measured": f"AR {e[f'v{k}_ar']:.4f} vs constant velocity {e[f'v{k}_cv']:.4f}",
-                "note": f"{int(e['series'])} body series, T_s = 1 s, true velocities",
-            })  # fmt: skip
+            rows.append(
+                table_row(
+                    f"{fam}: {k}-step velocity prediction RMS error [m/s]",
+                    "AR model (3.13)-(3.14), no numbers",
+                    f"AR {e[f'v{k}_ar']:.4f} vs constant velocity {e[f'v{k}_cv']:.4f}",
+                    f"{int(e['series'])} body series, T_s = 1 s, true velocities",
+                )
+            )
         k = max(HORIZONS)
-        rows.append({
-            "quantity": f"{fam}: {k} s position prediction RMS error [m]",
-            "thesis": "",
-            "measured": f"AR {e[f'p{k}_ar']:.4f} vs constant velocity {e[f'p{k}_cv']:.4f}",
-            "note": "positions from the predicted velocity samples",
-        })  # fmt: skip
+        rows.append(
+            table_row(
+                f"{fam}: {k} s position prediction RMS error [m]",
+                "",
+                f"AR {e[f'p{k}_ar']:.4f} vs constant velocity {e[f'p{k}_cv']:.4f}",
+                "positions from the predicted velocity samples",
+            )
+        )
     cl = study["closed_loop"]
     for fam in study["errors"]:
         parts = []
@@ -372,21 +329,24 @@ def prediction_rows(study: dict[str, Any]) -> list[dict[str, str]]:
             f"{PREDICTION_ARMS[a]} {cl[f'{fam}|{a}']['min_clearance']:.3f} m"
             for a in PREDICTION_ARMS if f"{fam}|{a}" in cl
         )  # fmt: skip
-        rows.append({
-            "quantity": f"{fam}: {PREDICTION_LAW} success by prediction",
-            "thesis": "",
-            "measured": f"{' / '.join(parts)} of {n}",
-            "note": f"mean min clearance: {clear}",
-        })  # fmt: skip
+        rows.append(
+            table_row(
+                f"{fam}: {PREDICTION_LAW} success by prediction",
+                "",
+                f"{' / '.join(parts)} of {n}",
+                f"mean min clearance: {clear}",
+            )
+        )
         use = study.get("usage", {}).get(fam)
         if use is not None:
-            rows.append({
-                "quantity": f"{fam}: M2 predictions made by AR fits (not the fallback)",
-                "thesis": "",
-                "measured": f"{100 * use['ar_share']:.1f}% of {int(use['decisions'])}",
-                "note": "the rest: constant velocity (under 12 samples of the body, or "
-                        "fits rejected)",
-            })  # fmt: skip
+            rows.append(
+                table_row(
+                    f"{fam}: M2 predictions made by AR fits (not the fallback)",
+                    "",
+                    f"{100 * use['ar_share']:.1f}% of {int(use['decisions'])}",
+                    "the rest: constant velocity (under 12 samples of the body, or fits rejected)",
+                )
+            )
     return rows
 
 
@@ -434,54 +394,6 @@ def prediction_finding(study: dict[str, Any]) -> str:
     )
 
 
-def _run_stored(
-    store: ResultsStore,
-    campaign: str,
-    config: dict[str, Any],
-    jobs: list[Job],
-    workers: int,
-    progress: bool,
-) -> None:
-    """Run the jobs of ``campaign`` the store lacks, each stored in its own transaction as it
-    finishes (:func:`~uvnav.bench.campaign.run_stored`: an interrupt loses only the episodes in
-    flight); other jobs' episodes already in the campaign are kept."""
-    total = len({j.key for j in jobs} - store.done_keys(store.campaign(campaign, config)))
-    say = _announce(total) if progress else None
-    run_stored(store, campaign, jobs, config=config, workers=workers, on_outcome=say)
-
-
-def _rerun_recorded(
-    store: ResultsStore,
-    campaign: str,
-    config: dict[str, Any],
-    jobs: list[Job],
-    workers: int,
-) -> dict[EpisodeKey, Any]:
-    """Run every job again with its trajectory recorded (for the figures); an episode the
-    campaign lacks is stored in its own transaction as it finishes, a stored one is kept.
-
-    Returns:
-        The recorded trajectory of each job by its resume key.
-
-    Raises:
-        RuntimeError: an episode failed (the one stored before is kept).
-    """
-    kept: dict[EpisodeKey, Any] = {}
-    with store.writer_lease():
-        cid = store.campaign(campaign, config)
-        done = store.done_keys(cid, include_errors=False)
-
-        def keep(out: JobOutcome) -> None:
-            outcome_record(out)  # raises for a failed episode
-            if out.job.key not in done:
-                store_outcome(store, cid, out)
-            kept[out.job.key] = out.result
-
-        recorded = [dataclasses.replace(j, record=True) for j in jobs]
-        run_in_workers(recorded, run_job, keep, workers=workers)
-    return kept
-
-
 def _requested(frame: Any, jobs: list[Job]) -> Any:
     """The rows of ``frame`` (a campaign's episodes) that belong to ``jobs``, in job order: the
     table of a run describes what it asked for; the store keeps every other run's rows."""
@@ -523,11 +435,8 @@ def reproduce_ch3(
         prediction_seeds: seeds per family of the prediction comparison (default: the random
             campaign's, at least ``PREDICTION_MIN_SEEDS``); 0 skips it.
 
-    Resumable and additive: every episode is stored in its own transaction as it finishes, so
-    an interrupted run keeps what it finished; episodes already in the store are not run again
-    (the thesis scenes run again only for the figures' trajectories), and another run's
-    episodes (other controllers, other seeds) are kept; the table describes the episodes this
-    call asked for.
+    Resumable and additive (:mod:`uvnav.experiments.campaigns`; the thesis scenes run again
+    only for the figures' trajectories); the table describes the episodes this call asked for.
 
     Raises:
         StaleCampaignError: a stored campaign of this run was made by other code (its
@@ -557,11 +466,14 @@ def reproduce_ch3(
         size = {"chapter": 3, "controllers": list(controllers), FINGERPRINT_KEY: fp}
         scene_cfg = {**size, "seed": 0}
         if render is not None:  # the figures' trajectories (not stored): the scenes run again
-            recorded = _rerun_recorded(store, SCENES_CAMPAIGN, scene_cfg, scene_jobs, workers)
+            recorded = cp.run_recorded(
+                store, SCENES_CAMPAIGN, scene_jobs, config=scene_cfg, workers=workers
+            )
         else:
-            _run_stored(store, SCENES_CAMPAIGN, scene_cfg, scene_jobs, workers, progress)
-        _run_stored(store, RANDOM_CAMPAIGN, {**size, "seeds": n_seeds}, rand_jobs, workers,
-                    progress)  # fmt: skip
+            cp.run_jobs(store, SCENES_CAMPAIGN, scene_jobs, config=scene_cfg, workers=workers,
+                        progress=_say(SCENES_CAMPAIGN, progress))  # fmt: skip
+        cp.run_jobs(store, RANDOM_CAMPAIGN, rand_jobs, config={**size, "seeds": n_seeds},
+                    workers=workers, progress=_say(RANDOM_CAMPAIGN, progress))  # fmt: skip
         frame = _requested(store.episodes_frame(RANDOM_CAMPAIGN), rand_jobs)
         scene_frame = _requested(store.episodes_frame(SCENES_CAMPAIGN), scene_jobs)
         study = (
@@ -574,23 +486,27 @@ def reproduce_ch3(
     for _, row in scene_frame.iterrows():
         if row["controller"] != controllers[0]:
             continue
-        table.append({
-            "quantity": f"{row['scenario']} ({row['controller']})",
-            "thesis": THESIS_CLAIMS.get(str(row["scenario"]), ""),
-            "measured": f"{row['status']}, min clearance {row['min_clearance']:.2f} m, "
-                        f"path {row['path_length']:.1f} m",
-            "note": "rates estimated from sensing, AR-predicted",
-        })  # fmt: skip
+        table.append(
+            table_row(
+                f"{row['scenario']} ({row['controller']})",
+                THESIS_CLAIMS.get(str(row["scenario"]), ""),
+                f"{row['status']}, min clearance {row['min_clearance']:.2f} m, "
+                f"path {row['path_length']:.1f} m",
+                "rates estimated from sensing, AR-predicted",
+            )
+        )
     failures: list[dict[str, Any]] = []
     for (ctrl, params), grp in frame.groupby(["controller", "params"]):
         motion = json.loads(str(params)).get("motion", "") if str(params).startswith("{") else ""
         rate = float(grp["success"].astype(float).mean())
-        table.append({
-            "quantity": f"random-ch3 success, {ctrl}, motion {motion or params}",
-            "thesis": ">= 98% (issue target for zhang2020-3d)" if ctrl == controllers[0] else "",
-            "measured": f"{100 * rate:.1f}% of {len(grp)}",
-            "note": f"collisions {int(grp['collision'].astype(float).sum())}",
-        })  # fmt: skip
+        table.append(
+            table_row(
+                f"random-ch3 success, {ctrl}, motion {motion or params}",
+                ">= 98% (issue target for zhang2020-3d)" if ctrl == controllers[0] else "",
+                f"{100 * rate:.1f}% of {len(grp)}",
+                f"collisions {int(grp['collision'].astype(float).sum())}",
+            )
+        )
         for _, fr in grp[~grp["success"].astype(bool)].iterrows():
             cause = (
                 f"collision (min clearance {fr['min_clearance']:.3f} m)"
@@ -602,12 +518,14 @@ def reproduce_ch3(
                 "motion": motion, "params": params, "status": fr["status"],
                 "min_clearance": fr["min_clearance"], "cause": cause,
             })  # fmt: skip
-    table.append({
-        "quantity": "one-step velocity prediction RMS error [m/s]",
-        "thesis": "AR model (3.13)-(3.14), no numbers",
-        "measured": f"AR {pred['ar_rms']:.4f} vs constant velocity {pred['constant_rms']:.4f}",
-        "note": f"{int(pred['series'])} obstacle series of the random scenes",
-    })  # fmt: skip
+    table.append(
+        table_row(
+            "one-step velocity prediction RMS error [m/s]",
+            "AR model (3.13)-(3.14), no numbers",
+            f"AR {pred['ar_rms']:.4f} vs constant velocity {pred['constant_rms']:.4f}",
+            f"{int(pred['series'])} obstacle series of the random scenes",
+        )
+    )
     finding = ""
     if study:
         table += prediction_rows(study)

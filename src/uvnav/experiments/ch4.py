@@ -15,19 +15,13 @@
    narrower gaps; :func:`~uvnav.scenarios.uuv2d.random_ch4_hard_scenario`) with the three laws
    (quick: 4 seeds; ``full``: 100) — campaign ``ch4-hard``.
 
-Every episode is an ordinary campaign job (:class:`~uvnav.bench.campaign.Job` with this chapter's
-runner, :func:`ch4_job`; run, stored and resumed by :func:`~uvnav.bench.campaign.run_campaign`)
-and a row of the SQLite results store (:class:`~uvnav.bench.store.ResultsStore`,
-``results_dir/uvnav.sqlite``, the database ``uvnav run`` and Chapter 3 use, DESIGN §5): the
-``controller`` column holds the law, ``params`` the sensing level (the job's tags:
-``{"noise_std", "dropout"}``, part of the resume key), ``family`` the generator (``random-ch4``,
-``random-ch4-hard``) or the scene, the metrics of :data:`~uvnav.sim.metrics.METRIC_NAMES` their
-own columns; the two facts the store has no column for, the number of obstacles and whether a
-forbidden region (the Fig. 4.2(b) inner space) was entered, are kept in ``effective_params``.
-Campaigns resume (a re-run skips the stored episodes) and only add to the store: no run deletes
-or replaces another run's episodes. Every campaign carries the code's :func:`fingerprint`; a run
-refuses to resume one stored by other code (:class:`~uvnav.bench.store.StaleCampaignError`, one
-line naming it for ``uvnav forget``), so old and new episodes are never mixed. The summary
+Every episode is a campaign job (:func:`ch4_job`, this chapter's runner) run and stored by
+:mod:`uvnav.experiments.campaigns` (resumable, fingerprinted, additive) in
+``results_dir/uvnav.sqlite``: the ``controller`` column holds the law, ``params`` the sensing
+level (the job's tags ``{"noise_std", "dropout"}``, part of the resume key), ``family`` the
+generator (``random-ch4``, ``random-ch4-hard``) or the scene; the number of obstacles and whether
+a forbidden region (the Fig. 4.2(b) inner space) was entered are kept in ``effective_params``.
+The summary
 (``results_dir/ch4/summary.json``) and the table "thesis reported vs uvnav measured" are computed
 from the stored rows, never typed in. The thesis reports no numbers for Chapter 4 (only Figs.
 4.7-4.9: the vehicle reaches E without collision), so the table's thesis column states that; Fig.
@@ -40,29 +34,21 @@ Figures are made by a renderer injected by the caller (``render=``; the CLI pass
 
 from __future__ import annotations
 
-import dataclasses
 import json
 import math
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from uvnav.bench.campaign import (
-    EpisodeRun,
-    Job,
-    outcome_record,
-    run_job,
-    run_stored,
-    store_outcome,
-    stored_records,
-)
+import uvnav.experiments.campaigns as cp
+from uvnav.bench.campaign import EpisodeRun, Job, outcome_record, run_job, stored_records
 from uvnav.bench.fingerprint import DB_NAME
-from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, check_fingerprints, extend_fingerprint
-from uvnav.bench.summary import outcome_stats
+from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, check_fingerprints
 from uvnav.controllers.base import make_law
+from uvnav.experiments.rows import table_row
 from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin, load_uuv2d_scenario
 from uvnav.sim.episode_uuv2d import Uuv2dTrajectory
 from uvnav.sim.metrics import METRIC_NAMES
@@ -96,14 +82,6 @@ def ch4_job(scene: str, law: str, seed: int, noise_std: float = 0.0, dropout: fl
     return Job(law, int(seed), label=scene, family=family, tags=tags, runner=_run_job)
 
 
-def fingerprint() -> str:
-    """The code fingerprint of this chapter's campaigns: the packages that decide an episode
-    (``code_fingerprint`` of :mod:`uvnav.experiments.ch2`) and this module (its runner)."""
-    from uvnav.bench.fingerprint import code_fingerprint
-
-    return extend_fingerprint(code_fingerprint(), "experiments/ch4.py")
-
-
 def run_ch4_job(
     job: Job, *, record: bool = False
 ) -> tuple[dict[str, Any], EpisodeResult[Uuv2dTrajectory]]:
@@ -113,7 +91,7 @@ def run_ch4_job(
     Raises:
         RuntimeError: the episode failed.
     """
-    out = run_job(dataclasses.replace(job, record=record))
+    out = run_job(replace(job, record=record))
     return _row(outcome_record(out)), out.result
 
 
@@ -162,28 +140,13 @@ def run_jobs(
     campaign: str,
     *,
     workers: int = 1,
-    progress: Callable[[int, int], None] | None = None,
+    progress: cp.Progress | None = None,
     config: dict[str, Any] | None = None,
 ) -> list[dict[str, Any]]:
-    """Run the jobs of ``campaign`` not yet in the store (a campaign: one transaction per
-    finished episode, so an interrupted campaign resumes); ``progress(done, total)`` after each
-    episode run.
-
-    Returns:
-        The rows of all requested jobs (stored and new), in job order.
-    """
-    jobs = list(jobs)
+    """The rows of ``jobs`` (stored and new, in job order), those ``campaign`` lacks run first
+    (:func:`uvnav.experiments.campaigns.run_jobs`)."""
     cfg = config or {"chapter": 4}
-    total = len({j.key for j in jobs} - store.done_keys(store.campaign(campaign, cfg)))
-    done = 0
-
-    def advance(_out: Any, _episode: int) -> None:
-        nonlocal done
-        done += 1
-        if progress is not None:
-            progress(done, total)
-
-    recs = run_stored(store, campaign, jobs, config=cfg, workers=workers, on_outcome=advance)
+    recs = cp.run_jobs(store, campaign, jobs, config=cfg, workers=workers, progress=progress)
     return [_row(r) for r in recs]
 
 
@@ -211,28 +174,18 @@ def hard_jobs(seeds: int, laws: Iterable[str] = LAWS, start: int = 0) -> list[Jo
     ]
 
 
-def _family(row: dict[str, Any]) -> str:
-    return str(row["scene"]).split(":", 1)[0]
-
-
 def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Per (scene family, law, noise, dropout): episodes, success / collision / timeout rates,
     forbidden entries, median path length, detour ratio, minimum clearance and decision time."""
-    groups: dict[tuple[str, str, float, float], list[dict[str, Any]]] = {}
-    for r in rows:
-        groups.setdefault((_family(r), r["law"], r["noise_std"], r["dropout"]), []).append(r)
-    return [
+    return cp.group_stats(
+        rows,
+        lambda r: (cp.family(r), r["law"], r["noise_std"], r["dropout"]),
+        ("family", "law", "noise_std", "dropout"),
         {
-            "family": family,
-            "law": law,
-            "noise_std": noise,
-            "dropout": drop,
-            **outcome_stats(rs),
-            "entered_forbidden": sum(bool(r["entered_forbidden"]) for r in rs),
-            "limit_violations": sum(int(r["limit_violations"]) for r in rs),
-        }
-        for (family, law, noise, drop), rs in sorted(groups.items())
-    ]
+            "entered_forbidden": lambda r: bool(r["entered_forbidden"]),
+            "limit_violations": lambda r: int(r["limit_violations"]),
+        },
+    )
 
 
 def failures(rows: list[dict[str, Any]], law: str | None = LAW) -> list[dict[str, Any]]:
@@ -240,11 +193,7 @@ def failures(rows: list[dict[str, Any]], law: str | None = LAW) -> list[dict[str
     sensing level, obstacles, status (the cause: ``collision`` or ``timeout``), clearance."""
     keep = ("scene", "seed", "law", "noise_std", "dropout", "n_obstacles", "status",
             "min_clearance")  # fmt: skip
-    return [
-        {k: r[k] for k in keep}
-        for r in rows
-        if (law is None or r["law"] == law) and r["status"] != "success"
-    ]
+    return cp.non_successes((r for r in rows if law is None or r["law"] == law), keep)
 
 
 @dataclass
@@ -282,17 +231,13 @@ def target_approach_check(traj: Uuv2dTrajectory, until: float = FIG47_UNTIL) -> 
 
 def _fig47_row(check: dict[str, float]) -> dict[str, Any]:
     held = "held" if check["target_approach"] else "NOT held"
-    return {
-        "quantity": f"Ch.4 Fig. 4.7: target approach for t = 0...{FIG47_UNTIL:g} s",
-        "thesis": f"t = 0...{FIG47_UNTIL:g} in target approach",
-        "measured": (
-            f"{held}; at ({check['x_m']:.2f}, {check['y_m']:.2f}) m at t = {FIG47_UNTIL:g} s"
-        ),
-        "note": (
-            f"{LAW}; clearance {check['clearance_m']:.2f} m there; first avoidance decision at "
-            f"t = {check['first_avoidance_s']:.1f} s"
-        ),
-    }
+    return table_row(
+        f"Ch.4 Fig. 4.7: target approach for t = 0...{FIG47_UNTIL:g} s",
+        f"t = 0...{FIG47_UNTIL:g} in target approach",
+        f"{held}; at ({check['x_m']:.2f}, {check['y_m']:.2f}) m at t = {FIG47_UNTIL:g} s",
+        f"{LAW}; clearance {check['clearance_m']:.2f} m there; first avoidance decision at "
+        f"t = {check['first_avoidance_s']:.1f} s",
+    )
 
 
 def _table(
@@ -306,29 +251,27 @@ def _table(
             continue
         clear = r["min_clearance"]
         table.append(
-            {
-                "quantity": f"Ch.4 {r['scene']}: outcome",
-                "thesis": "reaches E, no collision (figure only)",
-                "measured": f"{r['status']}, min clearance "
+            table_row(
+                f"Ch.4 {r['scene']}: outcome",
+                "reaches E, no collision (figure only)",
+                f"{r['status']}, min clearance "
                 + (f"{clear:.3f} m" if clear is not None else "-")
                 + (", ENTERED inner space" if r["entered_forbidden"] else ""),
-                "verdict": (
-                    "reproduced"
-                    if r["status"] == "success" and not r["entered_forbidden"]
-                    else "differs"
-                ),
-                "note": LAW,
-            }
+                LAW,
+                verdict="reproduced"
+                if r["status"] == "success" and not r["entered_forbidden"]
+                else "differs",
+            )
         )
     for c in campaign:
         if c["noise_std"] == 0 and c["dropout"] == 0:
             table.append(
-                {
-                    "quantity": f"Ch.4 {c['family']} success ({c['law']}, n={c['episodes']})",
-                    "thesis": "not reported",
-                    "measured": f"{100 * c['success_rate']:.1f} %",
-                    "note": f"collisions {100 * c['collision_rate']:.1f} %",
-                }
+                table_row(
+                    f"Ch.4 {c['family']} success ({c['law']}, n={c['episodes']})",
+                    "not reported",
+                    f"{100 * c['success_rate']:.1f} %",
+                    f"collisions {100 * c['collision_rate']:.1f} %",
+                )
             )
     return table
 
@@ -359,9 +302,8 @@ def reproduce_ch4(
         progress: ``progress(done, total)`` after each campaign episode.
         start_seed: first seed of every random family (seeds ``start_seed`` onwards).
 
-    Additive: an episode already in the store is never run again nor replaced (the thesis
-    scenes run again for the figures' trajectories, but only missing ones are stored), and
-    other runs' episodes are kept; each is stored in its own transaction as it finishes.
+    Additive (:mod:`uvnav.experiments.campaigns`): the thesis scenes run again for the figures'
+    trajectories, only missing episodes are stored.
 
     Raises:
         StaleCampaignError: a stored campaign of this chapter was made by other code (its
@@ -378,26 +320,17 @@ def reproduce_ch4(
         else (FULL_NOISE_SEEDS if full else QUICK_NOISE_SEEDS)
     )
     nh = hard_seeds if hard_seeds is not None else (FULL_HARD_SEEDS if full else QUICK_HARD_SEEDS)
-    scene_results: dict[tuple[str, str], EpisodeResult[Uuv2dTrajectory]] = {}
-    fp = fingerprint()
+    fp = cp.fingerprint("experiments/ch4.py")
     size = {"chapter": 4, "laws": list(LAWS), FINGERPRINT_KEY: fp}
+    scene_jobs = [ch4_job(scene, law, 0) for scene in list_uuv2d_builtin() for law in LAWS]
     with ResultsStore(db_path) as store:
         check_fingerprints(store, dict.fromkeys((SCENES_CAMPAIGN, *CAMPAIGNS), fp))
-        cid = store.campaign(SCENES_CAMPAIGN, {**size, "seed": 0})
-        stored = store.done_keys(cid)
-        for scene in list_uuv2d_builtin():
-            for law in LAWS:
-                job = ch4_job(scene, law, 0)
-                out = run_job(dataclasses.replace(job, record=True))  # the figures' trajectories
-                outcome_record(out)  # raises for a failed episode
-                if job.key not in stored:
-                    store_outcome(store, cid, out)
-                scene_results[(scene, law)] = out.result
-        scene_rows = [
-            r
-            for r in stored_rows(store, SCENES_CAMPAIGN)
-            if (r["scene"], r["law"]) in scene_results
-        ]
+        # run again for the figures' trajectories; stored only when missing
+        kept = cp.run_recorded(store, SCENES_CAMPAIGN, scene_jobs, config={**size, "seed": 0})
+        scene_results: dict[tuple[str, str], EpisodeResult[Uuv2dTrajectory]] = {
+            (str(j.label), j.controller): kept[j.key] for j in scene_jobs
+        }
+        scene_rows = [_row(r) for r in cp.job_records(store, SCENES_CAMPAIGN, scene_jobs)]
         clean, noisy = campaign_jobs(n, nn, start=start_seed)
         rows_random = run_jobs(clean, store, RANDOM_CAMPAIGN, workers=workers,
                                progress=progress, config={**size, "seeds": n})  # fmt: skip
@@ -433,20 +366,3 @@ def reproduce_ch4(
     if render is not None and report_dir is not None:
         summary.figures = list(render(Path(report_dir) / "ch4", scene_results, summary))
     return summary
-
-
-__all__ = [
-    "LAWS",
-    "METRIC_NAMES",
-    "Ch4Summary",
-    "campaign_jobs",
-    "ch4_job",
-    "failures",
-    "hard_jobs",
-    "reproduce_ch4",
-    "run_ch4_job",
-    "run_jobs",
-    "stored_rows",
-    "summarise",
-    "target_approach_check",
-]

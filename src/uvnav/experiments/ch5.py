@@ -15,15 +15,12 @@ geometric (min/argmin, the baseline), network (the BPNN) and oracle (true geomet
 4. on the harder ``random-ch5-dense`` family, noise 0 (quick: none; ``full``: 100) — campaign
    ``ch5-dense``.
 
-Every episode is an ordinary campaign job (:func:`ch5_job`: a :class:`~uvnav.bench.campaign.Job`
-with this experiment's runner, run, stored and resumed by
-:func:`~uvnav.bench.campaign.run_campaign`) and a row of the SQLite results store
-(:class:`~uvnav.bench.store.ResultsStore`, ``results_dir/uvnav.sqlite``, the database of
-``uvnav run``, DESIGN §5): the ``controller`` column holds the law, ``params`` (the job's tags)
-the locator and the noise level (plus, for the network, a digest of its checkpoint: part of the
-resume key, so a different network re-runs), ``family`` the generator or the scene; the facts the
-store has no column for (number of obstacles, whether Scene 2's inner space was entered) go to
-``effective_params``.
+Every episode is a campaign job (:func:`ch5_job`, this experiment's runner) run and stored by
+:mod:`uvnav.experiments.campaigns` in ``results_dir/uvnav.sqlite``: the ``controller`` column
+holds the law, ``params`` (the job's tags) the locator and the noise level (plus, for the
+network, a digest of its checkpoint: part of the resume key, so a different network re-runs),
+``family`` the generator or the scene; the number of obstacles and whether Scene 2's inner space
+was entered go to ``effective_params``.
 
 **Resumable.**  Nothing measured is lost when a run is interrupted: the data sets, learning rows
 and networks are stages under ``results_dir/ch5/cache`` (:mod:`uvnav.experiments.ch5_bpnn`), and
@@ -31,10 +28,8 @@ every random-campaign episode is one transaction of the store; a re-run skips wh
 (``fresh`` drops the cache; stored episodes are never deleted or replaced by a later run).  A
 cache without ``stages/`` (files ``row_*.json``, ``data_*.rng.json``) is dropped and recomputed
 from the same seeds (the same data; a network trained again to the same weights keeps its
-digest, which covers the weights only, and so its stored episodes).  Every campaign carries the
-code's :func:`fingerprint`; a run refuses to resume one stored by other code
-(:class:`~uvnav.bench.store.StaleCampaignError`, one line naming it for ``uvnav forget``) before
-it trains anything, so old and new episodes are never mixed.
+digest, which covers the weights only, and so its stored episodes).  A campaign stored by other
+code is refused (:class:`~uvnav.bench.store.StaleCampaignError`) before anything is trained.
 ``results_dir/ch5.json`` (rows, table, per-group summary, failures) and the table
 "thesis reported vs uvnav measured" are computed from the measured rows only.  Figures are drawn
 by a renderer the caller injects (:mod:`uvnav.viz` is a layer above).
@@ -55,24 +50,10 @@ from typing import Any
 
 import numpy as np
 
-from uvnav.bench.campaign import (
-    EpisodeRun,
-    Job,
-    outcome_record,
-    run_job,
-    run_stored,
-    store_outcome,
-    stored_records,
-)
+import uvnav.experiments.campaigns as cp
+from uvnav.bench.campaign import EpisodeRun, Job, outcome_record, run_job, stored_records
 from uvnav.bench.fingerprint import DB_NAME
-from uvnav.bench.store import (
-    FINGERPRINT_KEY,
-    EpisodeKey,
-    ResultsStore,
-    check_fingerprints,
-    extend_fingerprint,
-)
-from uvnav.bench.summary import outcome_stats
+from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, check_fingerprints
 from uvnav.controllers.zhang_uuv3d import (
     NAME as LAW,
 )
@@ -92,6 +73,7 @@ from uvnav.experiments.ch5_bpnn import (
     learning_row,
     learning_table,
 )
+from uvnav.experiments.rows import table_row
 from uvnav.learning.bpnn import (
     THESIS_ACCEPTED,
     VARIANTS,
@@ -107,7 +89,6 @@ from uvnav.scenarios.ch5 import (
     build_uuv3d,
     list_ch5_builtin,
     load_ch5_scenario,
-    random_ch5_scenario,
 )
 from uvnav.sim.episode_uuv3d import LocatedTrace
 from uvnav.sim.metrics import METRIC_NAMES
@@ -193,13 +174,10 @@ def ch5_job(
 
 
 def fingerprint() -> str:
-    """The code fingerprint of this experiment's campaigns: the packages that decide an episode
-    (:func:`uvnav.bench.fingerprint.code_fingerprint`), :mod:`uvnav.learning` (the network's
-    locator), this module (its runner) and :mod:`uvnav.experiments.ch5_bpnn` (the network)."""
-    from uvnav.bench.fingerprint import code_fingerprint
-
-    parts = ("learning", "experiments/ch5.py", "experiments/ch5_bpnn.py")
-    return extend_fingerprint(code_fingerprint(), *parts)
+    """The code fingerprint of this experiment's campaigns: the packages that decide an episode,
+    :mod:`uvnav.learning` (the network's locator), this module (its runner) and
+    :mod:`uvnav.experiments.ch5_bpnn` (the network)."""
+    return cp.fingerprint("learning", "experiments/ch5.py", "experiments/ch5_bpnn.py")
 
 
 def checkpoint_digest(path: Path) -> str:
@@ -275,55 +253,32 @@ def run_jobs(
     campaign: str,
     *,
     workers: int = 1,
-    on_episode: Callable[[], None] | None = None,
+    progress: cp.Progress | None = None,
     config: dict[str, Any] | None = None,
 ) -> list[dict[str, Any]]:
-    """Run the jobs of ``campaign`` not yet in the store (a campaign: one transaction per
-    finished episode, so an interrupted campaign resumes); ``on_episode()`` once per job, the
-    stored ones first.
-
-    Returns:
-        The rows of all requested jobs (stored and new), in job order.
-    """
-    jobs = list(jobs)
+    """The rows of ``jobs`` (stored and new, in job order), those ``campaign`` lacks run first
+    (:func:`uvnav.experiments.campaigns.run_jobs`)."""
     cfg = config or {"chapter": 5}
-    done = store.done_keys(store.campaign(campaign, cfg))
-    for _ in range(sum(j.key in done for j in jobs) if on_episode is not None else 0):
-        on_episode()  # type: ignore[misc]
-    recs = run_stored(
-        store, campaign, jobs, config=cfg, workers=workers,
-        on_outcome=None if on_episode is None else (lambda _o, _e: on_episode()),
-    )  # fmt: skip
+    recs = cp.run_jobs(store, campaign, jobs, config=cfg, workers=workers, progress=progress)
     return [_row(r) for r in recs]
-
-
-def _family(row: dict[str, Any]) -> str:
-    return str(row["scene"]).split(":", 1)[0]
 
 
 def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """Per (scene family, locator, noise): episodes, success / collision / timeout rates, inner
     space entries, median path length and detour ratio, minimum clearance, decision time."""
-    groups: dict[tuple[str, str, float], list[dict[str, Any]]] = {}
-    for r in rows:
-        groups.setdefault((_family(r), r["locator"], float(r["noise_std"])), []).append(r)
-    return [
-        {
-            "family": family,
-            "locator": loc,
-            "noise_std": noise,
-            **outcome_stats(rs),
-            "entered_inner_space": sum(bool(r["entered_inner_space"]) for r in rs),
-        }
-        for (family, loc, noise), rs in sorted(groups.items())
-    ]
+    return cp.group_stats(
+        rows,
+        lambda r: (cp.family(r), r["locator"], float(r["noise_std"])),
+        ("family", "locator", "noise_std"),
+        {"entered_inner_space": lambda r: bool(r["entered_inner_space"])},
+    )
 
 
 def failures(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
     """The episodes that did not succeed: scene, seed, locator, noise, obstacles, status (the
     cause: ``collision`` or ``timeout``), minimum clearance [m]."""
     keep = ("scene", "seed", "locator", "noise_std", "n_obstacles", "status", "min_clearance")
-    return [{k: r.get(k) for k in keep} for r in rows if r["status"] != "success"]
+    return cp.non_successes(rows, keep)
 
 
 def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
@@ -334,29 +289,20 @@ def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
     cl = summary.closed_loop
     for group in sorted({(r["locator"], r["noise_std"]) for r in cl}):
         loc, noise = group
-        thesis_rows = [
-            r
-            for r in cl
-            if (r["locator"], r["noise_std"]) == group and str(r["scene"]).startswith("thesis-ch5")
-        ]
-        rand_rows = [
-            r for r in cl if (r["locator"], r["noise_std"]) == group and _family(r) == GENERATOR_CH5
-        ]
-        dense_rows = [
-            r
-            for r in cl
-            if (r["locator"], r["noise_std"]) == group and _family(r) == GENERATOR_CH5_DENSE
-        ]
+        mine = [r for r in cl if (r["locator"], r["noise_std"]) == group]
+        thesis_rows = [r for r in mine if str(r["scene"]).startswith("thesis-ch5")]
+        rand_rows = [r for r in mine if cp.family(r) == GENERATOR_CH5]
+        dense_rows = [r for r in mine if cp.family(r) == GENERATOR_CH5_DENSE]
         if thesis_rows:
             ok = sum(bool(r["success"]) for r in thesis_rows)
             inner = sum(bool(r["entered_inner_space"]) for r in thesis_rows)
             rows.append(
-                {
-                    "quantity": f"Ch5 thesis scenes reached, no collision ({loc}, noise {noise} m)",
-                    "thesis": "3/3",
-                    "measured": f"{ok}/{len(thesis_rows)}",
-                    "note": f"entered Scene 2 inner space: {inner}",
-                }
+                table_row(
+                    f"Ch5 thesis scenes reached, no collision ({loc}, noise {noise} m)",
+                    "3/3",
+                    f"{ok}/{len(thesis_rows)}",
+                    f"entered Scene 2 inner space: {inner}",
+                )
             )
         families = (
             ("random scenes", rand_rows),
@@ -368,18 +314,18 @@ def build_ch5_table(summary: Ch5Summary) -> list[dict[str, Any]]:
             ok = sum(bool(r["success"]) for r in fam_rows)
             fails = [f"{r['scene']} {r['status']}" for r in fam_rows if not r["success"]]
             rows.append(
-                {
-                    "quantity": f"Ch5 {label} success ({loc}, noise {noise} m)",
-                    "thesis": "-",
-                    "measured": f"{ok / len(fam_rows):.1%} of {len(fam_rows)}",
-                    "note": (
+                table_row(
+                    f"Ch5 {label} success ({loc}, noise {noise} m)",
+                    "-",
+                    f"{ok / len(fam_rows):.1%} of {len(fam_rows)}",
+                    (
                         f"{len(fails)} failures: "
                         + ", ".join(fails[:6])
                         + (", ..." if len(fails) > 6 else "")
                     )
                     if fails
                     else "no failure",
-                }
+                )
             )
     return rows
 
@@ -464,9 +410,8 @@ def reproduce_ch5(
             targets (min/argmin of its inputs) at each of ``sizes`` the thesis reports (50, 150);
             default 20 quick, 50 full.
 
-    Additive: an episode already in the store is never run again nor replaced (the thesis
-    scenes run again for the figures' trajectories, but only missing ones are stored), and other
-    runs' episodes are kept; each is stored in its own transaction as it finishes.
+    Additive (:mod:`uvnav.experiments.campaigns`): the thesis scenes run again for the figures'
+    trajectories, only missing episodes are stored.
 
     Raises:
         StaleCampaignError: a stored campaign of this chapter was made by other code (its
@@ -565,30 +510,26 @@ def reproduce_ch5(
             "chapter": 5, "law": LAW, "locators": list(LOCATORS), "model": model_id,
             FINGERPRINT_KEY: fp,
         }  # fmt: skip
+        scene_jobs = [
+            ch5_job(scene, loc, 0, float(noise), cl_model, model_id if loc == "network" else "")
+            for scene in scene_list for noise in noise_list for loc in LOCATORS
+        ]  # fmt: skip
         with ResultsStore(db_path) as store:
             check_fingerprints(store, dict.fromkeys(CAMPAIGNS, fp))
-            cid = store.campaign(SCENES_CAMPAIGN, {**base_cfg, "noises": list(noise_list)})
-            stored = store.done_keys(cid)
-            wanted: set[EpisodeKey] = set()
-            for scene in scene_list:
-                for noise in noise_list:
-                    for loc in LOCATORS:
-                        job = ch5_job(scene, loc, 0, float(noise), cl_model,
-                                      model_id if loc == "network" else "")  # fmt: skip
-                        # run again for the figures' trajectories; stored only when missing
-                        done = run_job(dataclasses.replace(job, record=True))
-                        outcome_record(done)  # raises for a failed episode
-                        if job.key not in stored:
-                            store_outcome(store, cid, done)
-                        wanted.add(job.key)
-                        kept[(scene, loc, float(noise))] = done.result
-                        prog.advance(task2)
-            scene_rows = [
-                _row(r)
-                for r in stored_records(store, SCENES_CAMPAIGN)
-                if (r["scenario"], r["controller"], r["params_hash"], r["seed"]) in wanted
-            ]
+            # run again for the figures' trajectories; stored only when missing
+            results = cp.run_recorded(
+                store, SCENES_CAMPAIGN, scene_jobs, config={**base_cfg, "noises": list(noise_list)},
+                on_episode=lambda _out: prog.advance(task2),
+            )  # fmt: skip
+            for j in scene_jobs:
+                tags = dict(j.tags)
+                kept[(str(j.label), tags["locator"], tags["noise_std"])] = results[j.key]
+            scene_rows = [_row(r) for r in cp.job_records(store, SCENES_CAMPAIGN, scene_jobs)]
             rand_rows: list[dict[str, Any]] = []
+
+            def advance_from(ran: float) -> cp.Progress:
+                return lambda k, _n: prog.update(task2, completed=ran + k)
+
             for name, js in jobs.items():
                 if not js:
                     continue
@@ -597,14 +538,12 @@ def reproduce_ch5(
                     "seeds": len({j.seed for j in js}),
                     "noise_std": dict(js[0].tags)["noise_std"],
                 }
+                ran = prog.tasks[task2].completed
                 rand_rows += run_jobs(
-                    js,
-                    store,
-                    name,
-                    workers=workers,
-                    config=cfg_c,
-                    on_episode=lambda: prog.advance(task2),
-                )
+                    js, store, name, workers=workers, config=cfg_c,
+                    progress=advance_from(ran),
+                )  # fmt: skip
+                prog.update(task2, completed=ran + len(js))
     summary.models["episodes"] = kept
     summary.closed_loop = scene_rows + rand_rows
     summary.campaign = summarise(summary.closed_loop)
@@ -638,20 +577,3 @@ def reproduce_ch5(
     if render is not None and report_dir is not None:
         summary.figures = list(render(summary, Path(report_dir)))
     return summary
-
-
-__all__ = [
-    "CAMPAIGNS",
-    "LAW",
-    "Ch5Summary",
-    "build_ch5_table",
-    "ch5_job",
-    "checkpoint_digest",
-    "failures",
-    "random_ch5_scenario",
-    "reproduce_ch5",
-    "run_ch5_job",
-    "run_jobs",
-    "stored_rows",
-    "summarise",
-]

@@ -43,6 +43,7 @@ from typing import Any
 
 import numpy as np
 
+from uvnav.experiments.rows import table_row
 from uvnav.learning.bpnn import (
     ACCEPTED_SAMPLES,
     THESIS_ACCEPTED,
@@ -340,12 +341,12 @@ def _error_row(label: str, n: int, out: str, rs: list[dict[str, Any]]) -> dict[s
     if out == "index":
         note += _ties_note(rs)
     med_lo, med_hi = float(np.median([x["lo"] for x in g])), float(np.median([x["hi"] for x in g]))
-    return {
-        "quantity": f"{label} {n} samples: {out} error, test group",
-        "thesis": thesis,
-        "measured": f"median {_range(med_lo, med_hi)}",
-        "note": note,
-    }
+    return table_row(
+        f"{label} {n} samples: {out} error, test group",
+        thesis,
+        f"median {_range(med_lo, med_hi)}",
+        note,
+    )
 
 
 def _mae_row(label: str, n: int, out: str, rs: list[dict[str, Any]]) -> dict[str, Any]:
@@ -362,12 +363,12 @@ def _mae_row(label: str, n: int, out: str, rs: list[dict[str, Any]]) -> dict[str
         right = np.median([r["independent"]["network"]["index_accuracy"] for r in rs])
         right_b = np.median([r["independent"]["baseline"]["index_accuracy"] for r in rs])
         note += f"; sensor named right: network {right:.1%}, baseline {right_b:.1%}"
-    return {
-        "quantity": f"{label} {n}: {out} MAE, indep. test (baseline)",
-        "thesis": "-",
-        "measured": f"{np.median(ind):.3g} ({np.median(base):.3g})",
-        "note": note,
-    }
+    return table_row(
+        f"{label} {n}: {out} MAE, indep. test (baseline)",
+        "-",
+        f"{np.median(ind):.3g} ({np.median(base):.3g})",
+        note,
+    )
 
 
 def _learning_rows(label: str, n: int, rs: list[dict[str, Any]]) -> list[dict[str, Any]]:
@@ -377,16 +378,14 @@ def _learning_rows(label: str, n: int, rs: list[dict[str, Any]]) -> list[dict[st
         ok = sum(seed_succeeds(r) for r in rs)
         ref = THESIS_ERROR_RANGES[ACCEPTED_SAMPLES]
         rows.append(
-            {
-                "quantity": f"{label} {n} samples: outcome",
-                "thesis": "succeeds (acceptable)"
-                if THESIS_ACCEPTED[n]
-                else "fails (too scattered)",
-                "measured": f"succeeds on {ok}/{len(rs)} seeds",
-                "note": f"{thesis_statement(n, ok, len(rs))}; success = both test-group error "
+            table_row(
+                f"{label} {n} samples: outcome",
+                "succeeds (acceptable)" if THESIS_ACCEPTED[n] else "fails (too scattered)",
+                f"succeeds on {ok}/{len(rs)} seeds",
+                f"{thesis_statement(n, ok, len(rs))}; success = both test-group error "
                 f"ranges inside the thesis's accepted {ACCEPTED_SAMPLES}-sample ranges "
                 f"{_range(*ref['distance'])} and {_range(*ref['index'])}",
-            }
+            )
         )
     return rows + [_mae_row(label, n, out, rs) for out in OUTPUTS]
 
@@ -420,21 +419,3 @@ def json_default(x: Any) -> Any:
     if isinstance(x, float) and not math.isfinite(x):
         return None
     raise TypeError(type(x).__name__)
-
-
-__all__ = [
-    "FULL_SIZES",
-    "QUICK_SIZES",
-    "TEST_SEED",
-    "VARIANT_KEYS",
-    "VARIANT_LABELS",
-    "beam_ties",
-    "cached_dataset",
-    "json_default",
-    "learning_row",
-    "learning_table",
-    "range_inside",
-    "seed_succeeds",
-    "split_model_key",
-    "thesis_statement",
-]

@@ -21,11 +21,9 @@ beyond that assumption, in a separate campaign :data:`BEYOND_CAMPAIGN` whose row
 ``zhang2019-v1`` inside and inherits that law's assumption (``ControllerInfo.inner_law``), so it is
 refused and run beyond like it.
 
-Both campaigns live in the results store ``results_dir/uvnav.sqlite``, carry the code
-fingerprint (:func:`uvnav.bench.fingerprint.code_fingerprint`) and only add: a second run skips
-every stored episode; a campaign stored by other code is refused
-(:class:`~uvnav.bench.store.StaleCampaignError`).  The table shows the run's own cases (those it
-ran or found stored); ``uvnav report`` rebuilds it from every stored case (:func:`crowd_rows`).
+Both campaigns live in ``results_dir/uvnav.sqlite`` (:mod:`uvnav.experiments.campaigns`:
+resumable, fingerprinted, additive).  The table shows the run's own cases (those it ran or found
+stored); ``uvnav report`` rebuilds it from every stored case (:func:`crowd_rows`).
 """
 
 from __future__ import annotations
@@ -36,11 +34,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
+from uvnav.bench.fingerprint import DB_NAME, code_fingerprint
 from uvnav.bench.jobs import Job
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
-from uvnav.experiments.sections import ChapterSection, mode_text, rows_of
+from uvnav.experiments.campaigns import run_checked
+from uvnav.experiments.rows import rate_text, table_row
+from uvnav.experiments.sections import TITLES, ChapterSection, mode_text, rows_of
 
 CAMPAIGN = "crowdnav"
 BEYOND_CAMPAIGN = "crowdnav-beyond"
@@ -184,11 +184,6 @@ def reproduce_crowds(
 # ------------------------------------------------------------------------------------ the table
 
 
-def _rate(k: int, n: int) -> str:
-    lo, hi = wilson_interval(k, n)
-    return f"{k / n:.2f} [{lo:.2f}, {hi:.2f}]"
-
-
 def _mean(g: Any, name: str) -> float | None:
     col = g[name].dropna().astype(float)
     return float(col.mean()) if len(col) else None
@@ -235,14 +230,14 @@ def _row(gen: str, law: str, g: Any, *, beyond: bool) -> dict[str, str]:
             note = f"the law's assumption does not hold: {why}"
         else:
             measured, note = f"errors only ({errors})", ""
-        return {"quantity": quantity, "thesis": thesis, "measured": measured, "note": note}
+        return table_row(quantity, thesis, measured, note)
     st = ok["status"].astype(str)
     k_ok, k_hit = int((st == "success").sum()), int((st == "collision").sum())
     k_out = int((st == "timeout").sum())
     wins = ok[st == "success"]
     ttg = _mean(wins, "time_to_goal") if len(wins) else None
     measured = (
-        f"success {_rate(k_ok, n)}, collision {_rate(k_hit, n)}, timeout {k_out / n:.2f} "
+        f"success {rate_text(k_ok, n)}, collision {rate_text(k_hit, n)}, timeout {k_out / n:.2f} "
         f"(n={n}); time to goal {'n/a' if ttg is None else f'{ttg:.2f} s'}"
     )
     extra = []
@@ -258,7 +253,7 @@ def _row(gen: str, law: str, g: Any, *, beyond: bool) -> dict[str, str]:
     if errors:
         extra.append(f"errors {errors}")
     note = "; ".join([*extra, _social_note(ok)] if _social_note(ok) else extra)
-    row = {"quantity": quantity, "thesis": thesis, "measured": measured, "note": note}
+    row = table_row(quantity, thesis, measured, note)
     if paper:  # the paper's figure against ours: inside our 95 % interval or not
         row["verdict"] = "reproduced" if inside else "differs"
     return row
@@ -355,25 +350,7 @@ def crowds_section(summary: CrowdsSummary) -> ChapterSection:
         )
     return ChapterSection(
         key="crowds",
-        title="Beyond the thesis — CrowdNav's crowds, every 2D law",
+        title=TITLES["crowds"],
         intro=intro,
         rows=rows_of(summary.table),
     )
-
-
-__all__ = [
-    "BEYOND_CAMPAIGN",
-    "CAMPAIGN",
-    "CAMPAIGNS",
-    "FULL_CASES",
-    "GENERATORS",
-    "PAPER_ORCA",
-    "QUICK_CASES",
-    "CrowdsSummary",
-    "crowd_jobs",
-    "crowd_laws",
-    "crowd_rows",
-    "crowds_section",
-    "eth_rows",
-    "reproduce_crowds",
-]

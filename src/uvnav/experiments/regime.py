@@ -44,12 +44,14 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.fingerprint import DB_NAME, code_fingerprint, run_checked
+from uvnav.bench.fingerprint import DB_NAME, code_fingerprint
 from uvnav.bench.jobs import Job
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, ResultsStore
 from uvnav.bench.summary import wilson_interval
+from uvnav.experiments.campaigns import run_checked
 from uvnav.experiments.crowds import crowd_laws
-from uvnav.experiments.sections import ChapterSection, mode_text
+from uvnav.experiments.rows import rate_text
+from uvnav.experiments.sections import TITLES, ChapterSection, mode_text
 
 CAMPAIGN = "regime-map"
 GENERATOR = "crowdnav-circle"
@@ -266,9 +268,9 @@ class Rate:
         """``"0.87 [0.62, 0.96]"``, with ``" n=15 (small)"`` for a small sample."""
         if self.n == 0:
             return "no episodes"
-        lo, hi = self.interval
-        out = f"{self.p:.{digits}f} [{lo:.{digits}f}, {hi:.{digits}f}]"
-        return out + (f" n={self.n} (small)" if self.small else "")
+        return rate_text(self.k, self.n, f".{digits}f") + (
+            f" n={self.n} (small)" if self.small else ""
+        )
 
 
 @dataclass(frozen=True)
@@ -302,8 +304,6 @@ def _rates(g: Any) -> tuple[Rate, Rate, Rate, int]:
 def cell_stats(store: ResultsStore) -> dict[Regime, list[CellStats]]:
     """Per regime of the stored campaign, one :class:`CellStats` per law (laws sorted), on the
     seeds every law of that cell ran (equal samples); empty when the campaign is not stored."""
-    from uvnav.controllers.base import UnknownControllerError, requires_slower_obstacles
-
     camp = next((c for c in store.campaigns() if c["name"] == CAMPAIGN), None)
     if camp is None:
         return {}
@@ -318,12 +318,8 @@ def cell_stats(store: ResultsStore) -> dict[Regime, list[CellStats]]:
             continue
         stats = []
         for law, gl in g.groupby("controller", sort=True):
-            try:
-                slower = requires_slower_obstacles(str(law))
-            except UnknownControllerError:  # a law stored by a plug-in no longer installed
-                slower = False
             s, rc, c, err = _rates(gl)
-            beyond = slower and cell.speed_ratio >= 1.0
+            beyond = _slower(str(law)) and cell.speed_ratio >= 1.0
             stats.append(CellStats(str(law), s, rc, c, beyond=beyond, errors=err))
         out[cell] = stats
     return out
@@ -417,8 +413,7 @@ def ranking(stats: Sequence[CellStats]) -> tuple[list[CellStats], list[CellStats
 
 
 def _pct(r: Rate) -> str:
-    lo, hi = r.interval
-    return f"{r.p:.0%} [{lo:.0%}, {hi:.0%}]"
+    return rate_text(r.k, r.n, ".0%")
 
 
 #: the mark of a law run beyond the assumption it declares (thesis (2.6)) in that cell
@@ -594,6 +589,8 @@ def family_table(store: ResultsStore, *, families: Sequence[str] | None = None) 
 
 
 def _slower(law: str) -> bool:
+    """Whether ``law`` assumes obstacles slower than the robot (``False`` for a law stored by a
+    plug-in no longer installed)."""
     from uvnav.controllers.base import UnknownControllerError, requires_slower_obstacles
 
     try:
@@ -626,7 +623,7 @@ def regime_section(summary: RegimeSummary | None, *, full: bool) -> ChapterSecti
         )
     return ChapterSection(
         key="regime",
-        title="Beyond the thesis — where each law wins (regime map)",
+        title=TITLES["regime"],
         intro=(
             f"Every 2D law on CrowdNav's circle crossing over crowd density x pedestrian speed / "
             f"V_max x robot visible or not x sensing (campaign {CAMPAIGN}): {ran}. Every "
@@ -639,37 +636,3 @@ def regime_section(summary: RegimeSummary | None, *, full: bool) -> ChapterSecti
             "store."
         ],
     )
-
-
-__all__ = [
-    "CAMPAIGN",
-    "DENSITIES",
-    "FULL_SEEDS",
-    "LIDAR_BEAMS",
-    "LIDAR_NOISE",
-    "LIDAR_RANGE",
-    "LIDAR_VISIBLE",
-    "NOISES",
-    "QUICK_SEEDS",
-    "SMALL_SAMPLE",
-    "SPEED_RATIOS",
-    "VISIBLE",
-    "CellStats",
-    "FamilyCell",
-    "Rate",
-    "Regime",
-    "RegimeSummary",
-    "SensingCost",
-    "cell_stats",
-    "equal_seeds",
-    "family_table",
-    "law_lines",
-    "leaders",
-    "ranking",
-    "recommend",
-    "regime_jobs",
-    "regime_section",
-    "regimes",
-    "run_regime_map",
-    "sensing_costs",
-]

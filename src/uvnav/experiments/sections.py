@@ -70,6 +70,15 @@ class ChapterSection:
         for f in files:
             (self.figures if f.path.suffix.lower() in IMAGE_SUFFIXES else self.links).append(f)
 
+    def add_figures(
+        self, paths: Iterable[Path], caption: Callable[[Path], str | None], what: str = ""
+    ) -> None:
+        """Add the existing ``paths`` with their captions (:func:`caption_files`); with ``what``,
+        a note when the section has no figure ("the run had no ``what`` renderer")."""
+        self.add_files(caption_files(paths, caption))
+        if what and not self.figures:
+            self.notes.append(f"No figures: the run had no {what} renderer.")
+
 
 #: Draws Ch. 3 figures: ``(db_path, report_dir, [(scene, law, trajectory)]) -> files``.
 Ch3Renderer = Callable[[Path, Path, list[tuple[str, str, Any]]], list[Path]]
@@ -93,6 +102,20 @@ class ChapterRenderers:
     ch6: SummaryRenderer | None = None
     ch7: PlanRenderer | None = None
     beyond: FolderRenderer | None = None
+
+
+#: The built-in sections' headings by key.
+TITLES: dict[str, str] = {
+    "ch2": "Chapter 2 — a unicycle among moving, deforming obstacles",
+    "ch3": "Chapter 3 — a 3D flying robot with AR prediction",
+    "ch4": "Chapter 4 — a UUV among shape-changing obstacles",
+    "ch5": "Chapter 5 — a 3D UUV with nine sonars and a BPNN",
+    "ch6": "Chapter 6 — a CNN that drives (PilotNet on CarRacing)",
+    "ch7": "Chapter 7 — UAV reconnaissance of a terrain",
+    "crowds": "Beyond the thesis — CrowdNav's crowds, every 2D law",
+    "regime": "Beyond the thesis — where each law wins (regime map)",
+    "beyond": "Beyond the thesis — global planners, hybrid navigation, multi-robot",
+}
 
 
 def mode_text(full: bool) -> str:
@@ -155,7 +178,7 @@ def ch2_section(
         )
     return ChapterSection(
         key="ch2",
-        title="Chapter 2 — a unicycle among moving, deforming obstacles",
+        title=TITLES["ch2"],
         intro=intro,
         rows=rows_of(rows),
     )
@@ -206,16 +229,14 @@ def ch3_section(
         )
     sec = ChapterSection(
         key="ch3",
-        title="Chapter 3 — a 3D flying robot with AR prediction",
+        title=TITLES["ch3"],
         intro=intro,
         rows=rows_of(summary.table),
     )
     finding = getattr(summary, "finding", "")
     if finding:
         sec.notes.append(finding)
-    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch3_caption))
-    if not sec.figures:
-        sec.notes.append("No figures: the run had no Chapter 3 renderer.")
+    sec.add_figures(getattr(summary, "figures", []) or [], _ch3_caption, "Chapter 3")
     return sec
 
 
@@ -256,16 +277,14 @@ def ch4_section(
     )
     sec = ChapterSection(
         key="ch4",
-        title="Chapter 4 — a UUV among shape-changing obstacles",
+        title=TITLES["ch4"],
         intro=intro,
         rows=rows_of(summary.table),
     )
-    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch4_caption))
+    sec.add_figures(getattr(summary, "figures", []) or [], _ch4_caption, "Chapter 4")
     p = getattr(summary, "summary_path", None)
     if p is not None:
         sec.links += caption_files([Path(p)], lambda _p: "Chapter 4 results (JSON)")
-    if not sec.figures:
-        sec.notes.append("No figures: the run had no Chapter 4 renderer.")
     return sec
 
 
@@ -342,11 +361,11 @@ def ch5_section(summary: Any, *, full: bool) -> ChapterSection:
     )
     sec = ChapterSection(
         key="ch5",
-        title="Chapter 5 — a 3D UUV with nine sonars and a BPNN",
+        title=TITLES["ch5"],
         intro=intro,
         rows=rows_of(summary.table),
     )
-    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch5_caption))
+    sec.add_figures(getattr(summary, "figures", []) or [], _ch5_caption)
     if p is not None:
         sec.links += caption_files([Path(p)], lambda _p: "Chapter 5 results (JSON)")
     fails = list(getattr(summary, "failures", []) or [])
@@ -377,7 +396,7 @@ _CH6_CAPTIONS = {
 def ch6_section(summary: Any | None, *, full: bool) -> ChapterSection:
     """The Chapter 6 section from a :class:`uvnav.experiments.ch6.Ch6Summary` (``None``: not
     run, as in a test-sized run)."""
-    title = "Chapter 6 — a CNN that drives (PilotNet on CarRacing)"
+    title = TITLES["ch6"]
     if summary is None:
         return ChapterSection(
             key="ch6",
@@ -415,9 +434,7 @@ def ch6_section(summary: Any | None, *, full: bool) -> ChapterSection:
             "(uvnav reproduce ch6 --full or uvnav drive reproduce --full; measured figures in "
             "docs/thesis-notes.md)."
         )
-    sec.add_files(
-        caption_files(getattr(summary, "figures", []) or [], lambda p: _CH6_CAPTIONS.get(p.stem))
-    )
+    sec.add_figures(getattr(summary, "figures", []) or [], lambda p: _CH6_CAPTIONS.get(p.stem))
     return sec
 
 
@@ -453,13 +470,11 @@ def ch7_section(summary: Any, *, full: bool) -> ChapterSection:
     )
     sec = ChapterSection(
         key="ch7",
-        title="Chapter 7 — UAV reconnaissance of a terrain",
+        title=TITLES["ch7"],
         intro=intro,
         rows=rows_of(summary.table),
     )
-    sec.add_files(caption_files(getattr(summary, "figures", []) or [], _ch7_caption))
-    if not sec.figures:
-        sec.notes.append("No figures: the run had no Chapter 7 renderer.")
+    sec.add_figures(getattr(summary, "figures", []) or [], _ch7_caption, "Chapter 7")
     return sec
 
 
@@ -508,13 +523,11 @@ def beyond_section(
     )
     sec = ChapterSection(
         key="beyond",
-        title="Beyond the thesis — global planners, hybrid navigation, multi-robot",
+        title=TITLES["beyond"],
         intro=intro,
         rows=rows_of(rows),
     )
-    sec.add_files(caption_files(figures, _beyond_caption))
-    if not sec.figures:
-        sec.notes.append("No figures: the run had no beyond-the-thesis renderer.")
+    sec.add_figures(figures, _beyond_caption, "beyond-the-thesis")
     return sec
 
 

@@ -13,7 +13,7 @@ from pathlib import Path
 from typing import Any
 
 import uvnav.experiments.ch2 as rp
-from uvnav.experiments.sections import SECTIONS_DIR, ChapterSection
+from uvnav.experiments.sections import SECTIONS_DIR, TITLES, ChapterSection, rows_of
 
 #: Chapters whose results are files under the results folder, not store campaigns.
 _FILE_CHAPTERS = {"ch6": ("ch6", "ch6-quick"), "ch7": ("ch7",)}
@@ -32,9 +32,16 @@ def _rerun_section(key: str, why: str) -> ChapterSection:
     )
 
 
-def _ch2_from_store(store: Any) -> ChapterSection | None:
-    from uvnav.experiments.sections import rows_of
+def _rebuilt(
+    key: str, what: str, table: list[dict[str, Any]], figures: bool = True
+) -> ChapterSection:
+    """A section rebuilt from the stored episodes of ``what`` (its campaigns)."""
+    notes = [f"No figures: they are drawn by 'uvnav reproduce {key}' (or 'uvnav run')."]
+    intro = f"Rebuilt from the episodes stored in the database ({what})."
+    return ChapterSection(key, TITLES[key], intro, rows_of(table), notes=notes if figures else [])
 
+
+def _ch2_from_store(store: Any) -> ChapterSection | None:
     cfg = next((c["config"] for c in store.campaigns() if c["name"] == rp.SCENES_CAMPAIGN), None)
     if cfg is None:
         return None
@@ -43,45 +50,26 @@ def _ch2_from_store(store: Any) -> ChapterSection | None:
     table, _ = rp.build_table(store, scenes, ctrls, straight_line=straight)
     if store.campaign_id(rp.BASELINES_CAMPAIGN) is not None:
         table += rp.comparison_rows(store)
-    return ChapterSection(
-        key="ch2",
-        title="Chapter 2 — a unicycle among moving, deforming obstacles",
-        intro="Rebuilt from the episodes stored in the database (thesis scenes, random, baseline "
-        "and crowd campaigns).",
-        rows=rows_of(table),
-        notes=["No figures: they are drawn by 'uvnav reproduce ch2' (or 'uvnav run')."],
-    )
+    return _rebuilt("ch2", "thesis scenes, random, baseline and crowd campaigns", table)
 
 
 def _ch4_from_store(store: Any) -> ChapterSection:
     import uvnav.experiments.ch4 as r4
-    from uvnav.experiments.sections import rows_of
 
     rows = [r for name in r4.CAMPAIGNS for r in r4.stored_rows(store, name)]
     table = r4._table(r4.stored_rows(store, r4.SCENES_CAMPAIGN), r4.summarise(rows))
-    return ChapterSection(
-        key="ch4",
-        title="Chapter 4 — a UUV among shape-changing obstacles",
-        intro="Rebuilt from the episodes stored in the database (thesis scenes, random, noise and "
-        "hard campaigns).",
-        rows=rows_of(table),
-        notes=["No figures: they are drawn by 'uvnav reproduce ch4' (or 'uvnav run')."],
-    )
+    return _rebuilt("ch4", "thesis scenes, random, noise and hard campaigns", table)
 
 
 def _crowds_from_store(store: Any) -> ChapterSection:
     import uvnav.experiments.crowds as rc
-    from uvnav.experiments.sections import rows_of
 
-    return ChapterSection(
-        key="crowds",
-        title="Beyond the thesis — CrowdNav's crowds, every 2D law",
-        intro="Rebuilt from the episodes stored in the database (campaigns "
-        f"{', '.join(rc.CAMPAIGNS)}: every stored test case of CrowdNav's circle and square "
-        "crossing; success and collision with 95 % Wilson intervals, the paper's ORCA figure, "
-        "social metrics in the notes).",
-        rows=rows_of(rc.crowd_rows(store)),
+    what = (
+        f"campaigns {', '.join(rc.CAMPAIGNS)}: every stored test case of CrowdNav's circle and "
+        "square crossing; success and collision with 95 % Wilson intervals, the paper's ORCA "
+        "figure, social metrics in the notes"
     )
+    return _rebuilt("crowds", what, rc.crowd_rows(store), figures=False)
 
 
 def report_sections(db_path: Path) -> list[ChapterSection]:
@@ -133,6 +121,3 @@ def report_sections(db_path: Path) -> list[ChapterSection]:
             if section is not None:
                 out.append(section)
     return out
-
-
-__all__ = ["report_sections"]
