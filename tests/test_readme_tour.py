@@ -28,15 +28,16 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 README = ROOT / "README.md"
 
+_CLUSTER = "a multi-node cluster (tests/bench/test_bench_ray_cluster.py starts one)"
 #: lines not run, with why (matched at the start of the line)
 SKIP: dict[str, str] = {
     "make run": "the set-up and `uvnav run`, which the tour runs itself",
     "make test": "the set-up and the test suite, which CI runs before the tour",
     "source .venv/bin/activate": "the tour runs the installed console script directly",
     "uvnav replay my_bag/": "a user's own bag; the line before it replays the tour's run.mcap",
-    "ray get-auth-token": "a multi-node cluster (tests/bench/test_bench_ray_cluster.py starts one)",
-    "ray start": "a multi-node cluster (tests/bench/test_bench_ray_cluster.py starts one)",
-    "RAY_AUTH_MODE=token": "a multi-node cluster (tests/bench/test_bench_ray_cluster.py starts one)",
+    "ray get-auth-token": _CLUSTER,
+    "ray start": _CLUSTER,
+    "RAY_AUTH_MODE=token": _CLUSTER,
     "uvnav bench my-campaign.yaml --engine ray --address": "needs the cluster of the lines above",
 }
 
