@@ -33,9 +33,8 @@ from uvnav.bench.campaign import (
     stored_records,
 )
 from uvnav.bench.fingerprint import code_fingerprint
-from uvnav.bench.fingerprint import run_checked as run_checked  # scene-job campaigns
 from uvnav.bench.jobs import Job, JobOutcome
-from uvnav.bench.store import EpisodeKey, ResultsStore, extend_fingerprint
+from uvnav.bench.store import EpisodeKey, ResultsStore, StaleCampaignError, extend_fingerprint
 from uvnav.bench.summary import outcome_stats
 
 #: ``progress(done, total)`` after each episode run (``total``: the episodes the call runs)
@@ -166,3 +165,45 @@ def non_successes(rows: Iterable[dict[str, Any]], keep: Sequence[str]) -> list[d
 def family(row: Mapping[str, Any]) -> str:
     """A row's scene family: its ``scene`` before ``:`` (``random-ch4:3`` -> ``random-ch4``)."""
     return str(row["scene"]).split(":", 1)[0]
+
+
+def check_campaigns(store: ResultsStore, configs: dict[str, dict[str, Any]]) -> None:
+    """Check that every stored campaign of ``configs`` (name -> config) was made by the same code
+    (fingerprint); never deletes one.
+
+    Raises:
+        StaleCampaignError: naming every stored campaign whose fingerprint differs (its episodes
+            cannot be resumed and would be mixed with new ones; the user removes them).
+    """
+    stale = []
+    for c in store.campaigns():
+        cfg = configs.get(c["name"])
+        if cfg is not None and c["config"].get("fingerprint") != cfg["fingerprint"]:
+            stale.append(c["name"])
+    if stale:
+        raise StaleCampaignError(
+            store.path, stale, f"{'was' if len(stale) == 1 else 'were'} stored by other code"
+        )
+
+
+def run_checked(
+    store: ResultsStore,
+    plans: Sequence[tuple[str, dict[str, Any], list[Job]]],
+    *,
+    workers: int,
+    progress: bool,
+    statuses: bool = False,
+) -> dict[str, dict[str, Any]]:
+    """Check the stored campaigns of ``plans`` ((name, config, jobs); :func:`check_campaigns`),
+    then run each; returns name -> its counts: jobs, ran, skipped, errors, the status counts (with
+    ``statuses``) and the wall time [s]."""
+    check_campaigns(store, {name: cfg for name, cfg, _ in plans})
+    out: dict[str, dict[str, Any]] = {}
+    for name, cfg, jobs in plans:
+        run = run_campaign(store, name, jobs, config=cfg, workers=workers, progress=progress)
+        counts: dict[str, Any] = {"jobs": run.total, "ran": run.ran, "skipped": run.skipped}
+        counts["errors"] = run.errors
+        if statuses:
+            counts["statuses"] = dict(run.statuses)
+        out[name] = {**counts, "wall_time": round(run.wall_time, 2)}
+    return out
