@@ -12,10 +12,10 @@ Its package would declare, and the test writes into a ``.dist-info`` folder::
 from __future__ import annotations
 
 from uvnav.bench.fingerprint import DB_NAME, code_fingerprint
-from uvnav.experiments.campaigns import run_checked
 from uvnav.bench.jobs import Job
 from uvnav.bench.store import ResultsStore
 from uvnav.experiments import Experiment, ExperimentContext, ExperimentRun
+from uvnav.experiments.campaigns import run_checked
 from uvnav.experiments.sections import ChapterSection
 
 CAMPAIGN = "dummy-open-field"
