@@ -386,9 +386,12 @@ class EnvWorld:
 
     def vector(self, i: int) -> np.ndarray:
         """Robot i's observation vector (module docstring), float32."""
-        pose = self.pose(i)
+        one = self.one
+        if one is not None:
+            x, y, th = one.x, one.y, one.th
+        else:
+            x, y, th = (float(p) for p in self.pose(i))
         goal = self.goal(i)
-        x, y, th = float(pose[0]), float(pose[1]), float(pose[2])
         gx, gy = float(goal[0]) - x, float(goal[1]) - y
         bearing = math.atan2(gy, gx) - th
         out = np.empty(self.obs_size(), dtype=np.float32)
@@ -398,19 +401,19 @@ class EnvWorld:
         out[3] = min(max(self.speed(i) / self.spec(i).v_max, 0.0), 1.0)
         # clipped in [0, 1] after the cast to float32: the same numbers (0 and 1 are exact)
         scaled = out[4:]
-        np.divide(self.ranges(i, pose), self.max_range, out=scaled)
+        np.divide(self.ranges(i), self.max_range, out=scaled)
         np.minimum(np.maximum(scaled, 0.0, out=scaled), 1.0, out=scaled)
         return out
 
-    def ranges(self, i: int, pose: np.ndarray) -> np.ndarray:
-        """Robot i's lidar ranges [m] from ``pose`` (:func:`~uvnav.sensors.exact.lidar_scan`
-        without noise; for packed bodies the same numbers from one compiled call)."""
+    def ranges(self, i: int) -> np.ndarray:
+        """Robot i's lidar ranges [m] now (:func:`~uvnav.sensors.exact.lidar_scan` without
+        noise; for packed bodies the same numbers from one compiled call)."""
         one = self.one
         if one is not None and isinstance(one.bodies, PackedBodies):
             one.bodies.lidar(one.x, one.y, one.th, self._rel, self.max_range, self._ranges)
             return self._ranges
         field = self._lidar_field(i)
-        return lidar_scan(pose, field, n_rays=self.n_rays, max_range=self.max_range).ranges
+        return lidar_scan(self.pose(i), field, n_rays=self.n_rays, max_range=self.max_range).ranges
 
     def _lidar_field(self, i: int) -> ObstacleField:
         """The field robot i's lidar sees: everything but its own disc."""
