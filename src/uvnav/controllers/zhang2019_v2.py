@@ -99,7 +99,7 @@ import math
 from dataclasses import dataclass
 from itertools import accumulate, chain
 from operator import attrgetter
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -594,6 +594,23 @@ def plan_limited(
 _SOURCE = attrgetter("velocity_source")
 
 
+class LoopConstants:
+    """A law's :func:`loop_constants`, kept while its parameters and vehicle spec are the same
+    objects."""
+
+    def __init__(self) -> None:
+        self._of: tuple[object, object] | None = None
+        self._value: tuple[FloatArray, FloatArray] | None = None
+
+    def get(self, params: Zhang2019V2Params, spec: Any) -> tuple[FloatArray, FloatArray]:
+        """:func:`loop_constants` of ``params`` and ``spec``'s V_max and radius."""
+        of = self._of
+        if self._value is None or of is None or of[0] is not params or of[1] is not spec:
+            self._of = (params, spec)
+            self._value = loop_constants(params, float(spec.v_max), float(spec.radius))
+        return self._value
+
+
 def finite_position(pose: FloatArray) -> bool:
     """The position ``pose[:2]`` is finite (two float checks, no array made)."""
     return math.isfinite(pose[0]) and math.isfinite(pose[1])
@@ -624,11 +641,11 @@ class Zhang2019HolonomicV2(HolonomicLaw):
         self.params = params or Zhang2019V2Params()
         self.last_choice: Choice | None = None
         self._tracker = _tracker(self.params)
+        self._fixed = LoopConstants()
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
         self._tracker = _tracker(self.params)
-        self._constants = loop_constants(self.params, self._spec.v_max, self._spec.radius)
 
     def act(self, obs: Observation) -> VelocityCommand:
         period = self.decision_period(obs.time)
@@ -638,7 +655,7 @@ class Zhang2019HolonomicV2(HolonomicLaw):
         obs = tracked(obs, self._tracker)
         choice = plan(obs, self._goal, spec.v_max, spec.radius, period,
                       self.current_velocity(obs), self.params,
-                      constants=self._constants)  # fmt: skip
+                      constants=self._fixed.get(self.params, self._spec))  # fmt: skip
         self.last_choice = choice
         self._mode = "M1" if choice.preferred else "M2"
         return VelocityCommand(float(choice.velocity[0]), float(choice.velocity[1])).clipped(spec)
@@ -655,13 +672,13 @@ class Zhang2019V2(UnicycleController):
         self.last_choice: Choice | None = None
         self._aim = np.zeros(2)
         self._tracker = _tracker(self.params)
+        self._fixed = LoopConstants()
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
         self._aim = np.zeros(2)
         self._tracker = _tracker(self.params)
         self._turn = (0.0, 0.0)  # the turn rate at the last decision and the one commanded
-        self._constants = loop_constants(self.params, self._spec.v_max, self._spec.radius)
 
     def act(self, obs: Observation) -> UnicycleCommand:
         period = self.decision_period(obs.time)
@@ -673,7 +690,7 @@ class Zhang2019V2(UnicycleController):
             return self._act_limited(obs, period)
         choice = plan(obs, self._goal, spec.v_max, spec.radius, period, self._aim, self.params,
                       heading=obs.heading, u_max=spec.u_max,
-                      constants=self._constants)  # fmt: skip
+                      constants=self._fixed.get(self.params, self._spec))  # fmt: skip
         self.last_choice = choice
         self._mode = "M1" if choice.preferred else "M2"
         v = choice.velocity
