@@ -1,16 +1,28 @@
-"""The batched Nav2D env (issue 20, item 3): env steps per CPU-second under a random policy.
+"""The Nav2D env under a random policy: the batched env (issue 20, item 3) and a single
+``uvnav/Nav2D-v0``, env steps per CPU-second.
 
-Run: ``PYTHONPATH=src .venv/bin/python benchmarks/bench_vector_env.py [--quick] [--out DIR]``.
+Run: ``PYTHONPATH=src .venv/bin/python benchmarks/bench_vector_env.py [--quick] [--out DIR]
+[--against DIR]``.
 
-``gymnasium.make_vec("uvnav/Nav2D-v0", num_envs=256, vectorization_mode="vector_entry_point")``
-(:class:`uvnav.envs.nav2d_vec.Nav2DVectorEnv`, K packed worlds of :mod:`uvnav.sim.packed`) on a
-``random-ch2`` scene with 10 obstacles, a random policy (uniform actions from a seeded
-generator), autoreset on: env steps per CPU second of this process over 200 vector steps (40 with
-``--quick``), median of 5 runs.  Target: >= 100,000 env steps/s (the issue's, on 2 cores; this
-measures one).  The packed world step itself is timed beside ir-sim and the one loop by
-``benchmarks/peers/irsim_steps.py``.
+* Batched: ``gymnasium.make_vec("uvnav/Nav2D-v0", num_envs=256,
+  vectorization_mode="vector_entry_point")`` (:class:`uvnav.envs.nav2d_vec.Nav2DVectorEnv`, K
+  packed worlds of :mod:`uvnav.sim.packed`) over 200 vector steps (40 with ``--quick``), median
+  of 5 runs.  Target: >= 100,000 env steps/s (the issue's, on 2 cores; this measures one).  The
+  packed world step itself is timed beside ir-sim and the one loop by
+  ``benchmarks/peers/irsim_steps.py``.
+* Single: ``gymnasium.make("uvnav/Nav2D-v0")`` (:class:`uvnav.envs.nav2d.Nav2DEnv`, the default
+  settings: collisions judged along each step, 32 lidar beams, ``info["uvnav"]`` with the
+  observation a uvnav law would get) over 2,000 steps (300 with ``--quick``), reset when an
+  episode ends, median of 5 runs.  Each step: the action checked and mapped to a command, the
+  world's integration steps to the next decision (robot, obstacles, clearance, swept collision
+  check, metrics), the reward, the observation vector (goal, speed, the lidar cast) and the info.
+  ``--against DIR`` times the same in another uvnav source tree (a worktree of the release),
+  both sides in worker processes, alternating rounds, and reports the speed-up (ratio of the
+  medians); the issue's target is 10x.
 
-Prints target, measured, ratio, PASS/FAIL; ``--out DIR`` writes ``DIR/vector_env.json``.
+Both on a ``random-ch2`` scene with 10 obstacles, uniform actions from a seeded generator, CPU
+time of the process.  Prints target, measured, ratio, PASS/FAIL; ``--out DIR`` writes
+``DIR/vector_env.json``.
 """
 
 from __future__ import annotations
@@ -27,6 +39,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
 
+from ab_worker import SourceTreeWorker, serve, source_dir
 from run_benchmarks import machine_info
 
 from uvnav.scenarios.generators import generate
@@ -34,6 +47,9 @@ from uvnav.scenarios.generators import generate
 REPEATS = 5
 #: env steps per CPU-second
 TARGET_VEC = 100_000.0
+#: single env: steps/s over the baseline tree's (``--against``)
+TARGET_SINGLE_SPEEDUP = 10.0
+_HERE_SRC = Path(__file__).resolve().parents[1] / "src"
 
 
 def vector_steps_per_s(num_envs: int, steps: int, seed: int) -> tuple[float, int]:
@@ -59,6 +75,61 @@ def vector_steps_per_s(num_envs: int, steps: int, seed: int) -> tuple[float, int
     return num_envs * steps / cpu, ended
 
 
+def single_steps_per_s(steps: int, seed: int) -> tuple[float, int]:
+    """Steps per CPU-second of one ``uvnav/Nav2D-v0`` (default settings) under a random policy,
+    reset when an episode ends, and the number of episodes that ended."""
+    import gymnasium as gym
+
+    import uvnav.envs  # noqa: F401 - registers the envs
+
+    env = gym.make("uvnav/Nav2D-v0", scenario=generate("random-ch2", 3, n_obstacles=10))
+    rng = np.random.default_rng(seed)
+    env.reset(seed=seed)
+    acts = rng.uniform(-1, 1, (steps + 100, 2)).astype(np.float32)
+    for a in acts[:100]:  # compiled kernels loaded, caches warm, before timing
+        if any(env.step(a)[2:4]):
+            env.reset()
+    ended = 0
+    cpu = time.process_time()
+    for a in acts[100:]:
+        _, _, term, trunc, _ = env.step(a)
+        if term or trunc:
+            ended += 1
+            env.reset()
+    cpu = time.process_time() - cpu
+    env.close()
+    return steps / cpu, ended
+
+
+def _single_job(job: dict[str, Any]) -> dict[str, Any]:
+    rate, ended = single_steps_per_s(int(job["steps"]), int(job["seed"]))
+    return {"rate": rate, "ended": ended}
+
+
+def single_ab(steps: int, against: Path) -> dict[str, Any]:
+    """The single env in ``against``'s uvnav and in this checkout's, alternately (each side in
+    its own worker process, the order swapped every round), :data:`REPEATS` rounds."""
+    sides = {
+        "baseline": SourceTreeWorker(Path(__file__), source_dir(against), 120.0),
+        "current": SourceTreeWorker(Path(__file__), _HERE_SRC, 120.0),
+    }
+    rates: dict[str, list[float]] = {name: [] for name in sides}
+    try:
+        for r in range(REPEATS):
+            for name in list(sides) if r % 2 == 0 else list(reversed(sides)):
+                out = sides[name].run({"steps": steps, "seed": r})
+                if "error" in out:
+                    raise SystemExit(f"single env, {name}: {out['error']}")
+                rates[name].append(out["rate"])
+    finally:
+        for w in sides.values():
+            w.close()
+    med = {name: statistics.median(v) for name, v in rates.items()}
+    return {"sources": {name: w.uvnav for name, w in sides.items()}, "steps": steps,
+            "env_steps_per_s": rates, "median": med,
+            "speedup": med["current"] / med["baseline"]}  # fmt: skip
+
+
 def verdict(name: str, target: str, measured: str, ratio: float, ok: bool) -> dict[str, Any]:
     line = f"{name:<28} target {target:<14} measured {measured:<14} ratio {ratio:6.2f}"
     print(f"{line} {'PASS' if ok else 'FAIL'}")
@@ -69,8 +140,12 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--quick", action="store_true", help="shorter runs: a smoke test")
     ap.add_argument("--out", type=Path, help="write vector_env.json here")
+    ap.add_argument("--against", type=Path, help="also time the single env in this uvnav tree")
+    ap.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
-    vec_steps = 40 if args.quick else 200
+    if args.worker:
+        raise SystemExit(serve(_single_job))
+    vec_steps, single_steps = (40, 300) if args.quick else (200, 2000)
     out: dict[str, Any] = {"machine": machine_info(), "quick": args.quick}
     rates, ended = [], 0
     for rep in range(REPEATS):
@@ -82,8 +157,28 @@ def main() -> None:
                          "median": rate, "episodes_ended": ended, "target": TARGET_VEC}  # fmt: skip
     print(f"vector env, K = 256, 10 obstacles: {rate:,.0f} env steps/CPU-s "
           f"({ended} episodes ended)")  # fmt: skip
+    singles, ended = [], 0
+    for rep in range(REPEATS):
+        one, e = single_steps_per_s(single_steps, rep)
+        singles.append(one)
+        ended += e
+    single = statistics.median(singles)
+    out["single_env"] = {"steps": single_steps, "env_steps_per_s": singles, "median": single,
+                         "episodes_ended": ended}  # fmt: skip
+    print(f"single env, 10 obstacles: {single:,.0f} env steps/CPU-s ({ended} episodes ended)")
     out["targets"] = [verdict("vector env, K = 256", f">= {TARGET_VEC:,.0f}/s", f"{rate:,.0f}/s",
                               rate / TARGET_VEC, rate >= TARGET_VEC)]  # fmt: skip
+    if args.against is not None:
+        ab = single_ab(single_steps, args.against)
+        out["single_env_ab"] = ab
+        med = ab["median"]
+        print(f"single env side by side: baseline {med['baseline']:,.0f}, current "
+              f"{med['current']:,.0f} env steps/CPU-s")  # fmt: skip
+        speedup = ab["speedup"]
+        out["targets"].append(
+            verdict("single env vs baseline", f">= {TARGET_SINGLE_SPEEDUP:g}x", f"{speedup:.2f}x",
+                    speedup / TARGET_SINGLE_SPEEDUP, speedup >= TARGET_SINGLE_SPEEDUP)
+        )  # fmt: skip
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)
         (args.out / "vector_env.json").write_text(json.dumps(out, indent=1))

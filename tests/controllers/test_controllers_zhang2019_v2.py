@@ -13,10 +13,14 @@ from hypothesis import strategies as st
 
 from uvnav.controllers import make_controller
 from uvnav.controllers.base import controller_info, make_law, requires_slower_obstacles
+from uvnav.controllers.holonomic import toward_goal
 from uvnav.controllers.zhang2019_v2 import (
     Zhang2019V2Params,
+    body_table,
     boundary_discs,
+    extra_headings,
     plan,
+    reachable,
     tangent_directions,
 )
 from uvnav.dynamics import UnicycleSpec
@@ -26,6 +30,7 @@ from uvnav.geometry.contact import (
     candidate_risk_compiled,
     candidate_risk_py,
     closest_gap,
+    decide_compiled,
     first_contact,
 )
 from uvnav.geometry.kernels3d import compiled, numba_available
@@ -360,3 +365,60 @@ def test_tracker_leaves_exact_sensing_alone_and_helps_under_noise() -> None:
         for t in (False, True)
     }  # fmt: skip
     assert wins[True] > wins[False]
+
+
+# -- the one-call decision against the same decision prepared in numpy --------------------------
+
+
+def _prepared_in_numpy(
+    obs: Observation, v_prev: np.ndarray, heading: float | None, u_max: float
+) -> np.ndarray:
+    """The loop's decision with its inputs prepared by the numpy building blocks (reading,
+    reachable bodies, boundary discs, bounding radii, extra headings), then decide_compiled."""
+    p, v_max, pad, period = PARAMS, 1.0, 0.3 + PARAMS.safety_margin, 0.25
+    pos = np.asarray(obs.position, dtype=float)
+    v_pref = toward_goal(pos, GOAL, v_max, period)
+    table = body_table(obs.obstacles)
+    keep = reachable(table, v_max, p.horizon)
+    if not len(keep):
+        return np.array([v_pref[0], v_pref[1], math.inf, 1.0])
+    table = (table[0][keep], table[1][keep], table[2][keep])
+    scal, centre, vel = table
+    discs_only = bool(np.all(scal[:, 2] > 0.0))
+    if discs_only:
+        discs = (centre, vel, scal[:, 2], np.arange(len(scal)))
+    else:
+        discs = boundary_discs(tuple(obs.obstacles[k] for k in keep), p.spacing, table)[:4]
+    spin = np.sqrt(1.0 + (scal[:, 1] * p.horizon) ** 2)
+    body_r = np.where(scal[:, 2] > 0.0, scal[:, 3], scal[:, 3] * spin + 0.5 * p.spacing)
+    state = np.array([pos[0], pos[1], math.nan if heading is None else heading, u_max,
+                      v_pref[0], v_pref[1], v_prev[0], v_prev[1]])  # fmt: skip
+    weights = np.array([p.horizon, p.comfort, p.comfort_horizon, p.w_ttc, p.w_change,
+                        p.w_comfort, p.min_ttc, pad, p.forecast_horizon, p.max_tangent_bodies,
+                        p.safety_margin])  # fmt: skip
+    speeds = v_max * np.asarray(p.speed_levels, dtype=float)
+    headings = extra_headings(p.n_headings, v_pref, v_prev)
+    return decide_compiled(state, headings, speeds, discs, (centre, vel, body_r), weights)
+
+
+@settings(max_examples=150, deadline=None)
+@given(seed=st.integers(0, 10_000), n=st.integers(0, 20), unicycle=st.booleans(),
+       polygons=st.booleans(), still=st.booleans())  # fmt: skip
+def test_one_call_decision_equals_the_numpy_prepared_one_bit_for_bit(
+    seed: int, n: int, unicycle: bool, polygons: bool, still: bool
+) -> None:
+    """The whole decision in one loop (compiled when numba is there) reads the same bodies,
+    boundary discs and headings as the numpy preparation: the same velocity and first contact,
+    to the bit; so does its plain-Python copy."""
+    obs, v_prev = _random_scene(seed, n, polygons)
+    if still:
+        v_prev = np.zeros(2)
+    heading, u_max = (obs.heading, math.pi) if unicycle else (None, math.inf)
+    want = _prepared_in_numpy(obs, v_prev, heading, u_max)
+    args = (obs, GOAL, 1.0, 0.3, 0.25, v_prev, PARAMS)
+    for enabled in (True, False):
+        with compiled(enabled):
+            got = plan(*args, loop=True, heading=heading, u_max=u_max)
+        assert got.velocity.tolist() == want[:2].tolist()
+        assert got.ttc == want[2]
+        assert got.preferred == bool(want[3])

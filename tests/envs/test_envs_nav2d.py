@@ -14,10 +14,13 @@ from uvnav.controllers import make_controller
 from uvnav.core import AgentLog
 from uvnav.envs.core import RewardConfig
 from uvnav.envs.nav2d import Nav2DEnv
+from uvnav.geometry.kernels3d import compiled, numba_enabled
 from uvnav.scenarios import load_scenario
 from uvnav.scenarios.build import build_episode
+from uvnav.scenarios.generators import generate
 from uvnav.scenarios.schema import Scenario
 from uvnav.sim import run_episode, run_rng
+from uvnav.sim.bodies2d import PackedBodies
 
 
 def test_check_env_passes() -> None:
@@ -265,3 +268,51 @@ def test_the_multi_robot_env_refuses_a_non_finite_action_before_any_robot_moves(
     with pytest.raises(ValueError, match=r"^action of robot_2\[1\] is nan: an action must be"):
         env.step(actions)
     assert np.array_equal(env.world.state, poses) and env.world.t == 0.0
+
+
+def _rollout(kwargs: dict, steps: int) -> tuple[list, list[bool]]:
+    """A seeded random-action rollout through resets: every vector, reward, flag and info item
+    (the law's observation compared by ControllerView's equality), and whether each episode's
+    bodies were packed."""
+    env = Nav2DEnv(**kwargs)
+    rng = np.random.default_rng(1)
+    low, high = env.action_space.low, env.action_space.high  # type: ignore[attr-defined]
+    obs, info = env.reset(seed=11)
+    out: list = [obs, info]
+    packed = [isinstance(env.world.bodies, PackedBodies)]
+    for _ in range(steps):
+        obs, r, term, trunc, info = env.step(rng.uniform(low, high).astype(env.action_space.dtype))
+        out += [obs, r, term, trunc, info]
+        if term or trunc:
+            obs, info = env.reset()
+            out += [obs, info]
+            packed.append(isinstance(env.world.bodies, PackedBodies))
+    env.close()
+    return out, packed
+
+
+@pytest.mark.skipif(not numba_enabled(), reason="needs numba (the fast extra), enabled")
+@pytest.mark.parametrize(
+    "kwargs",
+    [
+        {},
+        {"swept": False},
+        {"raw_commands": True},
+        {"n_rays": 7, "max_range": 2.0},
+    ],
+)
+def test_compiled_bodies_and_lidar_give_the_reference_rollout(kwargs: dict) -> None:
+    """With numba the env's bodies move, sense and cast the lidar in compiled calls; a seeded
+    rollout of random actions through resets gives the numpy reference's observation vectors,
+    rewards, terminations, truncations and infos (the law's observation included), exactly."""
+    kwargs = {"scenario": generate("random-ch2", 3, n_obstacles=10), **kwargs}
+    fast, packed = _rollout(kwargs, 700)
+    with compiled(False):
+        slow, unpacked = _rollout(kwargs, 700)
+    assert all(packed) and not any(unpacked) and len(packed) >= 2  # a reset happened
+    assert len(fast) == len(slow)
+    for a, b in zip(fast, slow, strict=True):
+        if isinstance(a, np.ndarray):
+            assert a.dtype == b.dtype and np.array_equal(a, b)
+        else:
+            assert a == b

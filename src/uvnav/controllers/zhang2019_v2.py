@@ -80,13 +80,15 @@ This decision runs in numpy only (the compiled loop below serves the ideal vehic
 
 Two equal implementations of one decision.  The reference is numpy, vectorised over candidates x
 boundary discs (:func:`tangent_directions`, :func:`choose_velocity`).  With numba (the ``fast``
-extra) the whole choice after reading the observation runs in one compiled loop
-(:func:`uvnav.geometry.contact.decide_compiled`): it visits the candidates by their cost without
-the risk terms (a lower bound of the cost), checks each against the bodies with a bounding-disc
-cull, and stops once a safe candidate costs no more than the next bound, so candidates that
-cannot win are never checked.  It picks the reference's candidate (tests: hypothesis on random
-scenes); one decision with 100 pedestrians in range costs well under 200 µs of CPU time,
-about a third of it reading the observation's readings into arrays
+extra) everything after reading the observation's readings into arrays (:func:`body_table`,
+:func:`outline_rings`) runs in one compiled call
+(:func:`uvnav.controllers.zhang2019_v2_loop.plan_loop`: the reachable bodies, their boundary
+discs and the candidate headings, then :func:`uvnav.geometry.contact.decide_py`): it visits the
+candidates by their cost without the risk terms (a lower bound of the cost), checks each
+against the bodies with a bounding-disc cull, and stops once a safe candidate costs no more than
+the next bound, so candidates that cannot win are never checked.  It picks the reference's
+candidate (tests: hypothesis on random scenes); its cost grows linearly with the bodies in
+range, and reading the readings is the part that grows in Python
 (``benchmarks/bench_zhang2019_v2.py``).  Units: metres, seconds, radians.
 """
 
@@ -95,9 +97,9 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from itertools import chain
+from itertools import accumulate, chain
 from operator import attrgetter
-from typing import ClassVar
+from typing import Any, ClassVar
 
 import numpy as np
 
@@ -119,10 +121,17 @@ from uvnav.controllers.zhang2019_limits import (
     stoppable,
     turn_command,
 )
+from uvnav.controllers.zhang2019_v2_loop import (
+    N_PRM,
+    P_HEADINGS,
+    P_SPACING,
+    P_VMAX,
+    plan_loop,
+)
 from uvnav.dynamics.omni import VelocityCommand
 from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-from uvnav.geometry.contact import candidate_risk, candidate_risk_compiled, decide_compiled
+from uvnav.geometry.contact import candidate_risk, candidate_risk_compiled
 from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.prediction.tracking import CentreTracker
 from uvnav.sensors.observation import Observation, ObstacleReading
@@ -427,22 +436,29 @@ def plan(
     heading: float | None = None,
     u_max: float = math.inf,
     loop: bool | None = None,
+    constants: tuple[FloatArray, FloatArray] | None = None,
 ) -> Choice:
     """One decision of v2 for a robot at ``obs.position`` (both vehicles).
 
-    ``loop``: decide in one loop (:func:`uvnav.geometry.contact.decide_compiled`, compiled when
-    numba is enabled) or by :func:`tangent_directions` and :func:`choose_velocity` in numpy (the
-    reference); ``None``: the loop exactly when numba is enabled."""
+    ``loop``: decide in one loop (:func:`uvnav.controllers.zhang2019_v2_loop.plan_loop`, which
+    ends in :func:`uvnav.geometry.contact.decide_py`, compiled when numba is enabled) or by
+    :func:`tangent_directions` and :func:`choose_velocity` in numpy (the reference); ``None``:
+    the loop exactly when numba is enabled.  ``constants``: :func:`loop_constants` of these
+    ``params``, ``v_max`` and ``robot_radius`` when the caller keeps them (computed otherwise)."""
     p = params
+    use_loop = numba_enabled() if loop is None else loop
     pos = np.asarray(obs.position, dtype=float)
     v_pref = toward_goal(pos, goal, v_max, period)
+    if use_loop:
+        fixed = constants or loop_constants(p, v_max, robot_radius)
+        return _plan_in_loop(obs, v_pref, v_prev, fixed, heading, u_max)
     table = body_table(obs.obstacles)
     keep = reachable(table, v_max, p.horizon)
     if not len(keep):
         return Choice(v_pref, math.inf, True)
     if len(keep) < len(table[0]):
         table = (table[0][keep], table[1][keep], table[2][keep])
-    scal, centre, vel = table
+    scal = table[0]
     discs_only = bool(np.all(scal[:, 2] > 0.0))  # a crowd: the readings are not read again
     near = () if discs_only else tuple(obs.obstacles[k] for k in keep)
     headings = extra_headings(p.n_headings, v_pref, v_prev)
@@ -452,26 +468,68 @@ def plan(
     # drifts out to rho sqrt(1 + (u_i H)^2): the cull's disc must hold that too
     spin = np.sqrt(1.0 + (scal[:, 1] * p.horizon) ** 2)
     body_r = np.where(scal[:, 2] > 0.0, scal[:, 3], scal[:, 3] * spin + 0.5 * p.spacing)
-    use_loop = numba_enabled() if loop is None else loop
-    if use_loop:
-        state = np.array([pos[0], pos[1], math.nan if heading is None else heading, u_max,
-                          v_pref[0], v_pref[1], v_prev[0], v_prev[1]])  # fmt: skip
-        weights = np.array([p.horizon, p.comfort, p.comfort_horizon, p.w_ttc, p.w_change,
-                            p.w_comfort, p.min_ttc, pad, p.forecast_horizon,
-                            p.max_tangent_bodies, p.safety_margin])  # fmt: skip
-        if discs_only:
-            discs = (centre, vel, scal[:, 2], np.arange(len(scal)))
-        else:
-            discs = boundary_discs(near, p.spacing, table)[:4]
-        speeds = v_max * np.asarray(p.speed_levels, dtype=float)
-        out = decide_compiled(state, headings, speeds, discs, (centre, vel, body_r), weights)
-        return Choice(out[:2].copy(), float(out[2]), bool(out[3]))
     q, w, r, owner, rows = boundary_discs(near, p.spacing, table)
     reach = r + pad
     bodies = np.column_stack([rows, body_r + pad])
     tangents = nearest_tangents(pos, (q, w, reach, owner), p)
     return choose_velocity(pos, v_pref, v_prev, np.concatenate([tangents, headings]), v_max,
                            (q, w, reach, bodies), p, heading=heading, u_max=u_max)  # fmt: skip
+
+
+def loop_constants(
+    params: Zhang2019V2Params, v_max: float, robot_radius: float
+) -> tuple[FloatArray, FloatArray]:
+    """The arguments of :func:`uvnav.controllers.zhang2019_v2_loop.plan_loop` that stay fixed over
+    an episode: its ``prm`` vector and its ``speeds`` (not to be written to)."""
+    p = params
+    prm = np.zeros(N_PRM)
+    prm[:11] = (p.horizon, p.comfort, p.comfort_horizon, p.w_ttc, p.w_change, p.w_comfort,
+                p.min_ttc, robot_radius + p.safety_margin, p.forecast_horizon,
+                p.max_tangent_bodies, p.safety_margin)  # fmt: skip
+    prm[P_SPACING], prm[P_HEADINGS], prm[P_VMAX] = p.spacing, p.n_headings, v_max
+    return prm, v_max * np.asarray(p.speed_levels, dtype=float)
+
+
+def outline_rings(
+    readings: tuple[ObstacleReading, ...], scal: FloatArray
+) -> tuple[FloatArray, IntArray]:
+    """The outlines of ``readings`` stacked (V, 2) [m] and where each reading's rows start
+    (N + 1,), when any reading is a polygon (``scal``'s radius <= 0); none otherwise (a crowd of
+    discs).  A disc's outline is carried along but never read."""
+    n = len(readings)
+    if not n or not bool((scal[:, 2] <= 0.0).any()):
+        return _NO_RINGS, np.zeros(n + 1, dtype=np.int64)
+    outlines = [rd.outline for rd in readings]
+    try:
+        rings = np.concatenate(outlines, dtype=float)
+    except ValueError:  # an outline that is not (n, 2): as boundary_discs reads it
+        outlines = [np.asarray(x, dtype=float).reshape(-1, 2) for x in outlines]
+        rings = np.concatenate(outlines)
+    return rings, np.fromiter(accumulate(map(len, outlines), initial=0), np.int64, n + 1)
+
+
+_NO_RINGS = np.zeros((0, 2))
+
+
+def _plan_in_loop(
+    obs: Observation,
+    v_pref: FloatArray,
+    v_prev: FloatArray,
+    constants: tuple[FloatArray, FloatArray],
+    heading: float | None,
+    u_max: float,
+) -> Choice:
+    """:func:`plan`'s loop path: the readings read into arrays once, the rest of the decision in
+    :func:`uvnav.controllers.zhang2019_v2_loop.plan_loop`."""
+    pose = obs.pose
+    moving = 1.0 if math.hypot(v_prev[0], v_prev[1]) > 1e-9 else 0.0  # as extra_headings
+    state = np.array((pose[0], pose[1], math.nan if heading is None else heading, u_max,
+                      v_pref[0], v_pref[1], v_prev[0], v_prev[1], moving), dtype=float)  # fmt: skip
+    readings = obs.obstacles
+    table = body_table(readings)
+    prm, speeds = constants
+    out = plan_loop(state, table, outline_rings(readings, table[0]), speeds, prm)
+    return Choice(out[:2].copy(), float(out[2]), bool(out[3]))
 
 
 def nearest_tangents(
@@ -533,6 +591,31 @@ def plan_limited(
 # -- the two laws -----------------------------------------------------------------------------
 
 
+_SOURCE = attrgetter("velocity_source")
+
+
+class LoopConstants:
+    """A law's :func:`loop_constants`, kept while its parameters and vehicle spec are the same
+    objects."""
+
+    def __init__(self) -> None:
+        self._of: tuple[object, object] | None = None
+        self._value: tuple[FloatArray, FloatArray] | None = None
+
+    def get(self, params: Zhang2019V2Params, spec: Any) -> tuple[FloatArray, FloatArray]:
+        """:func:`loop_constants` of ``params`` and ``spec``'s V_max and radius."""
+        of = self._of
+        if self._value is None or of is None or of[0] is not params or of[1] is not spec:
+            self._of = (params, spec)
+            self._value = loop_constants(params, float(spec.v_max), float(spec.radius))
+        return self._value
+
+
+def finite_position(pose: FloatArray) -> bool:
+    """The position ``pose[:2]`` is finite (two float checks, no array made)."""
+    return math.isfinite(pose[0]) and math.isfinite(pose[1])
+
+
 def _tracker(p: Zhang2019V2Params) -> CentreTracker | None:
     if not p.track_estimates:
         return None
@@ -542,7 +625,7 @@ def _tracker(p: Zhang2019V2Params) -> CentreTracker | None:
 def tracked(obs: Observation, tracker: CentreTracker | None) -> Observation:
     """``obs`` with the tracker's centres and velocities for the bodies whose rates were
     estimated (the same object when nothing was estimated or there is no tracker)."""
-    if tracker is None or not any(r.velocity_source == "estimated" for r in obs.obstacles):
+    if tracker is None or "estimated" not in map(_SOURCE, obs.obstacles):
         return obs
     pos = np.asarray(obs.position, dtype=float)
     return dataclasses.replace(obs, obstacles=tracker.update(obs.time, obs.obstacles, pos))
@@ -558,6 +641,7 @@ class Zhang2019HolonomicV2(HolonomicLaw):
         self.params = params or Zhang2019V2Params()
         self.last_choice: Choice | None = None
         self._tracker = _tracker(self.params)
+        self._fixed = LoopConstants()
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
@@ -566,11 +650,12 @@ class Zhang2019HolonomicV2(HolonomicLaw):
     def act(self, obs: Observation) -> VelocityCommand:
         period = self.decision_period(obs.time)
         spec = self._spec
-        if not np.all(np.isfinite(obs.position)):
+        if not finite_position(obs.pose):
             return VelocityCommand(0.0, 0.0)
         obs = tracked(obs, self._tracker)
         choice = plan(obs, self._goal, spec.v_max, spec.radius, period,
-                      self.current_velocity(obs), self.params)  # fmt: skip
+                      self.current_velocity(obs), self.params,
+                      constants=self._fixed.get(self.params, self._spec))  # fmt: skip
         self.last_choice = choice
         self._mode = "M1" if choice.preferred else "M2"
         return VelocityCommand(float(choice.velocity[0]), float(choice.velocity[1])).clipped(spec)
@@ -587,6 +672,7 @@ class Zhang2019V2(UnicycleController):
         self.last_choice: Choice | None = None
         self._aim = np.zeros(2)
         self._tracker = _tracker(self.params)
+        self._fixed = LoopConstants()
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
@@ -597,13 +683,14 @@ class Zhang2019V2(UnicycleController):
     def act(self, obs: Observation) -> UnicycleCommand:
         period = self.decision_period(obs.time)
         spec = self._spec
-        if not (np.all(np.isfinite(obs.position)) and math.isfinite(obs.heading)):
+        if not (finite_position(obs.pose) and math.isfinite(obs.pose[2])):
             return UnicycleCommand(0.0, 0.0)
         obs = tracked(obs, self._tracker)
         if not spec.ideal:
             return self._act_limited(obs, period)
         choice = plan(obs, self._goal, spec.v_max, spec.radius, period, self._aim, self.params,
-                      heading=obs.heading, u_max=spec.u_max)  # fmt: skip
+                      heading=obs.heading, u_max=spec.u_max,
+                      constants=self._fixed.get(self.params, self._spec))  # fmt: skip
         self.last_choice = choice
         self._mode = "M1" if choice.preferred else "M2"
         v = choice.velocity

@@ -51,8 +51,9 @@ import numpy as np
 
 from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.obstacles.obstacle import ObstacleField
-from uvnav.sensors.exact import lidar_scan
+from uvnav.sensors.exact import beam_offsets, lidar_scan
 from uvnav.sensors.observation import Observation
+from uvnav.sim.bodies2d import PackedBodies
 from uvnav.sim.episode import World2D
 from uvnav.sim.multi import MultiUnicycleWorld
 from uvnav.validation import MAX_COORDINATE, clip, one_line
@@ -148,6 +149,8 @@ def checked_actions(name: str, actions: Any, shape: tuple[int, ...]) -> np.ndarr
         ) from None
     if a.shape != shape:
         raise ValueError(f"{name} must have shape {shape} (got {a.shape})")
+    if np.isfinite(a).all():
+        return a
     bad = np.argwhere(~np.isfinite(a))
     if len(bad):
         where = tuple(int(i) for i in bad[0])
@@ -313,6 +316,10 @@ class EnvWorld:
         self.k = len(world.obstacles)
         world.start([False] * world.n_agents)
         self.clearance = np.array([self._gap(i) for i in range(self.n)])
+        #: the one robot of a World2D, whose bodies may cast the lidar in one compiled call
+        self.one = world if isinstance(world, World2D) else None
+        self._rel = beam_offsets(self.n_rays, 2.0 * np.pi)
+        self._ranges = np.empty(self.n_rays)
 
     # ----------------------------------------------------------------- robot i of either world
     @property
@@ -360,7 +367,11 @@ class EnvWorld:
         return c if math.isfinite(c) else self.max_range
 
     def distance(self, i: int) -> float:
-        return float(math.hypot(*(self.goal(i) - self.pose(i)[:2])))
+        """Robot i's distance to its goal [m]."""
+        one = self.one
+        x, y = (one.x, one.y) if one is not None else (float(p) for p in self.pose(i)[:2])
+        goal = self.goal(i)
+        return math.hypot(float(goal[0]) - x, float(goal[1]) - y)
 
     # ------------------------------------------------------------------------ what the env adds
     def obs_size(self) -> int:
@@ -375,17 +386,34 @@ class EnvWorld:
 
     def vector(self, i: int) -> np.ndarray:
         """Robot i's observation vector (module docstring), float32."""
-        pose = self.pose(i)
-        gap = self.goal(i) - pose[:2]
-        bearing = math.atan2(gap[1], gap[0]) - pose[2]
-        scan = lidar_scan(pose, self._lidar_field(i), n_rays=self.n_rays, max_range=self.max_range)
+        one = self.one
+        if one is not None:
+            x, y, th = one.x, one.y, one.th
+        else:
+            x, y, th = (float(p) for p in self.pose(i))
+        goal = self.goal(i)
+        gx, gy = float(goal[0]) - x, float(goal[1]) - y
+        bearing = math.atan2(gy, gx) - th
         out = np.empty(self.obs_size(), dtype=np.float32)
-        out[0] = min(float(math.hypot(*gap)) / self.goal_scale, 1.0)
+        out[0] = min(math.hypot(gx, gy) / self.goal_scale, 1.0)
         out[1] = math.cos(bearing)
         out[2] = math.sin(bearing)
         out[3] = min(max(self.speed(i) / self.spec(i).v_max, 0.0), 1.0)
-        out[4:] = np.clip(scan.ranges / self.max_range, 0.0, 1.0)
+        # clipped in [0, 1] after the cast to float32: the same numbers (0 and 1 are exact)
+        scaled = out[4:]
+        np.divide(self.ranges(i), self.max_range, out=scaled)
+        np.minimum(np.maximum(scaled, 0.0, out=scaled), 1.0, out=scaled)
         return out
+
+    def ranges(self, i: int) -> np.ndarray:
+        """Robot i's lidar ranges [m] now (:func:`~uvnav.sensors.exact.lidar_scan` without
+        noise; for packed bodies the same numbers from one compiled call)."""
+        one = self.one
+        if one is not None and isinstance(one.bodies, PackedBodies):
+            one.bodies.lidar(one.x, one.y, one.th, self._rel, self.max_range, self._ranges)
+            return self._ranges
+        field = self._lidar_field(i)
+        return lidar_scan(self.pose(i), field, n_rays=self.n_rays, max_range=self.max_range).ranges
 
     def _lidar_field(self, i: int) -> ObstacleField:
         """The field robot i's lidar sees: everything but its own disc."""
@@ -404,9 +432,12 @@ class EnvWorld:
         if isinstance(w, World2D) and w.vehicle != "unicycle":
             return w.body.command(*box_command(a[0], *w.body.bounds(), self.raw_commands))
         spec = self.spec(i)
-        v, u = action_commands(a, np.array([spec.v_max]), np.array([spec.u_max]),
-                               self.raw_commands)  # fmt: skip
-        return UnicycleCommand(float(v[0]), float(u[0]))
+        a0, a1 = float(a[0, 0]), float(a[0, 1])
+        if self.raw_commands:
+            return UnicycleCommand(a0, a1)
+        # action_commands on one pair, in floats: the same operations in the same order
+        a0, a1 = min(max(a0, -1.0), 1.0), min(max(a1, -1.0), 1.0)
+        return UnicycleCommand(0.5 * (a0 + 1.0) * float(spec.v_max), a1 * float(spec.u_max))
 
     def rest(self, i: int) -> Any:
         """Robot ``i``'s command when it has no action: standing still."""
@@ -419,6 +450,8 @@ class EnvWorld:
         rewards (0 for robots that were already done)."""
         n, w = self.n, self.world
         actions = {i: checked_actions(self.action_name(i), a, (2,)) for i, a in actions.items()}
+        if self.one is not None:
+            return self._step_one(self.one, actions)
         before = [self.distance(i) for i in range(n)]
         was_running = [self.running(i) for i in range(n)]
         low = np.full(n, np.inf)
@@ -441,6 +474,30 @@ class EnvWorld:
                 self.clearance[i] = low[i]
             rewards[i] = self.reward.reward(
                 before[i] - self.distance(i), float(self.clearance[i]), self.status(i)
+            )
+        return rewards
+
+    def _step_one(self, w: World2D, actions: dict[int, np.ndarray]) -> np.ndarray:
+        """:meth:`step` for the one robot of a :class:`World2D` (checked ``actions``)."""
+        before = self.distance(0)
+        was_running = self.running(0)
+        low = math.inf
+        if not w.done:
+            if w.clock.due:
+                w.apply(self.command(0, actions[0]) if 0 in actions else self.rest(0))
+            while True:
+                alive = self.running(0)
+                w.advance()
+                if alive:
+                    low = min(low, self._gap(0))
+                if w.done or w.clock.due:
+                    break
+        rewards = np.zeros(1)
+        if was_running:
+            if math.isfinite(low):
+                self.clearance[0] = low
+            rewards[0] = self.reward.reward(
+                before - self.distance(0), float(self.clearance[0]), self.status(0)
             )
         return rewards
 

@@ -6,7 +6,9 @@ steps the simulator's own world, :class:`uvnav.sim.episode.World2D`
 (:class:`uvnav.envs.core.EnvWorld`): one env
 step is one decision (``control_period``), integrated with the scenario's ``dt`` and checked for
 collisions at every integration step by the world, so that an env episode driven by a law's
-commands (``raw_commands=True``) is bit for bit :func:`uvnav.sim.run_episode`'s.
+commands (``raw_commands=True``) is bit for bit :func:`uvnav.sim.run_episode`'s.  As there, with
+numba enabled a scene that packs (:func:`uvnav.sim.packed.pack_check`) moves, senses and casts the
+lidar in compiled calls (:class:`uvnav.sim.bodies2d.PackedBodies`), with the same numbers.
 
 * **Observation** ``Box(4 + n_rays,)`` float32: goal distance / ``goal_scale`` in [0, 1], cos and
   sin of the goal bearing in the robot frame, speed / V_max, then ``n_rays`` lidar ranges /
@@ -49,6 +51,7 @@ from uvnav.envs.core import (
     checked_scenario,
     goal_scale_for,
 )
+from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.scenarios.schema import Scenario
@@ -176,7 +179,8 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
             self._world.close()
         self.episode_seed = k = episode_seed(self.np_random, options)
         setup = build_episode(self.scenario, k)
-        world = World2D(setup, run_rng(k), exact=True, vehicle=self.vehicle, swept=self.swept)
+        world = World2D(setup, run_rng(k), exact=True, vehicle=self.vehicle, swept=self.swept,
+                        packed=numba_enabled())  # fmt: skip
         w = self._open(world)
         return w.vector(0), self._info(0)
 

@@ -414,6 +414,16 @@ class PackedBodies:
         """The obstacles' centres (k, 2) [m] now (a view) and ``None`` (every body exists)."""
         return self._st[S_X : S_Y + 1, : self.n].T, None
 
+    def lidar(
+        self, x: float, y: float, th: float, rel: FloatArray, max_range: float, out: FloatArray
+    ) -> None:
+        """The ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from ``(x, y, th)``,
+        beams at ``wrap(th + rel)`` [rad], into ``out`` (R,), in one compiled call
+        (:func:`~uvnav.sim.packed._lidar`; no field is built)."""
+        ring = np.empty((2, self._rings.shape[2]))
+        kernel("lidar")(x, y, th, rel, max_range, self.n, self._prm, self._st, self._rings,
+                        ring, out)  # fmt: skip
+
     def field(self) -> ObstacleField:
         """The :class:`ObstacleField` of now (built on first use after a step)."""
         if self._field is None:

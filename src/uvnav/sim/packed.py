@@ -425,6 +425,7 @@ _PUBLIC = {
     "advance_one": "advance_one_py",
     "sense_one": "sense_one_py",
     "clearance_one": "clearance_one_py",
+    "lidar": "_lidar",
 }
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
