@@ -5,9 +5,11 @@ not fit: ``uvnav run`` alone takes minutes).
 The tracked files are copied into a fresh folder, the README's named YAML blocks (a block whose
 first line is ``# NAME.yaml``) are written there, and each line runs there through the installed
 console script, as a user types it, after the rewrites of :data:`QUICK` (the quick size: no
-``--full``, fewer seeds, cases and epochs; a server stops after its first episode or a few
-seconds).  A line announced as refused (``# refused``) must end as one ``error:`` line with exit
-status 2; any other must exit 0 with no traceback.  Every line is either run or listed in
+``--full``, fewer seeds, cases and epochs; ``uvnav ros2 run`` is stopped by SIGTERM after 5 s,
+and ``uvnav view``, which waits for a Foxglove client, is watched by one,
+:mod:`foxglove_client`, until its one episode ends).  A line announced as refused
+(``# refused``) must end as one ``error:`` line with exit status 2; any other must exit 0
+with no traceback.  Every line is either run or listed in
 :data:`SKIP` with the reason, so a new README line that the tour does not know fails it.
 
 Run it with ``pytest tests/test_readme_tour.py --tour`` (skipped without ``--tour``).
@@ -52,13 +54,13 @@ QUICK: list[tuple[str, str]] = [
     (r"--epochs \d+", "--epochs 1"),
     (r"--rounds \d+", "--rounds 1"),
     (r"^(uvnav view .*)--speed \S+", r"\1--speed 50 --once --port 0"),
-    (r"^(uvnav ros2 run .*)$", r"timeout --preserve-status -s INT 5 \1"),
+    (r"^(uvnav ros2 run .*)$", r"timeout --preserve-status -k 10 -s TERM 5 \1"),
     (r"^\.venv/bin/python ", "{python} "),
     (r"^python ", "{python} "),
 ]
 
-#: exit statuses of a line that ends by a signal sent by the tour (Ctrl-C: 0 or 130)
-_STOPPED = {0, 130}
+#: exit statuses of a line that the tour stops with SIGTERM (a clean stop: 0; else 143)
+_STOPPED = {0, 143}
 #: the most one line may take [s] (``uvnav run`` at the quick size takes several minutes)
 _TIMEOUT = 1800
 
@@ -150,9 +152,7 @@ def test_the_readme_tour_runs_on_a_fresh_checkout(
             continue
         cmd = quick(line)
         tic = time.perf_counter()
-        run = subprocess.run(
-            cmd, shell=True, cwd=work, env=env, capture_output=True, text=True, timeout=_TIMEOUT
-        )
+        run = _watched(cmd, work, env) if cmd.startswith("uvnav view ") else _run(cmd, work, env)
         ran.append(f"{time.perf_counter() - tic:7.1f} s  {cmd}")
         said = run.stdout + run.stderr
         if refused:
@@ -165,6 +165,31 @@ def test_the_readme_tour_runs_on_a_fresh_checkout(
             failed.append(f"{cmd}: exit {run.returncode}: {said.strip().splitlines()[-3:]}")
     print("\n".join(ran))
     assert not failed, "\n".join(failed)
+
+
+def _run(cmd: str, cwd: Path, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        cmd, shell=True, cwd=cwd, env=env, capture_output=True, text=True, timeout=_TIMEOUT
+    )
+
+
+def _watched(cmd: str, cwd: Path, env: dict[str, str]) -> subprocess.CompletedProcess[str]:
+    """Run a ``uvnav view ... --once`` line with a Foxglove client subscribed to its topics (the
+    episode starts when one is), until it exits."""
+    from foxglove_client import session, view_port
+
+    proc = subprocess.Popen(
+        cmd, shell=True, cwd=cwd, env={**env, "PYTHONUNBUFFERED": "1"}, text=True,
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+    )  # fmt: skip
+    try:
+        _, _, got = session(view_port(proc))
+        out, err = proc.communicate(timeout=_TIMEOUT)
+    finally:
+        proc.kill()
+    if not got:
+        err += "no message reached the Foxglove client\n"
+    return subprocess.CompletedProcess(cmd, proc.returncode, out, err)
 
 
 #: Cyclone DDS on the loopback interface only (``uvnav ros2 run`` finds no robot on the network)
