@@ -69,7 +69,9 @@ from typing import Any
 import numpy as np
 
 from uvnav.bench.summary import wilson_interval
-from uvnav.controllers.base import controller_info, make_law
+from uvnav.cli.common import parse_params
+from uvnav.cli.errors import CliError
+from uvnav.controllers.base import ControllerParamsError, controller_info, make_law
 from uvnav.controllers.holonomic import OrcaHolonomic
 from uvnav.core import BaseProbe
 from uvnav.scenarios import crowd_dynamic
@@ -207,8 +209,10 @@ def run(
     turn_accel: float | None = None,
     humans: int | None = None,
     sensing_range: float | None = None,
+    law_params: dict[str, Any] | None = None,
 ) -> dict[str, Any]:
-    """Run the cases; returns the counts, rates, intervals and times."""
+    """Run the cases; returns the counts, rates, intervals and times.  ``law_params``: the
+    parameters of a law other than the paper's (its defaults where not given)."""
     rng_of = kinds()["nav2d"].episode_rng
     vehicle = controller_info(law_name).vehicle
     counts = {"success": 0, "collision": 0, "timeout": 0}
@@ -239,7 +243,7 @@ def run(
         setup = build_episode(scn, case)
         law: Any
         if law_name != PAPER_LAW:
-            law = make_law(law_name)
+            law = make_law(law_name, **(law_params or {}))
         elif pref == "crowdnav":
             law = CrowdNavPrefOrca()
             law.params = type(law.params)(**CROWDNAV_ORCA_PARAMS)
@@ -298,7 +302,7 @@ def run(
             if sensing_range is None and rule == DYNAMIC
             else ""
         ),
-        "params": dict(CROWDNAV_ORCA_PARAMS) if law_name == PAPER_LAW else {},
+        "params": dict(CROWDNAV_ORCA_PARAMS) if law_name == PAPER_LAW else dict(law_params or {}),
         "accel_max": accel,
         "turn_accel_max": turn_accel,
         "rates": rates,
@@ -444,8 +448,17 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--sensing-range", type=float, default=None, metavar="R",
                     help="the robot sees the humans within R [m] (default: the scenes' 20 m; "
                     "with --lidar, the lidar's range unless given)")  # fmt: skip
+    ap.add_argument("--param", "-p", action="append", default=None, metavar="KEY=VALUE",
+                    help="a parameter of --law (repeatable; value read as YAML; not with the "
+                    "paper's law)")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write crowdnav.json here")
     args = ap.parse_args(argv)
+    try:
+        law_params = parse_params(args.param)
+    except CliError as exc:
+        ap.error(str(exc))
+    if law_params and args.law == PAPER_LAW:
+        ap.error(f"--param: {PAPER_LAW} runs with the paper's parameters; name another --law")
     if args.sensing_range is not None and not (
         math.isfinite(args.sensing_range) and args.sensing_range > 0
     ):
@@ -466,10 +479,12 @@ def main(argv: list[str] | None = None) -> int:
             args.cases, rule=args.rule, substeps=args.substeps, pref=args.pref,
             outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
             swept=not args.sampled, lidar=args.lidar, accel=args.accel, turn_accel=args.turn_accel,
-            humans=args.humans, sensing_range=args.sensing_range,
+            humans=args.humans, sensing_range=args.sensing_range, law_params=law_params,
         )  # fmt: skip
     except NoCaseError as exc:
         ap.error(str(exc))
+    except ControllerParamsError as exc:
+        ap.error(f"--param: {exc}")
     print(report(r))
     if args.out is not None:
         args.out.mkdir(parents=True, exist_ok=True)

@@ -43,6 +43,26 @@ into the next stream of people, and never slows down, waits or backs off.  v2 th
    closing candidate by when the bodies themselves would touch, not 0 for all of them, so that
    it still tells stepping toward a passing pedestrian from standing still.
 
+**Social comfort** (on by default: ``w_social`` 3 /s, T_s 3 s, S 1.25 s, band 0.1 m; 0 turns
+it off).  Success says nothing of how the robot
+treats people; the intrusion ratio of Liu et al. (ICRA 2023, CrowdNav++; :mod:`uvnav.sim.social`)
+counts the steps at which the robot stands where a visible pedestrian will be within the next
+1.25 s, i.e. passing in front of someone walking.  The steps above only keep ``comfort`` metres
+from where each body *is*; with ``w_social`` > 0 a candidate also pays ``w_social soc`` (cost in
+m/s), ``soc`` [m] the depth of its path into the bodies' forecasts: over the robot's first
+``social_horizon`` T_s seconds along the candidate (the turn, then straight, as above), the
+largest ``reach + social_band - g`` over the moving bodies (clipped at 0), ``g`` the smallest
+distance from the robot at time t to the body's constant-velocity forecast from t to
+t + ``social_forecast`` S (the segment ``q + w t .. q + w (t + S)``).  In the body's frame the
+forecast seen along a straight stretch of the path sweeps a parallelogram, so ``g`` is a
+point-to-parallelogram distance in closed form (:func:`uvnav.geometry.contact.forecast_gap`).
+A path that crosses where someone is about to walk pays up to ``reach + band`` (about 0.7 m
+for a person); one that passes behind them, or waits, pays nothing.  Bodies standing still have
+no forecast beyond themselves and are left to ``comfort``.  The term only adds to the cost, so
+safety (the first contact, ``min_ttc``) still ranks first, and the branch-and-bound bound stays
+a lower bound.  On a vehicle with acceleration limits the rolled-out paths' segments that start
+before T_s are read the same way (:func:`path_social`).
+
 The holonomic robot takes the chosen velocity as it is; the unicycle steers toward the chosen
 direction with the sliding-mode law at the chosen speed times cos(beta) (its candidates are
 checked at the speed it will actually have, so a direction behind it counts as standing still
@@ -123,6 +143,7 @@ from uvnav.controllers.zhang2019_limits import (
 )
 from uvnav.controllers.zhang2019_v2_loop import (
     N_PRM,
+    N_WEIGHTS,
     P_HEADINGS,
     P_SPACING,
     P_VMAX,
@@ -131,7 +152,13 @@ from uvnav.controllers.zhang2019_v2_loop import (
 from uvnav.dynamics.omni import VelocityCommand
 from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-from uvnav.geometry.contact import candidate_risk, candidate_risk_compiled
+from uvnav.geometry.contact import (
+    candidate_risk,
+    candidate_risk_compiled,
+    forecast_gap,
+    social_risk,
+    social_risk_compiled,
+)
 from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.prediction.tracking import CentreTracker
 from uvnav.sensors.observation import Observation, ObstacleReading
@@ -166,6 +193,10 @@ class Zhang2019V2Params:
         track_accel_std: the filter's assumed white-noise acceleration of a body [m/s^2].
         rollout_step: longest substep [s] of the paths checked on a vehicle with acceleration
             limits (module docstring, "Acceleration limits").
+        w_social: weight [1/s] of the social term (module docstring, "Social comfort"): a
+            candidate pays ``w_social`` per metre by which its path over ``social_horizon`` [s]
+            comes closer than ``social_band`` [m] beyond the radius sum to where a moving body
+            will be over the next ``social_forecast`` [s]; 0 turns the term off.
     """
 
     horizon: float = 4.0
@@ -185,6 +216,10 @@ class Zhang2019V2Params:
     track_position_std: float = 0.1
     track_accel_std: float = 1.0
     rollout_step: float = 0.125
+    w_social: float = 3.0
+    social_horizon: float = 3.0
+    social_forecast: float = 1.25
+    social_band: float = 0.1
 
     def __post_init__(self) -> None:
         check_params(
@@ -198,8 +233,18 @@ class Zhang2019V2Params:
                 "track_position_std",
                 "track_accel_std",
                 "rollout_step",
+                "social_horizon",
+                "social_forecast",
             ),
-            non_negative=("safety_margin", "w_ttc", "w_change", "comfort", "w_comfort"),
+            non_negative=(
+                "safety_margin",
+                "w_ttc",
+                "w_change",
+                "comfort",
+                "w_comfort",
+                "w_social",
+                "social_band",
+            ),
         )
         for name in ("n_headings", "max_tangent_bodies"):
             value = getattr(self, name)
@@ -356,11 +401,14 @@ def choose_velocity(
         turn = s1[:, None] * np.column_stack([np.cos(mid), np.sin(mid)])
     q, w, reach, bodies = discs
     args = (p.horizon, p.comfort, p.comfort_horizon, p.safety_margin)
+    social = (p.social_horizon, p.social_forecast, p.social_band)
     if numba_enabled():
         ttc, pen = candidate_risk_compiled(position, cand, turn, tau, (q, w, reach), bodies, *args)
+        soc = social_risk_compiled(position, cand, turn, tau, (q, w, reach), social)
     else:
         ttc, pen = candidate_risk(position, cand, turn, tau, (q, w, reach), *args)
-    return least_cost(cand, ttc, pen, pref, v_prev, p)
+        soc = social_risk(position, cand, turn, tau, (q, w, reach), social)
+    return least_cost(cand, ttc, pen, pref, v_prev, p, soc=soc if p.w_social > 0.0 else None)
 
 
 def candidates(
@@ -386,15 +434,19 @@ def least_cost(
     params: Zhang2019V2Params,
     *,
     admissible: BoolArray | None = None,
+    soc: FloatArray | None = None,
 ) -> Choice:
     """The candidate of least cost among ``cand`` (ordered as :func:`candidates` makes them),
     given each one's first contact ``ttc`` [s] and comfort penalty ``pen`` [m] (module
     docstring, steps 3-4).  With ``admissible`` (a mask: the robot can still stop before the
     contact), a safe candidate must be admissible too, and where none is safe an admissible
-    one is preferred."""
+    one is preferred.  ``soc`` [m]: each one's social term (module docstring, "Social comfort"),
+    paid at ``w_social`` when given."""
     p = params
     cost = np.hypot(*(cand - v_pref).T) + p.w_change * np.hypot(*(cand - v_prev).T)
     cost = cost + p.w_ttc / np.maximum(ttc, 1e-3) + p.w_comfort * pen
+    if soc is not None:
+        cost = cost + p.w_social * soc
     safe = ttc > p.min_ttc
     if admissible is not None:
         safe = safe & admissible
@@ -483,9 +535,10 @@ def loop_constants(
     an episode: its ``prm`` vector and its ``speeds`` (not to be written to)."""
     p = params
     prm = np.zeros(N_PRM)
-    prm[:11] = (p.horizon, p.comfort, p.comfort_horizon, p.w_ttc, p.w_change, p.w_comfort,
-                p.min_ttc, robot_radius + p.safety_margin, p.forecast_horizon,
-                p.max_tangent_bodies, p.safety_margin)  # fmt: skip
+    prm[:N_WEIGHTS] = (p.horizon, p.comfort, p.comfort_horizon, p.w_ttc, p.w_change, p.w_comfort,
+                       p.min_ttc, robot_radius + p.safety_margin, p.forecast_horizon,
+                       p.max_tangent_bodies, p.safety_margin, p.w_social, p.social_horizon,
+                       p.social_forecast, p.social_band)  # fmt: skip
     prm[P_SPACING], prm[P_HEADINGS], prm[P_VMAX] = p.spacing, p.n_headings, v_max
     return prm, v_max * np.asarray(p.speed_levels, dtype=float)
 
@@ -585,7 +638,33 @@ def plan_limited(
     ttc, pen = path_risk(times, xy, (q, w, reach), p.horizon, p.comfort, p.comfort_horizon,
                          p.safety_margin)  # fmt: skip
     brakes = stoppable(times, xy, speeds, ttc, model)
-    return least_cost(cand, ttc, pen, v_pref, v_prev, p, admissible=brakes)
+    soc = path_social(times, xy, (q, w, reach), p) if p.w_social > 0.0 else None
+    return least_cost(cand, ttc, pen, v_pref, v_prev, p, admissible=brakes, soc=soc)
+
+
+def path_social(
+    times: FloatArray,
+    xy: FloatArray,
+    discs: tuple[FloatArray, FloatArray, FloatArray],
+    params: Zhang2019V2Params,
+) -> FloatArray:
+    """The social term [m] (module docstring, "Social comfort") of each rolled-out path ``xy``
+    (K, S + 1, 2) at ``times`` (S + 1,): over its segments that start before ``social_horizon``,
+    the largest ``reach + social_band - g`` (clipped at 0) over the moving discs (centres,
+    velocities, radius sums), ``g`` the distance from the robot on the segment to the disc's
+    forecast over ``social_forecast`` (:func:`uvnav.geometry.contact.forecast_gap`)."""
+    p = params
+    q, w, reach = discs
+    near = int(np.searchsorted(times, p.social_horizon, side="left"))  # segments 0 .. near - 1
+    moving = (w[:, 0] != 0.0) | (w[:, 1] != 0.0)
+    if not bool(moving.any()) or near < 1:
+        return np.zeros(xy.shape[0])
+    q, w, reach = q[moving], w[moving], reach[moving]
+    t = times[: near + 1]
+    d = q[None, None] + w[None, None] * t[None, :, None, None] - xy[:, : near + 1, None, :]
+    e = np.broadcast_to((w * p.social_forecast)[None, None], d[:, :-1].shape)
+    g = forecast_gap(d[:, :-1], np.diff(d, axis=1), e).min(axis=1)
+    return np.asarray(np.clip(reach[None, :] + p.social_band - g, 0.0, None).max(axis=1))
 
 
 # -- the two laws -----------------------------------------------------------------------------

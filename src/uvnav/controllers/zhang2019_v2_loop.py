@@ -30,9 +30,11 @@ from uvnav.geometry.kernels3d import numba_enabled
 
 IntArray = np.ndarray
 
-#: indices into the ``prm`` vector of :func:`plan_loop_py` (after decide_py's eleven weights)
-P_SPACING, P_HEADINGS, P_VMAX = 11, 12, 13
-N_PRM = 14
+#: how many weights :func:`uvnav.geometry.contact.decide_py` reads from the ``prm`` vector
+N_WEIGHTS = 15
+#: indices into the ``prm`` vector of :func:`plan_loop_py` (after decide_py's weights)
+P_SPACING, P_HEADINGS, P_VMAX = 15, 16, 17
+N_PRM = 18
 
 
 def boundary_discs_py(
@@ -160,7 +162,7 @@ def plan_loop_py(
     extra[n_h] = math.atan2(fy, fx)
     if moving:
         extra[n_h + 1] = math.atan2(oy, ox)
-    decide_py(state[:8], extra, speeds, q, w, r, owner, c_k, v_k, body_r, prm[:11], out)
+    decide_py(state[:8], extra, speeds, q, w, r, owner, c_k, v_k, body_r, prm[:N_WEIGHTS], out)
 
 
 _COMPILED: dict[str, Callable[..., Any]] = {}

@@ -8,7 +8,14 @@ then ``cand[k]`` (a holonomic robot: ``tau = 0``).  A boundary disc j (centre ``
 * ``ttc[k]``: the first time in [0, horizon] at which the robot is within ``reach`` of any disc
   (0 for a pair already in contact and closing; inf when none);
 * ``pen[k]``: the largest ``comfort - gap`` (clipped at 0) over the discs, ``gap`` the smallest
-  distance beyond ``reach`` over [0, comfort_horizon] while moving at ``turn[k]``.
+  distance beyond ``reach`` over [0, comfort_horizon] while moving at ``turn[k]``;
+* ``soc[k]`` (the social term, :func:`social_risk`): the largest ``reach + band - g`` (clipped at
+  0) over the *moving* discs, ``g`` the smallest distance between the robot, along the candidate
+  over its first T_s seconds, and the disc's constant-velocity forecast over the next S seconds
+  as it will be then (the segment ``q + w t .. q + w (t + S)`` at time t): 0 when the robot stays
+  ``band`` clear of where the body will walk, up to ``reach + band`` when its path crosses that
+  (passing in front of a walking person).  In the body's frame the forecast seen along a straight
+  stretch of the path is a parallelogram (:func:`forecast_gap`), so ``g`` is in closed form.
 
 :func:`candidate_risk` is the numpy reference (arrays K x M); with numba installed (the ``fast``
 extra) :func:`candidate_risk_compiled` runs one compiled loop that first tests each body's
@@ -124,6 +131,66 @@ def candidate_risk(
     return ttc, pen
 
 
+def forecast_gap(d: FloatArray, u: FloatArray, e: FloatArray) -> FloatArray:
+    """Distance [m] from the origin to the parallelogram ``d + alpha u + beta e`` (alpha, beta
+    in [0, 1]), elementwise over (..., 2); 0 when the origin lies in it.
+
+    With ``d`` a body relative to the robot, ``u`` its relative displacement over a stretch of
+    the robot's path and ``e`` the body's displacement over the forecast time, the parallelogram
+    holds every point of the body's forecast (module docstring, ``soc``) seen from the robot
+    along that stretch.
+
+    >>> forecast_gap(np.array([2.0, -1.0]), np.array([0.0, 2.0]), np.array([1.0, 0.0])).item()
+    2.0
+    >>> forecast_gap(np.array([-1.0, -1.0]), np.array([0.0, 2.0]), np.array([2.0, 0.0])).item()
+    0.0
+    """
+    c = u[..., 0] * e[..., 1] - u[..., 1] * e[..., 0]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        alpha = -(d[..., 0] * e[..., 1] - d[..., 1] * e[..., 0]) / c
+        beta = (d[..., 0] * u[..., 1] - d[..., 1] * u[..., 0]) / c
+    inside = (np.abs(c) > 1e-12) & (alpha >= 0.0) & (alpha <= 1.0) & (beta >= 0.0) & (beta <= 1.0)
+    edges = np.minimum(
+        np.minimum(_edge_gap(d, u), _edge_gap(d + e, u)),
+        np.minimum(_edge_gap(d, e), _edge_gap(d + u, e)),
+    )
+    return np.asarray(np.where(inside, 0.0, edges), dtype=float)
+
+
+def _edge_gap(a: FloatArray, e: FloatArray) -> FloatArray:
+    """Distance [m] from the origin to the segment ``a + s e``, s in [0, 1], elementwise."""
+    ee = e[..., 0] * e[..., 0] + e[..., 1] * e[..., 1]
+    s = np.clip(-(a[..., 0] * e[..., 0] + a[..., 1] * e[..., 1]) / np.maximum(ee, 1e-12), 0.0, 1.0)
+    return np.asarray(np.hypot(a[..., 0] + s * e[..., 0], a[..., 1] + s * e[..., 1]), dtype=float)
+
+
+def social_risk(
+    position: FloatArray,
+    cand: FloatArray,
+    turn: FloatArray,
+    tau: FloatArray,
+    discs: tuple[FloatArray, FloatArray, FloatArray],
+    social: tuple[float, float, float],
+) -> FloatArray:
+    """``soc`` per candidate (module docstring), numpy over K x M; ``social``: the robot's path
+    time T_s [s], the forecast time S [s] and the band [m]."""
+    q, w, reach = discs
+    span, forecast, band = social
+    if not len(q):
+        return np.zeros(len(cand))
+    d0 = (q - position)[None, :, :]
+    t1 = np.minimum(tau, span)[:, None, None]
+    t2 = span - t1
+    e = (w * forecast)[None, :, :]
+    a1 = w[None, :, :] - turn[:, None, :]
+    g1 = forecast_gap(d0, a1 * t1, e)
+    d1 = d0 + a1 * t1
+    g2 = forecast_gap(d1, (w[None, :, :] - cand[:, None, :]) * t2, e)
+    pen = reach[None, :] + band - np.minimum(g1, g2)
+    moving = (w[:, 0] != 0.0) | (w[:, 1] != 0.0)
+    return np.asarray(np.clip(np.where(moving[None, :], pen, 0.0), 0.0, None).max(axis=1))
+
+
 # -- the compiled path ------------------------------------------------------------------------
 
 
@@ -164,6 +231,82 @@ def _clear_scalar(px: float, py: float, vx: float, vy: float, lim: float, h: flo
     t = min(max(b / max(a, 1e-12), 0.0), h)
     dx, dy = px - vx * t, py - vy * t
     return dx * dx + dy * dy > lim * lim
+
+
+def _edge_scalar(ax: float, ay: float, ex: float, ey: float) -> float:
+    """:func:`_edge_gap` for one segment, on floats."""
+    ee = ex * ex + ey * ey
+    s = min(max(-(ax * ex + ay * ey) / max(ee, 1e-12), 0.0), 1.0)
+    return math.hypot(ax + s * ex, ay + s * ey)
+
+
+def _sheet_scalar(dx: float, dy: float, ux: float, uy: float, ex: float, ey: float) -> float:
+    """:func:`forecast_gap` for one parallelogram, on floats."""
+    c = ux * ey - uy * ex
+    if abs(c) > 1e-12:
+        alpha = -(dx * ey - dy * ex) / c
+        beta = (dx * uy - dy * ux) / c
+        if 0.0 <= alpha <= 1.0 and 0.0 <= beta <= 1.0:
+            return 0.0
+    return min(
+        min(_edge_scalar(dx, dy, ux, uy), _edge_scalar(dx + ex, dy + ey, ux, uy)),
+        min(_edge_scalar(dx, dy, ex, ey), _edge_scalar(dx + ux, dy + uy, ex, ey)),
+    )
+
+
+def social_one(
+    px: float,
+    py: float,
+    cx: float,
+    cy: float,
+    tx: float,
+    ty: float,
+    tk: float,
+    q: FloatArray,
+    w: FloatArray,
+    reach: FloatArray,
+    span: float,
+    forecast: float,
+    band: float,
+) -> float:
+    """``soc`` of one candidate (velocity ``(tx, ty)`` for ``tk`` s, then ``(cx, cy)``) for a
+    robot at ``(px, py)`` (module docstring; :func:`social_risk`'s numbers, on floats)."""
+    best = 0.0
+    t1 = min(tk, span)
+    t2 = span - t1
+    for j in range(q.shape[0]):
+        wx, wy = w[j, 0], w[j, 1]
+        if wx == 0.0 and wy == 0.0:
+            continue
+        dx, dy = q[j, 0] - px, q[j, 1] - py
+        ex, ey = wx * forecast, wy * forecast
+        ax, ay = wx - tx, wy - ty
+        g = _sheet_scalar(dx, dy, ax * t1, ay * t1, ex, ey)
+        dx, dy = dx + ax * t1, dy + ay * t1
+        g = min(g, _sheet_scalar(dx, dy, (wx - cx) * t2, (wy - cy) * t2, ex, ey))
+        pen = reach[j] + band - g
+        if pen > best:
+            best = pen
+    return best
+
+
+def social_risk_py(
+    position: FloatArray,
+    cand: FloatArray,
+    turn: FloatArray,
+    tau: FloatArray,
+    q: FloatArray,
+    w: FloatArray,
+    reach: FloatArray,
+    span: float,
+    forecast: float,
+    band: float,
+    soc: FloatArray,
+) -> None:
+    """The loop of :func:`social_risk_compiled`: :func:`social_one` per candidate, into ``soc``."""
+    for k in range(cand.shape[0]):
+        soc[k] = social_one(position[0], position[1], cand[k, 0], cand[k, 1], turn[k, 0],
+                            turn[k, 1], tau[k], q, w, reach, span, forecast, band)  # fmt: skip
 
 
 def risk_one(
@@ -307,7 +450,8 @@ def decide_py(
     preferred velocity x, y, the previous choice x, y; ``weights``: horizon, comfort,
     comfort horizon, w_ttc, w_change, w_comfort, min_ttc, the robot's radius plus margin,
     forecast time T_f, the number of nearest bodies whose tangents are candidates, the margin
-    (:func:`first_contact`).
+    (:func:`first_contact`), then w_social, the robot's path time T_s [s], the forecast time S [s]
+    and the band [m] of the social term (:func:`social_one`; not computed when w_social is 0).
 
     The same candidates, costs and first-index tie-break as
     :func:`uvnav.controllers.zhang2019_v2.choose_velocity`, but branch-and-bound: candidates are
@@ -320,6 +464,7 @@ def decide_py(
     horizon, comfort, c_h = weights[0], weights[1], weights[2]
     w_ttc, w_change, w_comfort, min_ttc = weights[3], weights[4], weights[5], weights[6]
     pad, t_f, n_tan, margin = weights[7], weights[8], weights[9], weights[10]
+    w_social, span, forecast, band = weights[11], weights[12], weights[13], weights[14]
     reach, grow = r + pad, np.empty(q.shape[0])
     bodies = np.empty((centre.shape[0], 7))
     n_few = 0
@@ -366,6 +511,9 @@ def decide_py(
         ttc, pen = risk_one(px, py, cand[k, 0], cand[k, 1], tx, ty, tk, q, w, reach, bodies,
                             horizon, comfort, c_h, margin)  # fmt: skip
         cost = bound[k] + w_ttc / max(ttc, 1e-3) + w_comfort * pen
+        if w_social > 0.0:
+            cost += w_social * social_one(px, py, cand[k, 0], cand[k, 1], tx, ty, tk, q, w,
+                                          reach, span, forecast, band)  # fmt: skip
         if cost < best[0] or (cost == best[0] and k < best[1]):
             best[0], best[1], best[4] = cost, k, ttc
         if ttc > min_ttc and (cost < best[2] or (cost == best[2] and k < best[3])):
@@ -383,8 +531,8 @@ def _kernels() -> dict[str, Callable[..., Any]]:
     call); the Python functions stay the reference path (:func:`compile_family`)."""
     if not _COMPILED:
         _COMPILED.update(compile_family([
-            _contact_scalar, _gap_scalar, _clear_scalar, risk_one, tangents_py, decide_py,
-            candidate_risk_py,
+            _contact_scalar, _gap_scalar, _clear_scalar, _edge_scalar, _sheet_scalar,
+            social_one, risk_one, tangents_py, decide_py, candidate_risk_py, social_risk_py,
         ]))  # fmt: skip
     return _COMPILED
 
@@ -412,6 +560,25 @@ def candidate_risk_compiled(
        float(horizon), float(comfort), float(comfort_horizon), float(margin), ttc,
        pen)  # fmt: skip
     return ttc, pen
+
+
+def social_risk_compiled(
+    position: FloatArray,
+    cand: FloatArray,
+    turn: FloatArray,
+    tau: FloatArray,
+    discs: tuple[FloatArray, FloatArray, FloatArray],
+    social: tuple[float, float, float],
+) -> FloatArray:
+    """:func:`social_risk` in one loop, compiled when numba is enabled."""
+    q, w, reach = discs
+    soc = np.empty(len(cand))
+    fn = _kernels()["social_risk_py"] if numba_enabled() else social_risk_py
+    c = np.ascontiguousarray
+    fn(c(position, dtype=float), c(cand, dtype=float), c(turn, dtype=float), c(tau, dtype=float),
+       c(q, dtype=float), c(w, dtype=float), c(reach, dtype=float), float(social[0]),
+       float(social[1]), float(social[2]), soc)  # fmt: skip
+    return soc
 
 
 def decide_compiled(
