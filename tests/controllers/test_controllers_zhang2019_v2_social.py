@@ -118,9 +118,8 @@ def test_rolled_out_straight_paths_read_the_same_term() -> None:
 
 def test_term_off_ignores_its_other_parameters() -> None:
     obs = observe(pedestrian(0, 2.5, -2.0, 0.0, 1.0), pedestrian(1, 4.0, 1.0, -0.5, 0.2))
-    base = Zhang2019V2Params(w_social=0.0)
-    other = Zhang2019V2Params(w_social=0.0, social_horizon=4.0, social_forecast=3.0,
-                              social_band=0.5)  # fmt: skip
+    base = Zhang2019V2Params()
+    other = Zhang2019V2Params(social_horizon=4.0, social_forecast=3.0, social_band=0.5)
     for loop in (True, False):
         for heading, u_max in ((None, math.inf), (0.0, math.pi)):
             a, b = (plan(obs, GOAL, 1.0, 0.3, 0.25, np.zeros(2), p, loop=loop, heading=heading,
@@ -134,8 +133,8 @@ def test_crossing_pedestrian_is_passed_behind_with_the_term(enabled: bool) -> No
     1 m/s: without the term the robot keeps its line at full speed and crosses a second ahead of
     them, deep in their forecast; with it, it slows and bears right, behind them, clear of it."""
     obs = observe(pedestrian(0, 2.5, -3.5, 0.0, 1.0))
-    off = Zhang2019V2Params(w_social=0.0)
-    on = Zhang2019V2Params()  # the term on, as by default
+    off = Zhang2019V2Params()
+    on = Zhang2019V2Params(w_social=2.0, social_horizon=3.0)
     social = (on.social_horizon, on.social_forecast, on.social_band)
     with compiled(enabled):
         v_off = plan(obs, GOAL, 1.0, 0.3, 0.25, np.zeros(2), off).velocity

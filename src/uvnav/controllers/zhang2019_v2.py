@@ -43,8 +43,7 @@ into the next stream of people, and never slows down, waits or backs off.  v2 th
    closing candidate by when the bodies themselves would touch, not 0 for all of them, so that
    it still tells stepping toward a passing pedestrian from standing still.
 
-**Social comfort** (on by default: ``w_social`` 3 /s, T_s 3 s, S 1.25 s, band 0.1 m; 0 turns
-it off).  Success says nothing of how the robot
+**Social comfort** (off by default: ``w_social`` 0).  Success says nothing of how the robot
 treats people; the intrusion ratio of Liu et al. (ICRA 2023, CrowdNav++; :mod:`uvnav.sim.social`)
 counts the steps at which the robot stands where a visible pedestrian will be within the next
 1.25 s, i.e. passing in front of someone walking.  The steps above only keep ``comfort`` metres
@@ -216,8 +215,8 @@ class Zhang2019V2Params:
     track_position_std: float = 0.1
     track_accel_std: float = 1.0
     rollout_step: float = 0.125
-    w_social: float = 3.0
-    social_horizon: float = 3.0
+    w_social: float = 0.0
+    social_horizon: float = 2.0
     social_forecast: float = 1.25
     social_band: float = 0.1
 
