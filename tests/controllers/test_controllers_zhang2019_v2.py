@@ -420,7 +420,9 @@ def test_one_call_decision_equals_the_numpy_prepared_one_bit_for_bit(
 ) -> None:
     """The whole decision in one loop (compiled when numba is there) reads the same bodies,
     boundary discs and headings as the numpy preparation: the same velocity and first contact,
-    to the bit; so does its plain-Python copy (with the social term on or off)."""
+    to the bit (with the social term on or off).  Its plain-Python copy agrees to 1e-12: CPython's
+    ``math`` and the compiled code's libm may round a sine or cosine one ulp apart (seed 1343,
+    five discs: vx 0.49361547999660504 compiled, 0.493615479996605 in plain Python)."""
     obs, v_prev = _random_scene(seed, n, polygons)
     if still:
         v_prev = np.zeros(2)
@@ -431,6 +433,10 @@ def test_one_call_decision_equals_the_numpy_prepared_one_bit_for_bit(
     for enabled in (True, False):
         with compiled(enabled):
             got = plan(*args, loop=True, heading=heading, u_max=u_max)
-        assert got.velocity.tolist() == want[:2].tolist()
-        assert got.ttc == want[2]
+        if enabled and numba_available():
+            assert got.velocity.tolist() == want[:2].tolist()
+            assert got.ttc == want[2]
+        else:
+            assert np.allclose(got.velocity, want[:2], rtol=0.0, atol=1e-12)
+            assert got.ttc == pytest.approx(want[2], rel=1e-12, abs=1e-12)
         assert got.preferred == bool(want[3])
