@@ -11,7 +11,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from uvnav.controllers.zhang2019_v2 import Zhang2019V2Params, path_social, plan
+from uvnav.controllers.zhang2019_limits import path_social
+from uvnav.controllers.zhang2019_v2 import Zhang2019V2Params, plan
 from uvnav.geometry.contact import (
     forecast_gap,
     social_risk,
@@ -113,7 +114,12 @@ def test_rolled_out_straight_paths_read_the_same_term() -> None:
     xy = times[None, :, None] * cand[:, None, :]
     want = social_risk(np.zeros(2), cand, cand, np.zeros(len(cand)), discs,
                        (p.social_horizon, p.social_forecast, p.social_band))  # fmt: skip
-    np.testing.assert_allclose(path_social(times, xy, discs, p), want, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(
+        path_social(times, xy, discs, p.social_horizon, p.social_forecast, p.social_band),
+        want,
+        rtol=0,
+        atol=1e-9,
+    )
 
 
 def test_term_off_ignores_its_other_parameters() -> None:

@@ -19,8 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from uvnav.controllers.holonomic import toward_goal
 from uvnav.geometry.angles import FloatArray
-from uvnav.geometry.contact import first_contact
+from uvnav.geometry.contact import first_contact, forecast_gap
 
 #: a mask, one entry per path
 BoolArray = npt.NDArray[np.bool_]
@@ -212,3 +213,39 @@ def segment_gap(
     t = np.clip(b / np.maximum(a, 1e-12), 0.0, span)
     gap = rel_pos - rel_vel * t[..., None]
     return np.asarray(np.hypot(gap[..., 0], gap[..., 1]) - reach, dtype=float)
+
+
+def preferred_under_limits(position: FloatArray, goal: FloatArray, model: RampModel) -> FloatArray:
+    """V_max toward ``goal`` [m/s], lowered to ``dist / T`` near it and to the speed from which
+    the robot can still stop at it, ``sqrt(2 a dist)``."""
+    pref = toward_goal(position, goal, model.v_max, model.period)
+    dist = math.hypot(*(np.asarray(goal, dtype=float) - position))
+    speed = math.hypot(pref[0], pref[1])
+    cap = math.sqrt(2.0 * model.accel * dist)
+    return pref * (cap / speed) if speed > cap else pref
+
+
+def path_social(
+    times: FloatArray,
+    xy: FloatArray,
+    discs: tuple[FloatArray, FloatArray, FloatArray],
+    horizon: float,
+    forecast: float,
+    band: float,
+) -> FloatArray:
+    """The social term [m] of v2 (:mod:`uvnav.controllers.zhang2019_v2`, "Social comfort") of
+    each rolled-out path ``xy`` (K, S + 1, 2) at ``times`` (S + 1,) [s]: over its segments that
+    start before ``horizon`` [s], the largest ``reach + band - g`` (clipped at 0) over the moving
+    discs (centres, velocities, radius sums), ``g`` the distance from the robot on the segment
+    to the disc's forecast over ``forecast`` [s] (:func:`uvnav.geometry.contact.forecast_gap`)."""
+    q, w, reach = discs
+    near = int(np.searchsorted(times, horizon, side="left"))  # segments 0 .. near - 1
+    moving = (w[:, 0] != 0.0) | (w[:, 1] != 0.0)
+    if not bool(moving.any()) or near < 1:
+        return np.zeros(xy.shape[0])
+    q, w, reach = q[moving], w[moving], reach[moving]
+    t = times[: near + 1]
+    d = q[None, None] + w[None, None] * t[None, :, None, None] - xy[:, : near + 1, None, :]
+    e = np.broadcast_to((w * forecast)[None, None], d[:, :-1].shape)
+    g = forecast_gap(d[:, :-1], np.diff(d, axis=1), e).min(axis=1)
+    return np.asarray(np.clip(reach[None, :] + band - g, 0.0, None).max(axis=1))

@@ -103,7 +103,7 @@ This decision runs in numpy only (the compiled loop below serves the ideal vehic
 Two equal implementations of one decision.  The reference is numpy, vectorised over candidates x
 boundary discs (:func:`tangent_directions`, :func:`choose_velocity`).  With numba (the ``fast``
 extra) everything after reading the observation's readings into arrays (:func:`body_table`,
-:func:`outline_rings`) runs in one compiled call
+:func:`~uvnav.controllers.zhang2019_v2_loop.outline_rings`) runs in one compiled call
 (:func:`uvnav.controllers.zhang2019_v2_loop.plan_loop`: the reachable bodies, their boundary
 discs and the candidate headings, then :func:`uvnav.geometry.contact.decide_py`): it visits the
 candidates by their cost without the risk terms (a lower bound of the cost), checks each
@@ -119,7 +119,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from itertools import accumulate, chain
+from itertools import chain
 from operator import attrgetter
 from typing import Any, ClassVar
 
@@ -138,6 +138,8 @@ from uvnav.controllers.zhang2019_limits import (
     RampModel,
     approach,
     path_risk,
+    path_social,
+    preferred_under_limits,
     rollout,
     speed_command,
     stoppable,
@@ -149,6 +151,7 @@ from uvnav.controllers.zhang2019_v2_loop import (
     P_HEADINGS,
     P_SPACING,
     P_VMAX,
+    outline_rings,
     plan_loop,
 )
 from uvnav.dynamics.omni import VelocityCommand
@@ -157,7 +160,6 @@ from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.contact import (
     candidate_risk,
     candidate_risk_compiled,
-    forecast_gap,
     social_risk,
     social_risk_compiled,
 )
@@ -545,27 +547,6 @@ def loop_constants(
     return prm, v_max * np.asarray(p.speed_levels, dtype=float)
 
 
-def outline_rings(
-    readings: tuple[ObstacleReading, ...], scal: FloatArray
-) -> tuple[FloatArray, IntArray]:
-    """The outlines of ``readings`` stacked (V, 2) [m] and where each reading's rows start
-    (N + 1,), when any reading is a polygon (``scal``'s radius <= 0); none otherwise (a crowd of
-    discs).  A disc's outline is carried along but never read."""
-    n = len(readings)
-    if not n or not bool((scal[:, 2] <= 0.0).any()):
-        return _NO_RINGS, np.zeros(n + 1, dtype=np.int64)
-    outlines = [rd.outline for rd in readings]
-    try:
-        rings = np.concatenate(outlines, dtype=float)
-    except ValueError:  # an outline that is not (n, 2): as boundary_discs reads it
-        outlines = [np.asarray(x, dtype=float).reshape(-1, 2) for x in outlines]
-        rings = np.concatenate(outlines)
-    return rings, np.fromiter(accumulate(map(len, outlines), initial=0), np.int64, n + 1)
-
-
-_NO_RINGS = np.zeros((0, 2))
-
-
 def _plan_in_loop(
     obs: Observation,
     v_pref: FloatArray,
@@ -601,16 +582,6 @@ def nearest_tangents(
     return tangent_directions(position, q[:n_few], grow[:n_few], owner[:n_few])
 
 
-def preferred_under_limits(position: FloatArray, goal: FloatArray, model: RampModel) -> FloatArray:
-    """V_max toward ``goal`` [m/s], lowered to ``dist / T`` near it and to the speed from which
-    the robot can still stop at it, ``sqrt(2 a dist)``."""
-    pref = toward_goal(position, goal, model.v_max, model.period)
-    dist = math.hypot(*(np.asarray(goal, dtype=float) - position))
-    speed = math.hypot(pref[0], pref[1])
-    cap = math.sqrt(2.0 * model.accel * dist)
-    return pref * (cap / speed) if speed > cap else pref
-
-
 def plan_limited(
     obs: Observation,
     goal: FloatArray,
@@ -640,33 +611,12 @@ def plan_limited(
     ttc, pen = path_risk(times, xy, (q, w, reach), p.horizon, p.comfort, p.comfort_horizon,
                          p.safety_margin)  # fmt: skip
     brakes = stoppable(times, xy, speeds, ttc, model)
-    soc = path_social(times, xy, (q, w, reach), p) if p.w_social > 0.0 else None
+    soc = (
+        path_social(times, xy, (q, w, reach), p.social_horizon, p.social_forecast, p.social_band)
+        if p.w_social > 0.0
+        else None
+    )
     return least_cost(cand, ttc, pen, v_pref, v_prev, p, admissible=brakes, soc=soc)
-
-
-def path_social(
-    times: FloatArray,
-    xy: FloatArray,
-    discs: tuple[FloatArray, FloatArray, FloatArray],
-    params: Zhang2019V2Params,
-) -> FloatArray:
-    """The social term [m] (module docstring, "Social comfort") of each rolled-out path ``xy``
-    (K, S + 1, 2) at ``times`` (S + 1,): over its segments that start before ``social_horizon``,
-    the largest ``reach + social_band - g`` (clipped at 0) over the moving discs (centres,
-    velocities, radius sums), ``g`` the distance from the robot on the segment to the disc's
-    forecast over ``social_forecast`` (:func:`uvnav.geometry.contact.forecast_gap`)."""
-    p = params
-    q, w, reach = discs
-    near = int(np.searchsorted(times, p.social_horizon, side="left"))  # segments 0 .. near - 1
-    moving = (w[:, 0] != 0.0) | (w[:, 1] != 0.0)
-    if not bool(moving.any()) or near < 1:
-        return np.zeros(xy.shape[0])
-    q, w, reach = q[moving], w[moving], reach[moving]
-    t = times[: near + 1]
-    d = q[None, None] + w[None, None] * t[None, :, None, None] - xy[:, : near + 1, None, :]
-    e = np.broadcast_to((w * p.social_forecast)[None, None], d[:, :-1].shape)
-    g = forecast_gap(d[:, :-1], np.diff(d, axis=1), e).min(axis=1)
-    return np.asarray(np.clip(reach[None, :] + p.social_band - g, 0.0, None).max(axis=1))
 
 
 # -- the two laws -----------------------------------------------------------------------------

@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 import types
 from collections.abc import Callable
+from itertools import accumulate
 from typing import Any
 
 import numpy as np
@@ -27,6 +28,7 @@ from uvnav.geometry import contact
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.contact import decide_py
 from uvnav.geometry.kernels3d import numba_enabled
+from uvnav.sensors.observation import ObstacleReading
 
 IntArray = np.ndarray
 
@@ -195,3 +197,24 @@ def plan_loop(
     scal, centre, vel = table
     fn(state, scal, centre, vel, rings[0], rings[1], speeds, prm, out)
     return out
+
+
+def outline_rings(
+    readings: tuple[ObstacleReading, ...], scal: FloatArray
+) -> tuple[FloatArray, np.ndarray]:
+    """The outlines of ``readings`` stacked (V, 2) [m] and where each reading's rows start
+    (N + 1,), when any reading is a polygon (``scal``'s radius <= 0); none otherwise (a crowd of
+    discs).  A disc's outline is carried along but never read."""
+    n = len(readings)
+    if not n or not bool((scal[:, 2] <= 0.0).any()):
+        return _NO_RINGS, np.zeros(n + 1, dtype=np.int64)
+    outlines = [rd.outline for rd in readings]
+    try:
+        rings = np.concatenate(outlines, dtype=float)
+    except ValueError:  # an outline that is not (n, 2): as boundary_discs reads it
+        outlines = [np.asarray(x, dtype=float).reshape(-1, 2) for x in outlines]
+        rings = np.concatenate(outlines)
+    return rings, np.fromiter(accumulate(map(len, outlines), initial=0), np.int64, n + 1)
+
+
+_NO_RINGS = np.zeros((0, 2))
