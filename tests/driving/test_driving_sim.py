@@ -138,3 +138,15 @@ def test_side_camera_sees_the_centre_view_of_a_shifted_car_and_gets_its_label(si
     fast = replace(tel, speed=tel.speed + 40.0)
     f_left, f_right = expert.side_steering(fast, s)
     assert f_left - f_right < e_left - e_right
+
+
+def test_step_on_track_puts_the_car_back_and_keeps_where_it_left(sim) -> None:
+    sim.reset(2)
+    for _ in range(300):  # full right lock and gas: off the road within a few seconds
+        st = sim.step_on_track(1.0, 0.5)
+        if st.left is not None:
+            break
+    assert st.left is not None and st.left.off_track  # the reading that left the track
+    assert not st.telemetry.off_track and st.telemetry.speed == 0.0  # back, at rest
+    assert st.frame.shape == sim.frame().shape
+    assert sim.step_on_track(0.0, 0.0).left is None  # on the track: a plain step

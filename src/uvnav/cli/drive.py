@@ -505,11 +505,8 @@ def play(
                 frames.append(frame)
                 pred.append(steer)
                 ref.append(exp.act(tel)[0])
-            st = sim.step(steer, thr)
+            st = sim.step_on_track(steer, thr)
             frame, tel = st.frame, st.telemetry
-            if tel.off_track:
-                tel = sim.put_back()
-                frame = sim.frame()
             if st.terminated or st.truncated:
                 break
         sim.close()

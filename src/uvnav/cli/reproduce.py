@@ -50,21 +50,29 @@ def _user_errors() -> tuple[type[Exception], ...]:
     return ExperimentError, StaleCampaignError
 
 
-def run_cmd(
-    full: Annotated[
-        bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
-    ] = False,
-    workers: Annotated[
-        int, typer.Option(min=1, callback=pool_workers, help="Worker processes.")
-    ] = 2,
-    results: Annotated[Path, typer.Option(help="Directory of the results database.")] = Path(
-        "results"
+#: the options ``uvnav run`` and ``uvnav reproduce`` share
+FullOption = Annotated[
+    bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
+]
+WorkersOption = Annotated[int, typer.Option(min=1, callback=pool_workers, help="Worker processes.")]
+ResultsOption = Annotated[Path, typer.Option(help="Directory of the results database.")]
+ReportOption = Annotated[Path, typer.Option(help="Directory of the HTML report.")]
+FreshOption = Annotated[
+    bool,
+    typer.Option(
+        "--fresh",
+        help="Remake the stages (trained networks, planned tours, data sets), even those made "
+        "by other code; stored episodes are kept.",
     ),
-    report: Annotated[Path, typer.Option(help="Directory of the HTML report.")] = Path("report"),
-    fresh: Annotated[
-        bool,
-        typer.Option("--fresh", help="Remake the experiments' stages (episodes are kept)."),
-    ] = False,
+]
+
+
+def run_cmd(
+    full: FullOption = False,
+    workers: WorkersOption = 2,
+    results: ResultsOption = Path("results"),
+    report: ReportOption = Path("report"),
+    fresh: FreshOption = False,
 ) -> None:
     """Reproduce the thesis's experiments: results database, report, and the comparison table."""
     run_all = optional("uvnav.experiments", "run_all", "the reproduction job (uvnav run)")
@@ -176,16 +184,10 @@ def reproduce_cmd(
         bool,
         typer.Option("--list", help="List the experiments (name, seeded, title, sizes) and exit."),
     ] = False,
-    full: Annotated[
-        bool, typer.Option("--full", help="Thesis-size runs instead of the quick mode.")
-    ] = False,
-    workers: Annotated[
-        int, typer.Option(min=1, callback=pool_workers, help="Worker processes.")
-    ] = 2,
-    results: Annotated[Path, typer.Option(help="Directory of the results database.")] = Path(
-        "results"
-    ),
-    report: Annotated[Path, typer.Option(help="Directory of the HTML report.")] = Path("report"),
+    full: FullOption = False,
+    workers: WorkersOption = 2,
+    results: ResultsOption = Path("results"),
+    report: ReportOption = Path("report"),
     seeds: Annotated[
         int | None,
         typer.Option(
@@ -203,14 +205,7 @@ def reproduce_cmd(
             help="First random scene (seeded experiments): seeds S .. S+N-1.",
         ),
     ] = 0,
-    fresh: Annotated[
-        bool,
-        typer.Option(
-            "--fresh",
-            help="Remake the experiment's stages (trained networks, planned tours, data sets), "
-            "even those made by other code; stored episodes are kept.",
-        ),
-    ] = False,
+    fresh: FreshOption = False,
 ) -> None:
     """Reproduce one experiment into the results store and its report section.
 

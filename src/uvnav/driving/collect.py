@@ -156,10 +156,8 @@ def collect_episode(
                 side_steering=sides,
             )
             rows += 1
-        st = sim.step(steer + noise[k], throttle)
+        st = sim.step_on_track(steer + noise[k], throttle)
         tel = st.telemetry
-        if tel.off_track:
-            tel = sim.put_back()
         if st.terminated or st.truncated:
             break
     writer.flush()

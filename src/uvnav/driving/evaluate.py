@@ -158,16 +158,14 @@ def run_closed_loop(
     steps = 0
     for _ in range(limit):
         steer, throttle = policy(frame, tel)
-        st = sim.step(steer, throttle)
+        st = sim.step_on_track(steer, throttle)
         steps += 1
         ret += st.reward
         frame, tel = st.frame, st.telemetry
-        dist.append(abs(tel.centre_distance))
-        speeds.append(tel.speed)
-        if tel.off_track:
-            interventions += 1
-            tel = sim.put_back()
-            frame = sim.frame()
+        seen = tel if st.left is None else st.left  # the reading before a put-back
+        dist.append(abs(seen.centre_distance))
+        speeds.append(seen.speed)
+        interventions += st.left is not None
         if st.terminated or st.truncated:
             break
     lap = tel.lap_complete or tel.tiles_visited >= tel.n_tiles

@@ -510,11 +510,8 @@ def dagger_collect(
                     )
                     rows += 1
                 steer, thr = (e_steer, e_thr) if rng.random() < beta else learner(frame, tel)
-                st = sim.step(steer, thr)
+                st = sim.step_on_track(steer, thr)
                 frame, tel = st.frame, st.telemetry
-                if tel.off_track:
-                    tel = sim.put_back()
-                    frame = sim.frame()
                 if st.terminated or st.truncated:
                     break
             writer.flush()

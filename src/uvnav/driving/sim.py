@@ -21,6 +21,7 @@ Units are CarRacing's Box2D units, written [m] and [m/s] here.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from dataclasses import dataclass, field
 from typing import Any, Literal
@@ -102,13 +103,16 @@ class Telemetry:
 
 @dataclass(frozen=True)
 class SimStep:
-    """Result of :meth:`DrivingSim.step`."""
+    """Result of :meth:`DrivingSim.step` (and :meth:`DrivingSim.step_on_track`, whose ``left``
+    is the telemetry at which the car left the track, before it was put back; ``None`` when it
+    stayed on it)."""
 
     frame: NDArray[np.uint8]
     telemetry: Telemetry
     reward: float
     terminated: bool
     truncated: bool
+    left: Telemetry | None = None
 
 
 @dataclass
@@ -267,6 +271,15 @@ class DrivingSim:
         return self.front_view() if self.camera == "front" else self.topdown_view()
 
     # ------------------------------------------------------------------ interventions
+    def step_on_track(self, steer: float, throttle: float) -> SimStep:
+        """:meth:`step`, then, when the car left the track, the intervention :meth:`put_back`:
+        the frame and telemetry are those after it, ``left`` the telemetry before it."""
+        st = self.step(steer, throttle)
+        if not st.telemetry.off_track:
+            return st
+        back = self.put_back()
+        return dataclasses.replace(st, frame=self.frame(), telemetry=back, left=st.telemetry)
+
     def put_back(self) -> Telemetry:
         """Intervention: put the car at rest on the nearest centreline point, facing along it."""
         from gymnasium.envs.box2d.car_dynamics import Car

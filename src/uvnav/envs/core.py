@@ -74,6 +74,19 @@ MAX_WEIGHT = 1e6
 MAX_LENGTH = MAX_COORDINATE
 
 
+def _as_float(name: str, value: Any, what: str) -> float:
+    """``value`` as a float (an int beyond float's range: inf); ``TypeError`` naming ``name``
+    when it is not a real number (a bool is not one)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(
+            f"{name} must be {what} (got {type(value).__name__} {clip(repr(value), 40)})"
+        )
+    try:
+        return float(value)
+    except OverflowError:  # an int beyond float's range
+        return math.inf
+
+
 def checked_real(name: str, value: Any, limit: float, *, positive: bool = False) -> float:
     """``value`` as a float when it is a real number (not a bool) with ``|value| <= limit``
     (and ``> 0`` when ``positive``).
@@ -82,14 +95,7 @@ def checked_real(name: str, value: Any, limit: float, *, positive: bool = False)
         TypeError: not a real number (one line naming ``name``).
         ValueError: NaN, ±inf or beyond ``limit`` (one line naming ``name``).
     """
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(
-            f"{name} must be a number (got {type(value).__name__} {clip(repr(value), 40)})"
-        )
-    try:
-        v = float(value)
-    except OverflowError:  # an int beyond float's range
-        v = math.inf
+    v = _as_float(name, value, "a number")
     if positive and not (math.isfinite(v) and 0 < v <= limit):
         raise ValueError(f"{name} must be a finite number > 0 and <= {limit:g} (got {v:g})")
     if not (math.isfinite(v) and abs(v) <= limit):
@@ -104,14 +110,7 @@ def checked_count(name: str, value: Any, low: int, high: int) -> int:
     Raises:
         TypeError: not a number; ValueError: not whole, or out of range (one line naming it).
     """
-    if isinstance(value, bool) or not isinstance(value, numbers.Real):
-        raise TypeError(
-            f"{name} must be a whole number (got {type(value).__name__} {clip(repr(value), 40)})"
-        )
-    try:
-        v = float(value)
-    except OverflowError:  # an int beyond float's range
-        v = math.inf
+    v = _as_float(name, value, "a whole number")
     if not (math.isfinite(v) and v.is_integer() and low <= v <= high):
         raise ValueError(
             f"{name} must be a whole number >= {low} and <= {high} (got {clip(repr(value), 40)})"

@@ -48,7 +48,12 @@ from typing import Annotated, Any, Literal
 import numpy as np
 from pydantic import Field
 
-from uvnav.scenarios.crowdnav import CROWDNAV_ORCA_PARAMS, MAX_DRAWS, UNICYCLE_U_MAX
+from uvnav.scenarios.crowdnav import (
+    CROWDNAV_ORCA_PARAMS,
+    MAX_DRAWS,
+    UNICYCLE_U_MAX,
+    crossing_robot,
+)
 from uvnav.scenarios.errors import ScenarioError
 from uvnav.scenarios.params import typed_generator
 from uvnav.scenarios.parse import scenario_from_dict
@@ -303,18 +308,9 @@ def crowd_dynamic_scenario(
         "control_period": time_step,
         "t_max": t_max,
         "goal_tolerance": robot_radius,
-        "robot": {
-            "model": "unicycle",
-            "start": [0.0, -arena_radius],
-            "heading": math.pi / 2,
-            "goal": [0.0, arena_radius],
-            "v_max": v_pref,
-            "u_max": u_max,
-            "radius": robot_radius,
-            "kinematics": kinematics,
-            "accel_max": accel_max,
-            "turn_accel_max": turn_accel_max,
-        },
+        "robot": crossing_robot(
+            arena_radius, v_pref, u_max, robot_radius, kinematics, accel_max, turn_accel_max
+        ),
         "sensing": {"range": sensing_range, "velocities": "known"},
         "obstacles": obstacles,
         "controller": {"name": controller, "params": params},

@@ -90,6 +90,32 @@ _Agent = tuple[float, float, float, float, float]  # px, py, gx, gy, radius
 MAX_DRAWS = 20_000
 
 
+def crossing_robot(
+    half: float,
+    v_pref: float,
+    u_max: float,
+    radius: float,
+    kinematics: str,
+    accel_max: float | None,
+    turn_accel_max: float | None,
+) -> dict[str, Any]:
+    """The ``robot`` section of a crossing scene: a unicycle from ``(0, -half)`` to ``(0, half)``
+    [m], facing +y, at ``v_pref`` [m/s] and ``u_max`` [rad/s], of ``radius`` [m], with its
+    kinematics and acceleration limits ([m/s^2], [rad/s^2]; ``None``: none)."""
+    return {
+        "model": "unicycle",
+        "start": [0.0, -half],
+        "heading": math.pi / 2,
+        "goal": [0.0, half],
+        "v_max": v_pref,
+        "u_max": u_max,
+        "radius": radius,
+        "kinematics": kinematics,
+        "accel_max": accel_max,
+        "turn_accel_max": turn_accel_max,
+    }
+
+
 def _give_up(i: int, n: int) -> ValueError:
     return ValueError(
         f"cannot place human {i + 1} of {n} apart from the others after {MAX_DRAWS} draws: too "
@@ -402,18 +428,9 @@ def crowdnav_scenario(
         "control_period": time_step,
         "t_max": time_limit - 1.0,
         "goal_tolerance": robot_radius,
-        "robot": {
-            "model": "unicycle",
-            "start": [0.0, -circle_radius],
-            "heading": math.pi / 2,
-            "goal": [0.0, circle_radius],
-            "v_max": v_pref,
-            "u_max": u_max,
-            "radius": robot_radius,
-            "kinematics": kinematics,
-            "accel_max": accel_max,
-            "turn_accel_max": turn_accel_max,
-        },
+        "robot": crossing_robot(
+            circle_radius, v_pref, u_max, robot_radius, kinematics, accel_max, turn_accel_max
+        ),
         "sensing": {
             "range": sensing_range,
             "velocities": velocities,

@@ -3,7 +3,8 @@ pedestrians' states, and the tracker :class:`MotionTracker` that feeds them.
 
 Every function takes arrays and returns numbers; :class:`~uvnav.sim.social.SocialTracker` and
 :class:`MotionTracker` call them at every integration step or at the end of the episode
-(:class:`uvnav.sim.episode.World2D`).  The metrics, with their units and sources:
+(:class:`uvnav.sim.episode.World2D`); the tracker counts the personal-space steps itself, as it
+counts its other distance thresholds.  The metrics, with their units and sources:
 
 ``personal_space_time`` [s]
     ``dt`` times the number of integration steps whose end state has a *gap* (disc to disc:
@@ -86,18 +87,6 @@ def time_to_collision(
     with np.errstate(invalid="ignore", divide="ignore"):
         t = np.where(hit, (-b - np.sqrt(np.maximum(disc, 0.0))) / np.where(a > 0, a, 1.0), np.inf)
     return np.where(c <= 0.0, 0.0, np.maximum(t, 0.0))
-
-
-def personal_space_time(gaps: np.ndarray, dt: float, distance: float = PERSONAL_DISTANCE) -> float:
-    """Time [s] spent with a gap below ``distance`` [m]: ``dt`` [s] times the number of
-    ``gaps`` (the smallest robot-pedestrian gap of each step, [m]) below it.
-
-    >>> personal_space_time(np.array([1.0, 0.49, 0.5, -0.1]), 0.25)
-    0.5
-    >>> personal_space_time(np.array([]), 0.25)
-    0.0
-    """
-    return float(dt) * int(np.count_nonzero(np.asarray(gaps, dtype=float) < distance))
 
 
 def heading_irregularity(

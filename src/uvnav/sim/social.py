@@ -90,7 +90,7 @@ import numpy as np
 
 from uvnav.obstacles.bodies import DiscBody
 from uvnav.obstacles.obstacle import Obstacle, ObstacleField
-from uvnav.sim.comfort import personal_space_time, time_to_collision
+from uvnav.sim.comfort import PERSONAL_DISTANCE, time_to_collision
 
 #: CrowdNav's discomfort distance [m] (gap below which the robot is "too close")
 DISCOMFORT_DISTANCE = 0.2
@@ -130,11 +130,11 @@ class SocialTracker:
         "_close_periods",
         "_close_steps",
         "_forecast",
-        "_gaps",
         "_ids",
         "_intruded_steps",
         "_intrusion_steps",
         "_last_period",
+        "_personal_steps",
         "_radii",
         "_radius",
         "_range",
@@ -170,7 +170,7 @@ class SocialTracker:
         self._forecast = np.arange(1, k + 1, dtype=float)[:, None] * self.dt  # (K, 1) [s]
         self._steps = 0
         self._intruded_steps = 0
-        self._gaps: list[float] = []  # the smallest gap of every step after the first [m]
+        self._personal_steps = 0  # steps after the first with a gap < PERSONAL_DISTANCE
         self.min_ttc = math.inf  # smallest time to collision with a pedestrian [s]
 
     def gap(self, fld: ObstacleField, px: float, py: float) -> float:
@@ -199,7 +199,7 @@ class SocialTracker:
         if step > 0:
             self._steps += 1
             self._intruded_steps += self.intrudes(fld, px, py)
-            self._gaps.append(g)
+            self._personal_steps += g < PERSONAL_DISTANCE
             ttc = self.time_to_collision(fld, px, py, velocity)
             if ttc < self.min_ttc:
                 self.min_ttc = ttc
@@ -251,7 +251,7 @@ class SocialTracker:
     @property
     def personal_space_time(self) -> float:
         """Time with a gap < :data:`uvnav.sim.comfort.PERSONAL_DISTANCE` [s]."""
-        return personal_space_time(np.asarray(self._gaps), self.dt)
+        return self.dt * self._personal_steps
 
     @property
     def intrusion_ratio(self) -> float:
