@@ -23,7 +23,7 @@ import numpy as np
 
 from uvnav.driving.dataset import DatasetError, LogWriter
 from uvnav.driving.expert import ExpertParams, PurePursuitExpert, ar1_noise
-from uvnav.driving.sim import DrivingSim
+from uvnav.driving.sim import DrivingSim, Telemetry
 
 DONE_NAME = "episodes.txt"
 #: what the dataset's images are (camera, size, field of view, recording noise): read by training
@@ -109,6 +109,37 @@ def done_seeds(root: Path | str) -> set[int]:
     return {int(x) for x in f.read_text().split()}
 
 
+def write_expert_row(
+    writer: LogWriter,
+    name: str,
+    sim: DrivingSim,
+    expert: PurePursuitExpert,
+    tel: Telemetry,
+    label: tuple[float, float, float],
+) -> None:
+    """Write one dataset row ``name``: the three camera images of now (the front camera's side
+    views; the top-down view, which has no side cameras, three times) and the expert's ``label``
+    for ``tel`` (:meth:`PurePursuitExpert.label`: steering, throttle, target speed [m/s]), with
+    the brake, the speed [m/s] and the side cameras' steering."""
+    steer, throttle, v_target = label
+    sides: tuple[float, float] | None = None
+    if sim.camera == "front":
+        left, centre, right = sim.side_views()
+        sides = expert.side_steering(tel, sim.side_shift)
+    else:
+        left = centre = right = sim.topdown_view()
+    writer.write(
+        name,
+        (centre, left, right),
+        steering=steer,
+        throttle=throttle,
+        brake=max(-throttle, 0.0),
+        speed=tel.speed,
+        target_speed=v_target,
+        side_steering=sides,
+    )
+
+
 def collect_episode(
     sim: DrivingSim,
     writer: LogWriter,
@@ -139,21 +170,8 @@ def collect_episode(
     for k in range(p.max_steps):
         steer, throttle, v_target = expert.label(tel)
         if k % p.record_every == 0:
-            sides: tuple[float, float] | None = None
-            if sim.camera == "front":
-                left, centre, right = sim.side_views()
-                sides = expert.side_steering(tel, sim.side_shift)
-            else:  # the top-down view has no side cameras: the same image three times
-                left = centre = right = sim.topdown_view()
-            writer.write(
-                f"{seed:05d}_{k:05d}",
-                (centre, left, right),
-                steering=steer,
-                throttle=throttle,
-                brake=max(-throttle, 0.0),
-                speed=tel.speed,
-                target_speed=v_target,
-                side_steering=sides,
+            write_expert_row(
+                writer, f"{seed:05d}_{k:05d}", sim, expert, tel, (steer, throttle, v_target)
             )
             rows += 1
         st = sim.step_on_track(steer + noise[k], throttle)

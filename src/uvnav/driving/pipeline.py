@@ -22,7 +22,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import NDArray
 
-from uvnav.driving.collect import dataset_meta
+from uvnav.driving.collect import dataset_meta, write_expert_row
 from uvnav.driving.dataset import (
     LogWriter,
     balance_indices,
@@ -495,19 +495,11 @@ def dagger_collect(
             assert sim.geometry is not None
             expert = PurePursuitExpert(sim.geometry)
             for k in range(max_steps):
-                e_steer, e_thr, e_target = expert.label(tel)
+                label = expert.label(tel)
+                e_steer, e_thr, _ = label
                 if k % record_every == 0:
-                    left, centre, right = sim.side_views()
-                    writer.write(
-                        f"d{round_id}_{seed:05d}_{k:05d}",
-                        (centre, left, right),
-                        steering=e_steer,
-                        throttle=e_thr,
-                        brake=max(-e_thr, 0.0),
-                        speed=tel.speed,
-                        target_speed=e_target,
-                        side_steering=expert.side_steering(tel, sim.side_shift),
-                    )
+                    name = f"d{round_id}_{seed:05d}_{k:05d}"
+                    write_expert_row(writer, name, sim, expert, tel, label)
                     rows += 1
                 steer, thr = (e_steer, e_thr) if rng.random() < beta else learner(frame, tel)
                 st = sim.step_on_track(steer, thr)
