@@ -8,7 +8,6 @@ import sqlite3
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from types import ModuleType
 from typing import Any
 
 import pytest
@@ -32,22 +31,24 @@ class Interruption:
 
 @pytest.fixture
 def interrupt_after(monkeypatch: pytest.MonkeyPatch) -> Callable[..., Interruption]:
-    """``interrupt_after(module, k, name="_run_job")``: the module's episode runner ``name``
-    raises :class:`KeyboardInterrupt` (a Ctrl-C) once, when asked for episode ``k + 1``; the
-    episodes asked for after that run as usual (a resumed run)."""
+    """``interrupt_after(k)``: the one scene runner
+    (:func:`uvnav.scenarios.episodes.run_scene`, which every campaign job runs through) raises
+    :class:`KeyboardInterrupt` (a Ctrl-C) once, when asked for episode ``k + 1``; the episodes
+    asked for after that run as usual (a resumed run)."""
+    import uvnav.scenarios.episodes as episodes
 
-    def arm(module: ModuleType, k: int, name: str = "_run_job") -> Interruption:
-        real = getattr(module, name)
+    def arm(k: int) -> Interruption:
+        real = episodes.run_scene
         seen = Interruption()
 
-        def runner(job: Any, **kw: Any) -> Any:
+        def runner(resolved: Any, law: Any = None, *args: Any, **kw: Any) -> Any:
             if not seen.fired and len(seen.before) == k:
                 seen.fired = True
                 raise KeyboardInterrupt
-            (seen.after if seen.fired else seen.before).append(f"{job.label} {job.controller}")
-            return real(job, **kw)
+            (seen.after if seen.fired else seen.before).append(f"{resolved.spec} {law}")
+            return real(resolved, law, *args, **kw)
 
-        monkeypatch.setattr(module, name, runner)
+        monkeypatch.setattr(episodes, "run_scene", runner)
         return seen
 
     return arm

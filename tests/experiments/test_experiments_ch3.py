@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pytest
 
-from uvnav.bench.campaign import EpisodeRun, Job, run_job
+import uvnav.scenarios.episodes as episodes
+from uvnav.bench.campaign import run_job
 from uvnav.bench.store import ResultsStore
 from uvnav.experiments import ch3 as r3
 from uvnav.experiments.sections import ch3_section
@@ -83,17 +85,21 @@ def test_the_study_stores_three_arms_per_family_and_resumes(
     tmp_path: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(r3, "horizon_errors", lambda motion: {"v1_ar": 1.0, "v1_cv": 2.0})
-    calls: list[str] = []
-    real_run_job = r3._run_job
+    monkeypatch.setattr(r3, "ar_usage", lambda fam, seeds: {"decisions": 1.0, "ar_share": 1.0})
+    calls: list[tuple[str, str]] = []
+    real_run_scene = episodes.run_scene
 
-    def run_job(job: Job) -> EpisodeRun:
-        calls.append(dict(job.tags)["motion"])
-        return real_run_job(job)
+    def run_scene(resolved: Any, *args: Any, **kw: Any) -> Any:
+        out = real_run_scene(resolved, *args, **kw)
+        calls.append((resolved.spec, json.dumps(out.params, sort_keys=True)))
+        return out
 
-    monkeypatch.setattr(r3, "_run_job", run_job)
+    monkeypatch.setattr(episodes, "run_scene", run_scene)
     with ResultsStore(tmp_path / "db.sqlite") as store:
         study = r3.prediction_study(store, n_seeds=1, start_seed=2)
-        assert sorted(calls) == sorted(list(r3.PREDICTION_ARMS) * len(r3.PREDICTION_FAMILIES))
+        # each family's scene 2 with each arm's law parameters: AR, constant velocity, oracle
+        arms = ['{"prediction": "last"}', "{}", '{"oracle": true}']
+        assert sorted(calls) == sorted((f"{f}:2", a) for f in r3.PREDICTION_FAMILIES for a in arms)
         assert set(study["closed_loop"]) == {
             f"{f}|{a}" for f in r3.PREDICTION_FAMILIES for a in r3.PREDICTION_ARMS
         }

@@ -85,11 +85,11 @@ def test_an_interrupted_run_keeps_its_episodes_and_resumes_to_the_same_rows(
     stored_rows: Any,
     set_fingerprint: Any,
 ) -> None:
-    module, run = _chapter(chapter)
+    _, run = _chapter(chapter)
     run(tmp_path / "whole")
     expected = stored_rows(tmp_path / "whole" / "uvnav.sqlite")
     parts = tmp_path / "parts"
-    seen = interrupt_after(module, k)
+    seen = interrupt_after(k)
     with pytest.raises(KeyboardInterrupt):
         run(parts)
     db = parts / "uvnav.sqlite"
@@ -125,8 +125,8 @@ def _stale_store(results: Path, campaign: str) -> Path:
 def test_uvnav_reproduce_refuses_a_stale_campaign_in_one_line(
     chapter: str, campaign: str, tmp_path: Path, interrupt_after: Any
 ) -> None:
-    module, _ = _chapter(chapter)
-    seen = interrupt_after(module, 0)  # no episode may run
+    _chapter(chapter)
+    seen = interrupt_after(0)  # no episode may run
     results = tmp_path / "res"
     db = _stale_store(results, campaign)
     out = CliRunner().invoke(

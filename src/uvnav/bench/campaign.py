@@ -84,6 +84,10 @@ def _resolved(spec: str) -> Any:
 
 def job_scene(job: Job) -> Any:
     """The job's scene (a :class:`uvnav.scenarios.catalog.Resolved`; runs in the worker)."""
+    if job.scenario is not None and job.scene_params:
+        from uvnav.scenarios.catalog import with_fields
+
+        return with_fields(_resolved(job.scenario), dict(job.scene_params))
     if job.scenario is not None:
         return _resolved(job.scenario)
     key = (job.generator, int(job.generator_seed or 0), job.generator_params)
@@ -102,7 +106,7 @@ def _scene_key(job: Job) -> tuple[Any, ...]:
     """What identifies a job's episode set-up but for the law: the scene and the episode seed
     (jobs with their own set-up or runner are their own)."""
     if job.scenario is not None:
-        return ("scenario", job.scenario, int(job.seed))
+        return ("scenario", job.scenario, job.scene_params, int(job.seed))
     if job.generator_seed is not None:
         return ("generator", job.generator_label, int(job.generator_seed), int(job.seed))
     return ("job", job.key)
@@ -154,10 +158,11 @@ def _run_job(job: Job) -> JobOutcome:
 
     tic = time.perf_counter()
     params: dict[str, Any] = job.params_dict
+    result: Any = None
     try:
         if job.runner is not None:
             status, metrics, traj, facts = job.runner(job)
-            params = {**job.store_params, **facts}
+            params, result = {**job.store_params, **facts}, traj
         elif job.setup_factory is not None:
             from uvnav.controllers import make_controller
 
@@ -185,7 +190,8 @@ def _run_job(job: Job) -> JobOutcome:
             finally:
                 for probe in probes:
                     getattr(probe, "close", lambda: None)()
-            status, metrics, traj, params = out.status, out.metrics, out.trajectory, out.params
+            status, metrics, traj = out.status, out.metrics, out.trajectory
+            params, result = {**out.params, **out.facts}, out.result
     except PlacementError as exc:  # the scene cannot be built: refused, with the generator's line
         return JobOutcome(
             job, STATUS_REFUSED, None, str(exc), time.perf_counter() - tic, None, params
@@ -200,7 +206,7 @@ def _run_job(job: Job) -> JobOutcome:
         wall_time=time.perf_counter() - tic,
         trajectory=traj if job.record and isinstance(traj, Trajectory) else None,
         effective_params=params,
-        result=traj if job.record and job.runner is not None else None,
+        result=result if job.record else None,
     )
 
 

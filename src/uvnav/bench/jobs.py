@@ -47,6 +47,9 @@ class Job:
             :data:`uvnav.scenarios.generators.DEFAULT_GENERATOR`).
         generator_params: keyword arguments of the generator (a mapping is accepted and frozen to
             sorted pairs); they become part of the scenario label, hence of the resume key.
+        scene_params: fields of the ``scenario``'s sections to set, ``section.field`` -> value
+            (``{"sensing.velocities": "estimated"}``;
+            :func:`uvnav.scenarios.catalog.with_fields`); part of the default label.
         setup_factory: a *module-level* (picklable) function ``seed -> EpisodeSetup``; needs
             ``label``.
         label: scenario label stored in the database (defaults from the source).
@@ -78,6 +81,7 @@ class Job:
     generator_seed: int | None = None
     generator: str = DEFAULT_GENERATOR
     generator_params: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
+    scene_params: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
     setup_factory: SetupFactory | None = None
     label: str | None = None
     family: str | None = None
@@ -92,6 +96,9 @@ class Job:
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", _freeze(self.params))
         object.__setattr__(self, "generator_params", _freeze(self.generator_params))
+        object.__setattr__(self, "scene_params", _freeze(self.scene_params))
+        if self.scene_params and self.scenario is None:
+            raise ValueError("scene_params need a scenario")
         object.__setattr__(self, "tags", _freeze(self.tags))
         own = (self.setup_factory, self.runner)
         sources = sum(x is not None for x in (self.scenario, self.generator_seed, *own))
@@ -141,6 +148,9 @@ class Job:
         """
         if self.label is not None:
             return self.label
+        if self.scenario is not None and self.scene_params:
+            sets = ",".join(f"{k}={canonical_json(v)}" for k, v in self.scene_params)
+            return f"{self.scenario}[{sets}]"
         if self.scenario is not None:
             return self.scenario
         return f"{self.generator_label}/{self.generator_seed:04d}"

@@ -21,7 +21,7 @@
    ``PREDICTION_MIN_SEEDS`` seeds per family; :func:`prediction_finding` turns the numbers into
    the section's one sentence.
 
-Every episode is a campaign job (:func:`ch3_job`, this chapter's runner) run and stored by
+Every episode is a scene campaign job (:func:`ch3_job`) run and stored by
 :mod:`uvnav.experiments.campaigns` (resumable, fingerprinted, additive), the controller column
 holding the law and ``params`` the motion knowledge (``{"motion": "known"|"predicted"}``, and
 ``"constant"`` in ``ch3-prediction``); the table "thesis reported vs uvnav measured" is read back
@@ -42,7 +42,7 @@ from typing import Any
 import numpy as np
 
 import uvnav.experiments.campaigns as cp
-from uvnav.bench.campaign import EpisodeRun, Job
+from uvnav.bench.campaign import Job
 from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.store import FINGERPRINT_KEY, EpisodeKey, ResultsStore, check_fingerprints
 from uvnav.experiments.rows import table_row
@@ -98,37 +98,35 @@ Renderer = Callable[[Path, Path, list[tuple[str, str, Any]]], list[Path]]
 def ch3_job(scene: str, law: str, seed: int, motion: str, *, record: bool = False) -> Job:
     """One episode as a campaign job: a scene (built-in name or generator label such as
     ``random-ch3:4``), a 3D law, a seed and the motion knowledge (the job's tags: the store's
-    ``params``, part of the resume key): ``"known"`` (oracle), ``"predicted"`` (estimated rates,
-    the law's own prediction) or ``"constant"`` (estimated rates used as they are,
-    ``prediction="last"``); ``record`` keeps the trajectory (the outcome's ``result``)."""
-    family = scene.split(":", 1)[0]
+    ``params``, part of the resume key): ``"known"`` (the scene senses true rates, the law is an
+    oracle), ``"predicted"`` (estimated rates, the law's own prediction) or ``"constant"``
+    (estimated rates used as they are, ``prediction="last"``); ``record`` keeps the result.
+
+    The motion knowledge sets the scene's ``sensing.velocities`` (a generator's ``velocities``
+    parameter) and the law's ``oracle`` / ``prediction``; the job runs as any scene job
+    (:func:`uvnav.scenarios.episodes.run_scene`) without the scene's own law parameters."""
+    family, _, number = scene.partition(":")
+    velocities = "known" if motion == "known" else "estimated"
+    params: dict[str, Any] = {}
+    if motion == "known":
+        params["oracle"] = True
+    elif motion == "constant":  # the sensed rates as they are, no AR models
+        params["prediction"] = "last"
+    where: dict[str, Any]
+    if number:
+        gen_params = {"velocities": velocities}
+        where = {"generator": family, "generator_seed": int(number), "generator_params": gen_params}
+    else:
+        where = {"scenario": scene, "scene_params": {"sensing.velocities": velocities}}
     return Job(
-        law, int(seed), label=scene, family=family, tags={"motion": motion}, record=record,
-        runner=_run_job,
+        law, int(seed), label=scene, family=family, tags={"motion": motion}, params=params,
+        record=record, use_scenario_params=False, **where,
     )  # fmt: skip
-
-
-def _run_job(job: Job) -> EpisodeRun:
-    """The campaign's runner: the scene with the rates the job's motion knowledge senses, the
-    law (oracle, or with ``prediction="last"`` for ``"constant"``), the episode."""
-    from uvnav.controllers.base import make_law
-    from uvnav.scenarios import load_scenario
-    from uvnav.sim.run import run_episode
-
-    motion = str(dict(job.tags)["motion"])
-    sc: Any = load_scenario(str(job.label))
-    setup = sc.build(job.seed, velocities="known" if motion == "known" else "estimated")
-    # "constant": the sensed (estimated) rates as they are, no AR models (zhang2020-3d-v1 only)
-    extra = {"prediction": "last"} if motion == "constant" else {}
-    law = make_law(job.controller, vehicle="vehicle3d", oracle=motion == "known", **extra)
-    res = run_episode(setup, law, np.random.default_rng(job.seed), record=job.record)
-    traj = res.trajectory
-    return res.status, res.metrics.to_dict(), traj, {}
 
 
 def fingerprint() -> str:
     """The code fingerprint of this chapter's campaigns: the packages that decide an episode
-    and this module (its runner)."""
+    and this module (its jobs)."""
     return cp.fingerprint("experiments/ch3.py")
 
 
@@ -210,10 +208,9 @@ def ar_usage(family: str, seeds: Sequence[int]) -> dict[str, float]:
 
     Returns:
         ``{"decisions": count, "ar_share": fraction (nan for none)}``."""
-    from uvnav.controllers.base import make_law
     from uvnav.core import BaseProbe
-    from uvnav.scenarios import load_scenario
-    from uvnav.sim.run import run_episode
+    from uvnav.scenarios.catalog import generate
+    from uvnav.scenarios.episodes import run_scene
 
     class _Use(BaseProbe):
         def __init__(self) -> None:
@@ -227,10 +224,8 @@ def ar_usage(family: str, seeds: Sequence[int]) -> dict[str, float]:
 
     use = _Use()
     for g in seeds:
-        sc: Any = load_scenario(f"{family}:{g}")
-        setup = sc.build(g, velocities="estimated")
-        law = make_law(PREDICTION_LAW, vehicle="vehicle3d")
-        run_episode(setup, law, np.random.default_rng(g), record=False, probes=(use,))
+        scene = generate(family, g, {"velocities": "estimated"})
+        run_scene(scene, PREDICTION_LAW, {}, g, use_scene_params=False, probes=(use,))
     share = use.ar / use.total if use.total else float("nan")
     return {"decisions": float(use.total), "ar_share": share}
 
@@ -532,7 +527,9 @@ def reproduce_ch3(
         finding = prediction_finding(study)
     figures: list[Path] = []
     if render is not None:
-        trajectories = [(str(j.label), j.controller, recorded[j.key]) for j in scene_jobs]
+        trajectories = [
+            (str(j.label), j.controller, recorded[j.key].trajectory) for j in scene_jobs
+        ]
         figures = render(db_path, Path(report_dir), trajectories)
     return Ch3Summary(
         table, db_path, failures, pred, figures, time.perf_counter() - tic, study, finding

@@ -464,6 +464,38 @@ def generate(name: str, seed: int, params: Mapping[str, Any] | None = None) -> R
     return Resolved(kind, scenario, spec, seed)
 
 
+def with_fields(resolved: Resolved, fields: Mapping[str, Any]) -> Resolved:
+    """``resolved`` with the section fields ``fields`` set, each named ``section.field``
+    (``sensing.velocities`` of a 3D scene, ``sonar.noise_std`` of a sonar scene); every section
+    changed is validated again by its own model (the scene's other checks are not rerun).
+
+    Raises:
+        ScenarioError: no such section or field, or a value the section refuses (one line).
+    """
+    from pydantic import BaseModel, ValidationError
+
+    sections: dict[str, dict[str, Any]] = {}
+    for path, value in fields.items():
+        section, _, name = str(path).partition(".")
+        sections.setdefault(section, {})[name] = value
+    update: dict[str, Any] = {}
+    for section, values in sections.items():
+        part = getattr(resolved.scenario, section, None)
+        fields_of = type(part).model_fields if isinstance(part, BaseModel) else {}
+        unknown = [n for n in values if n not in fields_of]
+        if unknown:
+            where = f"{section}.{unknown[0]}"
+            raise ScenarioError(resolved.spec, where, "is no field of the scene's sections")
+        try:
+            update[section] = type(part).model_validate({**part.model_dump(), **values})
+        except ValidationError as exc:
+            err = exc.errors(include_url=False)[0]
+            where = ".".join((section, *(str(x) for x in err["loc"])))
+            raise ScenarioError(resolved.spec, where, str(err["msg"])) from None
+    scenario = resolved.scenario.model_copy(update=update)
+    return Resolved(resolved.kind, scenario, resolved.spec, resolved.seed)
+
+
 def builtin_names() -> list[tuple[str, SceneKind]]:
     """Every built-in scene with its kind, in :data:`KINDS` order."""
     return [(name, k) for k in kinds().values() for name in k.builtins()]

@@ -47,6 +47,10 @@ class Outcome:
         extra: the kind's own results (forbidden regions, inner space, group metrics, robots;
             a single robot's ``contact_time``: the first contact of a collision [s], ``None``
             without one).
+        facts: what a campaign stores beside the law's parameters (its ``effective_params``):
+            the world's flags (Ch. 4 ``entered_forbidden``, Ch. 5 ``entered_inner_space``) and,
+            on a sonar scene (``uuv2d``, ``uuv3d``), ``n_obstacles``; multi-robot: ``group``
+            (the group metrics) and ``n_robots``.
         result, setup: the simulator's own result and setup (for figures).
     """
 
@@ -58,6 +62,7 @@ class Outcome:
     status: str
     metrics: dict[str, Any]
     extra: dict[str, Any] = field(default_factory=dict)
+    facts: dict[str, Any] = field(default_factory=dict)
     result: Any = None
     setup: Any = None
     trajectory: Any = None
@@ -238,6 +243,9 @@ def _one_vehicle(
     res = run_episode(setup, law, r.kind.episode_rng(seed), record=record, probes=probes, **options)
     out = _single(r, name, params, seed, res, setup=setup, trajectory=res.trajectory)
     out.extra.update(res.flags)
+    out.facts.update(res.flags)
+    if r.kind.name in ("uuv2d", "uuv3d"):
+        out.facts["n_obstacles"] = len(r.scenario.obstacles)
     if r.kind.name == "uuv3d":
         out.extra["locator"] = str(getattr(law.params, "locator", ""))
     return out
@@ -292,6 +300,7 @@ def _multi(
     return Outcome(
         kind=r.kind.name, scene=r.name, law=name, params=params, seed=seed, status=status,
         metrics=metrics, extra=extra, result=res, setup=setup,
+        facts={"group": g.to_dict(), "n_robots": len(setup.robots)},
     )  # fmt: skip
 
 
