@@ -55,14 +55,14 @@ def test_the_rows_are_read_back_from_stored_episodes_and_a_run_resumes(
     expected = stored_rows(tmp_path / "whole.sqlite")
     assert {k: len(v) for k, v in expected.items()} == {rb.OFFICE_CAMPAIGN: 4, rb.MULTI_CAMPAIGN: 1}
     db = tmp_path / "uvnav.sqlite"
-    seen = interrupt_after(rb, 3, "_run_office")
+    seen = interrupt_after(3)
     with ResultsStore(db) as store, pytest.raises(KeyboardInterrupt):
         _beyond(store)
     assert {k: len(v) for k, v in stored_rows(db).items()} == {rb.OFFICE_CAMPAIGN: 3}
     with ResultsStore(db) as store:
         assert _beyond(store) == rows  # the resume runs the missing episodes only
-    assert stored_rows(db) == expected and len(seen.after) == 1
+    assert stored_rows(db) == expected and len(seen.after) == 2  # the 4th office run, the swap
     set_fingerprint(db, rb.MULTI_CAMPAIGN)
     with pytest.raises(StaleCampaignError, match=f"'{rb.MULTI_CAMPAIGN}'") as err:
         rb.reproduce_beyond(tmp_path)
-    assert "\n" not in str(err.value) and len(seen.after) == 1  # refused before anything ran
+    assert "\n" not in str(err.value) and len(seen.after) == 2  # refused before anything ran

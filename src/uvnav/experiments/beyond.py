@@ -11,9 +11,10 @@ number to reproduce: the rows put each configuration next to its baseline, measu
   default: it treats the others as non-reactive) and, with ``full``, reciprocal responsibility
   0.5 (RVO2's own) — arrivals, robot-robot collisions, deadlocks, makespan.
 
-Every episode is a campaign job run and stored by :mod:`uvnav.experiments.campaigns` (campaigns
-``beyond-office`` and ``beyond-multi``: the law and its parameters as usual; a multi-robot
-episode's group metrics and robot count in ``effective_params``), and the rows are read back from
+Every episode is a scene campaign job run and stored by :mod:`uvnav.experiments.campaigns`
+(campaigns ``beyond-office`` and ``beyond-multi``: the law and its parameters as usual; a
+multi-robot episode's group metrics and robot count, the scene runner's facts, in
+``effective_params``), and the rows are read back from
 the stored episodes.  The replanning row (:func:`replan_rows`) times two planners on this machine
 and is computed, not stored.
 """
@@ -26,16 +27,10 @@ from pathlib import Path
 from typing import Any
 
 import uvnav.experiments.campaigns as cp
-from uvnav.bench.campaign import EpisodeRun, Job
+from uvnav.bench.campaign import Job
 from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, check_fingerprints
-from uvnav.controllers.base import make_controller
 from uvnav.experiments.rows import table_row
-from uvnav.scenarios.build import build_episode
-from uvnav.scenarios.loader import load_scenario
-from uvnav.scenarios.multi import build_multi, load_multi_scenario
-from uvnav.sim.run import run_episode
-from uvnav.sim.seeding import run_rng
 
 BEYOND = "— (beyond the thesis)"
 QUICK_LAWS = ("zhang2019-v1", "savkin-wang2013-v1")
@@ -56,41 +51,26 @@ CAMPAIGNS: tuple[str, ...] = (OFFICE_CAMPAIGN, MULTI_CAMPAIGN)
 
 def fingerprint() -> str:
     """The code fingerprint of these campaigns: the packages that decide an episode,
-    :mod:`uvnav.planners` (hybrid-v1's D* Lite) and this module (its runner)."""
+    :mod:`uvnav.planners` (hybrid-v1's D* Lite) and this module (its jobs)."""
     return cp.fingerprint("planners", "experiments/beyond.py")
 
 
 def office_job(law: str, scenario: str = "office-floor", *, hybrid: bool = False) -> Job:
-    """The law alone on ``scenario``, or ``hybrid-v1`` with it (``hybrid``), seed 0."""
+    """The law alone on ``scenario``, or ``hybrid-v1`` with it (``hybrid``), seed 0 (a scene
+    job without the scene's own law parameters)."""
     if hybrid:
-        return Job("hybrid-v1", 0, label=scenario, params={"law": law}, runner=_run_office)
-    return Job(law, 0, label=scenario, runner=_run_office)
+        return Job(
+            "hybrid-v1", 0, scenario=scenario, params={"law": law}, use_scenario_params=False
+        )
+    return Job(law, 0, scenario=scenario, use_scenario_params=False)
 
 
 def swap_job(spec: str, law: str, params: dict[str, Any]) -> Job:
-    """Every robot of the multi-robot scene ``spec`` with ``law`` (``params``), seed 0."""
-    return Job(law, 0, label=spec, params=params, runner=_run_swap)
-
-
-def _run_office(job: Job) -> EpisodeRun:
-    """The runner of :func:`office_job`: one robot on a 2D scene."""
-    ctrl = make_controller(job.controller, **job.params_dict)
-    setup = build_episode(load_scenario(str(job.label)), 0)
-    res = run_episode(setup, ctrl, run_rng(0), record=False)
-    return res.status, res.metrics.to_dict(), None, {}
-
-
-def _run_swap(job: Job) -> EpisodeRun:
-    """The runner of :func:`swap_job`: ``success`` when every robot arrived, ``collision``
-    when any collided, else ``timeout``; the group metrics and the number of robots are its
+    """Every robot of the multi-robot scene ``spec`` with ``law`` (``params``), seed 0: the
+    scene runner's group status (``success`` when every robot arrived, ``collision`` when any
+    collided, else ``timeout``) and metrics; the group metrics and the number of robots are its
     facts (the store's ``effective_params``)."""
-    sc = load_multi_scenario(str(job.label))
-    setup = build_multi(sc, 0, controller=job.controller, params=job.params_dict)
-    res = run_episode(setup, None, run_rng(0), record=False)
-    g = res.group
-    collided = any(s == "collision" for s in res.statuses)
-    status = "success" if g.all_arrived else ("collision" if collided else "timeout")
-    return status, {}, None, {"group": g.to_dict(), "n_robots": len(sc.robots)}
+    return Job(law, 0, scenario=spec, params=params, use_scenario_params=False)
 
 
 def _episode_text(rec: dict[str, Any]) -> str:
