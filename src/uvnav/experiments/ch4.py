@@ -15,7 +15,7 @@
    narrower gaps; :func:`~uvnav.scenarios.uuv2d.random_ch4_hard_scenario`) with the three laws
    (quick: 4 seeds; ``full``: 100) — campaign ``ch4-hard``.
 
-Every episode is a campaign job (:func:`ch4_job`, this chapter's runner) run and stored by
+Every episode is a scene campaign job (:func:`ch4_job`) run and stored by
 :mod:`uvnav.experiments.campaigns` (resumable, fingerprinted, additive) in
 ``results_dir/uvnav.sqlite``: the ``controller`` column holds the law, ``params`` the sensing
 level (the job's tags ``{"noise_std", "dropout"}``, part of the resume key), ``family`` the
@@ -44,15 +44,13 @@ from typing import Any
 import numpy as np
 
 import uvnav.experiments.campaigns as cp
-from uvnav.bench.campaign import EpisodeRun, Job, outcome_record, run_job, stored_records
+from uvnav.bench.campaign import Job, outcome_record, run_job, stored_records
 from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, check_fingerprints
-from uvnav.controllers.base import make_law
 from uvnav.experiments.rows import table_row
-from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin, load_uuv2d_scenario
+from uvnav.scenarios.uuv2d import UUV2D_GENERATORS, list_uuv2d_builtin
 from uvnav.sim.episode_uuv2d import Uuv2dTrajectory
 from uvnav.sim.metrics import METRIC_NAMES
-from uvnav.sim.run import run_episode
 from uvnav.sim.setup import EpisodeResult
 
 LAW = "zhang2022-uuv2d-v1"
@@ -76,10 +74,17 @@ CAMPAIGNS: tuple[str, ...] = (RANDOM_CAMPAIGN, NOISE_CAMPAIGN, HARD_CAMPAIGN)
 def ch4_job(scene: str, law: str, seed: int, noise_std: float = 0.0, dropout: float = 0.0) -> Job:
     """One episode as a campaign job: a scene (built-in name or ``random-ch4:<seed>``), a law,
     a seed and the sonar's sensing level (the job's tags: the store's ``params``, part of the
-    resume key, as the chapter's own job type stored them)."""
+    resume key).  A generated scene is drawn with the sensing level (the generator's
+    ``noise_std`` and ``dropout``); a built-in keeps its own sonar.  The job runs as any scene
+    job (:func:`uvnav.scenarios.episodes.run_scene`) without the scene's own law parameters."""
     tags = {"noise_std": float(noise_std), "dropout": float(dropout)}
-    family = scene.split(":", 1)[0]
-    return Job(law, int(seed), label=scene, family=family, tags=tags, runner=_run_job)
+    family, _, number = scene.partition(":")
+    where: dict[str, Any] = {"scenario": scene}
+    if number and family in UUV2D_GENERATORS:
+        where = {"generator": family, "generator_seed": int(number), "generator_params": tags}
+    return Job(
+        law, int(seed), label=scene, family=family, tags=tags, use_scenario_params=False, **where
+    )
 
 
 def run_ch4_job(
@@ -95,37 +100,22 @@ def run_ch4_job(
     return _row(outcome_record(out)), out.result
 
 
-def _run_job(job: Job) -> EpisodeRun:
-    """The campaign's runner: the scene with the job's sensing level, the law, the episode."""
-    scene = str(job.label)
-    family, _, number = scene.partition(":")
-    if number and family in UUV2D_GENERATORS:
-        sc = UUV2D_GENERATORS[family](int(number), **dict(job.tags))
-    else:
-        sc = load_uuv2d_scenario(scene)
-    law = make_law(job.controller, vehicle="uuv2d")
-    rng = np.random.default_rng(job.seed)
-    res = run_episode(sc.to_setup(), law, rng, record=job.record)
-    facts = {"n_obstacles": len(sc.obstacles), "entered_forbidden": res.flags["entered_forbidden"]}
-    return res.status, res.metrics.to_dict(), res, facts
-
-
 def _row(rec: dict[str, Any]) -> dict[str, Any]:
     """A stored record (:func:`~uvnav.bench.campaign.stored_records`) as this chapter's row."""
-    extra = rec["effective_params"]
+    params, extra = rec["params"], rec["effective_params"]
     return {
         "scene": rec["scenario"],
         "law": rec["controller"],
         "seed": int(rec["seed"]),
-        "noise_std": float(extra.get("noise_std", 0.0)),
-        "dropout": float(extra.get("dropout", 0.0)),
+        "noise_std": float(params.get("noise_std", 0.0)),
+        "dropout": float(params.get("dropout", 0.0)),
         "n_obstacles": int(extra.get("n_obstacles", 0)),
         "status": rec["status"],
         "entered_forbidden": bool(extra.get("entered_forbidden", False)),
         "wall_time": rec.get("wall_time"),
         **{m: rec.get(m) for m in METRIC_NAMES},
         "key": "|".join((rec["scenario"], rec["controller"], str(int(rec["seed"])),
-                         f"{extra.get('noise_std', 0.0):g}", f"{extra.get('dropout', 0.0):g}")),
+                         f"{params.get('noise_std', 0.0):g}", f"{params.get('dropout', 0.0):g}")),
     }  # fmt: skip
 
 
