@@ -191,7 +191,8 @@ def _run_job(job: Job) -> JobOutcome:
                 for probe in probes:
                     getattr(probe, "close", lambda: None)()
             status, metrics, traj = out.status, out.metrics, out.trajectory
-            params, result = {**out.params, **out.facts}, out.result
+            named = {k: v for k, v in job.tags if k in out.params}  # a tag stands for its param
+            params, result = {**out.params, **named, **out.facts}, out.result
     except PlacementError as exc:  # the scene cannot be built: refused, with the generator's line
         return JobOutcome(
             job, STATUS_REFUSED, None, str(exc), time.perf_counter() - tic, None, params

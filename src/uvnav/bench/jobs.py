@@ -65,7 +65,9 @@ class Job:
             (thesis (2.6)); by default such an episode is stored as ``refused``.
         tags: what identifies the episode beyond the controller parameters (an experiment's
             sensing level, locator, ...): stored with them in the ``params`` column and part of the
-            resume key, never passed to the law (a mapping is frozen to sorted pairs).
+            resume key, never passed to the law (a mapping is frozen to sorted pairs).  A tag named
+            as a parameter stands for it in the store (``params`` and ``effective_params``): a
+            checkpoint's digest for its path.
         runner: a *module-level* (picklable) function ``job -> (status, metrics, trajectory,
             facts)`` running an experiment's own episode of ``label`` (its own world set-up);
             ``facts`` are stored in ``effective_params`` after the tags.

@@ -15,12 +15,12 @@ geometric (min/argmin, the baseline), network (the BPNN) and oracle (true geomet
 4. on the harder ``random-ch5-dense`` family, noise 0 (quick: none; ``full``: 100) — campaign
    ``ch5-dense``.
 
-Every episode is a campaign job (:func:`ch5_job`, this experiment's runner) run and stored by
+Every episode is a scene campaign job (:func:`ch5_job`) run and stored by
 :mod:`uvnav.experiments.campaigns` in ``results_dir/uvnav.sqlite``: the ``controller`` column
 holds the law, ``params`` (the job's tags) the locator and the noise level (plus, for the
 network, a digest of its checkpoint: part of the resume key, so a different network re-runs),
 ``family`` the generator or the scene; the number of obstacles and whether Scene 2's inner space
-was entered go to ``effective_params``.
+was entered (the scene runner's facts) go to ``effective_params``.
 
 **Resumable.**  Nothing measured is lost when a run is interrupted: the data sets, learning rows
 and networks are stages under ``results_dir/ch5/cache`` (:mod:`uvnav.experiments.ch5_bpnn`), and
@@ -38,7 +38,6 @@ by a renderer the caller injects (:mod:`uvnav.viz` is a layer above).
 from __future__ import annotations
 
 import dataclasses
-import functools
 import hashlib
 import json
 import shutil
@@ -48,16 +47,11 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 import uvnav.experiments.campaigns as cp
-from uvnav.bench.campaign import EpisodeRun, Job, outcome_record, run_job, stored_records
+from uvnav.bench.campaign import Job, outcome_record, run_job, stored_records
 from uvnav.bench.fingerprint import DB_NAME
 from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, check_fingerprints
-from uvnav.controllers.zhang_uuv3d import (
-    NAME as LAW,
-)
-from uvnav.controllers.zhang_uuv3d import ZhangUUV3D, ZhangUUV3DParams, make_locator
+from uvnav.controllers.zhang_uuv3d import NAME as LAW
 from uvnav.experiments.ch5_bpnn import (
     FULL_LITERAL_SEEDS,
     FULL_SEEDS,
@@ -77,8 +71,6 @@ from uvnav.experiments.rows import table_row
 from uvnav.learning.bpnn import (
     THESIS_ACCEPTED,
     VARIANTS,
-    TrainedBPNN,
-    load_checkpoint,
     save_checkpoint,
     variant_config,
 )
@@ -86,13 +78,10 @@ from uvnav.scenarios.ch5 import (
     GENERATOR_CH5,
     GENERATOR_CH5_DENSE,
     RANDOM_CH5_VERSION,
-    build_uuv3d,
     list_ch5_builtin,
-    load_ch5_scenario,
 )
 from uvnav.sim.episode_uuv3d import LocatedTrace
 from uvnav.sim.metrics import METRIC_NAMES
-from uvnav.sim.run import run_episode
 from uvnav.sim.setup import EpisodeResult
 from uvnav.stages import Stages, write_atomic
 
@@ -153,29 +142,39 @@ def ch5_job(
     locator: str,
     seed: int,
     noise_std: float = 0.0,
-    model: str | TrainedBPNN | None = None,
+    model: str | None = None,
     model_id: str = "",
 ) -> Job:
     """One closed-loop episode as a campaign job: a scene (built-in or ``random-ch5:<seed>``), a
-    locator, a seed, the sonar range noise [m]; ``model`` is the network (a checkpoint path, or
-    the trained network itself in this process; ``network`` only) and ``model_id`` its digest.
+    locator, a seed, the sonar range noise [m]; ``model`` is the network's checkpoint path
+    (``network`` only) and ``model_id`` its digest.
 
-    The job's tags (the store's ``params``, hashed into the resume key) are the locator and the
-    noise, the digest for ``network`` and, for a random scene, the generator's version (a newer
-    generator re-runs its scenes).
+    The law's parameters are the locator and the checkpoint (``make_law`` builds the law with
+    them, over the scene's own parameters); the noise is the scene's (a generator's
+    ``noise_std``, a built-in's ``sonar.noise_std``).  The job's tags (the store's ``params``,
+    hashed into the resume key) are the locator and the noise, the digest for ``network`` (it
+    stands for the checkpoint's path in the store: the tag ``model`` overrides the parameter)
+    and, for a random scene, the generator's version (a newer generator re-runs its scenes).
     """
     tags: dict[str, Any] = {"locator": locator, "noise_std": float(noise_std)}
+    params: dict[str, Any] = {"locator": locator}
     if locator == "network":
         tags["model"] = model_id
-    if scene.startswith((GENERATOR_CH5 + ":", GENERATOR_CH5_DENSE + ":")):
+        params["model"] = str(model or "")
+    family, _, number = scene.partition(":")
+    where: dict[str, Any] = {"scenario": scene, "scene_params": {"sonar.noise_std": noise_std}}
+    if number and family in (GENERATOR_CH5, GENERATOR_CH5_DENSE):
         tags["generator"] = RANDOM_CH5_VERSION
-    runner = _run_job if model is None else functools.partial(_run_job, model=model)
-    return Job(LAW, int(seed), label=scene, family=scene.split(":", 1)[0], tags=tags, runner=runner)
+        where = {
+            "generator": family, "generator_seed": int(number),
+            "generator_params": {"noise_std": float(noise_std)},
+        }  # fmt: skip
+    return Job(LAW, int(seed), label=scene, family=family, tags=tags, params=params, **where)
 
 
 def fingerprint() -> str:
     """The code fingerprint of this experiment's campaigns: the packages that decide an episode,
-    :mod:`uvnav.learning` (the network's locator), this module (its runner) and
+    :mod:`uvnav.learning` (the network's locator), this module (its jobs) and
     :mod:`uvnav.experiments.ch5_bpnn` (the network)."""
     return cp.fingerprint("learning", "experiments/ch5.py", "experiments/ch5_bpnn.py")
 
@@ -188,28 +187,6 @@ def checkpoint_digest(path: Path) -> str:
 
     st = Path(path).with_suffix(".safetensors")
     return hashlib.sha256(save(load_file(str(st)))).hexdigest()[:16]
-
-
-_MODEL_CACHE: dict[str, TrainedBPNN] = {}
-
-
-def _run_job(job: Job, *, model: str | TrainedBPNN | None = None) -> EpisodeRun:
-    """The campaign's runner: the scene with the job's noise, the law with its locator."""
-    tags = dict(job.tags)
-    if isinstance(model, str):
-        if tags["locator"] == "network" and model not in _MODEL_CACHE:  # once per worker process
-            _MODEL_CACHE[model] = load_checkpoint(Path(model))
-        model = _MODEL_CACHE.get(model)
-    scn = load_ch5_scenario(str(job.label))
-    setup = build_uuv3d(scn, noise_std=tags["noise_std"])
-    params = ZhangUUV3DParams(**scn.controller.params)  # type: ignore[arg-type]
-    law = ZhangUUV3D(params, make_locator(tags["locator"], model=model))
-    res = run_episode(setup, law, np.random.default_rng(job.seed), record=job.record)
-    facts = {
-        "n_obstacles": len(scn.obstacles),
-        "entered_inner_space": res.flags["entered_inner_space"],
-    }
-    return res.status, res.metrics.to_dict(), res, facts
 
 
 def run_ch5_job(
@@ -511,7 +488,10 @@ def reproduce_ch5(
             FINGERPRINT_KEY: fp,
         }  # fmt: skip
         scene_jobs = [
-            ch5_job(scene, loc, 0, float(noise), cl_model, model_id if loc == "network" else "")
+            ch5_job(
+                scene, loc, 0, float(noise), str(model_path) if loc == "network" else None,
+                model_id if loc == "network" else "",
+            )
             for scene in scene_list for noise in noise_list for loc in LOCATORS
         ]  # fmt: skip
         with ResultsStore(db_path) as store:
