@@ -5,7 +5,6 @@ from __future__ import annotations
 from collections import deque
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from uvnav.bench.campaign import (
@@ -22,40 +21,26 @@ from uvnav.bench.campaign import (
     warm_up,
 )
 from uvnav.bench.store import ResultsStore
-from uvnav.dynamics import UnicycleSpec
-from uvnav.obstacles import ConstantVelocity, DiscBody, Obstacle, ObstacleState
-from uvnav.sim import METRIC_NAMES, EpisodeSetup
+from uvnav.sim import METRIC_NAMES
 
 # metrics that do not depend on timing (decision_us_* are wall-clock measurements)
 DETERMINISTIC = [m for m in METRIC_NAMES if not m.startswith("decision_us")]
 
 
-def tiny_setup(seed: int) -> EpisodeSetup:
+SCENES = Path(__file__).parents[1] / "scenes"
+#: a scene file that does not exist: its jobs fail to build (an ``error`` outcome)
+BROKEN = str(SCENES / "no-such-scene.yaml")
+
+
+def tiny_scene(seed: int) -> str:
     """Robot (0, 0) -> (2, 0) past one disc; the disc blocks the path for seed % 3 == 0."""
-    rng = np.random.default_rng(seed)
-    y = 0.0 if seed % 3 == 0 else float(rng.uniform(0.8, 1.5))
-    disc = Obstacle(
-        DiscBody(0.25),
-        ObstacleState(np.array([1.0, y])),
-        ConstantVelocity(np.array([0.0, float(rng.uniform(0.0, 0.1))])),
-    )
-    return EpisodeSetup(
-        spec=UnicycleSpec(1.0, 1.0, 0.1),
-        start=np.array([0.0, 0.0, 0.0]),
-        goal=np.array([2.0, 0.0]),
-        obstacles=[disc],
-        t_max=8.0,
-    )
-
-
-def broken_setup(seed: int) -> EpisodeSetup:
-    raise RuntimeError(f"cannot build seed {seed}")
+    return str(SCENES / ("tiny-blocked.yaml" if seed % 3 == 0 else "tiny-clear.yaml"))
 
 
 def tiny_jobs(seeds: range) -> list[Job]:
     params = [{}, {"slow_radius": 0.5}]
     return [
-        Job(controller="straight-v1", seed=s, setup_factory=tiny_setup, label="tiny", params=p)
+        Job(controller="straight-v1", seed=s, scenario=tiny_scene(s), params=p)
         for s in seeds
         for p in params
     ]
@@ -66,8 +51,10 @@ def test_job_validation_and_key() -> None:
         Job(controller="straight-v1", seed=0)
     with pytest.raises(ValueError, match="exactly one"):
         Job(controller="straight-v1", seed=0, scenario="a", generator_seed=1)
-    with pytest.raises(ValueError, match="label"):
-        Job(controller="straight-v1", seed=0, setup_factory=tiny_setup)
+    with pytest.raises(ValueError, match="scene_params need a scenario"):
+        Job(controller="straight-v1", seed=0, generator_seed=1, scene_params={"sensing.range": 2})
+    told = Job(controller="c", seed=0, scenario="s", scene_params={"sensing.range": 2})
+    assert told.scenario_label == "s[sensing.range=2]"
     a = Job(controller="c", seed=3, scenario="s", params={"b": 1, "a": 2})
     b = Job(controller="c", seed=3, scenario="s", params={"a": 2, "b": 1})
     assert a == b and a.key == b.key and hash(a) == hash(b)
@@ -84,10 +71,10 @@ def test_grid_jobs() -> None:
 
 
 def test_run_job_error_is_an_outcome() -> None:
-    out = run_job(Job(controller="straight-v1", seed=1, setup_factory=broken_setup, label="broken"))
+    out = run_job(Job(controller="straight-v1", seed=1, scenario=BROKEN))
     assert out.status == "error" and out.metrics is None
-    assert out.error is not None and "RuntimeError: cannot build seed 1" in out.error
-    unknown = run_job(Job(controller="no-such-law-v9", seed=1, setup_factory=tiny_setup, label="t"))
+    assert out.error is not None and "ScenarioError" in out.error and "no such file" in out.error
+    unknown = run_job(Job(controller="no-such-law-v9", seed=1, scenario=tiny_scene(1)))
     assert unknown.status == "error" and "no-such-law-v9" in (unknown.error or "")
 
 
@@ -135,14 +122,14 @@ def test_ctrl_c_keeps_finished_episodes_and_resume_completes(tmp_path: Path) -> 
 def test_failing_job_is_stored_and_campaign_continues(tmp_path: Path) -> None:
     jobs = [
         *tiny_jobs(range(2)),
-        Job(controller="straight-v1", seed=5, setup_factory=broken_setup, label="broken"),
+        Job(controller="straight-v1", seed=5, scenario=BROKEN),
     ]
     with ResultsStore(tmp_path / "r.sqlite") as store:
         run = run_campaign(store, "mixed", jobs)
         assert (run.ran, run.errors) == (5, 1)
         df = store.episodes_frame("mixed")
         err = df[df["status"] == "error"].iloc[0]
-        assert "cannot build seed 5" in err["error"]
+        assert "no such file" in err["error"]
         assert err[DETERMINISTIC].isna().all()
         # errors count as done unless retried
         assert run_campaign(store, "mixed", jobs).ran == 0
@@ -167,7 +154,7 @@ def test_process_pool_matches_in_process(tmp_path: Path) -> None:
 
 
 def test_recorded_job_stores_trajectory(tmp_path: Path) -> None:
-    job = Job(controller="straight-v1", seed=1, setup_factory=tiny_setup, label="tiny", record=True)
+    job = Job(controller="straight-v1", seed=1, scenario=tiny_scene(1), record=True)
     with ResultsStore(tmp_path / "r.sqlite") as store:
         run = run_campaign(store, "rec", [job])
         traj = store.load_trajectory(run.episode_ids[job.key])

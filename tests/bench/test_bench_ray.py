@@ -49,13 +49,15 @@ controllers: [{name: straight-v1}, {name: zhang2019-v1}]
 
 
 CRASH_SEED = 20
+#: a short scene (engine tests)
+TINY = str(Path(__file__).parents[1] / "scenes" / "tiny-clear.yaml")
 
 
-def crash_on_seed(job: Job) -> tuple[str, dict[str, Any], None, dict[str, Any]]:
-    """A chapter runner that kills its worker on :data:`CRASH_SEED` and is instant elsewhere."""
+def crash_on_seed(job: Job) -> list[Any]:
+    """A probe factory that kills its worker on :data:`CRASH_SEED` (no probe elsewhere)."""
     if job.seed == CRASH_SEED:
         os._exit(3)
-    return "success", {}, None, {}
+    return []
 
 
 @pytest.fixture(scope="module")
@@ -121,10 +123,11 @@ def check_a_dying_worker_costs_one_job(tmp_path: Path) -> None:
     """Instant jobs are batched 16 to a task once the first are back; the task holding the job
     that kills its worker fails (after Ray's retries), is run again one job per task, and only
     that job is stored as an error."""
-    jobs = [Job(controller="x", seed=s, runner=crash_on_seed, label=f"crash/{s}")
-            for s in range(40)]  # fmt: skip
+    jobs = [Job(controller="straight-v1", seed=s, scenario=TINY) for s in range(40)]
     with ResultsStore(tmp_path / "crash.sqlite") as store:
-        run = run_campaign(store, "crash", jobs, workers=2, engine="ray")
+        run = run_campaign(
+            store, "crash", jobs, workers=2, engine="ray", probe_factory=crash_on_seed
+        )
         df = store.episodes_frame("crash")
     assert (run.ran, run.errors) == (40, 1)
     bad = df[df["status"] == "error"]

@@ -96,13 +96,8 @@ def test_episode_file_names_are_sanitised() -> None:
     assert episode_file("../x y", "a/b", 0) == "x_y__a_b__0.mcap"
 
 
-def _own_episode(job: Job) -> Any:
-    raise AssertionError("not run here")
-
-
 def test_no_probe_for_jobs_without_a_2d_scene(tmp_path: Path) -> None:
     factory = McapFolder(tmp_path)
-    assert factory(Job(controller="zhang2019-v1", seed=0, runner=_own_episode, label="own")) == []
     scene_3d = Job(controller="zhang2019-3d-v1", seed=0, scenario="thesis-ch3-several-obstacles")
     assert factory(scene_3d) == []
     assert list(tmp_path.iterdir()) == []

@@ -102,21 +102,18 @@ def test_plot_comparison(tmp_path: Path) -> None:
         plot_comparison({}, tmp_path / "none.png")
 
 
-def _tiny(seed: int) -> EpisodeSetup:
-    return scene(seed)
-
-
-def _broken(seed: int) -> EpisodeSetup:
-    raise RuntimeError("no scene")
+SCENES = Path(__file__).parents[1] / "scenes"
 
 
 def test_plot_campaign_summary_handles_errors_and_nulls(tmp_path: Path) -> None:
     jobs = [
-        Job(controller="straight-v1", seed=s, setup_factory=_tiny, label="tiny", params=p)
+        Job(controller="straight-v1", seed=s, scenario=str(SCENES / "tiny-clear.yaml"), params=p)
         for s in range(4)
         for p in ({}, {"slow_radius": 1.0})
     ]
-    jobs.append(Job(controller="straight-v1", seed=9, setup_factory=_broken, label="broken"))
+    jobs.append(
+        Job(controller="straight-v1", seed=9, scenario="no-such-scene.yaml", label="broken")
+    )
     with ResultsStore(tmp_path / "r.sqlite") as store:
         run_campaign(store, "c", jobs)
         df = store.episodes_frame()

@@ -5,31 +5,18 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-import numpy as np
 import pytest
 
 from uvnav.bench.campaign import Job, run_campaign
 from uvnav.bench.store import ResultsStore
-from uvnav.dynamics import UnicycleSpec
-from uvnav.obstacles import ConstantVelocity, DiscBody, Obstacle, ObstacleState
-from uvnav.sim import EpisodeSetup
 from uvnav.viz.report import SIMULATION_NOTE, summary_table, write_report
 
-
-def small_setup(seed: int) -> EpisodeSetup:
-    y = 0.0 if seed % 2 == 0 else 1.0  # even seeds: a disc blocks the straight path
-    disc = Obstacle(DiscBody(0.3), ObstacleState(np.array([1.5, y])), ConstantVelocity(np.zeros(2)))
-    return EpisodeSetup(
-        spec=UnicycleSpec(1.0, 1.0, 0.1),
-        start=np.array([0.0, 0.0, 0.0]),
-        goal=np.array([3.0, 0.0]),
-        obstacles=[disc],
-        t_max=8.0,
-    )
+SCENES = Path(__file__).parents[1] / "scenes"
 
 
-def broken_setup(seed: int) -> EpisodeSetup:
-    raise ValueError("bad <scene>")
+def small_scene(seed: int) -> str:
+    """Even seeds: a disc blocks the straight path."""
+    return str(SCENES / ("tiny-blocked.yaml" if seed % 2 == 0 else "tiny-clear.yaml"))
 
 
 @pytest.fixture
@@ -39,7 +26,7 @@ def db(tmp_path: Path) -> Path:
         Job(
             controller="straight-v1",
             seed=s,
-            setup_factory=small_setup,
+            scenario=small_scene(s),
             label="small",
             family="small-family",
             params=p,
@@ -47,7 +34,8 @@ def db(tmp_path: Path) -> Path:
         for s in range(4)
         for p in ({}, {"slow_radius": 0.5})
     ]
-    jobs.append(Job(controller="straight-v1", seed=7, setup_factory=broken_setup, label="broken"))
+    # no such scene file: an error whose message holds markup
+    jobs.append(Job(controller="straight-v1", seed=7, scenario="bad <scene>.yaml", label="broken"))
     with ResultsStore(path) as store:
         run_campaign(store, "demo", jobs, config={"purpose": "test"})
     return path

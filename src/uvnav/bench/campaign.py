@@ -1,13 +1,13 @@
 """Campaigns: scenarios × controllers × seeds on a local process pool, streamed into the store.
 
 A campaign is a list of :class:`~uvnav.bench.jobs.Job` s — small picklable *descriptions*
-(scenario name, generator name, parameters and seed, or a module-level setup factory; controller
-name and parameters; seed; :mod:`uvnav.bench.jobs`, whose names are importable from here too).
-The episode is built inside the worker (``build_episode(load_scenario(name), seed)`` or
-``build_episode(generate(generator, g, **params), seed)``), so nothing heavy or stateful crosses
-process boundaries and the same job replays bit for bit anywhere (DESIGN §2, randomness): the
-stored metrics do not depend on the engine or the number of workers.  Campaign files (YAML) are
-expanded into jobs by :mod:`uvnav.bench.spec`.
+(scenario name or file, or generator name, parameters and seed; law name and parameters; tags;
+seed; :mod:`uvnav.bench.jobs`, whose names are importable from here too).  Every episode is
+built and run inside the worker by the one scene runner
+(:func:`uvnav.scenarios.episodes.run_scene`, the path of ``uvnav simulate``), so nothing heavy
+or stateful crosses process boundaries and the same job replays bit for bit anywhere (DESIGN
+§2, randomness): the stored metrics do not depend on the engine or the number of workers.
+Campaign files (YAML) are expanded into jobs by :mod:`uvnav.bench.spec`.
 
 :func:`run_campaign` writes each episode to the :class:`~uvnav.bench.store.ResultsStore` in its own
 transaction the moment it arrives, so an interrupted campaign (Ctrl-C, a killed machine) loses only
@@ -30,9 +30,9 @@ many groups as run about :data:`~uvnav.bench.jobs.TASK_SECONDS`
 (:class:`~uvnav.bench.jobs.TaskSizer`: a task's cost to the engine is fixed), so at most
 ``2 × workers`` tasks in flight are about half a second of each worker's work.
 As with any ``spawn``/``forkserver`` pool, a *script* that starts a campaign with ``workers > 1``
-must do so under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already do),
-and a ``setup_factory`` must be importable (defined at module level, not in a notebook cell); pass
-``mp_context=multiprocessing.get_context("fork")`` to lift both restrictions at fork's usual risks.
+must do so under ``if __name__ == "__main__":`` (console scripts such as ``uvnav`` already do);
+pass ``mp_context=multiprocessing.get_context("fork")`` to lift that restriction at fork's usual
+risks.
 """
 
 from __future__ import annotations
@@ -53,12 +53,11 @@ from contextlib import contextmanager, suppress
 from dataclasses import dataclass, field
 from typing import Any, TypeVar
 
-from uvnav.bench.jobs import EpisodeRun as EpisodeRun  # what a job's runner returns
 from uvnav.bench.jobs import Job, JobOutcome, TaskSizer, sized_batches
 from uvnav.bench.ray_engine import import_ray, run_ray
 from uvnav.bench.store import STATUS_ERROR, STATUS_REFUSED, EpisodeKey, ResultsStore
 from uvnav.scenarios.generators import DEFAULT_GENERATOR
-from uvnav.sim import Trajectory, run_episode, run_rng
+from uvnav.sim import Trajectory
 
 ENGINES = ("local", "ray")
 T = TypeVar("T")
@@ -103,13 +102,10 @@ def job_scene(job: Job) -> Any:
 
 
 def _scene_key(job: Job) -> tuple[Any, ...]:
-    """What identifies a job's episode set-up but for the law: the scene and the episode seed
-    (jobs with their own set-up or runner are their own)."""
+    """What identifies a job's episode set-up but for the law: the scene and the episode seed."""
     if job.scenario is not None:
         return ("scenario", job.scenario, job.scene_params, int(job.seed))
-    if job.generator_seed is not None:
-        return ("generator", job.generator_label, int(job.generator_seed), int(job.seed))
-    return ("job", job.key)
+    return ("generator", job.generator_label, int(job.generator_seed or 0), int(job.seed))
 
 
 def scene_groups(jobs: Sequence[Job]) -> list[list[Job]]:
@@ -141,9 +137,9 @@ def run_job(job: Job) -> JobOutcome:
     scene whose bodies cannot all be placed (:class:`~uvnav.scenarios.errors.PlacementError`,
     its one line as the reason).
 
-    Jobs with a scene (any kind) run through :func:`uvnav.scenarios.episodes.run_scene`, the
-    path of ``uvnav simulate``; jobs with a ``setup_factory`` run the 2D loop directly, jobs with
-    a ``runner`` their experiment's own episode.  The outcome's ``cpu_time`` is this thread's.
+    Every job runs through :func:`uvnav.scenarios.episodes.run_scene`, the path of ``uvnav
+    simulate``; its facts join the law's parameters in ``effective_params``.  The outcome's
+    ``cpu_time`` is this thread's.
     """
     cpu = time.thread_time()
     out = _run_job(job)
@@ -153,61 +149,44 @@ def run_job(job: Job) -> JobOutcome:
 
 def _run_job(job: Job) -> JobOutcome:
     """:func:`run_job` but for its CPU time."""
-    from uvnav.scenarios.episodes import AssumptionError, LawMismatchError
+    from uvnav.scenarios.episodes import AssumptionError, LawMismatchError, run_scene
     from uvnav.scenarios.errors import PlacementError
 
     tic = time.perf_counter()
     params: dict[str, Any] = job.params_dict
-    result: Any = None
+    probes = []
     try:
-        if job.runner is not None:
-            status, metrics, traj, facts = job.runner(job)
-            params, result = {**job.store_params, **facts}, traj
-        elif job.setup_factory is not None:
-            from uvnav.controllers import make_controller
-
-            setup = job.setup_factory(int(job.seed))
-            result = run_episode(
-                setup, make_controller(job.controller, **params), run_rng(int(job.seed)),
-                record=job.record,
-            )  # fmt: skip
-            status, metrics, traj = result.status, result.metrics.to_dict(), result.trajectory
-        else:
-            from uvnav.scenarios.episodes import run_scene
-
-            probes = list(job.probe_factory(job)) if job.probe_factory is not None else []
-            try:
-                out = run_scene(
-                    job_scene(job), job.controller, params, int(job.seed), record=job.record,
-                    use_scene_params=job.use_scenario_params,
-                    beyond_assumptions=job.beyond_assumptions, probes=probes,
-                )  # fmt: skip
-            except (AssumptionError, LawMismatchError) as exc:  # the law is refused here
-                return JobOutcome(
-                    job, STATUS_REFUSED, None, exc.problem, time.perf_counter() - tic, None,
-                    params,
-                )  # fmt: skip
-            finally:
-                for probe in probes:
-                    getattr(probe, "close", lambda: None)()
-            status, metrics, traj = out.status, out.metrics, out.trajectory
-            named = {k: v for k, v in job.tags if k in out.params}  # a tag stands for its param
-            params, result = {**out.params, **named, **out.facts}, out.result
+        probes = list(job.probe_factory(job)) if job.probe_factory is not None else []
+        out = run_scene(
+            job_scene(job), job.controller, params, int(job.seed), record=job.record,
+            use_scene_params=job.use_scenario_params, beyond_assumptions=job.beyond_assumptions,
+            probes=probes,
+        )  # fmt: skip
+    except (AssumptionError, LawMismatchError) as exc:  # the law is refused here
+        return JobOutcome(
+            job, STATUS_REFUSED, None, exc.problem, time.perf_counter() - tic, None, params
+        )
     except PlacementError as exc:  # the scene cannot be built: refused, with the generator's line
         return JobOutcome(
             job, STATUS_REFUSED, None, str(exc), time.perf_counter() - tic, None, params
         )
     except Exception as exc:  # a failing job is data, not a crash of the campaign
         return _error(job, exc, tic, params)
+    finally:
+        for probe in probes:
+            getattr(probe, "close", lambda: None)()
+    # a tag named as a parameter stands for it in the store (a checkpoint's digest for its path)
+    named = {k: v for k, v in dict(job.tags).items() if k in out.params}
+    traj = out.trajectory
     return JobOutcome(
         job=job,
-        status=status,
-        metrics=metrics,
+        status=out.status,
+        metrics=out.metrics,
         error=None,
         wall_time=time.perf_counter() - tic,
-        trajectory=traj if job.record and isinstance(traj, Trajectory) else None,
-        effective_params=params,
-        result=result if job.record else None,
+        trajectory=traj if isinstance(traj, Trajectory) and job.record else None,
+        effective_params={**out.params, **named, **out.facts},
+        result=out.result if job.record else None,
     )
 
 

@@ -1,8 +1,9 @@
 """Jobs: what one episode of a campaign is, what comes back, and how tasks are sized.
 
-A :class:`Job` is a small picklable *description* of one episode (scenario name, generator name,
-parameters and seed, or a module-level setup factory or runner; controller name and parameters;
-seed); its :attr:`Job.key` is the store's resume key.  A worker returns a :class:`JobOutcome`.
+A :class:`Job` is a small picklable *description* of one episode (a scene: scenario name or file
+with section fields to set, or generator name, parameters and seed; law name and parameters; tags;
+seed), run by the one scene runner (:func:`uvnav.scenarios.episodes.run_scene`); its
+:attr:`Job.key` is the store's resume key.  A worker returns a :class:`JobOutcome`.
 :class:`TaskSizer` and :func:`sized_batches` cut the scene groups of a campaign into tasks of
 about :data:`TASK_SECONDS` each, for the local pool (:mod:`uvnav.bench.campaign`) and for Ray
 (:mod:`uvnav.bench.ray_engine`) alike; running a job is :func:`uvnav.bench.campaign.run_job`.
@@ -17,11 +18,7 @@ from typing import Any
 
 from uvnav.bench.store import EpisodeKey, canonical_json, params_hash
 from uvnav.scenarios.generators import DEFAULT_GENERATOR
-from uvnav.sim import EpisodeSetup, Trajectory
-
-SetupFactory = Callable[[int], EpisodeSetup]
-#: what a job's ``runner`` returns: status, metrics, trajectory (or ``None``), facts to store
-EpisodeRun = tuple[str, dict[str, Any], Any, dict[str, Any]]
+from uvnav.sim import Trajectory
 
 
 def _freeze(
@@ -35,8 +32,7 @@ def _freeze(
 class Job:
     """One episode to run: where the scene comes from, which controller, which seed.
 
-    Exactly one scene source must be given: ``scenario``, ``generator_seed``, ``setup_factory``
-    or ``runner``.
+    Exactly one scene source must be given: ``scenario`` or ``generator_seed``.
 
     Attributes:
         controller: registry name, e.g. ``"zhang2019-v1"``.
@@ -50,8 +46,6 @@ class Job:
         scene_params: fields of the ``scenario``'s sections to set, ``section.field`` -> value
             (``{"sensing.velocities": "estimated"}``;
             :func:`uvnav.scenarios.catalog.with_fields`); part of the default label.
-        setup_factory: a *module-level* (picklable) function ``seed -> EpisodeSetup``; needs
-            ``label``.
         label: scenario label stored in the database (defaults from the source).
         family: scenario family reports group by (defaults: scenario name, or generator label).
         params: controller parameters (a mapping is accepted and frozen to sorted pairs).  When the
@@ -68,13 +62,10 @@ class Job:
             resume key, never passed to the law (a mapping is frozen to sorted pairs).  A tag named
             as a parameter stands for it in the store (``params`` and ``effective_params``): a
             checkpoint's digest for its path.
-        runner: a *module-level* (picklable) function ``job -> (status, metrics, trajectory,
-            facts)`` running an experiment's own episode of ``label`` (its own world set-up);
-            ``facts`` are stored in ``effective_params`` after the tags.
         probe_factory: a *module-level* (picklable) callable ``job -> list of probes``
-            (:class:`uvnav.core.Probe`) that watch a scene job's episode (not a
-            ``setup_factory`` or ``runner`` job's); a probe with a ``close()`` is closed after
-            it.  Not part of the resume key; :func:`~uvnav.bench.campaign.run_campaign` sets it.
+            (:class:`uvnav.core.Probe`) that watch the job's episode; a probe with a ``close()``
+            is closed after it.  Not part of the resume key;
+            :func:`~uvnav.bench.campaign.run_campaign` sets it.
     """
 
     controller: str
@@ -84,7 +75,6 @@ class Job:
     generator: str = DEFAULT_GENERATOR
     generator_params: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
     scene_params: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
-    setup_factory: SetupFactory | None = None
     label: str | None = None
     family: str | None = None
     params: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
@@ -92,7 +82,6 @@ class Job:
     record: bool = False
     beyond_assumptions: bool = False
     tags: Mapping[str, Any] | tuple[tuple[str, Any], ...] = ()
-    runner: Callable[[Job], EpisodeRun] | None = None
     probe_factory: Callable[[Job], Sequence[Any]] | None = None
 
     def __post_init__(self) -> None:
@@ -102,14 +91,8 @@ class Job:
         if self.scene_params and self.scenario is None:
             raise ValueError("scene_params need a scenario")
         object.__setattr__(self, "tags", _freeze(self.tags))
-        own = (self.setup_factory, self.runner)
-        sources = sum(x is not None for x in (self.scenario, self.generator_seed, *own))
-        if sources != 1:
-            raise ValueError(
-                "a Job needs exactly one of scenario, generator_seed, setup_factory, runner"
-            )
-        if any(x is not None for x in own) and self.label is None:
-            raise ValueError("a Job with a setup_factory or a runner needs a label")
+        if (self.scenario is None) == (self.generator_seed is None):
+            raise ValueError("a Job needs exactly one of scenario, generator_seed")
         if self.generator_seed is not None:
             from uvnav.scenarios.catalog import generators  # layer 5, imported when needed
 
@@ -151,7 +134,7 @@ class Job:
         if self.label is not None:
             return self.label
         if self.scenario is not None and self.scene_params:
-            sets = ",".join(f"{k}={canonical_json(v)}" for k, v in self.scene_params)
+            sets = ",".join(f"{k}={canonical_json(v)}" for k, v in dict(self.scene_params).items())
             return f"{self.scenario}[{sets}]"
         if self.scenario is not None:
             return self.scenario
@@ -188,9 +171,9 @@ class JobOutcome:
         error: ``"ExceptionType: message"`` for an error, else ``None``.
         wall_time: time spent in the worker, building included [s].
         trajectory: recorded trajectory when ``job.record``.
-        effective_params: parameters the controller was built with (a ``runner``'s job: its
-            tags and facts).
-        result: a ``runner``'s own result when ``job.record`` (for figures; never stored).
+        effective_params: parameters the law was built with (a tag named as a parameter in its
+            place) and the scene runner's facts (:attr:`uvnav.scenarios.episodes.Outcome.facts`).
+        result: the simulator's own result when ``job.record`` (for figures; never stored).
         cpu_time: CPU time of the worker's thread on the job, building included [s] (never
             stored; what a campaign's engine adds is measured against it, ``bench_ray.py``).
     """

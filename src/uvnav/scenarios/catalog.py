@@ -481,10 +481,11 @@ def with_fields(resolved: Resolved, fields: Mapping[str, Any]) -> Resolved:
     update: dict[str, Any] = {}
     for section, values in sections.items():
         part = getattr(resolved.scenario, section, None)
-        fields_of = type(part).model_fields if isinstance(part, BaseModel) else {}
-        unknown = [n for n in values if n not in fields_of]
-        if unknown:
-            where = f"{section}.{unknown[0]}"
+        unknown = [
+            n for n in values if not isinstance(part, BaseModel) or n not in type(part).model_fields
+        ]
+        if unknown or not isinstance(part, BaseModel):
+            where = f"{section}.{unknown[0] if unknown else ''}"
             raise ScenarioError(resolved.spec, where, "is no field of the scene's sections")
         try:
             update[section] = type(part).model_validate({**part.model_dump(), **values})
