@@ -316,3 +316,40 @@ def test_compiled_bodies_and_lidar_give_the_reference_rollout(kwargs: dict) -> N
             assert a.dtype == b.dtype and np.array_equal(a, b)
         else:
             assert a == b
+
+
+def _law_observations(read_at_once: bool, steps: int) -> list:
+    """The law's observations of a seeded random rollout (through resets): the world's
+    ``observe()`` at each step (``read_at_once``), or the infos' kept and read after the
+    rollout."""
+    env = Nav2DEnv(generate("random-ch2", 3, n_obstacles=10))
+    rng = np.random.default_rng(2)
+    _, info = env.reset(seed=5)
+    infos, seen = [info], [env.world.observe()] if read_at_once else []
+    for _ in range(steps):
+        *_, term, trunc, info = env.step(rng.uniform(-1, 1, 2).astype(np.float32))
+        infos.append(info)
+        if read_at_once:
+            seen.append(env.world.observe())
+        if term or trunc:
+            infos.append(env.reset()[1])
+            if read_at_once:
+                seen.append(env.world.observe())
+    return seen if read_at_once else [i["uvnav"].observation for i in infos]
+
+
+def test_the_law_observation_read_later_is_the_one_of_its_step() -> None:
+    """``info["uvnav"]``'s observation is made when first read; read after the env has moved on
+    it is, field for field, the one the world's sensors gave at its own step."""
+    now, later = _law_observations(True, 400), _law_observations(False, 400)
+    assert len(now) == len(later) > 400 and any(o.obstacles for o in now)
+    for a, b in zip(now, later, strict=True):
+        assert (a.time, a.speed, a.lidar, dict(a.extras)) == (b.time, b.speed, b.lidar, {})
+        assert np.array_equal(a.pose, b.pose) and np.array_equal(a.goal, b.goal)
+        assert len(a.obstacles) == len(b.obstacles)
+        for ra, rb in zip(a.obstacles, b.obstacles, strict=True):
+            for name in ("nearest_point", "centre", "velocity", "outline"):
+                assert np.array_equal(getattr(ra, name), getattr(rb, name))
+            for name in ("obstacle_id", "distance", "angular_velocity", "radius",
+                         "bounding_radius", "velocity_source"):  # fmt: skip
+                assert getattr(ra, name) == getattr(rb, name)

@@ -188,10 +188,10 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         w = self._world
         if w is None:
             raise RuntimeError("call reset() before step()")
-        reward = float(w.step({0: np.asarray(action)})[0])
-        terminated = w.status(0) in TERMINAL
+        reward = w.step_one(action)
+        info = w.info_one()
+        terminated = info["status"] in TERMINAL
         truncated = not terminated and w.world.done
-        info = self._info(0)
         if truncated:
             info["status"] = "timeout"
         return w.vector(0), reward, terminated, truncated, info

@@ -58,6 +58,17 @@ class Sensors2D:
         """Whether the readings carry the bodies' true rates (nothing estimated)."""
         return self.estimator is None
 
+    @property
+    def exact_only(self) -> bool:
+        """Whether an observation is the exact readings alone (nothing estimated or scanned, no
+        lidar, no plug-in): a function of the world's state at the decision, drawing nothing
+        from the generator and keeping nothing from one decision to the next."""
+        c = self.config
+        return (
+            self.estimator is None and self.scan_bodies is None and c.lidar is None
+            and not c.plugins
+        )  # fmt: skip
+
     def observe(
         self,
         t: float,

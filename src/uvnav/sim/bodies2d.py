@@ -9,6 +9,7 @@ random-turn motion (:func:`~uvnav.sim.packed.pack_check`), moved and measured in
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
@@ -90,6 +91,12 @@ class Bodies2D(Protocol):
 
     def readings(self, x: float, y: float, sensing_range: float) -> tuple[ObstacleReading, ...]:
         """The exact sensor's readings from ``(x, y)`` within ``sensing_range`` [m]."""
+
+    def readings_later(
+        self, x: float, y: float, sensing_range: float
+    ) -> Callable[[], tuple[ObstacleReading, ...]]:
+        """:meth:`readings` now, made when the returned function is called (the bodies may have
+        moved on by then)."""
 
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
         """The last step's start and end, with the robot's chord ``p0 -> p1``."""
@@ -251,6 +258,12 @@ class FieldBodies:
     def readings(self, x: float, y: float, sensing_range: float) -> tuple[ObstacleReading, ...]:
         return sense_obstacles(np.array((x, y)), self._field, sensing_range=sensing_range)
 
+    def readings_later(
+        self, x: float, y: float, sensing_range: float
+    ) -> Callable[[], tuple[ObstacleReading, ...]]:
+        got = self.readings(x, y, sensing_range)
+        return lambda: got
+
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
         b, f = self._before, self._field
         return StepPoses(b.centres, b.headings, f.centres, f.headings, b.present, f.present,
@@ -314,6 +327,8 @@ class PackedBodies:
         #: ``(x, y, range, m)`` of the readings the last step took, if it took any
         self._sensed: tuple[float, float, float, int] | None = None
         self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
+        self._lidar = kernel("lidar")
+        self._ring = np.empty((2, w))  # the lidar's scratch
         self._field: ObstacleField | None = ObstacleBatch(obstacles).field(template)
         self._prev = np.zeros((3, n))  # the poses before the last step: x, y, heading
         #: the most any body point moved over the last step [m]
@@ -388,20 +403,42 @@ class PackedBodies:
         """:func:`uvnav.sensors.exact.sense_obstacles` from ``(x, y)``: the readings within
         ``sensing_range`` [m], nearest first (ties in obstacle order).  Their arrays are views
         of one block copied for this call."""
-        got = self._sensed
-        if got is not None and got[:3] == (x, y, sensing_range):
-            m = got[3]
-        else:
-            m = self._sense(x, y, sensing_range, self.n, self._prm, self._st, self._rings,
-                            self._ids, self._rows, self._outlines)  # fmt: skip
+        m = self._sense_count(x, y, sensing_range)
         if m == 0:
             return ()
-        rows = self._rows[:m].copy()
+        return self._make_readings(self._ids[:m].tolist(), self._rows[:m].copy(),
+                                   self._outlines[:m].copy())  # fmt: skip
+
+    def readings_later(
+        self, x: float, y: float, sensing_range: float
+    ) -> Callable[[], tuple[ObstacleReading, ...]]:
+        """:meth:`readings` now, as a function: the sensed block is copied now, the reading
+        objects are made on the call."""
+        m = self._sense_count(x, y, sensing_range)
+        if m == 0:
+            return tuple
+        ids, rows = self._ids[:m].tolist(), self._rows[:m].copy()
         outlines = self._outlines[:m].copy()
+        return lambda: self._make_readings(ids, rows, outlines)
+
+    def _sense_count(self, x: float, y: float, sensing_range: float) -> int:
+        """The number of readings from ``(x, y)`` within ``sensing_range`` [m], written to the
+        sensed block (taken by the last step when it sensed from there)."""
+        got = self._sensed
+        if got is not None and got[:3] == (x, y, sensing_range):
+            return got[3]
+        return int(self._sense(x, y, sensing_range, self.n, self._prm, self._st, self._rings,
+                               self._ids, self._rows, self._outlines))  # fmt: skip
+
+    def _make_readings(
+        self, ids: list[int], rows: FloatArray, outlines: FloatArray
+    ) -> tuple[ObstacleReading, ...]:
+        """The reading objects of a sensed block (``ids``, and copies of its rows and
+        outlines: the readings' arrays are views of them)."""
         vals = rows.tolist()
         counts, bounds, make = self._counts, self._bounds, ObstacleReading.polygon
         out = []
-        for i, j in enumerate(self._ids[:m].tolist()):
+        for i, j in enumerate(ids):
             r = rows[i]
             reading = make(
                 j, vals[i][R_DIST], r[R_NEAR : R_NEAR + 2], r[R_CENTRE : R_CENTRE + 2],
@@ -420,9 +457,8 @@ class PackedBodies:
         """The ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from ``(x, y, th)``,
         beams at ``wrap(th + rel)`` [rad], into ``out`` (R,), in one compiled call
         (:func:`~uvnav.sim.packed._lidar`; no field is built)."""
-        ring = np.empty((2, self._rings.shape[2]))
-        kernel("lidar")(x, y, th, rel, max_range, self.n, self._prm, self._st, self._rings,
-                        ring, out)  # fmt: skip
+        self._lidar(x, y, th, rel, max_range, self.n, self._prm, self._st, self._rings,
+                    self._ring, out)  # fmt: skip
 
     def field(self) -> ObstacleField:
         """The :class:`ObstacleField` of now (built on first use after a step)."""

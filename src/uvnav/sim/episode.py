@@ -31,7 +31,7 @@ stepped by its own model, exact nearest points of every obstacle at every step).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, ClassVar
 
 import numpy as np
@@ -176,6 +176,18 @@ class World2D(OneVehicle):
             self.t, self.pose, self.speed, self.goal,
             lambda: self.bodies.readings(self.x, self.y, self.sensing_range), self.bodies.field,
         )  # fmt: skip
+
+    def observe_later(self, agent: int = 0) -> Callable[[], Observation]:
+        """:meth:`observe` now, as a function: where the observation is the exact readings
+        alone (:attr:`~uvnav.sensors.suite2d.Sensors2D.exact_only`) what it needs is kept now
+        and the objects are made on the call; otherwise the observation is made now."""
+        if not self.sensors.exact_only:
+            obs = self.observe(agent)
+            return lambda: obs
+        t, x, y, th, speed, goal = self.t, self.x, self.y, self.th, self.speed, self.goal
+        readings = self.bodies.readings_later(x, y, self.sensing_range)
+        return lambda: Observation(time=t, pose=np.array((x, y, th)), speed=speed, goal=goal,
+                                   obstacles=readings(), lidar=None, extras={})  # fmt: skip
 
     @property
     def speed(self) -> float:
