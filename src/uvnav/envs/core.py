@@ -412,7 +412,10 @@ class EnvWorld:
     def distance(self, i: int) -> float:
         """Robot i's distance to its goal [m]."""
         one = self.one
-        x, y = (one.x, one.y) if one is not None else (float(p) for p in self.pose(i)[:2])
+        if one is not None:
+            gx, gy = self._goal_xy
+            return math.hypot(gx - one.x, gy - one.y)
+        x, y = (float(p) for p in self.pose(i)[:2])
         goal = self.goal(i)
         return math.hypot(float(goal[0]) - x, float(goal[1]) - y)
 
@@ -462,6 +465,10 @@ class EnvWorld:
         out[2] = math.sin(bearing)
         speed = 0.0 if one.book.status in TERMINAL else float(one.speed)
         out[3] = min(max(speed / self._limits[0], 0.0), 1.0)
+        packed = self._packed
+        if packed is not None:  # the lidar and its scaling in one compiled call
+            packed.lidar_vector(x, y, th, self._rel, self.max_range, self._ranges, out)
+            return out
         scaled = out[4:]
         np.divide(self.ranges(0), self.max_range, out=scaled)
         np.minimum(np.maximum(scaled, 0.0, out=scaled), 1.0, out=scaled)

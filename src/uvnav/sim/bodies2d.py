@@ -327,7 +327,7 @@ class PackedBodies:
         #: ``(x, y, range, m)`` of the readings the last step took, if it took any
         self._sensed: tuple[float, float, float, int] | None = None
         self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
-        self._lidar = kernel("lidar")
+        self._lidar, self._lidar_vector = kernel("lidar"), kernel("lidar_vector")
         self._ring = np.empty((2, w))  # the lidar's scratch
         self._field: ObstacleField | None = ObstacleBatch(obstacles).field(template)
         self._prev = np.zeros((3, n))  # the poses before the last step: x, y, heading
@@ -350,9 +350,8 @@ class PackedBodies:
         self, t: float, dt: float, x: float, y: float, radius: float, sensing_range: float
     ) -> tuple[float, int | None]:
         """:meth:`step`: the exact clearance after the step, and the nearest body."""
-        gap, at = self.step(t, dt, x, y, radius, sensing_range)
         self._field = None
-        return gap, at
+        return self.step(t, dt, x, y, radius, sensing_range)
 
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
         """The last step's start and end (the poses it kept)."""
@@ -374,7 +373,10 @@ class PackedBodies:
         ``radius`` [m] at ``(x, y)`` then, and its nearest obstacle (-1 without any).  With a
         ``sensing_range`` >= 0 [m] the readings from there are taken in the same call, for
         :meth:`readings` to return."""
-        self._pw.ensure_draws()
+        pw = self._pw
+        if pw.safe_calls <= 0:  # (PackedWorlds.ensure_draws, inline)
+            pw.refill()
+        pw.safe_calls -= 1
         self._stepped = True
         gap, at, m, self.shift = self._advance(
             x, y, radius, t, dt, self.n, self._oi, self._prm, self._st, self._ubuf, self._rings,
@@ -459,6 +461,15 @@ class PackedBodies:
         (:func:`~uvnav.sim.packed._lidar`; no field is built)."""
         self._lidar(x, y, th, rel, max_range, self.n, self._prm, self._st, self._rings,
                     self._ring, out)  # fmt: skip
+
+    def lidar_vector(
+        self, x: float, y: float, th: float, rel: FloatArray, max_range: float, ranges: FloatArray,
+        out: np.ndarray,
+    ) -> None:  # fmt: skip
+        """:meth:`lidar` into ``ranges``, and each range over ``max_range``, in [0, 1], into
+        ``out[4:]`` (float32; an observation vector's lidar part), in one compiled call."""
+        self._lidar_vector(x, y, th, rel, max_range, self.n, self._prm, self._st, self._rings,
+                           self._ring, ranges, out)  # fmt: skip
 
     def field(self) -> ObstacleField:
         """The :class:`ObstacleField` of now (built on first use after a step)."""

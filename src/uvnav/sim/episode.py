@@ -102,6 +102,7 @@ class World2D(OneVehicle):
         self.clock = Clock(setup.dt, setup.control_period, setup.t_max)
         self.dt, self.ratio = self.clock.dt, self.clock.ratio
         self.goal = np.asarray(setup.goal, dtype=float)
+        self._gx, self._gy = float(self.goal[0]), float(self.goal[1])
         start = np.asarray(setup.start, dtype=float)
         self.x, self.y, self.th = float(start[0]), float(start[1]), float(start[2])
         self.obstacles = setup.obstacles
@@ -220,24 +221,17 @@ class World2D(OneVehicle):
         self.body.hold(new)
         return new
 
-    def _move(self, dt: float) -> tuple[float, float]:
-        """Integrate the robot over ``dt`` [s] (the vehicle's exact motion); returns the new
-        position, updates the heading, the total turn and the effort's turn term."""
-        nx, ny, self.th, turn, effort = self.body.move(
-            self.x, self.y, self.th, dt, self.clock.due, self.ratio * dt
-        )
-        self.book.effort += effort
-        self.turn += turn
-        return nx, ny
-
     def advance(self) -> None:
         """One step ``dt``: robot (exact), obstacles, clearance, collision and arrival."""
-        dt, book, clock, bodies = self.dt, self.book, self.clock, self.bodies
+        dt, book, clock, bodies, body = self.dt, self.book, self.clock, self.bodies, self.body
         x, y, t0, g0 = self.x, self.y, self.t, self.clearance
         if bodies.sees_robot:  # bodies that react to the robot see it as it starts the step
             bodies.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
-        travel, slack = self.body.travel(dt)
-        nx, ny = self._move(dt)
+        travel, slack = body.travel(dt)
+        # the vehicle's exact motion; the heading, the total turn and the effort's turn term
+        nx, ny, self.th, turn, effort = body.move(x, y, self.th, dt, clock.due, self.ratio * dt)
+        book.effort += effort
+        self.turn += turn
         book.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
         sense = self.sensing_range if (clock.step_index + 1) % self.ratio == 0 else -1.0
@@ -251,8 +245,13 @@ class World2D(OneVehicle):
             self.social.observe(self.field, nx, ny, clock.step_index, self.velocity())
         if self.history is not None:
             self.history.push(nx, ny, *bodies.centres())
-        contact_at = self._swept((x, y), (nx, ny), t0, g0, travel, slack)
-        gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)
+        sweep, contact_at = self.sweep, None
+        if sweep is not None:
+            ceiling = bodies.ceiling(book.min_clear, gap)
+            shift = bodies.shift  # with it, most steps are left alone without their poses
+            if shift is None or not sweep.idle(0.5 * (g0 + gap - travel - shift), ceiling):
+                contact_at = self._swept((x, y), (nx, ny), t0, g0, travel, slack, ceiling)
+        gd = math.hypot(self._gx - nx, self._gy - ny)
         self.done = book.judge(t, self.clearance, gd, contact_at) or clock.up
         if book.status == "collision":  # judged at the first contact when the sweep found it
             sweep = self.sweep
@@ -271,17 +270,15 @@ class World2D(OneVehicle):
         g0: float,
         travel: float,
         slack: float,
+        ceiling: float,
     ) -> float | None:
         """The step just made from ``p0`` (time ``t0`` [s], sampled gap ``g0`` [m]) to ``p1``,
-        judged along its length (:class:`~uvnav.sim.swept.SweptClearance`): the time of the
-        first contact [s], ``None`` without one."""
+        judged along its length (:class:`~uvnav.sim.swept.SweptClearance`; ``ceiling``: the
+        bodies' bound of the sampled minimum [m]): the time of the first contact [s], ``None``
+        without one."""
         sweep, bodies = self.sweep, self.bodies
-        if sweep is None:
-            return None
-        ceiling = bodies.ceiling(self.book.min_clear, self.clearance)
+        assert sweep is not None
         shift = bodies.shift
-        if shift is not None and sweep.idle(0.5 * (g0 + self.clearance - travel - shift), ceiling):
-            return None  # (most steps: no poses made)
         s = sweep.step(
             lambda: bodies.step_poses(np.array(p0), np.array(p1), slack),
             travel, g0, self.clearance, ceiling, shift=shift,

@@ -381,6 +381,28 @@ def _lidar(
             out[r] = min(out[r], ray_ring_hit_py(ox, oy, dx, dy, ring[0], ring[1]))
 
 
+def lidar_vector_py(
+    ox: float,
+    oy: float,
+    th: float,
+    rel: FloatArray,
+    max_range: float,
+    n_obs: int,
+    prm: FloatArray,
+    st: FloatArray,
+    rings: FloatArray,
+    ring: FloatArray,
+    ranges: FloatArray,
+    out: np.ndarray,
+) -> None:
+    """:func:`_lidar`'s ranges [m] into ``ranges`` (R,), and each over ``max_range``, in [0, 1],
+    into ``out[4:]`` (float32): the lidar part of one observation vector
+    (:meth:`uvnav.envs.core.EnvWorld.vector`), as :func:`observe_py` writes it."""
+    _lidar(ox, oy, th, rel, max_range, n_obs, prm, st, rings, ring, ranges)
+    for r in range(ranges.shape[0]):
+        out[4 + r] = min(max(ranges[r] / max_range, 0.0), 1.0)
+
+
 def observe_py(
     wf: FloatArray,
     wi: np.ndarray,
@@ -426,6 +448,7 @@ _PUBLIC = {
     "sense_one": "sense_one_py",
     "clearance_one": "clearance_one_py",
     "lidar": "_lidar",
+    "lidar_vector": "lidar_vector_py",
 }
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
@@ -439,7 +462,8 @@ def kernel(name: str) -> Callable[..., Any]:
     if not _KERNELS:
         _KERNELS.update(compile_family([
             wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py, ray_ring_hit_py,
-            _transform_ring, _move_obstacles, _clearance, _lidar, step_worlds_py, observe_py,
+            _transform_ring, _move_obstacles, _clearance, _lidar, lidar_vector_py, step_worlds_py,
+            observe_py,
             sense_one_py, advance_one_py, clearance_one_py,
         ]))  # fmt: skip
     return _KERNELS[_PUBLIC[name]]
@@ -529,7 +553,7 @@ class PackedWorlds:
         self.wi[:, I_ACTIVE] = 1
         self.wf[:, W_CLEAR] = self.wf[:, W_LOW] = math.inf
         self.rngs: list[list[np.random.Generator | None]] = [[] for _ in range(k)]
-        self._safe_calls = 0  # step() calls before a refill may be needed
+        self.safe_calls = 0  # step() calls before a refill may be needed
         self._templates: dict[tuple[int, ...], tuple[FieldTemplate, list[Any]]] = {}
         self._alloc(0, 2, ROW_BLOCKS * BLOCK)
 
@@ -632,7 +656,7 @@ class PackedWorlds:
             status = SUCCESS
         wi[I_STATUS] = status
         # the slot's rows are full: a top-up is due no sooner for it than for the others
-        self._safe_calls = min(self._safe_calls, b // (2 * ratio))
+        self.safe_calls = min(self.safe_calls, b // (2 * ratio))
 
     def load_obstacles(self, slot: int, obstacles: list[Obstacle], tpl: FieldTemplate,
                        b: int) -> None:  # fmt: skip
@@ -714,15 +738,15 @@ class PackedWorlds:
         self.read[due] += upos[due]
         upos[due] = 0  # (a row without a generator is never read)
         spare = (b - upos) // np.maximum(2 * self.wi[:, I_RATIO, None], 1)
-        self._safe_calls = int(spare.min()) if spare.size else 1 << 30
+        self.safe_calls = int(spare.min()) if spare.size else 1 << 30
 
     def ensure_draws(self) -> None:
         """Top up the rows (:meth:`refill`) when the next call could run one out, and count that
         call: :meth:`step`'s rule, for a caller that steps the slots' arrays itself (one
         integration step a call, as :class:`~uvnav.sim.bodies2d.PackedBodies` does)."""
-        if self._safe_calls <= 0:
+        if self.safe_calls <= 0:
             self.refill()
-        self._safe_calls -= 1
+        self.safe_calls -= 1
 
     def step(self, active: np.ndarray | None = None) -> None:
         """Advance every running world (of the ``active`` (k,) bool slots) by one decision with
@@ -730,7 +754,7 @@ class PackedWorlds:
         if active is not None:
             self.wi[:, I_ACTIVE] = active
         self.ensure_draws()  # its count is replaced by the kernel's, which knows the rows read
-        self._safe_calls = kernel("step")(
+        self.safe_calls = kernel("step")(
             self.wf, self.wi, self.oi, self.params, self.state, self.ubuf, self.rings
         )
         if active is not None:
