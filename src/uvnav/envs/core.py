@@ -706,7 +706,8 @@ def scene_bounds(world: EnvWorld, margin: float = 1.5) -> tuple[float, float, fl
     starts = np.array([world.pose(i)[:2] for i in range(world.n)])
     pts = [starts, np.array([world.goal(i) for i in range(world.n)])]
     if world.k:
-        c = world.world.field.centres[: world.k]
+        one = world.one
+        c = (one.bodies.centres()[0] if one is not None else world.world.field.centres)[: world.k]
         rad = world.world.template.bounding_radii[: world.k]
         near = np.hypot(*(c - starts[0]).T) < 100.0
         if near.any():

@@ -329,7 +329,7 @@ class PackedBodies:
         self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
         self._lidar, self._lidar_vector = kernel("lidar"), kernel("lidar_vector")
         self._ring = np.empty((2, w))  # the lidar's scratch
-        self._field: ObstacleField | None = ObstacleBatch(obstacles).field(template)
+        self._field: ObstacleField | None = None  # (before any step: the obstacles' own)
         self._prev = np.zeros((3, n))  # the poses before the last step: x, y, heading
         #: the most any body point moved over the last step [m]
         self.shift = 0.0
@@ -474,7 +474,11 @@ class PackedBodies:
     def field(self) -> ObstacleField:
         """The :class:`ObstacleField` of now (built on first use after a step)."""
         if self._field is None:
-            self._field = self._make_field()
+            self._field = (
+                self._make_field()
+                if self._stepped
+                else ObstacleBatch(self.obstacles).field(self.template)
+            )
         return self._field
 
     def _make_field(self) -> ObstacleField:
