@@ -353,3 +353,24 @@ def test_the_law_observation_read_later_is_the_one_of_its_step() -> None:
             for name in ("obstacle_id", "distance", "angular_velocity", "radius",
                          "bounding_radius", "velocity_source"):  # fmt: skip
                 assert getattr(ra, name) == getattr(rb, name)
+
+
+def test_the_law_view_pickles_and_crosses_an_async_vector_env() -> None:
+    """A view whose observation is made on first read pickles with it made (an async vector
+    env's workers send their infos through pipes), equal to the original."""
+    import pickle
+
+    env = Nav2DEnv(generate("random-ch2", 3, n_obstacles=10))
+    env.reset(seed=3)
+    *_, info = env.step(np.zeros(2, dtype=np.float32))
+    again = pickle.loads(pickle.dumps(info))
+    assert again["uvnav"] == info["uvnav"] and again["uvnav"].observation.obstacles
+    vec = gym.make_vec("uvnav/Nav2D-v0", num_envs=2, vectorization_mode="async",
+                       scenario=generate("random-ch2", 3, n_obstacles=10))  # fmt: skip
+    try:
+        vec.reset(seed=0)
+        *_, infos = vec.step(np.zeros((2, 2), dtype=np.float32))
+        views = infos["uvnav"]
+        assert len(views) == 2 and all(v.observation.time > 0 for v in views)
+    finally:
+        vec.close()

@@ -246,6 +246,11 @@ class ControllerView:
             self._make = None
         return obs
 
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled (and deep-copied) with its observation made: a vector env's worker sends
+        its infos to the main process."""
+        return (ControllerView, (self.observation, self.spec, self.raw_commands, self.vehicle))
+
     def __repr__(self) -> str:
         return (
             f"ControllerView(observation={self.observation!r}, spec={self.spec!r}, "
