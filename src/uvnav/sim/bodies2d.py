@@ -419,9 +419,9 @@ class PackedBodies:
         m = self._sense_count(x, y, sensing_range)
         if m == 0:
             return tuple
-        ids, rows = self._ids[:m].tolist(), self._rows[:m].copy()
-        outlines = self._outlines[:m].copy()
-        return lambda: self._make_readings(ids, rows, outlines)
+        # whole buffers: copying them is cheaper than slicing them first
+        ids, rows, outlines = self._ids.copy(), self._rows.copy(), self._outlines.copy()
+        return lambda: self._make_readings(ids[:m].tolist(), rows[:m], outlines[:m])
 
     def _sense_count(self, x: float, y: float, sensing_range: float) -> int:
         """The number of readings from ``(x, y)`` within ``sensing_range`` [m], written to the
