@@ -460,20 +460,21 @@ class EnvWorld:
 
     def _vector_one(self, one: World2D) -> np.ndarray:
         """:meth:`vector` of the one robot of a :class:`World2D`: the same operations on the
-        floats kept at the start."""
+        floats kept at the start (for packed bodies, in one compiled call)."""
         x, y, th = one.x, one.y, one.th
+        speed = 0.0 if one.book.status in TERMINAL else float(one.speed)
+        out = np.empty(4 + self.n_rays, dtype=np.float32)
+        packed = self._packed
+        if packed is not None:
+            packed.vector((x, y, th), self._goal_xy, self.goal_scale, speed, self._limits[0],
+                          self._rel, self.max_range, self._ranges, out)  # fmt: skip
+            return out
         gx, gy = self._goal_xy[0] - x, self._goal_xy[1] - y
         bearing = math.atan2(gy, gx) - th
-        out = np.empty(4 + self.n_rays, dtype=np.float32)
         out[0] = min(math.hypot(gx, gy) / self.goal_scale, 1.0)
         out[1] = math.cos(bearing)
         out[2] = math.sin(bearing)
-        speed = 0.0 if one.book.status in TERMINAL else float(one.speed)
         out[3] = min(max(speed / self._limits[0], 0.0), 1.0)
-        packed = self._packed
-        if packed is not None:  # the lidar and its scaling in one compiled call
-            packed.lidar_vector(x, y, th, self._rel, self.max_range, self._ranges, out)
-            return out
         scaled = out[4:]
         np.divide(self.ranges(0), self.max_range, out=scaled)
         np.minimum(np.maximum(scaled, 0.0, out=scaled), 1.0, out=scaled)

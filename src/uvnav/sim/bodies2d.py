@@ -327,8 +327,9 @@ class PackedBodies:
         #: ``(x, y, range, m)`` of the readings the last step took, if it took any
         self._sensed: tuple[float, float, float, int] | None = None
         self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
-        self._lidar, self._lidar_vector = kernel("lidar"), kernel("lidar_vector")
+        self._lidar, self._vector = kernel("lidar"), kernel("vector_one")
         self._ring = np.empty((2, w))  # the lidar's scratch
+        self._beams = np.empty((2, 0))
         self._field: ObstacleField | None = None  # (before any step: the obstacles' own)
         self._prev = np.zeros((3, n))  # the poses before the last step: x, y, heading
         #: the most any body point moved over the last step [m]
@@ -460,16 +461,28 @@ class PackedBodies:
         beams at ``wrap(th + rel)`` [rad], into ``out`` (R,), in one compiled call
         (:func:`~uvnav.sim.packed._lidar`; no field is built)."""
         self._lidar(x, y, th, rel, max_range, self.n, self._prm, self._st, self._rings,
-                    self._ring, out)  # fmt: skip
+                    self._ring, self._dirs(rel), out)  # fmt: skip
 
-    def lidar_vector(
-        self, x: float, y: float, th: float, rel: FloatArray, max_range: float, ranges: FloatArray,
+    def vector(
+        self, pose: tuple[float, float, float], goal: tuple[float, float], goal_scale: float,
+        speed: float, v_max: float, rel: FloatArray, max_range: float, ranges: FloatArray,
         out: np.ndarray,
     ) -> None:  # fmt: skip
-        """:meth:`lidar` into ``ranges``, and each range over ``max_range``, in [0, 1], into
-        ``out[4:]`` (float32; an observation vector's lidar part), in one compiled call."""
-        self._lidar_vector(x, y, th, rel, max_range, self.n, self._prm, self._st, self._rings,
-                           self._ring, ranges, out)  # fmt: skip
+        """An env's observation vector from ``pose`` ``(x, y, theta)`` into ``out`` (4 + R,)
+        float32 and its lidar ranges [m] into ``ranges`` (R,), in one compiled call
+        (:func:`~uvnav.sim.packed.vector_one_py`: goal ``(x, y)`` [m] and ``goal_scale`` [m],
+        ``speed`` and ``v_max`` [m/s], beams at heading + ``rel`` [rad] to ``max_range`` [m])."""
+        x, y, th = pose
+        self._vector(x, y, th, goal[0], goal[1], goal_scale, speed, v_max, rel, max_range,
+                     self.n, self._prm, self._st, self._rings, self._ring, self._dirs(rel),
+                     ranges, out)  # fmt: skip
+
+    def _dirs(self, rel: FloatArray) -> FloatArray:
+        """The lidar's scratch for the beams' directions, (2, R) for ``rel`` (R,)."""
+        dirs = self._beams
+        if dirs.shape[1] != rel.shape[0]:
+            dirs = self._beams = np.empty((2, rel.shape[0]))
+        return dirs
 
     def field(self) -> ObstacleField:
         """The :class:`ObstacleField` of now (built on first use after a step)."""

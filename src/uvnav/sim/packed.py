@@ -349,15 +349,15 @@ def _lidar(
     st: FloatArray,
     rings: FloatArray,
     ring: FloatArray,
+    dirs: FloatArray,
     out: FloatArray,
 ) -> None:
     """Ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from pose ``(ox, oy, th)`` in
     one world into ``out`` (R,): beams at ``wrap(th + rel)`` [rad], capped at ``max_range``
-    [m] (``ring`` (2, W): scratch).  A body is cast where :meth:`ObstacleField.ray_hits` casts
-    it, and only by the beams that meet its bounding disc (the others cannot hit it: the same
-    ranges, far fewer edges)."""
+    [m] (``ring`` (2, W) and ``dirs`` (2, R): scratch).  A body is cast where
+    :meth:`ObstacleField.ray_hits` casts it, and only by the beams that meet its bounding disc
+    (the others cannot hit it: the same ranges, far fewer edges)."""
     n_rays = rel.shape[0]
-    dirs = np.empty((2, n_rays))
     for r in range(n_rays):
         out[r] = max_range
         a = wrap_scalar(th + rel[r])
@@ -381,10 +381,15 @@ def _lidar(
             out[r] = min(out[r], ray_ring_hit_py(ox, oy, dx, dy, ring[0], ring[1]))
 
 
-def lidar_vector_py(
-    ox: float,
-    oy: float,
+def vector_one_py(
+    x: float,
+    y: float,
     th: float,
+    goal_x: float,
+    goal_y: float,
+    goal_scale: float,
+    speed: float,
+    v_max: float,
     rel: FloatArray,
     max_range: float,
     n_obs: int,
@@ -392,13 +397,23 @@ def lidar_vector_py(
     st: FloatArray,
     rings: FloatArray,
     ring: FloatArray,
+    dirs: FloatArray,
     ranges: FloatArray,
     out: np.ndarray,
 ) -> None:
-    """:func:`_lidar`'s ranges [m] into ``ranges`` (R,), and each over ``max_range``, in [0, 1],
-    into ``out[4:]`` (float32): the lidar part of one observation vector
-    (:meth:`uvnav.envs.core.EnvWorld.vector`), as :func:`observe_py` writes it."""
-    _lidar(ox, oy, th, rel, max_range, n_obs, prm, st, rings, ring, ranges)
+    """One observation vector of ``uvnav/Nav2D-v0`` (:meth:`uvnav.envs.core.EnvWorld.vector`)
+    into ``out`` (4 + R,) float32, as :func:`observe_py` writes a world's: from pose ``(x, y,
+    th)`` and goal ``(goal_x, goal_y)`` [m], the goal distance / ``goal_scale`` capped at 1, cos
+    and sin of the goal bearing in the robot frame, ``speed`` / ``v_max`` in [0, 1], and
+    :func:`_lidar`'s ranges [m] (into ``ranges`` (R,); scratch ``ring``, ``dirs``) over
+    ``max_range`` in [0, 1]."""
+    _lidar(x, y, th, rel, max_range, n_obs, prm, st, rings, ring, dirs, ranges)
+    gx, gy = goal_x - x, goal_y - y
+    bearing = math.atan2(gy, gx) - th
+    out[0] = min(pyhypot(gx, gy) / goal_scale, 1.0)
+    out[1] = math.cos(bearing)
+    out[2] = math.sin(bearing)
+    out[3] = min(max(speed / v_max, 0.0), 1.0)
     for r in range(ranges.shape[0]):
         out[4 + r] = min(max(ranges[r] / max_range, 0.0), 1.0)
 
@@ -422,10 +437,11 @@ def observe_py(
     and sin of the goal bearing in the robot frame, speed / V_max in [0, 1] (0 once arrived or
     collided), ranges / ``max_range`` in [0, 1] (beams at heading + ``rel`` [rad])."""
     ring = np.empty((2, rings.shape[3]))
+    dirs = np.empty((2, rel.shape[0]))
     for k in range(wf.shape[0]):
         x, y, th = wf[k, W_X], wf[k, W_Y], wf[k, W_TH]
         _lidar(x, y, th, rel, max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ring,
-               ranges[k])  # fmt: skip
+               dirs, ranges[k])  # fmt: skip
         gx, gy = wf[k, W_GX] - x, wf[k, W_GY] - y
         d = pyhypot(gx, gy)
         dist[k] = d
@@ -448,7 +464,7 @@ _PUBLIC = {
     "sense_one": "sense_one_py",
     "clearance_one": "clearance_one_py",
     "lidar": "_lidar",
-    "lidar_vector": "lidar_vector_py",
+    "vector_one": "vector_one_py",
 }
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
@@ -462,7 +478,7 @@ def kernel(name: str) -> Callable[..., Any]:
     if not _KERNELS:
         _KERNELS.update(compile_family([
             wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py, ray_ring_hit_py,
-            _transform_ring, _move_obstacles, _clearance, _lidar, lidar_vector_py, step_worlds_py,
+            _transform_ring, _move_obstacles, _clearance, _lidar, vector_one_py, step_worlds_py,
             observe_py,
             sense_one_py, advance_one_py, clearance_one_py,
         ]))  # fmt: skip
