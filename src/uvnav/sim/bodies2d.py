@@ -355,8 +355,11 @@ class PackedBodies:
         return self.step(t, dt, x, y, radius, sensing_range)
 
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
-        """The last step's start and end (the poses it kept)."""
-        return StepPoses(*self.poses_before(), *self.poses(), None, None, p0, p1, slack)
+        """The last step's start and end (the poses it kept): views of one copy of each, the
+        centres (k, 2) and headings (k,) of :meth:`poses_before` and :meth:`poses`."""
+        before = self._prev.copy()
+        now = self._st[S_X : S_HEADING + 1, : self.n].copy()  # (x, y, heading: rows in a row)
+        return StepPoses(before[:2].T, before[2], now[:2].T, now[2], None, None, p0, p1, slack)
 
     def ceiling(self, sampled_min: float, clearance: float) -> float:
         """An upper bound of the episode's sampled minimum so far [m] (every step's clearance is
