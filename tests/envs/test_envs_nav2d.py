@@ -374,3 +374,26 @@ def test_the_law_view_pickles_and_crosses_an_async_vector_env() -> None:
         assert len(views) == 2 and all(v.observation.time > 0 for v in views)
     finally:
         vec.close()
+
+
+@pytest.mark.parametrize(
+    "action",
+    [
+        np.array([3.0, -2.0]),
+        np.array([3.0, -2.0], dtype=np.float16),
+        np.array([300, -2]),
+        [3.0, -2.0],
+        (np.float32(1.5), -1.0),
+    ],
+)
+def test_any_form_of_an_action_steps_as_its_float_array(action: object) -> None:
+    """An action outside [-1, 1] is clipped, and an action of any array-like form or dtype
+    steps the env as the same numbers in a float64 array do."""
+    envs = [Nav2DEnv(generate("random-ch2", 3, n_obstacles=10)) for _ in range(2)]
+    for env in envs:
+        env.reset(seed=4)
+    for _ in range(5):
+        got = envs[0].step(action)  # type: ignore[arg-type]
+        want = envs[1].step(np.array([1.0, -1.0]))
+        assert np.array_equal(got[0], want[0]) and got[1:4] == want[1:4]
+        assert got[4]["uvnav"] == want[4]["uvnav"]

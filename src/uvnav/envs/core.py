@@ -64,6 +64,9 @@ OBS_DOC = (
     "lidar ranges / max_range x n_rays]"
 )
 
+#: The float dtypes an action array is read from as it is (exactly, as Python floats).
+_FLOATS = frozenset(np.dtype(t) for t in (np.float16, np.float32, np.float64))
+
 #: A robot's episode is over (terminated) in these statuses; it is ``"running"`` before.
 TERMINAL = ("success", "collision")
 
@@ -585,19 +588,15 @@ class EnvWorld:
         """The one robot's command of ``action`` (checked as :func:`checked_actions` checks
         it): :meth:`command`'s numbers, read from a float array of two finite entries without
         the checks' array."""
-        if (
-            type(action) is np.ndarray
-            and action.shape == (2,)
-            and action.dtype.kind == "f"
-            and action.dtype.itemsize <= 8
-        ):
+        if type(action) is np.ndarray and action.dtype in _FLOATS and action.shape == (2,):
             a0, a1 = action.tolist()
-            if math.isfinite(a0) and math.isfinite(a1):
-                if not self._unicycle:
-                    return self.command(0, action)
+            if math.isfinite(a0) and math.isfinite(a1) and self._unicycle:
                 if self.raw_commands:
                     return UnicycleCommand(a0, a1)
-                a0, a1 = min(max(a0, -1.0), 1.0), min(max(a1, -1.0), 1.0)
+                if not -1.0 <= a0 <= 1.0:  # (clipped: the same numbers as min(max(...)))
+                    a0 = min(max(a0, -1.0), 1.0)
+                if not -1.0 <= a1 <= 1.0:
+                    a1 = min(max(a1, -1.0), 1.0)
                 v_max, u_max = self._limits
                 return UnicycleCommand(0.5 * (a0 + 1.0) * v_max, a1 * u_max)
         return self.command(0, checked_actions("action", action, (2,)))
