@@ -325,6 +325,8 @@ def _law_observations(read_at_once: bool, steps: int) -> list:
     env = Nav2DEnv(generate("random-ch2", 3, n_obstacles=10))
     rng = np.random.default_rng(2)
     _, info = env.reset(seed=5)
+    # compiled bodies leave the sensing to the read (none in the steps)
+    assert env.world.sense_in_step != isinstance(env.world.bodies, PackedBodies)
     infos, seen = [info], [env.world.observe()] if read_at_once else []
     for _ in range(steps):
         *_, term, trunc, info = env.step(rng.uniform(-1, 1, 2).astype(np.float32))

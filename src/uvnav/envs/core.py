@@ -367,6 +367,9 @@ class EnvWorld:
         self._packed = (
             one.bodies if one is not None and isinstance(one.bodies, PackedBodies) else None
         )
+        if one is not None and self._packed is not None and one.sensors.exact_only:
+            # the law's view senses when it is read (World2D.observe_later), not in every step
+            one.sense_in_step = False
         if one is not None:  # what the one robot's step reads, as floats
             self._goal_xy = (float(one.goal[0]), float(one.goal[1]))
             self._limits = (float(one.spec.v_max), float(one.spec.u_max))

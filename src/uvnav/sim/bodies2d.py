@@ -418,14 +418,30 @@ class PackedBodies:
     def readings_later(
         self, x: float, y: float, sensing_range: float
     ) -> Callable[[], tuple[ObstacleReading, ...]]:
-        """:meth:`readings` now, as a function: the sensed block is copied now, the reading
-        objects are made on the call."""
-        m = self._sense_count(x, y, sensing_range)
+        """:meth:`readings` now, as a function: the block the last step sensed from ``(x, y)``
+        is copied now, or else the obstacles' state, sensed on the call; the reading objects are
+        made on the call."""
+        got = self._sensed
+        if got is None or got[:3] != (x, y, sensing_range):
+            state = self._st.copy()
+            return lambda: self._sensed_from(state, x, y, sensing_range)
+        m = got[3]
         if m == 0:
             return tuple
         # whole buffers: copying them is cheaper than slicing them first
         ids, rows, outlines = self._ids.copy(), self._rows.copy(), self._outlines.copy()
         return lambda: self._make_readings(ids[:m].tolist(), rows[:m], outlines[:m])
+
+    def _sensed_from(
+        self, state: FloatArray, x: float, y: float, sensing_range: float
+    ) -> tuple[ObstacleReading, ...]:
+        """The readings from ``(x, y)`` within ``sensing_range`` [m] of the obstacles in
+        ``state`` (a copy of the state array of a moment), in buffers of their own."""
+        ids, rows = np.empty_like(self._ids), np.empty_like(self._rows)
+        outlines = np.empty_like(self._outlines)
+        m = self._sense(x, y, sensing_range, self.n, self._prm, state, self._rings, ids, rows,
+                        outlines)  # fmt: skip
+        return self._make_readings(ids[:m].tolist(), rows[:m], outlines[:m]) if m else ()
 
     def _sense_count(self, x: float, y: float, sensing_range: float) -> int:
         """The number of readings from ``(x, y)`` within ``sensing_range`` [m], written to the

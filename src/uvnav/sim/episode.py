@@ -116,6 +116,10 @@ class World2D(OneVehicle):
         self.sensors = Sensors2D(setup.sensing, self.sense_rng)
         self.pedestrians = pedestrian_ids(self.obstacles)
         self.exact = exact
+        #: the bodies take the sensors' readings in the step that ends at a decision (the loop
+        #: reads them at every decision); a caller that reads them later, or never, may turn
+        #: it off (the same readings, taken when read)
+        self.sense_in_step = True
         self.t = 0.0
         self.done = False
 
@@ -234,7 +238,11 @@ class World2D(OneVehicle):
         self.turn += turn
         book.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
-        sense = self.sensing_range if (clock.step_index + 1) % self.ratio == 0 else -1.0
+        sense = (
+            self.sensing_range
+            if self.sense_in_step and (clock.step_index + 1) % self.ratio == 0
+            else -1.0
+        )
         gap, nearest = bodies.measure(self.t, dt, nx, ny, self.spec.radius, sense)
         self.clearance = gap
         if nearest is not None:
