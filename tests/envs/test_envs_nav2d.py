@@ -316,3 +316,86 @@ def test_compiled_bodies_and_lidar_give_the_reference_rollout(kwargs: dict) -> N
             assert a.dtype == b.dtype and np.array_equal(a, b)
         else:
             assert a == b
+
+
+def _law_observations(read_at_once: bool, steps: int) -> list:
+    """The law's observations of a seeded random rollout (through resets): the world's
+    ``observe()`` at each step (``read_at_once``), or the infos' kept and read after the
+    rollout."""
+    env = Nav2DEnv(generate("random-ch2", 3, n_obstacles=10))
+    rng = np.random.default_rng(2)
+    _, info = env.reset(seed=5)
+    # compiled bodies leave the sensing to the read (none in the steps)
+    assert env.world.sense_in_step != isinstance(env.world.bodies, PackedBodies)
+    infos, seen = [info], [env.world.observe()] if read_at_once else []
+    for _ in range(steps):
+        *_, term, trunc, info = env.step(rng.uniform(-1, 1, 2).astype(np.float32))
+        infos.append(info)
+        if read_at_once:
+            seen.append(env.world.observe())
+        if term or trunc:
+            infos.append(env.reset()[1])
+            if read_at_once:
+                seen.append(env.world.observe())
+    return seen if read_at_once else [i["uvnav"].observation for i in infos]
+
+
+def test_the_law_observation_read_later_is_the_one_of_its_step() -> None:
+    """``info["uvnav"]``'s observation is made when first read; read after the env has moved on
+    it is, field for field, the one the world's sensors gave at its own step."""
+    now, later = _law_observations(True, 400), _law_observations(False, 400)
+    assert len(now) == len(later) > 400 and any(o.obstacles for o in now)
+    for a, b in zip(now, later, strict=True):
+        assert (a.time, a.speed, a.lidar, dict(a.extras)) == (b.time, b.speed, b.lidar, {})
+        assert np.array_equal(a.pose, b.pose) and np.array_equal(a.goal, b.goal)
+        assert len(a.obstacles) == len(b.obstacles)
+        for ra, rb in zip(a.obstacles, b.obstacles, strict=True):
+            for name in ("nearest_point", "centre", "velocity", "outline"):
+                assert np.array_equal(getattr(ra, name), getattr(rb, name))
+            for name in ("obstacle_id", "distance", "angular_velocity", "radius",
+                         "bounding_radius", "velocity_source"):  # fmt: skip
+                assert getattr(ra, name) == getattr(rb, name)
+
+
+def test_the_law_view_pickles_and_crosses_an_async_vector_env() -> None:
+    """A view whose observation is made on first read pickles with it made (an async vector
+    env's workers send their infos through pipes), equal to the original."""
+    import pickle
+
+    env = Nav2DEnv(generate("random-ch2", 3, n_obstacles=10))
+    env.reset(seed=3)
+    *_, info = env.step(np.zeros(2, dtype=np.float32))
+    again = pickle.loads(pickle.dumps(info))
+    assert again["uvnav"] == info["uvnav"] and again["uvnav"].observation.obstacles
+    vec = gym.make_vec("uvnav/Nav2D-v0", num_envs=2, vectorization_mode="async",
+                       scenario=generate("random-ch2", 3, n_obstacles=10))  # fmt: skip
+    try:
+        vec.reset(seed=0)
+        *_, infos = vec.step(np.zeros((2, 2), dtype=np.float32))
+        views = infos["uvnav"]
+        assert len(views) == 2 and all(v.observation.time > 0 for v in views)
+    finally:
+        vec.close()
+
+
+@pytest.mark.parametrize(
+    "action",
+    [
+        np.array([3.0, -2.0]),
+        np.array([3.0, -2.0], dtype=np.float16),
+        np.array([300, -2]),
+        [3.0, -2.0],
+        (np.float32(1.5), -1.0),
+    ],
+)
+def test_any_form_of_an_action_steps_as_its_float_array(action: object) -> None:
+    """An action outside [-1, 1] is clipped, and an action of any array-like form or dtype
+    steps the env as the same numbers in a float64 array do."""
+    envs = [Nav2DEnv(generate("random-ch2", 3, n_obstacles=10)) for _ in range(2)]
+    for env in envs:
+        env.reset(seed=4)
+    for _ in range(5):
+        got = envs[0].step(action)  # type: ignore[arg-type]
+        want = envs[1].step(np.array([1.0, -1.0]))
+        assert np.array_equal(got[0], want[0]) and got[1:4] == want[1:4]
+        assert got[4]["uvnav"] == want[4]["uvnav"]

@@ -44,6 +44,7 @@ from __future__ import annotations
 import math
 import numbers
 import os
+from collections.abc import Callable
 from dataclasses import dataclass, fields
 from typing import Any
 
@@ -62,6 +63,9 @@ OBS_DOC = (
     "[goal distance / goal_scale, cos(goal bearing), sin(goal bearing), speed / v_max, "
     "lidar ranges / max_range x n_rays]"
 )
+
+#: The float dtypes an action array is read from as it is (exactly, as Python floats).
+_FLOATS = frozenset(np.dtype(t) for t in (np.float16, np.float32, np.float64))
 
 #: A robot's episode is over (terminated) in these statuses; it is ``"running"`` before.
 TERMINAL = ("success", "collision")
@@ -200,21 +204,61 @@ class RewardConfig:
         return r
 
 
-@dataclass(frozen=True, eq=False)
 class ControllerView:
     """What a uvnav controller is given at this decision: its
     :class:`~uvnav.sensors.Observation` (made by the world's sensor, as in the simulator) and its
     vehicle limits (``info["uvnav"]`` of the envs), whether the env takes raw commands, and the
     planar vehicle when it is not the unicycle (whose commands the action maps).
 
-    Equality compares the contents (numpy arrays element-wise), so Gymnasium's determinism
-    checks can compare infos.
+    ``ControllerView(observation, spec, raw_commands, vehicle)`` holds an observation made;
+    :meth:`deferred` one made on the first read of :attr:`observation` from what the world kept
+    at the decision (a policy that never reads it never pays for it).  Equality compares the
+    contents (numpy arrays element-wise), so Gymnasium's determinism checks can compare infos.
     """
 
-    observation: Observation
-    spec: Any
-    raw_commands: bool = False  # the env's action is the command (v, u) itself
-    vehicle: Any = None  # a Vehicle2D other than the unicycle
+    __slots__ = ("_make", "_observation", "raw_commands", "spec", "vehicle")
+
+    def __init__(
+        self,
+        observation: Observation,
+        spec: Any,
+        raw_commands: bool = False,  # the env's action is the command (v, u) itself
+        vehicle: Any = None,  # a Vehicle2D other than the unicycle
+    ) -> None:
+        self._observation: Observation | None = observation
+        self._make: Callable[[], Observation] | None = None
+        self.spec, self.raw_commands, self.vehicle = spec, raw_commands, vehicle
+
+    @classmethod
+    def deferred(
+        cls, make: Callable[[], Observation], spec: Any, raw_commands: bool, vehicle: Any
+    ) -> ControllerView:
+        """A view whose observation is ``make()``, called on the first read only."""
+        view = cls.__new__(cls)
+        view._observation, view._make = None, make
+        view.spec, view.raw_commands, view.vehicle = spec, raw_commands, vehicle
+        return view
+
+    @property
+    def observation(self) -> Observation:
+        """The law's observation at this decision."""
+        obs = self._observation
+        if obs is None:
+            assert self._make is not None
+            obs = self._observation = self._make()
+            self._make = None
+        return obs
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        """Pickled (and deep-copied) with its observation made: a vector env's worker sends
+        its infos to the main process."""
+        return (ControllerView, (self.observation, self.spec, self.raw_commands, self.vehicle))
+
+    def __repr__(self) -> str:
+        return (
+            f"ControllerView(observation={self.observation!r}, spec={self.spec!r}, "
+            f"raw_commands={self.raw_commands!r}, vehicle={self.vehicle!r})"
+        )
 
     def __eq__(self, other: object) -> bool:
         if not isinstance(other, ControllerView):
@@ -316,9 +360,20 @@ class EnvWorld:
         world.start([False] * world.n_agents)
         self.clearance = np.array([self._gap(i) for i in range(self.n)])
         #: the one robot of a World2D, whose bodies may cast the lidar in one compiled call
-        self.one = world if isinstance(world, World2D) else None
+        self.one = one = world if isinstance(world, World2D) else None
         self._rel = beam_offsets(self.n_rays, 2.0 * np.pi)
         self._ranges = np.empty(self.n_rays)
+        #: the one robot's compiled bodies, which cast the lidar in one call
+        self._packed = (
+            one.bodies if one is not None and isinstance(one.bodies, PackedBodies) else None
+        )
+        if one is not None and self._packed is not None and one.sensors.exact_only:
+            # the law's view senses when it is read (World2D.observe_later), not in every step
+            one.sense_in_step = False
+        if one is not None:  # what the one robot's step reads, as floats
+            self._goal_xy = (float(one.goal[0]), float(one.goal[1]))
+            self._limits = (float(one.spec.v_max), float(one.spec.u_max))
+            self._unicycle = one.vehicle == "unicycle"
 
     # ----------------------------------------------------------------- robot i of either world
     @property
@@ -368,7 +423,10 @@ class EnvWorld:
     def distance(self, i: int) -> float:
         """Robot i's distance to its goal [m]."""
         one = self.one
-        x, y = (one.x, one.y) if one is not None else (float(p) for p in self.pose(i)[:2])
+        if one is not None:
+            gx, gy = self._goal_xy
+            return math.hypot(gx - one.x, gy - one.y)
+        x, y = (float(p) for p in self.pose(i)[:2])
         goal = self.goal(i)
         return math.hypot(float(goal[0]) - x, float(goal[1]) - y)
 
@@ -378,18 +436,20 @@ class EnvWorld:
 
     def view(self, i: int) -> ControllerView:
         """Robot i's :class:`ControllerView`: the world's observation (call once per decision:
-        an estimator, a noisy lidar, advance with it) and its limits."""
+        an estimator, a noisy lidar, advance with it) and its limits.  A :class:`World2D`'s is
+        made when first read (:meth:`~uvnav.sim.episode.World2D.observe_later`)."""
         w = self.world
-        body = w.body if isinstance(w, World2D) and w.vehicle != "unicycle" else None
-        return ControllerView(w.observe(i), self.spec(i), self.raw_commands, body)
+        if isinstance(w, World2D):
+            body = w.body if w.vehicle != "unicycle" else None
+            return ControllerView.deferred(w.observe_later(i), w.spec, self.raw_commands, body)
+        return ControllerView(w.observe(i), self.spec(i), self.raw_commands)
 
     def vector(self, i: int) -> np.ndarray:
         """Robot i's observation vector (module docstring), float32."""
         one = self.one
         if one is not None:
-            x, y, th = one.x, one.y, one.th
-        else:
-            x, y, th = (float(p) for p in self.pose(i))
+            return self._vector_one(one)
+        x, y, th = (float(p) for p in self.pose(i))
         goal = self.goal(i)
         gx, gy = float(goal[0]) - x, float(goal[1]) - y
         bearing = math.atan2(gy, gx) - th
@@ -404,12 +464,34 @@ class EnvWorld:
         np.minimum(np.maximum(scaled, 0.0, out=scaled), 1.0, out=scaled)
         return out
 
+    def _vector_one(self, one: World2D) -> np.ndarray:
+        """:meth:`vector` of the one robot of a :class:`World2D`: the same operations on the
+        floats kept at the start (for packed bodies, in one compiled call)."""
+        x, y, th = one.x, one.y, one.th
+        speed = 0.0 if one.book.status in TERMINAL else float(one.speed)
+        out = np.empty(4 + self.n_rays, dtype=np.float32)
+        packed = self._packed
+        if packed is not None:
+            packed.vector((x, y, th), self._goal_xy, self.goal_scale, speed, self._limits[0],
+                          self._rel, self.max_range, self._ranges, out)  # fmt: skip
+            return out
+        gx, gy = self._goal_xy[0] - x, self._goal_xy[1] - y
+        bearing = math.atan2(gy, gx) - th
+        out[0] = min(math.hypot(gx, gy) / self.goal_scale, 1.0)
+        out[1] = math.cos(bearing)
+        out[2] = math.sin(bearing)
+        out[3] = min(max(speed / self._limits[0], 0.0), 1.0)
+        scaled = out[4:]
+        np.divide(self.ranges(0), self.max_range, out=scaled)
+        np.minimum(np.maximum(scaled, 0.0, out=scaled), 1.0, out=scaled)
+        return out
+
     def ranges(self, i: int) -> np.ndarray:
         """Robot i's lidar ranges [m] now (:func:`~uvnav.sensors.exact.lidar_scan` without
         noise; for packed bodies the same numbers from one compiled call)."""
-        one = self.one
-        if one is not None and isinstance(one.bodies, PackedBodies):
-            one.bodies.lidar(one.x, one.y, one.th, self._rel, self.max_range, self._ranges)
+        one, packed = self.one, self._packed
+        if one is not None and packed is not None:
+            packed.lidar(one.x, one.y, one.th, self._rel, self.max_range, self._ranges)
             return self._ranges
         field = self._lidar_field(i)
         return lidar_scan(self.pose(i), field, n_rays=self.n_rays, max_range=self.max_range).ranges
@@ -448,9 +530,9 @@ class EnvWorld:
         are applied, then the world advances to the next decision time or the end.  Returns the
         rewards (0 for robots that were already done)."""
         n, w = self.n, self.world
-        actions = {i: checked_actions(self.action_name(i), a, (2,)) for i, a in actions.items()}
         if self.one is not None:
-            return self._step_one(self.one, actions)
+            return np.array([self.step_one(actions.get(0))])
+        actions = {i: checked_actions(self.action_name(i), a, (2,)) for i, a in actions.items()}
         before = [self.distance(i) for i in range(n)]
         was_running = [self.running(i) for i in range(n)]
         low = np.full(n, np.inf)
@@ -476,29 +558,64 @@ class EnvWorld:
             )
         return rewards
 
-    def _step_one(self, w: World2D, actions: dict[int, np.ndarray]) -> np.ndarray:
-        """:meth:`step` for the one robot of a :class:`World2D` (checked ``actions``)."""
+    def step_one(self, action: Any) -> float:
+        """:meth:`step` for the one robot of a :class:`World2D`: its action (``None``: it
+        stands still) applied, the world advanced to the next decision; returns the reward (0
+        once the robot's episode is over)."""
+        w = self.one
+        assert w is not None
+        cmd = self.rest(0) if action is None else self._command_one(w, action)
+        book, clock = w.book, w.clock
         before = self.distance(0)
-        was_running = self.running(0)
+        was_running = book.status not in TERMINAL
         low = math.inf
         if not w.done:
-            if w.clock.due:
-                w.apply(self.command(0, actions[0]) if 0 in actions else self.rest(0))
+            if clock.due:
+                w.apply(cmd)
             while True:
-                alive = self.running(0)
+                alive = book.status not in TERMINAL
                 w.advance()
                 if alive:
-                    low = min(low, self._gap(0))
-                if w.done or w.clock.due:
+                    c = w.clearance
+                    low = min(low, c if math.isfinite(c) else self.max_range)
+                if w.done or clock.due:
                     break
-        rewards = np.zeros(1)
-        if was_running:
-            if math.isfinite(low):
-                self.clearance[0] = low
-            rewards[0] = self.reward.reward(
-                before - self.distance(0), float(self.clearance[0]), self.status(0)
-            )
-        return rewards
+        if not was_running:
+            return 0.0
+        if math.isfinite(low):
+            self.clearance[0] = low
+        status = book.status if book.status in TERMINAL else "running"
+        return self.reward.reward(before - self.distance(0), float(self.clearance[0]), status)
+
+    def _command_one(self, w: World2D, action: Any) -> Any:
+        """The one robot's command of ``action`` (checked as :func:`checked_actions` checks
+        it): :meth:`command`'s numbers, read from a float array of two finite entries without
+        the checks' array."""
+        if type(action) is np.ndarray and action.dtype in _FLOATS and action.shape == (2,):
+            a0, a1 = action.tolist()
+            if math.isfinite(a0) and math.isfinite(a1) and self._unicycle:
+                if self.raw_commands:
+                    return UnicycleCommand(a0, a1)
+                if not -1.0 <= a0 <= 1.0:  # (clipped: the same numbers as min(max(...)))
+                    a0 = min(max(a0, -1.0), 1.0)
+                if not -1.0 <= a1 <= 1.0:
+                    a1 = min(max(a1, -1.0), 1.0)
+                v_max, u_max = self._limits
+                return UnicycleCommand(0.5 * (a0 + 1.0) * v_max, a1 * u_max)
+        return self.command(0, checked_actions("action", action, (2,)))
+
+    def info_one(self) -> dict[str, Any]:
+        """The one robot's ``info`` (:meth:`EnvWorldEnv._info`)."""
+        w = self.one
+        assert w is not None
+        status = w.book.status
+        return {
+            "status": status if status in TERMINAL else "running",
+            "distance": self.distance(0),
+            "clearance": float(self.clearance[0]),
+            "time": w.t,
+            "uvnav": self.view(0),
+        }
 
     def close(self) -> None:
         """Write the obstacles' states back (the world's :meth:`close`)."""
@@ -550,6 +667,8 @@ class EnvWorldEnv:
     def _info(self, i: int) -> dict[str, Any]:
         w = self._world
         assert w is not None
+        if w.one is not None:
+            return w.info_one()
         return {
             "status": w.status(i),
             "distance": w.distance(i),
@@ -595,7 +714,8 @@ def scene_bounds(world: EnvWorld, margin: float = 1.5) -> tuple[float, float, fl
     starts = np.array([world.pose(i)[:2] for i in range(world.n)])
     pts = [starts, np.array([world.goal(i) for i in range(world.n)])]
     if world.k:
-        c = world.world.field.centres[: world.k]
+        one = world.one
+        c = (one.bodies.centres()[0] if one is not None else world.world.field.centres)[: world.k]
         rad = world.world.template.bounding_radii[: world.k]
         near = np.hypot(*(c - starts[0]).T) < 100.0
         if near.any():

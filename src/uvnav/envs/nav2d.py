@@ -25,7 +25,8 @@ lidar in compiled calls (:class:`uvnav.sim.bodies2d.PackedBodies`), with the sam
 * ``info``: ``status``, ``distance`` [m], ``clearance`` [m], ``time`` [s], and — so that any uvnav
   controller can drive the env (:func:`uvnav.envs.as_policy`) — ``uvnav``, a
   :class:`~uvnav.envs.core.ControllerView` holding the :class:`~uvnav.sensors.Observation` the
-  simulator would give the controller and the vehicle limits.
+  simulator would give the controller at this step (made when first read) and the vehicle
+  limits.
 * ``render_mode="rgb_array"``: 256 x 256 RGB frames.
 
 Each ``reset(seed=...)`` draws an episode seed from the env's generator, so random obstacles
@@ -188,10 +189,10 @@ class Nav2DEnv(EnvWorldEnv, gym.Env[np.ndarray, np.ndarray]):
         w = self._world
         if w is None:
             raise RuntimeError("call reset() before step()")
-        reward = float(w.step({0: np.asarray(action)})[0])
-        terminated = w.status(0) in TERMINAL
+        reward = w.step_one(action)
+        info = w.info_one()
+        terminated = info["status"] in TERMINAL
         truncated = not terminated and w.world.done
-        info = self._info(0)
         if truncated:
             info["status"] = "timeout"
         return w.vector(0), reward, terminated, truncated, info

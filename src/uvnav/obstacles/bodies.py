@@ -73,7 +73,7 @@ class PolygonBody:
 
     @property
     def bounding_radius(self) -> float:
-        return float(np.max(np.hypot(self.vertices[:, 0], self.vertices[:, 1])))
+        return float(np.hypot(self.vertices[:, 0], self.vertices[:, 1]).max())
 
     def outline(self, n: int = 0) -> FloatArray:
         return self.vertices

@@ -41,6 +41,7 @@ class Sensors2D:
         self.range = float(config.sensing_range)
         self.estimator: FiniteDifferenceEstimator | None = None
         self.scan_bodies: ScanBodies | None = None
+        self.exact_only = False
 
     def reset(self, oracle: bool) -> None:
         """A new episode: an oracle law reads the exact bodies with their true rates; any
@@ -52,6 +53,13 @@ class Sensors2D:
             else None
         )
         self.scan_bodies = ScanBodies() if c.bodies == "lidar" and not oracle else None
+        #: an observation is the exact readings alone (nothing estimated or scanned, no lidar,
+        #: no plug-in): a function of the world's state at the decision, drawing nothing from
+        #: the generator and keeping nothing from one decision to the next
+        self.exact_only = (
+            self.estimator is None and self.scan_bodies is None and c.lidar is None
+            and not c.plugins
+        )  # fmt: skip
 
     @property
     def true_rates(self) -> bool:

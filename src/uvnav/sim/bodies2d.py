@@ -9,6 +9,7 @@ random-turn motion (:func:`~uvnav.sim.packed.pack_check`), moved and measured in
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import Protocol
 
 import numpy as np
@@ -90,6 +91,12 @@ class Bodies2D(Protocol):
 
     def readings(self, x: float, y: float, sensing_range: float) -> tuple[ObstacleReading, ...]:
         """The exact sensor's readings from ``(x, y)`` within ``sensing_range`` [m]."""
+
+    def readings_later(
+        self, x: float, y: float, sensing_range: float
+    ) -> Callable[[], tuple[ObstacleReading, ...]]:
+        """:meth:`readings` now, made when the returned function is called (the bodies may have
+        moved on by then)."""
 
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
         """The last step's start and end, with the robot's chord ``p0 -> p1``."""
@@ -251,6 +258,12 @@ class FieldBodies:
     def readings(self, x: float, y: float, sensing_range: float) -> tuple[ObstacleReading, ...]:
         return sense_obstacles(np.array((x, y)), self._field, sensing_range=sensing_range)
 
+    def readings_later(
+        self, x: float, y: float, sensing_range: float
+    ) -> Callable[[], tuple[ObstacleReading, ...]]:
+        got = self.readings(x, y, sensing_range)
+        return lambda: got
+
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
         b, f = self._before, self._field
         return StepPoses(b.centres, b.headings, f.centres, f.headings, b.present, f.present,
@@ -314,7 +327,10 @@ class PackedBodies:
         #: ``(x, y, range, m)`` of the readings the last step took, if it took any
         self._sensed: tuple[float, float, float, int] | None = None
         self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
-        self._field: ObstacleField | None = ObstacleBatch(obstacles).field(template)
+        self._lidar, self._vector = kernel("lidar"), kernel("vector_one")
+        self._ring = np.empty((2, w))  # the lidar's scratch
+        self._beams = np.empty((2, 0))
+        self._field: ObstacleField | None = None  # (before any step: the obstacles' own)
         self._prev = np.zeros((3, n))  # the poses before the last step: x, y, heading
         #: the most any body point moved over the last step [m]
         self.shift = 0.0
@@ -335,13 +351,15 @@ class PackedBodies:
         self, t: float, dt: float, x: float, y: float, radius: float, sensing_range: float
     ) -> tuple[float, int | None]:
         """:meth:`step`: the exact clearance after the step, and the nearest body."""
-        gap, at = self.step(t, dt, x, y, radius, sensing_range)
         self._field = None
-        return gap, at
+        return self.step(t, dt, x, y, radius, sensing_range)
 
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
-        """The last step's start and end (the poses it kept)."""
-        return StepPoses(*self.poses_before(), *self.poses(), None, None, p0, p1, slack)
+        """The last step's start and end (the poses it kept): views of one copy of each, the
+        centres (k, 2) and headings (k,) of :meth:`poses_before` and :meth:`poses`."""
+        before = self._prev.copy()
+        now = self._st[S_X : S_HEADING + 1, : self.n].copy()  # (x, y, heading: rows in a row)
+        return StepPoses(before[:2].T, before[2], now[:2].T, now[2], None, None, p0, p1, slack)
 
     def ceiling(self, sampled_min: float, clearance: float) -> float:
         """An upper bound of the episode's sampled minimum so far [m] (every step's clearance is
@@ -359,7 +377,10 @@ class PackedBodies:
         ``radius`` [m] at ``(x, y)`` then, and its nearest obstacle (-1 without any).  With a
         ``sensing_range`` >= 0 [m] the readings from there are taken in the same call, for
         :meth:`readings` to return."""
-        self._pw.ensure_draws()
+        pw = self._pw
+        if pw.safe_calls <= 0:  # (PackedWorlds.ensure_draws, inline)
+            pw.refill()
+        pw.safe_calls -= 1
         self._stepped = True
         gap, at, m, self.shift = self._advance(
             x, y, radius, t, dt, self.n, self._oi, self._prm, self._st, self._ubuf, self._rings,
@@ -388,20 +409,58 @@ class PackedBodies:
         """:func:`uvnav.sensors.exact.sense_obstacles` from ``(x, y)``: the readings within
         ``sensing_range`` [m], nearest first (ties in obstacle order).  Their arrays are views
         of one block copied for this call."""
-        got = self._sensed
-        if got is not None and got[:3] == (x, y, sensing_range):
-            m = got[3]
-        else:
-            m = self._sense(x, y, sensing_range, self.n, self._prm, self._st, self._rings,
-                            self._ids, self._rows, self._outlines)  # fmt: skip
+        m = self._sense_count(x, y, sensing_range)
         if m == 0:
             return ()
-        rows = self._rows[:m].copy()
-        outlines = self._outlines[:m].copy()
+        return self._make_readings(self._ids[:m].tolist(), self._rows[:m].copy(),
+                                   self._outlines[:m].copy())  # fmt: skip
+
+    def readings_later(
+        self, x: float, y: float, sensing_range: float
+    ) -> Callable[[], tuple[ObstacleReading, ...]]:
+        """:meth:`readings` now, as a function: the block the last step sensed from ``(x, y)``
+        is copied now, or else the obstacles' state, sensed on the call; the reading objects are
+        made on the call."""
+        got = self._sensed
+        if got is None or got[:3] != (x, y, sensing_range):
+            state = self._st.copy()
+            return lambda: self._sensed_from(state, x, y, sensing_range)
+        m = got[3]
+        if m == 0:
+            return tuple
+        # whole buffers: copying them is cheaper than slicing them first
+        ids, rows, outlines = self._ids.copy(), self._rows.copy(), self._outlines.copy()
+        return lambda: self._make_readings(ids[:m].tolist(), rows[:m], outlines[:m])
+
+    def _sensed_from(
+        self, state: FloatArray, x: float, y: float, sensing_range: float
+    ) -> tuple[ObstacleReading, ...]:
+        """The readings from ``(x, y)`` within ``sensing_range`` [m] of the obstacles in
+        ``state`` (a copy of the state array of a moment), in buffers of their own."""
+        ids, rows = np.empty_like(self._ids), np.empty_like(self._rows)
+        outlines = np.empty_like(self._outlines)
+        m = self._sense(x, y, sensing_range, self.n, self._prm, state, self._rings, ids, rows,
+                        outlines)  # fmt: skip
+        return self._make_readings(ids[:m].tolist(), rows[:m], outlines[:m]) if m else ()
+
+    def _sense_count(self, x: float, y: float, sensing_range: float) -> int:
+        """The number of readings from ``(x, y)`` within ``sensing_range`` [m], written to the
+        sensed block (taken by the last step when it sensed from there)."""
+        got = self._sensed
+        if got is not None and got[:3] == (x, y, sensing_range):
+            return got[3]
+        return int(self._sense(x, y, sensing_range, self.n, self._prm, self._st, self._rings,
+                               self._ids, self._rows, self._outlines))  # fmt: skip
+
+    def _make_readings(
+        self, ids: list[int], rows: FloatArray, outlines: FloatArray
+    ) -> tuple[ObstacleReading, ...]:
+        """The reading objects of a sensed block (``ids``, and copies of its rows and
+        outlines: the readings' arrays are views of them)."""
         vals = rows.tolist()
         counts, bounds, make = self._counts, self._bounds, ObstacleReading.polygon
         out = []
-        for i, j in enumerate(self._ids[:m].tolist()):
+        for i, j in enumerate(ids):
             r = rows[i]
             reading = make(
                 j, vals[i][R_DIST], r[R_NEAR : R_NEAR + 2], r[R_CENTRE : R_CENTRE + 2],
@@ -420,14 +479,38 @@ class PackedBodies:
         """The ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from ``(x, y, th)``,
         beams at ``wrap(th + rel)`` [rad], into ``out`` (R,), in one compiled call
         (:func:`~uvnav.sim.packed._lidar`; no field is built)."""
-        ring = np.empty((2, self._rings.shape[2]))
-        kernel("lidar")(x, y, th, rel, max_range, self.n, self._prm, self._st, self._rings,
-                        ring, out)  # fmt: skip
+        self._lidar(x, y, th, rel, max_range, self.n, self._prm, self._st, self._rings,
+                    self._ring, self._dirs(rel), out)  # fmt: skip
+
+    def vector(
+        self, pose: tuple[float, float, float], goal: tuple[float, float], goal_scale: float,
+        speed: float, v_max: float, rel: FloatArray, max_range: float, ranges: FloatArray,
+        out: np.ndarray,
+    ) -> None:  # fmt: skip
+        """An env's observation vector from ``pose`` ``(x, y, theta)`` into ``out`` (4 + R,)
+        float32 and its lidar ranges [m] into ``ranges`` (R,), in one compiled call
+        (:func:`~uvnav.sim.packed.vector_one_py`: goal ``(x, y)`` [m] and ``goal_scale`` [m],
+        ``speed`` and ``v_max`` [m/s], beams at heading + ``rel`` [rad] to ``max_range`` [m])."""
+        x, y, th = pose
+        self._vector(x, y, th, goal[0], goal[1], goal_scale, speed, v_max, rel, max_range,
+                     self.n, self._prm, self._st, self._rings, self._ring, self._dirs(rel),
+                     ranges, out)  # fmt: skip
+
+    def _dirs(self, rel: FloatArray) -> FloatArray:
+        """The lidar's scratch for the beams' directions, (2, R) for ``rel`` (R,)."""
+        dirs = self._beams
+        if dirs.shape[1] != rel.shape[0]:
+            dirs = self._beams = np.empty((2, rel.shape[0]))
+        return dirs
 
     def field(self) -> ObstacleField:
         """The :class:`ObstacleField` of now (built on first use after a step)."""
         if self._field is None:
-            self._field = self._make_field()
+            self._field = (
+                self._make_field()
+                if self._stepped
+                else ObstacleBatch(self.obstacles).field(self.template)
+            )
         return self._field
 
     def _make_field(self) -> ObstacleField:

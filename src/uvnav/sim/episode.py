@@ -31,7 +31,7 @@ stepped by its own model, exact nearest points of every obstacle at every step).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any, ClassVar
 
 import numpy as np
@@ -102,6 +102,7 @@ class World2D(OneVehicle):
         self.clock = Clock(setup.dt, setup.control_period, setup.t_max)
         self.dt, self.ratio = self.clock.dt, self.clock.ratio
         self.goal = np.asarray(setup.goal, dtype=float)
+        self._gx, self._gy = float(self.goal[0]), float(self.goal[1])
         start = np.asarray(setup.start, dtype=float)
         self.x, self.y, self.th = float(start[0]), float(start[1]), float(start[2])
         self.obstacles = setup.obstacles
@@ -115,6 +116,10 @@ class World2D(OneVehicle):
         self.sensors = Sensors2D(setup.sensing, self.sense_rng)
         self.pedestrians = pedestrian_ids(self.obstacles)
         self.exact = exact
+        #: the bodies take the sensors' readings in the step that ends at a decision (the loop
+        #: reads them at every decision); a caller that reads them later, or never, may turn
+        #: it off (the same readings, taken when read)
+        self.sense_in_step = True
         self.t = 0.0
         self.done = False
 
@@ -177,6 +182,18 @@ class World2D(OneVehicle):
             lambda: self.bodies.readings(self.x, self.y, self.sensing_range), self.bodies.field,
         )  # fmt: skip
 
+    def observe_later(self, agent: int = 0) -> Callable[[], Observation]:
+        """:meth:`observe` now, as a function: where the observation is the exact readings
+        alone (:attr:`~uvnav.sensors.suite2d.Sensors2D.exact_only`) what it needs is kept now
+        and the objects are made on the call; otherwise the observation is made now."""
+        if not self.sensors.exact_only:
+            obs = self.observe(agent)
+            return lambda: obs
+        t, x, y, th, speed, goal = self.t, self.x, self.y, self.th, self.speed, self.goal
+        readings = self.bodies.readings_later(x, y, self.sensing_range)
+        return lambda: Observation(time=t, pose=np.array((x, y, th)), speed=speed, goal=goal,
+                                   obstacles=readings(), lidar=None, extras={})  # fmt: skip
+
     @property
     def speed(self) -> float:
         """The robot's speed now [m/s] (its vehicle's: the held command's, or on its way to it)."""
@@ -208,27 +225,24 @@ class World2D(OneVehicle):
         self.body.hold(new)
         return new
 
-    def _move(self, dt: float) -> tuple[float, float]:
-        """Integrate the robot over ``dt`` [s] (the vehicle's exact motion); returns the new
-        position, updates the heading, the total turn and the effort's turn term."""
-        nx, ny, self.th, turn, effort = self.body.move(
-            self.x, self.y, self.th, dt, self.clock.due, self.ratio * dt
-        )
-        self.book.effort += effort
-        self.turn += turn
-        return nx, ny
-
     def advance(self) -> None:
         """One step ``dt``: robot (exact), obstacles, clearance, collision and arrival."""
-        dt, book, clock, bodies = self.dt, self.book, self.clock, self.bodies
+        dt, book, clock, bodies, body = self.dt, self.book, self.clock, self.bodies, self.body
         x, y, t0, g0 = self.x, self.y, self.t, self.clearance
         if bodies.sees_robot:  # bodies that react to the robot see it as it starts the step
             bodies.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
-        travel, slack = self.body.travel(dt)
-        nx, ny = self._move(dt)
+        travel, slack = body.travel(dt)
+        # the vehicle's exact motion; the heading, the total turn and the effort's turn term
+        nx, ny, self.th, turn, effort = body.move(x, y, self.th, dt, clock.due, self.ratio * dt)
+        book.effort += effort
+        self.turn += turn
         book.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
-        sense = self.sensing_range if (clock.step_index + 1) % self.ratio == 0 else -1.0
+        sense = (
+            self.sensing_range
+            if self.sense_in_step and (clock.step_index + 1) % self.ratio == 0
+            else -1.0
+        )
         gap, nearest = bodies.measure(self.t, dt, nx, ny, self.spec.radius, sense)
         self.clearance = gap
         if nearest is not None:
@@ -239,8 +253,13 @@ class World2D(OneVehicle):
             self.social.observe(self.field, nx, ny, clock.step_index, self.velocity())
         if self.history is not None:
             self.history.push(nx, ny, *bodies.centres())
-        contact_at = self._swept((x, y), (nx, ny), t0, g0, travel, slack)
-        gd = math.hypot(self.goal[0] - nx, self.goal[1] - ny)
+        sweep, contact_at = self.sweep, None
+        if sweep is not None:
+            ceiling = bodies.ceiling(book.min_clear, gap)
+            shift = bodies.shift  # with it, most steps are left alone without their poses
+            if shift is None or not sweep.idle(0.5 * (g0 + gap - travel - shift), ceiling):
+                contact_at = self._swept((x, y), (nx, ny), t0, g0, travel, slack, ceiling)
+        gd = math.hypot(self._gx - nx, self._gy - ny)
         self.done = book.judge(t, self.clearance, gd, contact_at) or clock.up
         if book.status == "collision":  # judged at the first contact when the sweep found it
             sweep = self.sweep
@@ -259,17 +278,15 @@ class World2D(OneVehicle):
         g0: float,
         travel: float,
         slack: float,
+        ceiling: float,
     ) -> float | None:
         """The step just made from ``p0`` (time ``t0`` [s], sampled gap ``g0`` [m]) to ``p1``,
-        judged along its length (:class:`~uvnav.sim.swept.SweptClearance`): the time of the
-        first contact [s], ``None`` without one."""
+        judged along its length (:class:`~uvnav.sim.swept.SweptClearance`; ``ceiling``: the
+        bodies' bound of the sampled minimum [m]): the time of the first contact [s], ``None``
+        without one."""
         sweep, bodies = self.sweep, self.bodies
-        if sweep is None:
-            return None
-        ceiling = bodies.ceiling(self.book.min_clear, self.clearance)
+        assert sweep is not None
         shift = bodies.shift
-        if shift is not None and sweep.idle(0.5 * (g0 + self.clearance - travel - shift), ceiling):
-            return None  # (most steps: no poses made)
         s = sweep.step(
             lambda: bodies.step_poses(np.array(p0), np.array(p1), slack),
             travel, g0, self.clearance, ceiling, shift=shift,

@@ -349,15 +349,15 @@ def _lidar(
     st: FloatArray,
     rings: FloatArray,
     ring: FloatArray,
+    dirs: FloatArray,
     out: FloatArray,
 ) -> None:
     """Ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from pose ``(ox, oy, th)`` in
     one world into ``out`` (R,): beams at ``wrap(th + rel)`` [rad], capped at ``max_range``
-    [m] (``ring`` (2, W): scratch).  A body is cast where :meth:`ObstacleField.ray_hits` casts
-    it, and only by the beams that meet its bounding disc (the others cannot hit it: the same
-    ranges, far fewer edges)."""
+    [m] (``ring`` (2, W) and ``dirs`` (2, R): scratch).  A body is cast where
+    :meth:`ObstacleField.ray_hits` casts it, and only by the beams that meet its bounding disc
+    (the others cannot hit it: the same ranges, far fewer edges)."""
     n_rays = rel.shape[0]
-    dirs = np.empty((2, n_rays))
     for r in range(n_rays):
         out[r] = max_range
         a = wrap_scalar(th + rel[r])
@@ -381,6 +381,43 @@ def _lidar(
             out[r] = min(out[r], ray_ring_hit_py(ox, oy, dx, dy, ring[0], ring[1]))
 
 
+def vector_one_py(
+    x: float,
+    y: float,
+    th: float,
+    goal_x: float,
+    goal_y: float,
+    goal_scale: float,
+    speed: float,
+    v_max: float,
+    rel: FloatArray,
+    max_range: float,
+    n_obs: int,
+    prm: FloatArray,
+    st: FloatArray,
+    rings: FloatArray,
+    ring: FloatArray,
+    dirs: FloatArray,
+    ranges: FloatArray,
+    out: np.ndarray,
+) -> None:
+    """One observation vector of ``uvnav/Nav2D-v0`` (:meth:`uvnav.envs.core.EnvWorld.vector`)
+    into ``out`` (4 + R,) float32, as :func:`observe_py` writes a world's: from pose ``(x, y,
+    th)`` and goal ``(goal_x, goal_y)`` [m], the goal distance / ``goal_scale`` capped at 1, cos
+    and sin of the goal bearing in the robot frame, ``speed`` / ``v_max`` in [0, 1], and
+    :func:`_lidar`'s ranges [m] (into ``ranges`` (R,); scratch ``ring``, ``dirs``) over
+    ``max_range`` in [0, 1]."""
+    _lidar(x, y, th, rel, max_range, n_obs, prm, st, rings, ring, dirs, ranges)
+    gx, gy = goal_x - x, goal_y - y
+    bearing = math.atan2(gy, gx) - th
+    out[0] = min(pyhypot(gx, gy) / goal_scale, 1.0)
+    out[1] = math.cos(bearing)
+    out[2] = math.sin(bearing)
+    out[3] = min(max(speed / v_max, 0.0), 1.0)
+    for r in range(ranges.shape[0]):
+        out[4 + r] = min(max(ranges[r] / max_range, 0.0), 1.0)
+
+
 def observe_py(
     wf: FloatArray,
     wi: np.ndarray,
@@ -400,10 +437,11 @@ def observe_py(
     and sin of the goal bearing in the robot frame, speed / V_max in [0, 1] (0 once arrived or
     collided), ranges / ``max_range`` in [0, 1] (beams at heading + ``rel`` [rad])."""
     ring = np.empty((2, rings.shape[3]))
+    dirs = np.empty((2, rel.shape[0]))
     for k in range(wf.shape[0]):
         x, y, th = wf[k, W_X], wf[k, W_Y], wf[k, W_TH]
         _lidar(x, y, th, rel, max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ring,
-               ranges[k])  # fmt: skip
+               dirs, ranges[k])  # fmt: skip
         gx, gy = wf[k, W_GX] - x, wf[k, W_GY] - y
         d = pyhypot(gx, gy)
         dist[k] = d
@@ -426,6 +464,7 @@ _PUBLIC = {
     "sense_one": "sense_one_py",
     "clearance_one": "clearance_one_py",
     "lidar": "_lidar",
+    "vector_one": "vector_one_py",
 }
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
@@ -439,7 +478,8 @@ def kernel(name: str) -> Callable[..., Any]:
     if not _KERNELS:
         _KERNELS.update(compile_family([
             wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py, ray_ring_hit_py,
-            _transform_ring, _move_obstacles, _clearance, _lidar, step_worlds_py, observe_py,
+            _transform_ring, _move_obstacles, _clearance, _lidar, vector_one_py, step_worlds_py,
+            observe_py,
             sense_one_py, advance_one_py, clearance_one_py,
         ]))  # fmt: skip
     return _KERNELS[_PUBLIC[name]]
@@ -529,7 +569,7 @@ class PackedWorlds:
         self.wi[:, I_ACTIVE] = 1
         self.wf[:, W_CLEAR] = self.wf[:, W_LOW] = math.inf
         self.rngs: list[list[np.random.Generator | None]] = [[] for _ in range(k)]
-        self._safe_calls = 0  # step() calls before a refill may be needed
+        self.safe_calls = 0  # step() calls before a refill may be needed
         self._templates: dict[tuple[int, ...], tuple[FieldTemplate, list[Any]]] = {}
         self._alloc(0, 2, ROW_BLOCKS * BLOCK)
 
@@ -632,7 +672,7 @@ class PackedWorlds:
             status = SUCCESS
         wi[I_STATUS] = status
         # the slot's rows are full: a top-up is due no sooner for it than for the others
-        self._safe_calls = min(self._safe_calls, b // (2 * ratio))
+        self.safe_calls = min(self.safe_calls, b // (2 * ratio))
 
     def load_obstacles(self, slot: int, obstacles: list[Obstacle], tpl: FieldTemplate,
                        b: int) -> None:  # fmt: skip
@@ -714,15 +754,15 @@ class PackedWorlds:
         self.read[due] += upos[due]
         upos[due] = 0  # (a row without a generator is never read)
         spare = (b - upos) // np.maximum(2 * self.wi[:, I_RATIO, None], 1)
-        self._safe_calls = int(spare.min()) if spare.size else 1 << 30
+        self.safe_calls = int(spare.min()) if spare.size else 1 << 30
 
     def ensure_draws(self) -> None:
         """Top up the rows (:meth:`refill`) when the next call could run one out, and count that
         call: :meth:`step`'s rule, for a caller that steps the slots' arrays itself (one
         integration step a call, as :class:`~uvnav.sim.bodies2d.PackedBodies` does)."""
-        if self._safe_calls <= 0:
+        if self.safe_calls <= 0:
             self.refill()
-        self._safe_calls -= 1
+        self.safe_calls -= 1
 
     def step(self, active: np.ndarray | None = None) -> None:
         """Advance every running world (of the ``active`` (k,) bool slots) by one decision with
@@ -730,7 +770,7 @@ class PackedWorlds:
         if active is not None:
             self.wi[:, I_ACTIVE] = active
         self.ensure_draws()  # its count is replaced by the kernel's, which knows the rows read
-        self._safe_calls = kernel("step")(
+        self.safe_calls = kernel("step")(
             self.wf, self.wi, self.oi, self.params, self.state, self.ubuf, self.rings
         )
         if active is not None:

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -42,8 +42,7 @@ from uvnav.sim.social import APPEARED, GapHistory, blame, robot_closed
 ROT_TOL = 5e-4
 
 
-@dataclass(frozen=True, slots=True)
-class StepPoses:
+class StepPoses(NamedTuple):
     """The bodies and the robot at the start (0) and the end (1) of one step.
 
     Attributes:
@@ -64,6 +63,11 @@ class StepPoses:
     slack: float
 
 
+def _made(poses: StepPoses | Callable[[], StepPoses]) -> StepPoses:
+    """``poses``, made when it is the function making them."""
+    return poses() if callable(poses) else poses
+
+
 class SweptClearance:
     """The closest approach along every step of one robot (module docstring).
 
@@ -82,6 +86,7 @@ class SweptClearance:
         #: the last step's first contact: its poses, the body, the fraction of the step
         self.contact: tuple[StepPoses, int, float] | None = None
         self._kept: list[tuple[float, StepPoses]] = []
+        self._empty = not len(template)
         self._ceiling = math.inf
         self._rings = [
             template.rings[:, row, : int(template.counts[row]) + 1].T.copy()
@@ -111,18 +116,12 @@ class SweptClearance:
         """
         self._ceiling = min(self._ceiling, ceiling)
         self.contact = None
-        if not len(self.template):
+        if self._empty:
             return math.nan
         made = None if callable(poses) else poses
-
-        def get() -> StepPoses:
-            nonlocal made
-            if made is None:
-                made = poses() if callable(poses) else poses
-            return made
-
         if shift is None:
-            c0, c1, h0, h1 = _moving(get())
+            made = _made(poses)
+            c0, c1, h0, h1 = _moving(made)
             spin = np.abs(np.remainder(h1 - h0 + np.pi, 2.0 * np.pi) - np.pi)
             shift = float((np.hypot(*(c1 - c0).T) + spin * self.template.bounding_radii).max())
         reach = travel + shift
@@ -130,11 +129,11 @@ class SweptClearance:
         if made is not None and (made.present0 is not None or made.present1 is not None):
             bound = min(bound, _changed_bound(made, g0, g1, reach))
         if bound < 0.0:  # a contact is possible: now
-            gap, s_hit = self._sweep(get(), collide=True)
+            gap, s_hit = self._sweep(_made(poses) if made is None else made, collide=True)
             self.best = min(self.best, gap)
             return s_hit
         if bound < min(self.best, self._ceiling):
-            self._kept.append((bound, get()))
+            self._kept.append((bound, _made(poses) if made is None else made))
             if len(self._kept) >= self.BATCH:
                 self._flush()
         return math.nan
