@@ -49,10 +49,10 @@ name: tiny
 scenarios: [{generator: random-ch2, seeds: [0, 2]}]
 controllers: [{name: straight-v1}, {name: zhang2019-v1}]
 """
-#: long enough (a few seconds on two CPUs) to kill a node while it runs a task
+#: long enough (a few seconds on two loaded CPUs) to kill a node while it runs a task
 LARGE = """\
 name: large
-scenarios: [{generator: random-ch2, seeds: [0, 40]}]
+scenarios: [{generator: random-ch2, seeds: [0, 120]}]
 controllers: [{name: straight-v1}, {name: zhang2019-v1}]
 """
 COLUMNS = ["scenario", "controller", "params_hash", "seed", "status"]
@@ -252,10 +252,10 @@ def test_two_nodes_equal_local_and_a_dead_node_loses_nothing(
     stdout, stderr = (tmp_path / "out").read_text(), (tmp_path / "err").read_text()
     assert killed_at is not None, f"the campaign ended before the node ran a task: {stderr}"
     assert run.returncode == 0, stderr
-    assert "ran 80 episode(s) (0 error(s))" in stdout
+    assert "ran 240 episode(s) (0 error(s))" in stdout
     assert "(raylet)" not in stdout  # Ray's notices go to stderr, never into --json output
     got = _rows(db)
-    assert killed_at < len(got) == 80
+    assert killed_at < len(got) == 240
     pd.testing.assert_frame_equal(got, _local(tmp_path, LARGE))
 
 

@@ -372,8 +372,10 @@ class EnvWorld:
             one.sense_in_step = False
         if one is not None:  # what the one robot's step reads, as floats
             self._goal_xy = (float(one.goal[0]), float(one.goal[1]))
-            self._limits = (float(one.spec.v_max), float(one.spec.u_max))
             self._unicycle = one.vehicle == "unicycle"
+            # v_max for every vehicle; u_max where the vehicle turns (a plug-in's spec may not)
+            u_max = getattr(one.spec, "u_max", 0.0) if self._unicycle else 0.0
+            self._limits = (float(one.spec.v_max), float(u_max))
 
     # ----------------------------------------------------------------- robot i of either world
     @property
