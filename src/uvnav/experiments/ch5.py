@@ -173,9 +173,9 @@ def ch5_job(
 
 
 def fingerprint() -> str:
-    """The code fingerprint of this experiment's campaigns: the packages that decide an episode,
-    :mod:`uvnav.learning` (the network's locator), this module (its jobs) and
-    :mod:`uvnav.experiments.ch5_bpnn` (the network)."""
+    """The code fingerprint of this experiment's campaigns and stages: the packages that decide
+    an episode, :mod:`uvnav.learning` (the network and its locator), this module (its jobs) and
+    :mod:`uvnav.experiments.ch5_bpnn` (the data sets and learning rows)."""
     return cp.fingerprint("learning", "experiments/ch5.py", "experiments/ch5_bpnn.py")
 
 
