@@ -32,7 +32,7 @@ DESIGN_LAYERS = [
     {"uvnav.sensors", "uvnav.prediction"},
     {"uvnav.dynamics", "uvnav.obstacles"},
     {"uvnav.geometry"},
-    {"uvnav.core", "uvnav.stages"},  # issue 16: the contract every layer reads; the stage cache
+    {"uvnav.core", "uvnav.stages"},  # the contract every layer reads; atomic writes
 ]
 
 

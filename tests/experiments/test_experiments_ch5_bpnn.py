@@ -4,21 +4,33 @@ the same random stream, learning rows as stages, beam ties, the model keys."""
 from __future__ import annotations
 
 import json
+import shutil
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
 
+from uvnav.bench.stages import StageCache, StaleStageError
 from uvnav.experiments import ch5_bpnn as b5
 from uvnav.experiments.ch5_bpnn import cached_dataset
 from uvnav.sensors.sonar_dataset import sample_sonar_dataset
 
 
+def _cache(results: Path, fingerprint: str = "a" * 16, **kw: Any) -> StageCache:
+    return StageCache(results, fingerprint, **kw)
+
+
+def _stage_names(results: Path) -> list[str]:
+    return [s["name"] for s in _cache(results).stored()]
+
+
 def test_cached_dataset_resumes_the_same_data_and_random_stream(tmp_path: Path) -> None:
-    ds, rng = cached_dataset(4, 123, tmp_path)
-    files = sorted(str(p.relative_to(tmp_path)) for p in tmp_path.rglob("*"))
-    assert files == ["data_n4_r123.npz", "stages", "stages/data_n4_r123.json"]
-    again, rng2 = cached_dataset(4, 123, tmp_path)  # read back, nothing sampled
+    ds, rng = cached_dataset(4, 123, _cache(tmp_path))
+    assert _stage_names(tmp_path) == ["ch5-data-n4-r123"]
+    cache = _cache(tmp_path)
+    again, rng2 = cached_dataset(4, 123, cache)  # read back, nothing sampled
+    assert (cache.reused, cache.built) == (["ch5-data-n4-r123"], [])
     np.testing.assert_array_equal(again.ranges, ds.ranges)
     np.testing.assert_array_equal(again.target_index, ds.target_index)
     # one uninterrupted run: sample, then continue with the same generator
@@ -33,53 +45,79 @@ def test_cached_dataset_resumes_the_same_data_and_random_stream(tmp_path: Path) 
 def test_learning_rows_are_stages_built_on_their_data_and_test_set(tmp_path: Path) -> None:
     pytest.importorskip("torch")
     from uvnav.learning.bpnn import BPNNConfig
-    from uvnav.stages import Stages
 
     cfg = BPNNConfig(max_epochs=3)
-    test, _ = cached_dataset(6, 7, tmp_path)
-    row, model, _ = b5.learning_row(12, 0, test, cfg, cache=tmp_path)
-    assert (tmp_path / "model_n12_s0_plain.safetensors").is_file()
-    st = Stages(tmp_path / "stages")
-    again, back, _ = b5.learning_row(12, 0, test, cfg, cache=tmp_path, stages=st)
-    assert st.reused == ["data_n12_r10000", "row_n12_s0_plain"]  # nothing trained again
+    test, _ = cached_dataset(6, 7, _cache(tmp_path))
+    row, model, _ = b5.learning_row(12, 0, test, cfg, cache=_cache(tmp_path))
+    assert len(list(tmp_path.rglob("model.safetensors"))) == 1  # in the row's stage folder
+    cache = _cache(tmp_path)
+    again, back, _ = b5.learning_row(12, 0, test, cfg, cache=cache)
+    assert cache.reused == ["ch5-data-n12-r10000", "ch5-row-n12-s0-plain"]  # nothing trained
+    assert cache.built == []
     assert again == json.loads(json.dumps(row, default=b5.json_default))
     np.testing.assert_array_equal(back.predict(test.inputs), model.predict(test.inputs))
     # another independent test set: the row is measured again on the same data
-    other, _ = cached_dataset(6, 8, tmp_path)
-    st = Stages(tmp_path / "stages")
-    b5.learning_row(12, 0, other, cfg, cache=tmp_path, stages=st)
-    assert st.reused == ["data_n12_r10000"]
-    # the data set sampled again (its stage lost): the row built on it is recomputed too
-    (tmp_path / "stages" / "data_n12_r10000.json").unlink()
-    st = Stages(tmp_path / "stages")
-    b5.learning_row(12, 0, other, cfg, cache=tmp_path, stages=st)
-    assert st.reused == []
+    other, _ = cached_dataset(6, 8, _cache(tmp_path))
+    cache = _cache(tmp_path)
+    b5.learning_row(12, 0, other, cfg, cache=cache)
+    assert (cache.reused, cache.built) == (["ch5-data-n12-r10000"], ["ch5-row-n12-s0-plain"])
+    # the data set sampled again (its stage lost): the row built on it is trained again too
+    for f in (tmp_path / "stages").glob("*/stage.json"):
+        if json.loads(f.read_text())["name"] == "ch5-data-n12-r10000":
+            shutil.rmtree(f.parent)
+    cache = _cache(tmp_path)
+    b5.learning_row(12, 0, other, cfg, cache=cache)
+    assert cache.reused == [] and cache.built == ["ch5-data-n12-r10000", "ch5-row-n12-s0-plain"]
+
+
+def test_a_stage_of_other_code_is_refused_and_fresh_rebuilds_it(tmp_path: Path) -> None:
+    pytest.importorskip("torch")
+    from uvnav.learning.bpnn import BPNNConfig
+
+    cfg = BPNNConfig(max_epochs=3)
+    test, _ = cached_dataset(6, 7, None)
+    first, _, _ = b5.learning_row(12, 0, test, cfg, cache=_cache(tmp_path, "a" * 16))
+    # another code fingerprint: refused in one line naming the stage, nothing trained
+    with pytest.raises(StaleStageError) as err:
+        b5.learning_row(12, 0, test, cfg, cache=_cache(tmp_path, "b" * 16))
+    msg = str(err.value)
+    assert "\n" not in msg and "'ch5-data-n12-r10000'" in msg and "--fresh" in msg
+    fresh = _cache(tmp_path, "b" * 16, fresh=True)
+    again, _, _ = b5.learning_row(12, 0, test, cfg, cache=fresh)
+    assert fresh.reused == [] and fresh.built == ["ch5-data-n12-r10000", "ch5-row-n12-s0-plain"]
+    stored = sorted((s["name"], s["fingerprint"]) for s in _cache(tmp_path).stored())
+    # the data set remade in place; the row on it has new inputs (the data's new id), so the
+    # old row stays under its old key, never reused
+    assert stored == [("ch5-data-n12-r10000", "b" * 16), ("ch5-row-n12-s0-plain", "a" * 16),
+                      ("ch5-row-n12-s0-plain", "b" * 16)]  # fmt: skip
+    drop = ("train_seconds",)  # the same seeds: the same row
+    assert {k: v for k, v in again.items() if k not in drop} == {
+        k: v for k, v in first.items() if k not in drop
+    }
 
 
 def test_the_literal_experiments_rows_are_stages_of_their_own(tmp_path: Path) -> None:
     pytest.importorskip("torch")
     from uvnav.learning.bpnn import BPNNConfig
-    from uvnav.stages import Stages
 
     cfg = BPNNConfig(max_epochs=3)
-    test, _ = cached_dataset(6, 7, tmp_path)
-    geo, _, _ = b5.learning_row(20, 0, test, cfg, cache=tmp_path)
-    st = Stages(tmp_path / "stages")
-    row, model, ds = b5.learning_row(20, 0, test, cfg, cache=tmp_path, stages=st,
-                                     target_kind="readings")  # fmt: skip
-    assert st.reused == ["data_n20_r10000"]  # the same data, a new row (its own stage)
-    assert (tmp_path / "model_n20_s0_plain_readings.safetensors").is_file()
+    test, _ = cached_dataset(6, 7, None)
+    geo, _, _ = b5.learning_row(20, 0, test, cfg, cache=_cache(tmp_path))
+    cache = _cache(tmp_path)
+    row, model, ds = b5.learning_row(20, 0, test, cfg, cache=cache, target_kind="readings")
+    assert cache.reused == ["ch5-data-n20-r10000"]  # the same data, a new row (its own stage)
+    assert cache.built == ["ch5-row-n20-s0-plain-readings"]
     assert (row["targets"], model.target_kind, geo["targets"]) == ("readings",) * 2 + ("geometry",)
     assert row["division"] == [14, 3, 3]  # dividerand: round(0.15 * 20) = 3
     # its errors are against min/argmin of the inputs
     grp = model.split["test"]
     err = ds.inputs[grp].min(axis=1) - model.predict(ds.inputs[grp])[:, 0]
     assert row["test_group"]["network"]["distance"]["lo"] == pytest.approx(err.min())
-    st = Stages(tmp_path / "stages")
-    b5.learning_row(20, 0, test, cfg, cache=tmp_path, stages=st, target_kind="readings")
-    b5.learning_row(20, 0, test, cfg, cache=tmp_path, stages=st)
-    assert st.reused == ["data_n20_r10000", "row_n20_s0_plain_readings", "data_n20_r10000",
-                         "row_n20_s0_plain"]  # fmt: skip
+    cache = _cache(tmp_path)
+    b5.learning_row(20, 0, test, cfg, cache=cache, target_kind="readings")
+    b5.learning_row(20, 0, test, cfg, cache=cache)
+    assert cache.reused == ["ch5-data-n20-r10000", "ch5-row-n20-s0-plain-readings",
+                            "ch5-data-n20-r10000", "ch5-row-n20-s0-plain"]  # fmt: skip
 
 
 def test_beam_ties_names_the_samples_whose_true_sensor_is_not_argmin() -> None:

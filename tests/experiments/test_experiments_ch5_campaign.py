@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -103,14 +104,39 @@ def test_network_jobs_key_on_the_checkpoint_digest() -> None:
     assert "generator" not in ch5_job("thesis-ch5-scene1", "geometric", 0).store_params
 
 
-def test_a_cache_of_the_older_layout_is_dropped(tmp_path: Path) -> None:
-    cache = tmp_path / "ch5" / "cache"
-    cache.mkdir(parents=True)
-    (cache / "row_n50_s0_plain.json").write_text("{}")
-    (cache / "data_n4_r123.rng.json").write_text("{}")
-    with pytest.raises(TypeError):  # stop right after the cache is prepared
-        r5.reproduce_ch5(tmp_path, sizes=(50,), n_test="x", progress=False)  # type: ignore[arg-type]
-    assert sorted(p.name for p in cache.iterdir()) == ["stages"]
+def test_the_stages_resume_under_the_same_code_and_are_remade_under_another(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    pytest.importorskip("torch")
+    from uvnav.bench.stages import StageCache, StaleStageError
+
+    def run(fingerprint: str, **kw: Any) -> tuple[StageCache, Any]:
+        monkeypatch.setattr(r5, "fingerprint", lambda: fingerprint)
+        cache = StageCache(tmp_path, fingerprint, **kw)
+        summary = r5.reproduce_ch5(
+            tmp_path, sizes=(), n_seeds=0, literal_seeds=0, n_random=0, n_test=30, scenes=[],
+            closed_loop_samples=60, progress=False, cache=cache,
+        )  # fmt: skip
+        return cache, summary
+
+    stages = ["ch5-data-n30-r999999", "ch5-data-n60-r10100", "ch5-row-n60-s100-residual"]
+    first, s1 = run("a" * 16)
+    assert first.built == stages and first.reused == []
+    again, s2 = run("a" * 16)  # the same code: every stage resumed, nothing trained
+    assert again.built == [] and again.reused == stages
+    assert s2.learning == s1.learning
+    with ResultsStore(tmp_path / "uvnav.sqlite") as store:  # its campaigns (no episode) go:
+        for name in r5.CAMPAIGNS:  # only the stages are other code's
+            store.delete_campaign(name)
+    with pytest.raises(StaleStageError) as err:  # other code: refused before anything is made
+        run("b" * 16)
+    assert "\n" not in str(err.value) and "--fresh" in str(err.value)
+    remade, s3 = run("b" * 16, fresh=True)  # --fresh: every stage made again by this code
+    assert remade.built == stages and remade.reused == []
+    drop = ("train_seconds",)
+    assert [{k: v for k, v in r.items() if k not in drop} for r in s3.learning] == [
+        {k: v for k, v in r.items() if k not in drop} for r in s1.learning
+    ]
 
 
 def test_ch5_section_shows_the_animation_and_names_failures(tmp_path: Path) -> None:

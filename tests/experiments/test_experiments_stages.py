@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 import uvnav
-from uvnav.bench.stages import STAGE_FILE, STAGES_DIR, StageCache
+from uvnav.bench.stages import STAGE_FILE, STAGES_DIR, StageCache, StaleStageError
 from uvnav.bench.store import StaleCampaignError
 from uvnav.experiments import ExperimentContext, Size, builtin_experiments, run_experiment
 from uvnav.experiments.sections import SECTIONS_DIR
@@ -164,7 +164,7 @@ def test_a_run_over_results_of_other_code_is_refused_in_one_line(
     msg = str(err.value)
     assert "\n" not in msg and err.value.campaigns
     assert all(repr(c) in msg for c in err.value.campaigns), msg
-    if (tmp_path / STAGES_DIR).is_dir():  # a stage: --fresh remakes it
+    if isinstance(err.value, StaleStageError):  # a stage: --fresh remakes it
         assert "--fresh" in msg
         fresh = dataclasses.replace(tiny(name, tmp_path), fresh=True)
         assert run_experiment(name, fresh).sections

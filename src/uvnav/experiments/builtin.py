@@ -102,14 +102,15 @@ def run_ch4(ctx: ExperimentContext) -> ExperimentRun:
 
 
 def run_ch5(ctx: ExperimentContext) -> ExperimentRun:
-    """Chapter 5 (:func:`uvnav.experiments.ch5.reproduce_ch5`) and its section."""
+    """Chapter 5 (:func:`uvnav.experiments.ch5.reproduce_ch5`: its data sets and networks in the
+    results folder's stage cache, its episodes in the store) and its section."""
     from uvnav.experiments.ch5 import reproduce_ch5
 
     s5 = reproduce_ch5(
         ctx.results_dir, **_params(
             ctx, full=ctx.full, progress=ctx.progress, render=ctx.renderers.ch5,
             report_dir=ctx.report_dir, workers=ctx.workers, n_random=ctx.seeds,
-            start_seed=ctx.start_seed,
+            start_seed=ctx.start_seed, fresh=ctx.fresh,
         ),
     )  # fmt: skip
     return _run(sec.ch5_section(s5, full=ctx.full), s5, s5.table)

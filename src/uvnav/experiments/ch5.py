@@ -23,13 +23,14 @@ network, a digest of its checkpoint: part of the resume key, so a different netw
 was entered (the scene runner's facts) go to ``effective_params``.
 
 **Resumable.**  Nothing measured is lost when a run is interrupted: the data sets, learning rows
-and networks are stages under ``results_dir/ch5/cache`` (:mod:`uvnav.experiments.ch5_bpnn`), and
-every random-campaign episode is one transaction of the store; a re-run skips what is there
-(``fresh`` drops the cache; stored episodes are never deleted or replaced by a later run).  A
-cache without ``stages/`` (files ``row_*.json``, ``data_*.rng.json``) is dropped and recomputed
-from the same seeds (the same data; a network trained again to the same weights keeps its
-digest, which covers the weights only, and so its stored episodes).  A campaign stored by other
-code is refused (:class:`~uvnav.bench.store.StaleCampaignError`) before anything is trained.
+and networks are stages of the results folder's stage cache (``results_dir/stages``,
+:mod:`uvnav.experiments.ch5_bpnn`), made by the code of :func:`fingerprint`, and every
+random-campaign episode is one transaction of the store; a re-run skips what is there
+(``fresh`` remakes the stages; stored episodes are never deleted or replaced by a later run, and
+a network trained again to the same weights keeps its digest, which covers the weights only, and
+so its stored episodes).  A campaign stored by other code is refused
+(:class:`~uvnav.bench.store.StaleCampaignError`) before anything is trained, and so is a stage
+made by other code (:class:`~uvnav.bench.stages.StaleStageError`, unless ``fresh``).
 ``results_dir/ch5.json`` (rows, table, per-group summary, failures) and the table
 "thesis reported vs uvnav measured" are computed from the measured rows only.  Figures are drawn
 by a renderer the caller injects (:mod:`uvnav.viz` is a layer above).
@@ -40,7 +41,6 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import json
-import shutil
 import time
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
@@ -50,6 +50,7 @@ from typing import Any
 import uvnav.experiments.campaigns as cp
 from uvnav.bench.campaign import Job, outcome_record, run_job, stored_records
 from uvnav.bench.fingerprint import DB_NAME
+from uvnav.bench.stages import StageCache
 from uvnav.bench.store import FINGERPRINT_KEY, ResultsStore, check_fingerprints
 from uvnav.controllers.zhang_uuv3d import NAME as LAW
 from uvnav.experiments.ch5_bpnn import (
@@ -59,7 +60,6 @@ from uvnav.experiments.ch5_bpnn import (
     QUICK_LITERAL_SEEDS,
     QUICK_SEEDS,
     QUICK_SIZES,
-    STAGES_DIR,
     TEST_SEED,
     VARIANT_KEYS,
     cached_dataset,
@@ -83,7 +83,7 @@ from uvnav.scenarios.ch5 import (
 from uvnav.sim.episode_uuv3d import LocatedTrace
 from uvnav.sim.metrics import METRIC_NAMES
 from uvnav.sim.setup import EpisodeResult
-from uvnav.stages import Stages, write_atomic
+from uvnav.stages import write_atomic
 
 QUICK_RANDOM, FULL_RANDOM = 3, 300
 #: scenes of the harder family beyond the assumptions (``random-ch5-dense``, noise 0 only)
@@ -173,9 +173,9 @@ def ch5_job(
 
 
 def fingerprint() -> str:
-    """The code fingerprint of this experiment's campaigns: the packages that decide an episode,
-    :mod:`uvnav.learning` (the network's locator), this module (its jobs) and
-    :mod:`uvnav.experiments.ch5_bpnn` (the network)."""
+    """The code fingerprint of this experiment's campaigns and stages: the packages that decide
+    an episode, :mod:`uvnav.learning` (the network and its locator), this module (its jobs) and
+    :mod:`uvnav.experiments.ch5_bpnn` (the data sets and learning rows)."""
     return cp.fingerprint("learning", "experiments/ch5.py", "experiments/ch5_bpnn.py")
 
 
@@ -358,13 +358,14 @@ def reproduce_ch5(
     fresh: bool = False,
     start_seed: int = 0,
     literal_seeds: int | None = None,
+    cache: StageCache | None = None,
 ) -> Ch5Summary:
     """Run the Chapter 5 reproduction (module docstring); write ``results_dir/ch5.json`` and the
     closed-loop episodes to ``results_dir/uvnav.sqlite``.  Resumes an interrupted run.
 
     Args:
         results_dir: folder of ``ch5.json``, the results database, the closed-loop network's
-            checkpoint ``ch5_bpnn`` and the resume cache ``ch5/cache``.
+            checkpoint ``ch5_bpnn`` and the stage cache ``stages``.
         full: thesis-size runs (sizes up to 5000, 5 seeds, 300 random scenes, noise 0 and 0.05).
         sizes: sample counts (default 50, 150 quick).
         n_seeds: seeds per sample count (default 2 quick).
@@ -380,12 +381,14 @@ def reproduce_ch5(
             :func:`uvnav.viz.figures_ch5.render_ch5`); ``None`` skips figures.
         report_dir: folder of the figures.
         workers: processes for the random-scene campaigns.
-        fresh: discard the cache first (data sets, learning rows, networks); the stored
-            episodes are kept (a network trained again to the same weights resumes them).
+        fresh: remake the stages (data sets, learning rows, networks; with the default
+            cache); the stored episodes are kept (a network trained again to the same weights
+            resumes them).
         start_seed: first scene of the random families (``random-ch5:<start_seed>`` onwards).
         literal_seeds: seeds of the literal experiment — the plain network on the thesis's
             targets (min/argmin of its inputs) at each of ``sizes`` the thesis reports (50, 150);
             default 20 quick, 50 full.
+        cache: the stage cache (default ``StageCache(results_dir, fingerprint(), fresh=fresh)``).
 
     Additive (:mod:`uvnav.experiments.campaigns`): the thesis scenes run again for the figures'
     trajectories, only missing episodes are stored.
@@ -393,20 +396,18 @@ def reproduce_ch5(
     Raises:
         StaleCampaignError: a stored campaign of this chapter was made by other code (its
             :func:`fingerprint` differs); checked before anything is trained or run.
+        StaleStageError: a stage of these settings was made by other code (and not ``fresh``).
     """
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TimeElapsedColumn
 
     tic = time.perf_counter()
     results_dir = Path(results_dir)
     results_dir.mkdir(parents=True, exist_ok=True)
-    cache = results_dir / "ch5" / "cache"
     db_path = results_dir / DB_NAME
-    if cache.exists() and (fresh or not (cache / STAGES_DIR).is_dir()):
-        shutil.rmtree(cache)  # asked for, or a cache without stages/ (recomputed cleanly)
     fp = fingerprint()
     with ResultsStore(db_path) as store:
         check_fingerprints(store, dict.fromkeys(CAMPAIGNS, fp))  # before any training
-    stages = Stages(cache / STAGES_DIR)
+    cache = cache or StageCache(results_dir, fp, fresh=fresh)
     sizes = tuple(sizes) if sizes is not None else (FULL_SIZES if full else QUICK_SIZES)
     seeds = n_seeds if n_seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
     n_rand = n_random if n_random is not None else (FULL_RANDOM if full else QUICK_RANDOM)
@@ -437,13 +438,13 @@ def reproduce_ch5(
             prog.reset(sampling, total=n, visible=True, description=f"Ch5 sampling {n}")
             return lambda k: prog.update(sampling, completed=k)
 
-        test, _ = cached_dataset(n_test, TEST_SEED, cache, sampler(n_test), stages=stages)
+        test, _ = cached_dataset(n_test, TEST_SEED, cache, sampler(n_test))
         summary.datasets["independent_test"] = test
         for n in sizes:
             for s in range(seeds):
                 for cfg in variants:
                     row, model, ds = learning_row(
-                        n, s, test, cfg, cache=cache, on_sample=sampler(n), stages=stages
+                        n, s, test, cfg, cache=cache, on_sample=sampler(n)
                     )
                     summary.learning.append(row)
                     if s == 0:
@@ -454,7 +455,7 @@ def reproduce_ch5(
         for n in literal_sizes:  # the thesis's set-up: targets computed from the inputs
             for s in range(n_literal):
                 row, _, _ = learning_row(
-                    n, s, test, variants[0], cache=cache, on_sample=sampler(n), stages=stages,
+                    n, s, test, variants[0], cache=cache, on_sample=sampler(n),
                     target_kind="readings",
                 )  # fmt: skip
                 summary.learning.append(row)
@@ -467,7 +468,6 @@ def reproduce_ch5(
             variants[1],
             cache=cache,
             on_sample=sampler(closed_loop_samples),
-            stages=stages,
         )
         prog.update(sampling, visible=False)
         summary.learning.append(cl_row)

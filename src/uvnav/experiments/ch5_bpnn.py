@@ -24,10 +24,12 @@ samples a run agrees with the thesis when it fails too, and "inside the 50-sampl
 counted as agreement.
 
 **Resumable.**  Every sampled data set (with the generator state after sampling, so training
-continues exactly as in one go), every learning row and its trained network are cached as they
-finish — stages of :class:`uvnav.stages.Stages` in ``cache/stages/``, the files written
-atomically; a row is built on its data set's stage and names the independent test set, so new
-data retrain it.  The closed-loop runs that use the network are :mod:`uvnav.experiments.ch5`.
+continues exactly as in one go) and every learning row with its trained network is a stage of
+the results folder's stage cache (:class:`uvnav.bench.stages.StageCache`), keyed by its inputs
+and made by the code of the cache's fingerprint (:func:`uvnav.experiments.ch5.fingerprint`): a
+row's inputs hold its settings, targets and division, its data set's :attr:`~Stage.ref` and the
+digest of the independent test set, so new data retrain it.  The closed-loop runs that use the
+network are :mod:`uvnav.experiments.ch5`.
 """
 
 from __future__ import annotations
@@ -43,6 +45,7 @@ from typing import Any
 
 import numpy as np
 
+from uvnav.bench.stages import Stage, StageCache
 from uvnav.experiments.rows import table_row
 from uvnav.learning.bpnn import (
     ACCEPTED_SAMPLES,
@@ -57,7 +60,7 @@ from uvnav.learning.bpnn import (
     train_bpnn,
 )
 from uvnav.sensors.sonar_dataset import SonarDataset, sample_sonar_dataset
-from uvnav.stages import Stages, write_atomic
+from uvnav.stages import write_atomic
 
 QUICK_SIZES: tuple[int, ...] = (50, 150)
 FULL_SIZES: tuple[int, ...] = (50, 150, 500, 5000)
@@ -95,13 +98,13 @@ def split_model_key(key: str) -> tuple[int, str] | None:
 DATA_SUBDIVISIONS = 2
 #: seed of the independent test set
 TEST_SEED = 999_999
-#: the resume cache's stage records (:class:`uvnav.stages.Stages`), in ``cache/``
-STAGES_DIR = "stages"
+#: the files of a data set's and a learning row's stage, in its folder
+DATA_FILE, MODEL_FILE = "data.npz", "model"
 
 
 def _dataset_stage(n: int, rng_seed: int) -> tuple[str, dict[str, Any]]:
-    """Stage name and key of a sampled data set."""
-    return f"data_n{n}_r{rng_seed}", {
+    """Stage name and inputs of a sampled data set."""
+    return f"ch5-data-n{n}-r{rng_seed}", {
         "n": n,
         "rng_seed": rng_seed,
         "subdivisions": DATA_SUBDIVISIONS,
@@ -111,41 +114,43 @@ def _dataset_stage(n: int, rng_seed: int) -> tuple[str, dict[str, Any]]:
 def cached_dataset(
     n: int,
     rng_seed: int,
-    cache: Path | None = None,
+    cache: StageCache | None = None,
     on_sample: Callable[[int], None] | None = None,
-    *,
-    stages: Stages | None = None,
 ) -> tuple[SonarDataset, np.random.Generator]:
     """``n`` samples drawn with ``default_rng(rng_seed)`` and that generator *after* sampling.
 
-    With ``cache`` the data set is read from / written to ``cache/data_n<n>_r<rng_seed>.npz``
-    and the generator's state is the value of the stage ``data_n<n>_r<rng_seed>`` of ``stages``
-    (default ``Stages(cache / "stages")``), so a resumed run trains on the same data with the same
-    random stream as an uninterrupted one.
+    With ``cache`` the data set is the stage ``ch5-data-n<n>-r<rng_seed>`` (:func:`data_stage`),
+    so a resumed run trains on the same data with the same random stream as an uninterrupted one.
     """
-    rng = np.random.default_rng(rng_seed)
     if cache is None:
-        return sample_sonar_dataset(
-            n, rng, subdivisions=DATA_SUBDIVISIONS, on_sample=on_sample
-        ), rng
-    stages = stages if stages is not None else Stages(cache / STAGES_DIR)
-    name, key = _dataset_stage(n, rng_seed)
-    f = cache / f"{name}.npz"
-    state = stages.get(name, key, (f,))
-    if state is not None:
-        try:
-            with np.load(f, allow_pickle=False) as z:
-                ds = SonarDataset.from_arrays({k: z[k] for k in z.files})
-            rng.bit_generator.state = state
-            return ds, rng
-        except (OSError, ValueError, KeyError, TypeError):
-            stages.reused.remove(name)  # an unreadable file: sample again
-            rng = np.random.default_rng(rng_seed)
-    ds = sample_sonar_dataset(n, rng, subdivisions=DATA_SUBDIVISIONS, on_sample=on_sample)
-    arrays: dict[str, Any] = ds.arrays()
-    write_atomic(f, lambda fh: np.savez(fh, **arrays))
-    stages.put(name, key, rng.bit_generator.state)
+        rng = np.random.default_rng(rng_seed)
+        ds = sample_sonar_dataset(n, rng, subdivisions=DATA_SUBDIVISIONS, on_sample=on_sample)
+        return ds, rng
+    ds, rng, _ = data_stage(cache, n, rng_seed, on_sample)
     return ds, rng
+
+
+def data_stage(
+    cache: StageCache, n: int, rng_seed: int, on_sample: Callable[[int], None] | None = None
+) -> tuple[SonarDataset, np.random.Generator, Stage]:
+    """The data set of :func:`cached_dataset` as a stage of ``cache``: its arrays in
+    ``data.npz``, its value the generator's state after sampling.  Returns the data set read
+    from the stage, the generator in that state, and the stage."""
+    name, inputs = _dataset_stage(n, rng_seed)
+
+    def build(work: Path) -> Any:
+        rng = np.random.default_rng(rng_seed)
+        ds = sample_sonar_dataset(n, rng, subdivisions=DATA_SUBDIVISIONS, on_sample=on_sample)
+        arrays: dict[str, Any] = ds.arrays()
+        write_atomic(work / DATA_FILE, lambda fh: np.savez(fh, **arrays))
+        return rng.bit_generator.state
+
+    stage = cache.run(name, inputs, build)
+    with np.load(stage.folder / DATA_FILE, allow_pickle=False) as z:
+        ds = SonarDataset.from_arrays({k: z[k] for k in z.files})
+    rng = np.random.default_rng(rng_seed)
+    rng.bit_generator.state = stage.value
+    return ds, rng, stage
 
 
 def _dataset_digest(ds: SonarDataset) -> str:
@@ -163,9 +168,8 @@ def learning_row(
     test: SonarDataset,
     config: BPNNConfig | None = None,
     *,
-    cache: Path | None = None,
+    cache: StageCache | None = None,
     on_sample: Callable[[int], None] | None = None,
-    stages: Stages | None = None,
     target_kind: str = "geometry",
 ) -> tuple[dict[str, Any], TrainedBPNN, SonarDataset]:
     """Train on ``n`` fresh samples (seed ``seed``) and measure errors (module docstring).
@@ -174,32 +178,49 @@ def learning_row(
     (the true nearest distance and sensor) or ``"readings"`` (min/argmin of its own inputs, the
     thesis's set-up); both kinds train on the same data set of ``(n, seed)``.
 
-    With ``cache`` the data set, the row and the trained network are kept there (the row is the
-    stage ``row_n<n>_s<seed>_<variant>`` of ``stages``, default ``Stages(cache / "stages")``,
-    the network ``cache/model_n<n>_s<seed>_<variant>``; ``_readings`` appended for the thesis's
-    targets) and reused by a later call with the same settings, targets and division, the same
-    data set stage and the same independent test set (resume).
+    With ``cache`` the data set (:func:`data_stage`) and the row are stages: the row is the
+    stage ``ch5-row-n<n>-s<seed>-<variant>`` (``-readings`` appended for the thesis's targets),
+    its value the row and its network ``model.safetensors`` in its folder, reused by a later call
+    with the same settings, targets and division, the same data set stage and the same
+    independent test set (resume) under the same code fingerprint.
     """
     cfg = config or BPNNConfig()
-    variant = cfg.variant
-    if cache is not None and stages is None:
-        stages = Stages(cache / STAGES_DIR)
-    ds, rng = cached_dataset(n, 10_000 + seed, cache, on_sample, stages=stages)
-    suffix = "" if target_kind == "geometry" else f"_{target_kind}"
-    name = f"row_n{n}_s{seed}_{variant}{suffix}"
-    key: dict[str, Any] = {}
-    if cache is not None and stages is not None:
-        model_base = cache / f"model_n{n}_s{seed}_{variant}{suffix}"
-        key = {
-            "config": asdict(cfg),
-            "targets": target_kind,
-            "division": list(split_sizes(n, cfg.fractions)),  # the toolbox's rounding
-            "data": stages.ref(_dataset_stage(n, 10_000 + seed)[0]),
-            "test": _dataset_digest(test),
-        }
-        row = stages.get(name, key, (model_base.with_suffix(".safetensors"),))
-        if row is not None:
-            return row, load_checkpoint(model_base), ds
+    if cache is None:
+        ds, rng = cached_dataset(n, 10_000 + seed, None, on_sample)
+        row, model = _train_row(n, seed, ds, rng, test, cfg, target_kind)
+        return row, model, ds
+    ds, rng, data = data_stage(cache, n, 10_000 + seed, on_sample)
+    suffix = "" if target_kind == "geometry" else f"-{target_kind}"
+    inputs: dict[str, Any] = {
+        "config": asdict(cfg),
+        "targets": target_kind,
+        "division": list(split_sizes(n, cfg.fractions)),  # the toolbox's rounding
+        "data": data.ref,
+        "test": _dataset_digest(test),
+    }
+    trained: list[TrainedBPNN] = []
+
+    def build(work: Path) -> Any:
+        row, model = _train_row(n, seed, ds, rng, test, cfg, target_kind)
+        save_checkpoint(model, work / MODEL_FILE)
+        trained.append(model)
+        return json.loads(json.dumps(row, default=json_default))
+
+    stage = cache.run(f"ch5-row-n{n}-s{seed}-{cfg.variant}{suffix}", inputs, build)
+    model = trained[0] if trained else load_checkpoint(stage.folder / MODEL_FILE)
+    return dict(stage.value), model, ds
+
+
+def _train_row(
+    n: int,
+    seed: int,
+    ds: SonarDataset,
+    rng: np.random.Generator,
+    test: SonarDataset,
+    cfg: BPNNConfig,
+    target_kind: str,
+) -> tuple[dict[str, Any], TrainedBPNN]:
+    """Train on ``ds`` with ``rng`` and measure the row (:func:`learning_row`)."""
     y = ds.targets(target_kind)
     tic = time.perf_counter()
     model = train_bpnn(ds.inputs, y, rng, cfg, offset=ds.baseline(), target_kind=target_kind)
@@ -212,7 +233,7 @@ def learning_row(
     row = {
         "samples": n,
         "seed": seed,
-        "variant": variant,
+        "variant": cfg.variant,
         "targets": target_kind,
         "division": [len(model.split[g]) for g in ("train", "val", "test")],
         "train_seconds": round(train_s, 3),
@@ -225,10 +246,7 @@ def learning_row(
     }
     if target_kind == "geometry":  # min/argmin of the inputs has no ties to report
         row["test_group_beam_ties"] = beam_ties(ds, grp, pred[grp])
-    if cache is not None and stages is not None:
-        save_checkpoint(model, model_base)
-        stages.put(name, key, json.loads(json.dumps(row, default=json_default)))
-    return row, model, ds
+    return row, model
 
 
 def beam_ties(ds: SonarDataset, group: np.ndarray, predicted: np.ndarray) -> dict[str, Any]:
