@@ -4,11 +4,11 @@ The policy (:mod:`uvnav.learning.crowd_policy`: a set encoder with attention ove
 then a two-layer tanh MLP) reads :func:`~uvnav.controllers.crowd_features.crowd_vector` of its
 observation (the robot's goal-frame state and its ``k`` nearest seen humans, masked) and its
 mean action is the command: a velocity ``V_max a`` in the goal frame, scaled onto the disc of
-radius V_max.  The weights ship with uvnav (``weights/crowd-ppo-v1.safetensors``, a few hundred
-kB; their training record is in the ``.json`` beside them) and run here in numpy (float64, no
-torch), so the law is deterministic and needs only safetensors (``uvnav[learning]``) to load
-them.  It was trained on CrowdNav's circle crossing (train-phase seeds, 5 humans, invisible
-robot); ``k`` may be raised for larger crowds (the attention pools any number of humans).
+radius V_max.  The weights ship with uvnav (``weights/crowd-ppo-v1.safetensors``, 64 kB; their
+training record is in the ``.json`` beside them) and run here in numpy (float64, no torch), so
+the law is deterministic and needs only safetensors (``uvnav[learning]``) to load them.  It was
+trained on CrowdNav's circle crossing (train-phase seeds, 5 humans, invisible robot); ``k`` may
+be changed (the attention pools any number of humans; the weights were trained with 5).
 """
 
 from __future__ import annotations

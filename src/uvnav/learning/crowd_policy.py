@@ -113,10 +113,14 @@ def _curriculum_callback(cfg: TrainConfig) -> Any:
     class Curriculum(BaseCallback):
         """Raises the envs' human count from ``humans_start`` to 5 over the curriculum."""
 
+        n = -1
+
         def _on_step(self) -> bool:
             share = self.num_timesteps / max(cfg.steps * cfg.curriculum, 1.0)
             n = min(5, cfg.humans_start + int(share * (6 - cfg.humans_start)))
-            self.training_env.set_attr("humans", (n, n))
+            if n != self.n:
+                self.training_env.set_attr("humans", (n, n))
+                self.n = n
             return True
 
     return Curriculum()
