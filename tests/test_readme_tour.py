@@ -53,6 +53,7 @@ QUICK: list[tuple[str, str]] = [
     (r"--episodes \d+", "--episodes 2"),
     (r"--epochs \d+", "--epochs 1"),
     (r"--rounds \d+", "--rounds 1"),
+    (r"--steps \d+", "--steps 512"),  # uvnav crowd train: a few PPO updates
     (r"^(uvnav view .*)--speed \S+", r"\1--speed 50 --once --port 0"),
     (r"^(uvnav ros2 run .*)$", r"timeout --preserve-status -k 10 -s TERM 5 \1"),
     (r"^\.venv/bin/python ", "{python} "),

@@ -4,8 +4,9 @@ This module holds the root app, its ``--version`` / ``--debug`` options and ``uv
 every other command lives in its own module (:mod:`uvnav.cli.scenarios`,
 :mod:`uvnav.cli.controllers`, :mod:`uvnav.cli.bench`, :mod:`uvnav.cli.report`,
 :mod:`uvnav.cli.reproduce`, :mod:`uvnav.cli.recon`, :mod:`uvnav.cli.drive`,
-:mod:`uvnav.cli.sonar`) and is registered here, in the order ``uvnav --help`` lists them.  Helpers
-several command modules share are in :mod:`uvnav.cli.common`, which imports no command module.
+:mod:`uvnav.cli.sonar`, :mod:`uvnav.cli.crowd`) and is registered here, in the order ``uvnav
+--help`` lists them.  Helpers several command modules share are in :mod:`uvnav.cli.common`, which
+imports no command module.
 
 Commands parse their arguments, call the library and print with rich (or plain JSON/YAML where the
 output is meant for machines).  Errors take one path, :class:`~uvnav.cli.errors.UvnavGroup`: a
@@ -39,6 +40,7 @@ from uvnav.cli.common import fmt as _fmt
 from uvnav.cli.common import optional as _optional
 from uvnav.cli.common import text as _text
 from uvnav.cli.controllers import controllers_app
+from uvnav.cli.crowd import crowd_app
 from uvnav.cli.drive import drive_app
 from uvnav.cli.errors import DEBUG_KEY, CliError, uvnav_typer
 from uvnav.cli.mcap import close_episode, open_episode
@@ -62,6 +64,7 @@ app.add_typer(controllers_app, name="controllers")
 app.add_typer(recon_app, name="recon")
 app.add_typer(drive_app, name="drive")
 app.add_typer(sonar_app, name="sonar")
+app.add_typer(crowd_app, name="crowd")
 app.add_typer(ros2_app, name="ros2")
 
 

@@ -105,7 +105,7 @@ BUILTIN_MODULES_BY_VEHICLE: dict[str, tuple[str, ...]] = {
     "unicycle": BUILTIN_MODULES,
     "vehicle3d": ("zhang2020_3d", "apf3d", "vo3d", "zhang_uuv3d"),
     "uuv2d": ("zhang2022_uuv2d", "uuv2d_baselines"),
-    "holonomic": ("holonomic", "zhang2019_v2"),
+    "holonomic": ("holonomic", "zhang2019_v2", "crowd_ppo"),
 }
 _ENTRY_POINTS_LOADED = False
 

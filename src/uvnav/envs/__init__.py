@@ -8,6 +8,8 @@
 * :class:`uvnav.envs.nav2d_vec.Nav2DVectorEnv`: ``uvnav/Nav2D-v0`` batched, K worlds in one
   compiled step (``gymnasium.make_vec("uvnav/Nav2D-v0", num_envs=K,
   vectorization_mode="vector_entry_point")``).
+* :class:`uvnav.envs.crowd.CrowdNavEnv`: CrowdNav's circle crossing for learning a crowd law
+  (train-phase seeds, holonomic robot, the goal-frame crowd observation; not registered).
 * :func:`as_policy`: any uvnav controller as a policy for them.
 
 gymnasium and pettingzoo (``uvnav[envs]``) are imported only when an env class is used.

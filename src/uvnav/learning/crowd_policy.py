@@ -1,0 +1,219 @@
+"""Training the learned crowd law ``crowd-ppo-v1``: PPO (stable-baselines3) with a set encoder.
+
+The policy reads :func:`uvnav.controllers.crowd_features.crowd_vector` (the robot's goal-frame
+state and its ``k`` nearest seen humans, masked) through :class:`SetAttentionExtractor`: each
+human, concatenated with the robot's state, goes through a two-layer ReLU MLP (an embedding); a
+small MLP scores each embedding; a softmax over the seen humans' scores (empty slots weigh 0)
+pools the embeddings; the features are the robot's state and the pooled embedding (the
+attention-over-humans of SARL, Chen et al., ICRA 2019, as PPO's shared features).  PPO's actor
+and critic are two-layer tanh MLPs on them; the law acts with the actor's mean
+(:mod:`uvnav.controllers.crowd_ppo` runs it in numpy from the exported weights).
+
+:func:`train_crowd_policy` trains on :class:`uvnav.envs.crowd.CrowdNavEnv` (train-phase cases of
+CrowdNav's circle crossing) and :func:`export_policy` writes the actor's weights as safetensors
+with a JSON header (config + training record: seed, steps, CPU time, reward, curriculum).
+"""
+
+from __future__ import annotations
+
+import json
+import time
+from dataclasses import asdict, dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from uvnav.controllers.crowd_features import HUMAN_DIM, ROBOT_DIM
+from uvnav.controllers.crowd_ppo import FORMAT, WEIGHT_NAMES, PolicyConfig
+from uvnav.stages import write_atomic
+
+
+def _torch() -> Any:
+    import torch
+
+    return torch
+
+
+def _sb3() -> Any:
+    try:
+        import stable_baselines3
+    except ImportError as exc:
+        raise ImportError(
+            "training the crowd policy needs stable-baselines3: pip install 'uvnav[learning]'"
+        ) from exc
+    return stable_baselines3
+
+
+def make_extractor_class() -> type:
+    """:class:`SetAttentionExtractor`, defined once torch and stable-baselines3 are imported."""
+    torch = _torch()
+    nn = torch.nn
+    from stable_baselines3.common.torch_layers import BaseFeaturesExtractor
+
+    class SetAttentionExtractor(BaseFeaturesExtractor):
+        """Per-human MLP + masked attention pooling (module docstring)."""
+
+        def __init__(self, observation_space: Any, k: int = 5, embed: int = 64, score: int = 32):
+            super().__init__(observation_space, features_dim=ROBOT_DIM + embed)
+            self.k = k
+            self.embed = nn.Sequential(
+                nn.Linear(ROBOT_DIM + HUMAN_DIM, embed), nn.ReLU(),
+                nn.Linear(embed, embed), nn.ReLU(),
+            )  # fmt: skip
+            self.score = nn.Sequential(nn.Linear(embed, score), nn.ReLU(), nn.Linear(score, 1))
+
+        def forward(self, x: Any) -> Any:
+            robot = x[:, :ROBOT_DIM]
+            slots = x[:, ROBOT_DIM:].reshape(x.shape[0], self.k, HUMAN_DIM + 1)
+            humans, mask = slots[..., :HUMAN_DIM], slots[..., HUMAN_DIM]
+            pair = torch.cat([robot.unsqueeze(1).expand(-1, self.k, -1), humans], dim=-1)
+            e = self.embed(pair)
+            s = self.score(e).squeeze(-1).masked_fill(mask < 0.5, -1e9)
+            w = torch.softmax(s, dim=-1) * mask
+            return torch.cat([robot, (w.unsqueeze(-1) * e).sum(dim=1)], dim=-1)
+
+    return SetAttentionExtractor
+
+
+@dataclass(frozen=True)
+class TrainConfig:
+    """What a training run is given (all of it is kept in the training record).
+
+    Attributes:
+        steps: PPO's environment steps in all.
+        seed: seed of PPO, its envs and the drawn cases.
+        n_envs: envs stepped together.
+        k: human slots of the observation.
+        humans_start: humans per scene at the start of a linear curriculum to 5 over the first
+            ``curriculum`` share of the steps (5: no curriculum).
+        curriculum: share of the steps the curriculum lasts.
+        n_steps, batch_size, epochs, learning_rate, gamma, gae_lambda, ent_coef: PPO's
+            (the learning rate falls linearly to 0 over the run).
+    """
+
+    steps: int = 1_000_000
+    seed: int = 0
+    n_envs: int = 8
+    k: int = 5
+    humans_start: int = 5
+    curriculum: float = 0.3
+    n_steps: int = 256
+    batch_size: int = 256
+    epochs: int = 10
+    learning_rate: float = 3e-4
+    gamma: float = 0.99
+    gae_lambda: float = 0.95
+    ent_coef: float = 0.0
+
+
+def _curriculum_callback(cfg: TrainConfig) -> Any:
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class Curriculum(BaseCallback):
+        """Raises the envs' human count from ``humans_start`` to 5 over the curriculum."""
+
+        n = -1
+
+        def _on_step(self) -> bool:
+            share = self.num_timesteps / max(cfg.steps * cfg.curriculum, 1.0)
+            n = min(5, cfg.humans_start + int(share * (6 - cfg.humans_start)))
+            if n != self.n:
+                self.training_env.set_attr("humans", (n, n))
+                self.n = n
+            return True
+
+    return Curriculum()
+
+
+def train_crowd_policy(cfg: TrainConfig, *, log: Any = None) -> tuple[Any, dict[str, Any]]:
+    """Train PPO on :class:`~uvnav.envs.crowd.CrowdNavEnv`; returns ``(model, record)``.
+
+    ``log``: a callable given one line per PPO update (steps, mean return, success share) or
+    ``None``.
+    """
+    torch = _torch()
+    sb3 = _sb3()
+    from stable_baselines3.common.env_util import make_vec_env
+
+    from uvnav.envs.crowd import CROWD_REWARD, CrowdNavEnv
+
+    torch.set_num_threads(1)
+    cpu0, wall0 = time.process_time(), time.perf_counter()
+    n0 = min(cfg.humans_start, 5)
+    env = make_vec_env(CrowdNavEnv, n_envs=cfg.n_envs, seed=cfg.seed,
+                       env_kwargs={"k": cfg.k, "n_humans": (n0, n0)})  # fmt: skip
+    model = sb3.PPO(
+        "MlpPolicy", env, n_steps=cfg.n_steps, batch_size=cfg.batch_size, n_epochs=cfg.epochs,
+        learning_rate=lambda left: cfg.learning_rate * left, gamma=cfg.gamma,
+        gae_lambda=cfg.gae_lambda, ent_coef=cfg.ent_coef, seed=cfg.seed, device="cpu", verbose=0,
+        policy_kwargs={
+            "features_extractor_class": make_extractor_class(),
+            "features_extractor_kwargs": {"k": cfg.k},
+            "net_arch": {"pi": [64, 64], "vf": [64, 64]},
+        },
+    )  # fmt: skip
+    callbacks = [_curriculum_callback(cfg), _progress_callback(log)]
+    model.learn(total_timesteps=cfg.steps, callback=callbacks)
+    env.close()
+    record = {
+        "algorithm": "PPO (stable-baselines3 " + sb3.__version__ + ")",
+        "env": "CrowdNavEnv: crowdnav-circle, train phase (seeds 2000 + case), holonomic robot, "
+        "invisible to ORCA humans",
+        "train": asdict(cfg),
+        "reward": asdict(CROWD_REWARD),
+        "timesteps": int(model.num_timesteps),
+        "cpu_seconds": round(time.process_time() - cpu0, 1),
+        "wall_seconds": round(time.perf_counter() - wall0, 1),
+        "torch": torch.__version__,
+    }
+    return model, record
+
+
+def _progress_callback(log: Any) -> Any:
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class Progress(BaseCallback):
+        """One line per rollout: steps, episodes, success / collision / timeout shares."""
+
+        def __init__(self) -> None:
+            super().__init__()
+            self.counts: dict[str, int] = {}
+
+        def _on_step(self) -> bool:
+            for info, done in zip(self.locals["infos"], self.locals["dones"], strict=True):
+                if done:
+                    s = str(info.get("status"))
+                    self.counts[s] = self.counts.get(s, 0) + 1
+            return True
+
+        def _on_rollout_end(self) -> None:
+            n = sum(self.counts.values())
+            if log is not None and n:
+                shares = " ".join(f"{k} {v / n:.2f}" for k, v in sorted(self.counts.items()))
+                log(f"steps {self.num_timesteps} episodes {n} {shares}")
+            self.counts = {}
+
+    return Progress()
+
+
+def actor_weights(model: Any) -> dict[str, np.ndarray]:
+    """The actor's weights (features extractor, policy MLP, action mean) as float32 numpy
+    arrays named by :data:`uvnav.controllers.crowd_ppo.WEIGHT_NAMES`."""
+    state = model.policy.state_dict()
+    return {
+        name: state[name].detach().cpu().numpy().astype(np.float32).copy() for name in WEIGHT_NAMES
+    }
+
+
+def export_policy(model: Any, record: dict[str, Any], path: Path | str, k: int) -> Path:
+    """Write the actor's weights (safetensors; header under metadata key ``uvnav``) and the
+    header's JSON copy beside them; returns ``path``."""
+    from safetensors.numpy import save
+
+    path = Path(path)
+    header = {"format": FORMAT, "config": asdict(PolicyConfig(k=k)), "record": record}
+    text = json.dumps(header, sort_keys=True)
+    write_atomic(path, save(actor_weights(model), metadata={"uvnav": text}))
+    write_atomic(path.with_suffix(".json"), (json.dumps(header, indent=2) + "\n").encode())
+    return path
