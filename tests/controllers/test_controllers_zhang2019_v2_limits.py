@@ -149,5 +149,6 @@ def test_the_ideal_vehicle_does_not_read_the_spread() -> None:
         law = Zhang2019V2(Zhang2019V2Params(limited_spread=spread))
         res = run_episode(build_episode(scn, 7), law, kinds()["nav2d"].episode_rng(7),
                           vehicle="unicycle")  # fmt: skip
+        assert res.trajectory is not None
         paths.append(res.trajectory.robot)
     assert np.array_equal(paths[0], paths[1])
