@@ -175,12 +175,22 @@ def path_risk(
     comfort: float,
     comfort_horizon: float,
     margin: float,
+    spread: float = 0.0,
 ) -> tuple[FloatArray, FloatArray]:
     """``(ttc, pen)`` per path (:func:`uvnav.geometry.contact.candidate_risk`'s numbers for a
     path of straight segments): the first contact [s] within ``horizon`` of the robot, moving
     along each segment of ``xy`` (K, S + 1, 2) at constant velocity between ``times`` (S + 1,),
     with the discs (centres ``q``, velocities ``w``, radius sums ``reach``) moving at constant
-    velocity; and the largest ``comfort - gap`` over [0, ``comfort_horizon``] (0 when none)."""
+    velocity, each disc's reach grown by ``spread`` [m/s] times the end time of the segment
+    (where a body may be once it changes its velocity); and the largest ``comfort - gap`` over
+    [0, ``comfort_horizon``] (0 when none).
+
+    >>> t = np.array([0.0, 1.0, 2.0])
+    >>> xy = np.zeros((1, 3, 2))  # standing at the origin
+    >>> disc = (np.array([[3.0, 0.0]]), np.array([[-1.0, 0.0]]), np.array([1.0]))
+    >>> [round(float(path_risk(t, xy, disc, 4.0, 0.0, 1.0, 0.0, g)[0][0]), 6) for g in (0, 0.5)]
+    [2.0, 1.0]
+    """
     q, w, reach = discs
     k = xy.shape[0]
     if not len(q):
@@ -190,7 +200,8 @@ def path_risk(
     vel = np.diff(xy, axis=1) / h[None, :, None]
     rel = q[None, None] + w[None, None] * t0[None, :, None, None] - xy[:, :-1, None, :]
     rel_vel = vel[:, :, None, :] - w[None, None]
-    t = first_contact(rel, rel_vel, reach[None, None, :], seg_h[None, :, None], margin)
+    grown = reach[None, None, :] + spread * (t0 + h)[None, :, None]
+    t = first_contact(rel, rel_vel, grown, seg_h[None, :, None], margin)
     ttc = (t0[None, :, None] + t).min(axis=(1, 2))
     near = t0 < comfort_horizon
     c_h = np.minimum(h[near], comfort_horizon - t0[near])

@@ -85,8 +85,12 @@ says nothing; the choices made here (:mod:`uvnav.controllers.zhang2019_limits`):
   ramping between decisions, in substeps of at most ``rollout_step``, on arcs whatever the
   vehicle's kinematics (turn-then-move turns a period's worth at once: centimetres apart); the
   path's segments are
-  checked against every body in closed form, as on the ideal vehicle.  Standing still is
-  braking at a, turning toward T as the turn rate allows.
+  checked against every body in closed form, as on the ideal vehicle, each body's reach grown
+  by ``limited_spread`` times the segment's end time: a robot that cannot sidestep at once
+  keeps clear of where a body may be once others bend its path, not only of where its
+  constant velocity takes it (20 humans on CrowdNav's circle, cases 0-49: 19 -> 26 successes
+  with 0.1 m/s; 0.25 m/s blocks the way, 10).  Standing still is braking at a, turning toward
+  T as the turn rate allows.
 * The command is kept within the dynamic window of one period T (the last one measured):
   speed within v +- a T, turn rate within u +- B T, so that the vehicle reaches it by the next
   decision; the turn is the sliding-mode law slowed to a rate that can still be stopped at the
@@ -197,6 +201,9 @@ class Zhang2019V2Params:
         track_accel_std: the filter's assumed white-noise acceleration of a body [m/s^2].
         rollout_step: longest substep [s] of the paths checked on a vehicle with acceleration
             limits (module docstring, "Acceleration limits").
+        limited_spread: on a vehicle with acceleration limits, how fast [m/s] each body's reach
+            grows with the look-ahead time of a path's check (module docstring, "Acceleration
+            limits"); the ideal vehicle's decision does not read it.
         w_social: weight [1/s] of the social term (module docstring, "Social comfort"): a
             candidate pays ``w_social`` per metre by which its path over ``social_horizon`` [s]
             comes closer than ``social_band`` [m] beyond the radius sum to where a moving body
@@ -220,6 +227,7 @@ class Zhang2019V2Params:
     track_position_std: float = 0.1
     track_accel_std: float = 1.0
     rollout_step: float = 0.125
+    limited_spread: float = 0.1
     w_social: float = 0.0
     social_horizon: float = 2.0
     social_forecast: float = 1.25
@@ -246,6 +254,7 @@ class Zhang2019V2Params:
                 "w_change",
                 "comfort",
                 "w_comfort",
+                "limited_spread",
                 "w_social",
                 "social_band",
             ),
@@ -609,7 +618,7 @@ def plan_limited(
     times, xy, speeds = rollout(np.asarray(obs.pose, dtype=float), now[0], now[1], ang, spd,
                                 model, p.horizon, p.rollout_step)  # fmt: skip
     ttc, pen = path_risk(times, xy, (q, w, reach), p.horizon, p.comfort, p.comfort_horizon,
-                         p.safety_margin)  # fmt: skip
+                         p.safety_margin, p.limited_spread)  # fmt: skip
     brakes = stoppable(times, xy, speeds, ttc, model)
     soc = (
         path_social(times, xy, (q, w, reach), p.social_horizon, p.social_forecast, p.social_band)

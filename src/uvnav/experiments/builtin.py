@@ -208,8 +208,8 @@ SIZES: dict[str, dict[str, Size]] = {
         "full": Size("500 CrowdNav test cases per scene (the test set), every 2D law", 500),
     },
     "regime": {
-        "quick": Size("15 seeds per regime and law", 15),
-        "full": Size("60 seeds per regime and law", 60),
+        "quick": Size("30 seeds per regime and law", 30),
+        "full": Size("100 seeds per regime and law", 100),
     },
     "ch3": {
         "quick": Size("thesis scenes, 2 random scenes, prediction study", 2),

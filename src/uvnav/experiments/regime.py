@@ -16,6 +16,16 @@ point, the robot from (0, -4) to (0, 4) at V_max 1 m/s, 24 s) over a grid of reg
   estimated: :mod:`uvnav.sensors.scan_bodies`), for the robot visible or not as
   :data:`LIDAR_VISIBLE` says,
 
+and, in a slice at the default regime (humans at V_max, robot invisible, exact sensing: CrowdNav's
+protocol) rather than across the whole grid, two more axes:
+
+* crowd size :data:`LARGE_CROWD` (20 humans on the same circle);
+* vehicle limits: the unicycle ideal (speed and turn rate follow the command at once) or
+  acceleration-limited (:data:`ACCEL_MAX`, :data:`TURN_ACCEL_MAX`: ``UnicycleSpec.accel_max``,
+  ``turn_accel_max``) at :data:`LIMITED_DENSITIES`; only the laws whose vehicle keeps those
+  limits run there (:func:`keeps_limits`: the unicycle laws; the holonomic robot has none, and
+  would repeat its ideal cell),
+
 with the same ``seeds`` test cases in every cell (:data:`QUICK_SEEDS` in ``uvnav run``,
 :data:`FULL_SEEDS` with ``--full``), in one campaign :data:`CAMPAIGN` of the results store (the
 campaign machinery: resumable, fingerprinted like Chapter 2's).  Every law runs in every cell,
@@ -71,7 +81,18 @@ LIDAR_BEAMS, LIDAR_NOISE, LIDAR_RANGE = 360, 0.01, 5.0
 LIDAR_VISIBLE: tuple[bool, ...] = (False,)
 #: the robot's V_max in these scenes [m/s] (CrowdNav's robot ``v_pref``)
 V_MAX = 1.0
-QUICK_SEEDS, FULL_SEEDS = 15, 60
+#: the slice of the vehicle-limits and crowd-size axes: one speed ratio, the robot invisible,
+#: exact sensing (module docstring)
+SLICE_SPEED = 1.0
+#: the large crowd of the slice (CrowdSim's rule cannot place 20 humans apart on the 4 m circle
+#: for a few cases: those seeds are left out of that cell, :func:`placeable`)
+LARGE_CROWD = 20
+#: the acceleration-limited unicycle of the slice: speed [m/s^2] and turn-rate [rad/s^2] limits
+#: (|dv| <= 0.1 m/s per 0.1 s)
+ACCEL_MAX, TURN_ACCEL_MAX = 1.0, 2.0
+#: the crowds of the slice run on the acceleration-limited unicycle
+LIMITED_DENSITIES: tuple[int, ...] = (4, 7, 10, LARGE_CROWD)
+QUICK_SEEDS, FULL_SEEDS = 30, 100
 #: a rate on fewer episodes than this is flagged as a small sample
 SMALL_SAMPLE = 30
 
@@ -79,13 +100,15 @@ SMALL_SAMPLE = 30
 @dataclass(frozen=True, order=True)
 class Regime:
     """One cell of the grid: humans, their speed / V_max, robot visible, sensing noise [m],
-    and whether the robot senses by lidar alone (then ``noise`` is 0)."""
+    whether the robot senses by lidar alone (then ``noise`` is 0), and whether the unicycle has
+    acceleration limits (:data:`ACCEL_MAX`, :data:`TURN_ACCEL_MAX`)."""
 
     n_humans: int
     speed_ratio: float
     visible: bool
     noise: float
     lidar: bool = False
+    limited: bool = False
 
     def generator_params(self) -> dict[str, Any]:
         """Keyword arguments of the ``crowdnav-circle`` generator for this cell."""
@@ -101,6 +124,8 @@ class Regime:
                 bodies="lidar", velocities="estimated", lidar_beams=LIDAR_BEAMS,
                 lidar_noise=LIDAR_NOISE, sensing_range=LIDAR_RANGE,
             )  # fmt: skip
+        if self.limited:
+            p.update(accel_max=ACCEL_MAX, turn_accel_max=TURN_ACCEL_MAX)
         return p
 
     @property
@@ -122,12 +147,20 @@ class Regime:
         return "exact sensing" if self.noise == 0 else f"noise {self.noise:g} m"
 
     @property
+    def vehicle(self) -> str:
+        """``"ideal vehicle"`` or ``"accel-limited 1 m/s², 2 rad/s²"``."""
+        if not self.limited:
+            return "ideal vehicle"
+        return f"accel-limited {ACCEL_MAX:g} m/s², {TURN_ACCEL_MAX:g} rad/s²"
+
+    @property
     def label(self) -> str:
-        """``"8 humans, speed 1.5 V_max, invisible robot, exact sensing"``."""
+        """``"8 humans, speed 1.5 V_max, invisible robot, exact sensing"``, with
+        ``", accel-limited 1 m/s², 2 rad/s²"`` on a vehicle with limits."""
         seen = "visible" if self.visible else "invisible"
         return (
             f"{self.n_humans} humans, speed {self.speed_ratio:g} V_max, {seen} robot, "
-            f"{self.sensing}"
+            f"{self.sensing}" + (f", {self.vehicle}" if self.limited else "")
         )
 
 
@@ -137,9 +170,13 @@ def regimes(
     visible: Sequence[bool] = VISIBLE,
     noises: Sequence[float] = NOISES,
     lidar_visible: Sequence[bool] = LIDAR_VISIBLE,
+    large: Sequence[int] = (LARGE_CROWD,),
+    limited: Sequence[int] = LIMITED_DENSITIES,
 ) -> list[Regime]:
     """The grid, visible and sensing outermost (the report's panels), then speed, then density;
-    the lidar cells (for the visibilities of ``lidar_visible``) after the others."""
+    the lidar cells (for the visibilities of ``lidar_visible``) after the others; then the slice
+    (module docstring): the crowds of ``large`` on the ideal vehicle and those of ``limited`` on
+    the acceleration-limited one, at :data:`SLICE_SPEED`, robot invisible, exact sensing."""
     cells = [
         Regime(int(n), float(s), bool(v), float(z))
         for v in visible
@@ -153,11 +190,41 @@ def regimes(
         for s in speed_ratios
         for n in densities
     ]
-    return cells + lidar
+    slice_ = [Regime(int(n), SLICE_SPEED, False, 0.0) for n in large]
+    slice_ += [Regime(int(n), SLICE_SPEED, False, 0.0, limited=True) for n in limited]
+    return cells + lidar + slice_
+
+
+def keeps_limits(law: str) -> bool:
+    """Whether ``law``'s vehicle keeps the acceleration limits of the limited cells (a unicycle
+    does; the holonomic robot has none)."""
+    from uvnav.controllers.base import controller_info
+    from uvnav.dynamics.unicycle import UnicycleSpec
+    from uvnav.dynamics.vehicles import make_vehicle
+
+    spec = UnicycleSpec(V_MAX, 1.0, accel_max=ACCEL_MAX, turn_accel_max=TURN_ACCEL_MAX)
+    return not getattr(make_vehicle(controller_info(law).vehicle, spec).spec, "ideal", True)
+
+
+def placeable(cell: Regime, seed: int) -> bool:
+    """Whether CrowdSim's rule places the cell's humans apart for test case ``seed`` (always
+    for the grid's densities; a few cases of :data:`LARGE_CROWD` humans fail)."""
+    from uvnav.scenarios.crowdnav import crowdnav_scenario
+    from uvnav.scenarios.errors import ScenarioError
+
+    if cell.n_humans <= max(DENSITIES):
+        return True
+    try:
+        crowdnav_scenario(seed, rule="circle_crossing", **cell.generator_params())
+    except ScenarioError:
+        return False
+    return True
 
 
 def regime_jobs(laws: Sequence[str], cells: Sequence[Regime], seeds: range) -> list[Job]:
-    """One job per cell, seed and law; every law beyond its assumptions (module docstring)."""
+    """One job per cell, seed and law, every law beyond its assumptions (module docstring); a
+    limited cell's laws are those that keep its limits, a cell's seeds those it can place."""
+    keeps = {law: keeps_limits(law) for law in laws}
     return [
         Job(
             controller=law,
@@ -169,7 +236,9 @@ def regime_jobs(laws: Sequence[str], cells: Sequence[Regime], seeds: range) -> l
         )
         for cell in cells
         for g in seeds
+        if placeable(cell, g)
         for law in laws
+        if keeps[law] or not cell.limited
     ]
 
 
@@ -222,7 +291,9 @@ def run_regime_map(
     cfg = {
         "generator": GENERATOR,
         "controllers": run_laws,
-        "cells": [[c.n_humans, c.speed_ratio, c.visible, c.noise, c.lidar] for c in grid],
+        "cells": [
+            [c.n_humans, c.speed_ratio, c.visible, c.noise, c.lidar, c.limited] for c in grid
+        ],
         "v_max": V_MAX,
         "beyond_assumptions": True,
         "fingerprint": code_fingerprint(),
@@ -326,9 +397,10 @@ def cell_stats(store: ResultsStore) -> dict[Regime, list[CellStats]]:
 
 
 def _regime(row: Sequence[Any]) -> Regime:
-    """A stored cell ``[n, speed ratio, visible, noise(, lidar)]``."""
+    """A stored cell ``[n, speed ratio, visible, noise(, lidar(, limited))]``."""
     lidar = bool(row[4]) if len(row) > 4 else False
-    return Regime(int(row[0]), float(row[1]), bool(row[2]), float(row[3]), lidar)
+    limited = bool(row[5]) if len(row) > 5 else False
+    return Regime(int(row[0]), float(row[1]), bool(row[2]), float(row[3]), lidar, limited)
 
 
 @dataclass(frozen=True)
@@ -358,6 +430,7 @@ def sensing_costs(stats_by_cell: dict[Regime, list[CellStats]]) -> list[SensingC
             c
             for c in stats_by_cell
             if not c.lidar
+            and not c.limited
             and (c.n_humans, c.speed_ratio, c.visible)
             == (cell.n_humans, cell.speed_ratio, cell.visible)
         ]
@@ -486,6 +559,7 @@ def leaders(stats_by_cell: dict[Regime, list[CellStats]]) -> list[dict[str, str]
                 "regime": (
                     f"{cell.n_humans} × {cell.speed_ratio:g} V_max, "
                     f"{'visible' if cell.visible else 'invisible'}, {cell.sensing}"
+                    + (f", {cell.vehicle}" if cell.limited else "")
                 ),
                 "best": _name(top),
                 "success": _pct(top.success),
@@ -500,11 +574,11 @@ def law_lines(stats_by_cell: dict[Regime, list[CellStats]]) -> list[str]:
     """ "Which law, where" in a few lines: per panel of the map (robot visible or not, sensing)
     the law that is best or tied best (:func:`ranking`) in the most of its regimes, with how
     many; empty without a stored map."""
-    panels: dict[tuple[bool, bool, float], list[Regime]] = {}
+    panels: dict[tuple[bool, bool, bool, float], list[Regime]] = {}
     for cell in stats_by_cell:
-        panels.setdefault((cell.visible, cell.lidar, cell.noise), []).append(cell)
+        panels.setdefault((cell.limited, cell.visible, cell.lidar, cell.noise), []).append(cell)
     lines = []
-    for (visible, lidar, noise), cells in sorted(panels.items()):
+    for (limited, visible, lidar, noise), cells in sorted(panels.items()):
         wins: dict[str, int] = {}
         for c in cells:
             for s in ranking(stats_by_cell[c])[0]:
@@ -513,10 +587,11 @@ def law_lines(stats_by_cell: dict[Regime, list[CellStats]]) -> list[str]:
             continue
         top = max(wins.values())
         laws = sorted(law for law, k in wins.items() if k == top)
-        sensing = Regime(0, 0.0, visible, noise, lidar).sensing
+        panel = Regime(0, 0.0, visible, noise, lidar, limited)
         shown = ", ".join(laws[:2]) + (f" +{len(laws) - 2}" if len(laws) > 2 else "")
         seen = "visible" if visible else "invisible"
-        lines.append(f"  {seen} robot, {sensing}: {shown} ({top}/{len(cells)})")
+        vehicle = f", {panel.vehicle}" if limited else ""
+        lines.append(f"  {seen} robot, {panel.sensing}{vehicle}: {shown} ({top}/{len(cells)})")
     if lines:
         lines.insert(0, "which law, where (regime map: best or tied best in most regimes):")
     return lines
@@ -615,9 +690,16 @@ def regime_section(summary: RegimeSummary | None, *, full: bool) -> ChapterSecti
         lidar = (
             f" or a {LIDAR_BEAMS}-beam lidar alone" if any(c.lidar for c in summary.cells) else ""
         )
+        limited = sorted({c.n_humans for c in summary.cells if c.limited})
+        vehicle = (
+            f"; the unicycle ideal or {Regime(0, 0.0, False, 0.0, limited=True).vehicle} "
+            f"({', '.join(map(str, limited))} humans, the laws whose vehicle keeps the limits)"
+            if limited
+            else ""
+        )
         ran = (
             f"{len(summary.cells)} regimes ({dens} humans; speed {speeds} x V_max; robot "
-            f"invisible and visible; sensing noise {noises} m{lidar}), {summary.seeds} "
+            f"invisible and visible; sensing noise {noises} m{lidar}{vehicle}), {summary.seeds} "
             f"seed{'' if summary.seeds == 1 else 's'} per regime "
             f"and law ({mode_text(full)}), laws {', '.join(summary.laws)}"
         )
@@ -626,7 +708,9 @@ def regime_section(summary: RegimeSummary | None, *, full: bool) -> ChapterSecti
         title=TITLES["regime"],
         intro=(
             f"Every 2D law on CrowdNav's circle crossing over crowd density x pedestrian speed / "
-            f"V_max x robot visible or not x sensing (campaign {CAMPAIGN}): {ran}. Every "
+            f"V_max x robot visible or not x sensing, and at the default regime (speed "
+            f"{SLICE_SPEED:g} V_max, invisible robot, exact sensing) {LARGE_CROWD} humans and "
+            f"vehicle limits (campaign {CAMPAIGN}): {ran}. Every "
             "law runs in every regime, beyond its declared assumption where the regime breaks it "
             "(marked †)."
         ),

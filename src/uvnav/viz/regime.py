@@ -4,9 +4,11 @@
 shows first:
 
 * two heat maps over the regime grid of :mod:`uvnav.experiments.regime` — success and
-  robot-driven collisions, one row per law, one panel per (robot visible?, sensing) pair, one
-  column per (pedestrian speed / V_max, crowd density) — with each rate's 95 % Wilson interval
-  and sample size in its tooltip, a star on the laws the evidence cannot separate from the best;
+  robot-driven collisions, one row per law, one panel per (vehicle limits, robot visible?,
+  sensing), one column per (pedestrian speed / V_max, crowd density); a law not run in a cell
+  (the holonomic laws on the acceleration-limited unicycle) leaves it blank — with each rate's
+  95 % Wilson interval and sample size in its tooltip, a star on the laws the evidence cannot
+  separate from the best;
 * one generated recommendation per regime (:func:`uvnav.experiments.regime.recommend`);
 * what sensing costs each law: its success with exact readings, noisy centres and a lidar
   alone on the same crowds (:func:`uvnav.experiments.regime.sensing_costs`);
@@ -42,22 +44,24 @@ from uvnav.experiments.regime import (
 SMALL_MARK = "⚠"
 
 
-def _panel(c: Regime) -> tuple[bool, bool, float]:
-    """A cell's panel: the robot visible or not, then its sensing."""
-    return (c.visible, c.lidar, c.noise)
+def _panel(c: Regime) -> tuple[bool, bool, bool, float]:
+    """A cell's panel: the vehicle ideal or acceleration-limited, the robot visible or not,
+    then its sensing."""
+    return (c.limited, c.visible, c.lidar, c.noise)
 
 
-def _panels(cells: Sequence[Regime]) -> list[tuple[bool, bool, float]]:
+def _panels(cells: Sequence[Regime]) -> list[tuple[bool, bool, bool, float]]:
     return sorted({_panel(c) for c in cells})
 
 
-def _order(c: Regime) -> tuple[bool, bool, float, float, int]:
+def _order(c: Regime) -> tuple[bool, bool, bool, float, float, int]:
     return (*_panel(c), c.speed_ratio, c.n_humans)
 
 
-def _panel_title(visible: bool, lidar: bool, noise: float) -> str:
+def _panel_title(limited: bool, visible: bool, lidar: bool, noise: float) -> str:
     seen = "visible robot" if visible else "invisible robot"
-    return f"{seen}, {Regime(0, 0.0, visible, noise, lidar).sensing}"
+    panel = Regime(0, 0.0, visible, noise, lidar, limited)
+    return f"{seen}, {panel.sensing}" + (f", {panel.vehicle}" if limited else "")
 
 
 def _cell_colour(p: float, good: bool) -> str:
@@ -98,9 +102,9 @@ def regime_heatmap(
     """One heat map (``metric``: ``"success"`` or ``"robot_collision"``) as a table the report
     draws with no script: ``{"id", "title", "panels": [{"title", "columns"}], "rows": [{"law",
     "cells": [{"text", "bg", "fg", "title", "edge"}]}]}``: one row per law, one column group per
-    panel (robot visible or not, sensing; ``edge`` marks a panel's first column), one column per
-    (pedestrian speed / V_max, density); a cell is the rate in %, its tooltip the 95 % Wilson
-    interval and n."""
+    panel (vehicle limits, robot visible or not, sensing; ``edge`` marks a panel's first
+    column), one column per (pedestrian speed / V_max, density); a cell is the rate in %, its
+    tooltip the 95 % Wilson interval and n."""
     cells = sorted(stats, key=_order)
     laws = sorted({s.law for v in stats.values() for s in v})
     best = {c: {b.law for b in ranking(stats[c])[0]} for c in cells}
