@@ -9,6 +9,7 @@ place every experiment that runs jobs goes through.
 * :func:`run_jobs` — the jobs a campaign lacks, each stored in its own transaction as it
   finishes (an interrupt loses only the episodes in flight); returns the stored records of the
   jobs asked for, in job order.
+* :func:`run_rows` — :func:`run_jobs` with each record made an experiment's row.
 * :func:`run_recorded` — every job run again with its trajectory recorded (the figures'
   trajectories); an episode the campaign lacks is stored, a stored one is kept.
 * :func:`group_stats` / :func:`non_successes` — per-group outcome statistics and the episodes
@@ -95,6 +96,21 @@ def job_records(store: ResultsStore, campaign: str, jobs: Iterable[Job]) -> list
         for r in stored_records(store, campaign)
     }
     return [by_key[j.key] for j in jobs if j.key in by_key]
+
+
+def run_rows(
+    jobs: Iterable[Job],
+    store: ResultsStore,
+    campaign: str,
+    *,
+    row: Callable[[dict[str, Any]], dict[str, Any]],
+    config: Mapping[str, Any],
+    workers: int = 1,
+    progress: Progress | None = None,
+) -> list[dict[str, Any]]:
+    """:func:`run_jobs`, each stored record made an experiment's row by ``row``."""
+    recs = run_jobs(store, campaign, jobs, config=config, workers=workers, progress=progress)
+    return [row(r) for r in recs]
 
 
 def run_recorded(

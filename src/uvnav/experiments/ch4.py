@@ -34,6 +34,7 @@ Figures are made by a renderer injected by the caller (``render=``; the CLI pass
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 from collections.abc import Callable, Iterable
@@ -124,20 +125,10 @@ def stored_rows(store: ResultsStore, campaign: str) -> list[dict[str, Any]]:
     return [_row(r) for r in stored_records(store, campaign)]
 
 
-def run_jobs(
-    jobs: Iterable[Job],
-    store: ResultsStore,
-    campaign: str,
-    *,
-    workers: int = 1,
-    progress: cp.Progress | None = None,
-    config: dict[str, Any] | None = None,
-) -> list[dict[str, Any]]:
-    """The rows of ``jobs`` (stored and new, in job order), those ``campaign`` lacks run first
-    (:func:`uvnav.experiments.campaigns.run_jobs`)."""
-    cfg = config or {"chapter": 4}
-    recs = cp.run_jobs(store, campaign, jobs, config=cfg, workers=workers, progress=progress)
-    return [_row(r) for r in recs]
+#: ``run_jobs(jobs, store, campaign, *, workers=1, progress=None, config=...)``: the rows of
+#: ``jobs`` (stored and new, in job order), those ``campaign`` lacks run first
+#: (:func:`uvnav.experiments.campaigns.run_rows` with this chapter's row)
+run_jobs = functools.partial(cp.run_rows, row=_row, config={"chapter": 4})
 
 
 def campaign_jobs(

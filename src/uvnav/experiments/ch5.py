@@ -39,10 +39,11 @@ by a renderer the caller injects (:mod:`uvnav.viz` is a layer above).
 from __future__ import annotations
 
 import dataclasses
+import functools
 import hashlib
 import json
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -224,20 +225,10 @@ def stored_rows(store: ResultsStore, campaign: str) -> list[dict[str, Any]]:
     return [_row(r) for r in stored_records(store, campaign)]
 
 
-def run_jobs(
-    jobs: Iterable[Job],
-    store: ResultsStore,
-    campaign: str,
-    *,
-    workers: int = 1,
-    progress: cp.Progress | None = None,
-    config: dict[str, Any] | None = None,
-) -> list[dict[str, Any]]:
-    """The rows of ``jobs`` (stored and new, in job order), those ``campaign`` lacks run first
-    (:func:`uvnav.experiments.campaigns.run_jobs`)."""
-    cfg = config or {"chapter": 5}
-    recs = cp.run_jobs(store, campaign, jobs, config=cfg, workers=workers, progress=progress)
-    return [_row(r) for r in recs]
+#: ``run_jobs(jobs, store, campaign, *, workers=1, progress=None, config=...)``: the rows of
+#: ``jobs`` (stored and new, in job order), those ``campaign`` lacks run first
+#: (:func:`uvnav.experiments.campaigns.run_rows` with this chapter's row)
+run_jobs = functools.partial(cp.run_rows, row=_row, config={"chapter": 5})
 
 
 def summarise(rows: list[dict[str, Any]]) -> list[dict[str, Any]]:
