@@ -10,7 +10,9 @@ the report, the whole "thesis reported vs uvnav measured" table in ``RESULTS/the
 does) and rewrites the report (``--report``) with its section beside the sections the earlier runs
 saved (``RESULTS/sections``).  ``uvnav reproduce --list`` lists the experiments (the built-ins and
 the plug-ins of the ``uvnav.experiments`` entry-point group); ``uvnav reproduce all`` is
-``uvnav run``.
+``uvnav run``.  ``uvnav reproduce NAME --plan`` prints what the run would run, per campaign
+(:func:`uvnav.experiments.plan_summary`), and how much of it the results database holds; it runs
+nothing and writes nothing (``--json``: one JSON object).
 
 Chapter 6's pipeline with every option (noise, threads, head, DAgger rounds, ...) stays
 ``uvnav drive reproduce``; ``uvnav reproduce ch6`` runs the same function at ``uvnav run``'s size
@@ -20,6 +22,8 @@ Chapter 6's pipeline with every option (noise, threads, head, DAgger rounds, ...
 
 from __future__ import annotations
 
+import json
+import textwrap
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Annotated, Any
@@ -206,6 +210,17 @@ def reproduce_cmd(
         ),
     ] = 0,
     fresh: FreshOption = False,
+    plan: Annotated[
+        bool,
+        typer.Option(
+            "--plan",
+            help="Print what the run would run (per campaign: jobs, laws, scene families, "
+            "how many are stored in the results database; the stages) and exit; runs nothing.",
+        ),
+    ] = False,
+    json_: Annotated[
+        bool, typer.Option("--json", help="With --plan: print one JSON object.")
+    ] = False,
 ) -> None:
     """Reproduce one experiment into the results store and its report section.
 
@@ -213,6 +228,11 @@ def reproduce_cmd(
     replaced; a campaign stored by other code is refused (remove it with 'uvnav forget'), and so
     is a stage made by other code (remake it with --fresh).
     """
+    if json_ and not plan:
+        raise CliError("reproduce --json: only with --plan")
+    if plan:
+        _print_plan(name, results, full=full, seeds=seeds, start_seed=start_seed, as_json=json_)
+        return
     if list_:
         if name is not None:
             raise CliError(f"reproduce --list takes no experiment name (got {name!r})")
@@ -258,6 +278,69 @@ def reproduce_cmd(
     n_files = sum(len(s.figures) + len(s.links) for s in out.sections)
     typer.echo(f"wrote {out.db_path}")
     typer.echo(f"wrote {report_path} ({n_files} file(s) in the {name} section)")
+
+
+def _print_plan(
+    name: str | None, results: Path, *, full: bool, seeds: int | None, start_seed: int,
+    as_json: bool,
+) -> None:  # fmt: skip
+    """``--plan``: the experiment's plan as text (80 columns) or one JSON object."""
+    if name is None or name.strip().lower() == "all":
+        raise CliError("reproduce --plan: name one experiment ('uvnav reproduce --list')")
+    from uvnav.bench.store import NotAStoreError
+
+    context = optional("uvnav.experiments", "ExperimentContext", "the experiments")
+    plan_summary = optional("uvnav.experiments", "plan_summary", "the experiments' plans")
+    ctx = context(results, Path("report"), full=full, seeds=seeds, start_seed=start_seed)
+    refused: tuple[type[Exception], ...] = (*_user_errors(), NotAStoreError)
+    try:
+        summary = plan_summary(name.strip().lower(), ctx)
+    except refused as exc:
+        raise CliError(str(exc)) from None
+    if as_json:
+        typer.echo(json.dumps(summary, indent=1))
+        return
+    for line in plan_lines(summary):
+        typer.echo(line)
+
+
+def _wrapped(label: str, items: Sequence[str], width: int) -> list[str]:
+    """``label: a, b, c`` wrapped at ``width``, continued lines indented."""
+    text = f"{label}: {', '.join(items)}"
+    return textwrap.wrap(
+        text, width, initial_indent="  ", subsequent_indent="    ", break_on_hyphens=False
+    )
+
+
+def plan_lines(summary: dict[str, Any], width: int = 80) -> list[str]:
+    """``uvnav reproduce NAME --plan`` as text: the experiment and its size, the database and
+    how much of the plan it holds, per campaign its jobs and stored jobs, laws and scene
+    families, then the stages; every line at most ``width`` characters."""
+    head = f"{summary['experiment']} ({summary['size']}): {one_line(summary['runs'])}"
+    lines = textwrap.wrap(head, width, subsequent_indent="  ")
+    camps = summary["campaigns"]
+    jobs, stored = sum(c["jobs"] for c in camps), sum(c["stored"] for c in camps)
+    db = summary["database"]
+    held = f"{stored} of {jobs} jobs stored" if summary["database_exists"] else "none yet"
+    lines += textwrap.wrap(f"database {db}: {held}", width, subsequent_indent="  ")
+    if not summary["planned"]:
+        lines.append("it declares no plan: 'uvnav reproduce' runs it as a whole")
+    w = max([len("campaign"), *(len(c["name"]) for c in camps)]) + 2
+    if camps:
+        lines.append(f"{'campaign':<{w}}{'jobs':>8}{'stored':>8}")
+    elif summary["planned"]:
+        lines.append("no campaign: it runs stages only")
+    for c in camps:
+        lines.append(f"{c['name']:<{w}}{c['jobs']:>8}{c['stored']:>8}")
+        if c["stale"]:
+            lines += _wrapped("stale", ["stored by other code; a run refuses it"], width)
+        lines += _wrapped("laws", c["laws"], width)
+        lines += _wrapped("scenes", c["families"], width)
+    if summary["stages"]:
+        lines += textwrap.wrap(
+            f"stages: {', '.join(summary['stages'])}", width, subsequent_indent="  "
+        )
+    return [line if len(line) <= width else line[: width - 1] + "…" for line in lines]
 
 
 def _print_rows(sections: list[Any]) -> None:

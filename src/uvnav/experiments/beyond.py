@@ -73,6 +73,16 @@ def swap_job(spec: str, law: str, params: dict[str, Any]) -> Job:
     return Job(law, 0, scenario=spec, params=params, use_scenario_params=False)
 
 
+def office_jobs(laws: Sequence[str], scenario: str = "office-floor") -> list[Job]:
+    """Per law: the law alone, then ``hybrid-v1`` with it (:func:`office_job`)."""
+    return [office_job(law, scenario, hybrid=h) for law in laws for h in (False, True)]
+
+
+def swap_jobs(spec: str, controllers: Sequence[tuple[str, dict[str, Any]]]) -> list[Job]:
+    """One :func:`swap_job` per (law, parameters)."""
+    return [swap_job(spec, name, params) for name, params in controllers]
+
+
 def _episode_text(rec: dict[str, Any]) -> str:
     t = rec["time_to_goal"]
     when = f", {t:.1f} s" if t is not None else ""
@@ -85,8 +95,7 @@ def office_rows(
     """One row per law: the law alone vs hybrid-v1 with it, seed 0 (campaign
     ``beyond-office`` of ``store``, each episode stored as it finishes; a temporary store when
     none is given)."""
-    jobs = [office_job(law, scenario, hybrid=h) for law in laws for h in (False, True)]
-    recs = _stored(store, OFFICE_CAMPAIGN, jobs)
+    recs = _stored(store, OFFICE_CAMPAIGN, office_jobs(laws, scenario))
     rows = []
     for i, law in enumerate(laws):
         alone, hybrid = recs[2 * i], recs[2 * i + 1]
@@ -109,9 +118,9 @@ def swap_rows(
 ) -> list[dict[str, str]]:
     """One row per law on the multi-robot scene ``spec`` (every robot runs it), seed 0
     (campaign ``beyond-multi`` of ``store``, as :func:`office_rows`)."""
-    jobs = [swap_job(spec, name, params) for name, params in controllers]
+    recs = _stored(store, MULTI_CAMPAIGN, swap_jobs(spec, controllers))
     rows = []
-    for (name, params), rec in zip(controllers, _stored(store, MULTI_CAMPAIGN, jobs), strict=True):
+    for (name, params), rec in zip(controllers, recs, strict=True):
         g, n = rec["effective_params"]["group"], rec["effective_params"]["n_robots"]
         mk = f"{g['makespan']:.1f} s" if g["makespan"] is not None else "n/a"
         label = name + (f" ({', '.join(f'{k}={v}' for k, v in params.items())})" if params else "")
@@ -139,7 +148,22 @@ def _stored(store: ResultsStore | None, campaign: str, jobs: list[Job]) -> list[
             return _stored(temp, campaign, jobs)
     fp = fingerprint()
     check_fingerprints(store, {campaign: fp})
-    return cp.run_jobs(store, campaign, jobs, config={"experiment": "beyond", FINGERPRINT_KEY: fp})
+    return cp.run_jobs(store, campaign, jobs, config=_config(fp))
+
+
+def _config(fp: str) -> dict[str, Any]:
+    """The config of both campaigns (``fp``: :func:`fingerprint`'s)."""
+    return {"experiment": "beyond", FINGERPRINT_KEY: fp}
+
+
+def campaign_plans(*, full: bool = False) -> list[tuple[str, dict[str, Any], list[Job]]]:
+    """The campaigns :func:`reproduce_beyond` runs, (name, config, jobs) in order; nothing
+    runs (the replanning row is timed, not stored: no campaign)."""
+    cfg = _config(fingerprint())
+    return [
+        (OFFICE_CAMPAIGN, cfg, office_jobs(FULL_LAWS if full else QUICK_LAWS)),
+        (MULTI_CAMPAIGN, cfg, swap_jobs("antipodal:16", FULL_SWAP if full else QUICK_SWAP)),
+    ]
 
 
 def reproduce_beyond(

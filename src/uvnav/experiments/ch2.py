@@ -476,6 +476,44 @@ def comparison_straight_line(scenes: Sequence[str]) -> float | None:
     return float(np.hypot(*(np.asarray(setup.goal) - np.asarray(setup.start)[:2])))
 
 
+def _counts(
+    full: bool, n_random: int | None, n_baseline_seeds: int | None, n_crowd_seeds: int | None
+) -> tuple[int, int, int]:
+    """The random, baseline and crowd seed counts of a run (``None``: the quick/full size)."""
+    n_seeds = n_random if n_random is not None else (FULL_SEEDS if full else QUICK_SEEDS)
+    n_base = n_baseline_seeds if n_baseline_seeds is not None else n_seeds
+    n_crowd = n_crowd_seeds
+    if n_crowd is None:
+        n_crowd = FULL_CROWD_SEEDS if full else QUICK_CROWD_SEEDS
+    return n_seeds, n_base, n_crowd
+
+
+def campaign_plans(
+    *,
+    full: bool = False,
+    n_random: int | None = None,
+    start_seed: int = 0,
+    controllers: Sequence[str] = CONTROLLERS,
+    baselines: Sequence[str] = BASELINES,
+    n_baseline_seeds: int | None = None,
+    n_crowd_seeds: int | None = None,
+) -> list[tuple[str, dict[str, Any], list[Job]]]:
+    """The campaigns :func:`run_ch2` runs with these arguments, (name, config, jobs) in order;
+    nothing runs."""
+    n_seeds, n_base, n_crowd = _counts(full, n_random, n_baseline_seeds, n_crowd_seeds)
+    ctrls = list(controllers)
+    return _plans(
+        _thesis_scenes(),
+        ctrls,
+        [b for b in baselines if b not in ctrls],
+        seeds=range(start_seed, start_seed + n_seeds),
+        baseline_seeds=range(start_seed, start_seed + n_base),
+        n_crowd=n_crowd,
+        with_baselines=bool(baselines),
+        fp=code_fingerprint(),
+    )
+
+
 def run_ch2(
     results_dir: Path,
     *,
@@ -499,24 +537,14 @@ def run_ch2(
     results_dir = Path(results_dir)
     results_dir.mkdir(parents=True, exist_ok=True)
     db_path = results_dir / DB_NAME
-    n_seeds = n_random if n_random is not None else (FULL_SEEDS if full else QUICK_SEEDS)
-    n_base = n_baseline_seeds if n_baseline_seeds is not None else n_seeds
-    n_crowd = n_crowd_seeds
-    if n_crowd is None:
-        n_crowd = FULL_CROWD_SEEDS if full else QUICK_CROWD_SEEDS
+    n_seeds, n_base, n_crowd = _counts(full, n_random, n_baseline_seeds, n_crowd_seeds)
     scenes = _thesis_scenes()
     ctrls = list(controllers)
     base = [b for b in baselines if b not in ctrls]
-    plans = _plans(
-        scenes,
-        ctrls,
-        base,
-        seeds=range(start_seed, start_seed + n_seeds),
-        baseline_seeds=range(start_seed, start_seed + n_base),
-        n_crowd=n_crowd,
-        with_baselines=bool(baselines),
-        fp=code_fingerprint(),
-    )
+    plans = campaign_plans(
+        full=full, n_random=n_random, start_seed=start_seed, controllers=controllers,
+        baselines=baselines, n_baseline_seeds=n_baseline_seeds, n_crowd_seeds=n_crowd_seeds,
+    )  # fmt: skip
     with ResultsStore(db_path) as store:
         campaigns = run_checked(store, plans, workers=workers, progress=progress, statuses=True)
         straight = comparison_straight_line(scenes)

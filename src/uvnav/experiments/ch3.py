@@ -239,6 +239,14 @@ def prediction_jobs(n_seeds: int, start_seed: int = 0) -> list[Job]:
     ]  # fmt: skip
 
 
+def prediction_plan(
+    n_seeds: int, start_seed: int, fp: str
+) -> tuple[str, dict[str, Any], list[Job]]:
+    """The ``ch3-prediction`` campaign as (name, config, jobs); ``fp``: :func:`fingerprint`'s."""
+    config = {"chapter": 3, "law": PREDICTION_LAW, "seeds": n_seeds, FINGERPRINT_KEY: fp}
+    return PREDICTION_CAMPAIGN, config, prediction_jobs(n_seeds, start_seed)
+
+
 def closed_loop_rates(frame: Any) -> dict[str, dict[str, float]]:
     """Success / collision rates and mean min clearance by ``"family|arm"`` of stored
     ``ch3-prediction`` episodes (``frame`` from :meth:`ResultsStore.episodes_frame`)."""
@@ -276,8 +284,7 @@ def prediction_study(
     """
     fp = fp if fp is not None else fingerprint()
     check_fingerprints(store, {PREDICTION_CAMPAIGN: fp})
-    jobs = prediction_jobs(n_seeds, start_seed)
-    config = {"chapter": 3, "law": PREDICTION_LAW, "seeds": n_seeds, FINGERPRINT_KEY: fp}
+    _, config, jobs = prediction_plan(n_seeds, start_seed, fp)
     cp.run_jobs(store, PREDICTION_CAMPAIGN, jobs, config=config, workers=workers,
                 progress=_say(PREDICTION_CAMPAIGN, progress))  # fmt: skip
     frame = _requested(store.episodes_frame(PREDICTION_CAMPAIGN), jobs)
@@ -402,6 +409,47 @@ def _requested(frame: Any, jobs: list[Job]) -> Any:
     return frame.iloc[[i for _, i in rows]]
 
 
+def _counts(full: bool, n_random: int | None, prediction_seeds: int | None) -> tuple[int, int]:
+    """The random scenes and the prediction study's seeds per family of a run."""
+    n_seeds = n_random if n_random is not None else (FULL_SEEDS if full else QUICK_SEEDS)
+    n_pred = (
+        prediction_seeds if prediction_seeds is not None else max(n_seeds, PREDICTION_MIN_SEEDS)
+    )
+    return n_seeds, n_pred
+
+
+def campaign_plans(
+    *,
+    full: bool = False,
+    n_random: int | None = None,
+    start_seed: int = 0,
+    controllers: Sequence[str] = CONTROLLERS_3D,
+    prediction_seeds: int | None = None,
+) -> list[tuple[str, dict[str, Any], list[Job]]]:
+    """The campaigns :func:`reproduce_ch3` runs with these arguments, (name, config, jobs) in
+    order: the thesis scenes, the random scenes and (unless its seeds are 0) the prediction
+    study; nothing runs.  The study's AR-usage episodes run again every call and are not
+    stored, so they are no campaign."""
+    import uvnav.scenarios as scenarios
+
+    n_seeds, n_pred = _counts(full, n_random, prediction_seeds)
+    fp = fingerprint()
+    scenes = [n for n in scenarios.list_builtin() if n.startswith("thesis-ch3-")]
+    rand_jobs = [
+        ch3_job(f"{RANDOM_FAMILY}:{g}", c, g, m)
+        for g in range(start_seed, start_seed + n_seeds) for m in MOTIONS for c in controllers
+    ]  # fmt: skip
+    size = {"chapter": 3, "controllers": list(controllers), FINGERPRINT_KEY: fp}
+    plans = [
+        (SCENES_CAMPAIGN, {**size, "seed": 0},
+         [ch3_job(s, c, 0, "predicted") for s in scenes for c in controllers]),
+        (RANDOM_CAMPAIGN, {**size, "seeds": n_seeds}, rand_jobs),
+    ]  # fmt: skip
+    if n_pred > 0:
+        plans.append(prediction_plan(n_pred, start_seed, fp))
+    return plans
+
+
 def reproduce_ch3(
     results_dir: Path,
     report_dir: Path,
@@ -437,29 +485,20 @@ def reproduce_ch3(
         StaleCampaignError: a stored campaign of this run was made by other code (its
             fingerprint differs; nothing runs).
     """
-    import uvnav.scenarios as scenarios
-
     tic = time.perf_counter()
     results_dir = Path(results_dir)
     results_dir.mkdir(parents=True, exist_ok=True)
     db_path = results_dir / DB_NAME
-    n_seeds = n_random if n_random is not None else (FULL_SEEDS if full else QUICK_SEEDS)
-    scenes = [n for n in scenarios.list_builtin() if n.startswith("thesis-ch3-")]
-    scene_jobs = [ch3_job(s, c, 0, "predicted") for s in scenes for c in controllers]
-    rand_jobs = [
-        ch3_job(f"{RANDOM_FAMILY}:{g}", c, g, m)
-        for g in range(start_seed, start_seed + n_seeds) for m in MOTIONS for c in controllers
-    ]  # fmt: skip
-    n_pred = (
-        prediction_seeds if prediction_seeds is not None else max(n_seeds, PREDICTION_MIN_SEEDS)
-    )
+    _, n_pred = _counts(full, n_random, prediction_seeds)
+    plans = campaign_plans(
+        full=full, n_random=n_random, start_seed=start_seed, controllers=controllers,
+        prediction_seeds=prediction_seeds,
+    )  # fmt: skip
+    (_, scene_cfg, scene_jobs), (_, rand_cfg, rand_jobs) = plans[:2]
     fp = fingerprint()
     recorded: dict[EpisodeKey, Any] = {}
     with ResultsStore(db_path) as store:
-        names = [SCENES_CAMPAIGN, RANDOM_CAMPAIGN] + ([PREDICTION_CAMPAIGN] if n_pred > 0 else [])
-        check_fingerprints(store, dict.fromkeys(names, fp))  # before anything runs
-        size = {"chapter": 3, "controllers": list(controllers), FINGERPRINT_KEY: fp}
-        scene_cfg = {**size, "seed": 0}
+        check_fingerprints(store, {name: fp for name, _, _ in plans})  # before anything runs
         if render is not None:  # the figures' trajectories (not stored): the scenes run again
             recorded = cp.run_recorded(
                 store, SCENES_CAMPAIGN, scene_jobs, config=scene_cfg, workers=workers
@@ -467,7 +506,7 @@ def reproduce_ch3(
         else:
             cp.run_jobs(store, SCENES_CAMPAIGN, scene_jobs, config=scene_cfg, workers=workers,
                         progress=_say(SCENES_CAMPAIGN, progress))  # fmt: skip
-        cp.run_jobs(store, RANDOM_CAMPAIGN, rand_jobs, config={**size, "seeds": n_seeds},
+        cp.run_jobs(store, RANDOM_CAMPAIGN, rand_jobs, config=rand_cfg,
                     workers=workers, progress=_say(RANDOM_CAMPAIGN, progress))  # fmt: skip
         frame = _requested(store.episodes_frame(RANDOM_CAMPAIGN), rand_jobs)
         scene_frame = _requested(store.episodes_frame(SCENES_CAMPAIGN), scene_jobs)

@@ -257,6 +257,35 @@ def _table(
     return table
 
 
+def campaign_plans(
+    *,
+    full: bool = False,
+    seeds: int | None = None,
+    noise_seeds: int | None = None,
+    hard_seeds: int | None = None,
+    start_seed: int = 0,
+) -> list[tuple[str, dict[str, Any], list[Job]]]:
+    """The campaigns :func:`reproduce_ch4` runs with these arguments, (name, config, jobs) in
+    order: the thesis scenes, the random family, the noise sweep and the hard family; nothing
+    runs."""
+    n = seeds if seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
+    nn = (
+        noise_seeds
+        if noise_seeds is not None
+        else (FULL_NOISE_SEEDS if full else QUICK_NOISE_SEEDS)
+    )
+    nh = hard_seeds if hard_seeds is not None else (FULL_HARD_SEEDS if full else QUICK_HARD_SEEDS)
+    size = {"chapter": 4, "laws": list(LAWS), FINGERPRINT_KEY: cp.fingerprint("experiments/ch4.py")}
+    scene_jobs = [ch4_job(scene, law, 0) for scene in list_uuv2d_builtin() for law in LAWS]
+    clean, noisy = campaign_jobs(n, nn, start=start_seed)
+    return [
+        (SCENES_CAMPAIGN, {**size, "seed": 0}, scene_jobs),
+        (RANDOM_CAMPAIGN, {**size, "seeds": n}, clean),
+        (NOISE_CAMPAIGN, {**size, "seeds": nn, "levels": NOISE_LEVELS}, noisy),
+        (HARD_CAMPAIGN, {**size, "seeds": nh}, hard_jobs(nh, start=start_seed)),
+    ]
+
+
 def reproduce_ch4(
     results_dir: Path,
     report_dir: Path | None = None,
@@ -294,31 +323,23 @@ def reproduce_ch4(
     out_dir = results_dir / "ch4"
     out_dir.mkdir(parents=True, exist_ok=True)
     db_path = results_dir / DB_NAME
-    n = seeds if seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
-    nn = (
-        noise_seeds
-        if noise_seeds is not None
-        else (FULL_NOISE_SEEDS if full else QUICK_NOISE_SEEDS)
-    )
-    nh = hard_seeds if hard_seeds is not None else (FULL_HARD_SEEDS if full else QUICK_HARD_SEEDS)
-    fp = cp.fingerprint("experiments/ch4.py")
-    size = {"chapter": 4, "laws": list(LAWS), FINGERPRINT_KEY: fp}
-    scene_jobs = [ch4_job(scene, law, 0) for scene in list_uuv2d_builtin() for law in LAWS]
+    plans = campaign_plans(
+        full=full, seeds=seeds, noise_seeds=noise_seeds, hard_seeds=hard_seeds,
+        start_seed=start_seed,
+    )  # fmt: skip
+    (_, scene_cfg, scene_jobs), *campaigns = plans
     with ResultsStore(db_path) as store:
-        check_fingerprints(store, dict.fromkeys((SCENES_CAMPAIGN, *CAMPAIGNS), fp))
+        check_fingerprints(store, {name: cfg[FINGERPRINT_KEY] for name, cfg, _ in plans})
         # run again for the figures' trajectories; stored only when missing
-        kept = cp.run_recorded(store, SCENES_CAMPAIGN, scene_jobs, config={**size, "seed": 0})
+        kept = cp.run_recorded(store, SCENES_CAMPAIGN, scene_jobs, config=scene_cfg)
         scene_results: dict[tuple[str, str], EpisodeResult[Uuv2dTrajectory]] = {
             (str(j.label), j.controller): kept[j.key] for j in scene_jobs
         }
         scene_rows = [_row(r) for r in cp.job_records(store, SCENES_CAMPAIGN, scene_jobs)]
-        clean, noisy = campaign_jobs(n, nn, start=start_seed)
-        rows_random = run_jobs(clean, store, RANDOM_CAMPAIGN, workers=workers,
-                               progress=progress, config={**size, "seeds": n})  # fmt: skip
-        rows_noise = run_jobs(noisy, store, NOISE_CAMPAIGN, workers=workers, progress=progress,
-                              config={**size, "seeds": nn, "levels": NOISE_LEVELS})  # fmt: skip
-        rows_hard = run_jobs(hard_jobs(nh, start=start_seed), store, HARD_CAMPAIGN, workers=workers,
-                             progress=progress, config={**size, "seeds": nh})  # fmt: skip
+        rows_random, rows_noise, rows_hard = [
+            run_jobs(jobs, store, name, workers=workers, progress=progress, config=cfg)
+            for name, cfg, jobs in campaigns
+        ]
     rows = rows_random + rows_noise + rows_hard
     campaign = summarise(rows)
     fails = failures(rows_random)

@@ -330,6 +330,60 @@ def _campaign_jobs(
     return out
 
 
+#: the closed-loop network's tag in a plan made before it was trained
+UNTRAINED = "untrained"
+
+
+def campaign_plans(
+    results_dir: Path,
+    *,
+    full: bool = False,
+    n_random: int | None = None,
+    n_dense: int | None = None,
+    scenes: Sequence[str] | None = None,
+    noises: Sequence[float] | None = None,
+    start_seed: int = 0,
+    model_id: str | None = None,
+) -> list[tuple[str, dict[str, Any], list[Job]]]:
+    """The closed-loop campaigns :func:`reproduce_ch5` runs with these arguments, (name, config,
+    jobs) in order: the thesis scenes, then the random, noise and dense campaigns that have
+    jobs; nothing runs or trains.
+
+    The ``network`` locator's jobs carry the closed-loop network's digest (``model_id``): the
+    run passes the network it trained; a plan made without it takes the digest of the
+    checkpoint ``results_dir/ch5_bpnn`` a previous run saved (the network a run with unchanged
+    stages trains again), or :data:`UNTRAINED` when there is none, whose ``network`` keys no
+    run stores.  Every other job's key is the run's."""
+    results_dir = Path(results_dir)
+    model_path = results_dir / "ch5_bpnn"
+    if model_id is None:
+        saved = model_path.with_suffix(".safetensors").is_file()
+        model_id = checkpoint_digest(model_path) if saved else UNTRAINED
+    n_rand = n_random if n_random is not None else (FULL_RANDOM if full else QUICK_RANDOM)
+    n_dns = n_dense if n_dense is not None else (FULL_DENSE if full else QUICK_DENSE)
+    noise_list = (
+        tuple(noises) if noises is not None else ((0.0, NOISE_STD) if full else QUICK_NOISES)
+    )
+    base_cfg = {
+        "chapter": 5, "law": LAW, "locators": list(LOCATORS), "model": model_id,
+        FINGERPRINT_KEY: fingerprint(),
+    }  # fmt: skip
+    net = {True: (str(model_path), model_id), False: (None, "")}
+    scene_jobs = [
+        ch5_job(scene, loc, 0, float(noise), *net[loc == "network"])
+        for scene in (list(scenes) if scenes is not None else list_ch5_builtin())
+        for noise in noise_list for loc in LOCATORS
+    ]  # fmt: skip
+    plans = [(SCENES_CAMPAIGN, {**base_cfg, "noises": list(noise_list)}, scene_jobs)]
+    jobs = _campaign_jobs(n_rand, noise_list, model_path, model_id, n_dns, start_seed)
+    for name, js in jobs.items():
+        if js:
+            seeds = len({j.seed for j in js})
+            cfg = {**base_cfg, "seeds": seeds, "noise_std": dict(js[0].tags)["noise_std"]}
+            plans.append((name, cfg, js))
+    return plans
+
+
 def reproduce_ch5(
     results_dir: Path,
     *,
@@ -404,7 +458,6 @@ def reproduce_ch5(
     n_rand = n_random if n_random is not None else (FULL_RANDOM if full else QUICK_RANDOM)
     n_dns = n_dense if n_dense is not None else (FULL_DENSE if full else QUICK_DENSE)
     summary = Ch5Summary(db_path=db_path)
-    scene_list = list(scenes) if scenes is not None else list_ch5_builtin()
     default_noises = (0.0, NOISE_STD) if full else QUICK_NOISES
     noise_list = tuple(noises) if noises is not None else default_noises
     variants = tuple(variant_config(v) for v in VARIANTS)
@@ -468,28 +521,18 @@ def reproduce_ch5(
         summary.models["closed_loop"] = cl_model
         prog.advance(task)
 
-        jobs = _campaign_jobs(n_rand, noise_list, model_path, model_id, n_dns, start_seed)
-        n_episodes = len(scene_list) * len(LOCATORS) * len(noise_list) + sum(
-            map(len, jobs.values())
-        )
+        (_, scene_cfg, scene_jobs), *campaigns = campaign_plans(
+            results_dir, full=full, n_random=n_random, n_dense=n_dense, scenes=scenes,
+            noises=noises, start_seed=start_seed, model_id=model_id,
+        )  # fmt: skip
+        n_episodes = len(scene_jobs) + sum(len(js) for _, _, js in campaigns)
         task2 = prog.add_task("Ch5 closed loop", total=n_episodes)
         kept: dict[tuple[str, str, float], EpisodeResult[LocatedTrace]] = {}
-        base_cfg = {
-            "chapter": 5, "law": LAW, "locators": list(LOCATORS), "model": model_id,
-            FINGERPRINT_KEY: fp,
-        }  # fmt: skip
-        scene_jobs = [
-            ch5_job(
-                scene, loc, 0, float(noise), str(model_path) if loc == "network" else None,
-                model_id if loc == "network" else "",
-            )
-            for scene in scene_list for noise in noise_list for loc in LOCATORS
-        ]  # fmt: skip
         with ResultsStore(db_path) as store:
             check_fingerprints(store, dict.fromkeys(CAMPAIGNS, fp))
             # run again for the figures' trajectories; stored only when missing
             results = cp.run_recorded(
-                store, SCENES_CAMPAIGN, scene_jobs, config={**base_cfg, "noises": list(noise_list)},
+                store, SCENES_CAMPAIGN, scene_jobs, config=scene_cfg,
                 on_episode=lambda _out: prog.advance(task2),
             )  # fmt: skip
             for j in scene_jobs:
@@ -501,14 +544,7 @@ def reproduce_ch5(
             def advance_from(ran: float) -> cp.Progress:
                 return lambda k, _n: prog.update(task2, completed=ran + k)
 
-            for name, js in jobs.items():
-                if not js:
-                    continue
-                cfg_c = {
-                    **base_cfg,
-                    "seeds": len({j.seed for j in js}),
-                    "noise_std": dict(js[0].tags)["noise_std"],
-                }
+            for name, cfg_c, js in campaigns:
                 ran = prog.tasks[task2].completed
                 rand_rows += run_jobs(
                     js, store, name, workers=workers, config=cfg_c,

@@ -109,6 +109,50 @@ def crowd_jobs(laws: Sequence[str], cases: range, *, beyond_assumptions: bool = 
     ]
 
 
+def _laws(laws: Sequence[str] | None, beyond: Sequence[str] | None) -> tuple[list[str], list[str]]:
+    """The main campaign's laws and those run beyond the scenes' assumptions."""
+    default_laws, default_beyond = crowd_laws()
+    main = list(default_laws if laws is None else laws)
+    return main, list(default_beyond if beyond is None else beyond)
+
+
+def campaign_plans(
+    *,
+    full: bool = False,
+    cases: int | None = None,
+    start_case: int = 0,
+    laws: Sequence[str] | None = None,
+    beyond: Sequence[str] | None = None,
+) -> list[tuple[str, dict[str, Any], list[Job]]]:
+    """The campaigns :func:`reproduce_crowds` runs with these arguments, (name, config, jobs)
+    in order; nothing runs."""
+    main, over = _laws(laws, beyond)
+    n = cases if cases is not None else (FULL_CASES if full else QUICK_CASES)
+    run_cases = range(start_case, start_case + n)
+    fp = code_fingerprint()
+    plans: list[tuple[str, dict[str, Any], list[Job]]] = [
+        (
+            CAMPAIGN,
+            {"generators": list(GENERATORS), "controllers": main, "fingerprint": fp},
+            crowd_jobs(main, run_cases),
+        )
+    ]
+    if over:
+        plans.append(
+            (
+                BEYOND_CAMPAIGN,
+                {
+                    "generators": list(GENERATORS),
+                    "controllers": over,
+                    "beyond_assumptions": True,
+                    "fingerprint": fp,
+                },
+                crowd_jobs(over, run_cases, beyond_assumptions=True),
+            )
+        )
+    return plans
+
+
 def reproduce_crowds(
     results_dir: Path,
     *,
@@ -139,32 +183,10 @@ def reproduce_crowds(
     results_dir = Path(results_dir)
     results_dir.mkdir(parents=True, exist_ok=True)
     db_path = results_dir / DB_NAME
-    default_laws, default_beyond = crowd_laws()
-    main = list(default_laws if laws is None else laws)
-    over = list(default_beyond if beyond is None else beyond)
+    main, over = _laws(laws, beyond)
     n = cases if cases is not None else (FULL_CASES if full else QUICK_CASES)
     run_cases = range(start_case, start_case + n)
-    fp = code_fingerprint()
-    plans: list[tuple[str, dict[str, Any], list[Job]]] = [
-        (
-            CAMPAIGN,
-            {"generators": list(GENERATORS), "controllers": main, "fingerprint": fp},
-            crowd_jobs(main, run_cases),
-        )
-    ]
-    if over:
-        plans.append(
-            (
-                BEYOND_CAMPAIGN,
-                {
-                    "generators": list(GENERATORS),
-                    "controllers": over,
-                    "beyond_assumptions": True,
-                    "fingerprint": fp,
-                },
-                crowd_jobs(over, run_cases, beyond_assumptions=True),
-            )
-        )
+    plans = campaign_plans(full=full, cases=cases, start_case=start_case, laws=laws, beyond=beyond)
     with ResultsStore(db_path) as store:
         done = run_checked(store, plans, workers=workers, progress=progress)
         table = crowd_rows(store, cases=run_cases, laws=main, beyond=over)

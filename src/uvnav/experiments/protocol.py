@@ -1,7 +1,9 @@
 """What an experiment is: a name, a title, whether it runs random seeds, its declared sizes
-(:class:`Size`, quick and full), its place in the report, and a ``run`` that takes an
+(:class:`Size`, quick and full), its place in the report, a ``run`` that takes an
 :class:`ExperimentContext` (with the chosen size) and returns an :class:`ExperimentRun` (its report
-sections and its rows of the "thesis reported vs uvnav measured" table).
+sections and its rows of the "thesis reported vs uvnav measured" table) and, optionally, a
+``plan`` that returns the campaigns (:class:`PlannedCampaign`) the run would run at that size
+without running anything (``uvnav reproduce NAME --plan``), and the names of its stages.
 
 This module imports no experiment and no registry: the built-in experiments
 (:mod:`uvnav.experiments.builtin`) and the plug-ins of the entry-point group
@@ -10,12 +12,16 @@ This module imports no experiment and no registry: the built-in experiments
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from uvnav.experiments.sections import ChapterRenderers, ChapterSection
+
+if TYPE_CHECKING:
+    from uvnav.bench.jobs import Job
 
 #: entry-point group of plug-in experiments
 EXPERIMENT_GROUP = "uvnav.experiments"
@@ -112,6 +118,22 @@ class ExperimentRun:
 
 
 @dataclass(frozen=True)
+class PlannedCampaign:
+    """One campaign an experiment's run runs into the store.
+
+    Attributes:
+        name: the campaign's name in the store.
+        config: the config it is created with (its code fingerprint among it).
+        jobs: its jobs, in run order (their :attr:`~uvnav.bench.jobs.Job.key` are the resume
+            keys the run stores).
+    """
+
+    name: str
+    config: Mapping[str, Any] = field(hash=False)
+    jobs: tuple[Job, ...] = ()
+
+
+@dataclass(frozen=True)
 class Experiment:
     """One reproduction, run by ``uvnav reproduce NAME`` and, in :attr:`order`, by ``uvnav run``.
 
@@ -125,6 +147,11 @@ class Experiment:
         sections: the keys of the sections it returns (default: its name); the saved sections are
             found again by these keys.
         sizes: its declared sizes by name (:data:`SIZE_NAMES`).
+        plan: ``plan(ctx) -> [PlannedCampaign]``: the campaigns ``run(ctx)`` runs, in order, built
+            by the same functions and without running or storing anything (``None``: it declares
+            no plan).
+        stages: the names of its stages (training, planning, ...) that are not campaigns, in the
+            order run (shown by ``--plan``; they are run and cached by ``run``).
     """
 
     name: str
@@ -134,10 +161,21 @@ class Experiment:
     order: int = 1000
     sections: tuple[str, ...] = ()
     sizes: Mapping[str, Size] = field(default_factory=dict, hash=False)
+    plan: Callable[[ExperimentContext], list[PlannedCampaign]] | None = None
+    stages: tuple[str, ...] = ()
 
     def size(self, full: bool) -> Size:
         """Its declared ``full`` or ``quick`` size (an undeclared one runs nothing extra)."""
         return self.sizes.get("full" if full else "quick") or Size(runs="")
+
+    def prepare(self, ctx: ExperimentContext) -> ExperimentContext:
+        """``ctx`` as its ``run`` and ``plan`` get it: no seeds for an unseeded experiment, and
+        its declared size filled in when ``ctx`` has none."""
+        if not self.seeded:
+            ctx = dataclasses.replace(ctx, seeds=None, start_seed=0)
+        if ctx.size is None:
+            ctx = dataclasses.replace(ctx, size=self.size(ctx.full))
+        return ctx
 
     @property
     def section_keys(self) -> tuple[str, ...]:

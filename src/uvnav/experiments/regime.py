@@ -255,6 +255,32 @@ class RegimeSummary:
     wall_time: float = 0.0
 
 
+def campaign_plans(
+    *,
+    full: bool = False,
+    seeds: int | None = None,
+    start_seed: int = 0,
+    laws: Sequence[str] | None = None,
+    cells: Sequence[Regime] | None = None,
+) -> list[tuple[str, dict[str, Any], list[Job]]]:
+    """The one campaign :func:`run_regime_map` runs with these arguments, as (name, config,
+    jobs); nothing runs."""
+    run_laws = list(crowd_laws()[0] if laws is None else laws)
+    grid = list(regimes() if cells is None else cells)
+    n = seeds if seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
+    cfg = {
+        "generator": GENERATOR,
+        "controllers": run_laws,
+        "cells": [
+            [c.n_humans, c.speed_ratio, c.visible, c.noise, c.lidar, c.limited] for c in grid
+        ],
+        "v_max": V_MAX,
+        "beyond_assumptions": True,
+        "fingerprint": code_fingerprint(),
+    }
+    return [(CAMPAIGN, cfg, regime_jobs(run_laws, grid, range(start_seed, start_seed + n)))]
+
+
 def run_regime_map(
     results_dir: Path,
     *,
@@ -288,19 +314,9 @@ def run_regime_map(
     run_laws = list(crowd_laws()[0] if laws is None else laws)
     grid = list(regimes() if cells is None else cells)
     n = seeds if seeds is not None else (FULL_SEEDS if full else QUICK_SEEDS)
-    cfg = {
-        "generator": GENERATOR,
-        "controllers": run_laws,
-        "cells": [
-            [c.n_humans, c.speed_ratio, c.visible, c.noise, c.lidar, c.limited] for c in grid
-        ],
-        "v_max": V_MAX,
-        "beyond_assumptions": True,
-        "fingerprint": code_fingerprint(),
-    }
-    jobs = regime_jobs(run_laws, grid, range(start_seed, start_seed + n))
+    plans = campaign_plans(full=full, seeds=seeds, start_seed=start_seed, laws=laws, cells=cells)
     with ResultsStore(db_path) as store:
-        done = run_checked(store, [(CAMPAIGN, cfg, jobs)], workers=workers, progress=progress)
+        done = run_checked(store, plans, workers=workers, progress=progress)
     return RegimeSummary(
         db_path=db_path,
         laws=run_laws,

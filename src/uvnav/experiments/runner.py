@@ -11,7 +11,6 @@ beside its own.
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -72,11 +71,7 @@ def saved_sections(results_dir: Path) -> list[ChapterSection]:
 
 
 def _run_one(experiment: Experiment, ctx: ExperimentContext) -> ExperimentRun:
-    if not experiment.seeded:
-        ctx = dataclasses.replace(ctx, seeds=None, start_seed=0)
-    if ctx.size is None:
-        ctx = dataclasses.replace(ctx, size=experiment.size(ctx.full))
-    run = experiment.run(ctx)
+    run = experiment.run(experiment.prepare(ctx))
     keys = experiment.section_keys
     for s in run.sections:
         if s.key not in keys:
