@@ -94,3 +94,23 @@ def test_predict_and_update_are_the_textbook_steps() -> None:
     gain = cov[0, 0] / (cov[0, 0] + 0.01)
     assert np.allclose(p2, p + gain * (np.array([1.35, 0.1]) - p))
     assert cov2[0, 0] < cov[0, 0] and np.allclose(cov2, cov2.T)
+
+
+def _second_centre(tracker: CentreTracker, declared: float) -> np.ndarray:
+    """The filtered centre after a body seen at the origin is seen 1 m away 0.25 s later,
+    both sightings declaring ``declared`` [m] of centre noise."""
+    seen = dataclasses.replace(disc(0, np.zeros(2), np.zeros(2)), velocity_source="estimated",
+                               position_std=declared)  # fmt: skip
+    tracker.update(0.0, (seen,), ROBOT)
+    moved = dataclasses.replace(seen, centre=np.array([1.0, 0.0]))
+    return tracker.update(0.25, (moved,), ROBOT)[0].centre
+
+
+def test_the_readings_declared_noise_sets_the_filter() -> None:
+    """A precise reading moves the filtered centre further toward what was seen than a noisy
+    one; a reading that declares none is filtered with the tracker's own ``position_std``."""
+    precise = _second_centre(CentreTracker(position_std=0.3, accel_std=0.5), 0.01)
+    noisy = _second_centre(CentreTracker(position_std=0.01, accel_std=0.5), 0.3)
+    assert precise[0] > 0.99 and 0.0 < noisy[0] < 0.7
+    undeclared = _second_centre(CentreTracker(position_std=0.3, accel_std=0.5), 0.0)
+    assert np.array_equal(undeclared, _second_centre(CentreTracker(0.01, 0.5), 0.3))

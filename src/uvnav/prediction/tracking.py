@@ -18,7 +18,12 @@ observed centre with velocity 0 and variances ``(sigma_z^2, sigma_v0^2)``.
 :class:`CentreTracker` applies it to a law's readings: a reading whose ``velocity_source`` is
 ``"estimated"`` gets the filtered centre (its outline and nearest point moved with it) and the
 filtered velocity; a reading with known rates is returned as it is (nothing to filter), so a law
-that tracks is unchanged wherever sensing is exact.  Units: m, s, m/s.
+that tracks is unchanged wherever sensing is exact.  sigma_z is the sensor's: a reading that
+declares its centre's noise (``position_std`` > 0: the finite-difference estimator's added noise,
+a lidar's fitted centre) is filtered with it, one that declares none with the tracker's
+``position_std``.  The filter's responsiveness is set by the ratio sigma_a dt^2 / sigma_z (the
+tracking index), so one sigma_a serves both a precise sensor (a responsive filter: centres to a
+few cm) and a noisy one (a smooth filter).  Units: m, s, m/s.
 """
 
 from __future__ import annotations
@@ -69,7 +74,7 @@ class CentreTracker:
     """A constant-velocity Kalman filter per sensed body (module docstring); one per episode.
 
     Attributes:
-        position_std: sigma_z, the assumed noise of an observed centre [m].
+        position_std: sigma_z of a reading that declares no centre noise [m].
         accel_std: sigma_a, the assumed white-noise acceleration of a body [m/s^2].
         initial_speed_std: sigma_v0, the velocity spread of a body seen for the first time [m/s].
     """
@@ -97,14 +102,15 @@ class CentreTracker:
                 out.append(rd)
                 continue
             z = np.asarray(rd.centre, dtype=float)
+            sigma_z = rd.position_std if rd.position_std > 0 else self.position_std
             prev = self._tracks.get(rd.obstacle_id)
             if prev is None or not time > prev[0]:
                 p, v = z.copy(), np.zeros(2)
-                cov = np.diag([self.position_std**2, self.initial_speed_std**2])
+                cov = np.diag([sigma_z**2, self.initial_speed_std**2])
             else:
                 t0, p, v, cov = prev
                 p, v, cov = cv_predict(p, v, cov, time - t0, self.accel_std)
-                p, v, cov = cv_update(p, v, cov, z, self.position_std)
+                p, v, cov = cv_update(p, v, cov, z, sigma_z)
             self._tracks[rd.obstacle_id] = (time, p, v, cov)
             shift = p - z
             nearest = rd.nearest_point + shift
