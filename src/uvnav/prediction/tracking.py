@@ -23,11 +23,14 @@ declares its centre's noise (``position_std`` > 0: the finite-difference estimat
 a lidar's fitted centre) is filtered with it, one that declares none with the tracker's
 ``position_std``.  The filter's responsiveness is set by the ratio sigma_a dt^2 / sigma_z (the
 tracking index), so one sigma_a serves both a precise sensor (a responsive filter: centres to a
-few cm) and a noisy one (a smooth filter).  Units: m, s, m/s.
+few cm) and a noisy one (a smooth filter).  A walker's accelerations grow with its speed (turning
+at rate w at speed s is an acceleration s w), so sigma_a may grow with a track's filtered speed
+(``turn_std``): slow walkers get a smooth filter, fast ones a responsive one.  Units: m, s, m/s.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -77,11 +80,15 @@ class CentreTracker:
         position_std: sigma_z of a reading that declares no centre noise [m].
         accel_std: sigma_a, the assumed white-noise acceleration of a body [m/s^2].
         initial_speed_std: sigma_v0, the velocity spread of a body seen for the first time [m/s].
+        turn_std: the spread of a body's turn rate [rad/s]: a body moving at speed s turning at
+            rate w accelerates by s w, so a track's sigma_a is ``max(accel_std, turn_std s)``,
+            s its filtered speed before the prediction (0: sigma_a is ``accel_std`` alone).
     """
 
     position_std: float = 0.1
     accel_std: float = 1.0
     initial_speed_std: float = 1.0
+    turn_std: float = 0.0
     _tracks: dict[int, tuple[float, FloatArray, FloatArray, FloatArray]] = field(
         default_factory=dict
     )
@@ -109,7 +116,8 @@ class CentreTracker:
                 cov = np.diag([sigma_z**2, self.initial_speed_std**2])
             else:
                 t0, p, v, cov = prev
-                p, v, cov = cv_predict(p, v, cov, time - t0, self.accel_std)
+                sigma_a = max(self.accel_std, self.turn_std * math.hypot(v[0], v[1]))
+                p, v, cov = cv_predict(p, v, cov, time - t0, sigma_a)
                 p, v, cov = cv_update(p, v, cov, z, sigma_z)
             self._tracks[rd.obstacle_id] = (time, p, v, cov)
             shift = p - z
