@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -117,3 +118,16 @@ def test_discs_get_velocity_but_no_spin_estimate() -> None:
         ob.state = ob.motion.step(ob.state, i * 0.1, 0.1)
     assert r.velocity == pytest.approx(V_TRUE, abs=1e-9)
     assert r.angular_velocity == 0.0  # a disc's rotation is unobservable
+
+
+def test_readings_declare_their_centre_noise() -> None:
+    """The declared centre noise is the added noise combined with what the reading came with."""
+    field = ObstacleField.from_obstacles([Obstacle.moving_disc((2.0, 1.0), 0.3)])
+    (reading,) = sense_obstacles(np.zeros(2), field)
+    (plain,) = FiniteDifferenceEstimator(np.random.default_rng(0), 0.1).update(0.0, (reading,))
+    assert plain.position_std == pytest.approx(0.1)
+    fitted = dataclasses.replace(reading, position_std=0.05)
+    (both,) = FiniteDifferenceEstimator(np.random.default_rng(0), 0.1).update(0.0, (fitted,))
+    assert both.position_std == pytest.approx(math.hypot(0.05, 0.1))
+    (exact,) = FiniteDifferenceEstimator(np.random.default_rng(0), 0.0).update(0.0, (reading,))
+    assert exact.position_std == 0.0

@@ -109,3 +109,29 @@ def test_a_scene_says_in_one_line_what_scan_bodies_need() -> None:
         scenario_from_dict({**base, "sensing": {"bodies": "lidar", "lidar": {}}})
     with pytest.raises(ValueError, match="bodies sensed by lidar need a lidar"):
         SensingConfig(bodies="lidar")
+
+
+def test_the_declared_centre_noise_is_what_the_fit_shows() -> None:
+    """Discs of radius 0.3 m crossing a 360-beam scan with 1 cm range noise, sampled every
+    0.25 s: each reading declares ``centre_std``, and the part of the fitted centre's error that
+    changes from one scan to the next has about that spread per axis (what a tracker filters)."""
+    rng = np.random.default_rng(3)
+    changes = []
+    for _ in range(80):
+        start = rng.uniform(1.0, 4.0) * np.array([1.0, 0.0])
+        heading = rng.uniform(-math.pi, math.pi)
+        step = 0.25 * rng.uniform(0.5, 1.5) * np.array([math.cos(heading), math.sin(heading)])
+        bodies, last = ScanBodies(), None
+        for k in range(8):
+            c = start + k * step
+            if not 0.8 < math.hypot(*c) < 4.5:
+                break
+            scan = lidar_scan(POSE, _field((*c, 0.3)), rng, n_rays=360, noise_std=0.01)
+            (rd,) = bodies.readings(0.25 * k, POSE, scan, 5.0)
+            assert rd.position_std == bodies.centre_std > 0
+            if last is not None:
+                changes.append(rd.centre - c - last)
+            last = rd.centre - c
+    spread = math.sqrt(float(np.mean(np.square(changes))) / 2.0)
+    assert len(changes) > 200
+    assert 0.7 * ScanBodies.centre_std < spread < 1.3 * ScanBodies.centre_std

@@ -197,8 +197,9 @@ class Zhang2019V2Params:
             centres), plan on the centres and velocities of a constant-velocity Kalman filter per
             body (:class:`uvnav.prediction.tracking.CentreTracker`); readings with known rates
             are used as they are.
-        track_position_std: the filter's assumed centre noise [m].
-        track_accel_std: the filter's assumed white-noise acceleration of a body [m/s^2].
+        track_position_std: the filter's centre noise [m] for readings that declare none.
+        track_accel_std: the filter's white-noise acceleration of a body [m/s^2], at least.
+        track_turn_std: the filter's turn-rate spread [rad/s] (``CentreTracker.turn_std``).
         rollout_step: longest substep [s] of the paths checked on a vehicle with acceleration
             limits (module docstring, "Acceleration limits").
         limited_spread: on a vehicle with acceleration limits, how fast [m/s] each body's reach
@@ -225,7 +226,8 @@ class Zhang2019V2Params:
     w_comfort: float = 10.0
     track_estimates: bool = True
     track_position_std: float = 0.1
-    track_accel_std: float = 1.0
+    track_accel_std: float = 0.2
+    track_turn_std: float = 0.5
     rollout_step: float = 0.125
     limited_spread: float = 0.1
     w_social: float = 0.0
@@ -257,6 +259,7 @@ class Zhang2019V2Params:
                 "limited_spread",
                 "w_social",
                 "social_band",
+                "track_turn_std",
             ),
         )
         for name in ("n_headings", "max_tangent_bodies"):
@@ -659,7 +662,7 @@ def finite_position(pose: FloatArray) -> bool:
 def _tracker(p: Zhang2019V2Params) -> CentreTracker | None:
     if not p.track_estimates:
         return None
-    return CentreTracker(p.track_position_std, p.track_accel_std)
+    return CentreTracker(p.track_position_std, p.track_accel_std, turn_std=p.track_turn_std)
 
 
 def tracked(obs: Observation, tracker: CentreTracker | None) -> Observation:

@@ -10,11 +10,14 @@ mass centre and outline orientation:
              (2D Kabsch: atan2 of the summed cross / dot products) / dt_s.
 
 An obstacle seen for the first time gets zero rates.  Gaussian noise of ``position_noise`` [m] is
-added to the observed centre (and outline, rigidly) before differencing.
+added to the observed centre (and outline, rigidly) before differencing, and each reading declares
+its centre's noise (``position_std``): the incoming reading's own (a lidar's fitted centre, say)
+and the added noise, independent, combined as ``hypot(position_std, position_noise)``.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -64,6 +67,7 @@ class FiniteDifferenceEstimator:
                     velocity=velocity,
                     angular_velocity=omega,
                     velocity_source="estimated",
+                    position_std=math.hypot(rd.position_std, self.position_noise),
                 )
             )
         return tuple(out)

@@ -18,11 +18,19 @@ observed centre with velocity 0 and variances ``(sigma_z^2, sigma_v0^2)``.
 :class:`CentreTracker` applies it to a law's readings: a reading whose ``velocity_source`` is
 ``"estimated"`` gets the filtered centre (its outline and nearest point moved with it) and the
 filtered velocity; a reading with known rates is returned as it is (nothing to filter), so a law
-that tracks is unchanged wherever sensing is exact.  Units: m, s, m/s.
+that tracks is unchanged wherever sensing is exact.  sigma_z is the sensor's: a reading that
+declares its centre's noise (``position_std`` > 0: the finite-difference estimator's added noise,
+a lidar's fitted centre) is filtered with it, one that declares none with the tracker's
+``position_std``.  The filter's responsiveness is set by the ratio sigma_a dt^2 / sigma_z (the
+tracking index), so one sigma_a serves both a precise sensor (a responsive filter: centres to a
+few cm) and a noisy one (a smooth filter).  A walker's accelerations grow with its speed (turning
+at rate w at speed s is an acceleration s w), so sigma_a may grow with a track's filtered speed
+(``turn_std``): slow walkers get a smooth filter, fast ones a responsive one.  Units: m, s, m/s.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -69,14 +77,18 @@ class CentreTracker:
     """A constant-velocity Kalman filter per sensed body (module docstring); one per episode.
 
     Attributes:
-        position_std: sigma_z, the assumed noise of an observed centre [m].
+        position_std: sigma_z of a reading that declares no centre noise [m].
         accel_std: sigma_a, the assumed white-noise acceleration of a body [m/s^2].
         initial_speed_std: sigma_v0, the velocity spread of a body seen for the first time [m/s].
+        turn_std: the spread of a body's turn rate [rad/s]: a body moving at speed s turning at
+            rate w accelerates by s w, so a track's sigma_a is ``max(accel_std, turn_std s)``,
+            s its filtered speed before the prediction (0: sigma_a is ``accel_std`` alone).
     """
 
     position_std: float = 0.1
     accel_std: float = 1.0
     initial_speed_std: float = 1.0
+    turn_std: float = 0.0
     _tracks: dict[int, tuple[float, FloatArray, FloatArray, FloatArray]] = field(
         default_factory=dict
     )
@@ -97,14 +109,16 @@ class CentreTracker:
                 out.append(rd)
                 continue
             z = np.asarray(rd.centre, dtype=float)
+            sigma_z = rd.position_std if rd.position_std > 0 else self.position_std
             prev = self._tracks.get(rd.obstacle_id)
             if prev is None or not time > prev[0]:
                 p, v = z.copy(), np.zeros(2)
-                cov = np.diag([self.position_std**2, self.initial_speed_std**2])
+                cov = np.diag([sigma_z**2, self.initial_speed_std**2])
             else:
                 t0, p, v, cov = prev
-                p, v, cov = cv_predict(p, v, cov, time - t0, self.accel_std)
-                p, v, cov = cv_update(p, v, cov, z, self.position_std)
+                sigma_a = max(self.accel_std, self.turn_std * math.hypot(v[0], v[1]))
+                p, v, cov = cv_predict(p, v, cov, time - t0, sigma_a)
+                p, v, cov = cv_update(p, v, cov, z, sigma_z)
             self._tracks[rd.obstacle_id] = (time, p, v, cov)
             shift = p - z
             nearest = rd.nearest_point + shift

@@ -33,6 +33,8 @@ class ObstacleReading:
         radius: disc radius [m]; 0 for a polygon.
         bounding_radius: radius of the centroid-centred disc containing the body [m].
         velocity_source: ``"known"`` (ground truth) or ``"estimated"``.
+        position_std: the sensor's declared 1-sigma noise of ``centre`` [m] (per axis); 0 when
+            the sensor declares none (exact sensing, or a source that does not know it).
     """
 
     obstacle_id: int
@@ -45,6 +47,7 @@ class ObstacleReading:
     radius: float
     bounding_radius: float
     velocity_source: str = "known"
+    position_std: float = 0.0
 
     @classmethod
     def polygon(
@@ -66,7 +69,7 @@ class ObstacleReading:
             obstacle_id=obstacle_id, distance=distance, nearest_point=nearest_point,
             centre=centre, velocity=velocity, angular_velocity=angular_velocity,
             outline=outline, radius=0.0, bounding_radius=bounding_radius,
-            velocity_source="known",
+            velocity_source="known", position_std=0.0,
         )  # fmt: skip
         return r
 

@@ -20,6 +20,13 @@ readings every 2D law reads, with nothing of the world but the ranges:
    ``gate`` [m]; an unmatched segment opens a track with a new id, and a track unseen for
    ``forget`` [s] is dropped.  The id is the reading's ``obstacle_id``.
 
+Each reading declares its centre's noise, ``position_std`` = ``centre_std`` [m] per axis (what a
+tracker that filters the centres should assume).  The default is measured: 300 discs of radius
+0.3 m crossing the scan at 0.5-1.5 m/s, 0.8-4.5 m from a 360-beam scanner with 1 cm range noise,
+sampled every 0.25 s: the fitted centre's error has an RMS of 0.047 m per axis, of which the part
+that changes from one scan to the next (what a filter averages away) is 0.032 m; the rest, the
+short radius along the ray, changes slowly and no filter removes it.
+
 Velocities are left to the world's estimator: the readings say ``velocity_source="estimated"``
 with a zero velocity, and :class:`~uvnav.prediction.FiniteDifferenceEstimator` gives the rates
 of the associated centres (a law may filter them further, as ``zhang2019-v2`` does with its
@@ -102,6 +109,7 @@ class ScanBodies:
         min_radius, max_radius: the disc radius fitted to a segment stays in this range [m].
         gate: farthest a body is matched to a track's predicted centre [m].
         forget: a track unseen for this long is dropped [s].
+        centre_std: the noise each reading declares for its centre [m] (module docstring).
 
     The defaults were chosen on CrowdNav's validation cases (``crowdnav-circle`` with
     ``phase=val``, 150 cases, ``zhang2019-holonomic-v2``, 360 beams, 1 cm range noise): a gap of
@@ -115,6 +123,7 @@ class ScanBodies:
     max_radius: float = 0.5
     gate: float = 1.0
     forget: float = 1.0
+    centre_std: float = 0.03
     _tracks: dict[int, tuple[float, FloatArray, FloatArray]] = field(default_factory=dict)
     _next_id: int = 0
 
@@ -145,7 +154,7 @@ class ScanBodies:
             out.append(ObstacleReading(
                 obstacle_id=j, distance=dist, nearest_point=near, centre=centre,
                 velocity=np.zeros(2), angular_velocity=0.0, outline=_NO_OUTLINE, radius=radius,
-                bounding_radius=radius, velocity_source="estimated",
+                bounding_radius=radius, velocity_source="estimated", position_std=self.centre_std,
             ))  # fmt: skip
         return tuple(sorted(out, key=lambda rd: (rd.distance, rd.obstacle_id)))
 
