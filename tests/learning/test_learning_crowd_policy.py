@@ -68,6 +68,7 @@ def test_crowd_train_writes_weights_the_law_drives_with(tmp_path: Path) -> None:
     assert r.exit_code == 0, r.output
     assert json.loads(r.stdout)["train"]["seed"] == 3
     assert out.is_file() and out.with_suffix(".json").is_file()
+    assert list(tmp_path.glob("*.ckpt.*")) == []  # no checkpoint left once the weights are out
     r = runner.invoke(
         app, ["simulate", "crowdnav-circle:0", "--controller", "crowd-ppo-v1",
               "--param", f"weights={out}", "--json"],
@@ -90,3 +91,45 @@ def test_a_bad_option_is_one_line_with_status_2(args: list[str], message: str) -
     r = runner.invoke(app, ["crowd", "train", *args])
     assert r.exit_code == 2, r.output
     assert message in r.output
+
+
+def test_an_interrupted_run_continues_from_its_checkpoint(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Ctrl-C after the first checkpoint leaves the run's state on disk; the same config
+    continues it to its step count (CPU time added up); another config is refused in one
+    line."""
+    import dataclasses
+
+    import uvnav.learning.crowd_policy as cpol
+
+    cfg = TrainConfig(steps=256, n_envs=2, n_steps=32, batch_size=64, epochs=1)
+    ckpt = tmp_path / "p.ckpt.zip"
+    real, calls = cpol._save, []
+
+    def save_then_interrupt(*args: object, **kwargs: object) -> None:
+        real(*args, **kwargs)  # type: ignore[arg-type]
+        calls.append(1)
+        if len(calls) == 1:
+            raise KeyboardInterrupt
+
+    monkeypatch.setattr(cpol, "_save", save_then_interrupt)
+    with pytest.raises(KeyboardInterrupt):
+        train_crowd_policy(cfg, checkpoint=ckpt, every=64)
+    saved = json.loads(ckpt.with_suffix(".json").read_text())
+    assert ckpt.is_file() and 64 <= saved["timesteps"] < cfg.steps
+    monkeypatch.setattr(cpol, "_save", real)
+    model, record = train_crowd_policy(cfg, checkpoint=ckpt, every=64)
+    assert record["timesteps"] == model.num_timesteps == cfg.steps
+    assert record["cpu_seconds"] >= saved["cpu_seconds"] > 0
+    with pytest.raises(cpol.CheckpointMismatchError, match="other options"):
+        train_crowd_policy(dataclasses.replace(cfg, seed=1), checkpoint=ckpt)
+
+
+def test_the_cli_refuses_to_overwrite_an_interrupted_run(tmp_path: Path) -> None:
+    """A checkpoint beside --out is continued with --resume only, never silently restarted."""
+    out = tmp_path / "w.safetensors"
+    (tmp_path / "w.ckpt.zip").write_bytes(b"")
+    result = runner.invoke(app, ["crowd", "train", "--out", str(out), "--steps", "64"])
+    assert result.exit_code == 2
+    assert "--resume continues it" in result.output and len(result.output.strip().splitlines()) == 1

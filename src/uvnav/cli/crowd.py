@@ -4,7 +4,9 @@
   train-phase seeds (:mod:`uvnav.learning.crowd_policy`); writes the actor's weights
   (safetensors) and their header with the training record (JSON beside them).  The shipped
   weights are ``uvnav crowd train`` with its defaults; a trained file drives the law with
-  ``--param weights=FILE``.
+  ``--param weights=FILE``.  The run's state is saved beside the weights file every 100,000
+  steps and on Ctrl-C (``NAME.ckpt.zip``); the same command with ``--resume`` continues it, and
+  the checkpoint is removed once the weights are written.
 
 Evaluation is the law's, as any law's: ``uvnav simulate crowdnav-circle:0 --controller
 crowd-ppo-v1``, ``uvnav bench``, ``benchmarks/bench_crowdnav.py --law crowd-ppo-v1``.
@@ -21,7 +23,7 @@ from typing import Annotated
 import typer
 
 from uvnav.cli.checks import dumps
-from uvnav.cli.errors import CliError, uvnav_typer
+from uvnav.cli.errors import EX_INTERRUPTED, CliError, uvnav_typer
 
 crowd_app = uvnav_typer(help="The learned crowd law crowd-ppo-v1: train its PPO policy.")
 
@@ -51,6 +53,12 @@ def train_cmd(
             help="Humans per scene at the start of a linear curriculum to 5 (5: none).",
         ),
     ] = 5,
+    resume: Annotated[
+        bool,
+        typer.Option(
+            "--resume", help="Continue the interrupted run whose checkpoint is beside --out."
+        ),
+    ] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help="No progress lines on stderr.")] = False,
     as_json: Annotated[
         bool,
@@ -60,7 +68,12 @@ def train_cmd(
     ] = False,
 ) -> None:
     """Train crowd-ppo-v1's policy on CrowdNav's circle crossing (train seeds); write it."""
-    from uvnav.learning.crowd_policy import TrainConfig, export_policy, train_crowd_policy
+    from uvnav.learning.crowd_policy import (
+        CheckpointMismatchError,
+        TrainConfig,
+        export_policy,
+        train_crowd_policy,
+    )
 
     if steps > MAX_STEPS:
         raise CliError(f"--steps: {steps} is more than {MAX_STEPS}")
@@ -70,11 +83,29 @@ def train_cmd(
     cfg = TrainConfig(steps=steps, seed=seed, n_envs=n_envs, n_steps=n_steps,
                       batch_size=batch, humans_start=humans_start)  # fmt: skip
 
+    ckpt = checkpoint_path(out)
+    if ckpt.is_file() and not resume:
+        raise CliError(
+            f"--out: {ckpt} holds an interrupted run: --resume continues it (or delete it)"
+        )
+
     def log(line: str) -> None:
         print(line, file=sys.stderr, flush=True)
 
-    model, record = train_crowd_policy(cfg, log=None if quiet else log)
+    try:
+        model, record = train_crowd_policy(cfg, log=None if quiet else log, checkpoint=ckpt)
+    except CheckpointMismatchError as exc:
+        raise CliError(f"--resume: {exc}") from None
+    except KeyboardInterrupt:
+        typer.echo(
+            f"interrupted: the run's state is in {ckpt}; the same command with --resume "
+            "continues it",
+            err=True,
+        )
+        raise typer.Exit(EX_INTERRUPTED) from None
     path = export_policy(model, record, out, cfg.k)
+    for done in (ckpt, ckpt.with_suffix(".json")):
+        done.unlink(missing_ok=True)
     if as_json:
         typer.echo(dumps(record))
     else:
@@ -83,3 +114,9 @@ def train_cmd(
             f"({record['wall_seconds']} s wall)"
         )
     typer.echo(f"wrote {path} and {path.with_suffix('.json')}", err=as_json)
+
+
+def checkpoint_path(out: Path) -> Path:
+    """Where ``uvnav crowd train --out OUT`` keeps its run's state: ``OUT`` with ``.ckpt.zip``
+    for ``.safetensors``."""
+    return out.with_suffix(".ckpt.zip")

@@ -219,7 +219,11 @@ def reproduce_cmd(
         ),
     ] = False,
     json_: Annotated[
-        bool, typer.Option("--json", help="With --plan: print one JSON object.")
+        bool,
+        typer.Option(
+            "--json",
+            help="Print one JSON object (the plan; with --plan only) instead of the table.",
+        ),
     ] = False,
 ) -> None:
     """Reproduce one experiment into the results store and its report section.

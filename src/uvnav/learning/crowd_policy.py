@@ -12,6 +12,13 @@ and critic are two-layer tanh MLPs on them; the law acts with the actor's mean
 :func:`train_crowd_policy` trains on :class:`uvnav.envs.crowd.CrowdNavEnv` (train-phase cases of
 CrowdNav's circle crossing) and :func:`export_policy` writes the actor's weights as safetensors
 with a JSON header (config + training record: seed, steps, CPU time, reward, curriculum).
+
+A long run loses nothing when interrupted: with a ``checkpoint`` path, PPO's whole state (the
+policy, the optimiser, the step count) is saved there every ``every`` steps and when the run is
+interrupted (Ctrl-C), with the run's config and CPU time beside it (``<checkpoint>.json``); a run
+given the same path and config continues from it (:class:`CheckpointMismatchError` for another
+config).  The resumed run's environments restart from fresh cases, so its weights are not bit for
+bit an uninterrupted run's.
 """
 
 from __future__ import annotations
@@ -126,11 +133,30 @@ def _curriculum_callback(cfg: TrainConfig) -> Any:
     return Curriculum()
 
 
-def train_crowd_policy(cfg: TrainConfig, *, log: Any = None) -> tuple[Any, dict[str, Any]]:
+#: steps between two checkpoints of a training run
+CHECKPOINT_EVERY = 100_000
+
+
+class CheckpointMismatchError(ValueError):
+    """A checkpoint made by a run of another config (one line)."""
+
+
+def train_crowd_policy(
+    cfg: TrainConfig,
+    *,
+    log: Any = None,
+    checkpoint: Path | None = None,
+    every: int = CHECKPOINT_EVERY,
+) -> tuple[Any, dict[str, Any]]:
     """Train PPO on :class:`~uvnav.envs.crowd.CrowdNavEnv`; returns ``(model, record)``.
 
     ``log``: a callable given one line per PPO update (steps, mean return, success share) or
-    ``None``.
+    ``None``.  ``checkpoint``: a ``.zip`` path; an existing checkpoint there is continued (module
+    docstring), and the run saves its state there every ``every`` steps and on Ctrl-C (then
+    re-raises the interrupt).
+
+    Raises:
+        CheckpointMismatchError: the checkpoint was made with another config.
     """
     torch = _torch()
     sb3 = _sb3()
@@ -138,12 +164,50 @@ def train_crowd_policy(cfg: TrainConfig, *, log: Any = None) -> tuple[Any, dict[
 
     from uvnav.envs.crowd import CROWD_REWARD, CrowdNavEnv
 
+    meta = _checkpoint_meta(cfg, checkpoint)
+    spent = float(meta["cpu_seconds"]) if meta else 0.0
     torch.set_num_threads(1)
     cpu0, wall0 = time.process_time(), time.perf_counter()
     n0 = min(cfg.humans_start, 5)
     env = make_vec_env(CrowdNavEnv, n_envs=cfg.n_envs, seed=cfg.seed,
                        env_kwargs={"k": cfg.k, "n_humans": (n0, n0)})  # fmt: skip
-    model = sb3.PPO(
+    model = _load(sb3, cfg, env, checkpoint) if meta and checkpoint else _new(sb3, cfg, env)
+    callbacks = [_curriculum_callback(cfg), _progress_callback(log)]
+    done = int(model.num_timesteps)
+
+    def save() -> None:
+        if checkpoint is not None:
+            _save(model, cfg, checkpoint, spent + time.process_time() - cpu0)
+
+    if checkpoint is not None:
+        callbacks.append(_checkpoint_callback(save, every))
+    try:
+        model.learn(
+            total_timesteps=max(cfg.steps - done, 0), callback=callbacks,
+            reset_num_timesteps=done == 0,
+        )  # fmt: skip
+    except KeyboardInterrupt:
+        save()
+        raise
+    finally:
+        env.close()
+    record = {
+        "algorithm": "PPO (stable-baselines3 " + sb3.__version__ + ")",
+        "env": "CrowdNavEnv: crowdnav-circle, train phase (seeds 2000 + case), holonomic robot, "
+        "invisible to ORCA humans",
+        "train": asdict(cfg),
+        "reward": asdict(CROWD_REWARD),
+        "timesteps": int(model.num_timesteps),
+        "cpu_seconds": round(spent + time.process_time() - cpu0, 1),
+        "wall_seconds": round(time.perf_counter() - wall0, 1),
+        "torch": torch.__version__,
+    }
+    return model, record
+
+
+def _new(sb3: Any, cfg: TrainConfig, env: Any) -> Any:
+    """A new PPO model of ``cfg`` (module docstring) stepping ``env``."""
+    return sb3.PPO(
         "MlpPolicy", env, n_steps=cfg.n_steps, batch_size=cfg.batch_size, n_epochs=cfg.epochs,
         learning_rate=lambda left: cfg.learning_rate * left, gamma=cfg.gamma,
         gae_lambda=cfg.gae_lambda, ent_coef=cfg.ent_coef, seed=cfg.seed, device="cpu", verbose=0,
@@ -153,21 +217,61 @@ def train_crowd_policy(cfg: TrainConfig, *, log: Any = None) -> tuple[Any, dict[
             "net_arch": {"pi": [64, 64], "vf": [64, 64]},
         },
     )  # fmt: skip
-    callbacks = [_curriculum_callback(cfg), _progress_callback(log)]
-    model.learn(total_timesteps=cfg.steps, callback=callbacks)
-    env.close()
-    record = {
-        "algorithm": "PPO (stable-baselines3 " + sb3.__version__ + ")",
-        "env": "CrowdNavEnv: crowdnav-circle, train phase (seeds 2000 + case), holonomic robot, "
-        "invisible to ORCA humans",
-        "train": asdict(cfg),
-        "reward": asdict(CROWD_REWARD),
-        "timesteps": int(model.num_timesteps),
-        "cpu_seconds": round(time.process_time() - cpu0, 1),
-        "wall_seconds": round(time.perf_counter() - wall0, 1),
-        "torch": torch.__version__,
-    }
-    return model, record
+
+
+def _checkpoint_meta(cfg: TrainConfig, path: Path | None) -> dict[str, Any] | None:
+    """What a run of ``cfg`` saved beside its checkpoint at ``path`` (steps, CPU seconds), or
+    ``None`` when there is none.
+
+    Raises:
+        CheckpointMismatchError: the checkpoint was made with another config.
+    """
+    if path is None or not Path(path).is_file():
+        return None
+    meta: dict[str, Any] = json.loads(Path(path).with_suffix(".json").read_text())
+    if meta.get("train") != json.loads(json.dumps(asdict(cfg))):
+        raise CheckpointMismatchError(
+            f"{path}: a checkpoint of a run with other options ({meta.get('train')}); delete it "
+            "or give the same options"
+        )
+    return meta
+
+
+def _load(sb3: Any, cfg: TrainConfig, env: Any, path: Path) -> Any:
+    """The PPO model saved at ``path``, stepping ``env``, with ``cfg``'s learning-rate schedule."""
+    schedule = {"learning_rate": lambda left: cfg.learning_rate * left}
+    schedule["lr_schedule"] = schedule["learning_rate"]
+    return sb3.PPO.load(str(path), env=env, device="cpu", custom_objects=schedule)
+
+
+def _save(model: Any, cfg: TrainConfig, path: Path, cpu_seconds: float) -> None:
+    """PPO's state at ``path`` (written whole or not at all) and its config and CPU time beside
+    it."""
+    path = Path(path)
+    tmp = path.with_name(path.stem + ".tmp.zip")
+    model.save(str(tmp))
+    meta = {"train": asdict(cfg), "timesteps": int(model.num_timesteps), "cpu_seconds": cpu_seconds}
+    write_atomic(path.with_suffix(".json"), (json.dumps(meta, indent=1) + "\n").encode())
+    tmp.replace(path)
+
+
+def _checkpoint_callback(save: Any, every: int) -> Any:
+    from stable_baselines3.common.callbacks import BaseCallback
+
+    class Checkpoint(BaseCallback):
+        """Saves the run's state after the first rollout past each ``every`` steps."""
+
+        last = 0
+
+        def _on_step(self) -> bool:
+            return True
+
+        def _on_rollout_end(self) -> None:
+            if self.num_timesteps - self.last >= every:
+                self.last = self.num_timesteps
+                save()
+
+    return Checkpoint()
 
 
 def _progress_callback(log: Any) -> Any:
