@@ -32,7 +32,10 @@ def test_linear_program_stays_in_the_disc_and_left_of_every_line_when_it_can(
 ) -> None:
     lines = as_lines(rows)
     x, y = solve_orca_lines(lines, 0, speed, pref)
-    assert math.hypot(x, y) <= speed * (1 + 1e-9)
+    # RVO2's programs put the result on a line's chord of the disc (sqrt(r^2 - d^2) from the
+    # line's point, its coordinates up to 3 m): nearly antiparallel lines round it a few 1e-9
+    # outside (found: 4.2e-9 for lines at pi and 7e-4 rad), hence 1e-8
+    assert math.hypot(x, y) <= speed * (1 + 1e-8)
     fail, _, _ = kernel("lp2_py")(lines, len(rows), speed, pref[0], pref[1], False)
     if fail == len(rows):  # feasible: every half-plane holds
         slack = [dx * (py - y) - dy * (px - x) for px, py, dx, dy in lines.tolist()]
