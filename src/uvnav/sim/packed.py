@@ -440,20 +440,12 @@ def observe_py(
     dirs = np.empty((2, rel.shape[0]))
     for k in range(wf.shape[0]):
         x, y, th = wf[k, W_X], wf[k, W_Y], wf[k, W_TH]
-        _lidar(x, y, th, rel, max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ring,
-               dirs, ranges[k])  # fmt: skip
-        gx, gy = wf[k, W_GX] - x, wf[k, W_GY] - y
-        d = pyhypot(gx, gy)
-        dist[k] = d
-        bearing = math.atan2(gy, gx) - th
-        out[k, 0] = min(d / goal_scale, 1.0)
-        out[k, 1] = math.cos(bearing)
-        out[k, 2] = math.sin(bearing)
+        dist[k] = pyhypot(wf[k, W_GX] - x, wf[k, W_GY] - y)
         status = wi[k, I_STATUS]
         speed = 0.0 if status in (SUCCESS, COLLISION) else wf[k, W_V]
-        out[k, 3] = min(max(speed / wf[k, W_VMAX], 0.0), 1.0)
-        for r in range(ranges.shape[1]):
-            out[k, 4 + r] = min(max(ranges[k, r] / max_range, 0.0), 1.0)
+        vector_one_py(x, y, th, wf[k, W_GX], wf[k, W_GY], goal_scale, speed, wf[k, W_VMAX], rel,
+                      max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ring, dirs,
+                      ranges[k], out[k])  # fmt: skip
 
 
 #: the kernels by short name, and everything they call (callees first)
