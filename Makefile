@@ -73,8 +73,12 @@ $(STAMP_PEERS): pyproject.toml $(STAMP_RUN) | $(PY)
 
 peers: $(STAMP_PEERS)
 
-# every benchmark runs (one failing does not stop the others), then issue 20's summary table;
-# the exit status is 1 when any benchmark failed
+# every benchmark runs (one failing does not stop the others), then the summary table, which
+# also replaces the table in benchmarks/README.md; the exit status is 1 when any benchmark failed.
+# The release the single and vector envs are compared with (bench_vector_env.py --against), its
+# src/ unpacked from git when the repository has the commit (else their rows read "not measured")
+BENCH_RELEASE ?= 682d9d2
+BENCH_BASE := $(BENCH_OUT)/release-$(BENCH_RELEASE)
 BENCH_RUNS = \
 	benchmarks/run_benchmarks.py \
 	benchmarks/bench_multi.py \
@@ -82,7 +86,7 @@ BENCH_RUNS = \
 	benchmarks/bench_ch7.py \
 	benchmarks/bench_campaign.py \
 	benchmarks/bench_ray.py \
-	benchmarks/bench_vector_env.py \
+	"benchmarks/bench_vector_env.py $$against" \
 	"benchmarks/bench_crowdnav.py --cases 500" \
 	"benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-holonomic-v2" \
 	"benchmarks/bench_crowdnav.py --cases 500 --law zhang2019-v2" \
@@ -92,10 +96,17 @@ BENCH_RUNS = \
 	benchmarks/peers/navground_crowd.py
 
 bench: $(STAMP_RUN) peers
-	@status=0; for run in $(BENCH_RUNS); do \
+	@mkdir -p $(BENCH_OUT) && touch $(BENCH_OUT)/.sitting; against=; \
+	if git cat-file -e "$(BENCH_RELEASE)^{commit}" 2>/dev/null; then \
+	  rm -rf $(BENCH_BASE) && mkdir -p $(BENCH_BASE) && \
+	  git archive $(BENCH_RELEASE) src | tar -x -C $(BENCH_BASE) && against="--against $(BENCH_BASE)"; \
+	else echo "note: commit $(BENCH_RELEASE) is not in this repository: no release to compare with"; fi; \
+	status=0; for run in $(BENCH_RUNS); do \
 	  echo "== $$run"; $(PY) $$run --out $(BENCH_OUT) || { status=1; echo "FAILED: $$run"; }; \
 	done; \
-	echo; $(PY) benchmarks/summary.py --results $(BENCH_OUT); exit $$status
+	echo; $(PY) benchmarks/summary.py --results $(BENCH_OUT); \
+	$(PY) benchmarks/summary.py --results $(BENCH_OUT) --write-readme benchmarks/README.md; \
+	exit $$status
 
 clean:
 	rm -rf $(VENV) results report .pytest_cache .mypy_cache .ruff_cache

@@ -1,9 +1,9 @@
-"""The peer benchmarks' pure helpers and ``benchmarks/summary.py``'s table (no benchmark is run)."""
+"""The peer benchmarks' pure helpers (no benchmark is run; ``benchmarks/summary.py``'s table:
+``test_bench_results_summary.py``)."""
 
 from __future__ import annotations
 
 import importlib
-import json
 import sys
 from pathlib import Path
 from types import ModuleType
@@ -17,7 +17,6 @@ for folder in (BENCH, BENCH / "peers"):
         sys.path.insert(0, str(folder))
 
 import peerstats  # noqa: E402
-import summary  # noqa: E402
 
 
 @pytest.fixture
@@ -102,66 +101,3 @@ def test_navground_orca_judges_the_shared_law(peer_module: Any) -> None:
     assert t["pass"] is None and "not available" in t["note"]
     # the swap window: the crossing time at full speed (antipodal:10: 8 m at 0.7 m/s, dt 0.1)
     assert ng.window_steps(10) == 115
-
-
-def _write(folder: Path, name: str, payload: dict[str, Any]) -> None:
-    (folder / name).write_text(json.dumps(payload), encoding="utf-8")
-
-
-def test_summary_table(tmp_path: Path) -> None:
-    rows = summary.build_rows(tmp_path)  # nothing run yet
-    assert [r.result for r in rows] == ["not run"] * 7 + ["not measured"]
-    assert rows[-1].name == "vector env"
-    _write(
-        tmp_path,
-        "peers.json",
-        {
-            "available": False,
-            "quick": False,
-            "targets": {
-                "world_step_us_100": peerstats.judge(150.0, 15.0, "<="),
-                "world_step_us_10": peerstats.judge(2.5, 3.0, "<="),
-                "vs_irsim_100": peerstats.judge(None, 1000.0, ">="),
-            },
-        },
-    )
-    _write(
-        tmp_path,
-        "peers_orca.json",
-        {"available": True, "quick": True, "targets": {
-            "orca_vs_navground_10": peerstats.judge(46.0, 2.0, "<=")}},
-    )  # fmt: skip
-    _write(tmp_path, "campaign.json", {"wall_s_per_10000": 90.0, "pass": True, "quick": False})
-    _write(tmp_path, "summary.json", {"targets": {"a": {"pass": True}, "b": {"pass": False}}})
-    vec = {"name": "vector env, K = 256", "target": ">= 100,000/s", "measured": "110,066/s",
-           "ratio": 1.1007, "pass": True}  # fmt: skip
-    world = {"name": "world step, 10 obstacles", "ratio": 1.5, "pass": False}
-    _write(tmp_path, "vector_env.json", {"quick": True, "targets": [world, vec]})
-    rows = summary.build_rows(tmp_path)
-    got = {r.name.strip(): (r.measured, r.ratio, r.result) for r in rows}
-    assert got["world step, 100 polygons"] == ("150 µs", "10.0", "FAIL")
-    assert got["world step, 10 polygons"] == ("2.50 µs", "0.83", "PASS")
-    assert got["steps/s over ir-sim's"] == ("-", "-", "no peer")
-    assert got["ORCA antipodal:10 vs navground"] == ("46.0x", "23.0", "FAIL*")
-    assert got["ORCA antipodal:100 vs navground"][2] == "not run"
-    assert got["campaign, 10,000 episodes"] == ("90.0 s", "0.75", "PASS")
-    assert got["vector env, K = 256"] == ("110,066/s", "1.10", "PASS*")
-    assert len(rows) == 8  # the Ray row: tests/bench/test_bench_ray_summary.py
-    text = summary.render(rows, ["footer", summary.summary_line(tmp_path) or ""])
-    assert max(len(line) for line in text.splitlines()) <= summary.WIDTH
-    assert "* quick (smoke) run" in text and "1 of 2 pass" in text
-    (tmp_path / "campaign.json").write_text("{not json", encoding="utf-8")
-    assert summary.campaign_row(tmp_path).result == "not run"
-
-
-def test_summary_machine_line(tmp_path: Path) -> None:
-    """The footer line that says how fast the machine ran: ir-sim's medians from peers.json."""
-    assert summary.machine_line(tmp_path) is None
-    _write(tmp_path, "peers.json", {"results": {
-        "10": {"irsim": {"median_us_per_step": 1762.26}},
-        "100": {"irsim": {"median_us_per_step": 22345.0}}}})  # fmt: skip
-    line = summary.machine_line(tmp_path)
-    assert line == "machine: ir-sim's step here 1,762 µs (10 polygons), 22,345 µs (100 polygons)"
-    assert len(line) <= summary.WIDTH
-    _write(tmp_path, "peers.json", {"results": {"10": {"irsim": None}}})  # no peer installed
-    assert summary.machine_line(tmp_path) is None

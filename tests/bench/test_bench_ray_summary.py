@@ -1,9 +1,8 @@
-"""``benchmarks/summary.py``'s Ray row and ``benchmarks/bench_ray.py``'s pure helpers (no
-benchmark is run)."""
+"""``benchmarks/bench_ray.py``'s pure helpers (no benchmark is run; its row in the summary table:
+``test_bench_results_summary.py``)."""
 
 from __future__ import annotations
 
-import json
 import os
 import sys
 from pathlib import Path
@@ -16,33 +15,6 @@ if str(BENCH) not in sys.path:
     sys.path.insert(0, str(BENCH))
 
 import bench_ray  # noqa: E402
-import summary  # noqa: E402
-
-
-def _write(folder: Path, payload: dict[str, Any]) -> None:
-    (folder / "ray.json").write_text(json.dumps(payload), encoding="utf-8")
-
-
-def test_ray_row(tmp_path: Path) -> None:
-    assert summary.ray_row(tmp_path).result == "not run"
-    full = {"episodes": 10_000}
-    _write(tmp_path, {"quick": False, "ray_engine": full,
-                      "target": {"measured": 0.042, "limit": 0.1, "pass": True}})  # fmt: skip
-    row = summary.ray_row(tmp_path)
-    assert (row.measured, row.ratio, row.result) == ("4.20 %", "0.42", "PASS")
-    assert row.name in [r.name for r in summary.build_rows(tmp_path)]
-    # fewer episodes than the issue's campaign: the workers' warm-up weighs more, a smoke run
-    _write(tmp_path, {"quick": False, "ray_engine": {"episodes": 2_000},
-                      "target": {"measured": 0.042, "limit": 0.1, "pass": True}})  # fmt: skip
-    assert summary.ray_row(tmp_path).result == "PASS*"
-    _write(tmp_path, {"quick": True, "target": {"measured": 0.25, "limit": 0.1, "pass": False}})
-    assert summary.ray_row(tmp_path).result == "FAIL*"
-    _write(tmp_path, {"quick": False, "target": {"measured": None, "limit": 0.1, "pass": None,
-                                                 "note": "ray not installed"}})  # fmt: skip
-    row = summary.ray_row(tmp_path)
-    assert (row.measured, row.result) == ("-", "not measured")
-    (tmp_path / "ray.json").write_text("{not json", encoding="utf-8")
-    assert summary.ray_row(tmp_path).result == "not run"
 
 
 def test_judge_compares_ray_with_the_pool() -> None:
