@@ -5,7 +5,7 @@ obstacles wandering in an arena beside its path (N = 10 and 100), dt = 0.1 s, bu
 ``benchmarks/run_benchmarks.py``'s ``world_setup``.  uvnav runs it two ways, side by side: the
 packed world step (``uvnav.sim.packed.PackedWorlds``, one compiled call a step, the robot on a
 constant command; the side judged against the targets, when this uvnav has it) and the one loop
-(``uvnav.sim.run_episode`` with ``straight-v1`` and ``record=False``: sensing and a decision every
+(``uvnav.sim.run_episode`` with ``zhang2019-v1`` and ``record=False``: sensing and a decision every
 step on top; judged when there is no packed step).  The ir-sim side is a YAML world generated
 at run time with *the same polygons* (same seed, same ``random_nonconvex`` bodies and start
 poses), the robot driven by a constant action ``[0.707, 0]`` and the obstacles on ir-sim's own
@@ -69,7 +69,9 @@ REPEATS = peerstats.MIN_REPEATS
 UVNAV_STEPS = 3000
 #: the uvnav sides: the packed world step (judged, when this uvnav has it) and the one loop
 PACKED = "packed world step (uvnav.sim.packed.PackedWorlds, constant command)"
-LOOP = "run_episode (straight-v1, record off)"
+#: the law the loop side decides with (issue 37's general loop: sense, decide, advance)
+LOOP_LAW = "zhang2019-v1"
+LOOP = f"run_episode ({LOOP_LAW}, record off)"
 DT = 0.1
 IRSIM_STEPS = {10: 3000, 100: 1000}
 #: --quick: steps per episode (uvnav, ir-sim) and repeats
@@ -88,7 +90,7 @@ WORK = {
     "the robot on a constant command, clearance; no sensing, no law); ir-sim: EnvBase.step "
     "(every obstacle's behaviour and kinematics, the robot's, STRtree rebuild, collision query)",
     "loop": "uvnav: run_episode (every obstacle's motion, field rebuild, the robot's step and "
-    "collision check, sensing within 8 m, a straight-v1 decision); ir-sim: EnvBase.step (every "
+    "collision check, sensing within 8 m, a zhang2019-v1 decision); ir-sim: EnvBase.step (every "
     "obstacle's behaviour and kinematics, the robot's, STRtree rebuild, collision query)",
 }
 
@@ -183,9 +185,9 @@ def time_irsim(
 
 
 def time_uvnav(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
-    """One uvnav episode of ``n_steps`` steps (``straight-v1``, record off): CPU s, status."""
+    """One uvnav episode of ``n_steps`` steps (:data:`LOOP_LAW`, record off): CPU s, status."""
     wall, res, cpu = _time_episode(
-        lambda: world_setup(n_obstacles, n_steps, seed), "straight-v1", seed, False
+        lambda: world_setup(n_obstacles, n_steps, seed), LOOP_LAW, seed, False
     )
     return {"seed": seed, "steps": n_steps, "cpu_s": cpu, "wall_s": wall, "status": res.status}
 
@@ -321,7 +323,7 @@ def main(argv: list[str] | None = None) -> int:
         "benchmark": "peers_irsim",
         "description": "world steps per CPU second, 1 robot + N moving non-convex polygons, "
         "dt 0.1 s: ir-sim EnvBase.step (headless) vs uvnav's packed world step (judged, when this "
-        "uvnav has uvnav.sim.packed) and run_episode (straight-v1, record off)",
+        f"uvnav has uvnav.sim.packed) and run_episode ({LOOP_LAW}, record off)",
         "available": available,
         "uvnav_judged": PACKED if packed else LOOP,
         "irsim": info.get("irsim"),
@@ -345,7 +347,7 @@ def main(argv: list[str] | None = None) -> int:
             "collision tests; no sensing, no controller (a constant command)",
             "uvnav loop": "obstacle motion (RandomTurn) for every obstacle, ObstacleField rebuild, "
             "robot unicycle step, robot clearance/collision check, sensing within 8 m and a "
-            "straight-v1 decision every step",
+            f"{LOOP_LAW} decision every step",
         },
         "results": results,
         "targets": judged,
