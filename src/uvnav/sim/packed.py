@@ -128,6 +128,7 @@ from uvnav.sim.packed_sense import (  # noqa: F401 - the reading columns, re-exp
     R_OMEGA,
     R_VEL,
     _lidar,
+    _rough_cos_sin,
     advance_one_py,
     observe_py,
     sense_one_py,
@@ -157,7 +158,8 @@ def kernel(name: str) -> Callable[..., Any]:
     if not _KERNELS:
         _KERNELS.update(compile_family([
             wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py, ray_ring_hit_py,
-            _transform_ring, _move_obstacles, _clearance, _lidar, vector_one_py, step_worlds_py,
+            _transform_ring, _move_obstacles, _clearance, _rough_cos_sin, _lidar, vector_one_py,
+            step_worlds_py,
             observe_py,
             sense_one_py, advance_one_py, clearance_one_py,
         ]))  # fmt: skip
