@@ -27,7 +27,7 @@ from uvnav.sim.episode import World2D
 from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, kernel, pack_check
 from uvnav.sim.packed_sense import _rough_cos_sin
 from uvnav.sim.run import run_episode
-from uvnav.sim.seeding import run_rng
+from uvnav.sim.seeding import run_rng, world_rng
 from uvnav.sim.setup import EpisodeResult, EpisodeSetup
 
 REL = np.linspace(-np.pi, np.pi, 16, endpoint=False)
@@ -438,3 +438,21 @@ def test_the_lidar_kernel_is_lidar_scan_near_inside_and_far_from_bodies(compiled
                       worlds.state[0], worlds.rings[0], ring, dirs, ranges)  # fmt: skip
                 want = lidar_scan(np.array([x, y, th]), field, n_rays=90, max_range=4.0).ranges
                 np.testing.assert_array_equal(ranges, want)
+
+
+def test_a_restored_image_is_the_episode_load_builds() -> None:
+    """restore() with episode 2's generators gives the slot load(build_episode(scene, 2)) gives,
+    and the same steps after."""
+    scene = load_scenario("random-ch2:4")
+    fast, built = PackedWorlds(2), PackedWorlds(2)
+    fast.load(0, build_episode(scene, 1))
+    assert fast.restore(1, fast.image(0), world_rng(2).spawn(len(scene.obstacles)))
+    built.load(0, build_episode(scene, 1))
+    built.load(1, build_episode(scene, 2))
+    for _ in range(400):
+        for w in (fast, built):
+            w.command[:] = (0.3, 0.2)
+            w.step()
+        for name in ("wf", "wi", "oi", "read", "params", "state", "ubuf", "rings"):
+            np.testing.assert_array_equal(getattr(fast, name), getattr(built, name), name)
+    assert not np.array_equal(fast.state[0], fast.state[1])

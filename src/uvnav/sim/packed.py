@@ -355,6 +355,37 @@ class PackedWorlds:
         # the slot's rows are full: a top-up is due no sooner for it than for the others
         self.safe_calls = min(self.safe_calls, b // (2 * ratio))
 
+    def image(self, slot: int) -> tuple[np.ndarray, ...]:
+        """Copies of ``slot``'s rows as :meth:`load` left them, for :meth:`restore`."""
+        return tuple(a[slot].copy() for a in (self.wf, self.wi, self.oi, self.params, self.state,
+                                               self.rings))  # fmt: skip
+
+    def restore(self, slot: int, image: tuple[np.ndarray, ...],
+                generators: list[np.random.Generator]) -> bool:  # fmt: skip
+        """Put :meth:`image`'s episode in ``slot`` with obstacle ``o``'s draws from
+        ``generators[o]``: what :meth:`load` does for an episode of the same scene that differs
+        only in its generators (the draws of :class:`RandomTurn` are the only numbers a scene
+        seed changes), without building it.  False (and nothing done) when the arrays have been
+        reshaped since the image was taken; :meth:`load` it then."""
+        if any(a.shape[1:] != b.shape for a, b in zip(
+            (self.wf, self.wi, self.oi, self.params, self.state, self.rings), image, strict=True
+        )):  # fmt: skip
+            return False
+        self.wf[slot], self.wi[slot], self.oi[slot] = image[0], image[1], image[2]
+        self.params[slot], self.state[slot], self.rings[slot] = image[3], image[4], image[5]
+        self.read[slot] = 0
+        kinds = image[2][O_KIND]
+        rngs: list[np.random.Generator | None] = []
+        for o in range(int(image[1][I_NOBS])):
+            rng = generators[o] if kinds[o] == RANDOM_TURN else None
+            if rng is not None:
+                rng.random(out=self.ubuf[slot, o])
+            rngs.append(rng)
+        self.rngs[slot] = rngs
+        ratio = int(image[1][I_RATIO])
+        self.safe_calls = min(self.safe_calls, self.ubuf.shape[2] // (2 * ratio))
+        return True
+
     def load_obstacles(self, slot: int, obstacles: list[Obstacle], tpl: FieldTemplate,
                        b: int) -> None:  # fmt: skip
         """Put ``obstacles`` (packable: :func:`pack_check`; ``tpl`` their bodies' template) in
