@@ -24,9 +24,10 @@ from uvnav.scenarios.loader import load_scenario
 from uvnav.sensors.exact import lidar_scan
 from uvnav.sim.bodies2d import FieldBodies, PackedBodies
 from uvnav.sim.episode import World2D
-from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, pack_check
+from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, kernel, pack_check
+from uvnav.sim.packed_sense import _rough_cos_sin
 from uvnav.sim.run import run_episode
-from uvnav.sim.seeding import run_rng
+from uvnav.sim.seeding import run_rng, world_rng
 from uvnav.sim.setup import EpisodeResult, EpisodeSetup
 
 REL = np.linspace(-np.pi, np.pi, 16, endpoint=False)
@@ -405,3 +406,53 @@ def test_the_compiled_path_leaves_the_generators_where_the_numpy_path_does_acros
     for _ in range(200):
         world.bodies.step(0.05 * _, 0.05, 0.0, 0.0, 0.2)
     assert world.bodies._pw.read.max() > 0  # the rows were topped up
+
+
+def test_the_rough_directions_are_within_their_stated_error() -> None:
+    for a in [*np.linspace(-math.pi, math.pi, 20_001).tolist(), math.pi / 2, -math.pi / 2]:
+        c, s = _rough_cos_sin(a)
+        assert abs(c - math.cos(a)) <= 1e-12 and abs(s - math.sin(a)) <= 1e-12, a
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_the_lidar_kernel_is_lidar_scan_near_inside_and_far_from_bodies(compiled: bool) -> None:
+    """Poses around every body of a random-ch2 scene (on edges, inside, beyond the range): the
+    kernel's ranges equal :func:`lidar_scan`'s, beams in any direction."""
+    if compiled and not numba_available():
+        pytest.skip("needs numba (the fast extra)")
+    setup = build_episode(load_scenario("random-ch2:5"), 3)
+    field = ObstacleField.from_obstacles(setup.obstacles)
+    worlds = PackedWorlds(1)
+    worlds.load(0, setup)
+    rng = np.random.default_rng(7)
+    rel = np.linspace(-math.pi, math.pi, 90, endpoint=False)
+    ranges, dirs = np.empty(90), np.empty((2, 90))
+    ring = np.empty((2, worlds.rings.shape[3]))
+    with kernels(compiled):
+        lidar = kernel("lidar")
+        for ob in setup.obstacles:
+            for _ in range(20):
+                x, y = np.asarray(ob.state.position) + rng.normal(0.0, 1.0, 2)
+                th = float(rng.uniform(-7.0, 7.0))
+                lidar(float(x), float(y), th, rel, 4.0, len(setup.obstacles), worlds.params[0],
+                      worlds.state[0], worlds.rings[0], ring, dirs, ranges)  # fmt: skip
+                want = lidar_scan(np.array([x, y, th]), field, n_rays=90, max_range=4.0).ranges
+                np.testing.assert_array_equal(ranges, want)
+
+
+def test_a_restored_image_is_the_episode_load_builds() -> None:
+    """restore() with episode 2's generators gives the slot load(build_episode(scene, 2)) gives,
+    and the same steps after."""
+    scene = load_scenario("random-ch2:4")
+    fast, built = PackedWorlds(2), PackedWorlds(2)
+    fast.load(0, build_episode(scene, 1))
+    assert fast.restore(1, fast.image(0), world_rng(2).spawn(len(scene.obstacles)))
+    built.load(0, build_episode(scene, 1))
+    built.load(1, build_episode(scene, 2))
+    for _ in range(400):
+        for w in (fast, built):
+            w.command[:] = (0.3, 0.2)
+            w.step()
+        for name in ("wf", "wi", "oi", "read", "params", "state", "ubuf", "rings"):
+            np.testing.assert_array_equal(getattr(fast, name), getattr(built, name), name)
+    assert not np.array_equal(fast.state[0], fast.state[1])

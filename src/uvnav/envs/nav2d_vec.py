@@ -47,6 +47,7 @@ from uvnav.sim.packed import (
     PackedWorlds,
     pack_check,
 )
+from uvnav.sim.seeding import world_rng
 
 try:
     import gymnasium as gym
@@ -125,14 +126,21 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self._rngs: list[np.random.Generator | None] = [None] * k
         self._autoreset = np.zeros(k, dtype=np.bool_)
         self.episode_seeds = np.zeros(k, dtype=np.int64)
+        self._image: tuple[np.ndarray, ...] | None = None
 
     def _load(self, i: int, options: dict[str, Any] | None) -> None:
-        """Start sub-environment ``i``'s next episode (its generator picks the seed)."""
+        """Start sub-environment ``i``'s next episode (its generator picks the seed).  The first
+        episode is built (:func:`~uvnav.scenarios.build.build_episode`) and loaded, the others
+        restore its image with their own obstacle generators (:meth:`PackedWorlds.restore
+        <uvnav.sim.packed.PackedWorlds.restore>`): the same episodes, without building them."""
         rng = self._rngs[i]
         if rng is None:
             rng = self._rngs[i] = seeding.np_random()[0]
         self.episode_seeds[i] = k = episode_seed(rng, options)
-        self.worlds.load(i, build_episode(self.scenario, k))
+        children = world_rng(k).spawn(len(self.scenario.obstacles))  # build_episode's
+        if self._image is None or not self.worlds.restore(i, self._image, children):
+            self.worlds.load(i, build_episode(self.scenario, k))
+            self._image = self.worlds.image(i)
         c = float(self.worlds.clearance[i])
         self._clear[i] = c if np.isfinite(c) else self.max_range
 

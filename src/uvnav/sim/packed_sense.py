@@ -1,0 +1,322 @@
+"""The compiled sensing kernels of :mod:`uvnav.sim.packed`: the exact readings of one world,
+the lidar cast and ``uvnav/Nav2D-v0``'s observation vectors.
+
+Each function here is plain Python that numba compiles (:func:`uvnav.sim.packed.kernel`); the
+numbers are those of :func:`uvnav.sensors.exact.sense_obstacles` and
+:func:`uvnav.sensors.lidar_scan`, bit for bit.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.geometry.polygons import ray_ring_hit_py, ring_nearest_py
+from uvnav.geometry.small import pyhypot
+from uvnav.sim.packed_kernels import (
+    COLLISION,
+    I_NOBS,
+    I_STATUS,
+    P_BOUND,
+    S_HEADING,
+    S_OMEGA,
+    S_VX,
+    S_VY,
+    S_X,
+    S_Y,
+    SUCCESS,
+    W_GX,
+    W_GY,
+    W_TH,
+    W_V,
+    W_VMAX,
+    W_X,
+    W_Y,
+    _clearance,
+    _move_obstacles,
+    _transform_ring,
+)
+
+#: columns of :func:`sense_one_py`'s reading rows: distance [m], nearest point [m], centre [m],
+#: velocity [m/s], rotation rate [rad/s]
+R_DIST, R_NEAR, R_CENTRE, R_VEL, R_OMEGA = 0, 1, 3, 5, 7
+NR = 8
+
+
+def sense_one_py(x: float, y: float, sensing_range: float, n_obs: int, prm: FloatArray,
+                 st: FloatArray, rings: FloatArray, ids: np.ndarray, rows: FloatArray,
+                 outlines: FloatArray) -> int:  # fmt: skip
+    """The readings of :func:`uvnav.sensors.exact.sense_obstacles` in one world from
+    ``(x, y)``: their number ``m`` and, nearest first (ties in index order, NaN last, as a
+    stable ``argsort``), in the first ``m`` rows of ``ids`` (M,) the obstacles' indices, of
+    ``rows`` (M, NR) their ``R_*`` columns and of ``outlines`` (M, W, 2) their world rings.  The
+    distance to the set (0 inside) and nearest boundary point are those of
+    :meth:`ObstacleField.query`; a body whose bounding disc lies beyond ``sensing_range`` [m]
+    (with the query's cull margins) is not measured, its distance exceeding the range."""
+    slack = 1e-9 * (1.0 + abs(x) + abs(y))
+    limit = sensing_range * (1.0 + 1e-9) + slack
+    ring = np.empty((2, rings.shape[2]))
+    m = 0
+    for o in range(n_obs):
+        cx, cy = st[S_X, o], st[S_Y, o]
+        dx, dy = cx - x, cy - y
+        dd = dx * dx + dy * dy
+        dc = math.sqrt(dd) if dd < 1e300 else math.hypot(dx, dy)
+        if dc * (1.0 - 1e-9) - prm[P_BOUND, o] > limit:
+            continue
+        h = st[S_HEADING, o]
+        _transform_ring(rings, o, math.cos(h), math.sin(h), cx, cy, ring)
+        d, qx, qy, inside = ring_nearest_py(x, y, ring[0], ring[1], True)
+        if inside:
+            d = 0.0
+        if d > sensing_range:
+            continue
+        at = m  # insert after every reading nearer or as near (NaN: after all)
+        while at > 0:
+            prev = rows[at - 1, R_DIST]
+            if not (prev > d or (d == d and prev != prev)):
+                break
+            at -= 1
+        for r in range(m, at, -1):
+            ids[r] = ids[r - 1]
+            rows[r] = rows[r - 1]
+            outlines[r] = outlines[r - 1]
+        ids[at] = o
+        rows[at, R_DIST], rows[at, R_NEAR], rows[at, R_NEAR + 1] = d, qx, qy
+        rows[at, R_CENTRE], rows[at, R_CENTRE + 1] = cx, cy
+        rows[at, R_VEL], rows[at, R_VEL + 1] = st[S_VX, o], st[S_VY, o]
+        rows[at, R_OMEGA] = st[S_OMEGA, o]
+        for j in range(ring.shape[1]):
+            outlines[at, j, 0], outlines[at, j, 1] = ring[0, j], ring[1, j]
+        m += 1
+    return m
+
+
+def _rough_cos_sin(a: float) -> tuple[float, float]:
+    """cos and sin of ``a`` [rad] in [-pi, pi] within 1e-12 (Taylor series of degree 16 and 17
+    on [-pi/2, pi/2], folded), for tests that a margin makes safe: a few multiplications where
+    libm's exact ones cost a call each."""
+    r, sign = a, 1.0
+    if a > 0.5 * math.pi:
+        r, sign = math.pi - a, -1.0
+    elif a < -0.5 * math.pi:
+        r, sign = -math.pi - a, -1.0
+    q = r * r
+    c = 1.0 + q * (
+        -1.0 / 2
+        + q
+        * (
+            1.0 / 24
+            + q
+            * (
+                -1.0 / 720
+                + q
+                * (
+                    1.0 / 40320
+                    + q
+                    * (
+                        -1.0 / 3628800
+                        + q
+                        * (1.0 / 479001600 + q * (-1.0 / 87178291200 + q * (1.0 / 20922789888000)))
+                    )
+                )
+            )
+        )
+    )
+    sn = r * (
+        1.0
+        + q
+        * (
+            -1.0 / 6
+            + q
+            * (
+                1.0 / 120
+                + q
+                * (
+                    -1.0 / 5040
+                    + q
+                    * (
+                        1.0 / 362880
+                        + q
+                        * (
+                            -1.0 / 39916800
+                            + q
+                            * (
+                                1.0 / 6227020800
+                                + q * (-1.0 / 1307674368000 + q * (1.0 / 355687428096000))
+                            )
+                        )
+                    )
+                )
+            )
+        )
+    )
+    return sign * c, sn  # fmt: skip
+
+
+def _lidar(
+    ox: float,
+    oy: float,
+    th: float,
+    rel: FloatArray,
+    max_range: float,
+    n_obs: int,
+    prm: FloatArray,
+    st: FloatArray,
+    rings: FloatArray,
+    ring: FloatArray,
+    dirs: FloatArray,
+    out: FloatArray,
+) -> None:
+    """Ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from pose ``(ox, oy, th)`` in
+    one world into ``out`` (R,): beams at ``wrap(th + rel)`` [rad], capped at ``max_range``
+    [m] (``ring`` (2, W) and ``dirs`` (2, R): scratch).  A body is cast where
+    :meth:`ObstacleField.ray_hits` casts it, and only by the beams that meet its bounding disc
+    (the others cannot hit it: the same ranges, far fewer edges).
+
+    Two cheaper tests come first, each skipping only what the exact one skips: a body's centre
+    distance by ``sqrt`` (libm's ``hypot`` only where the two could decide differently), and a
+    beam's bounding-disc test with :func:`_rough_cos_sin`'s directions (kept in ``dirs``) and
+    a margin of 1e-9 (1 + centre offset) [m] over their 1e-12 error; a beam that passes it
+    takes libm's ``cos`` and ``sin`` and the exact test.  Most beams meet no body's disc, so
+    most beams take no ``cos`` or ``sin``."""
+    n_rays = rel.shape[0]
+    for r in range(n_rays):
+        out[r] = max_range
+        a = wrap_scalar(th + rel[r])
+        if -math.pi <= a <= math.pi:
+            dirs[0, r], dirs[1, r] = _rough_cos_sin(a)
+        else:  # not a number: no rough test skips it
+            dirs[0, r], dirs[1, r] = a, a
+    slack = 1e-9 * (1.0 + abs(ox) + abs(oy))
+    limit = max_range * (1.0 + 1e-9) + slack
+    for o in range(n_obs):
+        cx, cy, h = st[S_X, o], st[S_Y, o], st[S_HEADING, o]
+        bound = prm[P_BOUND, o]
+        ex, ey = cx - ox, cy - oy
+        dc = math.sqrt(ex * ex + ey * ey)
+        if abs(dc - bound - limit) <= 1e-12 * (1.0 + dc + bound + limit) or not dc < 1e300:
+            dc = math.hypot(cx - ox, cy - oy)  # near the edge, huge or not a number: libm's
+        if dc - bound > limit:
+            continue  # its hits would be beyond max_range
+        reach = bound * (1.0 + 1e-9) + slack
+        rough = reach + 1e-9 * (1.0 + abs(ex) + abs(ey))
+        cast = False
+        for r in range(n_rays):
+            dx, dy = dirs[0, r], dirs[1, r]
+            if abs(dx * ey - dy * ex) > rough or dx * ex + dy * ey < -rough:
+                continue
+            a = wrap_scalar(th + rel[r])
+            dx, dy = math.cos(a), math.sin(a)
+            # a beam that passes outside the bounding disc, or starts beyond it, cannot hit
+            if abs(dx * (cy - oy) - dy * (cx - ox)) > reach:
+                continue
+            if dx * (cx - ox) + dy * (cy - oy) < -reach:
+                continue
+            if not cast:
+                _transform_ring(rings, o, math.cos(h), math.sin(h), cx, cy, ring)
+                cast = True
+            out[r] = min(out[r], ray_ring_hit_py(ox, oy, dx, dy, ring[0], ring[1]))
+
+
+def vector_one_py(
+    x: float,
+    y: float,
+    th: float,
+    goal_x: float,
+    goal_y: float,
+    goal_scale: float,
+    speed: float,
+    v_max: float,
+    rel: FloatArray,
+    max_range: float,
+    n_obs: int,
+    prm: FloatArray,
+    st: FloatArray,
+    rings: FloatArray,
+    ring: FloatArray,
+    dirs: FloatArray,
+    ranges: FloatArray,
+    out: np.ndarray,
+) -> None:
+    """One observation vector of ``uvnav/Nav2D-v0`` (:meth:`uvnav.envs.core.EnvWorld.vector`)
+    into ``out`` (4 + R,) float32, as :func:`observe_py` writes a world's: from pose ``(x, y,
+    th)`` and goal ``(goal_x, goal_y)`` [m], the goal distance / ``goal_scale`` capped at 1, cos
+    and sin of the goal bearing in the robot frame, ``speed`` / ``v_max`` in [0, 1], and
+    :func:`_lidar`'s ranges [m] (into ``ranges`` (R,); scratch ``ring``, ``dirs``) over
+    ``max_range`` in [0, 1]."""
+    _lidar(x, y, th, rel, max_range, n_obs, prm, st, rings, ring, dirs, ranges)
+    gx, gy = goal_x - x, goal_y - y
+    bearing = math.atan2(gy, gx) - th
+    out[0] = min(pyhypot(gx, gy) / goal_scale, 1.0)
+    out[1] = math.cos(bearing)
+    out[2] = math.sin(bearing)
+    out[3] = min(max(speed / v_max, 0.0), 1.0)
+    for r in range(ranges.shape[0]):
+        out[4 + r] = min(max(ranges[r] / max_range, 0.0), 1.0)
+
+
+def observe_py(
+    wf: FloatArray,
+    wi: np.ndarray,
+    params: FloatArray,
+    state: FloatArray,
+    rings: FloatArray,
+    rel: FloatArray,
+    max_range: float,
+    goal_scale: float,
+    ranges: FloatArray,
+    out: np.ndarray,
+    dist: FloatArray,
+) -> None:
+    """``uvnav/Nav2D-v0``'s observation vectors (:meth:`uvnav.envs.core.EnvWorld.vector`) of
+    every world into ``out`` (K, 4 + R) float32, their lidar ranges [m] into ``ranges`` (K, R)
+    and goal distances [m] into ``dist`` (K,): goal distance / ``goal_scale`` capped at 1, cos
+    and sin of the goal bearing in the robot frame, speed / V_max in [0, 1] (0 once arrived or
+    collided), ranges / ``max_range`` in [0, 1] (beams at heading + ``rel`` [rad])."""
+    ring = np.empty((2, rings.shape[3]))
+    dirs = np.empty((2, rel.shape[0]))
+    for k in range(wf.shape[0]):
+        x, y, th = wf[k, W_X], wf[k, W_Y], wf[k, W_TH]
+        dist[k] = pyhypot(wf[k, W_GX] - x, wf[k, W_GY] - y)
+        status = wi[k, I_STATUS]
+        speed = 0.0 if status in (SUCCESS, COLLISION) else wf[k, W_V]
+        vector_one_py(x, y, th, wf[k, W_GX], wf[k, W_GY], goal_scale, speed, wf[k, W_VMAX], rel,
+                      max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ring, dirs,
+                      ranges[k], out[k])  # fmt: skip
+
+
+def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs: int,
+                   oi: np.ndarray, prm: FloatArray, st: FloatArray, ubuf: FloatArray,
+                   rings: FloatArray, sensing_range: float, ids: np.ndarray, rows: FloatArray,
+                   outlines: FloatArray,
+                   prev: FloatArray) -> tuple[float, int, int, float]:  # fmt: skip
+    """Move the ``n_obs`` obstacles of one world (one slot's ``oi``, ``params``, ``state``,
+    ``ubuf`` and ``rings``: :func:`step_worlds_py`'s layout) from ``t`` by ``dt`` [s]; return
+    :func:`_clearance` of the robot disc of ``radius`` [m] at ``(x, y)`` then, for a
+    ``sensing_range`` >= 0 [m] the number of readings :func:`sense_one_py` writes from there
+    (else -1), and the most any body point moved [m] (centre shift plus bounding radius times
+    the turn): the step of :class:`~uvnav.sim.bodies2d.PackedBodies`, in one call.  The poses
+    before the step go to ``prev`` (3, n): x, y, heading.  The caller guarantees two unread
+    draws per obstacle."""
+    ring = np.empty((2, rings.shape[2]))
+    low = np.empty(rings.shape[1])
+    for o in range(n_obs):
+        prev[0, o], prev[1, o], prev[2, o] = st[S_X, o], st[S_Y, o], st[S_HEADING, o]
+    _move_obstacles(n_obs, st, prm, oi, ubuf, t, dt)
+    shift = 0.0
+    for o in range(n_obs):
+        dx, dy = st[S_X, o] - prev[0, o], st[S_Y, o] - prev[1, o]
+        turn = abs(st[S_HEADING, o] - prev[2, o])
+        if turn > math.pi:  # (headings are wrapped)
+            turn = 2.0 * math.pi - turn
+        s = math.sqrt(dx * dx + dy * dy) + turn * prm[P_BOUND, o]
+        if s > shift:
+            shift = s
+    gap, at = _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)
+    m = -1
+    if sensing_range >= 0.0:
+        m = sense_one_py(x, y, sensing_range, n_obs, prm, st, rings, ids, rows, outlines)
+    return gap, at, m, shift
