@@ -250,10 +250,11 @@ class AgentLog:
 
     def record(self, mode: str, cpu_ns: int, wall_ns: int) -> None:
         """Account for one decision."""
-        if self._decided and mode != self.last_mode:
-            self.mode_switches += 1
+        if mode != self.last_mode:
+            if self._decided:
+                self.mode_switches += 1
+            self.last_mode = mode
         self._decided = True
-        self.last_mode = mode
         self.decision_us.append(cpu_ns / 1000.0)
         self.decision_wall_us.append(wall_ns / 1000.0)
 
@@ -283,8 +284,12 @@ def run_loop(
     for p in probes:
         p.on_start(world, laws)
     cpu_ns, wall_ns = _time.thread_time_ns, _time.perf_counter_ns
+    # the bound methods the loop calls at every step, looked up once
+    observe, apply, advance, deciding = world.observe, world.apply, world.advance, world.acting
+    acts = [law.act for law in laws]
+    records = [log.record for log in logs]
     while not world.done:
-        acting = world.acting()
+        acting = deciding()
         if groups and acting:
             for key, group in groups.items():
                 members = [i for i in acting if keys[i] == key]
@@ -295,24 +300,24 @@ def run_loop(
                 c1, w1 = cpu_ns(), wall_ns()
                 m = len(members)
                 for i, cmd in zip(members, cmds, strict=True):
-                    applied = world.apply(cmd, i)
-                    logs[i].record(laws[i].mode, (c1 - c0) // m, (w1 - w0) // m)
+                    applied = apply(cmd, i)
+                    records[i](laws[i].mode, (c1 - c0) // m, (w1 - w0) // m)
                     for p in probes:
                         p.on_decision(world, i, laws[i], None, applied)
             acting = [i for i in acting if keys[i] is None]
         for i in acting:
-            law = laws[i]
-            obs = world.observe(i)
+            obs = observe(i)
+            act = acts[i]
             c0, w0 = cpu_ns(), wall_ns()
-            cmd = law.act(obs)
+            cmd = act(obs)
             c1, w1 = cpu_ns(), wall_ns()
-            applied = world.apply(cmd, i)
-            logs[i].record(law.mode, c1 - c0, w1 - w0)
+            applied = apply(cmd, i)
+            records[i](laws[i].mode, c1 - c0, w1 - w0)
             for p in probes:
-                p.on_decision(world, i, law, obs, applied)
+                p.on_decision(world, i, laws[i], obs, applied)
         for p in probes:
             p.on_step(world, laws)
-        world.advance()
+        advance()
     for p in probes:
         p.on_end(world, laws)
     return logs

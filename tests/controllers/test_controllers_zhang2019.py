@@ -213,3 +213,21 @@ def test_the_grouping_is_the_pairwise_single_linkage_in_the_same_order(seed: int
         )
         sizes.append(len(got.members))
     assert max(sizes) >= 5  # groups of several bodies, not singletons only
+
+
+@pytest.mark.parametrize("heading", [0.0, 1e-12, -4e-10, 6e-10, 1e-9, 2e-9, 0.3, -2.0, math.pi])
+@pytest.mark.parametrize("x", [0.0, 9.9, 9.999])
+def test_m1_command_is_the_law_with_the_distance_to_the_target(heading: float, x: float) -> None:
+    """M1 skips the distance to T when T is straight ahead; the command is the one computed
+    with it (approach_speed and the heading law of note 10), bit for bit."""
+    from uvnav.controllers.base import approach_speed, heading_rate_toward
+    from uvnav.geometry.angles import wrap_scalar
+
+    ctrl = fresh()
+    obs = observe([x, 0.0, heading], [])
+    gx, gy = float(GOAL[0]) - x, float(GOAL[1])
+    beta = wrap_scalar(float(np.arctan2(gy, gx)) - heading)
+    v = approach_speed(SPEC.v_max, SPEC.u_max, float(np.hypot(gx, gy)), beta)
+    cmd = ctrl.approach_command(obs, 0.1)
+    assert (cmd.v, cmd.u) == (v, heading_rate_toward(beta, SPEC.u_max, 0.1))
+    assert type(cmd.v) is float and type(cmd.u) is float

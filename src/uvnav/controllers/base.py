@@ -420,7 +420,10 @@ def heading_rate_toward(angle_error: float, u_max: float, period: float) -> floa
     """
     if period <= 0:
         return float(u_max * np.sign(angle_error))
-    return saturate(angle_error / period, u_max)
+    rate = angle_error / period  # (saturate(rate, u_max), inline)
+    if not math.isfinite(rate):
+        return 0.0
+    return float(min(max(rate, -u_max), u_max))
 
 
 def approach_speed(v_max: float, u_max: float, dist: float, beta: float) -> float:

@@ -104,6 +104,10 @@ from uvnav.geometry.small import (
 from uvnav.sensors.observation import Observation, ObstacleReading
 
 _DISC_SAMPLES = 24
+#: |beta| [rad] up to which T counts as straight ahead in M1: |sin(beta)| < 1e-9 there, so
+#: :func:`approach_speed` does not read the distance (nor does M1 compute it)
+_ALIGNED = 5e-10
+_NO_IDS: frozenset[int] = frozenset()
 
 
 @dataclass(frozen=True)
@@ -312,7 +316,7 @@ class Zhang2019Controller(UnicycleController):
         return self._tag
 
     def _reset_law(self, rng: np.random.Generator) -> None:
-        self._group_ids = frozenset()
+        self._group_ids = _NO_IDS
         self._tag = 1
 
     # -- the pieces of §2.3 -------------------------------------------------------------------
@@ -462,12 +466,14 @@ class Zhang2019Controller(UnicycleController):
         lowered to the largest one whose turning circle passes through T,
         ``U_max d / (2 sin|beta|)``.
         """
-        gx = float(self._goal[0]) - float(obs.pose[0])
-        gy = float(self._goal[1]) - float(obs.pose[1])
-        dist = float(np.hypot(gx, gy))
-        beta = wrap_scalar(float(np.arctan2(gy, gx)) - obs.heading)
-        v = approach_speed(self._spec.v_max, self._spec.u_max, dist, beta)
-        return UnicycleCommand(v, heading_rate_toward(beta, self._spec.u_max, period))
+        px, py, heading = obs.pose.tolist()
+        gx, gy = float(self._goal[0]) - px, float(self._goal[1]) - py
+        beta = wrap_scalar(float(np.arctan2(gy, gx)) - heading)
+        # the distance matters only when T is off the heading (|sin(beta)| <= |beta|)
+        dist = float(np.hypot(gx, gy)) if abs(beta) > _ALIGNED else math.inf
+        spec = self._spec
+        v = approach_speed(spec.v_max, spec.u_max, dist, beta)
+        return UnicycleCommand(v, heading_rate_toward(beta, spec.u_max, period))
 
     # -- the switching law ---------------------------------------------------------------------
 
@@ -484,7 +490,7 @@ class Zhang2019Controller(UnicycleController):
                 break
         if threat is None:
             self._mode = "M1"
-            self._group_ids = frozenset()
+            self._group_ids = _NO_IDS
             return self.approach_command(obs, period)
         nearby = tuple(rd for rd in obs.obstacles if rd.distance <= 2.0 * p.switch_distance)
         group = group_around(threat, nearby, 2.0 * margin, p.forecast_horizon)

@@ -180,6 +180,7 @@ class Unicycle:
     def __init__(self, robot: UnicycleSpec) -> None:
         self.spec = robot
         self._ideal = robot.ideal
+        self._arc = robot.kinematics == "arc"
         self.reset()
 
     def rest(self) -> UnicycleCommand:
@@ -204,7 +205,9 @@ class Unicycle:
         )
 
     def saturate(self, cmd: UnicycleCommand, heading: float) -> tuple[UnicycleCommand, bool]:
-        return cmd.clipped(self.spec), cmd.violates(self.spec)
+        new = cmd.clipped(self.spec)
+        # a command returned as it is lies within the limits: it violates none
+        return new, new is not cmd and cmd.violates(self.spec)
 
     def pair(self, cmd: UnicycleCommand) -> tuple[float, float]:
         return cmd.v, cmd.u
@@ -234,13 +237,17 @@ class Unicycle:
         self, x: float, y: float, heading: float, dt: float, decision: bool, period: float
     ) -> tuple[float, float, float, float, float]:
         v, u = self._v, self._u = self._next(dt)
-        if self.spec.kinematics == "arc":
+        if self._arc:
             nx, ny, th = unicycle_advance(x, y, heading, v, u, dt)
         else:  # the period's turn at the decision, then straight
             nx, ny, th = turn_then_move(x, y, heading, v, u * period if decision else 0.0, dt)
         return nx, ny, th, abs(u) * dt, u**2 * dt
 
     def travel(self, dt: float) -> tuple[float, float]:
-        v, u = self._next(dt)
-        slack = arc_slack(v, u, dt) if self.spec.kinematics == "arc" else 0.0
+        if self._ideal:  # (self._next, inline)
+            cmd = self._cmd
+            v, u = cmd.v, cmd.u
+        else:
+            v, u = self._next(dt)
+        slack = arc_slack(v, u, dt) if self._arc else 0.0
         return abs(v) * dt, slack

@@ -347,13 +347,6 @@ class PackedBodies:
         """The clearance [m] at t = 0 and the nearest body (:meth:`clearance`)."""
         return self.clearance(x, y, radius)
 
-    def measure(
-        self, t: float, dt: float, x: float, y: float, radius: float, sensing_range: float
-    ) -> tuple[float, int | None]:
-        """:meth:`step`: the exact clearance after the step, and the nearest body."""
-        self._field = None
-        return self.step(t, dt, x, y, radius, sensing_range)
-
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
         """The last step's start and end (the poses it kept): views of one copy of each, the
         centres (k, 2) and headings (k,) of :meth:`poses_before` and :meth:`poses`."""
@@ -382,12 +375,16 @@ class PackedBodies:
             pw.refill()
         pw.safe_calls -= 1
         self._stepped = True
+        self._field = None
         gap, at, m, self.shift = self._advance(
             x, y, radius, t, dt, self.n, self._oi, self._prm, self._st, self._ubuf, self._rings,
             sensing_range, self._ids, self._rows, self._outlines, self._prev,
         )  # fmt: skip
         self._sensed = (x, y, sensing_range, m) if m >= 0 else None
         return float(gap), int(at)
+
+    #: (:class:`Bodies2D`) :meth:`step`: the exact clearance after the step, the nearest body
+    measure = step
 
     def clearance(self, x: float, y: float, radius: float) -> tuple[float, int]:
         """The clearance [m] of the robot disc of ``radius`` [m] at ``(x, y)`` now, and its

@@ -177,9 +177,15 @@ class World2D(OneVehicle):
         """What the robot's sensors give now (:class:`~uvnav.sensors.suite2d.Sensors2D`: the
         bodies within the range, exact or from the lidar scan, their rates known or estimated,
         the scan, the plug-ins)."""
-        return self.sensors.observe(
+        sensors, bodies = self.sensors, self.bodies
+        if sensors.exact_only:  # (the same observation, without the sensors' other parts)
+            return sensors.exact_observation(
+                self.t, np.array((self.x, self.y, self.th)), self.body.speed(), self.goal,
+                bodies.readings(self.x, self.y, self.sensing_range),
+            )  # fmt: skip
+        return sensors.observe(
             self.t, self.pose, self.speed, self.goal,
-            lambda: self.bodies.readings(self.x, self.y, self.sensing_range), self.bodies.field,
+            lambda: bodies.readings(self.x, self.y, self.sensing_range), bodies.field,
         )  # fmt: skip
 
     def observe_later(self, agent: int = 0) -> Callable[[], Observation]:
@@ -191,8 +197,8 @@ class World2D(OneVehicle):
             return lambda: obs
         t, x, y, th, speed, goal = self.t, self.x, self.y, self.th, self.speed, self.goal
         readings = self.bodies.readings_later(x, y, self.sensing_range)
-        return lambda: Observation(time=t, pose=np.array((x, y, th)), speed=speed, goal=goal,
-                                   obstacles=readings(), lidar=None, extras={})  # fmt: skip
+        exact = self.sensors.exact_observation
+        return lambda: exact(t, np.array((x, y, th)), speed, goal, readings())
 
     @property
     def speed(self) -> float:
@@ -228,22 +234,20 @@ class World2D(OneVehicle):
     def advance(self) -> None:
         """One step ``dt``: robot (exact), obstacles, clearance, collision and arrival."""
         dt, book, clock, bodies, body = self.dt, self.book, self.clock, self.bodies, self.body
-        x, y, t0, g0 = self.x, self.y, self.t, self.clearance
+        x, y, t0, g0, ratio = self.x, self.y, self.t, self.clearance, self.ratio
+        radius = self.spec.radius
         if bodies.sees_robot:  # bodies that react to the robot see it as it starts the step
-            bodies.see_robot(np.array((x, y)), np.array(self.velocity()), self.spec.radius)
+            bodies.see_robot(np.array((x, y)), np.array(self.velocity()), radius)
         travel, slack = body.travel(dt)
         # the vehicle's exact motion; the heading, the total turn and the effort's turn term
-        nx, ny, self.th, turn, effort = body.move(x, y, self.th, dt, clock.due, self.ratio * dt)
+        k = clock.step_index  # (a decision is due at this step when k % ratio == 0)
+        nx, ny, self.th, turn, effort = body.move(x, y, self.th, dt, k % ratio == 0, ratio * dt)
         book.effort += effort
         self.turn += turn
         book.path += math.hypot(nx - x, ny - y)
         self.x, self.y = nx, ny
-        sense = (
-            self.sensing_range
-            if self.sense_in_step and (clock.step_index + 1) % self.ratio == 0
-            else -1.0
-        )
-        gap, nearest = bodies.measure(self.t, dt, nx, ny, self.spec.radius, sense)
+        sense = self.sensing_range if self.sense_in_step and (k + 1) % ratio == 0 else -1.0
+        gap, nearest = bodies.measure(t0, dt, nx, ny, radius, sense)
         self.clearance = gap
         if nearest is not None:
             self.nearest = nearest
@@ -260,7 +264,7 @@ class World2D(OneVehicle):
             if shift is None or not sweep.idle(0.5 * (g0 + gap - travel - shift), ceiling):
                 contact_at = self._swept((x, y), (nx, ny), t0, g0, travel, slack, ceiling)
         gd = math.hypot(self._gx - nx, self._gy - ny)
-        self.done = book.judge(t, self.clearance, gd, contact_at) or clock.up
+        self.done = book.judge(t, gap, gd, contact_at) or clock.step_index >= clock.n_steps
         if book.status == "collision":  # judged at the first contact when the sweep found it
             sweep = self.sweep
             by = (

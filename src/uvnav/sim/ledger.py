@@ -320,7 +320,8 @@ class OneVehicle:
 
     def acting(self) -> tuple[int, ...]:
         """``(0,)`` at a decision time (every ``control_period``), else ``()``."""
-        return (0,) if self.clock.due else ()
+        clock = self.clock  # (clock.due, inline)
+        return (0,) if clock.step_index % clock.ratio == 0 else ()
 
     def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
         """The episode's metrics (each world's own)."""
