@@ -42,7 +42,7 @@ from uvnav.dynamics.vehicles import Vehicle2D, make_vehicle
 from uvnav.geometry.angles import FloatArray
 from uvnav.obstacles.obstacle import FieldTemplate, ObstacleField
 from uvnav.sensors.observation import Observation
-from uvnav.sensors.suite2d import Sensors2D
+from uvnav.sensors.suite2d import Sensors2D, observation
 from uvnav.sim.bodies2d import Bodies2D, FieldBodies, PackedBodies
 from uvnav.sim.comfort import MotionTracker
 from uvnav.sim.ledger import Clock, Ledger, OneVehicle
@@ -178,10 +178,11 @@ class World2D(OneVehicle):
         bodies within the range, exact or from the lidar scan, their rates known or estimated,
         the scan, the plug-ins)."""
         sensors, bodies = self.sensors, self.bodies
-        if sensors.exact_only:  # (the same observation, without the sensors' other parts)
-            return sensors.exact_observation(
-                self.t, np.array((self.x, self.y, self.th)), self.body.speed(), self.goal,
-                bodies.readings(self.x, self.y, self.sensing_range),
+        if sensors.exact_only:  # (Sensors2D.exact_observation, inline)
+            x, y = self.x, self.y
+            return observation(
+                self.t, np.array((x, y, self.th)), self.body.speed(), self.goal,
+                bodies.readings(x, y, self.sensing_range), None, {},
             )  # fmt: skip
         return sensors.observe(
             self.t, self.pose, self.speed, self.goal,
