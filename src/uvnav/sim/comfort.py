@@ -80,12 +80,17 @@ def time_to_collision(
     w = np.asarray(rel_vel, dtype=float).reshape(-1, 2)
     r = np.broadcast_to(np.asarray(radius_sum, dtype=float), (len(p),))
     c = p[:, 0] ** 2 + p[:, 1] ** 2 - r**2  # > 0: apart
-    b = p[:, 0] * w[:, 0] + p[:, 1] * w[:, 1]  # < 0: closing
-    a = w[:, 0] ** 2 + w[:, 1] ** 2
-    disc = b * b - a * c
-    hit = (b < 0.0) & (disc >= 0.0) & (a > 0.0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        t = np.where(hit, (-b - np.sqrt(np.maximum(disc, 0.0))) / np.where(a > 0, a, 1.0), np.inf)
+    # along the unit direction of the relative motion (the distance to contact, then over the
+    # speed): squaring a tiny speed would lose it to underflow
+    speed = np.hypot(w[:, 0], w[:, 1])
+    moving = speed > 0.0
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        u = w / np.where(moving, speed, 1.0)[:, None]
+        b = p[:, 0] * u[:, 0] + p[:, 1] * u[:, 1]  # < 0: closing
+        disc = b * b - c
+        hit = (b < 0.0) & (disc >= 0.0) & moving
+        reach = -b - np.sqrt(np.maximum(disc, 0.0))
+        t = np.where(hit, reach / np.where(moving, speed, 1.0), np.inf)
     return np.where(c <= 0.0, 0.0, np.maximum(t, 0.0))
 
 
