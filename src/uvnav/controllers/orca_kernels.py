@@ -332,10 +332,42 @@ def decide_group_py(
         out[k, 6] = 1.0 if pyhypot(nx - px, ny - py) >= 1e-6 else 0.0
 
 
+def group_decide_py(
+    members: np.ndarray, t: float, first_period: float, last_t: FloatArray, draws: FloatArray,
+    upos: np.ndarray, perturbation: float, pos: FloatArray, heading: FloatArray,
+    vel: FloatArray, radii: FloatArray, reach: FloatArray, goals: FloatArray, v_max: FloatArray,
+    u_max: FloatArray, max_neighbors: int, tau: float, responsibility: float,
+    scratch: FloatArray, idx: np.ndarray, periods: FloatArray, pick: FloatArray, out: FloatArray,
+) -> None:  # fmt: skip
+    """A group decision at time ``t`` [s] (:func:`decide_group_py` into ``out[:m]``, m =
+    ``len(members)``) with each member's decision clock and perturbation draws: member k (agent
+    ``i = members[k]``) decides over the time since its last decision ``last_t[i]``
+    (``first_period`` when NaN: none yet; at least 1 ms), then ``last_t[i] = t``; with a
+    ``perturbation``, it takes the next two of its pre-drawn numbers ``draws[i, upos[i]:]`` and
+    ``upos[i]`` moves on by 2.  ``periods`` (>= m,) and ``pick`` (>= m, 2) are scratch."""
+    m = members.shape[0]
+    for k in range(m):
+        i = members[k]
+        last = last_t[i]
+        if last != last:
+            periods[k] = first_period
+        else:
+            period = t - last
+            periods[k] = period if not (period < 1e-3) else 1e-3
+        last_t[i] = t
+        if perturbation > 0.0:
+            pick[k, 0], pick[k, 1] = draws[i, upos[i]], draws[i, upos[i] + 1]
+            upos[i] += 2
+    decide_group_py(
+        members, pos, heading, vel, radii, reach, goals, v_max, u_max, periods[:m], pick[:m],
+        perturbation, max_neighbors, tau, responsibility, scratch, idx, out[:m],
+    )  # fmt: skip
+
+
 #: everything the kernels call, callees first
 FAMILY: tuple[Callable[..., Any], ...] = (
     wrap_scalar, pyhypot, det2, lp1_py, lp2_py, lp3_py, solve_lines_py, neighbours_py,
-    agent_lines_py, track_py, decide_group_py,
+    agent_lines_py, track_py, decide_group_py, group_decide_py,
 )  # fmt: skip
 _KERNELS: dict[str, Callable[..., Any]] = {}
 

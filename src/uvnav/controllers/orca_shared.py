@@ -69,7 +69,13 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from uvnav.controllers.base import ControllerInfo, ControllerParamsError, check_params, register
+from uvnav.controllers.base import (
+    ControllerInfo,
+    ControllerParamsError,
+    LawState,
+    check_params,
+    register,
+)
 from uvnav.controllers.orca import OrcaController, OrcaParams
 from uvnav.controllers.orca_kernels import kernel
 from uvnav.core import DiscAgents
@@ -135,9 +141,49 @@ def group_scratch(params: OrcaParams) -> tuple[FloatArray, np.ndarray]:
     return np.zeros((2 * cap, 4)), np.zeros(cap, dtype=np.int64)
 
 
+#: perturbation draws pre-drawn per agent and block (two per decision)
+BLOCK = 64
+
+
+class Draws:
+    """Each agent's perturbation numbers, pre-drawn in blocks of ``2 BLOCK`` from its own
+    generator (``Generator.random(n)`` gives the numbers of ``n`` single draws, so an agent reads
+    the numbers it would draw one decision at a time).
+
+    Attributes:
+        draws: (N, 2 BLOCK) each agent's numbers; ``upos[i]`` the next unread one of agent i.
+    """
+
+    def __init__(self, rngs: Sequence[np.random.Generator | None], perturbation: float) -> None:
+        n = len(rngs)
+        self._rngs = rngs
+        self.on = perturbation > 0.0
+        self.draws = np.zeros((n, 2 * BLOCK))
+        self.upos = np.full(n, 2 * BLOCK, dtype=np.int64)
+        self._safe = 0  # decisions that cannot run out of pre-drawn numbers
+
+    def ready(self) -> None:
+        """Before a decision of any agents: refill when one could run out (every ``BLOCK``
+        decisions: each agent's unread numbers moved to the front, the rest drawn)."""
+        if self._safe == 0:
+            if self.on:
+                for i, g in enumerate(self._rngs):
+                    if g is None:
+                        continue
+                    rest = self.draws[i, self.upos[i] :].copy()
+                    self.draws[i, : len(rest)] = rest
+                    self.draws[i, len(rest) :] = g.random(2 * BLOCK - len(rest))
+            self.upos[:] = 0
+            self._safe = BLOCK
+        self._safe -= 1
+
+
 class SharedOrca:
     """Decides every member of a group of ``orca-shared-v1`` robots at once, in one call of
-    :func:`~uvnav.controllers.orca_kernels.decide_group_py` (module docstring).
+    :func:`~uvnav.controllers.orca_kernels.group_decide_py` (module docstring): the members'
+    decision clocks and perturbation draws (:class:`Draws`, from each law's generator) and
+    :func:`~uvnav.controllers.orca_kernels.decide_group_py` on the world's
+    :class:`~uvnav.core.DiscAgents`.
 
     Attributes:
         last_velocities: (m, 2) the members' new velocities at the last step [m/s] (rows in the
@@ -156,17 +202,29 @@ class SharedOrca:
         self.steps = 0
         self.alone = 0
 
-    def _episode(self, laws: Sequence[Any]) -> None:
-        """Every member-capable robot's goal and limits (fixed for the episode)."""
+    def _episode(self, laws: Sequence[Any], st: DiscAgents) -> None:
+        """Every member-capable robot's goal, limits, decision clock and generator, and every
+        robot's ORCA radius and neighbour range (fixed for the episode)."""
         n = len(laws)
         self._goals = np.zeros((n, 2))
         self._v_max = np.zeros(n)
         self._u_max = np.zeros(n)
+        self._last_t = np.full(n, np.nan)
+        rngs: list[np.random.Generator | None] = [None] * n
         for j, law in enumerate(laws):
             if getattr(law, "group_key", None) == (OrcaShared.name, self.params):
                 self._goals[j] = law._goal
                 self._v_max[j] = law._spec.v_max
                 self._u_max[j] = law._spec.u_max
+                if law._last_t is not None:
+                    self._last_t[j] = law._last_t
+                rngs[j] = law.rng
+        self._eps = float(getattr(self.params, "perturbation", 0.0))
+        self._draws = Draws(rngs, self._eps)
+        self._radii, self._reach = group_geometry(self.params, st.radii, st.sensing_range)
+        self._periods = np.zeros(n)
+        self._pick = np.zeros((n, 2))
+        self._out = np.empty((n, 7))
 
     def decide(
         self, world: Any, agents: Sequence[int], laws: Sequence[Any]
@@ -187,34 +245,32 @@ class SharedOrca:
             st: DiscAgents = view()
         except ValueError as exc:
             raise ControllerParamsError(f"orca-shared-v1 cannot drive this scene: {exc}") from exc
-        idx = np.asarray(agents, dtype=np.int64)
-        if not bool(np.all(st.exact[idx])):
+        idx = np.array(agents, dtype=np.int64)
+        if not st.exact[idx].all():
             raise ControllerParamsError(
                 "orca-shared-v1 reads the other robots' true states: its robots need exact "
                 "sensing (velocities='known')"
             )
         if self._goals is None:
-            self._episode(laws)
-        p = self.params
-        members = [laws[i] for i in agents]
-        periods = np.array([law.decision_period(st.time) for law in members], dtype=float)
-        eps = float(getattr(p, "perturbation", 0.0))
-        draws = np.zeros((len(members), 2))
-        if eps > 0.0:
-            for k, law in enumerate(members):
-                draws[k] = law.rng.random(2)
-        radii, reach = group_geometry(p, st.radii, st.sensing_range)
-        out = np.empty((len(members), 7))
-        kernel("decide_group_py")(
-            idx, st.positions, st.headings, st.velocities, radii, reach, self._goals,
-            self._v_max, self._u_max, periods, draws, eps, int(p.max_neighbors),
-            float(p.time_horizon), float(p.responsibility), self._scratch, self._idx, out,
+            self._episode(laws, st)
+        p, m, t = self.params, len(idx), st.time
+        self._draws.ready()
+        out = self._out
+        kernel("group_decide_py")(
+            idx, t, LawState.FIRST_PERIOD, self._last_t, self._draws.draws, self._draws.upos,
+            self._eps, st.positions, st.headings, st.velocities, self._radii, self._reach,
+            self._goals, self._v_max, self._u_max, int(p.max_neighbors), float(p.time_horizon),
+            float(p.responsibility), self._scratch, self._idx, self._periods, self._pick, out,
         )  # fmt: skip
         self.steps += 1
-        self.last_velocities, self.last_preferred = out[:, 2:4], out[:, 4:6]
-        for law, avoiding in zip(members, out[:, 6].tolist(), strict=True):
-            law._mode = "M2" if avoiding else "M1"
-        return [UnicycleCommand(v, u) for v, u in out[:, :2].tolist()]
+        self.last_velocities, self.last_preferred = out[:m, 2:4].copy(), out[:m, 4:6].copy()
+        cmds = []
+        for i, row in zip(agents, out[:m].tolist(), strict=True):
+            law = laws[i]
+            law._mode = "M2" if row[6] else "M1"
+            law._last_t = t  # the law's own clock, as LawState.decision_period keeps it
+            cmds.append(UnicycleCommand(row[0], row[1]))
+        return cmds
 
 
 register(
