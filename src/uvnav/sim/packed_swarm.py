@@ -316,6 +316,8 @@ class SwarmState:
         template = FieldTemplate.from_bodies([DiscBody(max(r, 1e-6)) for r in radii])
         rob = np.zeros((n, NR))
         rob[:, R_X : R_TH + 1] = [np.asarray(r.start, dtype=float)[:3] for r in robots]
+        th = rob[:, R_TH]
+        rob[:, R_VX], rob[:, R_VY] = 0.0 * np.cos(th), 0.0 * np.sin(th)  # held speed 0
         rob[:, R_GX : R_GY + 1] = [np.asarray(r.goal, dtype=float)[:2] for r in robots]
         rob[:, R_RADIUS] = radii
         floor = 4.0 * float(radii.max()) + 1.0  # the reach covers any robot that can touch
