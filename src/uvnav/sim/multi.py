@@ -308,6 +308,9 @@ class MultiUnicycleWorld:
         self.state = rob[:, R_X : R_TH + 1]  # views, valid for the episode
         self.clearance = rob[:, R_CLEAR]
         self._obstacle_sweeps = []
+        self._rows = list(rob)  # each robot's row (a view)
+        self._acting: tuple[bytes, list[int]] = (b"", [])
+        self._running: tuple[bytes, np.ndarray] = (b"", np.zeros(0, dtype=bool))
         self._vmax = [float(r.spec.v_max) for r in self.robots]
         self._umax = [float(r.spec.u_max) for r in self.robots]
         self.done = bool(core.ints[I_DONE]) or self.clock.up
@@ -315,7 +318,13 @@ class MultiUnicycleWorld:
     @property
     def active(self) -> np.ndarray:
         """(N,) the robots neither arrived nor collided."""
-        return self.core.status == RUNNING if self.core is not None else self._active
+        if self.core is None:
+            return self._active
+        status = self.core.status
+        key = status.tobytes()  # made again only when a robot ended
+        if key != self._running[0]:
+            self._running = (key, status == RUNNING)
+        return self._running[1]
 
     @property
     def books(self) -> list[Ledger]:
@@ -390,7 +399,13 @@ class MultiUnicycleWorld:
         """The active robots, in index order, at a decision time (every ``control_period``)."""
         if not self.clock.due:
             return []
-        return np.flatnonzero(self.active).tolist()
+        if self.core is None:
+            return np.flatnonzero(self._active).tolist()
+        status = self.core.status
+        key = status.tobytes()  # the list is made again only when a robot ended
+        if key != self._acting[0]:
+            self._acting = (key, np.flatnonzero(self.active).tolist())
+        return self._acting[1].copy()
 
     def observe(self, agent: int = 0) -> Observation:
         """Robot ``agent``'s readings of the obstacles and the other robots (its own disc left
@@ -473,16 +488,17 @@ class MultiUnicycleWorld:
 
     def _hold(self, cmd: UnicycleCommand, i: int) -> UnicycleCommand:
         """:meth:`apply` on the kernel path: the same rules, into the arrays."""
-        rob = self.core.rob  # type: ignore[union-attr]
+        row = self._rows[i]
         v, u = cmd.v, cmd.u
         vmax, umax = self._vmax[i], self._umax[i]
-        if v < -1e-9 or v > vmax + 1e-9 or abs(u) > umax + 1e-9:  # cmd.violates
-            rob[i, R_VIOL] += 1.0
         if not (type(v) is float and type(u) is float and 0.0 <= v <= vmax and -umax <= u <= umax):
+            if v < -1e-9 or v > vmax + 1e-9 or abs(u) > umax + 1e-9:  # cmd.violates
+                row[R_VIOL] += 1.0
             cmd = cmd.clipped(self.robots[i].spec)
+            v, u = cmd.v, cmd.u
         if self.clock.step_index:
-            rob[i, R_EFFORT] += ((cmd.v - rob[i, R_V]) ** 2) / (self.ratio * self.dt)
-        rob[i, R_V], rob[i, R_U] = cmd.v, cmd.u
+            row[R_EFFORT] += ((v - row[R_V]) ** 2) / (self.ratio * self.dt)
+        row[R_V], row[R_U] = v, u
         self.applied[i] = cmd
         return cmd
 

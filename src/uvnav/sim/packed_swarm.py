@@ -273,16 +273,27 @@ def swarm_advance_py(
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
 
-def _kernels() -> tuple[Callable[..., Any], Callable[..., Any]]:
-    """:func:`swarm_decide_py` and :func:`swarm_advance_py`, compiled when numba is enabled."""
+def _kernel(name: str) -> Callable[..., Any]:
+    """The function ``name`` of this module's kernels (:func:`swarm_decide_py`,
+    :func:`swarm_advance_py`, :func:`_pair_check`), compiled when numba is enabled."""
     if not numba_enabled():
-        return swarm_decide_py, swarm_advance_py
+        plain: dict[str, Callable[..., Any]] = {
+            "swarm_decide_py": swarm_decide_py,
+            "swarm_advance_py": swarm_advance_py,
+            "_pair_check": _pair_check,
+        }
+        return plain[name]
     if not _KERNELS:
         _KERNELS.update(compile_family(
             (*FAMILY, unicycle_advance, segment_gap, _pair_check, _arrivals, swarm_decide_py,
              swarm_advance_py)
         ))  # fmt: skip
-    return _KERNELS["swarm_decide_py"], _KERNELS["swarm_advance_py"]
+    return _KERNELS[name]
+
+
+def _kernels() -> tuple[Callable[..., Any], Callable[..., Any]]:
+    """:func:`swarm_decide_py` and :func:`swarm_advance_py`, compiled when numba is enabled."""
+    return _kernel("swarm_decide_py"), _kernel("swarm_advance_py")
 
 
 class SwarmState:
@@ -340,7 +351,8 @@ class SwarmState:
         )
         window = max(1, round(setup.deadlock_window / dt))
         self.hist = np.zeros((window + 1, n, 2))  # the last window + 1 positions before a step
-        _pair_check(rob, self.status, self.pairs, rob[:, R_X : R_Y + 1], False)
+        self._advance = _kernel("swarm_advance_py")
+        _kernel("_pair_check")(rob, self.status, self.pairs, rob[:, R_X : R_Y + 1], False)
         self.start_dist = np.hypot(*(rob[:, R_GX : R_GY + 1] - rob[:, R_X : R_Y + 1]).T)
         for i in range(n):
             if self.status[i] == RUNNING and self.start_dist[i] <= self.flt[F_TOL]:
@@ -351,7 +363,7 @@ class SwarmState:
     def advance(self) -> bool:
         """One step ``dt`` (:func:`swarm_advance_py`); returns whether the episode is over."""
         return bool(
-            _kernels()[1](self.rob, self.status, self.pairs, self.ints, self.flt, self.hist)
+            self._advance(self.rob, self.status, self.pairs, self.ints, self.flt, self.hist)
         )
 
     def reached(self) -> list[float | None]:
@@ -404,7 +416,8 @@ class PackedSwarm(SwarmState):
             raise ValueError(f"cannot pack this swarm: {reason}")
         super().__init__(setup)
         n, rob = self.n, self.rob
-        p: Any = setup.robots[0].controller.params
+        law: Any = setup.robots[0].controller
+        p = law.params
         radii = rob[:, R_RADIUS].copy()
         sensing = np.array([float(r.sensing.sensing_range) for r in setup.robots])
         rob[:, R_ORAD], rob[:, R_OREACH] = group_geometry(p, radii, sensing)
