@@ -127,11 +127,11 @@ def _pair_check(
             if j == i:
                 continue
             cx, cy = rob[j, R_X], rob[j, R_Y]
-            if not (math.isinf(limit) or np.hypot(cx - px, cy - py) - rob[j, R_BOUND] <= limit):
+            r = np.hypot(cx - px, cy - py)  # = hypot(px - cx, py - cy): hypot ignores signs
+            if not (math.isinf(limit) or r - rob[j, R_BOUND] <= limit):
                 continue
             rad = rob[j, R_DISC]
             offx, offy = px - cx, py - cy
-            r = np.hypot(offx, offy)
             if r > 0:
                 ux, uy = offx / r, offy / r
             else:
@@ -433,6 +433,11 @@ class PackedSwarm(SwarmState):
         self._periods = np.zeros(n)
         self._pick = np.zeros((n, 2))
         self._out = np.zeros((n, 7))
+        self._decide = _kernel("swarm_decide_py")
+        self._decide_args = (
+            rob, self.status, self.ints, self.flt, self._draws.draws, self._draws.upos,
+            self._scratch, self._idx, self._members, self._periods, self._pick, self._out,
+        )  # fmt: skip
         self._cpu_ns: list[int] = []  # each group decision's CPU and wall time per member [ns]
         self._wall_ns: list[int] = []
         self._finish()
@@ -462,18 +467,13 @@ class PackedSwarm(SwarmState):
         if self.ints[I_DONE]:
             return True
         self._draws.ready()
-        decide, advance = _kernels()
         c0, w0 = _time.thread_time_ns(), _time.perf_counter_ns()
-        m = decide(
-            self.rob, self.status, self.ints, self.flt, self._draws.draws, self._draws.upos,
-            self._scratch,
-            self._idx, self._members, self._periods, self._pick, self._out,
-        )  # fmt: skip
+        m = self._decide(*self._decide_args)
         if m:
             c1, w1 = _time.thread_time_ns(), _time.perf_counter_ns()
             self._cpu_ns.append((c1 - c0) // m)
             self._wall_ns.append((w1 - w0) // m)
-        done = advance(self.rob, self.status, self.pairs, self.ints, self.flt, self.hist)
+        done = self._advance(self.rob, self.status, self.pairs, self.ints, self.flt, self.hist)
         if done:
             self._finish()
         return bool(done)
