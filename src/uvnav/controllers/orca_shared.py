@@ -14,13 +14,14 @@ avoid as if they did not.  ``orca-shared-v1`` is ORCA's own multi-agent rule ins
 * **One decision per group.**  The robots whose laws are ``orca-shared-v1`` with equal parameters
   form a group (:class:`uvnav.core.LawGroup`; ``group_key`` = the parameters), decided by
   :class:`SharedOrca` once per decision time, before the other robots: one call of
-  :func:`~uvnav.controllers.orca_kernels.decide_group_py` (numba-compiled when enabled) computes
-  every member's preferred velocity, neighbours, half-planes, linear program and unicycle
-  command.  Every robot of the world is an agent (agent j = robot j); the members decide, the
-  others are discs that do not.  RVO2 itself (``pyrvo``) is not used here: through its Python
-  binding a group decision cost about 30 µs a robot in calls alone at 100 robots, and its float32
-  frame is not needed.  At responsibility 0.5 the port's velocities are RVO2's ``do_step``
-  within 2e-4 m/s on random groups without contact (a test; RVO2 rounds to float32).
+  :func:`~uvnav.controllers.orca_kernels.group_decide_py` (numba-compiled when enabled; the
+  packed swarm :mod:`uvnav.sim.packed_swarm` decides with the same kernel) computes every
+  member's decision period, preferred velocity, neighbours, half-planes, linear program and
+  unicycle command.  Every robot of the world is an agent (agent j = robot j); the members
+  decide, the others are discs that do not.  RVO2 itself (``pyrvo``) is not used here: through
+  its Python binding a group decision cost about 30 µs a robot in calls alone at 100 robots, and
+  its float32 frame is not needed.  At responsibility 0.5 the port's velocities are RVO2's
+  ``do_step`` within 2e-4 m/s on random groups without contact (a test; RVO2 rounds to float32).
 * **What it reads.**  The world's :class:`~uvnav.core.DiscAgents`
   (:meth:`uvnav.sim.multi.MultiUnicycleWorld.disc_agents`): every robot's centre, heading,
   velocity (its held command, zero once done) and radius — what exact sensing with known

@@ -38,10 +38,13 @@ over the last ``deadlock_window`` [s]: stuck, not merely slow), ``arrived`` (cou
 ``sum_of_times`` [s] (sum of arrival times when all arrived).
 
 Speed: when the world holds only the robots (no world obstacles: the antipodal swap, crossing
-flows), the collision checks and the sensing of all robots are computed at once per step
-(:class:`_DiscPairs`, (N, N) arrays) instead of one :meth:`ObstacleField.query` per robot — the
-same element-wise arithmetic as the field's disc kernel, so the results are identical (tested
-against the per-robot path, ``vectorised=False``).
+flows), the robots live in the arrays of :class:`~uvnav.sim.packed_swarm.SwarmState` and a step
+is its compiled step (the unicycles, the robot pairs along the step, the arrivals: the packed
+swarm's own kernel); :meth:`MultiUnicycleWorld.apply` holds commands into those arrays, and the
+field, the exact readings (:class:`_DiscPairs`, (N, N) arrays with the field's disc-kernel
+arithmetic) and the ledgers are made from them only when asked.  The results are identical to
+the per-robot path (``vectorised=False``: one :meth:`ObstacleField.query` per robot; tested
+against the packed swarm, bit for bit).
 """
 
 from __future__ import annotations

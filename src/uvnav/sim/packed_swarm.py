@@ -5,11 +5,14 @@ unicycles (2.1)-(2.4) with disc bodies) for the case that needs speed more than 
 robot on ``orca-shared-v1`` with the same parameters (ORCA, van den Berg et al., ISRR 2009:
 :mod:`uvnav.controllers.orca_shared`), exact sensing with known velocities, no obstacle besides
 the robots.  A step is :func:`swarm_decide_py` (the group decision,
-:func:`uvnav.controllers.orca_kernels.decide_group_py`, when one is due, and the commands held)
-then :func:`swarm_advance_py` (the unicycles, robot-pair checks, arrivals, time limit): loops over
-preallocated arrays, compiled by numba when it is enabled; the Python functions are the reference
-and the fallback.  Two calls, not one, so that the decisions are timed as the one loop times a
-group's (:func:`uvnav.core.run_loop`: CPU and wall time divided among the members).
+:func:`uvnav.controllers.orca_kernels.group_decide_py`, the kernel ``orca-shared-v1`` decides a
+group with in the loop too, when one is due, and the commands held) then
+:func:`swarm_advance_py` (the unicycles, robot-pair checks, arrivals, time limit: the step the
+loop world :class:`~uvnav.sim.multi.MultiUnicycleWorld` takes for a world of robots only, through
+:class:`SwarmState`): loops over preallocated arrays, compiled by numba when it is enabled; the
+Python functions are the reference and the fallback.  Two calls, not one, so that the decisions
+are timed as the one loop times a group's (:func:`uvnav.core.run_loop`: CPU and wall time divided
+among the members).
 
 It is :func:`uvnav.core.run_loop` over :class:`~uvnav.sim.multi.MultiUnicycleWorld` bit for bit
 (the tests compare every pose, status, clearance and collided pair at every step, and the whole
