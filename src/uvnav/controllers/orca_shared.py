@@ -276,6 +276,7 @@ class SharedOrca:
             self._episode(laws, st)
         if agents != self._agents:  # the same members as last time: the same index array
             self._agents, self._members = list(agents), np.array(agents, dtype=np.int64)
+            self._laws = [laws[i] for i in agents]
         m, t, out = len(agents), st.time, self._out
         self._draws.ready()
         kernel("group_decide_py")(
@@ -286,13 +287,10 @@ class SharedOrca:
         )  # fmt: skip
         self.steps += 1
         self._m = m
-        cmds = []
-        for i, row in zip(agents, out[:m].tolist(), strict=True):
-            law = laws[i]
-            law._mode = "M2" if row[6] else "M1"
+        for law, avoiding in zip(self._laws, out[:m, 6].tolist(), strict=True):
+            law._mode = "M2" if avoiding else "M1"
             law._last_t = t  # the law's own clock, as LawState.decision_period keeps it
-            cmds.append(UnicycleCommand(row[0], row[1]))
-        return cmds
+        return list(map(UnicycleCommand, out[:m, 0].tolist(), out[:m, 1].tolist()))
 
 
 register(

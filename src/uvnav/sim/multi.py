@@ -312,6 +312,10 @@ class MultiUnicycleWorld:
         self.clearance = rob[:, R_CLEAR]
         self._obstacle_sweeps = []
         self._rows = list(rob)  # each robot's row (a view)
+        self._views = (rob[:, R_X : R_Y + 1], rob[:, R_TH], rob[:, R_VX : R_VY + 1])
+        self._advance = core.advance_kernel
+        self._advance_args = (rob, core.status, core.pairs, core.ints, core.flt, core.hist)
+        self._stepped, self._rdt = self.clock.step_index > 0, self.ratio * self.dt
         self._acting: tuple[bytes, list[int]] = (b"", [])
         self._running: tuple[bytes, np.ndarray] = (b"", np.zeros(0, dtype=bool))
         self._vmax = [float(r.spec.v_max) for r in self.robots]
@@ -456,11 +460,10 @@ class MultiUnicycleWorld:
                 f"a group law reads a world of robots only; this one holds {self.k} obstacle(s)"
             )
         if self.core is not None:  # views of the arrays: read them before the next step
-            rob = self.core.rob
+            pos, th, vel = self._views
             return DiscAgents(
-                self.t, rob[:, R_X : R_Y + 1], rob[:, R_TH], rob[:, R_VX : R_VY + 1], self.radii,
-                self.active, self._sensing, self._exact,
-            )  # fmt: skip
+                self.t, pos, th, vel, self.radii, self.active, self._sensing, self._exact
+            )
         return DiscAgents(
             time=self.t,
             positions=self.state[:, :2].copy(),
@@ -499,8 +502,8 @@ class MultiUnicycleWorld:
                 row[R_VIOL] += 1.0
             cmd = cmd.clipped(self.robots[i].spec)
             v, u = cmd.v, cmd.u
-        if self.clock.step_index:
-            row[R_EFFORT] += ((v - row[R_V]) ** 2) / (self.ratio * self.dt)
+        if self._stepped:
+            row[R_EFFORT] += ((v - row[R_V]) ** 2) / self._rdt
         row[R_V], row[R_U] = v, u
         self.applied[i] = cmd
         return cmd
@@ -509,8 +512,9 @@ class MultiUnicycleWorld:
         """One step ``dt``: the active robots (exact), the obstacles, clearances, collisions,
         arrivals."""
         if self.core is not None:  # a world of robots only: the compiled step
-            self.done = self.core.advance()
+            self.done = bool(self._advance(*self._advance_args))
             self.t = self.clock.tick()
+            self._stepped = True
             return
         dt, state, active = self.dt, self.state, self._active
         start, t0, g0, f0 = state[:, :2].copy(), self.t, self.clearance.copy(), self._fld

@@ -354,7 +354,8 @@ class SwarmState:
         )
         window = max(1, round(setup.deadlock_window / dt))
         self.hist = np.zeros((window + 1, n, 2))  # the last window + 1 positions before a step
-        self._advance = _kernel("swarm_advance_py")
+        self.advance_kernel = _kernel("swarm_advance_py")  # its arguments: _advance_args
+        self._advance_args = (self.rob, self.status, self.pairs, self.ints, self.flt, self.hist)
         _kernel("_pair_check")(rob, self.status, self.pairs, rob[:, R_X : R_Y + 1], False)
         self.start_dist = np.hypot(*(rob[:, R_GX : R_GY + 1] - rob[:, R_X : R_Y + 1]).T)
         for i in range(n):
@@ -365,9 +366,7 @@ class SwarmState:
 
     def advance(self) -> bool:
         """One step ``dt`` (:func:`swarm_advance_py`); returns whether the episode is over."""
-        return bool(
-            self._advance(self.rob, self.status, self.pairs, self.ints, self.flt, self.hist)
-        )
+        return bool(self.advance_kernel(*self._advance_args))
 
     def reached(self) -> list[float | None]:
         """Each robot's arrival time [s] (``None`` before)."""
@@ -476,7 +475,7 @@ class PackedSwarm(SwarmState):
             c1, w1 = _time.thread_time_ns(), _time.perf_counter_ns()
             self._cpu_ns.append((c1 - c0) // m)
             self._wall_ns.append((w1 - w0) // m)
-        done = self._advance(self.rob, self.status, self.pairs, self.ints, self.flt, self.hist)
+        done = self.advance_kernel(*self._advance_args)
         if done:
             self._finish()
         return bool(done)
