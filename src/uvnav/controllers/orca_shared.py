@@ -78,7 +78,17 @@ from uvnav.controllers.base import (
     register,
 )
 from uvnav.controllers.orca import OrcaController, OrcaParams
-from uvnav.controllers.orca_kernels import kernel
+from uvnav.controllers.orca_kernels import (
+    G_GX,
+    G_GY,
+    G_LAST,
+    G_ORAD,
+    G_OREACH,
+    G_UMAX,
+    G_VMAX,
+    NG,
+    kernel,
+)
 from uvnav.core import DiscAgents
 from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray
@@ -199,7 +209,7 @@ class SharedOrca:
 
     def __init__(self, params: OrcaParams) -> None:
         self.params = params
-        self._goals: FloatArray | None = None
+        self._tab: FloatArray | None = None
         self._scratch, self._idx = group_scratch(params)
         self._out = np.empty((0, 7))
         self._m = 0
@@ -225,33 +235,33 @@ class SharedOrca:
             ControllerParamsError: a member's sensing is not exact (velocities known).
         """
         n = len(laws)
-        self._goals = np.zeros((n, 2))
-        self._v_max = np.zeros(n)
-        self._u_max = np.zeros(n)
-        self._last_t = np.full(n, np.nan)
+        self._tab = tab = np.zeros((n, NG))  # the agents' G_* columns
+        tab[:, G_LAST] = np.nan
         rngs: list[np.random.Generator | None] = [None] * n
         for j, law in enumerate(laws):
             if getattr(law, "group_key", None) == (OrcaShared.name, self.params):
-                self._goals[j] = law._goal
-                self._v_max[j] = law._spec.v_max
-                self._u_max[j] = law._spec.u_max
+                tab[j, G_GX : G_GY + 1] = law._goal
+                tab[j, G_VMAX], tab[j, G_UMAX] = law._spec.v_max, law._spec.u_max
                 if law._last_t is not None:
-                    self._last_t[j] = law._last_t
+                    tab[j, G_LAST] = law._last_t
                 rngs[j] = law.rng
                 if not st.exact[j]:
                     raise ControllerParamsError(
                         "orca-shared-v1 reads the other robots' true states: its robots need "
                         "exact sensing (velocities='known')"
                     )
-        self._eps = float(getattr(self.params, "perturbation", 0.0))
-        self._draws = Draws(rngs, self._eps)
-        self._radii, self._reach = group_geometry(self.params, st.radii, st.sensing_range)
+        p = self.params
+        eps = float(getattr(p, "perturbation", 0.0))
+        self._draws = Draws(rngs, eps)
+        tab[:, G_ORAD], tab[:, G_OREACH] = group_geometry(p, st.radii, st.sensing_range)
+        self._prm = np.array(
+            [eps, float(p.time_horizon), float(p.responsibility), LawState.FIRST_PERIOD]
+        )  # P_* entries
+        self._max_neighbors = int(p.max_neighbors)
         self._periods = np.zeros(n)
         self._pick = np.zeros((n, 2))
         self._out = np.empty((n, 7))
         self._agents: list[int] = []
-        p = self.params
-        self._scalars = (int(p.max_neighbors), float(p.time_horizon), float(p.responsibility))
 
     def decide(
         self, world: Any, agents: Sequence[int], laws: Sequence[Any]
@@ -272,7 +282,7 @@ class SharedOrca:
             st: DiscAgents = view()
         except ValueError as exc:
             raise ControllerParamsError(f"orca-shared-v1 cannot drive this scene: {exc}") from exc
-        if self._goals is None:
+        if self._tab is None:
             self._episode(laws, st)
         if agents != self._agents:  # the same members as last time: the same index array
             self._agents, self._members = list(agents), np.array(agents, dtype=np.int64)
@@ -280,10 +290,9 @@ class SharedOrca:
         m, t, out = len(agents), st.time, self._out
         self._draws.ready()
         kernel("group_decide_py")(
-            self._members, t, LawState.FIRST_PERIOD, self._last_t, self._draws.draws,
-            self._draws.upos, self._eps, st.positions, st.headings, st.velocities, self._radii,
-            self._reach, self._goals, self._v_max, self._u_max, *self._scalars, self._scratch,
-            self._idx, self._periods, self._pick, out,
+            self._members, t, self._prm, self._max_neighbors, self._tab, self._draws.draws,
+            self._draws.upos, st.positions, st.headings, st.velocities, self._scratch, self._idx,
+            self._periods, self._pick, out,
         )  # fmt: skip
         self.steps += 1
         self._m = m

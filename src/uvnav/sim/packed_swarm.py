@@ -71,21 +71,22 @@ from uvnav.sim.setup import MultiResult, MultiSetup
 RUNNING, SUCCESS, COLLISION, TIMEOUT = 0, 1, 2, 3
 STATUS_NAMES = ("running", "success", "collision", "timeout")
 # Columns of the (N, NR) float array of the robots: pose [m, m, rad], held command [m/s, rad/s],
-# velocity [m/s, m/s], goal [m], body radius [m], collision reach [m], ORCA radius [m], ORCA
-# neighbour range [m], V_max [m/s], U_max [rad/s], disc radius and bounding radius of the body
-# in the field [m], time reached [s] (NaN: not yet), path [m], clearance now and lowest [m],
-# time of the last decision [s] (NaN: none yet), control effort, commands outside the limits,
-# decisions taken, mode switches, last mode (-1: none yet, 0: M1, 1: M2), turn rate over the
-# last step [rad/s] (0 for a robot that did not move).
-(R_X, R_Y, R_TH, R_V, R_U, R_VX, R_VY, R_GX, R_GY, R_RADIUS, R_REACH, R_ORAD, R_OREACH, R_VMAX,
- R_UMAX, R_DISC, R_BOUND, R_REACHED, R_PATH, R_CLEAR, R_LOW, R_LAST_T, R_EFFORT, R_VIOL, R_NDEC,
+# velocity [m/s, m/s]; then a group's agent table (orca_kernels' G_* columns, from R_ORAD on):
+# ORCA radius [m], ORCA neighbour range [m], goal [m], V_max [m/s], U_max [rad/s], time of the
+# last decision [s] (NaN: none yet); then body radius [m], collision reach [m], disc radius and
+# bounding radius of the body in the field [m], time reached [s] (NaN: not yet), path [m],
+# clearance now and lowest [m], control effort, commands outside the limits, decisions taken,
+# mode switches, last mode (-1: none yet, 0: M1, 1: M2), turn rate over the last step [rad/s] (0
+# for a robot that did not move).
+(R_X, R_Y, R_TH, R_V, R_U, R_VX, R_VY, R_ORAD, R_OREACH, R_GX, R_GY, R_VMAX, R_UMAX, R_LAST_T,
+ R_RADIUS, R_REACH, R_DISC, R_BOUND, R_REACHED, R_PATH, R_CLEAR, R_LOW, R_EFFORT, R_VIOL, R_NDEC,
  R_SWITCH, R_MODE, R_W) = range(28)  # fmt: skip
 NR = 28
 # Entries of the int array of the swarm: step index, steps per decision, steps in the episode,
 # 1 when the episode is over, max_neighbors, next slot and length of the position history.
 (I_STEP, I_RATIO, I_NSTEPS, I_DONE, I_MAXNB, I_HNEXT, I_HLEN) = range(7)
 # Entries of the float array of the swarm: dt [s], goal tolerance [m], perturbation [m/s], time
-# horizon [s], responsibility, first decision period [s].
+# horizon [s], responsibility, first decision period [s] (from F_EPS on: orca_kernels' P_*).
 (F_DT, F_TOL, F_EPS, F_TAU, F_RESP, F_FIRST) = range(6)
 
 
@@ -195,10 +196,8 @@ def swarm_decide_py(
     if m == 0:
         return 0
     group_decide_py(
-        members[:m], step * dt, flt[F_FIRST], rob[:, R_LAST_T], draws, upos, flt[F_EPS],
-        rob[:, R_X:R_Y + 1], rob[:, R_TH], rob[:, R_VX:R_VY + 1], rob[:, R_ORAD],
-        rob[:, R_OREACH], rob[:, R_GX:R_GY + 1], rob[:, R_VMAX], rob[:, R_UMAX],
-        ints[I_MAXNB], flt[F_TAU], flt[F_RESP], scratch, idx, periods, pick, out,
+        members[:m], step * dt, flt[F_EPS:], ints[I_MAXNB], rob[:, R_ORAD:], draws, upos,
+        rob[:, R_X:R_Y + 1], rob[:, R_TH], rob[:, R_VX:R_VY + 1], scratch, idx, periods, pick, out,
     )  # fmt: skip
     for k in range(m):
         i = members[k]
