@@ -258,6 +258,7 @@ class SharedOrca:
             [eps, float(p.time_horizon), float(p.responsibility), LawState.FIRST_PERIOD]
         )  # P_* entries
         self._max_neighbors = int(p.max_neighbors)
+        self._kernel = kernel("group_decide_py")
         self._periods = np.zeros(n)
         self._pick = np.zeros((n, 2))
         self._out = np.empty((n, 7))
@@ -289,7 +290,7 @@ class SharedOrca:
             self._laws = [laws[i] for i in agents]
         m, t, out = len(agents), st.time, self._out
         self._draws.ready()
-        kernel("group_decide_py")(
+        self._kernel(
             self._members, t, self._prm, self._max_neighbors, self._tab, self._draws.draws,
             self._draws.upos, st.positions, st.headings, st.velocities, self._scratch, self._idx,
             self._periods, self._pick, out,

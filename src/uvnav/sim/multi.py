@@ -316,6 +316,7 @@ class MultiUnicycleWorld:
         self._advance = core.advance_kernel
         self._advance_args = (rob, core.status, core.pairs, core.ints, core.flt, core.hist)
         self._stepped, self._rdt = self.clock.step_index > 0, self.ratio * self.dt
+        self._held_v = [0.0] * self.n_agents  # each robot's held speed (rob's R_V) [m/s]
         self._acting: tuple[bytes, list[int]] = (b"", [])
         self._running: tuple[bytes, np.ndarray] = (b"", np.zeros(0, dtype=bool))
         self._vmax = [float(r.spec.v_max) for r in self.robots]
@@ -479,8 +480,22 @@ class MultiUnicycleWorld:
         """Hold ``cmd`` for robot ``agent``: counted in its ``limit_violations`` when outside
         (2.4), saturated."""
         i = agent
-        if self.core is not None:
-            return self._hold(cmd, i)
+        if self.core is not None:  # the kernel path: the same rules, into the arrays
+            v, u = cmd.v, cmd.u
+            vmax, umax = self._vmax[i], self._umax[i]
+            if not (
+                type(v) is float and type(u) is float and 0.0 <= v <= vmax and -umax <= u <= umax
+            ):
+                self._saturate(cmd, i)
+                cmd = cmd.clipped(self.robots[i].spec)
+                v, u = cmd.v, cmd.u
+            row = self._rows[i]
+            if self._stepped:
+                row[R_EFFORT] += ((v - self._held_v[i]) ** 2) / self._rdt
+            self._held_v[i] = row[R_V] = v
+            row[R_U] = u
+            self.applied[i] = cmd
+            return cmd
         spec = self.robots[i].spec
         book = self._books[i]
         if cmd.violates(spec):
@@ -492,21 +507,10 @@ class MultiUnicycleWorld:
         self.applied[i] = new
         return new
 
-    def _hold(self, cmd: UnicycleCommand, i: int) -> UnicycleCommand:
-        """:meth:`apply` on the kernel path: the same rules, into the arrays."""
-        row = self._rows[i]
-        v, u = cmd.v, cmd.u
-        vmax, umax = self._vmax[i], self._umax[i]
-        if not (type(v) is float and type(u) is float and 0.0 <= v <= vmax and -umax <= u <= umax):
-            if v < -1e-9 or v > vmax + 1e-9 or abs(u) > umax + 1e-9:  # cmd.violates
-                row[R_VIOL] += 1.0
-            cmd = cmd.clipped(self.robots[i].spec)
-            v, u = cmd.v, cmd.u
-        if self._stepped:
-            row[R_EFFORT] += ((v - row[R_V]) ** 2) / self._rdt
-        row[R_V], row[R_U] = v, u
-        self.applied[i] = cmd
-        return cmd
+    def _saturate(self, cmd: UnicycleCommand, i: int) -> None:
+        """Count ``cmd`` in robot i's limit violations when it is outside (2.4) (kernel path)."""
+        if cmd.violates(self.robots[i].spec):
+            self._rows[i][R_VIOL] += 1.0
 
     def advance(self) -> None:
         """One step ``dt``: the active robots (exact), the obstacles, clearances, collisions,
