@@ -486,7 +486,7 @@ class MultiUnicycleWorld:
             if not (
                 type(v) is float and type(u) is float and 0.0 <= v <= vmax and -umax <= u <= umax
             ):
-                self._saturate(cmd, i)
+                self._count_violation(cmd, i)
                 cmd = cmd.clipped(self.robots[i].spec)
                 v, u = cmd.v, cmd.u
             row = self._rows[i]
@@ -507,7 +507,7 @@ class MultiUnicycleWorld:
         self.applied[i] = new
         return new
 
-    def _saturate(self, cmd: UnicycleCommand, i: int) -> None:
+    def _count_violation(self, cmd: UnicycleCommand, i: int) -> None:
         """Count ``cmd`` in robot i's limit violations when it is outside (2.4) (kernel path)."""
         if cmd.violates(self.robots[i].spec):
             self._rows[i][R_VIOL] += 1.0
@@ -629,7 +629,11 @@ class MultiUnicycleWorld:
         if self._obstacle_sweeps:  # the minimum along the steps it kept
             book = self._books[agent]
             book.min_clear = self._obstacle_sweeps[agent].finish(book.min_clear)
-        return self.books[agent].metrics(log, top_speed=float(self.robots[agent].spec.v_max))
+        if self.core is not None:
+            book = self.core.ledger(agent, _STATUS[int(self.core.status[agent])])
+        else:
+            book = self._books[agent]
+        return book.metrics(log, top_speed=float(self.robots[agent].spec.v_max))
 
     def group_metrics(self) -> GroupMetrics:
         """The group's outcome (module docstring, :func:`group_outcome`)."""

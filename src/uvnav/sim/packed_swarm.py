@@ -380,17 +380,19 @@ class SwarmState:
         """The robot pairs (i < j) that overlapped."""
         return [(int(i), int(j)) for i, j in zip(*np.nonzero(self.pairs), strict=True)]
 
+    def ledger(self, i: int, status: str) -> Ledger:
+        """Robot i's :class:`~uvnav.sim.ledger.Ledger` with status ``status``."""
+        rob, reached = self.rob, float(self.rob[i, R_REACHED])
+        return Ledger.settled(
+            float(self.flt[F_TOL]), status=status, start_dist=float(self.start_dist[i]),
+            reached_at=None if reached != reached else reached, path=float(rob[i, R_PATH]),
+            effort=float(rob[i, R_EFFORT]), violations=int(rob[i, R_VIOL]),
+            min_clear=float(rob[i, R_LOW]),
+        )  # fmt: skip
+
     def ledgers(self, status: Sequence[str]) -> list[Ledger]:
         """Each robot's :class:`~uvnav.sim.ledger.Ledger` with status ``status[i]``."""
-        rob, reached, tol = self.rob, self.reached(), float(self.flt[F_TOL])
-        books = []
-        for i in range(self.n):
-            books.append(Ledger.settled(
-                tol, status=status[i], start_dist=float(self.start_dist[i]),
-                reached_at=reached[i], path=float(rob[i, R_PATH]), effort=float(rob[i, R_EFFORT]),
-                violations=int(rob[i, R_VIOL]), min_clear=float(rob[i, R_LOW]),
-            ))  # fmt: skip
-        return books
+        return [self.ledger(i, status[i]) for i in range(self.n)]
 
 
 class PackedSwarm(SwarmState):
