@@ -100,6 +100,19 @@ def test_packed_swarm_is_the_loop_world_bit_for_bit(case: str, use_numba: bool) 
     np.testing.assert_array_equal(swarm.rob[:, R_REACHED], reached)
 
 
+def test_the_robot_columns_from_r_orad_on_are_a_group_agent_table() -> None:
+    """The swarm hands rob[:, R_ORAD:] and flt[F_EPS:] to the group kernel as its G_* table and
+    P_* numbers: the columns must line up."""
+    from uvnav.controllers import orca_kernels as ok
+    from uvnav.sim import packed_swarm as ps
+
+    table = {"G_ORAD": ps.R_ORAD, "G_OREACH": ps.R_OREACH, "G_GX": ps.R_GX, "G_GY": ps.R_GY,
+             "G_VMAX": ps.R_VMAX, "G_UMAX": ps.R_UMAX, "G_LAST": ps.R_LAST_T}  # fmt: skip
+    assert {g: getattr(ok, g) for g in table} == {g: r - ps.R_ORAD for g, r in table.items()}
+    numbers = {"P_EPS": ps.F_EPS, "P_TAU": ps.F_TAU, "P_RESP": ps.F_RESP, "P_FIRST": ps.F_FIRST}
+    assert {p: getattr(ok, p) for p in numbers} == {p: f - ps.F_EPS for p, f in numbers.items()}
+
+
 def test_collisions_and_arrivals_at_the_start_end_the_robots_at_once() -> None:
     setup = crossing(4)
     setup.robots[1].start = setup.robots[0].start + np.array([0.1, 0.0, 0.0])  # overlapping

@@ -45,6 +45,13 @@ from uvnav.geometry.small import pyhypot
 
 #: RVO2's RVO_EPSILON.
 EPS = 1e-5
+#: Columns of a group's agent table (:func:`group_decide_py`): ORCA radius [m], neighbour range
+#: [m], goal [m], V_max [m/s], U_max [rad/s], time of the last decision [s] (NaN: none yet).
+G_ORAD, G_OREACH, G_GX, G_GY, G_VMAX, G_UMAX, G_LAST = range(7)
+NG = 7
+#: Entries of a group's numbers: perturbation [m/s], time horizon [s], responsibility, first
+#: decision period [s].
+P_EPS, P_TAU, P_RESP, P_FIRST = range(4)
 
 
 def det2(ax: float, ay: float, bx: float, by: float) -> float:
@@ -332,10 +339,46 @@ def decide_group_py(
         out[k, 6] = 1.0 if pyhypot(nx - px, ny - py) >= 1e-6 else 0.0
 
 
+def group_decide_py(
+    members: np.ndarray, t: float, prm: FloatArray, max_neighbors: int, tab: FloatArray,
+    draws: FloatArray, upos: np.ndarray, pos: FloatArray, heading: FloatArray, vel: FloatArray,
+    scratch: FloatArray, idx: np.ndarray, periods: FloatArray, pick: FloatArray, out: FloatArray,
+) -> None:  # fmt: skip
+    """A group decision at time ``t`` [s] (:func:`decide_group_py` into ``out[:m]``, m =
+    ``len(members)``) with each member's decision clock and perturbation draws.
+
+    ``tab`` (n, >= NG) holds each agent's ``G_*`` columns (ORCA radius and neighbour range, goal,
+    V_max, U_max, time of its last decision), ``prm`` the group's ``P_*`` numbers (perturbation,
+    time horizon, responsibility, first decision period).  Member k (agent ``i = members[k]``)
+    decides over the time since its last decision (the first period when NaN: none yet; at
+    least 1 ms), which becomes ``t``; with a perturbation it takes the next two of its pre-drawn
+    numbers ``draws[i, upos[i]:]`` and ``upos[i]`` moves on by 2.  ``periods`` (>= m,) and
+    ``pick`` (>= m, 2) are scratch."""
+    m = members.shape[0]
+    perturbation = prm[P_EPS]
+    for k in range(m):
+        i = members[k]
+        last = tab[i, G_LAST]
+        if last != last:
+            periods[k] = prm[P_FIRST]
+        else:
+            period = t - last
+            periods[k] = period if not (period < 1e-3) else 1e-3
+        tab[i, G_LAST] = t
+        if perturbation > 0.0:
+            pick[k, 0], pick[k, 1] = draws[i, upos[i]], draws[i, upos[i] + 1]
+            upos[i] += 2
+    decide_group_py(
+        members, pos, heading, vel, tab[:, G_ORAD], tab[:, G_OREACH], tab[:, G_GX:G_GY + 1],
+        tab[:, G_VMAX], tab[:, G_UMAX], periods[:m], pick[:m], perturbation, max_neighbors,
+        prm[P_TAU], prm[P_RESP], scratch, idx, out[:m],
+    )  # fmt: skip
+
+
 #: everything the kernels call, callees first
 FAMILY: tuple[Callable[..., Any], ...] = (
     wrap_scalar, pyhypot, det2, lp1_py, lp2_py, lp3_py, solve_lines_py, neighbours_py,
-    agent_lines_py, track_py, decide_group_py,
+    agent_lines_py, track_py, decide_group_py, group_decide_py,
 )  # fmt: skip
 _KERNELS: dict[str, Callable[..., Any]] = {}
 

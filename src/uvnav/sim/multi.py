@@ -38,10 +38,13 @@ over the last ``deadlock_window`` [s]: stuck, not merely slow), ``arrived`` (cou
 ``sum_of_times`` [s] (sum of arrival times when all arrived).
 
 Speed: when the world holds only the robots (no world obstacles: the antipodal swap, crossing
-flows), the collision checks and the sensing of all robots are computed at once per step
-(:class:`_DiscPairs`, (N, N) arrays) instead of one :meth:`ObstacleField.query` per robot — the
-same element-wise arithmetic as the field's disc kernel, so the results are identical (tested
-against the per-robot path, ``vectorised=False``).
+flows), the robots live in the arrays of :class:`~uvnav.sim.packed_swarm.SwarmState` and a step
+is its compiled step (the unicycles, the robot pairs along the step, the arrivals: the packed
+swarm's own kernel); :meth:`MultiUnicycleWorld.apply` holds commands into those arrays, and the
+field, the exact readings (:class:`_DiscPairs`, (N, N) arrays with the field's disc-kernel
+arithmetic) and the ledgers are made from them only when asked.  The results are identical to
+the per-robot path (``vectorised=False``: one :meth:`ObstacleField.query` per robot; tested
+against the packed swarm, bit for bit).
 """
 
 from __future__ import annotations
@@ -70,6 +73,22 @@ from uvnav.sensors.observation import Observation, ObstacleReading
 from uvnav.sensors.suite2d import Sensors2D
 from uvnav.sim.ledger import Clock, Ledger, group_outcome
 from uvnav.sim.metrics import EpisodeMetrics
+from uvnav.sim.packed_swarm import (
+    I_DONE,
+    R_CLEAR,
+    R_EFFORT,
+    R_TH,
+    R_U,
+    R_V,
+    R_VIOL,
+    R_VX,
+    R_VY,
+    R_W,
+    R_X,
+    R_Y,
+    RUNNING,
+    SwarmState,
+)
 from uvnav.sim.setup import (
     GroupMetrics,
     MultiResult,
@@ -78,6 +97,8 @@ from uvnav.sim.setup import (
 from uvnav.sim.swept import StepPoses, SweptClearance
 
 _NO_OUTLINE = np.zeros((0, 2))  # a disc's outline in a reading (as sense_obstacles gives it)
+#: a :class:`~uvnav.sim.packed_swarm.SwarmState` status code's name (a :class:`Ledger`'s)
+_STATUS = ("timeout", "success", "collision", "timeout")
 
 
 def _robot_velocity(v: float, th: float) -> tuple[float, float]:
@@ -218,6 +239,7 @@ class MultiUnicycleWorld:
         self.state = np.array([np.asarray(r.start, dtype=float)[:3] for r in robots])
         self.goals = np.array([np.asarray(r.goal, dtype=float)[:2] for r in robots])
         self.batched = vectorised and k == 0
+        self.core: SwarmState | None = None  # the robots' arrays on the kernel path
         self.t = 0.0
         self.done = False
 
@@ -232,7 +254,7 @@ class MultiUnicycleWorld:
     def _field(self) -> ObstacleField:
         """The obstacles and the robots (discs moving at their held commands; done robots
         still)."""
-        n, k, active, state = self.n_agents, self.k, self.active, self.state
+        n, k, active, state = self.n_agents, self.k, self._active, self.state
         vel = np.array([_robot_velocity(self.speeds[i], state[i, 2]) for i in range(n)])
         vel[~active] = 0.0
         omegas = np.where(active, self.turns, 0.0)
@@ -253,36 +275,104 @@ class MultiUnicycleWorld:
         n = self.n_agents
         for sensors, oracle in zip(self.sensors, oracles, strict=True):
             sensors.reset(oracle)
+        self.applied = [UnicycleCommand(0.0, 0.0) for _ in range(n)]
+        self.obstacle_hits = 0
+        self._exact = np.array([sensors.true_rates for sensors in self.sensors])
+        self._sensing = np.array([float(r.sensing.sensing_range) for r in self.robots])
+        self._at = -1  # the step of the cached field and robot pairs (kernel path)
+        self._pairs: _DiscPairs | None = None
+        if self.batched:
+            self._start_kernel()
+            return
+        self.core = None
         self.speeds = np.zeros(n)
         self.turns = np.zeros(n)
-        self.active = np.ones(n, dtype=bool)  # neither arrived nor collided
-        self.books = [Ledger(self.tol) for _ in range(n)]
+        self._active = np.ones(n, dtype=bool)  # neither arrived nor collided
+        self._books = [Ledger(self.tol) for _ in range(n)]
         self.clearance = np.full(n, np.inf)
-        self.pairs: set[tuple[int, int]] = set()
+        self._pair_set: set[tuple[int, int]] = set()
         obstacles = FieldTemplate.from_bodies([o.body for o in self.obstacles]) if self.k else None
         self._obstacle_sweeps = (
             [SweptClearance(obstacles, float(r)) for r in self.radii] if obstacles else []
         )
-        self.obstacle_hits = 0
         self.window = max(1, round(self.setup.deadlock_window / self.dt))
         self.history: list[FloatArray] = []
-        self.applied = [UnicycleCommand(0.0, 0.0) for _ in range(n)]
-        self._pairs: _DiscPairs | None = None
-        self.field = self._field()
+        self._fld = self._field()
         self._check()
         for i, gd in enumerate(self._goal_dists()):
-            self.active[i] = not self.books[i].begin(float(self.clearance[i]), gd)
-        self.done = not self.active.any() or self.clock.up
+            self._active[i] = not self._books[i].begin(float(self.clearance[i]), gd)
+        self.done = not self._active.any() or self.clock.up
+
+    def _start_kernel(self) -> None:
+        """The robots in a :class:`~uvnav.sim.packed_swarm.SwarmState` (a world of robots only):
+        its arrays are the state, and each step is its compiled kernel."""
+        self.core = core = SwarmState(self.setup)
+        rob = core.rob
+        self.state = rob[:, R_X : R_TH + 1]  # views, valid for the episode
+        self.clearance = rob[:, R_CLEAR]
+        self._obstacle_sweeps = []
+        self._rows = list(rob)  # each robot's row (a view)
+        self._views = (rob[:, R_X : R_Y + 1], rob[:, R_TH], rob[:, R_VX : R_VY + 1])
+        self._advance = core.advance_kernel
+        self._advance_args = (rob, core.status, core.pairs, core.ints, core.flt, core.hist)
+        self._stepped, self._rdt = self.clock.step_index > 0, self.ratio * self.dt
+        self._held_v = [0.0] * self.n_agents  # each robot's held speed (rob's R_V) [m/s]
+        self._acting: tuple[bytes, list[int]] = (b"", [])
+        self._running: tuple[bytes, np.ndarray] = (b"", np.zeros(0, dtype=bool))
+        self._vmax = [float(r.spec.v_max) for r in self.robots]
+        self._umax = [float(r.spec.u_max) for r in self.robots]
+        self.done = bool(core.ints[I_DONE]) or self.clock.up
+
+    @property
+    def active(self) -> np.ndarray:
+        """(N,) the robots neither arrived nor collided."""
+        if self.core is None:
+            return self._active
+        status = self.core.status
+        key = status.tobytes()  # made again only when a robot ended
+        if key != self._running[0]:
+            self._running = (key, status == RUNNING)
+        return self._running[1]
+
+    @property
+    def books(self) -> list[Ledger]:
+        """Each robot's :class:`~uvnav.sim.ledger.Ledger` (made from the arrays on the kernel
+        path)."""
+        return self.core.ledgers(self.status) if self.core is not None else self._books
+
+    @property
+    def pairs(self) -> set[tuple[int, int]]:
+        """The robot pairs (i < j) whose discs overlapped."""
+        return set(self.core.collided_pairs()) if self.core is not None else self._pair_set
+
+    @property
+    def field(self) -> ObstacleField:
+        """The obstacles and the robots now (discs moving at their held commands)."""
+        if self.core is None:
+            return self._fld
+        if self._at != self.clock.step_index:  # made once per step, when asked
+            self._at = self.clock.step_index
+            rob = self.core.rob
+            self._fld = self.template.field(
+                rob[:, R_X : R_Y + 1].copy(), rob[:, R_TH].copy(),
+                rob[:, R_VX : R_VY + 1].copy(), rob[:, R_W].copy(),
+            )  # fmt: skip
+            self._pairs = _DiscPairs(self._fld, self.state[:, :2], self.reach)
+        return self._fld
 
     @property
     def status(self) -> list[str]:
         """Each robot's ``success``, ``collision`` or ``timeout`` (also while running)."""
-        return [b.status for b in self.books]
+        if self.core is not None:
+            return [_STATUS[c] for c in self.core.status.tolist()]
+        return [b.status for b in self._books]
 
     @property
     def reached(self) -> list[float | None]:
         """Each robot's arrival time [s] (``None`` before)."""
-        return [b.reached_at for b in self.books]
+        if self.core is not None:
+            return self.core.reached()
+        return [b.reached_at for b in self._books]
 
     def _goal_dists(self) -> list[float]:
         """Each robot's distance to its goal now [m]."""
@@ -291,44 +381,39 @@ class MultiUnicycleWorld:
     def _check(self) -> None:
         """Clearances (``inf`` for a robot that is done) and the collisions' pairs and obstacle
         hits, after a step or at t = 0; the ledgers judge them."""
-        n, k, fld, active = self.n_agents, self.k, self.field, self.active
+        n, k, fld, active = self.n_agents, self.k, self._fld, self._active
         self._hit: set[int] = set()  # robots that hit an obstacle at this sample
-        if self.batched:
-            dp = _DiscPairs(fld, self.state[:, :2], self.reach)
-            self._pairs = dp
-            keep = dp.within & active[:, None]
-            np.fill_diagonal(keep, False)
-            gaps = dp.signed - self.radii[:, None]
-            self.clearance = np.where(keep, gaps, np.inf).min(axis=1)
-            hit_i, hit_j = np.nonzero(keep & (gaps < 0))
-            for i, j in zip(hit_i.tolist(), hit_j.tolist(), strict=True):
-                self.pairs.add((min(i, j), max(i, j)))
-        else:
-            self.clearance = np.full(n, np.inf)
-            for i in range(n):
-                if not active[i]:
-                    continue  # an arrived or wrecked robot's episode is over (as in run_episode)
-                # the own disc is always nearest: ask for everything within the reach instead
-                # (clearances beyond it are not tracked: min_clearance is exact when below it)
-                q = fld.query(self.state[i, :2], float(self.reach[i]), nearest=False)
-                own = q.ids == k + i
-                gaps = (q.signed - self.radii[i])[~own]
-                ids = q.ids[~own]
-                if len(gaps) == 0:
-                    continue
-                self.clearance[i] = float(gaps.min())
-                for j in ids[gaps < 0].tolist():
-                    if j >= k:
-                        self.pairs.add((min(i, j - k), max(i, j - k)))
-                    else:
-                        self.obstacle_hits += 1
-                        self._hit.add(i)
+        self.clearance = np.full(n, np.inf)
+        for i in range(n):
+            if not active[i]:
+                continue  # an arrived or wrecked robot's episode is over (as in run_episode)
+            # the own disc is always nearest: ask for everything within the reach instead
+            # (clearances beyond it are not tracked: min_clearance is exact when below it)
+            q = fld.query(self.state[i, :2], float(self.reach[i]), nearest=False)
+            own = q.ids == k + i
+            gaps = (q.signed - self.radii[i])[~own]
+            ids = q.ids[~own]
+            if len(gaps) == 0:
+                continue
+            self.clearance[i] = float(gaps.min())
+            for j in ids[gaps < 0].tolist():
+                if j >= k:
+                    self._pair_set.add((min(i, j - k), max(i, j - k)))
+                else:
+                    self.obstacle_hits += 1
+                    self._hit.add(i)
 
     def acting(self) -> list[int]:
         """The active robots, in index order, at a decision time (every ``control_period``)."""
         if not self.clock.due:
             return []
-        return np.flatnonzero(self.active).tolist()
+        if self.core is None:
+            return np.flatnonzero(self._active).tolist()
+        status = self.core.status
+        key = status.tobytes()  # the list is made again only when a robot ended
+        if key != self._acting[0]:
+            self._acting = (key, np.flatnonzero(self.active).tolist())
+        return self._acting[1].copy()
 
     def observe(self, agent: int = 0) -> Observation:
         """Robot ``agent``'s readings of the obstacles and the other robots (its own disc left
@@ -338,9 +423,10 @@ class MultiUnicycleWorld:
         pose = self.state[i].copy()
 
         def exact() -> tuple[ObstacleReading, ...]:
+            fld = self.field
             if self._pairs is not None:
-                return self._pairs.readings(i, self.field, sensing_range)
-            readings = sense_obstacles(pose[:2], self.field, sensing_range=sensing_range)
+                return self._pairs.readings(i, fld, sensing_range)
+            readings = sense_obstacles(pose[:2], fld, sensing_range=sensing_range)
             return tuple(rd for rd in readings if rd.obstacle_id != self.k + i)
 
         return self.sensors[i].observe(
@@ -364,7 +450,8 @@ class MultiUnicycleWorld:
     def disc_agents(self) -> DiscAgents:
         """Every robot's disc now, for a group law (:class:`uvnav.core.DiscAgents`; velocities
         as the other robots' readings give them; ``exact`` where a robot's readings carry the
-        true velocities).
+        true velocities).  On the kernel path (a world of robots only) the arrays are views of
+        the world's, valid until the next :meth:`advance`; they must not be written.
 
         Raises:
             ValueError: the world holds obstacles besides the robots (not covered yet).
@@ -373,23 +460,44 @@ class MultiUnicycleWorld:
             raise ValueError(
                 f"a group law reads a world of robots only; this one holds {self.k} obstacle(s)"
             )
+        if self.core is not None:  # views of the arrays: read them before the next step
+            pos, th, vel = self._views
+            return DiscAgents(
+                self.t, pos, th, vel, self.radii, self.active, self._sensing, self._exact
+            )
         return DiscAgents(
             time=self.t,
             positions=self.state[:, :2].copy(),
             headings=self.state[:, 2].copy(),
-            velocities=np.array(self.field.velocities, dtype=float),
+            velocities=np.array(self._fld.velocities, dtype=float),
             radii=self.radii.copy(),
-            active=self.active.copy(),
-            sensing_range=np.array([float(r.sensing.sensing_range) for r in self.robots]),
-            exact=np.array([sensors.true_rates for sensors in self.sensors]),
+            active=self._active.copy(),
+            sensing_range=self._sensing.copy(),
+            exact=self._exact.copy(),
         )
 
     def apply(self, cmd: UnicycleCommand, agent: int = 0) -> UnicycleCommand:
         """Hold ``cmd`` for robot ``agent``: counted in its ``limit_violations`` when outside
         (2.4), saturated."""
         i = agent
+        if self.core is not None:  # the kernel path: the same rules, into the arrays
+            v, u = cmd.v, cmd.u
+            vmax, umax = self._vmax[i], self._umax[i]
+            if not (
+                type(v) is float and type(u) is float and 0.0 <= v <= vmax and -umax <= u <= umax
+            ):
+                self._count_violation(cmd, i)
+                cmd = cmd.clipped(self.robots[i].spec)
+                v, u = cmd.v, cmd.u
+            row = self._rows[i]
+            if self._stepped:
+                row[R_EFFORT] += ((v - self._held_v[i]) ** 2) / self._rdt
+            self._held_v[i] = row[R_V] = v
+            row[R_U] = u
+            self.applied[i] = cmd
+            return cmd
         spec = self.robots[i].spec
-        book = self.books[i]
+        book = self._books[i]
         if cmd.violates(spec):
             book.violations += 1
         new = cmd.clipped(spec)
@@ -399,11 +507,21 @@ class MultiUnicycleWorld:
         self.applied[i] = new
         return new
 
+    def _count_violation(self, cmd: UnicycleCommand, i: int) -> None:
+        """Count ``cmd`` in robot i's limit violations when it is outside (2.4) (kernel path)."""
+        if cmd.violates(self.robots[i].spec):
+            self._rows[i][R_VIOL] += 1.0
+
     def advance(self) -> None:
         """One step ``dt``: the active robots (exact), the obstacles, clearances, collisions,
         arrivals."""
-        dt, state, active = self.dt, self.state, self.active
-        start, t0, g0, f0 = state[:, :2].copy(), self.t, self.clearance.copy(), self.field
+        if self.core is not None:  # a world of robots only: the compiled step
+            self.done = bool(self._advance(*self._advance_args))
+            self.t = self.clock.tick()
+            self._stepped = True
+            return
+        dt, state, active = self.dt, self.state, self._active
+        start, t0, g0, f0 = state[:, :2].copy(), self.t, self.clearance.copy(), self._fld
         moving = active.copy()
         held = np.array([(c.v, c.u) for c in self.applied]).reshape(-1, 2)
         slack = np.where(moving, np.abs(held[:, 0] * held[:, 1]) * dt * dt / 8.0, 0.0)
@@ -415,7 +533,7 @@ class MultiUnicycleWorld:
                 self.speeds[i] = self.turns[i] = 0.0
                 continue
             v, u = self.applied[i].v, self.applied[i].u
-            book = self.books[i]
+            book = self._books[i]
             book.effort += u * u * dt
             x, y, th = state[i]
             nx, ny, nth = unicycle_advance(float(x), float(y), float(th), v, u, dt)
@@ -424,7 +542,7 @@ class MultiUnicycleWorld:
             self.speeds[i], self.turns[i] = v, u
         self.batch.step(self.t, dt)
         self.t = t = self.clock.tick()
-        self.field = self._field()
+        self._fld = self._field()
         self._check()
         hit = self._sweep_robots(start, moving)
         if self._obstacle_sweeps:
@@ -432,7 +550,7 @@ class MultiUnicycleWorld:
         for i, gd in enumerate(self._goal_dists()):
             if active[i]:
                 at = None if math.isnan(hit[i]) else t0 + float(hit[i]) * dt
-                active[i] = not self.books[i].judge(t, float(self.clearance[i]), gd, at)
+                active[i] = not self._books[i].judge(t, float(self.clearance[i]), gd, at)
         self.done = not active.any() or self.clock.up
 
     def _sweep_robots(self, start: FloatArray, moving: np.ndarray) -> FloatArray:
@@ -460,12 +578,12 @@ class MultiUnicycleWorld:
         gaps = np.where(within, gaps, np.inf)
         for i in np.flatnonzero(within.any(axis=1)).tolist():
             low = float(gaps[i].min())
-            book = self.books[i]
+            book = self._books[i]
             book.min_clear = min(book.min_clear, low)
             if low >= 0.0:
                 continue
             for j in np.flatnonzero(gaps[i] < 0.0).tolist():
-                self.pairs.add((min(i, j), max(i, j)))
+                self._pair_set.add((min(i, j), max(i, j)))
                 _, _, s = disc_sweep(p0[i], p1[i], p0[j : j + 1], p1[j : j + 1], rad[i, j])
                 hit[i] = np.fmin(hit[i], s[0])
         return hit
@@ -477,7 +595,7 @@ class MultiUnicycleWorld:
         """The world's obstacles judged along the step for each moving robot
         (:class:`~uvnav.sim.swept.SweptClearance`); each robot's first contact as a fraction of
         the step (NaN: none)."""
-        k, f1 = self.k, self.field
+        k, f1 = self.k, self._fld
         pr0 = None if f0.present is None else f0.present[:k]
         pr1 = None if f1.present is None else f1.present[:k]
         hit = np.full(self.n_agents, np.nan)
@@ -486,7 +604,7 @@ class MultiUnicycleWorld:
                 f0.centres[:k], f0.headings[:k], f1.centres[:k], f1.headings[:k], pr0, pr1,
                 start[i], self.state[i, :2].copy(), float(slack[i]),
             )  # fmt: skip
-            book = self.books[i]
+            book = self._books[i]
             travel = abs(float(held[i, 0])) * self.dt
             s = self._obstacle_sweeps[i].step(
                 poses, travel, float(g0[i]), float(self.clearance[i]), book.min_clear
@@ -496,6 +614,12 @@ class MultiUnicycleWorld:
                 self.obstacle_hits += 1
         return hit
 
+    def _window_start(self) -> FloatArray | None:
+        """The positions at the start of the deadlock window (``None`` before the first step)."""
+        if self.core is not None:
+            return self.core.window_start()
+        return self.history[0] if self.history else None
+
     def close(self) -> None:
         """Write the obstacles' states back to their models (the setup's objects)."""
         self.batch.write_back()
@@ -503,15 +627,19 @@ class MultiUnicycleWorld:
     def metrics(self, log: AgentLog, agent: int = 0) -> EpisodeMetrics:
         """Robot ``agent``'s metrics (the names of a single-robot episode's)."""
         if self._obstacle_sweeps:  # the minimum along the steps it kept
-            book = self.books[agent]
+            book = self._books[agent]
             book.min_clear = self._obstacle_sweeps[agent].finish(book.min_clear)
-        return self.books[agent].metrics(log, top_speed=float(self.robots[agent].spec.v_max))
+        if self.core is not None:
+            book = self.core.ledger(agent, _STATUS[int(self.core.status[agent])])
+        else:
+            book = self._books[agent]
+        return book.metrics(log, top_speed=float(self.robots[agent].spec.v_max))
 
     def group_metrics(self) -> GroupMetrics:
         """The group's outcome (module docstring, :func:`group_outcome`)."""
         return group_outcome(
             self.setup, self.status, self.reached, self.state[:, :2],
-            self.history[0] if self.history else None, self.t, len(self.pairs),
+            self._window_start(), self.t, len(self.pairs),
             self.obstacle_hits,
         )  # fmt: skip
 

@@ -5,11 +5,14 @@ unicycles (2.1)-(2.4) with disc bodies) for the case that needs speed more than 
 robot on ``orca-shared-v1`` with the same parameters (ORCA, van den Berg et al., ISRR 2009:
 :mod:`uvnav.controllers.orca_shared`), exact sensing with known velocities, no obstacle besides
 the robots.  A step is :func:`swarm_decide_py` (the group decision,
-:func:`uvnav.controllers.orca_kernels.decide_group_py`, when one is due, and the commands held)
-then :func:`swarm_advance_py` (the unicycles, robot-pair checks, arrivals, time limit): loops over
-preallocated arrays, compiled by numba when it is enabled; the Python functions are the reference
-and the fallback.  Two calls, not one, so that the decisions are timed as the one loop times a
-group's (:func:`uvnav.core.run_loop`: CPU and wall time divided among the members).
+:func:`uvnav.controllers.orca_kernels.group_decide_py`, the kernel ``orca-shared-v1`` decides a
+group with in the loop too, when one is due, and the commands held) then
+:func:`swarm_advance_py` (the unicycles, robot-pair checks, arrivals, time limit: the step the
+loop world :class:`~uvnav.sim.multi.MultiUnicycleWorld` takes for a world of robots only, through
+:class:`SwarmState`): loops over preallocated arrays, compiled by numba when it is enabled; the
+Python functions are the reference and the fallback.  Two calls, not one, so that the decisions
+are timed as the one loop times a group's (:func:`uvnav.core.run_loop`: CPU and wall time divided
+among the members).
 
 It is :func:`uvnav.core.run_loop` over :class:`~uvnav.sim.multi.MultiUnicycleWorld` bit for bit
 (the tests compare every pose, status, clearance and collided pair at every step, and the whole
@@ -43,8 +46,16 @@ from typing import Any
 import numpy as np
 
 from uvnav.controllers.base import LawState
-from uvnav.controllers.orca_kernels import FAMILY, decide_group_py
-from uvnav.controllers.orca_shared import OrcaShared, group_geometry, group_scratch
+from uvnav.controllers.orca_kernels import FAMILY, group_decide_py
+from uvnav.controllers.orca_shared import (
+    BLOCK as BLOCK,
+)
+from uvnav.controllers.orca_shared import (
+    Draws,
+    OrcaShared,
+    group_geometry,
+    group_scratch,
+)
 from uvnav.core import AgentLog
 from uvnav.dynamics.unicycle import unicycle_advance
 from uvnav.geometry.angles import FloatArray
@@ -59,23 +70,23 @@ from uvnav.sim.setup import MultiResult, MultiSetup
 #: status codes of a packed robot (those of :mod:`uvnav.sim.packed`)
 RUNNING, SUCCESS, COLLISION, TIMEOUT = 0, 1, 2, 3
 STATUS_NAMES = ("running", "success", "collision", "timeout")
-#: perturbation draws pre-drawn per robot and block (two per decision)
-BLOCK = 64
 # Columns of the (N, NR) float array of the robots: pose [m, m, rad], held command [m/s, rad/s],
-# velocity [m/s, m/s], goal [m], body radius [m], collision reach [m], ORCA radius [m], ORCA
-# neighbour range [m], V_max [m/s], U_max [rad/s], disc radius and bounding radius of the body
-# in the field [m], time reached [s] (NaN: not yet), path [m], clearance now and lowest [m],
-# time of the last decision [s] (NaN: none yet), control effort, commands outside the limits,
-# decisions taken, mode switches, last mode (-1: none yet, 0: M1, 1: M2).
-(R_X, R_Y, R_TH, R_V, R_U, R_VX, R_VY, R_GX, R_GY, R_RADIUS, R_REACH, R_ORAD, R_OREACH, R_VMAX,
- R_UMAX, R_DISC, R_BOUND, R_REACHED, R_PATH, R_CLEAR, R_LOW, R_LAST_T, R_EFFORT, R_VIOL, R_NDEC,
- R_SWITCH, R_MODE) = range(27)  # fmt: skip
-NR = 27
+# velocity [m/s, m/s]; then a group's agent table (orca_kernels' G_* columns, from R_ORAD on):
+# ORCA radius [m], ORCA neighbour range [m], goal [m], V_max [m/s], U_max [rad/s], time of the
+# last decision [s] (NaN: none yet); then body radius [m], collision reach [m], disc radius and
+# bounding radius of the body in the field [m], time reached [s] (NaN: not yet), path [m],
+# clearance now and lowest [m], control effort, commands outside the limits, decisions taken,
+# mode switches, last mode (-1: none yet, 0: M1, 1: M2), turn rate over the last step [rad/s] (0
+# for a robot that did not move).
+(R_X, R_Y, R_TH, R_V, R_U, R_VX, R_VY, R_ORAD, R_OREACH, R_GX, R_GY, R_VMAX, R_UMAX, R_LAST_T,
+ R_RADIUS, R_REACH, R_DISC, R_BOUND, R_REACHED, R_PATH, R_CLEAR, R_LOW, R_EFFORT, R_VIOL, R_NDEC,
+ R_SWITCH, R_MODE, R_W) = range(28)  # fmt: skip
+NR = 28
 # Entries of the int array of the swarm: step index, steps per decision, steps in the episode,
 # 1 when the episode is over, max_neighbors, next slot and length of the position history.
 (I_STEP, I_RATIO, I_NSTEPS, I_DONE, I_MAXNB, I_HNEXT, I_HLEN) = range(7)
 # Entries of the float array of the swarm: dt [s], goal tolerance [m], perturbation [m/s], time
-# horizon [s], responsibility, first decision period [s].
+# horizon [s], responsibility, first decision period [s] (from F_EPS on: orca_kernels' P_*).
 (F_DT, F_TOL, F_EPS, F_TAU, F_RESP, F_FIRST) = range(6)
 
 
@@ -120,11 +131,11 @@ def _pair_check(
             if j == i:
                 continue
             cx, cy = rob[j, R_X], rob[j, R_Y]
-            if not (math.isinf(limit) or np.hypot(cx - px, cy - py) - rob[j, R_BOUND] <= limit):
+            r = np.hypot(cx - px, cy - py)  # = hypot(px - cx, py - cy): hypot ignores signs
+            if not (math.isinf(limit) or r - rob[j, R_BOUND] <= limit):
                 continue
             rad = rob[j, R_DISC]
             offx, offy = px - cx, py - cy
-            r = np.hypot(offx, offy)
             if r > 0:
                 ux, uy = offx / r, offy / r
             else:
@@ -177,28 +188,16 @@ def swarm_decide_py(
     step = ints[I_STEP]
     if step % ints[I_RATIO] != 0:
         return 0
-    t = step * dt
     m = 0
     for i in range(n):
         if status[i] == RUNNING:
             members[m] = i
-            last = rob[i, R_LAST_T]
-            if last != last:
-                periods[m] = flt[F_FIRST]
-            else:
-                period = t - last
-                periods[m] = period if not (period < 1e-3) else 1e-3
-            rob[i, R_LAST_T] = t
-            if flt[F_EPS] > 0.0:
-                pick[m, 0], pick[m, 1] = draws[i, upos[i]], draws[i, upos[i] + 1]
-                upos[i] += 2
             m += 1
     if m == 0:
         return 0
-    decide_group_py(
-        members[:m], rob[:, R_X:R_Y + 1], rob[:, R_TH], rob[:, R_VX:R_VY + 1], rob[:, R_ORAD],
-        rob[:, R_OREACH], rob[:, R_GX:R_GY + 1], rob[:, R_VMAX], rob[:, R_UMAX], periods[:m],
-        pick[:m], flt[F_EPS], ints[I_MAXNB], flt[F_TAU], flt[F_RESP], scratch, idx, out[:m],
+    group_decide_py(
+        members[:m], step * dt, flt[F_EPS:], ints[I_MAXNB], rob[:, R_ORAD:], draws, upos,
+        rob[:, R_X:R_Y + 1], rob[:, R_TH], rob[:, R_VX:R_VY + 1], scratch, idx, periods, pick, out,
     )  # fmt: skip
     for k in range(m):
         i = members[k]
@@ -250,9 +249,10 @@ def swarm_advance_py(
         ints[I_HLEN] += 1
     for i in range(n):
         if status[i] != RUNNING:
-            rob[i, R_VX] = rob[i, R_VY] = 0.0
+            rob[i, R_VX] = rob[i, R_VY] = rob[i, R_W] = 0.0
             continue
         x, y, u = rob[i, R_X], rob[i, R_Y], rob[i, R_U]
+        rob[i, R_W] = u
         rob[i, R_EFFORT] += u * u * dt
         nx, ny, nth = unicycle_advance(x, y, rob[i, R_TH], rob[i, R_V], u, dt)
         rob[i, R_PATH] += pyhypot(nx - x, ny - y)
@@ -275,64 +275,66 @@ def swarm_advance_py(
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
 
-def _kernels() -> tuple[Callable[..., Any], Callable[..., Any]]:
-    """:func:`swarm_decide_py` and :func:`swarm_advance_py`, compiled when numba is enabled."""
+def _kernel(name: str) -> Callable[..., Any]:
+    """The function ``name`` of this module's kernels (:func:`swarm_decide_py`,
+    :func:`swarm_advance_py`, :func:`_pair_check`), compiled when numba is enabled."""
     if not numba_enabled():
-        return swarm_decide_py, swarm_advance_py
+        plain: dict[str, Callable[..., Any]] = {
+            "swarm_decide_py": swarm_decide_py,
+            "swarm_advance_py": swarm_advance_py,
+            "_pair_check": _pair_check,
+        }
+        return plain[name]
     if not _KERNELS:
         _KERNELS.update(compile_family(
             (*FAMILY, unicycle_advance, segment_gap, _pair_check, _arrivals, swarm_decide_py,
              swarm_advance_py)
         ))  # fmt: skip
-    return _KERNELS["swarm_decide_py"], _KERNELS["swarm_advance_py"]
+    return _KERNELS[name]
 
 
-class PackedSwarm:
-    """One multi-robot episode of ``orca-shared-v1`` robots in packed arrays (module docstring).
+def _kernels() -> tuple[Callable[..., Any], Callable[..., Any]]:
+    """:func:`swarm_decide_py` and :func:`swarm_advance_py`, compiled when numba is enabled."""
+    return _kernel("swarm_decide_py"), _kernel("swarm_advance_py")
+
+
+class SwarmState:
+    """N ideal arc unicycles with disc bodies and nothing else in the world, in packed arrays,
+    each step one call of :func:`swarm_advance_py` (compiled when numba is enabled): the arrays
+    the loop world :class:`~uvnav.sim.multi.MultiUnicycleWorld` steps such a world with, and
+    :class:`PackedSwarm`'s.  The checks and arrivals at t = 0 are done here (as
+    :meth:`MultiUnicycleWorld.start` does them).
 
     Args:
-        setup: the scene (:func:`swarm_check` must pass); its laws' parameters are read, the
-            laws themselves are not called.
-        rng: the episode generator, spawned as :class:`~uvnav.sim.multi.MultiUnicycleWorld`
-            spawns it (robot i's law draws from child 2i).
+        setup: the scene (no obstacle besides the robots; every robot an ideal arc unicycle).
 
     Attributes:
-        rob: (N, NR) the robots (``R_*`` columns).
-        status: (N,) status codes (``RUNNING`` until arrival or collision; ``TIMEOUT`` at the end).
+        rob: (N, NR) the robots (``R_*`` columns; the ORCA columns left at 0).
+        status: (N,) status codes (``RUNNING`` until arrival or collision).
         pairs: (N, N) 1 where robots i < j overlapped at some step.
         start_dist: (N,) each robot's distance to its goal at the start [m].
 
     Raises:
-        ValueError: the scene cannot be packed (the reason in one line), or ``control_period``
-            is not a whole multiple of ``dt``.
+        ValueError: no robot, or ``control_period`` is not a whole multiple of ``dt``.
     """
 
-    def __init__(self, setup: MultiSetup, rng: np.random.Generator) -> None:
-        reason = swarm_check(setup)
-        if reason is not None:
-            raise ValueError(f"cannot pack this swarm: {reason}")
+    def __init__(self, setup: MultiSetup) -> None:
         robots = setup.robots
         n = len(robots)
         if n == 0:
             raise ValueError("a multi-robot episode needs at least one robot")
-        law: Any = robots[0].controller
-        p = law.params
         dt = float(setup.dt)
-        self.setup = setup
-        self.n = n
-        self.dt = dt
-        self._rngs = rng.spawn(2 * n)[0::2]  # each law's generator (child 2i)
+        self.setup, self.n, self.dt = setup, n, dt
         radii = np.array([float(r.spec.radius) for r in robots])
-        sensing = np.array([float(r.sensing.sensing_range) for r in robots])
         template = FieldTemplate.from_bodies([DiscBody(max(r, 1e-6)) for r in radii])
-        orad, oreach = group_geometry(p, radii, sensing)
         rob = np.zeros((n, NR))
         rob[:, R_X : R_TH + 1] = [np.asarray(r.start, dtype=float)[:3] for r in robots]
+        th = rob[:, R_TH]
+        rob[:, R_VX], rob[:, R_VY] = 0.0 * np.cos(th), 0.0 * np.sin(th)  # held speed 0
         rob[:, R_GX : R_GY + 1] = [np.asarray(r.goal, dtype=float)[:2] for r in robots]
         rob[:, R_RADIUS] = radii
-        floor = 4.0 * float(radii.max()) + 1.0
-        rob[:, R_REACH] = [max(s, floor) for s in sensing.tolist()]
-        rob[:, R_ORAD], rob[:, R_OREACH] = orad, oreach
+        floor = 4.0 * float(radii.max()) + 1.0  # the reach covers any robot that can touch
+        rob[:, R_REACH] = [max(float(r.sensing.sensing_range), floor) for r in robots]
         rob[:, R_VMAX] = [float(r.spec.v_max) for r in robots]
         rob[:, R_UMAX] = [float(r.spec.u_max) for r in robots]
         rob[:, R_DISC], rob[:, R_BOUND] = template.radii, template.bounding_radii
@@ -344,47 +346,104 @@ class PackedSwarm:
         self.pairs = np.zeros((n, n), dtype=np.uint8)
         self.ints = np.array(
             [0, decision_ratio(float(setup.control_period), dt), step_count(setup.t_max, dt), 0,
-             int(p.max_neighbors), 0, 0], dtype=np.int64,
+             0, 0, 0], dtype=np.int64,
         )  # fmt: skip
         self.flt = np.array(
-            [dt, float(setup.goal_tolerance), float(p.perturbation), float(p.time_horizon),
-             float(p.responsibility), float(LawState.FIRST_PERIOD)],
-        )  # fmt: skip
+            [dt, float(setup.goal_tolerance), 0.0, 0.0, 0.0, float(LawState.FIRST_PERIOD)]
+        )
         window = max(1, round(setup.deadlock_window / dt))
         self.hist = np.zeros((window + 1, n, 2))  # the last window + 1 positions before a step
-        self.draws = np.zeros((n, 2 * BLOCK))
-        self.upos = np.full(n, 2 * BLOCK, dtype=np.int64)
-        self._safe = 0  # steps that cannot run out of pre-drawn numbers
+        self.advance_kernel = _kernel("swarm_advance_py")  # its arguments: _advance_args
+        self._advance_args = (self.rob, self.status, self.pairs, self.ints, self.flt, self.hist)
+        _kernel("_pair_check")(rob, self.status, self.pairs, rob[:, R_X : R_Y + 1], False)
+        self.start_dist = np.hypot(*(rob[:, R_GX : R_GY + 1] - rob[:, R_X : R_Y + 1]).T)
+        for i in range(n):
+            if self.status[i] == RUNNING and self.start_dist[i] <= self.flt[F_TOL]:
+                self.status[i], rob[i, R_REACHED] = SUCCESS, 0.0
+        over = not bool(np.any(self.status == RUNNING)) or self.ints[I_NSTEPS] <= 0
+        self.ints[I_DONE] = int(over)
+
+    def advance(self) -> bool:
+        """One step ``dt`` (:func:`swarm_advance_py`); returns whether the episode is over."""
+        return bool(self.advance_kernel(*self._advance_args))
+
+    def reached(self) -> list[float | None]:
+        """Each robot's arrival time [s] (``None`` before)."""
+        return [None if r != r else float(r) for r in self.rob[:, R_REACHED].tolist()]
+
+    def window_start(self) -> FloatArray | None:
+        """The positions at the start of the deadlock window (``None`` before the first step)."""
+        hlen, cap = int(self.ints[I_HLEN]), self.hist.shape[0]
+        return self.hist[(int(self.ints[I_HNEXT]) - hlen) % cap] if hlen else None
+
+    def collided_pairs(self) -> list[tuple[int, int]]:
+        """The robot pairs (i < j) that overlapped."""
+        return [(int(i), int(j)) for i, j in zip(*np.nonzero(self.pairs), strict=True)]
+
+    def ledger(self, i: int, status: str) -> Ledger:
+        """Robot i's :class:`~uvnav.sim.ledger.Ledger` with status ``status``."""
+        rob, reached = self.rob, float(self.rob[i, R_REACHED])
+        return Ledger.settled(
+            float(self.flt[F_TOL]), status=status, start_dist=float(self.start_dist[i]),
+            reached_at=None if reached != reached else reached, path=float(rob[i, R_PATH]),
+            effort=float(rob[i, R_EFFORT]), violations=int(rob[i, R_VIOL]),
+            min_clear=float(rob[i, R_LOW]),
+        )  # fmt: skip
+
+    def ledgers(self, status: Sequence[str]) -> list[Ledger]:
+        """Each robot's :class:`~uvnav.sim.ledger.Ledger` with status ``status[i]``."""
+        return [self.ledger(i, status[i]) for i in range(self.n)]
+
+
+class PackedSwarm(SwarmState):
+    """One multi-robot episode of ``orca-shared-v1`` robots in packed arrays (module docstring):
+    a :class:`SwarmState` whose robots decide in :func:`swarm_decide_py`.
+
+    Args:
+        setup: the scene (:func:`swarm_check` must pass); its laws' parameters are read, the
+            laws themselves are not called.
+        rng: the episode generator, spawned as :class:`~uvnav.sim.multi.MultiUnicycleWorld`
+            spawns it (robot i's law draws from child 2i).
+
+    Attributes:
+        status: (N,) status codes (``RUNNING`` until arrival or collision; ``TIMEOUT`` at the end).
+
+    Raises:
+        ValueError: the scene cannot be packed (the reason in one line), or ``control_period``
+            is not a whole multiple of ``dt``.
+    """
+
+    def __init__(self, setup: MultiSetup, rng: np.random.Generator) -> None:
+        reason = swarm_check(setup)
+        if reason is not None:
+            raise ValueError(f"cannot pack this swarm: {reason}")
+        super().__init__(setup)
+        n, rob = self.n, self.rob
+        law: Any = setup.robots[0].controller
+        p = law.params
+        radii = rob[:, R_RADIUS].copy()
+        sensing = np.array([float(r.sensing.sensing_range) for r in setup.robots])
+        rob[:, R_ORAD], rob[:, R_OREACH] = group_geometry(p, radii, sensing)
+        self.ints[I_MAXNB] = int(p.max_neighbors)
+        self.flt[F_EPS : F_RESP + 1] = (
+            float(p.perturbation),
+            float(p.time_horizon),
+            float(p.responsibility),
+        )
+        self._draws = Draws(rng.spawn(2 * n)[0::2], float(p.perturbation))  # child 2i: law i
         self._scratch, self._idx = group_scratch(p)
         self._members = np.zeros(n, dtype=np.int64)
         self._periods = np.zeros(n)
         self._pick = np.zeros((n, 2))
         self._out = np.zeros((n, 7))
+        self._decide = _kernel("swarm_decide_py")
+        self._decide_args = (
+            rob, self.status, self.ints, self.flt, self._draws.draws, self._draws.upos,
+            self._scratch, self._idx, self._members, self._periods, self._pick, self._out,
+        )  # fmt: skip
         self._cpu_ns: list[int] = []  # each group decision's CPU and wall time per member [ns]
         self._wall_ns: list[int] = []
-        self._start()
-
-    def _start(self) -> None:
-        """Checks and arrivals at t = 0 (:meth:`MultiUnicycleWorld.start`)."""
-        rob, status = self.rob, self.status
-        _pair_check(rob, status, self.pairs, rob[:, R_X : R_Y + 1], False)
-        self.start_dist = np.hypot(*(rob[:, R_GX : R_GY + 1] - rob[:, R_X : R_Y + 1]).T)
-        for i in range(self.n):
-            if status[i] == RUNNING and self.start_dist[i] <= self.flt[F_TOL]:
-                status[i], rob[i, R_REACHED] = SUCCESS, 0.0
-        over = not bool(np.any(status == RUNNING)) or self.ints[I_NSTEPS] <= 0
-        self.ints[I_DONE] = int(over)
         self._finish()
-
-    def _refill(self) -> None:
-        """Every robot's unread numbers moved to the front, the rest drawn from its generator."""
-        if self.flt[F_EPS] > 0.0:
-            for i, g in enumerate(self._rngs):
-                rest = self.draws[i, self.upos[i] :].copy()
-                self.draws[i, : len(rest)] = rest
-                self.draws[i, len(rest) :] = g.random(2 * BLOCK - len(rest))
-        self.upos[:] = 0
-        self._safe = BLOCK
 
     def _finish(self) -> None:
         if self.ints[I_DONE]:
@@ -410,20 +469,14 @@ class PackedSwarm:
         :attr:`done`."""
         if self.ints[I_DONE]:
             return True
-        if self._safe == 0:
-            self._refill()
-        self._safe -= 1
-        decide, advance = _kernels()
+        self._draws.ready()
         c0, w0 = _time.thread_time_ns(), _time.perf_counter_ns()
-        m = decide(
-            self.rob, self.status, self.ints, self.flt, self.draws, self.upos, self._scratch,
-            self._idx, self._members, self._periods, self._pick, self._out,
-        )  # fmt: skip
+        m = self._decide(*self._decide_args)
         if m:
             c1, w1 = _time.thread_time_ns(), _time.perf_counter_ns()
             self._cpu_ns.append((c1 - c0) // m)
             self._wall_ns.append((w1 - w0) // m)
-        done = advance(self.rob, self.status, self.pairs, self.ints, self.flt, self.hist)
+        done = self.advance_kernel(*self._advance_args)
         if done:
             self._finish()
         return bool(done)
@@ -436,10 +489,6 @@ class PackedSwarm:
     def statuses(self) -> list[str]:
         """Each robot's status name (``running`` while the episode goes on)."""
         return [STATUS_NAMES[s] for s in self.status.tolist()]
-
-    def collided_pairs(self) -> list[tuple[int, int]]:
-        """The robot pairs (i < j) that overlapped."""
-        return [(int(i), int(j)) for i, j in zip(*np.nonzero(self.pairs), strict=True)]
 
     def logs(self) -> list[AgentLog]:
         """Each robot's :class:`~uvnav.core.AgentLog`: its mode switches, and its share of every
@@ -463,25 +512,24 @@ class PackedSwarm:
         recorded poses before each step and at the end, as :class:`PosesProbe` records them)."""
         rob, setup = self.rob, self.setup
         status = self.statuses()
-        reached = [None if r != r else float(r) for r in rob[:, R_REACHED].tolist()]
-        hlen, cap = int(self.ints[I_HLEN]), self.hist.shape[0]
-        start = self.hist[(int(self.ints[I_HNEXT]) - hlen) % cap] if hlen else None
         pairs = self.collided_pairs()
-        logs = self.logs()
-        tol = float(self.flt[F_TOL])
-        robots = []
-        for i in range(self.n):
-            book = Ledger.settled(
-                tol, status=status[i], start_dist=float(self.start_dist[i]),
-                reached_at=reached[i], path=float(rob[i, R_PATH]), effort=float(rob[i, R_EFFORT]),
-                violations=int(rob[i, R_VIOL]), min_clear=float(rob[i, R_LOW]),
-            )  # fmt: skip
-            robots.append(book.metrics(logs[i], top_speed=float(setup.robots[i].spec.v_max)))
+        books, logs = self.ledgers(status), self.logs()
+        robots = [
+            book.metrics(log, top_speed=float(r.spec.v_max))
+            for book, log, r in zip(books, logs, setup.robots, strict=True)
+        ]
         return MultiResult(
             robots=robots,
             statuses=status,
             group=group_outcome(
-                setup, status, reached, rob[:, R_X : R_Y + 1], start, self.t, len(pairs), 0
+                setup,
+                status,
+                self.reached(),
+                rob[:, R_X : R_Y + 1],
+                self.window_start(),
+                self.t,
+                len(pairs),
+                0,
             ),
             times=np.asarray(times) if len(times) else np.zeros(0),
             poses=np.asarray(poses) if len(poses) else np.zeros((0, self.n, 3)),
