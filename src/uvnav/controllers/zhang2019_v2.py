@@ -66,14 +66,24 @@ on CrowdNav circle cases 0-99), on cases 100-499 the intrusion ratio fell from 1
 kept or higher (``docs/design-notes.md``, "A social term in zhang2019-v2").
 
 The holonomic robot takes the chosen velocity as it is; the unicycle steers toward the chosen
-direction with the sliding-mode law at the chosen speed times cos(beta) (its candidates are
-checked at the speed it will actually have, so a direction behind it counts as standing still
-while it turns).
+direction with the sliding-mode law at the chosen speed times cos(beta).
 
-**Acceleration limits.**  The thesis's unicycle changes its speed and turn rate at once, and so
-does v2's plan on the ideal vehicle (the decision above, unchanged bit for bit).  On a unicycle
-whose spec has limits (``UnicycleSpec.accel_max`` a, ``turn_accel_max`` B: the vehicle moves
-its speed and turn rate toward the held command by at most a dt and B dt a step) the thesis
+**Checked along the path.**  The unicycle does not move along the chosen velocity: it turns at
+most U_max, slows by cos(beta) while it turns, and steers again at every decision.  Its
+candidates are therefore checked along the path its own steering drives toward each of them,
+decision after decision over H (the rolled-out paths below, with no limits on the ideal
+vehicle).  With ``rollout_paths`` off they are checked as the chapter's geometry suggests: one
+turn at U_max along its chord at ``s cos(beta / 2)``, then a straight line at s (the compiled
+loop below).  That check was measured to fail the unicycle on CrowdNav's circle crossing
+(CrowdNav's turn-then-move robot, cases 0-99: 5 failures against the holonomic robot's 1, all
+humans walking into a robot that had stopped or was spinning): a direction behind the robot
+costs the same as one ahead, the choice jumped by 90-180 degrees between decisions, and the
+robot turned on the spot or zigzagged until a human reached it.  Checked along its paths: 1
+failure on those cases (``docs/design-notes.md``, "The unicycle checked along its paths").
+
+**Acceleration limits.** The thesis's unicycle changes its speed and turn rate at once.  On a
+unicycle whose spec has limits (``UnicycleSpec.accel_max`` a, ``turn_accel_max`` B: the vehicle
+moves its speed and turn rate toward the held command by at most a dt and B dt a step) the thesis
 says nothing; the choices made here (:mod:`uvnav.controllers.zhang2019_limits`):
 
 * What the robot knows: its speed from its odometry (``obs.speed``), its turn rate from its
@@ -101,21 +111,26 @@ says nothing; the choices made here (:mod:`uvnav.controllers.zhang2019_limits`):
   and where no candidate is safe one that leaves it is preferred.
 * v_pref is lowered to ``sqrt(2 a d)`` at d from T, so that the robot can stop there.
 
-This decision runs in numpy only (the compiled loop below serves the ideal vehicle): about
-0.16 s of CPU per CrowdNav episode (5 humans, 0.05 s steps) against 0.04 s for the ideal plan.
+The unicycle's decision runs in one loop, compiled with numba
+(:mod:`uvnav.controllers.zhang2019_v2_paths`: the candidates visited by their cost without the
+risk terms, each path rolled out only as far as it is checked, bodies culled by boxes; the
+numpy building blocks are its reference, and run where numba is not installed or the social
+term is on): about 0.02 s of CPU per CrowdNav episode with 5 humans (0.25 s decisions; 0.013 s
+with ``rollout_paths`` off) and 0.04 s with limits and 0.05 s steps (numpy: 0.11 and 0.16 s).
 
-Two equal implementations of one decision.  The reference is numpy, vectorised over candidates x
-boundary discs (:func:`tangent_directions`, :func:`choose_velocity`).  With numba (the ``fast``
+Two equal implementations of the holonomic robot's decision (and the unicycle's with
+``rollout_paths`` off).  The reference is numpy, vectorised over candidates x boundary discs
+(:mod:`uvnav.controllers.zhang2019_v2_bodies`, :func:`choose_velocity`).  With numba (the ``fast``
 extra) everything after reading the observation's readings into arrays (:func:`body_table`,
 :func:`~uvnav.controllers.zhang2019_v2_loop.outline_rings`) runs in one compiled call
-(:func:`uvnav.controllers.zhang2019_v2_loop.plan_loop`: the reachable bodies, their boundary
-discs and the candidate headings, then :func:`uvnav.geometry.contact.decide_py`): it visits the
-candidates by their cost without the risk terms (a lower bound of the cost), checks each
-against the bodies with a bounding-disc cull, and stops once a safe candidate costs no more than
-the next bound, so candidates that cannot win are never checked.  It picks the reference's
-candidate (tests: hypothesis on random scenes); its cost grows linearly with the bodies in
-range, and reading the readings is the part that grows in Python
-(``benchmarks/bench_zhang2019_v2.py``).  Units: metres, seconds, radians.
+(:func:`uvnav.controllers.zhang2019_v2_loop.plan_loop`: the reachable bodies, their boundary discs
+and the candidate headings, then :func:`uvnav.geometry.contact.decide_py`): it visits the candidates
+by their cost without the risk terms (a lower bound of the cost), checks each against the bodies
+with a bounding-disc cull, and stops once a safe candidate costs no more than the next bound, so
+candidates that cannot win are never checked.  It picks the reference's candidate (tests: hypothesis
+on random scenes); its cost grows linearly with the bodies in range, and reading the readings is the
+part that grows in Python (``benchmarks/bench_zhang2019_v2.py``).
+Units: metres, seconds, radians.
 """
 
 from __future__ import annotations
@@ -123,7 +138,6 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from itertools import chain
 from operator import attrgetter
 from typing import Any, ClassVar
 
@@ -149,6 +163,13 @@ from uvnav.controllers.zhang2019_limits import (
     stoppable,
     turn_command,
 )
+from uvnav.controllers.zhang2019_v2_bodies import (
+    body_table,
+    boundary_discs,
+    extra_headings,
+    reachable,
+    tangent_directions,
+)
 from uvnav.controllers.zhang2019_v2_loop import (
     N_PRM,
     N_WEIGHTS,
@@ -158,6 +179,7 @@ from uvnav.controllers.zhang2019_v2_loop import (
     outline_rings,
     plan_loop,
 )
+from uvnav.controllers.zhang2019_v2_paths import plan_paths
 from uvnav.dynamics.omni import VelocityCommand
 from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
@@ -169,7 +191,7 @@ from uvnav.geometry.contact import (
 )
 from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.prediction.tracking import CentreTracker
-from uvnav.sensors.observation import Observation, ObstacleReading
+from uvnav.sensors.observation import Observation
 
 IntArray = np.ndarray
 
@@ -200,11 +222,15 @@ class Zhang2019V2Params:
         track_position_std: the filter's centre noise [m] for readings that declare none.
         track_accel_std: the filter's white-noise acceleration of a body [m/s^2], at least.
         track_turn_std: the filter's turn-rate spread [rad/s] (``CentreTracker.turn_std``).
-        rollout_step: longest substep [s] of the paths checked on a vehicle with acceleration
-            limits (module docstring, "Acceleration limits").
-        limited_spread: on a vehicle with acceleration limits, how fast [m/s] each body's reach
-            grows with the look-ahead time of a path's check (module docstring, "Acceleration
-            limits"); the ideal vehicle's decision does not read it.
+        rollout_step: longest substep [s] of the rolled-out paths (module docstring,
+            "Acceleration limits").
+        limited_spread: how fast [m/s] each body's reach grows with the look-ahead time of a
+            rolled-out path's check (module docstring, "Acceleration limits"); the holonomic
+            robot's decision, and the unicycle's with ``rollout_paths`` off, do not read it.
+        rollout_paths: on the unicycle without acceleration limits too, check each candidate
+            along the rolled-out path of the law's own steering (module docstring, "Checked
+            along the path"); off: the compiled check of one turn, then a straight line.  A
+            unicycle with acceleration limits always rolls out.
         w_social: weight [1/s] of the social term (module docstring, "Social comfort"): a
             candidate pays ``w_social`` per metre by which its path over ``social_horizon`` [s]
             comes closer than ``social_band`` [m] beyond the radius sum to where a moving body
@@ -230,6 +256,7 @@ class Zhang2019V2Params:
     track_turn_std: float = 0.5
     rollout_step: float = 0.125
     limited_spread: float = 0.1
+    rollout_paths: bool = True
     w_social: float = 0.0
     social_horizon: float = 2.0
     social_forecast: float = 1.25
@@ -274,103 +301,6 @@ class Zhang2019V2Params:
 
 
 # -- pure functions ----------------------------------------------------------------------------
-
-
-_SCALARS = attrgetter("distance", "angular_velocity", "radius", "bounding_radius")
-
-#: the readings as arrays: scalars (N, 4) (distance [m], angular velocity [rad/s], radius [m],
-#: bounding radius [m]), centres (N, 2) [m], velocities (N, 2) [m/s]
-BodyTable = tuple[FloatArray, FloatArray, FloatArray]
-
-
-def body_table(readings: tuple[ObstacleReading, ...]) -> BodyTable:
-    """The readings as arrays (:data:`BodyTable`), read in three passes (the one cost of a
-    decision that grows with the readings outside the compiled loop)."""
-    n = len(readings)
-    scal = np.fromiter(chain.from_iterable(map(_SCALARS, readings)), float, count=4 * n)
-    centre = np.array([rd.centre for rd in readings], dtype=float).reshape(n, 2)
-    vel = np.array([rd.velocity for rd in readings], dtype=float).reshape(n, 2)
-    return scal.reshape(n, 4), centre, vel
-
-
-def boundary_discs(
-    readings: tuple[ObstacleReading, ...], spacing: float, table: BodyTable | None = None
-) -> tuple[FloatArray, FloatArray, FloatArray, IntArray, FloatArray]:
-    """Every body as discs on its boundary: centres (M, 2) [m], velocities (M, 2) [m/s], radii
-    (M,) [m], the index of the body (M,), and per body (N, 6) its first and end disc index, its
-    centre and velocity (the rows of :func:`uvnav.geometry.contact.candidate_risk_compiled`, less
-    the reach).  ``table``: :func:`body_table` of ``readings`` when already read (then
-    ``readings`` is read only for the outlines of polygons, and may be empty when there are none).
-
-    A disc body is one disc; a polygon's edges are sampled so that no two neighbouring samples are
-    farther apart than ``spacing`` (the vertices and evenly spaced points between them), each
-    sample a disc of radius ``spacing / 2`` (which covers the edges) moving with
-    ``v_i + u_i x (q - c_i)``.  One pass over all edges of all bodies.
-
-    >>> from uvnav.sensors.observation import ObstacleReading
-    >>> z = np.zeros(2)
-    >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
-    >>> rd = ObstacleReading(0, 1.0, z, np.array([0.5, 0.5]), z, 0.0, sq, 0.0, 0.71)
-    >>> boundary_discs((rd,), 0.5)[0].shape
-    (8, 2)
-    """
-    scal, centre, vel = body_table(readings) if table is None else table
-    n, omega, disc_r = len(scal), scal[:, 1], scal[:, 2]
-    if n and bool(np.all(disc_r > 0.0)):  # discs only (a crowd): each body is its own disc
-        idx = np.arange(n)
-        rows = np.column_stack([idx, idx + 1, centre, vel]).astype(float)
-        return centre, vel, disc_r, idx, rows
-    rings = [np.asarray(rd.outline, dtype=float).reshape(-1, 2) if rd.radius <= 0.0
-             else centre[k : k + 1] for k, rd in enumerate(readings)]  # fmt: skip
-    sizes = np.array([len(x) for x in rings], dtype=int)
-    start = np.concatenate(rings) if n else np.zeros((0, 2))
-    first = np.repeat(np.cumsum(sizes) - sizes, sizes)
-    nxt = np.arange(len(start)) + 1
-    nxt = np.where(nxt - first >= np.repeat(sizes, sizes), first, nxt)
-    edge = np.where(np.repeat(disc_r > 0.0, sizes)[:, None], 0.0, start[nxt] - start)
-    n_sub = np.maximum(np.ceil(np.hypot(edge[:, 0], edge[:, 1]) / spacing).astype(int), 1)
-    idx = np.repeat(np.arange(len(start)), n_sub)
-    frac = np.arange(len(idx)) - np.repeat(np.cumsum(n_sub) - n_sub, n_sub)
-    q = start[idx] + (frac / n_sub[idx])[:, None] * edge[idx]
-    owner = np.repeat(np.repeat(np.arange(n), sizes), n_sub)
-    rel = q - centre[owner]
-    w = vel[owner] + omega[owner, None] * np.column_stack([-rel[:, 1], rel[:, 0]])
-    r = np.where(disc_r[owner] > 0.0, disc_r[owner], 0.5 * spacing)
-    counts = np.bincount(owner, minlength=n)
-    ends = np.cumsum(counts)
-    bodies = np.column_stack([ends - counts, ends, centre, vel]).astype(float)
-    return q, w, r, owner, bodies
-
-
-def tangent_directions(
-    position: FloatArray, centres: FloatArray, radii: FloatArray, owner: IntArray
-) -> FloatArray:
-    """Per body, the outermost tangent direction [rad] on each side over the circles
-    (``centres``, ``radii``) of that body (v1's note 3): two angles per body (``owner``: the
-    body of each circle, non-decreasing).
-
-    A circle that holds the robot gives the directions perpendicular to its radius.
-
-    >>> t = tangent_directions(np.zeros(2), np.array([[2.0, 0.0]]), np.array([1.0]),
-    ...                        np.array([0]))
-    >>> np.round(np.degrees(t), 6).tolist()
-    [-30.0, 30.0]
-    """
-    if not len(centres):
-        return np.zeros(0)
-    d = centres - position
-    dist = np.hypot(d[:, 0], d[:, 1])
-    base = np.arctan2(d[:, 1], d[:, 0])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        half = np.where(dist > radii, np.arcsin(np.minimum(radii / dist, 1.0)), 0.5 * np.pi)
-    starts = np.flatnonzero(np.r_[True, owner[1:] != owner[:-1]])
-    group = np.repeat(np.arange(len(starts)), np.diff(np.r_[starts, len(owner)]))
-    order = np.lexsort((dist, group))  # by body, nearest first
-    ref = base[order[starts]]
-    rel = (base - ref[group] + np.pi) % (2.0 * np.pi) - np.pi
-    lo = ref + np.minimum.reduceat(rel - half, starts)
-    hi = ref + np.maximum.reduceat(rel + half, starts)
-    return np.concatenate([lo, hi])
 
 
 @dataclass(frozen=True)
@@ -441,6 +371,14 @@ def candidates(
     return ang, spd, cand
 
 
+def base_cost(
+    cand: FloatArray, v_pref: FloatArray, v_prev: FloatArray, w_change: float
+) -> FloatArray:
+    """Each candidate's cost without the risk terms, ``||v - v_pref|| + w_change ||v - v_prev||``
+    [m/s] (a lower bound of its cost)."""
+    return np.asarray(np.hypot(*(cand - v_pref).T) + w_change * np.hypot(*(cand - v_prev).T))
+
+
 def least_cost(
     cand: FloatArray,
     ttc: FloatArray,
@@ -459,7 +397,7 @@ def least_cost(
     one is preferred.  ``soc`` [m]: each one's social term (module docstring, "Social comfort"),
     paid at ``w_social`` when given."""
     p = params
-    cost = np.hypot(*(cand - v_pref).T) + p.w_change * np.hypot(*(cand - v_prev).T)
+    cost = base_cost(cand, v_pref, v_prev, p.w_change)
     cost = cost + p.w_ttc / np.maximum(ttc, 1e-3) + p.w_comfort * pen
     if soc is not None:
         cost = cost + p.w_social * soc
@@ -472,24 +410,6 @@ def least_cost(
         cost = np.where(safe, cost, np.inf)
     k = int(np.argmin(cost))
     return Choice(cand[k], float(ttc[k]), bool(k == len(cand) - 2 and np.isinf(ttc[k])))
-
-
-def reachable(table: BodyTable, v_max: float, horizon: float) -> IntArray:
-    """Indices of the bodies that can come into contact with the robot within ``horizon`` [s]:
-    distance <= (V_max + the body's speed + |u_i| R_i) H."""
-    scal, _, vel = table
-    bound = np.hypot(vel[:, 0], vel[:, 1]) + np.abs(scal[:, 1]) * scal[:, 3]
-    return np.flatnonzero(scal[:, 0] <= (v_max + bound) * horizon)
-
-
-def extra_headings(n_headings: int, v_pref: FloatArray, v_prev: FloatArray) -> FloatArray:
-    """The candidate directions [rad] besides the tangents: ``n_headings`` evenly spread ones,
-    the direction of ``v_pref`` and that of ``v_prev`` (when it is not zero)."""
-    spread = 2.0 * np.pi * np.arange(n_headings) / max(n_headings, 1)
-    extra = [math.atan2(v_pref[1], v_pref[0])]
-    if math.hypot(v_prev[0], v_prev[1]) > 1e-9:
-        extra.append(math.atan2(v_prev[1], v_prev[0]))
-    return np.concatenate([spread, np.asarray(extra)])
 
 
 def plan(
@@ -510,7 +430,8 @@ def plan(
 
     ``loop``: decide in one loop (:func:`uvnav.controllers.zhang2019_v2_loop.plan_loop`, which
     ends in :func:`uvnav.geometry.contact.decide_py`, compiled when numba is enabled) or by
-    :func:`tangent_directions` and :func:`choose_velocity` in numpy (the reference); ``None``:
+    :func:`~uvnav.controllers.zhang2019_v2_bodies.tangent_directions` and
+    :func:`choose_velocity` in numpy (the reference); ``None``:
     the loop exactly when numba is enabled.  ``constants``: :func:`loop_constants` of these
     ``params``, ``v_max`` and ``robot_radius`` when the caller keeps them (computed otherwise)."""
     p = params
@@ -531,17 +452,22 @@ def plan(
     near = () if discs_only else tuple(obs.obstacles[k] for k in keep)
     headings = extra_headings(p.n_headings, v_pref, v_prev)
     pad = robot_radius + p.safety_margin
-    # a polygon's boundary discs reach half a spacing past its bounding disc; a rotating one's
-    # move along straight lines (v_i + u_i x (q - c_i)), so over H a point at rho from the centre
-    # drifts out to rho sqrt(1 + (u_i H)^2): the cull's disc must hold that too
-    spin = np.sqrt(1.0 + (scal[:, 1] * p.horizon) ** 2)
-    body_r = np.where(scal[:, 2] > 0.0, scal[:, 3], scal[:, 3] * spin + 0.5 * p.spacing)
     q, w, r, owner, rows = boundary_discs(near, p.spacing, table)
     reach = r + pad
-    bodies = np.column_stack([rows, body_r + pad])
+    bodies = np.column_stack([rows, bounding_reach(scal, p) + pad])
     tangents = nearest_tangents(pos, (q, w, reach, owner), p)
     return choose_velocity(pos, v_pref, v_prev, np.concatenate([tangents, headings]), v_max,
                            (q, w, reach, bodies), p, heading=heading, u_max=u_max)  # fmt: skip
+
+
+def path_constants(model: RampModel, params: Zhang2019V2Params) -> FloatArray:
+    """The ``prm`` vector of :func:`uvnav.controllers.zhang2019_v2_paths.choose_on_paths_py`."""
+    p = params
+    return np.array((model.v_max, model.u_max, model.accel, model.turn_accel, model.period,
+                     p.horizon, p.rollout_step, p.comfort, p.comfort_horizon, p.safety_margin,
+                     p.limited_spread, p.min_ttc, p.w_ttc, p.w_comfort, p.w_change,
+                     p.forecast_horizon, p.max_tangent_bodies, p.n_headings),
+                    dtype=float)  # fmt: skip
 
 
 def loop_constants(
@@ -580,6 +506,18 @@ def _plan_in_loop(
     return Choice(out[:2].copy(), float(out[2]), bool(out[3]))
 
 
+def bounding_reach(scal: FloatArray, params: Zhang2019V2Params) -> FloatArray:
+    """Per body (``scal``: :func:`body_table`'s scalars) the radius [m] of a disc about its
+    centre, moving with it, that holds its boundary discs over the horizon: a polygon's boundary
+    discs reach half a spacing past its bounding disc; a rotating one's move along straight
+    lines (v_i + u_i x (q - c_i)), so over H a point at rho from the centre drifts out to
+    rho sqrt(1 + (u_i H)^2)."""
+    spin = np.sqrt(1.0 + (scal[:, 1] * params.horizon) ** 2)
+    return np.asarray(
+        np.where(scal[:, 2] > 0.0, scal[:, 3], scal[:, 3] * spin + 0.5 * params.spacing)
+    )
+
+
 def nearest_tangents(
     position: FloatArray,
     discs: tuple[FloatArray, FloatArray, FloatArray, IntArray],
@@ -602,10 +540,17 @@ def plan_limited(
     now: tuple[float, float],
     v_prev: FloatArray,
     params: Zhang2019V2Params,
+    *,
+    loop: bool | None = None,
 ) -> Choice:
-    """One decision of v2 for a unicycle with acceleration limits (module docstring,
+    """One decision of v2 on the unicycle checked along rolled-out paths (module docstring,
     "Acceleration limits"): the candidates of :func:`plan`, each checked along the path the
-    vehicle follows toward it from its speed and turn rate ``now`` ([m/s], [rad/s])."""
+    vehicle follows toward it from its speed and turn rate ``now`` ([m/s], [rad/s]).
+
+    ``loop``: choose in one loop (:func:`uvnav.controllers.zhang2019_v2_paths.plan_paths`,
+    compiled when numba is enabled; not with the social term) or by :func:`rollout`,
+    :func:`path_risk` and :func:`least_cost` in numpy (the reference); ``None``: the loop exactly
+    when numba is enabled."""
     p = params
     pos = np.asarray(obs.position, dtype=float)
     v_pref = preferred_under_limits(pos, goal, model)
@@ -613,13 +558,24 @@ def plan_limited(
     keep = reachable(table, model.v_max, p.horizon)
     table = (table[0][keep], table[1][keep], table[2][keep])
     near = () if bool(np.all(table[0][:, 2] > 0.0)) else tuple(obs.obstacles[k] for k in keep)
-    q, w, r, owner, _ = boundary_discs(near, p.spacing, table)
+    q, w, r, owner, rows = boundary_discs(near, p.spacing, table)
     reach = r + robot_radius + p.safety_margin
+    pose = np.asarray(obs.pose, dtype=float)
+    if (numba_enabled() if loop is None else loop) and p.w_social == 0.0:
+        bodies = np.column_stack(
+            [rows, bounding_reach(table[0], p) + robot_radius + p.safety_margin]
+        )
+        moving = 1.0 if math.hypot(v_prev[0], v_prev[1]) > 1e-9 else 0.0  # as extra_headings
+        f_norm = math.hypot(v_pref[0], v_pref[1])
+        state = np.array((*pose, *now, *v_pref, f_norm, *v_prev, moving), dtype=float)
+        speeds = model.v_max * np.asarray(p.speed_levels, dtype=float)
+        out = plan_paths(state, (q, w, reach, owner), bodies, speeds, path_constants(model, p))
+        return Choice(out[:2].copy(), float(out[2]), bool(out[3]))
     tangents = nearest_tangents(pos, (q, w, reach, owner), p)
     headings = np.concatenate([tangents, extra_headings(p.n_headings, v_pref, v_prev)])
     ang, spd, cand = candidates(headings, model.v_max, p.speed_levels, v_pref)
-    times, xy, speeds = rollout(np.asarray(obs.pose, dtype=float), now[0], now[1], ang, spd,
-                                model, p.horizon, p.rollout_step)  # fmt: skip
+    times, xy, speeds = rollout(pose, now[0], now[1], ang, spd, model, p.horizon,
+                                p.rollout_step)  # fmt: skip
     ttc, pen = path_risk(times, xy, (q, w, reach), p.horizon, p.comfort, p.comfort_horizon,
                          p.safety_margin, p.limited_spread)  # fmt: skip
     brakes = stoppable(times, xy, speeds, ttc, model)
@@ -729,7 +685,7 @@ class Zhang2019V2(UnicycleController):
         if not (finite_position(obs.pose) and math.isfinite(obs.pose[2])):
             return UnicycleCommand(0.0, 0.0)
         obs = tracked(obs, self._tracker)
-        if not spec.ideal:
+        if self.params.rollout_paths or not spec.ideal:
             return self._act_limited(obs, period)
         choice = plan(obs, self._goal, spec.v_max, spec.radius, period, self._aim, self.params,
                       heading=obs.heading, u_max=spec.u_max,

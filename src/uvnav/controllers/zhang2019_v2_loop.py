@@ -1,16 +1,17 @@
 """The whole ``zhang2019-v2`` decision on the ideal vehicle after reading the observation, in one
 call (compiled by numba when it is enabled, plain Python otherwise).
 
-:func:`plan_loop_py` computes on floats, with the same operations in the same order, what the
-numpy building blocks of :mod:`uvnav.controllers.zhang2019_v2` compute: the bodies that can reach
-the robot within the horizon (:func:`~uvnav.controllers.zhang2019_v2.reachable`), their boundary
-discs (:func:`~uvnav.controllers.zhang2019_v2.boundary_discs`), their bounding radii for the cull
-and the extra headings (:func:`~uvnav.controllers.zhang2019_v2.extra_headings`); then it runs the
-branch-and-bound choice :func:`uvnav.geometry.contact.decide_py`.  The caller computes the
-preferred velocity and whether the previous choice is moving, in Python, as the building blocks
-do (CPython's ``math.hypot`` need not round as the C library's, which numba calls, does).  The
-result equals the building blocks' to the bit (tests); among a few polygons one call replaces
-some forty small numpy operations, whose fixed costs were most of a decision.
+:func:`plan_loop_py` computes on floats, with the same operations in the same order, what the numpy
+building blocks of :mod:`uvnav.controllers.zhang2019_v2` and
+:mod:`uvnav.controllers.zhang2019_v2_bodies` compute: the bodies that can reach the robot within the
+horizon (:func:`~uvnav.controllers.zhang2019_v2_bodies.reachable`), their boundary discs
+(:func:`~uvnav.controllers.zhang2019_v2_bodies.boundary_discs`), their bounding radii for the cull
+and the extra headings (:func:`~uvnav.controllers.zhang2019_v2_bodies.extra_headings`); then it runs
+the branch-and-bound choice :func:`uvnav.geometry.contact.decide_py`.  The caller computes the
+preferred velocity and whether the previous choice is moving, in Python, as the building blocks do
+(CPython's ``math.hypot`` need not round as the C library's, which numba calls, does).  The result
+equals the building blocks' to the bit (tests); among a few polygons one call replaces some forty
+small numpy operations, whose fixed costs were most of a decision.
 Units: metres, seconds, radians.
 """
 
@@ -51,8 +52,9 @@ def boundary_discs_py(
     """The boundary discs of the bodies ``keep``: centres (M, 2), velocities (M, 2), radii (M,)
     and owners (M,) (the index into ``keep``), as
     :func:`uvnav.controllers.zhang2019_v2.plan` makes them: where every kept body is a disc, the
-    bodies themselves; otherwise :func:`uvnav.controllers.zhang2019_v2.boundary_discs` (a disc
-    is its centre, a polygon, radius <= 0, its outline ``rings[ring_start[k]:ring_start[k + 1]]``
+    bodies themselves; otherwise
+    :func:`uvnav.controllers.zhang2019_v2_bodies.boundary_discs` (a disc is its centre, a
+    polygon, radius <= 0, its outline ``rings[ring_start[k]:ring_start[k + 1]]``
     sampled at most ``spacing`` apart)."""
     n_keep = keep.shape[0]
     discs_only = True

@@ -1,0 +1,408 @@
+"""The unicycle's choice of ``zhang2019-v2`` among candidates checked along their rolled-out paths,
+in one loop (compiled by numba when it is enabled, plain Python otherwise).
+
+:func:`plan_paths_py` computes per candidate, on floats and in the same order of operations, what
+the numpy building blocks of :mod:`uvnav.controllers.zhang2019_v2` and
+:mod:`uvnav.controllers.zhang2019_limits` compute for all of them at once: the candidates
+(:func:`~uvnav.controllers.zhang2019_v2.candidates`), the path of the law's own steering toward
+each (:func:`advance`, as :func:`~uvnav.controllers.zhang2019_limits.rollout`), its first contact
+and comfort penalty (:func:`risk_along`, as :func:`~uvnav.controllers.zhang2019_limits.path_risk`),
+whether the robot can still stop before that contact (as
+:func:`~uvnav.controllers.zhang2019_limits.stoppable`), and the least-cost choice (as
+:func:`~uvnav.controllers.zhang2019_v2.least_cost` with ``admissible``).  What it does not compute
+is what cannot change the choice:
+
+* it visits the candidates by their cost without the risk terms (a lower bound: the risk terms
+  are >= 0) and stops once a safe candidate costs no more than the next bound; a first visit
+  leaves a candidate as soon as it cannot be safe or cannot win, and only where no candidate is
+  safe are they all checked to the end (resuming where the first visit left off);
+* a path is rolled out only as far as it is checked, and its check stops at the segment of its
+  first contact (later segments start later) once past the comfort horizon;
+* per chunk of :data:`CHUNK` segments, the bodies are visited nearest first and the visit ends at
+  the first that cannot reach the chunk's path; a body, then a disc, whose box over the chunk
+  stays out of reach of the path's box is skipped.
+
+So it picks the reference's candidate, to rounding (its sines and cosines are the C library's,
+the reference's numpy's; tests: hypothesis on random scenes).  Units: metres, seconds, radians.
+"""
+
+from __future__ import annotations
+
+import math
+import types
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from uvnav.geometry import contact
+from uvnav.geometry.angles import FloatArray
+from uvnav.geometry.contact import _contact_scalar, _gap_scalar, tangents_py
+from uvnav.geometry.kernels3d import numba_enabled
+
+#: indices into the ``prm`` vector of :func:`choose_on_paths_py` and :func:`plan_paths_py`
+(M_VMAX, M_UMAX, M_ACCEL, M_TURN, M_PERIOD, M_HORIZON, M_STEP, M_COMFORT, M_CHOR, M_MARGIN,
+ M_SPREAD, M_MIN_TTC, M_W_TTC, M_W_COMFORT, M_W_CHANGE, M_T_F, M_N_TAN,
+ M_N_HEAD) = range(18)  # fmt: skip
+
+
+def _approach(value: float, target: float, most: float) -> float:
+    """``value`` moved toward ``target`` by at most ``most`` (as the vehicle does)."""
+    if math.isinf(most):
+        return target
+    return value + min(max(target - value, -most), most)
+
+
+def _window(now: float, rate: float, period: float, low: float, high: float) -> tuple[float, float]:
+    """The values reachable from ``now`` within one period, clipped to [``low``, ``high``]."""
+    step = rate * period
+    return min(max(now - step, low), high), min(max(now + step, low), high)
+
+
+def _turn(beta: float, u_now: float, prm: FloatArray) -> float:
+    """:func:`uvnav.controllers.zhang2019_limits.turn_command` for one heading error."""
+    period, u_max, a = prm[M_PERIOD], prm[M_UMAX], prm[M_TURN]
+    b = abs(beta)
+    mag = min(b / period, u_max)
+    if math.isfinite(a):
+        half = 0.5 * a * period
+        mag = min(mag, math.sqrt(half * half + 2.0 * a * b) - half)
+    lo, hi = _window(u_now, a, period, -u_max, u_max)
+    sign = 1.0 if beta > 0.0 else (-1.0 if beta < 0.0 else 0.0)
+    return min(max(sign * mag, lo), hi)
+
+
+def advance(
+    st: FloatArray, aim: float, speed: float, prm: FloatArray, n_sub: int, xy: FloatArray,
+    speeds: FloatArray, upto: int,
+) -> None:  # fmt: skip
+    """Extend the path of :func:`uvnav.controllers.zhang2019_limits.rollout` toward one ``aim``
+    [rad] at ``speed`` [m/s] (``xy`` (S + 1, 2), ``speeds`` (S + 1,), ``n_sub`` substeps per
+    period) to its point ``upto``; ``st``: heading, speed, turn rate, speed and turn rate
+    commanded, and the last point computed, updated (from ``xy[0]``, ``speeds[0]``: the pose, its
+    speed and turn rate, held, and 0)."""
+    h = prm[M_PERIOD] / n_sub
+    i0 = int(st[5])
+    x, y, th, v, u, v_cmd, u_cmd = xy[i0, 0], xy[i0, 1], st[0], st[1], st[2], st[3], st[4]
+    for i in range(i0, min(upto, xy.shape[0] - 1)):
+        if i % n_sub == 0:
+            beta = (aim - th + math.pi) % (2.0 * math.pi) - math.pi
+            lo, hi = _window(v, prm[M_ACCEL], prm[M_PERIOD], 0.0, prm[M_VMAX])
+            v_cmd = min(max(speed * max(math.cos(beta), 0.0), lo), hi)
+            u_cmd = _turn(beta, u, prm)
+        v1 = _approach(v, v_cmd, prm[M_ACCEL] * h)
+        u1 = _approach(u, u_cmd, prm[M_TURN] * h)
+        vm, half = 0.5 * (v + v1), 0.25 * (u + u1) * h
+        arg = math.pi * (half / math.pi if half != 0.0 else 1.0e-20)  # numpy's sinc
+        chord = vm * h * (math.sin(arg) / arg)
+        x = x + chord * math.cos(th + half)
+        y = y + chord * math.sin(th + half)
+        th = th + 2.0 * half
+        v, u = v1, u1
+        xy[i + 1, 0], xy[i + 1, 1], speeds[i + 1] = x, y, v
+        st[0], st[1], st[2], st[3], st[4], st[5] = th, v, u, v_cmd, u_cmd, i + 1
+
+
+#: segments per chunk of :func:`risk_along`'s cull
+CHUNK = 4
+
+
+def _box_gap(box: FloatArray, ax: float, ay: float, bx: float, by: float) -> float:
+    """Distance [m] between the box ``(x lo, x hi, y lo, y hi)`` and the bounding box of the
+    segment ``(ax, ay)``-``(bx, by)`` (0 when they overlap)."""
+    dx = max(min(ax, bx) - box[1], box[0] - max(ax, bx), 0.0)
+    dy = max(min(ay, by) - box[3], box[2] - max(ay, by), 0.0)
+    return math.hypot(dx, dy)
+
+
+def _path_box(xy: FloatArray, i0: int, i1: int, box: FloatArray) -> None:
+    """The bounding box of the path points ``xy[i0:i1 + 1]`` into ``box`` (x lo, x hi, y lo,
+    y hi)."""
+    box[0], box[1], box[2], box[3] = xy[i0, 0], xy[i0, 0], xy[i0, 1], xy[i0, 1]
+    for i in range(i0 + 1, i1 + 1):
+        box[0], box[1] = min(box[0], xy[i, 0]), max(box[1], xy[i, 0])
+        box[2], box[3] = min(box[2], xy[i, 1]), max(box[3], xy[i, 1])
+
+
+def _disc_along(
+    xy: FloatArray, times: FloatArray, i0: int, i1: int, qw: tuple[float, float, float, float],
+    reach: float, prm: FloatArray, risk: FloatArray,
+) -> None:  # fmt: skip
+    """Fold one disc (centre and velocity ``qw``, radius sum ``reach``) on the segments
+    ``i0 .. i1 - 1`` of the path ``xy`` into ``risk`` (first contact, comfort penalty)."""
+    horizon, comfort, c_h, margin = prm[M_HORIZON], prm[M_COMFORT], prm[M_CHOR], prm[M_MARGIN]
+    qx, qy, wx, wy = qw
+    for i in range(i0, i1):
+        t0 = times[i]
+        near = t0 < c_h
+        if not (near or risk[0] > t0):
+            continue
+        h = times[i + 1] - t0
+        vx, vy = (xy[i + 1, 0] - xy[i, 0]) / h, (xy[i + 1, 1] - xy[i, 1]) / h
+        rx, ry = qx + wx * t0 - xy[i, 0], qy + wy * t0 - xy[i, 1]
+        px, py = vx - wx, vy - wy
+        if risk[0] > t0:
+            seg_h = max(min(h, horizon - t0), 0.0)
+            grown = reach + prm[M_SPREAD] * (t0 + h)
+            t = t0 + _contact_scalar(rx, ry, px, py, grown, seg_h, margin)
+            if t < risk[0]:
+                risk[0] = t
+        if near:
+            g = comfort - _gap_scalar(rx, ry, px, py, reach, min(h, c_h - t0))
+            if g > risk[1]:
+                risk[1] = g
+
+
+def _far(box: FloatArray, qw: tuple[float, float, float, float], t_a: float, t_b: float,
+         lim: float) -> bool:  # fmt: skip
+    """A point moving with ``qw`` (position at 0, velocity) stays, over [``t_a``, ``t_b``],
+    farther than ``lim`` from the ``box``, box to box."""
+    qx, qy, wx, wy = qw
+    return _box_gap(box, qx + wx * t_a, qy + wy * t_a, qx + wx * t_b, qy + wy * t_b) > lim
+
+
+def risk_along(
+    path: tuple[FloatArray, FloatArray, FloatArray], aim: float, speed: float, n_sub: int,
+    times: FloatArray, discs: tuple[FloatArray, FloatArray, FloatArray], bodies: FloatArray,
+    cull: tuple[np.ndarray, FloatArray, float], prm: FloatArray, give_up: float, base: float,
+    safe_only: bool, risk: FloatArray,
+) -> None:  # fmt: skip
+    """The first contact and comfort penalty of one candidate's path
+    (:func:`uvnav.controllers.zhang2019_limits.path_risk` of one row), rolled out as far as it
+    is read (``path``: :func:`advance`'s ``xy``, ``speeds`` and ``st``), into ``risk`` (ttc, pen,
+    and the first segment not yet checked: a later call resumes there); stops early, with the
+    figures so far, once the cost exceeds ``give_up`` (``base`` plus the risk terms so far: the
+    path cannot win) or, when ``safe_only``, once a contact comes at or before ``min_ttc`` (the
+    path is not safe).
+
+    The path is checked :data:`CHUNK` segments at a time; a body (``bodies``: first and end
+    disc, centre, velocity, bounding reach), then a disc, whose positions over a chunk stay, box
+    to box, farther from the robot's than its grown reach (and the comfort distance within the
+    comfort horizon) is not checked on that chunk's segments: none would count.  ``cull``: the
+    bodies by their gap at the start (distance from the robot's start to the centre less the
+    bounding reach), that gap, and the largest body speed; the bodies are visited in that
+    order, and the visit stops at the first that cannot close in on the chunk's path."""
+    xy, speeds, st = path
+    q, w, reach = discs
+    order, gap, fastest = cull
+    c_h, spread, w_ttc, w_comfort = prm[M_CHOR], prm[M_SPREAD], prm[M_W_TTC], prm[M_W_COMFORT]
+    n_seg = times.shape[0] - 1
+    box = np.empty(4)
+    while risk[2] < n_seg:
+        i0 = int(risk[2])
+        i1 = min(i0 + CHUNK, n_seg)
+        if times[i0] >= c_h and risk[0] <= times[i0]:
+            risk[2] = n_seg  # no earlier contact on later segments, no comfort term beyond c_h
+            break
+        advance(st, aim, speed, prm, n_sub, xy, speeds, i1)
+        t_a, t_b = times[i0], times[i1]
+        lim_far = spread * t_b + (prm[M_COMFORT] if t_a < c_h else 0.0) + 1e-9
+        _path_box(xy, i0, i1, box)
+        out_to = 0.0  # how far from the start the path gets within the chunk: to a box corner
+        for corner in range(4):
+            cx, cy = box[corner // 2] - xy[0, 0], box[2 + corner % 2] - xy[0, 1]
+            out_to = max(out_to, math.hypot(cx, cy))
+        for b in order:
+            if gap[b] > fastest * t_b + out_to + lim_far:
+                break  # this body and the farther ones stay out of reach over the chunk
+            body = (bodies[b, 2], bodies[b, 3], bodies[b, 4], bodies[b, 5])
+            if _far(box, body, t_a, t_b, bodies[b, 6] + lim_far):
+                continue
+            first, end = int(bodies[b, 0]), int(bodies[b, 1])
+            for j in range(first, end):
+                qw = (q[j, 0], q[j, 1], w[j, 0], w[j, 1])
+                if end - first > 1 and _far(box, qw, t_a, t_b, reach[j] + lim_far):
+                    continue
+                _disc_along(xy, times, i0, i1, qw, reach[j], prm, risk)
+        risk[2] = i1
+        if risk[0] <= prm[M_MIN_TTC] and safe_only:
+            break
+        if base + w_ttc / max(risk[0], 1e-3) + w_comfort * risk[1] > give_up:
+            break
+
+
+def _stops(xy: FloatArray, times: FloatArray, speeds: FloatArray, ttc: float, n_sub: int,
+           prm: FloatArray) -> bool:  # fmt: skip
+    """:func:`uvnav.controllers.zhang2019_limits.stoppable` of one path."""
+    if not math.isfinite(ttc):
+        return True
+    length, to_contact = 0.0, math.nan
+    for i in range(times.shape[0] - 1):
+        after = length + math.hypot(xy[i + 1, 0] - xy[i, 0], xy[i + 1, 1] - xy[i, 1])
+        if ttc < times[i + 1]:  # numpy's interp on this interval
+            slope = (after - length) / (times[i + 1] - times[i])
+            to_contact = slope * (ttc - times[i]) + length
+            break
+        length = after
+    if math.isnan(to_contact):
+        to_contact = length
+    v_t = speeds[min(n_sub, speeds.shape[0] - 1)]
+    period = prm[M_PERIOD]
+    return to_contact >= v_t * period + v_t * v_t / (2.0 * prm[M_ACCEL])
+
+
+def _keep(best: FloatArray, slot: int, cost: float, k: int, ttc: float) -> None:
+    """Record candidate ``k`` in ``best``'s ``slot`` (cost, index, ttc) when it costs less, or as
+    much with a lower index."""
+    if cost < best[slot] or (cost == best[slot] and k < best[slot + 1]):
+        best[slot], best[slot + 1], best[slot + 2] = cost, k, ttc
+
+
+def choose_on_paths_py(
+    pose: FloatArray, now: FloatArray, cand: tuple[FloatArray, FloatArray, FloatArray],
+    order: np.ndarray, discs: tuple[FloatArray, FloatArray, FloatArray], bodies: FloatArray,
+    prm: FloatArray, out: FloatArray,
+) -> None:  # fmt: skip
+    """The least-cost candidate (``cand``: directions, speeds, costs without the risk terms;
+    visited in ``order``: that cost ascending, ties by index) of a unicycle at ``pose`` with
+    speed and turn rate ``now``, each checked along its rolled-out path against the ``discs``
+    (centres, velocities, radius sums) of the ``bodies`` (:func:`risk_along`): its index and
+    first contact [s] written into ``out`` (module docstring).  ``prm``: V_max, U_max, the speed
+    and turn-rate limits, the period, the horizon, the longest substep, comfort, the comfort
+    horizon, the margin, the spread, min_ttc, w_ttc and w_comfort."""
+    ang, spd, base = cand
+    period = prm[M_PERIOD]
+    n_sub = max(1, math.ceil(period / prm[M_STEP] - 1e-9))
+    h = period / n_sub
+    n = max(1, math.ceil(prm[M_HORIZON] / h - 1e-9))
+    times = h * np.arange(n + 1).astype(np.float64)
+    n_c = ang.shape[0]
+    xy, speeds, st = np.empty((n_c, n + 1, 2)), np.empty((n_c, n + 1)), np.empty((n_c, 6))
+    risk = np.zeros((n_c, 3))  # per path: first contact, comfort penalty, next segment
+    risk[:, 0] = math.inf
+    for k in range(n_c):  # every path starts at the pose, at the speed and turn rate it has
+        xy[k, 0, 0], xy[k, 0, 1], speeds[k, 0] = pose[0], pose[1], now[0]
+        st[k, 0], st[k, 1], st[k, 2], st[k, 3], st[k, 4], st[k, 5] = (
+            pose[2], now[0], now[1], now[0], now[1], 0.0)  # fmt: skip
+    min_ttc, w_ttc, w_comfort = prm[M_MIN_TTC], prm[M_W_TTC], prm[M_W_COMFORT]
+    gap = np.empty(bodies.shape[0])
+    fastest = 0.0
+    for b in range(bodies.shape[0]):
+        gap[b] = math.hypot(bodies[b, 2] - pose[0], bodies[b, 3] - pose[1]) - bodies[b, 6]
+        fastest = max(fastest, math.hypot(bodies[b, 4], bodies[b, 5]))
+    cull = (np.argsort(gap), gap, fastest)
+    # best safe, best admissible, best of all: cost, index, ttc
+    best = np.array([math.inf, -1.0, math.inf, math.inf, -1.0, math.inf, math.inf, -1.0, math.inf])
+    for safe_only in (True, False):  # the safe one if any; all of them only when none is
+        for k in order:
+            if best[1] >= 0.0 and base[k] > best[0]:
+                break
+            give_up = best[0] if best[1] >= 0.0 else math.inf
+            path = (xy[k], speeds[k], st[k])
+            risk_along(path, ang[k], spd[k], n_sub, times, discs, bodies, cull, prm, give_up,
+                       base[k], safe_only, risk[k])  # fmt: skip
+            ttc, pen = risk[k, 0], risk[k, 1]
+            cost = base[k] + w_ttc / max(ttc, 1e-3) + w_comfort * pen
+            if (safe_only and ttc <= min_ttc) or cost > give_up:
+                continue
+            if math.isfinite(ttc):  # the path to the contact and the speed after one period
+                advance(st[k], ang[k], spd[k], prm, n_sub, xy[k], speeds[k],
+                        max(n_sub, min(int(ttc / h) + 2, n)))  # fmt: skip
+            brakes = _stops(xy[k], times, speeds[k], ttc, n_sub, prm)
+            if brakes and ttc > min_ttc:
+                _keep(best, 0, cost, k, ttc)
+            if not safe_only and brakes:
+                _keep(best, 3, cost, k, ttc)
+            if not safe_only:
+                _keep(best, 6, cost, k, ttc)
+        if best[1] >= 0.0:
+            break
+    slot = 0 if best[1] >= 0.0 else (3 if best[4] >= 0.0 else 6)
+    out[0], out[1] = best[slot + 1], best[slot + 2]
+
+
+def plan_paths_py(
+    state: FloatArray, q: FloatArray, w: FloatArray, reach: FloatArray, owner: np.ndarray,
+    bodies: FloatArray, speeds: FloatArray, prm: FloatArray, out: FloatArray,
+) -> None:  # fmt: skip
+    """One decision of the unicycle on rolled-out paths after reading the observation: the
+    candidates of :func:`uvnav.controllers.zhang2019_v2.candidates` (the tangents of the forecast
+    circles of the nearest bodies, :func:`uvnav.geometry.contact.tangents_py`, the extra
+    headings, each at every speed of ``speeds``, the preferred velocity, standing still), their
+    costs without the risk terms, and :func:`choose_on_paths_py`; written into ``out``: velocity
+    x, y [m/s], its first contact [s], 1.0 when it is the preferred one.
+
+    ``state``: robot x, y, heading [rad], speed [m/s], turn rate [rad/s], the preferred velocity
+    x, y and its norm, the previous choice x, y, 1.0 when the previous choice is moving (its
+    direction is a candidate); ``q``, ``w``, ``reach``, ``owner``: the boundary discs (owner
+    non-decreasing, nearest body first); ``bodies`` (N, 7): per body its first and end disc,
+    centre, velocity and bounding reach (every disc's positions over the horizon within it);
+    ``prm``: :func:`choose_on_paths_py`'s, then w_change,
+    the forecast time T_f, the number of nearest bodies whose tangents are candidates and
+    n_headings."""
+    px, py = state[0], state[1]
+    fx, fy, f_norm, ox, oy = state[5], state[6], state[7], state[8], state[9]
+    n_tan, n_head, w_change = prm[M_N_TAN], int(prm[M_N_HEAD]), prm[M_W_CHANGE]
+    n_few = 0
+    grow = np.empty(q.shape[0])
+    for j in range(q.shape[0]):
+        grow[j] = reach[j] + math.hypot(w[j, 0], w[j, 1]) * prm[M_T_F]
+        if owner[j] < n_tan:
+            n_few = j + 1
+    tang = np.empty(2 * n_few + 1)
+    n_t = tangents_py(px, py, q, grow, owner, n_few, tang)
+    n_x = n_head + (2 if state[10] > 0.0 else 1)
+    n_s = speeds.shape[0]
+    n_c = (n_t + n_x) * n_s + 2
+    ang, spd = np.empty(n_c), np.empty(n_c)
+    for i in range(n_t + n_x):
+        if i < n_t:
+            a = tang[i]
+        elif i - n_t < n_head:
+            a = 2.0 * math.pi * float(i - n_t) / max(n_head, 1)
+        else:
+            a = math.atan2(fy, fx) if i - n_t == n_head else math.atan2(oy, ox)
+        for k in range(n_s):
+            ang[i * n_s + k], spd[i * n_s + k] = a, speeds[k]
+    ang[n_c - 2] = ang[n_c - 1] = math.atan2(fy, fx)
+    spd[n_c - 2], spd[n_c - 1] = f_norm, 0.0
+    cand, base = np.empty((n_c, 2)), np.empty(n_c)
+    for k in range(n_c):
+        cx, cy = spd[k] * math.cos(ang[k]), spd[k] * math.sin(ang[k])
+        cand[k, 0], cand[k, 1] = cx, cy
+        base[k] = math.hypot(cx - fx, cy - fy) + w_change * math.hypot(cx - ox, cy - oy)
+    order = np.argsort(base, kind="mergesort")
+    pick = np.empty(2)
+    choose_on_paths_py(state[:3], state[3:5], (ang, spd, base), order, (q, w, reach), bodies,
+                       prm, pick)  # fmt: skip
+    k = int(pick[0])
+    out[0], out[1], out[2] = cand[k, 0], cand[k, 1], pick[1]
+    out[3] = 1.0 if k == n_c - 2 and math.isinf(pick[1]) else 0.0
+
+
+_COMPILED: dict[str, Callable[..., Any]] = {}
+
+
+def _compiled_plan() -> Callable[..., Any]:
+    """:func:`plan_paths_py` compiled by numba (on the first call, or loaded from numba's
+    cache), calling the compiled copies of its helpers and of :mod:`uvnav.geometry.contact`'s."""
+    if not _COMPILED:
+        import numba
+
+        done = dict(contact._kernels())
+        kernels = (_approach, _window, _turn, advance, _box_gap, _path_box, _disc_along, _far,
+                   risk_along, _stops, _keep, choose_on_paths_py, plan_paths_py)  # fmt: skip
+        for f in kernels:
+            env = {**f.__globals__, **done}
+            copy = types.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
+            done[f.__name__] = _COMPILED[f.__name__] = numba.njit(cache=True, nogil=True)(copy)
+    return _COMPILED["plan_paths_py"]
+
+
+def plan_paths(
+    state: FloatArray,
+    discs: tuple[FloatArray, FloatArray, FloatArray, np.ndarray],
+    bodies: FloatArray,
+    speeds: FloatArray,
+    prm: FloatArray,
+) -> FloatArray:
+    """:func:`plan_paths_py` (compiled when numba is enabled): ``(vx, vy, ttc, preferred)``."""
+    q, w, reach, owner = discs
+    c = np.ascontiguousarray
+    out = np.empty(4)
+    fn = _compiled_plan() if numba_enabled() else plan_paths_py
+    fn(c(state, dtype=float), c(q, dtype=float).reshape(-1, 2), c(w, dtype=float).reshape(-1, 2),
+       c(reach, dtype=float), c(owner, dtype=np.int64), c(bodies, dtype=float).reshape(-1, 7),
+       c(speeds, dtype=float),
+       c(prm, dtype=float), out)  # fmt: skip
+    return out
