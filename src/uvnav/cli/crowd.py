@@ -13,7 +13,7 @@
   ``--resume`` continues it, and the checkpoint is removed once the weights are written.
 
 Evaluation is the law's, as any law's: ``uvnav simulate crowdnav-circle:0 --controller
-crowd-ppo-v1``, ``uvnav bench``, ``benchmarks/bench_crowdnav.py --law crowd-ppo-v1``.
+crowd-ppo-v2``, ``uvnav bench``, ``benchmarks/bench_crowdnav.py --law crowd-ppo-v2``.
 
 Bad options print ONE line ``error: ...`` naming the option and exit with status 2.
 """
