@@ -120,7 +120,8 @@ def test_an_action_is_a_velocity_in_the_goal_frame_within_v_max() -> None:
     assert action_velocity(np.array([np.nan, 0.0]), obs, 2.0) == (0.0, 0.0)
 
 
-def test_the_law_is_deterministic_and_drives_a_crowdnav_episode() -> None:
+@pytest.mark.parametrize("name", ["crowd-ppo-v1", "crowd-ppo-v2"])
+def test_the_law_is_deterministic_and_drives_a_crowdnav_episode(name: str) -> None:
     from uvnav.scenarios.build import build_episode
     from uvnav.scenarios.crowdnav import crowdnav_scenario
     from uvnav.sim.run import run_episode
@@ -128,7 +129,7 @@ def test_the_law_is_deterministic_and_drives_a_crowdnav_episode() -> None:
 
     def episode() -> tuple[str, float, int]:
         setup = build_episode(crowdnav_scenario(3), 3)
-        res = run_episode(setup, make_law("crowd-ppo-v1"), run_rng(3), vehicle="holonomic")
+        res = run_episode(setup, make_law(name), run_rng(3), vehicle="holonomic")
         return res.status, float(res.metrics.path_length), int(res.metrics.limit_violations)
 
     first = episode()
@@ -146,6 +147,19 @@ def test_the_same_observation_gives_the_same_command_to_any_copy_of_the_law() ->
         law.reset(OmniSpec(1.0, 0.3), np.array([0.0, 4.0]), np.random.default_rng(0))
         cmds.append(law.act(obs))
     assert cmds[0] == cmds[1] and cmds[0].speed <= 1.0 + 1e-12
+
+
+def test_v2_has_its_own_weights_and_supersedes_v1_in_the_campaigns() -> None:
+    """v2 loads its shipped file (another policy than v1's, same shape); v1 stays registered,
+    marked as superseded by v2."""
+    from uvnav.controllers.base import controller_info
+
+    v1, v2 = make_law("crowd-ppo-v1"), make_law("crowd-ppo-v2")
+    assert v2.name == "crowd-ppo-v2" and v2.policy.config == v1.policy.config
+    assert v1.policy.weights.keys() == v2.policy.weights.keys()
+    assert any(not np.array_equal(v1.policy.weights[n], w) for n, w in v2.policy.weights.items())
+    assert controller_info("crowd-ppo-v1").superseded_by == "crowd-ppo-v2"
+    assert controller_info("crowd-ppo-v2").superseded_by == ""
 
 
 @pytest.mark.parametrize(

@@ -133,3 +133,130 @@ def test_the_cli_refuses_to_overwrite_an_interrupted_run(tmp_path: Path) -> None
     result = runner.invoke(app, ["crowd", "train", "--out", str(out), "--steps", "64"])
     assert result.exit_code == 2
     assert "--resume continues it" in result.output and len(result.output.strip().splitlines()) == 1
+
+
+def test_a_mixed_env_draws_every_rule_from_training_seeds_only() -> None:
+    """Each rule of the mix comes up; CrowdNav scenes are of the train phase with the drawn
+    number of humans (20 on the circle included: unplaceable cases are drawn again), and the
+    harder crowd's seeds lie above every seed the benchmarks judge."""
+    from uvnav.envs.crowd import DYNAMIC_TRAIN_SEED, RULES
+
+    env = CrowdNavEnv(rules=RULES, n_humans=(20, 20), cases=50)
+    seen: dict[str, set[int]] = {}
+    for seed in range(40):
+        _, info = env.reset(seed=seed)
+        seen.setdefault(info["rule"], set()).add(info["case"])
+        world = env._world
+        assert world is not None
+        humans = sum(1 for r in world.view(0).observation.obstacles if r.is_disc)
+        if info["rule"] != "crowd_dynamic":
+            assert humans == 20  # CrowdNav scenes see every human (20 m)
+    assert set(seen) == set(RULES)
+    assert DYNAMIC_TRAIN_SEED >= 1_000_000 and all(c < 50 for c in set().union(*seen.values()))
+
+
+def test_a_mixed_env_builds_crowdnav_scenes_of_the_train_phase(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    import uvnav.envs.crowd as crowd_env
+
+    calls: list[tuple[int, dict[str, object]]] = []
+    real = crowd_env.crowdnav_scenario
+
+    def spy(case: int, **kw: object) -> object:
+        calls.append((case, kw))
+        return real(case, **kw)  # type: ignore[arg-type]
+
+    seeds: list[int] = []
+    real_dyn = crowd_env.crowd_dynamic_scenario
+    monkeypatch.setattr(crowd_env, "crowdnav_scenario", spy)
+
+    def spy_dynamic(seed: int) -> object:
+        seeds.append(seed)
+        return real_dyn(seed)
+
+    monkeypatch.setattr(crowd_env, "crowd_dynamic_scenario", spy_dynamic)
+    env = CrowdNavEnv(rules=("square_crossing", "crowd_dynamic"), n_humans=(5, 8))
+    for seed in range(12):
+        env.reset(seed=seed)
+    assert calls and all(kw["phase"] == "train" for _, kw in calls)
+    assert {kw["rule"] for _, kw in calls} == {"square_crossing"}
+    assert all(5 <= int(kw["n_humans"]) <= 8 for _, kw in calls)  # type: ignore[call-overload]
+    assert seeds and min(seeds) >= crowd_env.DYNAMIC_TRAIN_SEED
+
+
+def test_an_unknown_rule_is_refused() -> None:
+    with pytest.raises(ValueError, match="rules must be some of"):
+        CrowdNavEnv(rules=("corridor",))
+
+
+def test_the_curriculum_rises_to_the_range_low_then_draws_the_range() -> None:
+    from uvnav.learning.crowd_policy import curriculum_humans
+
+    cfg = TrainConfig(steps=1000, humans_start=2, humans=(5, 20), curriculum=0.5)
+    assert curriculum_humans(cfg, 0) == (2, 2)
+    assert curriculum_humans(cfg, 125) == (3, 3)
+    assert curriculum_humans(cfg, 374) == (4, 4)
+    assert curriculum_humans(cfg, 375) == (5, 20) == curriculum_humans(cfg, 1000)
+    assert curriculum_humans(TrainConfig(), 0) == (5, 5)  # crowd-ppo-v1's: no curriculum
+
+
+def test_fine_tuning_starts_from_the_given_policys_actor() -> None:
+    """A run with ``init`` (a shipped law's name) starts with that law's actor: before any update
+    its mean action is the law's numpy actor's; its action noise starts at exp(log_std_init)."""
+    import dataclasses
+
+    from stable_baselines3.common.env_util import make_vec_env
+
+    import uvnav.learning.crowd_policy as cpol
+    from uvnav.controllers.crowd_ppo import shipped_policy
+
+    cfg = dataclasses.replace(TINY, init="crowd-ppo-v1", log_std_init=-1.0)
+    env = make_vec_env(CrowdNavEnv, n_envs=1, seed=5)
+    model = cpol._new(cpol._sb3(), cfg, env)
+    cpol.load_actor(model, cfg.init)
+    policy = shipped_policy("crowd-ppo-v1")
+    x = np.asarray(env.reset())
+    got = np.clip(policy.mean_action(*split_vector(x[0].astype(float), 5)), -1, 1)
+    np.testing.assert_allclose(model.predict(x, deterministic=True)[0][0], got, atol=1e-5)
+    np.testing.assert_allclose(model.policy.log_std.detach().numpy(), [-1.0, -1.0])
+    fresh = cpol._new(cpol._sb3(), TINY, env)
+    assert not np.allclose(fresh.predict(x, deterministic=True)[0][0], got, atol=1e-3)
+
+
+def test_the_record_holds_the_command_that_reproduces_the_weights(tmp_path: Path) -> None:
+    """``command`` gives back the run's config: parsed by the CLI it trains the same config."""
+    out = tmp_path / "w.safetensors"
+    args = ["--steps", "64", "--n-envs", "2", "--n-steps", "32", "--humans", "5-20",
+            "--humans-start", "3", "--rule", "square_crossing", "--rule", "crowd_dynamic",
+            "--init", "crowd-ppo-v1", "--learning-rate", "0.0001",
+            "--log-std-init", "-1"]  # fmt: skip
+    r = runner.invoke(app, ["crowd", "train", "--quiet", "--json", "--out", str(out), *args])
+    assert r.exit_code == 0, r.output
+    record = json.loads(r.stdout)
+    assert record["train"]["rules"] == ["square_crossing", "crowd_dynamic"]
+    assert record["train"]["humans"] == [5, 20] and record["train"]["init"] == "crowd-ppo-v1"
+    (tmp_path / "again").mkdir()
+    again = tmp_path / "again" / "w.safetensors"
+    words = record["command"].split()
+    assert words[:3] == ["uvnav", "crowd", "train"] and "--out" in words
+    words[words.index("--out") + 1] = str(again)
+    r = runner.invoke(app, [*words[1:], "--quiet", "--json"])
+    assert r.exit_code == 0, r.output
+    assert json.loads(r.stdout)["train"] == record["train"]
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (["--humans", "20-5"], "--humans: '20-5' is not N or LOW-HIGH"),
+        (["--humans", "a"], "--humans"),
+        (["--humans", "5-10", "--humans-start", "6"], "--humans-start: 6 is more than"),
+        (["--rule", "corridor"], "--rule: 'corridor' is not one of"),
+        (["--init", "nowhere.safetensors"], "--init: nowhere.safetensors: file not found"),
+    ],
+)
+def test_a_bad_mix_option_is_one_line_with_status_2(args: list[str], message: str) -> None:
+    r = runner.invoke(app, ["crowd", "train", "--steps", "64", *args])
+    assert r.exit_code == 2, r.output
+    assert message in r.output and len(r.output.strip().splitlines()) == 1

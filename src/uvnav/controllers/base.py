@@ -85,6 +85,10 @@ class ControllerInfo:
     #: ``turn_accel_max``) when the vehicle has some; a law that does not is told so when it is
     #: run on such a vehicle (:func:`uvnav.scenarios.episodes.limits_note`)
     acceleration_limits: bool = False
+    #: the law that replaces this one in the campaigns' default law lists
+    #: (:func:`uvnav.experiments.crowds.crowd_laws`); the law stays registered, to reproduce
+    #: older figures ("": not replaced)
+    superseded_by: str = ""
 
 
 _REGISTRY: dict[str, ControllerInfo] = {}

@@ -1,4 +1,5 @@
-"""``crowd-ppo-v1``: a learned crowd law for the holonomic robot, trained here with PPO.
+"""``crowd-ppo-v1`` and ``crowd-ppo-v2``: learned crowd laws for the holonomic robot, trained here
+with PPO.
 
 The policy (:mod:`uvnav.learning.crowd_policy`: a set encoder with attention over the humans,
 then a two-layer tanh MLP) reads :func:`~uvnav.controllers.crowd_features.crowd_vector` of its
@@ -9,6 +10,12 @@ training record is in the ``.json`` beside them) and run here in numpy (float64,
 the law is deterministic and needs only safetensors (``uvnav[learning]``) to load them.  It was
 trained on CrowdNav's circle crossing (train-phase seeds, 5 humans, invisible robot); ``k`` may
 be changed (the attention pools any number of humans; the weights were trained with 5).
+
+``crowd-ppo-v2`` is the same law with other weights (``weights/crowd-ppo-v2.safetensors``): v1's
+policy trained on further on a mix of the protocols the laws are judged on (CrowdNav's circle
+and square crossing with 5-20 humans and the harder crowd of :mod:`uvnav.scenarios.crowd_dynamic`,
+training seeds only); its record holds the ``uvnav crowd train`` command.  v2 supersedes v1 in
+the campaigns (``ControllerInfo.superseded_by``); v1 stays registered for older figures.
 """
 
 from __future__ import annotations
@@ -35,6 +42,11 @@ MAX_K = 64
 FORMAT = "uvnav-crowd-policy-v1"
 #: the shipped weights, in this package
 WEIGHTS = "weights/crowd-ppo-v1.safetensors"
+#: the shipped policies by law name: their weights files in this package
+SHIPPED: dict[str, str] = {
+    "crowd-ppo-v1": WEIGHTS,
+    "crowd-ppo-v2": "weights/crowd-ppo-v2.safetensors",
+}
 _EMBED = ("features_extractor.embed.0", "features_extractor.embed.2")
 _SCORE = ("features_extractor.score.0", "features_extractor.score.2")
 _PI = ("mlp_extractor.policy_net.0", "mlp_extractor.policy_net.2", "action_net")
@@ -116,10 +128,17 @@ def read_policy(path: Path | str) -> CrowdPolicy:
     return CrowdPolicy(weights, PolicyConfig(**header.get("config", {})))
 
 
+def policy_file(ref: str) -> Path:
+    """The policy file ``ref`` names: a shipped law's (:data:`SHIPPED`) or a path."""
+    if ref in SHIPPED:
+        return Path(str(files("uvnav.controllers").joinpath(SHIPPED[ref])))
+    return Path(ref)
+
+
 @cache
-def shipped_policy() -> CrowdPolicy:
-    """The shipped ``crowd-ppo-v1`` policy (read once)."""
-    return read_policy(Path(str(files("uvnav.controllers").joinpath(WEIGHTS))))
+def shipped_policy(name: str = "crowd-ppo-v1") -> CrowdPolicy:
+    """The shipped policy of law ``name`` (read once)."""
+    return read_policy(policy_file(name))
 
 
 @dataclass(frozen=True)
@@ -150,9 +169,9 @@ class CrowdPpo(HolonomicLaw):
         self.params = params or CrowdPpoParams()
         w = self.params.weights
         try:
-            self.policy = read_policy(w) if w else shipped_policy()
+            self.policy = read_policy(w) if w else shipped_policy(self.name)
         except PolicyFileError as exc:
-            raise ControllerParamsError(f"crowd-ppo-v1: weights: {exc}") from None
+            raise ControllerParamsError(f"{self.name}: weights: {exc}") from None
 
     def act(self, obs: Observation) -> VelocityCommand:
         self.decision_period(obs.time)
@@ -175,6 +194,27 @@ register(
         params_type=CrowdPpoParams,
         summary="Learned crowd law: PPO with attention over the k nearest humans, trained here "
         "on CrowdNav's circle crossing (train seeds); the actor's mean, in numpy.",
+        reference="Chen, Liu, Kreiss, Alahi, ICRA 2019 (SARL's attention); Schulman et al. 2017 "
+        "(PPO); stable-baselines3",
+        vehicle="holonomic",
+        superseded_by="crowd-ppo-v2",
+    )
+)
+
+
+class CrowdPpoV2(CrowdPpo):
+    """``crowd-ppo-v2``: the law with the weights trained on the protocol mix (module docstring)."""
+
+    name: ClassVar[str] = "crowd-ppo-v2"
+
+
+register(
+    ControllerInfo(
+        name="crowd-ppo-v2",
+        factory=CrowdPpoV2,
+        params_type=CrowdPpoParams,
+        summary="Learned crowd law: crowd-ppo-v1's policy trained on further on CrowdNav's circle "
+        "and square crossing (5-20 humans) and the harder crowd (train seeds); numpy.",
         reference="Chen, Liu, Kreiss, Alahi, ICRA 2019 (SARL's attention); Schulman et al. 2017 "
         "(PPO); stable-baselines3",
         vehicle="holonomic",

@@ -1,10 +1,17 @@
-"""A Gymnasium env for learning crowd navigation: CrowdNav's circle crossing, holonomic robot.
+"""A Gymnasium env for learning crowd navigation: CrowdNav's crossings and the harder crowd.
 
-Each ``reset`` draws a case of ``crowdnav-circle`` (:func:`uvnav.scenarios.crowdnav.
-crowdnav_scenario`) from the env's generator among ``cases`` of the *train* phase (numpy legacy
-seeds ``2000 + case``: never the test phase's ``1000 + case`` that the benchmarks judge), with
-``n_humans`` humans (an int, or a ``(low, high)`` range drawn per episode: a curriculum), and
-steps the simulator's own world (:class:`uvnav.sim.episode.World2D` through
+Each ``reset`` draws one of the env's ``rules`` (uniformly), then a case among ``cases`` of that
+rule's *training* seeds, never a case the benchmarks judge:
+
+* ``circle_crossing`` / ``square_crossing``: :func:`uvnav.scenarios.crowdnav.crowdnav_scenario`
+  of the *train* phase (numpy legacy seeds ``2000 + case``, never the test phase's
+  ``1000 + case``), with ``n_humans`` humans (an int, or a ``(low, high)`` range drawn per
+  episode); a case whose humans cannot be placed apart is drawn again;
+* ``crowd_dynamic``: :func:`uvnav.scenarios.crowd_dynamic.crowd_dynamic_scenario` of seed
+  :data:`DYNAMIC_TRAIN_SEED` ``+ case`` (the benchmarks judge seeds below it), with its own
+  20 humans and 5 m sensing;
+
+and steps the simulator's own world (:class:`uvnav.sim.episode.World2D` through
 :class:`uvnav.envs.core.EnvWorld`: the world's integration, crowd and collision checks, one env
 step per 0.25 s decision).
 
@@ -15,7 +22,8 @@ step per 0.25 s decision).
   disc of radius V_max (:func:`~uvnav.controllers.crowd_features.action_velocity`).
 * **Reward**: :class:`uvnav.envs.core.RewardConfig` (progress to the goal, time, clearance under
   a margin, success, collision).
-* **Termination** on arrival or collision, **truncation** at the scene's time limit (24 s).
+* **Termination** on arrival or collision, **truncation** at the scene's time limit (24 s for
+  CrowdNav's scenes, 50 s for the harder crowd).
 """
 
 from __future__ import annotations
@@ -27,7 +35,10 @@ import numpy as np
 from uvnav.controllers.crowd_features import action_velocity, crowd_vector, vector_size
 from uvnav.envs.core import TERMINAL, EnvWorld, RewardConfig
 from uvnav.scenarios.build import build_episode
+from uvnav.scenarios.crowd_dynamic import crowd_dynamic_scenario
 from uvnav.scenarios.crowdnav import crowdnav_scenario
+from uvnav.scenarios.errors import ScenarioError
+from uvnav.scenarios.schema import Scenario
 from uvnav.sensors.observation import Observation
 from uvnav.sim.episode import World2D
 from uvnav.sim.seeding import run_rng
@@ -41,16 +52,23 @@ except ImportError as exc:  # pragma: no cover - exercised only without the extr
 #: the reward of the shipped policy's training: RewardConfig's, with a 0.2 m comfort margin
 #: (CrowdNav's discomfort distance)
 CROWD_REWARD = RewardConfig(clearance_margin=0.2)
+#: the scenes an env may draw from (module docstring)
+RULES: tuple[str, ...] = ("circle_crossing", "square_crossing", "crowd_dynamic")
+#: the first ``crowd-dynamic`` seed of training (seeds below it are the benchmarks')
+DYNAMIC_TRAIN_SEED = 1_000_000
+#: draws of a case before an env gives up on placing its humans
+MAX_CASE_DRAWS = 100
 
 
 class CrowdNavEnv(gym.Env[np.ndarray, np.ndarray]):
-    """CrowdNav's circle crossing for learning (module docstring).
+    """Crowd scenes for learning (module docstring).
 
     Args:
         k: human slots of the observation.
-        n_humans: humans per scene, or ``(low, high)``: drawn uniformly per episode.
-        cases: the train-phase cases drawn from (``range(0, cases)``).
+        n_humans: humans per CrowdNav scene, or ``(low, high)``: drawn uniformly per episode.
+        cases: the training cases drawn from (``range(0, cases)``).
         reward: reward weights.
+        rules: the scenes drawn from, uniformly per episode (:data:`RULES`).
     """
 
     metadata: dict[str, Any] = {"render_modes": []}  # noqa: RUF012 - gymnasium declares it an instance variable
@@ -62,6 +80,7 @@ class CrowdNavEnv(gym.Env[np.ndarray, np.ndarray]):
         n_humans: int | tuple[int, int] = 5,
         cases: int = 100_000,
         reward: RewardConfig = CROWD_REWARD,
+        rules: tuple[str, ...] = ("circle_crossing",),
     ) -> None:
         if not 1 <= int(k) <= 64:
             raise ValueError(f"k must be a whole number from 1 to 64 (got {k!r})")
@@ -70,6 +89,10 @@ class CrowdNavEnv(gym.Env[np.ndarray, np.ndarray]):
         if not 0 <= low <= high <= 64:
             raise ValueError(f"n_humans must be 0..64 or a range low <= high (got {n_humans!r})")
         self.humans = (int(low), int(high))
+        if not rules or any(r not in RULES for r in rules):
+            raise ValueError(f"rules must be some of {', '.join(RULES)} (got {rules!r})")
+        self.rules = tuple(rules)
+        self.rule = self.rules[0]
         self.cases = int(cases)
         self.reward_config = reward
         size = vector_size(self.k)
@@ -92,14 +115,28 @@ class CrowdNavEnv(gym.Env[np.ndarray, np.ndarray]):
         super().reset(seed=seed)
         if self._world is not None:
             self._world.close()
-        rng = self.np_random
-        self.case = int(rng.integers(self.cases))
-        n = int(rng.integers(self.humans[0], self.humans[1] + 1))
-        scene = crowdnav_scenario(self.case, phase="train", n_humans=n)
-        setup = build_episode(scene, self.case)
-        world = World2D(setup, run_rng(self.case), exact=True, vehicle="holonomic")
+        scene, seed = self._draw_scene()
+        setup = build_episode(scene, seed)
+        world = World2D(setup, run_rng(seed), exact=True, vehicle="holonomic")
         self._world = EnvWorld(world, n_rays=0, reward=self.reward_config, raw_commands=True)
-        return self._observe(), {"status": "running", "case": self.case}
+        return self._observe(), {"status": "running", "case": self.case, "rule": self.rule}
+
+    def _draw_scene(self) -> tuple[Scenario, int]:
+        """A training scene of a drawn rule and case, and its episode seed (module docstring)."""
+        rng = self.np_random
+        self.rule = self.rules[int(rng.integers(len(self.rules)))]
+        for _ in range(MAX_CASE_DRAWS):
+            self.case = int(rng.integers(self.cases))
+            n = int(rng.integers(self.humans[0], self.humans[1] + 1))
+            try:
+                if self.rule == "crowd_dynamic":
+                    seed = DYNAMIC_TRAIN_SEED + self.case
+                    return crowd_dynamic_scenario(seed), seed
+                rule: Any = self.rule
+                return crowdnav_scenario(self.case, rule=rule, phase="train", n_humans=n), self.case
+            except ScenarioError:
+                continue
+        raise RuntimeError(f"{self.rule}: no case of {MAX_CASE_DRAWS} could place its humans")
 
     def step(self, action: np.ndarray) -> tuple[np.ndarray, float, bool, bool, dict[str, Any]]:
         w, obs = self._world, self._obs
@@ -110,7 +147,7 @@ class CrowdNavEnv(gym.Env[np.ndarray, np.ndarray]):
         status = w.status(0)
         terminated = status in TERMINAL
         truncated = not terminated and w.world.done
-        info = {"status": "timeout" if truncated else status, "case": self.case}
+        info = {"status": "timeout" if truncated else status, "case": self.case, "rule": self.rule}
         return self._observe(), reward, terminated, truncated, info
 
     def close(self) -> None:

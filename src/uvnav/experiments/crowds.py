@@ -59,13 +59,14 @@ PAPER_LAW, PAPER_SCENE = "orca-holonomic-v1", "crowdnav-circle"
 
 
 def crowd_laws() -> tuple[list[str], list[str]]:
-    """``(laws, beyond)``: every registered 2D law (unicycle, then holonomic) of the main campaign,
-    and the laws also run beyond the scene's assumptions: those that require slower obstacles,
-    themselves or through the law they run inside (``hybrid-v1``)."""
+    """``(laws, beyond)``: every registered 2D law (unicycle, then holonomic) of the main campaign
+    but those another law supersedes (``ControllerInfo.superseded_by``), and the laws also run
+    beyond the scene's assumptions: those that require slower obstacles, themselves or through the
+    law they run inside (``hybrid-v1``)."""
     from uvnav.controllers.base import available_controllers, requires_slower_obstacles
 
     infos = {**available_controllers("unicycle"), **available_controllers("holonomic")}
-    laws = list(infos)
+    laws = [n for n, info in infos.items() if not info.superseded_by]
     return laws, [n for n in laws if requires_slower_obstacles(n)]
 
 

@@ -1,4 +1,4 @@
-"""Training the learned crowd law ``crowd-ppo-v1``: PPO (stable-baselines3) with a set encoder.
+"""Training the learned crowd laws ``crowd-ppo-v*``: PPO (stable-baselines3) with a set encoder.
 
 The policy reads :func:`uvnav.controllers.crowd_features.crowd_vector` (the robot's goal-frame
 state and its ``k`` nearest seen humans, masked) through :class:`SetAttentionExtractor`: each
@@ -9,9 +9,12 @@ attention-over-humans of SARL, Chen et al., ICRA 2019, as PPO's shared features)
 and critic are two-layer tanh MLPs on them; the law acts with the actor's mean
 (:mod:`uvnav.controllers.crowd_ppo` runs it in numpy from the exported weights).
 
-:func:`train_crowd_policy` trains on :class:`uvnav.envs.crowd.CrowdNavEnv` (train-phase cases of
-CrowdNav's circle crossing) and :func:`export_policy` writes the actor's weights as safetensors
-with a JSON header (config + training record: seed, steps, CPU time, reward, curriculum).
+:func:`train_crowd_policy` trains on :class:`uvnav.envs.crowd.CrowdNavEnv` (training cases of
+the config's scenes: CrowdNav's circle and square crossing, the harder crowd) and
+:func:`export_policy` writes the actor's weights as safetensors with a JSON header (config +
+training record: seed, steps, CPU time, reward, curriculum).  A run may start from an exported
+policy (``init``: fine-tuning): its actor's weights are loaded into the new model, whose critic
+starts fresh and whose action noise starts at ``exp(log_std_init)``.
 
 A long run loses nothing when interrupted: with a ``checkpoint`` path, PPO's whole state (the
 policy, the optimiser, the step count) is saved there every ``every`` steps and when the run is
@@ -92,9 +95,14 @@ class TrainConfig:
         seed: seed of PPO, its envs and the drawn cases.
         n_envs: envs stepped together.
         k: human slots of the observation.
-        humans_start: humans per scene at the start of a linear curriculum to 5 over the first
-            ``curriculum`` share of the steps (5: no curriculum).
+        humans_start: humans per scene at the start of a linear curriculum to ``humans[0]``
+            over the first ``curriculum`` share of the steps (``humans[0]``: no curriculum).
         curriculum: share of the steps the curriculum lasts.
+        humans: humans per CrowdNav scene after the curriculum, ``(low, high)`` drawn per
+            episode.
+        rules: the scenes drawn from (:data:`uvnav.envs.crowd.RULES`).
+        init: an exported policy file the actor starts from ("": a new policy).
+        log_std_init: the log standard deviation the action noise starts at.
         n_steps, batch_size, epochs, learning_rate, gamma, gae_lambda, ent_coef: PPO's
             (the learning rate falls linearly to 0 over the run).
     """
@@ -112,21 +120,33 @@ class TrainConfig:
     gamma: float = 0.99
     gae_lambda: float = 0.95
     ent_coef: float = 0.0
+    humans: tuple[int, int] = (5, 5)
+    rules: tuple[str, ...] = ("circle_crossing",)
+    init: str = ""
+    log_std_init: float = 0.0
+
+
+def curriculum_humans(cfg: TrainConfig, steps: int) -> tuple[int, int]:
+    """The envs' ``(low, high)`` humans after ``steps`` steps: one count rising linearly from
+    ``humans_start`` to ``humans[0]`` over the curriculum, then ``humans``."""
+    low, high = cfg.humans
+    share = steps / max(cfg.steps * cfg.curriculum, 1.0)
+    n = cfg.humans_start + int(share * (low + 1 - cfg.humans_start))
+    return (n, n) if n < low else (low, high)
 
 
 def _curriculum_callback(cfg: TrainConfig) -> Any:
     from stable_baselines3.common.callbacks import BaseCallback
 
     class Curriculum(BaseCallback):
-        """Raises the envs' human count from ``humans_start`` to 5 over the curriculum."""
+        """Raises the envs' human count over the curriculum (:func:`curriculum_humans`)."""
 
-        n = -1
+        n = (-1, -1)
 
         def _on_step(self) -> bool:
-            share = self.num_timesteps / max(cfg.steps * cfg.curriculum, 1.0)
-            n = min(5, cfg.humans_start + int(share * (6 - cfg.humans_start)))
+            n = curriculum_humans(cfg, self.num_timesteps)
             if n != self.n:
-                self.training_env.set_attr("humans", (n, n))
+                self.training_env.set_attr("humans", n)
                 self.n = n
             return True
 
@@ -168,10 +188,15 @@ def train_crowd_policy(
     spent = float(meta["cpu_seconds"]) if meta else 0.0
     torch.set_num_threads(1)
     cpu0, wall0 = time.process_time(), time.perf_counter()
-    n0 = min(cfg.humans_start, 5)
     env = make_vec_env(CrowdNavEnv, n_envs=cfg.n_envs, seed=cfg.seed,
-                       env_kwargs={"k": cfg.k, "n_humans": (n0, n0)})  # fmt: skip
-    model = _load(sb3, cfg, env, checkpoint) if meta and checkpoint else _new(sb3, cfg, env)
+                       env_kwargs={"k": cfg.k, "n_humans": curriculum_humans(cfg, 0),
+                                   "rules": tuple(cfg.rules)})  # fmt: skip
+    if meta and checkpoint:
+        model = _load(sb3, cfg, env, checkpoint)
+    else:
+        model = _new(sb3, cfg, env)
+        if cfg.init:
+            load_actor(model, cfg.init)
     callbacks = [_curriculum_callback(cfg), _progress_callback(log)]
     done = int(model.num_timesteps)
 
@@ -193,8 +218,7 @@ def train_crowd_policy(
         env.close()
     record = {
         "algorithm": "PPO (stable-baselines3 " + sb3.__version__ + ")",
-        "env": "CrowdNavEnv: crowdnav-circle, train phase (seeds 2000 + case), holonomic robot, "
-        "invisible to ORCA humans",
+        "env": env_text(cfg),
         "train": asdict(cfg),
         "reward": asdict(CROWD_REWARD),
         "timesteps": int(model.num_timesteps),
@@ -203,6 +227,41 @@ def train_crowd_policy(
         "torch": torch.__version__,
     }
     return model, record
+
+
+def env_text(cfg: TrainConfig) -> str:
+    """The training scenes of ``cfg``, in words (the record's ``env``)."""
+    from uvnav.envs.crowd import DYNAMIC_TRAIN_SEED
+
+    names = {
+        "circle_crossing": "crowdnav-circle",
+        "square_crossing": "crowdnav-square",
+        "crowd_dynamic": f"crowd-dynamic (seeds {DYNAMIC_TRAIN_SEED} + case, 20 humans, 5 m "
+        "sensing)",
+    }
+    scenes = ", ".join(names[r] for r in cfg.rules)
+    low, high = cfg.humans
+    crowd = f"{low}" if low == high else f"{low}-{high}"
+    return (
+        f"CrowdNavEnv: {scenes} drawn uniformly; CrowdNav scenes of the train phase (seeds "
+        f"2000 + case) with {crowd} humans; holonomic robot, invisible to ORCA humans"
+    )
+
+
+def load_actor(model: Any, path: Path | str) -> None:
+    """Set ``model``'s actor (:data:`~uvnav.controllers.crowd_ppo.WEIGHT_NAMES`) to the exported
+    policy's at ``path`` (or a shipped law's, by name: :func:`~uvnav.controllers.crowd_ppo.
+    policy_file`).
+
+    Raises:
+        PolicyFileError: not a policy file (one line).
+    """
+    from uvnav.controllers.crowd_ppo import policy_file, read_policy
+
+    torch = _torch()
+    weights = read_policy(policy_file(str(path))).weights
+    state = {n: torch.as_tensor(weights[n], dtype=torch.float32) for n in WEIGHT_NAMES}
+    model.policy.load_state_dict(state, strict=False)
 
 
 def _new(sb3: Any, cfg: TrainConfig, env: Any) -> Any:
@@ -215,6 +274,7 @@ def _new(sb3: Any, cfg: TrainConfig, env: Any) -> Any:
             "features_extractor_class": make_extractor_class(),
             "features_extractor_kwargs": {"k": cfg.k},
             "net_arch": {"pi": [64, 64], "vf": [64, 64]},
+            "log_std_init": cfg.log_std_init,
         },
     )  # fmt: skip
 
