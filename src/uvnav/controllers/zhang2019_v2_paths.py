@@ -35,6 +35,8 @@ from typing import Any
 
 import numpy as np
 
+from uvnav.controllers import zhang2019_v2_loop
+from uvnav.controllers.zhang2019_v2_loop import boundary_discs_py
 from uvnav.geometry import contact
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.contact import _contact_scalar, _gap_scalar, tangents_py
@@ -43,7 +45,7 @@ from uvnav.geometry.kernels3d import numba_enabled
 #: indices into the ``prm`` vector of :func:`choose_on_paths_py` and :func:`plan_paths_py`
 (M_VMAX, M_UMAX, M_ACCEL, M_TURN, M_PERIOD, M_HORIZON, M_STEP, M_COMFORT, M_CHOR, M_MARGIN,
  M_SPREAD, M_MIN_TTC, M_W_TTC, M_W_COMFORT, M_W_CHANGE, M_T_F, M_N_TAN,
- M_N_HEAD) = range(18)  # fmt: skip
+ M_N_HEAD, M_RADIUS, M_SPACING) = range(20)  # fmt: skip
 
 
 def _approach(value: float, target: float, most: float) -> float:
@@ -161,10 +163,33 @@ def _far(box: FloatArray, qw: tuple[float, float, float, float], t_a: float, t_b
     return _box_gap(box, qx + wx * t_a, qy + wy * t_a, qx + wx * t_b, qy + wy * t_b) > lim
 
 
+def _chunk_bodies(
+    c: int, t_a: float, t_b: float, lim: float, xy: FloatArray, bodies: FloatArray,
+    cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float],
+) -> None:  # fmt: skip
+    """The bodies (nearest first) that may come within reach of any path over chunk ``c``
+    (times ``t_a`` .. ``t_b``), into ``cull``'s lists: a path moves at most ``cull[4]`` [m/s]
+    from its start ``xy[0]``, so its box over the chunk lies in the square of that half-width
+    about the start, and a body whose box over the chunk stays, box to box, farther than its
+    bounding reach plus ``lim`` from that square is farther from the path's box too."""
+    order, lists, top = cull[0], cull[3], cull[4]
+    n_b = order.shape[0]
+    half = top * t_b * (1.0 + 1e-9) + 1e-9
+    square = np.array((xy[0, 0] - half, xy[0, 0] + half, xy[0, 1] - half, xy[0, 1] + half))
+    n = 0
+    for b in order:
+        body = (bodies[b, 2], bodies[b, 3], bodies[b, 4], bodies[b, 5])
+        if not _far(square, body, t_a, t_b, bodies[b, 6] + lim):
+            lists[0, c * n_b + n] = b
+            n += 1
+    lists[1, c] = n
+
+
 def risk_along(
     path: tuple[FloatArray, FloatArray, FloatArray], aim: float, speed: float, n_sub: int,
     times: FloatArray, discs: tuple[FloatArray, FloatArray, FloatArray], bodies: FloatArray,
-    cull: tuple[np.ndarray, FloatArray, float], prm: FloatArray, give_up: float, base: float,
+    cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float], prm: FloatArray,
+    give_up: float, base: float,
     safe_only: bool, risk: FloatArray,
 ) -> None:  # fmt: skip
     """The first contact and comfort penalty of one candidate's path
@@ -184,7 +209,8 @@ def risk_along(
     order, and the visit stops at the first that cannot close in on the chunk's path."""
     xy, speeds, st = path
     q, w, reach = discs
-    order, gap, fastest = cull
+    gap, fastest, lists = cull[1], cull[2], cull[3]
+    n_b = gap.shape[0]
     c_h, spread, w_ttc, w_comfort = prm[M_CHOR], prm[M_SPREAD], prm[M_W_TTC], prm[M_W_COMFORT]
     n_seg = times.shape[0] - 1
     box = np.empty(4)
@@ -202,7 +228,11 @@ def risk_along(
         for corner in range(4):
             cx, cy = box[corner // 2] - xy[0, 0], box[2 + corner % 2] - xy[0, 1]
             out_to = max(out_to, math.hypot(cx, cy))
-        for b in order:
+        c = i0 // CHUNK
+        if lists[1, c] < 0:
+            _chunk_bodies(c, t_a, t_b, lim_far, xy, bodies, cull)
+        for idx in range(lists[1, c]):
+            b = lists[0, c * n_b + idx]
             if gap[b] > fastest * t_b + out_to + lim_far:
                 break  # this body and the farther ones stay out of reach over the chunk
             body = (bodies[b, 2], bodies[b, 3], bodies[b, 4], bodies[b, 5])
@@ -280,7 +310,10 @@ def choose_on_paths_py(
     for b in range(bodies.shape[0]):
         gap[b] = math.hypot(bodies[b, 2] - pose[0], bodies[b, 3] - pose[1]) - bodies[b, 6]
         fastest = max(fastest, math.hypot(bodies[b, 4], bodies[b, 5]))
-    cull = (np.argsort(gap), gap, fastest)
+    n_chunks = (n + CHUNK - 1) // CHUNK
+    lists = np.full((2, max(n_chunks * bodies.shape[0], n_chunks)), -1, dtype=np.int64)
+    top = max(prm[M_VMAX], abs(now[0]))  # no path moves faster
+    cull = (np.argsort(gap), gap, fastest, lists, top)
     # best safe, best admissible, best of all: cost, index, ttc
     best = np.array([math.inf, -1.0, math.inf, math.inf, -1.0, math.inf, math.inf, -1.0, math.inf])
     for safe_only in (True, False):  # the safe one if any; all of them only when none is
@@ -370,6 +403,51 @@ def plan_paths_py(
     out[3] = 1.0 if k == n_c - 2 and math.isinf(pick[1]) else 0.0
 
 
+def plan_readings_py(
+    state: FloatArray, scal: FloatArray, centre: FloatArray, vel: FloatArray, rings: FloatArray,
+    ring_start: np.ndarray, speeds: FloatArray, prm: FloatArray, out: FloatArray,
+) -> None:  # fmt: skip
+    """:func:`plan_paths_py` from the readings as arrays (``scal``, ``centre``, ``vel``,
+    ``rings``, ``ring_start``: as :func:`uvnav.controllers.zhang2019_v2_loop.plan_loop_py`
+    reads them): the bodies that can reach the robot within the horizon
+    (:func:`~uvnav.controllers.zhang2019_v2_bodies.reachable`), their boundary discs
+    (:func:`~uvnav.controllers.zhang2019_v2_loop.boundary_discs_py`), each disc's reach (its
+    radius plus the robot's radius ``prm[M_RADIUS]`` and the margin) and per body its discs,
+    centre, velocity and bounding reach (:func:`uvnav.controllers.zhang2019_v2.bounding_reach`
+    plus the same), computed as the numpy building blocks compute them."""
+    v_max, horizon, spacing = prm[M_VMAX], prm[M_HORIZON], prm[M_SPACING]
+    n = scal.shape[0]
+    keep = np.empty(n, dtype=np.int64)
+    n_keep = 0
+    for k in range(n):
+        bound = math.hypot(vel[k, 0], vel[k, 1]) + abs(scal[k, 1]) * scal[k, 3]
+        if scal[k, 0] <= (v_max + bound) * horizon:
+            keep[n_keep] = k
+            n_keep += 1
+    keep = keep[:n_keep]
+    q, w, r, owner = boundary_discs_py(keep, scal, centre, vel, rings, ring_start, spacing)
+    reach = np.empty(r.shape[0])
+    for j in range(r.shape[0]):
+        reach[j] = r[j] + prm[M_RADIUS] + prm[M_MARGIN]
+    bodies = np.zeros((n_keep, 7))
+    for j in range(owner.shape[0]):  # owner is non-decreasing: each body's first and end disc
+        b = owner[j]
+        if j == 0 or owner[j - 1] != b:
+            bodies[b, 0] = j
+        bodies[b, 1] = j + 1
+    for i in range(n_keep):
+        k = keep[i]
+        bodies[i, 2], bodies[i, 3], bodies[i, 4], bodies[i, 5] = (
+            centre[k, 0], centre[k, 1], vel[k, 0], vel[k, 1])  # fmt: skip
+        if scal[k, 2] > 0.0:
+            bound_r = scal[k, 3]
+        else:
+            uh = scal[k, 1] * horizon
+            bound_r = scal[k, 3] * math.sqrt(1.0 + uh * uh) + 0.5 * spacing
+        bodies[i, 6] = bound_r + prm[M_RADIUS] + prm[M_MARGIN]
+    plan_paths_py(state, q, w, reach, owner, bodies, speeds, prm, out)
+
+
 _COMPILED: dict[str, Callable[..., Any]] = {}
 
 
@@ -379,30 +457,31 @@ def _compiled_plan() -> Callable[..., Any]:
     if not _COMPILED:
         import numba
 
-        done = dict(contact._kernels())
+        zhang2019_v2_loop._compiled_plan()
+        done = {**contact._kernels(), **zhang2019_v2_loop._COMPILED}
         kernels = (_approach, _window, _turn, advance, _box_gap, _path_box, _disc_along, _far,
-                   risk_along, _stops, _keep, choose_on_paths_py, plan_paths_py)  # fmt: skip
+                   _chunk_bodies,
+                   risk_along, _stops, _keep, choose_on_paths_py, plan_paths_py,
+                   plan_readings_py)  # fmt: skip
         for f in kernels:
             env = {**f.__globals__, **done}
             copy = types.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
             done[f.__name__] = _COMPILED[f.__name__] = numba.njit(cache=True, nogil=True)(copy)
-    return _COMPILED["plan_paths_py"]
+    return _COMPILED["plan_readings_py"]
 
 
 def plan_paths(
     state: FloatArray,
-    discs: tuple[FloatArray, FloatArray, FloatArray, np.ndarray],
-    bodies: FloatArray,
+    table: tuple[FloatArray, FloatArray, FloatArray],
+    rings: tuple[FloatArray, np.ndarray],
     speeds: FloatArray,
     prm: FloatArray,
 ) -> FloatArray:
-    """:func:`plan_paths_py` (compiled when numba is enabled): ``(vx, vy, ttc, preferred)``."""
-    q, w, reach, owner = discs
-    c = np.ascontiguousarray
+    """:func:`plan_readings_py` (compiled when numba is enabled) of the readings read into
+    arrays (``table``: :func:`~uvnav.controllers.zhang2019_v2_bodies.body_table`, ``rings``:
+    :func:`~uvnav.controllers.zhang2019_v2_loop.outline_rings`): ``(vx, vy, ttc, preferred)``."""
     out = np.empty(4)
-    fn = _compiled_plan() if numba_enabled() else plan_paths_py
-    fn(c(state, dtype=float), c(q, dtype=float).reshape(-1, 2), c(w, dtype=float).reshape(-1, 2),
-       c(reach, dtype=float), c(owner, dtype=np.int64), c(bodies, dtype=float).reshape(-1, 7),
-       c(speeds, dtype=float),
-       c(prm, dtype=float), out)  # fmt: skip
+    fn = _compiled_plan() if numba_enabled() else plan_readings_py
+    scal, centre, vel = table
+    fn(state, scal, centre, vel, rings[0], rings[1], speeds, prm, out)
     return out
