@@ -86,6 +86,7 @@ def advance(
     h = prm[M_PERIOD] / n_sub
     i0 = int(st[5])
     x, y, th, v, u, v_cmd, u_cmd = xy[i0, 0], xy[i0, 1], st[0], st[1], st[2], st[3], st[4]
+    half_was, sinc, last = math.nan, 1.0, i0
     for i in range(i0, min(upto, xy.shape[0] - 1)):
         if i % n_sub == 0:
             beta = (aim - th + math.pi) % (2.0 * math.pi) - math.pi
@@ -95,14 +96,17 @@ def advance(
         v1 = _approach(v, v_cmd, prm[M_ACCEL] * h)
         u1 = _approach(u, u_cmd, prm[M_TURN] * h)
         vm, half = 0.5 * (v + v1), 0.25 * (u + u1) * h
-        arg = math.pi * (half / math.pi if half != 0.0 else 1.0e-20)  # numpy's sinc
-        chord = vm * h * (math.sin(arg) / arg)
+        if half != half_was:  # the same half-turn as the substep before: the same sinc
+            arg = math.pi * (half / math.pi if half != 0.0 else 1.0e-20)  # numpy's sinc
+            sinc, half_was = math.sin(arg) / arg, half
+        chord = vm * h * sinc
         x = x + chord * math.cos(th + half)
         y = y + chord * math.sin(th + half)
         th = th + 2.0 * half
         v, u = v1, u1
         xy[i + 1, 0], xy[i + 1, 1], speeds[i + 1] = x, y, v
-        st[0], st[1], st[2], st[3], st[4], st[5] = th, v, u, v_cmd, u_cmd, i + 1
+        last = i + 1
+    st[0], st[1], st[2], st[3], st[4], st[5] = th, v, u, v_cmd, u_cmd, last
 
 
 #: segments per chunk of :func:`risk_along`'s cull
@@ -271,10 +275,15 @@ def _stops(xy: FloatArray, times: FloatArray, speeds: FloatArray, ttc: float, n_
     return to_contact >= v_t * period + v_t * v_t / (2.0 * prm[M_ACCEL])
 
 
+def _better(best: FloatArray, slot: int, cost: float, k: int) -> bool:
+    """Candidate ``k`` at ``cost`` would replace ``best``'s ``slot`` (cost, index, ttc): it costs
+    less, or as much with a lower index."""
+    return cost < best[slot] or (cost == best[slot] and k < best[slot + 1])
+
+
 def _keep(best: FloatArray, slot: int, cost: float, k: int, ttc: float) -> None:
-    """Record candidate ``k`` in ``best``'s ``slot`` (cost, index, ttc) when it costs less, or as
-    much with a lower index."""
-    if cost < best[slot] or (cost == best[slot] and k < best[slot + 1]):
+    """Record candidate ``k`` in ``best``'s ``slot`` when :func:`_better`."""
+    if _better(best, slot, cost, k):
         best[slot], best[slot + 1], best[slot + 2] = cost, k, ttc
 
 
@@ -327,6 +336,9 @@ def choose_on_paths_py(
             ttc, pen = risk[k, 0], risk[k, 1]
             cost = base[k] + w_ttc / max(ttc, 1e-3) + w_comfort * pen
             if (safe_only and ttc <= min_ttc) or cost > give_up:
+                continue
+            if not (safe_only or _better(best, 3, cost, k)):
+                _keep(best, 6, cost, k, ttc)  # whether it brakes cannot matter
                 continue
             if math.isfinite(ttc):  # the path to the contact and the speed after one period
                 advance(st[k], ang[k], spd[k], prm, n_sub, xy[k], speeds[k],
@@ -461,7 +473,7 @@ def _compiled_plan() -> Callable[..., Any]:
         done = {**contact._kernels(), **zhang2019_v2_loop._COMPILED}
         kernels = (_approach, _window, _turn, advance, _box_gap, _path_box, _disc_along, _far,
                    _chunk_bodies,
-                   risk_along, _stops, _keep, choose_on_paths_py, plan_paths_py,
+                   risk_along, _stops, _better, _keep, choose_on_paths_py, plan_paths_py,
                    plan_readings_py)  # fmt: skip
         for f in kernels:
             env = {**f.__globals__, **done}
