@@ -169,7 +169,7 @@ def _far(box: FloatArray, qw: tuple[float, float, float, float], t_a: float, t_b
 
 def _chunk_bodies(
     c: int, t_a: float, t_b: float, lim: float, xy: FloatArray, bodies: FloatArray,
-    cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float],
+    cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float, FloatArray],
 ) -> None:  # fmt: skip
     """The bodies (nearest first) that may come within reach of any path over chunk ``c``
     (times ``t_a`` .. ``t_b``), into ``cull``'s lists: a path moves at most ``cull[4]`` [m/s]
@@ -192,7 +192,7 @@ def _chunk_bodies(
 def risk_along(
     path: tuple[FloatArray, FloatArray, FloatArray], aim: float, speed: float, n_sub: int,
     times: FloatArray, discs: tuple[FloatArray, FloatArray, FloatArray], bodies: FloatArray,
-    cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float], prm: FloatArray,
+    cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float, FloatArray], prm: FloatArray,
     give_up: float, base: float,
     safe_only: bool, risk: FloatArray,
 ) -> None:  # fmt: skip
@@ -214,10 +214,9 @@ def risk_along(
     xy, speeds, st = path
     q, w, reach = discs
     gap, fastest, lists = cull[1], cull[2], cull[3]
-    n_b = gap.shape[0]
+    n_b, box = gap.shape[0], cull[5]
     c_h, spread, w_ttc, w_comfort = prm[M_CHOR], prm[M_SPREAD], prm[M_W_TTC], prm[M_W_COMFORT]
     n_seg = times.shape[0] - 1
-    box = np.empty(4)
     while risk[2] < n_seg:
         i0 = int(risk[2])
         i1 = min(i0 + CHUNK, n_seg)
@@ -260,6 +259,13 @@ def _stops(xy: FloatArray, times: FloatArray, speeds: FloatArray, ttc: float, n_
     """:func:`uvnav.controllers.zhang2019_limits.stoppable` of one path."""
     if not math.isfinite(ttc):
         return True
+    v_t = speeds[min(n_sub, speeds.shape[0] - 1)]
+    need = v_t * prm[M_PERIOD] + v_t * v_t / (2.0 * prm[M_ACCEL])
+    m = min(int(ttc / times[1]), times.shape[0] - 1)
+    while m > 0 and times[m] > ttc:
+        m -= 1
+    if math.hypot(xy[m, 0] - xy[0, 0], xy[m, 1] - xy[0, 1]) > need * (1.0 + 1e-9) + 1e-12:
+        return True  # the path to the contact is longer than the straight line to a point on it
     length, to_contact = 0.0, math.nan
     for i in range(times.shape[0] - 1):
         after = length + math.hypot(xy[i + 1, 0] - xy[i, 0], xy[i + 1, 1] - xy[i, 1])
@@ -270,9 +276,7 @@ def _stops(xy: FloatArray, times: FloatArray, speeds: FloatArray, ttc: float, n_
         length = after
     if math.isnan(to_contact):
         to_contact = length
-    v_t = speeds[min(n_sub, speeds.shape[0] - 1)]
-    period = prm[M_PERIOD]
-    return to_contact >= v_t * period + v_t * v_t / (2.0 * prm[M_ACCEL])
+    return to_contact >= need
 
 
 def _better(best: FloatArray, slot: int, cost: float, k: int) -> bool:
@@ -322,7 +326,7 @@ def choose_on_paths_py(
     n_chunks = (n + CHUNK - 1) // CHUNK
     lists = np.full((2, max(n_chunks * bodies.shape[0], n_chunks)), -1, dtype=np.int64)
     top = max(prm[M_VMAX], abs(now[0]))  # no path moves faster
-    cull = (np.argsort(gap), gap, fastest, lists, top)
+    cull = (np.argsort(gap), gap, fastest, lists, top, np.empty(4))
     # best safe, best admissible, best of all: cost, index, ttc
     best = np.array([math.inf, -1.0, math.inf, math.inf, -1.0, math.inf, math.inf, -1.0, math.inf])
     for safe_only in (True, False):  # the safe one if any; all of them only when none is
