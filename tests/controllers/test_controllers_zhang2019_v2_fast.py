@@ -43,7 +43,8 @@ def full_choice(
         xy, speeds = np.zeros((n + 1, 2)), np.zeros(n + 1)
         xy[0], speeds[0] = pose[:2], now[0]
         state = np.array([pose[2], now[0], now[1], now[0], now[1], 0.0])
-        paths.advance(state, ang[k], spd[k], prm, n_sub, xy, speeds, n)
+        track = np.zeros((n, 8))  # its own heading track: nothing shared
+        paths.advance(state, ang[k], spd[k], prm, n_sub, xy, speeds, n, track, np.zeros(1))
         risk = np.array([math.inf, 0.0, 0.0])
         for j in range(len(reach)):
             qw = (q[j, 0], q[j, 1], w[j, 0], w[j, 1])

@@ -76,36 +76,51 @@ def _turn(beta: float, u_now: float, prm: FloatArray) -> float:
 
 def advance(
     st: FloatArray, aim: float, speed: float, prm: FloatArray, n_sub: int, xy: FloatArray,
-    speeds: FloatArray, upto: int,
+    speeds: FloatArray, upto: int, track: FloatArray, known: FloatArray,
 ) -> None:  # fmt: skip
     """Extend the path of :func:`uvnav.controllers.zhang2019_limits.rollout` toward one ``aim``
     [rad] at ``speed`` [m/s] (``xy`` (S + 1, 2), ``speeds`` (S + 1,), ``n_sub`` substeps per
     period) to its point ``upto``; ``st``: heading, speed, turn rate, speed and turn rate
     commanded, and the last point computed, updated (from ``xy[0]``, ``speeds[0]``: the pose, its
-    speed and turn rate, held, and 0)."""
+    speed and turn rate, held, and 0).
+
+    The heading and turn rate do not depend on the speed: per substep ``track`` (S, 8) holds
+    the half-turn, its sinc, the cosine and sine of the chord's direction, the cosine of the
+    heading error (at a decision), the turn rate after, the heading after and the turn rate
+    commanded, shared by the paths toward the same ``aim`` from the same start; its first
+    ``known[0]`` rows are read, not computed again, and it is extended as the path is."""
     h = prm[M_PERIOD] / n_sub
     i0 = int(st[5])
     x, y, th, v, u, v_cmd, u_cmd = xy[i0, 0], xy[i0, 1], st[0], st[1], st[2], st[3], st[4]
-    half_was, sinc, last = math.nan, 1.0, i0
+    half_was, sinc, last, n_known = math.nan, 1.0, i0, int(known[0])
     for i in range(i0, min(upto, xy.shape[0] - 1)):
-        if i % n_sub == 0:
-            beta = (aim - th + math.pi) % (2.0 * math.pi) - math.pi
+        steer = i % n_sub == 0
+        if i >= n_known:  # the heading track, computed and kept for the paths toward ``aim``
+            if steer:
+                beta = (aim - th + math.pi) % (2.0 * math.pi) - math.pi
+                track[i, 4], track[i, 7] = math.cos(beta), _turn(beta, u, prm)
+            else:
+                track[i, 7] = track[i - 1, 7]
+            u1 = _approach(u, track[i, 7], prm[M_TURN] * h)
+            half = 0.25 * (u + u1) * h
+            if half != half_was:  # the same half-turn as the substep before: the same sinc
+                arg = math.pi * (half / math.pi if half != 0.0 else 1.0e-20)  # numpy's sinc
+                sinc, half_was = math.sin(arg) / arg, half
+            track[i, 0], track[i, 1], track[i, 5] = half, sinc, u1
+            track[i, 2], track[i, 3] = math.cos(th + half), math.sin(th + half)
+            track[i, 6] = th + 2.0 * half
+            n_known = i + 1
+        if steer:
             lo, hi = _window(v, prm[M_ACCEL], prm[M_PERIOD], 0.0, prm[M_VMAX])
-            v_cmd = min(max(speed * max(math.cos(beta), 0.0), lo), hi)
-            u_cmd = _turn(beta, u, prm)
+            v_cmd = min(max(speed * max(track[i, 4], 0.0), lo), hi)
         v1 = _approach(v, v_cmd, prm[M_ACCEL] * h)
-        u1 = _approach(u, u_cmd, prm[M_TURN] * h)
-        vm, half = 0.5 * (v + v1), 0.25 * (u + u1) * h
-        if half != half_was:  # the same half-turn as the substep before: the same sinc
-            arg = math.pi * (half / math.pi if half != 0.0 else 1.0e-20)  # numpy's sinc
-            sinc, half_was = math.sin(arg) / arg, half
-        chord = vm * h * sinc
-        x = x + chord * math.cos(th + half)
-        y = y + chord * math.sin(th + half)
-        th = th + 2.0 * half
-        v, u = v1, u1
+        chord = 0.5 * (v + v1) * h * track[i, 1]
+        x = x + chord * track[i, 2]
+        y = y + chord * track[i, 3]
+        th, v, u, u_cmd = track[i, 6], v1, track[i, 5], track[i, 7]
         xy[i + 1, 0], xy[i + 1, 1], speeds[i + 1] = x, y, v
         last = i + 1
+    known[0] = n_known
     st[0], st[1], st[2], st[3], st[4], st[5] = th, v, u, v_cmd, u_cmd, last
 
 
@@ -190,7 +205,8 @@ def _chunk_bodies(
 
 
 def risk_along(
-    path: tuple[FloatArray, FloatArray, FloatArray], aim: float, speed: float, n_sub: int,
+    path: tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray], aim: float,
+    speed: float, n_sub: int,
     times: FloatArray, discs: tuple[FloatArray, FloatArray, FloatArray], bodies: FloatArray,
     cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float, FloatArray], prm: FloatArray,
     give_up: float, base: float,
@@ -198,7 +214,8 @@ def risk_along(
 ) -> None:  # fmt: skip
     """The first contact and comfort penalty of one candidate's path
     (:func:`uvnav.controllers.zhang2019_limits.path_risk` of one row), rolled out as far as it
-    is read (``path``: :func:`advance`'s ``xy``, ``speeds`` and ``st``), into ``risk`` (ttc, pen,
+    is read (``path``: :func:`advance`'s ``xy``, ``speeds``, ``st``, ``track`` and ``known``),
+    into ``risk`` (ttc, pen,
     and the first segment not yet checked: a later call resumes there); stops early, with the
     figures so far, once the cost exceeds ``give_up`` (``base`` plus the risk terms so far: the
     path cannot win) or, when ``safe_only``, once a contact comes at or before ``min_ttc`` (the
@@ -211,7 +228,7 @@ def risk_along(
     bodies by their gap at the start (distance from the robot's start to the centre less the
     bounding reach), that gap, and the largest body speed; the bodies are visited in that
     order, and the visit stops at the first that cannot close in on the chunk's path."""
-    xy, speeds, st = path
+    xy, speeds, st, track, known = path
     q, w, reach = discs
     gap, fastest, lists = cull[1], cull[2], cull[3]
     n_b, box = gap.shape[0], cull[5]
@@ -223,7 +240,7 @@ def risk_along(
         if times[i0] >= c_h and risk[0] <= times[i0]:
             risk[2] = n_seg  # no earlier contact on later segments, no comfort term beyond c_h
             break
-        advance(st, aim, speed, prm, n_sub, xy, speeds, i1)
+        advance(st, aim, speed, prm, n_sub, xy, speeds, i1, track, known)
         t_a, t_b = times[i0], times[i1]
         lim_far = spread * t_b + (prm[M_COMFORT] if t_a < c_h else 0.0) + 1e-9
         _path_box(xy, i0, i1, box)
@@ -291,6 +308,18 @@ def _keep(best: FloatArray, slot: int, cost: float, k: int, ttc: float) -> None:
         best[slot], best[slot + 1], best[slot + 2] = cost, k, ttc
 
 
+def _groups(ang: FloatArray) -> np.ndarray:
+    """Per candidate the index of its direction among the distinct values of ``ang``."""
+    by = np.argsort(ang)
+    group = np.empty(ang.shape[0], dtype=np.int64)
+    g = -1
+    for i in range(by.shape[0]):
+        if i == 0 or ang[by[i]] != ang[by[i - 1]]:
+            g += 1
+        group[by[i]] = g
+    return group
+
+
 def choose_on_paths_py(
     pose: FloatArray, now: FloatArray, cand: tuple[FloatArray, FloatArray, FloatArray],
     order: np.ndarray, discs: tuple[FloatArray, FloatArray, FloatArray], bodies: FloatArray,
@@ -317,6 +346,9 @@ def choose_on_paths_py(
         xy[k, 0, 0], xy[k, 0, 1], speeds[k, 0] = pose[0], pose[1], now[0]
         st[k, 0], st[k, 1], st[k, 2], st[k, 3], st[k, 4], st[k, 5] = (
             pose[2], now[0], now[1], now[0], now[1], 0.0)  # fmt: skip
+    group = _groups(ang)  # the paths toward one direction share their heading track
+    track = np.empty((int(group.max()) + 1 if n_c else 0, n, 8))
+    known = np.zeros(track.shape[0])
     min_ttc, w_ttc, w_comfort = prm[M_MIN_TTC], prm[M_W_TTC], prm[M_W_COMFORT]
     gap = np.empty(bodies.shape[0])
     fastest = 0.0
@@ -334,7 +366,8 @@ def choose_on_paths_py(
             if best[1] >= 0.0 and base[k] > best[0]:
                 break
             give_up = best[0] if best[1] >= 0.0 else math.inf
-            path = (xy[k], speeds[k], st[k])
+            g = group[k]
+            path = (xy[k], speeds[k], st[k], track[g], known[g : g + 1])
             risk_along(path, ang[k], spd[k], n_sub, times, discs, bodies, cull, prm, give_up,
                        base[k], safe_only, risk[k])  # fmt: skip
             ttc, pen = risk[k, 0], risk[k, 1]
@@ -345,8 +378,9 @@ def choose_on_paths_py(
                 _keep(best, 6, cost, k, ttc)  # whether it brakes cannot matter
                 continue
             if math.isfinite(ttc):  # the path to the contact and the speed after one period
-                advance(st[k], ang[k], spd[k], prm, n_sub, xy[k], speeds[k],
-                        max(n_sub, min(int(ttc / h) + 2, n)))  # fmt: skip
+                upto = max(n_sub, min(int(ttc / h) + 2, n))
+                advance(st[k], ang[k], spd[k], prm, n_sub, xy[k], speeds[k], upto, track[g],
+                        known[g : g + 1])  # fmt: skip
             brakes = _stops(xy[k], times, speeds[k], ttc, n_sub, prm)
             if brakes and ttc > min_ttc:
                 _keep(best, 0, cost, k, ttc)
@@ -477,7 +511,7 @@ def _compiled_plan() -> Callable[..., Any]:
         done = {**contact._kernels(), **zhang2019_v2_loop._COMPILED}
         kernels = (_approach, _window, _turn, advance, _box_gap, _path_box, _disc_along, _far,
                    _chunk_bodies,
-                   risk_along, _stops, _better, _keep, choose_on_paths_py, plan_paths_py,
+                   risk_along, _stops, _better, _keep, _groups, choose_on_paths_py, plan_paths_py,
                    plan_readings_py)  # fmt: skip
         for f in kernels:
             env = {**f.__globals__, **done}
