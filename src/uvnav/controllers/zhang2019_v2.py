@@ -111,12 +111,13 @@ says nothing; the choices made here (:mod:`uvnav.controllers.zhang2019_limits`):
   and where no candidate is safe one that leaves it is preferred.
 * v_pref is lowered to ``sqrt(2 a d)`` at d from T, so that the robot can stop there.
 
-The unicycle's decision runs in one loop, compiled with numba
-(:mod:`uvnav.controllers.zhang2019_v2_paths`: the candidates visited by their cost without the
-risk terms, each path rolled out only as far as it is checked, bodies culled by boxes; the
-numpy building blocks are its reference, and run where numba is not installed or the social
-term is on): about 0.02 s of CPU per CrowdNav episode with 5 humans (0.25 s decisions; 0.013 s
-with ``rollout_paths`` off) and 0.04 s with limits and 0.05 s steps (numpy: 0.11 and 0.16 s).
+The unicycle's decision runs, after reading the readings into arrays, in one loop compiled
+with numba (:mod:`uvnav.controllers.zhang2019_v2_paths`: the reachable bodies and their discs,
+the candidates visited by their cost without the risk terms, each path rolled out only as far
+as it is checked, bodies culled by boxes; the numpy building blocks are its reference, and run
+where numba is not installed or the social term is on): about 0.02 s of CPU per CrowdNav
+episode with 5 humans (0.25 s decisions; 0.013 s with ``rollout_paths`` off) and 0.04 s with
+limits and 0.05 s steps (numpy: 0.11 and 0.16 s).
 
 Two equal implementations of the holonomic robot's decision (and the unicycle's with
 ``rollout_paths`` off).  The reference is numpy, vectorised over candidates x boundary discs

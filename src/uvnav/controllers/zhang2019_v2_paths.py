@@ -18,12 +18,21 @@ is what cannot change the choice:
   safe are they all checked to the end (resuming where the first visit left off);
 * a path is rolled out only as far as it is checked, and its check stops at the segment of its
   first contact (later segments start later) once past the comfort horizon;
-* per chunk of :data:`CHUNK` segments, the bodies are visited nearest first and the visit ends at
+* per chunk of :data:`CHUNK` segments, the bodies that can reach any path over the chunk (a
+  square about the start, as wide as the fastest path goes) are listed once per decision
+  (:func:`_chunk_bodies`); a candidate's chunk visits them nearest first and the visit ends at
   the first that cannot reach the chunk's path; a body, then a disc, whose box over the chunk
-  stays out of reach of the path's box is skipped.
+  stays out of reach of the path's box is skipped;
+* where no candidate is safe, whether one can still brake is computed only where its cost could
+  win; a braking check answers yes at once when the straight line to a point before the contact
+  already exceeds the stopping distance;
+* the heading and turn rate of a path do not depend on its speed: the paths toward one direction
+  share their sines and cosines (:func:`advance`'s track).
 
 So it picks the reference's candidate, to rounding (its sines and cosines are the C library's,
-the reference's numpy's; tests: hypothesis on random scenes).  Units: metres, seconds, radians.
+the reference's numpy's; tests: hypothesis on random scenes), and exactly the candidate of the
+full evaluation (every path to the horizon, every disc, every segment) made of its own kernels
+(tests).  Units: metres, seconds, radians.
 """
 
 from __future__ import annotations
@@ -418,10 +427,11 @@ def plan_paths_py(
     n_tan, n_head, w_change = prm[M_N_TAN], int(prm[M_N_HEAD]), prm[M_W_CHANGE]
     n_few = 0
     grow = np.empty(q.shape[0])
-    for j in range(q.shape[0]):
+    for j in range(q.shape[0]):  # the discs of the nearest bodies (owner is non-decreasing)
+        if owner[j] >= n_tan:
+            break
         grow[j] = reach[j] + math.hypot(w[j, 0], w[j, 1]) * prm[M_T_F]
-        if owner[j] < n_tan:
-            n_few = j + 1
+        n_few = j + 1
     tang = np.empty(2 * n_few + 1)
     n_t = tangents_py(px, py, q, grow, owner, n_few, tang)
     n_x = n_head + (2 if state[10] > 0.0 else 1)
