@@ -111,12 +111,13 @@ says nothing; the choices made here (:mod:`uvnav.controllers.zhang2019_limits`):
   and where no candidate is safe one that leaves it is preferred.
 * v_pref is lowered to ``sqrt(2 a d)`` at d from T, so that the robot can stop there.
 
-The unicycle's decision runs in one loop, compiled with numba
-(:mod:`uvnav.controllers.zhang2019_v2_paths`: the candidates visited by their cost without the
-risk terms, each path rolled out only as far as it is checked, bodies culled by boxes; the
-numpy building blocks are its reference, and run where numba is not installed or the social
-term is on): about 0.02 s of CPU per CrowdNav episode with 5 humans (0.25 s decisions; 0.013 s
-with ``rollout_paths`` off) and 0.04 s with limits and 0.05 s steps (numpy: 0.11 and 0.16 s).
+The unicycle's decision runs, after reading the readings into arrays, in one loop compiled
+with numba (:mod:`uvnav.controllers.zhang2019_v2_paths`: the reachable bodies and their discs,
+the candidates visited by their cost without the risk terms, each path rolled out only as far
+as it is checked, bodies culled by boxes; the numpy building blocks are its reference, and run
+where numba is not installed or the social term is on): about 0.02 s of CPU per CrowdNav
+episode with 5 humans (0.25 s decisions; 0.013 s with ``rollout_paths`` off) and 0.04 s with
+limits and 0.05 s steps (numpy: 0.11 and 0.16 s).
 
 Two equal implementations of the holonomic robot's decision (and the unicycle's with
 ``rollout_paths`` off).  The reference is numpy, vectorised over candidates x boundary discs
@@ -154,14 +155,11 @@ from uvnav.controllers.holonomic import HolonomicLaw, toward_goal
 from uvnav.controllers.zhang2019_limits import (
     BoolArray,
     RampModel,
-    approach,
     path_risk,
     path_social,
     preferred_under_limits,
     rollout,
-    speed_command,
     stoppable,
-    turn_command,
 )
 from uvnav.controllers.zhang2019_v2_bodies import (
     body_table,
@@ -179,6 +177,9 @@ from uvnav.controllers.zhang2019_v2_loop import (
     outline_rings,
     plan_loop,
 )
+from uvnav.controllers.zhang2019_v2_paths import _approach as paths_approach
+from uvnav.controllers.zhang2019_v2_paths import _turn as paths_turn
+from uvnav.controllers.zhang2019_v2_paths import _window as paths_window
 from uvnav.controllers.zhang2019_v2_paths import plan_paths
 from uvnav.dynamics.omni import VelocityCommand
 from uvnav.dynamics.unicycle import UnicycleCommand
@@ -460,14 +461,14 @@ def plan(
                            (q, w, reach, bodies), p, heading=heading, u_max=u_max)  # fmt: skip
 
 
-def path_constants(model: RampModel, params: Zhang2019V2Params) -> FloatArray:
-    """The ``prm`` vector of :func:`uvnav.controllers.zhang2019_v2_paths.choose_on_paths_py`."""
+def path_constants(model: RampModel, params: Zhang2019V2Params, robot_radius: float) -> FloatArray:
+    """The ``prm`` vector of :func:`uvnav.controllers.zhang2019_v2_paths.plan_readings_py`."""
     p = params
     return np.array((model.v_max, model.u_max, model.accel, model.turn_accel, model.period,
                      p.horizon, p.rollout_step, p.comfort, p.comfort_horizon, p.safety_margin,
                      p.limited_spread, p.min_ttc, p.w_ttc, p.w_comfort, p.w_change,
-                     p.forecast_horizon, p.max_tangent_bodies, p.n_headings),
-                    dtype=float)  # fmt: skip
+                     p.forecast_horizon, p.max_tangent_bodies, p.n_headings, robot_radius,
+                     p.spacing), dtype=float)  # fmt: skip
 
 
 def loop_constants(
@@ -542,6 +543,7 @@ def plan_limited(
     params: Zhang2019V2Params,
     *,
     loop: bool | None = None,
+    constants: tuple[FloatArray, FloatArray] | None = None,
 ) -> Choice:
     """One decision of v2 on the unicycle checked along rolled-out paths (module docstring,
     "Acceleration limits"): the candidates of :func:`plan`, each checked along the path the
@@ -550,27 +552,30 @@ def plan_limited(
     ``loop``: choose in one loop (:func:`uvnav.controllers.zhang2019_v2_paths.plan_paths`,
     compiled when numba is enabled; not with the social term) or by :func:`rollout`,
     :func:`path_risk` and :func:`least_cost` in numpy (the reference); ``None``: the loop exactly
-    when numba is enabled."""
+    when numba is enabled; ``constants``: the loop's ``prm`` vector and speeds
+    (:class:`PathConstants`) when already made."""
     p = params
     pos = np.asarray(obs.position, dtype=float)
     v_pref = preferred_under_limits(pos, goal, model)
+    pose = np.asarray(obs.pose, dtype=float)
+    if (numba_enabled() if loop is None else loop) and p.w_social == 0.0:
+        readings = obs.obstacles
+        table = body_table(readings)
+        moving = 1.0 if math.hypot(v_prev[0], v_prev[1]) > 1e-9 else 0.0  # as extra_headings
+        f_norm = math.hypot(v_pref[0], v_pref[1])
+        state = np.array((*pose, *now, *v_pref, f_norm, *v_prev, moving), dtype=float)
+        prm, speeds = constants or (
+            path_constants(model, p, robot_radius),
+            model.v_max * np.asarray(p.speed_levels, dtype=float),
+        )
+        out = plan_paths(state, table, outline_rings(readings, table[0]), speeds, prm)
+        return Choice(out[:2].copy(), float(out[2]), bool(out[3]))
     table = body_table(obs.obstacles)
     keep = reachable(table, model.v_max, p.horizon)
     table = (table[0][keep], table[1][keep], table[2][keep])
     near = () if bool(np.all(table[0][:, 2] > 0.0)) else tuple(obs.obstacles[k] for k in keep)
-    q, w, r, owner, rows = boundary_discs(near, p.spacing, table)
+    q, w, r, owner, _ = boundary_discs(near, p.spacing, table)
     reach = r + robot_radius + p.safety_margin
-    pose = np.asarray(obs.pose, dtype=float)
-    if (numba_enabled() if loop is None else loop) and p.w_social == 0.0:
-        bodies = np.column_stack(
-            [rows, bounding_reach(table[0], p) + robot_radius + p.safety_margin]
-        )
-        moving = 1.0 if math.hypot(v_prev[0], v_prev[1]) > 1e-9 else 0.0  # as extra_headings
-        f_norm = math.hypot(v_pref[0], v_pref[1])
-        state = np.array((*pose, *now, *v_pref, f_norm, *v_prev, moving), dtype=float)
-        speeds = model.v_max * np.asarray(p.speed_levels, dtype=float)
-        out = plan_paths(state, (q, w, reach, owner), bodies, speeds, path_constants(model, p))
-        return Choice(out[:2].copy(), float(out[2]), bool(out[3]))
     tangents = nearest_tangents(pos, (q, w, reach, owner), p)
     headings = np.concatenate([tangents, extra_headings(p.n_headings, v_pref, v_prev)])
     ang, spd, cand = candidates(headings, model.v_max, p.speed_levels, v_pref)
@@ -607,6 +612,26 @@ class LoopConstants:
         if self._value is None or of is None or of[0] is not params or of[1] is not spec:
             self._of = (params, spec)
             self._value = loop_constants(params, float(spec.v_max), float(spec.radius))
+        return self._value
+
+
+class PathConstants:
+    """:func:`plan_limited`'s ``constants``, kept while its parameters are the same object and
+    its vehicle model and radius are equal."""
+
+    def __init__(self) -> None:
+        self._of: tuple[object, RampModel, float] | None = None
+        self._value: tuple[FloatArray, FloatArray] = (np.zeros(0), np.zeros(0))
+
+    def get(
+        self, params: Zhang2019V2Params, model: RampModel, radius: float
+    ) -> tuple[FloatArray, FloatArray]:
+        """:func:`path_constants` of ``params``, ``model`` and ``radius``, and the speeds."""
+        of = self._of
+        if of is None or of[0] is not params or of[1] != model or of[2] != radius:
+            self._of = (params, model, radius)
+            speeds = model.v_max * np.asarray(params.speed_levels, dtype=float)
+            self._value = (path_constants(model, params, radius), speeds)
         return self._value
 
 
@@ -672,6 +697,7 @@ class Zhang2019V2(UnicycleController):
         self._aim = np.zeros(2)
         self._tracker = _tracker(self.params)
         self._fixed = LoopConstants()
+        self._paths = PathConstants()
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
@@ -710,11 +736,12 @@ class Zhang2019V2(UnicycleController):
         applies it; a command within the window of one period."""
         spec = self._spec
         model = RampModel(spec.v_max, spec.u_max, spec.accel_max, spec.turn_accel_max, period)
+        fixed = self._paths.get(self.params, model, float(spec.radius))
         u_before, u_cmd = self._turn
-        u_now = float(approach(np.array(u_before), np.array(u_cmd), spec.turn_accel_max * period))
+        u_now = paths_approach(u_before, u_cmd, spec.turn_accel_max * period)
         v_now = min(max(float(obs.speed), 0.0), spec.v_max) if math.isfinite(obs.speed) else 0.0
         choice = plan_limited(obs, self._goal, model, spec.radius, (v_now, u_now), self._aim,
-                              self.params)  # fmt: skip
+                              self.params, constants=fixed)  # fmt: skip
         self.last_choice = choice
         self._mode = "M1" if choice.preferred else "M2"
         v = choice.velocity
@@ -722,9 +749,9 @@ class Zhang2019V2(UnicycleController):
         self._aim = np.asarray(v, dtype=float)
         gap = v if speed >= 1e-9 else self._goal - obs.position  # standing: face the target
         beta = wrap_scalar(math.atan2(float(gap[1]), float(gap[0])) - obs.heading)
-        target = np.array([speed * max(math.cos(beta), 0.0)])
-        v_out = float(speed_command(target, np.array([v_now]), model)[0])
-        u_out = float(turn_command(np.array([beta]), np.array([u_now]), model)[0])
+        lo, hi = paths_window(v_now, model.accel, period, 0.0, model.v_max)
+        v_out = min(max(speed * max(math.cos(beta), 0.0), lo), hi)  # as speed_command
+        u_out = paths_turn(beta, u_now, fixed[0])  # as turn_command
         self._turn = (u_now, u_out)
         return UnicycleCommand(v_out, u_out).clipped(spec)
 

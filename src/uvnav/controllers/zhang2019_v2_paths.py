@@ -18,12 +18,21 @@ is what cannot change the choice:
   safe are they all checked to the end (resuming where the first visit left off);
 * a path is rolled out only as far as it is checked, and its check stops at the segment of its
   first contact (later segments start later) once past the comfort horizon;
-* per chunk of :data:`CHUNK` segments, the bodies are visited nearest first and the visit ends at
+* per chunk of :data:`CHUNK` segments, the bodies that can reach any path over the chunk (a
+  square about the start, as wide as the fastest path goes) are listed once per decision
+  (:func:`_chunk_bodies`); a candidate's chunk visits them nearest first and the visit ends at
   the first that cannot reach the chunk's path; a body, then a disc, whose box over the chunk
-  stays out of reach of the path's box is skipped.
+  stays out of reach of the path's box is skipped;
+* where no candidate is safe, whether one can still brake is computed only where its cost could
+  win; a braking check answers yes at once when the straight line to a point before the contact
+  already exceeds the stopping distance;
+* the heading and turn rate of a path do not depend on its speed: the paths toward one direction
+  share their sines and cosines (:func:`advance`'s track).
 
 So it picks the reference's candidate, to rounding (its sines and cosines are the C library's,
-the reference's numpy's; tests: hypothesis on random scenes).  Units: metres, seconds, radians.
+the reference's numpy's; tests: hypothesis on random scenes), and exactly the candidate of the
+full evaluation (every path to the horizon, every disc, every segment) made of its own kernels
+(tests).  Units: metres, seconds, radians.
 """
 
 from __future__ import annotations
@@ -35,6 +44,8 @@ from typing import Any
 
 import numpy as np
 
+from uvnav.controllers import zhang2019_v2_loop
+from uvnav.controllers.zhang2019_v2_loop import boundary_discs_py
 from uvnav.geometry import contact
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.contact import _contact_scalar, _gap_scalar, tangents_py
@@ -43,7 +54,7 @@ from uvnav.geometry.kernels3d import numba_enabled
 #: indices into the ``prm`` vector of :func:`choose_on_paths_py` and :func:`plan_paths_py`
 (M_VMAX, M_UMAX, M_ACCEL, M_TURN, M_PERIOD, M_HORIZON, M_STEP, M_COMFORT, M_CHOR, M_MARGIN,
  M_SPREAD, M_MIN_TTC, M_W_TTC, M_W_COMFORT, M_W_CHANGE, M_T_F, M_N_TAN,
- M_N_HEAD) = range(18)  # fmt: skip
+ M_N_HEAD, M_RADIUS, M_SPACING) = range(20)  # fmt: skip
 
 
 def _approach(value: float, target: float, most: float) -> float:
@@ -74,33 +85,52 @@ def _turn(beta: float, u_now: float, prm: FloatArray) -> float:
 
 def advance(
     st: FloatArray, aim: float, speed: float, prm: FloatArray, n_sub: int, xy: FloatArray,
-    speeds: FloatArray, upto: int,
+    speeds: FloatArray, upto: int, track: FloatArray, known: FloatArray,
 ) -> None:  # fmt: skip
     """Extend the path of :func:`uvnav.controllers.zhang2019_limits.rollout` toward one ``aim``
     [rad] at ``speed`` [m/s] (``xy`` (S + 1, 2), ``speeds`` (S + 1,), ``n_sub`` substeps per
     period) to its point ``upto``; ``st``: heading, speed, turn rate, speed and turn rate
     commanded, and the last point computed, updated (from ``xy[0]``, ``speeds[0]``: the pose, its
-    speed and turn rate, held, and 0)."""
+    speed and turn rate, held, and 0).
+
+    The heading and turn rate do not depend on the speed: per substep ``track`` (S, 8) holds
+    the half-turn, its sinc, the cosine and sine of the chord's direction, the cosine of the
+    heading error (at a decision), the turn rate after, the heading after and the turn rate
+    commanded, shared by the paths toward the same ``aim`` from the same start; its first
+    ``known[0]`` rows are read, not computed again, and it is extended as the path is."""
     h = prm[M_PERIOD] / n_sub
     i0 = int(st[5])
     x, y, th, v, u, v_cmd, u_cmd = xy[i0, 0], xy[i0, 1], st[0], st[1], st[2], st[3], st[4]
+    half_was, sinc, last, n_known = math.nan, 1.0, i0, int(known[0])
     for i in range(i0, min(upto, xy.shape[0] - 1)):
-        if i % n_sub == 0:
-            beta = (aim - th + math.pi) % (2.0 * math.pi) - math.pi
+        steer = i % n_sub == 0
+        if i >= n_known:  # the heading track, computed and kept for the paths toward ``aim``
+            if steer:
+                beta = (aim - th + math.pi) % (2.0 * math.pi) - math.pi
+                track[i, 4], track[i, 7] = math.cos(beta), _turn(beta, u, prm)
+            else:
+                track[i, 7] = track[i - 1, 7]
+            u1 = _approach(u, track[i, 7], prm[M_TURN] * h)
+            half = 0.25 * (u + u1) * h
+            if half != half_was:  # the same half-turn as the substep before: the same sinc
+                arg = math.pi * (half / math.pi if half != 0.0 else 1.0e-20)  # numpy's sinc
+                sinc, half_was = math.sin(arg) / arg, half
+            track[i, 0], track[i, 1], track[i, 5] = half, sinc, u1
+            track[i, 2], track[i, 3] = math.cos(th + half), math.sin(th + half)
+            track[i, 6] = th + 2.0 * half
+            n_known = i + 1
+        if steer:
             lo, hi = _window(v, prm[M_ACCEL], prm[M_PERIOD], 0.0, prm[M_VMAX])
-            v_cmd = min(max(speed * max(math.cos(beta), 0.0), lo), hi)
-            u_cmd = _turn(beta, u, prm)
+            v_cmd = min(max(speed * max(track[i, 4], 0.0), lo), hi)
         v1 = _approach(v, v_cmd, prm[M_ACCEL] * h)
-        u1 = _approach(u, u_cmd, prm[M_TURN] * h)
-        vm, half = 0.5 * (v + v1), 0.25 * (u + u1) * h
-        arg = math.pi * (half / math.pi if half != 0.0 else 1.0e-20)  # numpy's sinc
-        chord = vm * h * (math.sin(arg) / arg)
-        x = x + chord * math.cos(th + half)
-        y = y + chord * math.sin(th + half)
-        th = th + 2.0 * half
-        v, u = v1, u1
+        chord = 0.5 * (v + v1) * h * track[i, 1]
+        x = x + chord * track[i, 2]
+        y = y + chord * track[i, 3]
+        th, v, u, u_cmd = track[i, 6], v1, track[i, 5], track[i, 7]
         xy[i + 1, 0], xy[i + 1, 1], speeds[i + 1] = x, y, v
-        st[0], st[1], st[2], st[3], st[4], st[5] = th, v, u, v_cmd, u_cmd, i + 1
+        last = i + 1
+    known[0] = n_known
+    st[0], st[1], st[2], st[3], st[4], st[5] = th, v, u, v_cmd, u_cmd, last
 
 
 #: segments per chunk of :func:`risk_along`'s cull
@@ -161,15 +191,40 @@ def _far(box: FloatArray, qw: tuple[float, float, float, float], t_a: float, t_b
     return _box_gap(box, qx + wx * t_a, qy + wy * t_a, qx + wx * t_b, qy + wy * t_b) > lim
 
 
+def _chunk_bodies(
+    c: int, t_a: float, t_b: float, lim: float, xy: FloatArray, bodies: FloatArray,
+    cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float, FloatArray],
+) -> None:  # fmt: skip
+    """The bodies (nearest first) that may come within reach of any path over chunk ``c``
+    (times ``t_a`` .. ``t_b``), into ``cull``'s lists: a path moves at most ``cull[4]`` [m/s]
+    from its start ``xy[0]``, so its box over the chunk lies in the square of that half-width
+    about the start, and a body whose box over the chunk stays, box to box, farther than its
+    bounding reach plus ``lim`` from that square is farther from the path's box too."""
+    order, lists, top = cull[0], cull[3], cull[4]
+    n_b = order.shape[0]
+    half = top * t_b * (1.0 + 1e-9) + 1e-9
+    square = np.array((xy[0, 0] - half, xy[0, 0] + half, xy[0, 1] - half, xy[0, 1] + half))
+    n = 0
+    for b in order:
+        body = (bodies[b, 2], bodies[b, 3], bodies[b, 4], bodies[b, 5])
+        if not _far(square, body, t_a, t_b, bodies[b, 6] + lim):
+            lists[0, c * n_b + n] = b
+            n += 1
+    lists[1, c] = n
+
+
 def risk_along(
-    path: tuple[FloatArray, FloatArray, FloatArray], aim: float, speed: float, n_sub: int,
+    path: tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray], aim: float,
+    speed: float, n_sub: int,
     times: FloatArray, discs: tuple[FloatArray, FloatArray, FloatArray], bodies: FloatArray,
-    cull: tuple[np.ndarray, FloatArray, float], prm: FloatArray, give_up: float, base: float,
+    cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float, FloatArray], prm: FloatArray,
+    give_up: float, base: float,
     safe_only: bool, risk: FloatArray,
 ) -> None:  # fmt: skip
     """The first contact and comfort penalty of one candidate's path
     (:func:`uvnav.controllers.zhang2019_limits.path_risk` of one row), rolled out as far as it
-    is read (``path``: :func:`advance`'s ``xy``, ``speeds`` and ``st``), into ``risk`` (ttc, pen,
+    is read (``path``: :func:`advance`'s ``xy``, ``speeds``, ``st``, ``track`` and ``known``),
+    into ``risk`` (ttc, pen,
     and the first segment not yet checked: a later call resumes there); stops early, with the
     figures so far, once the cost exceeds ``give_up`` (``base`` plus the risk terms so far: the
     path cannot win) or, when ``safe_only``, once a contact comes at or before ``min_ttc`` (the
@@ -182,19 +237,19 @@ def risk_along(
     bodies by their gap at the start (distance from the robot's start to the centre less the
     bounding reach), that gap, and the largest body speed; the bodies are visited in that
     order, and the visit stops at the first that cannot close in on the chunk's path."""
-    xy, speeds, st = path
+    xy, speeds, st, track, known = path
     q, w, reach = discs
-    order, gap, fastest = cull
+    gap, fastest, lists = cull[1], cull[2], cull[3]
+    n_b, box = gap.shape[0], cull[5]
     c_h, spread, w_ttc, w_comfort = prm[M_CHOR], prm[M_SPREAD], prm[M_W_TTC], prm[M_W_COMFORT]
     n_seg = times.shape[0] - 1
-    box = np.empty(4)
     while risk[2] < n_seg:
         i0 = int(risk[2])
         i1 = min(i0 + CHUNK, n_seg)
         if times[i0] >= c_h and risk[0] <= times[i0]:
             risk[2] = n_seg  # no earlier contact on later segments, no comfort term beyond c_h
             break
-        advance(st, aim, speed, prm, n_sub, xy, speeds, i1)
+        advance(st, aim, speed, prm, n_sub, xy, speeds, i1, track, known)
         t_a, t_b = times[i0], times[i1]
         lim_far = spread * t_b + (prm[M_COMFORT] if t_a < c_h else 0.0) + 1e-9
         _path_box(xy, i0, i1, box)
@@ -202,7 +257,11 @@ def risk_along(
         for corner in range(4):
             cx, cy = box[corner // 2] - xy[0, 0], box[2 + corner % 2] - xy[0, 1]
             out_to = max(out_to, math.hypot(cx, cy))
-        for b in order:
+        c = i0 // CHUNK
+        if lists[1, c] < 0:
+            _chunk_bodies(c, t_a, t_b, lim_far, xy, bodies, cull)
+        for idx in range(lists[1, c]):
+            b = lists[0, c * n_b + idx]
             if gap[b] > fastest * t_b + out_to + lim_far:
                 break  # this body and the farther ones stay out of reach over the chunk
             body = (bodies[b, 2], bodies[b, 3], bodies[b, 4], bodies[b, 5])
@@ -226,6 +285,13 @@ def _stops(xy: FloatArray, times: FloatArray, speeds: FloatArray, ttc: float, n_
     """:func:`uvnav.controllers.zhang2019_limits.stoppable` of one path."""
     if not math.isfinite(ttc):
         return True
+    v_t = speeds[min(n_sub, speeds.shape[0] - 1)]
+    need = v_t * prm[M_PERIOD] + v_t * v_t / (2.0 * prm[M_ACCEL])
+    m = min(int(ttc / times[1]), times.shape[0] - 1)
+    while m > 0 and times[m] > ttc:
+        m -= 1
+    if math.hypot(xy[m, 0] - xy[0, 0], xy[m, 1] - xy[0, 1]) > need * (1.0 + 1e-9) + 1e-12:
+        return True  # the path to the contact is longer than the straight line to a point on it
     length, to_contact = 0.0, math.nan
     for i in range(times.shape[0] - 1):
         after = length + math.hypot(xy[i + 1, 0] - xy[i, 0], xy[i + 1, 1] - xy[i, 1])
@@ -236,16 +302,31 @@ def _stops(xy: FloatArray, times: FloatArray, speeds: FloatArray, ttc: float, n_
         length = after
     if math.isnan(to_contact):
         to_contact = length
-    v_t = speeds[min(n_sub, speeds.shape[0] - 1)]
-    period = prm[M_PERIOD]
-    return to_contact >= v_t * period + v_t * v_t / (2.0 * prm[M_ACCEL])
+    return to_contact >= need
+
+
+def _better(best: FloatArray, slot: int, cost: float, k: int) -> bool:
+    """Candidate ``k`` at ``cost`` would replace ``best``'s ``slot`` (cost, index, ttc): it costs
+    less, or as much with a lower index."""
+    return cost < best[slot] or (cost == best[slot] and k < best[slot + 1])
 
 
 def _keep(best: FloatArray, slot: int, cost: float, k: int, ttc: float) -> None:
-    """Record candidate ``k`` in ``best``'s ``slot`` (cost, index, ttc) when it costs less, or as
-    much with a lower index."""
-    if cost < best[slot] or (cost == best[slot] and k < best[slot + 1]):
+    """Record candidate ``k`` in ``best``'s ``slot`` when :func:`_better`."""
+    if _better(best, slot, cost, k):
         best[slot], best[slot + 1], best[slot + 2] = cost, k, ttc
+
+
+def _groups(ang: FloatArray) -> np.ndarray:
+    """Per candidate the index of its direction among the distinct values of ``ang``."""
+    by = np.argsort(ang)
+    group = np.empty(ang.shape[0], dtype=np.int64)
+    g = -1
+    for i in range(by.shape[0]):
+        if i == 0 or ang[by[i]] != ang[by[i - 1]]:
+            g += 1
+        group[by[i]] = g
+    return group
 
 
 def choose_on_paths_py(
@@ -274,13 +355,19 @@ def choose_on_paths_py(
         xy[k, 0, 0], xy[k, 0, 1], speeds[k, 0] = pose[0], pose[1], now[0]
         st[k, 0], st[k, 1], st[k, 2], st[k, 3], st[k, 4], st[k, 5] = (
             pose[2], now[0], now[1], now[0], now[1], 0.0)  # fmt: skip
+    group = _groups(ang)  # the paths toward one direction share their heading track
+    track = np.empty((int(group.max()) + 1 if n_c else 0, n, 8))
+    known = np.zeros(track.shape[0])
     min_ttc, w_ttc, w_comfort = prm[M_MIN_TTC], prm[M_W_TTC], prm[M_W_COMFORT]
     gap = np.empty(bodies.shape[0])
     fastest = 0.0
     for b in range(bodies.shape[0]):
         gap[b] = math.hypot(bodies[b, 2] - pose[0], bodies[b, 3] - pose[1]) - bodies[b, 6]
         fastest = max(fastest, math.hypot(bodies[b, 4], bodies[b, 5]))
-    cull = (np.argsort(gap), gap, fastest)
+    n_chunks = (n + CHUNK - 1) // CHUNK
+    lists = np.full((2, max(n_chunks * bodies.shape[0], n_chunks)), -1, dtype=np.int64)
+    top = max(prm[M_VMAX], abs(now[0]))  # no path moves faster
+    cull = (np.argsort(gap), gap, fastest, lists, top, np.empty(4))
     # best safe, best admissible, best of all: cost, index, ttc
     best = np.array([math.inf, -1.0, math.inf, math.inf, -1.0, math.inf, math.inf, -1.0, math.inf])
     for safe_only in (True, False):  # the safe one if any; all of them only when none is
@@ -288,16 +375,21 @@ def choose_on_paths_py(
             if best[1] >= 0.0 and base[k] > best[0]:
                 break
             give_up = best[0] if best[1] >= 0.0 else math.inf
-            path = (xy[k], speeds[k], st[k])
+            g = group[k]
+            path = (xy[k], speeds[k], st[k], track[g], known[g : g + 1])
             risk_along(path, ang[k], spd[k], n_sub, times, discs, bodies, cull, prm, give_up,
                        base[k], safe_only, risk[k])  # fmt: skip
             ttc, pen = risk[k, 0], risk[k, 1]
             cost = base[k] + w_ttc / max(ttc, 1e-3) + w_comfort * pen
             if (safe_only and ttc <= min_ttc) or cost > give_up:
                 continue
+            if not (safe_only or _better(best, 3, cost, k)):
+                _keep(best, 6, cost, k, ttc)  # whether it brakes cannot matter
+                continue
             if math.isfinite(ttc):  # the path to the contact and the speed after one period
-                advance(st[k], ang[k], spd[k], prm, n_sub, xy[k], speeds[k],
-                        max(n_sub, min(int(ttc / h) + 2, n)))  # fmt: skip
+                upto = max(n_sub, min(int(ttc / h) + 2, n))
+                advance(st[k], ang[k], spd[k], prm, n_sub, xy[k], speeds[k], upto, track[g],
+                        known[g : g + 1])  # fmt: skip
             brakes = _stops(xy[k], times, speeds[k], ttc, n_sub, prm)
             if brakes and ttc > min_ttc:
                 _keep(best, 0, cost, k, ttc)
@@ -335,10 +427,11 @@ def plan_paths_py(
     n_tan, n_head, w_change = prm[M_N_TAN], int(prm[M_N_HEAD]), prm[M_W_CHANGE]
     n_few = 0
     grow = np.empty(q.shape[0])
-    for j in range(q.shape[0]):
+    for j in range(q.shape[0]):  # the discs of the nearest bodies (owner is non-decreasing)
+        if owner[j] >= n_tan:
+            break
         grow[j] = reach[j] + math.hypot(w[j, 0], w[j, 1]) * prm[M_T_F]
-        if owner[j] < n_tan:
-            n_few = j + 1
+        n_few = j + 1
     tang = np.empty(2 * n_few + 1)
     n_t = tangents_py(px, py, q, grow, owner, n_few, tang)
     n_x = n_head + (2 if state[10] > 0.0 else 1)
@@ -370,6 +463,51 @@ def plan_paths_py(
     out[3] = 1.0 if k == n_c - 2 and math.isinf(pick[1]) else 0.0
 
 
+def plan_readings_py(
+    state: FloatArray, scal: FloatArray, centre: FloatArray, vel: FloatArray, rings: FloatArray,
+    ring_start: np.ndarray, speeds: FloatArray, prm: FloatArray, out: FloatArray,
+) -> None:  # fmt: skip
+    """:func:`plan_paths_py` from the readings as arrays (``scal``, ``centre``, ``vel``,
+    ``rings``, ``ring_start``: as :func:`uvnav.controllers.zhang2019_v2_loop.plan_loop_py`
+    reads them): the bodies that can reach the robot within the horizon
+    (:func:`~uvnav.controllers.zhang2019_v2_bodies.reachable`), their boundary discs
+    (:func:`~uvnav.controllers.zhang2019_v2_loop.boundary_discs_py`), each disc's reach (its
+    radius plus the robot's radius ``prm[M_RADIUS]`` and the margin) and per body its discs,
+    centre, velocity and bounding reach (:func:`uvnav.controllers.zhang2019_v2.bounding_reach`
+    plus the same), computed as the numpy building blocks compute them."""
+    v_max, horizon, spacing = prm[M_VMAX], prm[M_HORIZON], prm[M_SPACING]
+    n = scal.shape[0]
+    keep = np.empty(n, dtype=np.int64)
+    n_keep = 0
+    for k in range(n):
+        bound = math.hypot(vel[k, 0], vel[k, 1]) + abs(scal[k, 1]) * scal[k, 3]
+        if scal[k, 0] <= (v_max + bound) * horizon:
+            keep[n_keep] = k
+            n_keep += 1
+    keep = keep[:n_keep]
+    q, w, r, owner = boundary_discs_py(keep, scal, centre, vel, rings, ring_start, spacing)
+    reach = np.empty(r.shape[0])
+    for j in range(r.shape[0]):
+        reach[j] = r[j] + prm[M_RADIUS] + prm[M_MARGIN]
+    bodies = np.zeros((n_keep, 7))
+    for j in range(owner.shape[0]):  # owner is non-decreasing: each body's first and end disc
+        b = owner[j]
+        if j == 0 or owner[j - 1] != b:
+            bodies[b, 0] = j
+        bodies[b, 1] = j + 1
+    for i in range(n_keep):
+        k = keep[i]
+        bodies[i, 2], bodies[i, 3], bodies[i, 4], bodies[i, 5] = (
+            centre[k, 0], centre[k, 1], vel[k, 0], vel[k, 1])  # fmt: skip
+        if scal[k, 2] > 0.0:
+            bound_r = scal[k, 3]
+        else:
+            uh = scal[k, 1] * horizon
+            bound_r = scal[k, 3] * math.sqrt(1.0 + uh * uh) + 0.5 * spacing
+        bodies[i, 6] = bound_r + prm[M_RADIUS] + prm[M_MARGIN]
+    plan_paths_py(state, q, w, reach, owner, bodies, speeds, prm, out)
+
+
 _COMPILED: dict[str, Callable[..., Any]] = {}
 
 
@@ -379,30 +517,31 @@ def _compiled_plan() -> Callable[..., Any]:
     if not _COMPILED:
         import numba
 
-        done = dict(contact._kernels())
+        zhang2019_v2_loop._compiled_plan()
+        done = {**contact._kernels(), **zhang2019_v2_loop._COMPILED}
         kernels = (_approach, _window, _turn, advance, _box_gap, _path_box, _disc_along, _far,
-                   risk_along, _stops, _keep, choose_on_paths_py, plan_paths_py)  # fmt: skip
+                   _chunk_bodies,
+                   risk_along, _stops, _better, _keep, _groups, choose_on_paths_py, plan_paths_py,
+                   plan_readings_py)  # fmt: skip
         for f in kernels:
             env = {**f.__globals__, **done}
             copy = types.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
             done[f.__name__] = _COMPILED[f.__name__] = numba.njit(cache=True, nogil=True)(copy)
-    return _COMPILED["plan_paths_py"]
+    return _COMPILED["plan_readings_py"]
 
 
 def plan_paths(
     state: FloatArray,
-    discs: tuple[FloatArray, FloatArray, FloatArray, np.ndarray],
-    bodies: FloatArray,
+    table: tuple[FloatArray, FloatArray, FloatArray],
+    rings: tuple[FloatArray, np.ndarray],
     speeds: FloatArray,
     prm: FloatArray,
 ) -> FloatArray:
-    """:func:`plan_paths_py` (compiled when numba is enabled): ``(vx, vy, ttc, preferred)``."""
-    q, w, reach, owner = discs
-    c = np.ascontiguousarray
+    """:func:`plan_readings_py` (compiled when numba is enabled) of the readings read into
+    arrays (``table``: :func:`~uvnav.controllers.zhang2019_v2_bodies.body_table`, ``rings``:
+    :func:`~uvnav.controllers.zhang2019_v2_loop.outline_rings`): ``(vx, vy, ttc, preferred)``."""
     out = np.empty(4)
-    fn = _compiled_plan() if numba_enabled() else plan_paths_py
-    fn(c(state, dtype=float), c(q, dtype=float).reshape(-1, 2), c(w, dtype=float).reshape(-1, 2),
-       c(reach, dtype=float), c(owner, dtype=np.int64), c(bodies, dtype=float).reshape(-1, 7),
-       c(speeds, dtype=float),
-       c(prm, dtype=float), out)  # fmt: skip
+    fn = _compiled_plan() if numba_enabled() else plan_readings_py
+    scal, centre, vel = table
+    fn(state, scal, centre, vel, rings[0], rings[1], speeds, prm, out)
     return out
