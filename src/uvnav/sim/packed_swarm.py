@@ -173,6 +173,36 @@ def _arrivals(rob: FloatArray, status: np.ndarray, t: float, tol: float) -> None
             status[i], rob[i, R_REACHED] = SUCCESS, t
 
 
+def hold_py(
+    rob: FloatArray, members: np.ndarray, m: int, cmds: FloatArray, stepped: bool, period: float
+) -> None:
+    """Hold the commands ``cmds[k] = (V, u)`` of the robots ``members[k]`` (k < ``m``) as
+    :meth:`MultiUnicycleWorld.apply` holds one: counted in ``R_VIOL`` when outside the limits
+    (2.4) (:meth:`~uvnav.dynamics.unicycle.UnicycleCommand.violates`), saturated
+    (:meth:`~uvnav.dynamics.unicycle.UnicycleCommand.clipped`: NaN and infinite components 0),
+    the speed change's effort ``(V - V_held)^2 / period`` added once the episode has
+    ``stepped``, into ``R_V`` and ``R_U``."""
+    for k in range(m):
+        i = members[k]
+        v, u = cmds[k, 0], cmds[k, 1]
+        vmax, umax = rob[i, R_VMAX], rob[i, R_UMAX]
+        if v < -1e-9 or v > vmax + 1e-9 or abs(u) > umax + 1e-9:
+            rob[i, R_VIOL] += 1.0
+        if math.isfinite(v):
+            v = 0.0 if v < 0.0 else v
+            v = vmax if vmax < v else v
+        else:
+            v = 0.0
+        if math.isfinite(u):
+            u = -umax if -umax > u else u
+            u = umax if umax < u else u
+        else:
+            u = 0.0
+        if stepped:
+            rob[i, R_EFFORT] += ((v - rob[i, R_V]) ** 2) / period
+        rob[i, R_V], rob[i, R_U] = v, u
+
+
 def swarm_decide_py(
     rob: FloatArray, status: np.ndarray, ints: np.ndarray, flt: FloatArray, draws: FloatArray,
     upos: np.ndarray, scratch: FloatArray, idx: np.ndarray, members: np.ndarray,
@@ -199,27 +229,9 @@ def swarm_decide_py(
         members[:m], step * dt, flt[F_EPS:], ints[I_MAXNB], rob[:, R_ORAD:], draws, upos,
         rob[:, R_X:R_Y + 1], rob[:, R_TH], rob[:, R_VX:R_VY + 1], scratch, idx, periods, pick, out,
     )  # fmt: skip
+    hold_py(rob, members, m, out, step != 0, ints[I_RATIO] * dt)
     for k in range(m):
         i = members[k]
-        v, u = out[k, 0], out[k, 1]
-        vmax, umax = rob[i, R_VMAX], rob[i, R_UMAX]
-        if v < -1e-9 or v > vmax + 1e-9 or abs(u) > umax + 1e-9:
-            rob[i, R_VIOL] += 1.0
-        if math.isfinite(v):
-            v = 0.0 if v < 0.0 else v
-            v = vmax if vmax < v else v
-        else:
-            v = 0.0
-        if math.isfinite(u):
-            u = -umax if -umax > u else u
-            u = umax if umax < u else u
-        else:
-            u = 0.0
-        if step:
-            rob[i, R_EFFORT] += ((v - rob[i, R_V]) ** 2) / (ints[I_RATIO] * dt)
-        else:
-            rob[i, R_EFFORT] += 0.0
-        rob[i, R_V], rob[i, R_U] = v, u
         mode = out[k, 6]
         if rob[i, R_NDEC] > 0.0 and mode != rob[i, R_MODE]:
             rob[i, R_SWITCH] += 1.0
@@ -277,20 +289,27 @@ _KERNELS: dict[str, Callable[..., Any]] = {}
 
 def _kernel(name: str) -> Callable[..., Any]:
     """The function ``name`` of this module's kernels (:func:`swarm_decide_py`,
-    :func:`swarm_advance_py`, :func:`_pair_check`), compiled when numba is enabled."""
+    :func:`swarm_advance_py`, :func:`_pair_check`, :func:`hold_py`), compiled when numba is
+    enabled."""
     if not numba_enabled():
         plain: dict[str, Callable[..., Any]] = {
             "swarm_decide_py": swarm_decide_py,
             "swarm_advance_py": swarm_advance_py,
             "_pair_check": _pair_check,
+            "hold_py": hold_py,
         }
         return plain[name]
     if not _KERNELS:
         _KERNELS.update(compile_family(
-            (*FAMILY, unicycle_advance, segment_gap, _pair_check, _arrivals, swarm_decide_py,
-             swarm_advance_py)
+            (*FAMILY, unicycle_advance, segment_gap, _pair_check, _arrivals, hold_py,
+             swarm_decide_py, swarm_advance_py)
         ))  # fmt: skip
     return _KERNELS[name]
+
+
+def hold_kernel() -> Callable[..., Any]:
+    """:func:`hold_py`, compiled when numba is enabled."""
+    return _kernel("hold_py")
 
 
 def _kernels() -> tuple[Callable[..., Any], Callable[..., Any]]:
