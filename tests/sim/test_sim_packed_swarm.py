@@ -233,7 +233,7 @@ def test_a_bulk_hold_counts_and_saturates_commands_outside_the_limits_as_apply_d
             for step in range(2):  # the second hold adds the speed change's effort
                 cmds = np.array(odd[step:] + odd[:step])
                 if bulk:
-                    world.apply_many(range(6), cmds)  # type: ignore[arg-type]
+                    world.apply_many(range(6), cmds)
                 else:
                     for i, (v, u) in enumerate(cmds.tolist()):
                         world.apply(UnicycleCommand(v, u), i)
