@@ -169,26 +169,20 @@ class Draws:
 
     Attributes:
         draws: (N, 2 BLOCK) each agent's numbers; ``upos[i]`` the next unread one of agent i.
-        left: decisions that cannot run out of pre-drawn numbers (a caller that sees it above 0
-            may count it down itself instead of calling :meth:`ready`).
     """
 
-    def __init__(
-        self, rngs: Sequence[np.random.Generator | None], perturbation: float,
-        upos: np.ndarray | None = None,
-    ) -> None:  # fmt: skip
+    def __init__(self, rngs: Sequence[np.random.Generator | None], perturbation: float) -> None:
         n = len(rngs)
         self._rngs = rngs
         self.on = perturbation > 0.0
         self.draws = np.zeros((n, 2 * BLOCK))
-        self.upos = np.empty(n, dtype=np.int64) if upos is None else upos  # (n,) int64 to use
-        self.upos[:] = 2 * BLOCK
-        self.left = 0
+        self.upos = np.full(n, 2 * BLOCK, dtype=np.int64)
+        self._safe = 0  # decisions that cannot run out of pre-drawn numbers
 
     def ready(self) -> None:
         """Before a decision of any agents: refill when one could run out (every ``BLOCK``
         decisions: each agent's unread numbers moved to the front, the rest drawn)."""
-        if self.left == 0:
+        if self._safe == 0:
             if self.on:
                 for i, g in enumerate(self._rngs):
                     if g is None:
@@ -197,8 +191,8 @@ class Draws:
                     self.draws[i, : len(rest)] = rest
                     self.draws[i, len(rest) :] = g.random(2 * BLOCK - len(rest))
             self.upos[:] = 0
-            self.left = BLOCK
-        self.left -= 1
+            self._safe = BLOCK
+        self._safe -= 1
 
 
 class SharedOrca:

@@ -1,19 +1,18 @@
-"""Packed swarms: N unicycles deciding by ``orca-shared-v1``, stepped in one compiled call a step.
+"""Packed swarms: N unicycles deciding by ``orca-shared-v1``, stepped in two compiled calls a step.
 
 The multi-robot world of :mod:`uvnav.sim.multi` (thesis Ch. 8's robots that avoid each other;
 unicycles (2.1)-(2.4) with disc bodies) for the case that needs speed more than generality: every
 robot on ``orca-shared-v1`` with the same parameters (ORCA, van den Berg et al., ISRR 2009:
 :mod:`uvnav.controllers.orca_shared`), exact sensing with known velocities, no obstacle besides
-the robots.  A step is one call of :func:`swarm_step_py`: :func:`swarm_decide_py` (the group
-decision,
+the robots.  A step is :func:`swarm_decide_py` (the group decision,
 :func:`uvnav.controllers.orca_kernels.group_decide_py`, the kernel ``orca-shared-v1`` decides a
 group with in the loop too, when one is due, and the commands held) then
 :func:`swarm_advance_py` (the unicycles, robot-pair checks, arrivals, time limit: the step the
 loop world :class:`~uvnav.sim.multi.MultiUnicycleWorld` takes for a world of robots only, through
 :class:`SwarmState`): loops over preallocated arrays, compiled by numba when it is enabled; the
-Python functions are the reference and the fallback.  The world's share of a step is
-:func:`hold_py` too: the loop world holds a group's commands with it
-(:meth:`~uvnav.sim.multi.MultiUnicycleWorld.apply_many`).
+Python functions are the reference and the fallback.  Two calls, not one, so that the decisions
+are timed as the one loop times a group's (:func:`uvnav.core.run_loop`: CPU and wall time divided
+among the members).
 
 It is :func:`uvnav.core.run_loop` over :class:`~uvnav.sim.multi.MultiUnicycleWorld` bit for bit
 (the tests compare every pose, status, clearance and collided pair at every step, and the whole
@@ -34,13 +33,7 @@ here (:func:`run_swarm`; campaigns and ``uvnav simulate`` with them):
 * pairs: the arithmetic of :class:`uvnav.sim.multi._DiscPairs` with numpy's ``hypot`` (libm's,
   not CPython's) where it uses it.
 
-**Decision times.**  One compiled call a step (one dispatch, not two: the arguments' unboxing
-is a good part of a call at 10 robots) is timed as :func:`uvnav.core.run_loop` times a group
-(CPU and wall time divided among the robots that decided), so a robot's decision time here is
-its share of the whole step: the decision *and* the world's step (motion, pair checks,
-arrivals; about 40 % of the call at 10 robots on ``antipodal:10``).  It bounds the decision's
-own time from above; the loop world (``run_episode(..., vectorised=False)``, or any scene this
-module does not pack) times the decision alone.  Measured, so they differ from run to run.
+Decision times are measured, so they differ from run to run, as the loop's do.
 """
 
 from __future__ import annotations
@@ -316,49 +309,25 @@ def swarm_advance_py(
     return done
 
 
-def swarm_step_py(
-    rob: FloatArray, status: np.ndarray, pairs: np.ndarray, ints: np.ndarray, flt: FloatArray,
-    hist: FloatArray, draws: FloatArray, iwork: np.ndarray, fwork: FloatArray,
-) -> int:  # fmt: skip
-    """One iteration of the loop in one call: :func:`swarm_decide_py` then
-    :func:`swarm_advance_py`; returns twice the number of robots that decided, plus 1 when the
-    episode is over.  The N robots' work arrays are carved from two (fewer arguments, a cheaper
-    call): ``iwork`` (2 N + cap,) int64 holds ``upos`` (N,), ``members`` (N,) and ``idx``
-    (cap,); ``fwork`` (10 N + 8 cap,) the periods (N,), ``pick`` (N, 2), ``out`` (N, 7) and
-    ``scratch`` (2 cap, 4) (cap = max(max_neighbors, 1))."""
-    n = rob.shape[0]
-    cap = iwork.shape[0] - 2 * n
-    upos, members, idx = iwork[:n], iwork[n : 2 * n], iwork[2 * n :]
-    periods = fwork[:n]
-    pick = fwork[n : 3 * n].reshape((n, 2))
-    out = fwork[3 * n : 10 * n].reshape((n, 7))
-    scratch = fwork[10 * n :].reshape((2 * cap, 4))
-    m = swarm_decide_py(
-        rob, status, ints, flt, draws, upos, scratch, idx, members, periods, pick, out
-    )
-    return 2 * m + swarm_advance_py(rob, status, pairs, ints, flt, hist)
-
-
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
 
 def _kernel(name: str) -> Callable[..., Any]:
     """The function ``name`` of this module's kernels (:func:`swarm_decide_py`,
-    :func:`swarm_advance_py`, :func:`_pair_check`, :func:`hold_py`, :func:`swarm_step_py`),
-    compiled when numba is enabled."""
+    :func:`swarm_advance_py`, :func:`_pair_check`, :func:`hold_py`), compiled when numba is
+    enabled."""
     if not numba_enabled():
         plain: dict[str, Callable[..., Any]] = {
             "swarm_decide_py": swarm_decide_py,
             "swarm_advance_py": swarm_advance_py,
             "_pair_check": _pair_check,
             "hold_py": hold_py,
-            "swarm_step_py": swarm_step_py,
         }
         return plain[name]
     if not _KERNELS:
         _KERNELS.update(compile_family(
             (*FAMILY, unicycle_advance, segment_gap, _side_gaps, _pair_check, _arrivals, hold_py,
-             swarm_decide_py, swarm_advance_py, swarm_step_py)
+             swarm_decide_py, swarm_advance_py)
         ))  # fmt: skip
     return _KERNELS[name]
 
@@ -366,6 +335,11 @@ def _kernel(name: str) -> Callable[..., Any]:
 def hold_kernel() -> Callable[..., Any]:
     """:func:`hold_py`, compiled when numba is enabled."""
     return _kernel("hold_py")
+
+
+def _kernels() -> tuple[Callable[..., Any], Callable[..., Any]]:
+    """:func:`swarm_decide_py` and :func:`swarm_advance_py`, compiled when numba is enabled."""
+    return _kernel("swarm_decide_py"), _kernel("swarm_advance_py")
 
 
 class SwarmState:
@@ -500,14 +474,16 @@ class PackedSwarm(SwarmState):
             float(p.time_horizon),
             float(p.responsibility),
         )
-        scratch, idx = group_scratch(p)
-        iwork = np.zeros(2 * n + len(idx), dtype=np.int64)  # swarm_step_py's work arrays
-        fwork = np.zeros(10 * n + scratch.size)
-        self._draws = Draws(rng.spawn(2 * n)[0::2], float(p.perturbation), iwork[:n])  # law i:
-        self._step = _kernel("swarm_step_py")  # child 2i
-        self._step_args = (
-            rob, self.status, self.pairs, self.ints, self.flt, self.hist, self._draws.draws,
-            iwork, fwork,
+        self._draws = Draws(rng.spawn(2 * n)[0::2], float(p.perturbation))  # child 2i: law i
+        self._scratch, self._idx = group_scratch(p)
+        self._members = np.zeros(n, dtype=np.int64)
+        self._periods = np.zeros(n)
+        self._pick = np.zeros((n, 2))
+        self._out = np.zeros((n, 7))
+        self._decide = _kernel("swarm_decide_py")
+        self._decide_args = (
+            rob, self.status, self.ints, self.flt, self._draws.draws, self._draws.upos,
+            self._scratch, self._idx, self._members, self._periods, self._pick, self._out,
         )  # fmt: skip
         self._cpu_ns: list[int] = []  # each group decision's CPU and wall time per member [ns]
         self._wall_ns: list[int] = []
@@ -532,28 +508,22 @@ class PackedSwarm(SwarmState):
         return self.step_index * self.dt
 
     def step(self) -> bool:
-        """One iteration of the loop in one compiled call (:func:`swarm_step_py`): the decisions
-        when due, then one step ``dt``; returns :attr:`done`.  The call's CPU and wall time,
-        divided among the robots that decided, is each one's decision time (module docstring,
-        "Decision times")."""
+        """One iteration of the loop: the decisions when due (their CPU and wall time kept, as
+        :func:`uvnav.core.run_loop` keeps a group's), then one step ``dt``; returns
+        :attr:`done`."""
         if self.ints[I_DONE]:
             return True
-        draws = self._draws
-        if draws.left:
-            draws.left -= 1
-        else:
-            draws.ready()
+        self._draws.ready()
         c0, w0 = _time.thread_time_ns(), _time.perf_counter_ns()
-        code = self._step(*self._step_args)
-        c1, w1 = _time.thread_time_ns(), _time.perf_counter_ns()
-        m = code >> 1
+        m = self._decide(*self._decide_args)
         if m:
+            c1, w1 = _time.thread_time_ns(), _time.perf_counter_ns()
             self._cpu_ns.append((c1 - c0) // m)
             self._wall_ns.append((w1 - w0) // m)
-        if code & 1:
+        done = self.advance_kernel(*self._advance_args)
+        if done:
             self._finish()
-            return True
-        return False
+        return bool(done)
 
     def run(self) -> None:
         """Step to the end."""
