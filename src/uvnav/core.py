@@ -31,6 +31,13 @@ members deciding; probes get ``obs=None``).  A group may read more of the world 
 agent's observation (e.g. :class:`DiscAgents`, the state of every disc robot), so only laws that
 say so join one (``orca-shared-v1``, :mod:`uvnav.controllers.orca_shared`).
 
+**Bulk hold.**  When no probe watches, the world has ``apply_many(agents, commands)`` and the
+group ``decide_many(world, members, laws)`` (both optional), the group's commands travel as one
+array (a row per member, in the world's layout: ``(V, u)`` for the unicycle), held by one
+``apply_many`` call, and the members' decisions are recorded in one pass
+(:meth:`AgentLog.record_group`): no command object is made per member.  What is held, counted
+and recorded is what the per-member path holds, counts and records.
+
 Decision period and integration step are separate: a world says when a decision is due (every
 ``control_period``, a whole multiple of ``dt``).  The loop counts each agent's mode switches and
 times each decision with :func:`time.thread_time_ns` (CPU time of this thread, immune to other
@@ -248,6 +255,24 @@ class AgentLog:
         """:attr:`decision_us` as an array (one zero when no decision was made)."""
         return np.asarray(self.decision_us) if self.decision_us else np.zeros(1)
 
+    @staticmethod
+    def record_group(
+        logs: Sequence[AgentLog], laws: Sequence[Any], agents: Sequence[int], cpu_ns: int,
+        wall_ns: int,
+    ) -> None:  # fmt: skip
+        """:meth:`record` for each of ``agents`` (``laws[i].mode``, the same CPU and wall time
+        each), in one pass."""
+        cpu, wall = cpu_ns / 1000.0, wall_ns / 1000.0
+        for i in agents:
+            log, mode = logs[i], laws[i].mode
+            if mode != log.last_mode:
+                if log._decided:
+                    log.mode_switches += 1
+                log.last_mode = mode
+            log._decided = True
+            log.decision_us.append(cpu)
+            log.decision_wall_us.append(wall)
+
     def record(self, mode: str, cpu_ns: int, wall_ns: int) -> None:
         """Account for one decision."""
         if mode != self.last_mode:
@@ -288,12 +313,25 @@ def run_loop(
     observe, apply, advance, deciding = world.observe, world.apply, world.advance, world.acting
     acts = [law.act for law in laws]
     records = [log.record for log in logs]
+    apply_many = None if probes else getattr(world, "apply_many", None)
+    bulk = {k: getattr(g, "decide_many", None) if apply_many else None for k, g in groups.items()}
+    whole = len(groups) == 1 and None not in keys  # every agent in the one group
+    record_group = AgentLog.record_group
     while not world.done:
         acting = deciding()
         if groups and acting:
             for key, group in groups.items():
-                members = [i for i in acting if keys[i] == key]
+                members = acting if whole else [i for i in acting if keys[i] == key]
                 if not members:
+                    continue
+                many = bulk[key]
+                if many is not None:  # module docstring, "Bulk hold"
+                    c0, w0 = cpu_ns(), wall_ns()
+                    held = many(world, members, laws)
+                    c1, w1 = cpu_ns(), wall_ns()
+                    m = len(members)
+                    apply_many(members, held)  # type: ignore[misc]
+                    record_group(logs, laws, members, (c1 - c0) // m, (w1 - w0) // m)
                     continue
                 c0, w0 = cpu_ns(), wall_ns()
                 cmds = group.decide(world, members, laws)
@@ -304,7 +342,7 @@ def run_loop(
                     records[i](laws[i].mode, (c1 - c0) // m, (w1 - w0) // m)
                     for p in probes:
                         p.on_decision(world, i, laws[i], None, applied)
-            acting = [i for i in acting if keys[i] is None]
+            acting = [] if whole else [i for i in acting if keys[i] is None]
         for i in acting:
             obs = observe(i)
             act = acts[i]

@@ -163,3 +163,86 @@ def test_run_multi_gives_the_loop_worlds_result_through_the_swarm(
     assert loop.poses.tobytes() == packed.poses.tobytes()
     assert loop.times.tobytes() == packed.times.tobytes()
     assert all(m.decision_us_p99 > 0 for m in packed.robots)
+
+
+def mixed(n: int) -> MultiSetup:
+    """Crossing robots, every third one on another law (reading the others' held speeds)."""
+    setup = crossing(n)
+    for i in range(0, n, 3):
+        setup.robots[i].controller = make_law("straight-v1")
+    return setup
+
+
+class Applies:
+    """Counts a world's bulk holds (``apply_many`` calls) and passes them on."""
+
+    def __init__(self, world: MultiUnicycleWorld) -> None:
+        self.calls, self._inner = 0, world.apply_many
+
+    def __call__(self, agents: Any, commands: Any) -> None:
+        self.calls += 1
+        self._inner(agents, commands)
+
+
+@pytest.mark.parametrize("use_numba", KERNELS)
+@pytest.mark.parametrize("vectorised", [True, False])
+@pytest.mark.parametrize("case", ["antipodal-8", "crossing-7-decide-every-2-steps", "mixed-7"])
+def test_the_bulk_hold_holds_records_and_counts_what_the_per_robot_path_does(
+    case: str, vectorised: bool, use_numba: bool
+) -> None:
+    """Without probes run_loop holds a group's commands in one apply_many call; with a probe it
+    applies them one robot at a time: the same poses, metrics, modes and held commands."""
+    runs = []
+    for probes in ((), (BaseProbe(),)):
+        setup = mixed(7) if case == "mixed-7" else CASES[case]()
+        world = MultiUnicycleWorld(setup, np.random.default_rng(3), vectorised=vectorised)
+        spy = Applies(world)
+        world.apply_many = spy  # type: ignore[method-assign]
+        with compiled(use_numba):
+            logs = run_loop(world, [r.controller for r in setup.robots], probes)
+        res = world.result(logs, None)
+        runs.append((spy.calls, res, logs, world.state.tobytes(), list(world.applied)))
+    (bulk_calls, a, la, sa, ha), (per_calls, b, lb, sb, hb) = runs
+    assert bulk_calls > BLOCK and per_calls == 0
+    timing = {"decision_us_median", "decision_us_p99"}
+    for ma, mb in zip(a.robots, b.robots, strict=True):
+        da, db = ma.to_dict(), mb.to_dict()
+        assert {k: da[k] for k in da if k not in timing} == {
+            k: db[k] for k in db if k not in timing
+        }
+    assert any(m.mode_switches for m in a.robots) and any(m.control_effort for m in a.robots)
+    assert a.group == b.group and a.statuses == b.statuses and a.collided_pairs == b.collided_pairs
+    assert sa == sb and ha == hb
+    assert [(g.mode_switches, g.last_mode, len(g.decision_us)) for g in la] == [
+        (g.mode_switches, g.last_mode, len(g.decision_us)) for g in lb
+    ]
+
+
+@pytest.mark.parametrize("use_numba", KERNELS)
+def test_a_bulk_hold_counts_and_saturates_commands_outside_the_limits_as_apply_does(
+    use_numba: bool,
+) -> None:
+    from uvnav.dynamics.unicycle import UnicycleCommand
+
+    odd = [(0.3, 0.2), (-0.1, 0.0), (5.0, -9.0), (np.nan, 0.5), (0.2, np.inf), (-0.0, 1.4)]
+    worlds = []
+    with compiled(use_numba):
+        for bulk in (True, False):
+            world = MultiUnicycleWorld(antipodal(6), np.random.default_rng(0))
+            world.start([False] * 6)
+            for step in range(2):  # the second hold adds the speed change's effort
+                cmds = np.array(odd[step:] + odd[:step])
+                if bulk:
+                    world.apply_many(range(6), cmds)
+                else:
+                    for i, (v, u) in enumerate(cmds.tolist()):
+                        world.apply(UnicycleCommand(v, u), i)
+                world.advance()
+            worlds.append(world)
+    a, b = worlds
+    assert a.core is not None and b.core is not None
+    assert a.core.rob.tobytes() == b.core.rob.tobytes()
+    assert a.applied == b.applied
+    assert a.applied[1:4] == [UnicycleCommand(0.7, -1.4), UnicycleCommand(0.0, 0.5),
+                              UnicycleCommand(0.2, 0.0)]  # fmt: skip
+    assert [book.violations for book in a.books] == [1, 2, 1, 1, 1, 0]  # NaN speeds not counted

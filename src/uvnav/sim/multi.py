@@ -88,6 +88,7 @@ from uvnav.sim.packed_swarm import (
     R_Y,
     RUNNING,
     SwarmState,
+    hold_kernel,
 )
 from uvnav.sim.setup import (
     GroupMetrics,
@@ -275,7 +276,7 @@ class MultiUnicycleWorld:
         n = self.n_agents
         for sensors, oracle in zip(self.sensors, oracles, strict=True):
             sensors.reset(oracle)
-        self.applied = [UnicycleCommand(0.0, 0.0) for _ in range(n)]
+        self._applied: list[UnicycleCommand] | None = [UnicycleCommand(0.0, 0.0)] * n
         self.obstacle_hits = 0
         self._exact = np.array([sensors.true_rates for sensors in self.sensors])
         self._sensing = np.array([float(r.sensing.sensing_range) for r in self.robots])
@@ -316,7 +317,8 @@ class MultiUnicycleWorld:
         self._advance = core.advance_kernel
         self._advance_args = (rob, core.status, core.pairs, core.ints, core.flt, core.hist)
         self._stepped, self._rdt = self.clock.step_index > 0, self.ratio * self.dt
-        self._held_v = [0.0] * self.n_agents  # each robot's held speed (rob's R_V) [m/s]
+        self._hold = hold_kernel()
+        self._many: tuple[list[int], np.ndarray] = ([], np.zeros(0, dtype=np.int64))
         self._acting: tuple[bytes, list[int]] = (b"", [])
         self._running: tuple[bytes, np.ndarray] = (b"", np.zeros(0, dtype=bool))
         self._vmax = [float(r.spec.v_max) for r in self.robots]
@@ -491,9 +493,8 @@ class MultiUnicycleWorld:
                 v, u = cmd.v, cmd.u
             row = self._rows[i]
             if self._stepped:
-                row[R_EFFORT] += ((v - self._held_v[i]) ** 2) / self._rdt
-            self._held_v[i] = row[R_V] = v
-            row[R_U] = u
+                row[R_EFFORT] += ((v - row[R_V]) ** 2) / self._rdt
+            row[R_V], row[R_U] = v, u
             self.applied[i] = cmd
             return cmd
         spec = self.robots[i].spec
@@ -506,6 +507,29 @@ class MultiUnicycleWorld:
             book.effort += ((new.v - prev) ** 2) / (self.ratio * self.dt)
         self.applied[i] = new
         return new
+
+    def apply_many(self, agents: Sequence[int], commands: FloatArray) -> None:
+        """Hold ``commands[k] = (V, u)`` for robot ``agents[k]``, each as :meth:`apply` holds one
+        (the group laws' bulk hold, :func:`uvnav.core.run_loop`).  On the kernel path (a world of
+        robots only) one compiled call (:func:`~uvnav.sim.packed_swarm.hold_py`) writes them
+        into the arrays and no command object is made; :attr:`applied` is made from the arrays
+        when next asked."""
+        if self.core is None:
+            for i, (v, u) in zip(agents, commands.tolist(), strict=True):
+                self.apply(UnicycleCommand(v, u), i)
+            return
+        if agents != self._many[0]:  # the same robots as last time: the same index array
+            self._many = (list(agents), np.array(agents, dtype=np.int64))
+        self._hold(self.core.rob, self._many[1], len(agents), commands, self._stepped, self._rdt)
+        self._applied = None
+
+    @property
+    def applied(self) -> list[UnicycleCommand]:
+        """Each robot's command held now (the saturated one; zero before its first decision)."""
+        if self._applied is None:  # after a bulk hold: made from the arrays
+            held = self.core.rob[:, R_V : R_U + 1].tolist()  # type: ignore[union-attr]
+            self._applied = [UnicycleCommand(v, u) for v, u in held]
+        return self._applied
 
     def _count_violation(self, cmd: UnicycleCommand, i: int) -> None:
         """Count ``cmd`` in robot i's limit violations when it is outside (2.4) (kernel path)."""

@@ -69,6 +69,7 @@ from uvnav.sim.setup import MultiResult, MultiSetup
 
 #: status codes of a packed robot (those of :mod:`uvnav.sim.packed`)
 RUNNING, SUCCESS, COLLISION, TIMEOUT = 0, 1, 2, 3
+_HIT = 4  # running when the pair check began, collided in it
 STATUS_NAMES = ("running", "success", "collision", "timeout")
 # Columns of the (N, NR) float array of the robots: pose [m, m, rad], held command [m/s, rad/s],
 # velocity [m/s, m/s]; then a group's agent table (orca_kernels' G_* columns, from R_ORAD on):
@@ -109,6 +110,27 @@ def swarm_check(setup: MultiSetup) -> str | None:
     return None
 
 
+def _side_gaps(
+    r: float, px: float, py: float, cx: float, cy: float, rad: float, own: float, chord: float,
+    swept: bool,
+) -> tuple[float, float]:  # fmt: skip
+    """A robot at ``(px, py)`` of radius ``own``: its gap to the disc of radius ``rad`` at
+    ``(cx, cy)``, ``r`` away (the disc kernel's arithmetic: the depth of a centre inside a disc,
+    else ``max(r - rad, 0)``), and its least gap along the step (``chord``: the least centre
+    distance over the step; the gap now when not ``swept``) [m]."""
+    if r < rad:
+        offx, offy = px - cx, py - cy
+        if r > 0:
+            ux, uy = offx / r, offy / r
+        else:
+            ux, uy = _X_AXIS[0], _X_AXIS[1]
+        signed = -np.hypot(cx + ux * rad - px, cy + uy * rad - py)
+    else:
+        signed = max(r - rad, 0.0)
+    gap = signed - own
+    return gap, chord - (rad + own) if swept else gap
+
+
 def _pair_check(
     rob: FloatArray, status: np.ndarray, pairs: np.ndarray, start: FloatArray, swept: bool
 ) -> None:
@@ -116,52 +138,55 @@ def _pair_check(
     :class:`~uvnav.sim.multi._DiscPairs`' arithmetic) and, with ``swept``, of the pairs along the
     step from the positions ``start`` (N, 2), as :meth:`MultiUnicycleWorld._sweep_robots` judges
     them (:func:`~uvnav.geometry.sweep.segment_gap` on the robots' chords); a robot that collided
-    stops."""
+    stops.
+
+    Each pair i < j is visited once: its centre distance and chord distance serve both robots
+    (``hypot`` ignores signs and the chord's operations are those of the offsets negated, so
+    either robot gets the numbers it would compute alone), and each robot's minima take its
+    pairs in robot order, as a robot-by-robot pass does."""
     n = rob.shape[0]
     for i in range(n):
-        if status[i] != RUNNING:
-            rob[i, R_CLEAR] = math.inf
-            continue
+        rob[i, R_CLEAR] = math.inf
+    for i in range(n):
+        run_i = status[i] == RUNNING or status[i] == _HIT
         px, py = rob[i, R_X], rob[i, R_Y]
-        limit = rob[i, R_REACH] * (1.0 + _CULL_REL) + _CULL_ABS * (1.0 + abs(px) + abs(py))
-        low = math.inf
-        lowest = math.inf
-        seen = False
-        for j in range(n):
-            if j == i:
+        lim_i = rob[i, R_REACH] * (1.0 + _CULL_REL) + _CULL_ABS * (1.0 + abs(px) + abs(py))
+        for j in range(i + 1, n):
+            run_j = status[j] == RUNNING or status[j] == _HIT
+            if not (run_i or run_j):
                 continue
             cx, cy = rob[j, R_X], rob[j, R_Y]
             r = np.hypot(cx - px, cy - py)  # = hypot(px - cx, py - cy): hypot ignores signs
-            if not (math.isinf(limit) or r - rob[j, R_BOUND] <= limit):
+            keep_i = run_i and (math.isinf(lim_i) or r - rob[j, R_BOUND] <= lim_i)
+            keep_j = False
+            if run_j:
+                lim_j = rob[j, R_REACH] * (1.0 + _CULL_REL) + _CULL_ABS * (1.0 + abs(cx) + abs(cy))
+                keep_j = math.isinf(lim_j) or r - rob[i, R_BOUND] <= lim_j
+            if not (keep_i or keep_j):
                 continue
-            rad = rob[j, R_DISC]
-            offx, offy = px - cx, py - cy
-            if r > 0:
-                ux, uy = offx / r, offy / r
-            else:
-                ux, uy = _X_AXIS[0], _X_AXIS[1]
-            if r < rad:
-                signed = -np.hypot(cx + ux * rad - px, cy + uy * rad - py)
-            else:
-                signed = max(r - rad, 0.0)
-            gap = signed - rob[i, R_RADIUS]
-            along = gap
+            chord = 0.0
             if swept:
-                along = segment_gap(
-                    start[i, 0] - start[j, 0], start[i, 1] - start[j, 1], px - cx, py - cy,
-                    rad + rob[i, R_RADIUS],
+                chord = segment_gap(
+                    start[i, 0] - start[j, 0], start[i, 1] - start[j, 1], px - cx, py - cy, 0.0
+                )
+            for k in range(2):  # robot i's side, then robot j's
+                if not (keep_i if k == 0 else keep_j):
+                    continue
+                a, b = (i, j) if k == 0 else (j, i)
+                gap, along = _side_gaps(
+                    r, rob[a, R_X], rob[a, R_Y], rob[b, R_X], rob[b, R_Y], rob[b, R_DISC],
+                    rob[a, R_RADIUS], chord, swept,
                 )  # fmt: skip
-            seen = True
-            if gap < low:
-                low = gap
-            if min(gap, along) < lowest:
-                lowest = min(gap, along)
-            if gap < 0 or along < 0:
-                pairs[min(i, j), max(i, j)] = 1
-                status[i] = COLLISION
-        rob[i, R_CLEAR] = low
-        if seen and lowest < rob[i, R_LOW]:
-            rob[i, R_LOW] = lowest
+                if gap < rob[a, R_CLEAR]:
+                    rob[a, R_CLEAR] = gap
+                if min(gap, along) < rob[a, R_LOW]:
+                    rob[a, R_LOW] = min(gap, along)
+                if gap < 0 or along < 0:
+                    pairs[i, j] = 1
+                    status[a] = _HIT
+    for i in range(n):
+        if status[i] == _HIT:
+            status[i] = COLLISION
 
 
 def _arrivals(rob: FloatArray, status: np.ndarray, t: float, tol: float) -> None:
@@ -171,6 +196,36 @@ def _arrivals(rob: FloatArray, status: np.ndarray, t: float, tol: float) -> None
             continue
         if pyhypot(rob[i, R_GX] - rob[i, R_X], rob[i, R_GY] - rob[i, R_Y]) <= tol:
             status[i], rob[i, R_REACHED] = SUCCESS, t
+
+
+def hold_py(
+    rob: FloatArray, members: np.ndarray, m: int, cmds: FloatArray, stepped: bool, period: float
+) -> None:
+    """Hold the commands ``cmds[k] = (V, u)`` of the robots ``members[k]`` (k < ``m``) as
+    :meth:`MultiUnicycleWorld.apply` holds one: counted in ``R_VIOL`` when outside the limits
+    (2.4) (:meth:`~uvnav.dynamics.unicycle.UnicycleCommand.violates`), saturated
+    (:meth:`~uvnav.dynamics.unicycle.UnicycleCommand.clipped`: NaN and infinite components 0),
+    the speed change's effort ``(V - V_held)^2 / period`` added once the episode has
+    ``stepped``, into ``R_V`` and ``R_U``."""
+    for k in range(m):
+        i = members[k]
+        v, u = cmds[k, 0], cmds[k, 1]
+        vmax, umax = rob[i, R_VMAX], rob[i, R_UMAX]
+        if v < -1e-9 or v > vmax + 1e-9 or abs(u) > umax + 1e-9:
+            rob[i, R_VIOL] += 1.0
+        if math.isfinite(v):
+            v = 0.0 if v < 0.0 else v
+            v = vmax if vmax < v else v
+        else:
+            v = 0.0
+        if math.isfinite(u):
+            u = -umax if -umax > u else u
+            u = umax if umax < u else u
+        else:
+            u = 0.0
+        if stepped:
+            rob[i, R_EFFORT] += ((v - rob[i, R_V]) ** 2) / period
+        rob[i, R_V], rob[i, R_U] = v, u
 
 
 def swarm_decide_py(
@@ -199,27 +254,9 @@ def swarm_decide_py(
         members[:m], step * dt, flt[F_EPS:], ints[I_MAXNB], rob[:, R_ORAD:], draws, upos,
         rob[:, R_X:R_Y + 1], rob[:, R_TH], rob[:, R_VX:R_VY + 1], scratch, idx, periods, pick, out,
     )  # fmt: skip
+    hold_py(rob, members, m, out, step != 0, ints[I_RATIO] * dt)
     for k in range(m):
         i = members[k]
-        v, u = out[k, 0], out[k, 1]
-        vmax, umax = rob[i, R_VMAX], rob[i, R_UMAX]
-        if v < -1e-9 or v > vmax + 1e-9 or abs(u) > umax + 1e-9:
-            rob[i, R_VIOL] += 1.0
-        if math.isfinite(v):
-            v = 0.0 if v < 0.0 else v
-            v = vmax if vmax < v else v
-        else:
-            v = 0.0
-        if math.isfinite(u):
-            u = -umax if -umax > u else u
-            u = umax if umax < u else u
-        else:
-            u = 0.0
-        if step:
-            rob[i, R_EFFORT] += ((v - rob[i, R_V]) ** 2) / (ints[I_RATIO] * dt)
-        else:
-            rob[i, R_EFFORT] += 0.0
-        rob[i, R_V], rob[i, R_U] = v, u
         mode = out[k, 6]
         if rob[i, R_NDEC] > 0.0 and mode != rob[i, R_MODE]:
             rob[i, R_SWITCH] += 1.0
@@ -277,20 +314,27 @@ _KERNELS: dict[str, Callable[..., Any]] = {}
 
 def _kernel(name: str) -> Callable[..., Any]:
     """The function ``name`` of this module's kernels (:func:`swarm_decide_py`,
-    :func:`swarm_advance_py`, :func:`_pair_check`), compiled when numba is enabled."""
+    :func:`swarm_advance_py`, :func:`_pair_check`, :func:`hold_py`), compiled when numba is
+    enabled."""
     if not numba_enabled():
         plain: dict[str, Callable[..., Any]] = {
             "swarm_decide_py": swarm_decide_py,
             "swarm_advance_py": swarm_advance_py,
             "_pair_check": _pair_check,
+            "hold_py": hold_py,
         }
         return plain[name]
     if not _KERNELS:
         _KERNELS.update(compile_family(
-            (*FAMILY, unicycle_advance, segment_gap, _pair_check, _arrivals, swarm_decide_py,
-             swarm_advance_py)
+            (*FAMILY, unicycle_advance, segment_gap, _side_gaps, _pair_check, _arrivals, hold_py,
+             swarm_decide_py, swarm_advance_py)
         ))  # fmt: skip
     return _KERNELS[name]
+
+
+def hold_kernel() -> Callable[..., Any]:
+    """:func:`hold_py`, compiled when numba is enabled."""
+    return _kernel("hold_py")
 
 
 def _kernels() -> tuple[Callable[..., Any], Callable[..., Any]]:
