@@ -45,6 +45,7 @@ from uvnav.sim.packed import (
     SUCCESS,
     TIMEOUT,
     PackedWorlds,
+    kernel,
     pack_check,
 )
 from uvnav.sim.seeding import world_rng
@@ -201,16 +202,14 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         before = self._dist.copy()
         self._commands(actions, running & (w.status != TIMEOUT))
         w.step(~restart)
-        clear = np.where(np.isfinite(w.low), w.low, self.max_range)
-        self._clear = np.where(running & np.isfinite(w.low), clear, self._clear)
         self._observe()
         cfg = self.reward_config
-        r = cfg.progress * (before - self._dist) - cfg.time
-        r = r - cfg.clearance * np.maximum(0.0, cfg.clearance_margin - self._clear)
-        r = np.where(w.status == SUCCESS, r + cfg.success, r)
-        r = np.where(w.status == COLLISION, r - cfg.collision, r)
-        rewards = np.where(running, r, 0.0)
-        terminated = ~restart & ((w.status == SUCCESS) | (w.status == COLLISION))
-        truncated = ~restart & (w.status == TIMEOUT)
+        weights = np.array([cfg.progress, cfg.time, cfg.clearance, cfg.clearance_margin,
+                            cfg.success, cfg.collision], dtype=float)  # fmt: skip
+        rewards = np.empty(self.num_envs)
+        terminated = np.empty(self.num_envs, dtype=np.bool_)
+        truncated = np.empty(self.num_envs, dtype=np.bool_)
+        kernel("outcome")(w.status, w.low, restart, running, before, self._dist, self._clear,
+                          weights, rewards, terminated, truncated)  # fmt: skip
         self._autoreset = terminated | truncated
         return self._obs.copy(), rewards, terminated, truncated, self._infos()

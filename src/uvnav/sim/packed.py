@@ -131,6 +131,7 @@ from uvnav.sim.packed_sense import (  # noqa: F401 - the reading columns, re-exp
     _rough_cos_sin,
     advance_one_py,
     observe_py,
+    outcome_py,
     sense_one_py,
     vector_one_py,
 )
@@ -145,6 +146,7 @@ _PUBLIC = {
     "clearance_one": "clearance_one_py",
     "lidar": "_lidar",
     "vector_one": "vector_one_py",
+    "outcome": "outcome_py",
 }
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
@@ -161,7 +163,7 @@ def kernel(name: str) -> Callable[..., Any]:
             _transform_ring, _move_obstacles, _clearance, _rough_cos_sin, _lidar, vector_one_py,
             step_worlds_py,
             observe_py,
-            sense_one_py, advance_one_py, clearance_one_py,
+            sense_one_py, advance_one_py, clearance_one_py, outcome_py,
         ]))  # fmt: skip
     return _KERNELS[_PUBLIC[name]]
 

@@ -27,6 +27,7 @@ from uvnav.sim.packed_kernels import (
     S_X,
     S_Y,
     SUCCESS,
+    TIMEOUT,
     W_GX,
     W_GY,
     W_TH,
@@ -286,6 +287,35 @@ def observe_py(
         vector_one_py(x, y, th, wf[k, W_GX], wf[k, W_GY], goal_scale, speed, wf[k, W_VMAX], rel,
                       max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ring, dirs,
                       ranges[k], out[k])  # fmt: skip
+
+
+def outcome_py(status: np.ndarray, low: FloatArray, restart: np.ndarray, running: np.ndarray,
+               before: FloatArray, dist: FloatArray, clear: FloatArray, weights: FloatArray,
+               rewards: FloatArray, terminated: np.ndarray,
+               truncated: np.ndarray) -> None:  # fmt: skip
+    """``uvnav/Nav2D-v0``'s rewards, terminations and truncations of K worlds after a step (the
+    operations of :meth:`uvnav.envs.core.EnvWorld.reward` on each): from the worlds' status
+    codes and lowest clearances ``low`` [m] over the step, the (K,) bools ``restart`` (the world
+    restarted instead of stepping) and ``running`` (it stepped from a running state), goal
+    distances ``before`` and ``dist`` [m] and the reward's ``weights`` (progress, time,
+    clearance, clearance margin, success, collision).  ``clear`` [m] takes ``low`` where the
+    world ran and ``low`` is finite, and is the clearance the penalty reads."""
+    progress, time_cost, clearance, margin = weights[0], weights[1], weights[2], weights[3]
+    success, collision = weights[4], weights[5]
+    for k in range(status.shape[0]):
+        if running[k] and abs(low[k]) < math.inf:
+            clear[k] = low[k]
+        s = status[k]
+        r = progress * (before[k] - dist[k]) - time_cost
+        gap = margin - clear[k]
+        r = r - clearance * (0.0 if gap <= 0.0 else gap)  # numpy's maximum(0.0, gap)
+        if s == SUCCESS:
+            r = r + success
+        if s == COLLISION:
+            r = r - collision
+        rewards[k] = r if running[k] else 0.0
+        terminated[k] = not restart[k] and s in (SUCCESS, COLLISION)
+        truncated[k] = not restart[k] and s == TIMEOUT
 
 
 def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs: int,
