@@ -440,6 +440,52 @@ def test_the_lidar_kernel_is_lidar_scan_near_inside_and_far_from_bodies(compiled
                 np.testing.assert_array_equal(ranges, want)
 
 
+def _grazing_poses(setup: EpisodeSetup, rel: np.ndarray) -> Iterator[tuple[float, float, float]]:
+    """Poses whose beam ``r`` (every ``r`` in turn) runs just inside a body's vertex farthest
+    from its centre, nearly tangent to its bounding disc: beams at the edge of the body's
+    angular extent, meeting its edges near their ends."""
+    for ob in setup.obstacles:
+        assert isinstance(ob.body, PolygonBody)
+        centre = np.asarray(ob.state.position, dtype=float)
+        c, s = math.cos(ob.state.heading), math.sin(ob.state.heading)
+        pts = ob.body.vertices @ np.array([[c, s], [-s, c]]) + centre
+        v = pts[int(np.argmax(np.hypot(*(pts - centre).T)))]
+        out = (v - centre) / np.hypot(*(v - centre))
+        for side in (1.0, -1.0):
+            tangent = side * np.array([-out[1], out[0]])
+            for far in (0.6, 1.7, 3.4):
+                p = v + far * tangent - 1e-4 * out
+                bearing = math.atan2(v[1] - p[1], v[0] - p[0])
+                for r in range(rel.shape[0]):
+                    yield float(p[0]), float(p[1]), bearing - float(rel[r])
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+@pytest.mark.parametrize("n_rays", [7, 32])
+def test_the_lidar_culls_keep_the_beams_grazing_a_body(compiled: bool, n_rays: int) -> None:
+    """Beams grazing each body at the edge of its angular extent, at every beam index: the
+    kernel's ranges (beams culled by the bodies' bounding discs) equal :func:`lidar_scan`'s,
+    which casts every beam on every body in range; a disc test that is not safe (a disc 1e-6
+    narrower) fails here."""
+    setup = build_episode(load_scenario("random-ch2:5"), 3)
+    field = ObstacleField.from_obstacles(setup.obstacles)
+    worlds = PackedWorlds(1)
+    worlds.load(0, setup)
+    rel = np.linspace(-math.pi, math.pi, n_rays, endpoint=False)
+    ranges, dirs = np.empty(n_rays), np.empty((2, n_rays))
+    ring = np.empty((2, worlds.rings.shape[3]))
+    hits = 0
+    with kernels(compiled):
+        lidar = kernel("lidar")
+        for x, y, th in _grazing_poses(setup, rel):
+            lidar(x, y, th, rel, 4.0, len(setup.obstacles), worlds.params[0], worlds.state[0],
+                  worlds.rings[0], ring, dirs, ranges)  # fmt: skip
+            want = lidar_scan(np.array([x, y, th]), field, n_rays=n_rays, max_range=4.0).ranges
+            np.testing.assert_array_equal(ranges, want)
+            hits += int((want < 4.0).sum())
+    assert hits > 0
+
+
 def test_a_restored_image_is_the_episode_load_builds() -> None:
     """restore() with episode 2's generators gives the slot load(build_episode(scene, 2)) gives,
     and the same steps after."""

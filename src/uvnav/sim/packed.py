@@ -42,7 +42,7 @@ import numpy as np
 from uvnav.dynamics.unicycle import UnicycleSpec, unicycle_advance
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
-from uvnav.geometry.polygons import ray_ring_hit_py, ring_nearest_py
+from uvnav.geometry.polygons import ring_nearest_py
 from uvnav.geometry.small import pyhypot
 from uvnav.obstacles.bodies import PolygonBody
 from uvnav.obstacles.motion import ConstantVelocity, RandomTurn
@@ -127,7 +127,9 @@ from uvnav.sim.packed_sense import (  # noqa: F401 - the reading columns, re-exp
     R_NEAR,
     R_OMEGA,
     R_VEL,
+    _features,
     _lidar,
+    _lidar_in,
     _rough_cos_sin,
     advance_one_py,
     observe_py,
@@ -159,8 +161,9 @@ def kernel(name: str) -> Callable[..., Any]:
         return globals()[_PUBLIC[name]]
     if not _KERNELS:
         _KERNELS.update(compile_family([
-            wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py, ray_ring_hit_py,
-            _transform_ring, _move_obstacles, _clearance, _rough_cos_sin, _lidar, vector_one_py,
+            wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py,
+            _transform_ring, _move_obstacles, _clearance, _rough_cos_sin,
+            _lidar_in, _lidar, _features, vector_one_py,
             step_worlds_py,
             observe_py,
             sense_one_py, advance_one_py, clearance_one_py, outcome_py,

@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-from uvnav.geometry.polygons import ray_ring_hit_py, ring_nearest_py
+from uvnav.geometry.polygons import ring_nearest_py
 from uvnav.geometry.small import pyhypot
 from uvnav.sim.packed_kernels import (
     COLLISION,
@@ -157,6 +157,66 @@ def _rough_cos_sin(a: float) -> tuple[float, float]:
     return sign * c, sn  # fmt: skip
 
 
+def _lidar_in(k: int, ox: float, oy: float, th: float, rel: FloatArray, max_range: float,
+              n_obs: int, params: FloatArray, state: FloatArray, rings: FloatArray,
+              ring: FloatArray, dirs: FloatArray, ranges: FloatArray) -> None:  # fmt: skip
+    """:func:`_lidar` of world ``k`` of the packed arrays ``params``, ``state``, ``rings``
+    (:func:`step_worlds_py`'s layout) into ``ranges[k]``, indexing them here: slicing them per
+    world and passing the slices cost more than a tenth of the cast."""
+    n_rays = rel.shape[0]
+    for r in range(n_rays):
+        ranges[k, r] = max_range
+        a = wrap_scalar(th + rel[r])
+        if -math.pi <= a <= math.pi:
+            dirs[0, r], dirs[1, r] = _rough_cos_sin(a)
+        else:  # not a number: no rough test skips it
+            dirs[0, r], dirs[1, r] = a, a
+    slack = 1e-9 * (1.0 + abs(ox) + abs(oy))
+    limit = max_range * (1.0 + 1e-9) + slack
+    for o in range(n_obs):
+        cx, cy, h = state[k, S_X, o], state[k, S_Y, o], state[k, S_HEADING, o]
+        bound = params[k, P_BOUND, o]
+        ex, ey = cx - ox, cy - oy
+        dc = math.sqrt(ex * ex + ey * ey)
+        if abs(dc - bound - limit) <= 1e-12 * (1.0 + dc + bound + limit) or not dc < 1e300:
+            dc = math.hypot(cx - ox, cy - oy)  # near the edge, huge or not a number: libm's
+        if dc - bound > limit:
+            continue  # its hits would be beyond max_range
+        reach = bound * (1.0 + 1e-9) + slack
+        rough = reach + 1e-9 * (1.0 + abs(ex) + abs(ey))
+        cast = False
+        for r in range(n_rays):
+            dx, dy = dirs[0, r], dirs[1, r]
+            if abs(dx * ey - dy * ex) > rough or dx * ex + dy * ey < -rough:
+                continue
+            a = wrap_scalar(th + rel[r])
+            dx, dy = math.cos(a), math.sin(a)
+            # a beam that passes outside the bounding disc, or starts beyond it, cannot hit
+            if abs(dx * (cy - oy) - dy * (cx - ox)) > reach:
+                continue
+            if dx * (cx - ox) + dy * (cy - oy) < -reach:
+                continue
+            if not cast:  # _transform_ring's operations, inlined (as the loop below)
+                ch, sh = math.cos(h), math.sin(h)
+                for j in range(ring.shape[1]):
+                    rx, ry = rings[k, 0, o, j], rings[k, 1, o, j]
+                    ring[0, j] = ch * rx + sh * -ry + cx
+                    ring[1, j] = ch * ry + sh * rx + cy
+                cast = True
+            best = ranges[k, r]  # ray_ring_hit_py's loop, inlined
+            for j in range(ring.shape[1] - 1):
+                sx, sy = ring[0, j], ring[1, j]
+                qx, qy = ring[0, j + 1] - sx, ring[1, j + 1] - sy
+                wx, wy = sx - ox, sy - oy
+                den = dx * qy - dy * qx
+                if abs(den) >= 1e-12:
+                    t = (wx * qy - wy * qx) / den
+                    s = (wx * dy - wy * dx) / den
+                    if t >= 0.0 and s >= 0.0 and s <= 1.0 and t < best:
+                        best = t
+            ranges[k, r] = best
+
+
 def _lidar(
     ox: float,
     oy: float,
@@ -182,44 +242,14 @@ def _lidar(
     beam's bounding-disc test with :func:`_rough_cos_sin`'s directions (kept in ``dirs``) and
     a margin of 1e-9 (1 + centre offset) [m] over their 1e-12 error; a beam that passes it
     takes libm's ``cos`` and ``sin`` and the exact test.  Most beams meet no body's disc, so
-    most beams take no ``cos`` or ``sin``."""
-    n_rays = rel.shape[0]
-    for r in range(n_rays):
-        out[r] = max_range
-        a = wrap_scalar(th + rel[r])
-        if -math.pi <= a <= math.pi:
-            dirs[0, r], dirs[1, r] = _rough_cos_sin(a)
-        else:  # not a number: no rough test skips it
-            dirs[0, r], dirs[1, r] = a, a
-    slack = 1e-9 * (1.0 + abs(ox) + abs(oy))
-    limit = max_range * (1.0 + 1e-9) + slack
-    for o in range(n_obs):
-        cx, cy, h = st[S_X, o], st[S_Y, o], st[S_HEADING, o]
-        bound = prm[P_BOUND, o]
-        ex, ey = cx - ox, cy - oy
-        dc = math.sqrt(ex * ex + ey * ey)
-        if abs(dc - bound - limit) <= 1e-12 * (1.0 + dc + bound + limit) or not dc < 1e300:
-            dc = math.hypot(cx - ox, cy - oy)  # near the edge, huge or not a number: libm's
-        if dc - bound > limit:
-            continue  # its hits would be beyond max_range
-        reach = bound * (1.0 + 1e-9) + slack
-        rough = reach + 1e-9 * (1.0 + abs(ex) + abs(ey))
-        cast = False
-        for r in range(n_rays):
-            dx, dy = dirs[0, r], dirs[1, r]
-            if abs(dx * ey - dy * ex) > rough or dx * ex + dy * ey < -rough:
-                continue
-            a = wrap_scalar(th + rel[r])
-            dx, dy = math.cos(a), math.sin(a)
-            # a beam that passes outside the bounding disc, or starts beyond it, cannot hit
-            if abs(dx * (cy - oy) - dy * (cx - ox)) > reach:
-                continue
-            if dx * (cx - ox) + dy * (cy - oy) < -reach:
-                continue
-            if not cast:
-                _transform_ring(rings, o, math.cos(h), math.sin(h), cx, cy, ring)
-                cast = True
-            out[r] = min(out[r], ray_ring_hit_py(ox, oy, dx, dy, ring[0], ring[1]))
+    most beams take no ``cos`` or ``sin``.  The ring's transform (:func:`_transform_ring`) and
+    the ray-ring test (:func:`uvnav.geometry.polygons.ray_ring_hit_py`) are their operations
+    written out in the loop, where calls that passed array rows cost more than the
+    arithmetic.  (Skipping an edge's two divisions by its numerators' signs first, and keeping
+    libm's directions across bodies, made a stepping env's observation slower: their branches
+    mispredict.)"""
+    _lidar_in(0, ox, oy, th, rel, max_range, n_obs, prm[None], st[None], rings[None], ring,
+              dirs, out[None])  # fmt: skip
 
 
 def vector_one_py(
@@ -249,14 +279,23 @@ def vector_one_py(
     :func:`_lidar`'s ranges [m] (into ``ranges`` (R,); scratch ``ring``, ``dirs``) over
     ``max_range`` in [0, 1]."""
     _lidar(x, y, th, rel, max_range, n_obs, prm, st, rings, ring, dirs, ranges)
+    _features(0, x, y, th, goal_x, goal_y, goal_scale, speed, v_max, max_range, ranges[None],
+              out[None])  # fmt: skip
+
+
+def _features(k: int, x: float, y: float, th: float, goal_x: float, goal_y: float,
+              goal_scale: float, speed: float, v_max: float, max_range: float,
+              ranges: FloatArray, out: np.ndarray) -> None:  # fmt: skip
+    """Row ``k`` of the observation vectors ``out`` (K, 4 + R) float32 (:func:`vector_one_py`'s)
+    from the pose, goal, speed and the lidar ranges ``ranges[k]`` [m]."""
     gx, gy = goal_x - x, goal_y - y
     bearing = math.atan2(gy, gx) - th
-    out[0] = min(pyhypot(gx, gy) / goal_scale, 1.0)
-    out[1] = math.cos(bearing)
-    out[2] = math.sin(bearing)
-    out[3] = min(max(speed / v_max, 0.0), 1.0)
-    for r in range(ranges.shape[0]):
-        out[4 + r] = min(max(ranges[r] / max_range, 0.0), 1.0)
+    out[k, 0] = min(pyhypot(gx, gy) / goal_scale, 1.0)
+    out[k, 1] = math.cos(bearing)
+    out[k, 2] = math.sin(bearing)
+    out[k, 3] = min(max(speed / v_max, 0.0), 1.0)
+    for r in range(ranges.shape[1]):
+        out[k, 4 + r] = min(max(ranges[k, r] / max_range, 0.0), 1.0)
 
 
 def observe_py(
@@ -284,9 +323,10 @@ def observe_py(
         dist[k] = pyhypot(wf[k, W_GX] - x, wf[k, W_GY] - y)
         status = wi[k, I_STATUS]
         speed = 0.0 if status in (SUCCESS, COLLISION) else wf[k, W_V]
-        vector_one_py(x, y, th, wf[k, W_GX], wf[k, W_GY], goal_scale, speed, wf[k, W_VMAX], rel,
-                      max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ring, dirs,
-                      ranges[k], out[k])  # fmt: skip
+        _lidar_in(k, x, y, th, rel, max_range, wi[k, I_NOBS], params, state, rings, ring, dirs,
+                  ranges)  # fmt: skip
+        _features(k, x, y, th, wf[k, W_GX], wf[k, W_GY], goal_scale, speed, wf[k, W_VMAX],
+                  max_range, ranges, out)  # fmt: skip
 
 
 def outcome_py(status: np.ndarray, low: FloatArray, restart: np.ndarray, running: np.ndarray,
@@ -335,7 +375,7 @@ def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs
     low = np.empty(rings.shape[1])
     for o in range(n_obs):
         prev[0, o], prev[1, o], prev[2, o] = st[S_X, o], st[S_Y, o], st[S_HEADING, o]
-    _move_obstacles(n_obs, st, prm, oi, ubuf, t, dt)
+    _move_obstacles(0, n_obs, st[None], prm[None], oi[None], ubuf[None], t, dt)
     shift = 0.0
     for o in range(n_obs):
         dx, dy = st[S_X, o] - prev[0, o], st[S_Y, o] - prev[1, o]
@@ -345,7 +385,7 @@ def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs
         s = math.sqrt(dx * dx + dy * dy) + turn * prm[P_BOUND, o]
         if s > shift:
             shift = s
-    gap, at = _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)
+    gap, at = _clearance(0, x, y, radius, n_obs, prm[None], st[None], rings[None], ring, low)
     m = -1
     if sensing_range >= 0.0:
         m = sense_one_py(x, y, sensing_range, n_obs, prm, st, rings, ids, rows, outlines)
