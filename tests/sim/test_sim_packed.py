@@ -24,7 +24,14 @@ from uvnav.scenarios.loader import load_scenario
 from uvnav.sensors.exact import lidar_scan
 from uvnav.sim.bodies2d import FieldBodies, PackedBodies
 from uvnav.sim.episode import World2D
-from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, kernel, pack_check
+from uvnav.sim.packed import (
+    BLOCK,
+    STATUS_NAMES,
+    PackedWorlds,
+    kernel,
+    pack_check,
+    reseed_spawned,
+)
 from uvnav.sim.packed_sense import _rough_cos_sin
 from uvnav.sim.run import run_episode
 from uvnav.sim.seeding import run_rng, world_rng
@@ -502,3 +509,18 @@ def test_a_restored_image_is_the_episode_load_builds() -> None:
         for name in ("wf", "wi", "oi", "read", "params", "state", "ubuf", "rings"):
             np.testing.assert_array_equal(getattr(fast, name), getattr(built, name), name)
     assert not np.array_equal(fast.state[0], fast.state[1])
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_reseeded_generators_are_the_spawned_children_of_the_world_stream(compiled: bool) -> None:
+    """reseed_spawned([k, 1], gens) leaves gens as world_rng(k).spawn(n)'s generators: the
+    same PCG64 states and the same draws, for seeds of one, two and three 32-bit words."""
+    with kernels(compiled):
+        for k in [0, 1, 7, 2**31 - 2, 2**32, 2**40 + 3, 2**63 - 1, 2**70 + 5]:
+            for n in (1, 10):
+                want = world_rng(k).spawn(n)
+                got = [np.random.default_rng(99) for _ in range(n)]
+                reseed_spawned([k, 1], got)
+                for g, w in zip(got, want, strict=True):
+                    assert g.bit_generator.state == w.bit_generator.state, k
+                    np.testing.assert_array_equal(g.random(5), w.random(5))

@@ -47,8 +47,9 @@ from uvnav.sim.packed import (
     PackedWorlds,
     kernel,
     pack_check,
+    reseed_spawned,
 )
-from uvnav.sim.seeding import world_rng
+from uvnav.sim.seeding import _WORLD as WORLD_KEY
 
 try:
     import gymnasium as gym
@@ -125,6 +126,8 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self._dist = np.zeros(k)
         self._clear = np.zeros(k)
         self._rngs: list[np.random.Generator | None] = [None] * k
+        #: each slot's obstacle generators, reseeded at each restored reset
+        self._pool: list[list[np.random.Generator] | None] = [None] * k
         self._autoreset = np.zeros(k, dtype=np.bool_)
         self.episode_seeds = np.zeros(k, dtype=np.int64)
         self._image: tuple[np.ndarray, ...] | None = None
@@ -132,16 +135,29 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
     def _load(self, i: int, options: dict[str, Any] | None) -> None:
         """Start sub-environment ``i``'s next episode (its generator picks the seed).  The first
         episode is built (:func:`~uvnav.scenarios.build.build_episode`) and loaded, the others
-        restore its image with their own obstacle generators (:meth:`PackedWorlds.restore
-        <uvnav.sim.packed.PackedWorlds.restore>`): the same episodes, without building them."""
+        restore its image (:meth:`PackedWorlds.restore <uvnav.sim.packed.PackedWorlds.restore>`)
+        with the slot's own obstacle generators, set to the states the children of
+        :func:`~uvnav.sim.seeding.world_rng` would have (:func:`reseed_spawned
+        <uvnav.sim.packed.reseed_spawned>`): the same episodes, without building them."""
         rng = self._rngs[i]
         if rng is None:
             rng = self._rngs[i] = seeding.np_random()[0]
         self.episode_seeds[i] = k = episode_seed(rng, options)
-        children = world_rng(k).spawn(len(self.scenario.obstacles))  # build_episode's
-        if self._image is None or not self.worlds.restore(i, self._image, children):
-            self.worlds.load(i, build_episode(self.scenario, k))
-            self._image = self.worlds.image(i)
+        if self._image is not None:
+            children = self._pool[i]
+            if children is None:
+                n = len(self.scenario.obstacles)
+                children = self._pool[i] = [np.random.default_rng(0) for _ in range(n)]
+            reseed_spawned([k, WORLD_KEY], children)  # world_rng(k).spawn(n): build_episode's
+            if self.worlds.restore(i, self._image, children):
+                self._set_clear(i)
+                return
+        self.worlds.load(i, build_episode(self.scenario, k))
+        self._image = self.worlds.image(i)
+        self._set_clear(i)
+
+    def _set_clear(self, i: int) -> None:
+        """Sub-environment ``i``'s clearance for the reward, from its world's at the start."""
         c = float(self.worlds.clearance[i])
         self._clear[i] = c if np.isfinite(c) else self.max_range
 

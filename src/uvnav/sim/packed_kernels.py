@@ -234,3 +234,55 @@ def clearance_one_py(x: float, y: float, radius: float, n_obs: int, prm: FloatAr
     ring = np.empty((2, rings.shape[2]))
     low = np.empty(rings.shape[1])
     return _clearance(0, x, y, radius, n_obs, prm[None], st[None], rings[None], ring, low)
+
+
+# numpy's SeedSequence constants (hash and mix multipliers) and PCG64's multiplier
+_M32 = 0xFFFFFFFF
+_INIT_A, _MULT_A, _INIT_B, _MULT_B = 0x43B0D7E5, 0x931E8875, 0x8B51F9DD, 0x58F38DED
+_MIX_L, _MIX_R = 0xCA01F9DD, 0x4973F715
+
+
+def _hashmix(value: int, hc: int) -> tuple[int, int]:
+    """SeedSequence's ``hashmix`` of ``value`` with hash constant ``hc`` (32-bit words held in
+    int64, products wrapping): the mixed value and the next constant."""
+    value ^= hc
+    hc = (hc * _MULT_A) & _M32
+    value = (value * hc) & _M32
+    return value ^ (value >> 16), hc
+
+
+def _mix(x: int, y: int) -> int:
+    """SeedSequence's ``mix`` of two 32-bit words (held in int64, products wrapping)."""
+    r = (_MIX_L * x - _MIX_R * y) & _M32
+    return r ^ (r >> 16)
+
+
+def spawn_words_py(entropy: np.ndarray, out: np.ndarray) -> None:
+    """The first 8 32-bit words of ``generate_state`` (as int64, low word of each uint64 first)
+    of the children ``c`` < ``out.shape[0]`` that ``numpy.random.SeedSequence.spawn`` makes of
+    a sequence whose run entropy, as 32-bit words padded with zeros to the pool size 4, is
+    ``entropy`` (E,) int64: the children's spawn keys ``(c,)`` mixed in after it, numpy's
+    operations on the words.  What a :class:`numpy.random.PCG64` seeded by child ``c`` takes as
+    its state and increment."""
+    n_ent = entropy.shape[0]
+    mixer = np.zeros(4, dtype=np.int64)
+    for c in range(out.shape[0]):
+        hc = _INIT_A
+        for i in range(4):
+            mixer[i], hc = _hashmix(int(entropy[i]), hc)
+        for src in range(4):
+            for dst in range(4):
+                if src != dst:
+                    v, hc = _hashmix(int(mixer[src]), hc)
+                    mixer[dst] = _mix(int(mixer[dst]), v)
+        for src in range(4, n_ent + 1):  # the run entropy's tail, then the spawn key
+            word = int(entropy[src]) if src < n_ent else c
+            for dst in range(4):
+                v, hc = _hashmix(word, hc)
+                mixer[dst] = _mix(int(mixer[dst]), v)
+        hb = _INIT_B
+        for j in range(8):
+            v = int(mixer[j % 4]) ^ hb
+            hb = (hb * _MULT_B) & _M32
+            v = (v * hb) & _M32
+            out[c, j] = v ^ (v >> 16)
