@@ -471,9 +471,10 @@ def _grazing_poses(setup: EpisodeSetup, rel: np.ndarray) -> Iterator[tuple[float
 @pytest.mark.parametrize("n_rays", [7, 32])
 def test_the_lidar_culls_keep_the_beams_grazing_a_body(compiled: bool, n_rays: int) -> None:
     """Beams grazing each body at the edge of its angular extent, at every beam index: the
-    kernel's ranges (beams culled by the bodies' bounding discs) equal :func:`lidar_scan`'s,
-    which casts every beam on every body in range; a disc test that is not safe (a disc 1e-6
-    narrower) fails here."""
+    kernel's ranges and the observation kernel's (beams culled by the bodies' bounding discs,
+    rough directions by polynomial or by rotation, headings near 0, 630 and 6280 rad) equal
+    :func:`lidar_scan`'s, which casts every beam on every body in range; a disc test that is
+    not safe (a disc 1e-6 narrower, rough directions 1e-6 rad off) fails here."""
     setup = build_episode(load_scenario("random-ch2:5"), 3)
     field = ObstacleField.from_obstacles(setup.obstacles)
     worlds = PackedWorlds(1)
@@ -481,15 +482,20 @@ def test_the_lidar_culls_keep_the_beams_grazing_a_body(compiled: bool, n_rays: i
     rel = np.linspace(-math.pi, math.pi, n_rays, endpoint=False)
     ranges, dirs = np.empty(n_rays), np.empty((2, n_rays))
     ring = np.empty((2, worlds.rings.shape[3]))
+    batch, out, dist = np.empty((1, n_rays)), np.empty((1, 4 + n_rays), np.float32), np.empty(1)
     hits = 0
     with kernels(compiled):
         lidar = kernel("lidar")
-        for x, y, th in _grazing_poses(setup, rel):
-            lidar(x, y, th, rel, 4.0, len(setup.obstacles), worlds.params[0], worlds.state[0],
-                  worlds.rings[0], ring, dirs, ranges)  # fmt: skip
-            want = lidar_scan(np.array([x, y, th]), field, n_rays=n_rays, max_range=4.0).ranges
-            np.testing.assert_array_equal(ranges, want)
-            hits += int((want < 4.0).sum())
+        for x, y, th0 in _grazing_poses(setup, rel):
+            for th in (th0, th0 + 200.0 * math.pi, th0 - 2000.0 * math.pi):
+                lidar(x, y, th, rel, 4.0, len(setup.obstacles), worlds.params[0],
+                      worlds.state[0], worlds.rings[0], ring, dirs, ranges)  # fmt: skip
+                worlds.robot[0] = (x, y, th)  # observe's path: rough directions by rotation
+                worlds.observe(rel, 4.0, 10.0, batch, out, dist)
+                want = lidar_scan(np.array([x, y, th]), field, n_rays=n_rays, max_range=4.0)
+                np.testing.assert_array_equal(ranges, want.ranges)
+                np.testing.assert_array_equal(batch[0], want.ranges)
+                hits += int((want.ranges < 4.0).sum())
     assert hits > 0
 
 
