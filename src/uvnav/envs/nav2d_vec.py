@@ -201,8 +201,9 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         v, u = action_commands(actions, vmax, umax, self.raw_commands)
         v = np.minimum(np.maximum(v, 0.0), vmax)
         u = np.minimum(np.maximum(u, -umax), umax)
-        self.worlds.command[acting, 0] = v[acting]
-        self.worlds.command[acting, 1] = u[acting]
+        cmd = self.worlds.command
+        np.copyto(cmd[:, 0], v, where=acting)
+        np.copyto(cmd[:, 1], u, where=acting)
 
     def step(
         self, actions: np.ndarray

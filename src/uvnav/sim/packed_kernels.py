@@ -154,10 +154,12 @@ def _clearance(k: int, x: float, y: float, radius: float, n_obs: int, params: Fl
         o = first if j < 0 else j
         if j == first or low[o] > gap + slack:
             continue  # done first, or its bounding disc is farther than the gap so far
-        h = state[k, S_HEADING, o]
-        _transform_ring(
-            rings[k], o, math.cos(h), math.sin(h), state[k, S_X, o], state[k, S_Y, o], ring
-        )
+        h, cx, cy = state[k, S_HEADING, o], state[k, S_X, o], state[k, S_Y, o]
+        c, s = math.cos(h), math.sin(h)
+        for j in range(ring.shape[1]):  # _transform_ring's operations, inlined
+            rx, ry = rings[k, 0, o, j], rings[k, 1, o, j]
+            ring[0, j] = c * rx + s * -ry + cx
+            ring[1, j] = c * ry + s * rx + cy
         d, qx, qy, inside = ring_nearest_py(x, y, ring[0], ring[1], True)
         if inside:
             d = -float(np.hypot(qx - x, qy - y))  # numpy's (libm's), as the field's depth
