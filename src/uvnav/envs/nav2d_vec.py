@@ -131,6 +131,7 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self._autoreset = np.zeros(k, dtype=np.bool_)
         self.episode_seeds = np.zeros(k, dtype=np.int64)
         self._image: tuple[np.ndarray, ...] | None = None
+        self._names = np.array(STATUS_NAMES, dtype=object)
 
     def _load(self, i: int, options: dict[str, Any] | None) -> None:
         """Start sub-environment ``i``'s next episode (its generator picks the seed).  The first
@@ -168,7 +169,7 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
 
     def _infos(self) -> dict[str, Any]:
         w = self.worlds
-        status = np.array(STATUS_NAMES, dtype=object)[w.status]
+        status = self._names[w.status]
         ones = np.ones(self.num_envs, dtype=np.bool_)
         return {
             "status": status, "_status": ones,
