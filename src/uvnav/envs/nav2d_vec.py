@@ -216,9 +216,13 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         restart = self._autoreset.copy()
         for i in restart.nonzero()[0].tolist():
             self._load(i, None)
-        running = ~restart & (w.status != SUCCESS) & (w.status != COLLISION)
         before = self._dist.copy()
-        self._commands(actions, running & (w.status != TIMEOUT))
+        if self.raw_commands:
+            running = ~restart & (w.status != SUCCESS) & (w.status != COLLISION)
+            self._commands(actions, running & (w.status != TIMEOUT))
+        else:  # the same rule, compiled
+            running = np.empty(self.num_envs, dtype=np.bool_)
+            kernel("commands")(actions, restart, w.wf, w.wi, running)
         w.step(~restart)
         self._observe()
         cfg = self.reward_config

@@ -135,6 +135,7 @@ from uvnav.sim.packed_sense import (  # noqa: F401 - the reading columns, re-exp
     _lidar_in,
     _rough_cos_sin,
     advance_one_py,
+    commands_py,
     observe_py,
     outcome_py,
     sense_one_py,
@@ -152,6 +153,7 @@ _PUBLIC = {
     "lidar": "_lidar",
     "vector_one": "vector_one_py",
     "outcome": "outcome_py",
+    "commands": "commands_py",
     "spawn_words": "spawn_words_py",
 }
 _KERNELS: dict[str, Callable[..., Any]] = {}
@@ -170,7 +172,7 @@ def kernel(name: str) -> Callable[..., Any]:
             _lidar_in, _lidar, _features, vector_one_py,
             step_worlds_py,
             observe_py,
-            sense_one_py, advance_one_py, clearance_one_py, outcome_py,
+            sense_one_py, advance_one_py, clearance_one_py, outcome_py, commands_py,
             _hashmix, _mix, spawn_words_py,
         ]))  # fmt: skip
     return _KERNELS[_PUBLIC[name]]

@@ -31,6 +31,8 @@ from uvnav.sim.packed_kernels import (
     W_GX,
     W_GY,
     W_TH,
+    W_U,
+    W_UMAX,
     W_V,
     W_VMAX,
     W_X,
@@ -345,6 +347,28 @@ def observe_py(
                   ranges, turns)  # fmt: skip
         _features(k, x, y, th, wf[k, W_GX], wf[k, W_GY], goal_scale, speed, wf[k, W_VMAX],
                   max_range, ranges, out)  # fmt: skip
+
+
+def commands_py(actions: FloatArray, restart: np.ndarray, wf: FloatArray, wi: np.ndarray,
+                running: np.ndarray) -> None:  # fmt: skip
+    """``uvnav/Nav2D-v0``'s normalised ``actions`` (K, 2) (finite) to held commands of the worlds
+    that act: :func:`uvnav.envs.core.action_commands` (clipped to [-1, 1], mapped onto [0,
+    V_max] x [-U_max, U_max]) then :meth:`UnicycleCommand.clipped
+    <uvnav.dynamics.unicycle.UnicycleCommand.clipped>`'s saturation, numpy's operations per
+    world.  ``running[k]`` says whether world ``k`` steps from a running state (not
+    ``restart[k]``, not arrived or collided); it acts unless it also timed out."""
+    for k in range(wf.shape[0]):
+        status = wi[k, I_STATUS]
+        running[k] = not restart[k] and status != SUCCESS and status != COLLISION
+        if not running[k] or status == TIMEOUT:
+            continue
+        vmax, umax = wf[k, W_VMAX], wf[k, W_UMAX]
+        a0 = min(max(actions[k, 0], -1.0), 1.0)
+        a1 = min(max(actions[k, 1], -1.0), 1.0)
+        v = 0.5 * (a0 + 1.0) * vmax
+        u = a1 * umax
+        wf[k, W_V] = min(max(v, 0.0), vmax)
+        wf[k, W_U] = min(max(u, -umax), umax)
 
 
 def outcome_py(status: np.ndarray, low: FloatArray, restart: np.ndarray, running: np.ndarray,
