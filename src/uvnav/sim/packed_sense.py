@@ -340,13 +340,20 @@ def observe_py(
         turns[0, r], turns[1, r] = math.cos(rel[r]), math.sin(rel[r])
     for k in range(wf.shape[0]):
         x, y, th = wf[k, W_X], wf[k, W_Y], wf[k, W_TH]
-        dist[k] = pyhypot(wf[k, W_GX] - x, wf[k, W_GY] - y)
+        gx, gy = wf[k, W_GX] - x, wf[k, W_GY] - y
+        dist[k] = d = pyhypot(gx, gy)
         status = wi[k, I_STATUS]
         speed = 0.0 if status in (SUCCESS, COLLISION) else wf[k, W_V]
         _lidar_in(k, x, y, th, rel, max_range, wi[k, I_NOBS], params, state, rings, ring, dirs,
                   ranges, turns)  # fmt: skip
-        _features(k, x, y, th, wf[k, W_GX], wf[k, W_GY], goal_scale, speed, wf[k, W_VMAX],
-                  max_range, ranges, out)  # fmt: skip
+        # _features' operations, written out (the distance computed once)
+        bearing = math.atan2(gy, gx) - th
+        out[k, 0] = min(d / goal_scale, 1.0)
+        out[k, 1] = math.cos(bearing)
+        out[k, 2] = math.sin(bearing)
+        out[k, 3] = min(max(speed / wf[k, W_VMAX], 0.0), 1.0)
+        for r in range(rel.shape[0]):
+            out[k, 4 + r] = min(max(ranges[k, r] / max_range, 0.0), 1.0)
 
 
 def commands_py(actions: FloatArray, restart: np.ndarray, wf: FloatArray, wi: np.ndarray,
