@@ -24,7 +24,14 @@ from uvnav.scenarios.loader import load_scenario
 from uvnav.sensors.exact import lidar_scan
 from uvnav.sim.bodies2d import FieldBodies, PackedBodies
 from uvnav.sim.episode import World2D
-from uvnav.sim.packed import BLOCK, STATUS_NAMES, PackedWorlds, kernel, pack_check
+from uvnav.sim.packed import (
+    BLOCK,
+    STATUS_NAMES,
+    PackedWorlds,
+    kernel,
+    pack_check,
+    reseed_spawned,
+)
 from uvnav.sim.packed_sense import _rough_cos_sin
 from uvnav.sim.run import run_episode
 from uvnav.sim.seeding import run_rng, world_rng
@@ -440,6 +447,58 @@ def test_the_lidar_kernel_is_lidar_scan_near_inside_and_far_from_bodies(compiled
                 np.testing.assert_array_equal(ranges, want)
 
 
+def _grazing_poses(setup: EpisodeSetup, rel: np.ndarray) -> Iterator[tuple[float, float, float]]:
+    """Poses whose beam ``r`` (every ``r`` in turn) runs just inside a body's vertex farthest
+    from its centre, nearly tangent to its bounding disc: beams at the edge of the body's
+    angular extent, meeting its edges near their ends."""
+    for ob in setup.obstacles:
+        assert isinstance(ob.body, PolygonBody)
+        centre = np.asarray(ob.state.position, dtype=float)
+        c, s = math.cos(ob.state.heading), math.sin(ob.state.heading)
+        pts = ob.body.vertices @ np.array([[c, s], [-s, c]]) + centre
+        v = pts[int(np.argmax(np.hypot(*(pts - centre).T)))]
+        out = (v - centre) / np.hypot(*(v - centre))
+        for side in (1.0, -1.0):
+            tangent = side * np.array([-out[1], out[0]])
+            for far in (0.6, 1.7, 3.4):
+                p = v + far * tangent - 1e-4 * out
+                bearing = math.atan2(v[1] - p[1], v[0] - p[0])
+                for r in range(rel.shape[0]):
+                    yield float(p[0]), float(p[1]), bearing - float(rel[r])
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+@pytest.mark.parametrize("n_rays", [7, 32])
+def test_the_lidar_culls_keep_the_beams_grazing_a_body(compiled: bool, n_rays: int) -> None:
+    """Beams grazing each body at the edge of its angular extent, at every beam index: the
+    kernel's ranges and the observation kernel's (beams culled by the bodies' bounding discs,
+    rough directions by polynomial or by rotation, headings near 0, 630 and 6280 rad) equal
+    :func:`lidar_scan`'s, which casts every beam on every body in range; a disc test that is
+    not safe (a disc 1e-6 narrower, rough directions 1e-6 rad off) fails here."""
+    setup = build_episode(load_scenario("random-ch2:5"), 3)
+    field = ObstacleField.from_obstacles(setup.obstacles)
+    worlds = PackedWorlds(1)
+    worlds.load(0, setup)
+    rel = np.linspace(-math.pi, math.pi, n_rays, endpoint=False)
+    ranges, dirs = np.empty(n_rays), np.empty((2, n_rays))
+    ring = np.empty((2, worlds.rings.shape[3]))
+    batch, out, dist = np.empty((1, n_rays)), np.empty((1, 4 + n_rays), np.float32), np.empty(1)
+    hits = 0
+    with kernels(compiled):
+        lidar = kernel("lidar")
+        for x, y, th0 in _grazing_poses(setup, rel):
+            for th in (th0, th0 + 200.0 * math.pi, th0 - 2000.0 * math.pi):
+                lidar(x, y, th, rel, 4.0, len(setup.obstacles), worlds.params[0],
+                      worlds.state[0], worlds.rings[0], ring, dirs, ranges)  # fmt: skip
+                worlds.robot[0] = (x, y, th)  # observe's path: rough directions by rotation
+                worlds.observe(rel, 4.0, 10.0, batch, out, dist)
+                want = lidar_scan(np.array([x, y, th]), field, n_rays=n_rays, max_range=4.0)
+                np.testing.assert_array_equal(ranges, want.ranges)
+                np.testing.assert_array_equal(batch[0], want.ranges)
+                hits += int((want.ranges < 4.0).sum())
+    assert hits > 0
+
+
 def test_a_restored_image_is_the_episode_load_builds() -> None:
     """restore() with episode 2's generators gives the slot load(build_episode(scene, 2)) gives,
     and the same steps after."""
@@ -456,3 +515,18 @@ def test_a_restored_image_is_the_episode_load_builds() -> None:
         for name in ("wf", "wi", "oi", "read", "params", "state", "ubuf", "rings"):
             np.testing.assert_array_equal(getattr(fast, name), getattr(built, name), name)
     assert not np.array_equal(fast.state[0], fast.state[1])
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_reseeded_generators_are_the_spawned_children_of_the_world_stream(compiled: bool) -> None:
+    """reseed_spawned([k, 1], gens) leaves gens as world_rng(k).spawn(n)'s generators: the
+    same PCG64 states and the same draws, for seeds of one, two and three 32-bit words."""
+    with kernels(compiled):
+        for k in [0, 1, 7, 2**31 - 2, 2**32, 2**40 + 3, 2**63 - 1, 2**70 + 5]:
+            for n in (1, 10):
+                want = world_rng(k).spawn(n)
+                got = [np.random.default_rng(99) for _ in range(n)]
+                reseed_spawned([k, 1], got)
+                for g, w in zip(got, want, strict=True):
+                    assert g.bit_generator.state == w.bit_generator.state, k
+                    np.testing.assert_array_equal(g.random(5), w.random(5))

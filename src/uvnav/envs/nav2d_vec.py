@@ -45,9 +45,11 @@ from uvnav.sim.packed import (
     SUCCESS,
     TIMEOUT,
     PackedWorlds,
+    kernel,
     pack_check,
+    reseed_spawned,
 )
-from uvnav.sim.seeding import world_rng
+from uvnav.sim.seeding import _WORLD as WORLD_KEY
 
 try:
     import gymnasium as gym
@@ -124,23 +126,39 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self._dist = np.zeros(k)
         self._clear = np.zeros(k)
         self._rngs: list[np.random.Generator | None] = [None] * k
+        #: each slot's obstacle generators, reseeded at each restored reset
+        self._pool: list[list[np.random.Generator] | None] = [None] * k
         self._autoreset = np.zeros(k, dtype=np.bool_)
         self.episode_seeds = np.zeros(k, dtype=np.int64)
         self._image: tuple[np.ndarray, ...] | None = None
+        self._names = np.array(STATUS_NAMES, dtype=object)
 
     def _load(self, i: int, options: dict[str, Any] | None) -> None:
         """Start sub-environment ``i``'s next episode (its generator picks the seed).  The first
         episode is built (:func:`~uvnav.scenarios.build.build_episode`) and loaded, the others
-        restore its image with their own obstacle generators (:meth:`PackedWorlds.restore
-        <uvnav.sim.packed.PackedWorlds.restore>`): the same episodes, without building them."""
+        restore its image (:meth:`PackedWorlds.restore <uvnav.sim.packed.PackedWorlds.restore>`)
+        with the slot's own obstacle generators, set to the states the children of
+        :func:`~uvnav.sim.seeding.world_rng` would have (:func:`reseed_spawned
+        <uvnav.sim.packed.reseed_spawned>`): the same episodes, without building them."""
         rng = self._rngs[i]
         if rng is None:
             rng = self._rngs[i] = seeding.np_random()[0]
         self.episode_seeds[i] = k = episode_seed(rng, options)
-        children = world_rng(k).spawn(len(self.scenario.obstacles))  # build_episode's
-        if self._image is None or not self.worlds.restore(i, self._image, children):
-            self.worlds.load(i, build_episode(self.scenario, k))
-            self._image = self.worlds.image(i)
+        if self._image is not None:
+            children = self._pool[i]
+            if children is None:
+                n = len(self.scenario.obstacles)
+                children = self._pool[i] = [np.random.default_rng(0) for _ in range(n)]
+            reseed_spawned([k, WORLD_KEY], children)  # world_rng(k).spawn(n): build_episode's
+            if self.worlds.restore(i, self._image, children):
+                self._set_clear(i)
+                return
+        self.worlds.load(i, build_episode(self.scenario, k))
+        self._image = self.worlds.image(i)
+        self._set_clear(i)
+
+    def _set_clear(self, i: int) -> None:
+        """Sub-environment ``i``'s clearance for the reward, from its world's at the start."""
         c = float(self.worlds.clearance[i])
         self._clear[i] = c if np.isfinite(c) else self.max_range
 
@@ -151,7 +169,7 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
 
     def _infos(self) -> dict[str, Any]:
         w = self.worlds
-        status = np.array(STATUS_NAMES, dtype=object)[w.status]
+        status = self._names[w.status]
         ones = np.ones(self.num_envs, dtype=np.bool_)
         return {
             "status": status, "_status": ones,
@@ -184,8 +202,9 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         v, u = action_commands(actions, vmax, umax, self.raw_commands)
         v = np.minimum(np.maximum(v, 0.0), vmax)
         u = np.minimum(np.maximum(u, -umax), umax)
-        self.worlds.command[acting, 0] = v[acting]
-        self.worlds.command[acting, 1] = u[acting]
+        cmd = self.worlds.command
+        np.copyto(cmd[:, 0], v, where=acting)
+        np.copyto(cmd[:, 1], u, where=acting)
 
     def step(
         self, actions: np.ndarray
@@ -197,20 +216,22 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         restart = self._autoreset.copy()
         for i in restart.nonzero()[0].tolist():
             self._load(i, None)
-        running = ~restart & (w.status != SUCCESS) & (w.status != COLLISION)
         before = self._dist.copy()
-        self._commands(actions, running & (w.status != TIMEOUT))
+        if self.raw_commands:
+            running = ~restart & (w.status != SUCCESS) & (w.status != COLLISION)
+            self._commands(actions, running & (w.status != TIMEOUT))
+        else:  # the same rule, compiled
+            running = np.empty(self.num_envs, dtype=np.bool_)
+            kernel("commands")(actions, restart, w.wf, w.wi, running)
         w.step(~restart)
-        clear = np.where(np.isfinite(w.low), w.low, self.max_range)
-        self._clear = np.where(running & np.isfinite(w.low), clear, self._clear)
         self._observe()
         cfg = self.reward_config
-        r = cfg.progress * (before - self._dist) - cfg.time
-        r = r - cfg.clearance * np.maximum(0.0, cfg.clearance_margin - self._clear)
-        r = np.where(w.status == SUCCESS, r + cfg.success, r)
-        r = np.where(w.status == COLLISION, r - cfg.collision, r)
-        rewards = np.where(running, r, 0.0)
-        terminated = ~restart & ((w.status == SUCCESS) | (w.status == COLLISION))
-        truncated = ~restart & (w.status == TIMEOUT)
+        weights = np.array([cfg.progress, cfg.time, cfg.clearance, cfg.clearance_margin,
+                            cfg.success, cfg.collision], dtype=float)  # fmt: skip
+        rewards = np.empty(self.num_envs)
+        terminated = np.empty(self.num_envs, dtype=np.bool_)
+        truncated = np.empty(self.num_envs, dtype=np.bool_)
+        kernel("outcome")(w.status, w.low, restart, running, before, self._dist, self._clear,
+                          weights, rewards, terminated, truncated)  # fmt: skip
         self._autoreset = terminated | truncated
         return self._obs.copy(), rewards, terminated, truncated, self._infos()

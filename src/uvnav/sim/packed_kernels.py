@@ -49,48 +49,61 @@ N_PARAMS = 18
 N_STATE = 11
 
 
-def _move_obstacles(n: int, st: FloatArray, prm: FloatArray, oi: np.ndarray, ubuf: FloatArray,
-                    t: float, dt: float) -> None:  # fmt: skip
-    """Advance obstacles ``0..n-1`` of one world (``st`` (S, M), ``prm`` (P, M), ``oi`` (2, M),
-    ``ubuf`` (M, B)) from ``t`` by ``dt`` [s]: :class:`ObstacleBatch`'s arithmetic.
+def _move_obstacles(k: int, n: int, state: FloatArray, params: FloatArray, oi: np.ndarray,
+                    ubuf: FloatArray, t: float, dt: float) -> None:  # fmt: skip
+    """Advance obstacles ``0..n-1`` of world ``k`` (``state`` (K, S, M), ``params`` (K, P, M),
+    ``oi`` (K, 2, M), ``ubuf`` (K, M, B)) from ``t`` by ``dt`` [s]: :class:`ObstacleBatch`'s
+    arithmetic.
 
-    One call moves them all: a compiled call that takes arrays passes each one as a struct and
-    counts references to it, about 35 ns for the four arrays here, more than a random-turn step
-    itself (about 25 ns) when it was made once per obstacle."""
+    One call moves them all, and takes the packed arrays whole: a compiled call that takes
+    arrays passes each one as a struct and counts references to it, about 35 ns for the four
+    arrays here, more than a random-turn step itself (about 25 ns) when it was made once per
+    obstacle, and slicing them per world costs more."""
     for o in range(n):
-        kind = oi[O_KIND, o]
+        kind = oi[k, O_KIND, o]
         if kind == CONSTANT:
-            st[S_HEADING, o] = wrap_scalar(st[S_HEADING, o] + prm[P_OMEGA, o] * dt)
-            st[S_X, o] = st[S_X, o] + prm[P_VX, o] * dt
-            st[S_Y, o] = st[S_Y, o] + prm[P_VY, o] * dt
-            st[S_VX, o], st[S_VY, o], st[S_OMEGA, o] = prm[P_VX, o], prm[P_VY, o], prm[P_OMEGA, o]
+            state[k, S_HEADING, o] = wrap_scalar(
+                state[k, S_HEADING, o] + params[k, P_OMEGA, o] * dt
+            )
+            state[k, S_X, o] = state[k, S_X, o] + params[k, P_VX, o] * dt
+            state[k, S_Y, o] = state[k, S_Y, o] + params[k, P_VY, o] * dt
+            state[k, S_VX, o], state[k, S_VY, o], state[k, S_OMEGA, o] = (
+                params[k, P_VX, o],
+                params[k, P_VY, o],
+                params[k, P_OMEGA, o],
+            )
             continue
-        if t >= st[S_THRESHOLD, o]:  # a new speed and turn rate (RandomTurn.step's two draws)
-            p = oi[O_UPOS, o]
-            st[S_SPEED, o] = prm[P_SPEED_LO, o] + prm[P_SPEED_SPAN, o] * ubuf[o, p]
-            st[S_TURN, o] = prm[P_TURN_LO, o] + prm[P_TURN_SPAN, o] * ubuf[o, p + 1]
-            oi[O_UPOS, o] = p + 2
-            nc = t + prm[P_PERIOD, o]
-            st[S_NEXT, o] = nc
-            st[S_THRESHOLD, o] = nc - 1e-12
-        turn = st[S_TURN, o]
-        px, py = st[S_X, o], st[S_Y, o]
-        if prm[P_ARENA, o] > 0.0 and not (
-            prm[P_X0, o] <= px <= prm[P_X1, o] and prm[P_Y0, o] <= py <= prm[P_Y1, o]
+        if t >= state[k, S_THRESHOLD, o]:  # a new speed and turn rate (RandomTurn.step's two draws)
+            p = oi[k, O_UPOS, o]
+            state[k, S_SPEED, o] = (
+                params[k, P_SPEED_LO, o] + params[k, P_SPEED_SPAN, o] * ubuf[k, o, p]
+            )
+            state[k, S_TURN, o] = (
+                params[k, P_TURN_LO, o] + params[k, P_TURN_SPAN, o] * ubuf[k, o, p + 1]
+            )
+            oi[k, O_UPOS, o] = p + 2
+            nc = t + params[k, P_PERIOD, o]
+            state[k, S_NEXT, o] = nc
+            state[k, S_THRESHOLD, o] = nc - 1e-12
+        turn = state[k, S_TURN, o]
+        px, py = state[k, S_X, o], state[k, S_Y, o]
+        if params[k, P_ARENA, o] > 0.0 and not (
+            params[k, P_X0, o] <= px <= params[k, P_X1, o]
+            and params[k, P_Y0, o] <= py <= params[k, P_Y1, o]
         ):  # outside its arena: turn back toward the centre at the largest rate
-            to_c = math.atan2(prm[P_MIDY, o] - py, prm[P_MIDX, o] - px)
-            lim = prm[P_LIMIT, o]
-            turn = min(max(wrap_scalar(to_c - st[S_COURSE, o]) / dt, -lim), lim)
-        om = turn + prm[P_SPIN, o]
-        course = wrap_scalar(st[S_COURSE, o] + turn * dt)
-        st[S_HEADING, o] = wrap_scalar(st[S_HEADING, o] + om * dt)
-        st[S_COURSE, o] = course
+            to_c = math.atan2(params[k, P_MIDY, o] - py, params[k, P_MIDX, o] - px)
+            lim = params[k, P_LIMIT, o]
+            turn = min(max(wrap_scalar(to_c - state[k, S_COURSE, o]) / dt, -lim), lim)
+        om = turn + params[k, P_SPIN, o]
+        course = wrap_scalar(state[k, S_COURSE, o] + turn * dt)
+        state[k, S_HEADING, o] = wrap_scalar(state[k, S_HEADING, o] + om * dt)
+        state[k, S_COURSE, o] = course
         mid = course - 0.5 * turn * dt
-        speed = st[S_SPEED, o]
+        speed = state[k, S_SPEED, o]
         vx, vy = math.cos(mid) * speed, math.sin(mid) * speed
-        st[S_X, o] = px + vx * dt
-        st[S_Y, o] = py + vy * dt
-        st[S_VX, o], st[S_VY, o], st[S_OMEGA, o] = vx, vy, om
+        state[k, S_X, o] = px + vx * dt
+        state[k, S_Y, o] = py + vy * dt
+        state[k, S_VX, o], state[k, S_VY, o], state[k, S_OMEGA, o] = vx, vy, om
 
 
 def _transform_ring(rings: FloatArray, o: int, c: float, s: float, cx: float, cy: float,
@@ -103,11 +116,12 @@ def _transform_ring(rings: FloatArray, o: int, c: float, s: float, cx: float, cy
         out[1, j] = c * ry + s * rx + cy
 
 
-def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray, st: FloatArray,
-               rings: FloatArray, ring: FloatArray,
+def _clearance(k: int, x: float, y: float, radius: float, n_obs: int, params: FloatArray,
+               state: FloatArray, rings: FloatArray, ring: FloatArray,
                low: FloatArray) -> tuple[float, int]:  # fmt: skip
-    """Exact clearance [m] of the robot disc at ``(x, y)`` in one world (``prm`` (P, M), ``st``
-    (S, M), ``rings`` (2, M, W); ``ring`` (2, W) and ``low`` (M,) scratch): the signed distance
+    """Exact clearance [m] of the robot disc at ``(x, y)`` in world ``k`` (``params`` (K, P,
+    M), ``state`` (K, S, M), ``rings`` (K, 2, M, W), taken whole as :func:`_move_obstacles`
+    takes them; ``ring`` (2, W) and ``low`` (M,) scratch): the signed distance
     of :meth:`ObstacleField.query` (boundary distance outside, minus it inside) minus the
     radius, and the obstacle it is to (the first in index order on a tie, as the field's
     ``argmin``); ``(inf, -1)`` without obstacles.
@@ -128,10 +142,10 @@ def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray, s
     slack = 1e-9 * (1.0 + abs(x) + abs(y))
     first, best = 0, math.inf
     for o in range(n_obs):
-        dx, dy = st[S_X, o] - x, st[S_Y, o] - y
+        dx, dy = state[k, S_X, o] - x, state[k, S_Y, o] - y
         dd = dx * dx + dy * dy
         dc = math.sqrt(dd) if dd < 1e300 else math.hypot(dx, dy)
-        bound = dc * (1.0 - 1e-9) - prm[P_BOUND, o] - radius
+        bound = dc * (1.0 - 1e-9) - params[k, P_BOUND, o] - radius
         low[o] = bound
         if bound < best:
             first, best = o, bound
@@ -140,8 +154,12 @@ def _clearance(x: float, y: float, radius: float, n_obs: int, prm: FloatArray, s
         o = first if j < 0 else j
         if j == first or low[o] > gap + slack:
             continue  # done first, or its bounding disc is farther than the gap so far
-        h = st[S_HEADING, o]
-        _transform_ring(rings, o, math.cos(h), math.sin(h), st[S_X, o], st[S_Y, o], ring)
+        h, cx, cy = state[k, S_HEADING, o], state[k, S_X, o], state[k, S_Y, o]
+        c, s = math.cos(h), math.sin(h)
+        for j in range(ring.shape[1]):  # _transform_ring's operations, inlined
+            rx, ry = rings[k, 0, o, j], rings[k, 1, o, j]
+            ring[0, j] = c * rx + s * -ry + cx
+            ring[1, j] = c * ry + s * rx + cy
         d, qx, qy, inside = ring_nearest_py(x, y, ring[0], ring[1], True)
         if inside:
             d = -float(np.hypot(qx - x, qy - y))  # numpy's (libm's), as the field's depth
@@ -185,10 +203,10 @@ def step_worlds_py(
             t = i * dt
             x, y, th = unicycle_advance(wf[k, W_X], wf[k, W_Y], wf[k, W_TH], v, u, dt)
             wf[k, W_X], wf[k, W_Y], wf[k, W_TH] = x, y, th
-            _move_obstacles(wi[k, I_NOBS], state[k], params[k], oi[k], ubuf[k], t, dt)
+            _move_obstacles(k, wi[k, I_NOBS], state, params, oi, ubuf, t, dt)
             wi[k, I_STEP] = i = i + 1
-            gap, _ = _clearance(x, y, radius, wi[k, I_NOBS], params[k], state[k], rings[k],
-                                ring, low)  # fmt: skip
+            gap, _ = _clearance(k, x, y, radius, wi[k, I_NOBS], params, state, rings, ring,
+                                low)  # fmt: skip
             wf[k, W_CLEAR] = gap
             if gap < wf[k, W_LOW]:
                 wf[k, W_LOW] = gap
@@ -217,4 +235,56 @@ def clearance_one_py(x: float, y: float, radius: float, n_obs: int, prm: FloatAr
     nearest obstacle (-1 without any), without building the field."""
     ring = np.empty((2, rings.shape[2]))
     low = np.empty(rings.shape[1])
-    return _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)
+    return _clearance(0, x, y, radius, n_obs, prm[None], st[None], rings[None], ring, low)
+
+
+# numpy's SeedSequence constants (hash and mix multipliers) and PCG64's multiplier
+_M32 = 0xFFFFFFFF
+_INIT_A, _MULT_A, _INIT_B, _MULT_B = 0x43B0D7E5, 0x931E8875, 0x8B51F9DD, 0x58F38DED
+_MIX_L, _MIX_R = 0xCA01F9DD, 0x4973F715
+
+
+def _hashmix(value: int, hc: int) -> tuple[int, int]:
+    """SeedSequence's ``hashmix`` of ``value`` with hash constant ``hc`` (32-bit words held in
+    int64, products wrapping): the mixed value and the next constant."""
+    value ^= hc
+    hc = (hc * _MULT_A) & _M32
+    value = (value * hc) & _M32
+    return value ^ (value >> 16), hc
+
+
+def _mix(x: int, y: int) -> int:
+    """SeedSequence's ``mix`` of two 32-bit words (held in int64, products wrapping)."""
+    r = (_MIX_L * x - _MIX_R * y) & _M32
+    return r ^ (r >> 16)
+
+
+def spawn_words_py(entropy: np.ndarray, out: np.ndarray) -> None:
+    """The first 8 32-bit words of ``generate_state`` (as int64, low word of each uint64 first)
+    of the children ``c`` < ``out.shape[0]`` that ``numpy.random.SeedSequence.spawn`` makes of
+    a sequence whose run entropy, as 32-bit words padded with zeros to the pool size 4, is
+    ``entropy`` (E,) int64: the children's spawn keys ``(c,)`` mixed in after it, numpy's
+    operations on the words.  What a :class:`numpy.random.PCG64` seeded by child ``c`` takes as
+    its state and increment."""
+    n_ent = entropy.shape[0]
+    mixer = np.zeros(4, dtype=np.int64)
+    for c in range(out.shape[0]):
+        hc = _INIT_A
+        for i in range(4):
+            mixer[i], hc = _hashmix(int(entropy[i]), hc)
+        for src in range(4):
+            for dst in range(4):
+                if src != dst:
+                    v, hc = _hashmix(int(mixer[src]), hc)
+                    mixer[dst] = _mix(int(mixer[dst]), v)
+        for src in range(4, n_ent + 1):  # the run entropy's tail, then the spawn key
+            word = int(entropy[src]) if src < n_ent else c
+            for dst in range(4):
+                v, hc = _hashmix(word, hc)
+                mixer[dst] = _mix(int(mixer[dst]), v)
+        hb = _INIT_B
+        for j in range(8):
+            v = int(mixer[j % 4]) ^ hb
+            hb = (hb * _MULT_B) & _M32
+            v = (v * hb) & _M32
+            out[c, j] = v ^ (v >> 16)

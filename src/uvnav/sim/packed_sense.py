@@ -13,7 +13,7 @@ import math
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_scalar
-from uvnav.geometry.polygons import ray_ring_hit_py, ring_nearest_py
+from uvnav.geometry.polygons import ring_nearest_py
 from uvnav.geometry.small import pyhypot
 from uvnav.sim.packed_kernels import (
     COLLISION,
@@ -27,9 +27,12 @@ from uvnav.sim.packed_kernels import (
     S_X,
     S_Y,
     SUCCESS,
+    TIMEOUT,
     W_GX,
     W_GY,
     W_TH,
+    W_U,
+    W_UMAX,
     W_V,
     W_VMAX,
     W_X,
@@ -156,6 +159,81 @@ def _rough_cos_sin(a: float) -> tuple[float, float]:
     return sign * c, sn  # fmt: skip
 
 
+def _lidar_in(k: int, ox: float, oy: float, th: float, rel: FloatArray, max_range: float,
+              n_obs: int, params: FloatArray, state: FloatArray, rings: FloatArray,
+              ring: FloatArray, dirs: FloatArray, ranges: FloatArray,
+              turns: FloatArray) -> None:  # fmt: skip
+    """:func:`_lidar` of world ``k`` of the packed arrays ``params``, ``state``, ``rings``
+    (:func:`step_worlds_py`'s layout) into ``ranges[k]``, indexing them here: slicing them per
+    world and passing the slices cost more than a tenth of the cast.
+
+    With ``turns`` (2, R) holding libm's cos and sin of ``rel`` (else (2, 0)) and ``|th|`` at
+    most 1e3 rad, the rough directions are those turns rotated by libm's cos and sin of
+    ``th``: within 1e-12 of each beam's exact direction, as :func:`_rough_cos_sin`'s are (the
+    sum ``th + rel`` and its wrap round by under 2e-13 rad there), for two calls a world
+    instead of a polynomial a beam."""
+    n_rays = rel.shape[0]
+    rotate = turns.shape[1] == n_rays and abs(th) <= 1e3
+    ct = st = 0.0
+    if rotate:
+        ct, st = math.cos(th), math.sin(th)
+    for r in range(n_rays):
+        ranges[k, r] = max_range
+        if rotate:
+            cr, sr = turns[0, r], turns[1, r]
+            dirs[0, r], dirs[1, r] = ct * cr - st * sr, st * cr + ct * sr
+            continue
+        a = wrap_scalar(th + rel[r])
+        if -math.pi <= a <= math.pi:
+            dirs[0, r], dirs[1, r] = _rough_cos_sin(a)
+        else:  # not a number: no rough test skips it
+            dirs[0, r], dirs[1, r] = a, a
+    slack = 1e-9 * (1.0 + abs(ox) + abs(oy))
+    limit = max_range * (1.0 + 1e-9) + slack
+    for o in range(n_obs):
+        cx, cy, h = state[k, S_X, o], state[k, S_Y, o], state[k, S_HEADING, o]
+        bound = params[k, P_BOUND, o]
+        ex, ey = cx - ox, cy - oy
+        dc = math.sqrt(ex * ex + ey * ey)
+        if abs(dc - bound - limit) <= 1e-12 * (1.0 + dc + bound + limit) or not dc < 1e300:
+            dc = math.hypot(cx - ox, cy - oy)  # near the edge, huge or not a number: libm's
+        if dc - bound > limit:
+            continue  # its hits would be beyond max_range
+        reach = bound * (1.0 + 1e-9) + slack
+        rough = reach + 1e-9 * (1.0 + abs(ex) + abs(ey))
+        cast = False
+        for r in range(n_rays):
+            dx, dy = dirs[0, r], dirs[1, r]
+            if abs(dx * ey - dy * ex) > rough or dx * ex + dy * ey < -rough:
+                continue
+            a = wrap_scalar(th + rel[r])
+            dx, dy = math.cos(a), math.sin(a)
+            # a beam that passes outside the bounding disc, or starts beyond it, cannot hit
+            if abs(dx * (cy - oy) - dy * (cx - ox)) > reach:
+                continue
+            if dx * (cx - ox) + dy * (cy - oy) < -reach:
+                continue
+            if not cast:  # _transform_ring's operations, inlined (as the loop below)
+                ch, sh = math.cos(h), math.sin(h)
+                for j in range(ring.shape[1]):
+                    rx, ry = rings[k, 0, o, j], rings[k, 1, o, j]
+                    ring[0, j] = ch * rx + sh * -ry + cx
+                    ring[1, j] = ch * ry + sh * rx + cy
+                cast = True
+            best = ranges[k, r]  # ray_ring_hit_py's loop, inlined
+            for j in range(ring.shape[1] - 1):
+                sx, sy = ring[0, j], ring[1, j]
+                qx, qy = ring[0, j + 1] - sx, ring[1, j + 1] - sy
+                wx, wy = sx - ox, sy - oy
+                den = dx * qy - dy * qx
+                if abs(den) >= 1e-12:
+                    t = (wx * qy - wy * qx) / den
+                    s = (wx * dy - wy * dx) / den
+                    if t >= 0.0 and s >= 0.0 and s <= 1.0 and t < best:
+                        best = t
+            ranges[k, r] = best
+
+
 def _lidar(
     ox: float,
     oy: float,
@@ -181,44 +259,14 @@ def _lidar(
     beam's bounding-disc test with :func:`_rough_cos_sin`'s directions (kept in ``dirs``) and
     a margin of 1e-9 (1 + centre offset) [m] over their 1e-12 error; a beam that passes it
     takes libm's ``cos`` and ``sin`` and the exact test.  Most beams meet no body's disc, so
-    most beams take no ``cos`` or ``sin``."""
-    n_rays = rel.shape[0]
-    for r in range(n_rays):
-        out[r] = max_range
-        a = wrap_scalar(th + rel[r])
-        if -math.pi <= a <= math.pi:
-            dirs[0, r], dirs[1, r] = _rough_cos_sin(a)
-        else:  # not a number: no rough test skips it
-            dirs[0, r], dirs[1, r] = a, a
-    slack = 1e-9 * (1.0 + abs(ox) + abs(oy))
-    limit = max_range * (1.0 + 1e-9) + slack
-    for o in range(n_obs):
-        cx, cy, h = st[S_X, o], st[S_Y, o], st[S_HEADING, o]
-        bound = prm[P_BOUND, o]
-        ex, ey = cx - ox, cy - oy
-        dc = math.sqrt(ex * ex + ey * ey)
-        if abs(dc - bound - limit) <= 1e-12 * (1.0 + dc + bound + limit) or not dc < 1e300:
-            dc = math.hypot(cx - ox, cy - oy)  # near the edge, huge or not a number: libm's
-        if dc - bound > limit:
-            continue  # its hits would be beyond max_range
-        reach = bound * (1.0 + 1e-9) + slack
-        rough = reach + 1e-9 * (1.0 + abs(ex) + abs(ey))
-        cast = False
-        for r in range(n_rays):
-            dx, dy = dirs[0, r], dirs[1, r]
-            if abs(dx * ey - dy * ex) > rough or dx * ex + dy * ey < -rough:
-                continue
-            a = wrap_scalar(th + rel[r])
-            dx, dy = math.cos(a), math.sin(a)
-            # a beam that passes outside the bounding disc, or starts beyond it, cannot hit
-            if abs(dx * (cy - oy) - dy * (cx - ox)) > reach:
-                continue
-            if dx * (cx - ox) + dy * (cy - oy) < -reach:
-                continue
-            if not cast:
-                _transform_ring(rings, o, math.cos(h), math.sin(h), cx, cy, ring)
-                cast = True
-            out[r] = min(out[r], ray_ring_hit_py(ox, oy, dx, dy, ring[0], ring[1]))
+    most beams take no ``cos`` or ``sin``.  The ring's transform (:func:`_transform_ring`) and
+    the ray-ring test (:func:`uvnav.geometry.polygons.ray_ring_hit_py`) are their operations
+    written out in the loop, where calls that passed array rows cost more than the
+    arithmetic.  (Skipping an edge's two divisions by its numerators' signs first, and keeping
+    libm's directions across bodies, made a stepping env's observation slower: their branches
+    mispredict.)"""
+    _lidar_in(0, ox, oy, th, rel, max_range, n_obs, prm[None], st[None], rings[None], ring,
+              dirs, out[None], dirs[:, :0])  # fmt: skip
 
 
 def vector_one_py(
@@ -248,14 +296,23 @@ def vector_one_py(
     :func:`_lidar`'s ranges [m] (into ``ranges`` (R,); scratch ``ring``, ``dirs``) over
     ``max_range`` in [0, 1]."""
     _lidar(x, y, th, rel, max_range, n_obs, prm, st, rings, ring, dirs, ranges)
+    _features(0, x, y, th, goal_x, goal_y, goal_scale, speed, v_max, max_range, ranges[None],
+              out[None])  # fmt: skip
+
+
+def _features(k: int, x: float, y: float, th: float, goal_x: float, goal_y: float,
+              goal_scale: float, speed: float, v_max: float, max_range: float,
+              ranges: FloatArray, out: np.ndarray) -> None:  # fmt: skip
+    """Row ``k`` of the observation vectors ``out`` (K, 4 + R) float32 (:func:`vector_one_py`'s)
+    from the pose, goal, speed and the lidar ranges ``ranges[k]`` [m]."""
     gx, gy = goal_x - x, goal_y - y
     bearing = math.atan2(gy, gx) - th
-    out[0] = min(pyhypot(gx, gy) / goal_scale, 1.0)
-    out[1] = math.cos(bearing)
-    out[2] = math.sin(bearing)
-    out[3] = min(max(speed / v_max, 0.0), 1.0)
-    for r in range(ranges.shape[0]):
-        out[4 + r] = min(max(ranges[r] / max_range, 0.0), 1.0)
+    out[k, 0] = min(pyhypot(gx, gy) / goal_scale, 1.0)
+    out[k, 1] = math.cos(bearing)
+    out[k, 2] = math.sin(bearing)
+    out[k, 3] = min(max(speed / v_max, 0.0), 1.0)
+    for r in range(ranges.shape[1]):
+        out[k, 4 + r] = min(max(ranges[k, r] / max_range, 0.0), 1.0)
 
 
 def observe_py(
@@ -278,14 +335,76 @@ def observe_py(
     collided), ranges / ``max_range`` in [0, 1] (beams at heading + ``rel`` [rad])."""
     ring = np.empty((2, rings.shape[3]))
     dirs = np.empty((2, rel.shape[0]))
+    turns = np.empty((2, rel.shape[0]))  # the beams' offsets as rotations, for every world
+    for r in range(rel.shape[0]):
+        turns[0, r], turns[1, r] = math.cos(rel[r]), math.sin(rel[r])
     for k in range(wf.shape[0]):
         x, y, th = wf[k, W_X], wf[k, W_Y], wf[k, W_TH]
-        dist[k] = pyhypot(wf[k, W_GX] - x, wf[k, W_GY] - y)
+        gx, gy = wf[k, W_GX] - x, wf[k, W_GY] - y
+        dist[k] = d = pyhypot(gx, gy)
         status = wi[k, I_STATUS]
         speed = 0.0 if status in (SUCCESS, COLLISION) else wf[k, W_V]
-        vector_one_py(x, y, th, wf[k, W_GX], wf[k, W_GY], goal_scale, speed, wf[k, W_VMAX], rel,
-                      max_range, wi[k, I_NOBS], params[k], state[k], rings[k], ring, dirs,
-                      ranges[k], out[k])  # fmt: skip
+        _lidar_in(k, x, y, th, rel, max_range, wi[k, I_NOBS], params, state, rings, ring, dirs,
+                  ranges, turns)  # fmt: skip
+        # _features' operations, written out (the distance computed once)
+        bearing = math.atan2(gy, gx) - th
+        out[k, 0] = min(d / goal_scale, 1.0)
+        out[k, 1] = math.cos(bearing)
+        out[k, 2] = math.sin(bearing)
+        out[k, 3] = min(max(speed / wf[k, W_VMAX], 0.0), 1.0)
+        for r in range(rel.shape[0]):
+            out[k, 4 + r] = min(max(ranges[k, r] / max_range, 0.0), 1.0)
+
+
+def commands_py(actions: FloatArray, restart: np.ndarray, wf: FloatArray, wi: np.ndarray,
+                running: np.ndarray) -> None:  # fmt: skip
+    """``uvnav/Nav2D-v0``'s normalised ``actions`` (K, 2) (finite) to held commands of the worlds
+    that act: :func:`uvnav.envs.core.action_commands` (clipped to [-1, 1], mapped onto [0,
+    V_max] x [-U_max, U_max]) then :meth:`UnicycleCommand.clipped
+    <uvnav.dynamics.unicycle.UnicycleCommand.clipped>`'s saturation, numpy's operations per
+    world.  ``running[k]`` says whether world ``k`` steps from a running state (not
+    ``restart[k]``, not arrived or collided); it acts unless it also timed out."""
+    for k in range(wf.shape[0]):
+        status = wi[k, I_STATUS]
+        running[k] = not restart[k] and status != SUCCESS and status != COLLISION
+        if not running[k] or status == TIMEOUT:
+            continue
+        vmax, umax = wf[k, W_VMAX], wf[k, W_UMAX]
+        a0 = min(max(actions[k, 0], -1.0), 1.0)
+        a1 = min(max(actions[k, 1], -1.0), 1.0)
+        v = 0.5 * (a0 + 1.0) * vmax
+        u = a1 * umax
+        wf[k, W_V] = min(max(v, 0.0), vmax)
+        wf[k, W_U] = min(max(u, -umax), umax)
+
+
+def outcome_py(status: np.ndarray, low: FloatArray, restart: np.ndarray, running: np.ndarray,
+               before: FloatArray, dist: FloatArray, clear: FloatArray, weights: FloatArray,
+               rewards: FloatArray, terminated: np.ndarray,
+               truncated: np.ndarray) -> None:  # fmt: skip
+    """``uvnav/Nav2D-v0``'s rewards, terminations and truncations of K worlds after a step (the
+    operations of :meth:`uvnav.envs.core.EnvWorld.reward` on each): from the worlds' status
+    codes and lowest clearances ``low`` [m] over the step, the (K,) bools ``restart`` (the world
+    restarted instead of stepping) and ``running`` (it stepped from a running state), goal
+    distances ``before`` and ``dist`` [m] and the reward's ``weights`` (progress, time,
+    clearance, clearance margin, success, collision).  ``clear`` [m] takes ``low`` where the
+    world ran and ``low`` is finite, and is the clearance the penalty reads."""
+    progress, time_cost, clearance, margin = weights[0], weights[1], weights[2], weights[3]
+    success, collision = weights[4], weights[5]
+    for k in range(status.shape[0]):
+        if running[k] and abs(low[k]) < math.inf:
+            clear[k] = low[k]
+        s = status[k]
+        r = progress * (before[k] - dist[k]) - time_cost
+        gap = margin - clear[k]
+        r = r - clearance * (0.0 if gap <= 0.0 else gap)  # numpy's maximum(0.0, gap)
+        if s == SUCCESS:
+            r = r + success
+        if s == COLLISION:
+            r = r - collision
+        rewards[k] = r if running[k] else 0.0
+        terminated[k] = not restart[k] and s in (SUCCESS, COLLISION)
+        truncated[k] = not restart[k] and s == TIMEOUT
 
 
 def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs: int,
@@ -305,7 +424,7 @@ def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs
     low = np.empty(rings.shape[1])
     for o in range(n_obs):
         prev[0, o], prev[1, o], prev[2, o] = st[S_X, o], st[S_Y, o], st[S_HEADING, o]
-    _move_obstacles(n_obs, st, prm, oi, ubuf, t, dt)
+    _move_obstacles(0, n_obs, st[None], prm[None], oi[None], ubuf[None], t, dt)
     shift = 0.0
     for o in range(n_obs):
         dx, dy = st[S_X, o] - prev[0, o], st[S_Y, o] - prev[1, o]
@@ -315,7 +434,7 @@ def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs
         s = math.sqrt(dx * dx + dy * dy) + turn * prm[P_BOUND, o]
         if s > shift:
             shift = s
-    gap, at = _clearance(x, y, radius, n_obs, prm, st, rings, ring, low)
+    gap, at = _clearance(0, x, y, radius, n_obs, prm[None], st[None], rings[None], ring, low)
     m = -1
     if sensing_range >= 0.0:
         m = sense_one_py(x, y, sensing_range, n_obs, prm, st, rings, ids, rows, outlines)
