@@ -18,7 +18,6 @@ Units: metres, seconds, radians.
 from __future__ import annotations
 
 import math
-import types
 from collections.abc import Callable
 from itertools import accumulate
 from typing import Any
@@ -28,7 +27,7 @@ import numpy as np
 from uvnav.geometry import contact
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.contact import decide_py
-from uvnav.geometry.kernels3d import numba_enabled
+from uvnav.geometry.kernels3d import compile_family, numba_enabled
 from uvnav.sensors.observation import ObstacleReading
 
 IntArray = np.ndarray
@@ -176,13 +175,9 @@ def _compiled_plan() -> Callable[..., Any]:
     """:func:`plan_loop_py` compiled by numba (on the first call, or loaded from numba's cache),
     calling the compiled copies of :mod:`uvnav.geometry.contact`'s loops."""
     if not _COMPILED:
-        import numba
-
-        done = dict(contact._kernels())
-        for f in (boundary_discs_py, plan_loop_py):
-            env = {**f.__globals__, **done}
-            copy = types.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
-            done[f.__name__] = _COMPILED[f.__name__] = numba.njit(cache=True, nogil=True)(copy)
+        _COMPILED.update(
+            compile_family((boundary_discs_py, plan_loop_py), bound=contact._kernels())
+        )
     return _COMPILED["plan_loop_py"]
 
 

@@ -38,7 +38,6 @@ full evaluation (every path to the horizon, every disc, every segment) made of i
 from __future__ import annotations
 
 import math
-import types
 from collections.abc import Callable
 from typing import Any
 
@@ -49,7 +48,7 @@ from uvnav.controllers.zhang2019_v2_loop import boundary_discs_py
 from uvnav.geometry import contact
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.contact import _contact_scalar, _gap_scalar, tangents_py
-from uvnav.geometry.kernels3d import numba_enabled
+from uvnav.geometry.kernels3d import compile_family, numba_enabled
 
 #: indices into the ``prm`` vector of :func:`choose_on_paths_py` and :func:`plan_paths_py`
 (M_VMAX, M_UMAX, M_ACCEL, M_TURN, M_PERIOD, M_HORIZON, M_STEP, M_COMFORT, M_CHOR, M_MARGIN,
@@ -515,18 +514,13 @@ def _compiled_plan() -> Callable[..., Any]:
     """:func:`plan_paths_py` compiled by numba (on the first call, or loaded from numba's
     cache), calling the compiled copies of its helpers and of :mod:`uvnav.geometry.contact`'s."""
     if not _COMPILED:
-        import numba
-
         zhang2019_v2_loop._compiled_plan()
-        done = {**contact._kernels(), **zhang2019_v2_loop._COMPILED}
         kernels = (_approach, _window, _turn, advance, _box_gap, _path_box, _disc_along, _far,
                    _chunk_bodies,
                    risk_along, _stops, _better, _keep, _groups, choose_on_paths_py, plan_paths_py,
                    plan_readings_py)  # fmt: skip
-        for f in kernels:
-            env = {**f.__globals__, **done}
-            copy = types.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
-            done[f.__name__] = _COMPILED[f.__name__] = numba.njit(cache=True, nogil=True)(copy)
+        bound = {**contact._kernels(), **zhang2019_v2_loop._COMPILED}
+        _COMPILED.update(compile_family(kernels, bound=bound))
     return _COMPILED["plan_readings_py"]
 
 

@@ -33,7 +33,7 @@ import importlib.util
 import math
 import os
 import types
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
 from typing import Any
 
@@ -49,6 +49,7 @@ _ENABLED = _HAVE_NUMBA and os.environ.get("UVNAV_NO_NUMBA", "") != "1"
 
 def compile_family(
     functions: Sequence[Callable[..., Any] | tuple[str, Callable[..., Any]]],
+    bound: Mapping[str, Callable[..., Any]] | None = None,
 ) -> dict[str, Callable[..., Any]]:
     """numba-compiled copies of ``functions`` (callees before callers), by name.
 
@@ -57,16 +58,19 @@ def compile_family(
     functions stay untouched: they remain the reference path of :func:`use_compiled` (False).  A
     ``(name, function)`` pair binds the function's compiled copy under ``name`` (a global the
     Python path binds to something numba cannot compile the same, e.g. ``math.hypot``).
+    ``bound``: compiled kernels of other families, bound under their names in every copy (not
+    returned).
     """
     import numba
 
-    done: dict[str, Callable[..., Any]] = {}
+    done: dict[str, Callable[..., Any]] = dict(bound or {})
+    made: dict[str, Callable[..., Any]] = {}
     for item in functions:
         name, f = item if isinstance(item, tuple) else (item.__name__, item)
         env = {**f.__globals__, **done}
         copy = types.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
-        done[name] = numba.njit(cache=True, nogil=True)(copy)
-    return done
+        done[name] = made[name] = numba.njit(cache=True, nogil=True)(copy)
+    return made
 
 
 def numba_available() -> bool:
