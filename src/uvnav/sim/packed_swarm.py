@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.controllers.base import LawState
-from uvnav.controllers.orca_kernels import FAMILY, group_decide_py
+from uvnav.controllers.orca_kernels import FAMILY, group_decide_py, hypot_versus_py
 from uvnav.controllers.orca_shared import (
     BLOCK as BLOCK,
 )
@@ -226,7 +226,7 @@ def _arrivals(rob: FloatArray, status: np.ndarray, t: float, tol: float) -> None
     for i in range(rob.shape[0]):
         if status[i] != RUNNING:
             continue
-        if pyhypot(rob[i, R_GX] - rob[i, R_X], rob[i, R_GY] - rob[i, R_Y]) <= tol:
+        if hypot_versus_py(rob[i, R_GX] - rob[i, R_X], rob[i, R_GY] - rob[i, R_Y], tol) <= tol:
             status[i], rob[i, R_REACHED] = SUCCESS, t
 
 
