@@ -342,6 +342,7 @@ def swarm_advance_py(
 
 
 _KERNELS: dict[str, Callable[..., Any]] = {}
+_cpu_clock, _wall_clock = _time.thread_time_ns, _time.perf_counter_ns  # the decision timers
 
 
 def _kernel(name: str) -> Callable[..., Any]:
@@ -519,6 +520,7 @@ class PackedSwarm(SwarmState):
         )
         upos = int_views(self.iw, n)[2]
         self._draws = Draws(rng.spawn(2 * n)[0::2], float(p.perturbation), upos)  # child 2i: law i
+        self._ready = self._draws.ready
         self._decide = _kernel("swarm_decide_py")
         self._decide_args = (rob, self._draws.draws, self.iw, self.fw)
         self._cpu_ns: list[int] = []  # each group decision's CPU and wall time per member [ns]
@@ -526,7 +528,8 @@ class PackedSwarm(SwarmState):
         self._finish()
 
     def _finish(self) -> None:
-        if self.ints[I_DONE]:
+        self._over = bool(self.ints[I_DONE])
+        if self._over:
             self.status[self.status == RUNNING] = TIMEOUT
 
     @property
@@ -547,19 +550,19 @@ class PackedSwarm(SwarmState):
         """One iteration of the loop: the decisions when due (their CPU and wall time kept, as
         :func:`uvnav.core.run_loop` keeps a group's), then one step ``dt``; returns
         :attr:`done`."""
-        if self.ints[I_DONE]:
+        if self._over:
             return True
-        self._draws.ready()
-        c0, w0 = _time.thread_time_ns(), _time.perf_counter_ns()
+        self._ready()
+        c0, w0 = _cpu_clock(), _wall_clock()
         m = self._decide(*self._decide_args)
         if m:
-            c1, w1 = _time.thread_time_ns(), _time.perf_counter_ns()
+            c1, w1 = _cpu_clock(), _wall_clock()
             self._cpu_ns.append((c1 - c0) // m)
             self._wall_ns.append((w1 - w0) // m)
-        done = self.advance_kernel(*self._advance_args)
-        if done:
+        if self.advance_kernel(*self._advance_args):
+            self._over = True
             self._finish()
-        return bool(done)
+        return self._over
 
     def run(self) -> None:
         """Step to the end."""
