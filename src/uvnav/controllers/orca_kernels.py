@@ -290,6 +290,20 @@ def track_py(
     return v, u
 
 
+def hypot_versus_py(x: float, y: float, limit: float) -> float:
+    """For comparing ``pyhypot(x, y)`` with ``limit``: :func:`pyhypot` where it is within a
+    relative 1e-9 of ``limit`` (or ``limit`` is outside [1e-150, 1e150]), else a number on the
+    same side of ``limit`` (0.0 below it, +inf above), told from the squares (1e-9 is far above
+    their rounding and the hypot's), so any comparison with ``limit`` comes out the same."""
+    if 1e-150 <= limit <= 1e150:
+        sq = x * x + y * y
+        if sq >= (limit * (1.0 + 1e-9)) ** 2:
+            return math.inf
+        if sq <= (limit * (1.0 - 1e-9)) ** 2:
+            return 0.0
+    return pyhypot(x, y)
+
+
 def decide_group_py(
     members: np.ndarray, pos: FloatArray, heading: FloatArray, vel: FloatArray,
     radii: FloatArray, reach: FloatArray, goals: FloatArray, v_max: FloatArray,
@@ -336,7 +350,7 @@ def decide_group_py(
         v, u = track_py(nx, ny, heading[i], v_max[i], u_max[i], period, px, py)
         out[k, 0], out[k, 1], out[k, 2], out[k, 3] = v, u, nx, ny
         out[k, 4], out[k, 5] = px, py
-        out[k, 6] = 1.0 if pyhypot(nx - px, ny - py) >= 1e-6 else 0.0
+        out[k, 6] = 1.0 if hypot_versus_py(nx - px, ny - py, 1e-6) >= 1e-6 else 0.0
 
 
 def group_decide_py(
@@ -378,7 +392,7 @@ def group_decide_py(
 #: everything the kernels call, callees first
 FAMILY: tuple[Callable[..., Any], ...] = (
     wrap_scalar, pyhypot, det2, lp1_py, lp2_py, lp3_py, solve_lines_py, neighbours_py,
-    agent_lines_py, track_py, decide_group_py, group_decide_py,
+    agent_lines_py, track_py, hypot_versus_py, decide_group_py, group_decide_py,
 )  # fmt: skip
 _KERNELS: dict[str, Callable[..., Any]] = {}
 

@@ -171,12 +171,20 @@ class Draws:
         draws: (N, 2 BLOCK) each agent's numbers; ``upos[i]`` the next unread one of agent i.
     """
 
-    def __init__(self, rngs: Sequence[np.random.Generator | None], perturbation: float) -> None:
+    def __init__(
+        self,
+        rngs: Sequence[np.random.Generator | None],
+        perturbation: float,
+        upos: np.ndarray | None = None,
+    ) -> None:
+        """``upos``: an (N,) int64 array to keep the read positions in (a view into a caller's
+        buffer), else a new one."""
         n = len(rngs)
         self._rngs = rngs
         self.on = perturbation > 0.0
         self.draws = np.zeros((n, 2 * BLOCK))
-        self.upos = np.full(n, 2 * BLOCK, dtype=np.int64)
+        self.upos = np.zeros(n, dtype=np.int64) if upos is None else upos
+        self.upos[:] = 2 * BLOCK
         self._safe = 0  # decisions that cannot run out of pre-drawn numbers
 
     def ready(self) -> None:

@@ -46,7 +46,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.controllers.base import LawState
-from uvnav.controllers.orca_kernels import FAMILY, group_decide_py
+from uvnav.controllers.orca_kernels import FAMILY, group_decide_py, hypot_versus_py
 from uvnav.controllers.orca_shared import (
     BLOCK as BLOCK,
 )
@@ -54,7 +54,6 @@ from uvnav.controllers.orca_shared import (
     Draws,
     OrcaShared,
     group_geometry,
-    group_scratch,
 )
 from uvnav.core import AgentLog
 from uvnav.dynamics.unicycle import unicycle_advance
@@ -89,6 +88,39 @@ NR = 28
 # Entries of the float array of the swarm: dt [s], goal tolerance [m], perturbation [m/s], time
 # horizon [s], responsibility, first decision period [s] (from F_EPS on: orca_kernels' P_*).
 (F_DT, F_TOL, F_EPS, F_TAU, F_RESP, F_FIRST) = range(6)
+
+
+#: length of the int and float arrays of the swarm (``I_*`` and ``F_*`` entries)
+NI, NF = 7, 6
+
+
+def int_views(
+    iw: np.ndarray, n: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The views of a packed swarm's int buffer ``iw`` (NI + 3 n + cap,) for n robots: its
+    ``I_*`` entries, the status codes, each robot's next unread draw, the decision's members and
+    its neighbour scratch (cap = max(max_neighbors, 1) entries)."""
+    return (
+        iw[:NI], iw[NI : NI + n], iw[NI + n : NI + 2 * n], iw[NI + 2 * n : NI + 3 * n],
+        iw[NI + 3 * n :],
+    )  # fmt: skip
+
+
+def float_views(
+    fw: FloatArray, n: int
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The views of a packed swarm's float buffer ``fw`` (NF + 10 n + 8 cap,) for n robots: its
+    ``F_*`` entries, the members' decision periods (n,), their draws (n, 2), the decision's
+    output (n, 7) and the ORCA scratch (2 cap, 4)."""
+    a, b, c = NF + n, NF + 3 * n, NF + 10 * n
+    rows = (fw.shape[0] - c) // 4
+    return (
+        fw[:NF],
+        fw[NF:a],
+        fw[a:b].reshape((n, 2)),
+        fw[b:c].reshape((n, 7)),
+        fw[c:].reshape((rows, 4)),
+    )
 
 
 def swarm_check(setup: MultiSetup) -> str | None:
@@ -194,7 +226,7 @@ def _arrivals(rob: FloatArray, status: np.ndarray, t: float, tol: float) -> None
     for i in range(rob.shape[0]):
         if status[i] != RUNNING:
             continue
-        if pyhypot(rob[i, R_GX] - rob[i, R_X], rob[i, R_GY] - rob[i, R_Y]) <= tol:
+        if hypot_versus_py(rob[i, R_GX] - rob[i, R_X], rob[i, R_GY] - rob[i, R_Y], tol) <= tol:
             status[i], rob[i, R_REACHED] = SUCCESS, t
 
 
@@ -228,17 +260,17 @@ def hold_py(
         rob[i, R_V], rob[i, R_U] = v, u
 
 
-def swarm_decide_py(
-    rob: FloatArray, status: np.ndarray, ints: np.ndarray, flt: FloatArray, draws: FloatArray,
-    upos: np.ndarray, scratch: FloatArray, idx: np.ndarray, members: np.ndarray,
-    periods: FloatArray, pick: FloatArray, out: FloatArray,
-) -> int:  # fmt: skip
+def swarm_decide_py(rob: FloatArray, draws: FloatArray, iw: np.ndarray, fw: FloatArray) -> int:
     """The decisions of the running robots when one is due (every ``ratio`` steps), held as
     :meth:`MultiUnicycleWorld.apply` holds them (limit violations counted, effort of the speed
     change, saturated; the mode of each decision counted as :class:`uvnav.core.AgentLog` counts
     it); returns how many robots decided.  ``draws`` (N, 2 BLOCK) holds each robot's pre-drawn
-    numbers from ``upos[i]`` on; the other arrays are the swarm's (:class:`PackedSwarm`)."""
+    numbers; the swarm's other arrays are views into two buffers (one array argument each, so
+    the compiled call unboxes four): ``iw`` its ints (:func:`int_views`), ``fw`` its floats
+    (:func:`float_views`)."""
     n = rob.shape[0]
+    ints, status, upos, members, idx = int_views(iw, n)
+    flt, periods, pick, out, scratch = float_views(fw, n)
     dt = flt[F_DT]
     step = ints[I_STEP]
     if step % ints[I_RATIO] != 0:
@@ -310,6 +342,7 @@ def swarm_advance_py(
 
 
 _KERNELS: dict[str, Callable[..., Any]] = {}
+_cpu_clock, _wall_clock = _time.thread_time_ns, _time.perf_counter_ns  # the decision timers
 
 
 def _kernel(name: str) -> Callable[..., Any]:
@@ -327,7 +360,7 @@ def _kernel(name: str) -> Callable[..., Any]:
     if not _KERNELS:
         _KERNELS.update(compile_family(
             (*FAMILY, unicycle_advance, segment_gap, _side_gaps, _pair_check, _arrivals, hold_py,
-             swarm_decide_py, swarm_advance_py)
+             int_views, float_views, swarm_decide_py, swarm_advance_py)
         ))  # fmt: skip
     return _KERNELS[name]
 
@@ -340,6 +373,17 @@ def hold_kernel() -> Callable[..., Any]:
 def _kernels() -> tuple[Callable[..., Any], Callable[..., Any]]:
     """:func:`swarm_decide_py` and :func:`swarm_advance_py`, compiled when numba is enabled."""
     return _kernel("swarm_decide_py"), _kernel("swarm_advance_py")
+
+
+def _robots(setup: MultiSetup) -> Sequence[Any]:
+    """The scene's robots.
+
+    Raises:
+        ValueError: there is none.
+    """
+    if not setup.robots:
+        raise ValueError("a multi-robot episode needs at least one robot")
+    return setup.robots
 
 
 class SwarmState:
@@ -362,11 +406,9 @@ class SwarmState:
         ValueError: no robot, or ``control_period`` is not a whole multiple of ``dt``.
     """
 
-    def __init__(self, setup: MultiSetup) -> None:
-        robots = setup.robots
+    def __init__(self, setup: MultiSetup, extra_ints: int = 0, extra_floats: int = 0) -> None:
+        robots = _robots(setup)
         n = len(robots)
-        if n == 0:
-            raise ValueError("a multi-robot episode needs at least one robot")
         dt = float(setup.dt)
         self.setup, self.n, self.dt = setup, n, dt
         radii = np.array([float(r.spec.radius) for r in robots])
@@ -386,15 +428,16 @@ class SwarmState:
         rob[:, R_CLEAR] = rob[:, R_LOW] = np.inf
         rob[:, R_MODE] = -1.0
         self.rob = rob
-        self.status = np.zeros(n, dtype=np.int64)
+        self.iw = np.zeros(NI + n + extra_ints, dtype=np.int64)  # ints, status, then extra
+        self.fw = np.zeros(NF + extra_floats)  # flt, then extra
+        self.ints, self.status = self.iw[:NI], self.iw[NI : NI + n]
         self.pairs = np.zeros((n, n), dtype=np.uint8)
-        self.ints = np.array(
-            [0, decision_ratio(float(setup.control_period), dt), step_count(setup.t_max, dt), 0,
-             0, 0, 0], dtype=np.int64,
+        self.ints[:] = (
+            0, decision_ratio(float(setup.control_period), dt), step_count(setup.t_max, dt), 0,
+            0, 0, 0,
         )  # fmt: skip
-        self.flt = np.array(
-            [dt, float(setup.goal_tolerance), 0.0, 0.0, 0.0, float(LawState.FIRST_PERIOD)]
-        )
+        self.flt = self.fw[:NF]
+        self.flt[:] = (dt, float(setup.goal_tolerance), 0.0, 0.0, 0.0, LawState.FIRST_PERIOD)
         window = max(1, round(setup.deadlock_window / dt))
         self.hist = np.zeros((window + 1, n, 2))  # the last window + 1 positions before a step
         self.advance_kernel = _kernel("swarm_advance_py")  # its arguments: _advance_args
@@ -461,10 +504,11 @@ class PackedSwarm(SwarmState):
         reason = swarm_check(setup)
         if reason is not None:
             raise ValueError(f"cannot pack this swarm: {reason}")
-        super().__init__(setup)
-        n, rob = self.n, self.rob
-        law: Any = setup.robots[0].controller
+        law: Any = _robots(setup)[0].controller
         p = law.params
+        n, cap = len(setup.robots), max(int(p.max_neighbors), 1)
+        super().__init__(setup, extra_ints=2 * n + cap, extra_floats=10 * n + 8 * cap)
+        rob = self.rob
         radii = rob[:, R_RADIUS].copy()
         sensing = np.array([float(r.sensing.sensing_range) for r in setup.robots])
         rob[:, R_ORAD], rob[:, R_OREACH] = group_geometry(p, radii, sensing)
@@ -474,23 +518,18 @@ class PackedSwarm(SwarmState):
             float(p.time_horizon),
             float(p.responsibility),
         )
-        self._draws = Draws(rng.spawn(2 * n)[0::2], float(p.perturbation))  # child 2i: law i
-        self._scratch, self._idx = group_scratch(p)
-        self._members = np.zeros(n, dtype=np.int64)
-        self._periods = np.zeros(n)
-        self._pick = np.zeros((n, 2))
-        self._out = np.zeros((n, 7))
+        upos = int_views(self.iw, n)[2]
+        self._draws = Draws(rng.spawn(2 * n)[0::2], float(p.perturbation), upos)  # child 2i: law i
+        self._ready = self._draws.ready
         self._decide = _kernel("swarm_decide_py")
-        self._decide_args = (
-            rob, self.status, self.ints, self.flt, self._draws.draws, self._draws.upos,
-            self._scratch, self._idx, self._members, self._periods, self._pick, self._out,
-        )  # fmt: skip
+        self._decide_args = (rob, self._draws.draws, self.iw, self.fw)
         self._cpu_ns: list[int] = []  # each group decision's CPU and wall time per member [ns]
         self._wall_ns: list[int] = []
         self._finish()
 
     def _finish(self) -> None:
-        if self.ints[I_DONE]:
+        self._over = bool(self.ints[I_DONE])
+        if self._over:
             self.status[self.status == RUNNING] = TIMEOUT
 
     @property
@@ -511,19 +550,19 @@ class PackedSwarm(SwarmState):
         """One iteration of the loop: the decisions when due (their CPU and wall time kept, as
         :func:`uvnav.core.run_loop` keeps a group's), then one step ``dt``; returns
         :attr:`done`."""
-        if self.ints[I_DONE]:
+        if self._over:
             return True
-        self._draws.ready()
-        c0, w0 = _time.thread_time_ns(), _time.perf_counter_ns()
+        self._ready()
+        c0, w0 = _cpu_clock(), _wall_clock()
         m = self._decide(*self._decide_args)
         if m:
-            c1, w1 = _time.thread_time_ns(), _time.perf_counter_ns()
+            c1, w1 = _cpu_clock(), _wall_clock()
             self._cpu_ns.append((c1 - c0) // m)
             self._wall_ns.append((w1 - w0) // m)
-        done = self.advance_kernel(*self._advance_args)
-        if done:
+        if self.advance_kernel(*self._advance_args):
+            self._over = True
             self._finish()
-        return bool(done)
+        return self._over
 
     def run(self) -> None:
         """Step to the end."""
