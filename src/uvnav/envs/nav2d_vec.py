@@ -132,6 +132,8 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self.episode_seeds = np.zeros(k, dtype=np.int64)
         self._image: tuple[np.ndarray, ...] | None = None
         self._names = np.array(STATUS_NAMES, dtype=object)
+        self._weights_of: RewardConfig | None = None
+        self._weight_row = np.zeros(6)
 
     def _load(self, i: int, options: dict[str, Any] | None) -> None:
         """Start sub-environment ``i``'s next episode (its generator picks the seed).  The first
@@ -206,6 +208,17 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         np.copyto(cmd[:, 0], v, where=acting)
         np.copyto(cmd[:, 1], u, where=acting)
 
+    def _weights(self) -> np.ndarray:
+        """The reward's weights (progress, time, clearance, clearance margin, success,
+        collision) of :attr:`reward_config`, kept while it is the same object."""
+        cfg = self.reward_config
+        if self._weights_of is not cfg:
+            self._weights_of = cfg
+            self._weight_row = np.array([cfg.progress, cfg.time, cfg.clearance,
+                                         cfg.clearance_margin, cfg.success, cfg.collision],
+                                        dtype=float)  # fmt: skip
+        return self._weight_row
+
     def step(
         self, actions: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
@@ -216,22 +229,17 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         restart = self._autoreset.copy()
         for i in restart.nonzero()[0].tolist():
             self._load(i, None)
-        before = self._dist.copy()
         if self.raw_commands:
             running = ~restart & (w.status != SUCCESS) & (w.status != COLLISION)
             self._commands(actions, running & (w.status != TIMEOUT))
-        else:  # the same rule, compiled
-            running = np.empty(self.num_envs, dtype=np.bool_)
-            kernel("commands")(actions, restart, w.wf, w.wi, running)
-        w.step(~restart)
-        self._observe()
-        cfg = self.reward_config
-        weights = np.array([cfg.progress, cfg.time, cfg.clearance, cfg.clearance_margin,
-                            cfg.success, cfg.collision], dtype=float)  # fmt: skip
         rewards = np.empty(self.num_envs)
         terminated = np.empty(self.num_envs, dtype=np.bool_)
         truncated = np.empty(self.num_envs, dtype=np.bool_)
-        kernel("outcome")(w.status, w.low, restart, running, before, self._dist, self._clear,
-                          weights, rewards, terminated, truncated)  # fmt: skip
+        w.ensure_draws()  # its count is replaced by the kernel's, which knows the rows read
+        w.safe_calls = kernel("vector_step")(
+            actions, restart, self.raw_commands, w.wf, w.wi, w.oi, w.params, w.state, w.ubuf,
+            w.rings, self._rel, self.max_range, self.goal_scale, self._ranges, self._obs,
+            self._dist, self._clear, self._weights(), rewards, terminated, truncated,
+        )  # fmt: skip
         self._autoreset = terminated | truncated
         return self._obs.copy(), rewards, terminated, truncated, self._infos()

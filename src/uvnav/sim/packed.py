@@ -140,6 +140,7 @@ from uvnav.sim.packed_sense import (  # noqa: F401 - the reading columns, re-exp
     outcome_py,
     sense_one_py,
     vector_one_py,
+    vector_step_py,
 )
 from uvnav.sim.setup import EpisodeSetup
 
@@ -154,6 +155,7 @@ _PUBLIC = {
     "vector_one": "vector_one_py",
     "outcome": "outcome_py",
     "commands": "commands_py",
+    "vector_step": "vector_step_py",
     "spawn_words": "spawn_words_py",
 }
 _KERNELS: dict[str, Callable[..., Any]] = {}
@@ -173,6 +175,7 @@ def kernel(name: str) -> Callable[..., Any]:
             step_worlds_py,
             observe_py,
             sense_one_py, advance_one_py, clearance_one_py, outcome_py, commands_py,
+            vector_step_py,
             _hashmix, _mix, spawn_words_py,
         ]))  # fmt: skip
     return _KERNELS[_PUBLIC[name]]
