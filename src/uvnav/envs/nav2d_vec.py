@@ -47,7 +47,6 @@ from uvnav.sim.packed import (
     PackedWorlds,
     kernel,
     pack_check,
-    reseed_spawned,
 )
 from uvnav.sim.seeding import _WORLD as WORLD_KEY
 
@@ -138,10 +137,10 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
     def _load(self, i: int, options: dict[str, Any] | None) -> None:
         """Start sub-environment ``i``'s next episode (its generator picks the seed).  The first
         episode is built (:func:`~uvnav.scenarios.build.build_episode`) and loaded, the others
-        restore its image (:meth:`PackedWorlds.restore <uvnav.sim.packed.PackedWorlds.restore>`)
-        with the slot's own obstacle generators, set to the states the children of
-        :func:`~uvnav.sim.seeding.world_rng` would have (:func:`reseed_spawned
-        <uvnav.sim.packed.reseed_spawned>`): the same episodes, without building them."""
+        restore its image (:meth:`PackedWorlds.restore_spawned
+        <uvnav.sim.packed.PackedWorlds.restore_spawned>`) with the slot's own obstacle
+        generators, reseeded to the states the children of :func:`~uvnav.sim.seeding.world_rng`
+        would have: the same episodes, without building them."""
         rng = self._rngs[i]
         if rng is None:
             rng = self._rngs[i] = seeding.np_random()[0]
@@ -151,8 +150,8 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
             if children is None:
                 n = len(self.scenario.obstacles)
                 children = self._pool[i] = [np.random.default_rng(0) for _ in range(n)]
-            reseed_spawned([k, WORLD_KEY], children)  # world_rng(k).spawn(n): build_episode's
-            if self.worlds.restore(i, self._image, children):
+            # world_rng(k).spawn(n): build_episode's generators
+            if self.worlds.restore_spawned(i, self._image, [k, WORLD_KEY], children):
                 self._set_clear(i)
                 return
         self.worlds.load(i, build_episode(self.scenario, k))
