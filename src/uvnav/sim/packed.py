@@ -377,6 +377,7 @@ class PackedWorlds:
             rings[:, :, :m0, w0:] = self.rings[:, :, :, :1]  # more copies of the first vertex
         self.oi, self.params, self.state, self.ubuf, self.rings = oi, params, state, ubuf, rings
         self.read = read
+        self._fitted: tuple[np.ndarray, ...] | None = None  # (see _put)
 
     def load(self, slot: int, setup: EpisodeSetup) -> None:
         """Put ``setup``'s episode in ``slot`` as :meth:`World2D.start
@@ -422,6 +423,22 @@ class PackedWorlds:
         return tuple(a[slot].copy() for a in (self.wf, self.wi, self.oi, self.params, self.state,
                                                self.rings))  # fmt: skip
 
+    def _put(self, slot: int, image: tuple[np.ndarray, ...]) -> bool:
+        """Copy :meth:`image`'s rows into ``slot`` (no draws read yet); False (nothing done)
+        when the arrays' rows no longer have its shapes.  The last image that fitted is
+        remembered until the arrays are reshaped, sparing the shape checks."""
+        if image is not self._fitted:
+            if any(a.shape[1:] != b.shape for a, b in zip(
+                (self.wf, self.wi, self.oi, self.params, self.state, self.rings), image,
+                strict=True,
+            )):  # fmt: skip
+                return False
+            self._fitted = image
+        self.wf[slot], self.wi[slot], self.oi[slot] = image[0], image[1], image[2]
+        self.params[slot], self.state[slot], self.rings[slot] = image[3], image[4], image[5]
+        self.read[slot] = 0
+        return True
+
     def restore(self, slot: int, image: tuple[np.ndarray, ...],
                 generators: list[np.random.Generator]) -> bool:  # fmt: skip
         """Put :meth:`image`'s episode in ``slot`` with obstacle ``o``'s draws from
@@ -429,13 +446,8 @@ class PackedWorlds:
         only in its generators (the draws of :class:`RandomTurn` are the only numbers a scene
         seed changes), without building it.  False (and nothing done) when the arrays have been
         reshaped since the image was taken; :meth:`load` it then."""
-        if any(a.shape[1:] != b.shape for a, b in zip(
-            (self.wf, self.wi, self.oi, self.params, self.state, self.rings), image, strict=True
-        )):  # fmt: skip
+        if not self._put(slot, image):
             return False
-        self.wf[slot], self.wi[slot], self.oi[slot] = image[0], image[1], image[2]
-        self.params[slot], self.state[slot], self.rings[slot] = image[3], image[4], image[5]
-        self.read[slot] = 0
         self._pending.pop(slot, None)
         kinds = image[2][O_KIND]
         rngs: list[np.random.Generator | None] = []
@@ -459,13 +471,8 @@ class PackedWorlds:
         if not numba_enabled():
             reseed_spawned(entropy, generators)
             return self.restore(slot, image, generators)
-        if any(a.shape[1:] != b.shape for a, b in zip(
-            (self.wf, self.wi, self.oi, self.params, self.state, self.rings), image, strict=True
-        )):  # fmt: skip
+        if not self._put(slot, image):
             return False
-        self.wf[slot], self.wi[slot], self.oi[slot] = image[0], image[1], image[2]
-        self.params[slot], self.state[slot], self.rings[slot] = image[3], image[4], image[5]
-        self.read[slot] = 0
         kinds = image[2][O_KIND]
         pcg = np.empty((len(generators), 4), dtype=np.uint64)
         kernel("spawn_fill")(entropy_words(entropy), kinds, self.ubuf[slot], pcg)
