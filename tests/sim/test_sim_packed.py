@@ -561,3 +561,32 @@ def test_restore_spawned_is_the_episode_load_builds(compiled: bool) -> None:
                 assert (g is None) == (w is None)
                 if g is not None:
                     assert g.bit_generator.state == w.bit_generator.state
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_restore_spawned_many_is_restore_spawned_of_each(compiled: bool) -> None:
+    """restore_spawned_many() of two slots leaves the arrays and generators that
+    restore_spawned() of each leaves (seeds of one and two 32-bit words)."""
+    scene = load_scenario("random-ch2:4")
+    n = len(scene.obstacles)
+    with kernels(compiled):
+        many, each = PackedWorlds(3), PackedWorlds(3)
+        for w in (many, each):
+            w.load(0, build_episode(scene, 1))
+        img = many.image(0)
+        seeds = [2, 2**40 + 3]
+        gens = [[np.random.default_rng(9) for _ in range(n)] for _ in seeds]
+        assert many.restore_spawned_many([1, 2], img, seeds, 1, gens)
+        gens1 = [[np.random.default_rng(9) for _ in range(n)] for _ in seeds]
+        for slot, k, g in zip([1, 2], seeds, gens1, strict=True):
+            assert each.restore_spawned(slot, img, [k, 1], g)
+        for name in ("wf", "wi", "oi", "read", "params", "state", "ubuf", "rings"):
+            np.testing.assert_array_equal(getattr(many, name), getattr(each, name), name)
+        assert not np.array_equal(many.ubuf[1], many.ubuf[2])
+        for slot in (1, 2):
+            many.sync_generators(slot)
+            each.sync_generators(slot)
+            for g, h in zip(many.rngs[slot], each.rngs[slot], strict=True):
+                assert (g is None) == (h is None)
+                if g is not None:
+                    assert g.bit_generator.state == h.bit_generator.state

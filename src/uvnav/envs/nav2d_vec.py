@@ -141,22 +141,49 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         <uvnav.sim.packed.PackedWorlds.restore_spawned>`) with the slot's own obstacle
         generators, reseeded to the states the children of :func:`~uvnav.sim.seeding.world_rng`
         would have: the same episodes, without building them."""
+        self._start(i, self._next_seed(i, options))
+
+    def _next_seed(self, i: int, options: dict[str, Any] | None) -> int:
+        """Sub-environment ``i``'s next episode seed, from its generator."""
         rng = self._rngs[i]
         if rng is None:
             rng = self._rngs[i] = seeding.np_random()[0]
         self.episode_seeds[i] = k = episode_seed(rng, options)
-        if self._image is not None:
-            children = self._pool[i]
-            if children is None:
-                n = len(self.scenario.obstacles)
-                children = self._pool[i] = [np.random.default_rng(0) for _ in range(n)]
-            # world_rng(k).spawn(n): build_episode's generators
-            if self.worlds.restore_spawned(i, self._image, [k, WORLD_KEY], children):
-                self._set_clear(i)
-                return
+        return k
+
+    def _children(self, i: int) -> list[np.random.Generator]:
+        """Sub-environment ``i``'s obstacle generators (reseeded at each restored reset)."""
+        children = self._pool[i]
+        if children is None:
+            n = len(self.scenario.obstacles)
+            children = self._pool[i] = [np.random.default_rng(0) for _ in range(n)]
+        return children
+
+    def _start(self, i: int, k: int) -> None:
+        """Start sub-environment ``i``'s episode of seed ``k`` (:meth:`_load`)."""
+        # world_rng(k).spawn(n): build_episode's generators
+        if self._image is not None and self.worlds.restore_spawned(
+            i, self._image, [k, WORLD_KEY], self._children(i)
+        ):
+            self._set_clear(i)
+            return
         self.worlds.load(i, build_episode(self.scenario, k))
         self._image = self.worlds.image(i)
         self._set_clear(i)
+
+    def _restart(self, ids: list[int]) -> None:
+        """:meth:`_load` of sub-environments ``ids`` (no options), the restored ones in one
+        compiled call (:meth:`PackedWorlds.restore_spawned_many
+        <uvnav.sim.packed.PackedWorlds.restore_spawned_many>`)."""
+        seeds = [self._next_seed(i, None) for i in ids]
+        if self._image is not None and self.worlds.restore_spawned_many(
+            ids, self._image, seeds, WORLD_KEY, [self._children(i) for i in ids]
+        ):
+            c = self.worlds.clearance[ids]
+            self._clear[ids] = np.where(np.isfinite(c), c, self.max_range)
+            return
+        for i, k in zip(ids, seeds, strict=True):
+            self._start(i, k)
 
     def _set_clear(self, i: int) -> None:
         """Sub-environment ``i``'s clearance for the reward, from its world's at the start."""
@@ -226,8 +253,9 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         actions = checked_actions("actions", actions, (self.num_envs, 2))
         w = self.worlds
         restart = self._autoreset.copy()
-        for i in restart.nonzero()[0].tolist():
-            self._load(i, None)
+        ids = restart.nonzero()[0].tolist()
+        if ids:
+            self._restart(ids)
         if self.raw_commands:
             running = ~restart & (w.status != SUCCESS) & (w.status != COLLISION)
             self._commands(actions, running & (w.status != TIMEOUT))

@@ -122,6 +122,7 @@ from uvnav.sim.packed_kernels import (
     _pcg_step,
     _transform_ring,
     clearance_one_py,
+    restore_many_py,
     spawn_fill_py,
     spawn_words_py,
     step_worlds_py,
@@ -161,6 +162,7 @@ _PUBLIC = {
     "vector_step": "vector_step_py",
     "spawn_words": "spawn_words_py",
     "spawn_fill": "spawn_fill_py",
+    "restore_many": "restore_many_py",
 }
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
@@ -181,6 +183,7 @@ def kernel(name: str) -> Callable[..., Any]:
             sense_one_py, advance_one_py, clearance_one_py, outcome_py, commands_py,
             vector_step_py,
             _hashmix, _mix, spawn_words_py, _mulhi, _pcg_step, spawn_fill_py,
+            restore_many_py,
         ]))  # fmt: skip
     return _KERNELS[_PUBLIC[name]]
 
@@ -423,10 +426,9 @@ class PackedWorlds:
         return tuple(a[slot].copy() for a in (self.wf, self.wi, self.oi, self.params, self.state,
                                                self.rings))  # fmt: skip
 
-    def _put(self, slot: int, image: tuple[np.ndarray, ...]) -> bool:
-        """Copy :meth:`image`'s rows into ``slot`` (no draws read yet); False (nothing done)
-        when the arrays' rows no longer have its shapes.  The last image that fitted is
-        remembered until the arrays are reshaped, sparing the shape checks."""
+    def _fits(self, image: tuple[np.ndarray, ...]) -> bool:
+        """The arrays' rows have :meth:`image`'s shapes (the last image that fitted is
+        remembered until the arrays are reshaped)."""
         if image is not self._fitted:
             if any(a.shape[1:] != b.shape for a, b in zip(
                 (self.wf, self.wi, self.oi, self.params, self.state, self.rings), image,
@@ -434,6 +436,38 @@ class PackedWorlds:
             )):  # fmt: skip
                 return False
             self._fitted = image
+        return True
+
+    def restore_spawned_many(self, slots: list[int], image: tuple[np.ndarray, ...],
+                             seeds: list[int], key: int,
+                             generators: list[list[np.random.Generator]]) -> bool:  # fmt: skip
+        """:meth:`restore_spawned` of ``image`` into each of ``slots`` with entropy ``[seeds[i],
+        key]`` and ``generators[i]``, the compiled part in one call; False (and nothing done)
+        when the arrays have been reshaped since the image was taken."""
+        if not numba_enabled() or not (0 <= key < 2**32 and all(0 <= k < 2**63 for k in seeds)):
+            return all(self.restore_spawned(s, image, [k, key], g)
+                       for s, k, g in zip(slots, seeds, generators, strict=True))  # fmt: skip
+        if not self._fits(image):
+            return False
+        n = int(image[1][I_NOBS])
+        pcg = np.empty((len(slots), len(generators[0]), 4), dtype=np.uint64)
+        kernel("restore_many")(np.array(slots, dtype=np.int64), np.array(seeds, dtype=np.int64),
+                               key, *image, self.wf, self.wi, self.oi, self.params, self.state,
+                               self.rings, self.read, self.ubuf, pcg)  # fmt: skip
+        drawn = [kind == RANDOM_TURN for kind in image[2][O_KIND, :n].tolist()]
+        for s, gens, p in zip(slots, generators, pcg, strict=True):
+            self.rngs[s] = [g if d else None for g, d in zip(gens, drawn, strict=False)]
+            self._pending[s] = p
+        ratio = int(image[1][I_RATIO])
+        self.safe_calls = min(self.safe_calls, self.ubuf.shape[2] // (2 * ratio))
+        return True
+
+    def _put(self, slot: int, image: tuple[np.ndarray, ...]) -> bool:
+        """Copy :meth:`image`'s rows into ``slot`` (no draws read yet); False (nothing done)
+        when the arrays' rows no longer have its shapes.  The last image that fitted is
+        remembered until the arrays are reshaped, sparing the shape checks."""
+        if not self._fits(image):
+            return False
         self.wf[slot], self.wi[slot], self.oi[slot] = image[0], image[1], image[2]
         self.params[slot], self.state[slot], self.rings[slot] = image[3], image[4], image[5]
         self.read[slot] = 0

@@ -346,3 +346,29 @@ def spawn_fill_py(entropy: np.ndarray, kinds: np.ndarray, rows: FloatArray,
                 x = (x >> rot) | (x << ((_SH64 - rot) & _SH63))
                 rows[c, j] = float(x >> _SH11) * _TO_UNIT
         pcg[c, 0], pcg[c, 1], pcg[c, 2], pcg[c, 3] = hi, lo, inc_hi, inc_lo
+
+
+def restore_many_py(slots: np.ndarray, seeds: np.ndarray, key: int, img_wf: FloatArray,
+                    img_wi: np.ndarray, img_oi: np.ndarray, img_params: FloatArray,
+                    img_state: FloatArray, img_rings: FloatArray, wf: FloatArray,
+                    wi: np.ndarray, oi: np.ndarray, params: FloatArray, state: FloatArray,
+                    rings: FloatArray, read: np.ndarray, ubuf: FloatArray,
+                    pcg: np.ndarray) -> None:  # fmt: skip
+    """Put one slot's image (``img_*``: its rows of the packed arrays) in each slot
+    ``slots[i]``, no draws read, with its obstacles' rows of draws filled by
+    :func:`spawn_fill_py` from the run entropy ``[seeds[i], key]`` (``0 <= seeds[i] < 2^63``,
+    ``0 <= key < 2^32``; the generators' states after the draws into ``pcg[i]``):
+    :meth:`PackedWorlds.restore_spawned_many <uvnav.sim.packed.PackedWorlds>` in one call."""
+    words = np.zeros(4, dtype=np.int64)
+    for i in range(slots.shape[0]):
+        s = slots[i]
+        wf[s] = img_wf
+        wi[s] = img_wi
+        oi[s] = img_oi
+        params[s] = img_params
+        state[s] = img_state
+        rings[s] = img_rings
+        read[s] = 0
+        lo, hi = seeds[i] & _M32, seeds[i] >> 32  # entropy_words([seeds[i], key])
+        words[0], words[1], words[2], words[3] = (lo, key, 0, 0) if hi == 0 else (lo, hi, key, 0)
+        spawn_fill_py(words, img_oi[O_KIND], ubuf[s], pcg[i])
