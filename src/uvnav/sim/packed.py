@@ -292,7 +292,8 @@ class PackedWorlds:
     their generators, read ahead by up to a row of pre-drawn numbers (:data:`ROW_BLOCKS` x
     :data:`BLOCK`, more where a decision has over :data:`BLOCK` integration steps): the models
     are not written back (unlike :meth:`World2D.close
-    <uvnav.sim.episode.World2D.close>`).
+    <uvnav.sim.episode.World2D.close>`).  A slot restored by :meth:`restore_spawned` (compiled)
+    has its generators' states set at its next top-up, or by :meth:`sync_generators`.
     """
 
     oi: np.ndarray
