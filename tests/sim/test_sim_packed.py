@@ -530,3 +530,63 @@ def test_reseeded_generators_are_the_spawned_children_of_the_world_stream(compil
                 for g, w in zip(got, want, strict=True):
                     assert g.bit_generator.state == w.bit_generator.state, k
                     np.testing.assert_array_equal(g.random(5), w.random(5))
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_restore_spawned_is_the_episode_load_builds(compiled: bool) -> None:
+    """restore_spawned() with entropy [k, 1] (world_rng(k)'s) gives slot 1 what
+    load(build_episode(scene, k)) gives, over 300 steps and a top-up that reads its generators,
+    and its generators end in the built episode's generators' states."""
+    scene = load_scenario("random-ch2:4")
+    n = len(scene.obstacles)
+    with kernels(compiled):
+        for k in (2, 2**40 + 3):
+            fast, built = PackedWorlds(2), PackedWorlds(2)
+            fast.load(0, build_episode(scene, 1))
+            gens = [np.random.default_rng(99) for _ in range(n)]
+            assert fast.restore_spawned(1, fast.image(0), [k, 1], gens)
+            built.load(0, build_episode(scene, 1))
+            built.load(1, build_episode(scene, k))
+            for step in range(300):
+                for w in (fast, built):
+                    w.command[:] = (0.3, 0.2)
+                    w.step()
+                    if step == 150:  # every row read to half: all are topped up
+                        w.oi[:, 1] = np.maximum(w.oi[:, 1], w.ubuf.shape[2] // 2)
+                        w.refill()
+            for name in ("wf", "wi", "oi", "read", "params", "state", "ubuf", "rings"):
+                np.testing.assert_array_equal(getattr(fast, name), getattr(built, name), name)
+            assert fast.read[1].max() > 0
+            for g, w in zip(fast.rngs[1], built.rngs[1], strict=True):
+                assert (g is None) == (w is None)
+                if g is not None:
+                    assert g.bit_generator.state == w.bit_generator.state
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_restore_spawned_many_is_restore_spawned_of_each(compiled: bool) -> None:
+    """restore_spawned_many() of two slots leaves the arrays and generators that
+    restore_spawned() of each leaves (seeds of one and two 32-bit words)."""
+    scene = load_scenario("random-ch2:4")
+    n = len(scene.obstacles)
+    with kernels(compiled):
+        many, each = PackedWorlds(3), PackedWorlds(3)
+        for w in (many, each):
+            w.load(0, build_episode(scene, 1))
+        img = many.image(0)
+        seeds = [2, 2**40 + 3]
+        gens = [[np.random.default_rng(9) for _ in range(n)] for _ in seeds]
+        assert many.restore_spawned_many([1, 2], img, seeds, 1, gens)
+        gens1 = [[np.random.default_rng(9) for _ in range(n)] for _ in seeds]
+        for slot, k, g in zip([1, 2], seeds, gens1, strict=True):
+            assert each.restore_spawned(slot, img, [k, 1], g)
+        for name in ("wf", "wi", "oi", "read", "params", "state", "ubuf", "rings"):
+            np.testing.assert_array_equal(getattr(many, name), getattr(each, name), name)
+        assert not np.array_equal(many.ubuf[1], many.ubuf[2])
+        for slot in (1, 2):
+            many.sync_generators(slot)
+            each.sync_generators(slot)
+            for g, h in zip(many.rngs[slot], each.rngs[slot], strict=True):
+                assert (g is None) == (h is None)
+                if g is not None:
+                    assert g.bit_generator.state == h.bit_generator.state

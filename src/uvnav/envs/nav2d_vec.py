@@ -47,7 +47,6 @@ from uvnav.sim.packed import (
     PackedWorlds,
     kernel,
     pack_check,
-    reseed_spawned,
 )
 from uvnav.sim.seeding import _WORLD as WORLD_KEY
 
@@ -132,30 +131,59 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self.episode_seeds = np.zeros(k, dtype=np.int64)
         self._image: tuple[np.ndarray, ...] | None = None
         self._names = np.array(STATUS_NAMES, dtype=object)
+        self._weights_of: RewardConfig | None = None
+        self._weight_row = np.zeros(6)
 
     def _load(self, i: int, options: dict[str, Any] | None) -> None:
         """Start sub-environment ``i``'s next episode (its generator picks the seed).  The first
         episode is built (:func:`~uvnav.scenarios.build.build_episode`) and loaded, the others
-        restore its image (:meth:`PackedWorlds.restore <uvnav.sim.packed.PackedWorlds.restore>`)
-        with the slot's own obstacle generators, set to the states the children of
-        :func:`~uvnav.sim.seeding.world_rng` would have (:func:`reseed_spawned
-        <uvnav.sim.packed.reseed_spawned>`): the same episodes, without building them."""
+        restore its image (:meth:`PackedWorlds.restore_spawned
+        <uvnav.sim.packed.PackedWorlds.restore_spawned>`) with the slot's own obstacle
+        generators, reseeded to the states the children of :func:`~uvnav.sim.seeding.world_rng`
+        would have: the same episodes, without building them."""
+        self._start(i, self._next_seed(i, options))
+
+    def _next_seed(self, i: int, options: dict[str, Any] | None) -> int:
+        """Sub-environment ``i``'s next episode seed, from its generator."""
         rng = self._rngs[i]
         if rng is None:
             rng = self._rngs[i] = seeding.np_random()[0]
         self.episode_seeds[i] = k = episode_seed(rng, options)
-        if self._image is not None:
-            children = self._pool[i]
-            if children is None:
-                n = len(self.scenario.obstacles)
-                children = self._pool[i] = [np.random.default_rng(0) for _ in range(n)]
-            reseed_spawned([k, WORLD_KEY], children)  # world_rng(k).spawn(n): build_episode's
-            if self.worlds.restore(i, self._image, children):
-                self._set_clear(i)
-                return
+        return k
+
+    def _children(self, i: int) -> list[np.random.Generator]:
+        """Sub-environment ``i``'s obstacle generators (reseeded at each restored reset)."""
+        children = self._pool[i]
+        if children is None:
+            n = len(self.scenario.obstacles)
+            children = self._pool[i] = [np.random.default_rng(0) for _ in range(n)]
+        return children
+
+    def _start(self, i: int, k: int) -> None:
+        """Start sub-environment ``i``'s episode of seed ``k`` (:meth:`_load`)."""
+        # world_rng(k).spawn(n): build_episode's generators
+        if self._image is not None and self.worlds.restore_spawned(
+            i, self._image, [k, WORLD_KEY], self._children(i)
+        ):
+            self._set_clear(i)
+            return
         self.worlds.load(i, build_episode(self.scenario, k))
         self._image = self.worlds.image(i)
         self._set_clear(i)
+
+    def _restart(self, ids: list[int]) -> None:
+        """:meth:`_load` of sub-environments ``ids`` (no options), the restored ones in one
+        compiled call (:meth:`PackedWorlds.restore_spawned_many
+        <uvnav.sim.packed.PackedWorlds.restore_spawned_many>`)."""
+        seeds = [self._next_seed(i, None) for i in ids]
+        if self._image is not None and self.worlds.restore_spawned_many(
+            ids, self._image, seeds, WORLD_KEY, [self._children(i) for i in ids]
+        ):
+            c = self.worlds.clearance[ids]
+            self._clear[ids] = np.where(np.isfinite(c), c, self.max_range)
+            return
+        for i, k in zip(ids, seeds, strict=True):
+            self._start(i, k)
 
     def _set_clear(self, i: int) -> None:
         """Sub-environment ``i``'s clearance for the reward, from its world's at the start."""
@@ -206,6 +234,17 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         np.copyto(cmd[:, 0], v, where=acting)
         np.copyto(cmd[:, 1], u, where=acting)
 
+    def _weights(self) -> np.ndarray:
+        """The reward's weights (progress, time, clearance, clearance margin, success,
+        collision) of :attr:`reward_config`, kept while it is the same object."""
+        cfg = self.reward_config
+        if self._weights_of is not cfg:
+            self._weights_of = cfg
+            self._weight_row = np.array([cfg.progress, cfg.time, cfg.clearance,
+                                         cfg.clearance_margin, cfg.success, cfg.collision],
+                                        dtype=float)  # fmt: skip
+        return self._weight_row
+
     def step(
         self, actions: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, dict[str, Any]]:
@@ -214,24 +253,20 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         actions = checked_actions("actions", actions, (self.num_envs, 2))
         w = self.worlds
         restart = self._autoreset.copy()
-        for i in restart.nonzero()[0].tolist():
-            self._load(i, None)
-        before = self._dist.copy()
+        ids = restart.nonzero()[0].tolist()
+        if ids:
+            self._restart(ids)
         if self.raw_commands:
             running = ~restart & (w.status != SUCCESS) & (w.status != COLLISION)
             self._commands(actions, running & (w.status != TIMEOUT))
-        else:  # the same rule, compiled
-            running = np.empty(self.num_envs, dtype=np.bool_)
-            kernel("commands")(actions, restart, w.wf, w.wi, running)
-        w.step(~restart)
-        self._observe()
-        cfg = self.reward_config
-        weights = np.array([cfg.progress, cfg.time, cfg.clearance, cfg.clearance_margin,
-                            cfg.success, cfg.collision], dtype=float)  # fmt: skip
         rewards = np.empty(self.num_envs)
         terminated = np.empty(self.num_envs, dtype=np.bool_)
         truncated = np.empty(self.num_envs, dtype=np.bool_)
-        kernel("outcome")(w.status, w.low, restart, running, before, self._dist, self._clear,
-                          weights, rewards, terminated, truncated)  # fmt: skip
+        w.ensure_draws()  # its count is replaced by the kernel's, which knows the rows read
+        w.safe_calls = kernel("vector_step")(
+            actions, restart, self.raw_commands, w.wf, w.wi, w.oi, w.params, w.state, w.ubuf,
+            w.rings, self._rel, self.max_range, self.goal_scale, self._ranges, self._obs,
+            self._dist, self._clear, self._weights(), rewards, terminated, truncated,
+        )  # fmt: skip
         self._autoreset = terminated | truncated
         return self._obs.copy(), rewards, terminated, truncated, self._infos()

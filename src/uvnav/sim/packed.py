@@ -118,8 +118,12 @@ from uvnav.sim.packed_kernels import (
     _hashmix,
     _mix,
     _move_obstacles,
+    _mulhi,
+    _pcg_step,
     _transform_ring,
     clearance_one_py,
+    restore_many_py,
+    spawn_fill_py,
     spawn_words_py,
     step_worlds_py,
 )
@@ -140,6 +144,7 @@ from uvnav.sim.packed_sense import (  # noqa: F401 - the reading columns, re-exp
     outcome_py,
     sense_one_py,
     vector_one_py,
+    vector_step_py,
 )
 from uvnav.sim.setup import EpisodeSetup
 
@@ -154,7 +159,10 @@ _PUBLIC = {
     "vector_one": "vector_one_py",
     "outcome": "outcome_py",
     "commands": "commands_py",
+    "vector_step": "vector_step_py",
     "spawn_words": "spawn_words_py",
+    "spawn_fill": "spawn_fill_py",
+    "restore_many": "restore_many_py",
 }
 _KERNELS: dict[str, Callable[..., Any]] = {}
 
@@ -173,7 +181,9 @@ def kernel(name: str) -> Callable[..., Any]:
             step_worlds_py,
             observe_py,
             sense_one_py, advance_one_py, clearance_one_py, outcome_py, commands_py,
-            _hashmix, _mix, spawn_words_py,
+            vector_step_py,
+            _hashmix, _mix, spawn_words_py, _mulhi, _pcg_step, spawn_fill_py,
+            restore_many_py,
         ]))  # fmt: skip
     return _KERNELS[_PUBLIC[name]]
 
@@ -183,12 +193,9 @@ _PCG_MULT = (2549297995355413924 << 64) + 4865540595714422341
 _M128 = (1 << 128) - 1
 
 
-def reseed_spawned(entropy: list[int], generators: list[np.random.Generator]) -> None:
-    """Set ``generators`` (PCG64) to the states of ``np.random.default_rng(entropy).spawn(n)``'s
-    ``n`` = ``len(generators)`` generators (``entropy``: non-negative ints), bit for bit,
-    without building the seed sequences: their words by :func:`spawn_words_py`, PCG64's seeding
-    (``pcg64_set_seed``) on Python ints.  A batched env's reset gives each of a world's
-    obstacles the generator ``build_episode`` would, at a tenth of the cost."""
+def entropy_words(entropy: list[int]) -> np.ndarray:
+    """``SeedSequence``'s run entropy of ``entropy`` (non-negative ints) as 32-bit words (int64,
+    low word first, padded with zeros to the pool size 4): :func:`spawn_words_py`'s input."""
     words: list[int] = []
     for v in entropy:
         v = int(v)
@@ -198,14 +205,27 @@ def reseed_spawned(entropy: list[int], generators: list[np.random.Generator]) ->
             words.append(v & 0xFFFFFFFF)
             v >>= 32
     words += [0] * (4 - len(words))
+    return np.array(words, dtype=np.int64)
+
+
+def set_pcg_state(generator: np.random.Generator, state: int, inc: int) -> None:
+    """Set a PCG64 ``generator``'s state and increment (128-bit ints)."""
+    generator.bit_generator.state = {"bit_generator": "PCG64", "has_uint32": 0, "uinteger": 0,
+                                     "state": {"state": state, "inc": inc}}  # fmt: skip
+
+
+def reseed_spawned(entropy: list[int], generators: list[np.random.Generator]) -> None:
+    """Set ``generators`` (PCG64) to the states of ``np.random.default_rng(entropy).spawn(n)``'s
+    ``n`` = ``len(generators)`` generators (``entropy``: non-negative ints), bit for bit,
+    without building the seed sequences: their words by :func:`spawn_words_py`, PCG64's seeding
+    (``pcg64_set_seed``) on Python ints.  A batched env's reset gives each of a world's
+    obstacles the generator ``build_episode`` would, at a tenth of the cost."""
     out = np.empty((len(generators), 8), dtype=np.int64)
-    kernel("spawn_words")(np.array(words, dtype=np.int64), out)
+    kernel("spawn_words")(entropy_words(entropy), out)
     for g, w in zip(generators, out.tolist(), strict=True):
         seed = (w[1] << 96) | (w[0] << 64) | (w[3] << 32) | w[2]
         inc = ((((w[5] << 96) | (w[4] << 64) | (w[7] << 32) | w[6]) << 1) | 1) & _M128
-        state = ((inc + seed) * _PCG_MULT + inc) & _M128
-        g.bit_generator.state = {"bit_generator": "PCG64", "has_uint32": 0, "uinteger": 0,
-                                 "state": {"state": state, "inc": inc}}  # fmt: skip
+        set_pcg_state(g, ((inc + seed) * _PCG_MULT + inc) & _M128, inc)
 
 
 def pack_check(setup: EpisodeSetup) -> str | None:
@@ -272,7 +292,8 @@ class PackedWorlds:
     their generators, read ahead by up to a row of pre-drawn numbers (:data:`ROW_BLOCKS` x
     :data:`BLOCK`, more where a decision has over :data:`BLOCK` integration steps): the models
     are not written back (unlike :meth:`World2D.close
-    <uvnav.sim.episode.World2D.close>`).
+    <uvnav.sim.episode.World2D.close>`).  A slot restored by :meth:`restore_spawned` (compiled)
+    has its generators' states set at its next top-up, or by :meth:`sync_generators`.
     """
 
     oi: np.ndarray
@@ -294,6 +315,9 @@ class PackedWorlds:
         self.rngs: list[list[np.random.Generator | None]] = [[] for _ in range(k)]
         self.safe_calls = 0  # step() calls before a refill may be needed
         self._templates: dict[tuple[int, ...], tuple[FieldTemplate, list[Any]]] = {}
+        #: slots restored by :meth:`restore_spawned` whose generators' states are not yet set:
+        #: (n, 4) uint64 states and increments (high and low words) after the draws
+        self._pending: dict[int, np.ndarray] = {}
         self._alloc(0, 2, ROW_BLOCKS * BLOCK)
 
     # views of the state, by meaning
@@ -357,6 +381,7 @@ class PackedWorlds:
             rings[:, :, :m0, w0:] = self.rings[:, :, :, :1]  # more copies of the first vertex
         self.oi, self.params, self.state, self.ubuf, self.rings = oi, params, state, ubuf, rings
         self.read = read
+        self._fitted: tuple[np.ndarray, ...] | None = None  # (see _put)
 
     def load(self, slot: int, setup: EpisodeSetup) -> None:
         """Put ``setup``'s episode in ``slot`` as :meth:`World2D.start
@@ -402,6 +427,53 @@ class PackedWorlds:
         return tuple(a[slot].copy() for a in (self.wf, self.wi, self.oi, self.params, self.state,
                                                self.rings))  # fmt: skip
 
+    def _fits(self, image: tuple[np.ndarray, ...]) -> bool:
+        """The arrays' rows have :meth:`image`'s shapes (the last image that fitted is
+        remembered until the arrays are reshaped)."""
+        if image is not self._fitted:
+            if any(a.shape[1:] != b.shape for a, b in zip(
+                (self.wf, self.wi, self.oi, self.params, self.state, self.rings), image,
+                strict=True,
+            )):  # fmt: skip
+                return False
+            self._fitted = image
+        return True
+
+    def restore_spawned_many(self, slots: list[int], image: tuple[np.ndarray, ...],
+                             seeds: list[int], key: int,
+                             generators: list[list[np.random.Generator]]) -> bool:  # fmt: skip
+        """:meth:`restore_spawned` of ``image`` into each of ``slots`` with entropy ``[seeds[i],
+        key]`` and ``generators[i]``, the compiled part in one call; False (and nothing done)
+        when the arrays have been reshaped since the image was taken."""
+        if not numba_enabled() or not (0 <= key < 2**32 and all(0 <= k < 2**63 for k in seeds)):
+            return all(self.restore_spawned(s, image, [k, key], g)
+                       for s, k, g in zip(slots, seeds, generators, strict=True))  # fmt: skip
+        if not self._fits(image):
+            return False
+        n = int(image[1][I_NOBS])
+        pcg = np.empty((len(slots), len(generators[0]), 4), dtype=np.uint64)
+        kernel("restore_many")(np.array(slots, dtype=np.int64), np.array(seeds, dtype=np.int64),
+                               key, *image, self.wf, self.wi, self.oi, self.params, self.state,
+                               self.rings, self.read, self.ubuf, pcg)  # fmt: skip
+        drawn = [kind == RANDOM_TURN for kind in image[2][O_KIND, :n].tolist()]
+        for s, gens, p in zip(slots, generators, pcg, strict=True):
+            self.rngs[s] = [g if d else None for g, d in zip(gens, drawn, strict=False)]
+            self._pending[s] = p
+        ratio = int(image[1][I_RATIO])
+        self.safe_calls = min(self.safe_calls, self.ubuf.shape[2] // (2 * ratio))
+        return True
+
+    def _put(self, slot: int, image: tuple[np.ndarray, ...]) -> bool:
+        """Copy :meth:`image`'s rows into ``slot`` (no draws read yet); False (nothing done)
+        when the arrays' rows no longer have its shapes.  The last image that fitted is
+        remembered until the arrays are reshaped, sparing the shape checks."""
+        if not self._fits(image):
+            return False
+        self.wf[slot], self.wi[slot], self.oi[slot] = image[0], image[1], image[2]
+        self.params[slot], self.state[slot], self.rings[slot] = image[3], image[4], image[5]
+        self.read[slot] = 0
+        return True
+
     def restore(self, slot: int, image: tuple[np.ndarray, ...],
                 generators: list[np.random.Generator]) -> bool:  # fmt: skip
         """Put :meth:`image`'s episode in ``slot`` with obstacle ``o``'s draws from
@@ -409,13 +481,9 @@ class PackedWorlds:
         only in its generators (the draws of :class:`RandomTurn` are the only numbers a scene
         seed changes), without building it.  False (and nothing done) when the arrays have been
         reshaped since the image was taken; :meth:`load` it then."""
-        if any(a.shape[1:] != b.shape for a, b in zip(
-            (self.wf, self.wi, self.oi, self.params, self.state, self.rings), image, strict=True
-        )):  # fmt: skip
+        if not self._put(slot, image):
             return False
-        self.wf[slot], self.wi[slot], self.oi[slot] = image[0], image[1], image[2]
-        self.params[slot], self.state[slot], self.rings[slot] = image[3], image[4], image[5]
-        self.read[slot] = 0
+        self._pending.pop(slot, None)
         kinds = image[2][O_KIND]
         rngs: list[np.random.Generator | None] = []
         for o in range(int(image[1][I_NOBS])):
@@ -428,6 +496,39 @@ class PackedWorlds:
         self.safe_calls = min(self.safe_calls, self.ubuf.shape[2] // (2 * ratio))
         return True
 
+    def restore_spawned(self, slot: int, image: tuple[np.ndarray, ...], entropy: list[int],
+                        generators: list[np.random.Generator]) -> bool:  # fmt: skip
+        """:meth:`restore` with ``generators`` (PCG64, one per obstacle) reseeded as
+        :func:`reseed_spawned` (``entropy``, ``generators``) reseeds them: the same draws, seeded
+        and drawn in one compiled call (:func:`spawn_fill_py`) when numba is enabled, the
+        generators' own states then set only when a top-up next reads them
+        (:meth:`sync_generators`)."""
+        if not numba_enabled():
+            reseed_spawned(entropy, generators)
+            return self.restore(slot, image, generators)
+        if not self._put(slot, image):
+            return False
+        kinds = image[2][O_KIND]
+        pcg = np.empty((len(generators), 4), dtype=np.uint64)
+        kernel("spawn_fill")(entropy_words(entropy), kinds, self.ubuf[slot], pcg)
+        n = int(image[1][I_NOBS])
+        self.rngs[slot] = [g if kinds[o] == RANDOM_TURN else None
+                           for o, g in enumerate(generators[:n])]  # fmt: skip
+        self._pending[slot] = pcg
+        ratio = int(image[1][I_RATIO])
+        self.safe_calls = min(self.safe_calls, self.ubuf.shape[2] // (2 * ratio))
+        return True
+
+    def sync_generators(self, slot: int) -> None:
+        """Set the states of ``slot``'s generators to what its draws have consumed, where
+        :meth:`restore_spawned` drew for them without setting them (nothing otherwise)."""
+        pcg = self._pending.pop(slot, None)
+        if pcg is None:
+            return
+        for g, (hi, lo, ihi, ilo) in zip(self.rngs[slot], pcg.tolist(), strict=False):
+            if g is not None:
+                set_pcg_state(g, (hi << 64) | lo, (ihi << 64) | ilo)
+
     def load_obstacles(self, slot: int, obstacles: list[Obstacle], tpl: FieldTemplate,
                        b: int) -> None:  # fmt: skip
         """Put ``obstacles`` (packable: :func:`pack_check`; ``tpl`` their bodies' template) in
@@ -437,6 +538,7 @@ class PackedWorlds:
         if m > self.rings.shape[2] or w > self.rings.shape[3] or b > self.ubuf.shape[2]:
             self._alloc(max(m, self.rings.shape[2]), max(w, self.rings.shape[3]), b)
         self.wi[slot, I_NOBS] = m
+        self._pending.pop(slot, None)
         self.oi[slot, O_KIND] = EMPTY
         self.oi[slot, O_UPOS] = 0
         self.read[slot] = 0
@@ -500,6 +602,8 @@ class PackedWorlds:
         upos = self.oi[:, O_UPOS]
         due = (upos >= b // 2).nonzero()
         for slot, o, p in zip(due[0].tolist(), due[1].tolist(), upos[due].tolist(), strict=True):
+            if self._pending:
+                self.sync_generators(slot)
             rng = self.rngs[slot][o]
             if rng is not None:
                 row = self.ubuf[slot, o]

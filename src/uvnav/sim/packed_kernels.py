@@ -288,3 +288,87 @@ def spawn_words_py(entropy: np.ndarray, out: np.ndarray) -> None:
             hb = (hb * _MULT_B) & _M32
             v = (v * hb) & _M32
             out[c, j] = v ^ (v >> 16)
+
+
+# PCG64's multiplier in two words, and the constants of the 128-bit arithmetic, as uint64
+_PM_HI, _PM_LO = np.uint64(2549297995355413924), np.uint64(4865540595714422341)
+_U32, _U0, _U1 = np.uint64(0xFFFFFFFF), np.uint64(0), np.uint64(1)
+_SH11, _SH32, _SH58, _SH63, _SH64 = (np.uint64(11), np.uint64(32), np.uint64(58), np.uint64(63),
+                                     np.uint64(64))  # fmt: skip
+_TO_UNIT = 1.0 / 9007199254740992.0
+
+
+def _mulhi(a: np.uint64, b: np.uint64) -> np.uint64:
+    """The high word of the 128-bit product of two uint64 words."""
+    a0, a1, b0, b1 = a & _U32, a >> _SH32, b & _U32, b >> _SH32
+    p00, p01, p10 = a0 * b0, a0 * b1, a1 * b0
+    mid = (p00 >> _SH32) + (p01 & _U32) + (p10 & _U32)
+    return a1 * b1 + (p01 >> _SH32) + (p10 >> _SH32) + (mid >> _SH32)
+
+
+def _pcg_step(hi: np.uint64, lo: np.uint64, inc_hi: np.uint64,
+              inc_lo: np.uint64) -> tuple[np.uint64, np.uint64]:  # fmt: skip
+    """PCG64's state advance (state x multiplier + increment, mod 2^128) on two words each."""
+    t = lo * _PM_LO
+    new_lo = t + inc_lo
+    carry = _U1 if new_lo < t else _U0
+    new_hi = _mulhi(lo, _PM_LO) + hi * _PM_LO + lo * _PM_HI + inc_hi + carry
+    return new_hi, new_lo
+
+
+def spawn_fill_py(entropy: np.ndarray, kinds: np.ndarray, rows: FloatArray,
+                  pcg: np.ndarray) -> None:  # fmt: skip
+    """Seed the ``n`` = ``pcg.shape[0]`` PCG64 generators of ``SeedSequence.spawn(n)`` of a run
+    entropy ``entropy`` (:func:`spawn_words_py`'s) and fill row ``c`` of ``rows`` (M, B) with
+    child ``c``'s first B ``Generator.random()`` numbers where ``kinds[c]`` is
+    :data:`RANDOM_TURN`: numpy's ``pcg64_set_seed`` and ``next_double`` (the XSL-RR output of
+    each advanced state, its top 53 bits over 2^53), bit for bit.  Each generator's state after
+    its draws goes to ``pcg[c]`` (uint64: state high and low words, increment high and low)."""
+    n = pcg.shape[0]
+    words = np.empty((n, 8), dtype=np.int64)
+    spawn_words_py(entropy, words)
+    for c in range(n):
+        w = words[c]
+        s_hi = (np.uint64(w[1]) << _SH32) | np.uint64(w[0])
+        s_lo = (np.uint64(w[3]) << _SH32) | np.uint64(w[2])
+        q_hi = (np.uint64(w[5]) << _SH32) | np.uint64(w[4])
+        q_lo = (np.uint64(w[7]) << _SH32) | np.uint64(w[6])
+        inc_hi = (q_hi << _U1) | (q_lo >> _SH63)
+        inc_lo = (q_lo << _U1) | _U1
+        lo = inc_lo + s_lo  # state 0 advanced (the increment), plus the seed
+        hi = inc_hi + s_hi + (_U1 if lo < inc_lo else _U0)
+        hi, lo = _pcg_step(hi, lo, inc_hi, inc_lo)
+        if kinds[c] == RANDOM_TURN:
+            for j in range(rows.shape[1]):
+                hi, lo = _pcg_step(hi, lo, inc_hi, inc_lo)
+                x = hi ^ lo
+                rot = hi >> _SH58
+                x = (x >> rot) | (x << ((_SH64 - rot) & _SH63))
+                rows[c, j] = float(x >> _SH11) * _TO_UNIT
+        pcg[c, 0], pcg[c, 1], pcg[c, 2], pcg[c, 3] = hi, lo, inc_hi, inc_lo
+
+
+def restore_many_py(slots: np.ndarray, seeds: np.ndarray, key: int, img_wf: FloatArray,
+                    img_wi: np.ndarray, img_oi: np.ndarray, img_params: FloatArray,
+                    img_state: FloatArray, img_rings: FloatArray, wf: FloatArray,
+                    wi: np.ndarray, oi: np.ndarray, params: FloatArray, state: FloatArray,
+                    rings: FloatArray, read: np.ndarray, ubuf: FloatArray,
+                    pcg: np.ndarray) -> None:  # fmt: skip
+    """Put one slot's image (``img_*``: its rows of the packed arrays) in each slot
+    ``slots[i]``, no draws read, with its obstacles' rows of draws filled by
+    :func:`spawn_fill_py` from the run entropy ``[seeds[i], key]`` (``0 <= seeds[i] < 2^63``,
+    ``0 <= key < 2^32``; the generators' states after the draws into ``pcg[i]``):
+    :meth:`PackedWorlds.restore_spawned_many <uvnav.sim.packed.PackedWorlds>` in one call."""
+    words = np.zeros(4, dtype=np.int64)
+    for i in range(slots.shape[0]):
+        s = slots[i]
+        wf[s] = img_wf
+        wi[s] = img_wi
+        oi[s] = img_oi
+        params[s] = img_params
+        state[s] = img_state
+        rings[s] = img_rings
+        read[s] = 0
+        lo, hi = seeds[i] & _M32, seeds[i] >> 32  # entropy_words([seeds[i], key])
+        words[0], words[1], words[2], words[3] = (lo, key, 0, 0) if hi == 0 else (lo, hi, key, 0)
+        spawn_fill_py(words, img_oi[O_KIND], ubuf[s], pcg[i])

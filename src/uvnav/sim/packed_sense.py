@@ -17,6 +17,7 @@ from uvnav.geometry.polygons import ring_nearest_py
 from uvnav.geometry.small import pyhypot
 from uvnav.sim.packed_kernels import (
     COLLISION,
+    I_ACTIVE,
     I_NOBS,
     I_STATUS,
     P_BOUND,
@@ -30,6 +31,7 @@ from uvnav.sim.packed_kernels import (
     TIMEOUT,
     W_GX,
     W_GY,
+    W_LOW,
     W_TH,
     W_U,
     W_UMAX,
@@ -40,6 +42,7 @@ from uvnav.sim.packed_kernels import (
     _clearance,
     _move_obstacles,
     _transform_ring,
+    step_worlds_py,
 )
 
 #: columns of :func:`sense_one_py`'s reading rows: distance [m], nearest point [m], centre [m],
@@ -439,3 +442,36 @@ def advance_one_py(x: float, y: float, radius: float, t: float, dt: float, n_obs
     if sensing_range >= 0.0:
         m = sense_one_py(x, y, sensing_range, n_obs, prm, st, rings, ids, rows, outlines)
     return gap, at, m, shift
+
+
+def vector_step_py(actions: FloatArray, restart: np.ndarray, raw: bool, wf: FloatArray,
+                   wi: np.ndarray, oi: np.ndarray, params: FloatArray, state: FloatArray,
+                   ubuf: FloatArray, rings: FloatArray, rel: FloatArray, max_range: float,
+                   goal_scale: float, ranges: FloatArray, out: np.ndarray, dist: FloatArray,
+                   clear: FloatArray, weights: FloatArray, rewards: FloatArray,
+                   terminated: np.ndarray, truncated: np.ndarray) -> int:  # fmt: skip
+    """One step of ``uvnav/Nav2D-v0``'s batched env in one call: the held commands from the
+    normalised ``actions`` (:func:`commands_py`; with ``raw`` the caller has set them and only
+    which worlds run is worked out), every world not restarting (``restart`` (K,) bool) advanced
+    by one decision (:func:`step_worlds_py`), the observation vectors, lidar ranges and goal
+    distances (:func:`observe_py`), then the rewards, terminations and truncations
+    (:func:`outcome_py`, from the goal distances before and after).  Returns
+    :func:`step_worlds_py`'s count of calls the pre-drawn numbers cover."""
+    k_all = wf.shape[0]
+    running = np.empty(k_all, dtype=np.bool_)
+    if raw:
+        for k in range(k_all):
+            s = wi[k, I_STATUS]
+            running[k] = not restart[k] and s != SUCCESS and s != COLLISION
+    else:
+        commands_py(actions, restart, wf, wi, running)
+    before = dist.copy()
+    for k in range(k_all):
+        wi[k, I_ACTIVE] = 0 if restart[k] else 1
+    safe = step_worlds_py(wf, wi, oi, params, state, ubuf, rings)
+    for k in range(k_all):
+        wi[k, I_ACTIVE] = 1
+    observe_py(wf, wi, params, state, rings, rel, max_range, goal_scale, ranges, out, dist)
+    outcome_py(wi[:, I_STATUS], wf[:, W_LOW], restart, running, before, dist, clear, weights,
+               rewards, terminated, truncated)  # fmt: skip
+    return safe
