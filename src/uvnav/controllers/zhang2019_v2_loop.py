@@ -39,6 +39,21 @@ P_SPACING, P_HEADINGS, P_VMAX = 15, 16, 17
 N_PRM = 18
 
 
+def reachable_py(scal: FloatArray, vel: FloatArray, v_max: float, horizon: float) -> np.ndarray:
+    """Indices of the bodies that can reach the robot within ``horizon`` [s]: a body's distance
+    ``scal[k, 0]`` [m] at most (``v_max`` + its speed + |angular velocity| x bounding radius)
+    x ``horizon`` (:func:`uvnav.controllers.zhang2019_v2_bodies.reachable`, as a loop)."""
+    n = scal.shape[0]
+    keep = np.empty(n, dtype=np.int64)
+    n_keep = 0
+    for k in range(n):
+        bound = math.hypot(vel[k, 0], vel[k, 1]) + abs(scal[k, 1]) * scal[k, 3]
+        if scal[k, 0] <= (v_max + bound) * horizon:
+            keep[n_keep] = k
+            n_keep += 1
+    return keep[:n_keep]
+
+
 def boundary_discs_py(
     keep: IntArray,
     scal: FloatArray,
@@ -129,18 +144,11 @@ def plan_loop_py(
     """
     v_max, horizon = prm[P_VMAX], prm[0]
     fx, fy = state[4], state[5]
-    n = scal.shape[0]
-    keep = np.empty(n, dtype=np.int64)
-    n_keep = 0
-    for k in range(n):
-        bound = math.hypot(vel[k, 0], vel[k, 1]) + abs(scal[k, 1]) * scal[k, 3]
-        if scal[k, 0] <= (v_max + bound) * horizon:
-            keep[n_keep] = k
-            n_keep += 1
+    keep = reachable_py(scal, vel, v_max, horizon)
+    n_keep = keep.shape[0]
     if n_keep == 0:
         out[0], out[1], out[2], out[3] = fx, fy, math.inf, 1.0
         return
-    keep = keep[:n_keep]
     spacing = prm[P_SPACING]
     q, w, r, owner = boundary_discs_py(keep, scal, centre, vel, rings, ring_start, spacing)
     c_k, v_k, body_r = np.empty((n_keep, 2)), np.empty((n_keep, 2)), np.empty(n_keep)
@@ -176,7 +184,9 @@ def _compiled_plan() -> Callable[..., Any]:
     calling the compiled copies of :mod:`uvnav.geometry.contact`'s loops."""
     if not _COMPILED:
         _COMPILED.update(
-            compile_family((boundary_discs_py, plan_loop_py), bound=contact._kernels())
+            compile_family(
+                (reachable_py, boundary_discs_py, plan_loop_py), bound=contact._kernels()
+            )
         )
     return _COMPILED["plan_loop_py"]
 

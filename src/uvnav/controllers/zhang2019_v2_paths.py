@@ -44,7 +44,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.controllers import zhang2019_v2_loop
-from uvnav.controllers.zhang2019_v2_loop import boundary_discs_py
+from uvnav.controllers.zhang2019_v2_loop import boundary_discs_py, reachable_py
 from uvnav.geometry import contact
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.contact import _contact_scalar, _gap_scalar, tangents_py
@@ -475,15 +475,8 @@ def plan_readings_py(
     centre, velocity and bounding reach (:func:`uvnav.controllers.zhang2019_v2.bounding_reach`
     plus the same), computed as the numpy building blocks compute them."""
     v_max, horizon, spacing = prm[M_VMAX], prm[M_HORIZON], prm[M_SPACING]
-    n = scal.shape[0]
-    keep = np.empty(n, dtype=np.int64)
-    n_keep = 0
-    for k in range(n):
-        bound = math.hypot(vel[k, 0], vel[k, 1]) + abs(scal[k, 1]) * scal[k, 3]
-        if scal[k, 0] <= (v_max + bound) * horizon:
-            keep[n_keep] = k
-            n_keep += 1
-    keep = keep[:n_keep]
+    keep = reachable_py(scal, vel, v_max, horizon)
+    n_keep = keep.shape[0]
     q, w, r, owner = boundary_discs_py(keep, scal, centre, vel, rings, ring_start, spacing)
     reach = np.empty(r.shape[0])
     for j in range(r.shape[0]):
