@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -141,6 +142,16 @@ def test_what_cannot_be_packed_is_refused_with_its_reason() -> None:
         PackedSwarm(setup, np.random.default_rng(0))
 
 
+def assert_same_metrics_but_timing(a: Sequence[Any], b: Sequence[Any]) -> None:
+    """Robot by robot, every metric of ``a`` equals ``b``'s except the decision times."""
+    timing = {"decision_us_median", "decision_us_p99"}
+    for ma, mb in zip(a, b, strict=True):
+        da, db = ma.to_dict(), mb.to_dict()
+        assert {k: v for k, v in da.items() if k not in timing} == {
+            k: v for k, v in db.items() if k not in timing
+        }
+
+
 @pytest.mark.parametrize("use_numba", KERNELS)
 @pytest.mark.parametrize("case", sorted(CASES))
 def test_run_multi_gives_the_loop_worlds_result_through_the_swarm(
@@ -151,12 +162,7 @@ def test_run_multi_gives_the_loop_worlds_result_through_the_swarm(
     with compiled(use_numba):
         loop = run_episode(CASES[case](), None, np.random.default_rng(9), vectorised=False)
         packed = run_episode(CASES[case](), None, np.random.default_rng(9))
-    timing = {"decision_us_median", "decision_us_p99"}
-    for a, b in zip(loop.robots, packed.robots, strict=True):
-        da, db = a.to_dict(), b.to_dict()
-        assert {k: da[k] for k in da if k not in timing} == {
-            k: db[k] for k in db if k not in timing
-        }
+    assert_same_metrics_but_timing(loop.robots, packed.robots)
     assert any(m.mode_switches for m in loop.robots) and any(m.control_effort for m in loop.robots)
     assert loop.group == packed.group and loop.statuses == packed.statuses
     assert loop.collided_pairs == packed.collided_pairs
@@ -204,12 +210,7 @@ def test_the_bulk_hold_holds_records_and_counts_what_the_per_robot_path_does(
         runs.append((spy.calls, res, logs, world.state.tobytes(), list(world.applied)))
     (bulk_calls, a, la, sa, ha), (per_calls, b, lb, sb, hb) = runs
     assert bulk_calls > BLOCK and per_calls == 0
-    timing = {"decision_us_median", "decision_us_p99"}
-    for ma, mb in zip(a.robots, b.robots, strict=True):
-        da, db = ma.to_dict(), mb.to_dict()
-        assert {k: da[k] for k in da if k not in timing} == {
-            k: db[k] for k in db if k not in timing
-        }
+    assert_same_metrics_but_timing(a.robots, b.robots)
     assert any(m.mode_switches for m in a.robots) and any(m.control_effort for m in a.robots)
     assert a.group == b.group and a.statuses == b.statuses and a.collided_pairs == b.collided_pairs
     assert sa == sb and ha == hb

@@ -516,26 +516,6 @@ def _rings_kernel() -> Callable[..., Any]:
     return _RINGS[0]
 
 
-def ray_ring_hit_py(
-    ox: float, oy: float, dx: float, dy: float, xs: FloatArray, ys: FloatArray
-) -> float:
-    """:func:`rays_rings_hit` for one unit ray from ``(ox, oy)`` along ``(dx, dy)`` and one
-    closed ring (``xs``, ``ys`` [m]) as a loop: the distance [m] to its first crossing, ``inf``
-    on a miss (the same operations, for compiled callers)."""
-    best = math.inf
-    for j in range(xs.shape[0] - 1):
-        sx, sy = xs[j], ys[j]
-        ex, ey = xs[j + 1] - sx, ys[j + 1] - sy
-        wx, wy = sx - ox, sy - oy
-        den = dx * ey - dy * ex
-        if abs(den) >= _EPS:
-            t = (wx * ey - wy * ex) / den
-            s = (wx * dy - wy * dx) / den
-            if t >= 0.0 and s >= 0.0 and s <= 1.0 and t < best:
-                best = t
-    return best
-
-
 def rays_rings_hit(
     origin: FloatArray | tuple[float, float], directions: FloatArray, rings: FloatArray
 ) -> FloatArray:

@@ -223,7 +223,7 @@ def _lidar_in(k: int, ox: float, oy: float, th: float, rel: FloatArray, max_rang
                     ring[0, j] = ch * rx + sh * -ry + cx
                     ring[1, j] = ch * ry + sh * rx + cy
                 cast = True
-            best = ranges[k, r]  # ray_ring_hit_py's loop, inlined
+            best = ranges[k, r]  # rays_rings_hit's test for one ray and one ring, as a loop
             for j in range(ring.shape[1] - 1):
                 sx, sy = ring[0, j], ring[1, j]
                 qx, qy = ring[0, j + 1] - sx, ring[1, j + 1] - sy
@@ -263,7 +263,7 @@ def _lidar(
     a margin of 1e-9 (1 + centre offset) [m] over their 1e-12 error; a beam that passes it
     takes libm's ``cos`` and ``sin`` and the exact test.  Most beams meet no body's disc, so
     most beams take no ``cos`` or ``sin``.  The ring's transform (:func:`_transform_ring`) and
-    the ray-ring test (:func:`uvnav.geometry.polygons.ray_ring_hit_py`) are their operations
+    the ray-ring test (:func:`uvnav.geometry.polygons.rays_rings_hit`'s) are their operations
     written out in the loop, where calls that passed array rows cost more than the
     arithmetic.  (Skipping an edge's two divisions by its numerators' signs first, and keeping
     libm's directions across bodies, made a stepping env's observation slower: their branches
