@@ -18,6 +18,7 @@ from uvnav.obstacles import (
     PolygonBody,
 )
 from uvnav.sensors import lidar_scan, sense_obstacles
+from uvnav.sensors.observation import Readings, read_arrays
 
 ARROW = np.array([[-0.6, -0.4], [0.7, -0.5], [0.2, 0.1], [0.6, 0.6], [-0.5, 0.5]])
 
@@ -202,3 +203,15 @@ def test_sensing_reuses_a_wider_query_without_changing_readings(sensing_range: f
         assert a.obstacle_id == b.obstacle_id and a.distance == b.distance
         for name in ("nearest_point", "centre", "velocity", "outline"):
             assert np.array_equal(getattr(a, name), getattr(b, name))
+
+
+@pytest.mark.parametrize("sensing_range", [0.0, 4.5, math.inf])
+def test_the_readings_as_arrays_are_the_readings(sensing_range: float) -> None:
+    """The sensor's readings give themselves as arrays read from the field, exactly what
+    reading each reading gives (discs and polygons), read-only."""
+    readings = sense_obstacles(np.array([0.2, -0.1]), _ring_world(), sensing_range=sensing_range)
+    assert isinstance(readings, Readings) or readings == ()
+    if readings:
+        for got, ref in zip(readings.arrays, read_arrays(tuple(readings)), strict=True):
+            assert got.shape == ref.shape and np.array_equal(got, ref)
+            assert not got.flags.writeable

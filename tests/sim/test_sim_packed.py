@@ -22,6 +22,7 @@ from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
 from uvnav.sensors.exact import lidar_scan
+from uvnav.sensors.observation import Readings, read_arrays
 from uvnav.sim.bodies2d import FieldBodies, PackedBodies
 from uvnav.sim.episode import World2D
 from uvnav.sim.packed import (
@@ -590,3 +591,25 @@ def test_restore_spawned_many_is_restore_spawned_of_each(compiled: bool) -> None
                 assert (g is None) == (h is None)
                 if g is not None:
                     assert g.bit_generator.state == h.bit_generator.state
+
+
+@pytest.mark.parametrize("packed", [True, False])
+def test_the_readings_arrays_are_what_the_readings_hold(packed: bool) -> None:
+    """Both obstacle stores give readings whose arrays (made from the store's own arrays) are
+    exactly what reading every reading gives, read-only, through a few steps."""
+    with kernels(packed and numba_available()):
+        world = World2D(build_episode(load_scenario("random-ch2:2"), 2), run_rng(2),
+                        exact=False, packed=packed)  # fmt: skip
+        world.start([False])
+        for _ in range(3):
+            for x, y in ((0.0, 0.0), (5.0, 5.0), (9.0, 2.0)):
+                got = world.bodies.readings(x, y, 6.0)
+                assert isinstance(got, Readings) or got == ()
+                if got:
+                    ref = read_arrays(tuple(got))
+                    for a, b in zip(got.arrays, ref, strict=True):
+                        assert a.shape == b.shape and np.array_equal(a, b)
+                        assert not a.flags.writeable
+            world.apply(UnicycleCommand(0.5, 0.3))
+            for _ in range(4):
+                world.advance()

@@ -9,31 +9,25 @@ Units: metres, seconds, radians.
 from __future__ import annotations
 
 import math
-from itertools import chain
-from operator import attrgetter
 
 import numpy as np
 
 from uvnav.geometry.angles import FloatArray
-from uvnav.sensors.observation import ObstacleReading
+from uvnav.sensors.observation import ObstacleReading, ReadingArrays, Readings, read_arrays
 
 IntArray = np.ndarray
 
-_SCALARS = attrgetter("distance", "angular_velocity", "radius", "bounding_radius")
-
-#: the readings as arrays: scalars (N, 4) (distance [m], angular velocity [rad/s], radius [m],
-#: bounding radius [m]), centres (N, 2) [m], velocities (N, 2) [m/s]
-BodyTable = tuple[FloatArray, FloatArray, FloatArray]
+#: the readings as arrays (:data:`~uvnav.sensors.observation.ReadingArrays`)
+BodyTable = ReadingArrays
 
 
 def body_table(readings: tuple[ObstacleReading, ...]) -> BodyTable:
-    """The readings as arrays (:data:`BodyTable`), read in three passes (the one cost of a
-    decision that grows with the readings outside the compiled loop)."""
-    n = len(readings)
-    scal = np.fromiter(chain.from_iterable(map(_SCALARS, readings)), float, count=4 * n)
-    centre = np.array([rd.centre for rd in readings], dtype=float).reshape(n, 2)
-    vel = np.array([rd.velocity for rd in readings], dtype=float).reshape(n, 2)
-    return scal.reshape(n, 4), centre, vel
+    """The readings as arrays (:data:`BodyTable`): the sensor's own arrays when it gave them
+    (:class:`~uvnav.sensors.observation.Readings`), else read reading by reading (the one cost of
+    a decision that grows with the readings outside the compiled loop)."""
+    if isinstance(readings, Readings):
+        return readings.arrays
+    return read_arrays(readings)
 
 
 def boundary_discs(
@@ -50,7 +44,7 @@ def boundary_discs(
     sample a disc of radius ``spacing / 2`` (which covers the edges) moving with
     ``v_i + u_i x (q - c_i)``.  One pass over all edges of all bodies.
 
-    >>> from uvnav.sensors.observation import ObstacleReading
+    >>> from uvnav.sensors.observation import ObstacleReading, ReadingArrays, Readings, read_arrays
     >>> z = np.zeros(2)
     >>> sq = np.array([[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]])
     >>> rd = ObstacleReading(0, 1.0, z, np.array([0.5, 0.5]), z, 0.0, sq, 0.0, 0.71)

@@ -19,10 +19,11 @@ is what cannot change the choice:
 * a path is rolled out only as far as it is checked, and its check stops at the segment of its
   first contact (later segments start later) once past the comfort horizon;
 * per chunk of :data:`CHUNK` segments, the bodies that can reach any path over the chunk (a
-  square about the start, as wide as the fastest path goes) are listed once per decision
-  (:func:`_chunk_bodies`); a candidate's chunk visits them nearest first and the visit ends at
-  the first that cannot reach the chunk's path; a body, then a disc, whose box over the chunk
-  stays out of reach of the path's box is skipped;
+  square about the start, as wide as the fastest path goes) are listed once per decision, by
+  the low x of their boxes over the chunk grown by their reach (:func:`_chunk_bodies`); a
+  candidate's chunk visits only those whose grown boxes meet its path's box (a bisection on
+  that low x, then a box test: sweep and prune), and skips a body, then a disc, whose box over
+  the chunk stays out of reach of the path's box;
 * where no candidate is safe, whether one can still brake is computed only where its cost could
   win; a braking check answers yes at once when the straight line to a point before the contact
   already exceeds the stopping distance;
@@ -47,7 +48,7 @@ from uvnav.controllers import zhang2019_v2_loop
 from uvnav.controllers.zhang2019_v2_loop import boundary_discs_py, reachable_py
 from uvnav.geometry import contact
 from uvnav.geometry.angles import FloatArray
-from uvnav.geometry.contact import _contact_scalar, _gap_scalar, tangents_py
+from uvnav.geometry.contact import _contact_scalar, tangents_py
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
 
 #: indices into the ``prm`` vector of :func:`choose_on_paths_py` and :func:`plan_paths_py`
@@ -136,12 +137,18 @@ def advance(
 CHUNK = 4
 
 
-def _box_gap(box: FloatArray, ax: float, ay: float, bx: float, by: float) -> float:
-    """Distance [m] between the box ``(x lo, x hi, y lo, y hi)`` and the bounding box of the
-    segment ``(ax, ay)``-``(bx, by)`` (0 when they overlap)."""
+def _box_far(box: FloatArray, ax: float, ay: float, bx: float, by: float, lim: float) -> bool:
+    """The distance [m] between the box ``(x lo, x hi, y lo, y hi)`` and the bounding box of the
+    segment ``(ax, ay)``-``(bx, by)`` exceeds ``lim``: ``hypot(dx, dy) > lim``, decided on the
+    squares where they settle it (far from equality) and by ``hypot`` where they do not."""
     dx = max(min(ax, bx) - box[1], box[0] - max(ax, bx), 0.0)
     dy = max(min(ay, by) - box[3], box[2] - max(ay, by), 0.0)
-    return math.hypot(dx, dy)
+    sq, lim_sq = dx * dx + dy * dy, lim * lim
+    if sq > lim_sq * (1.0 + 1e-12):
+        return True
+    if sq < lim_sq * (1.0 - 1e-12):
+        return False
+    return math.hypot(dx, dy) > lim
 
 
 def _path_box(xy: FloatArray, i0: int, i1: int, box: FloatArray) -> None:
@@ -151,6 +158,20 @@ def _path_box(xy: FloatArray, i0: int, i1: int, box: FloatArray) -> None:
     for i in range(i0 + 1, i1 + 1):
         box[0], box[1] = min(box[0], xy[i, 0]), max(box[1], xy[i, 0])
         box[2], box[3] = min(box[2], xy[i, 1]), max(box[3], xy[i, 1])
+
+
+def _gap_under(px: float, py: float, vx: float, vy: float, reach: float, h: float,
+               upto: float) -> float:  # fmt: skip
+    """:func:`uvnav.geometry.contact._gap_scalar` of the pair where it may be under ``upto``
+    [m], ``inf`` where the squared distance already shows it is not (no square root)."""
+    a = vx * vx + vy * vy
+    b = px * vx + py * vy
+    t = min(max(b / max(a, 1e-12), 0.0), h)
+    dx, dy = px - vx * t, py - vy * t
+    lim = reach + upto
+    if lim > 0.0 and dx * dx + dy * dy > (lim + 1e-9) * (lim + 1e-9) * (1.0 + 1e-12):
+        return math.inf
+    return math.hypot(dx, dy) - reach
 
 
 def _disc_along(
@@ -177,7 +198,7 @@ def _disc_along(
             if t < risk[0]:
                 risk[0] = t
         if near:
-            g = comfort - _gap_scalar(rx, ry, px, py, reach, min(h, c_h - t0))
+            g = comfort - _gap_under(rx, ry, px, py, reach, min(h, c_h - t0), comfort - risk[1])
             if g > risk[1]:
                 risk[1] = g
 
@@ -187,36 +208,67 @@ def _far(box: FloatArray, qw: tuple[float, float, float, float], t_a: float, t_b
     """A point moving with ``qw`` (position at 0, velocity) stays, over [``t_a``, ``t_b``],
     farther than ``lim`` from the ``box``, box to box."""
     qx, qy, wx, wy = qw
-    return _box_gap(box, qx + wx * t_a, qy + wy * t_a, qx + wx * t_b, qy + wy * t_b) > lim
+    return _box_far(box, qx + wx * t_a, qy + wy * t_a, qx + wx * t_b, qy + wy * t_b, lim)
 
 
 def _chunk_bodies(
     c: int, t_a: float, t_b: float, lim: float, xy: FloatArray, bodies: FloatArray,
-    cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float, FloatArray],
+    cull: tuple[np.ndarray, float, FloatArray, FloatArray, FloatArray],
 ) -> None:  # fmt: skip
-    """The bodies (nearest first) that may come within reach of any path over chunk ``c``
-    (times ``t_a`` .. ``t_b``), into ``cull``'s lists: a path moves at most ``cull[4]`` [m/s]
-    from its start ``xy[0]``, so its box over the chunk lies in the square of that half-width
-    about the start, and a body whose box over the chunk stays, box to box, farther than its
-    bounding reach plus ``lim`` from that square is farther from the path's box too."""
-    order, lists, top = cull[0], cull[3], cull[4]
-    n_b = order.shape[0]
+    """The bodies that may come within reach of any path over chunk ``c`` (times ``t_a`` ..
+    ``t_b``), into ``cull``'s lists, by the low x of their boxes: a path moves at most
+    ``cull[1]`` [m/s] from its start ``xy[0]``, so its box over the chunk lies in the square of
+    that half-width about the start, and a body whose box over the chunk stays, box to box,
+    farther than its bounding reach plus ``lim`` from that square is farther from the path's box
+    too.  Per listed body, its box over the chunk grown by that reach (``cull[3]``, rows from
+    ``c * N``: x lo, x hi, y lo, y hi), and in ``cull[2][c]`` the widest of them in x: a path's
+    box can meet only those whose low x lies within that width below its own low x."""
+    lists, top, grown = cull[0], cull[1], cull[3]
+    n_b = bodies.shape[0]
     half = top * t_b * (1.0 + 1e-9) + 1e-9
     square = np.array((xy[0, 0] - half, xy[0, 0] + half, xy[0, 1] - half, xy[0, 1] + half))
+    row0 = c * n_b
+    near = np.empty(n_b, dtype=np.int64)
+    lows = np.empty(n_b)
     n = 0
-    for b in order:
+    for b in range(n_b):
         body = (bodies[b, 2], bodies[b, 3], bodies[b, 4], bodies[b, 5])
         if not _far(square, body, t_a, t_b, bodies[b, 6] + lim):
-            lists[0, c * n_b + n] = b
+            pad = (bodies[b, 6] + lim) * (1.0 + 1e-9) + 1e-9  # never tighter than _far
+            near[n] = b
+            lows[n] = min(body[0] + body[2] * t_a, body[0] + body[2] * t_b) - pad
             n += 1
+    by = np.argsort(lows[:n])
+    for i in range(n):
+        b = near[by[i]]
+        pad = (bodies[b, 6] + lim) * (1.0 + 1e-9) + 1e-9
+        xa, xb = bodies[b, 2] + bodies[b, 4] * t_a, bodies[b, 2] + bodies[b, 4] * t_b
+        ya, yb = bodies[b, 3] + bodies[b, 5] * t_a, bodies[b, 3] + bodies[b, 5] * t_b
+        lists[0, row0 + i] = b
+        grown[row0 + i, 0], grown[row0 + i, 1] = lows[by[i]], max(xa, xb) + pad
+        grown[row0 + i, 2], grown[row0 + i, 3] = min(ya, yb) - pad, max(ya, yb) + pad
+        cull[2][c] = max(cull[2][c], grown[row0 + i, 1] - grown[row0 + i, 0])
     lists[1, c] = n
+
+
+def _first_at_least(grown: FloatArray, lo: int, hi: int, value: float) -> int:
+    """The first row in ``lo .. hi - 1`` of ``grown`` (sorted by its column 0) whose column 0
+    is at least ``value`` (``hi`` when none is): a bisection that makes no view."""
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if grown[mid, 0] < value:
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
 
 
 def risk_along(
     path: tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray], aim: float,
     speed: float, n_sub: int,
     times: FloatArray, discs: tuple[FloatArray, FloatArray, FloatArray], bodies: FloatArray,
-    cull: tuple[np.ndarray, FloatArray, float, np.ndarray, float, FloatArray], prm: FloatArray,
+    cull: tuple[np.ndarray, float, FloatArray, FloatArray, FloatArray],
+    prm: FloatArray,
     give_up: float, base: float,
     safe_only: bool, risk: FloatArray,
 ) -> None:  # fmt: skip
@@ -232,14 +284,15 @@ def risk_along(
     The path is checked :data:`CHUNK` segments at a time; a body (``bodies``: first and end
     disc, centre, velocity, bounding reach), then a disc, whose positions over a chunk stay, box
     to box, farther from the robot's than its grown reach (and the comfort distance within the
-    comfort horizon) is not checked on that chunk's segments: none would count.  ``cull``: the
-    bodies by their gap at the start (distance from the robot's start to the centre less the
-    bounding reach), that gap, and the largest body speed; the bodies are visited in that
-    order, and the visit stops at the first that cannot close in on the chunk's path."""
+    comfort horizon) is not checked on that chunk's segments: none would count.  ``cull``: per
+    chunk the bodies that can reach some path, by the low x of their grown boxes
+    (:func:`_chunk_bodies`: lists, the fastest path's speed, the widest box per chunk, the
+    boxes), and room for the path's box; a chunk visits only the bodies whose grown boxes meet
+    the path's box, found by bisection on that low x."""
     xy, speeds, st, track, known = path
     q, w, reach = discs
-    gap, fastest, lists = cull[1], cull[2], cull[3]
-    n_b, box = gap.shape[0], cull[5]
+    lists, wide, grown, box = cull[0], cull[2], cull[3], cull[4]
+    n_b = bodies.shape[0]
     c_h, spread, w_ttc, w_comfort = prm[M_CHOR], prm[M_SPREAD], prm[M_W_TTC], prm[M_W_COMFORT]
     n_seg = times.shape[0] - 1
     while risk[2] < n_seg:
@@ -252,17 +305,17 @@ def risk_along(
         t_a, t_b = times[i0], times[i1]
         lim_far = spread * t_b + (prm[M_COMFORT] if t_a < c_h else 0.0) + 1e-9
         _path_box(xy, i0, i1, box)
-        out_to = 0.0  # how far from the start the path gets within the chunk: to a box corner
-        for corner in range(4):
-            cx, cy = box[corner // 2] - xy[0, 0], box[2 + corner % 2] - xy[0, 1]
-            out_to = max(out_to, math.hypot(cx, cy))
         c = i0 // CHUNK
         if lists[1, c] < 0:
             _chunk_bodies(c, t_a, t_b, lim_far, xy, bodies, cull)
-        for idx in range(lists[1, c]):
-            b = lists[0, c * n_b + idx]
-            if gap[b] > fastest * t_b + out_to + lim_far:
-                break  # this body and the farther ones stay out of reach over the chunk
+        row0, end = c * n_b, c * n_b + lists[1, c]
+        at = _first_at_least(grown, row0, end, box[0] - wide[c])
+        for idx in range(at, end):
+            if grown[idx, 0] > box[1]:
+                break  # this body and the next ones lie beyond the path's box in x
+            if grown[idx, 1] < box[0] or grown[idx, 2] > box[3] or grown[idx, 3] < box[2]:
+                continue
+            b = lists[0, idx]
             body = (bodies[b, 2], bodies[b, 3], bodies[b, 4], bodies[b, 5])
             if _far(box, body, t_a, t_b, bodies[b, 6] + lim_far):
                 continue
@@ -358,15 +411,11 @@ def choose_on_paths_py(
     track = np.empty((int(group.max()) + 1 if n_c else 0, n, 8))
     known = np.zeros(track.shape[0])
     min_ttc, w_ttc, w_comfort = prm[M_MIN_TTC], prm[M_W_TTC], prm[M_W_COMFORT]
-    gap = np.empty(bodies.shape[0])
-    fastest = 0.0
-    for b in range(bodies.shape[0]):
-        gap[b] = math.hypot(bodies[b, 2] - pose[0], bodies[b, 3] - pose[1]) - bodies[b, 6]
-        fastest = max(fastest, math.hypot(bodies[b, 4], bodies[b, 5]))
     n_chunks = (n + CHUNK - 1) // CHUNK
-    lists = np.full((2, max(n_chunks * bodies.shape[0], n_chunks)), -1, dtype=np.int64)
+    n_rows = max(n_chunks * bodies.shape[0], n_chunks)
+    lists = np.full((2, n_rows), -1, dtype=np.int64)
     top = max(prm[M_VMAX], abs(now[0]))  # no path moves faster
-    cull = (np.argsort(gap), gap, fastest, lists, top, np.empty(4))
+    cull = (lists, top, np.zeros(n_chunks), np.empty((n_rows, 4)), np.empty(4))
     # best safe, best admissible, best of all: cost, index, ttc
     best = np.array([math.inf, -1.0, math.inf, math.inf, -1.0, math.inf, math.inf, -1.0, math.inf])
     for safe_only in (True, False):  # the safe one if any; all of them only when none is
@@ -508,8 +557,8 @@ def _compiled_plan() -> Callable[..., Any]:
     cache), calling the compiled copies of its helpers and of :mod:`uvnav.geometry.contact`'s."""
     if not _COMPILED:
         zhang2019_v2_loop._compiled_plan()
-        kernels = (_approach, _window, _turn, advance, _box_gap, _path_box, _disc_along, _far,
-                   _chunk_bodies,
+        kernels = (_approach, _window, _turn, advance, _box_far, _path_box, _gap_under, _disc_along,
+                   _far, _chunk_bodies, _first_at_least,
                    risk_along, _stops, _better, _keep, _groups, choose_on_paths_py, plan_paths_py,
                    plan_readings_py)  # fmt: skip
         bound = {**contact._kernels(), **zhang2019_v2_loop._COMPILED}

@@ -12,7 +12,7 @@ import numpy as np
 
 from uvnav.geometry.angles import FloatArray, wrap_to_pi
 from uvnav.obstacles.obstacle import ObstacleField
-from uvnav.sensors.observation import LidarScan, ObstacleReading
+from uvnav.sensors.observation import LidarScan, ObstacleReading, ReadingArrays, Readings
 
 _EMPTY = np.zeros((0, 2))
 
@@ -40,7 +40,8 @@ def sense_obstacles(
     ids = q.ids
     if len(dist) == 0:
         return ()
-    order = np.argsort(dist, kind="stable").tolist() if len(dist) > 1 else [0]
+    by = np.argsort(dist, kind="stable")
+    order = by.tolist()
     out = []
     for i in order:
         d = float(dist[i])
@@ -61,7 +62,19 @@ def sense_obstacles(
                 bounding_radius=float(field.bounding_radii[j]),
             )
         )
-    return tuple(out)
+    kept = by[: len(out)]
+    return Readings.lazy(out, lambda: _arrays(field, dist[kept], ids[kept]))
+
+
+def _arrays(field: ObstacleField, dist: FloatArray, ids: np.ndarray) -> ReadingArrays:
+    """The readings of bodies ``ids`` at distances ``dist`` [m] as arrays, from the ``field``
+    (a snapshot: its arrays do not change)."""
+    scal = np.empty((len(ids), 4))
+    scal[:, 0] = dist
+    scal[:, 1] = field.angular_velocities[ids]
+    scal[:, 2] = field.radii[ids]
+    scal[:, 3] = field.bounding_radii[ids]
+    return scal, field.centres[ids], field.velocities[ids]
 
 
 @functools.lru_cache(maxsize=64)

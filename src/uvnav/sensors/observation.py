@@ -9,8 +9,10 @@ simulator's sensing configuration and written in :attr:`ObstacleReading.velocity
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
+from itertools import chain
+from operator import attrgetter
 from typing import Any
 
 import numpy as np
@@ -85,6 +87,73 @@ class ObstacleReading:
         if got is None:
             got = self.__dict__["_speed"] = float(np.hypot(self.velocity[0], self.velocity[1]))
         return got
+
+
+_SCALARS = attrgetter("distance", "angular_velocity", "radius", "bounding_radius")
+
+#: readings as arrays: scalars (N, 4) (distance [m], angular velocity [rad/s], radius [m],
+#: bounding radius [m]), centres (N, 2) [m], velocities (N, 2) [m/s], one row per reading
+ReadingArrays = tuple[FloatArray, FloatArray, FloatArray]
+
+
+def read_arrays(readings: tuple[ObstacleReading, ...]) -> ReadingArrays:
+    """``readings`` as :data:`ReadingArrays`, read reading by reading (three passes).
+
+    >>> z = np.zeros(2)
+    >>> rd = ObstacleReading(3, 1.5, z, np.array([2.0, 0.0]), np.array([0.0, 1.0]), 0.0,
+    ...                      np.zeros((0, 2)), 0.5, 0.5)
+    >>> [a.tolist() for a in read_arrays((rd,))]
+    [[[1.5, 0.0, 0.5, 0.5]], [[2.0, 0.0]], [[0.0, 1.0]]]
+    """
+    n = len(readings)
+    scal = np.fromiter(chain.from_iterable(map(_SCALARS, readings)), float, count=4 * n)
+    centre = np.array([rd.centre for rd in readings], dtype=float).reshape(n, 2)
+    vel = np.array([rd.velocity for rd in readings], dtype=float).reshape(n, 2)
+    return scal.reshape(n, 4), centre, vel
+
+
+class Readings(tuple[ObstacleReading, ...]):
+    """Readings, nearest first, that also give themselves as arrays (:attr:`arrays`), made on
+    first use from the sensor's own arrays rather than from every reading.
+
+    A sensor that reads its world from arrays returns this; a law that works on arrays reads
+    :attr:`arrays` (one call) where it would read N reading objects.  Any other tuple of
+    readings (filtered, estimated, noisy: every new tuple is a plain one, and so is a copy or
+    an unpickled one) has no arrays and is read reading by reading (:func:`read_arrays`).
+
+    >>> r = Readings.lazy((), lambda: (np.zeros((0, 4)), np.zeros((0, 2)), np.zeros((0, 2))))
+    >>> r == (), r.arrays[0].shape
+    (True, (0, 4))
+    >>> type(r[:0]) is tuple  # a slice is a new, plain tuple
+    True
+    """
+
+    _arrays: ReadingArrays | None = None
+    _make: Callable[[], ReadingArrays] | None = None
+
+    @classmethod
+    def lazy(
+        cls, readings: Iterable[ObstacleReading], make: Callable[[], ReadingArrays]
+    ) -> Readings:
+        """``readings`` whose :attr:`arrays` ``make()`` returns when first read (``make`` must
+        read a state that no longer changes, and give what :func:`read_arrays` would)."""
+        out = cls(readings)
+        out._make = make
+        return out
+
+    @property
+    def arrays(self) -> ReadingArrays:
+        """The readings as :data:`ReadingArrays` (read-only; made once)."""
+        got = self._arrays
+        if got is None:
+            got = self._make() if self._make is not None else read_arrays(self)
+            for a in got:
+                a.flags.writeable = False
+            self._arrays, self._make = got, None
+        return got
+
+    def __reduce__(self) -> tuple[type[tuple[ObstacleReading, ...]], tuple[Any, ...]]:
+        return tuple, (tuple(self),)
 
 
 @dataclass(frozen=True)

@@ -19,7 +19,7 @@ from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.motion import RandomTurn
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField, ObstacleState
 from uvnav.sensors.exact import sense_obstacles
-from uvnav.sensors.observation import ObstacleReading
+from uvnav.sensors.observation import ObstacleReading, ReadingArrays, Readings
 from uvnav.sim.packed import (
     BLOCK,
     I_RATIO,
@@ -464,7 +464,14 @@ class PackedBodies:
                 r[R_VEL : R_VEL + 2], vals[i][R_OMEGA], outlines[i, : counts[j]], bounds[j],
             )  # fmt: skip
             out.append(reading)
-        return tuple(out)
+        return Readings.lazy(out, lambda: self._arrays(ids, rows))
+
+    def _arrays(self, ids: list[int], rows: FloatArray) -> ReadingArrays:
+        """A sensed block (``ids`` and its rows, copies) as the readings' arrays."""
+        scal = np.zeros((len(ids), 4))
+        scal[:, 0], scal[:, 1] = rows[:, R_DIST], rows[:, R_OMEGA]
+        scal[:, 3] = np.asarray(self._bounds, dtype=float)[ids]
+        return scal, rows[:, R_CENTRE : R_CENTRE + 2], rows[:, R_VEL : R_VEL + 2]
 
     def centres(self) -> tuple[FloatArray, np.ndarray | None]:
         """The obstacles' centres (k, 2) [m] now (a view) and ``None`` (every body exists)."""
