@@ -215,3 +215,9 @@ def test_the_readings_as_arrays_are_the_readings(sensing_range: float) -> None:
         for got, ref in zip(readings.arrays, read_arrays(tuple(readings)), strict=True):
             assert got.shape == ref.shape and np.array_equal(got, ref)
             assert not got.flags.writeable
+
+
+def test_the_sensor_says_every_velocity_is_known() -> None:
+    readings = sense_obstacles(np.zeros(2), _ring_world(), sensing_range=5.0)
+    assert isinstance(readings, Readings) and readings.all_known
+    assert all(r.velocity_source == "known" for r in readings)

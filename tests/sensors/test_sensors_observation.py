@@ -9,7 +9,7 @@ import pickle
 import numpy as np
 import pytest
 
-from uvnav.sensors.observation import ObstacleReading, Readings, read_arrays
+from uvnav.sensors.observation import ObstacleReading, Readings, any_estimated, read_arrays
 
 
 def test_a_polygon_reading_built_fast_is_the_constructors() -> None:
@@ -57,3 +57,11 @@ def test_readings_without_a_maker_read_themselves() -> None:
     got = Readings(rds).arrays
     assert all(np.array_equal(a, b) for a, b in zip(got, read_arrays(rds), strict=True))
     assert read_arrays(())[0].shape == (0, 4)
+
+
+def test_whether_any_velocity_is_estimated_is_the_sensors_word_or_the_readings() -> None:
+    est = dataclasses.replace(_disc(1, 2.0), velocity_source="estimated")
+    assert any_estimated((_disc(0, 1.0), est)) and not any_estimated((_disc(0, 1.0),))
+    said = Readings.lazy((_disc(0, 1.0),), lambda: read_arrays(()), all_known=True)
+    assert not any_estimated(said) and not any_estimated(Readings((_disc(0, 1.0),)))
+    assert any_estimated(Readings((est,)))

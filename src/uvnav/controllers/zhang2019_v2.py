@@ -139,7 +139,6 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from operator import attrgetter
 from typing import Any, ClassVar
 
 import numpy as np
@@ -192,7 +191,7 @@ from uvnav.geometry.contact import (
 )
 from uvnav.geometry.kernels3d import numba_enabled
 from uvnav.prediction.tracking import CentreTracker
-from uvnav.sensors.observation import Observation
+from uvnav.sensors.observation import Observation, any_estimated
 
 IntArray = np.ndarray
 
@@ -595,9 +594,6 @@ def plan_limited(
 # -- the two laws -----------------------------------------------------------------------------
 
 
-_SOURCE = attrgetter("velocity_source")
-
-
 class LoopConstants:
     """A law's :func:`loop_constants`, kept while its parameters and vehicle spec are the same
     objects."""
@@ -649,7 +645,7 @@ def _tracker(p: Zhang2019V2Params) -> CentreTracker | None:
 def tracked(obs: Observation, tracker: CentreTracker | None) -> Observation:
     """``obs`` with the tracker's centres and velocities for the bodies whose rates were
     estimated (the same object when nothing was estimated or there is no tracker)."""
-    if tracker is None or "estimated" not in map(_SOURCE, obs.obstacles):
+    if tracker is None or not any_estimated(obs.obstacles):
         return obs
     pos = np.asarray(obs.position, dtype=float)
     return dataclasses.replace(obs, obstacles=tracker.update(obs.time, obs.obstacles, pos))

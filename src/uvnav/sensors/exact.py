@@ -63,7 +63,7 @@ def sense_obstacles(
             )
         )
     kept = by[: len(out)]
-    return Readings.lazy(out, lambda: _arrays(field, dist[kept], ids[kept]))
+    return Readings.lazy(out, lambda: _arrays(field, dist[kept], ids[kept]), all_known=True)
 
 
 def _arrays(field: ObstacleField, dist: FloatArray, ids: np.ndarray) -> ReadingArrays:

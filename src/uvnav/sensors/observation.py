@@ -90,6 +90,7 @@ class ObstacleReading:
 
 
 _SCALARS = attrgetter("distance", "angular_velocity", "radius", "bounding_radius")
+_SOURCE = attrgetter("velocity_source")
 
 #: readings as arrays: scalars (N, 4) (distance [m], angular velocity [rad/s], radius [m],
 #: bounding radius [m]), centres (N, 2) [m], velocities (N, 2) [m/s], one row per reading
@@ -112,6 +113,14 @@ def read_arrays(readings: tuple[ObstacleReading, ...]) -> ReadingArrays:
     return scal.reshape(n, 4), centre, vel
 
 
+def any_estimated(readings: tuple[ObstacleReading, ...]) -> bool:
+    """Some reading's velocity is ``"estimated"`` (asked of the sensor where it said, else of
+    every reading)."""
+    if isinstance(readings, Readings) and readings.all_known is not None:
+        return not readings.all_known
+    return "estimated" in map(_SOURCE, readings)
+
+
 class Readings(tuple[ObstacleReading, ...]):
     """Readings, nearest first, that also give themselves as arrays (:attr:`arrays`), made on
     first use from the sensor's own arrays rather than from every reading.
@@ -130,15 +139,22 @@ class Readings(tuple[ObstacleReading, ...]):
 
     _arrays: ReadingArrays | None = None
     _make: Callable[[], ReadingArrays] | None = None
+    #: every reading's velocity is ``"known"`` (``None``: not said, read from the readings)
+    all_known: bool | None = None
 
     @classmethod
     def lazy(
-        cls, readings: Iterable[ObstacleReading], make: Callable[[], ReadingArrays]
+        cls,
+        readings: Iterable[ObstacleReading],
+        make: Callable[[], ReadingArrays],
+        *,
+        all_known: bool | None = None,
     ) -> Readings:
         """``readings`` whose :attr:`arrays` ``make()`` returns when first read (``make`` must
-        read a state that no longer changes, and give what :func:`read_arrays` would)."""
+        read a state that no longer changes, and give what :func:`read_arrays` would);
+        ``all_known``: the sensor says whether every velocity is the true one."""
         out = cls(readings)
-        out._make = make
+        out._make, out.all_known = make, all_known
         return out
 
     @property

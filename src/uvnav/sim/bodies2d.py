@@ -464,7 +464,7 @@ class PackedBodies:
                 r[R_VEL : R_VEL + 2], vals[i][R_OMEGA], outlines[i, : counts[j]], bounds[j],
             )  # fmt: skip
             out.append(reading)
-        return Readings.lazy(out, lambda: self._arrays(ids, rows))
+        return Readings.lazy(out, lambda: self._arrays(ids, rows), all_known=True)
 
     def _arrays(self, ids: list[int], rows: FloatArray) -> ReadingArrays:
         """A sensed block (``ids`` and its rows, copies) as the readings' arrays."""
