@@ -103,3 +103,28 @@ def test_rolled_out_paths_cross_where_the_straight_line_check_is_walked_into(cas
     before = run_scene(scene, "zhang2019-v2", {"rollout_paths": False})
     assert before.status == "collision"
     assert run_scene(scene, "zhang2019-v2").status == "success"
+
+
+def _gate(speed: float) -> Observation:
+    """A robot at the origin at 1 m/s toward GOAL, two people 0.2 m either side of its way
+    (0.7 m ahead) walking along it at ``speed``."""
+    people = tuple(_reading(k, x, 0.7, 0.0, speed, False) for k, x in enumerate((-0.8, 0.8)))
+    return Observation(time=0.0, pose=np.array([0.0, 0.0, math.pi / 2]), speed=1.0, goal=GOAL,
+                       obstacles=people)  # fmt: skip
+
+
+@pytest.mark.parametrize("loop", [False, True])
+def test_people_standing_beside_the_way_are_passed_walking_ones_kept_at_comfort(
+    loop: bool,
+) -> None:
+    """People standing still are kept clear of but not at the comfort distance (with it, two
+    people standing at either side of the way stop the robot for good); people walking there
+    still slow it down."""
+    ideal, ahead = MODELS["ideal"], np.array([0.0, 1.0])
+    for min_speed, expected in ((0.1, ahead), (0.0, np.zeros(2))):  # 0: the comfort for all
+        p = Zhang2019V2Params(comfort_min_speed=min_speed)
+        got = plan_limited(_gate(0.0), GOAL, ideal, 0.3, (1.0, 0.0), ahead, p, loop=loop)
+        np.testing.assert_allclose(got.velocity, expected, atol=1e-9)
+    walking = plan_limited(_gate(0.5), GOAL, ideal, 0.3, (1.0, 0.0), ahead, Zhang2019V2Params(),
+                           loop=loop)  # fmt: skip
+    assert 0.0 < math.hypot(*walking.velocity) < 0.5

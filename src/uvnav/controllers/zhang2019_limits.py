@@ -176,6 +176,7 @@ def path_risk(
     comfort_horizon: float,
     margin: float,
     spread: float = 0.0,
+    min_speed: float = 0.0,
 ) -> tuple[FloatArray, FloatArray]:
     """``(ttc, pen)`` per path (:func:`uvnav.geometry.contact.candidate_risk`'s numbers for a
     path of straight segments): the first contact [s] within ``horizon`` of the robot, moving
@@ -183,7 +184,8 @@ def path_risk(
     with the discs (centres ``q``, velocities ``w``, radius sums ``reach``) moving at constant
     velocity, each disc's reach grown by ``spread`` [m/s] times the end time of the segment
     (where a body may be once it changes its velocity); and the largest ``comfort - gap`` over
-    [0, ``comfort_horizon``] (0 when none).
+    [0, ``comfort_horizon``] (0 when none) over the discs moving at ``min_speed`` [m/s] or faster
+    (a body standing still is kept clear of, not at a comfort distance).
 
     >>> t = np.array([0.0, 1.0, 2.0])
     >>> xy = np.zeros((1, 3, 2))  # standing at the origin
@@ -206,6 +208,7 @@ def path_risk(
     near = t0 < comfort_horizon
     c_h = np.minimum(h[near], comfort_horizon - t0[near])
     gap = segment_gap(rel[:, near], rel_vel[:, near], reach[None, None, :], c_h[None, :, None])
+    gap = np.where(np.hypot(w[:, 0], w[:, 1]) >= min_speed, gap, np.inf)
     pen = np.clip(comfort - gap, 0.0, None).max(axis=(1, 2)) if np.any(near) else np.zeros(k)
     return np.asarray(ttc, dtype=float), np.asarray(pen, dtype=float)
 

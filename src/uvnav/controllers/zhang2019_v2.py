@@ -235,6 +235,11 @@ class Zhang2019V2Params:
             candidate pays ``w_social`` per metre by which its path over ``social_horizon`` [s]
             comes closer than ``social_band`` [m] beyond the radius sum to where a moving body
             will be over the next ``social_forecast`` [s]; 0 turns the term off.
+        comfort_min_speed: on rolled-out paths, only bodies moving at this speed [m/s] or faster
+            are kept ``comfort`` away; one standing still is only kept clear of (people standing
+            at or beside the target would otherwise hold the robot off it for good); the
+            holonomic robot's decision, and the unicycle's with ``rollout_paths`` off, do not
+            read it.
     """
 
     horizon: float = 4.0
@@ -261,6 +266,7 @@ class Zhang2019V2Params:
     social_horizon: float = 2.0
     social_forecast: float = 1.25
     social_band: float = 0.1
+    comfort_min_speed: float = 0.1
 
     def __post_init__(self) -> None:
         check_params(
@@ -287,6 +293,7 @@ class Zhang2019V2Params:
                 "w_social",
                 "social_band",
                 "track_turn_std",
+                "comfort_min_speed",
             ),
         )
         for name in ("n_headings", "max_tangent_bodies"):
@@ -467,7 +474,7 @@ def path_constants(model: RampModel, params: Zhang2019V2Params, robot_radius: fl
                      p.horizon, p.rollout_step, p.comfort, p.comfort_horizon, p.safety_margin,
                      p.limited_spread, p.min_ttc, p.w_ttc, p.w_comfort, p.w_change,
                      p.forecast_horizon, p.max_tangent_bodies, p.n_headings, robot_radius,
-                     p.spacing), dtype=float)  # fmt: skip
+                     p.spacing, p.comfort_min_speed), dtype=float)  # fmt: skip
 
 
 def loop_constants(
@@ -581,7 +588,7 @@ def plan_limited(
     times, xy, speeds = rollout(pose, now[0], now[1], ang, spd, model, p.horizon,
                                 p.rollout_step)  # fmt: skip
     ttc, pen = path_risk(times, xy, (q, w, reach), p.horizon, p.comfort, p.comfort_horizon,
-                         p.safety_margin, p.limited_spread)  # fmt: skip
+                         p.safety_margin, p.limited_spread, p.comfort_min_speed)  # fmt: skip
     brakes = stoppable(times, xy, speeds, ttc, model)
     soc = (
         path_social(times, xy, (q, w, reach), p.social_horizon, p.social_forecast, p.social_band)

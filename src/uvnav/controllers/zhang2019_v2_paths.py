@@ -54,7 +54,7 @@ from uvnav.geometry.kernels3d import compile_family, numba_enabled
 #: indices into the ``prm`` vector of :func:`choose_on_paths_py` and :func:`plan_paths_py`
 (M_VMAX, M_UMAX, M_ACCEL, M_TURN, M_PERIOD, M_HORIZON, M_STEP, M_COMFORT, M_CHOR, M_MARGIN,
  M_SPREAD, M_MIN_TTC, M_W_TTC, M_W_COMFORT, M_W_CHANGE, M_T_F, M_N_TAN,
- M_N_HEAD, M_RADIUS, M_SPACING) = range(20)  # fmt: skip
+ M_N_HEAD, M_RADIUS, M_SPACING, M_STILL) = range(21)  # fmt: skip
 
 
 def _approach(value: float, target: float, most: float) -> float:
@@ -182,9 +182,10 @@ def _disc_along(
     ``i0 .. i1 - 1`` of the path ``xy`` into ``risk`` (first contact, comfort penalty)."""
     horizon, comfort, c_h, margin = prm[M_HORIZON], prm[M_COMFORT], prm[M_CHOR], prm[M_MARGIN]
     qx, qy, wx, wy = qw
+    walks = math.hypot(wx, wy) >= prm[M_STILL]  # a body standing still: no comfort distance
     for i in range(i0, i1):
         t0 = times[i]
-        near = t0 < c_h
+        near = t0 < c_h and walks
         if not (near or risk[0] > t0):
             continue
         h = times[i + 1] - t0
