@@ -6,12 +6,13 @@ obstacles wandering in an arena beside its path (N = 10 and 100), dt = 0.1 s, bu
 packed world step (``uvnav.sim.packed.PackedWorlds``, one compiled call a step, the robot on a
 constant command; the side judged against the targets, when this uvnav has it) and the one loop
 (``uvnav.sim.run_episode`` with ``zhang2019-v1`` and ``record=False``: sensing and a decision every
-step on top; judged when there is no packed step).  The ir-sim side is a YAML world generated
-at run time with *the same polygons* (same seed, same ``random_nonconvex`` bodies and start
-poses), the robot driven by a constant action ``[0.707, 0]`` and the obstacles on ir-sim's own
-``dash`` + ``wander`` behavior (drive to a random goal in the same arena, draw a new one on
-arrival).  ir-sim runs headless (``headless=True``: no figure, no rendering, no animation
-saving, no pauses).
+step on top; judged when there is no packed step), and that loop again deciding with
+``straight-v1``, whose decision reads only the goal (the loop's own cost, reported beside).
+The ir-sim side is a YAML world generated at run time with *the same polygons* (same seed, same
+``random_nonconvex`` bodies and start poses), the robot driven by a constant action ``[0.707, 0]``
+and the obstacles on ir-sim's own ``dash`` + ``wander`` behavior (drive to a random goal in the
+same arena, draw a new one on arrival). ir-sim runs headless (``headless=True``: no figure, no
+rendering, no animation saving, no pauses).
 
 Run (from the repository root)::
 
@@ -72,6 +73,10 @@ PACKED = "packed world step (uvnav.sim.packed.PackedWorlds, constant command)"
 #: the law the loop side decides with (issue 37's general loop: sense, decide, advance)
 LOOP_LAW = "zhang2019-v1"
 LOOP = f"run_episode ({LOOP_LAW}, record off)"
+#: the loop again with a law whose decision costs next to nothing (it reads only the goal): the
+#: loop's own cost (sense, advance, bookkeeping) beside the law's, reported, not judged
+BARE_LAW = "straight-v1"
+BARE = f"run_episode ({BARE_LAW}, record off)"
 DT = 0.1
 IRSIM_STEPS = {10: 3000, 100: 1000}
 #: --quick: steps per episode (uvnav, ir-sim) and repeats
@@ -184,10 +189,10 @@ def time_irsim(
     return {"seed": seed, "steps": n_steps, "cpu_s": cpu, **status}
 
 
-def time_uvnav(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
-    """One uvnav episode of ``n_steps`` steps (:data:`LOOP_LAW`, record off): CPU s, status."""
+def time_uvnav(n_obstacles: int, n_steps: int, seed: int, law: str = LOOP_LAW) -> dict[str, Any]:
+    """One uvnav episode of ``n_steps`` steps (``law``, record off): CPU s, status."""
     wall, res, cpu = _time_episode(
-        lambda: world_setup(n_obstacles, n_steps, seed), LOOP_LAW, seed, False
+        lambda: world_setup(n_obstacles, n_steps, seed), law, seed, False
     )
     return {"seed": seed, "steps": n_steps, "cpu_s": cpu, "wall_s": wall, "status": res.status}
 
@@ -273,6 +278,7 @@ def main(argv: list[str] | None = None) -> int:
                 time_packed(n, 20, 99)
             ir_runs: list[dict[str, Any]] = []
             loop_runs: list[dict[str, Any]] = []
+            bare_runs: list[dict[str, Any]] = []
             packed_runs: list[dict[str, Any]] = []
             for r in range(repeats):  # interleaved so drifting machine load hits every side
                 if available:
@@ -280,12 +286,15 @@ def main(argv: list[str] | None = None) -> int:
                 if packed:
                     packed_runs.append(time_packed(n, uv_steps, r))
                 loop_runs.append(time_uvnav(n, uv_steps, r))
+                bare_runs.append(time_uvnav(n, uv_steps, r, BARE_LAW))
             loop = {"side": LOOP, **peerstats.summarize(loop_runs), "runs": loop_runs}
+            bare = {"side": BARE, **peerstats.summarize(bare_runs), "runs": bare_runs}
             row: dict[str, Any] = {"irsim": {"available": False}}
             if packed:
                 row["uvnav"] = {"side": PACKED, **peerstats.summarize(packed_runs)}
                 row["uvnav"]["runs"] = packed_runs
                 row["uvnav_loop"] = loop
+                row["uvnav_loop_bare"] = bare
             else:
                 row["uvnav"] = loop
             uv = row["uvnav"]
@@ -304,9 +313,12 @@ def main(argv: list[str] | None = None) -> int:
                     row["ratio_loop_over_irsim"] = peerstats.ratio(
                         ir["median_us_per_step"], loop["median_us_per_step"]
                     )
+                    row["ratio_loop_bare_over_irsim"] = peerstats.ratio(
+                        ir["median_us_per_step"], bare["median_us_per_step"]
+                    )
             warnings = [
                 f"uvnav run {i} ended early ({x['status']})"
-                for i, x in enumerate(packed_runs + loop_runs)
+                for i, x in enumerate(packed_runs + loop_runs + bare_runs)
                 if x["status"] != "timeout"
             ]
             warnings += [
@@ -348,6 +360,8 @@ def main(argv: list[str] | None = None) -> int:
             "uvnav loop": "obstacle motion (RandomTurn) for every obstacle, ObstacleField rebuild, "
             "robot unicycle step, robot clearance/collision check, sensing within 8 m and a "
             f"{LOOP_LAW} decision every step",
+            "uvnav loop, bare": f"the same loop deciding with {BARE_LAW} (it reads only the goal): "
+            "the loop's own cost without the law's",
         },
         "results": results,
         "targets": judged,
@@ -362,7 +376,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"world step, CPU time, median of {repeats} runs" + (" (quick)" if args.quick else ""))
     print(f"uvnav judged: {PACKED if packed else LOOP}")
     head = f"{'N':>4} {'ir-sim µs/step':>15} {'uvnav µs/step':>14} {'uvnav/ir-sim':>13}"
-    print(head + (f" {'loop µs/step':>13} {'loop/ir-sim':>12}" if packed else ""))
+    loop_head = f" {'loop µs/step':>13} {'loop/ir-sim':>12} {'bare µs/step':>13}"
+    print(head + (loop_head if packed else ""))
     for n, row in results.items():
         ir_us = row.get("irsim", {}).get("median_us_per_step")
         ratio = row.get("ratio_uvnav_over_irsim")
@@ -373,6 +388,7 @@ def main(argv: list[str] | None = None) -> int:
         if packed:
             loop_us = row["uvnav_loop"]["median_us_per_step"]
             line += f" {fmt(loop_us, 13, 1)} {fmt(row.get('ratio_loop_over_irsim'), 11, 2)}x"
+            line += f" {fmt(row['uvnav_loop_bare']['median_us_per_step'], 13, 1)}"
         print(line)
         for w in row.get("warnings", []):
             print(f"      warning: {w}")
