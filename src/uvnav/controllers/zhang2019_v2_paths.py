@@ -487,21 +487,27 @@ def plan_paths_py(
     n_s = speeds.shape[0]
     n_c = (n_t + n_x) * n_s + 2
     ang, spd = np.empty(n_c), np.empty(n_c)
-    for i in range(n_t + n_x):
+    cand, base = np.empty((n_c, 2)), np.empty(n_c)
+    for i in range(n_t + n_x + 1):  # each direction's cosine and sine once, for all its speeds
         if i < n_t:
             a = tang[i]
         elif i - n_t < n_head:
             a = 2.0 * math.pi * float(i - n_t) / max(n_head, 1)
-        else:
-            a = math.atan2(fy, fx) if i - n_t == n_head else math.atan2(oy, ox)
-        for k in range(n_s):
-            ang[i * n_s + k], spd[i * n_s + k] = a, speeds[k]
-    ang[n_c - 2] = ang[n_c - 1] = math.atan2(fy, fx)
-    spd[n_c - 2], spd[n_c - 1] = f_norm, 0.0
-    cand, base = np.empty((n_c, 2)), np.empty(n_c)
+        elif i - n_t == n_head + 1 and i < n_t + n_x:  # the previous choice's direction
+            a = math.atan2(oy, ox)
+        else:  # the goal's, for the preferred velocity and standing still too
+            a = math.atan2(fy, fx)
+        cos_a, sin_a = math.cos(a), math.sin(a)
+        for k in range(n_s if i < n_t + n_x else 2):
+            j = i * n_s + k if i < n_t + n_x else n_c - 2 + k
+            ang[j] = a
+            if i < n_t + n_x:
+                spd[j] = speeds[k]
+            else:  # the preferred velocity, then standing still
+                spd[j] = f_norm if k == 0 else 0.0
+            cand[j, 0], cand[j, 1] = spd[j] * cos_a, spd[j] * sin_a
     for k in range(n_c):
-        cx, cy = spd[k] * math.cos(ang[k]), spd[k] * math.sin(ang[k])
-        cand[k, 0], cand[k, 1] = cx, cy
+        cx, cy = cand[k, 0], cand[k, 1]
         base[k] = math.hypot(cx - fx, cy - fy) + w_change * math.hypot(cx - ox, cy - oy)
     order = np.argsort(base, kind="mergesort")
     pick = np.empty(2)
