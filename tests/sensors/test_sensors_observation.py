@@ -12,6 +12,16 @@ import pytest
 from uvnav.sensors.observation import ObstacleReading, Readings, any_estimated, read_arrays
 
 
+def test_a_disc_reading_built_fast_is_the_constructors() -> None:
+    args = (2, 0.7, np.array([0.1, 0.2]), np.array([0.5, 0.5]), np.array([1.0, 0.0]), 0.0,
+            np.zeros((0, 2)), 0.3, 0.3)  # fmt: skip
+    fast, slow = ObstacleReading.known(*args), ObstacleReading(*args)
+    for f in dataclasses.fields(slow):
+        a, b = getattr(fast, f.name), getattr(slow, f.name)
+        assert a is b or a == b
+    assert fast.is_disc and fast.speed == 1.0
+
+
 def test_a_polygon_reading_built_fast_is_the_constructors() -> None:
     args = (3, 0.5, np.array([1.0, 2.0]), np.array([1.5, 2.5]), np.array([0.3, -0.4]), 0.2,
             np.array([[1.0, 2.0], [2.0, 2.0], [1.5, 3.0]]), 0.9)  # fmt: skip

@@ -569,7 +569,8 @@ def plan_limited(
         table = body_table(readings)
         moving = 1.0 if math.hypot(v_prev[0], v_prev[1]) > 1e-9 else 0.0  # as extra_headings
         f_norm = math.hypot(v_pref[0], v_pref[1])
-        state = np.array((*pose, *now, *v_pref, f_norm, *v_prev, moving), dtype=float)
+        state = np.array((pose[0], pose[1], pose[2], now[0], now[1], v_pref[0], v_pref[1],
+                          f_norm, v_prev[0], v_prev[1], moving), dtype=float)  # fmt: skip
         prm, speeds = constants or (
             path_constants(model, p, robot_radius),
             model.v_max * np.asarray(p.speed_levels, dtype=float),

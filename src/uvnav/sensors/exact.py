@@ -41,40 +41,52 @@ def sense_obstacles(
     if len(dist) == 0:
         return ()
     by = np.argsort(dist, kind="stable")
-    order = by.tolist()
-    out = []
-    for i in order:
-        d = float(dist[i])
-        if d > sensing_range:
-            break
-        j = int(ids[i])
-        poly = q.outline(i)
-        out.append(
-            ObstacleReading(
-                obstacle_id=j,
-                distance=d,
-                nearest_point=q.nearest[i].copy(),
-                centre=field.centres[j].copy(),
-                velocity=field.velocities[j].copy(),
-                angular_velocity=float(field.angular_velocities[j]),
-                outline=poly if poly is not None else _EMPTY,
-                radius=float(field.radii[j]),
-                bounding_radius=float(field.bounding_radii[j]),
-            )
-        )
-    kept = by[: len(out)]
-    return Readings.lazy(out, lambda: _arrays(field, dist[kept], ids[kept]), all_known=True)
+    beyond = dist[by] > sensing_range  # nearest first: the readings end at the first beyond
+    kept = by[: int(np.argmax(beyond))] if bool(beyond.any()) else by
+    if len(kept) == 0:
+        return ()
+    j = ids[kept]
+    block = _Block(
+        dist[kept],
+        field.centres[j],
+        field.velocities[j],
+        q.nearest[kept],
+        field.angular_velocities[j],
+        field.radii[j],
+        field.bounding_radii[j],
+    )
+    rows = zip(
+        j.tolist(),
+        block.dist.tolist(),
+        block.omega.tolist(),
+        block.radius.tolist(),
+        block.bound.tolist(),
+        map(q.outline, kept.tolist()),
+        strict=True,
+    )
+    make, near, centre, vel = ObstacleReading.known, block.near, block.centre, block.vel
+    out = [
+        make(jk, d, near[k], centre[k], vel[k], w, _EMPTY if poly is None else poly, r, b)
+        for k, (jk, d, w, r, b, poly) in enumerate(rows)
+    ]
+    return Readings.lazy(out, block.arrays, all_known=True)
 
 
-def _arrays(field: ObstacleField, dist: FloatArray, ids: np.ndarray) -> ReadingArrays:
-    """The readings of bodies ``ids`` at distances ``dist`` [m] as arrays, from the ``field``
-    (a snapshot: its arrays do not change)."""
-    scal = np.empty((len(ids), 4))
-    scal[:, 0] = dist
-    scal[:, 1] = field.angular_velocities[ids]
-    scal[:, 2] = field.radii[ids]
-    scal[:, 3] = field.bounding_radii[ids]
-    return scal, field.centres[ids], field.velocities[ids]
+class _Block:
+    """The kept bodies' numbers, gathered once from the field (nearest first): the readings'
+    arrays are views of these rows, and :meth:`arrays` stacks the scalars."""
+
+    __slots__ = ("bound", "centre", "dist", "near", "omega", "radius", "vel")
+
+    def __init__(self, dist: FloatArray, centre: FloatArray, vel: FloatArray, near: FloatArray,
+                 omega: FloatArray, radius: FloatArray, bound: FloatArray) -> None:  # fmt: skip
+        self.dist, self.centre, self.vel, self.near = dist, centre, vel, near
+        self.omega, self.radius, self.bound = omega, radius, bound
+
+    def arrays(self) -> ReadingArrays:
+        """:data:`~uvnav.sensors.observation.ReadingArrays` of the readings."""
+        scal = np.column_stack((self.dist, self.omega, self.radius, self.bound))
+        return scal.astype(float, copy=False), self.centre, self.vel
 
 
 @functools.lru_cache(maxsize=64)

@@ -52,6 +52,31 @@ class ObstacleReading:
     position_std: float = 0.0
 
     @classmethod
+    def known(
+        cls,
+        obstacle_id: int,
+        distance: float,
+        nearest_point: FloatArray,
+        centre: FloatArray,
+        velocity: FloatArray,
+        angular_velocity: float,
+        outline: FloatArray,
+        radius: float,
+        bounding_radius: float,
+    ) -> ObstacleReading:
+        """A reading with its true velocity, built without the frozen ``__init__`` (which sets
+        each field through ``object.__setattr__``): the same object, in half the time, for a
+        simulator that builds thousands of readings a second."""
+        r = object.__new__(cls)
+        r.__dict__.update(
+            obstacle_id=obstacle_id, distance=distance, nearest_point=nearest_point,
+            centre=centre, velocity=velocity, angular_velocity=angular_velocity,
+            outline=outline, radius=radius, bounding_radius=bounding_radius,
+            velocity_source="known", position_std=0.0,
+        )  # fmt: skip
+        return r
+
+    @classmethod
     def polygon(
         cls,
         obstacle_id: int,
@@ -63,17 +88,9 @@ class ObstacleReading:
         outline: FloatArray,
         bounding_radius: float,
     ) -> ObstacleReading:
-        """A polygon's reading with its true velocity, built without the frozen ``__init__``
-        (which sets each field through ``object.__setattr__``): the same object, in half the
-        time, for a simulator that builds thousands of readings a second."""
-        r = object.__new__(cls)
-        r.__dict__.update(
-            obstacle_id=obstacle_id, distance=distance, nearest_point=nearest_point,
-            centre=centre, velocity=velocity, angular_velocity=angular_velocity,
-            outline=outline, radius=0.0, bounding_radius=bounding_radius,
-            velocity_source="known", position_std=0.0,
-        )  # fmt: skip
-        return r
+        """:meth:`known` for a polygon (radius 0)."""
+        return cls.known(obstacle_id, distance, nearest_point, centre, velocity, angular_velocity,
+                         outline, 0.0, bounding_radius)  # fmt: skip
 
     @property
     def is_disc(self) -> bool:
