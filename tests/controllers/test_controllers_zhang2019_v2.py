@@ -141,7 +141,7 @@ def test_compiled_and_numpy_paths_agree(seed: int, n: int, unicycle: bool) -> No
     cand = spd[:, None] * np.column_stack([np.cos(ang), np.sin(ang)])
     tau = rng.uniform(0.0, 1.5, k) if unicycle else np.zeros(k)
     turn = cand * rng.uniform(0.3, 1.0, (k, 1)) if unicycle else cand
-    args = (4.0, 0.3, 1.0, 0.05)
+    args = (4.0, 0.3, 1.0, 0.05, rng.choice([0.0, 0.6]))  # 0.6 m/s: some discs count as still
     ref = candidate_risk(np.zeros(2), cand, turn, tau, (q, w, reach), *args)
     got = candidate_risk_compiled(np.zeros(2), cand, turn, tau, (q, w, reach), bodies, *args)
     ttc_py, pen_py = np.empty(k), np.empty(k)
@@ -289,14 +289,18 @@ def square_body(k: int, x: float, y: float, vx: float, vy: float, spin: float) -
     return ObstacleReading(k, d, c * 0.5, c, np.array([vx, vy]), spin, outline, 0.0, 0.71)
 
 
-def _random_scene(seed: int, n: int, polygons: bool) -> tuple[Observation, np.ndarray]:
+def _random_scene(
+    seed: int, n: int, polygons: bool, standing: bool = False
+) -> tuple[Observation, np.ndarray]:
+    """Up to ``n`` bodies around the origin (every third a spinning square with ``polygons``;
+    every second standing still with ``standing``) and a previous choice."""
     rng = np.random.default_rng(seed)
     readings = []
     for k in range(n):
         x, y = rng.uniform(-6.0, 6.0, 2)
         if math.hypot(x, y) < 1.2:
             continue
-        vx, vy = rng.uniform(-1.2, 1.2, 2)
+        vx, vy = rng.uniform(-1.2, 1.2, 2) * (0.0 if standing and k % 2 else 1.0)
         make_polygon = polygons and k % 3 == 0
         readings.append(
             square_body(k, x, y, vx, vy, rng.uniform(-0.5, 0.5))
@@ -308,17 +312,17 @@ def _random_scene(seed: int, n: int, polygons: bool) -> tuple[Observation, np.nd
 
 @settings(max_examples=80, deadline=None)
 @given(seed=st.integers(0, 10_000), n=st.integers(0, 14), unicycle=st.booleans(),
-       polygons=st.booleans(), social=st.booleans())  # fmt: skip
+       polygons=st.booleans(), social=st.booleans(), standing=st.booleans())  # fmt: skip
 # a square spinning at 0.45 rad/s: its linearly moving boundary points leave the bounding disc
 # over the horizon, and the loop's cull once skipped the contact the reference found at 3.996 s
-@example(seed=6129, n=1, unicycle=True, polygons=True, social=False)
+@example(seed=6129, n=1, unicycle=True, polygons=True, social=False, standing=False)
 def test_loop_chooses_what_the_numpy_reference_chooses(
-    seed: int, n: int, unicycle: bool, polygons: bool, social: bool
+    seed: int, n: int, unicycle: bool, polygons: bool, social: bool, standing: bool
 ) -> None:
     """Branch-and-bound visits only candidates that can still win: the loop (plain Python here,
     compiled in the law) and the exhaustive numpy reference pick the same velocity, with the
-    social term on or off."""
-    obs, v_prev = _random_scene(seed, n, polygons)
+    social term on or off, and with people standing still (not kept at the comfort distance)."""
+    obs, v_prev = _random_scene(seed, n, polygons, standing)
     kw = {"heading": obs.heading, "u_max": math.pi} if unicycle else {}
     args = (obs, GOAL, 1.0, 0.3, 0.25, v_prev, SOCIAL if social else PARAMS)
     with compiled(False):
@@ -373,6 +377,33 @@ def test_tracker_leaves_exact_sensing_alone_and_helps_under_noise() -> None:
     assert wins[True] > wins[False]
 
 
+def _gate(speed: float) -> Observation:
+    """Two people 0.2 m either side of the robot's way to GOAL (0.7 m ahead), walking along it
+    at ``speed``."""
+    return observe(pedestrian(0, 0.7, -0.8, speed, 0.0), pedestrian(1, 0.7, 0.8, speed, 0.0))
+
+
+@pytest.mark.parametrize("loop", [False, True])
+@pytest.mark.parametrize("unicycle", [False, True])
+def test_people_standing_beside_the_way_are_passed_walking_ones_kept_at_comfort(
+    loop: bool, unicycle: bool
+) -> None:
+    """People standing still are kept clear of but not at the comfort distance (with it, two
+    people standing at either side of the way stop the robot for good); people walking there
+    still slow it down.  The numpy reference and the loop (plain and compiled) alike."""
+    ahead = np.array([1.0, 0.0])
+    kw = {"heading": 0.0, "u_max": math.pi} if unicycle else {}
+    for enabled in (False, True):
+        for min_speed, expected in ((0.1, ahead), (0.0, np.zeros(2))):  # 0: the comfort for all
+            p = Zhang2019V2Params(comfort_min_speed=min_speed)
+            with compiled(enabled):
+                got = plan(_gate(0.0), GOAL, 1.0, 0.3, 0.25, ahead, p, loop=loop, **kw)  # type: ignore[arg-type]
+            np.testing.assert_allclose(got.velocity, expected, atol=1e-9)
+        with compiled(enabled):
+            walking = plan(_gate(0.5), GOAL, 1.0, 0.3, 0.25, ahead, PARAMS, loop=loop, **kw)  # type: ignore[arg-type]
+        assert 0.0 < math.hypot(*walking.velocity) < 0.9
+
+
 # -- the one-call decision against the same decision prepared in numpy --------------------------
 
 
@@ -406,7 +437,7 @@ def _prepared_in_numpy(
     weights = np.array([p.horizon, p.comfort, p.comfort_horizon, p.w_ttc, p.w_change,
                         p.w_comfort, p.min_ttc, pad, p.forecast_horizon, p.max_tangent_bodies,
                         p.safety_margin, p.w_social, p.social_horizon, p.social_forecast,
-                        p.social_band])  # fmt: skip
+                        p.social_band, p.comfort_min_speed])  # fmt: skip
     speeds = v_max * np.asarray(p.speed_levels, dtype=float)
     headings = extra_headings(p.n_headings, v_pref, v_prev)
     return decide_compiled(state, headings, speeds, discs, (centre, vel, body_r), weights)
@@ -414,16 +445,17 @@ def _prepared_in_numpy(
 
 @settings(max_examples=150, deadline=None)
 @given(seed=st.integers(0, 10_000), n=st.integers(0, 20), unicycle=st.booleans(),
-       polygons=st.booleans(), still=st.booleans(), social=st.booleans())  # fmt: skip
+       polygons=st.booleans(), still=st.booleans(), social=st.booleans(),
+       standing=st.booleans())  # fmt: skip
 def test_one_call_decision_equals_the_numpy_prepared_one_bit_for_bit(
-    seed: int, n: int, unicycle: bool, polygons: bool, still: bool, social: bool
+    seed: int, n: int, unicycle: bool, polygons: bool, still: bool, social: bool, standing: bool
 ) -> None:
     """The whole decision in one loop (compiled when numba is there) reads the same bodies,
     boundary discs and headings as the numpy preparation: the same velocity and first contact,
     to the bit (with the social term on or off).  Its plain-Python copy agrees to 1e-12: CPython's
     ``math`` and the compiled code's libm may round a sine or cosine one ulp apart (seed 1343,
     five discs: vx 0.49361547999660504 compiled, 0.493615479996605 in plain Python)."""
-    obs, v_prev = _random_scene(seed, n, polygons)
+    obs, v_prev = _random_scene(seed, n, polygons, standing)
     if still:
         v_prev = np.zeros(2)
     p = SOCIAL if social else PARAMS

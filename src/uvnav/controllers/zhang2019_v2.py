@@ -235,11 +235,9 @@ class Zhang2019V2Params:
             candidate pays ``w_social`` per metre by which its path over ``social_horizon`` [s]
             comes closer than ``social_band`` [m] beyond the radius sum to where a moving body
             will be over the next ``social_forecast`` [s]; 0 turns the term off.
-        comfort_min_speed: on rolled-out paths, only bodies moving at this speed [m/s] or faster
-            are kept ``comfort`` away; one standing still is only kept clear of (people standing
-            at or beside the target would otherwise hold the robot off it for good); the
-            holonomic robot's decision, and the unicycle's with ``rollout_paths`` off, do not
-            read it.
+        comfort_min_speed: only bodies moving at this speed [m/s] or faster are kept
+            ``comfort`` away; one standing still is only kept clear of (people standing at or
+            beside the target would otherwise hold the robot off it for good).
     """
 
     horizon: float = 4.0
@@ -353,7 +351,7 @@ def choose_velocity(
         s1 = spd * np.maximum(np.cos(0.5 * beta), 0.0)
         turn = s1[:, None] * np.column_stack([np.cos(mid), np.sin(mid)])
     q, w, reach, bodies = discs
-    args = (p.horizon, p.comfort, p.comfort_horizon, p.safety_margin)
+    args = (p.horizon, p.comfort, p.comfort_horizon, p.safety_margin, p.comfort_min_speed)
     social = (p.social_horizon, p.social_forecast, p.social_band)
     if numba_enabled():
         ttc, pen = candidate_risk_compiled(position, cand, turn, tau, (q, w, reach), bodies, *args)
@@ -487,7 +485,7 @@ def loop_constants(
     prm[:N_WEIGHTS] = (p.horizon, p.comfort, p.comfort_horizon, p.w_ttc, p.w_change, p.w_comfort,
                        p.min_ttc, robot_radius + p.safety_margin, p.forecast_horizon,
                        p.max_tangent_bodies, p.safety_margin, p.w_social, p.social_horizon,
-                       p.social_forecast, p.social_band)  # fmt: skip
+                       p.social_forecast, p.social_band, p.comfort_min_speed)  # fmt: skip
     prm[P_SPACING], prm[P_HEADINGS], prm[P_VMAX] = p.spacing, p.n_headings, v_max
     return prm, v_max * np.asarray(p.speed_levels, dtype=float)
 

@@ -33,10 +33,10 @@ from uvnav.sensors.observation import ObstacleReading
 IntArray = np.ndarray
 
 #: how many weights :func:`uvnav.geometry.contact.decide_py` reads from the ``prm`` vector
-N_WEIGHTS = 15
+N_WEIGHTS = 16
 #: indices into the ``prm`` vector of :func:`plan_loop_py` (after decide_py's weights)
-P_SPACING, P_HEADINGS, P_VMAX = 15, 16, 17
-N_PRM = 18
+P_SPACING, P_HEADINGS, P_VMAX = 16, 17, 18
+N_PRM = 19
 
 
 def reachable_py(scal: FloatArray, vel: FloatArray, v_max: float, horizon: float) -> np.ndarray:

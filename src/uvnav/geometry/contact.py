@@ -7,8 +7,11 @@ then ``cand[k]`` (a holonomic robot: ``tau = 0``).  A boundary disc j (centre ``
 
 * ``ttc[k]``: the first time in [0, horizon] at which the robot is within ``reach`` of any disc
   (0 for a pair already in contact and closing; inf when none);
-* ``pen[k]``: the largest ``comfort - gap`` (clipped at 0) over the discs, ``gap`` the smallest
-  distance beyond ``reach`` over [0, comfort_horizon] while moving at ``turn[k]``;
+* ``pen[k]``: the largest ``comfort - gap`` (clipped at 0) over the discs moving at
+  ``min_speed`` or faster, ``gap`` the smallest distance beyond ``reach`` over
+  [0, comfort_horizon] while moving at ``turn[k]`` (a disc standing still is kept clear of, not
+  at a comfort distance: people standing at or beside the goal would otherwise hold the robot
+  off it for good);
 * ``soc[k]`` (the social term, :func:`social_risk`): the largest ``reach + band - g`` (clipped at
   0) over the *moving* discs, ``g`` the smallest distance between the robot, along the candidate
   over its first T_s seconds, and the disc's constant-velocity forecast over the next S seconds
@@ -113,9 +116,10 @@ def candidate_risk(
     comfort: float,
     comfort_horizon: float,
     margin: float = 0.0,
+    min_speed: float = 0.0,
 ) -> tuple[FloatArray, FloatArray]:
     """``(ttc, pen)`` per candidate (module docstring), numpy over K x M; ``margin``: that of
-    :func:`first_contact`."""
+    :func:`first_contact`; ``min_speed`` [m/s]: the slowest disc kept at the comfort distance."""
     q, w, reach = discs
     if not len(q):
         return np.full(len(cand), np.inf), np.zeros(len(cand))
@@ -127,7 +131,8 @@ def candidate_risk(
     t2 = first_contact(rel2, cand[:, None, :] - w[None, :, :], r, (horizon - tau)[:, None], margin)
     ttc = np.minimum(t1, tau[:, None] + t2).min(axis=1)
     gap = closest_gap(rel, turn_rel, r, comfort_horizon)
-    pen = np.clip(comfort - gap, 0.0, None).max(axis=1)
+    walks = w[:, 0] * w[:, 0] + w[:, 1] * w[:, 1] >= min_speed * min_speed
+    pen = np.clip(np.where(walks[None, :], comfort - gap, 0.0), 0.0, None).max(axis=1)
     return ttc, pen
 
 
@@ -146,7 +151,7 @@ def forecast_gap(d: FloatArray, u: FloatArray, e: FloatArray) -> FloatArray:
     0.0
     """
     c = u[..., 0] * e[..., 1] - u[..., 1] * e[..., 0]
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
         alpha = -(d[..., 0] * e[..., 1] - d[..., 1] * e[..., 0]) / c
         beta = (d[..., 0] * u[..., 1] - d[..., 1] * u[..., 0]) / c
     inside = (np.abs(c) > 1e-12) & (alpha >= 0.0) & (alpha <= 1.0) & (beta >= 0.0) & (beta <= 1.0)
@@ -325,14 +330,15 @@ def risk_one(
     comfort: float,
     comfort_horizon: float,
     margin: float,
+    min_speed: float,
 ) -> tuple[float, float]:
     """``(ttc, pen)`` of one candidate (velocity ``(tx, ty)`` for ``tk`` s, then ``(cx, cy)``)
     for a robot at ``(px, py)``, with the bounding-disc cull (compiled by numba; plain Python
-    otherwise).
+    otherwise); only discs moving at ``min_speed`` [m/s] or faster are kept ``comfort`` away.
 
     ``bodies`` (N, 7): first disc index, end index, centre x, y, velocity x, y, bounding reach.
     """
-    best_t, best_p = math.inf, 0.0
+    best_t, best_p, still2 = math.inf, 0.0, min_speed * min_speed
     for b in range(bodies.shape[0]):
         bx, by = bodies[b, 2] - px, bodies[b, 3] - py
         ux, uy = tx - bodies[b, 4], ty - bodies[b, 5]
@@ -352,6 +358,8 @@ def risk_one(
             t = min(t, tk + t2)
             if t < best_t:
                 best_t = t
+            if w[j, 0] * w[j, 0] + w[j, 1] * w[j, 1] < still2:
+                continue  # standing still: kept clear of, not at the comfort distance
             g = comfort - _gap_scalar(rx, ry, ax, ay, reach[j], comfort_horizon)
             if g > best_p:
                 best_p = g
@@ -371,6 +379,7 @@ def candidate_risk_py(
     comfort: float,
     comfort_horizon: float,
     margin: float,
+    min_speed: float,
     ttc: FloatArray,
     pen: FloatArray,
 ) -> None:
@@ -379,7 +388,7 @@ def candidate_risk_py(
     for k in range(cand.shape[0]):
         ttc[k], pen[k] = risk_one(position[0], position[1], cand[k, 0], cand[k, 1], turn[k, 0],
                                   turn[k, 1], tau[k], q, w, reach, bodies, horizon, comfort,
-                                  comfort_horizon, margin)  # fmt: skip
+                                  comfort_horizon, margin, min_speed)  # fmt: skip
 
 
 def tangents_py(
@@ -451,7 +460,8 @@ def decide_py(
     comfort horizon, w_ttc, w_change, w_comfort, min_ttc, the robot's radius plus margin,
     forecast time T_f, the number of nearest bodies whose tangents are candidates, the margin
     (:func:`first_contact`), then w_social, the robot's path time T_s [s], the forecast time S [s]
-    and the band [m] of the social term (:func:`social_one`; not computed when w_social is 0).
+    and the band [m] of the social term (:func:`social_one`; not computed when w_social is 0),
+    then the slowest speed [m/s] of a body kept at the comfort distance (:func:`risk_one`).
 
     The same candidates, costs and first-index tie-break as
     :func:`uvnav.controllers.zhang2019_v2.choose_velocity`, but branch-and-bound: candidates are
@@ -465,6 +475,7 @@ def decide_py(
     w_ttc, w_change, w_comfort, min_ttc = weights[3], weights[4], weights[5], weights[6]
     pad, t_f, n_tan, margin = weights[7], weights[8], weights[9], weights[10]
     w_social, span, forecast, band = weights[11], weights[12], weights[13], weights[14]
+    min_speed = weights[15]
     reach, grow = r + pad, np.empty(q.shape[0])
     bodies = np.empty((centre.shape[0], 7))
     n_few = 0
@@ -509,7 +520,7 @@ def decide_py(
             s1 = spd[k] * max(math.cos(0.5 * beta), 0.0)
             tx, ty = s1 * math.cos(hd + 0.5 * beta), s1 * math.sin(hd + 0.5 * beta)
         ttc, pen = risk_one(px, py, cand[k, 0], cand[k, 1], tx, ty, tk, q, w, reach, bodies,
-                            horizon, comfort, c_h, margin)  # fmt: skip
+                            horizon, comfort, c_h, margin, min_speed)  # fmt: skip
         cost = bound[k] + w_ttc / max(ttc, 1e-3) + w_comfort * pen
         if w_social > 0.0:
             cost += w_social * social_one(px, py, cand[k, 0], cand[k, 1], tx, ty, tk, q, w,
@@ -548,6 +559,7 @@ def candidate_risk_compiled(
     comfort: float,
     comfort_horizon: float,
     margin: float = 0.0,
+    min_speed: float = 0.0,
 ) -> tuple[FloatArray, FloatArray]:
     """:func:`candidate_risk` with the bounding-disc cull, compiled (module docstring)."""
     q, w, reach = discs
@@ -557,8 +569,8 @@ def candidate_risk_compiled(
     fn(np.ascontiguousarray(position, dtype=float), np.ascontiguousarray(cand),
        np.ascontiguousarray(turn), np.ascontiguousarray(tau), np.ascontiguousarray(q),
        np.ascontiguousarray(w), np.ascontiguousarray(reach), np.ascontiguousarray(bodies),
-       float(horizon), float(comfort), float(comfort_horizon), float(margin), ttc,
-       pen)  # fmt: skip
+       float(horizon), float(comfort), float(comfort_horizon), float(margin), float(min_speed),
+       ttc, pen)  # fmt: skip
     return ttc, pen
 
 
