@@ -104,7 +104,8 @@ def test_a_human_between_the_robot_and_its_goal_is_straight_ahead() -> None:
 
 def test_polygons_are_not_humans_and_the_vector_splits_back() -> None:
     square = np.array([[2.0, 2.0], [3.0, 2.0], [3.0, 3.0], [2.0, 3.0]])
-    wall = ObstacleReading.polygon(7, 2.0, square[0], square.mean(0), np.zeros(2), 0.0, square, 1.0)
+    z = np.zeros(2)
+    wall = ObstacleReading.known(7, 2.0, square[0], square.mean(0), z, 0.0, square, 0.0, 1.0)
     obs = Observation(0.0, np.zeros(3), 0.0, np.array([4.0, 0.0]), (wall,))
     x = crowd_vector(obs, 3, 1.0, 0.3)
     assert x.shape == (vector_size(3),) and x.dtype == np.float32

@@ -25,7 +25,7 @@ def test_a_disc_reading_built_fast_is_the_constructors() -> None:
 def test_a_polygon_reading_built_fast_is_the_constructors() -> None:
     args = (3, 0.5, np.array([1.0, 2.0]), np.array([1.5, 2.5]), np.array([0.3, -0.4]), 0.2,
             np.array([[1.0, 2.0], [2.0, 2.0], [1.5, 3.0]]), 0.9)  # fmt: skip
-    fast = ObstacleReading.polygon(*args)
+    fast = ObstacleReading.known(*args[:7], 0.0, args[7])
     slow = ObstacleReading(*args[:7], 0.0, args[7])
     for f in dataclasses.fields(slow):
         a, b = getattr(fast, f.name), getattr(slow, f.name)

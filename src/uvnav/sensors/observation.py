@@ -76,22 +76,6 @@ class ObstacleReading:
         )  # fmt: skip
         return r
 
-    @classmethod
-    def polygon(
-        cls,
-        obstacle_id: int,
-        distance: float,
-        nearest_point: FloatArray,
-        centre: FloatArray,
-        velocity: FloatArray,
-        angular_velocity: float,
-        outline: FloatArray,
-        bounding_radius: float,
-    ) -> ObstacleReading:
-        """:meth:`known` for a polygon (radius 0)."""
-        return cls.known(obstacle_id, distance, nearest_point, centre, velocity, angular_velocity,
-                         outline, 0.0, bounding_radius)  # fmt: skip
-
     @property
     def is_disc(self) -> bool:
         return self.radius > 0.0

@@ -455,13 +455,13 @@ class PackedBodies:
         """The reading objects of a sensed block (``ids``, and copies of its rows and
         outlines: the readings' arrays are views of them)."""
         vals = rows.tolist()
-        counts, bounds, make = self._counts, self._bounds, ObstacleReading.polygon
+        counts, bounds, make = self._counts, self._bounds, ObstacleReading.known
         out = []
         for i, j in enumerate(ids):
             r = rows[i]
             reading = make(
                 j, vals[i][R_DIST], r[R_NEAR : R_NEAR + 2], r[R_CENTRE : R_CENTRE + 2],
-                r[R_VEL : R_VEL + 2], vals[i][R_OMEGA], outlines[i, : counts[j]], bounds[j],
+                r[R_VEL : R_VEL + 2], vals[i][R_OMEGA], outlines[i, : counts[j]], 0.0, bounds[j],
             )  # fmt: skip
             out.append(reading)
         return Readings.lazy(out, lambda: self._arrays(ids, rows), all_known=True)
