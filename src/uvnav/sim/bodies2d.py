@@ -10,7 +10,7 @@ random-turn motion (:func:`~uvnav.sim.packed.pack_check`), moved and measured in
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -42,6 +42,7 @@ from uvnav.sim.packed import (
     S_X,
     S_Y,
     PackedWorlds,
+    direct,
     kernel,
 )
 from uvnav.sim.swept import StepPoses
@@ -326,7 +327,9 @@ class PackedBodies:
         self._stepped = False
         #: ``(x, y, range, m)`` of the readings the last step took, if it took any
         self._sensed: tuple[float, float, float, int] | None = None
-        self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
+        # the kernels called at every step, without numba's dispatch after their first call
+        self._advance = self._direct("_advance", kernel("advance_one"))
+        self._sense = self._direct("_sense", kernel("sense_one"))
         self._lidar, self._vector = kernel("lidar"), kernel("vector_one")
         self._ring = np.empty((2, w))  # the lidar's scratch
         self._beams = np.empty((2, 0))
@@ -334,6 +337,18 @@ class PackedBodies:
         self._prev = np.zeros((3, n))  # the poses before the last step: x, y, heading
         #: the most any body point moved over the last step [m]
         self.shift = 0.0
+
+    def _direct(self, name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
+        """``fn``, called through :func:`~uvnav.sim.packed.direct` at its first call, which
+        then sets the attribute ``name`` to the function that skips the dispatch (every call
+        passes the same buffers and the same kinds of numbers)."""
+
+        def first(*args: Any) -> Any:
+            out, fast = direct(fn, *args)
+            setattr(self, name, fast)
+            return out
+
+        return first
 
     #: the compiled bodies react to no robot (:func:`~uvnav.sim.packed.pack_check`)
     sees_robot = False
