@@ -102,6 +102,12 @@ class Bodies2D(Protocol):
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
         """The last step's start and end, with the robot's chord ``p0 -> p1``."""
 
+    def step_poses_later(
+        self, p0: tuple[float, float], p1: tuple[float, float], slack: float
+    ) -> Callable[[], StepPoses]:
+        """:meth:`step_poses` of the last step, made when the returned function is called (the
+        bodies may have moved on by then)."""
+
     def ceiling(self, sampled_min: float, clearance: float) -> float:
         """An upper bound of the episode's sampled minimum clearance so far [m]."""
 
@@ -270,6 +276,14 @@ class FieldBodies:
         return StepPoses(b.centres, b.headings, f.centres, f.headings, b.present, f.present,
                          p0, p1, slack)  # fmt: skip
 
+    def step_poses_later(
+        self, p0: tuple[float, float], p1: tuple[float, float], slack: float
+    ) -> Callable[[], StepPoses]:
+        """:meth:`step_poses` made now (its arrays are the fields' own, which stay as they
+        are), returned by the function."""
+        poses = self.step_poses(np.array(p0), np.array(p1), slack)
+        return lambda: poses
+
     def ceiling(self, sampled_min: float, clearance: float) -> float:
         if self._tracker is not None:
             return self._tracker.best
@@ -365,9 +379,18 @@ class PackedBodies:
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
         """The last step's start and end (the poses it kept): views of one copy of each, the
         centres (k, 2) and headings (k,) of :meth:`poses_before` and :meth:`poses`."""
+        return self.step_poses_later(p0, p1, slack)()
+
+    def step_poses_later(
+        self, p0: tuple[float, float] | FloatArray, p1: tuple[float, float] | FloatArray,
+        slack: float,
+    ) -> Callable[[], StepPoses]:  # fmt: skip
+        """:meth:`step_poses` from copies of the poses taken now, made when the returned
+        function is called (the robot's chord as arrays then)."""
         before = self._prev.copy()
         now = self._st[S_X : S_HEADING + 1, : self.n].copy()  # (x, y, heading: rows in a row)
-        return StepPoses(before[:2].T, before[2], now[:2].T, now[2], None, None, p0, p1, slack)
+        return lambda: StepPoses(before[:2].T, before[2], now[:2].T, now[2], None, None,
+                                 np.array(p0), np.array(p1), slack)  # fmt: skip
 
     def ceiling(self, sampled_min: float, clearance: float) -> float:
         """An upper bound of the episode's sampled minimum so far [m] (every step's clearance is
