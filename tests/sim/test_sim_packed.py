@@ -29,6 +29,7 @@ from uvnav.sim.packed import (
     BLOCK,
     STATUS_NAMES,
     PackedWorlds,
+    direct,
     kernel,
     pack_check,
     reseed_spawned,
@@ -265,6 +266,28 @@ def test_a_loaded_worlds_clearance_is_the_fields_at_the_start(compiled: bool) ->
         collided += STATUS_NAMES[int(worlds.status[slot])] == "collision"
         assert (STATUS_NAMES[int(worlds.status[slot])] == "collision") == (want < 0)
     assert 30 < collided < 270
+
+
+@pytest.mark.parametrize("compiled", [True, False])
+def test_a_direct_kernel_gives_what_the_kernel_gives(compiled: bool) -> None:
+    """:func:`direct` returns the kernel's result and a function that skips numba's dispatch
+    (the kernel itself on the Python path) giving the same numbers for other values."""
+    body = PolygonBody.from_vertices(SQUARE)
+    still = ConstantVelocity(np.zeros(2))
+    obstacles = [Obstacle(body, ObstacleState(position=np.zeros(2)), still)]
+    with kernels(compiled):
+        worlds = PackedWorlds(1)
+        worlds.load(0, EpisodeSetup(spec=SPEC, start=np.array([3.0, 0.0, 0.0]),
+                                    goal=np.array([9.0, 9.0]), obstacles=obstacles, dt=0.1,
+                                    control_period=0.1))  # fmt: skip
+        fn = kernel("clearance_one")
+        arrays = (worlds.params[0], worlds.state[0], worlds.rings[0])
+        out, fast = direct(fn, 3.0, 0.0, 0.2, 1, *arrays)
+        assert out == fn(3.0, 0.0, 0.2, 1, *arrays)
+        assert (fast is fn) is not compiled
+        for x, y in ((1.0, 0.5), (-2.0, 0.25), (0.1, 0.0)):
+            assert fast(x, y, 0.2, 1, *arrays) == fn(x, y, 0.2, 1, *arrays)
+    assert out[0] == pytest.approx(3.0 - 0.4 - 0.2)
 
 
 @pytest.mark.parametrize("compiled", [True, False])

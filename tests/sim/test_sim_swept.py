@@ -223,3 +223,31 @@ def test_two_robots_that_cross_between_two_samples_collide() -> None:
     res = run_episode(setup, None, np.random.default_rng(0), record=False, vectorised=True)
     assert res.statuses == ["collision", "collision"] and res.collided_pairs == [(0, 1)]
     assert all(m.min_clearance is not None and m.min_clearance < 0 for m in res.robots)
+
+
+def test_kept_steps_made_later_give_the_minimum_of_steps_made_at_once() -> None:
+    """A robot passing a square: every step fed to two sweeps, one with the poses made at once,
+    one with functions making them (``later``): the same minimum, and the functions of kept
+    steps that cannot matter are never called."""
+    from uvnav.obstacles.obstacle import FieldTemplate
+    from uvnav.sim.swept import StepPoses, SweptClearance
+
+    template = FieldTemplate.from_bodies([PolygonBody.from_vertices(0.2 * WALL)])
+    now, later = SweptClearance(template, 0.05), SweptClearance(template, 0.05)
+    called: list[int] = []
+    centre, heading = np.array([[0.0, 0.6]]), np.array([0.0])
+    for k in range(40):  # the robot along y = 0, from x = -2 to x = 2 at 0.1 m a step
+        p0, p1 = np.array([-2.0 + 0.1 * k, 0.0]), np.array([-1.9 + 0.1 * k, 0.0])
+        poses = StepPoses(centre, heading, centre, heading, None, None, p0, p1, 0.0)
+        # the gaps at the step's ends, lower bounds: the square's lower edge is at y = 0.2
+        g0, g1 = (math.hypot(max(abs(p[0]) - 0.004, 0.0), 0.2) - 0.05 for p in (p0, p1))
+        ceiling = min(now.best, g0, g1)
+        assert math.isnan(now.step(poses, 0.1, g0, g1, ceiling, shift=0.0))
+
+        def make(poses: StepPoses = poses, k: int = k) -> StepPoses:
+            called.append(k)
+            return poses
+
+        assert math.isnan(later.step(make, 0.1, g0, g1, ceiling, shift=0.0, later=True))
+    assert later.finish(math.inf) == now.finish(math.inf) == pytest.approx(0.15)
+    assert 0 < len(called) < 10  # kept: the steps near x = 0; swept: the few below the best

@@ -10,7 +10,7 @@ random-turn motion (:func:`~uvnav.sim.packed.pack_check`), moved and measured in
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Protocol
+from typing import Any, Protocol
 
 import numpy as np
 
@@ -42,6 +42,7 @@ from uvnav.sim.packed import (
     S_X,
     S_Y,
     PackedWorlds,
+    direct,
     kernel,
 )
 from uvnav.sim.swept import StepPoses
@@ -100,6 +101,12 @@ class Bodies2D(Protocol):
 
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
         """The last step's start and end, with the robot's chord ``p0 -> p1``."""
+
+    def step_poses_later(
+        self, p0: tuple[float, float], p1: tuple[float, float], slack: float
+    ) -> Callable[[], StepPoses]:
+        """:meth:`step_poses` of the last step, made when the returned function is called (the
+        bodies may have moved on by then)."""
 
     def ceiling(self, sampled_min: float, clearance: float) -> float:
         """An upper bound of the episode's sampled minimum clearance so far [m]."""
@@ -269,6 +276,14 @@ class FieldBodies:
         return StepPoses(b.centres, b.headings, f.centres, f.headings, b.present, f.present,
                          p0, p1, slack)  # fmt: skip
 
+    def step_poses_later(
+        self, p0: tuple[float, float], p1: tuple[float, float], slack: float
+    ) -> Callable[[], StepPoses]:
+        """:meth:`step_poses` made now (its arrays are the fields' own, which stay as they
+        are), returned by the function."""
+        poses = self.step_poses(np.array(p0), np.array(p1), slack)
+        return lambda: poses
+
     def ceiling(self, sampled_min: float, clearance: float) -> float:
         if self._tracker is not None:
             return self._tracker.best
@@ -326,7 +341,9 @@ class PackedBodies:
         self._stepped = False
         #: ``(x, y, range, m)`` of the readings the last step took, if it took any
         self._sensed: tuple[float, float, float, int] | None = None
-        self._advance, self._sense = kernel("advance_one"), kernel("sense_one")
+        # the kernels called at every step, without numba's dispatch after their first call
+        self._advance = self._direct("_advance", kernel("advance_one"))
+        self._sense = self._direct("_sense", kernel("sense_one"))
         self._lidar, self._vector = kernel("lidar"), kernel("vector_one")
         self._ring = np.empty((2, w))  # the lidar's scratch
         self._beams = np.empty((2, 0))
@@ -334,6 +351,18 @@ class PackedBodies:
         self._prev = np.zeros((3, n))  # the poses before the last step: x, y, heading
         #: the most any body point moved over the last step [m]
         self.shift = 0.0
+
+    def _direct(self, name: str, fn: Callable[..., Any]) -> Callable[..., Any]:
+        """``fn``, called through :func:`~uvnav.sim.packed.direct` at its first call, which
+        then sets the attribute ``name`` to the function that skips the dispatch (every call
+        passes the same buffers and the same kinds of numbers)."""
+
+        def first(*args: Any) -> Any:
+            out, fast = direct(fn, *args)
+            setattr(self, name, fast)
+            return out
+
+        return first
 
     #: the compiled bodies react to no robot (:func:`~uvnav.sim.packed.pack_check`)
     sees_robot = False
@@ -350,9 +379,18 @@ class PackedBodies:
     def step_poses(self, p0: FloatArray, p1: FloatArray, slack: float) -> StepPoses:
         """The last step's start and end (the poses it kept): views of one copy of each, the
         centres (k, 2) and headings (k,) of :meth:`poses_before` and :meth:`poses`."""
+        return self.step_poses_later(p0, p1, slack)()
+
+    def step_poses_later(
+        self, p0: tuple[float, float] | FloatArray, p1: tuple[float, float] | FloatArray,
+        slack: float,
+    ) -> Callable[[], StepPoses]:  # fmt: skip
+        """:meth:`step_poses` from copies of the poses taken now, made when the returned
+        function is called (the robot's chord as arrays then)."""
         before = self._prev.copy()
         now = self._st[S_X : S_HEADING + 1, : self.n].copy()  # (x, y, heading: rows in a row)
-        return StepPoses(before[:2].T, before[2], now[:2].T, now[2], None, None, p0, p1, slack)
+        return lambda: StepPoses(before[:2].T, before[2], now[:2].T, now[2], None, None,
+                                 np.array(p0), np.array(p1), slack)  # fmt: skip
 
     def ceiling(self, sampled_min: float, clearance: float) -> float:
         """An upper bound of the episode's sampled minimum so far [m] (every step's clearance is

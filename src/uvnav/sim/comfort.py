@@ -40,6 +40,7 @@ counts its other distance thresholds.  The metrics, with their units and sources
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
 
@@ -181,6 +182,11 @@ class MotionTracker:
     def observe(self, x: float, y: float, heading: float) -> None:
         """The state at the end of an integration step: centre [m], heading [rad]."""
         self._rows.append((x, y, heading))
+
+    def track(self) -> Callable[[tuple[float, float, float]], None]:
+        """:meth:`observe` as a function of one ``(x, y, heading)`` tuple (for a world that
+        observes at every step: one call, no method lookup)."""
+        return self._rows.append
 
     def metrics(self) -> dict[str, float | None]:
         """``heading_irregularity`` [rad] over the steps' end states and ``jerk`` [m/s^3]

@@ -167,6 +167,7 @@ class World2D(OneVehicle):
         self.body.reset()
         self.applied: Any = self.body.rest()  # the command held now
         self.motion = MotionTracker(self.goal, self.dt, self.x, self.y, self.th, self.velocity())
+        self._track = self.motion.track()
         self.book = book = Ledger(self.setup.goal_tolerance)
         gd = math.hypot(self.goal[0] - self.x, self.goal[1] - self.y)
         self.done = book.begin(self.clearance, gd) or self.clock.up
@@ -252,10 +253,11 @@ class World2D(OneVehicle):
         self.clearance = gap
         if nearest is not None:
             self.nearest = nearest
-        self.t = t = clock.tick()
-        self.motion.observe(nx, ny, self.th)
+        clock.step_index = k1 = k + 1  # (clock.tick, inline: t = k dt)
+        self.t = clock.t = t = k1 * clock.dt
+        self._track((nx, ny, self.th))
         if self.social is not None:
-            self.social.observe(self.field, nx, ny, clock.step_index, self.velocity())
+            self.social.observe(self.field, nx, ny, k1, self.velocity())
         if self.history is not None:
             self.history.push(nx, ny, *bodies.centres())
         sweep, contact_at = self.sweep, None
@@ -265,7 +267,7 @@ class World2D(OneVehicle):
             if shift is None or not sweep.idle(0.5 * (g0 + gap - travel - shift), ceiling):
                 contact_at = self._swept((x, y), (nx, ny), t0, g0, travel, slack, ceiling)
         gd = math.hypot(self._gx - nx, self._gy - ny)
-        self.done = book.judge(t, gap, gd, contact_at) or clock.step_index >= clock.n_steps
+        self.done = book.judge(t, gap, gd, contact_at) or k1 >= clock.n_steps
         if book.status == "collision":  # judged at the first contact when the sweep found it
             sweep = self.sweep
             by = (
@@ -293,8 +295,8 @@ class World2D(OneVehicle):
         assert sweep is not None
         shift = bodies.shift
         s = sweep.step(
-            lambda: bodies.step_poses(np.array(p0), np.array(p1), slack),
-            travel, g0, self.clearance, ceiling, shift=shift,
+            bodies.step_poses_later(p0, p1, slack), travel, g0, self.clearance, ceiling,
+            shift=shift, later=True,
         )  # fmt: skip
         return None if math.isnan(s) else t0 + s * self.dt
 

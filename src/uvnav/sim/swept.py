@@ -15,7 +15,8 @@ and ``g1 - (1 - s) D``, so the step's closest approach is at least ``(g0 + g1 - 
   sweep of their bounding discs), which gives the collision and the fraction of the step at the
   first contact;
 * a step whose bound is below the best minimum seen so far may hold the episode's closest
-  approach: it is kept (its poses: a few array references), and the kept steps are swept in
+  approach: it is kept (its poses: a few array references, or copies of the bodies' poses from
+  which they are made if it is swept), and the kept steps are swept in
   batches and at the end, in increasing order of bound, until the bound reaches the best;
 * any other step cannot matter to either.
 
@@ -85,7 +86,8 @@ class SweptClearance:
         self.best = math.inf  # the least swept gap so far [m]
         #: the last step's first contact: its poses, the body, the fraction of the step
         self.contact: tuple[StepPoses, int, float] | None = None
-        self._kept: list[tuple[float, StepPoses]] = []
+        #: the kept steps: their bound [m] and poses, or the function of copies making them
+        self._kept: list[tuple[float, StepPoses | Callable[[], StepPoses]]] = []
         self._empty = not len(template)
         self._ceiling = math.inf
         self._rings = [
@@ -101,6 +103,7 @@ class SweptClearance:
         g1: float,
         ceiling: float,
         shift: float | None = None,
+        later: bool = False,
     ) -> float:
         """Account for one step; returns the fraction of the step [0, 1] at the robot's first
         contact with a body, or NaN when it touched none.
@@ -113,6 +116,9 @@ class SweptClearance:
             ceiling: an upper bound of the episode's sampled minimum clearance so far [m].
             shift: the most any body point moved over the step [m], when the caller knows it
                 (every body present at both ends); else it is measured on ``poses``.
+            later: ``poses`` is a function of copies of the step's poses, which may be called
+                after the bodies moved on: a kept step keeps it and makes the poses only if it
+                is swept (most kept steps are not).
         """
         self._ceiling = min(self._ceiling, ceiling)
         self.contact = None
@@ -133,7 +139,9 @@ class SweptClearance:
             self.best = min(self.best, gap)
             return s_hit
         if bound < min(self.best, self._ceiling):
-            self._kept.append((bound, _made(poses) if made is None else made))
+            if made is None and not later:
+                made = _made(poses)
+            self._kept.append((bound, poses if made is None else made))
             if len(self._kept) >= self.BATCH:
                 self._flush()
         return math.nan
@@ -156,7 +164,7 @@ class SweptClearance:
         for bound, poses in sorted(self._kept, key=lambda e: e[0]):
             if bound >= min(self.best, self._ceiling):
                 break
-            gap, _ = self._sweep(poses, collide=False)
+            gap, _ = self._sweep(_made(poses), collide=False)
             self.best = min(self.best, gap)
         self._kept.clear()
 
