@@ -198,6 +198,8 @@ def test_the_node_drives_the_robot_to_its_goal_over_dds(law: str, sim: Sim, tmp_
             node.kill()
             node.wait()
     text = log.read_text()
-    for line in ("waiting for a goal", "driving", "goal reached", "stopped: no scan for 0.5 s",
+    # "waiting for a goal" is said only when the node looks before the goal arrives (a loaded
+    # machine may start it later): tests/ros2/test_ros2_cli.py and test_ros2_navigator.py hold it
+    for line in ("driving", "goal reached", "stopped: no scan for 0.5 s",
                  "stopped (zero Twist sent)"):  # fmt: skip
         assert line in text, text
