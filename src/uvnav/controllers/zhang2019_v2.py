@@ -43,27 +43,27 @@ into the next stream of people, and never slows down, waits or backs off.  v2 th
    closing candidate by when the bodies themselves would touch, not 0 for all of them, so that
    it still tells stepping toward a passing pedestrian from standing still.
 
-**Social comfort** (off by default: ``w_social`` 0).  Success says nothing of how the robot
-treats people; the intrusion ratio of Liu et al. (ICRA 2023, CrowdNav++; :mod:`uvnav.sim.social`)
-counts the steps at which the robot stands where a visible pedestrian will be within the next
-1.25 s, i.e. passing in front of someone walking.  The steps above only keep ``comfort`` metres
-from where each body *is*; with ``w_social`` > 0 a candidate also pays ``w_social soc`` (cost in
-m/s), ``soc`` [m] the depth of its path into the bodies' forecasts: over the robot's first
-``social_horizon`` T_s seconds along the candidate (the turn, then straight, as above), the
-largest ``reach + social_band - g`` over the moving bodies (clipped at 0), ``g`` the smallest
-distance from the robot at time t to the body's constant-velocity forecast from t to
-t + ``social_forecast`` S (the segment ``q + w t .. q + w (t + S)``).  In the body's frame the
-forecast seen along a straight stretch of the path sweeps a parallelogram, so ``g`` is a
-point-to-parallelogram distance in closed form (:func:`uvnav.geometry.contact.forecast_gap`).
-A path that crosses where someone is about to walk pays up to ``reach + band`` (about 0.7 m
-for a person); one that passes behind them, or waits, pays nothing.  Bodies standing still have
-no forecast beyond themselves and are left to ``comfort``.  The term only adds to the cost, so
-safety (the first contact, ``min_ttc``) still ranks first, and the branch-and-bound bound stays
-a lower bound.  On a vehicle with acceleration limits the rolled-out paths' segments that start
-before T_s are read the same way (:func:`path_social`).  With ``w_social`` 3 and T_s 3 s (tuned
-on CrowdNav circle cases 0-99), on cases 100-499 the intrusion ratio fell from 12 to 1 %
-(holonomic) and 14 to 2 % (unicycle) with 5 humans, 20 to 9 % and 31 to 16 % with 20, success
-kept or higher (``docs/design-notes.md``, "A social term in zhang2019-v2").
+**Social comfort** (off by default: ``w_social`` 0). Success says nothing of how the robot treats
+people; the intrusion ratio of Liu et al. (ICRA 2023, CrowdNav++; :mod:`uvnav.sim.social`) counts
+the steps at which the robot stands where a visible pedestrian will be within the next 1.25 s, i.e.
+passing in front of someone walking. The steps above only keep ``comfort`` metres from where each
+walking body *is*; with ``w_social`` > 0 a candidate also pays ``w_social soc`` (cost in m/s),
+``soc`` [m] the depth of its path into the bodies' forecasts: over the robot's first
+``social_horizon`` T_s seconds along the candidate (the turn, then straight, as above), the largest
+``reach + social_band - g`` over the moving bodies (clipped at 0), ``g`` the smallest distance from
+the robot at time t to the body's constant-velocity forecast from t to t + ``social_forecast`` S
+(the segment ``q + w t .. q + w (t + S)``). In the body's frame the forecast seen along a straight
+stretch of the path sweeps a parallelogram, so ``g`` is a point-to-parallelogram distance in closed
+form (:func:`uvnav.geometry.contact.forecast_gap`). A path that crosses where someone is about to
+walk pays up to ``reach + band`` (about 0.7 m for a person); one that passes behind them, or waits,
+pays nothing. Bodies standing still have no forecast beyond themselves, nor a ``comfort`` distance
+(slower than ``comfort_min_speed``): they are kept clear of only. The term only adds to the cost,
+so safety (the first contact, ``min_ttc``) still ranks first, and the branch-and-bound bound stays
+a lower bound. On a vehicle with acceleration limits the rolled-out paths' segments that start
+before T_s are read the same way (:func:`path_social`). With ``w_social`` 3 and T_s 3 s (tuned on
+CrowdNav circle cases 0-99), on cases 100-499 the intrusion ratio fell from 12 to 1 % (holonomic)
+and 14 to 2 % (unicycle) with 5 humans, 20 to 9 % and 31 to 16 % with 20, success kept or higher
+(``docs/design-notes.md``, "A social term in zhang2019-v2").
 
 The holonomic robot takes the chosen velocity as it is; the unicycle steers toward the chosen
 direction with the sliding-mode law at the chosen speed times cos(beta).
