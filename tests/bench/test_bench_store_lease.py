@@ -10,6 +10,8 @@ import sys
 import textwrap
 from pathlib import Path
 
+import pytest
+
 from uvnav.bench.store import ResultsStore, lock_path, writer_lease
 
 CAMPAIGN = """\
@@ -105,3 +107,31 @@ def test_every_command_reports_a_database_in_use_as_one_line() -> None:
 
     msg = "database r.sqlite is in use by another uvnav process (pid 7); wait for it to finish"
     assert user_error(StoreInUseError(msg)) == (msg, 2)
+
+
+@pytest.mark.parametrize("at", ["ftruncate", "pwrite"])
+def test_an_interrupt_while_taking_the_lease_leaves_it_free(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, at: str
+) -> None:
+    """Ctrl-C lands between any two bytecodes: one right after the lock is taken must not leave
+    it held by this process (a later run here would be refused, naming its own pid)."""
+    db = tmp_path / "i.sqlite"
+    real = getattr(os, at)
+    calls = [0]
+
+    def interrupted(*args: object) -> object:
+        calls[0] += 1
+        if calls[0] == 1:
+            raise KeyboardInterrupt
+        return real(*args)
+
+    monkeypatch.setattr(os, at, interrupted)
+    with pytest.raises(KeyboardInterrupt), writer_lease(db):
+        pass
+    monkeypatch.setattr(os, at, real)
+    with writer_lease(db):  # free again, in this process and for another
+        code = f"from uvnav.bench.store import writer_lease\nwith writer_lease({str(db)!r}): pass"
+        other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+        assert other.returncode == 1 and "StoreInUseError" in other.stderr
+    other = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert other.returncode == 0, other.stderr

@@ -220,27 +220,26 @@ def writer_lease(db: str | Path) -> Iterator[None]:
             held[1] -= 1
         return
     fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-    try:
-        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except BlockingIOError:
-        holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
-        os.close(fd)
-        raise StoreInUseError(
-            f"database {db} is in use by another uvnav process (pid {holder}); wait for it to "
-            "finish or use another --db"
-        ) from None
-    except BaseException:
-        os.close(fd)
-        raise
-    os.ftruncate(fd, 0)
-    os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
-    _LEASES[key] = [fd, 1]
-    try:
+    try:  # from here on, whatever interrupts (Ctrl-C lands between any two bytecodes) closes fd
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
+            raise StoreInUseError(
+                f"database {db} is in use by another uvnav process (pid {holder}); wait for it "
+                "to finish or use another --db"
+            ) from None
+        _LEASES[key] = [fd, 1]
+        os.ftruncate(fd, 0)
+        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
         yield
     finally:
-        del _LEASES[key]
-        os.ftruncate(fd, 0)
-        os.close(fd)  # closing the descriptor releases the flock
+        try:
+            if _LEASES.get(key, [-1])[0] == fd:  # held: forget it and clear the pid
+                del _LEASES[key]
+                os.ftruncate(fd, 0)
+        finally:
+            os.close(fd)  # closing the descriptor releases the flock
 
 
 # --------------------------------------------------------------------------------------------------
