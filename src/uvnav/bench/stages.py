@@ -36,7 +36,11 @@ from importlib import metadata
 from pathlib import Path
 from typing import Any
 
-from uvnav.bench.store import StaleCampaignError, StoreInUseError, extend_fingerprint
+from uvnav.bench.store import (
+    StaleCampaignError,
+    extend_fingerprint,
+    pid_lock,
+)
 from uvnav.stages import normalise_key, write_atomic
 
 #: the folder of the stages inside a results folder
@@ -233,33 +237,20 @@ class StageCache:
 
 @contextlib.contextmanager
 def _building(lock: Path, name: str) -> Iterator[None]:
-    """Hold the exclusive right to build one stage (a non-blocking ``flock`` on ``lock``, with
-    this process's pid in it; none where ``flock`` does not exist).
+    """Hold the exclusive right to build one stage (:func:`uvnav.bench.store.pid_lock` on
+    ``lock``).
 
     Raises:
         StoreInUseError: another process is building it (at once, without waiting).
     """
-    try:
-        import fcntl
-    except ImportError:  # not POSIX: no lock
-        yield
-        return
+
+    def refused(pid: str) -> str:
+        return (f"stage {name!r} in {lock.parent} is being made by another uvnav process (pid "
+                f"{pid}); wait for it to finish or use another --results folder")  # fmt: skip
+
     lock.parent.mkdir(parents=True, exist_ok=True)
-    fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
-    try:
-        try:
-            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except BlockingIOError:
-            holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
-            raise StoreInUseError(
-                f"stage {name!r} in {lock.parent} is being made by another uvnav process (pid "
-                f"{holder}); wait for it to finish or use another --results folder"
-            ) from None
-        os.ftruncate(fd, 0)
-        os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
+    with pid_lock(lock, refused):
         yield
-    finally:
-        os.close(fd)  # releases the flock
 
 
 def _plain(value: Any) -> Any:

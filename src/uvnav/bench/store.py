@@ -49,7 +49,7 @@ import math
 import os
 import sqlite3
 import urllib.parse
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import AbstractContextManager, contextmanager
 from datetime import UTC, datetime
 from pathlib import Path
@@ -183,8 +183,8 @@ class StoreInUseError(PermissionError):
     """
 
 
-#: leases held by this process: lock-file path -> [file descriptor, nesting depth]
-_LEASES: dict[str, list[int]] = {}
+#: leases held by this process: lock-file path -> nesting depth
+_LEASES: dict[str, int] = {}
 
 
 def lock_path(db: str | Path) -> Path:
@@ -194,52 +194,69 @@ def lock_path(db: str | Path) -> Path:
 
 
 @contextmanager
-def writer_lease(db: str | Path) -> Iterator[None]:
-    """Hold the exclusive right to write campaigns into ``db`` (re-entrant within a process).
-
-    An exclusive, non-blocking ``flock`` on :func:`lock_path` whose file holds this process's pid;
-    released on exit (or by the kernel when the process dies).  Where ``flock`` does not exist
-    (Windows) there is no lease.
+def pid_lock(path: Path, refused: Callable[[str], str]) -> Iterator[None]:
+    """Hold an exclusive, non-blocking ``flock`` on ``path`` whose file holds this process's pid
+    while it is held (cleared on release); released on exit, whatever interrupts it (Ctrl-C lands
+    between any two bytecodes), or by the kernel when the process dies.  Where ``flock`` does not
+    exist (Windows) there is no lock.
 
     Raises:
-        StoreInUseError: another process holds it (at once, without waiting).
+        StoreInUseError: another process holds it (at once, without waiting), with the message
+            ``refused(pid of the holder)``.
     """
     try:
         import fcntl
-    except ImportError:  # not POSIX: no lease
+    except ImportError:  # not POSIX: no lock
         yield
         return
-    path = lock_path(db)
-    key = str(path.resolve())
-    held = _LEASES.get(key)
-    if held is not None:
-        held[1] += 1
-        try:
-            yield
-        finally:
-            held[1] -= 1
-        return
     fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-    try:  # from here on, whatever interrupts (Ctrl-C lands between any two bytecodes) closes fd
+    taken = False
+    try:  # from here on, whatever interrupts closes fd
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             holder = os.pread(fd, 32, 0).decode(errors="replace").strip() or "unknown"
-            raise StoreInUseError(
-                f"database {db} is in use by another uvnav process (pid {holder}); wait for it "
-                "to finish or use another --db"
-            ) from None
-        _LEASES[key] = [fd, 1]
+            raise StoreInUseError(refused(holder)) from None
+        taken = True
         os.ftruncate(fd, 0)
         os.pwrite(fd, f"{os.getpid()}\n".encode(), 0)
         yield
     finally:
         try:
-            if _LEASES.get(key, [-1])[0] == fd:  # held: forget it and clear the pid
-                del _LEASES[key]
+            if taken:  # clear the pid
                 os.ftruncate(fd, 0)
         finally:
             os.close(fd)  # closing the descriptor releases the flock
+
+
+@contextmanager
+def writer_lease(db: str | Path) -> Iterator[None]:
+    """Hold the exclusive right to write campaigns into ``db`` (re-entrant within a process): a
+    :func:`pid_lock` on :func:`lock_path`.
+
+    Raises:
+        StoreInUseError: another process holds it (at once, without waiting).
+    """
+    path = lock_path(db)
+    key = str(path.resolve())
+    if key in _LEASES:
+        _LEASES[key] += 1
+        try:
+            yield
+        finally:
+            _LEASES[key] -= 1
+        return
+
+    def refused(pid: str) -> str:
+        return (f"database {db} is in use by another uvnav process (pid {pid}); wait for it to "
+                "finish or use another --db")  # fmt: skip
+
+    with pid_lock(path, refused):
+        try:
+            _LEASES[key] = 1
+            yield
+        finally:
+            _LEASES.pop(key, None)
 
 
 # --------------------------------------------------------------------------------------------------
