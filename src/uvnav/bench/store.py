@@ -195,22 +195,16 @@ def lock_path(db: str | Path) -> Path:
 
 @contextmanager
 def pid_lock(path: Path, refused: Callable[[str], str]) -> Iterator[None]:
-    """Hold an exclusive, non-blocking ``flock`` on ``path`` whose file holds this process's pid
-    while it is held (cleared on release); released on exit, whatever interrupts it (Ctrl-C lands
-    between any two bytecodes), or by the kernel when the process dies.  Where ``flock`` does not
-    exist (Windows) there is no lock.
-
-    Raises:
-        StoreInUseError: another process holds it (at once, without waiting), with the message
-            ``refused(pid of the holder)``.
-    """
+    """An exclusive, non-blocking ``flock`` on ``path`` whose file holds this process's pid while
+    held; released on exit, whatever interrupts (Ctrl-C lands between any two bytecodes), or by
+    the kernel when the process dies; none where ``flock`` does not exist (Windows).  Raises
+    :class:`StoreInUseError` ``(refused(holder's pid))`` at once when another process holds it."""
     try:
         import fcntl
     except ImportError:  # not POSIX: no lock
         yield
         return
-    fd = os.open(path, os.O_RDWR | os.O_CREAT, 0o644)
-    taken = False
+    fd, taken = os.open(path, os.O_RDWR | os.O_CREAT, 0o644), False
     try:  # from here on, whatever interrupts closes fd
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
@@ -247,11 +241,8 @@ def writer_lease(db: str | Path) -> Iterator[None]:
             _LEASES[key] -= 1
         return
 
-    def refused(pid: str) -> str:
-        return (f"database {db} is in use by another uvnav process (pid {pid}); wait for it to "
-                "finish or use another --db")  # fmt: skip
-
-    with pid_lock(path, refused):
+    with pid_lock(path, lambda pid: f"database {db} is in use by another uvnav process (pid "
+                  f"{pid}); wait for it to finish or use another --db"):  # fmt: skip
         try:
             _LEASES[key] = 1
             yield

@@ -48,7 +48,7 @@ from uvnav.controllers import zhang2019_v2_loop
 from uvnav.controllers.zhang2019_v2_loop import boundary_discs_py, reachable_py
 from uvnav.geometry import contact
 from uvnav.geometry.angles import FloatArray
-from uvnav.geometry.contact import _contact_scalar, tangents_py
+from uvnav.geometry.contact import _contact_scalar, _gap_scalar, tangents_py
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
 
 #: indices into the ``prm`` vector of :func:`choose_on_paths_py` and :func:`plan_paths_py`
@@ -160,20 +160,6 @@ def _path_box(xy: FloatArray, i0: int, i1: int, box: FloatArray) -> None:
         box[2], box[3] = min(box[2], xy[i, 1]), max(box[3], xy[i, 1])
 
 
-def _gap_under(px: float, py: float, vx: float, vy: float, reach: float, h: float,
-               upto: float) -> float:  # fmt: skip
-    """:func:`uvnav.geometry.contact._gap_scalar` of the pair where it may be under ``upto``
-    [m], ``inf`` where the squared distance already shows it is not (no square root)."""
-    a = vx * vx + vy * vy
-    b = px * vx + py * vy
-    t = min(max(b / max(a, 1e-12), 0.0), h)
-    dx, dy = px - vx * t, py - vy * t
-    lim = reach + upto
-    if lim > 0.0 and dx * dx + dy * dy > (lim + 1e-9) * (lim + 1e-9) * (1.0 + 1e-12):
-        return math.inf
-    return math.hypot(dx, dy) - reach
-
-
 def _disc_along(
     xy: FloatArray, times: FloatArray, i0: int, i1: int, qw: tuple[float, float, float, float],
     reach: float, prm: FloatArray, risk: FloatArray,
@@ -199,7 +185,7 @@ def _disc_along(
             if t < risk[0]:
                 risk[0] = t
         if near:
-            g = comfort - _gap_under(rx, ry, px, py, reach, min(h, c_h - t0), comfort - risk[1])
+            g = comfort - _gap_scalar(rx, ry, px, py, reach, min(h, c_h - t0))
             if g > risk[1]:
                 risk[1] = g
 
@@ -252,18 +238,6 @@ def _chunk_bodies(
     lists[1, c] = n
 
 
-def _first_at_least(grown: FloatArray, lo: int, hi: int, value: float) -> int:
-    """The first row in ``lo .. hi - 1`` of ``grown`` (sorted by its column 0) whose column 0
-    is at least ``value`` (``hi`` when none is): a bisection that makes no view."""
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if grown[mid, 0] < value:
-            lo = mid + 1
-        else:
-            hi = mid
-    return lo
-
-
 def risk_along(
     path: tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray], aim: float,
     speed: float, n_sub: int,
@@ -310,7 +284,7 @@ def risk_along(
         if lists[1, c] < 0:
             _chunk_bodies(c, t_a, t_b, lim_far, xy, bodies, cull)
         row0, end = c * n_b, c * n_b + lists[1, c]
-        at = _first_at_least(grown, row0, end, box[0] - wide[c])
+        at = row0 + np.searchsorted(grown[row0:end, 0], box[0] - wide[c])
         for idx in range(at, end):
             if grown[idx, 0] > box[1]:
                 break  # this body and the next ones lie beyond the path's box in x
@@ -564,8 +538,8 @@ def _compiled_plan() -> Callable[..., Any]:
     cache), calling the compiled copies of its helpers and of :mod:`uvnav.geometry.contact`'s."""
     if not _COMPILED:
         zhang2019_v2_loop._compiled_plan()
-        kernels = (_approach, _window, _turn, advance, _box_far, _path_box, _gap_under, _disc_along,
-                   _far, _chunk_bodies, _first_at_least,
+        kernels = (_approach, _window, _turn, advance, _box_far, _path_box, _disc_along, _far,
+                   _chunk_bodies,
                    risk_along, _stops, _better, _keep, _groups, choose_on_paths_py, plan_paths_py,
                    plan_readings_py)  # fmt: skip
         bound = {**contact._kernels(), **zhang2019_v2_loop._COMPILED}

@@ -179,16 +179,16 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         if self._image is not None and self.worlds.restore_spawned_many(
             ids, self._image, seeds, WORLD_KEY, [self._children(i) for i in ids]
         ):
-            c = self.worlds.clearance[ids]
-            self._clear[ids] = np.where(np.isfinite(c), c, self.max_range)
+            self._set_clear(ids)
             return
         for i, k in zip(ids, seeds, strict=True):
             self._start(i, k)
 
-    def _set_clear(self, i: int) -> None:
-        """Sub-environment ``i``'s clearance for the reward, from its world's at the start."""
-        c = float(self.worlds.clearance[i])
-        self._clear[i] = c if np.isfinite(c) else self.max_range
+    def _set_clear(self, ids: int | list[int]) -> None:
+        """Sub-environments ``ids``' clearance for the reward, from their worlds' at the start
+        (``max_range`` where it is not finite)."""
+        c = self.worlds.clearance[ids]
+        self._clear[ids] = np.where(np.isfinite(c), c, self.max_range)
 
     def _observe(self) -> None:
         """Observation vectors and goal distances of every sub-environment."""

@@ -46,47 +46,21 @@ def sense_obstacles(
     if len(kept) == 0:
         return ()
     j = ids[kept]
-    block = _Block(
-        dist[kept],
-        field.centres[j],
-        field.velocities[j],
-        q.nearest[kept],
-        field.angular_velocities[j],
-        field.radii[j],
-        field.bounding_radii[j],
-    )
-    rows = zip(
-        j.tolist(),
-        block.dist.tolist(),
-        block.omega.tolist(),
-        block.radius.tolist(),
-        block.bound.tolist(),
-        map(q.outline, kept.tolist()),
-        strict=True,
-    )
-    make, near, centre, vel = ObstacleReading.known, block.near, block.centre, block.vel
+    d, centre, vel, near = dist[kept], field.centres[j], field.velocities[j], q.nearest[kept]
+    omega, radius, bound = field.angular_velocities[j], field.radii[j], field.bounding_radii[j]
+    rows = zip(j.tolist(), d.tolist(), omega.tolist(), radius.tolist(), bound.tolist(),
+               map(q.outline, kept.tolist()), strict=True)  # fmt: skip
+    make = ObstacleReading.known  # each reading's arrays are views of the rows gathered above
     out = [
-        make(jk, d, near[k], centre[k], vel[k], w, _EMPTY if poly is None else poly, r, b)
-        for k, (jk, d, w, r, b, poly) in enumerate(rows)
+        make(jk, dk, near[k], centre[k], vel[k], w, _EMPTY if poly is None else poly, r, b)
+        for k, (jk, dk, w, r, b, poly) in enumerate(rows)
     ]
-    return Readings.lazy(out, block.arrays, all_known=True)
 
+    def arrays() -> ReadingArrays:
+        scal = np.column_stack((d, omega, radius, bound)).astype(float, copy=False)
+        return scal, centre, vel
 
-class _Block:
-    """The kept bodies' numbers, gathered once from the field (nearest first): the readings'
-    arrays are views of these rows, and :meth:`arrays` stacks the scalars."""
-
-    __slots__ = ("bound", "centre", "dist", "near", "omega", "radius", "vel")
-
-    def __init__(self, dist: FloatArray, centre: FloatArray, vel: FloatArray, near: FloatArray,
-                 omega: FloatArray, radius: FloatArray, bound: FloatArray) -> None:  # fmt: skip
-        self.dist, self.centre, self.vel, self.near = dist, centre, vel, near
-        self.omega, self.radius, self.bound = omega, radius, bound
-
-    def arrays(self) -> ReadingArrays:
-        """:data:`~uvnav.sensors.observation.ReadingArrays` of the readings."""
-        scal = np.column_stack((self.dist, self.omega, self.radius, self.bound))
-        return scal.astype(float, copy=False), self.centre, self.vel
+    return Readings.lazy(out, arrays, all_known=True)
 
 
 @functools.lru_cache(maxsize=64)

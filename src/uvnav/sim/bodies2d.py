@@ -508,7 +508,7 @@ class PackedBodies:
         """A sensed block (``ids`` and its rows, copies) as the readings' arrays."""
         scal = np.zeros((len(ids), 4))
         scal[:, 0], scal[:, 1] = rows[:, R_DIST], rows[:, R_OMEGA]
-        scal[:, 3] = np.asarray(self._bounds, dtype=float)[ids]
+        scal[:, 3] = self.template.bounding_radii[ids]
         return scal, rows[:, R_CENTRE : R_CENTRE + 2], rows[:, R_VEL : R_VEL + 2]
 
     def centres(self) -> tuple[FloatArray, np.ndarray | None]:

@@ -253,8 +253,8 @@ class World2D(OneVehicle):
         self.clearance = gap
         if nearest is not None:
             self.nearest = nearest
-        clock.step_index = k1 = k + 1  # (clock.tick, inline: t = k dt)
-        self.t = clock.t = t = k1 * clock.dt
+        self.t = t = clock.tick()
+        k1 = k + 1
         self._track((nx, ny, self.th))
         if self.social is not None:
             self.social.observe(self.field, nx, ny, k1, self.velocity())
