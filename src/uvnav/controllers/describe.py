@@ -12,8 +12,16 @@ from typing import Any
 
 
 def attribute_docs(cls: type) -> dict[str, str]:
-    """Field descriptions from the ``Attributes:`` section of a Google-style class docstring."""
-    doc = inspect.getdoc(cls) or ""
+    """Field descriptions from the ``Attributes:`` sections of a Google-style class docstring
+    and of its bases' (a subclass's entry wins over its base's)."""
+    out: dict[str, str] = {}
+    for klass in reversed(cls.__mro__):
+        out.update(_section_docs(inspect.cleandoc(klass.__dict__.get("__doc__") or "")))
+    return out
+
+
+def _section_docs(doc: str) -> dict[str, str]:
+    """The entries of the ``Attributes:`` (``Args:``, ``Parameters:``) sections of ``doc``."""
     out: dict[str, str] = {}
     in_section = False
     indent: int | None = None

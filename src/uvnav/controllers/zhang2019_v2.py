@@ -60,10 +60,11 @@ pays nothing. Bodies standing still have no forecast beyond themselves, nor a ``
 (slower than ``comfort_min_speed``): they are kept clear of only. The term only adds to the cost,
 so safety (the first contact, ``min_ttc``) still ranks first, and the branch-and-bound bound stays
 a lower bound. On a vehicle with acceleration limits the rolled-out paths' segments that start
-before T_s are read the same way (:func:`path_social`). With ``w_social`` 3 and T_s 3 s (tuned on
-CrowdNav circle cases 0-99), on cases 100-499 the intrusion ratio fell from 12 to 1 % (holonomic)
-and 14 to 2 % (unicycle) with 5 humans, 20 to 9 % and 31 to 16 % with 20, success kept or higher
-(``docs/design-notes.md``, "A social term in zhang2019-v2").
+before T_s are read the same way (:func:`path_social`); figures: ``docs/design-notes.md``.
+
+**A route around the crowd** (``route_*``; on by default on the holonomic robot only): the law
+steers for the way point of the route of least length plus crowd exposure, not for T itself
+(:mod:`uvnav.controllers.crowd_route`).
 
 The holonomic robot takes the chosen velocity as it is; the unicycle steers toward the chosen
 direction with the sliding-mode law at the chosen speed times cos(beta).
@@ -74,12 +75,9 @@ candidates are therefore checked along the path its own steering drives toward e
 decision after decision over H (the rolled-out paths below, with no limits on the ideal
 vehicle).  With ``rollout_paths`` off they are checked as the chapter's geometry suggests: one
 turn at U_max along its chord at ``s cos(beta / 2)``, then a straight line at s (the compiled
-loop below).  That check was measured to fail the unicycle on CrowdNav's circle crossing
-(CrowdNav's turn-then-move robot, cases 0-99: 5 failures against the holonomic robot's 1, all
-humans walking into a robot that had stopped or was spinning): a direction behind the robot
-costs the same as one ahead, the choice jumped by 90-180 degrees between decisions, and the
-robot turned on the spot or zigzagged until a human reached it.  Checked along its paths: 1
-failure on those cases (``docs/design-notes.md``, "The unicycle checked along its paths").
+loop below).  With that check a direction behind the robot costs the same as one ahead, so the
+choice jumped between decisions and the robot turned on the spot or zigzagged until a human
+reached it (``docs/design-notes.md``, "The unicycle checked along its paths").
 
 **Acceleration limits.** The thesis's unicycle changes its speed and turn rate at once.  On a
 unicycle whose spec has limits (``UnicycleSpec.accel_max`` a, ``turn_accel_max`` B: the vehicle
@@ -150,6 +148,7 @@ from uvnav.controllers.base import (
     heading_rate_toward,
     register,
 )
+from uvnav.controllers.crowd_route import CrowdRoute, RouteParams
 from uvnav.controllers.holonomic import HolonomicLaw, toward_goal
 from uvnav.controllers.zhang2019_limits import (
     BoolArray,
@@ -197,8 +196,9 @@ IntArray = np.ndarray
 
 
 @dataclass(frozen=True)
-class Zhang2019V2Params:
-    """Parameters of ``zhang2019-v2`` and ``zhang2019-holonomic-v2``.
+class Zhang2019V2Params(RouteParams):
+    """Parameters of ``zhang2019-v2`` and ``zhang2019-holonomic-v2`` (the ``route_*`` ones:
+    :class:`~uvnav.controllers.crowd_route.RouteParams`, off here).
 
     Attributes:
         horizon: H [s], how far ahead every candidate is checked against every body.
@@ -267,6 +267,7 @@ class Zhang2019V2Params:
     comfort_min_speed: float = 0.1
 
     def __post_init__(self) -> None:
+        super().__post_init__()
         check_params(
             self,
             positive=(
@@ -657,6 +658,14 @@ def tracked(obs: Observation, tracker: CentreTracker | None) -> Observation:
     return dataclasses.replace(obs, obstacles=tracker.update(obs.time, obs.obstacles, pos))
 
 
+@dataclass(frozen=True)
+class Zhang2019HolonomicV2Params(Zhang2019V2Params):
+    """``zhang2019-holonomic-v2``'s parameters: :class:`Zhang2019V2Params` with the route
+    layer on (:mod:`uvnav.controllers.crowd_route`)."""
+
+    route_weight: float = 2.0
+
+
 class Zhang2019HolonomicV2(HolonomicLaw):
     """v2 on the holonomic robot: the chosen velocity as it is."""
 
@@ -664,14 +673,16 @@ class Zhang2019HolonomicV2(HolonomicLaw):
 
     def __init__(self, params: Zhang2019V2Params | None = None) -> None:
         super().__init__()
-        self.params = params or Zhang2019V2Params()
+        self.params = params or Zhang2019HolonomicV2Params()
         self.last_choice: Choice | None = None
         self._tracker = _tracker(self.params)
         self._fixed = LoopConstants()
+        self._route = CrowdRoute(self.params.route_settings(self.params.comfort_min_speed))
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
         self._tracker = _tracker(self.params)
+        self._route.reset()
 
     def act(self, obs: Observation) -> VelocityCommand:
         period = self.decision_period(obs.time)
@@ -679,7 +690,8 @@ class Zhang2019HolonomicV2(HolonomicLaw):
         if not finite_position(obs.pose):
             return VelocityCommand(0.0, 0.0)
         obs = tracked(obs, self._tracker)
-        choice = plan(obs, self._goal, spec.v_max, spec.radius, period,
+        goal = self._route.aim(obs.position, self._goal, obs.obstacles, spec.v_max)
+        choice = plan(obs, goal, spec.v_max, spec.radius, period,
                       self.current_velocity(obs), self.params,
                       constants=self._fixed.get(self.params, self._spec))  # fmt: skip
         self.last_choice = choice
@@ -700,9 +712,11 @@ class Zhang2019V2(UnicycleController):
         self._tracker = _tracker(self.params)
         self._fixed = LoopConstants()
         self._paths = PathConstants()
+        self._route = CrowdRoute(self.params.route_settings(self.params.comfort_min_speed))
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
+        self._route.reset()
         self._aim = np.zeros(2)
         self._tracker = _tracker(self.params)
         self._turn = (0.0, 0.0)  # the turn rate at the last decision and the one commanded
@@ -713,9 +727,10 @@ class Zhang2019V2(UnicycleController):
         if not (finite_position(obs.pose) and math.isfinite(obs.pose[2])):
             return UnicycleCommand(0.0, 0.0)
         obs = tracked(obs, self._tracker)
+        goal = self._route.aim(obs.position, self._goal, obs.obstacles, spec.v_max)
         if self.params.rollout_paths or not spec.ideal:
-            return self._act_limited(obs, period)
-        choice = plan(obs, self._goal, spec.v_max, spec.radius, period, self._aim, self.params,
+            return self._act_limited(obs, period, goal)
+        choice = plan(obs, goal, spec.v_max, spec.radius, period, self._aim, self.params,
                       heading=obs.heading, u_max=spec.u_max,
                       constants=self._fixed.get(self.params, self._spec))  # fmt: skip
         self.last_choice = choice
@@ -724,7 +739,7 @@ class Zhang2019V2(UnicycleController):
         speed = float(np.hypot(v[0], v[1]))
         self._aim = np.asarray(v, dtype=float)
         if speed < 1e-9:  # standing still: face the target meanwhile
-            gap = self._goal - obs.position
+            gap = goal - obs.position
             aim = math.atan2(float(gap[1]), float(gap[0]))
         else:
             aim = math.atan2(float(v[1]), float(v[0]))
@@ -732,24 +747,24 @@ class Zhang2019V2(UnicycleController):
         speed *= max(math.cos(beta), 0.0)  # v1's turn slowdown (note 7)
         return UnicycleCommand(speed, heading_rate_toward(beta, spec.u_max, period)).clipped(spec)
 
-    def _act_limited(self, obs: Observation, period: float) -> UnicycleCommand:
-        """The decision on a vehicle with acceleration limits (module docstring): the speed it
-        has from its odometry, the turn rate it has from its last command as the vehicle
-        applies it; a command within the window of one period."""
+    def _act_limited(self, obs: Observation, period: float, goal: FloatArray) -> UnicycleCommand:
+        """The decision for ``goal`` on a vehicle with acceleration limits (module docstring):
+        the speed it has from its odometry, the turn rate it has from its last command as the
+        vehicle applies it; a command within the window of one period."""
         spec = self._spec
         model = RampModel(spec.v_max, spec.u_max, spec.accel_max, spec.turn_accel_max, period)
         fixed = self._paths.get(self.params, model, float(spec.radius))
         u_before, u_cmd = self._turn
         u_now = paths_approach(u_before, u_cmd, spec.turn_accel_max * period)
         v_now = min(max(float(obs.speed), 0.0), spec.v_max) if math.isfinite(obs.speed) else 0.0
-        choice = plan_limited(obs, self._goal, model, spec.radius, (v_now, u_now), self._aim,
+        choice = plan_limited(obs, goal, model, spec.radius, (v_now, u_now), self._aim,
                               self.params, constants=fixed)  # fmt: skip
         self.last_choice = choice
         self._mode = "M1" if choice.preferred else "M2"
         v = choice.velocity
         speed = float(np.hypot(v[0], v[1]))
         self._aim = np.asarray(v, dtype=float)
-        gap = v if speed >= 1e-9 else self._goal - obs.position  # standing: face the target
+        gap = v if speed >= 1e-9 else goal - obs.position  # standing: face the target
         beta = wrap_scalar(math.atan2(float(gap[1]), float(gap[0])) - obs.heading)
         lo, hi = paths_window(v_now, model.accel, period, 0.0, model.v_max)
         v_out = min(max(speed * max(math.cos(beta), 0.0), lo), hi)  # as speed_command
@@ -775,8 +790,9 @@ register(
     ControllerInfo(
         name="zhang2019-holonomic-v2",
         factory=Zhang2019HolonomicV2,
-        params_type=Zhang2019V2Params,
-        summary="zhang2019-v2 on the holonomic robot: the chosen velocity applied as it is.",
+        params_type=Zhang2019HolonomicV2Params,
+        summary="zhang2019-v2 on the holonomic robot: the chosen velocity applied as it is, "
+        "steering for a route around the crowd.",
         reference=_REFERENCE,
         vehicle="holonomic",
     )

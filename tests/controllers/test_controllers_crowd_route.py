@@ -1,0 +1,119 @@
+"""The route layer around the crowd (uvnav.controllers.crowd_route) and the v2 laws that use it."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from uvnav.controllers.crowd_route import (
+    SPACING,
+    CrowdRoute,
+    RouteSettings,
+    exposure,
+    fan_way_points,
+    route_samples,
+)
+from uvnav.controllers.zhang2019_v2 import Zhang2019HolonomicV2Params, Zhang2019V2Params
+from uvnav.sensors.observation import ObstacleReading
+
+GOAL = np.array([12.0, 0.0])
+ON = RouteSettings(weight=2.0)
+point = st.tuples(st.floats(-8.0, 8.0), st.floats(-8.0, 8.0)).map(np.array)
+
+
+def person(k: int, x: float, y: float, vx: float, vy: float, r: float = 0.3) -> ObstacleReading:
+    """A disc of radius ``r`` seen from the origin."""
+    c = np.array([x, y])
+    d = float(np.hypot(x, y))
+    return ObstacleReading(k, max(d - r, 0.0), c * (1.0 - r / max(d, 1e-9)), c,
+                           np.array([vx, vy]), 0.0, np.zeros((0, 2)), r, r)  # fmt: skip
+
+
+def stream(vx: float, vy: float) -> list[ObstacleReading]:
+    """Eight people on and around the direct line 2-5 m ahead, all at (vx, vy)."""
+    spots = [(2.0, 0.0), (3.0, 0.5), (3.0, -0.5), (4.0, 0.0), (4.0, 1.0), (4.0, -1.0),
+             (5.0, 0.5), (5.0, -0.5)]  # fmt: skip
+    return [person(k, x, y, vx, vy) for k, (x, y) in enumerate(spots)]
+
+
+def test_people_walking_on_the_way_are_gone_around() -> None:
+    route = CrowdRoute(ON)
+    aim = route.aim(np.zeros(2), GOAL, stream(-1.0, 0.0), 1.0)
+    assert not np.array_equal(aim, GOAL)
+    assert abs(aim[1]) > 1.0  # well off the direct line
+    assert math.hypot(*aim) == pytest.approx(ON.lookahead)
+
+
+def test_a_clear_way_people_standing_or_the_layer_off_keep_the_goal() -> None:
+    walking_far = [person(0, 0.0, 30.0, 1.0, 0.0)]
+    assert CrowdRoute(ON).aim(np.zeros(2), GOAL, walking_far, 1.0) is GOAL
+    assert CrowdRoute(ON).aim(np.zeros(2), GOAL, stream(0.0, 0.0), 1.0) is GOAL
+    assert CrowdRoute(ON).aim(np.zeros(2), GOAL, (), 1.0) is GOAL
+    assert CrowdRoute(RouteSettings()).aim(np.zeros(2), GOAL, stream(-1.0, 0.0), 1.0) is GOAL
+    near = np.array([0.5, 0.0])
+    assert CrowdRoute(ON).aim(np.zeros(2), near, stream(-1.0, 0.0), 1.0) is near
+
+
+def test_the_way_point_is_held_until_another_is_clearly_better() -> None:
+    route = CrowdRoute(ON)
+    first = route.aim(np.zeros(2), GOAL, stream(-1.0, 0.0), 1.0).copy()
+    # a step on, the same stream: the held way point wins over its neighbours in the fan
+    again = route.aim(np.array([0.1, 0.0]), GOAL, stream(-1.0, 0.0), 1.0)
+    assert np.array_equal(again, first)
+    route.reset()
+    assert route.way is None
+
+
+@settings(max_examples=60, deadline=None)
+@given(position=point, goal=point)
+def test_routes_are_no_shorter_than_the_direct_one(position: np.ndarray, goal: np.ndarray) -> None:
+    ways = fan_way_points(position, goal, 4.0)
+    assert np.array_equal(ways[0], goal)
+    points, arc, weights, length = route_samples(position, ways, goal)
+    direct = math.dist(position, goal)
+    assert length[0] == pytest.approx(direct, abs=1e-9)
+    assert (length >= direct - 1e-9).all()
+    assert np.allclose(weights.sum(axis=1), length)
+    assert (np.diff(arc, axis=1) >= -1e-9).all()
+    # the first sample lies within half a spacing of the robot, the last of the goal
+    assert (np.hypot(*(points[:, 0] - position).T) <= 0.5 * SPACING + 1e-9).all()
+    assert (np.hypot(*(points[:, -1] - goal).T) <= 0.5 * SPACING + 1e-9).all()
+
+
+@settings(max_examples=60, deadline=None)
+@given(centre=point, velocity=st.tuples(st.floats(-1.5, 1.5), st.floats(-1.5, 1.5)))
+def test_exposure_is_one_per_metre_on_a_person_and_vanishes_far_off(
+    centre: np.ndarray, velocity: tuple[float, float]
+) -> None:
+    bodies = (centre[None], np.array([velocity]), np.array([0.3]))
+    at = np.array([[centre], [centre + 100.0]])  # a sample on the person (t = 0), one far off
+    e = exposure(at, np.zeros((2, 1)), np.ones((2, 1)), bodies, 1.0, RouteSettings())
+    assert e[0] == pytest.approx(1.0)
+    assert e[1] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_holonomic_v2_routes_by_default_the_unicycle_does_not() -> None:
+    assert Zhang2019HolonomicV2Params().route_weight > 0
+    assert Zhang2019V2Params().route_weight == 0
+    with pytest.raises(ValueError, match="route_sigma must be a number > 0"):
+        Zhang2019V2Params(route_sigma=0.0)
+    with pytest.raises(ValueError, match="route_weight must be a number >= 0"):
+        Zhang2019HolonomicV2Params(route_weight=-1.0)
+
+
+def test_the_route_keeps_the_robot_out_of_the_harder_crowds_way() -> None:
+    """crowd-dynamic cases 0-3 (20 walking humans, 5 m sensing): with the route the robot
+    intrudes on the humans' forecasts less than steering for the goal itself."""
+    from uvnav.scenarios.catalog import generate
+    from uvnav.scenarios.episodes import run_scene
+
+    def intrusion(weight: float) -> float:
+        runs = [run_scene(generate("crowd-dynamic", s, {}), "zhang2019-holonomic-v2",
+                          {"route_weight": weight}) for s in range(4)]  # fmt: skip
+        return float(np.mean([o.metrics["intrusion_ratio"] for o in runs]))
+
+    assert intrusion(2.0) < 0.5 * intrusion(0.0)
