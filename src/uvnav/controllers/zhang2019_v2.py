@@ -65,6 +65,10 @@ CrowdNav circle cases 0-99), on cases 100-499 the intrusion ratio fell from 12 t
 and 14 to 2 % (unicycle) with 5 humans, 20 to 9 % and 31 to 16 % with 20, success kept or higher
 (``docs/design-notes.md``, "A social term in zhang2019-v2").
 
+**Declared noise.** Each body is grown by ``noise_sigmas`` times the centre noise its reading
+declares (``position_std``) in the one body table every decision path reads
+(:func:`~uvnav.controllers.zhang2019_v2_bodies.body_table`); exact readings declare none.
+
 The holonomic robot takes the chosen velocity as it is; the unicycle steers toward the chosen
 direction with the sliding-mode law at the chosen speed times cos(beta).
 
