@@ -66,6 +66,10 @@ before T_s are read the same way (:func:`path_social`); figures: ``docs/design-n
 steers for the way point of the route of least length plus crowd exposure, not for T itself
 (:mod:`uvnav.controllers.crowd_route`).
 
+**Declared noise.** Each body is grown by ``noise_sigmas`` times the centre noise its reading
+declares (``position_std``) in the one body table every decision path reads
+(:func:`~uvnav.controllers.zhang2019_v2_bodies.body_table`); exact readings declare none.
+
 The holonomic robot takes the chosen velocity as it is; the unicycle steers toward the chosen
 direction with the sliding-mode law at the chosen speed times cos(beta).
 
@@ -238,6 +242,8 @@ class Zhang2019V2Params(RouteParams):
         comfort_min_speed: only bodies moving at this speed [m/s] or faster are kept
             ``comfort`` away; one standing still is only kept clear of (people standing at or
             beside the target would otherwise hold the robot off it for good).
+        noise_sigmas: each body is grown by this many times the centre noise [m] its reading
+            declares (``position_std``; :func:`~uvnav.controllers.zhang2019_v2_bodies.body_table`).
     """
 
     horizon: float = 4.0
@@ -265,6 +271,7 @@ class Zhang2019V2Params(RouteParams):
     social_forecast: float = 1.25
     social_band: float = 0.1
     comfort_min_speed: float = 0.1
+    noise_sigmas: float = 0.5
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -293,6 +300,7 @@ class Zhang2019V2Params(RouteParams):
                 "social_band",
                 "track_turn_std",
                 "comfort_min_speed",
+                "noise_sigmas",
             ),
         )
         for name in ("n_headings", "max_tangent_bodies"):
@@ -446,8 +454,8 @@ def plan(
     v_pref = toward_goal(pos, goal, v_max, period)
     if use_loop:
         fixed = constants or loop_constants(p, v_max, robot_radius)
-        return _plan_in_loop(obs, v_pref, v_prev, fixed, heading, u_max)
-    table = body_table(obs.obstacles)
+        return _plan_in_loop(obs, v_pref, v_prev, fixed, (heading, u_max), p.noise_sigmas)
+    table = body_table(obs.obstacles, p.noise_sigmas)
     keep = reachable(table, v_max, p.horizon)
     if not len(keep):
         return Choice(v_pref, math.inf, True)
@@ -496,17 +504,17 @@ def _plan_in_loop(
     v_pref: FloatArray,
     v_prev: FloatArray,
     constants: tuple[FloatArray, FloatArray],
-    heading: float | None,
-    u_max: float,
+    turning: tuple[float | None, float],
+    noise_sigmas: float,
 ) -> Choice:
     """:func:`plan`'s loop path: the readings read into arrays once, the rest of the decision in
     :func:`uvnav.controllers.zhang2019_v2_loop.plan_loop`."""
-    pose = obs.pose
+    pose, (heading, u_max) = obs.pose, turning
     moving = 1.0 if math.hypot(v_prev[0], v_prev[1]) > 1e-9 else 0.0  # as extra_headings
     state = np.array((pose[0], pose[1], math.nan if heading is None else heading, u_max,
                       v_pref[0], v_pref[1], v_prev[0], v_prev[1], moving), dtype=float)  # fmt: skip
     readings = obs.obstacles
-    table = body_table(readings)
+    table = body_table(readings, noise_sigmas)
     prm, speeds = constants
     out = plan_loop(state, table, outline_rings(readings, table[0]), speeds, prm)
     return Choice(out[:2].copy(), float(out[2]), bool(out[3]))
@@ -565,7 +573,7 @@ def plan_limited(
     pose = np.asarray(obs.pose, dtype=float)
     if (numba_enabled() if loop is None else loop) and p.w_social == 0.0:
         readings = obs.obstacles
-        table = body_table(readings)
+        table = body_table(readings, p.noise_sigmas)
         moving = 1.0 if math.hypot(v_prev[0], v_prev[1]) > 1e-9 else 0.0  # as extra_headings
         f_norm = math.hypot(v_pref[0], v_pref[1])
         state = np.array((pose[0], pose[1], pose[2], now[0], now[1], v_pref[0], v_pref[1],
@@ -576,7 +584,7 @@ def plan_limited(
         )
         out = plan_paths(state, table, outline_rings(readings, table[0]), speeds, prm)
         return Choice(out[:2].copy(), float(out[2]), bool(out[3]))
-    table = body_table(obs.obstacles)
+    table = body_table(obs.obstacles, p.noise_sigmas)
     keep = reachable(table, model.v_max, p.horizon)
     table = (table[0][keep], table[1][keep], table[2][keep])
     near = () if bool(np.all(table[0][:, 2] > 0.0)) else tuple(obs.obstacles[k] for k in keep)

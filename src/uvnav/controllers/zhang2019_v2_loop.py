@@ -99,7 +99,7 @@ def boundary_discs_py(
     for i in range(n_keep):
         k = keep[i]
         cx, cy, vx, vy, om = centre[k, 0], centre[k, 1], vel[k, 0], vel[k, 1], scal[k, 1]
-        rk = scal[k, 2] if scal[k, 2] > 0.0 else 0.5 * spacing
+        rk = scal[k, 2] if scal[k, 2] > 0.0 else 0.5 * spacing - scal[k, 2]
         polygon = scal[k, 2] <= 0.0
         a, b = (ring_start[k], ring_start[k + 1]) if polygon else (0, 1)
         for v in range(a, b):
