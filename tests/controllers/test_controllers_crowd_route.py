@@ -10,14 +10,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from uvnav.controllers.crowd_route import (
-    SPACING,
     CrowdRoute,
     RouteSettings,
-    exposure,
     fan_way_points,
-    route_samples,
+    route_costs,
+    route_costs_py,
 )
 from uvnav.controllers.zhang2019_v2 import Zhang2019HolonomicV2Params, Zhang2019V2Params
+from uvnav.geometry.kernels3d import compiled
 from uvnav.sensors.observation import ObstacleReading
 
 GOAL = np.array([12.0, 0.0])
@@ -73,27 +73,44 @@ def test_the_way_point_is_held_until_another_is_clearly_better() -> None:
 def test_routes_are_no_shorter_than_the_direct_one(position: np.ndarray, goal: np.ndarray) -> None:
     ways = fan_way_points(position, goal, 4.0)
     assert np.array_equal(ways[0], goal)
-    points, arc, weights, length = route_samples(position, ways, goal)
+    length = route_costs(position, goal, ways, np.zeros((0, 5)), 1.0, RouteSettings(weight=1.0))
     direct = math.dist(position, goal)
     assert length[0] == pytest.approx(direct, abs=1e-9)
     assert (length >= direct - 1e-9).all()
-    assert np.allclose(weights.sum(axis=1), length)
-    assert (np.diff(arc, axis=1) >= -1e-9).all()
-    # the first sample lies within half a spacing of the robot, the last of the goal
-    assert (np.hypot(*(points[:, 0] - position).T) <= 0.5 * SPACING + 1e-9).all()
-    assert (np.hypot(*(points[:, -1] - goal).T) <= 0.5 * SPACING + 1e-9).all()
+    assert np.allclose(
+        length[1:], np.hypot(*(ways[1:] - position).T) + np.hypot(*(goal - ways[1:]).T)
+    )
 
 
 @settings(max_examples=60, deadline=None)
 @given(centre=point, velocity=st.tuples(st.floats(-1.5, 1.5), st.floats(-1.5, 1.5)))
-def test_exposure_is_one_per_metre_on_a_person_and_vanishes_far_off(
+def test_a_person_costs_one_per_metre_walked_through_them_and_nothing_far_off(
     centre: np.ndarray, velocity: tuple[float, float]
 ) -> None:
-    bodies = (centre[None], np.array([velocity]), np.array([0.3]))
-    at = np.array([[centre], [centre + 100.0]])  # a sample on the person (t = 0), one far off
-    e = exposure(at, np.zeros((2, 1)), np.ones((2, 1)), bodies, 1.0, RouteSettings())
-    assert e[0] == pytest.approx(1.0)
-    assert e[1] == pytest.approx(0.0, abs=1e-12)
+    """A 0.1 m route through a (large) person's centre at t = 0 pays 0.1 m of exposure; one
+    100 m away pays none."""
+    body = np.array([[*centre, *velocity, 0.3]])
+    ways = centre + np.array([[0.1, 0.0], [100.1, 100.0]])
+    starts = (centre, centre + 100.0)
+    for start, way in zip(starts, ways, strict=True):
+        bare = route_costs(start, way, way[None], body, 1e6, RouteSettings(weight=0.0))
+        paid = route_costs(start, way, way[None], body, 1e6, RouteSettings(weight=1.0))
+        near = math.dist(start, centre) < 1.0
+        assert paid[0] - bare[0] == pytest.approx(0.1 if near else 0.0, abs=1e-9)
+
+
+@pytest.mark.parametrize("enabled", [True, False])
+def test_compiled_and_python_route_costs_agree(enabled: bool) -> None:
+    rng = np.random.default_rng(3)
+    bodies = np.column_stack((rng.uniform(-6, 6, (30, 2)), rng.uniform(-1, 1, (30, 2)),
+                              rng.uniform(0.3, 0.5, 30)))  # fmt: skip
+    position, goal = np.array([0.0, -6.0]), np.array([0.0, 6.0])
+    ways = fan_way_points(position, goal, 4.0)
+    with compiled(enabled):
+        got = route_costs(position, goal, ways, bodies, 1.0, ON)
+    want = np.empty(len(ways))
+    route_costs_py(0.0, -6.0, ways, 0.0, 6.0, bodies, 1.0, ON.sigma, ON.horizon, ON.weight, want)
+    assert np.allclose(got, want, rtol=1e-12, atol=1e-12)
 
 
 def test_holonomic_v2_routes_by_default_the_unicycle_does_not() -> None:

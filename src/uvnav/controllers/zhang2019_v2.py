@@ -96,13 +96,10 @@ says nothing; the choices made here (:mod:`uvnav.controllers.zhang2019_limits`):
   law's own steering (below) replayed decision after decision for the horizon H, the vehicle
   ramping between decisions, in substeps of at most ``rollout_step``, on arcs whatever the
   vehicle's kinematics (turn-then-move turns a period's worth at once: centimetres apart); the
-  path's segments are
-  checked against every body in closed form, as on the ideal vehicle, each body's reach grown
-  by ``limited_spread`` times the segment's end time: a robot that cannot sidestep at once
-  keeps clear of where a body may be once others bend its path, not only of where its
-  constant velocity takes it (20 humans on CrowdNav's circle, cases 0-49: 19 -> 26 successes
-  with 0.1 m/s; 0.25 m/s blocks the way, 10).  Standing still is braking at a, turning toward
-  T as the turn rate allows.
+  path's segments are checked against every body in closed form, each body's reach grown by
+  ``limited_spread`` times the segment's end time (a robot that cannot sidestep at once keeps
+  clear of where a body may be once others bend its path).  Standing still is braking at a,
+  turning toward T as the turn rate allows.
 * The command is kept within the dynamic window of one period T (the last one measured):
   speed within v +- a T, turn rate within u +- B T, so that the vehicle reaches it by the next
   decision; the turn is the sliding-mode law slowed to a rate that can still be stopped at the
@@ -117,22 +114,17 @@ The unicycle's decision runs, after reading the readings into arrays, in one loo
 with numba (:mod:`uvnav.controllers.zhang2019_v2_paths`: the reachable bodies and their discs,
 the candidates visited by their cost without the risk terms, each path rolled out only as far
 as it is checked, bodies culled by boxes; the numpy building blocks are its reference, and run
-where numba is not installed or the social term is on): about 0.02 s of CPU per CrowdNav
-episode with 5 humans (0.25 s decisions; 0.013 s with ``rollout_paths`` off) and 0.04 s with
-limits and 0.05 s steps (numpy: 0.11 and 0.16 s).
+where numba is not installed or the social term is on).
 
 Two equal implementations of the holonomic robot's decision (and the unicycle's with
 ``rollout_paths`` off).  The reference is numpy, vectorised over candidates x boundary discs
 (:mod:`uvnav.controllers.zhang2019_v2_bodies`, :func:`choose_velocity`).  With numba (the ``fast``
 extra) everything after reading the observation's readings into arrays (:func:`body_table`,
 :func:`~uvnav.controllers.zhang2019_v2_loop.outline_rings`) runs in one compiled call
-(:func:`uvnav.controllers.zhang2019_v2_loop.plan_loop`: the reachable bodies, their boundary discs
-and the candidate headings, then :func:`uvnav.geometry.contact.decide_py`): it visits the candidates
-by their cost without the risk terms (a lower bound of the cost), checks each against the bodies
-with a bounding-disc cull, and stops once a safe candidate costs no more than the next bound, so
-candidates that cannot win are never checked.  It picks the reference's candidate (tests: hypothesis
-on random scenes); its cost grows linearly with the bodies in range, and reading the readings is the
-part that grows in Python (``benchmarks/bench_zhang2019_v2.py``).
+(:func:`uvnav.controllers.zhang2019_v2_loop.plan_loop`, then
+:func:`uvnav.geometry.contact.decide_py`): it visits the candidates by a lower bound of their cost
+and stops once a safe candidate costs no more than the next bound, picking the reference's
+candidate (tests: hypothesis on random scenes); ``benchmarks/bench_zhang2019_v2.py`` times it.
 Units: metres, seconds, radians.
 """
 
