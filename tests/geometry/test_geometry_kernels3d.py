@@ -15,6 +15,7 @@ from uvnav.geometry.frames3d import online_frame, rotation_from_vector
 from uvnav.geometry.kernels3d import (
     ATAN2_BOUND_ERROR,
     atan2_bound,
+    compile_family,
     nearest_triangle_py,
     numba_available,
     numba_enabled,
@@ -154,3 +155,28 @@ def test_atan2_bound_is_within_its_error_everywhere() -> None:
     assert atan2_bound(0.0, 0.0) == 0.0
     assert atan2_bound(1.0, 0.0) == pytest.approx(0.5 * math.pi, abs=1.5e-5)
     assert atan2_bound(-1.0, -1.0) == pytest.approx(-0.75 * math.pi, abs=1.5e-5)
+
+
+def _callee_one(x: float) -> float:
+    return x + 1.0
+
+
+def _callee_two(x: float) -> float:
+    return x + 2.0
+
+
+def _caller(x: float) -> float:
+    return _callee(x)  # noqa: F821 - bound by compile_family
+
+
+@pytest.mark.skipif(not numba_available(), reason="needs numba (the fast extra)")
+def test_a_kernel_is_compiled_again_when_a_callee_it_inlines_changes() -> None:
+    """numba's cache keys a kernel on its own file only; the family's stamp in every copy's
+    name keeps a caller cached with one callee from being loaded with another."""
+    one = compile_family([("_callee", _callee_one), _caller])
+    two = compile_family([("_callee", _callee_two), _caller])
+    assert one["_caller"](1.0) == 2.0
+    assert two["_caller"](1.0) == 3.0
+    assert one["_caller"].py_func.__qualname__ != two["_caller"].py_func.__qualname__
+    again = compile_family([("_callee", _callee_one), _caller])
+    assert again["_caller"].py_func.__qualname__ == one["_caller"].py_func.__qualname__

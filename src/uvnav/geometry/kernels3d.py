@@ -29,6 +29,7 @@ here, because each query is a handful of array operations whose fixed overhead
 
 from __future__ import annotations
 
+import hashlib
 import importlib.util
 import math
 import os
@@ -65,12 +66,51 @@ def compile_family(
 
     done: dict[str, Callable[..., Any]] = dict(bound or {})
     made: dict[str, Callable[..., Any]] = {}
+    stamp = family_stamp(functions, bound)
     for item in functions:
         name, f = item if isinstance(item, tuple) else (item.__name__, item)
         env = {**f.__globals__, **done}
         copy = types.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
+        copy.__qualname__ = f"{f.__qualname__}_{stamp}"
         done[name] = made[name] = numba.njit(cache=True, nogil=True)(copy)
     return made
+
+
+def family_stamp(
+    functions: Sequence[Callable[..., Any] | tuple[str, Callable[..., Any]]],
+    bound: Mapping[str, Callable[..., Any]] | None = None,
+) -> str:
+    """A digest of the code of ``functions`` and of the ``bound`` kernels (their Python
+    functions), part of every compiled copy's name and so of numba's cache key.
+
+    numba's cache checks only the source file of the function it compiled: a callee changed in
+    another file (a kernel compiled with the callee inlined) would be loaded stale from the
+    cache.  Named after the whole family, a copy is compiled again when any of its code changes.
+
+    >>> def f(): return 1
+    >>> def g(): return 2
+    >>> family_stamp([f]) == family_stamp([f]), family_stamp([f]) == family_stamp([("f", g)])
+    (True, False)
+    """
+    digest = hashlib.sha1(usedforsecurity=False)
+    items = [*(i if isinstance(i, tuple) else (i.__name__, i) for i in functions),
+             *sorted((bound or {}).items())]  # fmt: skip
+    for name, f in items:
+        digest.update(name.encode() + _code_bytes(getattr(f, "py_func", f).__code__))
+    return digest.hexdigest()[:12]
+
+
+def _code_bytes(code: types.CodeType) -> bytes:
+    """What a code object computes, as bytes the same in every process (its bytecode, names
+    and constants, nested code included; ``marshal`` would not do: its output depends on
+    reference counts)."""
+    consts = [
+        _code_bytes(c) if isinstance(c, types.CodeType)
+        else repr(sorted(map(repr, c)) if isinstance(c, frozenset) else c).encode()
+        for c in code.co_consts
+    ]  # fmt: skip
+    names = (*code.co_names, *code.co_varnames, *code.co_freevars, code.co_filename)
+    return code.co_code + b"\0".join(consts) + "\0".join(names).encode()
 
 
 def numba_available() -> bool:
