@@ -83,15 +83,16 @@ class RouteSettings:
 
 @dataclass(frozen=True)
 class RouteParams:
-    """A law's parameters of the route layer (:class:`RouteSettings`, named ``route_*``; the
-    law gives ``min_speed``).
+    """A law's parameters of the route layer (module docstring; the law gives the speed below
+    which a body costs nothing).
 
     Attributes:
-        route_weight: :attr:`RouteSettings.weight` [m per unit of exposure]; 0: off.
-        route_sigma: :attr:`RouteSettings.sigma` [m].
-        route_lookahead: :attr:`RouteSettings.lookahead` [m].
-        route_hold: :attr:`RouteSettings.hold` [m].
-        route_horizon: :attr:`RouteSettings.horizon` [s].
+        route_weight: metres a route may grow to spare one unit of exposure to walking people
+            (a metre walked through one); 0 turns the route off (the law steers for the goal).
+        route_sigma: spread [m] of a walking person's cost around where they will be.
+        route_lookahead: distance [m] of the route's way points from the robot.
+        route_hold: metres the way point held from the last decision is spared.
+        route_horizon: how far ahead [s] the people's positions are forecast.
     """
 
     route_weight: float = 0.0
