@@ -179,6 +179,7 @@ from uvnav.dynamics.omni import VelocityCommand
 from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
 from uvnav.geometry.contact import (
+    TANGENT_SLACK,
     candidate_risk,
     candidate_risk_compiled,
     social_risk,
@@ -534,7 +535,7 @@ def nearest_tangents(
     body first)."""
     q, w, reach, owner = discs
     n_few = int(np.searchsorted(owner, params.max_tangent_bodies))  # readings come nearest first
-    grow = reach + np.hypot(w[:, 0], w[:, 1]) * params.forecast_horizon
+    grow = reach * (1.0 + TANGENT_SLACK) + np.hypot(w[:, 0], w[:, 1]) * params.forecast_horizon
     return tangent_directions(position, q[:n_few], grow[:n_few], owner[:n_few])
 
 

@@ -48,7 +48,7 @@ from uvnav.controllers import zhang2019_v2_loop
 from uvnav.controllers.zhang2019_v2_loop import boundary_discs_py, reachable_py
 from uvnav.geometry import contact
 from uvnav.geometry.angles import FloatArray
-from uvnav.geometry.contact import _contact_scalar, _gap_scalar, tangents_py
+from uvnav.geometry.contact import TANGENT_SLACK, _contact_scalar, _gap_scalar, tangents_py
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
 
 #: indices into the ``prm`` vector of :func:`choose_on_paths_py` and :func:`plan_paths_py`
@@ -453,7 +453,7 @@ def plan_paths_py(
     for j in range(q.shape[0]):  # the discs of the nearest bodies (owner is non-decreasing)
         if owner[j] >= n_tan:
             break
-        grow[j] = reach[j] + math.hypot(w[j, 0], w[j, 1]) * prm[M_T_F]
+        grow[j] = reach[j] * (1.0 + TANGENT_SLACK) + math.hypot(w[j, 0], w[j, 1]) * prm[M_T_F]
         n_few = j + 1
     tang = np.empty(2 * n_few + 1)
     n_t = tangents_py(px, py, q, grow, owner, n_few, tang)

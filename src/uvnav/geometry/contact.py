@@ -44,6 +44,13 @@ from uvnav.geometry.kernels3d import compile_family, numba_enabled
 IntArray = np.ndarray
 
 
+#: the forecast circles the tangents touch are the contact discs grown by this share: a tangent
+#: to a standing body's disc grazes it, and whether a contact exactly at the tangent point
+#: counts would be decided by rounding, differently in numpy and in the compiled loops; grown,
+#: the tangent clears the disc by about a nanometre in both
+TANGENT_SLACK = 1e-9
+
+
 def first_contact(
     rel_pos: FloatArray,
     rel_vel: FloatArray,
@@ -480,7 +487,7 @@ def decide_py(
     bodies = np.empty((centre.shape[0], 7))
     n_few = 0
     for j in range(q.shape[0]):
-        grow[j] = reach[j] + math.hypot(w[j, 0], w[j, 1]) * t_f
+        grow[j] = reach[j] * (1.0 + TANGENT_SLACK) + math.hypot(w[j, 0], w[j, 1]) * t_f
         if owner[j] < n_tan:
             n_few = j + 1
         if j == 0 or owner[j] != owner[j - 1]:
