@@ -48,7 +48,7 @@ from uvnav.sensors.observation import ObstacleReading, Readings, read_arrays
 
 #: routes in the fan: the direct one and ``FAN - 1`` way points (the goal's direction excluded)
 FAN = 13
-#: distance between the samples of a route [m]
+#: the longest distance between two samples of a route's leg [m]
 SPACING = 0.25
 #: the goal closer than this [m]: steer for it
 DIRECT_WITHIN = 1.0
@@ -120,8 +120,8 @@ def fan_way_points(position: FloatArray, goal: FloatArray, lookahead: float) -> 
     """
     gap = goal - position
     reach = min(lookahead, math.hypot(gap[0], gap[1]))
-    angles = np.linspace(-math.pi / 2, math.pi / 2, FAN)
-    angles = math.atan2(gap[1], gap[0]) + angles[angles != 0.0]
+    fan = np.delete(np.linspace(-math.pi / 2, math.pi / 2, FAN), FAN // 2)  # the goal's own
+    angles = math.atan2(gap[1], gap[0]) + fan
     ways = position + reach * np.column_stack((np.cos(angles), np.sin(angles)))
     return np.vstack((goal[None], ways))
 
