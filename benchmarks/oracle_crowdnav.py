@@ -28,9 +28,11 @@ a human:
   search was weak (the dedup keeps one state per cell, so it is evidence, not proof).
 
 Run: ``PYTHONPATH=src .venv/bin/python benchmarks/oracle_crowdnav.py --humans 20 --first 100
---cases 400`` (``--out DIR`` writes ``DIR/oracle-crowdnav-<humans>.json``).  Reported: the
-oracle's success fraction with its 95 % Wilson interval (the bench's), the replay agreement,
-the cases with no surviving sequence, the CPU time.
+--cases 400`` (``--out DIR`` writes ``DIR/oracle-crowdnav-<humans>.json``; ``--sample N``: N of
+those cases drawn by a generator seeded 0; ``--clearance M``: the oracle keeps M [m] from every
+human, which says how much room its successes have).  Reported: the oracle's success fraction
+with its 95 % Wilson interval (the bench's), the replay agreement, the cases with no surviving
+sequence, the CPU time.
 """
 
 from __future__ import annotations
@@ -109,6 +111,8 @@ class Case:
         start: the robot's (x, y, heading).
         goal: the goal (x, y) [m]; ``tolerance`` its arrival radius [m].
         dt: the integration step [s]; ``ratio`` steps per decision.
+        clearance: the gap [m] the oracle keeps from every human beyond touching (0: it may
+            pass as close as the world allows).
     """
 
     centres: np.ndarray
@@ -119,6 +123,7 @@ class Case:
     tolerance: float
     dt: float
     ratio: int
+    clearance: float = 0.0
 
     @property
     def steps(self) -> int:
@@ -151,8 +156,9 @@ def human_track(setup: EpisodeSetup) -> np.ndarray:
     return out
 
 
-def oracle_case(scn: Any, case: int) -> Case:
-    """The ground truth of ``case`` of the scene (the humans' future included)."""
+def oracle_case(scn: Any, case: int, clearance: float = 0.0) -> Case:
+    """The ground truth of ``case`` of the scene (the humans' future included); the oracle
+    keeps ``clearance`` [m] from the humans."""
     setup = build_episode(scn, case)
     spec = setup.spec
     assert isinstance(spec, UnicycleSpec)
@@ -163,7 +169,7 @@ def oracle_case(scn: Any, case: int) -> Case:
         start=(float(start[0]), float(start[1]), float(start[2])),
         goal=(float(setup.goal[0]), float(setup.goal[1])),
         tolerance=float(setup.goal_tolerance), dt=float(setup.dt),
-        ratio=round(float(setup.control_period) / float(setup.dt)),
+        ratio=round(float(setup.control_period) / float(setup.dt)), clearance=clearance,
     )  # fmt: skip
 
 
@@ -246,8 +252,8 @@ def expand(c: Case, beam: Beam, period_index: int, s: Search) -> tuple[Beam, np.
     x, y, th = beam.x[parent], beam.y[parent], beam.th[parent]
     v, u = beam.v[parent], beam.u[parent]
     k0 = period_index * c.ratio
-    near = _near_humans(c, beam, k0, spec.v_max * period + spec.radius + 0.01)
-    reach2 = (c.radii[near] + spec.radius + MARGIN) ** 2
+    near = _near_humans(c, beam, k0, spec.v_max * period + spec.radius + c.clearance + 0.01)
+    reach2 = (c.radii[near] + spec.radius + c.clearance + MARGIN) ** 2
     alive = np.ones(len(x), dtype=bool)
     arrived = np.full(len(x), -1)
     gx, gy = c.goal
@@ -369,9 +375,9 @@ def replay(scn: Any, case: int, cmds: np.ndarray) -> tuple[str, float | None]:
     return res.status, res.metrics.time_to_goal
 
 
-def run_case(case: int, scn: Any, survive_s: float) -> dict[str, Any]:
+def run_case(case: int, scn: Any, survive_s: float, clearance: float = 0.0) -> dict[str, Any]:
     """One case: the oracle's search, the world's replay, and the survival search on a miss."""
-    c = oracle_case(scn, case)
+    c = oracle_case(scn, case, clearance)
     for tier in range(len(LADDER)):
         t, cmds = search(c, LADDER[tier])
         if t is not None:
@@ -392,6 +398,7 @@ def run(
     turn_accel: float,
     substeps: int,
     survive_s: float,
+    clearance: float = 0.0,
 ) -> dict[str, Any]:
     """Every case's oracle row and the totals (success = found and confirmed by the world)."""
     rows: list[dict[str, Any]] = []
@@ -405,10 +412,10 @@ def run(
                 raise
             unplaceable.append(case)
             continue
-        rows.append(run_case(case, scn, survive_s))
+        rows.append(run_case(case, scn, survive_s, clearance))
     cpu = time.process_time() - cpu0
     return summarise(rows, unplaceable, cpu, humans=humans, accel=accel, turn_accel=turn_accel,
-                     substeps=substeps, survive_s=survive_s)  # fmt: skip
+                     substeps=substeps, survive_s=survive_s, clearance=clearance)  # fmt: skip
 
 
 def summarise(
@@ -445,7 +452,8 @@ def report(r: dict[str, Any]) -> str:
     return "\n".join([
         f"ORACLE (reads the ground truth, the humans' future included; no causal law can do "
         f"this) on crowdnav-circle, {r['cases']} cases, {r['humans']} humans, limits "
-        f"{r['accel']:g} m/s^2, {r['turn_accel']:g} rad/s^2, {r['substeps']} substeps"
+        f"{r['accel']:g} m/s^2, {r['turn_accel']:g} rad/s^2, {r['substeps']} substeps, "
+        f"keeping {r['clearance']:g} m from the humans"
         + (f", {len(r['unplaceable'])} unplaceable left out" if r["unplaceable"] else ""),
         f"  oracle success {s['count']:4d}  {s['rate']:.3f}  95% [{lo:.3f}, {hi:.3f}] "
         f"(each confirmed by replaying its commands in the world)",
@@ -480,6 +488,8 @@ def main(argv: list[str] | None = None) -> int:
         metavar="T",
         help="horizon of the survival search where no success is found [s]",
     )
+    ap.add_argument("--clearance", type=float, default=0.0, metavar="M",
+                    help="the gap the oracle keeps from every human [m] (default 0)")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write oracle-crowdnav-N.json here")
     args = ap.parse_args(argv)
     if args.cases < 1 or args.substeps < 1 or args.first < 0:
@@ -490,6 +500,8 @@ def main(argv: list[str] | None = None) -> int:
                         ("--survive", args.survive)):  # fmt: skip
         if not (math.isfinite(value) and value > 0):
             ap.error(f"{name} must be a number > 0 (got {value!r})")
+    if not (math.isfinite(args.clearance) and args.clearance >= 0):
+        ap.error(f"--clearance must be a number >= 0 (got {args.clearance!r})")
     cases = list(range(args.first, args.first + args.cases))
     if args.sample is not None:
         if not 1 <= args.sample <= args.cases:
@@ -498,7 +510,7 @@ def main(argv: list[str] | None = None) -> int:
             int(x) for x in np.random.default_rng(0).choice(cases, args.sample, replace=False)
         )
     r = run(cases, humans=args.humans, accel=args.accel, turn_accel=args.turn_accel,
-            substeps=args.substeps, survive_s=args.survive)  # fmt: skip
+            substeps=args.substeps, survive_s=args.survive, clearance=args.clearance)  # fmt: skip
     r["case_numbers"] = cases
     r["sampled"] = args.sample is not None
     print(report(r))
@@ -506,7 +518,8 @@ def main(argv: list[str] | None = None) -> int:
         args.out.mkdir(parents=True, exist_ok=True)
         r["machine"] = {"cpus": os.cpu_count(), "load": os.getloadavg(),
                         "python": sys.version.split()[0]}  # fmt: skip
-        (args.out / f"oracle-crowdnav-{args.humans}.json").write_text(json.dumps(r, indent=1))
+        tag = f"-clearance{args.clearance:g}" if args.clearance else ""
+        (args.out / f"oracle-crowdnav-{args.humans}{tag}.json").write_text(json.dumps(r, indent=1))
     return 0
 
 

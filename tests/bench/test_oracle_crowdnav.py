@@ -3,6 +3,7 @@ is the world's, and the oracle's search finds the obvious success of an empty sc
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 from pathlib import Path
 from typing import Any
@@ -87,3 +88,15 @@ def test_a_case_with_no_way_out_survives_no_time() -> None:
                         c.ratio)  # fmt: skip
     assert oracle.search(boxed) == (None, None)
     assert oracle.survives(boxed, 2.0) == 0.0
+
+
+def test_the_clearance_keeps_the_oracle_off_a_human_it_could_pass_close_to() -> None:
+    c = oracle.oracle_case(oracle.scene(100, 0, 1.0, 2.0, 5), 100)
+    # one human standing 0.7 m beside the straight run: 0.1 m of room at the closest
+    centres = np.tile(np.array([[0.7, 0.0]]), (c.steps + 1, 1, 1))
+    beside = oracle.Case(centres, np.array([0.3]), c.spec, c.start, c.goal, c.tolerance, c.dt,
+                         c.ratio)  # fmt: skip
+    close, _ = oracle.search(beside)
+    wide, _ = oracle.search(dataclasses.replace(beside, clearance=0.2))
+    assert close is not None and close == pytest.approx(8.2, abs=0.11)
+    assert wide is not None and wide > close
