@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import types
 from functools import cache
 
 import numpy as np
@@ -16,6 +17,7 @@ from uvnav.geometry.kernels3d import (
     ATAN2_BOUND_ERROR,
     atan2_bound,
     compile_family,
+    family_stamp,
     nearest_triangle_py,
     numba_available,
     numba_enabled,
@@ -180,3 +182,19 @@ def test_a_kernel_is_compiled_again_when_a_callee_it_inlines_changes() -> None:
     assert one["_caller"].py_func.__qualname__ != two["_caller"].py_func.__qualname__
     again = compile_family([("_callee", _callee_one), _caller])
     assert again["_caller"].py_func.__qualname__ == one["_caller"].py_func.__qualname__
+
+
+_STEP = 1.0
+
+
+def _uses_a_constant(x: float) -> float:
+    return x + _STEP
+
+
+def test_the_stamp_follows_the_module_constants_a_kernel_reads() -> None:
+    """numba compiles a module-level number in as a constant: a family reading another value
+    of it gets another stamp."""
+    f = _uses_a_constant
+    other = types.FunctionType(f.__code__, {**f.__globals__, "_STEP": 2.0}, f.__name__)
+    assert family_stamp([f]) == family_stamp([f])
+    assert family_stamp([f]) != family_stamp([other])

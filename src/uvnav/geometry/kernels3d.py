@@ -96,20 +96,23 @@ def family_stamp(
     items = [*(i if isinstance(i, tuple) else (i.__name__, i) for i in functions),
              *sorted((bound or {}).items())]  # fmt: skip
     for name, f in items:
-        digest.update(name.encode() + _code_bytes(getattr(f, "py_func", f).__code__))
+        py = getattr(f, "py_func", f)
+        digest.update(name.encode() + _code_bytes(py.__code__, py.__globals__))
     return digest.hexdigest()[:12]
 
 
-def _code_bytes(code: types.CodeType) -> bytes:
-    """What a code object computes, as bytes the same in every process (its bytecode, names
-    and constants, nested code included; ``marshal`` would not do: its output depends on
-    reference counts)."""
+def _code_bytes(code: types.CodeType, scope: Mapping[str, Any]) -> bytes:
+    """What a code object computes, as bytes the same in every process: its bytecode, names
+    and constants, nested code included, and the values of the module-level numbers and
+    strings it reads from ``scope`` (numba compiles those in as constants); ``marshal`` would
+    not do: its output depends on reference counts."""
     consts = [
-        _code_bytes(c) if isinstance(c, types.CodeType)
+        _code_bytes(c, scope) if isinstance(c, types.CodeType)
         else repr(sorted(map(repr, c)) if isinstance(c, frozenset) else c).encode()
         for c in code.co_consts
     ]  # fmt: skip
-    names = (*code.co_names, *code.co_varnames, *code.co_freevars, code.co_filename)
+    read = [repr(scope[n]) for n in code.co_names if isinstance(scope.get(n), int | float | str)]
+    names = (*code.co_names, *code.co_varnames, *code.co_freevars, code.co_filename, *read)
     return code.co_code + b"\0".join(consts) + "\0".join(names).encode()
 
 
