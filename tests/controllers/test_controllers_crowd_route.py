@@ -11,7 +11,7 @@ from hypothesis import strategies as st
 
 from uvnav.controllers.crowd_route import (
     CrowdRoute,
-    RouteSettings,
+    RouteParams,
     fan_way_points,
     route_costs,
     route_costs_py,
@@ -21,7 +21,7 @@ from uvnav.geometry.kernels3d import compiled
 from uvnav.sensors.observation import ObstacleReading
 
 GOAL = np.array([12.0, 0.0])
-ON = RouteSettings(weight=2.0)
+ON = RouteParams(route_weight=2.0)
 point = st.tuples(st.floats(-8.0, 8.0), st.floats(-8.0, 8.0)).map(np.array)
 
 
@@ -41,25 +41,25 @@ def stream(vx: float, vy: float) -> list[ObstacleReading]:
 
 
 def test_people_walking_on_the_way_are_gone_around() -> None:
-    route = CrowdRoute(ON)
+    route = CrowdRoute(ON, 0.1)
     aim = route.aim(np.zeros(2), GOAL, stream(-1.0, 0.0), 1.0)
     assert not np.array_equal(aim, GOAL)
     assert abs(aim[1]) > 1.0  # well off the direct line
-    assert math.hypot(*aim) == pytest.approx(ON.lookahead)
+    assert math.hypot(*aim) == pytest.approx(ON.route_lookahead)
 
 
 def test_a_clear_way_people_standing_or_the_layer_off_keep_the_goal() -> None:
     walking_far = [person(0, 0.0, 30.0, 1.0, 0.0)]
-    assert CrowdRoute(ON).aim(np.zeros(2), GOAL, walking_far, 1.0) is GOAL
-    assert CrowdRoute(ON).aim(np.zeros(2), GOAL, stream(0.0, 0.0), 1.0) is GOAL
-    assert CrowdRoute(ON).aim(np.zeros(2), GOAL, (), 1.0) is GOAL
-    assert CrowdRoute(RouteSettings()).aim(np.zeros(2), GOAL, stream(-1.0, 0.0), 1.0) is GOAL
+    assert CrowdRoute(ON, 0.1).aim(np.zeros(2), GOAL, walking_far, 1.0) is GOAL
+    assert CrowdRoute(ON, 0.1).aim(np.zeros(2), GOAL, stream(0.0, 0.0), 1.0) is GOAL
+    assert CrowdRoute(ON, 0.1).aim(np.zeros(2), GOAL, (), 1.0) is GOAL
+    assert CrowdRoute(RouteParams(), 0.1).aim(np.zeros(2), GOAL, stream(-1.0, 0.0), 1.0) is GOAL
     near = np.array([0.5, 0.0])
-    assert CrowdRoute(ON).aim(np.zeros(2), near, stream(-1.0, 0.0), 1.0) is near
+    assert CrowdRoute(ON, 0.1).aim(np.zeros(2), near, stream(-1.0, 0.0), 1.0) is near
 
 
 def test_the_way_point_is_held_until_another_is_clearly_better() -> None:
-    route = CrowdRoute(ON)
+    route = CrowdRoute(ON, 0.1)
     first = route.aim(np.zeros(2), GOAL, stream(-1.0, 0.0), 1.0).copy()
     # a step on, the same stream: the held way point wins over its neighbours in the fan
     again = route.aim(np.array([0.1, 0.0]), GOAL, stream(-1.0, 0.0), 1.0)
@@ -73,7 +73,7 @@ def test_the_way_point_is_held_until_another_is_clearly_better() -> None:
 def test_routes_are_no_shorter_than_the_direct_one(position: np.ndarray, goal: np.ndarray) -> None:
     ways = fan_way_points(position, goal, 4.0)
     assert np.array_equal(ways[0], goal)
-    length = route_costs(position, goal, ways, np.zeros((0, 5)), 1.0, RouteSettings(weight=1.0))
+    length = route_costs(position, goal, ways, np.zeros((0, 5)), 1.0, RouteParams(route_weight=1.0))
     direct = math.dist(position, goal)
     assert length[0] == pytest.approx(direct, abs=1e-9)
     assert (length >= direct - 1e-9).all()
@@ -93,8 +93,8 @@ def test_a_person_costs_one_per_metre_walked_through_them_and_nothing_far_off(
     ways = centre + np.array([[0.1, 0.0], [100.1, 100.0]])
     starts = (centre, centre + 100.0)
     for start, way in zip(starts, ways, strict=True):
-        bare = route_costs(start, way, way[None], body, 1e6, RouteSettings(weight=0.0))
-        paid = route_costs(start, way, way[None], body, 1e6, RouteSettings(weight=1.0))
+        bare = route_costs(start, way, way[None], body, 1e6, RouteParams(route_weight=0.0))
+        paid = route_costs(start, way, way[None], body, 1e6, RouteParams(route_weight=1.0))
         near = math.dist(start, centre) < 1.0
         assert paid[0] - bare[0] == pytest.approx(0.1 if near else 0.0, abs=1e-9)
 
@@ -109,7 +109,8 @@ def test_compiled_and_python_route_costs_agree(enabled: bool) -> None:
     with compiled(enabled):
         got = route_costs(position, goal, ways, bodies, 1.0, ON)
     want = np.empty(len(ways))
-    route_costs_py(0.0, -6.0, ways, 0.0, 6.0, bodies, 1.0, ON.sigma, ON.horizon, ON.weight, want)
+    sigma, horizon, weight = ON.route_sigma, ON.route_horizon, ON.route_weight
+    route_costs_py(0.0, -6.0, ways, 0.0, 6.0, bodies, 1.0, sigma, horizon, weight, want)
     assert np.allclose(got, want, rtol=1e-12, atol=1e-12)
 
 

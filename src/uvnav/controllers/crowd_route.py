@@ -42,9 +42,10 @@ from typing import Any
 import numpy as np
 
 from uvnav.controllers.base import check_params
+from uvnav.controllers.zhang2019_v2_bodies import body_table
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
-from uvnav.sensors.observation import ObstacleReading, Readings, read_arrays
+from uvnav.sensors.observation import ObstacleReading
 
 #: routes in the fan: the direct one and ``FAN - 1`` way points (the goal's direction excluded)
 FAN = 13
@@ -59,32 +60,9 @@ CUT = 5.0
 
 
 @dataclass(frozen=True)
-class RouteSettings:
-    """The route layer's settings.
-
-    Attributes:
-        weight: metres a route's length may grow to spare one unit of exposure; 0 turns the
-            layer off (the law steers for the goal).
-        sigma: spread [m] of a person's cost around where they will be.
-        lookahead: distance [m] of the way points from the robot.
-        hold: what the way point held from the last decision is spared [m].
-        horizon: how far ahead [s] the people's positions are forecast (constant velocity);
-            a later sample meets them where they are then.
-        min_speed: bodies slower than this [m/s] cost nothing.
-    """
-
-    weight: float = 0.0
-    sigma: float = 0.8
-    lookahead: float = 4.0
-    hold: float = 0.5
-    horizon: float = 2.0
-    min_speed: float = 0.1
-
-
-@dataclass(frozen=True)
 class RouteParams:
     """A law's parameters of the route layer (module docstring; the law gives the speed below
-    which a body costs nothing).
+    which a body costs nothing, :class:`CrowdRoute`'s ``min_speed``).
 
     Attributes:
         route_weight: metres a route may grow to spare one unit of exposure to walking people
@@ -104,11 +82,6 @@ class RouteParams:
     def __post_init__(self) -> None:
         check_params(self, positive=("route_sigma", "route_lookahead", "route_horizon"),
                      non_negative=("route_weight", "route_hold"))  # fmt: skip
-
-    def route_settings(self, min_speed: float) -> RouteSettings:
-        """These parameters as the layer's settings (``min_speed`` [m/s])."""
-        return RouteSettings(self.route_weight, self.route_sigma, self.route_lookahead,
-                             self.route_hold, self.route_horizon, min_speed)  # fmt: skip
 
 
 def fan_way_points(position: FloatArray, goal: FloatArray, lookahead: float) -> FloatArray:
@@ -205,13 +178,11 @@ def route_costs_py(
 def moving_bodies(readings: Sequence[ObstacleReading], min_speed: float) -> FloatArray:
     """The ``readings`` that move at ``min_speed`` [m/s] or faster, finite, as
     :func:`route_costs_py`'s ``bodies`` (N, 5): centre, velocity, radius (a polygon's bounding
-    radius) [m, m/s]; read from the sensor's arrays where it gives them."""
+    radius) [m, m/s]; read as v2 reads them (:func:`body_table`: the sensor's arrays where it
+    gives them)."""
     if not readings:
         return np.zeros((0, 5))
-    if isinstance(readings, Readings):
-        scal, centres, velocities = readings.arrays
-    else:
-        scal, centres, velocities = read_arrays(tuple(readings))
+    scal, centres, velocities = body_table(tuple(readings), 0.0)
     radii = np.where(scal[:, 2] > 0.0, scal[:, 2], scal[:, 3])
     table = np.column_stack((centres, velocities, radii))
     keep = np.hypot(velocities[:, 0], velocities[:, 1]) >= min_speed
@@ -220,14 +191,14 @@ def moving_bodies(readings: Sequence[ObstacleReading], min_speed: float) -> Floa
 
 def route_costs(
     position: FloatArray, goal: FloatArray, ways: FloatArray, bodies: FloatArray, v_max: float,
-    settings: RouteSettings,
+    params: RouteParams,
 ) -> FloatArray:  # fmt: skip
     """:func:`route_costs_py` (compiled when numba is enabled) of ``ways`` (K, 2), (K,) [m]."""
     out = np.empty(len(ways))
     fn = _compiled() if numba_enabled() else route_costs_py
-    s = settings
+    p = params
     fn(float(position[0]), float(position[1]), ways, float(goal[0]), float(goal[1]), bodies,
-       float(v_max), s.sigma, s.horizon, s.weight, out)  # fmt: skip
+       float(v_max), p.route_sigma, p.route_horizon, p.route_weight, out)  # fmt: skip
     return out
 
 
@@ -245,8 +216,9 @@ class CrowdRoute:
     """The route layer of one law (module docstring): :meth:`aim` each decision, :meth:`reset`
     each episode."""
 
-    def __init__(self, settings: RouteSettings) -> None:
-        self.settings = settings
+    def __init__(self, params: RouteParams, min_speed: float) -> None:
+        self.params = params
+        self.min_speed = min_speed
         self.way: FloatArray | None = None
 
     def reset(self) -> None:
@@ -261,21 +233,21 @@ class CrowdRoute:
         v_max: float,
     ) -> FloatArray:
         """The point to steer for [m], (2,): the goal or the chosen route's way point."""
-        s = self.settings
+        p = self.params
         position = np.asarray(position, dtype=float)[:2]
-        if s.weight <= 0.0 or not np.isfinite(position).all():
+        if p.route_weight <= 0.0 or not np.isfinite(position).all():
             return goal
-        bodies = moving_bodies(readings, s.min_speed)
+        bodies = moving_bodies(readings, self.min_speed)
         gap = goal - position
         if len(bodies) == 0 or math.hypot(gap[0], gap[1]) <= DIRECT_WITHIN:
             self.way = None
             return goal
-        ways = fan_way_points(position, goal, s.lookahead)
+        ways = fan_way_points(position, goal, p.route_lookahead)
         if self.way is not None:
             ways = np.vstack((ways, self.way[None]))
-        cost = route_costs(position, goal, ways, bodies, v_max, s)
+        cost = route_costs(position, goal, ways, bodies, v_max, p)
         if self.way is not None:
-            cost[-1] -= s.hold
+            cost[-1] -= p.route_hold
         k = int(np.argmin(cost))
         self.way = None if k == 0 else ways[k].copy()
         if self.way is None or math.dist(self.way, position) <= REACHED:

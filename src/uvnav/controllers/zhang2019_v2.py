@@ -678,7 +678,7 @@ class Zhang2019HolonomicV2(HolonomicLaw):
         self.last_choice: Choice | None = None
         self._tracker = _tracker(self.params)
         self._fixed = LoopConstants()
-        self._route = CrowdRoute(self.params.route_settings(self.params.comfort_min_speed))
+        self._route = CrowdRoute(self.params, self.params.comfort_min_speed)
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
@@ -713,7 +713,7 @@ class Zhang2019V2(UnicycleController):
         self._tracker = _tracker(self.params)
         self._fixed = LoopConstants()
         self._paths = PathConstants()
-        self._route = CrowdRoute(self.params.route_settings(self.params.comfort_min_speed))
+        self._route = CrowdRoute(self.params, self.params.comfort_min_speed)
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
