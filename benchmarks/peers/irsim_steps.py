@@ -8,6 +8,10 @@ constant command; the side judged against the targets, when this uvnav has it) a
 (``uvnav.sim.run_episode`` with ``zhang2019-v1`` and ``record=False``: sensing and a decision every
 step on top; judged when there is no packed step), and that loop again deciding with
 ``straight-v1``, whose decision reads only the goal (the loop's own cost, reported beside).
+Beside them, reported and not judged, the floor of any loop that asks a law written in Python
+at every step: the compiled world step with sensing called from a bare Python ``for``, plus
+``zhang2019-v1``'s ``act`` alone on the loop's observations (:func:`time_floor`); the loop
+targets' records carry it as their note.
 The ir-sim side is a YAML world generated at run time with *the same polygons* (same seed, same
 ``random_nonconvex`` bodies and start poses), the robot driven by a constant action ``[0.707, 0]``
 and the obstacles on ir-sim's own ``dash`` + ``wander`` behavior (drive to a random goal in the
@@ -224,20 +228,90 @@ def time_packed(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
     return {"seed": seed, "steps": n_steps - 1, "cpu_s": cpu, "status": status}
 
 
+def time_floor(n_obstacles: int, n_steps: int, seed: int, law: str = LOOP_LAW) -> dict[str, Any]:
+    """What no loop that asks a Python law at every step can go below, on the loop's scene:
+    CPU µs per step of (a) the world's compiled step with sensing, called from a bare Python
+    loop (:class:`~uvnav.sim.bodies2d.PackedBodies.step`: every obstacle's motion, the
+    clearance and the readings within 8 m, in one call; the robot moved on a constant command
+    by two lines of Python) and (b) ``law``'s ``act`` alone, on the observations the loop gave
+    it over the first ``n_steps // 10`` steps of the same episode (replayed in order, in a
+    bare ``for``)."""
+    from uvnav.controllers.base import make_law
+    from uvnav.core import BaseProbe
+    from uvnav.sim.episode import World2D
+    from uvnav.sim.run import run_episode
+
+    world = World2D(world_setup(n_obstacles, n_steps, seed), np.random.default_rng(seed),
+                    exact=False, packed=True)  # fmt: skip
+    bodies, radius = world.bodies, float(CH2_SPEC.radius)
+    x, t, step = 0.0, 0.0, CH2_SPEC.v_max * DT
+    bodies.step(t, DT, x, 0.0, radius, 8.0)  # not timed: compiles (or loads the cache)
+    cpu0 = peerstats.cpu_s()
+    for _ in range(n_steps - 1):
+        x += step
+        t += DT
+        bodies.step(t, DT, x, 0.0, radius, 8.0)
+    world_us = (peerstats.cpu_s() - cpu0) / (n_steps - 1) * 1e6
+
+    class Keep(BaseProbe):
+        def __init__(self) -> None:
+            self.seen: list[Any] = []
+
+        def on_decision(self, world: Any, agent: int, law: Any, obs: Any, applied: Any) -> None:
+            self.seen.append(obs)
+
+    keep, short = Keep(), max(n_steps // 10, 2)
+    run_episode(world_setup(n_obstacles, short, seed), make_law(law),
+                np.random.default_rng(seed), record=False, probes=[keep])  # fmt: skip
+    actor = make_law(law)
+    spec, goal, rng = world.law_setup()
+    actor.reset(spec, goal, rng)
+    actor.act(keep.seen[0])  # not timed: the first decision's warm-up
+    cpu0 = peerstats.cpu_s()
+    for obs in keep.seen:
+        actor.act(obs)
+    act_us = (peerstats.cpu_s() - cpu0) / len(keep.seen) * 1e6
+    return {"seed": seed, "world_sense_us": world_us, "act_us": act_us,
+            "floor_us": world_us + act_us}  # fmt: skip
+
+
+def floor_summary(runs: list[dict[str, Any]]) -> dict[str, Any]:
+    """The medians over ``runs`` of :func:`time_floor`'s parts [µs per step]."""
+    med = {k: float(np.median([r[k] for r in runs])) for k in ("world_sense_us", "act_us")}
+    return {**med, "floor_us": med["world_sense_us"] + med["act_us"], "law": LOOP_LAW,
+            "runs": runs}  # fmt: skip
+
+
+def floor_note(row: dict[str, Any]) -> str | None:
+    """The floor of a loop that asks a Python law at every step, as a record's note."""
+    floor, ratio = row.get("floor"), row.get("ratio_floor_over_irsim")
+    if floor is None or ratio is None:
+        return None
+    return (
+        f"no loop can beat {ratio:,.0f}x here: the compiled world and sensing step "
+        f"({floor['world_sense_us']:.2f} µs) plus the law's act alone "
+        f"({floor['act_us']:.2f} µs) take {floor['floor_us']:.2f} µs a step"
+    )
+
+
 def targets(results: dict[str, Any]) -> dict[str, Any]:
     """Issue 20's world-step targets judged on the medians in ``results`` (keyed by N)."""
     out: dict[str, Any] = {}
     for key, (n, what, limit, direction) in TARGETS.items():
         row = results.get(str(n), {})
+        note = None
         if key.startswith("vs_irsim"):
             measured = row.get("ratio_uvnav_over_irsim")
         elif key.startswith("loop_vs_irsim"):  # the loop is the judged side without packed
             measured = row.get("ratio_loop_over_irsim", row.get("ratio_uvnav_over_irsim"))
+            note = floor_note(row)
         else:
             measured = row.get("uvnav", {}).get("median_us_per_step")
         out[key] = {"what": what, **peerstats.judge(measured, limit, direction)}
         if measured is None and "vs_irsim" in key:
             out[key]["note"] = "ir-sim not available: not measured"
+        elif note is not None:
+            out[key]["note"] = note
     return out
 
 
@@ -279,6 +353,7 @@ def main(argv: list[str] | None = None) -> int:
             ir_runs: list[dict[str, Any]] = []
             loop_runs: list[dict[str, Any]] = []
             bare_runs: list[dict[str, Any]] = []
+            floor_runs: list[dict[str, Any]] = []
             packed_runs: list[dict[str, Any]] = []
             for r in range(repeats):  # interleaved so drifting machine load hits every side
                 if available:
@@ -287,6 +362,7 @@ def main(argv: list[str] | None = None) -> int:
                     packed_runs.append(time_packed(n, uv_steps, r))
                 loop_runs.append(time_uvnav(n, uv_steps, r))
                 bare_runs.append(time_uvnav(n, uv_steps, r, BARE_LAW))
+                floor_runs.append(time_floor(n, uv_steps, r))
             loop = {"side": LOOP, **peerstats.summarize(loop_runs), "runs": loop_runs}
             bare = {"side": BARE, **peerstats.summarize(bare_runs), "runs": bare_runs}
             row: dict[str, Any] = {"irsim": {"available": False}}
@@ -295,6 +371,7 @@ def main(argv: list[str] | None = None) -> int:
                 row["uvnav"]["runs"] = packed_runs
                 row["uvnav_loop"] = loop
                 row["uvnav_loop_bare"] = bare
+                row["floor"] = floor_summary(floor_runs)
             else:
                 row["uvnav"] = loop
             uv = row["uvnav"]
@@ -315,6 +392,9 @@ def main(argv: list[str] | None = None) -> int:
                     )
                     row["ratio_loop_bare_over_irsim"] = peerstats.ratio(
                         ir["median_us_per_step"], bare["median_us_per_step"]
+                    )
+                    row["ratio_floor_over_irsim"] = peerstats.ratio(
+                        ir["median_us_per_step"], row["floor"]["floor_us"]
                     )
             warnings = [
                 f"uvnav run {i} ended early ({x['status']})"
@@ -362,6 +442,9 @@ def main(argv: list[str] | None = None) -> int:
             f"{LOOP_LAW} decision every step",
             "uvnav loop, bare": f"the same loop deciding with {BARE_LAW} (it reads only the goal): "
             "the loop's own cost without the law's",
+            "floor": "reported, not judged: the compiled world step with sensing called from a "
+            f"bare Python loop, plus {LOOP_LAW}'s act alone on the loop's observations; what "
+            "no loop that asks a Python law at every step can go below",
         },
         "results": results,
         "targets": judged,
@@ -376,7 +459,7 @@ def main(argv: list[str] | None = None) -> int:
     print(f"world step, CPU time, median of {repeats} runs" + (" (quick)" if args.quick else ""))
     print(f"uvnav judged: {PACKED if packed else LOOP}")
     head = f"{'N':>4} {'ir-sim µs/step':>15} {'uvnav µs/step':>14} {'uvnav/ir-sim':>13}"
-    loop_head = f" {'loop µs/step':>13} {'loop/ir-sim':>12} {'bare µs/step':>13}"
+    loop_head = f" {'loop µs/step':>13} {'loop/ir-sim':>12} {'bare µs':>8} {'floor µs':>9}"
     print(head + (loop_head if packed else ""))
     for n, row in results.items():
         ir_us = row.get("irsim", {}).get("median_us_per_step")
@@ -388,7 +471,8 @@ def main(argv: list[str] | None = None) -> int:
         if packed:
             loop_us = row["uvnav_loop"]["median_us_per_step"]
             line += f" {fmt(loop_us, 13, 1)} {fmt(row.get('ratio_loop_over_irsim'), 11, 2)}x"
-            line += f" {fmt(row['uvnav_loop_bare']['median_us_per_step'], 13, 1)}"
+            line += f" {fmt(row['uvnav_loop_bare']['median_us_per_step'], 8, 1)}"
+            line += f" {fmt(row['floor']['floor_us'], 9, 2)}"
         print(line)
         for w in row.get("warnings", []):
             print(f"      warning: {w}")

@@ -9,6 +9,7 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
+import numpy as np
 import pytest
 
 BENCH = Path(__file__).resolve().parents[2] / "benchmarks"
@@ -84,6 +85,22 @@ def test_irsim_targets(peer_module: Any) -> None:
     del results["100"]["ratio_uvnav_over_irsim"]
     t = irsim_steps.targets(results)
     assert t["vs_irsim_100"]["pass"] is None and "not measured" in t["vs_irsim_100"]["note"]
+
+
+def test_irsim_floor_parts_and_note(peer_module: Any) -> None:
+    irsim_steps = peer_module("irsim_steps")
+    runs = [irsim_steps.time_floor(10, 40, seed) for seed in (0, 1, 2)]
+    for run in runs:
+        assert run["world_sense_us"] > 0.0 and run["act_us"] > 0.0
+        assert run["floor_us"] == pytest.approx(run["world_sense_us"] + run["act_us"])
+    floor = irsim_steps.floor_summary(runs)
+    assert floor["world_sense_us"] == pytest.approx(np.median([r["world_sense_us"] for r in runs]))
+    row = {"uvnav": {"median_us_per_step": 1.0}, "ratio_loop_over_irsim": 40.0,
+           "floor": floor, "ratio_floor_over_irsim": 101.4}  # fmt: skip
+    t = irsim_steps.targets({"10": row})["loop_vs_irsim_10"]
+    assert t["pass"] is False and t["note"].startswith("no loop can beat 101x here")
+    del row["ratio_floor_over_irsim"]  # ir-sim not measured: no floor ratio to state
+    assert "note" not in irsim_steps.targets({"10": row})["loop_vs_irsim_10"]
 
 
 def test_navground_orca_judges_the_swarm_and_the_loop(peer_module: Any) -> None:
