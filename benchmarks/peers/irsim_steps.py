@@ -231,7 +231,7 @@ def time_packed(n_obstacles: int, n_steps: int, seed: int) -> dict[str, Any]:
 def time_floor(n_obstacles: int, n_steps: int, seed: int, law: str = LOOP_LAW) -> dict[str, Any]:
     """What no loop that asks a Python law at every step can go below, on the loop's scene:
     CPU µs per step of (a) the world's compiled step with sensing, called from a bare Python
-    loop (:class:`~uvnav.sim.bodies2d.PackedBodies.step`: every obstacle's motion, the
+    loop (:class:`~uvnav.sim.bodies2d.PackedBodies.measure`: every obstacle's motion, the
     clearance and the readings within 8 m, in one call; the robot moved on a constant command
     by two lines of Python) and (b) ``law``'s ``act`` alone, on the observations the loop gave
     it over the first ``n_steps // 10`` steps of the same episode (replayed in order, in a
@@ -245,12 +245,12 @@ def time_floor(n_obstacles: int, n_steps: int, seed: int, law: str = LOOP_LAW) -
                     exact=False, packed=True)  # fmt: skip
     bodies, radius = world.bodies, float(CH2_SPEC.radius)
     x, t, step = 0.0, 0.0, CH2_SPEC.v_max * DT
-    bodies.step(t, DT, x, 0.0, radius, 8.0)  # not timed: compiles (or loads the cache)
+    bodies.measure(t, DT, x, 0.0, radius, 8.0)  # not timed: compiles (or loads the cache)
     cpu0 = peerstats.cpu_s()
     for _ in range(n_steps - 1):
         x += step
         t += DT
-        bodies.step(t, DT, x, 0.0, radius, 8.0)
+        bodies.measure(t, DT, x, 0.0, radius, 8.0)
     world_us = (peerstats.cpu_s() - cpu0) / (n_steps - 1) * 1e6
 
     class Keep(BaseProbe):
