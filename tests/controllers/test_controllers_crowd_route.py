@@ -10,9 +10,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from uvnav.controllers.crowd_route import (
+    CUT,
+    SPACING,
     CrowdRoute,
     RouteParams,
     fan_way_points,
+    moving_bodies,
+    nearest,
     route_costs,
     route_costs_py,
 )
@@ -68,6 +72,47 @@ def test_the_way_point_is_held_until_another_is_clearly_better() -> None:
     assert route.way is None
 
 
+def test_a_route_period_holds_the_last_search_until_it_runs_out() -> None:
+    """With ``route_period`` the fan is searched again only once the period has passed (or the
+    way point is reached): in between, a crowd that walks off the way does not move the aim."""
+    route = CrowdRoute(RouteParams(route_weight=2.0, route_period=0.75), 0.1)
+    first = route.aim(np.zeros(2), GOAL, stream(-1.0, 0.0), 1.0, 0.0).copy()
+    assert not np.array_equal(first, GOAL)
+    gone = [person(0, 0.0, 30.0, 1.0, 0.0)]  # the way is clear now
+    assert np.array_equal(route.aim(np.zeros(2), GOAL, gone, 1.0, 0.5), first)
+    assert route.aim(np.zeros(2), GOAL, gone, 1.0, 0.75) is GOAL  # searched again
+    every = CrowdRoute(ON, 0.1)  # period 0: every decision searches
+    every.aim(np.zeros(2), GOAL, stream(-1.0, 0.0), 1.0, 0.0)
+    assert every.aim(np.zeros(2), GOAL, gone, 1.0, 0.25) is GOAL
+    # a way point reached, or the goal within DIRECT_WITHIN, ends the hold at once
+    route.reset()
+    way = route.aim(np.zeros(2), GOAL, stream(-1.0, 0.0), 1.0, 0.0).copy()
+    assert route.aim(way, GOAL, gone, 1.0, 0.25) is GOAL
+    near = np.array([0.5, 0.0])
+    assert route.aim(np.zeros(2), near, stream(-1.0, 0.0), 1.0, 0.3) is near
+
+
+def test_route_bodies_keeps_the_nearest_walking_people() -> None:
+    crowd = [*stream(-1.0, 0.0), person(9, 0.0, 30.0, 1.0, 0.0)]
+    table = moving_bodies(crowd, 0.1)
+    two = nearest(table, np.zeros(2), 2)
+    assert two[:, :2].tolist() == [[2.0, 0.0], [3.0, 0.5]]
+    assert nearest(table, np.zeros(2), 0) is table
+    assert nearest(table, np.zeros(2), len(table)) is table
+    # only the far walker kept: the direct route is clear of it
+    far_only = CrowdRoute(RouteParams(route_weight=2.0, route_bodies=1), 0.1)
+    assert far_only.aim(np.zeros(2), GOAL, [person(0, 0.0, 30.0, 1.0, 0.0)], 1.0) is GOAL
+    # the nearest walks off the way, the stream behind it blocks it: costed only with all
+    aside = [person(8, 0.5, -1.0, 0.0, -1.0), *stream(-1.0, 0.0)]
+    one = CrowdRoute(RouteParams(route_weight=2.0, route_bodies=1), 0.1)
+    assert one.aim(np.zeros(2), GOAL, aside, 1.0) is GOAL
+    assert not np.array_equal(CrowdRoute(ON, 0.1).aim(np.zeros(2), GOAL, aside, 1.0), GOAL)
+    with pytest.raises(ValueError, match="route_bodies must be an integer >= 0"):
+        RouteParams(route_bodies=-1)
+    with pytest.raises(ValueError, match="route_period must be a number >= 0"):
+        RouteParams(route_period=-0.5)
+
+
 @settings(max_examples=60, deadline=None)
 @given(position=point, goal=point)
 def test_routes_are_no_shorter_than_the_direct_one(position: np.ndarray, goal: np.ndarray) -> None:
@@ -80,6 +125,49 @@ def test_routes_are_no_shorter_than_the_direct_one(position: np.ndarray, goal: n
     assert np.allclose(
         length[1:], np.hypot(*(ways[1:] - position).T) + np.hypot(*(goal - ways[1:]).T)
     )
+
+
+def every_pair_costs(position: np.ndarray, goal: np.ndarray, ways: np.ndarray,
+                     bodies: np.ndarray, p: RouteParams) -> np.ndarray:  # fmt: skip
+    """The exposure of every sample over every body, nothing culled, in the kernel's order
+    (samples in turn, bodies in turn): what :func:`route_costs_py` must give."""
+    far, sigma, out = (CUT * p.route_sigma) ** 2, p.route_sigma, np.zeros(len(ways))
+    for k, way in enumerate(ways):
+        length, cost = 0.0, 0.0
+        for a, b in ((position, way), (way, goal)):
+            d = b - a
+            size = math.sqrt(d[0] * d[0] + d[1] * d[1])
+            n = max(math.ceil(size / SPACING), 1)
+            for j in range(n):
+                s = a + d * ((j + 0.5) / n)
+                t = min((length + size / n * (j + 0.5)) / 1.0, p.route_horizon)
+                for c in bodies:
+                    e = s - c[:2] - c[2:4] * t
+                    gap = math.sqrt(e[0] * e[0] + e[1] * e[1]) - c[4]
+                    if gap <= 0.0:
+                        cost += size / n
+                    elif gap * gap < far:
+                        cost += size / n * math.exp(-0.5 * (gap / sigma) ** 2)
+            length += size
+        out[k] = length + p.route_weight * cost
+    return out
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), n=st.integers(0, 30), sigma=st.sampled_from([0.3, 0.8]))
+def test_culling_samples_out_of_reach_changes_no_bit(seed: int, n: int, sigma: float) -> None:
+    """The kernel visits each body's samples within its reach only; the pairs it skips add
+    nothing, so its costs are those of every pair, to the bit."""
+    rng = np.random.default_rng(seed)
+    bodies = np.column_stack([rng.uniform(-10, 10, (n, 2)), rng.uniform(-1.5, 1.5, (n, 2)),
+                              rng.uniform(0.2, 0.6, n)])  # fmt: skip
+    position, goal = rng.uniform(-8, 8, 2), rng.uniform(-8, 8, 2)
+    ways = np.vstack((fan_way_points(position, goal, 4.0), position[None]))  # a leg of no length
+    p = RouteParams(route_weight=2.0, route_sigma=sigma)
+    got = np.empty(len(ways))
+    route_costs_py(position[0], position[1], ways, goal[0], goal[1], bodies, 1.0, sigma,
+                   p.route_horizon, 2.0, got)  # fmt: skip
+    assert np.array_equal(got, every_pair_costs(position, goal, ways, bodies, p))
 
 
 @settings(max_examples=60, deadline=None)

@@ -21,10 +21,14 @@ keeps a decision within tens of microseconds:
   radius ``r_i``: a polygon's bounding radius).  People standing still are left to the local
   law, which keeps clear of them; counting them would hold the robot off a goal beside which
   someone stands.  One loop over routes, samples and bodies (:func:`route_costs_py`, compiled
-  by numba when it is enabled) skips the pairs more than ``CUT`` sigmas apart.
+  by numba when it is enabled) visits each body's samples within its reach only and skips the
+  pairs more than ``CUT`` sigmas apart.  ``route_bodies`` > 0 costs only the nearest that
+  many walking people.
 * **Choice.**  The route of least ``length + weight * exposure`` [m].  The robot steers for its
   way point, or for the goal when the direct route wins, the goal is within ``DIRECT_WITHIN``
-  m, no moving body is sensed, or the way point is within ``REACHED`` m.
+  m, no moving body is sensed, or the way point is within ``REACHED`` m.  With
+  ``route_period`` > 0 the fan is searched again only once that period has passed (or the way
+  point is reached), the last choice held in between.
 
 The bodies are those the robot senses (a person out of range costs nothing), with the rates the
 readings give (true or estimated).  Measured on the harder crowd (``crowd-dynamic``, tuning
@@ -57,6 +61,10 @@ DIRECT_WITHIN = 1.0
 REACHED = 0.5
 #: a body farther than this many sigmas from a sample adds nothing to it
 CUT = 5.0
+#: added to a body's reach [m] when its samples are culled (rounding never drops one in reach)
+REACH_SLACK = 1e-6
+#: the fan's directions [rad] from the goal's, the goal's own left out
+_FAN_ANGLES = np.delete(np.linspace(-math.pi / 2, math.pi / 2, FAN), FAN // 2)
 
 
 @dataclass(frozen=True)
@@ -71,6 +79,10 @@ class RouteParams:
         route_lookahead: distance [m] of the route's way points from the robot.
         route_hold: metres the way point held from the last decision is spared.
         route_horizon: how far ahead [s] the people's positions are forecast.
+        route_period: the fan is searched at most once every ``route_period`` [s]; in between
+            the law steers for the point the last search chose (while the goal is farther than
+            ``DIRECT_WITHIN`` m and the way point than ``REACHED`` m); 0: every decision.
+        route_bodies: only the nearest ``route_bodies`` walking people are costed; 0: all.
     """
 
     route_weight: float = 0.0
@@ -78,10 +90,14 @@ class RouteParams:
     route_lookahead: float = 4.0
     route_hold: float = 0.5
     route_horizon: float = 2.0
+    route_period: float = 0.0
+    route_bodies: int = 0
 
     def __post_init__(self) -> None:
         check_params(self, positive=("route_sigma", "route_lookahead", "route_horizon"),
-                     non_negative=("route_weight", "route_hold"))  # fmt: skip
+                     non_negative=("route_weight", "route_hold", "route_period"))  # fmt: skip
+        if not isinstance(self.route_bodies, int) or self.route_bodies < 0:
+            raise ValueError(f"route_bodies must be an integer >= 0 (got {self.route_bodies!r})")
 
 
 def fan_way_points(position: FloatArray, goal: FloatArray, lookahead: float) -> FloatArray:
@@ -93,27 +109,38 @@ def fan_way_points(position: FloatArray, goal: FloatArray, lookahead: float) -> 
     """
     gap = goal - position
     reach = min(lookahead, math.hypot(gap[0], gap[1]))
-    fan = np.delete(np.linspace(-math.pi / 2, math.pi / 2, FAN), FAN // 2)  # the goal's own
-    angles = math.atan2(gap[1], gap[0]) + fan
+    angles = math.atan2(gap[1], gap[0]) + _FAN_ANGLES
     ways = position + reach * np.column_stack((np.cos(angles), np.sin(angles)))
     return np.vstack((goal[None], ways))
 
 
-def _near_leg(ax: float, ay: float, dx: float, dy: float, bodies: FloatArray, horizon: float,
-              cut: float, near: np.ndarray) -> int:  # fmt: skip
-    """The bodies (:func:`route_costs_py`'s) that may come within ``cut`` [m] of the leg from
-    ``(ax, ay)`` along ``(dx, dy)`` within ``horizon`` [s], into ``near``; returns how many:
-    a body is left out when its centre is farther from the leg than its radius, ``cut`` and
-    the way it walks in ``horizon`` together."""
+def _near_leg(ax: float, ay: float, dx: float, dy: float, n: int, bodies: FloatArray,
+              horizon: float, cut: float, near: np.ndarray, span: np.ndarray) -> int:  # fmt: skip
+    """The bodies (:func:`route_costs_py`'s) that may come within ``cut`` [m] of one of the
+    ``n`` samples of the leg from ``(ax, ay)`` along ``(dx, dy)`` (at ``u = (j + 0.5) / n``)
+    within ``horizon`` [s], into ``near``, and the first and last such sample of each into
+    ``span`` (m, 2); returns how many.  A sample farther from a body's centre than its radius,
+    ``cut`` and the way it walks in ``horizon`` together is out of its reach (the exposure
+    adds nothing there), and a body with no sample in reach is left out."""
     dd = dx * dx + dy * dy
     m = 0
     for i in range(bodies.shape[0]):
         cx, cy = bodies[i, 0] - ax, bodies[i, 1] - ay
-        u = 0.0 if dd <= 0.0 else min(max((cx * dx + cy * dy) / dd, 0.0), 1.0)
-        ex, ey = cx - u * dx, cy - u * dy
         walk = math.sqrt(bodies[i, 2] ** 2 + bodies[i, 3] ** 2) * horizon
-        if math.sqrt(ex * ex + ey * ey) <= bodies[i, 4] + cut + walk:
-            near[m] = i
+        reach = bodies[i, 4] + cut + walk + REACH_SLACK
+        along = cx * dx + cy * dy
+        rest = cx * cx + cy * cy - reach * reach
+        if dd <= 0.0:  # a leg of no length: its samples all lie at its start
+            first, last = (0, n - 1) if rest <= 0.0 else (n, -1)
+        else:
+            disc = along * along - dd * rest
+            if disc < 0.0:
+                continue
+            root = math.sqrt(disc)
+            first = max(math.ceil((along - root) / dd * n - 0.5), 0)
+            last = min(math.floor((along + root) / dd * n - 0.5), n - 1)
+        if first <= last:
+            near[m], span[m, 0], span[m, 1] = i, first, last
             m += 1
     return m
 
@@ -136,7 +163,8 @@ def route_costs_py(
     -> ``ways[k]`` -> goal ``(gx, gy)``, each leg cut into ``ceil(length / SPACING)`` equal
     pieces sampled at their midpoints; the module docstring's exposure of each sample over the
     ``bodies`` (N, 5): centre x, y [m], velocity x, y [m/s], radius [m], the robot at ``v_max``
-    [m/s]; a body more than ``CUT`` sigmas off a sample adds nothing to it (under 4e-6).
+    [m/s]; a body more than ``CUT`` sigmas off a sample adds nothing to it (under 4e-6), and
+    only the samples within its reach (:func:`_near_leg`) are visited.
 
     >>> out = np.zeros(2)
     >>> one = np.array([[2.0, 0.0, 0.0, 0.0, 0.3]])
@@ -147,6 +175,7 @@ def route_costs_py(
     """
     far = (CUT * sigma) ** 2
     near = np.empty(bodies.shape[0], dtype=np.int64)
+    span = np.empty((bodies.shape[0], 2), dtype=np.int64)
     for k in range(ways.shape[0]):
         wx, wy = ways[k, 0], ways[k, 1]
         length = 0.0
@@ -155,15 +184,20 @@ def route_costs_py(
             ax, ay = (px, py) if leg == 0 else (wx, wy)
             bx, by = (wx, wy) if leg == 0 else (gx, gy)
             dx, dy = bx - ax, by - ay
-            span = math.sqrt(dx * dx + dy * dy)
-            m = _near_leg(ax, ay, dx, dy, bodies, horizon, CUT * sigma, near)
-            n = max(math.ceil(span / SPACING), 1)
-            piece = span / n
-            for j in range(n if m > 0 else 0):
+            size = math.sqrt(dx * dx + dy * dy)
+            n = max(math.ceil(size / SPACING), 1)
+            m = _near_leg(ax, ay, dx, dy, n, bodies, horizon, CUT * sigma, near, span)
+            piece = size / n
+            lo = span[:m, 0].min() if m > 0 else n
+            hi = span[:m, 1].max() if m > 0 else -1
+            for j in range(lo, hi + 1):
                 u = (j + 0.5) / n
                 sx, sy = ax + dx * u, ay + dy * u
                 t = min((length + piece * (j + 0.5)) / v_max, horizon)
-                for i in near[:m]:
+                for q in range(m):
+                    if j < span[q, 0] or j > span[q, 1]:
+                        continue
+                    i = near[q]
                     ex = sx - bodies[i, 0] - bodies[i, 2] * t
                     ey = sy - bodies[i, 1] - bodies[i, 3] * t
                     gap = math.sqrt(ex * ex + ey * ey) - bodies[i, 4]
@@ -171,8 +205,14 @@ def route_costs_py(
                         cost += piece
                     elif gap * gap < far:
                         cost += piece * math.exp(-0.5 * (gap / sigma) ** 2)
-            length += span
+            length += size
         out[k] = length + weight * cost
+
+
+def _as_tuple(readings: Sequence[ObstacleReading]) -> tuple[ObstacleReading, ...]:
+    """``readings`` as a tuple: themselves when they are one (the sensor's
+    :class:`~uvnav.sensors.observation.Readings` keep their arrays), else a copy."""
+    return readings if isinstance(readings, tuple) else tuple(readings)
 
 
 def moving_bodies(readings: Sequence[ObstacleReading], min_speed: float) -> FloatArray:
@@ -182,11 +222,21 @@ def moving_bodies(readings: Sequence[ObstacleReading], min_speed: float) -> Floa
     gives them)."""
     if not readings:
         return np.zeros((0, 5))
-    scal, centres, velocities = body_table(tuple(readings), 0.0)
+    scal, centres, velocities = body_table(_as_tuple(readings), 0.0)
     radii = np.where(scal[:, 2] > 0.0, scal[:, 2], scal[:, 3])
     table = np.column_stack((centres, velocities, radii))
     keep = np.hypot(velocities[:, 0], velocities[:, 1]) >= min_speed
     return table[keep & np.isfinite(table).all(axis=1)]
+
+
+def nearest(bodies: FloatArray, position: FloatArray, count: int) -> FloatArray:
+    """The ``count`` rows of ``bodies`` (:func:`moving_bodies`) whose centres lie nearest
+    ``position`` [m] (nearest first), or all of them, as they are, when ``count`` is 0 or no
+    fewer than the rows."""
+    if count <= 0 or len(bodies) <= count:
+        return bodies
+    gap = np.hypot(bodies[:, 0] - position[0], bodies[:, 1] - position[1])
+    return bodies[np.argsort(gap, kind="stable")[:count]]
 
 
 def route_costs(
@@ -220,10 +270,20 @@ class CrowdRoute:
         self.params = params
         self.min_speed = min_speed
         self.way: FloatArray | None = None
+        self.next_search = -math.inf
 
     def reset(self) -> None:
-        """Forget the held way point."""
+        """Forget the held way point and search at the next decision."""
         self.way = None
+        self.next_search = -math.inf
+
+    def _held(self, position: FloatArray, goal: FloatArray, time: float) -> FloatArray | None:
+        """The point the last search chose while ``route_period`` holds it (``None``: search)."""
+        if time >= self.next_search or math.dist(goal, position) <= DIRECT_WITHIN:
+            return None
+        if self.way is None:
+            return goal
+        return None if math.dist(self.way, position) <= REACHED else self.way
 
     def aim(
         self,
@@ -231,13 +291,18 @@ class CrowdRoute:
         goal: FloatArray,
         readings: Sequence[ObstacleReading],
         v_max: float,
+        time: float = 0.0,
     ) -> FloatArray:
-        """The point to steer for [m], (2,): the goal or the chosen route's way point."""
+        """The point to steer for [m], (2,) at ``time`` [s]: the goal or the chosen route's way
+        point."""
         p = self.params
         position = np.asarray(position, dtype=float)[:2]
         if p.route_weight <= 0.0 or not np.isfinite(position).all():
             return goal
-        bodies = moving_bodies(readings, self.min_speed)
+        held = self._held(position, goal, time) if p.route_period > 0.0 else None
+        if held is not None:
+            return held
+        bodies = nearest(moving_bodies(readings, self.min_speed), position, p.route_bodies)
         gap = goal - position
         if len(bodies) == 0 or math.hypot(gap[0], gap[1]) <= DIRECT_WITHIN:
             self.way = None
@@ -250,6 +315,7 @@ class CrowdRoute:
             cost[-1] -= p.route_hold
         k = int(np.argmin(cost))
         self.way = None if k == 0 else ways[k].copy()
+        self.next_search = time + p.route_period
         if self.way is None or math.dist(self.way, position) <= REACHED:
             return goal
         return self.way

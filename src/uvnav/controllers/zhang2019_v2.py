@@ -691,7 +691,7 @@ class Zhang2019HolonomicV2(HolonomicLaw):
         if not finite_position(obs.pose):
             return VelocityCommand(0.0, 0.0)
         obs = tracked(obs, self._tracker)
-        goal = self._route.aim(obs.position, self._goal, obs.obstacles, spec.v_max)
+        goal = self._route.aim(obs.position, self._goal, obs.obstacles, spec.v_max, obs.time)
         choice = plan(obs, goal, spec.v_max, spec.radius, period,
                       self.current_velocity(obs), self.params,
                       constants=self._fixed.get(self.params, self._spec))  # fmt: skip
@@ -728,7 +728,7 @@ class Zhang2019V2(UnicycleController):
         if not (finite_position(obs.pose) and math.isfinite(obs.pose[2])):
             return UnicycleCommand(0.0, 0.0)
         obs = tracked(obs, self._tracker)
-        goal = self._route.aim(obs.position, self._goal, obs.obstacles, spec.v_max)
+        goal = self._route.aim(obs.position, self._goal, obs.obstacles, spec.v_max, obs.time)
         if self.params.rollout_paths or not spec.ideal:
             return self._act_limited(obs, period, goal)
         choice = plan(obs, goal, spec.v_max, spec.radius, period, self._aim, self.params,
