@@ -46,6 +46,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.controllers.base import check_params
+from uvnav.controllers.crowd_grid import GRID_AHEAD, GRID_SIGMA, grid_way_point
 from uvnav.controllers.zhang2019_v2_bodies import body_table
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
@@ -83,6 +84,10 @@ class RouteParams:
             the law steers for the point the last search chose (while the goal is farther than
             ``DIRECT_WITHIN`` m and the way point than ``REACHED`` m); 0: every decision.
         route_bodies: only the nearest ``route_bodies`` walking people are costed; 0: all.
+        route_limited_weight: on a vehicle with acceleration limits, the route is planned on
+            a grid instead (:mod:`~uvnav.controllers.crowd_grid`, every body costed, walking
+            or standing) with this weight [m per unit of exposure], whatever ``route_weight``
+            says; 0: as on the ideal vehicle.
     """
 
     route_weight: float = 0.0
@@ -92,10 +97,12 @@ class RouteParams:
     route_horizon: float = 2.0
     route_period: float = 0.0
     route_bodies: int = 0
+    route_limited_weight: float = 3.0
 
     def __post_init__(self) -> None:
         check_params(self, positive=("route_sigma", "route_lookahead", "route_horizon"),
-                     non_negative=("route_weight", "route_hold", "route_period"))  # fmt: skip
+                     non_negative=("route_weight", "route_hold", "route_period",
+                                   "route_limited_weight"))  # fmt: skip
         if not isinstance(self.route_bodies, int) or self.route_bodies < 0:
             raise ValueError(f"route_bodies must be an integer >= 0 (got {self.route_bodies!r})")
 
@@ -271,11 +278,14 @@ class CrowdRoute:
         self.min_speed = min_speed
         self.way: FloatArray | None = None
         self.next_search = -math.inf
+        self.limited = False
 
-    def reset(self) -> None:
-        """Forget the held way point and search at the next decision."""
+    def reset(self, limited: bool = False) -> None:
+        """Forget the held way point and search at the next decision; ``limited``: the
+        vehicle has acceleration limits (the grid route, ``route_limited_weight``)."""
         self.way = None
         self.next_search = -math.inf
+        self.limited = limited
 
     def _held(self, position: FloatArray, goal: FloatArray, time: float) -> FloatArray | None:
         """The point the last search chose while ``route_period`` holds it (``None``: search)."""
@@ -297,6 +307,8 @@ class CrowdRoute:
         point."""
         p = self.params
         position = np.asarray(position, dtype=float)[:2]
+        if self.limited and p.route_limited_weight > 0.0:
+            return self._grid_aim(position, goal, readings, v_max)
         if p.route_weight <= 0.0 or not np.isfinite(position).all():
             return goal
         held = self._held(position, goal, time) if p.route_period > 0.0 else None
@@ -319,3 +331,17 @@ class CrowdRoute:
         if self.way is None or math.dist(self.way, position) <= REACHED:
             return goal
         return self.way
+
+    def _grid_aim(self, position: FloatArray, goal: FloatArray,
+                  readings: Sequence[ObstacleReading], v_max: float) -> FloatArray:  # fmt: skip
+        """The grid route's way point (:func:`~uvnav.controllers.crowd_grid.grid_way_point`
+        over every sensed body), or the goal when it is within ``DIRECT_WITHIN`` m or nothing
+        is sensed."""
+        p = self.params
+        if not np.isfinite(position).all() or math.dist(goal, position) <= DIRECT_WITHIN:
+            return goal
+        bodies = moving_bodies(readings, 0.0)
+        if len(bodies) == 0:
+            return goal
+        return grid_way_point(position, goal, bodies, v_max, p.route_horizon, GRID_SIGMA,
+                              p.route_limited_weight, GRID_AHEAD)  # fmt: skip

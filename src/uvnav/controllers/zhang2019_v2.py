@@ -62,9 +62,9 @@ so safety (the first contact, ``min_ttc``) still ranks first, and the branch-and
 a lower bound. On a vehicle with acceleration limits the rolled-out paths' segments that start
 before T_s are read the same way (:func:`path_social`); figures: ``docs/design-notes.md``.
 
-**A route around the crowd** (``route_*``; on by default on the holonomic robot only): the law
-steers for the way point of the route of least length plus crowd exposure, not for T itself
-(:mod:`uvnav.controllers.crowd_route`).
+**A route around the crowd** (``route_*``): the law steers for a way point, not for T itself: a
+fan of routes on the holonomic robot (:mod:`uvnav.controllers.crowd_route`), a grid path with
+acceleration limits (:mod:`uvnav.controllers.crowd_grid`); off on the ideal unicycle.
 
 **Declared noise.** Each body is grown by ``noise_sigmas`` times the centre noise its reading
 declares (``position_std``) in the one body table every decision path reads
@@ -717,7 +717,7 @@ class Zhang2019V2(UnicycleController):
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
-        self._route.reset()
+        self._route.reset(limited=not self._spec.ideal)
         self._aim = np.zeros(2)
         self._tracker = _tracker(self.params)
         self._turn = (0.0, 0.0)  # the turn rate at the last decision and the one commanded

@@ -1,0 +1,137 @@
+"""The grid route around the crowd (uvnav.controllers.crowd_grid) and the limited v2 using it."""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from uvnav.controllers.base import make_law
+from uvnav.controllers.crowd_grid import (
+    CELL,
+    REACH,
+    exposure_map_py,
+    grid_way_point,
+    grid_way_point_py,
+    least_cost_path_py,
+)
+from uvnav.controllers.crowd_route import CrowdRoute, RouteParams
+from uvnav.dynamics.unicycle import UnicycleSpec
+from uvnav.geometry.kernels3d import compiled
+from uvnav.sensors.observation import ObstacleReading
+
+LIMITED = UnicycleSpec(v_max=1.0, u_max=2.0, radius=0.3, accel_max=1.0, turn_accel_max=2.0)
+
+
+def person(k: int, x: float, y: float, vx: float = 0.0, vy: float = 0.0) -> ObstacleReading:
+    """A disc of radius 0.3 m seen from the origin."""
+    c, r = np.array([x, y]), 0.3
+    d = float(np.hypot(x, y))
+    return ObstacleReading(k, max(d - r, 0.0), c * (1.0 - r / max(d, 1e-9)), c,
+                           np.array([vx, vy]), 0.0, np.zeros((0, 2)), r, r)  # fmt: skip
+
+
+def wall(gap_y: float) -> np.ndarray:
+    """People standing shoulder to shoulder across x = 3 m, from y = -6 to 6 m, but for a gap
+    about ``gap_y``: the bodies table (centre, velocity, radius)."""
+    ys = [y for y in np.arange(-6.0, 6.01, 0.5) if abs(y - gap_y) > 1.0]
+    return np.array([[3.0, y, 0.0, 0.0, 0.3] for y in ys])
+
+
+def octile(a: tuple[int, int], b: tuple[int, int]) -> float:
+    """The shortest 8-connected path length between two cells, in cells."""
+    dx, dy = abs(a[0] - b[0]), abs(a[1] - b[1])
+    return max(dx, dy) + (math.sqrt(2.0) - 1.0) * min(dx, dy)
+
+
+cells = st.tuples(st.integers(0, 9), st.integers(0, 7))
+
+
+@settings(max_examples=60, deadline=None)
+@given(cells, cells, st.integers(0, 2**32 - 1))
+def test_the_path_is_connected_and_on_free_ground_as_short_as_any(
+    start: tuple[int, int], goal: tuple[int, int], seed: int
+) -> None:
+    cost = np.random.default_rng(seed).uniform(0.0, 3.0, (10, 8))
+    path = np.zeros(80, dtype=np.int64)
+    n = least_cost_path_py(cost, *start, *goal, 1.0, path)
+    steps = [divmod(int(k), 8) for k in path[:n]]
+    assert steps[0] == start and steps[-1] == goal
+    assert all(max(abs(a[0] - b[0]), abs(a[1] - b[1])) == 1 for a, b in itertools.pairwise(steps))
+    n = least_cost_path_py(np.zeros((10, 8)), *start, *goal, 1.0, path)
+    steps = [divmod(int(k), 8) for k in path[:n]]
+    length = sum(math.dist(a, b) for a, b in itertools.pairwise(steps))
+    assert length == pytest.approx(octile(start, goal))
+
+
+def test_a_cell_costs_by_where_a_walker_will_be_when_the_robot_gets_there() -> None:
+    out = np.zeros((1, 1))
+    walker = np.array([[2.0, 2.0, 0.0, -1.0, 0.3]])  # walks down onto the cell in 2 s
+    exposure_map_py(1.875, -0.125, 0.0, 0.0, walker, 1.0, 2.0, 0.5, out)  # cell at (2, 0)
+    assert out[0, 0] == pytest.approx(1.0)  # reached at t = 2 s, when the walker is there
+    exposure_map_py(1.875, -0.125, 0.0, 0.0, walker, 1.0, 0.5, 0.5, out)  # forecast capped
+    assert out[0, 0] == pytest.approx(math.exp(-0.5 * ((1.5 - 0.3) / 0.5) ** 2))
+
+
+def test_the_way_point_heads_for_the_gap_in_a_wall_of_people() -> None:
+    for gap_y in (-3.0, 3.0):
+        way = grid_way_point(np.zeros(2), np.array([6.0, 0.0]), wall(gap_y), 1.0, 2.0, 0.6,
+                             3.0, 2.0)  # fmt: skip
+        assert np.sign(way[1]) == np.sign(gap_y) and abs(way[1]) > 0.5
+        assert math.hypot(*way) == pytest.approx(2.0, abs=2 * CELL)
+
+
+def test_on_open_ground_the_way_point_lies_ahead_on_the_line_and_far_goals_are_cut() -> None:
+    far = np.array([[0.0, 40.0, 0.0, 0.0, 0.3]])
+    way = grid_way_point(np.zeros(2), np.array([30.0, 0.0]), far, 1.0, 2.0, 0.6, 3.0, 2.0)
+    assert way[0] == pytest.approx(2.0, abs=CELL) and abs(way[1]) <= CELL
+    way = grid_way_point(np.zeros(2), np.array([30.0, 0.0]), far, 1.0, 2.0, 0.6, 3.0, 99.0)
+    assert way.tolist() == pytest.approx([REACH, 0.0])  # the path is shorter: its (sub)goal
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_compiled_search_agrees_with_plain_python(seed: int) -> None:
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(0, 15))
+    bodies = np.column_stack([rng.uniform(-5, 5, (n, 2)), rng.uniform(-1, 1, (n, 2)),
+                              rng.uniform(0.2, 0.5, n)])  # fmt: skip
+    pos, goal = rng.uniform(-5, 5, 2), rng.uniform(-5, 5, 2)
+    ref = np.empty(2)
+    grid_way_point_py(pos[0], pos[1], goal[0], goal[1], bodies, 1.0, 2.0, 0.6, 3.0, 2.0, ref)
+    with compiled(True):
+        got = grid_way_point(pos, goal, bodies, 1.0, 2.0, 0.6, 3.0, 2.0)
+    assert got.tolist() == ref.tolist()
+
+
+def test_the_route_plans_on_the_grid_only_for_a_limited_vehicle() -> None:
+    goal = np.array([6.0, 0.0])
+    people = [person(k, 3.0, y) for k, y in enumerate(np.arange(-6.0, 6.01, 0.5))
+              if abs(y - 3.0) > 1.0]  # fmt: skip
+    route = CrowdRoute(RouteParams(), 0.1)
+    route.reset(limited=True)
+    aim = route.aim(np.zeros(2), goal, people, 1.0)
+    assert aim[1] > 0.5  # toward the gap, standing people counted
+    route.reset(limited=False)
+    assert route.aim(np.zeros(2), goal, people, 1.0) is goal  # the fan is off by default
+    off = CrowdRoute(RouteParams(route_limited_weight=0.0), 0.1)
+    off.reset(limited=True)
+    assert off.aim(np.zeros(2), goal, people, 1.0) is goal
+    route.reset(limited=True)
+    assert route.aim(np.zeros(2), goal, (), 1.0) is goal
+    assert route.aim(np.array([5.5, 0.0]), goal, people, 1.0) is goal  # within 1 m of it
+
+
+def test_zhang2019_v2_plans_the_grid_route_with_acceleration_limits_only() -> None:
+    law = make_law("zhang2019-v2")
+    law.reset(LIMITED, np.array([6.0, 0.0]), np.random.default_rng(0))
+    assert law._route.limited
+    law.reset(UnicycleSpec(v_max=1.0, u_max=2.0, radius=0.3), np.zeros(2),
+              np.random.default_rng(0))  # fmt: skip
+    assert not law._route.limited
+    with pytest.raises(ValueError, match="route_limited_weight"):
+        make_law("zhang2019-v2", route_limited_weight=-1.0)
