@@ -30,6 +30,11 @@ keeps a decision within tens of microseconds:
   ``route_period`` > 0 the fan is searched again only once that period has passed (or the way
   point is reached), the last choice held in between.
 
+On a vehicle with acceleration limits (:meth:`CrowdRoute.reset` is told) the route is planned
+on a grid instead (:mod:`uvnav.controllers.crowd_grid`, ``route_limited_weight``): a path that
+bends round a crowd of any shape, standing people counted, for a vehicle that cannot sidestep
+once the crowd is upon it.
+
 The bodies are those the robot senses (a person out of range costs nothing), with the rates the
 readings give (true or estimated).  Measured on the harder crowd (``crowd-dynamic``, tuning
 cases 0-99, holonomic): success 0.84 -> 0.98, intrusion ratio 0.205 -> 0.023, time to goal
