@@ -22,9 +22,10 @@ in its simplest form:
 
 Measured on CrowdNav's circle with 20 humans, the unicycle limited to 1 m/s^2 and 2 rad/s^2
 (tuning cases 0-99): ``zhang2019-v2`` 0.57 without a route, 0.64-0.68 with the fan of
-:mod:`~uvnav.controllers.crowd_route`, 0.70-0.73 with this grid (``docs/design-notes.md``).
-One search is one compiled call (numba when enabled, plain Python otherwise), about a
-millisecond for 20 people over a 16 x 8 m box.  Units: metres, seconds.
+:mod:`~uvnav.controllers.crowd_route`, 0.75 with this grid; on held-out cases 100-499 0.531
+without, 0.741 with it (``docs/design-notes.md``).  One search is one compiled call (numba when
+enabled, plain Python otherwise), about 0.24 ms for 20 people over a 16 x 8 m box.  Units:
+metres, seconds.
 """
 
 from __future__ import annotations
