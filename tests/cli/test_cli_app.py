@@ -354,6 +354,15 @@ def test_controllers_list_fits_an_80_column_terminal(monkeypatch: pytest.MonkeyP
     assert v1.endswith("*") and out[-1].startswith("* requires obstacles slower")
 
 
+def test_controllers_show_wraps_long_descriptions_in_a_pipe() -> None:
+    from uvnav.cli.controllers import DESCRIPTION_WIDTH
+
+    out = invoke("controllers", "show", "zhang2019-v2").stdout
+    rows = [line for line in out.splitlines() if line.startswith("│")]
+    assert rows and max(len(line) for line in rows) <= 80 + DESCRIPTION_WIDTH
+    assert any(line.startswith("│ route_limited_weight ") for line in rows)  # names whole
+
+
 def test_controllers_show_reads_without_python_types_or_markup() -> None:
     shown = json.loads(invoke("controllers", "show", "zhang2019-v1", "--json").stdout)
     by_name = {p["name"]: p for p in shown["params"]}

@@ -21,6 +21,9 @@ from uvnav.dynamics.vehicles import vehicle_names
 
 controllers_app = uvnav_typer(help="Registered navigation laws.")
 
+#: the widest a parameter's description runs before it wraps [columns]
+DESCRIPTION_WIDTH = 56
+
 
 def _param_rows(info: ControllerInfo) -> list[dict[str, Any]]:
     rows = []
@@ -153,7 +156,7 @@ def controllers_show(
     table.add_column("name", no_wrap=True)
     table.add_column("type")
     table.add_column("default", justify="right")
-    table.add_column("description")
+    table.add_column("description", max_width=DESCRIPTION_WIDTH)  # wrapped, in a pipe too
     for row in rows:
         table.add_row(
             _text(row["name"]), _text(row["type"]), _text(_fmt(row["default"])), _text(row["doc"])
