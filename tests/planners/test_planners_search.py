@@ -11,7 +11,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from uvnav.planners import astar, dijkstra, grid_edges, path_cost
-from uvnav.planners.search import MOVES
+from uvnav.planners.search import MOVES, costed_dijkstra
 
 
 @st.composite
@@ -87,3 +87,37 @@ def test_bad_inputs() -> None:
         astar(occ, (0, 0), (5, 5))
     with pytest.raises(ValueError, match="heuristic"):
         astar(occ, (0, 0), (2, 2), heuristic="manhattan")  # type: ignore[arg-type]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.tuples(st.integers(0, 9), st.integers(0, 7)), st.tuples(st.integers(0, 9),
+       st.integers(0, 7)), st.integers(0, 2**32 - 1))  # fmt: skip
+def test_costed_dijkstra_is_connected_cheapest_and_octile_on_free_ground(
+    start: tuple[int, int], goal: tuple[int, int], seed: int
+) -> None:
+    cost = np.random.default_rng(seed).uniform(0.0, 3.0, (10, 8))
+    path = costed_dijkstra(cost, start, goal, weight=2.0)
+    cells = [tuple(c) for c in path.cells.tolist()]
+    assert cells[0] == start and cells[-1] == goal
+    steps = np.abs(np.diff(path.cells, axis=0))
+    assert (steps.max(axis=1) == 1).all() if len(steps) else start == goal
+    moves = np.hypot(*np.diff(path.cells, axis=0).T)
+    mean = 0.5 * (cost[tuple(path.cells[:-1].T)] + cost[tuple(path.cells[1:].T)])
+    assert path.cost == pytest.approx(float((moves * (1.0 + 2.0 * mean)).sum()))
+    straight = costed_dijkstra(cost, start, goal, weight=0.0)  # no cost: the shortest
+    assert straight.cost == pytest.approx(dijkstra(np.zeros((10, 8), bool), start, goal).cost)
+    assert (
+        path.cost
+        <= float(
+            (
+                np.hypot(*np.diff(straight.cells, axis=0).T)
+                * (
+                    1.0
+                    + 2.0
+                    * 0.5
+                    * (cost[tuple(straight.cells[:-1].T)] + cost[tuple(straight.cells[1:].T)])
+                )
+            ).sum()
+        )
+        + 1e-9
+    )

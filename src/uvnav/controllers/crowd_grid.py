@@ -16,21 +16,21 @@ in its simplest form:
   a crowd that has come to a halt is what a slow vehicle must go around.  A body more than
   ``CUT`` sigmas off adds nothing.
 * **The path.**  Dijkstra over the 8-connected cells from the robot's cell to the goal's, a
-  step between two cells costing its length times ``1 + weight * (mean of their costs)``.
+  step between two cells costing its length times ``1 + weight * (mean of their costs)``
+  (:func:`uvnav.planners.search.costed_dijkstra`, scipy's).
 * **The way point.**  The cell centre ``ahead`` m along the path (path length counted from the
   robot), or the goal when the path is shorter.
 
 Measured on CrowdNav's circle with 20 humans, the unicycle limited to 1 m/s^2 and 2 rad/s^2
 (tuning cases 0-99): ``zhang2019-v2`` 0.57 without a route, 0.64-0.68 with the fan of
 :mod:`~uvnav.controllers.crowd_route`, 0.75 with this grid; on held-out cases 100-499 0.531
-without, 0.741 with it (``docs/design-notes.md``).  One search is one compiled call (numba when
-enabled, plain Python otherwise), about 0.24 ms for 20 people over a 16 x 8 m box.  Units:
-metres, seconds.
+without, 0.741 with it (``docs/design-notes.md``).  One search is the exposure map in one
+compiled call (numba when enabled, plain Python otherwise) and scipy's Dijkstra: 0.56 ms CPU
+for 20 people over a 16 x 8 m box.  Units: metres, seconds.
 """
 
 from __future__ import annotations
 
-import heapq
 import math
 from collections.abc import Callable
 from typing import Any
@@ -39,6 +39,7 @@ import numpy as np
 
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
+from uvnav.planners.search import costed_dijkstra
 
 #: the side of a cell [m]
 CELL = 0.25
@@ -84,99 +85,44 @@ def exposure_map_py(x0: float, y0: float, px: float, py: float, bodies: FloatArr
             out[i, j] = total
 
 
-def least_cost_path_py(cost: FloatArray, si: int, sj: int, gi: int, gj: int, weight: float,
-                       path: np.ndarray) -> int:  # fmt: skip
-    """Dijkstra over the 8-connected cells of ``cost`` (nx, ny) from ``(si, sj)`` to ``(gi,
-    gj)``, a step costing its length (in cells) times ``1 + weight * (mean of the two cells'
-    costs)``: the cells of the cheapest path, robot first, as flat indices ``i * ny + j`` in
-    ``path`` (nx * ny,); returns how many.
-
-    >>> cost = np.zeros((3, 3)); cost[1, :2] = 10.0  # a wall with a gap at the top
-    >>> path = np.zeros(9, dtype=np.int64)
-    >>> n = least_cost_path_py(cost, 0, 0, 2, 0, 1.0, path)
-    >>> [divmod(int(k), 3) for k in path[:n]]
-    [(0, 0), (0, 1), (1, 2), (2, 1), (2, 0)]
-    """
-    nx, ny = cost.shape
-    dist = np.full(nx * ny, np.inf)
-    prev = np.full(nx * ny, -1, dtype=np.int64)
-    start, goal = si * ny + sj, gi * ny + gj
-    dist[start] = 0.0
-    heap = [(0.0, start)]
-    while heap:
-        d, k = heapq.heappop(heap)
-        if k == goal:
-            break
-        if d > dist[k]:
-            continue
-        i, j = k // ny, k % ny
-        for di in range(-1, 2):
-            for dj in range(-1, 2):
-                a, b = i + di, j + dj
-                if (di == 0 and dj == 0) or a < 0 or b < 0 or a >= nx or b >= ny:
-                    continue
-                step = math.sqrt(di * di + dj * dj)
-                nd = d + step * (1.0 + weight * 0.5 * (cost[i, j] + cost[a, b]))
-                if nd < dist[a * ny + b]:
-                    dist[a * ny + b] = nd
-                    prev[a * ny + b] = k
-                    heapq.heappush(heap, (nd, a * ny + b))
-    n = 0
-    k = goal
-    while k >= 0:
-        path[n] = k
-        n += 1
-        k = prev[k] if k != start else -1
-    path[:n] = path[:n][::-1].copy()
-    return n
-
-
-def grid_way_point_py(px: float, py: float, gx: float, gy: float, bodies: FloatArray, v: float,
-                      horizon: float, sigma: float, weight: float, ahead: float,
-                      out: FloatArray) -> None:  # fmt: skip
-    """The module docstring's way point from the robot ``(px, py)`` toward the goal ``(gx,
-    gy)`` [m] into ``out`` (2,): :func:`exposure_map_py`, :func:`least_cost_path_py`, then the
-    cell centre ``ahead`` [m] along the path (the goal, or the sub-goal ``REACH`` m toward it,
-    when the path is shorter)."""
-    dx, dy = gx - px, gy - py
-    dist = math.sqrt(dx * dx + dy * dy)
+def grid_way_point(
+    position: FloatArray, goal: FloatArray, bodies: FloatArray, v_max: float, horizon: float,
+    sigma: float, weight: float, ahead: float,
+) -> FloatArray:  # fmt: skip
+    """The module docstring's way point [m], (2,), from the robot at ``position`` toward
+    ``goal``: :func:`exposure_map_py` (compiled when numba is enabled), the cheapest path over it
+    (:func:`uvnav.planners.search.costed_dijkstra`), then the cell centre ``ahead`` [m] along
+    the path (the goal, or the sub-goal ``REACH`` m toward it, when the path is shorter)."""
+    px, py = float(position[0]), float(position[1])
+    gx, gy = float(goal[0]), float(goal[1])
+    dist = math.hypot(gx - px, gy - py)
     if dist > REACH:
-        gx, gy = px + dx * (REACH / dist), py + dy * (REACH / dist)
+        gx, gy = px + (gx - px) * (REACH / dist), py + (gy - py) * (REACH / dist)
     x0, y0 = min(px, gx) - PAD, min(py, gy) - PAD
-    nx = int(math.ceil((max(px, gx) + PAD - x0) / CELL))  # noqa: RUF046 (numba: a float)
-    ny = int(math.ceil((max(py, gy) + PAD - y0) / CELL))  # noqa: RUF046
+    nx = math.ceil((max(px, gx) + PAD - x0) / CELL)
+    ny = math.ceil((max(py, gy) + PAD - y0) / CELL)
     cost = np.empty((nx, ny))
-    exposure_map_py(x0, y0, px, py, bodies, v, horizon, sigma, cost)
-    si, sj = min(int((px - x0) / CELL), nx - 1), min(int((py - y0) / CELL), ny - 1)
-    gi, gj = min(int((gx - x0) / CELL), nx - 1), min(int((gy - y0) / CELL), ny - 1)
-    path = np.empty(nx * ny, dtype=np.int64)
-    n = least_cost_path_py(cost, si, sj, gi, gj, weight, path)
-    out[0], out[1] = gx, gy
-    walked, lx, ly = 0.0, px, py
-    for q in range(1, n):
-        cx = x0 + (path[q] // ny + 0.5) * CELL
-        cy = y0 + (path[q] % ny + 0.5) * CELL
-        walked += math.sqrt((cx - lx) ** 2 + (cy - ly) ** 2)
-        lx, ly = cx, cy
-        if walked >= ahead:
-            out[0], out[1] = cx, cy
-            return
+    _exposure()(x0, y0, px, py, np.ascontiguousarray(bodies, dtype=float), float(v_max),
+                float(horizon), float(sigma), cost)  # fmt: skip
+
+    def cell(x: float, y: float) -> tuple[int, int]:
+        return min(int((x - x0) / CELL), nx - 1), min(int((y - y0) / CELL), ny - 1)
+
+    path = costed_dijkstra(cost, cell(px, py), cell(gx, gy), weight=weight).cells
+    centres = np.array([x0, y0]) + (path[1:] + 0.5) * CELL
+    walked = np.cumsum(np.hypot(*np.diff(np.vstack(([px, py], centres)), axis=0).T))
+    far = np.flatnonzero(walked >= ahead)
+    return centres[far[0]].copy() if len(far) else np.array([gx, gy])
 
 
 _COMPILED: dict[str, Callable[..., Any]] = {}
 
 
-def grid_way_point(
-    position: FloatArray, goal: FloatArray, bodies: FloatArray, v_max: float, horizon: float,
-    sigma: float, weight: float, ahead: float,
-) -> FloatArray:  # fmt: skip
-    """:func:`grid_way_point_py` (compiled when numba is enabled): the way point [m], (2,)."""
-    if not _COMPILED and numba_enabled():
-        fam = (exposure_map_py, least_cost_path_py, grid_way_point_py)
-        _COMPILED.update(compile_family(fam))
-    fn = _COMPILED["grid_way_point_py"] if numba_enabled() else grid_way_point_py
-    out = np.empty(2)
-    fn(float(position[0]), float(position[1]), float(goal[0]), float(goal[1]),
-       np.ascontiguousarray(bodies, dtype=float), float(v_max), float(horizon), float(sigma),
-       float(weight), float(ahead), out)  # fmt: skip
-    return out
+def _exposure() -> Callable[..., Any]:
+    """:func:`exposure_map_py`, compiled by numba when it is enabled (on the first call, or from
+    numba's cache)."""
+    if not numba_enabled():
+        return exposure_map_py
+    if not _COMPILED:
+        _COMPILED.update(compile_family((exposure_map_py,)))
+    return _COMPILED["exposure_map_py"]

@@ -119,18 +119,47 @@ def dijkstra(occupied: np.ndarray, start: Cell, goal: Cell, *, resolution: float
     ``expanded`` is the number of vertices with a finite distance (scipy searches them all when
     given no ``limit``).
     """
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import dijkstra as sp_dijkstra
-
     occ = np.asarray(occupied, dtype=bool)
     _check_cells(occ, start, goal)
-    rows, cols = occ.shape
-    n = rows * cols
-    s = start[0] * cols + start[1]
-    g = goal[0] * cols + goal[1]
     if occ[start] or occ[goal]:
         return _no_path(0)
     src, dst, w = grid_edges(occ, resolution)
+    return _scipy_path(src, dst, w, occ.shape, start, goal)
+
+
+def costed_dijkstra(
+    cell_cost: np.ndarray, start: Cell, goal: Cell, *, weight: float = 1.0,
+    resolution: float = 1.0,
+) -> GridPath:  # fmt: skip
+    """Cheapest 8-connected path from ``start`` to ``goal`` (row, col) over a grid of free cells
+    that each cost something (``cell_cost``, >= 0): a move costs its length [m] times ``1 +
+    weight * (mean of its two cells' costs)``; scipy's Dijkstra on :func:`grid_edges`' graph.
+    ``cost`` is the path's cost in those units.
+
+    >>> cost = np.zeros((3, 3)); cost[1, :2] = 10.0  # a costly wall with a gap at one end
+    >>> costed_dijkstra(cost, (0, 0), (2, 0)).cells.tolist()
+    [[0, 0], [0, 1], [1, 2], [2, 1], [2, 0]]
+    """
+    cost = np.asarray(cell_cost, dtype=float)
+    _check_cells(cost, start, goal)
+    src, dst, length = grid_edges(np.zeros(cost.shape, dtype=bool), resolution)
+    flat = cost.ravel()
+    w = length * (1.0 + weight * 0.5 * (flat[src] + flat[dst]))
+    return _scipy_path(src, dst, w, cost.shape, start, goal)
+
+
+def _scipy_path(
+    src: np.ndarray, dst: np.ndarray, w: np.ndarray, shape: tuple[int, ...], start: Cell,
+    goal: Cell,
+) -> GridPath:  # fmt: skip
+    """scipy's Dijkstra on the directed edges ``src`` -> ``dst`` of cost ``w`` of a grid of
+    ``shape``, from ``start`` to ``goal``."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import dijkstra as sp_dijkstra
+
+    rows, cols = shape
+    n = rows * cols
+    s, g = start[0] * cols + start[1], goal[0] * cols + goal[1]
     graph = csr_matrix((w, (src, dst)), shape=(n, n))
     dist, pred = sp_dijkstra(graph, directed=True, indices=s, return_predecessors=True)
     expanded = int(np.isfinite(dist).sum())
