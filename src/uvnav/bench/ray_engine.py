@@ -58,7 +58,7 @@ from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import ExitStack, contextmanager, redirect_stdout
 from pathlib import Path
-from types import ModuleType
+from types import FrameType, ModuleType
 from typing import Any, TextIO
 
 from uvnav.bench.jobs import TASK_SECONDS, Job, JobOutcome, TaskSizer, sized_batches
@@ -464,17 +464,36 @@ def _probe() -> tuple[str, str]:
 
 #: the thread of Ray's driver that prints cluster notices (``ray._private.worker``)
 RAY_NOTICE_THREAD = "ray_listen_error_messages"
+#: the function of Ray's driver that prints its notices and the workers' log lines
+RAY_PRINTER = "print_worker_logs"
 log = logging.getLogger(__name__)
 
 
+def _from_ray_printer() -> bool:
+    """Whether :meth:`_NoticeFilter.write` was called from Ray's :data:`RAY_PRINTER` (through
+    at most three frames: it prints with a ``print`` of Ray's own), as the notices are that
+    Ray held back as repeats and prints from the main thread when it disconnects."""
+    frame: FrameType | None = sys._getframe(2)
+    for _ in range(4):
+        if frame is None:
+            return False
+        code = frame.f_code
+        if code.co_name == RAY_PRINTER and "ray" in code.co_filename:
+            return True
+        frame = frame.f_back
+    return False
+
+
 class _NoticeFilter(io.TextIOBase):
-    """``sys.stdout`` less what Ray's notice thread writes, which goes to this module's log."""
+    """``sys.stdout`` less what Ray's notice thread writes and what Ray's log printer writes
+    from any thread, which go to this module's log.  (The workers' own output never reaches
+    the printer here: every ``ray.init`` of this module passes ``log_to_driver=False``.)"""
 
     def __init__(self, target: TextIO) -> None:
         self._target = target
 
     def write(self, text: str) -> int:
-        if threading.current_thread().name == RAY_NOTICE_THREAD:
+        if threading.current_thread().name == RAY_NOTICE_THREAD or _from_ray_printer():
             if text.strip():
                 log.info("ray: %s", text.strip())
             return len(text)
@@ -487,8 +506,9 @@ class _NoticeFilter(io.TextIOBase):
 @contextmanager
 def _ray_notices_logged() -> Iterator[None]:
     """Ray's driver prints cluster notices on stdout from a thread of its own: a task retried
-    because its node died, a node marked dead (even one of an earlier session).  For the
-    duration they go to this module's log instead, so that stdout carries only the command's
+    because its node died, a node marked dead (even one of an earlier session); the repeats it
+    held back it prints from the main thread as it disconnects.  For the duration they go to
+    this module's log instead, so that stdout carries only the command's
     output (``--json``) and stderr its one-line errors; everything else printed is unchanged."""
     with redirect_stdout(_NoticeFilter(sys.stdout)):
         yield
