@@ -10,7 +10,14 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from uvnav.controllers.base import make_law
-from uvnav.controllers.crowd_grid import CELL, REACH, _exposure, exposure_map_py, grid_way_point
+from uvnav.controllers.crowd_grid import (
+    CELL,
+    REACH,
+    _exposure,
+    exposure_map_py,
+    grid_bodies,
+    grid_way_point,
+)
 from uvnav.controllers.crowd_route import CrowdRoute, RouteParams
 from uvnav.dynamics.unicycle import UnicycleSpec
 from uvnav.geometry.kernels3d import compiled
@@ -89,6 +96,30 @@ def test_the_route_plans_on_the_grid_only_for_a_limited_vehicle() -> None:
     route.reset(limited=True)
     assert route.aim(np.zeros(2), goal, (), 1.0) is goal
     assert route.aim(np.array([5.5, 0.0]), goal, people, 1.0) is goal  # within 1 m of it
+
+
+def slab(k: int, y0: float, y1: float) -> ObstacleReading:
+    """A static wall 0.2 m thick across x = 3 m from ``y0`` to ``y1`` [m], seen from the
+    origin."""
+    outline = np.array([[3.0, y0], [3.2, y0], [3.2, y1], [3.0, y1]])
+    c = outline.mean(axis=0)
+    bound = float(np.hypot(*(outline - c).T).max())
+    return ObstacleReading(k, 3.0, np.array([3.0, 0.0]), c, np.zeros(2), 0.0, outline, 0.0,
+                           bound)  # fmt: skip
+
+
+def test_a_wall_costs_along_its_outline_and_the_route_heads_for_its_doorway() -> None:
+    """A wall with a doorway, as two polygons: the route plans round their outlines (read as
+    discs along them, not as their bounding discs, which put the doorway at y = -2 m inside
+    both) and heads for the doorway, on either side."""
+    route = CrowdRoute(RouteParams(), 0.1)
+    route.reset(limited=True)
+    for gap in (-2.0, 2.0):
+        walls = (slab(0, -8.0, gap - 0.8), slab(1, gap + 0.8, 8.0))
+        bodies = grid_bodies(walls)
+        assert np.abs(bodies[:, 0] - 3.1).max() <= 0.1 + 1e-9  # on the outlines
+        aim = route.aim(np.zeros(2), np.array([6.0, 0.0]), walls, 1.0)
+        assert np.sign(aim[1]) == np.sign(gap) and abs(aim[1]) > 1.0, gap
 
 
 def test_zhang2019_v2_plans_the_grid_route_with_acceleration_limits_only() -> None:

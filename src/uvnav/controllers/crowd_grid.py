@@ -13,8 +13,9 @@ in its simplest form:
   (straight-line time: no path search per time); it costs
   ``sum_i exp(-max(||c - q_i - w_i min(t, horizon)|| - r_i, 0)^2 / (2 sigma^2))`` over every
   sensed body ``i`` (centre ``q_i``, velocity ``w_i``, radius ``r_i``), walking or standing:
-  a crowd that has come to a halt is what a slow vehicle must go around.  A body more than
-  ``CUT`` sigmas off adds nothing.
+  a crowd that has come to a halt is what a slow vehicle must go around.  A polygon (a wall)
+  counts as discs along its outline (:func:`grid_bodies`): its bounding disc would cover a
+  corridor or a doorway whole.  A body more than ``CUT`` sigmas off adds nothing.
 * **The path.**  Dijkstra over the 8-connected cells from the robot's cell to the goal's, a
   step between two cells costing its length times ``1 + weight * (mean of their costs)``
   (:func:`uvnav.planners.search.costed_dijkstra`, scipy's).
@@ -32,14 +33,16 @@ for 20 people over a 16 x 8 m box.  Units: metres, seconds.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
 
+from uvnav.controllers.zhang2019_v2_bodies import boundary_discs
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
 from uvnav.planners.search import costed_dijkstra
+from uvnav.sensors.observation import ObstacleReading
 
 #: the side of a cell [m]
 CELL = 0.25
@@ -53,6 +56,32 @@ CUT = 5.0
 GRID_SIGMA = 0.6
 #: how far along the path [m] the law's way point lies
 GRID_AHEAD = 2.0
+#: a polygon's outline is read as discs this far apart [m]
+OUTLINE_SPACING = 2 * CELL
+
+
+def grid_bodies(readings: Sequence[ObstacleReading]) -> FloatArray:
+    """The sensed bodies as :func:`exposure_map_py`'s ``bodies`` (N, 5), finite rows only: a
+    disc as itself, a polygon as discs along its outline ``OUTLINE_SPACING`` m apart, each of
+    half that radius, moving with the body (:func:`~uvnav.controllers.zhang2019_v2_bodies.
+    boundary_discs`, as v2 reads bodies), so that a wall costs where it stands, not over its
+    bounding disc.
+
+    >>> from uvnav.sensors.observation import ObstacleReading
+    >>> z = np.zeros(2)
+    >>> wall = np.array([[0.0, -2.0], [0.2, -2.0], [0.2, 2.0], [0.0, 2.0]])
+    >>> rd = ObstacleReading(0, 1.0, z, np.array([0.1, 0.0]), z, 0.0, wall, 0.0, 2.0)
+    >>> b = grid_bodies((rd,))
+    >>> len(b), float(b[:, 4].max()), float(np.abs(b[:, 0] - 0.1).max())
+    (18, 0.25, 0.1)
+    """
+    if not readings:
+        return np.zeros((0, 5))
+    centres, velocities, radii, _, _ = boundary_discs(
+        readings if isinstance(readings, tuple) else tuple(readings), OUTLINE_SPACING
+    )
+    table = np.column_stack((centres, velocities, radii))
+    return table[np.isfinite(table).all(axis=1)]
 
 
 def exposure_map_py(x0: float, y0: float, px: float, py: float, bodies: FloatArray, v: float,

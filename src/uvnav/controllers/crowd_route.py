@@ -51,7 +51,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.controllers.base import check_params
-from uvnav.controllers.crowd_grid import GRID_AHEAD, GRID_SIGMA, grid_way_point
+from uvnav.controllers.crowd_grid import GRID_AHEAD, GRID_SIGMA, grid_bodies, grid_way_point
 from uvnav.controllers.zhang2019_v2_bodies import body_table
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
@@ -340,12 +340,12 @@ class CrowdRoute:
     def _grid_aim(self, position: FloatArray, goal: FloatArray,
                   readings: Sequence[ObstacleReading], v_max: float) -> FloatArray:  # fmt: skip
         """The grid route's way point (:func:`~uvnav.controllers.crowd_grid.grid_way_point`
-        over every sensed body), or the goal when it is within ``DIRECT_WITHIN`` m or nothing
-        is sensed."""
+        over every sensed body, :func:`~uvnav.controllers.crowd_grid.grid_bodies`), or the goal
+        when it is within ``DIRECT_WITHIN`` m or nothing is sensed."""
         p = self.params
         if not np.isfinite(position).all() or math.dist(goal, position) <= DIRECT_WITHIN:
             return goal
-        bodies = moving_bodies(readings, 0.0)
+        bodies = grid_bodies(readings)
         if len(bodies) == 0:
             return goal
         return grid_way_point(position, goal, bodies, v_max, p.route_horizon, GRID_SIGMA,
