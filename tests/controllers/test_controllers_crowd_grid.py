@@ -10,7 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from uvnav.controllers.base import make_law
-from uvnav.controllers.crowd_grid import CELL, REACH, _exposure, exposure_map_py, grid_way_point
+from uvnav.controllers.crowd_grid import CELL, REACH, _kernel, exposure_map_py, grid_way_point
 from uvnav.controllers.crowd_route import CrowdRoute, RouteParams
 from uvnav.dynamics.unicycle import UnicycleSpec
 from uvnav.geometry.kernels3d import compiled
@@ -69,7 +69,7 @@ def test_the_compiled_map_agrees_with_plain_python(seed: int) -> None:
     ref, got = np.empty((12, 9)), np.empty((12, 9))
     exposure_map_py(-1.5, -1.0, 0.3, -0.2, bodies, 1.0, 2.0, 0.6, ref)
     with compiled(True):
-        _exposure()(-1.5, -1.0, 0.3, -0.2, bodies, 1.0, 2.0, 0.6, got)
+        _kernel("exposure_map_py")(-1.5, -1.0, 0.3, -0.2, bodies, 1.0, 2.0, 0.6, got)
     np.testing.assert_allclose(got, ref, rtol=1e-12, atol=1e-15)  # libm vs LLVM: last digits
 
 

@@ -14,7 +14,8 @@ in its simplest form:
   ``sum_i exp(-max(||c - q_i - w_i min(t, horizon)|| - r_i, 0)^2 / (2 sigma^2))`` over every
   sensed body ``i`` (centre ``q_i``, velocity ``w_i``, radius ``r_i``), walking or standing:
   a crowd that has come to a halt is what a slow vehicle must go around.  A body more than
-  ``CUT`` sigmas off adds nothing.
+  ``CUT`` sigmas off adds nothing.  Optionally (``forecast`` > 0) each body is instead where a
+  crowd rollout puts it (:mod:`~uvnav.controllers.crowd_forecast`, :func:`exposure_track_py`).
 * **The path.**  Dijkstra over the 8-connected cells from the robot's cell to the goal's, a
   step between two cells costing its length times ``1 + weight * (mean of their costs)``
   (:func:`uvnav.planners.search.costed_dijkstra`, scipy's).
@@ -37,6 +38,8 @@ from typing import Any
 
 import numpy as np
 
+from uvnav.controllers.crowd_forecast import FORECAST_STEP, body_at, crowd_forecast
+from uvnav.controllers.crowd_forecast import kernel as forecast_kernel
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
 from uvnav.planners.search import costed_dijkstra
@@ -85,14 +88,48 @@ def exposure_map_py(x0: float, y0: float, px: float, py: float, bodies: FloatArr
             out[i, j] = total
 
 
+def exposure_track_py(x0: float, y0: float, px: float, py: float, track: FloatArray,
+                      radii: FloatArray, step: float, v: float, horizon: float, sigma: float,
+                      out: FloatArray) -> None:  # fmt: skip
+    """:func:`exposure_map_py` with each body where ``track`` (K + 1, N, 2: centres every
+    ``step`` [s], :func:`~uvnav.controllers.crowd_forecast.crowd_forecast`) puts it at the
+    time the robot reaches the cell (capped at ``horizon`` [s]); ``radii`` (N,) [m].
+
+    >>> out = np.zeros((3, 1))  # the body walks 1 m/s along +x: at 0.5 m by 0.5 s
+    >>> track = np.array([[[0.0, 0.0]], [[0.25, 0.0]], [[0.5, 0.0]]])
+    >>> exposure_track_py(-0.125, -0.125, 0.0, 0.0, track, np.array([0.1]), 0.25, 1.0, 2.0,
+    ...                   0.5, out)
+    >>> out.round(3).ravel().tolist()  # each cell reached as the body gets there
+    [1.0, 1.0, 1.0]
+    """
+    far = CUT * sigma
+    for i in range(out.shape[0]):
+        cx = x0 + (i + 0.5) * CELL
+        for j in range(out.shape[1]):
+            cy = y0 + (j + 0.5) * CELL
+            t = min(math.sqrt((cx - px) ** 2 + (cy - py) ** 2) / v, horizon)
+            total = 0.0
+            for b in range(track.shape[1]):
+                bx, by = body_at(track, b, t, step)
+                gap = math.sqrt((cx - bx) ** 2 + (cy - by) ** 2) - radii[b]
+                if gap <= 0.0:
+                    total += 1.0
+                elif gap < far:
+                    total += math.exp(-0.5 * (gap / sigma) ** 2)
+            out[i, j] = total
+
+
 def grid_way_point(
     position: FloatArray, goal: FloatArray, bodies: FloatArray, v_max: float, horizon: float,
-    sigma: float, weight: float, ahead: float,
+    sigma: float, weight: float, ahead: float, forecast: float = 0.0,
 ) -> FloatArray:  # fmt: skip
     """The module docstring's way point [m], (2,), from the robot at ``position`` toward
     ``goal``: :func:`exposure_map_py` (compiled when numba is enabled), the cheapest path over it
     (:func:`uvnav.planners.search.costed_dijkstra`), then the cell centre ``ahead`` [m] along
-    the path (the goal, or the sub-goal ``REACH`` m toward it, when the path is shorter)."""
+    the path (the goal, or the sub-goal ``REACH`` m toward it, when the path is shorter).
+    ``forecast`` > 0: the bodies are forecast by a crowd rollout over ``forecast`` [s]
+    (:func:`~uvnav.controllers.crowd_forecast.crowd_forecast`, :func:`exposure_track_py`)
+    instead of at constant velocity over ``horizon``."""
     px, py = float(position[0]), float(position[1])
     gx, gy = float(goal[0]), float(goal[1])
     dist = math.hypot(gx - px, gy - py)
@@ -102,8 +139,14 @@ def grid_way_point(
     nx = math.ceil((max(px, gx) + PAD - x0) / CELL)
     ny = math.ceil((max(py, gy) + PAD - y0) / CELL)
     cost = np.empty((nx, ny))
-    _exposure()(x0, y0, px, py, np.ascontiguousarray(bodies, dtype=float), float(v_max),
-                float(horizon), float(sigma), cost)  # fmt: skip
+    table = np.ascontiguousarray(bodies, dtype=float)
+    if forecast > 0.0:
+        _kernel("exposure_track_py")(x0, y0, px, py, crowd_forecast(table, forecast),
+                                     np.ascontiguousarray(table[:, 4]), FORECAST_STEP,
+                                     float(v_max), float(forecast), float(sigma), cost)  # fmt: skip
+    else:
+        _kernel("exposure_map_py")(x0, y0, px, py, table, float(v_max), float(horizon),
+                                   float(sigma), cost)  # fmt: skip
 
     def cell(x: float, y: float) -> tuple[int, int]:
         return min(int((x - x0) / CELL), nx - 1), min(int((y - y0) / CELL), ny - 1)
@@ -118,11 +161,16 @@ def grid_way_point(
 _COMPILED: dict[str, Callable[..., Any]] = {}
 
 
-def _exposure() -> Callable[..., Any]:
-    """:func:`exposure_map_py`, compiled by numba when it is enabled (on the first call, or from
-    numba's cache)."""
+def _kernel(name: str) -> Callable[..., Any]:
+    """:func:`exposure_map_py` or :func:`exposure_track_py` by ``name``, compiled by numba when
+    it is enabled (on the first call, or from numba's cache)."""
     if not numba_enabled():
-        return exposure_map_py
+        plain: dict[str, Callable[..., Any]] = {
+            "exposure_map_py": exposure_map_py, "exposure_track_py": exposure_track_py,
+        }  # fmt: skip
+        return plain[name]
     if not _COMPILED:
         _COMPILED.update(compile_family((exposure_map_py,)))
-    return _COMPILED["exposure_map_py"]
+        bound = {"body_at": forecast_kernel("body_at")}
+        _COMPILED.update(compile_family((exposure_track_py,), bound=bound))
+    return _COMPILED[name]

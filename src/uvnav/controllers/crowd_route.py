@@ -93,6 +93,9 @@ class RouteParams:
             a grid instead (:mod:`~uvnav.controllers.crowd_grid`, every body costed, walking
             or standing) with this weight [m per unit of exposure], whatever ``route_weight``
             says; 0: as on the ideal vehicle.
+        route_forecast: the grid route forecasts the people by a crowd rollout over this many
+            seconds (:mod:`~uvnav.controllers.crowd_forecast`); 0: at constant velocity over
+            ``route_horizon``.
     """
 
     route_weight: float = 0.0
@@ -103,11 +106,12 @@ class RouteParams:
     route_period: float = 0.0
     route_bodies: int = 0
     route_limited_weight: float = 3.0
+    route_forecast: float = 0.0
 
     def __post_init__(self) -> None:
         check_params(self, positive=("route_sigma", "route_lookahead", "route_horizon"),
                      non_negative=("route_weight", "route_hold", "route_period",
-                                   "route_limited_weight"))  # fmt: skip
+                                   "route_limited_weight", "route_forecast"))  # fmt: skip
         if not isinstance(self.route_bodies, int) or self.route_bodies < 0:
             raise ValueError(f"route_bodies must be an integer >= 0 (got {self.route_bodies!r})")
 
@@ -349,4 +353,4 @@ class CrowdRoute:
         if len(bodies) == 0:
             return goal
         return grid_way_point(position, goal, bodies, v_max, p.route_horizon, GRID_SIGMA,
-                              p.route_limited_weight, GRID_AHEAD)  # fmt: skip
+                              p.route_limited_weight, GRID_AHEAD, p.route_forecast)  # fmt: skip
