@@ -360,7 +360,7 @@ def test_controllers_show_wraps_long_descriptions_in_a_pipe() -> None:
     out = invoke("controllers", "show", "zhang2019-v2").stdout
     rows = [line for line in out.splitlines() if line.startswith("│")]
     assert rows and max(len(line) for line in rows) <= 80 + DESCRIPTION_WIDTH
-    assert any(line.startswith("│ route_limited_weight ") for line in rows)  # names whole
+    assert any(line.startswith("│ route_grid_weight ") for line in rows)  # names whole
 
 
 def test_controllers_show_reads_without_python_types_or_markup() -> None:

@@ -90,7 +90,7 @@ def test_the_route_plans_on_the_grid_only_for_a_limited_vehicle() -> None:
     assert aim[1] > 0.5  # toward the gap, standing people counted
     route.reset(limited=False)
     assert route.aim(np.zeros(2), goal, people, 1.0) is goal  # the fan is off by default
-    off = CrowdRoute(RouteParams(route_limited_weight=0.0), 0.1)
+    off = CrowdRoute(RouteParams(route_grid_weight=0.0), 0.1)
     off.reset(limited=True)
     assert off.aim(np.zeros(2), goal, people, 1.0) is goal
     route.reset(limited=True)
@@ -122,12 +122,37 @@ def test_a_wall_costs_along_its_outline_and_the_route_heads_for_its_doorway() ->
         assert np.sign(aim[1]) == np.sign(gap) and abs(aim[1]) > 1.0, gap
 
 
-def test_zhang2019_v2_plans_the_grid_route_with_acceleration_limits_only() -> None:
+def test_zhang2019_v2_plans_the_grid_route_with_acceleration_limits_or_when_asked() -> None:
+    ideal = UnicycleSpec(v_max=1.0, u_max=2.0, radius=0.3)
     law = make_law("zhang2019-v2")
     law.reset(LIMITED, np.array([6.0, 0.0]), np.random.default_rng(0))
-    assert law._route.limited
-    law.reset(UnicycleSpec(v_max=1.0, u_max=2.0, radius=0.3), np.zeros(2),
-              np.random.default_rng(0))  # fmt: skip
-    assert not law._route.limited
-    with pytest.raises(ValueError, match="route_limited_weight"):
-        make_law("zhang2019-v2", route_limited_weight=-1.0)
+    assert law._route.grid
+    law.reset(ideal, np.zeros(2), np.random.default_rng(0))
+    assert not law._route.grid
+    law = make_law("zhang2019-v2", route_grid="all")
+    law.reset(ideal, np.zeros(2), np.random.default_rng(0))
+    assert law._route.grid
+    holonomic = make_law("zhang2019-holonomic-v2", route_grid="all")
+    holonomic.reset(ideal, np.zeros(2), np.random.default_rng(0))
+    assert not holonomic._route.grid  # the fan, whatever route_grid says
+    with pytest.raises(ValueError, match="route_grid_weight"):
+        make_law("zhang2019-v2", route_grid_weight=-1.0)
+    with pytest.raises(ValueError, match="route_grid must be one of limited, all"):
+        make_law("zhang2019-v2", route_grid="some")
+
+
+def test_the_grid_way_point_is_held_for_route_period() -> None:
+    """With ``route_period`` the grid is searched again only once it has passed: the way point
+    found at t = 0 is kept at t = 0.5 s although the people moved; at t = 1 s it is searched
+    again."""
+    goal = np.array([6.0, 0.0])
+    route = CrowdRoute(RouteParams(route_period=1.0), 0.1)
+    route.reset(limited=True, unicycle=True)
+    gap_left = [person(k, 3.0, y) for k, y in enumerate(np.arange(-6.0, 6.01, 0.5))
+                if abs(y - 3.0) > 1.0]  # fmt: skip
+    gap_right = [person(k, 3.0, y) for k, y in enumerate(np.arange(-6.0, 6.01, 0.5))
+                 if abs(y + 3.0) > 1.0]  # fmt: skip
+    first = route.aim(np.zeros(2), goal, gap_left, 1.0, 0.0)
+    assert first[1] > 0.5
+    assert route.aim(np.zeros(2), goal, gap_right, 1.0, 0.5) is first
+    assert route.aim(np.zeros(2), goal, gap_right, 1.0, 1.0)[1] < -0.5

@@ -139,7 +139,7 @@ def test_the_spread_look_ahead_keeps_clear_of_a_human_who_turns_into_the_robot()
     # 20 humans, the local law alone (no grid route): checked against constant velocities
     # alone, the robot is walked into by a human whose path others bend; with each reach
     # growing 0.1 m/s of look-ahead it arrives
-    alone = Zhang2019V2Params(route_limited_weight=0.0)
+    alone = Zhang2019V2Params(route_grid_weight=0.0)
     still = run(1, Zhang2019V2(replace(alone, limited_spread=0.0)), n_humans=20)
     assert still.status == "collision" and still.metrics.collision_by == "pedestrian"
     assert run(1, Zhang2019V2(alone), n_humans=20).status == "success"

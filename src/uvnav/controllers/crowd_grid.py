@@ -2,7 +2,7 @@
 where people will be, for a vehicle that cannot sidestep at once.
 
 uvnav's own layer, beyond the thesis, used by ``zhang2019-v2`` on a unicycle with acceleration
-limits (:class:`~uvnav.controllers.crowd_route.CrowdRoute`, ``route_limited_weight``).  It is
+limits (:class:`~uvnav.controllers.crowd_route.CrowdRoute`, ``route_grid_weight``).  It is
 the time-dependent planning on a social cost map of Kollmitz, Hsiao, Gaa and Burgard ("Time
 dependent planning on a layered social cost map for human-aware robot navigation", ECMR 2015)
 in its simplest form:

@@ -30,10 +30,11 @@ keeps a decision within tens of microseconds:
   ``route_period`` > 0 the fan is searched again only once that period has passed (or the way
   point is reached), the last choice held in between.
 
-On a vehicle with acceleration limits (:meth:`CrowdRoute.reset` is told) the route is planned
-on a grid instead (:mod:`uvnav.controllers.crowd_grid`, ``route_limited_weight``): a path that
-bends round a crowd of any shape, standing people counted, for a vehicle that cannot sidestep
-once the crowd is upon it.
+On a unicycle with acceleration limits (:meth:`CrowdRoute.reset` is told), and with
+``route_grid="all"`` on every unicycle, the route is planned on a grid instead
+(:mod:`uvnav.controllers.crowd_grid`, ``route_grid_weight``): a path that bends round a crowd of
+any shape, standing people counted, for a vehicle that cannot sidestep once the crowd is upon
+it.  ``route_period`` holds its way point between searches as it holds the fan's.
 
 The bodies are those the robot senses (a person out of range costs nothing), with the rates the
 readings give (true or estimated).  Measured on the harder crowd (``crowd-dynamic``, tuning
@@ -69,6 +70,8 @@ REACHED = 0.5
 CUT = 5.0
 #: added to a body's reach [m] when its samples are culled (rounding never drops one in reach)
 REACH_SLACK = 1e-6
+#: :attr:`RouteParams.route_grid`'s values
+GRID_VEHICLES = ("limited", "all")
 #: the fan's directions [rad] from the goal's, the goal's own left out
 _FAN_ANGLES = np.delete(np.linspace(-math.pi / 2, math.pi / 2, FAN), FAN // 2)
 
@@ -89,10 +92,14 @@ class RouteParams:
             the law steers for the point the last search chose (while the goal is farther than
             ``DIRECT_WITHIN`` m and the way point than ``REACHED`` m); 0: every decision.
         route_bodies: only the nearest ``route_bodies`` walking people are costed; 0: all.
-        route_limited_weight: on a vehicle with acceleration limits, the route is planned on
-            a grid instead (:mod:`~uvnav.controllers.crowd_grid`, every body costed, walking
-            or standing) with this weight [m per unit of exposure], whatever ``route_weight``
+        route_grid_weight: on the unicycles ``route_grid`` names, the route is planned on a
+            grid instead (:mod:`~uvnav.controllers.crowd_grid`, every body costed, walking or
+            standing) with this weight [m per unit of exposure], whatever ``route_weight``
             says; 0: as on the ideal vehicle.
+        route_grid: which unicycles plan on the grid: ``"limited"``, those with acceleration
+            limits; ``"all"``, every one (the ideal unicycle too; with ``route_period`` 1 s
+            the design notes measure its gains and its cost).  The holonomic law plans no
+            grid route.
     """
 
     route_weight: float = 0.0
@@ -102,14 +109,18 @@ class RouteParams:
     route_horizon: float = 2.0
     route_period: float = 0.0
     route_bodies: int = 0
-    route_limited_weight: float = 3.0
+    route_grid_weight: float = 3.0
+    route_grid: str = "limited"
 
     def __post_init__(self) -> None:
         check_params(self, positive=("route_sigma", "route_lookahead", "route_horizon"),
                      non_negative=("route_weight", "route_hold", "route_period",
-                                   "route_limited_weight"))  # fmt: skip
+                                   "route_grid_weight"))  # fmt: skip
         if not isinstance(self.route_bodies, int) or self.route_bodies < 0:
             raise ValueError(f"route_bodies must be an integer >= 0 (got {self.route_bodies!r})")
+        if self.route_grid not in GRID_VEHICLES:
+            raise ValueError(f"route_grid must be one of {', '.join(GRID_VEHICLES)} "
+                             f"(got {self.route_grid!r})")  # fmt: skip
 
 
 def fan_way_points(position: FloatArray, goal: FloatArray, lookahead: float) -> FloatArray:
@@ -283,14 +294,18 @@ class CrowdRoute:
         self.min_speed = min_speed
         self.way: FloatArray | None = None
         self.next_search = -math.inf
-        self.limited = False
+        self.grid = False
 
-    def reset(self, limited: bool = False) -> None:
-        """Forget the held way point and search at the next decision; ``limited``: the
-        vehicle has acceleration limits (the grid route, ``route_limited_weight``)."""
+    def reset(self, limited: bool = False, unicycle: bool = False) -> None:
+        """Forget the held way point and search at the next decision.  The route is planned on
+        the grid (:attr:`grid`) on a ``unicycle`` that is ``limited`` (it has acceleration
+        limits), or on any unicycle with ``route_grid="all"``, while ``route_grid_weight``
+        > 0."""
+        p = self.params
         self.way = None
         self.next_search = -math.inf
-        self.limited = limited
+        on = limited or (unicycle and p.route_grid == "all")
+        self.grid = on and p.route_grid_weight > 0.0
 
     def _held(self, position: FloatArray, goal: FloatArray, time: float) -> FloatArray | None:
         """The point the last search chose while ``route_period`` holds it (``None``: search)."""
@@ -312,13 +327,13 @@ class CrowdRoute:
         point."""
         p = self.params
         position = np.asarray(position, dtype=float)[:2]
-        if self.limited and p.route_limited_weight > 0.0:
-            return self._grid_aim(position, goal, readings, v_max)
-        if p.route_weight <= 0.0 or not np.isfinite(position).all():
+        if not (self.grid or p.route_weight > 0.0) or not np.isfinite(position).all():
             return goal
         held = self._held(position, goal, time) if p.route_period > 0.0 else None
         if held is not None:
             return held
+        if self.grid:
+            return self._grid_aim(position, goal, readings, v_max, time)
         bodies = nearest(moving_bodies(readings, self.min_speed), position, p.route_bodies)
         gap = goal - position
         if len(bodies) == 0 or math.hypot(gap[0], gap[1]) <= DIRECT_WITHIN:
@@ -338,15 +353,19 @@ class CrowdRoute:
         return self.way
 
     def _grid_aim(self, position: FloatArray, goal: FloatArray,
-                  readings: Sequence[ObstacleReading], v_max: float) -> FloatArray:  # fmt: skip
+                  readings: Sequence[ObstacleReading], v_max: float,
+                  time: float) -> FloatArray:  # fmt: skip
         """The grid route's way point (:func:`~uvnav.controllers.crowd_grid.grid_way_point`
-        over every sensed body, :func:`~uvnav.controllers.crowd_grid.grid_bodies`), or the goal
-        when it is within ``DIRECT_WITHIN`` m or nothing is sensed."""
+        over every sensed body, :func:`~uvnav.controllers.crowd_grid.grid_bodies`), held as
+        :meth:`aim` holds the fan's, or the goal when it is within ``DIRECT_WITHIN`` m or
+        nothing is sensed."""
         p = self.params
+        self.way, self.next_search = None, time + p.route_period
         if not np.isfinite(position).all() or math.dist(goal, position) <= DIRECT_WITHIN:
             return goal
         bodies = grid_bodies(readings)
         if len(bodies) == 0:
             return goal
-        return grid_way_point(position, goal, bodies, v_max, p.route_horizon, GRID_SIGMA,
-                              p.route_limited_weight, GRID_AHEAD)  # fmt: skip
+        self.way = grid_way_point(position, goal, bodies, v_max, p.route_horizon, GRID_SIGMA,
+                                  p.route_grid_weight, GRID_AHEAD)  # fmt: skip
+        return self.way

@@ -717,7 +717,7 @@ class Zhang2019V2(UnicycleController):
 
     def _reset_law(self, rng: np.random.Generator) -> None:
         self.last_choice = None
-        self._route.reset(limited=not self._spec.ideal)
+        self._route.reset(limited=not self._spec.ideal, unicycle=True)
         self._aim = np.zeros(2)
         self._tracker = _tracker(self.params)
         self._turn = (0.0, 0.0)  # the turn rate at the last decision and the one commanded
