@@ -20,11 +20,12 @@ Dijkstra's (property-tested).
 
 from __future__ import annotations
 
+import functools
 import heapq
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 
@@ -142,10 +143,34 @@ def costed_dijkstra(
     """
     cost = np.asarray(cell_cost, dtype=float)
     _check_cells(cost, start, goal)
-    src, dst, length = grid_edges(np.zeros(cost.shape, dtype=bool), resolution)
+    src, dst, length, indptr = _open_grid(cost.shape[0], cost.shape[1], float(resolution))
     flat = cost.ravel()
     w = length * (1.0 + weight * 0.5 * (flat[src] + flat[dst]))
-    return _scipy_path(src, dst, w, cost.shape, start, goal)
+    return _csgraph_path(_csr(w, dst, indptr), cost.shape, start, goal)
+
+
+@functools.lru_cache(maxsize=8)
+def _open_grid(
+    rows: int, cols: int, resolution: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`grid_edges` of a grid of free cells, in the order of a CSR matrix (by source,
+    then target): sources, targets, lengths [m] and the row pointers; kept per shape, since a
+    planner searches the same grid over and over (sorting the edges was half a search)."""
+    src, dst, length = grid_edges(np.zeros((rows, cols), dtype=bool), resolution)
+    order = np.lexsort((dst, src))
+    indptr = np.searchsorted(src[order], np.arange(rows * cols + 1))
+    out = (src[order], dst[order], length[order], indptr)
+    for a in out:
+        a.flags.writeable = False
+    return out
+
+
+def _csr(w: np.ndarray, dst: np.ndarray, indptr: np.ndarray) -> Any:
+    """The sparse graph of edge costs ``w`` to ``dst`` in CSR order (``indptr``: row pointers)."""
+    from scipy.sparse import csr_matrix
+
+    n = len(indptr) - 1
+    return csr_matrix((w, dst, indptr), shape=(n, n))
 
 
 def _scipy_path(
@@ -155,12 +180,18 @@ def _scipy_path(
     """scipy's Dijkstra on the directed edges ``src`` -> ``dst`` of cost ``w`` of a grid of
     ``shape``, from ``start`` to ``goal``."""
     from scipy.sparse import csr_matrix
+
+    n = shape[0] * shape[1]
+    return _csgraph_path(csr_matrix((w, (src, dst)), shape=(n, n)), shape, start, goal)
+
+
+def _csgraph_path(graph: Any, shape: tuple[int, ...], start: Cell, goal: Cell) -> GridPath:
+    """scipy's Dijkstra on the sparse ``graph`` of a grid of ``shape``, from ``start`` to
+    ``goal``."""
     from scipy.sparse.csgraph import dijkstra as sp_dijkstra
 
-    rows, cols = shape
-    n = rows * cols
+    cols = shape[1]
     s, g = start[0] * cols + start[1], goal[0] * cols + goal[1]
-    graph = csr_matrix((w, (src, dst)), shape=(n, n))
     dist, pred = sp_dijkstra(graph, directed=True, indices=s, return_predecessors=True)
     expanded = int(np.isfinite(dist).sum())
     if not np.isfinite(dist[g]):
