@@ -314,7 +314,7 @@ class CrowdRoute:
         position = np.asarray(position, dtype=float)[:2]
         if self.limited and p.route_limited_weight > 0.0:
             return self._grid_aim(position, goal, readings, v_max)
-        if p.route_weight <= 0.0 or not np.isfinite(position).all():
+        if p.route_weight <= 0.0 or not (math.isfinite(position[0]) and math.isfinite(position[1])):
             return goal
         held = self._held(position, goal, time) if p.route_period > 0.0 else None
         if held is not None:
