@@ -1,7 +1,8 @@
 """A route around the crowd: the way point a local law steers for, chosen by crowd exposure.
 
-uvnav's own layer, beyond the thesis: ``zhang2019-holonomic-v2`` (on by default) and
-``zhang2019-v2`` (off by default) steer for the way point it gives instead of the goal itself.
+uvnav's own layer, beyond the thesis: ``zhang2019-holonomic-v2`` and ``zhang2019-v2`` (on by
+default in both; the unicycle's searched every 0.75 s over the 12 nearest walkers) steer for the
+way point it gives instead of the goal itself.
 The idea is the layered social cost map of mobile-robot navigation stacks (Kollmitz, Hsiao,
 Gaa, Burgard, "Time dependent planning on a layered social cost map for human-aware robot
 navigation", ECMR 2015): a route is judged by its length plus what it costs the people it

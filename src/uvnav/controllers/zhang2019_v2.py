@@ -63,8 +63,9 @@ a lower bound. On a vehicle with acceleration limits the rolled-out paths' segme
 before T_s are read the same way (:func:`path_social`); figures: ``docs/design-notes.md``.
 
 **A route around the crowd** (``route_*``): the law steers for a way point, not for T itself: a
-fan of routes on the holonomic robot (:mod:`uvnav.controllers.crowd_route`), a grid path with
-acceleration limits (:mod:`uvnav.controllers.crowd_grid`); off on the ideal unicycle.
+fan of routes (:mod:`uvnav.controllers.crowd_route`; on the ideal unicycle searched every 0.75 s,
+shorter and costed over the 12 nearest walkers), a grid path with acceleration limits
+(:mod:`uvnav.controllers.crowd_grid`).
 
 **Declared noise.** Each body is grown by ``noise_sigmas`` times the centre noise its reading
 declares (``position_std``) in the one body table every decision path reads
@@ -195,7 +196,7 @@ IntArray = np.ndarray
 @dataclass(frozen=True)
 class Zhang2019V2Params(RouteParams):
     """Parameters of ``zhang2019-v2`` and ``zhang2019-holonomic-v2`` (the ``route_*`` ones:
-    :class:`~uvnav.controllers.crowd_route.RouteParams`, off here).
+    :class:`~uvnav.controllers.crowd_route.RouteParams`, on with the unicycle's defaults here).
 
     Attributes:
         horizon: H [s], how far ahead every candidate is checked against every body.
@@ -239,6 +240,10 @@ class Zhang2019V2Params(RouteParams):
             declares (``position_std``; :func:`~uvnav.controllers.zhang2019_v2_bodies.body_table`).
     """
 
+    route_weight: float = 3.0
+    route_lookahead: float = 3.0
+    route_period: float = 0.75
+    route_bodies: int = 12
     horizon: float = 4.0
     forecast_horizon: float = 1.0
     safety_margin: float = 0.05
@@ -624,9 +629,13 @@ def tracked(obs: Observation, tracker: CentreTracker | None) -> Observation:
 @dataclass(frozen=True)
 class Zhang2019HolonomicV2Params(Zhang2019V2Params):
     """``zhang2019-holonomic-v2``'s parameters: :class:`Zhang2019V2Params` with the route
-    layer on (:mod:`uvnav.controllers.crowd_route`)."""
+    layer's own defaults (:mod:`uvnav.controllers.crowd_route`): searched at every decision over
+    every walker."""
 
     route_weight: float = 2.0
+    route_lookahead: float = 4.0
+    route_period: float = 0.0
+    route_bodies: int = 0
 
 
 class Zhang2019HolonomicV2(HolonomicLaw):
