@@ -158,12 +158,12 @@ def test_zhang2019_v2_plans_the_grid_route_with_acceleration_limits_or_when_aske
         make_law("zhang2019-v2", route_grid="some")
 
 
-def test_the_grid_way_point_is_held_for_route_period() -> None:
-    """With ``route_period`` the grid is searched again only once it has passed: the way point
+def test_the_grid_way_point_is_held_for_route_grid_period() -> None:
+    """With ``route_grid_period`` the grid is searched again only once it has passed: the way point
     found at t = 0 is kept at t = 0.5 s although the people moved; at t = 1 s it is searched
     again."""
     goal = np.array([6.0, 0.0])
-    route = CrowdRoute(RouteParams(route_period=1.0), 0.1)
+    route = CrowdRoute(RouteParams(route_grid_period=1.0), 0.1)
     route.reset(limited=True, unicycle=True)
     gap_left = [person(k, 3.0, y) for k, y in enumerate(np.arange(-6.0, 6.01, 0.5))
                 if abs(y - 3.0) > 1.0]  # fmt: skip

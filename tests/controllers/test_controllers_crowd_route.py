@@ -202,9 +202,11 @@ def test_compiled_and_python_route_costs_agree(enabled: bool) -> None:
     assert np.allclose(got, want, rtol=1e-12, atol=1e-12)
 
 
-def test_holonomic_v2_routes_by_default_the_unicycle_does_not() -> None:
-    assert Zhang2019HolonomicV2Params().route_weight > 0
-    assert Zhang2019V2Params().route_weight == 0
+def test_both_v2_laws_route_by_default_the_unicycle_less_often_over_fewer_walkers() -> None:
+    holo, uni = Zhang2019HolonomicV2Params(), Zhang2019V2Params()
+    assert holo.route_weight > 0 and uni.route_weight > 0
+    assert (holo.route_period, holo.route_bodies) == (0.0, 0)  # every decision, every walker
+    assert (uni.route_period, uni.route_bodies) == (0.75, 12)
     with pytest.raises(ValueError, match="route_sigma must be a number > 0"):
         Zhang2019V2Params(route_sigma=0.0)
     with pytest.raises(ValueError, match="route_weight must be a number >= 0"):

@@ -27,7 +27,11 @@ ACCEL, TURN_ACCEL, DT, PERIOD = 1.0, 2.0, 0.05, 0.25
 
 
 class IdealPlanning(Zhang2019V2):
-    """v2 told that its vehicle is ideal (the law before it planned with the limits)."""
+    """v2 told that its vehicle is ideal (the law before it planned with the limits), steering
+    for the goal itself (the ideal unicycle's route off)."""
+
+    def __init__(self) -> None:
+        super().__init__(Zhang2019V2Params(route_weight=0.0))
 
     def reset(self, spec: UnicycleSpec, goal: np.ndarray, rng: np.random.Generator) -> None:
         ideal = dataclasses.replace(spec, accel_max=math.inf, turn_accel_max=math.inf)
@@ -139,7 +143,7 @@ def test_the_spread_look_ahead_keeps_clear_of_a_human_who_turns_into_the_robot()
     # 20 humans, the local law alone (no grid route): checked against constant velocities
     # alone, the robot is walked into by a human whose path others bend; with each reach
     # growing 0.1 m/s of look-ahead it arrives
-    alone = Zhang2019V2Params(route_grid_weight=0.0)
+    alone = Zhang2019V2Params(route_grid_weight=0.0, route_weight=0.0)
     still = run(1, Zhang2019V2(replace(alone, limited_spread=0.0)), n_humans=20)
     assert still.status == "collision" and still.metrics.collision_by == "pedestrian"
     assert run(1, Zhang2019V2(alone), n_humans=20).status == "success"

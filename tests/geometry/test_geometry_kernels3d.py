@@ -198,3 +198,19 @@ def test_the_stamp_follows_the_module_constants_a_kernel_reads() -> None:
     other = types.FunctionType(f.__code__, {**f.__globals__, "_STEP": 2.0}, f.__name__)
     assert family_stamp([f]) == family_stamp([f])
     assert family_stamp([f]) != family_stamp([other])
+
+
+def _ratio(x: float, y: float) -> float:
+    return x / y
+
+
+@pytest.mark.skipif(not numba_available(), reason="needs numba (the fast extra)")
+def test_the_numpy_error_model_divides_by_zero_without_raising() -> None:
+    """``error_model="numpy"``: a float divided by zero gives inf, as numpy's does; the default
+    raises as Python does; the two copies carry different names (separate cache entries)."""
+    plain = compile_family([_ratio])["_ratio"]
+    quiet = compile_family([_ratio], error_model="numpy")["_ratio"]
+    assert quiet(1.0, 0.0) == math.inf and quiet(3.0, 2.0) == plain(3.0, 2.0) == 1.5
+    with pytest.raises(ZeroDivisionError):
+        plain(1.0, 0.0)
+    assert plain.py_func.__qualname__ != quiet.py_func.__qualname__

@@ -63,8 +63,9 @@ a lower bound. On a vehicle with acceleration limits the rolled-out paths' segme
 before T_s are read the same way (:func:`path_social`); figures: ``docs/design-notes.md``.
 
 **A route around the crowd** (``route_*``): the law steers for a way point, not for T itself: a
-fan of routes on the holonomic robot (:mod:`uvnav.controllers.crowd_route`), a grid path with
-acceleration limits (:mod:`uvnav.controllers.crowd_grid`); off on the ideal unicycle.
+fan of routes (:mod:`uvnav.controllers.crowd_route`; on the ideal unicycle searched every 0.75 s,
+shorter and costed over the 12 nearest walkers), a grid path with acceleration limits
+(:mod:`uvnav.controllers.crowd_grid`).
 
 **Declared noise.** Each body is grown by ``noise_sigmas`` times the centre noise its reading
 declares (``position_std``) in the one body table every decision path reads
@@ -174,7 +175,7 @@ from uvnav.controllers.zhang2019_v2_loop import (
 from uvnav.controllers.zhang2019_v2_paths import _approach as paths_approach
 from uvnav.controllers.zhang2019_v2_paths import _turn as paths_turn
 from uvnav.controllers.zhang2019_v2_paths import _window as paths_window
-from uvnav.controllers.zhang2019_v2_paths import plan_paths
+from uvnav.controllers.zhang2019_v2_steer import PathConstants, path_constants, plan_on_floats
 from uvnav.dynamics.omni import VelocityCommand
 from uvnav.dynamics.unicycle import UnicycleCommand
 from uvnav.geometry.angles import FloatArray, wrap_scalar
@@ -195,7 +196,7 @@ IntArray = np.ndarray
 @dataclass(frozen=True)
 class Zhang2019V2Params(RouteParams):
     """Parameters of ``zhang2019-v2`` and ``zhang2019-holonomic-v2`` (the ``route_*`` ones:
-    :class:`~uvnav.controllers.crowd_route.RouteParams`, off here).
+    :class:`~uvnav.controllers.crowd_route.RouteParams`, on with the unicycle's defaults here).
 
     Attributes:
         horizon: H [s], how far ahead every candidate is checked against every body.
@@ -239,6 +240,10 @@ class Zhang2019V2Params(RouteParams):
             declares (``position_std``; :func:`~uvnav.controllers.zhang2019_v2_bodies.body_table`).
     """
 
+    route_weight: float = 3.0
+    route_lookahead: float = 3.0
+    route_period: float = 0.75
+    route_bodies: int = 12
     horizon: float = 4.0
     forecast_horizon: float = 1.0
     safety_margin: float = 0.05
@@ -467,16 +472,6 @@ def plan(
                            (q, w, reach, bodies), p, heading=heading, u_max=u_max)  # fmt: skip
 
 
-def path_constants(model: RampModel, params: Zhang2019V2Params, robot_radius: float) -> FloatArray:
-    """The ``prm`` vector of :func:`uvnav.controllers.zhang2019_v2_paths.plan_readings_py`."""
-    p = params
-    return np.array((model.v_max, model.u_max, model.accel, model.turn_accel, model.period,
-                     p.horizon, p.rollout_step, p.comfort, p.comfort_horizon, p.safety_margin,
-                     p.limited_spread, p.min_ttc, p.w_ttc, p.w_comfort, p.w_change,
-                     p.forecast_horizon, p.max_tangent_bodies, p.n_headings, robot_radius,
-                     p.spacing, p.comfort_min_speed), dtype=float)  # fmt: skip
-
-
 def loop_constants(
     params: Zhang2019V2Params, v_max: float, robot_radius: float
 ) -> tuple[FloatArray, FloatArray]:
@@ -561,22 +556,14 @@ def plan_limited(
     when numba is enabled; ``constants``: the loop's ``prm`` vector and speeds
     (:class:`PathConstants`) when already made."""
     p = params
+    if (numba_enabled() if loop is None else loop) and p.w_social == 0.0:
+        out = plan_on_floats(obs, goal, model, now, v_prev, p.noise_sigmas, constants or (
+            path_constants(model, p, robot_radius),
+            model.v_max * np.asarray(p.speed_levels, dtype=float)))  # fmt: skip
+        return Choice(out[:2].copy(), float(out[2]), bool(out[3]))
     pos = np.asarray(obs.position, dtype=float)
     v_pref = preferred_under_limits(pos, goal, model)
     pose = np.asarray(obs.pose, dtype=float)
-    if (numba_enabled() if loop is None else loop) and p.w_social == 0.0:
-        readings = obs.obstacles
-        table = body_table(readings, p.noise_sigmas)
-        moving = 1.0 if math.hypot(v_prev[0], v_prev[1]) > 1e-9 else 0.0  # as extra_headings
-        f_norm = math.hypot(v_pref[0], v_pref[1])
-        state = np.array((pose[0], pose[1], pose[2], now[0], now[1], v_pref[0], v_pref[1],
-                          f_norm, v_prev[0], v_prev[1], moving), dtype=float)  # fmt: skip
-        prm, speeds = constants or (
-            path_constants(model, p, robot_radius),
-            model.v_max * np.asarray(p.speed_levels, dtype=float),
-        )
-        out = plan_paths(state, table, outline_rings(readings, table[0]), speeds, prm)
-        return Choice(out[:2].copy(), float(out[2]), bool(out[3]))
     table = body_table(obs.obstacles, p.noise_sigmas)
     keep = reachable(table, model.v_max, p.horizon)
     table = (table[0][keep], table[1][keep], table[2][keep])
@@ -619,26 +606,6 @@ class LoopConstants:
         return self._value
 
 
-class PathConstants:
-    """:func:`plan_limited`'s ``constants``, kept while its parameters are the same object and
-    its vehicle model and radius are equal."""
-
-    def __init__(self) -> None:
-        self._of: tuple[object, RampModel, float] | None = None
-        self._value: tuple[FloatArray, FloatArray] = (np.zeros(0), np.zeros(0))
-
-    def get(
-        self, params: Zhang2019V2Params, model: RampModel, radius: float
-    ) -> tuple[FloatArray, FloatArray]:
-        """:func:`path_constants` of ``params``, ``model`` and ``radius``, and the speeds."""
-        of = self._of
-        if of is None or of[0] is not params or of[1] != model or of[2] != radius:
-            self._of = (params, model, radius)
-            speeds = model.v_max * np.asarray(params.speed_levels, dtype=float)
-            self._value = (path_constants(model, params, radius), speeds)
-        return self._value
-
-
 def finite_position(pose: FloatArray) -> bool:
     """The position ``pose[:2]`` is finite (two float checks, no array made)."""
     return math.isfinite(pose[0]) and math.isfinite(pose[1])
@@ -662,9 +629,13 @@ def tracked(obs: Observation, tracker: CentreTracker | None) -> Observation:
 @dataclass(frozen=True)
 class Zhang2019HolonomicV2Params(Zhang2019V2Params):
     """``zhang2019-holonomic-v2``'s parameters: :class:`Zhang2019V2Params` with the route
-    layer on (:mod:`uvnav.controllers.crowd_route`)."""
+    layer's own defaults (:mod:`uvnav.controllers.crowd_route`): searched at every decision over
+    every walker."""
 
     route_weight: float = 2.0
+    route_lookahead: float = 4.0
+    route_period: float = 0.0
+    route_bodies: int = 0
 
 
 class Zhang2019HolonomicV2(HolonomicLaw):
@@ -753,13 +724,12 @@ class Zhang2019V2(UnicycleController):
         the speed it has from its odometry, the turn rate it has from its last command as the
         vehicle applies it; a command within the window of one period."""
         spec = self._spec
-        model = RampModel(spec.v_max, spec.u_max, spec.accel_max, spec.turn_accel_max, period)
-        fixed = self._paths.get(self.params, model, float(spec.radius))
+        model, prm, speeds = self._paths.get(self.params, spec, period)
         u_before, u_cmd = self._turn
         u_now = paths_approach(u_before, u_cmd, spec.turn_accel_max * period)
         v_now = min(max(float(obs.speed), 0.0), spec.v_max) if math.isfinite(obs.speed) else 0.0
         choice = plan_limited(obs, goal, model, spec.radius, (v_now, u_now), self._aim,
-                              self.params, constants=fixed)  # fmt: skip
+                              self.params, constants=(prm, speeds))  # fmt: skip
         self.last_choice = choice
         self._mode = "M1" if choice.preferred else "M2"
         v = choice.velocity
@@ -769,7 +739,7 @@ class Zhang2019V2(UnicycleController):
         beta = wrap_scalar(math.atan2(float(gap[1]), float(gap[0])) - obs.heading)
         lo, hi = paths_window(v_now, model.accel, period, 0.0, model.v_max)
         v_out = min(max(speed * max(math.cos(beta), 0.0), lo), hi)  # as speed_command
-        u_out = paths_turn(beta, u_now, fixed[0])  # as turn_command
+        u_out = paths_turn(beta, u_now, prm)  # as turn_command
         self._turn = (u_now, u_out)
         return UnicycleCommand(v_out, u_out).clipped(spec)
 

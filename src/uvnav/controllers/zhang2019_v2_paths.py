@@ -543,7 +543,7 @@ def _compiled_plan() -> Callable[..., Any]:
                    risk_along, _stops, _better, _keep, _groups, choose_on_paths_py, plan_paths_py,
                    plan_readings_py)  # fmt: skip
         bound = {**contact._kernels(), **zhang2019_v2_loop._COMPILED}
-        _COMPILED.update(compile_family(kernels, bound=bound))
+        _COMPILED.update(compile_family(kernels, bound=bound, error_model="numpy"))
     return _COMPILED["plan_readings_py"]
 
 

@@ -36,7 +36,7 @@ import os
 import types
 from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import contextmanager
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -51,6 +51,8 @@ _ENABLED = _HAVE_NUMBA and os.environ.get("UVNAV_NO_NUMBA", "") != "1"
 def compile_family(
     functions: Sequence[Callable[..., Any] | tuple[str, Callable[..., Any]]],
     bound: Mapping[str, Callable[..., Any]] | None = None,
+    *,
+    error_model: Literal["python", "numpy"] = "python",
 ) -> dict[str, Callable[..., Any]]:
     """numba-compiled copies of ``functions`` (callees before callers), by name.
 
@@ -60,19 +62,20 @@ def compile_family(
     ``(name, function)`` pair binds the function's compiled copy under ``name`` (a global the
     Python path binds to something numba cannot compile the same, e.g. ``math.hypot``).
     ``bound``: compiled kernels of other families, bound under their names in every copy (not
-    returned).
+    returned).  ``error_model``: numba's (``"numpy"``: a float divided by zero gives inf or nan
+    instead of raising, which spares a check at every division; a copy's name carries it).
     """
     import numba
 
     done: dict[str, Callable[..., Any]] = dict(bound or {})
     made: dict[str, Callable[..., Any]] = {}
-    stamp = family_stamp(functions, bound)
+    stamp = family_stamp(functions, bound) + ("" if error_model == "python" else f"_{error_model}")
     for item in functions:
         name, f = item if isinstance(item, tuple) else (item.__name__, item)
         env = {**f.__globals__, **done}
         copy = types.FunctionType(f.__code__, env, f.__name__, f.__defaults__, f.__closure__)
         copy.__qualname__ = f"{f.__qualname__}_{stamp}"
-        done[name] = made[name] = numba.njit(cache=True, nogil=True)(copy)
+        done[name] = made[name] = numba.njit(cache=True, nogil=True, error_model=error_model)(copy)
     return made
 
 
