@@ -32,6 +32,27 @@ def test_judge_compares_ray_with_the_pool() -> None:
     assert bench_ray.judge(inproc, run(None, 20.0, 0.8), run(2.2, 20.4, 1.6))["pass"] is None
 
 
+def test_pooled_runs_are_summed_and_judged_per_episode_of_the_sum() -> None:
+    def run(cpu: float, jobs: float, wall: float) -> dict[str, Any]:
+        return {"episodes": 100, "statuses": {"success": 99, "collision": 1}, "wall_s": wall,
+                "session_wall_s": 0.5, "cpu_s": cpu, "jobs_cpu_s": jobs,
+                "cpu_s_by_process": {"driver": 0.1, "ray workers": cpu - 0.1},
+                "startup": {"cpu_s": 3.0}}  # fmt: skip
+
+    both = bench_ray.pooled(run(2.2, 2.0, 1.5), run(2.6, 2.2, 2.5))
+    assert both["episodes"] == 200 and both["runs"] == 2
+    assert both["statuses"] == {"collision": 2, "success": 198}
+    assert both["cpu_s"] == pytest.approx(4.8) and both["episodes_per_s"] == pytest.approx(50.0)
+    assert both["jobs_cpu_ms_per_episode"] == pytest.approx(21.0)
+    assert both["overhead_ms_per_episode"] == pytest.approx(3.0)
+    assert both["cpu_s_by_process"] == pytest.approx({"driver": 0.2, "ray workers": 4.6})
+    inproc = {"cpu_s": 2.0, "jobs_cpu_ms_per_episode": 20.0}
+    pool = bench_ray.pooled(run(2.1, 2.0, 1.0), run(2.1, 2.0, 1.0))
+    got = bench_ray.judge(inproc, pool, both)
+    assert got["ray_added_cpu_ms"] == pytest.approx(3.0)  # (4.8 - 4.2) CPU-s over 200
+    assert got["ray_added_with_startup_ms"] == pytest.approx(3.0 + 30.0)  # 3 s a run of 100
+
+
 @pytest.mark.skipif(not os.path.isdir("/proc/self"), reason="reads /proc")
 def test_tree_snapshot_sees_this_process() -> None:
     snap = bench_ray.tree_snapshot()
