@@ -2,7 +2,8 @@
 where people will be, for a vehicle that cannot sidestep at once.
 
 uvnav's own layer, beyond the thesis, used by ``zhang2019-v2`` on a unicycle with acceleration
-limits (:class:`~uvnav.controllers.crowd_route.CrowdRoute`, ``route_grid_weight``).  It is
+limits, and on every unicycle with ``route_grid="all"``
+(:class:`~uvnav.controllers.crowd_route.CrowdRoute`, ``route_grid_weight``).  It is
 the time-dependent planning on a social cost map of Kollmitz, Hsiao, Gaa and Burgard ("Time
 dependent planning on a layered social cost map for human-aware robot navigation", ECMR 2015)
 in its simplest form:
@@ -26,14 +27,15 @@ Measured on CrowdNav's circle with 20 humans, the unicycle limited to 1 m/s^2 an
 (tuning cases 0-99): ``zhang2019-v2`` 0.57 without a route, 0.64-0.68 with the fan of
 :mod:`~uvnav.controllers.crowd_route`, 0.75 with this grid; on held-out cases 100-499 0.531
 without, 0.741 with it (``docs/design-notes.md``).  One search is the exposure map in one
-compiled call (numba when enabled, plain Python otherwise) and scipy's Dijkstra: 0.56 ms CPU
-for 20 people over a 16 x 8 m box.  Units: metres, seconds.
+compiled call (numba when enabled, plain Python otherwise) and scipy's Dijkstra: 0.31 ms CPU
+for 20 people on CrowdNav's circle (an 8 x 16 m box), 1.1 ms for 100 people over 15 x 15 m.
+Units: metres, seconds.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -60,7 +62,7 @@ GRID_AHEAD = 2.0
 OUTLINE_SPACING = 2 * CELL
 
 
-def grid_bodies(readings: Sequence[ObstacleReading]) -> FloatArray:
+def grid_bodies(readings: tuple[ObstacleReading, ...]) -> FloatArray:
     """The sensed bodies as :func:`exposure_map_py`'s ``bodies`` (N, 5), finite rows only: a
     disc as itself, a polygon as discs along its outline ``OUTLINE_SPACING`` m apart, each of
     half that radius, moving with the body (:func:`~uvnav.controllers.zhang2019_v2_bodies.
@@ -77,9 +79,7 @@ def grid_bodies(readings: Sequence[ObstacleReading]) -> FloatArray:
     """
     if not readings:
         return np.zeros((0, 5))
-    centres, velocities, radii, _, _ = boundary_discs(
-        readings if isinstance(readings, tuple) else tuple(readings), OUTLINE_SPACING
-    )
+    centres, velocities, radii, _, _ = boundary_discs(readings, OUTLINE_SPACING)
     table = np.column_stack((centres, velocities, radii))
     return table[np.isfinite(table).all(axis=1)]
 

@@ -97,7 +97,7 @@ class RouteParams:
         route_grid_weight: on the unicycles ``route_grid`` names, the route is planned on a
             grid instead (:mod:`~uvnav.controllers.crowd_grid`, every body costed, walking or
             standing) with this weight [m per unit of exposure], whatever ``route_weight``
-            says; 0: as on the ideal vehicle.
+            says; 0: no grid route (the fan, as on the unicycles ``route_grid`` leaves out).
         route_grid: which unicycles plan on the grid: ``"limited"``, those with acceleration
             limits; ``"all"``, every one (the ideal unicycle too; with ``route_grid_period`` 1 s
             the design notes measure its gains and its cost).  The holonomic law plans no
@@ -370,9 +370,9 @@ class CrowdRoute:
         nothing is sensed."""
         p = self.params
         self.way, self.next_search = None, time + p.route_grid_period
-        if not np.isfinite(position).all() or math.dist(goal, position) <= DIRECT_WITHIN:
+        if math.dist(goal, position) <= DIRECT_WITHIN:
             return goal
-        bodies = grid_bodies(readings)
+        bodies = grid_bodies(_as_tuple(readings))
         if len(bodies) == 0:
             return goal
         self.way = grid_way_point(position, goal, bodies, v_max, p.route_horizon, GRID_SIGMA,

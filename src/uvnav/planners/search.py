@@ -124,8 +124,11 @@ def dijkstra(occupied: np.ndarray, start: Cell, goal: Cell, *, resolution: float
     _check_cells(occ, start, goal)
     if occ[start] or occ[goal]:
         return _no_path(0)
+    from scipy.sparse import csr_matrix
+
     src, dst, w = grid_edges(occ, resolution)
-    return _scipy_path(src, dst, w, occ.shape, start, goal)
+    n = occ.size
+    return _csgraph_path(csr_matrix((w, (src, dst)), shape=(n, n)), occ.shape, start, goal)
 
 
 def costed_dijkstra(
@@ -171,18 +174,6 @@ def _csr(w: np.ndarray, dst: np.ndarray, indptr: np.ndarray) -> Any:
 
     n = len(indptr) - 1
     return csr_matrix((w, dst, indptr), shape=(n, n))
-
-
-def _scipy_path(
-    src: np.ndarray, dst: np.ndarray, w: np.ndarray, shape: tuple[int, ...], start: Cell,
-    goal: Cell,
-) -> GridPath:  # fmt: skip
-    """scipy's Dijkstra on the directed edges ``src`` -> ``dst`` of cost ``w`` of a grid of
-    ``shape``, from ``start`` to ``goal``."""
-    from scipy.sparse import csr_matrix
-
-    n = shape[0] * shape[1]
-    return _csgraph_path(csr_matrix((w, (src, dst)), shape=(n, n)), shape, start, goal)
 
 
 def _csgraph_path(graph: Any, shape: tuple[int, ...], start: Cell, goal: Cell) -> GridPath:
