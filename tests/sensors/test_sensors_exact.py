@@ -7,6 +7,8 @@ import math
 import numpy as np
 import pytest
 import shapely
+from hypothesis import given
+from hypothesis import strategies as st
 from shapely.geometry import LineString, Point, Polygon
 
 from uvnav.obstacles import (
@@ -18,6 +20,7 @@ from uvnav.obstacles import (
     PolygonBody,
 )
 from uvnav.sensors import lidar_scan, sense_obstacles
+from uvnav.sensors.exact import beam_directions, beam_offsets, beam_turns
 from uvnav.sensors.observation import Readings, read_arrays
 
 ARROW = np.array([[-0.6, -0.4], [0.7, -0.5], [0.2, 0.1], [0.6, 0.6], [-0.5, 0.5]])
@@ -139,6 +142,18 @@ def test_lidar_ranges_agree_with_ray_casts(fov: float) -> None:
     assert scan.ranges == pytest.approx(ref, abs=1e-9)
     assert np.any(scan.ranges < 6.0)
     assert scan.max_range == 6.0
+
+
+@given(st.floats(-1e3, 1e3), st.integers(1, 400))
+def test_the_beams_are_unit_vectors_at_heading_plus_offset(theta: float, n_rays: int) -> None:
+    """The beams turned by the heading point at ``theta + offset`` within a few 1e-16 (the
+    rotation of two rounded unit vectors), and have unit length as closely."""
+    rel = beam_offsets(n_rays, 2.0 * math.pi)
+    d = beam_directions(theta, beam_turns(rel))
+    assert d.shape == (n_rays, 2)
+    exact = np.column_stack([np.cos(theta + rel), np.sin(theta + rel)])
+    assert np.abs(d - exact).max() <= 1e-13 * (1.0 + abs(theta))
+    assert np.abs(np.hypot(d[:, 0], d[:, 1]) - 1.0).max() <= 1e-15
 
 
 def test_lidar_empty_world_reads_max_range() -> None:

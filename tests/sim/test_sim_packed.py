@@ -21,7 +21,7 @@ from uvnav.obstacles.bodies import DiscBody, PolygonBody
 from uvnav.obstacles.motion import ConstantVelocity, RandomTurn, Waypoints
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.loader import load_scenario
-from uvnav.sensors.exact import lidar_scan
+from uvnav.sensors.exact import beam_turns, lidar_scan
 from uvnav.sensors.observation import Readings, read_arrays
 from uvnav.sim.bodies2d import FieldBodies, PackedBodies
 from uvnav.sim.episode import World2D
@@ -34,7 +34,6 @@ from uvnav.sim.packed import (
     pack_check,
     reseed_spawned,
 )
-from uvnav.sim.packed_sense import _rough_cos_sin
 from uvnav.sim.run import run_episode
 from uvnav.sim.seeding import run_rng, world_rng
 from uvnav.sim.setup import EpisodeResult, EpisodeSetup
@@ -439,12 +438,6 @@ def test_the_compiled_path_leaves_the_generators_where_the_numpy_path_does_acros
     assert world.bodies._pw.read.max() > 0  # the rows were topped up
 
 
-def test_the_rough_directions_are_within_their_stated_error() -> None:
-    for a in [*np.linspace(-math.pi, math.pi, 20_001).tolist(), math.pi / 2, -math.pi / 2]:
-        c, s = _rough_cos_sin(a)
-        assert abs(c - math.cos(a)) <= 1e-12 and abs(s - math.sin(a)) <= 1e-12, a
-
-
 @pytest.mark.parametrize("compiled", [False, True])
 def test_the_lidar_kernel_is_lidar_scan_near_inside_and_far_from_bodies(compiled: bool) -> None:
     """Poses around every body of a random-ch2 scene (on edges, inside, beyond the range): the
@@ -457,6 +450,7 @@ def test_the_lidar_kernel_is_lidar_scan_near_inside_and_far_from_bodies(compiled
     worlds.load(0, setup)
     rng = np.random.default_rng(7)
     rel = np.linspace(-math.pi, math.pi, 90, endpoint=False)
+    turns = beam_turns(rel)
     ranges, dirs = np.empty(90), np.empty((2, 90))
     ring = np.empty((2, worlds.rings.shape[3]))
     with kernels(compiled):
@@ -465,7 +459,7 @@ def test_the_lidar_kernel_is_lidar_scan_near_inside_and_far_from_bodies(compiled
             for _ in range(20):
                 x, y = np.asarray(ob.state.position) + rng.normal(0.0, 1.0, 2)
                 th = float(rng.uniform(-7.0, 7.0))
-                lidar(float(x), float(y), th, rel, 4.0, len(setup.obstacles), worlds.params[0],
+                lidar(float(x), float(y), th, turns, 4.0, len(setup.obstacles), worlds.params[0],
                       worlds.state[0], worlds.rings[0], ring, dirs, ranges)  # fmt: skip
                 want = lidar_scan(np.array([x, y, th]), field, n_rays=90, max_range=4.0).ranges
                 np.testing.assert_array_equal(ranges, want)
@@ -496,14 +490,14 @@ def _grazing_poses(setup: EpisodeSetup, rel: np.ndarray) -> Iterator[tuple[float
 def test_the_lidar_culls_keep_the_beams_grazing_a_body(compiled: bool, n_rays: int) -> None:
     """Beams grazing each body at the edge of its angular extent, at every beam index: the
     kernel's ranges and the observation kernel's (beams culled by the bodies' bounding discs,
-    rough directions by polynomial or by rotation, headings near 0, 630 and 6280 rad) equal
-    :func:`lidar_scan`'s, which casts every beam on every body in range; a disc test that is
-    not safe (a disc 1e-6 narrower, rough directions 1e-6 rad off) fails here."""
+    headings near 0, 630 and 6280 rad) equal :func:`lidar_scan`'s, which casts every beam on
+    every body in range; a disc test that is not safe (a disc 1e-6 narrower) fails here."""
     setup = build_episode(load_scenario("random-ch2:5"), 3)
     field = ObstacleField.from_obstacles(setup.obstacles)
     worlds = PackedWorlds(1)
     worlds.load(0, setup)
     rel = np.linspace(-math.pi, math.pi, n_rays, endpoint=False)
+    turns = beam_turns(rel)
     ranges, dirs = np.empty(n_rays), np.empty((2, n_rays))
     ring = np.empty((2, worlds.rings.shape[3]))
     batch, out, dist = np.empty((1, n_rays)), np.empty((1, 4 + n_rays), np.float32), np.empty(1)
@@ -512,9 +506,9 @@ def test_the_lidar_culls_keep_the_beams_grazing_a_body(compiled: bool, n_rays: i
         lidar = kernel("lidar")
         for x, y, th0 in _grazing_poses(setup, rel):
             for th in (th0, th0 + 200.0 * math.pi, th0 - 2000.0 * math.pi):
-                lidar(x, y, th, rel, 4.0, len(setup.obstacles), worlds.params[0],
+                lidar(x, y, th, turns, 4.0, len(setup.obstacles), worlds.params[0],
                       worlds.state[0], worlds.rings[0], ring, dirs, ranges)  # fmt: skip
-                worlds.robot[0] = (x, y, th)  # observe's path: rough directions by rotation
+                worlds.robot[0] = (x, y, th)  # observe's path
                 worlds.observe(rel, 4.0, 10.0, batch, out, dist)
                 want = lidar_scan(np.array([x, y, th]), field, n_rays=n_rays, max_range=4.0)
                 np.testing.assert_array_equal(ranges, want.ranges)

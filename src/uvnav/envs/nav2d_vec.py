@@ -131,6 +131,11 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self.episode_seeds = np.zeros(k, dtype=np.int64)
         self._image: tuple[np.ndarray, ...] | None = None
         self._names = np.array(STATUS_NAMES, dtype=object)
+        #: the info's masks (every sub-environment has every entry), shared and read-only
+        self._ones = np.ones(k, dtype=np.bool_)
+        self._ones.flags.writeable = False
+        #: the clearance [m] for the reward of an episode restored from :attr:`_image`
+        self._image_clear = 0.0
         self._weights_of: RewardConfig | None = None
         self._weight_row = np.zeros(6)
 
@@ -170,6 +175,7 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         self.worlds.load(i, build_episode(self.scenario, k))
         self._image = self.worlds.image(i)
         self._set_clear(i)
+        self._image_clear = float(self._clear[i])
 
     def _restart(self, ids: list[int]) -> None:
         """:meth:`_load` of sub-environments ``ids`` (no options), the restored ones in one
@@ -179,7 +185,7 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
         if self._image is not None and self.worlds.restore_spawned_many(
             ids, self._image, seeds, WORLD_KEY, [self._children(i) for i in ids]
         ):
-            self._set_clear(ids)
+            self._clear[ids] = self._image_clear  # every restored world starts as the image
             return
         for i, k in zip(ids, seeds, strict=True):
             self._start(i, k)
@@ -198,7 +204,7 @@ class Nav2DVectorEnv(gym.vector.VectorEnv[np.ndarray, np.ndarray, np.ndarray]):
     def _infos(self) -> dict[str, Any]:
         w = self.worlds
         status = self._names[w.status]
-        ones = np.ones(self.num_envs, dtype=np.bool_)
+        ones = self._ones
         return {
             "status": status, "_status": ones,
             "distance": self._dist.copy(), "_distance": ones,

@@ -7,6 +7,7 @@ noise and dropout, a ``numpy.random.Generator``.
 from __future__ import annotations
 
 import functools
+import math
 
 import numpy as np
 
@@ -79,6 +80,41 @@ def beam_offsets(n_rays: int, fov: float) -> FloatArray:
     return rel
 
 
+def beam_turns(rel: FloatArray) -> FloatArray:
+    """The beams' offsets ``rel`` (R,) [rad] as rotations (2, R): libm's cos and sin of each
+    (``math.cos``, ``math.sin``, as the compiled lidar computes them).
+
+    >>> beam_turns(np.array([0.0, np.pi / 2])).round(12).tolist()
+    [[1.0, 0.0], [0.0, 1.0]]
+    """
+    return np.array([[math.cos(a) for a in rel.tolist()], [math.sin(a) for a in rel.tolist()]],
+                    dtype=float).reshape(2, len(rel))  # fmt: skip
+
+
+@functools.lru_cache(maxsize=64)
+def _offset_turns(n_rays: int, fov: float) -> FloatArray:
+    """:func:`beam_turns` of :func:`beam_offsets`, read-only, shared."""
+    turns = beam_turns(beam_offsets(n_rays, fov))
+    turns.flags.writeable = False
+    return turns
+
+
+def beam_directions(theta: float, turns: FloatArray) -> FloatArray:
+    """Unit directions (R, 2) of the beams at offsets ``turns`` (:func:`beam_turns`) from the
+    heading ``theta`` [rad]: each offset's rotation turned by libm's cos and sin of ``theta``,
+    the way a range sensor's beams are fixed in its frame.  The compiled lidar
+    (:mod:`uvnav.sim.packed_sense`) computes the same products, so both casts see the same
+    beams bit for bit; each is within a few 1e-16 of ``(cos, sin)`` of ``theta`` plus the
+    offset.
+
+    >>> d = beam_directions(0.3, beam_turns(np.array([0.0, 0.2])))
+    >>> bool(np.allclose(d, [[math.cos(0.3), math.sin(0.3)], [math.cos(0.5), math.sin(0.5)]]))
+    True
+    """
+    c, s = math.cos(theta), math.sin(theta)
+    return np.stack([c * turns[0] - s * turns[1], s * turns[0] + c * turns[1]], axis=-1)
+
+
 def lidar_scan(
     pose: FloatArray,
     field: ObstacleField,
@@ -92,8 +128,9 @@ def lidar_scan(
 ) -> LidarScan:
     """A planar range scan centred on the robot's heading.
 
-    Beam angles are in the world frame, wrapped to (-pi, pi].  Obstacles whose bounding disc lies
-    beyond ``max_range`` are not ray-cast (they cannot change a range).
+    Beam angles are in the world frame, wrapped to (-pi, pi]; the beams cast along
+    :func:`beam_directions` (the sensor's fixed offsets turned by the heading).  Obstacles whose
+    bounding disc lies beyond ``max_range`` are not ray-cast (they cannot change a range).
 
     Args:
         pose: ``[x, y, theta]``.
@@ -104,7 +141,7 @@ def lidar_scan(
     """
     x, y, th = float(pose[0]), float(pose[1]), float(pose[2])
     angles = wrap_to_pi(th + beam_offsets(int(n_rays), float(fov)))
-    dirs = np.stack([np.cos(angles), np.sin(angles)], axis=-1)
+    dirs = beam_directions(th, _offset_turns(int(n_rays), float(fov)))
     ranges = np.full(n_rays, max_range)
     if len(field):
         hits = field.ray_hits(np.array([x, y]), dirs, max_range=max_range).min(axis=1)

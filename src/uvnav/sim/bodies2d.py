@@ -18,7 +18,7 @@ from uvnav.geometry.angles import FloatArray
 from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.obstacles.motion import RandomTurn
 from uvnav.obstacles.obstacle import FieldTemplate, Obstacle, ObstacleField, ObstacleState
-from uvnav.sensors.exact import sense_obstacles
+from uvnav.sensors.exact import beam_turns, sense_obstacles
 from uvnav.sensors.observation import ObstacleReading, ReadingArrays, Readings
 from uvnav.sim.packed import (
     BLOCK,
@@ -347,6 +347,9 @@ class PackedBodies:
         self._lidar, self._vector = kernel("lidar"), kernel("vector_one")
         self._ring = np.empty((2, w))  # the lidar's scratch
         self._beams = np.empty((2, 0))
+        #: the beams' offsets last read (a read-only array) and their rotations (beam_turns)
+        self._turns_of: FloatArray | None = None
+        self._turns = np.empty((2, 0))
         self._field: ObstacleField | None = None  # (before any step: the obstacles' own)
         self._prev = np.zeros((3, n))  # the poses before the last step: x, y, heading
         #: the most any body point moved over the last step [m]
@@ -519,10 +522,11 @@ class PackedBodies:
         self, x: float, y: float, th: float, rel: FloatArray, max_range: float, out: FloatArray
     ) -> None:
         """The ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from ``(x, y, th)``,
-        beams at ``wrap(th + rel)`` [rad], into ``out`` (R,), in one compiled call
+        beams at ``rel`` [rad] from the heading, into ``out`` (R,), in one compiled call
         (:func:`~uvnav.sim.packed._lidar`; no field is built)."""
-        self._lidar(x, y, th, rel, max_range, self.n, self._prm, self._st, self._rings,
-                    self._ring, self._dirs(rel), out)  # fmt: skip
+        turns, dirs = self._beams_of(rel)
+        self._lidar(x, y, th, turns, max_range, self.n, self._prm, self._st, self._rings,
+                    self._ring, dirs, out)  # fmt: skip
 
     def vector(
         self, pose: tuple[float, float, float], goal: tuple[float, float], goal_scale: float,
@@ -534,16 +538,22 @@ class PackedBodies:
         (:func:`~uvnav.sim.packed.vector_one_py`: goal ``(x, y)`` [m] and ``goal_scale`` [m],
         ``speed`` and ``v_max`` [m/s], beams at heading + ``rel`` [rad] to ``max_range`` [m])."""
         x, y, th = pose
-        self._vector(x, y, th, goal[0], goal[1], goal_scale, speed, v_max, rel, max_range,
-                     self.n, self._prm, self._st, self._rings, self._ring, self._dirs(rel),
-                     ranges, out)  # fmt: skip
+        turns, dirs = self._beams_of(rel)
+        self._vector(x, y, th, goal[0], goal[1], goal_scale, speed, v_max, turns, max_range,
+                     self.n, self._prm, self._st, self._rings, self._ring, dirs, ranges,
+                     out)  # fmt: skip
 
-    def _dirs(self, rel: FloatArray) -> FloatArray:
-        """The lidar's scratch for the beams' directions, (2, R) for ``rel`` (R,)."""
-        dirs = self._beams
-        if dirs.shape[1] != rel.shape[0]:
-            dirs = self._beams = np.empty((2, rel.shape[0]))
-        return dirs
+    def _beams_of(self, rel: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """The beams' rotations (:func:`~uvnav.sensors.exact.beam_turns`, (2, R)) for ``rel``
+        (R,) [rad], kept while the same read-only array comes back (an env's
+        :func:`~uvnav.sensors.exact.beam_offsets`), and the lidar's scratch for their
+        directions, (2, R)."""
+        if rel is not self._turns_of:
+            self._turns = beam_turns(rel)
+            self._turns_of = None if rel.flags.writeable else rel
+        if self._beams.shape[1] != rel.shape[0]:
+            self._beams = np.empty((2, rel.shape[0]))
+        return self._turns, self._beams
 
     def field(self) -> ObstacleField:
         """The :class:`ObstacleField` of now (built on first use after a step)."""

@@ -137,7 +137,6 @@ from uvnav.sim.packed_sense import (  # noqa: F401 - the reading columns, re-exp
     _features,
     _lidar,
     _lidar_in,
-    _rough_cos_sin,
     advance_one_py,
     commands_py,
     observe_py,
@@ -176,7 +175,7 @@ def kernel(name: str) -> Callable[..., Any]:
     if not _KERNELS:
         _KERNELS.update(compile_family([
             wrap_scalar, unicycle_advance, pyhypot, ring_nearest_py,
-            _transform_ring, _move_obstacles, _clearance, _rough_cos_sin,
+            _transform_ring, _move_obstacles, _clearance,
             _lidar_in, _lidar, _features, vector_one_py,
             step_worlds_py,
             observe_py,

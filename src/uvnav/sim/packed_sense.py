@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from uvnav.geometry.angles import FloatArray, wrap_scalar
+from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.polygons import ring_nearest_py
 from uvnav.geometry.small import pyhypot
 from uvnav.sim.packed_kernels import (
@@ -100,97 +100,17 @@ def sense_one_py(x: float, y: float, sensing_range: float, n_obs: int, prm: Floa
     return m
 
 
-def _rough_cos_sin(a: float) -> tuple[float, float]:
-    """cos and sin of ``a`` [rad] in [-pi, pi] within 1e-12 (Taylor series of degree 16 and 17
-    on [-pi/2, pi/2], folded), for tests that a margin makes safe: a few multiplications where
-    libm's exact ones cost a call each."""
-    r, sign = a, 1.0
-    if a > 0.5 * math.pi:
-        r, sign = math.pi - a, -1.0
-    elif a < -0.5 * math.pi:
-        r, sign = -math.pi - a, -1.0
-    q = r * r
-    c = 1.0 + q * (
-        -1.0 / 2
-        + q
-        * (
-            1.0 / 24
-            + q
-            * (
-                -1.0 / 720
-                + q
-                * (
-                    1.0 / 40320
-                    + q
-                    * (
-                        -1.0 / 3628800
-                        + q
-                        * (1.0 / 479001600 + q * (-1.0 / 87178291200 + q * (1.0 / 20922789888000)))
-                    )
-                )
-            )
-        )
-    )
-    sn = r * (
-        1.0
-        + q
-        * (
-            -1.0 / 6
-            + q
-            * (
-                1.0 / 120
-                + q
-                * (
-                    -1.0 / 5040
-                    + q
-                    * (
-                        1.0 / 362880
-                        + q
-                        * (
-                            -1.0 / 39916800
-                            + q
-                            * (
-                                1.0 / 6227020800
-                                + q * (-1.0 / 1307674368000 + q * (1.0 / 355687428096000))
-                            )
-                        )
-                    )
-                )
-            )
-        )
-    )
-    return sign * c, sn  # fmt: skip
-
-
-def _lidar_in(k: int, ox: float, oy: float, th: float, rel: FloatArray, max_range: float,
+def _lidar_in(k: int, ox: float, oy: float, th: float, turns: FloatArray, max_range: float,
               n_obs: int, params: FloatArray, state: FloatArray, rings: FloatArray,
-              ring: FloatArray, dirs: FloatArray, ranges: FloatArray,
-              turns: FloatArray) -> None:  # fmt: skip
+              ring: FloatArray, dirs: FloatArray, ranges: FloatArray) -> None:  # fmt: skip
     """:func:`_lidar` of world ``k`` of the packed arrays ``params``, ``state``, ``rings``
     (:func:`step_worlds_py`'s layout) into ``ranges[k]``, indexing them here: slicing them per
-    world and passing the slices cost more than a tenth of the cast.
-
-    With ``turns`` (2, R) holding libm's cos and sin of ``rel`` (else (2, 0)) and ``|th|`` at
-    most 1e3 rad, the rough directions are those turns rotated by libm's cos and sin of
-    ``th``: within 1e-12 of each beam's exact direction, as :func:`_rough_cos_sin`'s are (the
-    sum ``th + rel`` and its wrap round by under 2e-13 rad there), for two calls a world
-    instead of a polynomial a beam."""
-    n_rays = rel.shape[0]
-    rotate = turns.shape[1] == n_rays and abs(th) <= 1e3
-    ct = st = 0.0
-    if rotate:
-        ct, st = math.cos(th), math.sin(th)
-    for r in range(n_rays):
+    world and passing the slices cost more than a tenth of the cast."""
+    ct, st = math.cos(th), math.sin(th)
+    for r in range(turns.shape[1]):
         ranges[k, r] = max_range
-        if rotate:
-            cr, sr = turns[0, r], turns[1, r]
-            dirs[0, r], dirs[1, r] = ct * cr - st * sr, st * cr + ct * sr
-            continue
-        a = wrap_scalar(th + rel[r])
-        if -math.pi <= a <= math.pi:
-            dirs[0, r], dirs[1, r] = _rough_cos_sin(a)
-        else:  # not a number: no rough test skips it
-            dirs[0, r], dirs[1, r] = a, a
+        cr, sr = turns[0, r], turns[1, r]
+        dirs[0, r], dirs[1, r] = ct * cr - st * sr, st * cr + ct * sr
     slack = 1e-9 * (1.0 + abs(ox) + abs(oy))
     limit = max_range * (1.0 + 1e-9) + slack
     for o in range(n_obs):
@@ -203,18 +123,11 @@ def _lidar_in(k: int, ox: float, oy: float, th: float, rel: FloatArray, max_rang
         if dc - bound > limit:
             continue  # its hits would be beyond max_range
         reach = bound * (1.0 + 1e-9) + slack
-        rough = reach + 1e-9 * (1.0 + abs(ex) + abs(ey))
         cast = False
-        for r in range(n_rays):
+        for r in range(turns.shape[1]):
             dx, dy = dirs[0, r], dirs[1, r]
-            if abs(dx * ey - dy * ex) > rough or dx * ex + dy * ey < -rough:
-                continue
-            a = wrap_scalar(th + rel[r])
-            dx, dy = math.cos(a), math.sin(a)
             # a beam that passes outside the bounding disc, or starts beyond it, cannot hit
-            if abs(dx * (cy - oy) - dy * (cx - ox)) > reach:
-                continue
-            if dx * (cx - ox) + dy * (cy - oy) < -reach:
+            if abs(dx * ey - dy * ex) > reach or dx * ex + dy * ey < -reach:
                 continue
             if not cast:  # _transform_ring's operations, inlined (as the loop below)
                 ch, sh = math.cos(h), math.sin(h)
@@ -241,7 +154,7 @@ def _lidar(
     ox: float,
     oy: float,
     th: float,
-    rel: FloatArray,
+    turns: FloatArray,
     max_range: float,
     n_obs: int,
     prm: FloatArray,
@@ -252,24 +165,25 @@ def _lidar(
     out: FloatArray,
 ) -> None:
     """Ranges [m] of :func:`uvnav.sensors.lidar_scan` (no noise) from pose ``(ox, oy, th)`` in
-    one world into ``out`` (R,): beams at ``wrap(th + rel)`` [rad], capped at ``max_range``
-    [m] (``ring`` (2, W) and ``dirs`` (2, R): scratch).  A body is cast where
-    :meth:`ObstacleField.ray_hits` casts it, and only by the beams that meet its bounding disc
-    (the others cannot hit it: the same ranges, far fewer edges).
+    one world into ``out`` (R,): beams along :func:`~uvnav.sensors.exact.beam_directions`, the
+    offsets' rotations ``turns`` (2, R) (:func:`~uvnav.sensors.exact.beam_turns`) turned by
+    libm's cos and sin of ``th``, capped at ``max_range`` [m] (``ring`` (2, W) and ``dirs`` (2,
+    R): scratch).  A body is cast where :meth:`ObstacleField.ray_hits` casts it, and only by
+    the beams that meet its bounding disc (the others cannot hit it: the same ranges, far fewer
+    edges).
 
-    Two cheaper tests come first, each skipping only what the exact one skips: a body's centre
-    distance by ``sqrt`` (libm's ``hypot`` only where the two could decide differently), and a
-    beam's bounding-disc test with :func:`_rough_cos_sin`'s directions (kept in ``dirs``) and
-    a margin of 1e-9 (1 + centre offset) [m] over their 1e-12 error; a beam that passes it
-    takes libm's ``cos`` and ``sin`` and the exact test.  Most beams meet no body's disc, so
-    most beams take no ``cos`` or ``sin``.  The ring's transform (:func:`_transform_ring`) and
-    the ray-ring test (:func:`uvnav.geometry.polygons.rays_rings_hit`'s) are their operations
-    written out in the loop, where calls that passed array rows cost more than the
-    arithmetic.  (Skipping an edge's two divisions by its numerators' signs first, and keeping
-    libm's directions across bodies, made a stepping env's observation slower: their branches
+    A body's centre distance is taken by ``sqrt`` (libm's ``hypot`` only where the two could
+    decide differently), and a beam's bounding-disc test has a relative margin of 1e-9 over the
+    body's bounding radius.  The ring's transform (:func:`_transform_ring`) and the ray-ring
+    test (:func:`uvnav.geometry.polygons.rays_rings_hit`'s) are their operations written out
+    in the loop, where calls that passed array rows cost more than the arithmetic.  The beams
+    are fixed in the sensor's frame and turned once a scan: two libm calls a scan, where a beam
+    at its own angle took a cos and a sin for every beam that met a body's disc (about a fifth
+    of ``uvnav/Nav2D-v0``'s batched observation).  (Skipping an edge's two divisions by its
+    numerators' signs first made a stepping env's observation slower: their branches
     mispredict.)"""
-    _lidar_in(0, ox, oy, th, rel, max_range, n_obs, prm[None], st[None], rings[None], ring,
-              dirs, out[None], dirs[:, :0])  # fmt: skip
+    _lidar_in(0, ox, oy, th, turns, max_range, n_obs, prm[None], st[None], rings[None], ring,
+              dirs, out[None])  # fmt: skip
 
 
 def vector_one_py(
@@ -281,7 +195,7 @@ def vector_one_py(
     goal_scale: float,
     speed: float,
     v_max: float,
-    rel: FloatArray,
+    turns: FloatArray,
     max_range: float,
     n_obs: int,
     prm: FloatArray,
@@ -296,9 +210,9 @@ def vector_one_py(
     into ``out`` (4 + R,) float32, as :func:`observe_py` writes a world's: from pose ``(x, y,
     th)`` and goal ``(goal_x, goal_y)`` [m], the goal distance / ``goal_scale`` capped at 1, cos
     and sin of the goal bearing in the robot frame, ``speed`` / ``v_max`` in [0, 1], and
-    :func:`_lidar`'s ranges [m] (into ``ranges`` (R,); scratch ``ring``, ``dirs``) over
-    ``max_range`` in [0, 1]."""
-    _lidar(x, y, th, rel, max_range, n_obs, prm, st, rings, ring, dirs, ranges)
+    :func:`_lidar`'s ranges [m] (beams at ``turns``; into ``ranges`` (R,); scratch ``ring``,
+    ``dirs``) over ``max_range`` in [0, 1]."""
+    _lidar(x, y, th, turns, max_range, n_obs, prm, st, rings, ring, dirs, ranges)
     _features(0, x, y, th, goal_x, goal_y, goal_scale, speed, v_max, max_range, ranges[None],
               out[None])  # fmt: skip
 
@@ -338,7 +252,7 @@ def observe_py(
     collided), ranges / ``max_range`` in [0, 1] (beams at heading + ``rel`` [rad])."""
     ring = np.empty((2, rings.shape[3]))
     dirs = np.empty((2, rel.shape[0]))
-    turns = np.empty((2, rel.shape[0]))  # the beams' offsets as rotations, for every world
+    turns = np.empty((2, rel.shape[0]))  # beam_turns(rel), for every world
     for r in range(rel.shape[0]):
         turns[0, r], turns[1, r] = math.cos(rel[r]), math.sin(rel[r])
     for k in range(wf.shape[0]):
@@ -347,8 +261,8 @@ def observe_py(
         dist[k] = d = pyhypot(gx, gy)
         status = wi[k, I_STATUS]
         speed = 0.0 if status in (SUCCESS, COLLISION) else wf[k, W_V]
-        _lidar_in(k, x, y, th, rel, max_range, wi[k, I_NOBS], params, state, rings, ring, dirs,
-                  ranges, turns)  # fmt: skip
+        _lidar_in(k, x, y, th, turns, max_range, wi[k, I_NOBS], params, state, rings, ring,
+                  dirs, ranges)  # fmt: skip
         # _features' operations, written out (the distance computed once)
         bearing = math.atan2(gy, gx) - th
         out[k, 0] = min(d / goal_scale, 1.0)
