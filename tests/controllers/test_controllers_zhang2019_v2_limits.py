@@ -159,3 +159,20 @@ def test_the_ideal_vehicle_checked_in_a_straight_line_does_not_read_the_spread()
         assert res.trajectory is not None
         paths.append(res.trajectory.robot)
     assert np.array_equal(paths[0], paths[1])
+
+
+def test_a_still_spread_below_one_lets_the_robot_reach_a_goal_beside_standing_people() -> None:
+    # 20 humans, CrowdNav's case 9: the humans stand at their goals round the ring, two of them
+    # beside the robot's goal; with every body's reach growing 0.1 m/s the paths toward the
+    # goal touch them within min_ttc and the robot crawls in at 0.3 m/s and runs out of time;
+    # standing bodies grown half as fast, it arrives
+    assert run(9, Zhang2019V2(), n_humans=20).status == "timeout"
+    res = run(9, Zhang2019V2(Zhang2019V2Params(still_spread=0.5)), n_humans=20)
+    assert res.status == "success"
+
+
+def test_still_spread_is_a_share_of_the_spread() -> None:
+    with pytest.raises(ValueError, match="still_spread"):
+        Zhang2019V2Params(still_spread=1.5)
+    with pytest.raises(ValueError, match="still_spread"):
+        Zhang2019V2Params(still_spread=-0.1)

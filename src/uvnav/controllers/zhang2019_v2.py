@@ -172,6 +172,7 @@ from uvnav.controllers.zhang2019_v2_loop import (
     outline_rings,
     plan_loop,
 )
+from uvnav.controllers.zhang2019_v2_paths import M_HORIZON
 from uvnav.controllers.zhang2019_v2_paths import _approach as paths_approach
 from uvnav.controllers.zhang2019_v2_paths import _turn as paths_turn
 from uvnav.controllers.zhang2019_v2_paths import _window as paths_window
@@ -238,6 +239,11 @@ class Zhang2019V2Params(RouteParams):
             beside the target would otherwise hold the robot off it for good).
         noise_sigmas: each body is grown by this many times the centre noise [m] its reading
             declares (``position_std``; :func:`~uvnav.controllers.zhang2019_v2_bodies.body_table`).
+        goal_horizon: on a vehicle with acceleration limits, the paths are checked only until
+            the goal could be reached, ``distance / V_max + goal_horizon`` [s] (at most
+            ``horizon``): a person standing behind the goal is no contact; 0: off.
+        still_spread: the share (0-1) of ``limited_spread`` by which a body slower than
+            ``comfort_min_speed`` grows along a rolled-out path (1: as a walking one).
     """
 
     route_weight: float = 3.0
@@ -270,6 +276,8 @@ class Zhang2019V2Params(RouteParams):
     social_band: float = 0.1
     comfort_min_speed: float = 0.1
     noise_sigmas: float = 0.5
+    goal_horizon: float = 0.0
+    still_spread: float = 1.0
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -299,8 +307,12 @@ class Zhang2019V2Params(RouteParams):
                 "track_turn_std",
                 "comfort_min_speed",
                 "noise_sigmas",
+                "goal_horizon",
+                "still_spread",
             ),
         )
+        if self.still_spread > 1.0:
+            raise ValueError(f"still_spread must be at most 1 (got {self.still_spread!r})")
         for name in ("n_headings", "max_tangent_bodies"):
             value = getattr(self, name)
             if not isinstance(value, int) or isinstance(value, bool) or value < 0:
@@ -725,6 +737,11 @@ class Zhang2019V2(UnicycleController):
         vehicle applies it; a command within the window of one period."""
         spec = self._spec
         model, prm, speeds = self._paths.get(self.params, spec, period)
+        if self.params.goal_horizon > 0.0:  # check the paths only until the goal is reached
+            reach = math.dist(self._goal, obs.position) / spec.v_max + self.params.goal_horizon
+            if reach < prm[M_HORIZON]:
+                prm = prm.copy()
+                prm[M_HORIZON] = reach
         u_before, u_cmd = self._turn
         u_now = paths_approach(u_before, u_cmd, spec.turn_accel_max * period)
         v_now = min(max(float(obs.speed), 0.0), spec.v_max) if math.isfinite(obs.speed) else 0.0
