@@ -243,7 +243,8 @@ class Zhang2019V2Params(RouteParams):
             the goal could be reached, ``distance / V_max + goal_horizon`` [s] (at most
             ``horizon``): a person standing behind the goal is no contact; 0: off.
         still_spread: the share (0-1) of ``limited_spread`` by which a body slower than
-            ``comfort_min_speed`` grows along a rolled-out path (1: as a walking one).
+            ``comfort_min_speed`` grows along a rolled-out path (1: as a walking one), and
+            by at most ``still_cap`` [m] (0: no cap).
     """
 
     route_weight: float = 3.0
@@ -278,6 +279,7 @@ class Zhang2019V2Params(RouteParams):
     noise_sigmas: float = 0.5
     goal_horizon: float = 0.0
     still_spread: float = 1.0
+    still_cap: float = 0.0
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -309,6 +311,7 @@ class Zhang2019V2Params(RouteParams):
                 "noise_sigmas",
                 "goal_horizon",
                 "still_spread",
+                "still_cap",
             ),
         )
         if self.still_spread > 1.0:
