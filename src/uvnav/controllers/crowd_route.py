@@ -55,7 +55,6 @@ import numpy as np
 
 from uvnav.controllers.base import check_params
 from uvnav.controllers.crowd_grid import GRID_AHEAD, GRID_SIGMA, grid_bodies, grid_way_point
-from uvnav.controllers.crowd_timed import timed_way_point
 from uvnav.controllers.zhang2019_v2_bodies import body_table
 from uvnav.geometry.angles import FloatArray
 from uvnav.geometry.kernels3d import compile_family, numba_enabled
@@ -106,12 +105,6 @@ class RouteParams:
         route_grid_period: the grid is searched at most once every ``route_grid_period`` [s],
             the way point held in between as ``route_period`` holds the fan's; 0: every
             decision.
-        route_timed: above 0, the grid route is searched over cells and time
-            (:mod:`~uvnav.controllers.crowd_timed`, a move that waits in place) at this share
-            of V_max; 0: the grid of :mod:`~uvnav.controllers.crowd_grid`.
-        route_timed_step: the time search's layer [s]; ``route_timed_span``: how far its
-            layers reach [s]; ``route_timed_horizon``: how far ahead [s] the people are
-            forecast there.
     """
 
     route_weight: float = 0.0
@@ -124,17 +117,11 @@ class RouteParams:
     route_grid_weight: float = 3.0
     route_grid: str = "limited"
     route_grid_period: float = 0.0
-    route_timed: float = 0.0
-    route_timed_step: float = 0.5
-    route_timed_span: float = 6.0
-    route_timed_horizon: float = 4.0
 
     def __post_init__(self) -> None:
         check_params(self, positive=("route_sigma", "route_lookahead", "route_horizon"),
                      non_negative=("route_weight", "route_hold", "route_period",
-                                   "route_grid_weight", "route_grid_period", "route_timed",
-                                   "route_timed_step", "route_timed_span",
-                                   "route_timed_horizon"))  # fmt: skip
+                                   "route_grid_weight", "route_grid_period"))  # fmt: skip
         if not isinstance(self.route_bodies, int) or self.route_bodies < 0:
             raise ValueError(f"route_bodies must be an integer >= 0 (got {self.route_bodies!r})")
         if self.route_grid not in GRID_VEHICLES:
@@ -388,11 +375,6 @@ class CrowdRoute:
         bodies = grid_bodies(_as_tuple(readings))
         if len(bodies) == 0:
             return goal
-        if p.route_timed > 0.0:
-            self.way = timed_way_point(position, goal, bodies, v_max, p.route_timed_horizon,
-                                       GRID_SIGMA, p.route_grid_weight, GRID_AHEAD, p.route_timed,
-                                       p.route_timed_step, p.route_timed_span)  # fmt: skip
-            return self.way
         self.way = grid_way_point(position, goal, bodies, v_max, p.route_horizon, GRID_SIGMA,
                                   p.route_grid_weight, GRID_AHEAD)  # fmt: skip
         return self.way

@@ -99,7 +99,9 @@ says nothing; the choices made here (:mod:`uvnav.controllers.zhang2019_limits`):
   vehicle's kinematics (turn-then-move turns a period's worth at once: centimetres apart); the
   path's segments are checked against every body in closed form, each body's reach grown by
   ``limited_spread`` times the segment's end time (a robot that cannot sidestep at once keeps
-  clear of where a body may be once others bend its path).  Standing still is braking at a,
+  clear of where a body may be once others bend its path; a standing body's by at most
+  ``still_cap``, and with ``goal_horizon`` the check ends once the goal could be reached, both
+  off by default).  Standing still is braking at a,
   turning toward T as the turn rate allows.
 * The command is kept within the dynamic window of one period T (the last one measured):
   speed within v +- a T, turn rate within u +- B T, so that the vehicle reaches it by the next
@@ -242,9 +244,10 @@ class Zhang2019V2Params(RouteParams):
         goal_horizon: on a vehicle with acceleration limits, the paths are checked only until
             the goal could be reached, ``distance / V_max + goal_horizon`` [s] (at most
             ``horizon``): a person standing behind the goal is no contact; 0: off.
-        still_spread: the share (0-1) of ``limited_spread`` by which a body slower than
-            ``comfort_min_speed`` grows along a rolled-out path (1: as a walking one), and
-            by at most ``still_cap`` [m] (0: no cap).
+        still_cap: a body slower than ``comfort_min_speed`` grows along a rolled-out path by
+            ``limited_spread`` times the look-ahead up to ``still_cap`` [m] (0: no cap, as a
+            walking one): the spread would otherwise keep the robot off a goal beside which
+            people stand (the design notes measure 0.05 m with ``goal_horizon`` 1 s).
     """
 
     route_weight: float = 3.0
@@ -278,7 +281,6 @@ class Zhang2019V2Params(RouteParams):
     comfort_min_speed: float = 0.1
     noise_sigmas: float = 0.5
     goal_horizon: float = 0.0
-    still_spread: float = 1.0
     still_cap: float = 0.0
 
     def __post_init__(self) -> None:
@@ -310,12 +312,9 @@ class Zhang2019V2Params(RouteParams):
                 "comfort_min_speed",
                 "noise_sigmas",
                 "goal_horizon",
-                "still_spread",
                 "still_cap",
             ),
         )
-        if self.still_spread > 1.0:
-            raise ValueError(f"still_spread must be at most 1 (got {self.still_spread!r})")
         for name in ("n_headings", "max_tangent_bodies"):
             value = getattr(self, name)
             if not isinstance(value, int) or isinstance(value, bool) or value < 0:
