@@ -241,13 +241,15 @@ class Zhang2019V2Params(RouteParams):
             beside the target would otherwise hold the robot off it for good).
         noise_sigmas: each body is grown by this many times the centre noise [m] its reading
             declares (``position_std``; :func:`~uvnav.controllers.zhang2019_v2_bodies.body_table`).
-        goal_horizon: on a vehicle with acceleration limits, the paths are checked only until
-            the goal could be reached, ``distance / V_max + goal_horizon`` [s] (at most
-            ``horizon``): a person standing behind the goal is no contact; 0: off.
+        goal_horizon: the rolled-out paths (``rollout_paths``, or acceleration limits) are
+            checked only until the goal could be reached, ``distance / V_max + goal_horizon``
+            [s] (at most ``horizon``): a person standing behind the goal is no contact; 0: off.
         still_cap: a body slower than ``comfort_min_speed`` grows along a rolled-out path by
             ``limited_spread`` times the look-ahead up to ``still_cap`` [m] (0: no cap, as a
             walking one): the spread would otherwise keep the robot off a goal beside which
-            people stand (the design notes measure 0.05 m with ``goal_horizon`` 1 s).
+            people stand (the design notes measure 0.05 m with ``goal_horizon`` 1 s on the
+            limited unicycle).  The numpy reference
+            (:func:`~uvnav.controllers.zhang2019_limits.path_risk`) reads neither.
     """
 
     route_weight: float = 3.0
