@@ -54,7 +54,7 @@ from uvnav.geometry.kernels3d import compile_family, numba_enabled
 #: indices into the ``prm`` vector of :func:`choose_on_paths_py` and :func:`plan_paths_py`
 (M_VMAX, M_UMAX, M_ACCEL, M_TURN, M_PERIOD, M_HORIZON, M_STEP, M_COMFORT, M_CHOR, M_MARGIN,
  M_SPREAD, M_MIN_TTC, M_W_TTC, M_W_COMFORT, M_W_CHANGE, M_T_F, M_N_TAN,
- M_N_HEAD, M_RADIUS, M_SPACING, M_STILL) = range(21)  # fmt: skip
+ M_N_HEAD, M_RADIUS, M_SPACING, M_STILL, M_STILL_CAP) = range(22)  # fmt: skip
 
 
 def _approach(value: float, target: float, most: float) -> float:
@@ -180,7 +180,10 @@ def _disc_along(
         px, py = vx - wx, vy - wy
         if risk[0] > t0:
             seg_h = max(min(h, horizon - t0), 0.0)
-            grown = reach + prm[M_SPREAD] * (t0 + h)
+            spread = prm[M_SPREAD] * (t0 + h)
+            if not walks:  # a body standing still grows by at most still_cap
+                spread = min(spread, prm[M_STILL_CAP])
+            grown = reach + spread
             t = t0 + _contact_scalar(rx, ry, px, py, grown, seg_h, margin)
             if t < risk[0]:
                 risk[0] = t

@@ -61,7 +61,8 @@ def path_constants(model: RampModel, params: Any, robot_radius: float) -> FloatA
                      p.horizon, p.rollout_step, p.comfort, p.comfort_horizon, p.safety_margin,
                      p.limited_spread, p.min_ttc, p.w_ttc, p.w_comfort, p.w_change,
                      p.forecast_horizon, p.max_tangent_bodies, p.n_headings, robot_radius,
-                     p.spacing, p.comfort_min_speed), dtype=float)  # fmt: skip
+                     p.spacing, p.comfort_min_speed,
+                     p.still_cap if p.still_cap > 0.0 else math.inf), dtype=float)  # fmt: skip
 
 
 class PathConstants:
