@@ -165,15 +165,30 @@ def test_a_capped_spread_lets_the_robot_reach_a_goal_beside_standing_people() ->
     # 20 humans, CrowdNav's case 9: the humans stand at their goals round the ring, two of them
     # beside the robot's goal; with every body's reach growing 0.1 m/s of look-ahead the paths
     # toward the goal touch them within min_ttc, and the robot creeps in and runs out of time;
-    # standing bodies grown by at most 0.05 m and the paths checked until the goal, it arrives
-    assert run(9, Zhang2019V2(), n_humans=20).status == "timeout"
-    fix = Zhang2019V2Params(still_cap=0.05, goal_horizon=1.0)
-    assert run(9, Zhang2019V2(fix), n_humans=20).status == "success"
+    # standing bodies grown by at most 0.05 m and the paths checked until the goal (the
+    # defaults on a vehicle with acceleration limits), it arrives
+    uncapped = Zhang2019V2Params(still_cap=0.0, goal_horizon=0.0)
+    assert run(9, Zhang2019V2(uncapped), n_humans=20).status == "timeout"
+    assert run(9, Zhang2019V2(), n_humans=20).status == "success"
 
 
-def test_the_cap_and_the_goal_horizon_are_off_by_default_and_not_negative() -> None:
+def test_the_ideal_unicycle_does_not_read_the_cap_or_the_goal_horizon() -> None:
+    # 20 humans, case 7: read on the ideal unicycle, the cap and the goal horizon change its
+    # path; it checks its rolled-out paths as before
+    scn = crowdnav_scenario(7, dt=DT, n_humans=20)
+    paths = []
+    for cap, horizon in ((0.0, 0.0), (0.05, 1.0)):
+        law = Zhang2019V2(Zhang2019V2Params(still_cap=cap, goal_horizon=horizon))
+        res = run_episode(build_episode(scn, 7), law, kinds()["nav2d"].episode_rng(7),
+                          vehicle="unicycle")  # fmt: skip
+        assert res.trajectory is not None
+        paths.append(res.trajectory.robot)
+    assert np.array_equal(paths[0], paths[1])
+
+
+def test_the_cap_and_the_goal_horizon_default_to_the_tuned_values_and_are_not_negative() -> None:
     p = Zhang2019V2Params()
-    assert p.still_cap == 0.0 and p.goal_horizon == 0.0
+    assert p.still_cap == 0.05 and p.goal_horizon == 1.0
     for name in ("still_cap", "goal_horizon"):
         with pytest.raises(ValueError, match=name):
             Zhang2019V2Params(**{name: -0.1})

@@ -99,9 +99,10 @@ says nothing; the choices made here (:mod:`uvnav.controllers.zhang2019_limits`):
   vehicle's kinematics (turn-then-move turns a period's worth at once: centimetres apart); the
   path's segments are checked against every body in closed form, each body's reach grown by
   ``limited_spread`` times the segment's end time (a robot that cannot sidestep at once keeps
-  clear of where a body may be once others bend its path; a standing body's by at most
-  ``still_cap``, and with ``goal_horizon`` the check ends once the goal could be reached, both
-  off by default).  Standing still is braking at a,
+  clear of where a body may be once others bend its path; on a vehicle with acceleration
+  limits a standing body's by at most ``still_cap``, and the check ends ``goal_horizon`` after
+  the goal could be reached: people standing beside the goal would otherwise hold the robot
+  off it).  Standing still is braking at a,
   turning toward T as the turn rate allows.
 * The command is kept within the dynamic window of one period T (the last one measured):
   speed within v +- a T, turn rate within u +- B T, so that the vehicle reaches it by the next
@@ -241,15 +242,18 @@ class Zhang2019V2Params(RouteParams):
             beside the target would otherwise hold the robot off it for good).
         noise_sigmas: each body is grown by this many times the centre noise [m] its reading
             declares (``position_std``; :func:`~uvnav.controllers.zhang2019_v2_bodies.body_table`).
-        goal_horizon: the rolled-out paths (``rollout_paths``, or acceleration limits) are
-            checked only until the goal could be reached, ``distance / V_max + goal_horizon``
-            [s] (at most ``horizon``): a person standing behind the goal is no contact; 0: off.
-        still_cap: a body slower than ``comfort_min_speed`` grows along a rolled-out path by
-            ``limited_spread`` times the look-ahead up to ``still_cap`` [m] (0: no cap, as a
-            walking one): the spread would otherwise keep the robot off a goal beside which
-            people stand (the design notes measure 0.05 m with ``goal_horizon`` 1 s on the
-            limited unicycle).  The numpy reference
-            (:func:`~uvnav.controllers.zhang2019_limits.path_risk`) reads neither.
+        goal_horizon: on a vehicle with acceleration limits, the rolled-out paths are checked
+            only until the goal could be reached, ``distance / V_max + goal_horizon`` [s] (at
+            most ``horizon``): a person standing behind the goal is no contact; 0: off.
+        still_cap: on a vehicle with acceleration limits, a body slower than
+            ``comfort_min_speed`` grows along a rolled-out path by ``limited_spread`` times the
+            look-ahead up to ``still_cap`` [m] (0: no cap, as a walking one): the spread would
+            otherwise keep the robot off a goal beside which people stand.  Both were tuned
+            together on the limited unicycle (CrowdNav's circle, 20 humans, cases 0-99: 0.857
+            against 0.765 without; held out 0.831 against 0.741, ``docs/design-notes.md``); on
+            the ideal unicycle, which they did not help (the harder crowd 0.960 against 0.970),
+            neither is read, nor by the numpy reference
+            (:func:`~uvnav.controllers.zhang2019_limits.path_risk`).
     """
 
     route_weight: float = 3.0
@@ -282,8 +286,8 @@ class Zhang2019V2Params(RouteParams):
     social_band: float = 0.1
     comfort_min_speed: float = 0.1
     noise_sigmas: float = 0.5
-    goal_horizon: float = 0.0
-    still_cap: float = 0.0
+    goal_horizon: float = 1.0
+    still_cap: float = 0.05
 
     def __post_init__(self) -> None:
         super().__post_init__()
@@ -741,7 +745,7 @@ class Zhang2019V2(UnicycleController):
         vehicle applies it; a command within the window of one period."""
         spec = self._spec
         model, prm, speeds = self._paths.get(self.params, spec, period)
-        if self.params.goal_horizon > 0.0:  # check the paths only until the goal is reached
+        if self.params.goal_horizon > 0.0 and not spec.ideal:  # paths checked until the goal
             reach = math.dist(self._goal, obs.position) / spec.v_max + self.params.goal_horizon
             if reach < prm[M_HORIZON]:
                 prm = prm.copy()

@@ -55,14 +55,17 @@ def preferred_floats(
 
 def path_constants(model: RampModel, params: Any, robot_radius: float) -> FloatArray:
     """The ``prm`` vector of :func:`uvnav.controllers.zhang2019_v2_paths.plan_readings_py` of a
-    law's parameters (:class:`~uvnav.controllers.zhang2019_v2.Zhang2019V2Params`)."""
+    law's parameters (:class:`~uvnav.controllers.zhang2019_v2.Zhang2019V2Params`); a
+    standing body's spread is capped at ``still_cap`` on a vehicle with acceleration limits
+    only."""
     p = params
+    limited = not (math.isinf(model.accel) and math.isinf(model.turn_accel))
+    still_cap = p.still_cap if p.still_cap > 0.0 and limited else math.inf
     return np.array((model.v_max, model.u_max, model.accel, model.turn_accel, model.period,
                      p.horizon, p.rollout_step, p.comfort, p.comfort_horizon, p.safety_margin,
                      p.limited_spread, p.min_ttc, p.w_ttc, p.w_comfort, p.w_change,
                      p.forecast_horizon, p.max_tangent_bodies, p.n_headings, robot_radius,
-                     p.spacing, p.comfort_min_speed,
-                     p.still_cap if p.still_cap > 0.0 else math.inf), dtype=float)  # fmt: skip
+                     p.spacing, p.comfort_min_speed, still_cap), dtype=float)  # fmt: skip
 
 
 class PathConstants:
