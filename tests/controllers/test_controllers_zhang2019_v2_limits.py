@@ -149,16 +149,19 @@ def test_the_spread_look_ahead_keeps_clear_of_a_human_who_turns_into_the_robot()
     assert run(1, Zhang2019V2(alone), n_humans=20).status == "success"
 
 
+def ideal_path(case: int, params: Zhang2019V2Params, n_humans: int = 5) -> np.ndarray:
+    """The robot's path on CrowdNav's circle ``case``, the ideal unicycle driven by v2."""
+    scn = crowdnav_scenario(case, dt=DT, n_humans=n_humans)
+    res = run_episode(build_episode(scn, case), Zhang2019V2(params),
+                      kinds()["nav2d"].episode_rng(case), vehicle="unicycle")  # fmt: skip
+    assert res.trajectory is not None
+    return np.asarray(res.trajectory.robot)
+
+
 def test_the_ideal_vehicle_checked_in_a_straight_line_does_not_read_the_spread() -> None:
-    scn = crowdnav_scenario(7, dt=DT)
-    paths = []
-    for spread in (0.0, 0.5):
-        law = Zhang2019V2(Zhang2019V2Params(limited_spread=spread, rollout_paths=False))
-        res = run_episode(build_episode(scn, 7), law, kinds()["nav2d"].episode_rng(7),
-                          vehicle="unicycle")  # fmt: skip
-        assert res.trajectory is not None
-        paths.append(res.trajectory.robot)
-    assert np.array_equal(paths[0], paths[1])
+    a, b = (ideal_path(7, Zhang2019V2Params(limited_spread=s, rollout_paths=False))
+            for s in (0.0, 0.5))  # fmt: skip
+    assert np.array_equal(a, b)
 
 
 def test_a_capped_spread_lets_the_robot_reach_a_goal_beside_standing_people() -> None:
@@ -175,15 +178,9 @@ def test_a_capped_spread_lets_the_robot_reach_a_goal_beside_standing_people() ->
 def test_the_ideal_unicycle_does_not_read_the_cap_or_the_goal_horizon() -> None:
     # 20 humans, case 7: read on the ideal unicycle, the cap and the goal horizon change its
     # path; it checks its rolled-out paths as before
-    scn = crowdnav_scenario(7, dt=DT, n_humans=20)
-    paths = []
-    for cap, horizon in ((0.0, 0.0), (0.05, 1.0)):
-        law = Zhang2019V2(Zhang2019V2Params(still_cap=cap, goal_horizon=horizon))
-        res = run_episode(build_episode(scn, 7), law, kinds()["nav2d"].episode_rng(7),
-                          vehicle="unicycle")  # fmt: skip
-        assert res.trajectory is not None
-        paths.append(res.trajectory.robot)
-    assert np.array_equal(paths[0], paths[1])
+    a, b = (ideal_path(7, Zhang2019V2Params(still_cap=cap, goal_horizon=horizon), n_humans=20)
+            for cap, horizon in ((0.0, 0.0), (0.05, 1.0)))  # fmt: skip
+    assert np.array_equal(a, b)
 
 
 def test_the_cap_and_the_goal_horizon_default_to_the_tuned_values_and_are_not_negative() -> None:
@@ -191,4 +188,4 @@ def test_the_cap_and_the_goal_horizon_default_to_the_tuned_values_and_are_not_ne
     assert p.still_cap == 0.05 and p.goal_horizon == 1.0
     for name in ("still_cap", "goal_horizon"):
         with pytest.raises(ValueError, match=name):
-            Zhang2019V2Params(**{name: -0.1})
+            replace(p, **{name: -0.1})
