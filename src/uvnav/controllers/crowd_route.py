@@ -105,18 +105,6 @@ class RouteParams:
         route_grid_period: the grid is searched at most once every ``route_grid_period`` [s],
             the way point held in between as ``route_period`` holds the fan's; 0: every
             decision.
-        route_jam: on a vehicle with acceleration limits, the least number of bodies whose
-            constant-velocity forecast over ``route_jam_horizon`` [s] comes within
-            ``route_jam_radius`` [m] of the straight line from the robot to the goal, ahead of
-            it, that makes the route hold back (:func:`jam_hold`): the law steers for the
-            point ``route_jam_clear`` [m] short of the first such contact along the line (where
-            it stands when that is nearer), instead of the grid's way point; 0: off.
-        route_jam_floor: while the route holds back, the law tries only the speeds [m/s] from
-            which it can stop at the held point, ``sqrt(2 a d)`` at ``d`` from it
-            (:meth:`CrowdRoute.jam_speed`), and those of at most ``route_jam_floor``; at V_max
-            or above, every speed (the held point alone).
-        route_jam_core: hold short of the ``route_jam``-th body's first contact along the line
-            (the crowd's core) instead of the first body's.
     """
 
     route_weight: float = 0.0
@@ -129,21 +117,11 @@ class RouteParams:
     route_grid_weight: float = 3.0
     route_grid: str = "limited"
     route_grid_period: float = 0.0
-    route_jam: int = 0
-    route_jam_horizon: float = 4.0
-    route_jam_radius: float = 1.0
-    route_jam_clear: float = 1.0
-    route_jam_floor: float = 0.3
-    route_jam_core: bool = False
 
     def __post_init__(self) -> None:
         check_params(self, positive=("route_sigma", "route_lookahead", "route_horizon"),
                      non_negative=("route_weight", "route_hold", "route_period",
-                                   "route_grid_weight", "route_grid_period",
-                                   "route_jam_horizon", "route_jam_radius",
-                                   "route_jam_clear", "route_jam_floor"))  # fmt: skip
-        if not isinstance(self.route_jam, int) or self.route_jam < 0:
-            raise ValueError(f"route_jam must be an integer >= 0 (got {self.route_jam!r})")
+                                   "route_grid_weight", "route_grid_period"))  # fmt: skip
         if not isinstance(self.route_bodies, int) or self.route_bodies < 0:
             raise ValueError(f"route_bodies must be an integer >= 0 (got {self.route_bodies!r})")
         if self.route_grid not in GRID_VEHICLES:
@@ -260,49 +238,6 @@ def route_costs_py(
         out[k] = length + weight * cost
 
 
-#: time step [s] of :func:`jam_hold`'s forecast
-JAM_STEP = 0.25
-#: the shortest distance [m] ahead of the robot of :func:`jam_hold`'s point
-JAM_FACE = 1e-3
-#: :func:`jam_hold` counts only contacts this far [m] or farther along the line from the robot
-JAM_NEAR = 0.5
-
-
-def jam_hold(position: FloatArray, goal: FloatArray, bodies: FloatArray, count: int,
-             horizon: float, radius: float, clear: float,
-             core: bool = False) -> FloatArray | None:  # fmt: skip
-    """The point to hold at [m], (2,), or ``None``: where at least ``count`` of ``bodies`` (N,
-    5: centre, velocity, radius; :func:`~uvnav.controllers.crowd_grid.grid_bodies`), forecast
-    at constant velocity every ``JAM_STEP`` s up to ``horizon`` [s], come within ``radius`` [m]
-    beyond their own radius of the segment from the robot to the goal at ``JAM_NEAR`` m or
-    more along it, the point ``clear`` [m] short of the nearest such contact along the line
-    (``core``: of the ``count``-th body's first contact), or ``JAM_FACE`` m ahead of the robot
-    when that is closer (the law stops there facing the goal).
-
-    >>> ring = np.array([[2.0, 3.0, 0.0, -1.0, 0.3], [2.5, -3.0, 0.0, 1.0, 0.3]])
-    >>> jam_hold(np.zeros(2), np.array([8.0, 0.0]), ring, 2, 4.0, 0.5, 1.0).tolist()
-    [1.0, 0.0]
-    >>> jam_hold(np.zeros(2), np.array([8.0, 0.0]), ring, 3, 4.0, 0.5, 1.0) is None
-    True
-    """
-    gap = goal - position
-    length = math.hypot(gap[0], gap[1])
-    if count <= 0 or len(bodies) < count or length <= JAM_NEAR:
-        return None
-    unit = gap / length
-    t = np.arange(0.0, horizon + 1e-9, JAM_STEP)
-    rel = bodies[:, None, :2] + bodies[:, None, 2:4] * t[None, :, None] - position  # (N, T, 2)
-    along = rel @ unit
-    across = np.abs(rel[..., 0] * unit[1] - rel[..., 1] * unit[0])
-    hit = (along >= JAM_NEAR) & (along <= length) & (across <= radius + bodies[:, 4:5])
-    touched = hit.any(axis=1)
-    if int(touched.sum()) < count:
-        return None
-    firsts = np.sort(np.where(hit, along, np.inf).min(axis=1))
-    first = float(firsts[count - 1] if core else firsts[0])
-    return position + unit * max(first - clear, JAM_FACE)
-
-
 def _as_tuple(readings: Sequence[ObstacleReading]) -> tuple[ObstacleReading, ...]:
     """``readings`` as a tuple: themselves when they are one (the sensor's
     :class:`~uvnav.sensors.observation.Readings` keep their arrays), else a copy."""
@@ -366,16 +301,6 @@ class CrowdRoute:
         self.way: FloatArray | None = None
         self.next_search = -math.inf
         self.grid = False
-        self.limited = False
-        self.jam_room = math.inf
-
-    def jam_speed(self, accel: float) -> float:
-        """The fastest speed [m/s] the law should try at this decision: ``inf`` unless the route
-        holds back (:func:`jam_hold`), then the larger of ``route_jam_floor`` and the speed from
-        which deceleration ``accel`` [m/s^2] stops the robot at the held point."""
-        if not math.isfinite(self.jam_room):
-            return math.inf
-        return max(math.sqrt(2.0 * accel * self.jam_room), self.params.route_jam_floor)
 
     def reset(self, limited: bool = False, unicycle: bool = False) -> None:
         """Forget the held way point and search at the next decision.  The route is planned on
@@ -387,8 +312,6 @@ class CrowdRoute:
         self.next_search = -math.inf
         on = limited or (unicycle and p.route_grid == "all")
         self.grid = on and p.route_grid_weight > 0.0
-        self.limited = limited
-        self.jam_room = math.inf
 
     def _held(self, position: FloatArray, goal: FloatArray, time: float) -> FloatArray | None:
         """The point the last search chose while ``route_period`` (the grid's:
@@ -418,13 +341,6 @@ class CrowdRoute:
         held = self._held(position, goal, time) if period > 0.0 else None
         if held is not None:
             return held
-        if self.limited and p.route_jam > 0:
-            hold = jam_hold(position, goal, grid_bodies(_as_tuple(readings)), p.route_jam,
-                            p.route_jam_horizon, p.route_jam_radius, p.route_jam_clear,
-                            p.route_jam_core)
-            self.jam_room = math.inf if hold is None else math.dist(hold, position)
-            if hold is not None:
-                return hold
         if self.grid:
             return self._grid_aim(position, goal, readings, v_max, time)
         bodies = nearest(moving_bodies(readings, self.min_speed), position, p.route_bodies)

@@ -745,8 +745,6 @@ class Zhang2019V2(UnicycleController):
         vehicle applies it; a command within the window of one period."""
         spec = self._spec
         model, prm, speeds = self._paths.get(self.params, spec, period)
-        if (cap := self._route.jam_speed(model.accel)) < model.v_max:  # holding back
-            speeds = speeds[speeds <= cap + 1e-9]
         if self.params.goal_horizon > 0.0 and not spec.ideal:  # paths checked until the goal
             reach = math.dist(self._goal, obs.position) / spec.v_max + self.params.goal_horizon
             if reach < prm[M_HORIZON]:
