@@ -34,10 +34,9 @@ that at 300 (the marginal costs 100->300 and 300->1,000 are recorded beside it),
 crowd the share of candidates checked grows with the density — about 46, 84 and 125 of 125 at
 100, 300 and 1,000 pedestrians within 8 m — so v2's time per pedestrian grows up to the boxed
 one's.  v1's open-crowd time is recorded beside its target but not judged: v1 switches between
-going to the goal (tens of µs) and avoiding (the group, 0.7-2 ms), and which it does depends on
-the pose, so its open-crowd median falls in whichever mode holds the middle call — at 300
-pedestrians 7 of the 16 poses go to the goal, and the median flips between the two modes from run
-to run (per body 0.88x and 1.55x of the 300 one at 1,000 in two sittings).
+going to the goal and avoiding (building the group, tens of times the cost), and which it does
+depends on the pose, so its open-crowd median falls in whichever mode holds the middle call and
+flips between the two from run to run (docs/design-notes.md).
 """
 
 from __future__ import annotations
