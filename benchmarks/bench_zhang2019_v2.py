@@ -222,7 +222,7 @@ WORK = {
     "zhang2019_v2_decision_linear_1000": "zhang2019-v2 boxed in (every candidate checked "
     "against every pedestrian): µs per pedestrian at 1,000 over that at 300",
     "zhang2019_v1_decision_linear_1000": "zhang2019-v1 boxed in (every decision avoiding, "
-    "the group of :func:`group_around` built): µs per pedestrian at 1,000 over that at 300",
+    "the group of the pedestrian in the way built): µs per pedestrian at 1,000 over that at 300",
 }
 UNITS = {"zhang2019_v2_decision_us_median_100": " µs", "zhang2019_v2_vs_orca_decision_100": "x",
          "zhang2019_v2_vs_v1_episode_cpu": "x"}  # fmt: skip
