@@ -45,6 +45,17 @@ class RampModel:
     turn_accel: float
     period: float
 
+    @property
+    def ideal(self) -> bool:
+        """The speed and the turn rate follow the command at once (both limits infinite), as
+        :attr:`uvnav.dynamics.unicycle.UnicycleSpec.ideal` of the spec it was made from.
+
+        >>> RampModel(1.0, 1.0, math.inf, math.inf, 0.25).ideal, RampModel(1.0, 1.0, 1.0,
+        ...     math.inf, 0.25).ideal
+        (True, False)
+        """
+        return math.isinf(self.accel) and math.isinf(self.turn_accel)
+
     def window(self, now: FloatArray | float, rate: float, low: float, high: float) -> FloatArray:
         """The values reachable from ``now`` within one period at ``rate`` per second, clipped to
         [``low``, ``high``]: ``(lo, hi)`` arrays."""

@@ -59,8 +59,7 @@ def path_constants(model: RampModel, params: Any, robot_radius: float) -> FloatA
     standing body's spread is capped at ``still_cap`` on a vehicle with acceleration limits
     only."""
     p = params
-    limited = not (math.isinf(model.accel) and math.isinf(model.turn_accel))
-    still_cap = p.still_cap if p.still_cap > 0.0 and limited else math.inf
+    still_cap = p.still_cap if p.still_cap > 0.0 and not model.ideal else math.inf
     return np.array((model.v_max, model.u_max, model.accel, model.turn_accel, model.period,
                      p.horizon, p.rollout_step, p.comfort, p.comfort_horizon, p.safety_margin,
                      p.limited_spread, p.min_ttc, p.w_ttc, p.w_comfort, p.w_change,
