@@ -49,6 +49,11 @@ Options for the protocol study (defaults = the reproduction):
   random times and on arrival, 6 m circle, 5 m sensing unless ``--sensing-range``) instead of
   CrowdNav's scenes; no paper figure or target applies (the verdict is ``no target``), cases run
   in order from ``--first`` (default 0), and ``--humans`` defaults to the scene's 20.
+* ``--robot-visible``: the humans see the robot and avoid it as one more ORCA agent (CrowdNav's
+  ``visible = true``; the scenes' ``robot_visible``) instead of walking as if it were not there;
+  the test protocol's robot is invisible, so such a run reports no verdict.
+* ``--control-period P``: the robot decides every P [s] (a whole multiple of the integration
+  step ``0.25 / substeps``) instead of every 0.25 s; the humans still decide every 0.25 s.
 * ``--pref crowdnav``: the robot's preferred velocity as CrowdNav's ORCA sets it (1 m/s toward
   the goal beyond 1 m, the gap within) instead of ``orca-holonomic-v1``'s (V_max, lowered to
   ``dist / period`` on the last step).
@@ -86,7 +91,8 @@ from uvnav.scenarios.crowdnav import (
     TIME_STEP,
     crowdnav_scenario,
 )
-from uvnav.scenarios.errors import ScenarioError
+from uvnav.scenarios.errors import FieldError, ScenarioError
+from uvnav.scenarios.limits import check_timing
 from uvnav.sim.run import run_episode
 
 #: Chen et al. ICRA 2019, Table I, ORCA (invisible robot)
@@ -212,9 +218,13 @@ def run(
     humans: int | None = None,
     sensing_range: float | None = None,
     law_params: dict[str, Any] | None = None,
+    robot_visible: bool = False,
+    control_period: float | None = None,
 ) -> dict[str, Any]:
     """Run the cases; returns the counts, rates, intervals and times.  ``law_params``: the
-    parameters of a law other than the paper's (its defaults where not given)."""
+    parameters of a law other than the paper's (its defaults where not given);
+    ``robot_visible``, ``control_period``: the module docstring's ``--robot-visible`` and
+    ``--control-period``."""
     rng_of = kinds()["nav2d"].episode_rng
     vehicle = controller_info(law_name).vehicle
     counts = {"success": 0, "collision": 0, "timeout": 0}
@@ -236,7 +246,8 @@ def run(
         if sensing_range is not None:
             sensing["sensing_range"] = sensing_range
         try:
-            scn = _scene(case, rule, substeps, kinematics, humans, sensing, accel, turn_accel)
+            scn = _scene(case, rule, substeps, kinematics, humans, sensing, (accel, turn_accel),
+                         robot_visible, control_period)  # fmt: skip
         except ScenarioError as exc:
             if exc.path not in ("n_humans", "params.n_humans"):
                 raise
@@ -307,6 +318,8 @@ def run(
         "params": dict(CROWDNAV_ORCA_PARAMS) if law_name == PAPER_LAW else dict(law_params or {}),
         "accel_max": accel,
         "turn_accel_max": turn_accel,
+        "robot_visible": robot_visible,
+        "control_period": TIME_STEP if control_period is None else control_period,
         "rates": rates,
         "robot_driven_collisions": {
             "count": robot_driven,
@@ -319,10 +332,13 @@ def run(
         "wall_s": wall,
         "cpu_ms_per_episode": 1000.0 * cpu / max(cases, 1),
         "paper": PAPER,
-        "target": None if rule == DYNAMIC else TARGETS.get(law_name),
-        "has_target": rule != DYNAMIC and (law_name in TARGETS or law_name == PAPER_LAW),
+        "target": None if rule == DYNAMIC or robot_visible else TARGETS.get(law_name),
+        "has_target": rule != DYNAMIC
+        and not robot_visible
+        and (law_name in TARGETS or law_name == PAPER_LAW),
         "pass": bool(
             rule == DYNAMIC
+            or robot_visible
             or (
                 counts["success"] / max(cases, 1) >= TARGETS[law_name]
                 if law_name in TARGETS
@@ -340,21 +356,29 @@ def _scene(
     kinematics: str,
     humans: int | None,
     sensing: dict[str, Any],
-    accel: float | None,
-    turn_accel: float | None,
+    limits: tuple[float | None, float | None],
+    robot_visible: bool = False,
+    control_period: float | None = None,
 ) -> Any:
-    """Case ``case``'s scene of ``rule`` (CrowdNav's, or the harder crowd's)."""
+    """Case ``case``'s scene of ``rule`` (CrowdNav's, or the harder crowd's); ``limits``: the
+    unicycle's (``accel_max``, ``turn_accel_max``).
+
+    Raises:
+        FieldError: ``control_period`` is not a whole multiple of the integration step.
+    """
     n: dict[str, Any] = {} if humans is None else {"n_humans": humans}
+    accel, turn_accel = limits
+    common: dict[str, Any] = dict(dt=TIME_STEP / substeps, kinematics=kinematics, accel_max=accel,
+                                  turn_accel_max=turn_accel, robot_visible=robot_visible,
+                                  **n, **sensing)  # fmt: skip
     if rule == DYNAMIC:
-        return crowd_dynamic_scenario(
-            case, dt=TIME_STEP / substeps, kinematics=kinematics,  # type: ignore[arg-type]
-            accel_max=accel, turn_accel_max=turn_accel, **n, **sensing,
-        )  # fmt: skip
-    return crowdnav_scenario(
-        case, rule=rule, dt=TIME_STEP / substeps,  # type: ignore[arg-type]
-        kinematics=kinematics, **n, **sensing,  # type: ignore[arg-type]
-        accel_max=accel, turn_accel_max=turn_accel,
-    )  # fmt: skip
+        scn = crowd_dynamic_scenario(case, **common)
+    else:
+        scn = crowdnav_scenario(case, rule=rule, **common)  # type: ignore[arg-type]
+    if control_period is None:
+        return scn
+    check_timing(scn.t_max, scn.dt, control_period)
+    return scn.model_copy(update={"control_period": control_period})
 
 
 def crowd_records(r: dict[str, Any]) -> list[dict[str, Any]]:
@@ -386,8 +410,11 @@ def report(r: dict[str, Any]) -> str:
             f", limits {r['accel_max']} m/s^2, {r['turn_accel_max']} rad/s^2"
             if r["accel_max"] is not None or r["turn_accel_max"] is not None
             else ""
-        ),
-    ]
+        )
+        + (f", robot decides every {r['control_period']:g} s"
+           if r["control_period"] != TIME_STEP else "")
+        + (", robot visible to the humans" if r["robot_visible"] else ""),
+    ]  # fmt: skip
     for key in ("success", "collision", "timeout"):
         x = r["rates"][key]
         lo, hi = x["ci95"]
@@ -418,6 +445,8 @@ def report(r: dict[str, Any]) -> str:
     verdict = "PASS" if r["pass"] else "FAIL"
     if r["rule"] == DYNAMIC:
         lines.append("  no target: the harder crowd has no paper figure")
+    elif r["robot_visible"]:
+        lines.append("  no target: the test protocol's robot is invisible to the humans")
     elif r["target"] is not None:
         lines.append(f"  {verdict}: success {r['rates']['success']['rate']:.3f} against the "
                      f"target >= {r['target']:.2f}")  # fmt: skip
@@ -474,6 +503,10 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--param", "-p", action="append", default=None, metavar="KEY=VALUE",
                     help="a parameter of --law (repeatable; value read as YAML; not with the "
                     "paper's law)")  # fmt: skip
+    ap.add_argument("--robot-visible", action="store_true",
+                    help="the humans see the robot and avoid it (no verdict)")  # fmt: skip
+    ap.add_argument("--control-period", type=float, default=None, metavar="P",
+                    help="the robot decides every P [s] (default 0.25, as the humans)")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write crowdnav.json here")
     args = ap.parse_args(argv)
     try:
@@ -503,9 +536,12 @@ def main(argv: list[str] | None = None) -> int:
             outcome=args.outcome, first=args.first, law_name=args.law, kinematics=args.kinematics,
             swept=not args.sampled, lidar=args.lidar, accel=args.accel, turn_accel=args.turn_accel,
             humans=args.humans, sensing_range=args.sensing_range, law_params=law_params,
+            robot_visible=args.robot_visible, control_period=args.control_period,
         )  # fmt: skip
     except NoCaseError as exc:
         ap.error(str(exc))
+    except FieldError as exc:
+        ap.error(f"--control-period: {exc}")
     except ControllerParamsError as exc:
         ap.error(f"--param: {exc}")
     print(report(r))

@@ -110,3 +110,30 @@ def test_a_law_with_no_target_is_reported_not_judged(capsys: pytest.CaptureFixtu
     assert bench_crowdnav.main(["--cases", "1", "--law", "straight-holonomic-v1"]) == 0
     out = capsys.readouterr().out
     assert "no target: only orca-holonomic-v1" in out and "FAIL" not in out
+
+
+def test_robot_visible_scenes_and_no_verdict(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--robot-visible``: every human avoids the robot, and the run is not judged against
+    the invisible-robot protocol's target."""
+    scn = bench_crowdnav._scene(0, "circle_crossing", 1, "turn-then-move", 5, {}, (None, None),
+                                robot_visible=True)  # fmt: skip
+    assert [o.motion.sees_robot for o in scn.obstacles] == [True] * 5
+    blind = bench_crowdnav._scene(0, "circle_crossing", 1, "turn-then-move", 5, {}, (None, None))
+    assert not any(o.motion.sees_robot for o in blind.obstacles)
+    args = ["--cases", "1", "--first", "0", "--law", "zhang2019-holonomic-v2", "--robot-visible"]
+    assert bench_crowdnav.main(args) == 0
+    out = capsys.readouterr().out
+    assert "robot visible to the humans" in out and "no target: the test protocol" in out
+
+
+def test_control_period_is_the_robots_alone(capsys: pytest.CaptureFixture[str]) -> None:
+    """``--control-period``: the robot's decision period; the humans keep CrowdNav's 0.25 s;
+    a period that is not a whole number of integration steps is a one-line error."""
+    scn = bench_crowdnav._scene(0, "circle_crossing", 5, "turn-then-move", None, {},
+                                (1.0, 2.0), control_period=0.1)  # fmt: skip
+    assert scn.control_period == pytest.approx(0.1)
+    assert {o.motion.period for o in scn.obstacles} == {0.25}
+    with pytest.raises(SystemExit) as exc:
+        bench_crowdnav.main(["--cases", "1", "--substeps", "5", "--control-period", "0.12"])
+    assert exc.value.code == 2
+    assert "--control-period: must be a positive multiple of dt" in capsys.readouterr().err
