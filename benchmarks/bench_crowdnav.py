@@ -289,6 +289,7 @@ def run(
         rates[key] = {"count": k, "rate": k / cases, "ci95": [lo, hi]}
     lo, hi = wilson_interval(counts["success"], cases)
     rd_lo, rd_hi = wilson_interval(robot_driven, cases)
+    protocol = rule != DYNAMIC and not robot_visible  # CrowdNav's test protocol: judged
     return {
         "cases": cases,
         "first_case": first,
@@ -332,13 +333,10 @@ def run(
         "wall_s": wall,
         "cpu_ms_per_episode": 1000.0 * cpu / max(cases, 1),
         "paper": PAPER,
-        "target": None if rule == DYNAMIC or robot_visible else TARGETS.get(law_name),
-        "has_target": rule != DYNAMIC
-        and not robot_visible
-        and (law_name in TARGETS or law_name == PAPER_LAW),
+        "target": TARGETS.get(law_name) if protocol else None,
+        "has_target": protocol and (law_name in TARGETS or law_name == PAPER_LAW),
         "pass": bool(
-            rule == DYNAMIC
-            or robot_visible
+            not protocol
             or (
                 counts["success"] / max(cases, 1) >= TARGETS[law_name]
                 if law_name in TARGETS

@@ -225,9 +225,9 @@ def targets(decisions: dict[str, Any], episodes: dict[str, Any]) -> dict[str, di
     per_ep = {law: e["cpu_ms_mean"] for law, e in episodes.items()}
     v2_v1 = judged("zhang2019-v2 / zhang2019-v1 mean CPU per random-ch2 episode",
                    per_ep["zhang2019-v2"] / per_ep["zhang2019-v1"], TARGET_RATIO)  # fmt: skip
-    if "cpu_ms" in episodes["zhang2019-v2"] and len(episodes["zhang2019-v2"]["cpu_ms"]) > 1:
-        lo, hi = paired_ratio_interval(episodes["zhang2019-v2"]["cpu_ms"],
-                                       episodes["zhang2019-v1"]["cpu_ms"])  # fmt: skip
+    samples = [episodes[law].get("cpu_ms", []) for law in ("zhang2019-v2", "zhang2019-v1")]
+    if len(samples[0]) > 1:  # one scene (--seeds 1) has no spread to resample
+        lo, hi = paired_ratio_interval(*samples)
         v2_v1 |= {
             "ci95": [lo, hi],
             "note": f"95 % paired bootstrap interval {lo:.2f}-{hi:.2f}x",
