@@ -244,15 +244,16 @@ def _near_humans(c: Case, beam: Beam, k0: int, reach: float) -> np.ndarray:
     return np.flatnonzero(box.all(axis=1))
 
 
-def expand(c: Case, beam: Beam, period_index: int, s: Search) -> tuple[Beam, np.ndarray | None]:
-    """Every child of ``beam`` over the period ``period_index``: the survivors (no contact over
-    the period) and, where some child arrives, the arrival step of each survivor (-1: none)."""
+def advance(
+    c: Case, state: tuple[np.ndarray, ...], cv: np.ndarray, cu: np.ndarray, k0: int,
+    near: np.ndarray,
+) -> tuple[tuple[np.ndarray, ...], np.ndarray, np.ndarray]:  # fmt: skip
+    """Every state ``(x, y, heading, v, omega)`` driven by its command ``(cv, cu)`` over the
+    period starting at integration step ``k0``, judged against the humans ``near``: the states
+    at its end, which stayed clear of them (an arrival first counts as clear), and the step of
+    each one's arrival (-1: none)."""
     spec, dt, period = c.spec, c.dt, c.dt * c.ratio
-    parent, cv, cu = commands(beam.v, beam.u, spec, period, s)
-    x, y, th = beam.x[parent], beam.y[parent], beam.th[parent]
-    v, u = beam.v[parent], beam.u[parent]
-    k0 = period_index * c.ratio
-    near = _near_humans(c, beam, k0, spec.v_max * period + spec.radius + c.clearance + 0.01)
+    x, y, th, v, u = state
     reach2 = (c.radii[near] + spec.radius + c.clearance + MARGIN) ** 2
     alive = np.ones(len(x), dtype=bool)
     arrived = np.full(len(x), -1)
@@ -271,6 +272,18 @@ def expand(c: Case, beam: Beam, period_index: int, s: Search) -> tuple[Beam, np.
         x, y = nx, ny
         at_goal = alive & (arrived < 0) & (np.hypot(gx - x, gy - y) <= c.tolerance)
         arrived[at_goal] = k0 + j + 1
+    return (x, y, th, v, u), alive, arrived
+
+
+def expand(c: Case, beam: Beam, period_index: int, s: Search) -> tuple[Beam, np.ndarray | None]:
+    """Every child of ``beam`` over the period ``period_index``: the survivors (no contact over
+    the period) and, where some child arrives, the arrival step of each survivor (-1: none)."""
+    spec, period = c.spec, c.dt * c.ratio
+    parent, cv, cu = commands(beam.v, beam.u, spec, period, s)
+    k0 = period_index * c.ratio
+    near = _near_humans(c, beam, k0, spec.v_max * period + spec.radius + c.clearance + 0.01)
+    state = (beam.x[parent], beam.y[parent], beam.th[parent], beam.v[parent], beam.u[parent])
+    (x, y, th, v, u), alive, arrived = advance(c, state, cv, cu, k0, near)
     keep = np.flatnonzero(alive)
     cmds = np.concatenate((beam.cmds[parent[keep]], np.stack((cv, cu), 1)[keep, None, :]), 1)
     out = Beam(x[keep], y[keep], th[keep], v[keep], u[keep], cmds)
