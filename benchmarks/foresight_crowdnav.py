@@ -48,7 +48,6 @@ from uvnav.bench.summary import wilson_interval
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.scenarios.build import build_episode
 from uvnav.scenarios.catalog import kinds
-from uvnav.scenarios.errors import ScenarioError
 from uvnav.sensors.observation import Observation
 from uvnav.sim.run import run_episode
 
@@ -220,14 +219,8 @@ def run(cases: list[int], *, humans: int, see: str, horizon: float, clearance: f
     rows: list[dict[str, Any]] = []
     unplaceable: list[int] = []
     cpu0 = time.process_time()
-    for case in cases:
-        try:
-            scn = oc.scene(case, humans, oc.ACCEL, oc.TURN_ACCEL, oc.SUBSTEPS)
-        except ScenarioError as exc:
-            if exc.path not in ("n_humans", "params.n_humans"):
-                raise
-            unplaceable.append(case)
-            continue
+    for case, scn in oc.placeable(cases, humans, oc.ACCEL, oc.TURN_ACCEL, oc.SUBSTEPS,
+                                  unplaceable):  # fmt: skip
         rows.append(run_case(case, scn, see, horizon, clearance))
     n = len(rows)
     count = {k: sum(r["status"] == k for r in rows) for k in ("success", "collision", "timeout")}
@@ -269,11 +262,7 @@ def report(r: dict[str, Any]) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--humans", type=int, default=20, help="number of humans (default 20)")
-    ap.add_argument("--first", type=int, default=100, help="first case (default 100)")
-    ap.add_argument("--cases", type=int, default=400, help="number of cases (default 400)")
-    ap.add_argument("--sample", type=int, default=None, metavar="N",
-                    help="N of those cases, drawn by a generator seeded 0")  # fmt: skip
+    oc.add_case_options(ap)
     ap.add_argument("--see", choices=SEES, default="truth",
                     help="truth: the humans' future (oracle); cv: constant velocity")  # fmt: skip
     ap.add_argument("--horizon", type=float, default=4.0, metavar="S",
@@ -282,21 +271,11 @@ def main(argv: list[str] | None = None) -> int:
                     help="the gap kept from every forecast human [m] (default 0)")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write the JSON record here")
     args = ap.parse_args(argv)
-    if args.cases < 1 or args.first < 0:
-        ap.error("--cases must be >= 1, --first >= 0")
-    if not 0 <= args.humans <= 1000:
-        ap.error(f"--humans must be in 0..1000 (got {args.humans})")
     if not (math.isfinite(args.horizon) and args.horizon >= 0.25):
         ap.error(f"--horizon must be a number >= 0.25 (got {args.horizon!r})")
     if not (math.isfinite(args.clearance) and args.clearance >= 0):
         ap.error(f"--clearance must be a number >= 0 (got {args.clearance!r})")
-    cases = list(range(args.first, args.first + args.cases))
-    if args.sample is not None:
-        if not 1 <= args.sample <= args.cases:
-            ap.error(f"--sample must be in 1..{args.cases} (got {args.sample})")
-        cases = sorted(
-            int(x) for x in np.random.default_rng(0).choice(cases, args.sample, replace=False)
-        )
+    cases = oc.chosen_cases(ap, args)
     r = run(cases, humans=args.humans, see=args.see, horizon=args.horizon,
             clearance=args.clearance)  # fmt: skip
     r["case_numbers"] = cases

@@ -43,6 +43,7 @@ import math
 import os
 import sys
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -403,6 +404,23 @@ def run_case(case: int, scn: Any, survive_s: float, clearance: float = 0.0) -> d
     return row
 
 
+def placeable(
+    cases: list[int], humans: int, accel: float, turn_accel: float, substeps: int,
+    unplaceable: list[int],
+) -> Iterator[tuple[int, Any]]:  # fmt: skip
+    """Each case whose humans CrowdSim could place apart, with its scene (:func:`scene`); the
+    others are appended to ``unplaceable``."""
+    for case in cases:
+        try:
+            scn = scene(case, humans, accel, turn_accel, substeps)
+        except ScenarioError as exc:
+            if exc.path not in ("n_humans", "params.n_humans"):
+                raise
+            unplaceable.append(case)
+            continue
+        yield case, scn
+
+
 def run(
     cases: list[int],
     *,
@@ -417,14 +435,7 @@ def run(
     rows: list[dict[str, Any]] = []
     unplaceable: list[int] = []
     cpu0 = time.process_time()
-    for case in cases:
-        try:
-            scn = scene(case, humans, accel, turn_accel, substeps)
-        except ScenarioError as exc:
-            if exc.path not in ("n_humans", "params.n_humans"):
-                raise
-            unplaceable.append(case)
-            continue
+    for case, scn in placeable(cases, humans, accel, turn_accel, substeps, unplaceable):
         rows.append(run_case(case, scn, survive_s, clearance))
     cpu = time.process_time() - cpu0
     return summarise(rows, unplaceable, cpu, humans=humans, accel=accel, turn_accel=turn_accel,
@@ -478,18 +489,33 @@ def report(r: dict[str, Any]) -> str:
     ])  # fmt: skip
 
 
-def main(argv: list[str] | None = None) -> int:
-    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+def add_case_options(ap: argparse.ArgumentParser) -> None:
+    """The options that choose the cases: ``--humans``, ``--first``, ``--cases``, ``--sample``."""
     ap.add_argument("--humans", type=int, default=20, help="number of humans (default 20)")
     ap.add_argument("--first", type=int, default=100, help="first case (default 100)")
     ap.add_argument("--cases", type=int, default=400, help="number of cases (default 400)")
-    ap.add_argument(
-        "--sample",
-        type=int,
-        default=None,
-        metavar="N",
-        help="N of those cases drawn by a generator seeded 0 instead of all",
-    )
+    ap.add_argument("--sample", type=int, default=None, metavar="N",
+                    help="N of those cases, drawn by a generator seeded 0")  # fmt: skip
+
+
+def chosen_cases(ap: argparse.ArgumentParser, args: argparse.Namespace) -> list[int]:
+    """The cases :func:`add_case_options`' options choose (a bad value: ``ap.error``, exit 2)."""
+    if args.cases < 1 or args.first < 0:
+        ap.error(f"--cases must be >= 1 and --first >= 0 (got {args.cases}, {args.first})")
+    if not 0 <= args.humans <= 1000:
+        ap.error(f"--humans must be in 0..1000 (got {args.humans})")
+    cases = list(range(args.first, args.first + args.cases))
+    if args.sample is None:
+        return cases
+    if not 1 <= args.sample <= args.cases:
+        ap.error(f"--sample must be in 1..{args.cases} (got {args.sample})")
+    drawn = np.random.default_rng(0).choice(cases, args.sample, replace=False)
+    return sorted(int(x) for x in drawn)
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    add_case_options(ap)
     ap.add_argument("--accel", type=float, default=ACCEL, help="largest speed change [m/s^2]")
     ap.add_argument("--turn-accel", type=float, default=TURN_ACCEL,
                     help="largest turn-rate change [rad/s^2]")  # fmt: skip
@@ -505,23 +531,15 @@ def main(argv: list[str] | None = None) -> int:
                     help="the gap the oracle keeps from every human [m] (default 0)")  # fmt: skip
     ap.add_argument("--out", type=Path, default=None, help="write oracle-crowdnav-N.json here")
     args = ap.parse_args(argv)
-    if args.cases < 1 or args.substeps < 1 or args.first < 0:
-        ap.error("--cases and --substeps must be >= 1, --first >= 0")
-    if not 0 <= args.humans <= 1000:
-        ap.error(f"--humans must be in 0..1000 (got {args.humans})")
+    if args.substeps < 1:
+        ap.error(f"--substeps must be >= 1 (got {args.substeps})")
     for name, value in (("--accel", args.accel), ("--turn-accel", args.turn_accel),
                         ("--survive", args.survive)):  # fmt: skip
         if not (math.isfinite(value) and value > 0):
             ap.error(f"{name} must be a number > 0 (got {value!r})")
     if not (math.isfinite(args.clearance) and args.clearance >= 0):
         ap.error(f"--clearance must be a number >= 0 (got {args.clearance!r})")
-    cases = list(range(args.first, args.first + args.cases))
-    if args.sample is not None:
-        if not 1 <= args.sample <= args.cases:
-            ap.error(f"--sample must be in 1..{args.cases} (got {args.sample})")
-        cases = sorted(
-            int(x) for x in np.random.default_rng(0).choice(cases, args.sample, replace=False)
-        )
+    cases = chosen_cases(ap, args)
     r = run(cases, humans=args.humans, accel=args.accel, turn_accel=args.turn_accel,
             substeps=args.substeps, survive_s=args.survive, clearance=args.clearance)  # fmt: skip
     r["case_numbers"] = cases
