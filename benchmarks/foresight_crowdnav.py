@@ -213,14 +213,15 @@ def run_case(case: int, scn: Any, see: str, horizon: float, clearance: float) ->
     }
 
 
-def run(cases: list[int], *, humans: int, see: str, horizon: float, clearance: float = 0.0
-        ) -> dict[str, Any]:  # fmt: skip
-    """Every case's row and the totals (module docstring)."""
+def run(cases: list[int], *, humans: int, see: str, horizon: float, clearance: float = 0.0,
+        label: str | None = None) -> dict[str, Any]:  # fmt: skip
+    """Every case's row and the totals (module docstring); ``label``: a progress bar of that
+    name on stderr."""
     rows: list[dict[str, Any]] = []
     unplaceable: list[int] = []
     cpu0 = time.process_time()
     for case, scn in oc.placeable(cases, humans, oc.ACCEL, oc.TURN_ACCEL, oc.SUBSTEPS,
-                                  unplaceable):  # fmt: skip
+                                  unplaceable, label):  # fmt: skip
         rows.append(run_case(case, scn, see, horizon, clearance))
     n = len(rows)
     count = {k: sum(r["status"] == k for r in rows) for k in ("success", "collision", "timeout")}
@@ -277,7 +278,7 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--clearance must be a number >= 0 (got {args.clearance!r})")
     cases = oc.chosen_cases(ap, args)
     r = run(cases, humans=args.humans, see=args.see, horizon=args.horizon,
-            clearance=args.clearance)  # fmt: skip
+            clearance=args.clearance, label=f"foresight {args.see} {args.horizon:g} s")  # fmt: skip
     r["case_numbers"] = cases
     print(report(r))
     if args.out is not None:

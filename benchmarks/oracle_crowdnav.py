@@ -43,7 +43,7 @@ import math
 import os
 import sys
 import time
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -406,11 +406,12 @@ def run_case(case: int, scn: Any, survive_s: float, clearance: float = 0.0) -> d
 
 def placeable(
     cases: list[int], humans: int, accel: float, turn_accel: float, substeps: int,
-    unplaceable: list[int],
+    unplaceable: list[int], label: str | None = None,
 ) -> Iterator[tuple[int, Any]]:  # fmt: skip
     """Each case whose humans CrowdSim could place apart, with its scene (:func:`scene`); the
-    others are appended to ``unplaceable``."""
-    for case in cases:
+    others are appended to ``unplaceable``.  ``label``: a progress bar of that name on stderr
+    (none when ``None``)."""
+    for case in _shown(cases, label):
         try:
             scn = scene(case, humans, accel, turn_accel, substeps)
         except ScenarioError as exc:
@@ -419,6 +420,16 @@ def placeable(
             unplaceable.append(case)
             continue
         yield case, scn
+
+
+def _shown(cases: list[int], label: str | None) -> Iterable[int]:
+    """``cases``, under a transient rich progress bar on stderr when ``label`` is given."""
+    if label is None:
+        return cases
+    from rich.console import Console
+    from rich.progress import track
+
+    return track(cases, description=label, console=Console(stderr=True), transient=True)
 
 
 def run(
@@ -430,12 +441,14 @@ def run(
     substeps: int,
     survive_s: float,
     clearance: float = 0.0,
+    label: str | None = None,
 ) -> dict[str, Any]:
-    """Every case's oracle row and the totals (success = found and confirmed by the world)."""
+    """Every case's oracle row and the totals (success = found and confirmed by the world);
+    ``label``: :func:`placeable`'s progress bar."""
     rows: list[dict[str, Any]] = []
     unplaceable: list[int] = []
     cpu0 = time.process_time()
-    for case, scn in placeable(cases, humans, accel, turn_accel, substeps, unplaceable):
+    for case, scn in placeable(cases, humans, accel, turn_accel, substeps, unplaceable, label):
         rows.append(run_case(case, scn, survive_s, clearance))
     cpu = time.process_time() - cpu0
     return summarise(rows, unplaceable, cpu, humans=humans, accel=accel, turn_accel=turn_accel,
@@ -541,7 +554,8 @@ def main(argv: list[str] | None = None) -> int:
         ap.error(f"--clearance must be a number >= 0 (got {args.clearance!r})")
     cases = chosen_cases(ap, args)
     r = run(cases, humans=args.humans, accel=args.accel, turn_accel=args.turn_accel,
-            substeps=args.substeps, survive_s=args.survive, clearance=args.clearance)  # fmt: skip
+            substeps=args.substeps, survive_s=args.survive, clearance=args.clearance,
+            label="oracle")  # fmt: skip
     r["case_numbers"] = cases
     r["sampled"] = args.sample is not None
     print(report(r))
