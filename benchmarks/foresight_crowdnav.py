@@ -18,8 +18,8 @@ robot's state for ``horizon`` seconds.  Its plan is the first arrival it finds, 
 states that get furthest in time without a contact, the one nearest the goal
 (:func:`~oracle_crowdnav.progress`).  The planner keeps its previous plan (the part not yet
 driven) unless the new one stays clear at least as long under the new forecast: a beam search
-started afresh each period may lose a way out that the last one found, and this is what a plan
-that must be kept feasible across decisions does.  Where nothing stays clear for one period it
+started afresh each period may lose a way out that the last one found, and the kept plan is
+what carries it from one decision to the next.  Where nothing stays clear for one period it
 brakes.  The first command of the plan is sent; the world judges the episode.
 
 Run: ``PYTHONPATH=src .venv/bin/python benchmarks/foresight_crowdnav.py --horizon 4 --sample 50``
