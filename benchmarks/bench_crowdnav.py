@@ -232,6 +232,7 @@ def run(
     times: list[float] = []
     intrusion: list[float] = []
     statuses: list[str] = []
+    collided_by: list[str | None] = []
     unplaceable: list[int] = []
     cpu0, wall0 = time.process_time(), time.perf_counter()
     if rule == DYNAMIC and first is None:
@@ -275,6 +276,7 @@ def run(
         counts[status] += 1
         robot_driven += int(status == "collision" and res.metrics.collision_by == "robot")
         statuses.append(status)
+        collided_by.append(res.metrics.collision_by if status == "collision" else None)
         if res.metrics.intrusion_ratio is not None:
             intrusion.append(res.metrics.intrusion_ratio)
         if status == "success" and arrival is not None:
@@ -344,6 +346,7 @@ def run(
             )
         ),
         "statuses": statuses,
+        "collided_by": collided_by,
     }
 
 

@@ -11,8 +11,8 @@ a human:
 
 * each command goes through the limits the world applies (speed in [0, V_max], turn rate within
   U_max, the speed and the turn rate moving toward it by at most ``accel_max dt`` and
-  ``turn_accel_max dt`` per integration step, CrowdNav's turn-then-move kinematics:
-  :mod:`uvnav.dynamics.unicycle`);
+  ``turn_accel_max dt`` per integration step, CrowdNav's turn-then-move kinematics with the
+  period's ramped turn taken at the decision: :mod:`uvnav.dynamics.unicycle`);
 * a collision is judged as the world judges it: along every integration step (robot and humans
   moving straight within it), the discs' radius sum, contact when the distance drops below it;
   arrival when the centre ends an integration step within the goal tolerance;
@@ -51,6 +51,7 @@ from typing import Any
 import numpy as np
 
 from uvnav.bench.summary import wilson_interval
+from uvnav.controllers.zhang2019_limits import ramp_turns
 from uvnav.dynamics.unicycle import UnicycleCommand, UnicycleSpec
 from uvnav.obstacles.batch import ObstacleBatch
 from uvnav.scenarios.build import build_episode
@@ -260,10 +261,10 @@ def advance(
     arrived = np.full(len(x), -1)
     gx, gy = c.goal
     for j in range(c.ratio):
+        if j == 0:  # the period's turn at the decision, as the vehicle takes it
+            th = _wrap(th + ramp_turns(u, cu, spec.turn_accel_max, period))
         v = _approach(v, cv, spec.accel_max * dt)
         u = _approach(u, cu, spec.turn_accel_max * dt)
-        if j == 0:
-            th = _wrap(th + u * period)
         nx, ny = x + v * dt * np.cos(th), y + v * dt * np.sin(th)
         if len(near):
             k = k0 + j

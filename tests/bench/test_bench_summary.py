@@ -5,10 +5,19 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from uvnav.bench.store import ResultsStore
-from uvnav.bench.summary import FAILURE_COLUMNS, SUMMARY_COLUMNS, controller_summary, failure_rows
+from uvnav.bench.summary import (
+    FAILURE_COLUMNS,
+    SUMMARY_COLUMNS,
+    controller_summary,
+    failure_rows,
+    paired_difference_interval,
+)
 
 
 def _metrics(status: str, **social: Any) -> dict[str, Any]:
@@ -91,3 +100,38 @@ def test_failure_rows_give_seed_and_cause(tmp_path: Path) -> None:
         (5, "refused: speed bound 2 m/s >= V_max 1 m/s"),
     ]
     assert rows[0]["min_clearance"] == 0.1 and rows[-1]["min_clearance"] is None
+
+
+def _paired_counts(a: np.ndarray, b: np.ndarray) -> tuple[int, int, int, int]:
+    return (int(np.sum(a & ~b)), int(np.sum(~a & b)), int(np.sum(a & b)), int(np.sum(~a & ~b)))
+
+
+@pytest.mark.parametrize(("p_a", "p_b", "rho"), [(0.85, 0.83, 0.3), (0.97, 0.90, 0.0)])
+def test_paired_difference_interval_covers_the_true_difference(
+    p_a: float, p_b: float, rho: float
+) -> None:
+    """Newcombe's paired interval covers the true difference about 95 % of the time: 1,000
+    seeded draws of 390 correlated pairs (a shared uniform for a share ``rho`` of the cases)."""
+    rng = np.random.default_rng(0)
+    covered = 0
+    for _ in range(1000):
+        shared = rng.random(390) < rho
+        u = rng.random(390)
+        a = np.where(shared, u, rng.random(390)) < p_a
+        b = np.where(shared, u, rng.random(390)) < p_b
+        diff, lo, hi = paired_difference_interval(*_paired_counts(a, b))
+        assert lo <= diff <= hi
+        covered += lo <= p_a - p_b <= hi
+    assert 0.93 <= covered / 1000 <= 0.975
+
+
+@given(st.lists(st.tuples(st.booleans(), st.booleans()), min_size=1, max_size=60))
+def test_paired_difference_interval_swaps_with_its_sides(pairs: list[tuple[bool, bool]]) -> None:
+    """Swapping A and B negates the difference and mirrors the interval, inside [-1, 1]."""
+    a = np.array([p[0] for p in pairs])
+    b = np.array([p[1] for p in pairs])
+    diff, lo, hi = paired_difference_interval(*_paired_counts(a, b))
+    back, lo_b, hi_b = paired_difference_interval(*_paired_counts(b, a))
+    assert -1.0 <= lo <= diff <= hi <= 1.0
+    assert back == pytest.approx(-diff)
+    assert lo_b == pytest.approx(-hi) and hi_b == pytest.approx(-lo)

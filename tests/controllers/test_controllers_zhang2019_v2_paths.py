@@ -23,6 +23,8 @@ GOAL = np.array([0.0, 6.0])
 MODELS = {
     "ideal": RampModel(1.0, math.pi, math.inf, math.inf, 0.25),
     "limited": RampModel(1.0, math.pi, 1.0, 2.0, 0.25),
+    "limited-turn-first": RampModel(1.0, math.pi, 1.0, 2.0, 0.25, turn_first=True),
+    "ideal-turn-first": RampModel(1.0, math.pi, math.inf, math.inf, 0.25, turn_first=True),
 }
 
 

@@ -227,3 +227,26 @@ def test_an_ideal_unicycle_takes_the_command_at_once() -> None:
     assert body.speed() == 0.7 and body.velocity(0.0) == (0.7, 0.0)
     with pytest.raises(ValueError, match="accel_max must be > 0"):
         UnicycleSpec(1.0, 1.0, accel_max=0.0)
+
+
+@given(st.floats(-2.0, 2.0), st.floats(-2.0, 2.0), st.floats(0.5, 10.0))
+def test_a_limited_turn_then_move_turns_as_the_arc_whatever_the_step(
+    u0: float, u_cmd: float, turn_accel: float
+) -> None:
+    """The period's turn, taken at the decision, is the heading the ramped turn rate gives the
+    arc vehicle by the period's end, at any integration step (not one step's ramp times T)."""
+    period = 0.25
+    ends = []
+    for kinematics, n in (("turn-then-move", 1), ("turn-then-move", 5), ("turn-then-move", 25),
+                          ("arc", 200)):  # fmt: skip
+        body = Unicycle(UnicycleSpec(1.0, 3.0, 0.3, kinematics=kinematics, accel_max=1.0,
+                                     turn_accel_max=turn_accel))  # fmt: skip
+        body._u = u0  # the turn rate it has
+        body.hold(UnicycleCommand(0.5, u_cmd))
+        th = 0.0
+        for k in range(n):
+            _, _, th, _, _ = body.move(0.0, 0.0, th, period / n, k == 0, period)
+        ends.append(th)
+    assert ends[0] == pytest.approx(ends[1], abs=1e-12) == pytest.approx(ends[2], abs=1e-12)
+    # the arc steps at the rate each step reached: a staircase above the ramp by B dt T / 2
+    assert ends[0] == pytest.approx(ends[3], abs=1e-12 + turn_accel * (period / 200) * period)

@@ -27,9 +27,11 @@ Measured on CrowdNav's circle with 20 humans, the unicycle limited to 1 m/s^2 an
 (tuning cases 0-99): ``zhang2019-v2`` 0.57 without a route, 0.64-0.68 with the fan of
 :mod:`~uvnav.controllers.crowd_route`, 0.75 with this grid; on held-out cases 100-499 0.531
 without, 0.741 with it, 0.831 with it and the law's capped spread for standing people
-(``Zhang2019V2Params.still_cap``; ``docs/design-notes.md``).  One search is the exposure map in one
-compiled call (numba when enabled, plain Python otherwise) and scipy's Dijkstra: 0.31 ms CPU
-for 20 people on CrowdNav's circle (an 8 x 16 m box), 1.1 ms for 100 people over 15 x 15 m.
+(``Zhang2019V2Params.still_cap``), 0.908 once the turn-then-move vehicle turned as its arc would
+by each decision and the law checked its paths so (``docs/design-notes.md``).  One search is the
+exposure map in one compiled call (numba when enabled, plain Python otherwise) and scipy's
+Dijkstra: 0.31 ms CPU for 20 people on CrowdNav's circle (an 8 x 16 m box), 1.1 ms for 100
+people over 15 x 15 m.
 Units: metres, seconds.
 """
 

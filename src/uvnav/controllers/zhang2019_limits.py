@@ -37,6 +37,9 @@ class RampModel:
         accel: largest speed change [m/s^2] (``inf``: at once).
         turn_accel: largest turn-rate change [rad/s^2] (``inf``: at once).
         period: the decision period T [s] a command is held for.
+        turn_first: the vehicle turns by the period's turn at each decision, then moves
+            straight (``turn-then-move`` kinematics, :func:`uvnav.dynamics.unicycle.ramp_turn`);
+            ``False``: it turns along arcs.
     """
 
     v_max: float
@@ -44,6 +47,7 @@ class RampModel:
     accel: float
     turn_accel: float
     period: float
+    turn_first: bool = False
 
     @property
     def ideal(self) -> bool:
@@ -70,6 +74,25 @@ def approach(value: FloatArray, target: FloatArray, most: float) -> FloatArray:
     if math.isinf(most):
         return np.asarray(target, dtype=float)
     return np.asarray(value + np.clip(target - value, -most, most), dtype=float)
+
+
+def ramp_turns(u_now: FloatArray, target: FloatArray, rate: float, period: float) -> FloatArray:
+    """:func:`uvnav.dynamics.unicycle.ramp_turn` elementwise, the same to the bit: the heading
+    change [rad] over ``period`` of turn rates moving from ``u_now`` toward ``target`` at
+    ``rate`` [rad/s^2].
+
+    >>> ramp_turns(np.zeros(2), np.array([1.0, 0.2]), 2.0, 0.25).round(6).tolist()
+    [0.0625, 0.04]
+    """
+    u_now, target = np.asarray(u_now, dtype=float), np.asarray(target, dtype=float)
+    if math.isinf(rate):
+        return np.asarray(target * period, dtype=float)
+    gap = target - u_now
+    ramp = np.minimum(np.abs(gap) / rate, period) if rate > 0.0 else np.full_like(gap, period)
+    u_end = u_now + np.copysign(rate * ramp, gap)
+    return np.asarray(np.where(ramp < period, 0.5 * (u_now + u_end) * ramp
+                               + target * (period - ramp), 0.5 * (u_now + u_end) * period),
+                      dtype=float)  # fmt: skip
 
 
 def speed_command(target: FloatArray, v_now: FloatArray, model: RampModel) -> FloatArray:
@@ -120,7 +143,8 @@ def rollout(
     At every decision (each period T) the law commands ``speed cos(beta)`` (0 for an aim behind)
     and :func:`turn_command`, both within the window; between decisions the vehicle moves its
     speed and turn rate toward them at its limits, in substeps of at most ``step`` [s], each
-    integrated on its arc at the substep's mean speed and turn rate.
+    integrated on its arc at the substep's mean speed and turn rate; a ``turn_first`` vehicle
+    instead turns by the period's ramped turn at the decision and moves straight.
 
     >>> m = RampModel(1.0, 1.0, 1.0, math.inf, 0.25)
     >>> t, xy, v = rollout(np.zeros(3), 0.0, 0.0, np.zeros(1), np.ones(1), m, 1.0, 0.25)
@@ -142,9 +166,11 @@ def rollout(
             beta = (aim - th + np.pi) % (2.0 * np.pi) - np.pi
             v_cmd = speed_command(speed * np.maximum(np.cos(beta), 0.0), v, model)
             u_cmd = turn_command(beta, u, model)
+            if model.turn_first:
+                th = th + ramp_turns(u, u_cmd, model.turn_accel, model.period)
         v1 = approach(v, v_cmd, model.accel * h)
         u1 = approach(u, u_cmd, model.turn_accel * h)
-        vm, half = 0.5 * (v + v1), 0.25 * (u + u1) * h
+        vm, half = 0.5 * (v + v1), (0.0 if model.turn_first else 0.25) * (u + u1) * h
         chord = vm * h * np.sinc(half / np.pi)
         x = x + chord * np.cos(th + half)
         y = y + chord * np.sin(th + half)

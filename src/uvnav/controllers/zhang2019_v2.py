@@ -95,8 +95,10 @@ says nothing; the choices made here (:mod:`uvnav.controllers.zhang2019_limits`):
 * The same candidates (directions at the speed levels, v_pref, standing still), each checked
   along the path the vehicle will follow toward it from its current speed and turn rate: the
   law's own steering (below) replayed decision after decision for the horizon H, the vehicle
-  ramping between decisions, in substeps of at most ``rollout_step``, on arcs whatever the
-  vehicle's kinematics (turn-then-move turns a period's worth at once: centimetres apart); the
+  ramping between decisions, in substeps of at most ``rollout_step``, on arcs, or, on a
+  turn-then-move vehicle, turning by the period's ramped turn at each decision and moving
+  straight, as that vehicle does (checked on arcs, its paths were some centimetres off, and
+  near people that was the margin: ``docs/design-notes.md``, issue 35); the
   path's segments are checked against every body in closed form, each body's reach grown by
   ``limited_spread`` times the segment's end time (a robot that cannot sidestep at once keeps
   clear of where a body may be once others bend its path; on a vehicle with acceleration
@@ -250,7 +252,8 @@ class Zhang2019V2Params(RouteParams):
             look-ahead up to ``still_cap`` [m] (0: no cap, as a walking one): the spread would
             otherwise keep the robot off a goal beside which people stand.  Both were tuned
             together on the limited unicycle (CrowdNav's circle, 20 humans, cases 0-99: 0.857
-            against 0.765 without; held out 0.831 against 0.741, ``docs/design-notes.md``); on
+            against 0.765 without; held out 0.831 against 0.741, before the turn-then-move
+            vehicle's turn was fixed, ``docs/design-notes.md``); on
             the ideal unicycle, which they did not help (the harder crowd 0.960 against 0.970),
             neither is read, nor by the numpy reference
             (:func:`~uvnav.controllers.zhang2019_limits.path_risk`).

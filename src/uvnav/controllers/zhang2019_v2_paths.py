@@ -54,7 +54,7 @@ from uvnav.geometry.kernels3d import compile_family, numba_enabled
 #: indices into the ``prm`` vector of :func:`choose_on_paths_py` and :func:`plan_paths_py`
 (M_VMAX, M_UMAX, M_ACCEL, M_TURN, M_PERIOD, M_HORIZON, M_STEP, M_COMFORT, M_CHOR, M_MARGIN,
  M_SPREAD, M_MIN_TTC, M_W_TTC, M_W_COMFORT, M_W_CHANGE, M_T_F, M_N_TAN,
- M_N_HEAD, M_RADIUS, M_SPACING, M_STILL, M_STILL_CAP) = range(22)  # fmt: skip
+ M_N_HEAD, M_RADIUS, M_SPACING, M_STILL, M_STILL_CAP, M_TURN_FIRST) = range(23)  # fmt: skip
 
 
 def _approach(value: float, target: float, most: float) -> float:
@@ -62,6 +62,19 @@ def _approach(value: float, target: float, most: float) -> float:
     if math.isinf(most):
         return target
     return value + min(max(target - value, -most), most)
+
+
+def _ramp_turn(u_now: float, target: float, rate: float, period: float) -> float:
+    """:func:`uvnav.dynamics.unicycle.ramp_turn` (the period's turn of a turn-then-move
+    vehicle), as the vehicle computes it."""
+    if math.isinf(rate):
+        return target * period
+    gap = target - u_now
+    ramp = min(abs(gap) / rate, period) if rate > 0.0 else period
+    u_end = u_now + math.copysign(rate * ramp, gap)
+    if ramp < period:
+        return 0.5 * (u_now + u_end) * ramp + target * (period - ramp)
+    return 0.5 * (u_now + u_end) * period
 
 
 def _window(now: float, rate: float, period: float, low: float, high: float) -> tuple[float, float]:
@@ -97,7 +110,9 @@ def advance(
     the half-turn, its sinc, the cosine and sine of the chord's direction, the cosine of the
     heading error (at a decision), the turn rate after, the heading after and the turn rate
     commanded, shared by the paths toward the same ``aim`` from the same start; its first
-    ``known[0]`` rows are read, not computed again, and it is extended as the path is."""
+    ``known[0]`` rows are read, not computed again, and it is extended as the path is.  With
+    ``prm[M_TURN_FIRST]`` the vehicle turns by the period's turn at each decision and moves
+    straight (:func:`uvnav.controllers.zhang2019_limits.rollout`'s ``turn_first``)."""
     h = prm[M_PERIOD] / n_sub
     i0 = int(st[5])
     x, y, th, v, u, v_cmd, u_cmd = xy[i0, 0], xy[i0, 1], st[0], st[1], st[2], st[3], st[4]
@@ -111,7 +126,12 @@ def advance(
             else:
                 track[i, 7] = track[i - 1, 7]
             u1 = _approach(u, track[i, 7], prm[M_TURN] * h)
-            half = 0.25 * (u + u1) * h
+            if prm[M_TURN_FIRST] > 0.0:  # the period's turn at the decision, then straight
+                if steer:
+                    th = th + _ramp_turn(u, track[i, 7], prm[M_TURN], prm[M_PERIOD])
+                half = 0.0
+            else:
+                half = 0.25 * (u + u1) * h
             if half != half_was:  # the same half-turn as the substep before: the same sinc
                 arg = math.pi * (half / math.pi if half != 0.0 else 1.0e-20)  # numpy's sinc
                 sinc, half_was = math.sin(arg) / arg, half
@@ -541,8 +561,8 @@ def _compiled_plan() -> Callable[..., Any]:
     cache), calling the compiled copies of its helpers and of :mod:`uvnav.geometry.contact`'s."""
     if not _COMPILED:
         zhang2019_v2_loop._compiled_plan()
-        kernels = (_approach, _window, _turn, advance, _box_far, _path_box, _disc_along, _far,
-                   _chunk_bodies,
+        kernels = (_approach, _ramp_turn, _window, _turn, advance, _box_far, _path_box,
+                   _disc_along, _far, _chunk_bodies,
                    risk_along, _stops, _better, _keep, _groups, choose_on_paths_py, plan_paths_py,
                    plan_readings_py)  # fmt: skip
         bound = {**contact._kernels(), **zhang2019_v2_loop._COMPILED}

@@ -64,7 +64,15 @@ def path_constants(model: RampModel, params: Any, robot_radius: float) -> FloatA
                      p.horizon, p.rollout_step, p.comfort, p.comfort_horizon, p.safety_margin,
                      p.limited_spread, p.min_ttc, p.w_ttc, p.w_comfort, p.w_change,
                      p.forecast_horizon, p.max_tangent_bodies, p.n_headings, robot_radius,
-                     p.spacing, p.comfort_min_speed, still_cap), dtype=float)  # fmt: skip
+                     p.spacing, p.comfort_min_speed, still_cap, float(model.turn_first)),
+                    dtype=float)  # fmt: skip
+
+
+def ramp_model(spec: UnicycleSpec, period: float) -> RampModel:
+    """What the law knows of its vehicle ``spec`` at the decision period ``period`` [s]: its
+    limits and whether it turns first (``turn-then-move``) or along arcs."""
+    return RampModel(spec.v_max, spec.u_max, spec.accel_max, spec.turn_accel_max, period,
+                     turn_first=spec.kinematics == "turn-then-move")  # fmt: skip
 
 
 class PathConstants:
@@ -86,11 +94,11 @@ class PathConstants:
         if value is not None and of is not None and of[0] is params and of[1] is spec:
             if of[2] == period:
                 return value
-            model = RampModel(spec.v_max, spec.u_max, spec.accel_max, spec.turn_accel_max, period)
+            model = ramp_model(spec, period)
             if model != value[0]:
                 value = (model, path_constants(model, params, float(spec.radius)), value[2])
         else:
-            model = RampModel(spec.v_max, spec.u_max, spec.accel_max, spec.turn_accel_max, period)
+            model = ramp_model(spec, period)
             speeds = model.v_max * np.asarray(params.speed_levels, dtype=float)
             value = (model, path_constants(model, params, float(spec.radius)), speeds)
         self._of, self._value = (params, spec, period), value

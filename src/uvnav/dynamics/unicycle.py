@@ -20,7 +20,10 @@ A second kinematics, ``turn-then-move`` (:data:`KINEMATICS`), is the unicycle of
 benchmark (Chen et al., ICRA 2019; CrowdSim's ``ActionRot``: ``theta += r``, then a straight move
 at ``v`` for the time step): the turn of a whole decision period, ``u T``, happens at once when
 the decision is taken, and the robot then moves straight along its new heading
-(:func:`turn_then_move`).  The same command ``(v, u)`` and limits (2.4) drive both.
+(:func:`turn_then_move`).  The same command ``(v, u)`` and limits (2.4) drive both.  Under a
+turn-rate limit the period's turn is the heading change the ramped turn rate makes over the
+period (:func:`ramp_turn`: the arc's heading at the period's end, taken at once), whatever the
+integration step; the turn rate itself ramps step by step as on the arc.
 """
 
 from __future__ import annotations
@@ -141,6 +144,25 @@ def turn_then_move(
     return x + v * dt * math.cos(th), y + v * dt * math.sin(th), th
 
 
+def ramp_turn(u_now: float, target: float, rate: float, period: float) -> float:
+    """The heading change [rad] over ``period`` [s] of a turn rate that moves from ``u_now``
+    toward ``target`` [rad/s] at ``rate`` [rad/s^2] (``inf``: at once) and then holds it.
+
+    >>> ramp_turn(0.0, 1.0, math.inf, 0.25), ramp_turn(0.0, 1.0, 2.0, 0.25)  # at once; ramping
+    (0.25, 0.0625)
+    >>> ramp_turn(0.0, 0.2, 2.0, 0.25)  # reaches 0.2 rad/s after 0.1 s: 0.01 + 0.03
+    0.04
+    """
+    if math.isinf(rate):
+        return target * period
+    gap = target - u_now
+    ramp = min(abs(gap) / rate, period) if rate > 0.0 else period
+    u_end = u_now + math.copysign(rate * ramp, gap)
+    if ramp < period:  # reaches the target, then holds it
+        return 0.5 * (u_now + u_end) * ramp + target * (period - ramp)
+    return 0.5 * (u_now + u_end) * period
+
+
 def approach(value: float, target: float, most: float) -> float:
     """``value`` moved toward ``target`` by at most ``most`` (>= 0).
 
@@ -236,11 +258,14 @@ class Unicycle:
     def move(
         self, x: float, y: float, heading: float, dt: float, decision: bool, period: float
     ) -> tuple[float, float, float, float, float]:
+        u_was = self._u
         v, u = self._v, self._u = self._next(dt)
         if self._arc:
             nx, ny, th = unicycle_advance(x, y, heading, v, u, dt)
-        else:  # the period's turn at the decision, then straight
-            nx, ny, th = turn_then_move(x, y, heading, v, u * period if decision else 0.0, dt)
+        else:  # the period's turn at the decision (the ramp's, module docstring), then straight
+            turn = (ramp_turn(u_was, self._cmd.u, self.spec.turn_accel_max, period)
+                    if decision else 0.0)  # fmt: skip
+            nx, ny, th = turn_then_move(x, y, heading, v, turn, dt)
         return nx, ny, th, abs(u) * dt, u**2 * dt
 
     def travel(self, dt: float) -> tuple[float, float]:
