@@ -12,8 +12,10 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from uvnav.controllers.zhang2019_limits import RampModel
+from uvnav.controllers.zhang2019_limits import RampModel, ramp_turns
 from uvnav.controllers.zhang2019_v2 import Zhang2019V2Params, plan_limited
+from uvnav.controllers.zhang2019_v2_paths import _ramp_turn
+from uvnav.dynamics.unicycle import ramp_turn
 from uvnav.geometry.kernels3d import compiled, numba_available
 from uvnav.scenarios.catalog import resolve
 from uvnav.scenarios.episodes import run_scene
@@ -131,3 +133,17 @@ def test_people_standing_beside_the_way_are_passed_walking_ones_kept_at_comfort(
     walking = plan_limited(_gate(0.5), GOAL, ideal, 0.3, (1.0, 0.0), ahead, Zhang2019V2Params(),
                            loop=loop)  # fmt: skip
     assert 0.0 < math.hypot(*walking.velocity) < 0.5
+
+
+@given(st.lists(st.tuples(st.floats(-3.0, 3.0), st.floats(-3.0, 3.0)), min_size=1, max_size=8),
+       st.sampled_from([0.5, 2.0, 7.3, math.inf]), st.sampled_from([0.1, 0.25]))  # fmt: skip
+def test_the_period_turn_is_the_vehicles_to_the_bit_in_every_copy(
+    pairs: list[tuple[float, float]], rate: float, period: float
+) -> None:
+    """The vehicle's period turn, the numpy rollout's and the compiled loop's are one number:
+    the oracle's replays and the law's paths depend on it."""
+    u_now = np.array([p[0] for p in pairs])
+    target = np.array([p[1] for p in pairs])
+    vehicle = [ramp_turn(a, b, rate, period) for a, b in pairs]
+    assert ramp_turns(u_now, target, rate, period).tolist() == vehicle
+    assert [_ramp_turn(a, b, rate, period) for a, b in pairs] == vehicle
