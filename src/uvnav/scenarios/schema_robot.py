@@ -38,7 +38,8 @@ class RobotSpec(FileModel):
         "arc",
         description=(
             "how a held command moves the unicycle: 'arc' (the thesis's, a continuous turn) or "
-            "'turn-then-move' (CrowdNav's: the period's turn at once, then straight)"
+            "'turn-then-move' (CrowdNav's: the period's turn at once, then straight; under "
+            "turn_accel_max, the turn the ramped rate makes over the period)"
         ),
     )
     accel_max: float | None = Field(
