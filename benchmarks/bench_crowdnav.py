@@ -228,7 +228,6 @@ def run(
     rng_of = kinds()["nav2d"].episode_rng
     vehicle = controller_info(law_name).vehicle
     counts = {"success": 0, "collision": 0, "timeout": 0}
-    robot_driven = 0
     times: list[float] = []
     intrusion: list[float] = []
     statuses: list[str] = []
@@ -274,7 +273,6 @@ def run(
             status = probe.status or res.status
             arrival = probe.at if probe.status == "success" else arrival
         counts[status] += 1
-        robot_driven += int(status == "collision" and res.metrics.collision_by == "robot")
         statuses.append(status)
         collided_by.append(res.metrics.collision_by if status == "collision" else None)
         if res.metrics.intrusion_ratio is not None:
@@ -290,6 +288,7 @@ def run(
         lo, hi = wilson_interval(k, cases)
         rates[key] = {"count": k, "rate": k / cases, "ci95": [lo, hi]}
     lo, hi = wilson_interval(counts["success"], cases)
+    robot_driven = collided_by.count("robot")
     rd_lo, rd_hi = wilson_interval(robot_driven, cases)
     protocol = rule != DYNAMIC and not robot_visible  # CrowdNav's test protocol: judged
     return {

@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import json
 import sys
+from collections import Counter
 from pathlib import Path
 from typing import Any
 
@@ -57,15 +58,18 @@ def compare(a: dict[str, Any], b: dict[str, Any], names: tuple[str, str]) -> dic
     if a["case_numbers"] != b["case_numbers"]:
         raise PairError(f"{names[1]}: field 'case_numbers' differs from {names[0]}'s "
                         "(run both on the same --first, --cases, --humans and --rule)")  # fmt: skip
-    won_a = [s == "success" for s in a["statuses"]]
-    won_b = [s == "success" for s in b["statuses"]]
-    only_a = sum(x and not y for x, y in zip(won_a, won_b, strict=True))
-    only_b = sum(y and not x for x, y in zip(won_a, won_b, strict=True))
-    both = sum(x and y for x, y in zip(won_a, won_b, strict=True))
-    n = len(won_a)
-    diff, lo, hi = paired_difference_interval(only_a, only_b, both, n - only_a - only_b - both)
-    return {"cases": n, "success": [sum(won_a), sum(won_b)], "only": [only_a, only_b],
-            "both": both, "difference": diff, "ci95": [lo, hi]}  # fmt: skip
+    pairs = Counter((x == "success", y == "success")
+                    for x, y in zip(a["statuses"], b["statuses"], strict=True))  # fmt: skip
+    only_a, only_b, both = pairs[True, False], pairs[False, True], pairs[True, True]
+    diff, lo, hi = paired_difference_interval(only_a, only_b, both, pairs[False, False])
+    return {
+        "cases": pairs.total(),
+        "success": [both + only_a, both + only_b],
+        "only": [only_a, only_b],
+        "both": both,
+        "difference": diff,
+        "ci95": [lo, hi],
+    }
 
 
 def report(a: dict[str, Any], b: dict[str, Any], c: dict[str, Any]) -> str:

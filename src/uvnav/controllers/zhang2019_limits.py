@@ -88,7 +88,7 @@ def ramp_turns(u_now: FloatArray, target: FloatArray, rate: float, period: float
     if math.isinf(rate):
         return np.asarray(target * period, dtype=float)
     gap = target - u_now
-    ramp = np.minimum(np.abs(gap) / rate, period) if rate > 0.0 else np.full_like(gap, period)
+    ramp = np.minimum(np.abs(gap) / rate, period)
     u_end = u_now + np.copysign(rate * ramp, gap)
     return np.asarray(np.where(ramp < period, 0.5 * (u_now + u_end) * ramp
                                + target * (period - ramp), 0.5 * (u_now + u_end) * period),

@@ -70,7 +70,7 @@ def _ramp_turn(u_now: float, target: float, rate: float, period: float) -> float
     if math.isinf(rate):
         return target * period
     gap = target - u_now
-    ramp = min(abs(gap) / rate, period) if rate > 0.0 else period
+    ramp = min(abs(gap) / rate, period)
     u_end = u_now + math.copysign(rate * ramp, gap)
     if ramp < period:
         return 0.5 * (u_now + u_end) * ramp + target * (period - ramp)
